@@ -1,0 +1,406 @@
+// voxfield — Grid<T> implementation. Included by grid.h; not a public header on its own.
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <string>
+#include <tuple>
+
+#include "voxfield/parallel.h"
+
+namespace voxfield {
+
+template <class T>
+Grid<T>::Grid(int chunk_edge, T background, std::optional<Box3i> bounds)
+    : chunk_edge_(chunk_edge), chunk_shift_(0), background_(background), bounds_(bounds) {
+  if (chunk_edge < kMinChunkEdge || chunk_edge > kMaxChunkEdge ||
+      !std::has_single_bit(static_cast<unsigned>(chunk_edge))) {
+    throw InvalidArgument("chunk edge must be a power of two from 8 to 128, got " +
+                          std::to_string(chunk_edge));
+  }
+  if (bounds_ && bounds_->empty()) {
+    throw InvalidArgument("grid bounds " + to_string(*bounds_) + " are empty");
+  }
+  chunk_shift_ = std::countr_zero(static_cast<unsigned>(chunk_edge));
+}
+
+template <class T>
+Grid<T>::Grid(const Grid& other)
+    : chunk_edge_(other.chunk_edge_),
+      chunk_shift_(other.chunk_shift_),
+      background_(other.background_),
+      bounds_(other.bounds_) {
+  chunks_.reserve(other.chunks_.size());
+  const std::int64_t n = chunk_volume();
+  for (const auto& [coord, src] : other.chunks_) {
+    Chunk copy;
+    copy.uniform = src.uniform;
+    copy.ref = src.ref;
+    copy.ref_count = src.ref_count;
+    if (src.voxels) {
+      copy.voxels.reset(new T[n]);
+      std::copy(src.voxels.get(), src.voxels.get() + n, copy.voxels.get());
+    }
+    chunks_.emplace(coord, std::move(copy));
+  }
+}
+
+template <class T>
+Grid<T>& Grid<T>::operator=(const Grid& other) {
+  if (this != &other) *this = Grid(other);
+  return *this;
+}
+
+template <class T>
+void Grid<T>::require_in_bounds(const Box3i& box, const char* what) const {
+  if (bounds_ && !bounds_->contains(box)) {
+    throw InvalidArgument(std::string(what) + ": box " + to_string(box) +
+                          " reaches outside the grid bounds " + to_string(*bounds_));
+  }
+}
+
+template <class T>
+T Grid<T>::get(Vec3i p) const {
+  auto it = chunks_.find(chunk_of(p));
+  if (it == chunks_.end()) return background_;
+  const Chunk& c = it->second;
+  return c.voxels ? c.voxels[local_index(p)] : c.uniform;
+}
+
+template <class T>
+typename Grid<T>::Chunk& Grid<T>::expand(Chunk& chunk) {
+  const std::int64_t n = chunk_volume();
+  chunk.voxels.reset(new T[n]);
+  std::fill(chunk.voxels.get(), chunk.voxels.get() + n, chunk.uniform);
+  chunk.ref = chunk.uniform;
+  chunk.ref_count = n;
+  return chunk;
+}
+
+template <class T>
+void Grid<T>::set(Vec3i p, T value) {
+  if (bounds_ && !bounds_->contains(p)) {
+    throw InvalidArgument("set: voxel " + to_string(p) + " is outside the grid bounds " +
+                          to_string(*bounds_));
+  }
+  const Vec3i coord = chunk_of(p);
+  auto it = chunks_.find(coord);
+  if (it == chunks_.end()) {
+    if (value == background_) return;
+    Chunk c;
+    c.uniform = background_;
+    it = chunks_.emplace(coord, std::move(c)).first;
+  }
+  Chunk& c = it->second;
+  if (!c.voxels) {
+    if (c.uniform == value) return;
+    expand(c);
+  }
+  T& slot = c.voxels[local_index(p)];
+  if (slot == value) return;
+  if (slot == c.ref) --c.ref_count;
+  if (value == c.ref) ++c.ref_count;
+  slot = value;
+  if (c.ref_count == chunk_volume()) {
+    // Every voxel is back to the value the chunk was expanded from: store it as that value again.
+    if (c.ref == background_) {
+      chunks_.erase(it);
+    } else {
+      c.voxels.reset();
+      c.uniform = c.ref;
+    }
+  }
+}
+
+template <class T>
+void Grid<T>::collapse_if_uniform(typename ChunkMap::iterator it) {
+  Chunk& c = it->second;
+  if (!c.voxels) {
+    if (c.uniform == background_) chunks_.erase(it);
+    return;
+  }
+  const std::int64_t n = chunk_volume();
+  const T first = c.voxels[0];
+  const T* v = c.voxels.get();
+  if (std::all_of(v, v + n, [&](const T& x) { return x == first; })) {
+    if (first == background_) {
+      chunks_.erase(it);
+    } else {
+      c.voxels.reset();
+      c.uniform = first;
+    }
+    return;
+  }
+  // Still dense: re-anchor the O(1) collapse counter on the background, the most likely value
+  // for edits to restore.
+  c.ref = background_;
+  c.ref_count = std::count(v, v + n, background_);
+}
+
+template <class T>
+std::vector<Vec3i> Grid<T>::chunks_overlapping(const Box3i& box) const {
+  std::vector<Vec3i> out;
+  if (box.empty()) return out;
+  const Vec3i lo = chunk_of(box.begin);
+  const Vec3i hi = chunk_of(box.end - Vec3i::splat(1));
+  for (int z = lo.z; z <= hi.z; ++z)
+    for (int y = lo.y; y <= hi.y; ++y)
+      for (int x = lo.x; x <= hi.x; ++x) out.push_back({x, y, z});
+  return out;
+}
+
+template <class T>
+void Grid<T>::fill(const Box3i& box, T value) {
+  if (box.empty()) return;
+  require_in_bounds(box, "fill");
+  for (const Vec3i coord : chunks_overlapping(box)) {
+    const Box3i cb = chunk_box(coord);
+    const Box3i part = cb.intersect(box);
+    auto it = chunks_.find(coord);
+    if (part == cb) {  // the whole chunk: store as a value
+      if (value == background_) {
+        if (it != chunks_.end()) chunks_.erase(it);
+      } else {
+        if (it == chunks_.end()) it = chunks_.emplace(coord, Chunk{}).first;
+        it->second.voxels.reset();
+        it->second.uniform = value;
+      }
+      continue;
+    }
+    if (it == chunks_.end()) {
+      if (value == background_) continue;
+      Chunk c;
+      c.uniform = background_;
+      it = chunks_.emplace(coord, std::move(c)).first;
+    }
+    Chunk& c = it->second;
+    if (!c.voxels) {
+      if (c.uniform == value) continue;
+      expand(c);
+    }
+    for (int z = part.begin.z; z < part.end.z; ++z)
+      for (int y = part.begin.y; y < part.end.y; ++y) {
+        T* row = c.voxels.get() + local_index({part.begin.x, y, z});
+        std::fill(row, row + (part.end.x - part.begin.x), value);
+      }
+    collapse_if_uniform(it);
+  }
+}
+
+template <class T>
+void Grid<T>::copy_to_dense(const Box3i& box, T* out) const {
+  if (box.empty()) return;
+  const Vec3i size = box.size();
+  const std::int64_t sx = size.x, sxy = std::int64_t{size.x} * size.y;
+  for (const Vec3i coord : chunks_overlapping(box)) {
+    const Box3i part = chunk_box(coord).intersect(box);
+    auto it = chunks_.find(coord);
+    const Chunk* c = it == chunks_.end() ? nullptr : &it->second;
+    const int run = part.end.x - part.begin.x;
+    for (int z = part.begin.z; z < part.end.z; ++z)
+      for (int y = part.begin.y; y < part.end.y; ++y) {
+        T* dst = out + (z - box.begin.z) * sxy + (y - box.begin.y) * sx + (part.begin.x - box.begin.x);
+        if (c && c->voxels) {
+          const T* src = c->voxels.get() + local_index({part.begin.x, y, z});
+          std::copy(src, src + run, dst);
+        } else {
+          std::fill(dst, dst + run, c ? c->uniform : background_);
+        }
+      }
+  }
+}
+
+template <class T>
+void Grid<T>::copy_from_dense(const Box3i& box, const T* in) {
+  if (box.empty()) return;
+  require_in_bounds(box, "copy_from_dense");
+  const Vec3i size = box.size();
+  const std::int64_t sx = size.x, sxy = std::int64_t{size.x} * size.y;
+  for (const Vec3i coord : chunks_overlapping(box)) {
+    const Box3i part = chunk_box(coord).intersect(box);
+    auto it = chunks_.find(coord);
+    if (it == chunks_.end()) {
+      Chunk c;
+      c.uniform = background_;
+      it = chunks_.emplace(coord, std::move(c)).first;
+    }
+    Chunk& c = it->second;
+    if (!c.voxels) expand(c);
+    const int run = part.end.x - part.begin.x;
+    for (int z = part.begin.z; z < part.end.z; ++z)
+      for (int y = part.begin.y; y < part.end.y; ++y) {
+        const T* src = in + (z - box.begin.z) * sxy + (y - box.begin.y) * sx + (part.begin.x - box.begin.x);
+        std::copy(src, src + run, c.voxels.get() + local_index({part.begin.x, y, z}));
+      }
+    collapse_if_uniform(it);
+  }
+}
+
+template <class T>
+Box3i Grid<T>::content_bounds() const {
+  Box3i result{{0, 0, 0}, {0, 0, 0}};
+  const int e = chunk_edge_;
+  for (const auto& [coord, c] : chunks_) {
+    const Box3i cb = chunk_box(coord);
+    if (!c.voxels) {
+      if (!(c.uniform == background_)) result = result.unite(cb);
+      continue;
+    }
+    // Scan the dense chunk for its tight box; skip it when it cannot grow the result.
+    if (result.contains(cb)) continue;
+    Vec3i lo{e, e, e}, hi{-1, -1, -1};
+    const T* v = c.voxels.get();
+    for (int z = 0; z < e; ++z)
+      for (int y = 0; y < e; ++y)
+        for (int x = 0; x < e; ++x) {
+          if (*v++ == background_) continue;
+          lo = {std::min(lo.x, x), std::min(lo.y, y), std::min(lo.z, z)};
+          hi = {std::max(hi.x, x), std::max(hi.y, y), std::max(hi.z, z)};
+        }
+    if (hi.x >= 0) result = result.unite(Box3i::from_inclusive(cb.begin + lo, cb.begin + hi));
+  }
+  return result;
+}
+
+template <class T>
+std::int64_t Grid<T>::count_non_background() const {
+  std::int64_t total = 0;
+  const std::int64_t n = chunk_volume();
+  for (const auto& [coord, c] : chunks_) {
+    if (!c.voxels) {
+      if (!(c.uniform == background_)) total += n;
+    } else {
+      total += n - std::count(c.voxels.get(), c.voxels.get() + n, background_);
+    }
+  }
+  return total;
+}
+
+template <class T>
+GridMemory Grid<T>::memory() const {
+  GridMemory m;
+  // Node-based hash map: one node (key, chunk, next pointer, cached hash) per chunk, plus the
+  // bucket array.
+  constexpr std::size_t kNodeBytes = sizeof(Vec3i) + sizeof(Chunk) + 2 * sizeof(void*);
+  m.bytes = sizeof(Grid) + chunks_.bucket_count() * sizeof(void*) + chunks_.size() * kNodeBytes;
+  for (const auto& [coord, c] : chunks_) {
+    if (c.voxels) {
+      ++m.dense_chunks;
+      m.bytes += static_cast<std::size_t>(chunk_volume()) * sizeof(T);
+    } else {
+      ++m.uniform_chunks;
+    }
+  }
+  m.voxels_covered = static_cast<std::int64_t>(chunks_.size()) * chunk_volume();
+  return m;
+}
+
+template <class T>
+void Grid<T>::compact() {
+  for (auto it = chunks_.begin(); it != chunks_.end();) {
+    auto next = std::next(it);
+    collapse_if_uniform(it);
+    it = next;
+  }
+}
+
+template <class T>
+void Grid<T>::for_each_chunk(const std::function<void(const ChunkView<T>&)>& f) const {
+  for (const auto& [coord, c] : chunks_) f(ChunkView<T>{coord, chunk_box(coord), c.voxels.get(), c.uniform});
+}
+
+template <class T>
+void Grid<T>::parallel_for_each_chunk(const std::function<void(const ChunkView<T>&)>& f) const {
+  std::vector<const typename ChunkMap::value_type*> entries;
+  entries.reserve(chunks_.size());
+  for (const auto& entry : chunks_) entries.push_back(&entry);
+  parallel_for(entries.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const auto& [coord, c] = *entries[i];
+      f(ChunkView<T>{coord, chunk_box(coord), c.voxels.get(), c.uniform});
+    }
+  });
+}
+
+template <class T>
+std::vector<Vec3i> Grid<T>::chunk_coords() const {
+  std::vector<Vec3i> out;
+  out.reserve(chunks_.size());
+  for (const auto& entry : chunks_) out.push_back(entry.first);
+  std::sort(out.begin(), out.end(), [](const Vec3i& a, const Vec3i& b) {
+    return std::tie(a.z, a.y, a.x) < std::tie(b.z, b.y, b.x);
+  });
+  return out;
+}
+
+template <class T>
+void Grid<T>::generate_chunks(const std::vector<Vec3i>& chunks,
+                              const std::function<void(Vec3i, T*)>& f) {
+  if (bounds_) {
+    for (const Vec3i coord : chunks) {
+      if (chunk_box(coord).intersect(*bounds_).empty()) {
+        throw InvalidArgument("generate_chunks: chunk " + to_string(coord) +
+                              " lies outside the grid bounds " + to_string(*bounds_));
+      }
+    }
+  }
+  const std::int64_t n = chunk_volume();
+  // Produce every chunk into fresh storage first, so that a throwing f leaves the grid unchanged.
+  // The uniformity scan runs in the same parallel pass; only the map updates are sequential.
+  std::vector<std::unique_ptr<T[]>> produced(chunks.size());
+  std::vector<std::int64_t> background_count(chunks.size());
+  std::vector<char> uniform(chunks.size());
+  for (auto& p : produced) p.reset(new T[n]);
+  parallel_for(chunks.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      T* v = produced[i].get();
+      f(chunks[i], v);
+      if (bounds_) {
+        const Box3i cb = chunk_box(chunks[i]);
+        if (!bounds_->contains(cb)) {
+          // Voxels beyond the bounds do not exist: keep them at the background.
+          for (int z = 0; z < chunk_edge_; ++z)
+            for (int y = 0; y < chunk_edge_; ++y)
+              for (int x = 0; x < chunk_edge_; ++x)
+                if (!bounds_->contains(cb.begin + Vec3i{x, y, z})) v[local_index({x, y, z})] = background_;
+        }
+      }
+      const T first = v[0];
+      uniform[i] = std::all_of(v, v + n, [&](const T& x) { return x == first; });
+      background_count[i] = uniform[i] ? (first == background_ ? n : 0) : std::count(v, v + n, background_);
+    }
+  });
+  for (std::size_t i = 0; i < chunks.size(); ++i) {
+    auto it = chunks_.find(chunks[i]);
+    if (uniform[i] && produced[i][0] == background_) {
+      if (it != chunks_.end()) chunks_.erase(it);
+      continue;
+    }
+    if (it == chunks_.end()) it = chunks_.emplace(chunks[i], Chunk{}).first;
+    Chunk& c = it->second;
+    if (uniform[i]) {
+      c.uniform = produced[i][0];
+      c.voxels.reset();
+    } else {
+      c.voxels = std::move(produced[i]);
+      c.ref = background_;
+      c.ref_count = background_count[i];
+    }
+  }
+}
+
+template <class T>
+T Grid<T>::ReadAccessor::get(Vec3i p) {
+  const Vec3i coord = grid_->chunk_of(p);
+  if (!(coord == cached_coord_)) {
+    auto it = grid_->chunks_.find(coord);
+    cached_chunk_ = it == grid_->chunks_.end() ? nullptr : &it->second;
+    cached_coord_ = coord;
+  }
+  if (!cached_chunk_) return grid_->background_;
+  const Chunk* c = static_cast<const Chunk*>(cached_chunk_);
+  return c->voxels ? c->voxels[grid_->local_index(p)] : c->uniform;
+}
+
+}  // namespace voxfield

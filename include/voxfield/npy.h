@@ -1,0 +1,60 @@
+// voxfield — NumPy .npy volumes.
+//
+// Reads format versions 1.0, 2.0 and 3.0 with dtypes bool, int8, uint8, int16, uint16, int32,
+// uint32, float32 and float64, either byte order, C or Fortran order. A volume is a 3-D array
+// indexed a[x, y, z]; in memory voxfield keeps it x fastest (Fortran order), which is also how it
+// writes it, so that reading back in NumPy gives the same a[x, y, z]. Other shapes and dtypes are
+// rejected with a FormatError.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "voxfield/world.h"
+
+namespace voxfield {
+
+enum class DType { kBool, kInt8, kUInt8, kInt16, kUInt16, kInt32, kUInt32, kFloat32, kFloat64 };
+
+std::size_t dtype_size(DType t);
+const char* dtype_name(DType t);  // NumPy's name: "bool", "uint8", "float32", ...
+
+// A dense 3-D volume of one dtype: dims.x * dims.y * dims.z values, x fastest, native byte order.
+struct NpyVolume {
+  DType dtype = DType::kUInt8;
+  Vec3i dims;
+  std::vector<std::uint8_t> bytes;
+
+  std::int64_t count() const { return Box3i::from_size(dims).volume(); }
+  // Value i (x fastest) converted to double, whatever the dtype.
+  double value(std::int64_t i) const;
+};
+
+NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name);
+NpyVolume read_npy(const std::filesystem::path& path);
+// Encodes as format 1.0 (2.0 when the header needs it), Fortran order, little-endian.
+std::vector<std::uint8_t> encode_npy(const NpyVolume& volume);
+void write_npy(const NpyVolume& volume, const std::filesystem::path& path);
+
+// Builds a volume from dense values (x fastest). T must match dtype's size.
+template <class T>
+NpyVolume make_npy(DType dtype, Vec3i dims, const T* values) {
+  if (sizeof(T) != dtype_size(dtype)) throw InvalidArgument("make_npy: element size does not match dtype");
+  NpyVolume v{dtype, dims, {}};
+  v.bytes.resize(static_cast<std::size_t>(v.count()) * sizeof(T));
+  std::memcpy(v.bytes.data(), values, v.bytes.size());
+  return v;
+}
+
+// Volume -> World: every non-zero value is that material, placed with a[x, y, z] at voxel (x, y, z).
+// Throws FormatError when a value is not an integer in 0..255 (bool counts as material 1).
+World world_from_npy(const NpyVolume& volume, const std::string& name,
+                     int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge);
+// World -> uint8 volume of the materials in `box` (a[x, y, z] is voxel box.begin + (x, y, z)).
+NpyVolume npy_from_world(const World& world, const Box3i& box);
+
+}  // namespace voxfield

@@ -1,0 +1,76 @@
+// voxfield — bounds-checked little-endian reader for binary parsers (internal).
+//
+// Every read checks the remaining length first and throws FormatError naming the file and the
+// absolute offset, so a parser built on it cannot read out of bounds whatever the input.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <span>
+#include <string>
+
+#include "voxfield/error.h"
+
+namespace voxfield::detail {
+
+class ByteReader {
+ public:
+  ByteReader(std::span<const std::uint8_t> bytes, const std::string& name, std::uint64_t base = 0)
+      : bytes_(bytes), name_(&name), base_(base) {}
+
+  std::uint64_t offset() const { return base_ + pos_; }  // absolute offset in the file
+  std::size_t remaining() const { return bytes_.size() - pos_; }
+  bool at_end() const { return pos_ == bytes_.size(); }
+
+  [[noreturn]] void fail(const std::string& what) const { throw FormatError(*name_, offset(), what); }
+  [[noreturn]] void fail_at(std::uint64_t absolute_offset, const std::string& what) const {
+    throw FormatError(*name_, absolute_offset, what);
+  }
+
+  void need(std::size_t n, const char* what) const {
+    if (n > remaining()) {
+      fail(std::string("truncated ") + what + ": needs " + std::to_string(n) + " bytes, " +
+           std::to_string(remaining()) + " left");
+    }
+  }
+  std::uint8_t u8(const char* what = "byte") {
+    need(1, what);
+    return bytes_[pos_++];
+  }
+  std::uint32_t u32(const char* what = "integer") {
+    need(4, what);
+    std::uint32_t v;
+    std::memcpy(&v, bytes_.data() + pos_, 4);  // voxfield targets little-endian hosts
+    pos_ += 4;
+    return v;
+  }
+  std::int32_t i32(const char* what = "integer") { return static_cast<std::int32_t>(u32(what)); }
+  std::uint16_t u16(const char* what = "integer") {
+    need(2, what);
+    std::uint16_t v;
+    std::memcpy(&v, bytes_.data() + pos_, 2);
+    pos_ += 2;
+    return v;
+  }
+  std::span<const std::uint8_t> take(std::size_t n, const char* what) {
+    need(n, what);
+    auto s = bytes_.subspan(pos_, n);
+    pos_ += n;
+    return s;
+  }
+  // A sub-reader over the next n bytes, reporting offsets in the same file.
+  ByteReader sub(std::size_t n, const char* what) {
+    const std::uint64_t at = offset();
+    auto s = take(n, what);
+    return ByteReader(s, *name_, at);
+  }
+  void skip(std::size_t n, const char* what) { take(n, what); }
+
+ private:
+  std::span<const std::uint8_t> bytes_;
+  const std::string* name_;
+  std::uint64_t base_;
+  std::size_t pos_ = 0;
+};
+
+}  // namespace voxfield::detail

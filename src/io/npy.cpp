@@ -1,0 +1,323 @@
+// voxfield — NumPy .npy reader and writer.
+//
+// Format: NumPy's "NEP 1 — A simple file format for NumPy arrays": magic "\x93NUMPY", major and
+// minor version, a little-endian header length (2 bytes in 1.0, 4 bytes in 2.0/3.0), then a Python
+// dict literal with 'descr', 'fortran_order' and 'shape', padded with spaces to a multiple of 64
+// bytes and ended by a newline. The parser accepts exactly that literal grammar, no more.
+#include <algorithm>
+#include <bit>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+
+#include "byte_reader.h"
+#include "voxfield/file.h"
+#include "voxfield/npy.h"
+
+namespace voxfield {
+namespace {
+
+struct DTypeInfo {
+  DType type;
+  char kind;  // NumPy kind letter
+  int size;
+  const char* name;
+};
+constexpr DTypeInfo kDTypes[] = {
+    {DType::kBool, 'b', 1, "bool"},      {DType::kInt8, 'i', 1, "int8"},
+    {DType::kUInt8, 'u', 1, "uint8"},    {DType::kInt16, 'i', 2, "int16"},
+    {DType::kUInt16, 'u', 2, "uint16"},  {DType::kInt32, 'i', 4, "int32"},
+    {DType::kUInt32, 'u', 4, "uint32"},  {DType::kFloat32, 'f', 4, "float32"},
+    {DType::kFloat64, 'f', 8, "float64"},
+};
+
+const DTypeInfo& info(DType t) {
+  for (const auto& d : kDTypes)
+    if (d.type == t) return d;
+  throw InvalidArgument("unknown dtype");
+}
+
+// Minimal parser for the header's Python dict literal.
+class HeaderParser {
+ public:
+  HeaderParser(const std::string& text, const std::string& name, std::uint64_t base)
+      : s_(text), name_(name), base_(base) {}
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw FormatError(name_, base_ + pos_, "bad .npy header: " + what);
+  }
+  void ws() {
+    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+  }
+  bool eat(char c) {
+    ws();
+    if (pos_ < s_.size() && s_[pos_] == c) {
+      ++pos_;
+      return true;
+    }
+    return false;
+  }
+  void expect(char c) {
+    if (!eat(c)) fail(std::string("expected '") + c + "'");
+  }
+  std::string quoted() {
+    ws();
+    if (pos_ >= s_.size() || (s_[pos_] != '\'' && s_[pos_] != '"')) fail("expected a string");
+    const char q = s_[pos_++];
+    const std::size_t start = pos_;
+    while (pos_ < s_.size() && s_[pos_] != q) ++pos_;
+    if (pos_ >= s_.size()) fail("unterminated string");
+    return s_.substr(start, pos_++ - start);
+  }
+  bool boolean() {
+    ws();
+    if (s_.compare(pos_, 4, "True") == 0) {
+      pos_ += 4;
+      return true;
+    }
+    if (s_.compare(pos_, 5, "False") == 0) {
+      pos_ += 5;
+      return false;
+    }
+    fail("expected True or False");
+  }
+  std::vector<std::int64_t> tuple() {
+    expect('(');
+    std::vector<std::int64_t> out;
+    while (!eat(')')) {
+      ws();
+      std::int64_t v = 0;
+      bool any = false;
+      while (pos_ < s_.size() && std::isdigit(static_cast<unsigned char>(s_[pos_]))) {
+        if (v > (std::int64_t{1} << 40)) fail("dimension too large");
+        v = v * 10 + (s_[pos_++] - '0');
+        any = true;
+      }
+      ws();
+      if (pos_ < s_.size() && s_[pos_] == 'L') ++pos_;  // Python 2 long suffix
+      if (!any) fail("expected a dimension");
+      out.push_back(v);
+      if (out.size() > 32) fail("too many dimensions");
+      if (!eat(',')) {
+        expect(')');
+        break;
+      }
+    }
+    return out;
+  }
+
+  std::string descr;
+  bool fortran = false;
+  std::vector<std::int64_t> shape;
+
+  void parse() {
+    bool have_descr = false, have_order = false, have_shape = false;
+    expect('{');
+    while (!eat('}')) {
+      const std::string key = quoted();
+      expect(':');
+      if (key == "descr") {
+        descr = quoted();
+        have_descr = true;
+      } else if (key == "fortran_order") {
+        fortran = boolean();
+        have_order = true;
+      } else if (key == "shape") {
+        shape = tuple();
+        have_shape = true;
+      } else {
+        fail("unexpected key '" + key + "'");
+      }
+      if (!eat(',')) {
+        expect('}');
+        break;
+      }
+    }
+    if (!have_descr || !have_order || !have_shape) fail("needs 'descr', 'fortran_order' and 'shape'");
+  }
+
+ private:
+  const std::string& s_;
+  const std::string& name_;
+  std::uint64_t base_;
+  std::size_t pos_ = 0;
+};
+
+template <class T>
+double load_as_double(const std::uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  return static_cast<double>(v);
+}
+
+}  // namespace
+
+std::size_t dtype_size(DType t) { return static_cast<std::size_t>(info(t).size); }
+const char* dtype_name(DType t) { return info(t).name; }
+
+double NpyVolume::value(std::int64_t i) const {
+  const std::uint8_t* p = bytes.data() + static_cast<std::size_t>(i) * dtype_size(dtype);
+  switch (dtype) {
+    case DType::kBool: return *p ? 1.0 : 0.0;
+    case DType::kInt8: return load_as_double<std::int8_t>(p);
+    case DType::kUInt8: return load_as_double<std::uint8_t>(p);
+    case DType::kInt16: return load_as_double<std::int16_t>(p);
+    case DType::kUInt16: return load_as_double<std::uint16_t>(p);
+    case DType::kInt32: return load_as_double<std::int32_t>(p);
+    case DType::kUInt32: return load_as_double<std::uint32_t>(p);
+    case DType::kFloat32: return load_as_double<float>(p);
+    case DType::kFloat64: return load_as_double<double>(p);
+  }
+  return 0.0;
+}
+
+NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name) {
+  detail::ByteReader r(bytes, name);
+  static constexpr std::uint8_t kMagic[6] = {0x93, 'N', 'U', 'M', 'P', 'Y'};
+  auto magic = r.take(6, "magic");
+  if (!std::equal(magic.begin(), magic.end(), kMagic)) r.fail_at(0, "not a .npy file (bad magic)");
+  const int major = r.u8("version"), minor = r.u8("version");
+  std::uint32_t header_len;
+  if (major == 1) {
+    header_len = r.u16("header length");
+  } else if (major == 2 || major == 3) {
+    header_len = r.u32("header length");
+  } else {
+    r.fail_at(6, "unsupported .npy version " + std::to_string(major) + "." + std::to_string(minor));
+  }
+  const std::uint64_t header_at = r.offset();
+  auto header_bytes = r.take(header_len, "header");
+  const std::string header(header_bytes.begin(), header_bytes.end());
+  HeaderParser h(header, name, header_at);
+  h.parse();
+
+  // descr: byte order character then kind and size, e.g. "<f4", "|u1", "|b1".
+  if (h.descr.size() < 3) r.fail_at(header_at, "unsupported dtype '" + h.descr + "'");
+  const char order = h.descr[0];
+  const char kind = h.descr[1];
+  int size = 0;
+  for (std::size_t i = 2; i < h.descr.size(); ++i) {
+    if (!std::isdigit(static_cast<unsigned char>(h.descr[i])) || size > 64) {
+      r.fail_at(header_at, "unsupported dtype '" + h.descr + "'");
+    }
+    size = size * 10 + (h.descr[i] - '0');
+  }
+  const DTypeInfo* found = nullptr;
+  for (const auto& d : kDTypes)
+    if (d.kind == kind && d.size == size) found = &d;
+  if (!found || (order != '<' && order != '>' && order != '|' && order != '=')) {
+    r.fail_at(header_at, "unsupported dtype '" + h.descr +
+                             "' (voxfield reads bool, int8/16/32, uint8/16/32, float32, float64)");
+  }
+  if (h.shape.size() != 3) {
+    r.fail_at(header_at, "expected a 3-D array a[x, y, z], got " + std::to_string(h.shape.size()) +
+                             " dimensions");
+  }
+  NpyVolume v;
+  v.dtype = found->type;
+  for (int k = 0; k < 3; ++k) {
+    if (h.shape[k] < 1 || h.shape[k] > (std::int64_t{1} << 30)) {
+      r.fail_at(header_at, "dimension " + std::to_string(h.shape[k]) + " outside 1..2^30");
+    }
+    v.dims[k] = static_cast<std::int32_t>(h.shape[k]);
+  }
+  const std::uint64_t n = static_cast<std::uint64_t>(v.count());
+  const std::uint64_t data_bytes = n * static_cast<std::uint64_t>(size);
+  if (data_bytes / static_cast<std::uint64_t>(size) != n || data_bytes > r.remaining()) {
+    r.fail("array data of " + std::to_string(data_bytes) + " bytes but only " +
+           std::to_string(r.remaining()) + " bytes follow the header");
+  }
+  auto data = r.take(static_cast<std::size_t>(data_bytes), "array data");
+  v.bytes.resize(data.size());
+  const bool swap = size > 1 && order == '>';
+  if (h.fortran) {
+    std::memcpy(v.bytes.data(), data.data(), data.size());
+  } else {
+    // C order: z fastest. Transpose to x fastest.
+    const std::int64_t X = v.dims.x, Y = v.dims.y, Z = v.dims.z;
+    for (std::int64_t x = 0; x < X; ++x)
+      for (std::int64_t y = 0; y < Y; ++y)
+        for (std::int64_t z = 0; z < Z; ++z) {
+          const std::int64_t src = (x * Y + y) * Z + z, dst = (z * Y + y) * X + x;
+          std::memcpy(v.bytes.data() + dst * size, data.data() + src * size, static_cast<std::size_t>(size));
+        }
+  }
+  if (swap) {
+    for (std::size_t i = 0; i < v.bytes.size(); i += static_cast<std::size_t>(size)) {
+      std::reverse(v.bytes.begin() + static_cast<std::ptrdiff_t>(i),
+                   v.bytes.begin() + static_cast<std::ptrdiff_t>(i) + size);
+    }
+  }
+  if (v.dtype == DType::kBool) {
+    for (auto& b : v.bytes) b = b ? 1 : 0;
+  }
+  return v;
+}
+
+NpyVolume read_npy(const std::filesystem::path& path) {
+  const auto bytes = read_file(path);
+  return parse_npy(bytes, path.string());
+}
+
+std::vector<std::uint8_t> encode_npy(const NpyVolume& v) {
+  const DTypeInfo& d = info(v.dtype);
+  if (v.bytes.size() != static_cast<std::size_t>(v.count()) * static_cast<std::size_t>(d.size)) {
+    throw InvalidArgument("encode_npy: volume holds " + std::to_string(v.bytes.size()) +
+                          " bytes, expected " + std::to_string(v.count() * d.size));
+  }
+  const std::string descr = std::string(d.size == 1 ? "|" : "<") + d.kind + std::to_string(d.size);
+  std::string header = "{'descr': '" + descr + "', 'fortran_order': True, 'shape': (" +
+                       std::to_string(v.dims.x) + ", " + std::to_string(v.dims.y) + ", " +
+                       std::to_string(v.dims.z) + "), }";
+  // Pad with spaces so that magic + version + length + header + '\n' is a multiple of 64.
+  const bool v2 = header.size() + 11 > 65535;
+  const std::size_t prefix = v2 ? 12 : 10;
+  const std::size_t total = (prefix + header.size() + 1 + 63) / 64 * 64;
+  header.append(total - prefix - header.size() - 1, ' ');
+  header.push_back('\n');
+  std::vector<std::uint8_t> out;
+  out.reserve(total + v.bytes.size());
+  const std::uint8_t magic[8] = {0x93, 'N', 'U', 'M', 'P', 'Y', static_cast<std::uint8_t>(v2 ? 2 : 1), 0};
+  out.insert(out.end(), magic, magic + 8);
+  const std::uint32_t len = static_cast<std::uint32_t>(header.size());
+  out.push_back(static_cast<std::uint8_t>(len & 0xFF));
+  out.push_back(static_cast<std::uint8_t>((len >> 8) & 0xFF));
+  if (v2) {
+    out.push_back(static_cast<std::uint8_t>((len >> 16) & 0xFF));
+    out.push_back(static_cast<std::uint8_t>(len >> 24));
+  }
+  out.insert(out.end(), header.begin(), header.end());
+  out.insert(out.end(), v.bytes.begin(), v.bytes.end());
+  return out;
+}
+
+void write_npy(const NpyVolume& volume, const std::filesystem::path& path) {
+  write_file_atomic(path, encode_npy(volume));
+}
+
+World world_from_npy(const NpyVolume& v, const std::string& name, int chunk_edge) {
+  World world(chunk_edge);
+  std::vector<std::uint8_t> materials(static_cast<std::size_t>(v.count()));
+  for (std::int64_t i = 0; i < v.count(); ++i) {
+    const double m = v.value(i);
+    if (!(m >= 0 && m <= 255 && std::floor(m) == m)) {
+      const std::int64_t x = i % v.dims.x, y = (i / v.dims.x) % v.dims.y, z = i / (std::int64_t{v.dims.x} * v.dims.y);
+      throw FormatError(name, 0, "value " + std::to_string(m) + " at a[" + std::to_string(x) + ", " +
+                                     std::to_string(y) + ", " + std::to_string(z) +
+                                     "] is not a material index 0..255");
+    }
+    materials[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(m);
+  }
+  world.voxels.copy_from_dense(Box3i::from_size(v.dims), materials.data());
+  return world;
+}
+
+NpyVolume npy_from_world(const World& world, const Box3i& box) {
+  if (box.empty()) throw InvalidArgument("npy_from_world: empty box " + to_string(box));
+  NpyVolume v{DType::kUInt8, box.size(), {}};
+  v.bytes.resize(static_cast<std::size_t>(box.volume()));
+  world.voxels.copy_to_dense(box, v.bytes.data());
+  return v;
+}
+
+}  // namespace voxfield
