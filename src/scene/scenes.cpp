@@ -65,7 +65,7 @@ class Terrain {
   int height(int x, int y) const {
     const double f = 3.0 / horizontal_;
     const double n = fbm2(o_.seed, x * f, y * f, 5);
-    return static_cast<int>(std::lround(o_.size.z * (0.46 + 0.30 * n)));
+    return static_cast<int>(std::lround(o_.size.z * std::clamp(0.52 + 0.75 * n, 0.08, 0.92)));
   }
   int water_level() const { return static_cast<int>(o_.size.z * 0.36); }
 
@@ -112,8 +112,8 @@ class Terrain {
     if (z > 1 && z < h - 4) {
       const double f = 4.0 / horizontal_;
       const double n = fbm3(o_.seed ^ 0xCA7Eull, x * f, y * f, z * f * 1.6, 3);
-      if (std::abs(n) < 0.075) return kAir;
-      if (std::abs(n) < 0.085) return kMoss;  // cave walls
+      if (std::abs(n) < 0.03) return kAir;
+      if (std::abs(n) < 0.036) return kMoss;  // cave walls
     }
     const int depth = h - 1 - z;
     if (h <= water_level() + 1) return depth < 3 ? kSand : kStone;

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Installs voxfield's build and test dependencies from Debian 12 packages, only when something is
+# missing (so repeated runs cost a second). Needs root or sudo for the install step.
+# Why each package was chosen: docs/architecture.md, "Dependencies".
+set -euo pipefail
+
+packages=(
+  cmake ninja-build g++ pkg-config   # toolchain
+  libtbb-dev                         # thread pool (oneTBB)
+  zlib1g-dev                         # TDCZ models in .vox files
+  nlohmann-json3-dev                 # JSON output of the CLI
+  libcli11-dev                       # CLI parsing
+  libgtest-dev                       # tests
+  python3 python3-numpy              # test oracle: NumPy reads and writes .npy
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+echo "voxfield: installing missing packages: ${missing[*]}" >&2
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

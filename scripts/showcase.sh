@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Quick start, command 1: set up, build and run the showcase (the main job). The report lands in
+# out/report.md. Extra arguments go to `voxfield showcase` (try --help).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh
+cmake --preset release >/dev/null
+cmake --build --preset release
+./build/release/bin/voxfield showcase --out out "$@"
