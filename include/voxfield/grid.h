@@ -119,6 +119,12 @@ class Grid {
   void for_each_chunk(const std::function<void(const ChunkView<T>&)>& f) const;
   // The same on voxfield's thread pool; f must be safe to call concurrently.
   void parallel_for_each_chunk(const std::function<void(const ChunkView<T>&)>& f) const;
+  // One chunk: its dense voxels, or the single value it holds (the background when absent).
+  ChunkView<T> chunk_view(Vec3i coord) const {
+    auto it = chunks_.find(coord);
+    if (it == chunks_.end()) return {coord, chunk_box(coord), nullptr, background_};
+    return {coord, chunk_box(coord), it->second.voxels.get(), it->second.uniform};
+  }
   // Coordinates of every stored chunk, sorted by (z, y, x) so that results are deterministic.
   std::vector<Vec3i> chunk_coords() const;
 
@@ -129,6 +135,10 @@ class Grid {
   // (reset to the background).
   void generate_chunks(const std::vector<Vec3i>& chunks,
                        const std::function<void(Vec3i, T*)>& f);
+  // Takes ownership of one dense array of edge^3 values (x fastest) per coordinate, replacing what
+  // was stored there; uniform ones are collapsed (scanned in parallel). Same bounds rule as
+  // generate_chunks. Throws InvalidArgument (changing nothing) when the sizes disagree.
+  void adopt_chunks(const std::vector<Vec3i>& chunks, std::vector<std::unique_ptr<T[]>> data);
 
   // Read-only accessor caching the last chunk looked up: ~5x faster than get() for coherent access.
   // Any write to the grid invalidates it.

@@ -337,25 +337,36 @@ std::vector<Vec3i> Grid<T>::chunk_coords() const {
 template <class T>
 void Grid<T>::generate_chunks(const std::vector<Vec3i>& chunks,
                               const std::function<void(Vec3i, T*)>& f) {
-  if (bounds_) {
-    for (const Vec3i coord : chunks) {
-      if (chunk_box(coord).intersect(*bounds_).empty()) {
-        throw InvalidArgument("generate_chunks: chunk " + to_string(coord) +
-                              " lies outside the grid bounds " + to_string(*bounds_));
-      }
+  const std::int64_t n = chunk_volume();
+  // Produce every chunk into fresh storage first, so that a throwing f leaves the grid unchanged.
+  std::vector<std::unique_ptr<T[]>> produced(chunks.size());
+  for (auto& p : produced) p.reset(new T[n]);
+  parallel_for(chunks.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) f(chunks[i], produced[i].get());
+  });
+  adopt_chunks(chunks, std::move(produced));
+}
+
+template <class T>
+void Grid<T>::adopt_chunks(const std::vector<Vec3i>& chunks, std::vector<std::unique_ptr<T[]>> data) {
+  if (data.size() != chunks.size()) {
+    throw InvalidArgument("adopt_chunks: " + std::to_string(data.size()) + " arrays for " +
+                          std::to_string(chunks.size()) + " chunks");
+  }
+  for (std::size_t i = 0; i < chunks.size(); ++i) {
+    if (!data[i]) throw InvalidArgument("adopt_chunks: null array for chunk " + to_string(chunks[i]));
+    if (bounds_ && chunk_box(chunks[i]).intersect(*bounds_).empty()) {
+      throw InvalidArgument("adopt_chunks: chunk " + to_string(chunks[i]) +
+                            " lies outside the grid bounds " + to_string(*bounds_));
     }
   }
   const std::int64_t n = chunk_volume();
-  // Produce every chunk into fresh storage first, so that a throwing f leaves the grid unchanged.
-  // The uniformity scan runs in the same parallel pass; only the map updates are sequential.
-  std::vector<std::unique_ptr<T[]>> produced(chunks.size());
+  // The uniformity scan and the bounds reset run in parallel; only the map updates are sequential.
   std::vector<std::int64_t> background_count(chunks.size());
   std::vector<char> uniform(chunks.size());
-  for (auto& p : produced) p.reset(new T[n]);
   parallel_for(chunks.size(), 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
-      T* v = produced[i].get();
-      f(chunks[i], v);
+      T* v = data[i].get();
       if (bounds_) {
         const Box3i cb = chunk_box(chunks[i]);
         if (!bounds_->contains(cb)) {
@@ -373,17 +384,17 @@ void Grid<T>::generate_chunks(const std::vector<Vec3i>& chunks,
   });
   for (std::size_t i = 0; i < chunks.size(); ++i) {
     auto it = chunks_.find(chunks[i]);
-    if (uniform[i] && produced[i][0] == background_) {
+    if (uniform[i] && data[i][0] == background_) {
       if (it != chunks_.end()) chunks_.erase(it);
       continue;
     }
     if (it == chunks_.end()) it = chunks_.emplace(chunks[i], Chunk{}).first;
     Chunk& c = it->second;
     if (uniform[i]) {
-      c.uniform = produced[i][0];
+      c.uniform = data[i][0];
       c.voxels.reset();
     } else {
-      c.voxels = std::move(produced[i]);
+      c.voxels = std::move(data[i]);
       c.ref = background_;
       c.ref_count = background_count[i];
     }

@@ -1,0 +1,574 @@
+// voxfield — exact distance transforms (Manhattan, Chebyshev, Euclidean; signed; clamped; nearest
+// sites) by separable passes.
+//
+// Meijster, Roerdink & Hesselink, "A general algorithm for computing distance transforms in linear
+// time" (2000), with the line kernels in line_transforms.h. The passes run in this order:
+//
+//  A. along z, per column: g(x,y,z) = distance in voxels to the nearest site in the column
+//     (x, y, *). Runs on rows of chunk-edge voxels along x at once (vectorisable), and stores g in
+//     the output chunks themselves, so no volume-sized scratch is needed (peak memory beyond input
+//     and output is a few slices).
+//  B. along x and C. along y, per z-slice: a slice only needs its own g values, so each slice is
+//     gathered into thread-local buffers, solved in 2-D, and written back in place as final values.
+//
+// Signed fields need two transforms (to solid and to air) but only one stored g per voxel: a
+// solid voxel's distance to the nearest solid is 0 and an air voxel's distance to the nearest air
+// is 0, so each voxel stores the one that is not trivially zero.
+//
+// With a clamp D, a g whose contribution alone exceeds D is dropped as "none": any site reached
+// through it is farther than D, so the clamped result is unchanged. This also lets integer
+// storage hold g in place when the clamp (explicit, or implied by the type's range) fits.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <type_traits>
+
+#include "line_transforms.h"
+#include "voxfield/distance.h"
+#include "voxfield/parallel.h"
+
+namespace voxfield {
+namespace {
+
+using detail::Chebyshev;
+using detail::EuclideanInt;
+using detail::EuclideanReal;
+
+// Chunk arrays covering a chunk-aligned box, addressed by voxel.
+template <class T>
+struct ChunkedVolume {
+  Box3i box;  // chunk-aligned
+  int edge = 0, shift = 0;
+  Vec3i nchunks;
+  std::vector<Vec3i> coords;
+  std::vector<std::unique_ptr<T[]>> chunks;
+
+  ChunkedVolume(const Box3i& aligned, int chunk_edge) : box(aligned), edge(chunk_edge) {
+    shift = std::countr_zero(static_cast<unsigned>(chunk_edge));
+    nchunks = {box.size().x >> shift, box.size().y >> shift, box.size().z >> shift};
+    const Vec3i c0{box.begin.x >> shift, box.begin.y >> shift, box.begin.z >> shift};
+    const std::size_t n = static_cast<std::size_t>(nchunks.x) * nchunks.y * nchunks.z;
+    coords.reserve(n);
+    chunks.resize(n);
+    for (int z = 0; z < nchunks.z; ++z)
+      for (int y = 0; y < nchunks.y; ++y)
+        for (int x = 0; x < nchunks.x; ++x) coords.push_back(c0 + Vec3i{x, y, z});
+    const std::size_t volume = std::size_t{1} << (3 * shift);
+    for (auto& c : chunks) c.reset(new T[volume]);
+  }
+  // Pointer to the `edge` voxels of the row (chunk column cx, y, z), x fastest.
+  T* row(int cx, int y, int z) {
+    const int ly = y - box.begin.y, lz = z - box.begin.z;
+    const std::size_t ci = (static_cast<std::size_t>(lz >> shift) * nchunks.y + (ly >> shift)) * nchunks.x + cx;
+    const int mask = edge - 1;
+    return chunks[ci].get() + (static_cast<std::size_t>(lz & mask) << (2 * shift)) +
+           (static_cast<std::size_t>(ly & mask) << shift);
+  }
+  T& at(int x, int y, int z) {
+    const int lx = x - box.begin.x;
+    return row(lx >> shift, y, z)[lx & (edge - 1)];
+  }
+};
+
+// Rows of the world's chunks as 0/1 solid flags, for the same chunk-aligned box.
+class SolidRows {
+ public:
+  SolidRows(const Grid<std::uint8_t>& g, const Box3i& aligned) : box_(aligned) {
+    edge_ = g.chunk_edge();
+    shift_ = g.chunk_shift();
+    nchunks_ = {box_.size().x >> shift_, box_.size().y >> shift_, box_.size().z >> shift_};
+    const Vec3i c0{box_.begin.x >> shift_, box_.begin.y >> shift_, box_.begin.z >> shift_};
+    std::fill(std::begin(zeros_), std::end(zeros_), 0);
+    std::fill(std::begin(ones_), std::end(ones_), 1);
+    for (int z = 0; z < nchunks_.z; ++z)
+      for (int y = 0; y < nchunks_.y; ++y)
+        for (int x = 0; x < nchunks_.x; ++x) {
+          const ChunkView<std::uint8_t> v = g.chunk_view(c0 + Vec3i{x, y, z});
+          chunks_.push_back(v.voxels ? v.voxels : (v.uniform_value ? ones_ : zeros_));
+          dense_.push_back(v.voxels != nullptr);
+        }
+  }
+  // Material row (dense chunks) or a row of 0/1 (uniform chunks): non-zero means solid.
+  const std::uint8_t* row(int cx, int y, int z) const {
+    const int ly = y - box_.begin.y, lz = z - box_.begin.z;
+    const std::size_t ci = (static_cast<std::size_t>(lz >> shift_) * nchunks_.y + (ly >> shift_)) * nchunks_.x + cx;
+    if (!dense_[ci]) return chunks_[ci];
+    const int mask = edge_ - 1;
+    return chunks_[ci] + (static_cast<std::size_t>(lz & mask) << (2 * shift_)) +
+           (static_cast<std::size_t>(ly & mask) << shift_);
+  }
+  bool solid(int x, int y, int z) const {
+    const int lx = x - box_.begin.x;
+    return row(lx >> shift_, y, z)[lx & (edge_ - 1)] != 0;
+  }
+
+ private:
+  Box3i box_;
+  int edge_, shift_;
+  Vec3i nchunks_;
+  std::vector<const std::uint8_t*> chunks_;
+  std::vector<char> dense_;
+  std::uint8_t zeros_[128], ones_[128];
+};
+
+// What the passes need to know, resolved once from the options.
+struct Plan {
+  Metric metric;
+  bool is_signed;
+  bool sites;
+  bool unit_spacing;
+  std::array<double, 3> spacing;
+  double clamp;  // D in distance units, or +inf
+  Box3i domain;  // B
+  Box3i aligned; // A: chunks covering B
+};
+
+// Pass A on one chunk column (cx, cy) of the domain: for rows y in the domain, sweep z down and up.
+// U: the unsigned integer the output storage holds g in; g >= cap is stored as kInf ("none").
+template <class U>
+void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, ChunkedVolume<SiteOffset>* sites,
+            int cx, int cy, std::uint32_t cap) {
+  constexpr U kInf = std::numeric_limits<U>::max();
+  const int e = g.edge;
+  const int y0 = std::max(p.domain.begin.y, g.box.begin.y + cy * e);
+  const int y1 = std::min(p.domain.end.y, g.box.begin.y + (cy + 1) * e);
+  const int z0 = p.domain.begin.z, z1 = p.domain.end.z;
+  std::uint32_t ds[128], da[128];
+  std::int32_t ls[128], la[128];  // z of the last solid / air site seen (sites only)
+  for (int y = y0; y < y1; ++y) {
+    // Forward (increasing z): distance to the nearest site at or below.
+    std::fill(ds, ds + e, cap);
+    std::fill(da, da + e, cap);
+    std::fill(ls, ls + e, INT32_MIN / 2);
+    std::fill(la, la + e, INT32_MIN / 2);
+    for (int z = z0; z < z1; ++z) {
+      const std::uint8_t* w = world.row(cx, y, z);
+      U* out = g.row(cx, y, z);
+      for (int i = 0; i < e; ++i) {
+        const bool solid = w[i] != 0;
+        ds[i] = solid ? 0u : std::min(ds[i] + 1u, cap);
+        da[i] = solid ? std::min(da[i] + 1u, cap) : 0u;
+        const std::uint32_t v = (p.is_signed && solid) ? da[i] : ds[i];
+        out[i] = v >= cap ? kInf : static_cast<U>(v);
+      }
+      if (sites) {
+        SiteOffset* so = sites->row(cx, y, z);
+        for (int i = 0; i < e; ++i) {
+          const bool solid = w[i] != 0;
+          if (solid) ls[i] = z; else la[i] = z;
+          so[i].dz = static_cast<std::int16_t>(std::clamp((p.is_signed && solid ? la[i] : ls[i]) - z, -32768, 32767));
+        }
+      }
+    }
+    // Backward (decreasing z): keep the smaller; on a tie the site below (found first) stays.
+    std::fill(ds, ds + e, cap);
+    std::fill(da, da + e, cap);
+    std::fill(ls, ls + e, INT32_MAX / 2);
+    std::fill(la, la + e, INT32_MAX / 2);
+    for (int z = z1 - 1; z >= z0; --z) {
+      const std::uint8_t* w = world.row(cx, y, z);
+      U* out = g.row(cx, y, z);
+      for (int i = 0; i < e; ++i) {
+        const bool solid = w[i] != 0;
+        ds[i] = solid ? 0u : std::min(ds[i] + 1u, cap);
+        da[i] = solid ? std::min(da[i] + 1u, cap) : 0u;
+        const std::uint32_t v = (p.is_signed && solid) ? da[i] : ds[i];
+        const U stored = v >= cap ? kInf : static_cast<U>(v);
+        out[i] = std::min(out[i], stored);
+      }
+      if (sites) {
+        SiteOffset* so = sites->row(cx, y, z);
+        for (int i = 0; i < e; ++i) {
+          const bool solid = w[i] != 0;
+          if (solid) ls[i] = z; else la[i] = z;
+          const std::int32_t above = (p.is_signed && solid ? la[i] : ls[i]) - z;  // >= 0
+          const std::int32_t below = -static_cast<std::int32_t>(so[i].dz);        // >= 0 when found
+          if (above < below) so[i].dz = static_cast<std::int16_t>(std::min(above, 32767));
+        }
+      }
+    }
+  }
+}
+
+// Per-thread buffers for one slice.
+template <class V>
+struct SliceBuffers {
+  std::vector<V> f, h, ht, hc;
+  std::vector<std::int32_t> argb, argc, s, t;
+  void resize(int X, int Y) {
+    const std::size_t n = static_cast<std::size_t>(X) * Y;
+    f.resize(n);
+    h.resize(n);
+    ht.resize(n);
+    hc.resize(n);
+    argb.resize(n);
+    argc.resize(n);
+    s.resize(static_cast<std::size_t>(std::max(X, Y)));
+    t.resize(static_cast<std::size_t>(std::max(X, Y)));
+  }
+};
+
+// Solves the 2-D problem of one slice: f (X*Y, x fastest) -> hc (transposed: y fastest) and the
+// minimising (x', y') per voxel through argb / argc.
+template <class Kernel, class V>
+void solve_slice(const Kernel& kx, const Kernel& ky, int X, int Y, SliceBuffers<V>& b) {
+  for (int y = 0; y < Y; ++y) {
+    const std::size_t o = static_cast<std::size_t>(y) * X;
+    kx(X, b.f.data() + o, b.h.data() + o, b.argb.data() + o, b.s.data(), b.t.data());
+  }
+  // Transpose so that pass C also runs on contiguous lines (blocked for the cache).
+  constexpr int kBlock = 32;
+  for (int y0 = 0; y0 < Y; y0 += kBlock)
+    for (int x0 = 0; x0 < X; x0 += kBlock)
+      for (int y = y0; y < std::min(Y, y0 + kBlock); ++y)
+        for (int x = x0; x < std::min(X, x0 + kBlock); ++x)
+          b.ht[static_cast<std::size_t>(x) * Y + y] = b.h[static_cast<std::size_t>(y) * X + x];
+  for (int x = 0; x < X; ++x) {
+    const std::size_t o = static_cast<std::size_t>(x) * Y;
+    ky(Y, b.ht.data() + o, b.hc.data() + o, b.argc.data() + o, b.s.data(), b.t.data());
+  }
+}
+
+// Integer square root: floor(sqrt(n)) exactly.
+std::uint64_t isqrt(std::uint64_t n) {
+  std::uint64_t r = static_cast<std::uint64_t>(std::sqrt(static_cast<double>(n)));
+  while (r > 0 && r * r > n) --r;
+  while ((r + 1) * (r + 1) <= n) ++r;
+  return r;
+}
+
+// Turns results into stored values of type T.
+template <class T>
+struct Encoder {
+  const Plan& p;
+  DistanceEncoding enc;
+  double none_value;  // decoded value for "no site within reach"
+
+  // d >= 0: the distance to the relevant site; `inside`: negate (signed field, solid voxel).
+  // `cost` is what the passes minimised (squared for Euclidean), for exact integer rounding.
+  T encode(double cost, bool has_site, bool inside) const {
+    double d;
+    if (!has_site) {
+      d = none_value;
+    } else if (p.metric == Metric::kEuclidean) {
+      d = std::sqrt(cost);
+    } else {
+      d = cost;
+    }
+    d = std::min(d, p.clamp);
+    if constexpr (std::is_same_v<T, float>) {
+      return static_cast<float>(inside ? -d : d);
+    } else {
+      constexpr double kMax = static_cast<double>(std::numeric_limits<T>::max());
+      double scaled;
+      if (std::isinf(d)) {
+        scaled = inside ? -1e300 : 1e300;
+      } else if (p.metric == Metric::kEuclidean && p.unit_spacing && has_site && d < p.clamp &&
+                 enc.scale == std::floor(enc.scale)) {
+        // floor(sqrt(cost) * S) computed exactly in integers (cost is an integer here).
+        const std::uint64_t n = static_cast<std::uint64_t>(cost) * static_cast<std::uint64_t>(enc.scale * enc.scale);
+        const std::uint64_t r = isqrt(n);
+        scaled = inside ? -static_cast<double>(r + (r * r != n ? 1 : 0)) : static_cast<double>(r);
+      } else {
+        scaled = std::floor((inside ? -d : d) * enc.scale);
+      }
+      return static_cast<T>(std::clamp(scaled + static_cast<double>(enc.bias), 0.0, kMax));
+    }
+  }
+};
+
+template <class T, class U, class V, class Kernel>
+void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
+                 ChunkedVolume<SiteOffset>* sites, const Kernel& kx, const Kernel& ky,
+                 const Encoder<T>& encoder, std::uint32_t cap, V inf) {
+  constexpr U kInfU = std::numeric_limits<U>::max();
+  const int X = p.domain.size().x, Y = p.domain.size().y;
+  const int bx = p.domain.begin.x, by = p.domain.begin.y;
+  const double sz = p.spacing[2];
+  const double clamp_cost = p.metric == Metric::kEuclidean ? p.clamp * p.clamp : p.clamp;
+  // g (voxels along z) -> the cost the 2-D passes minimise.
+  auto cost_of = [&](U stored) -> V {
+    if (stored == kInfU || stored >= cap) return inf;
+    if (p.metric == Metric::kEuclidean) {
+      const double c = p.unit_spacing ? static_cast<double>(stored) * stored : (sz * stored) * (sz * stored);
+      return c > clamp_cost ? inf : static_cast<V>(c);
+    }
+    return static_cast<V>(stored);
+  };
+  const int passes = p.is_signed ? 2 : 1;
+  parallel_for(static_cast<std::size_t>(p.domain.size().z), 1, [&](std::size_t zb, std::size_t ze) {
+    SliceBuffers<V> buf[2];
+    std::vector<std::uint8_t> solid(static_cast<std::size_t>(X) * Y);
+    std::vector<std::int16_t> dz(sites ? static_cast<std::size_t>(X) * Y : 0);
+    for (auto& b : buf) b.resize(X, Y);
+    for (std::size_t zi = zb; zi < ze; ++zi) {
+      const int z = p.domain.begin.z + static_cast<int>(zi);
+      // Gather the slice.
+      for (int y = 0; y < Y; ++y)
+        for (int x = 0; x < X; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y) * X + x;
+          const U stored = g.at(bx + x, by + y, z);
+          const bool s = world.solid(bx + x, by + y, z);
+          solid[i] = s;
+          const V c = cost_of(stored);
+          buf[0].f[i] = (p.is_signed && s) ? V(0) : c;  // distance to solid
+          if (p.is_signed) buf[1].f[i] = s ? c : V(0);  // distance to air
+          if (sites) dz[i] = sites->at(bx + x, by + y, z).dz;
+        }
+      for (int k = 0; k < passes; ++k) solve_slice(kx, ky, X, Y, buf[k]);
+      // Write the final values back into the same slice.
+      for (int y = 0; y < Y; ++y)
+        for (int x = 0; x < X; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y) * X + x;
+          const bool inside = p.is_signed && solid[i];
+          const SliceBuffers<V>& b = buf[inside ? 1 : 0];
+          const std::size_t ti = static_cast<std::size_t>(x) * Y + y;  // transposed index
+          const V cost = b.hc[ti];
+          const std::int32_t ys = b.argc[ti];
+          const bool has_site = ys >= 0 && cost < inf && static_cast<double>(cost) <= clamp_cost;
+          const T value = encoder.encode(static_cast<double>(cost), has_site, inside);
+          std::memcpy(&g.at(bx + x, by + y, z), &value, sizeof(T));  // T and U have the same size
+          if (sites) {
+            SiteOffset so;
+            if (has_site) {
+              const std::int32_t xs = b.argb[static_cast<std::size_t>(ys) * X + x];
+              so.dx = static_cast<std::int16_t>(xs - x);
+              so.dy = static_cast<std::int16_t>(ys - y);
+              // A column voxel that is itself a site of this transform (solid for the distance to
+              // solid, air for the distance to air) stored the other transform's dz: its own is 0.
+              const std::size_t col = static_cast<std::size_t>(ys) * X + xs;
+              const bool column_is_site = p.is_signed ? (solid[col] != 0) != inside : solid[col] != 0;
+              so.dz = column_is_site ? std::int16_t{0} : dz[col];
+            }
+            sites->at(bx + x, by + y, z) = so;
+          }
+        }
+    }
+  });
+}
+
+template <class T, class U>
+DistanceField run(const Grid<std::uint8_t>& occupancy, const DistanceOptions& options, const Plan& p,
+                  const DistanceEncoding& enc, T background) {
+  DistanceField out;
+  out.options = options;
+  out.domain = p.domain;
+  out.encoding = enc;
+  const int edge = occupancy.chunk_edge();
+  Grid<T> values(edge, background, occupancy.bounds());
+  std::optional<Grid<SiteOffset>> sites_grid;
+  if (p.sites) sites_grid.emplace(edge, SiteOffset{}, occupancy.bounds());
+  if (p.domain.empty()) {
+    out.values = std::move(values);
+    out.sites = std::move(sites_grid);
+    return out;
+  }
+
+  ChunkedVolume<U> g(p.aligned, edge);
+  std::optional<ChunkedVolume<SiteOffset>> sites;
+  if (p.sites) sites.emplace(p.aligned, edge);
+  const SolidRows world(occupancy, p.aligned);
+
+  // Chunks reaching outside the domain keep the background there.
+  {
+    U bg;
+    std::memcpy(&bg, &background, sizeof(U));
+    const std::size_t volume = std::size_t{1} << (3 * g.shift);
+    parallel_for(g.chunks.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const Vec3i lo{g.coords[i].x * edge, g.coords[i].y * edge, g.coords[i].z * edge};
+        if (!p.domain.contains(Box3i{lo, lo + Vec3i::splat(edge)})) {
+          std::fill(g.chunks[i].get(), g.chunks[i].get() + volume, bg);
+          if (sites) std::fill(sites->chunks[i].get(), sites->chunks[i].get() + volume, SiteOffset{});
+        }
+      }
+    });
+  }
+
+  // Largest g worth keeping: beyond it a column's site is farther than the clamp.
+  constexpr std::uint64_t kInfU = std::numeric_limits<U>::max();
+  std::uint64_t cap = kInfU;
+  if (std::isfinite(p.clamp)) {
+    const double vox = std::floor(p.clamp / p.spacing[2]) + 1;
+    cap = static_cast<std::uint64_t>(std::min<double>(vox, static_cast<double>(kInfU)));
+  }
+  cap = std::min<std::uint64_t>(cap, std::numeric_limits<std::uint32_t>::max() - 1);
+  const std::uint32_t cap32 = static_cast<std::uint32_t>(cap);
+
+  // Pass A.
+  const int ncx = g.nchunks.x, ncy = g.nchunks.y;
+  parallel_for(static_cast<std::size_t>(ncx) * ncy, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      pass_z<U>(p, world, g, sites ? &*sites : nullptr, static_cast<int>(i % ncx), static_cast<int>(i / ncx), cap32);
+    }
+  });
+
+  // Passes B and C, and encoding.
+  const double none_value = std::isfinite(p.clamp) ? p.clamp : std::numeric_limits<double>::infinity();
+  const Encoder<T> encoder{p, enc, none_value};
+  ChunkedVolume<SiteOffset>* sp = sites ? &*sites : nullptr;
+  if (p.metric == Metric::kManhattan) {
+    auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t*, std::int32_t*) {
+      detail::manhattan_1d(n, f, o, a);
+    };
+    pass_slices<T, U, std::int32_t>(p, world, g, sp, k, k, encoder, cap32, detail::kManhattanInf);
+  } else if (p.metric == Metric::kChebyshev) {
+    auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
+      detail::envelope_1d(Chebyshev{}, n, f, o, a, s, t);
+    };
+    pass_slices<T, U, std::int32_t>(p, world, g, sp, k, k, encoder, cap32, Chebyshev::kInf);
+  } else if (p.unit_spacing) {
+    auto k = [](int n, const std::int64_t* f, std::int64_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
+      detail::envelope_1d(EuclideanInt{}, n, f, o, a, s, t);
+    };
+    pass_slices<T, U, std::int64_t>(p, world, g, sp, k, k, encoder, cap32, EuclideanInt::kInf);
+  } else {
+    const EuclideanReal ex{p.spacing[0] * p.spacing[0]}, ey{p.spacing[1] * p.spacing[1]};
+    auto kx = [ex](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
+      detail::envelope_1d(ex, n, f, o, a, s, t);
+    };
+    auto ky = [ey](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
+      detail::envelope_1d(ey, n, f, o, a, s, t);
+    };
+    using K = std::function<void(int, const double*, double*, std::int32_t*, std::int32_t*, std::int32_t*)>;
+    pass_slices<T, U, double, K>(p, world, g, sp, K(kx), K(ky), encoder, cap32, EuclideanReal::kInf);
+  }
+
+  // Hand the chunks to the grids (uniform ones collapse).
+  std::vector<std::unique_ptr<T[]>> typed(g.chunks.size());
+  for (std::size_t i = 0; i < g.chunks.size(); ++i) typed[i].reset(reinterpret_cast<T*>(g.chunks[i].release()));
+  values.adopt_chunks(g.coords, std::move(typed));
+  if (sites) sites_grid->adopt_chunks(sites->coords, std::move(sites->chunks));
+  out.values = std::move(values);
+  out.sites = std::move(sites_grid);
+  return out;
+}
+
+Box3i chunk_aligned(const Box3i& b, int shift) {
+  const int e = 1 << shift;
+  const Vec3i lo{(b.begin.x >> shift) * e, (b.begin.y >> shift) * e, (b.begin.z >> shift) * e};
+  const Vec3i hi{((b.end.x - 1) >> shift) * e + e, ((b.end.y - 1) >> shift) * e + e, ((b.end.z - 1) >> shift) * e + e};
+  return {lo, hi};
+}
+
+}  // namespace
+
+const char* metric_name(Metric m) {
+  switch (m) {
+    case Metric::kManhattan: return "manhattan";
+    case Metric::kChebyshev: return "chebyshev";
+    case Metric::kEuclidean: return "euclidean";
+  }
+  return "?";
+}
+
+const char* storage_name(Storage s) {
+  switch (s) {
+    case Storage::kU8: return "u8";
+    case Storage::kU16: return "u16";
+    case Storage::kF32: return "f32";
+  }
+  return "?";
+}
+
+Metric parse_metric(const std::string& name) {
+  for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
+    if (name == metric_name(m)) return m;
+  throw InvalidArgument("unknown metric \"" + name + "\" (manhattan, chebyshev, euclidean)");
+}
+
+Storage parse_storage(const std::string& name) {
+  for (Storage s : {Storage::kU8, Storage::kU16, Storage::kF32})
+    if (name == storage_name(s)) return s;
+  throw InvalidArgument("unknown storage \"" + name + "\" (u8, u16, f32)");
+}
+
+double DistanceField::distance(Vec3i p) const {
+  return std::visit([&](const auto& g) { return encoding.decode(static_cast<double>(g.get(p))); }, values);
+}
+
+int DistanceField::chunk_edge() const {
+  return std::visit([](const auto& g) { return g.chunk_edge(); }, values);
+}
+
+DistanceField compute_distance_field(const World& world, const DistanceOptions& options) {
+  return compute_distance_field(world.voxels, options);
+}
+
+DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o) {
+  if (!(o.max_distance >= 0) || std::isinf(o.max_distance)) {
+    throw InvalidArgument("max distance must be a finite number >= 0 (0 = no clamp)");
+  }
+  for (double s : o.spacing)
+    if (!(s > 0) || !std::isfinite(s)) throw InvalidArgument("voxel spacing must be positive and finite");
+  const bool unit_spacing = o.spacing == std::array<double, 3>{1, 1, 1};
+  if (!unit_spacing && o.metric != Metric::kEuclidean) {
+    throw InvalidArgument(std::string("voxel spacing applies to the euclidean metric only, not ") + metric_name(o.metric));
+  }
+  if (o.fixed_point_scale < 0 || !std::isfinite(o.fixed_point_scale)) {
+    throw InvalidArgument("fixed-point scale must be >= 0");
+  }
+  Plan p;
+  p.metric = o.metric;
+  p.is_signed = o.signed_distance;
+  p.sites = o.nearest_sites;
+  p.unit_spacing = unit_spacing;
+  p.spacing = o.spacing;
+  p.clamp = o.max_distance > 0 ? o.max_distance : std::numeric_limits<double>::infinity();
+
+  // Encoding.
+  DistanceEncoding enc;
+  if (o.storage != Storage::kF32) {
+    const int bits = o.storage == Storage::kU8 ? 8 : 16;
+    enc.scale = o.metric != Metric::kEuclidean ? 1.0
+                : o.fixed_point_scale > 0      ? o.fixed_point_scale
+                                               : (bits == 8 ? 4.0 : 16.0);
+    enc.bias = o.signed_distance ? (std::int64_t{1} << (bits - 1)) : 0;
+    // Integer storage cannot hold more than its range: that range acts as a clamp.
+    const double type_max = static_cast<double>((std::int64_t{1} << bits) - 1);
+    const double range = (type_max - static_cast<double>(enc.bias)) / enc.scale;
+    if (!std::isfinite(p.clamp) || p.clamp > range) p.clamp = std::isfinite(p.clamp) ? std::min(p.clamp, range) : range;
+    // g is held in place in the output type: it must reach past the clamp along z.
+    if (type_max * o.spacing[2] < p.clamp) {
+      throw InvalidArgument("voxel spacing " + std::to_string(o.spacing[2]) + " along z is too fine for " +
+                            storage_name(o.storage) + " storage with this clamp; use f32");
+    }
+  }
+
+  // Domain.
+  if (o.domain) {
+    p.domain = *o.domain;
+  } else if (occupancy.bounds()) {
+    p.domain = *occupancy.bounds();
+  } else {
+    const Box3i content = occupancy.content_bounds();
+    const double grow = o.max_distance > 0 ? std::ceil(o.max_distance / std::min({o.spacing[0], o.spacing[1], o.spacing[2]})) : 1.0;
+    p.domain = content.empty() ? content : content.grown(static_cast<std::int32_t>(std::min(grow, 1e6)));
+  }
+  if (!p.domain.empty()) {
+    const Vec3i s = p.domain.size();
+    const std::int64_t limit = o.nearest_sites ? 32767 : (std::int64_t{1} << 30);
+    if (s.x > limit || s.y > limit || s.z > limit) {
+      throw InvalidArgument("domain " + to_string(p.domain) + " is too large" +
+                            (o.nearest_sites ? std::string(" for 16-bit nearest-site offsets") : std::string()));
+    }
+    p.aligned = chunk_aligned(p.domain, occupancy.chunk_shift());
+  }
+
+  switch (o.storage) {
+    case Storage::kU8: {
+      const auto bg = static_cast<std::uint8_t>(std::min(255.0, std::floor(std::min(p.clamp, 1e300) * enc.scale) + static_cast<double>(enc.bias)));
+      return run<std::uint8_t, std::uint8_t>(occupancy, o, p, enc, bg);
+    }
+    case Storage::kU16: {
+      const auto bg = static_cast<std::uint16_t>(std::min(65535.0, std::floor(std::min(p.clamp, 1e300) * enc.scale) + static_cast<double>(enc.bias)));
+      return run<std::uint16_t, std::uint16_t>(occupancy, o, p, enc, bg);
+    }
+    case Storage::kF32:
+      return run<float, std::uint32_t>(occupancy, o, p, enc, static_cast<float>(p.clamp));
+  }
+  throw InvalidArgument("unknown storage");
+}
+
+}  // namespace voxfield

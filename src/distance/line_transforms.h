@@ -1,0 +1,133 @@
+// voxfield — one-dimensional exact distance transforms, the building block of the separable
+// passes (internal).
+//
+// Each routine solves, on a line of n voxels,
+//     out[x] = min over i of F(x, i),   arg[x] = the smallest minimising i (-1 when none),
+// where F(x, i) combines the cost f[i] of the best site seen through voxel i by the previous
+// passes with the step from i to x along this axis:
+//     Euclidean  F = w (x - i)^2 + f[i]        (w = spacing^2 along this axis; f squared)
+//     Chebyshev  F = max(|x - i|, f[i])
+//     Manhattan  F = |x - i| + f[i]
+// The Euclidean and Chebyshev routines are the lower-envelope scan of Meijster, Roerdink and
+// Hesselink, "A general algorithm for computing distance transforms in linear time" (2000): a
+// forward scan keeps the sites whose F is minimal somewhere, with the first voxel t[q] where site
+// s[q] takes over; Sep(i, u) is the last x at which the earlier site i is still no worse than u.
+// Because Sep keeps ties with the earlier site and a site is popped only when strictly worse,
+// the smallest minimising index wins every tie. Manhattan needs no envelope: a forward and a
+// backward min-plus sweep (Rosenfeld & Pfaltz 1966) give the same result in two passes.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace voxfield::detail {
+
+// floor(a / b) for b > 0.
+inline std::int64_t floor_div(std::int64_t a, std::int64_t b) {
+  const std::int64_t q = a / b;
+  return (a % b != 0 && a < 0) ? q - 1 : q;
+}
+
+// Euclidean with unit spacing: integer arithmetic, exact.
+struct EuclideanInt {
+  using Value = std::int64_t;
+  static constexpr Value kInf = std::numeric_limits<std::int64_t>::max() / 4;
+  static Value F(std::int64_t x, std::int64_t i, Value fi) { return (x - i) * (x - i) + fi; }
+  static std::int64_t Sep(std::int64_t i, std::int64_t u, Value fi, Value fu) {
+    return floor_div(u * u - i * i + fu - fi, 2 * (u - i));
+  }
+};
+
+// Euclidean with spacing: w = spacing^2 along the line.
+struct EuclideanReal {
+  using Value = double;
+  static constexpr Value kInf = std::numeric_limits<double>::infinity();
+  double w = 1;
+  Value F(std::int64_t x, std::int64_t i, Value fi) const {
+    const double d = static_cast<double>(x - i);
+    return w * d * d + fi;
+  }
+  std::int64_t Sep(std::int64_t i, std::int64_t u, Value fi, Value fu) const {
+    const double num = w * static_cast<double>(u * u - i * i) + fu - fi;
+    const double sep = std::floor(num / (2.0 * w * static_cast<double>(u - i)));
+    // Keep far-away crossings in range of int64; anything beyond the line is equivalent.
+    return static_cast<std::int64_t>(std::clamp(sep, -1e15, 1e15));
+  }
+};
+
+struct Chebyshev {
+  using Value = std::int32_t;
+  static constexpr Value kInf = std::numeric_limits<std::int32_t>::max() / 4;
+  static Value F(std::int64_t x, std::int64_t i, Value fi) {
+    return std::max(static_cast<Value>(x > i ? x - i : i - x), fi);
+  }
+  static std::int64_t Sep(std::int64_t i, std::int64_t u, Value fi, Value fu) {
+    const std::int64_t mid = floor_div(i + u, 2);
+    return fi <= fu ? std::max<std::int64_t>(i + fu, mid) : std::min<std::int64_t>(u - fi, mid);
+  }
+};
+
+// Lower-envelope scan (Meijster et al. 2000, phase 2). s, t: scratch of n ints.
+template <class Traits>
+void envelope_1d(const Traits& tr, int n, const typename Traits::Value* f,
+                 typename Traits::Value* out, std::int32_t* arg, std::int32_t* s, std::int32_t* t) {
+  using Value = typename Traits::Value;
+  int q = -1;
+  for (int u = 0; u < n; ++u) {
+    const Value fu = f[u];
+    if (!(fu < Traits::kInf)) continue;
+    while (q >= 0 && tr.F(t[q], s[q], f[s[q]]) > tr.F(t[q], u, fu)) --q;
+    if (q < 0) {
+      q = 0;
+      s[0] = u;
+      t[0] = 0;
+    } else {
+      const std::int64_t w = 1 + tr.Sep(s[q], u, f[s[q]], fu);
+      if (w < n) {
+        ++q;
+        s[q] = u;
+        t[q] = static_cast<std::int32_t>(w);
+      }
+    }
+  }
+  if (q < 0) {
+    std::fill(out, out + n, Traits::kInf);
+    std::fill(arg, arg + n, -1);
+    return;
+  }
+  for (int x = n - 1; x >= 0; --x) {
+    out[x] = tr.F(x, s[q], f[s[q]]);
+    arg[x] = s[q];
+    if (x == t[q]) --q;
+  }
+}
+
+// Manhattan: forward and backward min-plus sweeps. kInf saturates.
+inline constexpr std::int32_t kManhattanInf = std::numeric_limits<std::int32_t>::max() / 4;
+
+inline void manhattan_1d(int n, const std::int32_t* f, std::int32_t* out, std::int32_t* arg) {
+  std::int32_t best = kManhattanInf, site = -1;
+  for (int x = 0; x < n; ++x) {
+    const std::int32_t from_left = site >= 0 ? best + 1 : kManhattanInf;
+    if (f[x] < from_left) {  // own site only when strictly better: ties stay with the left
+      best = f[x];
+      site = f[x] < kManhattanInf ? x : -1;
+    } else {
+      best = from_left;
+    }
+    out[x] = best;
+    arg[x] = site;
+  }
+  for (int x = n - 2; x >= 0; --x) {
+    if (arg[x + 1] < 0) continue;
+    const std::int32_t from_right = out[x + 1] + 1;
+    if (from_right < out[x]) {  // strictly: ties keep the smaller index
+      out[x] = from_right;
+      arg[x] = arg[x + 1];
+    }
+  }
+}
+
+}  // namespace voxfield::detail

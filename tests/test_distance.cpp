@@ -1,0 +1,355 @@
+// Exact distance fields against a brute-force oracle: random worlds of odd sizes, every metric,
+// signed and unsigned, clamped and not, anisotropic spacing, every storage, several chunk edges and
+// thread counts, nearest sites with the documented tie-breaking rule; plus tiny hand-made worlds
+// with figures worked out by hand.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <tuple>
+
+#include "voxfield/distance.h"
+#include "voxfield/parallel.h"
+
+using namespace voxfield;
+
+namespace {
+
+// The oracle. For every voxel of `domain`, scan every site and keep the best by the documented
+// key: smallest distance; then smallest site y; then smallest distance within the site's y-plane
+// (the x-z part of the offset); then smallest site x; then smallest |dz|; then smallest site z.
+struct OracleResult {
+  double distance;  // signed when requested; +inf when no site
+  bool has_site;
+  SiteOffset site;
+  double cost;      // squared distance for Euclidean
+};
+
+double metric_cost(Metric m, const std::array<double, 3>& sp, int dx, int dy, int dz) {
+  const double ax = std::abs(dx) * sp[0], ay = std::abs(dy) * sp[1], az = std::abs(dz) * sp[2];
+  switch (m) {
+    case Metric::kManhattan: return ax + ay + az;
+    case Metric::kChebyshev: return std::max({ax, ay, az});
+    case Metric::kEuclidean: return ax * ax + ay * ay + az * az;
+  }
+  return 0;
+}
+
+std::vector<OracleResult> oracle(const std::vector<char>& solid, const Box3i& domain, const DistanceOptions& o) {
+  const Vec3i n = domain.size();
+  auto idx = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * n.y + y) * n.x + x; };
+  std::vector<Vec3i> solids, airs;
+  for (int z = 0; z < n.z; ++z)
+    for (int y = 0; y < n.y; ++y)
+      for (int x = 0; x < n.x; ++x) (solid[idx(x, y, z)] ? solids : airs).push_back({x, y, z});
+  std::vector<OracleResult> out(solid.size());
+  for (int z = 0; z < n.z; ++z)
+    for (int y = 0; y < n.y; ++y)
+      for (int x = 0; x < n.x; ++x) {
+        const bool inside = solid[idx(x, y, z)];
+        OracleResult r{std::numeric_limits<double>::infinity(), false, {}, 0};
+        if (inside && !o.signed_distance) {
+          r = {0.0, true, {0, 0, 0}, 0};
+          out[idx(x, y, z)] = r;
+          continue;
+        }
+        const auto& sites = inside ? airs : solids;
+        std::tuple<double, int, double, int, int, int> best{1e300, 0, 0, 0, 0, 0};
+        for (const Vec3i s : sites) {
+          const int dx = s.x - x, dy = s.y - y, dz = s.z - z;
+          const std::tuple<double, int, double, int, int, int> key{
+              metric_cost(o.metric, o.spacing, dx, dy, dz), s.y, metric_cost(o.metric, o.spacing, dx, 0, dz), s.x,
+              std::abs(dz), s.z};
+          if (key < best) {
+            best = key;
+            r.has_site = true;
+            r.site = {static_cast<std::int16_t>(dx), static_cast<std::int16_t>(dy), static_cast<std::int16_t>(dz)};
+          }
+        }
+        if (r.has_site) {
+          r.cost = std::get<0>(best);
+          r.distance = o.metric == Metric::kEuclidean ? std::sqrt(r.cost) : r.cost;
+        }
+        out[idx(x, y, z)] = r;
+      }
+  return out;
+}
+
+std::uint64_t isqrt_ref(std::uint64_t v) {
+  std::uint64_t r = 0;
+  while ((r + 1) * (r + 1) <= v) ++r;
+  return r;
+}
+
+// What the field must store for an oracle result, given the options.
+double expected_stored(const OracleResult& r, bool inside, const DistanceOptions& o, const DistanceField& f) {
+  const double clamp = o.max_distance > 0 ? o.max_distance : std::numeric_limits<double>::infinity();
+  const bool unit = o.spacing == std::array<double, 3>{1, 1, 1};
+  double d = r.has_site ? r.distance : std::numeric_limits<double>::infinity();
+  if (o.storage == Storage::kF32) {
+    d = std::min(d, clamp);
+    return static_cast<float>(inside && o.signed_distance ? -d : d);
+  }
+  const double type_max = o.storage == Storage::kU8 ? 255 : 65535;
+  const double S = f.encoding.scale, bias = static_cast<double>(f.encoding.bias);
+  const double range = (type_max - bias) / S;
+  const double eff_clamp = std::min(clamp, range);
+  const bool neg = inside && o.signed_distance;
+  double scaled;
+  if (d >= eff_clamp) {
+    scaled = std::floor((neg ? -eff_clamp : eff_clamp) * S);
+  } else if (o.metric == Metric::kEuclidean && unit) {
+    const std::uint64_t v = static_cast<std::uint64_t>(r.cost) * static_cast<std::uint64_t>(S * S);
+    const std::uint64_t q = isqrt_ref(v);
+    scaled = neg ? -static_cast<double>(q + (q * q != v)) : static_cast<double>(q);
+  } else {
+    scaled = std::floor((neg ? -d : d) * S);
+  }
+  return std::clamp(scaled + bias, 0.0, type_max);
+}
+
+double stored_at(const DistanceField& f, Vec3i p) {
+  return std::visit([&](const auto& g) { return static_cast<double>(g.get(p)); }, f.values);
+}
+
+struct Case {
+  Metric metric;
+  bool is_signed;
+  double clamp;
+  Storage storage;
+  std::array<double, 3> spacing;
+  int chunk_edge;
+  int threads;
+};
+
+std::string describe(const Case& c) {
+  return std::string(metric_name(c.metric)) + (c.is_signed ? " signed" : " unsigned") + " clamp " +
+         std::to_string(c.clamp) + " " + storage_name(c.storage) + " spacing " + std::to_string(c.spacing[0]) + "," +
+         std::to_string(c.spacing[1]) + "," + std::to_string(c.spacing[2]) + " edge " + std::to_string(c.chunk_edge) +
+         " threads " + std::to_string(c.threads);
+}
+
+// Builds a random bounded world, runs the field and compares every voxel and site with the oracle.
+void check_case(const Case& c, std::uint32_t seed, Vec3i size, double density) {
+  SCOPED_TRACE(describe(c) + " seed " + std::to_string(seed));
+  std::mt19937 rng(seed);
+  const Box3i bounds{{-5, 3, -9}, Vec3i{-5, 3, -9} + size};
+  World w(c.chunk_edge, bounds);
+  std::vector<char> solid(static_cast<std::size_t>(bounds.volume()));
+  std::size_t i = 0;
+  for (int z = bounds.begin.z; z < bounds.end.z; ++z)
+    for (int y = bounds.begin.y; y < bounds.end.y; ++y)
+      for (int x = bounds.begin.x; x < bounds.end.x; ++x, ++i) {
+        solid[i] = std::uniform_real_distribution<double>(0, 1)(rng) < density;
+        if (solid[i]) w.voxels.set({x, y, z}, static_cast<std::uint8_t>(1 + rng() % 200));
+      }
+  DistanceOptions o;
+  o.metric = c.metric;
+  o.signed_distance = c.is_signed;
+  o.max_distance = c.clamp;
+  o.storage = c.storage;
+  o.spacing = c.spacing;
+  o.nearest_sites = true;
+  std::optional<ThreadLimit> limit;
+  limit.emplace(c.threads);
+  const DistanceField f = compute_distance_field(w, o);
+  ASSERT_EQ(f.domain, bounds);
+  const auto expect = oracle(solid, bounds, o);
+  const bool unit = c.spacing == std::array<double, 3>{1, 1, 1};
+  const double clamp = c.clamp > 0 ? c.clamp : std::numeric_limits<double>::infinity();
+  int reported = 0;
+  i = 0;
+  for (int z = bounds.begin.z; z < bounds.end.z; ++z)
+    for (int y = bounds.begin.y; y < bounds.end.y; ++y)
+      for (int x = bounds.begin.x; x < bounds.end.x; ++x, ++i) {
+        const Vec3i p{x, y, z};
+        const OracleResult& r = expect[i];
+        const double want = expected_stored(r, solid[i], o, f);
+        const double got = stored_at(f, p);
+        // Anisotropic Euclidean sums squares in another order than the oracle: allow rounding
+        // (relative 1e-6 on the f32 value; one fixed-point step for integer storage).
+        const double tol = unit ? 0.0 : (c.storage == Storage::kF32 ? 1e-6 * std::max(1.0, std::abs(want)) : 1.0);
+        if (!(std::abs(got - want) <= tol) && !(std::isinf(got) && std::isinf(want) && got == want)) {
+          if (reported++ < 5) ADD_FAILURE() << "value at " << to_string(p) << ": got " << got << " want " << want;
+        }
+        // Sites: exact offsets wherever the distance is within the clamp (ties make anisotropic
+        // rounding ambiguous, so there only the distance to the reported site is checked).
+        const SiteOffset s = f.sites->get(p);
+        const bool within = r.has_site && r.distance <= clamp;
+        if (!within) {
+          if (!s.none() && reported++ < 5) ADD_FAILURE() << "site at " << to_string(p) << " should be none";
+          continue;
+        }
+        if (solid[i] && !c.is_signed) {
+          if (!(s == SiteOffset{0, 0, 0}) && reported++ < 5) ADD_FAILURE() << "solid voxel site not itself";
+          continue;
+        }
+        if (unit) {
+          if (!(s == r.site) && reported++ < 5) {
+            ADD_FAILURE() << "site at " << to_string(p) << ": got " << s.dx << "," << s.dy << "," << s.dz << " want "
+                          << r.site.dx << "," << r.site.dy << "," << r.site.dz;
+          }
+        } else if (!s.none()) {
+          const double d = std::sqrt(metric_cost(c.metric, c.spacing, s.dx, s.dy, s.dz));
+          if (std::abs(d - r.distance) > 1e-9 * std::max(1.0, r.distance) && reported++ < 5) {
+            ADD_FAILURE() << "site at " << to_string(p) << " is at " << d << ", nearest at " << r.distance;
+          }
+        } else if (reported++ < 5) {
+          ADD_FAILURE() << "missing site at " << to_string(p);
+        }
+      }
+  EXPECT_EQ(reported, 0);
+}
+
+}  // namespace
+
+TEST(ExactDistance, RandomWorldsAgainstBruteForce) {
+  const std::array<double, 3> unit{1, 1, 1}, aniso{0.5, 1.25, 2.0};
+  std::uint32_t seed = 1;
+  for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
+    for (bool sgn : {false, true})
+      for (double clamp : {0.0, 3.5, 7.0})
+        for (Storage st : {Storage::kF32, Storage::kU8, Storage::kU16}) {
+          const int edge = (seed % 3 == 0) ? 8 : (seed % 3 == 1 ? 16 : 32);
+          const int threads = seed % 2 ? 2 : 1;
+          const double density = (seed % 4 == 0) ? 0.02 : (seed % 4 == 1 ? 0.1 : (seed % 4 == 2 ? 0.3 : 0.6));
+          check_case({m, sgn, clamp, st, unit, edge, threads}, seed, {23, 17, 19}, density);
+          ++seed;
+        }
+  for (bool sgn : {false, true})
+    for (double clamp : {0.0, 4.0})
+      for (Storage st : {Storage::kF32, Storage::kU16}) {
+        check_case({Metric::kEuclidean, sgn, clamp, st, aniso, 8, 2}, seed, {21, 13, 17}, 0.05);
+        ++seed;
+      }
+}
+
+TEST(ExactDistance, IdenticalForEveryChunkEdgeAndThreadCount) {
+  std::mt19937 rng(77);
+  const Box3i bounds{{0, 0, 0}, {45, 38, 70}};
+  for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean}) {
+    std::vector<float> reference;
+    for (int edge : {8, 16, 32, 64, 128}) {
+      for (int threads : {1, 2}) {
+        World w(edge, bounds);
+        std::mt19937 r2(5);
+        for (int k = 0; k < 300; ++k) {
+          w.voxels.set({static_cast<int>(r2() % 45), static_cast<int>(r2() % 38), static_cast<int>(r2() % 70)}, 1);
+        }
+        DistanceOptions o;
+        o.metric = m;
+        o.signed_distance = true;
+        ThreadLimit limit(threads);
+        const DistanceField f = compute_distance_field(w, o);
+        std::vector<float> dense(static_cast<std::size_t>(bounds.volume()));
+        std::get<Grid<float>>(f.values).copy_to_dense(bounds, dense.data());
+        if (reference.empty()) {
+          reference = dense;
+        } else {
+          EXPECT_EQ(dense, reference) << metric_name(m) << " edge " << edge << " threads " << threads;
+        }
+      }
+    }
+  }
+}
+
+TEST(ExactDistance, EmptyAndFullWorlds) {
+  const Box3i bounds{{0, 0, 0}, {20, 9, 11}};
+  World empty(16, bounds);
+  for (Storage st : {Storage::kF32, Storage::kU8, Storage::kU16}) {
+    DistanceOptions o;
+    o.storage = st;
+    const DistanceField f = compute_distance_field(empty, o);
+    const double v = stored_at(f, {3, 3, 3});
+    if (st == Storage::kF32) {
+      EXPECT_TRUE(std::isinf(v) && v > 0);
+    } else {
+      EXPECT_EQ(v, st == Storage::kU8 ? 255 : 65535);
+    }
+    o.max_distance = 5;
+    EXPECT_EQ(compute_distance_field(empty, o).distance({3, 3, 3}), 5);
+  }
+  World full(16, bounds);
+  full.voxels.fill(bounds, 4);
+  DistanceOptions o;
+  o.signed_distance = true;
+  EXPECT_TRUE(std::isinf(compute_distance_field(full, o).distance({1, 1, 1})));
+  EXPECT_LT(compute_distance_field(full, o).distance({1, 1, 1}), 0);
+  o.max_distance = 3;
+  EXPECT_EQ(compute_distance_field(full, o).distance({1, 1, 1}), -3);
+  o.signed_distance = false;
+  EXPECT_EQ(compute_distance_field(full, o).distance({1, 1, 1}), 0);
+}
+
+TEST(ExactDistance, HandWorkedFigures) {
+  // One solid voxel at the origin of an unbounded world; the default domain is its box grown by
+  // the clamp.
+  World w;
+  w.voxels.set({0, 0, 0}, 1);
+  DistanceOptions o;
+  o.max_distance = 10;
+  o.metric = Metric::kManhattan;
+  DistanceField f = compute_distance_field(w, o);
+  EXPECT_EQ(f.domain, (Box3i{{-10, -10, -10}, {11, 11, 11}}));
+  EXPECT_EQ(f.distance({3, -4, 2}), 9);
+  EXPECT_EQ(f.distance({3, -4, 5}), 10);   // 12, clamped
+  EXPECT_EQ(f.distance({500, 0, 0}), 10);  // outside the domain: the background D
+  o.metric = Metric::kChebyshev;
+  f = compute_distance_field(w, o);
+  EXPECT_EQ(f.distance({3, -4, 2}), 4);
+  o.metric = Metric::kEuclidean;
+  f = compute_distance_field(w, o);
+  EXPECT_FLOAT_EQ(static_cast<float>(f.distance({3, 4, 0})), 5.0f);
+  EXPECT_FLOAT_EQ(static_cast<float>(f.distance({1, 1, 1})), std::sqrt(3.0f));
+  // Fixed point rounds down: sqrt(2) * 4 = 5.66 -> 5 -> 1.25 voxels, never above the truth.
+  o.storage = Storage::kU8;
+  f = compute_distance_field(w, o);
+  EXPECT_EQ(std::get<Grid<std::uint8_t>>(f.values).get({1, 1, 0}), 5);
+  EXPECT_EQ(f.distance({1, 1, 0}), 1.25);
+  // Signed: a 3x3x3 solid cube; its centre is 2 from the nearest air voxel.
+  World cube(8, Box3i{{-4, -4, -4}, {5, 5, 5}});
+  cube.voxels.fill({{-1, -1, -1}, {2, 2, 2}}, 2);
+  DistanceOptions s;
+  s.signed_distance = true;
+  s.metric = Metric::kEuclidean;
+  s.nearest_sites = true;
+  const DistanceField c = compute_distance_field(cube, s);
+  EXPECT_EQ(c.distance({0, 0, 0}), -2);
+  EXPECT_EQ(c.distance({1, 1, 1}), -1);
+  EXPECT_EQ(c.distance({2, 0, 0}), 1);
+  EXPECT_FLOAT_EQ(static_cast<float>(c.distance({2, 2, 2})), std::sqrt(3.0f));
+  // Ties: the centre's nearest air voxels are the six face neighbours at distance 2; the rule
+  // picks the smallest y first: (0, -2, 0).
+  EXPECT_EQ(c.sites->get({0, 0, 0}), (SiteOffset{0, -2, 0}));
+  // Signed integer storage is offset binary: 128 is the surface.
+  s.storage = Storage::kU8;
+  s.metric = Metric::kManhattan;
+  const DistanceField ci = compute_distance_field(cube, s);
+  EXPECT_EQ(std::get<Grid<std::uint8_t>>(ci.values).get({0, 0, 0}), 128 - 2);
+  EXPECT_EQ(std::get<Grid<std::uint8_t>>(ci.values).get({3, 0, 0}), 128 + 2);
+}
+
+TEST(ExactDistance, RejectsBadOptions) {
+  World w;
+  w.voxels.set({0, 0, 0}, 1);
+  DistanceOptions o;
+  o.max_distance = -1;
+  EXPECT_THROW(compute_distance_field(w, o), InvalidArgument);
+  o = {};
+  o.spacing = {1, 0, 1};
+  o.metric = Metric::kEuclidean;
+  EXPECT_THROW(compute_distance_field(w, o), InvalidArgument);
+  o.spacing = {1, 2, 1};
+  o.metric = Metric::kManhattan;
+  EXPECT_THROW(compute_distance_field(w, o), InvalidArgument);
+  o = {};
+  o.metric = Metric::kEuclidean;
+  o.storage = Storage::kU8;
+  o.spacing = {1, 1, 0.01};  // g along z would overflow u8 before reaching the clamp
+  EXPECT_THROW(compute_distance_field(w, o), InvalidArgument);
+  o = {};
+  o.nearest_sites = true;
+  o.domain = Box3i{{0, 0, 0}, {40000, 1, 1}};
+  EXPECT_THROW(compute_distance_field(w, o), InvalidArgument);
+  EXPECT_THROW(parse_metric("taxicab"), InvalidArgument);
+}
