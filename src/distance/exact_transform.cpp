@@ -124,109 +124,201 @@ struct Plan {
   Box3i aligned; // A: chunks covering B
 };
 
-// Pass A on one chunk column (cx, cy) of the domain: for rows y in the domain, sweep z down and up.
+// Pass A on one chunk column (cx, cy) of the domain: for rows y in the domain, sweep z up and down
+// over `edge` lanes along x at once. The column of a row (Z x edge values) lives in `col`, a
+// thread-local buffer small enough for the cache, so each output voxel is written exactly once.
 // U: the unsigned integer the output storage holds g in; g >= cap is stored as kInf ("none").
-template <class U>
+template <class U, bool kSigned>
 void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, ChunkedVolume<SiteOffset>* sites,
-            int cx, int cy, std::uint32_t cap) {
+            int cx, int cy, std::uint32_t cap, std::vector<std::uint32_t>& col) {
   constexpr U kInf = std::numeric_limits<U>::max();
   const int e = g.edge;
   const int y0 = std::max(p.domain.begin.y, g.box.begin.y + cy * e);
   const int y1 = std::min(p.domain.end.y, g.box.begin.y + (cy + 1) * e);
   const int z0 = p.domain.begin.z, z1 = p.domain.end.z;
+  col.resize(static_cast<std::size_t>(z1 - z0) * e);
   std::uint32_t ds[128], da[128];
   std::int32_t ls[128], la[128];  // z of the last solid / air site seen (sites only)
   for (int y = y0; y < y1; ++y) {
     // Forward (increasing z): distance to the nearest site at or below.
     std::fill(ds, ds + e, cap);
     std::fill(da, da + e, cap);
+    for (int z = z0; z < z1; ++z) {
+      const std::uint8_t* w = world.row(cx, y, z);
+      std::uint32_t* c = col.data() + static_cast<std::size_t>(z - z0) * e;
+      for (int i = 0; i < e; ++i) {
+        const bool solid = w[i] != 0;
+        ds[i] = solid ? 0u : std::min(ds[i] + 1u, cap);
+        if constexpr (kSigned) {
+          da[i] = solid ? std::min(da[i] + 1u, cap) : 0u;
+          c[i] = solid ? da[i] : ds[i];
+        } else {
+          c[i] = ds[i];
+        }
+      }
+    }
+    // Backward (decreasing z): keep the smaller, and store once.
+    std::fill(ds, ds + e, cap);
+    std::fill(da, da + e, cap);
+    for (int z = z1 - 1; z >= z0; --z) {
+      const std::uint8_t* w = world.row(cx, y, z);
+      const std::uint32_t* c = col.data() + static_cast<std::size_t>(z - z0) * e;
+      U* out = g.row(cx, y, z);
+      for (int i = 0; i < e; ++i) {
+        const bool solid = w[i] != 0;
+        ds[i] = solid ? 0u : std::min(ds[i] + 1u, cap);
+        std::uint32_t v;
+        if constexpr (kSigned) {
+          da[i] = solid ? std::min(da[i] + 1u, cap) : 0u;
+          v = std::min(c[i], solid ? da[i] : ds[i]);
+        } else {
+          v = std::min(c[i], ds[i]);
+        }
+        out[i] = v >= cap ? kInf : static_cast<U>(v);
+      }
+    }
+    if (!sites) continue;
+    // Nearest site along z: below (found by the upward sweep) wins ties.
     std::fill(ls, ls + e, INT32_MIN / 2);
     std::fill(la, la + e, INT32_MIN / 2);
     for (int z = z0; z < z1; ++z) {
       const std::uint8_t* w = world.row(cx, y, z);
-      U* out = g.row(cx, y, z);
+      SiteOffset* so = sites->row(cx, y, z);
       for (int i = 0; i < e; ++i) {
         const bool solid = w[i] != 0;
-        ds[i] = solid ? 0u : std::min(ds[i] + 1u, cap);
-        da[i] = solid ? std::min(da[i] + 1u, cap) : 0u;
-        const std::uint32_t v = (p.is_signed && solid) ? da[i] : ds[i];
-        out[i] = v >= cap ? kInf : static_cast<U>(v);
-      }
-      if (sites) {
-        SiteOffset* so = sites->row(cx, y, z);
-        for (int i = 0; i < e; ++i) {
-          const bool solid = w[i] != 0;
-          if (solid) ls[i] = z; else la[i] = z;
-          so[i].dz = static_cast<std::int16_t>(std::clamp((p.is_signed && solid ? la[i] : ls[i]) - z, -32768, 32767));
-        }
+        if (solid) ls[i] = z; else la[i] = z;
+        so[i].dz = static_cast<std::int16_t>(std::clamp((kSigned && solid ? la[i] : ls[i]) - z, -32768, 32767));
       }
     }
-    // Backward (decreasing z): keep the smaller; on a tie the site below (found first) stays.
-    std::fill(ds, ds + e, cap);
-    std::fill(da, da + e, cap);
     std::fill(ls, ls + e, INT32_MAX / 2);
     std::fill(la, la + e, INT32_MAX / 2);
     for (int z = z1 - 1; z >= z0; --z) {
       const std::uint8_t* w = world.row(cx, y, z);
-      U* out = g.row(cx, y, z);
+      SiteOffset* so = sites->row(cx, y, z);
       for (int i = 0; i < e; ++i) {
         const bool solid = w[i] != 0;
-        ds[i] = solid ? 0u : std::min(ds[i] + 1u, cap);
-        da[i] = solid ? std::min(da[i] + 1u, cap) : 0u;
-        const std::uint32_t v = (p.is_signed && solid) ? da[i] : ds[i];
-        const U stored = v >= cap ? kInf : static_cast<U>(v);
-        out[i] = std::min(out[i], stored);
-      }
-      if (sites) {
-        SiteOffset* so = sites->row(cx, y, z);
-        for (int i = 0; i < e; ++i) {
-          const bool solid = w[i] != 0;
-          if (solid) ls[i] = z; else la[i] = z;
-          const std::int32_t above = (p.is_signed && solid ? la[i] : ls[i]) - z;  // >= 0
-          const std::int32_t below = -static_cast<std::int32_t>(so[i].dz);        // >= 0 when found
-          if (above < below) so[i].dz = static_cast<std::int16_t>(std::min(above, 32767));
-        }
+        if (solid) ls[i] = z; else la[i] = z;
+        const std::int32_t above = (kSigned && solid ? la[i] : ls[i]) - z;  // >= 0
+        const std::int32_t below = -static_cast<std::int32_t>(so[i].dz);    // >= 0 when found
+        if (above < below) so[i].dz = static_cast<std::int16_t>(std::min(above, 32767));
       }
     }
   }
 }
 
-// Per-thread buffers for one slice.
+// Per-thread buffers for one slice. Results (h, arg_x, arg_y) end up row-major: index y*X + x.
+// Arrays are left uninitialised: every element is written before it is read.
+template <class A>
+struct Scratch {
+  std::unique_ptr<A[]> p;
+  void resize(std::size_t n) { p.reset(new A[n]); }
+  A* data() { return p.get(); }
+  const A* data() const { return p.get(); }
+  A& operator[](std::size_t i) { return p[i]; }
+  const A& operator[](std::size_t i) const { return p[i]; }
+};
+
 template <class V>
 struct SliceBuffers {
-  std::vector<V> f, h, ht, hc;
-  std::vector<std::int32_t> argb, argc, s, t;
+  Scratch<V> f, h, tmp;
+  Scratch<std::int32_t> arg_x, arg_y, targ, s, t;
   void resize(int X, int Y) {
     const std::size_t n = static_cast<std::size_t>(X) * Y;
     f.resize(n);
     h.resize(n);
-    ht.resize(n);
-    hc.resize(n);
-    argb.resize(n);
-    argc.resize(n);
+    tmp.resize(n);
+    arg_x.resize(n);
+    arg_y.resize(n);
+    targ.resize(n);
     s.resize(static_cast<std::size_t>(std::max(X, Y)));
     t.resize(static_cast<std::size_t>(std::max(X, Y)));
   }
 };
 
-// Solves the 2-D problem of one slice: f (X*Y, x fastest) -> hc (transposed: y fastest) and the
-// minimising (x', y') per voxel through argb / argc.
-template <class Kernel, class V>
-void solve_slice(const Kernel& kx, const Kernel& ky, int X, int Y, SliceBuffers<V>& b) {
-  for (int y = 0; y < Y; ++y) {
-    const std::size_t o = static_cast<std::size_t>(y) * X;
-    kx(X, b.f.data() + o, b.h.data() + o, b.argb.data() + o, b.s.data(), b.t.data());
-  }
-  // Transpose so that pass C also runs on contiguous lines (blocked for the cache).
+// Blocked transpose of an X-by-Y row-major array (index y*X + x) into Y-by-X (index x*Y + y).
+template <class A>
+void transpose(const A* in, A* out, int X, int Y) {
   constexpr int kBlock = 32;
   for (int y0 = 0; y0 < Y; y0 += kBlock)
     for (int x0 = 0; x0 < X; x0 += kBlock)
       for (int y = y0; y < std::min(Y, y0 + kBlock); ++y)
         for (int x = x0; x < std::min(X, x0 + kBlock); ++x)
-          b.ht[static_cast<std::size_t>(x) * Y + y] = b.h[static_cast<std::size_t>(y) * X + x];
+          out[static_cast<std::size_t>(x) * Y + y] = in[static_cast<std::size_t>(y) * X + x];
+}
+
+// 2-D solve of one slice with an envelope kernel (Chebyshev, Euclidean): pass B along x on rows,
+// transpose, pass C along y on rows, transpose back.
+template <class Kernel, class V>
+void solve_slice_envelope(const Kernel& kx, const Kernel& ky, int X, int Y, SliceBuffers<V>& b) {
+  for (int y = 0; y < Y; ++y) {
+    const std::size_t o = static_cast<std::size_t>(y) * X;
+    kx(X, b.f.data() + o, b.h.data() + o, b.arg_x.data() + o, b.s.data(), b.t.data());
+  }
+  transpose(b.h.data(), b.tmp.data(), X, Y);
   for (int x = 0; x < X; ++x) {
     const std::size_t o = static_cast<std::size_t>(x) * Y;
-    ky(Y, b.ht.data() + o, b.hc.data() + o, b.argc.data() + o, b.s.data(), b.t.data());
+    ky(Y, b.tmp.data() + o, b.f.data() + o, b.targ.data() + o, b.s.data(), b.t.data());
+  }
+  transpose(b.f.data(), b.h.data(), Y, X);
+  transpose(b.targ.data(), b.arg_y.data(), Y, X);
+}
+
+// 2-D solve of one slice for Manhattan: min-plus sweeps along x per row, then along y across whole
+// rows at once (contiguous, vectorisable). Ties keep the smaller index, as the envelope does.
+inline void solve_slice_manhattan(int X, int Y, SliceBuffers<std::int32_t>& b, bool track_sites) {
+  constexpr std::int32_t kInf = detail::kManhattanInf;
+  std::int32_t* h = b.h.data();
+  for (int y = 0; y < Y; ++y) {
+    const std::size_t o = static_cast<std::size_t>(y) * X;
+    if (track_sites) {
+      detail::manhattan_1d(X, b.f.data() + o, h + o, b.arg_x.data() + o);
+    } else {
+      const std::int32_t* f = b.f.data() + o;
+      std::int32_t* r = h + o;
+      std::int32_t best = kInf;
+      for (int x = 0; x < X; ++x) r[x] = best = std::min(f[x], std::min(best + 1, kInf));
+      for (int x = X - 2; x >= 0; --x) r[x] = std::min(r[x], r[x + 1] + 1);
+    }
+  }
+  std::int32_t* ay = b.arg_y.data();
+  if (track_sites) {
+    for (int y = 0; y < Y; ++y)
+      for (int x = 0; x < X; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * X + x;
+        ay[i] = h[i] < kInf ? y : -1;
+      }
+  }
+  for (int y = 1; y < Y; ++y) {
+    std::int32_t* r = h + static_cast<std::size_t>(y) * X;
+    const std::int32_t* prev = r - X;
+    if (track_sites) {
+      std::int32_t* a = ay + static_cast<std::size_t>(y) * X;
+      const std::int32_t* pa = a - X;
+      for (int x = 0; x < X; ++x) {
+        if (pa[x] >= 0 && prev[x] + 1 <= r[x]) {
+          r[x] = prev[x] + 1;
+          a[x] = pa[x];
+        }
+      }
+    } else {
+      for (int x = 0; x < X; ++x) r[x] = std::min(r[x], std::min(prev[x] + 1, kInf));
+    }
+  }
+  for (int y = Y - 2; y >= 0; --y) {
+    std::int32_t* r = h + static_cast<std::size_t>(y) * X;
+    const std::int32_t* next = r + X;
+    if (track_sites) {
+      std::int32_t* a = ay + static_cast<std::size_t>(y) * X;
+      const std::int32_t* na = a + X;
+      for (int x = 0; x < X; ++x) {
+        if (na[x] >= 0 && next[x] + 1 < r[x]) {
+          r[x] = next[x] + 1;
+          a[x] = na[x];
+        }
+      }
+    } else {
+      for (int x = 0; x < X; ++x) r[x] = std::min(r[x], std::min(next[x] + 1, kInf));
+    }
   }
 }
 
@@ -278,61 +370,101 @@ struct Encoder {
   }
 };
 
-template <class T, class U, class V, class Kernel>
+// Calls fn(cx, local_x0, count, x_offset) for the pieces of the domain row that fall in each chunk
+// column: local_x0 is the first voxel within the chunk row, x_offset its index within the domain.
+template <class Fn>
+void for_each_row_segment(const Plan& p, int edge, int shift, Fn&& fn) {
+  const int bx = p.domain.begin.x, ex = p.domain.end.x, ax = p.aligned.begin.x;
+  for (int cx = (bx - ax) >> shift; cx <= (ex - 1 - ax) >> shift; ++cx) {
+    const int c0 = ax + (cx << shift);
+    const int x0 = std::max(bx, c0), x1 = std::min(ex, c0 + edge);
+    fn(cx, x0 - c0, x1 - x0, x0 - bx);
+  }
+}
+
+template <class T, class U, class V, class Solve>
 void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
-                 ChunkedVolume<SiteOffset>* sites, const Kernel& kx, const Kernel& ky,
-                 const Encoder<T>& encoder, std::uint32_t cap, V inf) {
+                 ChunkedVolume<SiteOffset>* sites, const Solve& solve, const Encoder<T>& encoder,
+                 std::uint32_t cap, V inf) {
   constexpr U kInfU = std::numeric_limits<U>::max();
   const int X = p.domain.size().x, Y = p.domain.size().y;
-  const int bx = p.domain.begin.x, by = p.domain.begin.y;
+  const int by = p.domain.begin.y;
   const double sz = p.spacing[2];
   const double clamp_cost = p.metric == Metric::kEuclidean ? p.clamp * p.clamp : p.clamp;
-  // g (voxels along z) -> the cost the 2-D passes minimise.
-  auto cost_of = [&](U stored) -> V {
-    if (stored == kInfU || stored >= cap) return inf;
-    if (p.metric == Metric::kEuclidean) {
-      const double c = p.unit_spacing ? static_cast<double>(stored) * stored : (sz * stored) * (sz * stored);
-      return c > clamp_cost ? inf : static_cast<V>(c);
-    }
-    return static_cast<V>(stored);
-  };
+  const V clamp_v = clamp_cost >= static_cast<double>(inf) ? inf : static_cast<V>(clamp_cost);
+  const bool euclid = p.metric == Metric::kEuclidean;
+  const U cap_u = static_cast<U>(std::min<std::uint64_t>(cap, kInfU));
   const int passes = p.is_signed ? 2 : 1;
-  parallel_for(static_cast<std::size_t>(p.domain.size().z), 1, [&](std::size_t zb, std::size_t ze) {
+  // Ranges of several slices each, so that the buffers are allocated a few times per thread only.
+  const std::size_t Z = static_cast<std::size_t>(p.domain.size().z);
+  const std::size_t grain = std::max<std::size_t>(1, Z / (4 * static_cast<std::size_t>(max_threads())));
+  parallel_for(Z, grain, [&](std::size_t zb, std::size_t ze) {
     SliceBuffers<V> buf[2];
     std::vector<std::uint8_t> solid(static_cast<std::size_t>(X) * Y);
     std::vector<std::int16_t> dz(sites ? static_cast<std::size_t>(X) * Y : 0);
-    for (auto& b : buf) b.resize(X, Y);
+    for (int k = 0; k < passes; ++k) buf[k].resize(X, Y);
     for (std::size_t zi = zb; zi < ze; ++zi) {
       const int z = p.domain.begin.z + static_cast<int>(zi);
-      // Gather the slice.
-      for (int y = 0; y < Y; ++y)
-        for (int x = 0; x < X; ++x) {
-          const std::size_t i = static_cast<std::size_t>(y) * X + x;
-          const U stored = g.at(bx + x, by + y, z);
-          const bool s = world.solid(bx + x, by + y, z);
-          solid[i] = s;
-          const V c = cost_of(stored);
-          buf[0].f[i] = (p.is_signed && s) ? V(0) : c;  // distance to solid
-          if (p.is_signed) buf[1].f[i] = s ? c : V(0);  // distance to air
-          if (sites) dz[i] = sites->at(bx + x, by + y, z).dz;
-        }
-      for (int k = 0; k < passes; ++k) solve_slice(kx, ky, X, Y, buf[k]);
-      // Write the final values back into the same slice.
-      for (int y = 0; y < Y; ++y)
-        for (int x = 0; x < X; ++x) {
-          const std::size_t i = static_cast<std::size_t>(y) * X + x;
-          const bool inside = p.is_signed && solid[i];
-          const SliceBuffers<V>& b = buf[inside ? 1 : 0];
-          const std::size_t ti = static_cast<std::size_t>(x) * Y + y;  // transposed index
-          const V cost = b.hc[ti];
-          const std::int32_t ys = b.argc[ti];
-          const bool has_site = ys >= 0 && cost < inf && static_cast<double>(cost) <= clamp_cost;
-          const T value = encoder.encode(static_cast<double>(cost), has_site, inside);
-          std::memcpy(&g.at(bx + x, by + y, z), &value, sizeof(T));  // T and U have the same size
+      // Gather the slice: g -> the cost the 2-D passes minimise.
+      for (int y = 0; y < Y; ++y) {
+        for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
+          const U* gs = g.row(cx, by + y, z) + lx;
+          const std::uint8_t* ws = world.row(cx, by + y, z) + lx;
+          const std::size_t o = static_cast<std::size_t>(y) * X + xo;
+          V* f0 = buf[0].f.data() + o;
+          for (int i = 0; i < count; ++i) {
+            V c;
+            if (euclid) {
+              const double gz = p.unit_spacing ? static_cast<double>(gs[i]) : sz * gs[i];
+              c = gs[i] >= cap_u ? inf : static_cast<V>(gz * gz);
+              c = c > clamp_v ? inf : c;
+            } else {
+              c = gs[i] >= cap_u ? inf : static_cast<V>(gs[i]);
+            }
+            f0[i] = c;
+          }
+          if (p.is_signed) {
+            V* f1 = buf[1].f.data() + o;
+            std::uint8_t* so = solid.data() + o;
+            for (int i = 0; i < count; ++i) {
+              const bool s = ws[i] != 0;
+              so[i] = s;
+              f1[i] = s ? f0[i] : V(0);  // distance to air
+              f0[i] = s ? V(0) : f0[i];  // distance to solid
+            }
+          } else if (sites) {
+            std::uint8_t* so = solid.data() + o;
+            for (int i = 0; i < count; ++i) so[i] = ws[i] != 0;
+          }
           if (sites) {
+            const SiteOffset* ss = sites->row(cx, by + y, z) + lx;
+            for (int i = 0; i < count; ++i) dz[o + i] = ss[i].dz;
+          }
+        });
+      }
+      for (int k = 0; k < passes; ++k) solve(X, Y, buf[k]);
+      // Encode and write the final values back into the same slice.
+      for (int y = 0; y < Y; ++y) {
+        for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
+          T* out = reinterpret_cast<T*>(g.row(cx, by + y, z)) + lx;  // T and U have the same size
+          const std::size_t o = static_cast<std::size_t>(y) * X + xo;
+          for (int i = 0; i < count; ++i) {
+            const bool inside = p.is_signed && solid[o + i];
+            const V cost = buf[inside ? 1 : 0].h[o + i];
+            const bool has_site = cost < inf && cost <= clamp_v;
+            out[i] = encoder.encode(static_cast<double>(cost), has_site, inside);
+          }
+          if (!sites) return;
+          SiteOffset* so_out = sites->row(cx, by + y, z) + lx;
+          for (int i = 0; i < count; ++i) {
+            const int x = xo + i;
+            const bool inside = p.is_signed && solid[o + i];
+            const SliceBuffers<V>& b = buf[inside ? 1 : 0];
+            const V cost = b.h[o + i];
             SiteOffset so;
-            if (has_site) {
-              const std::int32_t xs = b.argb[static_cast<std::size_t>(ys) * X + x];
+            if (cost < inf && cost <= clamp_v) {
+              const std::int32_t ys = b.arg_y[o + i];
+              const std::int32_t xs = b.arg_x[static_cast<std::size_t>(ys) * X + x];
               so.dx = static_cast<std::int16_t>(xs - x);
               so.dy = static_cast<std::int16_t>(ys - y);
               // A column voxel that is itself a site of this transform (solid for the distance to
@@ -341,9 +473,10 @@ void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
               const bool column_is_site = p.is_signed ? (solid[col] != 0) != inside : solid[col] != 0;
               so.dz = column_is_site ? std::int16_t{0} : dz[col];
             }
-            sites->at(bx + x, by + y, z) = so;
+            so_out[i] = so;
           }
-        }
+        });
+      }
     }
   });
 }
@@ -399,8 +532,15 @@ DistanceField run(const Grid<std::uint8_t>& occupancy, const DistanceOptions& op
   // Pass A.
   const int ncx = g.nchunks.x, ncy = g.nchunks.y;
   parallel_for(static_cast<std::size_t>(ncx) * ncy, 1, [&](std::size_t b, std::size_t e) {
+    std::vector<std::uint32_t> col;
+    ChunkedVolume<SiteOffset>* sp = sites ? &*sites : nullptr;
     for (std::size_t i = b; i < e; ++i) {
-      pass_z<U>(p, world, g, sites ? &*sites : nullptr, static_cast<int>(i % ncx), static_cast<int>(i / ncx), cap32);
+      const int cx = static_cast<int>(i % ncx), cy = static_cast<int>(i / ncx);
+      if (p.is_signed) {
+        pass_z<U, true>(p, world, g, sp, cx, cy, cap32, col);
+      } else {
+        pass_z<U, false>(p, world, g, sp, cx, cy, cap32, col);
+      }
     }
   });
 
@@ -409,30 +549,32 @@ DistanceField run(const Grid<std::uint8_t>& occupancy, const DistanceOptions& op
   const Encoder<T> encoder{p, enc, none_value};
   ChunkedVolume<SiteOffset>* sp = sites ? &*sites : nullptr;
   if (p.metric == Metric::kManhattan) {
-    auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t*, std::int32_t*) {
-      detail::manhattan_1d(n, f, o, a);
-    };
-    pass_slices<T, U, std::int32_t>(p, world, g, sp, k, k, encoder, cap32, detail::kManhattanInf);
+    const bool track = p.sites;
+    auto solve = [track](int X, int Y, SliceBuffers<std::int32_t>& b) { solve_slice_manhattan(X, Y, b, track); };
+    pass_slices<T, U, std::int32_t>(p, world, g, sp, solve, encoder, cap32, detail::kManhattanInf);
   } else if (p.metric == Metric::kChebyshev) {
     auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(Chebyshev{}, n, f, o, a, s, t);
     };
-    pass_slices<T, U, std::int32_t>(p, world, g, sp, k, k, encoder, cap32, Chebyshev::kInf);
+    auto solve = [k](int X, int Y, SliceBuffers<std::int32_t>& b) { solve_slice_envelope(k, k, X, Y, b); };
+    pass_slices<T, U, std::int32_t>(p, world, g, sp, solve, encoder, cap32, Chebyshev::kInf);
   } else if (p.unit_spacing) {
     auto k = [](int n, const std::int64_t* f, std::int64_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(EuclideanInt{}, n, f, o, a, s, t);
     };
-    pass_slices<T, U, std::int64_t>(p, world, g, sp, k, k, encoder, cap32, EuclideanInt::kInf);
+    auto solve = [k](int X, int Y, SliceBuffers<std::int64_t>& b) { solve_slice_envelope(k, k, X, Y, b); };
+    pass_slices<T, U, std::int64_t>(p, world, g, sp, solve, encoder, cap32, EuclideanInt::kInf);
   } else {
     const EuclideanReal ex{p.spacing[0] * p.spacing[0]}, ey{p.spacing[1] * p.spacing[1]};
-    auto kx = [ex](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
+    using K = std::function<void(int, const double*, double*, std::int32_t*, std::int32_t*, std::int32_t*)>;
+    const K kx = [ex](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(ex, n, f, o, a, s, t);
     };
-    auto ky = [ey](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
+    const K ky = [ey](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(ey, n, f, o, a, s, t);
     };
-    using K = std::function<void(int, const double*, double*, std::int32_t*, std::int32_t*, std::int32_t*)>;
-    pass_slices<T, U, double, K>(p, world, g, sp, K(kx), K(ky), encoder, cap32, EuclideanReal::kInf);
+    auto solve = [&](int X, int Y, SliceBuffers<double>& b) { solve_slice_envelope(kx, ky, X, Y, b); };
+    pass_slices<T, U, double>(p, world, g, sp, solve, encoder, cap32, EuclideanReal::kInf);
   }
 
   // Hand the chunks to the grids (uniform ones collapse).
