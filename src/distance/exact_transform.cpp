@@ -24,6 +24,7 @@
 #include <functional>
 #include <type_traits>
 
+#include "field_plan.h"
 #include "line_transforms.h"
 #include "voxfield/distance.h"
 #include "voxfield/parallel.h"
@@ -112,17 +113,7 @@ class SolidRows {
   std::uint8_t zeros_[128], ones_[128];
 };
 
-// What the passes need to know, resolved once from the options.
-struct Plan {
-  Metric metric;
-  bool is_signed;
-  bool sites;
-  bool unit_spacing;
-  std::array<double, 3> spacing;
-  double clamp;  // D in distance units, or +inf
-  Box3i domain;  // B
-  Box3i aligned; // A: chunks covering B
-};
+using Plan = detail::FieldPlan;
 
 // Pass A on one chunk column (cx, cy) of the domain: for rows y in the domain, sweep z up and down
 // over `edge` lanes along x at once. The column of a row (Z x edge values) lives in `col`, a
@@ -638,7 +629,9 @@ DistanceField compute_distance_field(const World& world, const DistanceOptions& 
   return compute_distance_field(world.voxels, options);
 }
 
-DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o) {
+namespace detail {
+
+FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o) {
   if (!(o.max_distance >= 0) || std::isinf(o.max_distance)) {
     throw InvalidArgument("max distance must be a finite number >= 0 (0 = no clamp)");
   }
@@ -651,7 +644,7 @@ DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy, const 
   if (o.fixed_point_scale < 0 || !std::isfinite(o.fixed_point_scale)) {
     throw InvalidArgument("fixed-point scale must be >= 0");
   }
-  Plan p;
+  FieldPlan p;
   p.metric = o.metric;
   p.is_signed = o.signed_distance;
   p.sites = o.nearest_sites;
@@ -660,17 +653,16 @@ DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy, const 
   p.clamp = o.max_distance > 0 ? o.max_distance : std::numeric_limits<double>::infinity();
 
   // Encoding.
-  DistanceEncoding enc;
   if (o.storage != Storage::kF32) {
     const int bits = o.storage == Storage::kU8 ? 8 : 16;
-    enc.scale = o.metric != Metric::kEuclidean ? 1.0
-                : o.fixed_point_scale > 0      ? o.fixed_point_scale
-                                               : (bits == 8 ? 4.0 : 16.0);
-    enc.bias = o.signed_distance ? (std::int64_t{1} << (bits - 1)) : 0;
+    p.encoding.scale = o.metric != Metric::kEuclidean ? 1.0
+                       : o.fixed_point_scale > 0      ? o.fixed_point_scale
+                                                      : (bits == 8 ? 4.0 : 16.0);
+    p.encoding.bias = o.signed_distance ? (std::int64_t{1} << (bits - 1)) : 0;
     // Integer storage cannot hold more than its range: that range acts as a clamp.
     const double type_max = static_cast<double>((std::int64_t{1} << bits) - 1);
-    const double range = (type_max - static_cast<double>(enc.bias)) / enc.scale;
-    if (!std::isfinite(p.clamp) || p.clamp > range) p.clamp = std::isfinite(p.clamp) ? std::min(p.clamp, range) : range;
+    const double range = (type_max - static_cast<double>(p.encoding.bias)) / p.encoding.scale;
+    p.clamp = std::min(p.clamp, range);
     // g is held in place in the output type: it must reach past the clamp along z.
     if (type_max * o.spacing[2] < p.clamp) {
       throw InvalidArgument("voxel spacing " + std::to_string(o.spacing[2]) + " along z is too fine for " +
@@ -697,18 +689,20 @@ DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy, const 
     }
     p.aligned = chunk_aligned(p.domain, occupancy.chunk_shift());
   }
+  return p;
+}
 
+}  // namespace detail
+
+DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o) {
+  const Plan p = detail::make_field_plan(occupancy, o);
   switch (o.storage) {
-    case Storage::kU8: {
-      const auto bg = static_cast<std::uint8_t>(std::min(255.0, std::floor(std::min(p.clamp, 1e300) * enc.scale) + static_cast<double>(enc.bias)));
-      return run<std::uint8_t, std::uint8_t>(occupancy, o, p, enc, bg);
-    }
-    case Storage::kU16: {
-      const auto bg = static_cast<std::uint16_t>(std::min(65535.0, std::floor(std::min(p.clamp, 1e300) * enc.scale) + static_cast<double>(enc.bias)));
-      return run<std::uint16_t, std::uint16_t>(occupancy, o, p, enc, bg);
-    }
+    case Storage::kU8:
+      return run<std::uint8_t, std::uint8_t>(occupancy, o, p, p.encoding, detail::field_background<std::uint8_t>(p));
+    case Storage::kU16:
+      return run<std::uint16_t, std::uint16_t>(occupancy, o, p, p.encoding, detail::field_background<std::uint16_t>(p));
     case Storage::kF32:
-      return run<float, std::uint32_t>(occupancy, o, p, enc, static_cast<float>(p.clamp));
+      return run<float, std::uint32_t>(occupancy, o, p, p.encoding, detail::field_background<float>(p));
   }
   throw InvalidArgument("unknown storage");
 }
