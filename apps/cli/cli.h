@@ -24,6 +24,8 @@ void add_info(CLI::App& app, Action& action);
 void add_convert(CLI::App& app, Action& action);
 void add_generate(CLI::App& app, Action& action);
 void add_showcase(CLI::App& app, Action& action);
+void add_field(CLI::App& app, Action& action);
+void add_compare(CLI::App& app, Action& action);
 
 // A world read from any supported file, with what the file said about itself.
 struct LoadedWorld {

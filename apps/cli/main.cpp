@@ -11,6 +11,8 @@ int main(int argc, char** argv) {
   voxfield::cli::Action action;
   voxfield::cli::add_info(app, action);
   voxfield::cli::add_convert(app, action);
+  voxfield::cli::add_field(app, action);
+  voxfield::cli::add_compare(app, action);
   voxfield::cli::add_generate(app, action);
   voxfield::cli::add_showcase(app, action);
   try {

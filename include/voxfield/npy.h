@@ -28,6 +28,10 @@ struct NpyVolume {
   DType dtype = DType::kUInt8;
   Vec3i dims;
   std::vector<std::uint8_t> bytes;
+  // Values per voxel. Above 1 the array is 4-D, a[x, y, z, c], stored with the component slowest
+  // (Fortran order): bytes hold `components` whole volumes one after another. Written only;
+  // parse_npy reads 3-D volumes.
+  int components = 1;
 
   std::int64_t count() const { return Box3i::from_size(dims).volume(); }
   // Value i (x fastest) converted to double, whatever the dtype.
@@ -44,7 +48,7 @@ void write_npy(const NpyVolume& volume, const std::filesystem::path& path);
 template <class T>
 NpyVolume make_npy(DType dtype, Vec3i dims, const T* values) {
   if (sizeof(T) != dtype_size(dtype)) throw InvalidArgument("make_npy: element size does not match dtype");
-  NpyVolume v{dtype, dims, {}};
+  NpyVolume v{dtype, dims, {}, 1};
   v.bytes.resize(static_cast<std::size_t>(v.count()) * sizeof(T));
   std::memcpy(v.bytes.data(), values, v.bytes.size());
   return v;

@@ -261,14 +261,17 @@ NpyVolume read_npy(const std::filesystem::path& path) {
 
 std::vector<std::uint8_t> encode_npy(const NpyVolume& v) {
   const DTypeInfo& d = info(v.dtype);
-  if (v.bytes.size() != static_cast<std::size_t>(v.count()) * static_cast<std::size_t>(d.size)) {
+  if (v.components < 1) throw InvalidArgument("encode_npy: components must be >= 1");
+  const std::size_t expect = static_cast<std::size_t>(v.count()) * static_cast<std::size_t>(v.components) *
+                             static_cast<std::size_t>(d.size);
+  if (v.bytes.size() != expect) {
     throw InvalidArgument("encode_npy: volume holds " + std::to_string(v.bytes.size()) +
-                          " bytes, expected " + std::to_string(v.count() * d.size));
+                          " bytes, expected " + std::to_string(expect));
   }
   const std::string descr = std::string(d.size == 1 ? "|" : "<") + d.kind + std::to_string(d.size);
-  std::string header = "{'descr': '" + descr + "', 'fortran_order': True, 'shape': (" +
-                       std::to_string(v.dims.x) + ", " + std::to_string(v.dims.y) + ", " +
-                       std::to_string(v.dims.z) + "), }";
+  std::string shape = std::to_string(v.dims.x) + ", " + std::to_string(v.dims.y) + ", " + std::to_string(v.dims.z);
+  if (v.components > 1) shape += ", " + std::to_string(v.components);
+  std::string header = "{'descr': '" + descr + "', 'fortran_order': True, 'shape': (" + shape + "), }";
   // Pad with spaces so that magic + version + length + header + '\n' is a multiple of 64.
   const bool v2 = header.size() + 11 > 65535;
   const std::size_t prefix = v2 ? 12 : 10;
@@ -314,7 +317,7 @@ World world_from_npy(const NpyVolume& v, const std::string& name, int chunk_edge
 
 NpyVolume npy_from_world(const World& world, const Box3i& box) {
   if (box.empty()) throw InvalidArgument("npy_from_world: empty box " + to_string(box));
-  NpyVolume v{DType::kUInt8, box.size(), {}};
+  NpyVolume v{DType::kUInt8, box.size(), {}, 1};
   v.bytes.resize(static_cast<std::size_t>(box.volume()));
   world.voxels.copy_to_dense(box, v.bytes.data());
   return v;

@@ -1,5 +1,6 @@
 // voxfield — brute force: every voxel scans every site. The dissertation's baseline (and the
 // definition of the exact transform); O(voxels x sites), so it refuses large inputs.
+#include <cstdio>
 #include <string>
 
 #include "dense_problem.h"
@@ -13,8 +14,10 @@ void brute_force(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stat
     if (p.site[i]) sites.push_back(static_cast<std::int32_t>(i));
   const double work = static_cast<double>(p.size()) * static_cast<double>(sites.size());
   if (work > max_work) {
-    throw InvalidArgument("brute force would need " + std::to_string(work) +
-                          " distance evaluations (limit " + std::to_string(max_work) + "); use a smaller input");
+    char text[160];
+    std::snprintf(text, sizeof text, "brute force would need %.3g distance evaluations (limit %.3g); use a smaller input",
+                  work, max_work);
+    throw InvalidArgument(text);
   }
   std::vector<Vec3i> site_xyz(sites.size());
   for (std::size_t k = 0; k < sites.size(); ++k) site_xyz[k] = p.coord(static_cast<std::size_t>(sites[k]));

@@ -9,6 +9,7 @@
 // real sites — never too small, sometimes too large where a better site was never offered.
 // Ping-pong buffers make every pass read only the previous one, like separate GPU dispatches.
 #include <algorithm>
+#include <tuple>
 
 #include "dense_problem.h"
 #include "voxfield/parallel.h"
@@ -16,35 +17,58 @@
 namespace voxfield::detail {
 namespace {
 
-void flood_pass(const DenseProblem& p, const std::vector<std::int32_t>& in, std::vector<std::int32_t>& out, int step) {
+// A voxel's current nearest site, as coordinates in the domain (x < 0: none). Coordinates rather
+// than indices keep the 27 candidate distances of a pass free of divisions.
+struct Site {
+  std::int16_t x = -1, y = -1, z = -1;
+};
+
+// Comparable distance of an offset: exact integers for unit spacing (squared for Euclidean).
+struct UnitCost {
+  Metric m;
+  std::int64_t operator()(int dx, int dy, int dz) const {
+    dx = std::abs(dx), dy = std::abs(dy), dz = std::abs(dz);
+    switch (m) {
+      case Metric::kManhattan: return dx + dy + dz;
+      case Metric::kChebyshev: return std::max({dx, dy, dz});
+      case Metric::kEuclidean: return std::int64_t{dx} * dx + std::int64_t{dy} * dy + std::int64_t{dz} * dz;
+    }
+    return 0;
+  }
+};
+
+struct SpacedCost {
+  const DenseProblem* p;
+  double operator()(int dx, int dy, int dz) const { return p->distance(dx, dy, dz); }
+};
+
+template <class Cost>
+void flood_pass(const DenseProblem& p, const Cost& cost, const std::vector<Site>& in, std::vector<Site>& out, int step) {
+  using C = decltype(cost(0, 0, 0));
   parallel_for(static_cast<std::size_t>(p.n.z) * p.n.y, 8, [&](std::size_t r0, std::size_t r1) {
     for (std::size_t r = r0; r < r1; ++r) {
       const int y = static_cast<int>(r % p.n.y), z = static_cast<int>(r / p.n.y);
       for (int x = 0; x < p.n.x; ++x) {
         const std::size_t i = p.index(x, y, z);
-        std::int32_t best = in[i];
-        double best_d = std::numeric_limits<double>::infinity();
-        if (best >= 0) {
-          const Vec3i s = p.coord(static_cast<std::size_t>(best));
-          best_d = p.distance(s.x - x, s.y - y, s.z - z);
-        }
+        Site best = in[i];
+        C best_c = best.x >= 0 ? cost(best.x - x, best.y - y, best.z - z) : std::numeric_limits<C>::max();
         for (int dz = -1; dz <= 1; ++dz) {
           const int qz = z + dz * step;
           if (qz < 0 || qz >= p.n.z) continue;
           for (int dy = -1; dy <= 1; ++dy) {
             const int qy = y + dy * step;
             if (qy < 0 || qy >= p.n.y) continue;
+            const std::size_t row = p.index(0, qy, qz);
             for (int dx = -1; dx <= 1; ++dx) {
               const int qx = x + dx * step;
-              if (qx < 0 || qx >= p.n.x || (dx == 0 && dy == 0 && dz == 0)) continue;
-              const std::int32_t cand = in[p.index(qx, qy, qz)];
-              if (cand < 0 || cand == best) continue;
-              const Vec3i s = p.coord(static_cast<std::size_t>(cand));
-              const double d = p.distance(s.x - x, s.y - y, s.z - z);
-              // Ties go to the smaller site index, so the result does not depend on scan order.
-              if (d < best_d || (d == best_d && cand < best)) {
-                best_d = d;
-                best = cand;
+              if (qx < 0 || qx >= p.n.x) continue;
+              const Site s = in[row + static_cast<std::size_t>(qx)];
+              if (s.x < 0) continue;
+              const C c = cost(s.x - x, s.y - y, s.z - z);
+              // Ties go to the smaller (z, y, x), so the result does not depend on scan order.
+              if (c < best_c || (c == best_c && std::tie(s.z, s.y, s.x) < std::tie(best.z, best.y, best.x))) {
+                best_c = c;
+                best = s;
               }
             }
           }
@@ -58,25 +82,45 @@ void flood_pass(const DenseProblem& p, const std::vector<std::int32_t>& in, std:
 }  // namespace
 
 void jump_flood(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats, const std::vector<int>& extra_steps) {
-  std::vector<std::int32_t> a(p.size()), b(p.size());
-  for (std::size_t i = 0; i < p.size(); ++i) a[i] = p.site[i] ? static_cast<std::int32_t>(i) : -1;
+  if (std::max({p.n.x, p.n.y, p.n.z}) > 32767) throw InvalidArgument("jump flooding supports domains up to 32767 voxels per axis");
+  std::vector<Site> a(p.size()), b(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!p.site[i]) continue;
+    const Vec3i c = p.coord(i);
+    a[i] = {static_cast<std::int16_t>(c.x), static_cast<std::int16_t>(c.y), static_cast<std::int16_t>(c.z)};
+  }
   const int largest = std::max({p.n.x, p.n.y, p.n.z});
   std::vector<int> steps;
   int step = 1;
   while (step * 2 < largest) step *= 2;
   for (; step >= 1; step /= 2) steps.push_back(step);
   steps.insert(steps.end(), extra_steps.begin(), extra_steps.end());
+  const bool unit = p.spacing == std::array<double, 3>{1, 1, 1};
   for (int k : steps) {
-    flood_pass(p, a, b, k);
+    if (unit) {
+      flood_pass(p, UnitCost{p.metric}, a, b, k);
+    } else {
+      flood_pass(p, SpacedCost{&p}, a, b, k);
+    }
     std::swap(a, b);
     ++stats.passes;
     stats.updates += static_cast<std::int64_t>(p.size()) * 27;
   }
   out.d.resize(p.size());
+  out.site.resize(p.size());
   parallel_for(p.size(), 4096, [&](std::size_t b0, std::size_t b1) {
-    for (std::size_t i = b0; i < b1; ++i) out.d[i] = a[i] >= 0 ? static_cast<float>(p.distance(i, static_cast<std::size_t>(a[i]))) : kFar;
+    for (std::size_t i = b0; i < b1; ++i) {
+      const Site s = a[i];
+      if (s.x < 0) {
+        out.d[i] = kFar;
+        out.site[i] = -1;
+        continue;
+      }
+      const Vec3i c = p.coord(i);
+      out.d[i] = static_cast<float>(p.distance(s.x - c.x, s.y - c.y, s.z - c.z));
+      out.site[i] = static_cast<std::int32_t>(p.index(s.x, s.y, s.z));
+    }
   });
-  out.site = std::move(a);
 }
 
 }  // namespace voxfield::detail

@@ -1,0 +1,120 @@
+// voxfield field IN -o OUT.npy [options]: a distance field of a world, written as .npy.
+#include <fstream>
+#include <iostream>
+
+#include "cli.h"
+#include "field_args.h"
+#include "voxfield/npy.h"
+#include "voxfield/parallel.h"
+
+namespace voxfield::cli {
+namespace {
+
+struct FieldSettings {
+  std::string in, out, sites, stats, packed;
+  std::string algorithm = "exact";
+  FieldArgs field;
+};
+
+// The field's values over `box` as an .npy volume of the storage's dtype.
+NpyVolume field_volume(const DistanceField& f, const Box3i& box) {
+  return std::visit(
+      [&](const auto& g) {
+        using T = typename std::decay_t<decltype(g)>::value_type;
+        std::vector<T> dense(static_cast<std::size_t>(box.volume()));
+        g.copy_to_dense(box, dense.data());
+        const DType t = std::is_same_v<T, float> ? DType::kFloat32
+                        : std::is_same_v<T, std::uint16_t> ? DType::kUInt16
+                                                           : DType::kUInt8;
+        return make_npy(t, box.size(), dense.data());
+      },
+      f.values);
+}
+
+// Nearest-site offsets as int16 a[x, y, z, 3]; -32768 where there is none.
+NpyVolume sites_volume(const Grid<SiteOffset>& g, const Box3i& box) {
+  const std::size_t n = static_cast<std::size_t>(box.volume());
+  std::vector<SiteOffset> dense(n);
+  g.copy_to_dense(box, dense.data());
+  std::vector<std::int16_t> planes(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    planes[i] = dense[i].dx;
+    planes[n + i] = dense[i].dy;
+    planes[2 * n + i] = dense[i].dz;
+  }
+  NpyVolume v{DType::kInt16, box.size(), {}, 3};
+  v.bytes.resize(planes.size() * sizeof(std::int16_t));
+  std::memcpy(v.bytes.data(), planes.data(), v.bytes.size());
+  return v;
+}
+
+int run_field(const FieldSettings& s) {
+  std::optional<ThreadLimit> limit;
+  if (s.field.threads > 0) limit.emplace(s.field.threads);
+  const LoadedWorld in = load_world(s.in, s.field.chunk_edge);
+  DistanceOptions o = s.field.options();
+  o.domain = in.extent;  // the output covers the input's volume, indexed like it
+  o.nearest_sites = !s.sites.empty();
+  AlgorithmOptions a;
+  a.algorithm = parse_algorithm(s.algorithm);
+  a.focus = s.field.focus_box();
+  if (a.algorithm == Algorithm::kLod && !a.focus) throw InvalidArgument("--algorithm lod needs --focus");
+  if (o.domain->empty()) throw InvalidArgument(s.in + ": the input holds no volume");
+  AlgorithmStats stats;
+  const DistanceField f = compute_distance_field(in.world, o, a, &stats);
+
+  write_npy(field_volume(f, f.domain), s.out);
+  if (!s.sites.empty()) {
+    if (!f.sites) throw InvalidArgument("--sites: the " + s.algorithm + " algorithm does not track nearest sites");
+    write_npy(sites_volume(*f.sites, f.domain), s.sites);
+  }
+  if (!s.packed.empty()) {
+    const auto packed = pack_dissertation_format(in.world, f, f.domain);
+    write_npy(make_npy(DType::kUInt32, f.domain.size(), packed.data()), s.packed);
+  }
+  const Vec3i d = f.domain.size();
+  nlohmann::json j{{"algorithm", s.algorithm},
+                   {"metric", metric_name(o.metric)},
+                   {"signed", o.signed_distance},
+                   {"max_distance", o.max_distance},
+                   {"storage", storage_name(o.storage)},
+                   {"dims", {d.x, d.y, d.z}},
+                   {"threads", max_threads()},
+                   {"chunk", s.field.chunk_edge},
+                   {"ms", stats.ms},
+                   {"mvox_per_s", static_cast<double>(f.domain.volume()) / (stats.ms * 1e3)},
+                   {"passes", stats.passes},
+                   {"iterations", stats.iterations},
+                   {"peak_rss_mb", static_cast<double>(peak_rss_bytes()) / 1048576.0}};
+  if (a.algorithm != Algorithm::kExact) {
+    DistanceOptions exact_o = o;
+    exact_o.nearest_sites = false;
+    j["error"] = error_json(compare_fields(f, compute_distance_field(in.world, exact_o), in.world));
+  }
+  if (!s.stats.empty()) {
+    const std::string text = j.dump(2) + "\n";
+    write_file_atomic(s.stats, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+  }
+  std::cerr << "voxfield: " << s.algorithm << " " << metric_name(o.metric) << " field of " << d.x << "x" << d.y << "x"
+            << d.z << " in " << stats.ms << " ms, wrote " << s.out << "\n";
+  return 0;
+}
+
+}  // namespace
+
+void add_field(CLI::App& app, Action& action) {
+  auto s = std::make_shared<FieldSettings>();
+  CLI::App* cmd = app.add_subcommand("field", "Compute a distance field and write it as .npy (a[x, y, z], like the input)");
+  cmd->add_option("IN", s->in, "input .vox or .npy")->required();
+  cmd->add_option("-o,--output", s->out, "output .npy")->required();
+  s->field.add_to(cmd);
+  cmd->add_option("--algorithm", s->algorithm,
+                  "exact, brute, brute-chunked, fim, jfa-seed, jfa, jfa+1, jfa+2, hybrid, lod")
+      ->capture_default_str();
+  cmd->add_option("--sites", s->sites, "also write nearest-site offsets as int16 a[x, y, z, 3] to this .npy");
+  cmd->add_option("--packed", s->packed, "also write the dissertation's packed uint32 voxels to this .npy");
+  cmd->add_option("--stats", s->stats, "write timing (ms: compute only) and error figures as JSON");
+  cmd->callback([s, &action] { action = [s] { return run_field(*s); }; });
+}
+
+}  // namespace voxfield::cli

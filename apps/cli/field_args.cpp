@@ -1,0 +1,60 @@
+// voxfield CLI — parsing of the distance-field options.
+#include "field_args.h"
+
+#include <sys/resource.h>
+
+namespace voxfield::cli {
+
+void FieldArgs::add_to(CLI::App* cmd) {
+  cmd->add_option("--metric", metric, "manhattan, chebyshev or euclidean")
+      ->check(CLI::IsMember({"manhattan", "chebyshev", "euclidean"}))
+      ->capture_default_str();
+  cmd->add_flag("--signed", is_signed, "negative distances inside solids (to the nearest air voxel)");
+  cmd->add_option("--max-distance", max_distance, "clamp D: values beyond D read D (0 = no clamp)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--storage", storage, "u8, u16 or f32 (integer Euclidean: fixed point, rounded down)")
+      ->check(CLI::IsMember({"u8", "u16", "f32"}))
+      ->capture_default_str();
+  cmd->add_option("--spacing", spacing, "voxel size sx,sy,sz (euclidean only)")->delimiter(',')->expected(3);
+  cmd->add_option("--focus", focus, "focus box x0,y0,z0,x1,y1,z1 for lod (min inclusive, max exclusive)")
+      ->delimiter(',')
+      ->expected(6);
+  cmd->add_option("--chunk", chunk_edge, "chunk edge 8..128")->check(CLI::IsMember({8, 16, 32, 64, 128}));
+  cmd->add_option("--threads", threads, "threads to use (default: all cores)")->check(CLI::PositiveNumber);
+}
+
+DistanceOptions FieldArgs::options() const {
+  DistanceOptions o;
+  o.metric = parse_metric(metric);
+  o.signed_distance = is_signed;
+  o.max_distance = max_distance;
+  o.storage = parse_storage(storage);
+  if (!spacing.empty()) o.spacing = {spacing[0], spacing[1], spacing[2]};
+  return o;
+}
+
+std::optional<Box3i> FieldArgs::focus_box() const {
+  if (focus.empty()) return std::nullopt;
+  const Box3i b{{focus[0], focus[1], focus[2]}, {focus[3], focus[4], focus[5]}};
+  if (b.empty()) throw InvalidArgument("--focus box " + to_string(b) + " is empty");
+  return b;
+}
+
+std::size_t peak_rss_bytes() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<std::size_t>(u.ru_maxrss) * 1024;
+}
+
+nlohmann::json error_json(const FieldError& e) {
+  return {{"measured_voxels", e.air_voxels},
+          {"wrong_voxels", e.wrong},
+          {"percent_wrong", e.percent_wrong()},
+          {"max_over", e.max_over},
+          {"max_under", e.max_under},
+          {"unsafe_voxels", e.too_large},
+          {"percent_unsafe", e.percent_unsafe()},
+          {"too_small_voxels", e.too_small}};
+}
+
+}  // namespace voxfield::cli

@@ -1,0 +1,35 @@
+// voxfield CLI — the distance-field options shared by `field`, `compare` (and later `edit`).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "voxfield/algorithms.h"
+#include "voxfield/file.h"
+
+namespace voxfield::cli {
+
+struct FieldArgs {
+  std::string metric = "manhattan";
+  bool is_signed = false;
+  double max_distance = 0;
+  std::string storage = "f32";
+  std::vector<double> spacing;
+  std::vector<int> focus;
+  int chunk_edge = 32;
+  int threads = 0;
+
+  void add_to(CLI::App* cmd);
+  DistanceOptions options() const;
+  std::optional<Box3i> focus_box() const;
+};
+
+// Resident-set high-water mark of this process, in bytes.
+std::size_t peak_rss_bytes();
+
+nlohmann::json error_json(const FieldError& e);
+
+}  // namespace voxfield::cli
