@@ -11,7 +11,7 @@ packages=(
   nlohmann-json3-dev                 # JSON output of the CLI
   libcli11-dev                       # CLI parsing
   libgtest-dev                       # tests
-  python3 python3-numpy              # test oracle: NumPy reads and writes .npy
+  python3 python3-numpy python3-scipy # test oracles: NumPy reads and writes .npy, SciPy's distance transforms
 )
 
 missing=()

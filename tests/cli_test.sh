@@ -94,5 +94,71 @@ check "generate" 0 "$V" generate terrain --size 40,30,20 -o "$tmp/t.npy"
 check "numpy reads generated" 0 $PY -c "
 import numpy as np; a = np.load('$tmp/t.npy'); assert a.shape == (40, 30, 20) and 0.3 < (a != 0).mean() < 0.7"
 
+
+# Distance fields against SciPy's exact transforms (an independent implementation).
+if $PY -c "import scipy.ndimage" 2>/dev/null; then
+  check "world for fields" 0 $PY -c "
+import numpy as np
+rng = np.random.default_rng(11)
+a = (rng.random((37, 23, 29)) < 0.03).astype(np.uint8) * 7
+a[5:12, 3:9, 20:27] = 3
+np.save('$tmp/w.npy', a)"
+  for m in manhattan chebyshev euclidean; do
+    check "field $m" 0 "$V" field "$tmp/w.npy" -o "$tmp/f_$m.npy" --metric $m --stats "$tmp/s_$m.json" --sites "$tmp/n_$m.npy"
+  done
+  check "field signed euclidean" 0 "$V" field "$tmp/w.npy" -o "$tmp/f_signed.npy" --metric euclidean --signed
+  check "field clamped u8" 0 "$V" field "$tmp/w.npy" -o "$tmp/f_u8.npy" --metric euclidean --storage u8 --max-distance 5
+  check "field anisotropic" 0 "$V" field "$tmp/w.npy" -o "$tmp/f_aniso.npy" --metric euclidean --spacing 0.5,1,2.5
+  check "field jfa-seed stats" 0 "$V" field "$tmp/w.npy" -o "$tmp/f_seed.npy" --algorithm jfa-seed --stats "$tmp/s_seed.json" --packed "$tmp/packed.npy"
+  check "scipy agrees" 0 $PY -c "
+import json, numpy as np
+from scipy import ndimage as nd
+a = np.load('$tmp/w.npy'); air = a == 0; solid = ~air
+edt = nd.distance_transform_edt(air)
+ref = {'euclidean': edt, 'manhattan': nd.distance_transform_cdt(air, metric='taxicab'),
+       'chebyshev': nd.distance_transform_cdt(air, metric='chessboard')}
+for m, r in ref.items():
+    f = np.load('$tmp/f_%s.npy' % m)
+    assert f.dtype == np.float32 and f.shape == a.shape, (m, f.dtype, f.shape)
+    assert np.allclose(f, r, rtol=0, atol=1e-5), (m, np.abs(f - r).max())
+    # nearest sites: the reported site is solid and exactly as far as the distance says
+    n = np.load('$tmp/n_%s.npy' % m).astype(int)
+    assert n.shape == a.shape + (3,)
+    idx = np.indices(a.shape).transpose(1, 2, 3, 0) + n
+    assert (a[idx[..., 0], idx[..., 1], idx[..., 2]] != 0).all(), m
+    o = np.abs(n)
+    d = {'euclidean': np.sqrt((o ** 2).sum(-1)), 'manhattan': o.sum(-1), 'chebyshev': o.max(-1)}[m]
+    assert np.allclose(d, r, atol=1e-5), m
+    s = json.load(open('$tmp/s_%s.json' % m))
+    assert s['metric'] == m and s['algorithm'] == 'exact' and s['dims'] == [37, 23, 29] and s['ms'] > 0, s
+signed = np.where(solid, -nd.distance_transform_edt(solid), edt)
+assert np.allclose(np.load('$tmp/f_signed.npy'), signed, atol=1e-5)
+u8 = np.load('$tmp/f_u8.npy'); assert u8.dtype == np.uint8
+assert (u8 == np.floor(np.minimum(edt, 5) * 4 + 1e-9).astype(np.uint8)).all()
+aniso = nd.distance_transform_edt(air, sampling=(0.5, 1, 2.5))
+assert np.allclose(np.load('$tmp/f_aniso.npy'), aniso, rtol=1e-6, atol=1e-5)
+seed = json.load(open('$tmp/s_seed.json'))
+assert seed['algorithm'] == 'jfa-seed' and seed['error']['max_under'] == 0 and 'percent_unsafe' in seed['error'], seed
+assert (np.load('$tmp/f_seed.npy') >= ref['manhattan'] - 1e-6).all()
+p = np.load('$tmp/packed.npy'); assert p.dtype == np.uint32
+assert ((p >> 8) & 255 == np.minimum(np.load('$tmp/f_seed.npy'), 255).astype(np.uint32)).all()
+"
+  check "compare" 0 "$V" compare "$tmp/w.npy" --metric chebyshev --json "$tmp/cmp.json"
+  expect_grep "compare table" "$tmp/out" "jfa+2"
+  check "compare json" 0 $PY -c "
+import json; j = json.load(open('$tmp/cmp.json'))
+names = [r['algorithm'] for r in j['algorithms']]
+assert names == ['exact','brute','brute-chunked','fim','jfa-seed','jfa','jfa+1','jfa+2','hybrid','lod'], names
+assert j['algorithms'][0]['error']['wrong_voxels'] == 0 and j['algorithms'][1]['error']['wrong_voxels'] == 0"
+else
+  echo "note: SciPy not installed; skipped the SciPy cross-checks"
+fi
+check "field: lod without focus" 1 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --algorithm lod
+check "field: unknown metric" 2 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --metric taxicab
+check "field: spacing with manhattan" 1 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --spacing 1,2,3
+check "field: bad input" 1 "$V" field "$C/dotvox_not_a.vox" -o "$tmp/x.npy"
+[ ! -e "$tmp/x.npy" ] && passes=$((passes+1)) || { echo "FAIL: output written despite errors"; fails=$((fails+1)); }
+for cmd in field compare; do check "$cmd --help" 0 "$V" "$cmd" --help; done
+
 echo "$passes passed, $fails failed"
 [ "$fails" -eq 0 ]
