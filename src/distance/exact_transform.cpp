@@ -239,19 +239,41 @@ void transpose(const A* in, A* out, int X, int Y) {
 
 // 2-D solve of one slice with an envelope kernel (Chebyshev, Euclidean): pass B along x on rows,
 // transpose, pass C along y on rows, transpose back.
+// One line through the envelope kernel, with shortcuts for the lines that are common in real
+// worlds and need no envelope: all sites (cost 0 everywhere: inside solid matter) and no site at
+// all (open air far from everything).
 template <class Kernel, class V>
-void solve_slice_envelope(const Kernel& kx, const Kernel& ky, int X, int Y, SliceBuffers<V>& b) {
+void solve_line(const Kernel& k, int n, const V* f, V* out, std::int32_t* arg, std::int32_t* s, std::int32_t* t, V inf) {
+  bool all_zero = true, all_inf = true;
+  for (int i = 0; i < n; ++i) {
+    all_zero &= f[i] == V(0);
+    all_inf &= !(f[i] < inf);
+  }
+  if (all_zero || all_inf) {
+    std::fill(out, out + n, all_zero ? V(0) : inf);
+    if (arg) {
+      for (int i = 0; i < n; ++i) arg[i] = all_zero ? i : -1;
+    }
+    return;
+  }
+  k(n, f, out, arg, s, t);
+}
+
+template <class Kernel, class V>
+void solve_slice_envelope(const Kernel& kx, const Kernel& ky, int X, int Y, SliceBuffers<V>& b, bool track_sites, V inf) {
+  std::int32_t* arg_x = track_sites ? b.arg_x.data() : nullptr;
+  std::int32_t* targ = track_sites ? b.targ.data() : nullptr;
   for (int y = 0; y < Y; ++y) {
     const std::size_t o = static_cast<std::size_t>(y) * X;
-    kx(X, b.f.data() + o, b.h.data() + o, b.arg_x.data() + o, b.s.data(), b.t.data());
+    solve_line(kx, X, b.f.data() + o, b.h.data() + o, arg_x ? arg_x + o : nullptr, b.s.data(), b.t.data(), inf);
   }
   transpose(b.h.data(), b.tmp.data(), X, Y);
   for (int x = 0; x < X; ++x) {
     const std::size_t o = static_cast<std::size_t>(x) * Y;
-    ky(Y, b.tmp.data() + o, b.f.data() + o, b.targ.data() + o, b.s.data(), b.t.data());
+    solve_line(ky, Y, b.tmp.data() + o, b.f.data() + o, targ ? targ + o : nullptr, b.s.data(), b.t.data(), inf);
   }
   transpose(b.f.data(), b.h.data(), Y, X);
-  transpose(b.targ.data(), b.arg_y.data(), Y, X);
+  if (track_sites) transpose(b.targ.data(), b.arg_y.data(), Y, X);
 }
 
 // 2-D solve of one slice for Manhattan: min-plus sweeps along x per row, then along y across whole
@@ -439,11 +461,28 @@ void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
         for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
           T* out = reinterpret_cast<T*>(g.row(cx, by + y, z)) + lx;  // T and U have the same size
           const std::size_t o = static_cast<std::size_t>(y) * X + xo;
-          for (int i = 0; i < count; ++i) {
-            const bool inside = p.is_signed && solid[o + i];
-            const V cost = buf[inside ? 1 : 0].h[o + i];
-            const bool has_site = cost < inf && cost <= clamp_v;
-            out[i] = encoder.encode(static_cast<double>(cost), has_site, inside);
+          if constexpr (std::is_same_v<T, float>) {
+            if (!p.is_signed) {
+              // The common case, kept branch-light: float distance, clamp, +inf/D when none.
+              const V* h = buf[0].h.data() + o;
+              const float none = static_cast<float>(encoder.none_value);
+              const float clamp_f = static_cast<float>(std::min(p.clamp, 3.0e38));
+              for (int i = 0; i < count; ++i) {
+                const V cost = h[i];
+                const bool has_site = cost < inf && cost <= clamp_v;
+                const float d = euclid ? std::sqrt(static_cast<float>(static_cast<double>(cost)))
+                                       : static_cast<float>(cost);
+                out[i] = has_site ? std::min(d, clamp_f) : none;
+              }
+            }
+          }
+          if (!std::is_same_v<T, float> || p.is_signed) {
+            for (int i = 0; i < count; ++i) {
+              const bool inside = p.is_signed && solid[o + i];
+              const V cost = buf[inside ? 1 : 0].h[o + i];
+              const bool has_site = cost < inf && cost <= clamp_v;
+              out[i] = encoder.encode(static_cast<double>(cost), has_site, inside);
+            }
           }
           if (!sites) return;
           SiteOffset* so_out = sites->row(cx, by + y, z) + lx;
@@ -547,13 +586,21 @@ DistanceField run(const Grid<std::uint8_t>& occupancy, const DistanceOptions& op
     auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(Chebyshev{}, n, f, o, a, s, t);
     };
-    auto solve = [k](int X, int Y, SliceBuffers<std::int32_t>& b) { solve_slice_envelope(k, k, X, Y, b); };
+    auto solve = [k, &p](int X, int Y, SliceBuffers<std::int32_t>& b) { solve_slice_envelope(k, k, X, Y, b, p.sites, Chebyshev::kInf); };
     pass_slices<T, U, std::int32_t>(p, world, g, sp, solve, encoder, cap32, Chebyshev::kInf);
+  } else if (p.unit_spacing && static_cast<double>(p.domain.size().x) * p.domain.size().x +
+                                       static_cast<double>(p.domain.size().y) * p.domain.size().y +
+                                       static_cast<double>(p.domain.size().z) * p.domain.size().z < (1 << 29)) {
+    auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
+      detail::envelope_1d(detail::EuclideanInt32{}, n, f, o, a, s, t);
+    };
+    auto solve = [k, &p](int X, int Y, SliceBuffers<std::int32_t>& b) { solve_slice_envelope(k, k, X, Y, b, p.sites, detail::EuclideanInt32::kInf); };
+    pass_slices<T, U, std::int32_t>(p, world, g, sp, solve, encoder, cap32, detail::EuclideanInt32::kInf);
   } else if (p.unit_spacing) {
     auto k = [](int n, const std::int64_t* f, std::int64_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(EuclideanInt{}, n, f, o, a, s, t);
     };
-    auto solve = [k](int X, int Y, SliceBuffers<std::int64_t>& b) { solve_slice_envelope(k, k, X, Y, b); };
+    auto solve = [k, &p](int X, int Y, SliceBuffers<std::int64_t>& b) { solve_slice_envelope(k, k, X, Y, b, p.sites, EuclideanInt::kInf); };
     pass_slices<T, U, std::int64_t>(p, world, g, sp, solve, encoder, cap32, EuclideanInt::kInf);
   } else {
     const EuclideanReal ex{p.spacing[0] * p.spacing[0]}, ey{p.spacing[1] * p.spacing[1]};
@@ -564,7 +611,7 @@ DistanceField run(const Grid<std::uint8_t>& occupancy, const DistanceOptions& op
     const K ky = [ey](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(ey, n, f, o, a, s, t);
     };
-    auto solve = [&](int X, int Y, SliceBuffers<double>& b) { solve_slice_envelope(kx, ky, X, Y, b); };
+    auto solve = [&](int X, int Y, SliceBuffers<double>& b) { solve_slice_envelope(kx, ky, X, Y, b, p.sites, EuclideanReal::kInf); };
     pass_slices<T, U, double>(p, world, g, sp, solve, encoder, cap32, EuclideanReal::kInf);
   }
 

@@ -1,0 +1,98 @@
+// voxfield benchmark: exact distance fields on the generated scenes and the real corpus.
+//
+// Every line reports the median, min and max of N timed runs after a warm-up, the throughput,
+// the threads used, and the memory the transform needed beyond its input and its output (peak
+// resident set during the run, minus the resident set before it, minus the output's own bytes).
+// Output: a table on stdout and, with --json, one record per line for bench/report.py.
+#include <CLI/CLI.hpp>
+#include <malloc.h>
+
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "bench_util.h"
+#include "voxfield/distance.h"
+#include "voxfield/parallel.h"
+#include "voxfield/scene.h"
+#include "voxfield/vox.h"
+
+using namespace voxfield;
+
+int main(int argc, char** argv) {
+  CLI::App app{"voxfield field benchmark"};
+  std::vector<std::string> scenes{"spheres", "terrain"};
+  std::vector<int> sizes{128, 256};
+  std::vector<std::string> metrics{"manhattan", "chebyshev", "euclidean"};
+  std::vector<int> threads{1, 2};
+  std::vector<std::string> vox_files;
+  std::string storage = "f32", json_path;
+  int runs = 5;
+  double clamp = 0;
+  app.add_option("--scenes", scenes)->delimiter(',');
+  app.add_option("--sizes", sizes)->delimiter(',');
+  app.add_option("--metrics", metrics)->delimiter(',');
+  app.add_option("--threads", threads)->delimiter(',');
+  app.add_option("--vox", vox_files, "real .vox files to include")->delimiter(',');
+  app.add_option("--storage", storage);
+  app.add_option("--max-distance", clamp);
+  app.add_option("--runs", runs)->check(CLI::Range(1, 1000));
+  app.add_option("--json", json_path, "append one JSON record per line");
+  CLI11_PARSE(app, argc, argv);
+
+  struct Input {
+    std::string name;
+    World world;
+  };
+  std::vector<Input> inputs;
+  for (const auto& s : scenes)
+    for (int n : sizes) {
+      SceneOptions o;
+      o.size = Vec3i::splat(n);
+      inputs.push_back({s + "-" + std::to_string(n), make_scene(s, o)});
+    }
+  for (const auto& f : vox_files) {
+    VoxImport in = read_vox(f);
+    // Bound the world to its content so that the domain is the model's box.
+    World w(32, in.world.voxels.content_bounds());
+    std::vector<std::uint8_t> dense(static_cast<std::size_t>(w.voxels.bounds()->volume()));
+    in.world.voxels.copy_to_dense(*w.voxels.bounds(), dense.data());
+    w.voxels.copy_from_dense(*w.voxels.bounds(), dense.data());
+    inputs.push_back({std::filesystem::path(f).stem().string(), std::move(w)});
+  }
+  std::ofstream json;
+  if (!json_path.empty()) json.open(json_path, std::ios::app);
+  std::printf("%-26s %-10s %4s %9s %9s %9s %10s %12s\n", "input", "metric", "thr", "median", "min", "max", "Mvox/s",
+              "extra B/vox");
+  for (const auto& in : inputs) {
+    const Box3i domain = *in.world.voxels.bounds();
+    const double voxels = static_cast<double>(domain.volume());
+    for (const auto& m : metrics)
+      for (int t : threads) {
+        DistanceOptions o;
+        o.metric = parse_metric(m);
+        o.storage = parse_storage(storage);
+        o.max_distance = clamp;
+        ThreadLimit limit(t);
+        const bench::Timing tm = bench::time_runs(runs, [&] { (void)compute_distance_field(in.world, o); });
+        // Memory: one more run with the peak reset.
+        malloc_trim(0);  // return freed pages, so that the baseline is what is really in use
+        bench::reset_peak_rss();
+        const std::size_t before = bench::proc_status_bytes("VmRSS");
+        const DistanceField f = compute_distance_field(in.world, o);
+        const std::size_t peak = bench::proc_status_bytes("VmHWM");
+        const std::size_t out_bytes = std::visit([](const auto& g) { return g.memory().bytes; }, f.values);
+        const double extra = (static_cast<double>(peak) - static_cast<double>(before) - static_cast<double>(out_bytes)) / voxels;
+        std::printf("%-26s %-10s %4d %9.1f %9.1f %9.1f %10.0f %12.3f\n", in.name.c_str(), m.c_str(), t, tm.median_ms,
+                    tm.min_ms, tm.max_ms, voxels / (tm.median_ms * 1e3), extra);
+        std::fflush(stdout);
+        if (json) {
+          json << nlohmann::json{{"tool", "voxfield"}, {"input", in.name},     {"metric", m},
+                                 {"threads", t},       {"storage", storage},   {"max_distance", clamp},
+                                 {"voxels", voxels},   {"median_ms", tm.median_ms}, {"min_ms", tm.min_ms},
+                                 {"max_ms", tm.max_ms}, {"runs", runs},        {"extra_bytes_per_voxel", extra}}
+                      .dump()
+               << "\n";
+        }
+      }
+  }
+}
