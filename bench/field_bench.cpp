@@ -14,6 +14,7 @@
 #include "voxfield/distance.h"
 #include "voxfield/parallel.h"
 #include "voxfield/scene.h"
+#include "voxfield/npy.h"
 #include "voxfield/vox.h"
 
 using namespace voxfield;
@@ -24,7 +25,7 @@ int main(int argc, char** argv) {
   std::vector<int> sizes{128, 256};
   std::vector<std::string> metrics{"manhattan", "chebyshev", "euclidean"};
   std::vector<int> threads{1, 2};
-  std::vector<std::string> vox_files;
+  std::vector<std::string> files;
   std::string storage = "f32", json_path;
   int runs = 5;
   double clamp = 0;
@@ -32,7 +33,7 @@ int main(int argc, char** argv) {
   app.add_option("--sizes", sizes)->delimiter(',');
   app.add_option("--metrics", metrics)->delimiter(',');
   app.add_option("--threads", threads)->delimiter(',');
-  app.add_option("--vox", vox_files, "real .vox files to include")->delimiter(',');
+  app.add_option("--inputs", files, ".vox or .npy files to include (named by their stem)")->delimiter(',');
   app.add_option("--storage", storage);
   app.add_option("--max-distance", clamp);
   app.add_option("--runs", runs)->check(CLI::Range(1, 1000));
@@ -46,17 +47,25 @@ int main(int argc, char** argv) {
   std::vector<Input> inputs;
   for (const auto& s : scenes)
     for (int n : sizes) {
+      if (s.empty()) continue;
       SceneOptions o;
       o.size = Vec3i::splat(n);
       inputs.push_back({s + "-" + std::to_string(n), make_scene(s, o)});
     }
-  for (const auto& f : vox_files) {
-    VoxImport in = read_vox(f);
-    // Bound the world to its content so that the domain is the model's box.
-    World w(32, in.world.voxels.content_bounds());
-    std::vector<std::uint8_t> dense(static_cast<std::size_t>(w.voxels.bounds()->volume()));
-    in.world.voxels.copy_to_dense(*w.voxels.bounds(), dense.data());
-    w.voxels.copy_from_dense(*w.voxels.bounds(), dense.data());
+  for (const auto& f : files) {
+    World loaded;
+    if (std::filesystem::path(f).extension() == ".npy") {
+      loaded = world_from_npy(read_npy(f), f);
+    } else {
+      loaded = std::move(read_vox(f).world);
+    }
+    // Bound the world so that the domain is the file's volume (npy) or content box (vox).
+    const Box3i box = std::filesystem::path(f).extension() == ".npy" ? Box3i::from_size(read_npy(f).dims)
+                                                                      : loaded.voxels.content_bounds();
+    World w(32, box);
+    std::vector<std::uint8_t> dense(static_cast<std::size_t>(box.volume()));
+    loaded.voxels.copy_to_dense(box, dense.data());
+    w.voxels.copy_from_dense(box, dense.data());
     inputs.push_back({std::filesystem::path(f).stem().string(), std::move(w)});
   }
   std::ofstream json;

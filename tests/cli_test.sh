@@ -160,5 +160,9 @@ check "field: bad input" 1 "$V" field "$C/dotvox_not_a.vox" -o "$tmp/x.npy"
 [ ! -e "$tmp/x.npy" ] && passes=$((passes+1)) || { echo "FAIL: output written despite errors"; fails=$((fails+1)); }
 for cmd in field compare; do check "$cmd --help" 0 "$V" "$cmd" --help; done
 
+check "showcase (small)" 0 "$V" showcase --size 48 --out "$tmp/showcase"
+expect_grep "showcase report" "$tmp/showcase/report.md" "jfa-seed"
+expect_grep "showcase round trip" "$tmp/showcase/report.md" "identical"
+
 echo "$passes passed, $fails failed"
 [ "$fails" -eq 0 ]

@@ -353,3 +353,21 @@ TEST(ExactDistance, RejectsBadOptions) {
   EXPECT_THROW(compute_distance_field(w, o), InvalidArgument);
   EXPECT_THROW(parse_metric("taxicab"), InvalidArgument);
 }
+
+TEST(ExactDistance, WideDomainsUseTheSixtyFourBitKernel) {
+  // Squared distances beyond 2^29 select the 64-bit Euclidean kernel; check it on a long line.
+  const int n = 24000;
+  World w(8, Box3i::from_size({n, 1, 1}));  // small chunks: a thin domain in 128^3 chunks would be mostly padding
+  w.voxels.set({0, 0, 0}, 1);
+  w.voxels.set({n - 1, 0, 0}, 1);
+  w.voxels.set({9000, 0, 0}, 1);
+  DistanceOptions o;
+  o.metric = Metric::kEuclidean;
+  o.nearest_sites = true;
+  const DistanceField f = compute_distance_field(w, o);
+  for (int x : {1, 4499, 4500, 4501, 8999, 16499, 16500, 16501, n - 2}) {
+    const double want = std::min({std::abs(x - 0), std::abs(x - 9000), std::abs(x - (n - 1))});
+    EXPECT_EQ(f.distance({x, 0, 0}), want) << x;
+  }
+  EXPECT_EQ(f.sites->get({4500, 0, 0}), (SiteOffset{-4500, 0, 0}));  // a tie: the smaller x wins
+}

@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Packages only the benchmarks need: the peers voxfield is compared with, and plotting.
+set -euo pipefail
+packages=(python3-scipy python3-matplotlib libopenvdb-dev)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
