@@ -28,7 +28,7 @@ list=$(IFS=,; echo "${inputs[*]}")
 "$bin/voxfield-bench-field" --scenes "" --inputs "$list" --threads 1,2 --runs "$runs" --json "$out/records.jsonl"
 unset OPENBLAS_CORETYPE OPENBLAS_L2_SIZE
 /usr/bin/python3 bench/peers/scipy_peer.py --runs "$runs" --json "$out/records.jsonl" "${inputs[@]}"
-g++ -O3 -std=c++20 -Iinclude bench/peers/openvdb/openvdb_peer.cpp -Lbuild/release -lvoxfield -lopenvdb \
+g++ -O3 -std=c++20 -Iinclude -Ibench bench/peers/openvdb/openvdb_peer.cpp -Lbuild/release -lvoxfield -lopenvdb \
   -lImath-3_1 -ltbb -lz -o "$out/openvdb_peer"
 "$out/openvdb_peer" "$runs" "$out/records.jsonl" "$out/inputs/spheres-128.npy" "$out/inputs/terrain-128.npy" \
   "$out/inputs/spheres-256.npy" "$out/inputs/terrain-256.npy"

@@ -97,8 +97,7 @@ int run_compare(const CompareSettings& s) {
                      {"threads", max_threads()},
                      {"focus", {focus.begin.x, focus.begin.y, focus.begin.z, focus.end.x, focus.end.y, focus.end.z}},
                      {"algorithms", rows}};
-    const std::string text = j.dump(2) + "\n";
-    write_file_atomic(s.json, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+    write_json(j, s.json);
   }
   return 0;
 }

@@ -92,8 +92,7 @@ int run_field(const FieldSettings& s) {
     j["error"] = error_json(compare_fields(f, compute_distance_field(in.world, exact_o), in.world));
   }
   if (!s.stats.empty()) {
-    const std::string text = j.dump(2) + "\n";
-    write_file_atomic(s.stats, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+    write_json(j, s.stats);
   }
   std::cerr << "voxfield: " << s.algorithm << " " << metric_name(o.metric) << " field of " << d.x << "x" << d.y << "x"
             << d.z << " in " << stats.ms << " ms, wrote " << s.out << "\n";

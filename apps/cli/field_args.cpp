@@ -57,4 +57,9 @@ nlohmann::json error_json(const FieldError& e) {
           {"too_small_voxels", e.too_small}};
 }
 
+void write_json(const nlohmann::json& j, const std::string& path) {
+  const std::string text = j.dump(2) + "\n";
+  write_file_atomic(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+}
+
 }  // namespace voxfield::cli

@@ -32,4 +32,7 @@ std::size_t peak_rss_bytes();
 
 nlohmann::json error_json(const FieldError& e);
 
+// Writes `j` (indented) to `path` atomically.
+void write_json(const nlohmann::json& j, const std::string& path);
+
 }  // namespace voxfield::cli

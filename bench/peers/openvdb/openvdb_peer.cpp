@@ -18,21 +18,9 @@
 #include <fstream>
 #include <vector>
 
+#include "bench_util.h"
 #include "voxfield/distance.h"
 #include "voxfield/npy.h"
-
-template <class Fn>
-std::array<double, 3> time_runs(int runs, Fn&& fn) {
-  fn();
-  std::vector<double> ms;
-  for (int r = 0; r < runs; ++r) {
-    const auto t0 = std::chrono::steady_clock::now();
-    fn();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  std::sort(ms.begin(), ms.end());
-  return {ms[ms.size() / 2], ms.front(), ms.back()};
-}
 
 int main(int argc, char** argv) {
   if (argc < 3) {
@@ -61,19 +49,19 @@ int main(int argc, char** argv) {
           }
     }
     const double voxels = static_cast<double>(v.count());
-    auto record = [&](const char* what, std::array<double, 3> t, double max_err) {
-      std::printf("%-26s %-22s %4d %9.1f %9.1f %9.1f %10.1f  max err %.2f\n", name.c_str(), what, 2, t[0], t[1], t[2],
-                  voxels / (t[0] * 1e3), max_err);
+    auto record = [&](const char* what, voxfield::bench::Timing t, double max_err) {
+      std::printf("%-26s %-22s %4d %9.1f %9.1f %9.1f %10.1f  max err %.2f\n", name.c_str(), what, 2, t.median_ms, t.min_ms, t.max_ms,
+                  voxels / (t.median_ms * 1e3), max_err);
       std::fflush(stdout);
       json << "{\"tool\": \"openvdb\", \"input\": \"" << name << "\", \"metric\": \"" << what
-           << "\", \"threads\": 2, \"voxels\": " << voxels << ", \"median_ms\": " << t[0] << ", \"min_ms\": " << t[1]
-           << ", \"max_ms\": " << t[2] << ", \"runs\": " << runs << ", \"max_error\": " << max_err << "}\n";
+           << "\", \"threads\": 2, \"voxels\": " << voxels << ", \"median_ms\": " << t.median_ms << ", \"min_ms\": " << t.min_ms
+           << ", \"max_ms\": " << t.max_ms << ", \"runs\": " << runs << ", \"max_error\": " << max_err << "}\n";
     };
     openvdb::FloatGrid::Ptr band;
-    const auto t_band = time_runs(runs, [&] { band = openvdb::tools::topologyToLevelSet(*mask, 3); });
+    const auto t_band = voxfield::bench::time_runs(runs, [&] { band = openvdb::tools::topologyToLevelSet(*mask, 3); });
     record("topologyToLevelSet-hw3", t_band, -1);
     openvdb::FloatGrid::Ptr sdf;
-    const auto t_sdf = time_runs(runs, [&] { sdf = openvdb::tools::fogToSdf(*fog, 0.5f); });
+    const auto t_sdf = voxfield::bench::time_runs(runs, [&] { sdf = openvdb::tools::fogToSdf(*fog, 0.5f); });
     // Error of the full SDF in air, against voxfield's exact Euclidean distance minus 0.5.
     voxfield::World w(32, voxfield::Box3i::from_size(v.dims));
     w.voxels.copy_from_dense(voxfield::Box3i::from_size(v.dims), v.bytes.data());
