@@ -62,7 +62,9 @@ TEST(Algorithms, FimAndHybridAreExactForManhattanAndChebyshev) {
       AlgorithmStats stats;
       const FieldError e = run(w, m, a, false, {}, &stats);
       EXPECT_EQ(e.wrong, 0) << metric_name(m) << " " << algorithm_name(a);
-      if (a == Algorithm::kFim) EXPECT_GT(stats.iterations, 10) << metric_name(m);
+      if (a == Algorithm::kFim) {
+        EXPECT_GT(stats.iterations, 10) << metric_name(m);
+      }
     }
     EXPECT_EQ(run(w, m, Algorithm::kFim, true).wrong, 0) << "signed " << metric_name(m);
   }

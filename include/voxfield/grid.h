@@ -140,6 +140,13 @@ class Grid {
   // generate_chunks. Throws InvalidArgument (changing nothing) when the sizes disagree.
   void adopt_chunks(const std::vector<Vec3i>& chunks, std::vector<std::unique_ptr<T[]>> data);
 
+  // Edits one chunk in place: makes it dense (expanding a uniform or absent chunk), calls
+  // f(T* voxels) on its edge^3 values (x fastest), which returns whether it changed anything, and
+  // collapses the chunk again if it came out uniform. Throws InvalidArgument for a chunk wholly
+  // outside a bounded grid; f must not write voxels beyond the bounds.
+  template <class F>
+  void edit_chunk(Vec3i coord, F&& f);
+
   // Read-only accessor caching the last chunk looked up: ~5x faster than get() for coherent access.
   // Any write to the grid invalidates it.
   class ReadAccessor {

@@ -402,6 +402,34 @@ void Grid<T>::adopt_chunks(const std::vector<Vec3i>& chunks, std::vector<std::un
 }
 
 template <class T>
+template <class F>
+void Grid<T>::edit_chunk(Vec3i coord, F&& f) {
+  if (bounds_ && chunk_box(coord).intersect(*bounds_).empty()) {
+    throw InvalidArgument("edit_chunk: chunk " + to_string(coord) + " lies outside the grid bounds " +
+                          to_string(*bounds_));
+  }
+  auto it = chunks_.find(coord);
+  const bool existed = it != chunks_.end();
+  if (!existed) {
+    Chunk c;
+    c.uniform = background_;
+    it = chunks_.emplace(coord, std::move(c)).first;
+  }
+  Chunk& c = it->second;
+  const bool was_uniform = !c.voxels;
+  if (was_uniform) expand(c);
+  bool changed = false;
+  try {
+    changed = f(c.voxels.get());
+  } catch (...) {
+    if (was_uniform) c.voxels.reset();  // nothing was meant to change: restore the single value
+    if (!existed) chunks_.erase(it);
+    throw;
+  }
+  if (changed || was_uniform) collapse_if_uniform(it);
+}
+
+template <class T>
 T Grid<T>::ReadAccessor::get(Vec3i p) {
   const Vec3i coord = grid_->chunk_of(p);
   if (!(coord == cached_coord_)) {

@@ -1,0 +1,49 @@
+// voxfield — distance fields that follow a world through its edits.
+//
+// A DynamicDistanceField is bound to a World and a set of DistanceOptions. After edits recorded in
+// DirtyRegions, update() recomputes only what they can change, with the same exact kernel as a
+// full computation, so the field stays bit-identical to a full rebuild:
+//
+//   with clamp D, a voxel's value depends only on sites within distance D, so an edit in box B
+//   changes values only inside B grown by D (the "reach"), and recomputing those needs the sites
+//   inside B grown by 2D. Integer storage clamps at its range even without an explicit D.
+//
+// Unclamped f32 fields have an unbounded reach: every update recomputes the whole domain (cost
+// proportional to the world, not the edit). Clamp the field to make updates local.
+#pragma once
+
+#include "voxfield/distance.h"
+#include "voxfield/edit.h"
+
+namespace voxfield {
+
+class DynamicDistanceField {
+ public:
+  // Binds to `world` (which must outlive this object) and computes the field. The domain must
+  // stay fixed: the world must be bounded, or options.domain given; otherwise InvalidArgument.
+  DynamicDistanceField(const World& world, DistanceOptions options);
+
+  struct UpdateStats {
+    std::int64_t voxels_recomputed = 0;  // voxels whose values were recomputed (the reach boxes)
+    std::int64_t voxels_read = 0;        // voxels the kernel ran over (reach boxes grown by D)
+    int regions = 0;                     // merged boxes recomputed
+  };
+
+  // Recomputes the whole field.
+  void rebuild();
+  // Recomputes what the recorded changes can affect. The caller clears `dirty` afterwards.
+  UpdateStats update(const DirtyRegions& dirty);
+
+  const DistanceField& field() const { return field_; }
+  const DistanceOptions& options() const { return options_; }
+  // How far, in voxels along each axis, a change can move values (the domain size when unbounded).
+  Vec3i reach() const { return reach_; }
+
+ private:
+  const World* world_;
+  DistanceOptions options_;
+  Vec3i reach_;
+  DistanceField field_;
+};
+
+}  // namespace voxfield

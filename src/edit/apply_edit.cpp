@@ -1,0 +1,144 @@
+// voxfield — applying edits to worlds, chunk by chunk, and recording what changed.
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <tuple>
+
+#include "voxfield/edit.h"
+
+namespace voxfield {
+namespace {
+
+constexpr std::int64_t kMaxEditVoxels = std::int64_t{1} << 33;
+
+void validate(const Edit& e) {
+  struct Check {
+    void operator()(const SphereBrush& s) const {
+      if (!(s.radius >= 0) || !std::isfinite(s.radius)) throw InvalidArgument("sphere radius must be >= 0");
+    }
+    void operator()(const BoxBrush& b) const {
+      if (b.min.x > b.max.x || b.min.y > b.max.y || b.min.z > b.max.z) {
+        throw InvalidArgument("box min " + to_string(b.min) + " exceeds max " + to_string(b.max));
+      }
+    }
+    void operator()(const RotatedBoxBrush& b) const {
+      for (double h : b.half_extent)
+        if (!(h >= 0) || !std::isfinite(h)) throw InvalidArgument("rotated box half extents must be >= 0");
+    }
+    void operator()(const CapsuleBrush& c) const {
+      if (!(c.radius >= 0) || !std::isfinite(c.radius)) throw InvalidArgument("capsule radius must be >= 0");
+    }
+    void operator()(const StampBrush& s) const {
+      if (!s.model) throw InvalidArgument("stamp without a model");
+    }
+  };
+  std::visit(Check{}, e.brush);
+  const bool stamp = std::holds_alternative<StampBrush>(e.brush);
+  if (e.op != EditOp::kCarve && !stamp && e.material == 0) {
+    throw InvalidArgument("place and paint need a material 1..255 (carve sets air)");
+  }
+}
+
+}  // namespace
+
+DirtyRegions::DirtyRegions(int chunk_edge) : shift_(0) {
+  if (chunk_edge < 1 || (chunk_edge & (chunk_edge - 1)) != 0) throw InvalidArgument("dirty-region chunk edge must be a power of two");
+  while ((1 << shift_) < chunk_edge) ++shift_;
+}
+
+void DirtyRegions::add(const Box3i& changed) {
+  if (changed.empty()) return;
+  const Vec3i lo{changed.begin.x >> shift_, changed.begin.y >> shift_, changed.begin.z >> shift_};
+  const Vec3i hi{(changed.end.x - 1) >> shift_, (changed.end.y - 1) >> shift_, (changed.end.z - 1) >> shift_};
+  const int e = 1 << shift_;
+  for (int z = lo.z; z <= hi.z; ++z)
+    for (int y = lo.y; y <= hi.y; ++y)
+      for (int x = lo.x; x <= hi.x; ++x) {
+        const Box3i cb{{x * e, y * e, z * e}, {x * e + e, y * e + e, z * e + e}};
+        const Box3i part = cb.intersect(changed);
+        auto [it, inserted] = per_chunk_.try_emplace({x, y, z}, part);
+        if (!inserted) it->second = it->second.unite(part);
+      }
+}
+
+std::vector<Box3i> DirtyRegions::boxes() const {
+  std::vector<std::pair<Vec3i, Box3i>> all(per_chunk_.begin(), per_chunk_.end());
+  std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
+    return std::tie(a.first.z, a.first.y, a.first.x) < std::tie(b.first.z, b.first.y, b.first.x);
+  });
+  std::vector<Box3i> out;
+  out.reserve(all.size());
+  for (const auto& [c, b] : all) out.push_back(b);
+  return out;
+}
+
+Box3i DirtyRegions::bounds() const {
+  Box3i u{{0, 0, 0}, {0, 0, 0}};
+  for (const auto& [c, b] : per_chunk_) u = u.unite(b);
+  return u;
+}
+
+EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
+  validate(e);
+  Box3i box = brush_bounds(e.brush);
+  if (world.voxels.bounds()) box = box.intersect(*world.voxels.bounds());
+  EditResult result;
+  result.changed_box = {{0, 0, 0}, {0, 0, 0}};
+  if (box.empty()) return result;
+  if (box.volume() > kMaxEditVoxels) {
+    throw InvalidArgument("edit covers " + std::to_string(box.volume()) + " voxels; the limit is 2^33");
+  }
+  const StampBrush* stamp = std::get_if<StampBrush>(&e.brush);
+  Grid<std::uint8_t>& g = world.voxels;
+  const int edge = g.chunk_edge();
+  const Vec3i c0 = g.chunk_of(box.begin), c1 = g.chunk_of(box.end - Vec3i::splat(1));
+  Vec3i lo = box.end, hi = box.begin - Vec3i::splat(1);
+  for (int cz = c0.z; cz <= c1.z; ++cz)
+    for (int cy = c0.y; cy <= c1.y; ++cy)
+      for (int cx = c0.x; cx <= c1.x; ++cx) {
+        const Vec3i coord{cx, cy, cz};
+        const Box3i cb = g.chunk_box(coord);
+        const Box3i part = cb.intersect(box);
+        // A uniform chunk the operation cannot change is skipped without expanding it.
+        const ChunkView<std::uint8_t> view = g.chunk_view(coord);
+        if (view.uniform() && !stamp) {
+          const std::uint8_t v = view.uniform_value;
+          if ((e.op == EditOp::kPlace && v == e.material) || (e.op != EditOp::kPlace && v == 0)) continue;
+        }
+        Vec3i clo = part.end, chi = part.begin - Vec3i::splat(1);  // changes inside this chunk
+        g.edit_chunk(coord, [&](std::uint8_t* voxels) {
+          bool changed = false;
+          for (int z = part.begin.z; z < part.end.z; ++z)
+            for (int y = part.begin.y; y < part.end.y; ++y)
+              for (int x = part.begin.x; x < part.end.x; ++x) {
+                const Vec3i p{x, y, z};
+                if (!brush_contains(e.brush, p)) continue;
+                std::uint8_t& v = voxels[((z - cb.begin.z) * edge + (y - cb.begin.y)) * edge + (x - cb.begin.x)];
+                const std::uint8_t paint = stamp ? stamp->model->voxels.get(p - stamp->offset) : e.material;
+                std::uint8_t next = v;
+                switch (e.op) {
+                  case EditOp::kPlace: next = paint; break;
+                  case EditOp::kCarve: next = 0; break;
+                  case EditOp::kPaint: next = v != 0 ? paint : v; break;
+                }
+                if (next == v) continue;
+                v = next;
+                changed = true;
+                ++result.voxels_changed;
+                clo = {std::min(clo.x, x), std::min(clo.y, y), std::min(clo.z, z)};
+                chi = {std::max(chi.x, x), std::max(chi.y, y), std::max(chi.z, z)};
+              }
+          return changed;
+        });
+        if (chi.x >= clo.x) {
+          const Box3i changed = Box3i::from_inclusive(clo, chi);
+          if (dirty) dirty->add(changed);
+          lo = {std::min(lo.x, clo.x), std::min(lo.y, clo.y), std::min(lo.z, clo.z)};
+          hi = {std::max(hi.x, chi.x), std::max(hi.y, chi.y), std::max(hi.z, chi.z)};
+        }
+      }
+  if (result.voxels_changed > 0) result.changed_box = Box3i::from_inclusive(lo, hi);
+  return result;
+}
+
+}  // namespace voxfield

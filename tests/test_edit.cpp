@@ -1,0 +1,221 @@
+// Brushes and edits against per-voxel definitions, and incremental distance updates against full
+// rebuilds (bit-identical, after every edit of long random streams).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "voxfield/dynamic_field.h"
+#include "voxfield/edit.h"
+
+using namespace voxfield;
+
+namespace {
+
+std::vector<std::uint8_t> dense(const World& w, const Box3i& b) {
+  std::vector<std::uint8_t> v(static_cast<std::size_t>(b.volume()));
+  w.voxels.copy_to_dense(b, v.data());
+  return v;
+}
+
+// The definition of each operation, voxel by voxel, as the oracle.
+void apply_by_definition(World& w, const Edit& e) {
+  Box3i box = brush_bounds(e.brush);
+  if (w.voxels.bounds()) box = box.intersect(*w.voxels.bounds());
+  const StampBrush* stamp = std::get_if<StampBrush>(&e.brush);
+  for (int z = box.begin.z; z < box.end.z; ++z)
+    for (int y = box.begin.y; y < box.end.y; ++y)
+      for (int x = box.begin.x; x < box.end.x; ++x) {
+        const Vec3i p{x, y, z};
+        if (!brush_contains(e.brush, p)) continue;
+        const std::uint8_t m = stamp ? stamp->model->voxels.get(p - stamp->offset) : e.material;
+        const std::uint8_t old = w.voxels.get(p);
+        if (e.op == EditOp::kPlace) w.voxels.set(p, m);
+        if (e.op == EditOp::kCarve) w.voxels.set(p, 0);
+        if (e.op == EditOp::kPaint && old != 0) w.voxels.set(p, m);
+      }
+}
+
+Edit random_edit(std::mt19937& rng, const Box3i& area, const std::shared_ptr<const World>& model) {
+  auto uni = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
+  auto coord = [&](int axis) { return uni(area.begin[axis] - 4, area.end[axis] + 4); };
+  Edit e;
+  e.op = static_cast<EditOp>(rng() % 3);
+  e.material = static_cast<std::uint8_t>(1 + rng() % 5);
+  switch (rng() % 5) {
+    case 0: e.brush = SphereBrush{{coord(0), coord(1), coord(2)}, uni(0, 7)}; break;
+    case 1: {
+      const Vec3i a{static_cast<int>(coord(0)), static_cast<int>(coord(1)), static_cast<int>(coord(2))};
+      e.brush = BoxBrush{a, a + Vec3i{static_cast<int>(rng() % 9), static_cast<int>(rng() % 9), static_cast<int>(rng() % 9)}};
+      break;
+    }
+    case 2: e.brush = RotatedBoxBrush{{coord(0), coord(1), coord(2)}, {uni(0, 5), uni(0, 3), uni(0, 4)}, {uni(0, 90), uni(0, 90), uni(0, 90)}}; break;
+    case 3: e.brush = CapsuleBrush{{coord(0), coord(1), coord(2)}, {coord(0), coord(1), coord(2)}, uni(0, 3)}; break;
+    default: e.brush = StampBrush{model, {static_cast<int>(coord(0)), static_cast<int>(coord(1)), static_cast<int>(coord(2))}};
+  }
+  return e;
+}
+
+std::shared_ptr<const World> small_model() {
+  auto m = std::make_shared<World>(8);
+  for (int i = 0; i < 5; ++i) m->voxels.set({i, i % 2, 2 * (i % 3)}, static_cast<std::uint8_t>(10 + i));
+  return m;
+}
+
+}  // namespace
+
+TEST(Edit, EveryBrushAndOperationMatchesItsDefinition) {
+  std::mt19937 rng(21);
+  const Box3i bounds{{-7, 3, -20}, {40, 35, 13}};  // odd, negative, not chunk aligned
+  World a(16, bounds), b(16, bounds);
+  const auto model = small_model();
+  DirtyRegions dirty(16);
+  for (int i = 0; i < 400; ++i) {
+    const Edit e = random_edit(rng, bounds, model);
+    const std::vector<std::uint8_t> before = dense(a, bounds);
+    const EditResult r = apply_edit(a, e, &dirty);
+    apply_by_definition(b, e);
+    const std::vector<std::uint8_t> after = dense(a, bounds);
+    ASSERT_EQ(after, dense(b, bounds)) << "edit " << i;
+    // The reported count and box are exactly the changed voxels; dirty regions cover them.
+    std::int64_t changed = 0;
+    std::size_t k = 0;
+    for (int z = bounds.begin.z; z < bounds.end.z; ++z)
+      for (int y = bounds.begin.y; y < bounds.end.y; ++y)
+        for (int x = bounds.begin.x; x < bounds.end.x; ++x, ++k) {
+          if (before[k] == after[k]) continue;
+          ++changed;
+          ASSERT_TRUE(r.changed_box.contains(Vec3i{x, y, z}));
+          bool covered = false;
+          for (const Box3i& d : dirty.boxes()) covered |= d.contains(Vec3i{x, y, z});
+          ASSERT_TRUE(covered);
+        }
+    ASSERT_EQ(changed, r.voxels_changed);
+    dirty.clear();
+  }
+  // Chunks emptied by carving collapse away again.
+  World c(16, bounds);
+  apply_edit(c, {EditOp::kPlace, SphereBrush{{10, 10, 0}, 6}, 3});
+  EXPECT_GT(c.voxels.chunk_count(), 0u);
+  apply_edit(c, {EditOp::kCarve, BoxBrush{bounds.begin, bounds.end - Vec3i::splat(1)}, 1});
+  EXPECT_EQ(c.voxels.chunk_count(), 0u);
+}
+
+TEST(Edit, ShapesByHand) {
+  World w(8, Box3i{{-20, -20, -20}, {20, 20, 20}});
+  EXPECT_EQ(apply_edit(w, {EditOp::kPlace, SphereBrush{{0, 0, 0}, 1}, 2}).voxels_changed, 7);  // centre + 6
+  EXPECT_EQ(apply_edit(w, {EditOp::kPlace, BoxBrush{{5, 5, 5}, {6, 7, 8}}, 2}).voxels_changed, 2 * 3 * 4);
+  // A box rotated 90 degrees about z swaps its x and y extents.
+  World r(8, Box3i{{-20, -20, -20}, {20, 20, 20}});
+  apply_edit(r, {EditOp::kPlace, RotatedBoxBrush{{0, 0, 0}, {3, 1, 0}, {0, 0, 90}}, 1});
+  EXPECT_EQ(r.voxels.content_bounds(), (Box3i::from_inclusive({-1, -3, 0}, {1, 3, 0})));
+  // A capsule of radius 0 is the voxels on its segment.
+  World s(8, Box3i{{-20, -20, -20}, {20, 20, 20}});
+  EXPECT_EQ(apply_edit(s, {EditOp::kPlace, CapsuleBrush{{0, 0, 0}, {5, 0, 0}, 0}, 1}).voxels_changed, 6);
+  // Paint never creates matter.
+  EXPECT_EQ(apply_edit(s, {EditOp::kPaint, SphereBrush{{2, 0, 0}, 3}, 9}).voxels_changed, 6);
+  EXPECT_EQ(s.solid_count(), 6);
+  // Clipped at the bounds; out-of-bounds edits change nothing.
+  EXPECT_EQ(apply_edit(s, {EditOp::kPlace, BoxBrush{{19, 19, 19}, {30, 30, 30}}, 1}).voxels_changed, 1);
+  EXPECT_EQ(apply_edit(s, {EditOp::kPlace, SphereBrush{{100, 0, 0}, 5}, 1}).voxels_changed, 0);
+  // Malformed edits are refused before anything changes.
+  EXPECT_THROW(apply_edit(s, {EditOp::kPlace, SphereBrush{{0, 0, 0}, -1}, 1}), InvalidArgument);
+  EXPECT_THROW(apply_edit(s, {EditOp::kPlace, BoxBrush{{1, 0, 0}, {0, 0, 0}}, 1}), InvalidArgument);
+  EXPECT_THROW(apply_edit(s, {EditOp::kPlace, SphereBrush{{0, 0, 0}, 2}, 0}), InvalidArgument);
+  EXPECT_THROW(apply_edit(s, {EditOp::kPlace, StampBrush{nullptr, {0, 0, 0}}, 1}), InvalidArgument);
+  EXPECT_EQ(s.solid_count(), 7);
+}
+
+namespace {
+
+struct FieldCase {
+  Metric metric;
+  bool is_signed;
+  double clamp;
+  Storage storage;
+  bool sites;
+  std::array<double, 3> spacing{1, 1, 1};
+};
+
+void expect_same_field(const DistanceField& a, const DistanceField& b, const Box3i& box, int step) {
+  std::visit(
+      [&](const auto& ga) {
+        using G = std::decay_t<decltype(ga)>;
+        const G& gb = std::get<G>(b.values);
+        std::vector<typename G::value_type> va(static_cast<std::size_t>(box.volume())), vb(va.size());
+        ga.copy_to_dense(box, va.data());
+        gb.copy_to_dense(box, vb.data());
+        ASSERT_TRUE(std::memcmp(va.data(), vb.data(), va.size() * sizeof(va[0])) == 0) << "values differ after edit " << step;
+      },
+      a.values);
+  ASSERT_EQ(a.sites.has_value(), b.sites.has_value());
+  if (a.sites) {
+    std::vector<SiteOffset> sa(static_cast<std::size_t>(box.volume())), sb(sa.size());
+    a.sites->copy_to_dense(box, sa.data());
+    b.sites->copy_to_dense(box, sb.data());
+    ASSERT_TRUE(sa == sb) << "sites differ after edit " << step;
+  }
+}
+
+}  // namespace
+
+TEST(DynamicField, IncrementalUpdatesEqualFullRebuilds) {
+  const FieldCase cases[] = {
+      {Metric::kManhattan, false, 6, Storage::kF32, true},  {Metric::kEuclidean, true, 5, Storage::kF32, true},
+      {Metric::kChebyshev, true, 4, Storage::kU8, false},   {Metric::kEuclidean, false, 0, Storage::kU8, true},
+      {Metric::kManhattan, true, 3, Storage::kU16, true},   {Metric::kEuclidean, false, 7.5, Storage::kU16, false},
+      {Metric::kEuclidean, true, 6, Storage::kF32, false, {0.5, 1.0, 2.0}},
+  };
+  const Box3i bounds{{-9, 0, 4}, {43, 37, 33}};
+  const auto model = small_model();
+  std::uint32_t seed = 100;
+  int total_edits = 0;
+  for (const FieldCase& c : cases) {
+    SCOPED_TRACE(std::string(metric_name(c.metric)) + (c.is_signed ? " signed" : "") + " clamp " +
+                 std::to_string(c.clamp) + " " + storage_name(c.storage));
+    std::mt19937 rng(seed++);
+    World w(16, bounds);
+    for (int i = 0; i < 40; ++i) apply_edit(w, random_edit(rng, bounds, model));
+    DistanceOptions o;
+    o.metric = c.metric;
+    o.signed_distance = c.is_signed;
+    o.max_distance = c.clamp;
+    o.storage = c.storage;
+    o.nearest_sites = c.sites;
+    o.spacing = c.spacing;
+    DynamicDistanceField live(w, o);
+    DirtyRegions dirty(16);
+    for (int i = 0; i < 250; ++i) {
+      // One to three edits between updates: placements, deletions and paints, across chunk
+      // borders and reaching past the world's bounds.
+      const int batch = 1 + static_cast<int>(rng() % 3);
+      for (int k = 0; k < batch; ++k) apply_edit(w, random_edit(rng, bounds, model), &dirty);
+      total_edits += batch;
+      live.update(dirty);
+      dirty.clear();
+      const DistanceField full = compute_distance_field(w, live.options());
+      expect_same_field(live.field(), full, bounds, i);
+      if (HasFatalFailure()) return;
+    }
+  }
+  EXPECT_GT(total_edits, 2000);
+}
+
+TEST(DynamicField, UpdatesStayLocal) {
+  World w(16, Box3i::from_size({128, 128, 128}));
+  DistanceOptions o;
+  o.metric = Metric::kEuclidean;
+  o.max_distance = 8;
+  DynamicDistanceField live(w, o);
+  EXPECT_EQ(live.reach(), (Vec3i{8, 8, 8}));
+  DirtyRegions dirty(16);
+  apply_edit(w, {EditOp::kPlace, SphereBrush{{64, 64, 64}, 2}, 1}, &dirty);
+  const auto stats = live.update(dirty);
+  EXPECT_EQ(stats.regions, 1);
+  EXPECT_EQ(stats.voxels_recomputed, 21 * 21 * 21);  // the 5^3 edit grown by 8 on every side
+  EXPECT_EQ(stats.voxels_read, 37 * 37 * 37);        // ... and by 8 more for the sites
+  EXPECT_EQ(live.field().distance({64, 64, 71}), 5);
+  // Unbounded worlds without a domain are refused.
+  World open;
+  EXPECT_THROW(DynamicDistanceField(open, o), InvalidArgument);
+}
