@@ -153,6 +153,48 @@ assert j['algorithms'][0]['error']['wrong_voxels'] == 0 and j['algorithms'][1]['
 else
   echo "note: SciPy not installed; skipped the SciPy cross-checks"
 fi
+# Scripted edits: the world replayed in NumPy, the field checked against SciPy.
+if $PY -c "import scipy.ndimage" 2>/dev/null; then
+  check "edit world" 0 $PY -c "
+import numpy as np
+a = np.zeros((40, 30, 20), np.uint8); a[20:30, 5:25, 0:8] = 2; np.save('$tmp/e.npy', a)"
+  cat > "$tmp/edits.jsonl" <<'JSONL'
+{"op":"place","shape":"sphere","center":[10,10,10],"radius":4,"material":3}
+{"op":"carve","shape":"box","min":[22,8,2],"max":[27,12,7]}
+
+{"op":"paint","shape":"sphere","center":[25,15,4],"radius":6,"material":9}
+{"op":"place","shape":"box","min":[35,25,15],"max":[45,35,25],"material":4}
+{"op":"place","shape":"capsule","a":[2,2,18],"b":[12,20,18],"radius":1.5,"material":5}
+JSONL
+  check "edit" 0 "$V" edit "$tmp/e.npy" -e "$tmp/edits.jsonl" -o "$tmp/e_field.npy" --metric euclidean \
+      --max-distance 6 --save-world "$tmp/e_world.npy" --stats "$tmp/e_stats.json"
+  check "edits replayed" 0 $PY -c "
+import json, numpy as np
+from scipy import ndimage as nd
+a = np.load('$tmp/e.npy')
+x, y, z = np.indices(a.shape)
+a[(x - 10) ** 2 + (y - 10) ** 2 + (z - 10) ** 2 <= 16] = 3
+a[22:28, 8:13, 2:8] = 0
+m = ((x - 25) ** 2 + (y - 15) ** 2 + (z - 4) ** 2 <= 36) & (a != 0); a[m] = 9
+a[35:, 25:, 15:] = 4
+p = np.stack([x, y, z], -1).astype(float); A = np.array([2, 2, 18.]); B = np.array([12, 20, 18.])
+t = np.clip(((p - A) @ (B - A)) / ((B - A) @ (B - A)), 0, 1)
+a[((p - A - t[..., None] * (B - A)) ** 2).sum(-1) <= 2.25] = 5
+w = np.load('$tmp/e_world.npy')
+assert (w == a).all(), np.argwhere(w != a)[:5]
+f = np.load('$tmp/e_field.npy')
+assert np.allclose(f, np.minimum(nd.distance_transform_edt(a == 0), 6), atol=1e-5)
+s = json.load(open('$tmp/e_stats.json'))
+assert s['edits'] == 5 and len(s['edit_ms']) == 5 and len(s['voxels_recomputed']) == 5 and s['p99_ms'] >= s['p50_ms'], s
+assert all(v > 0 for v in s['voxels_recomputed'])
+"
+  printf '%s\n' '{"op":"place","shape":"sphere","center":[1,1,1],"radius":2}' '{"op":"place","shape":"blob"}' > "$tmp/bad.jsonl"
+  check "edit: malformed line" 1 "$V" edit "$tmp/e.npy" -e "$tmp/bad.jsonl" -o "$tmp/bad_field.npy"
+  expect_grep "edit: line number" "$tmp/err" "line 2"
+  [ ! -e "$tmp/bad_field.npy" ] && passes=$((passes+1)) || { echo "FAIL: edit wrote output despite a bad line"; fails=$((fails+1)); }
+fi
+check "edit --help" 0 "$V" edit --help
+
 check "field: lod without focus" 1 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --algorithm lod
 check "field: unknown metric" 2 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --metric taxicab
 check "field: spacing with manhattan" 1 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --spacing 1,2,3

@@ -16,38 +16,6 @@ struct FieldSettings {
   FieldArgs field;
 };
 
-// The field's values over `box` as an .npy volume of the storage's dtype.
-NpyVolume field_volume(const DistanceField& f, const Box3i& box) {
-  return std::visit(
-      [&](const auto& g) {
-        using T = typename std::decay_t<decltype(g)>::value_type;
-        std::vector<T> dense(static_cast<std::size_t>(box.volume()));
-        g.copy_to_dense(box, dense.data());
-        const DType t = std::is_same_v<T, float> ? DType::kFloat32
-                        : std::is_same_v<T, std::uint16_t> ? DType::kUInt16
-                                                           : DType::kUInt8;
-        return make_npy(t, box.size(), dense.data());
-      },
-      f.values);
-}
-
-// Nearest-site offsets as int16 a[x, y, z, 3]; -32768 where there is none.
-NpyVolume sites_volume(const Grid<SiteOffset>& g, const Box3i& box) {
-  const std::size_t n = static_cast<std::size_t>(box.volume());
-  std::vector<SiteOffset> dense(n);
-  g.copy_to_dense(box, dense.data());
-  std::vector<std::int16_t> planes(3 * n);
-  for (std::size_t i = 0; i < n; ++i) {
-    planes[i] = dense[i].dx;
-    planes[n + i] = dense[i].dy;
-    planes[2 * n + i] = dense[i].dz;
-  }
-  NpyVolume v{DType::kInt16, box.size(), {}, 3};
-  v.bytes.resize(planes.size() * sizeof(std::int16_t));
-  std::memcpy(v.bytes.data(), planes.data(), v.bytes.size());
-  return v;
-}
-
 int run_field(const FieldSettings& s) {
   std::optional<ThreadLimit> limit;
   if (s.field.threads > 0) limit.emplace(s.field.threads);

@@ -9,6 +9,7 @@
 
 #include "voxfield/algorithms.h"
 #include "voxfield/file.h"
+#include "voxfield/npy.h"
 
 namespace voxfield::cli {
 
@@ -31,6 +32,11 @@ struct FieldArgs {
 std::size_t peak_rss_bytes();
 
 nlohmann::json error_json(const FieldError& e);
+
+// The field's values over `box` as an .npy volume of the storage's dtype.
+NpyVolume field_volume(const DistanceField& f, const Box3i& box);
+// Nearest-site offsets as int16 a[x, y, z, 3]; -32768 where there is none.
+NpyVolume sites_volume(const Grid<SiteOffset>& g, const Box3i& box);
 
 // Writes `j` (indented) to `path` atomically.
 void write_json(const nlohmann::json& j, const std::string& path);
