@@ -195,6 +195,17 @@ assert all(v > 0 for v in s['voxels_recomputed'])
 fi
 check "edit --help" 0 "$V" edit --help
 
+# The durable world format through the CLI.
+check "convert to vfw" 0 "$V" convert "$C/ephtracy_monu10.vox" "$tmp/m.vfw"
+check "info vfw" 0 "$V" info "$tmp/m.vfw"
+expect_grep "vfw solid count" "$tmp/out" "solid voxels:  150764"
+check "convert vfw to vox" 0 "$V" convert "$tmp/m.vfw" "$tmp/m2.vox"
+check "info vfw round trip" 0 "$V" info "$tmp/m2.vox"
+expect_grep "vfw round trip count" "$tmp/out" "solid voxels:  150764"
+head -c 3000 "$tmp/m.vfw" > "$tmp/cut.vfw"
+check "truncated vfw" 1 "$V" info "$tmp/cut.vfw"
+expect_grep "truncated vfw message" "$tmp/err" "cut.vfw"
+
 check "field: lod without focus" 1 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --algorithm lod
 check "field: unknown metric" 2 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --metric taxicab
 check "field: spacing with manhattan" 1 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --spacing 1,2,3

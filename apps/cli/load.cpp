@@ -4,6 +4,7 @@
 
 #include "cli.h"
 #include "voxfield/npy.h"
+#include "voxfield/world_file.h"
 
 namespace voxfield::cli {
 namespace {
@@ -40,7 +41,24 @@ LoadedWorld load_world(const std::filesystem::path& path, int chunk_edge) {
                     std::string("NumPy .npy, ") + dtype_name(v.dtype), std::nullopt};
     return out;
   }
-  throw InvalidArgument(path.string() + ": unknown file type \"" + ext + "\" (expected .vox or .npy)");
+  if (ext == ".vfw") {
+    WorldFile f = read_world_file(path);
+    const Box3i extent = f.world.voxels.bounds() ? *f.world.voxels.bounds() : f.world.voxels.content_bounds();
+    const std::string description = "voxfield world, format " + std::to_string(f.version) + ", " +
+                                    std::to_string(f.fields.size()) + " distance field(s)";
+    if (f.world.voxels.chunk_edge() != chunk_edge) {
+      // Re-chunk to the edge asked for.
+      World w(chunk_edge, f.world.voxels.bounds());
+      w.palette = f.world.palette;
+      const Box3i content = f.world.voxels.content_bounds();
+      std::vector<std::uint8_t> dense(static_cast<std::size_t>(content.volume()));
+      f.world.voxels.copy_to_dense(content, dense.data());
+      w.voxels.copy_from_dense(content, dense.data());
+      return {std::move(w), "vfw", extent, description, std::nullopt};
+    }
+    return {std::move(f.world), "vfw", extent, description, std::nullopt};
+  }
+  throw InvalidArgument(path.string() + ": unknown file type \"" + ext + "\" (expected .vox, .npy or .vfw)");
 }
 
 void save_world(const World& world, const Box3i& extent, const std::filesystem::path& path) {
@@ -51,8 +69,10 @@ void save_world(const World& world, const Box3i& extent, const std::filesystem::
     Box3i box = extent.unite(world.voxels.content_bounds());
     if (box.empty()) box = Box3i::from_size({1, 1, 1});
     write_npy(npy_from_world(world, box), path);
+  } else if (ext == ".vfw") {
+    write_world_file(world, path);
   } else {
-    throw InvalidArgument(path.string() + ": unknown output type \"" + ext + "\" (expected .vox or .npy)");
+    throw InvalidArgument(path.string() + ": unknown output type \"" + ext + "\" (expected .vox, .npy or .vfw)");
   }
 }
 

@@ -1,0 +1,265 @@
+// voxfield — .vfw world files (format: docs/formats.md, "voxfield world files").
+//
+// Layout, all little-endian:
+//   header   "VXFWORLD" u32 version u32 section_count u32 crc32(previous 16 bytes)
+//   sections u32 kind (1 world, 2 distance field), u64 bytes, payload, u32 crc32(payload)
+// A grid inside a payload: u32 chunk_edge, u32 value_bytes, background value, u8 bounded
+// [+ 6 x i32 bounds], u64 chunk_count, then per chunk: 3 x i32 coordinate, u8 kind (0 uniform: one
+// value follows; 1 dense: u32 size + zlib stream of edge^3 values, x fastest).
+// Every section carries its own CRC-32, so a flipped bit anywhere is caught before it is used.
+#include "voxfield/world_file.h"
+
+#include <zlib.h>
+
+#include <cstring>
+#include <type_traits>
+
+#include "byte_reader.h"
+#include "voxfield/file.h"
+
+namespace voxfield {
+namespace {
+
+constexpr char kMagic[8] = {'V', 'X', 'F', 'W', 'O', 'R', 'L', 'D'};
+enum SectionKind : std::uint32_t { kWorldSection = 1, kFieldSection = 2 };
+
+class Out {
+ public:
+  std::vector<std::uint8_t> b;
+  template <class T>
+  void put(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const auto* p = reinterpret_cast<const std::uint8_t*>(&v);
+    b.insert(b.end(), p, p + sizeof(T));
+  }
+  void bytes(const void* p, std::size_t n) {
+    const auto* q = static_cast<const std::uint8_t*>(p);
+    b.insert(b.end(), q, q + n);
+  }
+};
+
+std::uint32_t crc(const std::uint8_t* p, std::size_t n) {
+  uLong c = crc32(0L, Z_NULL, 0);
+  while (n > 0) {
+    const uInt part = static_cast<uInt>(std::min<std::size_t>(n, 1u << 30));
+    c = crc32(c, p, part);
+    p += part;
+    n -= part;
+  }
+  return static_cast<std::uint32_t>(c);
+}
+
+template <class T>
+void put_grid(Out& o, const Grid<T>& g) {
+  o.put<std::uint32_t>(static_cast<std::uint32_t>(g.chunk_edge()));
+  o.put<std::uint32_t>(sizeof(T));
+  o.put(g.background());
+  o.put<std::uint8_t>(g.bounds() ? 1 : 0);
+  if (g.bounds()) {
+    for (int k = 0; k < 3; ++k) o.put<std::int32_t>(g.bounds()->begin[k]);
+    for (int k = 0; k < 3; ++k) o.put<std::int32_t>(g.bounds()->end[k]);
+  }
+  const std::vector<Vec3i> coords = g.chunk_coords();
+  o.put<std::uint64_t>(coords.size());
+  const std::size_t raw = static_cast<std::size_t>(g.chunk_volume()) * sizeof(T);
+  std::vector<std::uint8_t> packed(compressBound(static_cast<uLong>(raw)));
+  for (const Vec3i c : coords) {
+    o.put<std::int32_t>(c.x);
+    o.put<std::int32_t>(c.y);
+    o.put<std::int32_t>(c.z);
+    const ChunkView<T> v = g.chunk_view(c);
+    if (v.uniform()) {
+      o.put<std::uint8_t>(0);
+      o.put(v.uniform_value);
+      continue;
+    }
+    o.put<std::uint8_t>(1);
+    uLongf size = static_cast<uLongf>(packed.size());
+    if (compress2(packed.data(), &size, reinterpret_cast<const Bytef*>(v.voxels), static_cast<uLong>(raw), 1) != Z_OK) {
+      throw Error("world file: zlib could not compress a chunk");
+    }
+    o.put<std::uint32_t>(static_cast<std::uint32_t>(size));
+    o.bytes(packed.data(), size);
+  }
+}
+
+template <class T>
+T get(detail::ByteReader& r, const char* what) {
+  T v;
+  std::memcpy(&v, r.take(sizeof(T), what).data(), sizeof(T));
+  return v;
+}
+
+template <class T>
+Grid<T> get_grid(detail::ByteReader& r) {
+  const auto edge = get<std::uint32_t>(r, "chunk edge");
+  if (edge < 8 || edge > 128 || (edge & (edge - 1)) != 0) r.fail("chunk edge " + std::to_string(edge) + " is not a power of two in 8..128");
+  if (get<std::uint32_t>(r, "value size") != sizeof(T)) r.fail("value size does not match the grid's type");
+  const T background = get<T>(r, "background");
+  std::optional<Box3i> bounds;
+  if (get<std::uint8_t>(r, "bounds flag")) {
+    Box3i b;
+    for (int k = 0; k < 3; ++k) b.begin[k] = get<std::int32_t>(r, "bounds");
+    for (int k = 0; k < 3; ++k) b.end[k] = get<std::int32_t>(r, "bounds");
+    if (b.empty()) r.fail("empty grid bounds " + to_string(b));
+    bounds = b;
+  }
+  Grid<T> g(static_cast<int>(edge), background, bounds);
+  const auto count = get<std::uint64_t>(r, "chunk count");
+  if (count > r.remaining() / 13) r.fail("chunk count " + std::to_string(count) + " overruns the section");
+  const std::size_t raw = static_cast<std::size_t>(g.chunk_volume()) * sizeof(T);
+  std::vector<Vec3i> coords;
+  std::vector<std::unique_ptr<T[]>> data;
+  for (std::uint64_t i = 0; i < count; ++i) {
+    Vec3i c;
+    c.x = get<std::int32_t>(r, "chunk coordinate");
+    c.y = get<std::int32_t>(r, "chunk coordinate");
+    c.z = get<std::int32_t>(r, "chunk coordinate");
+    const auto kind = get<std::uint8_t>(r, "chunk kind");
+    if (bounds && g.chunk_box(c).intersect(*bounds).empty()) r.fail("chunk " + to_string(c) + " lies outside the grid bounds");
+    if (kind == 0) {
+      // Uniform chunks stay single values: no voxel array is allocated for them.
+      const T v = get<T>(r, "uniform value");
+      g.fill(bounds ? g.chunk_box(c).intersect(*bounds) : g.chunk_box(c), v);
+      continue;
+    }
+    std::unique_ptr<T[]> voxels(new T[static_cast<std::size_t>(g.chunk_volume())]);
+    if (kind == 1) {
+      const auto size = get<std::uint32_t>(r, "chunk size");
+      auto packed = r.take(size, "chunk data");
+      uLongf out = static_cast<uLongf>(raw);
+      if (uncompress(reinterpret_cast<Bytef*>(voxels.get()), &out, packed.data(), size) != Z_OK || out != raw) {
+        r.fail("chunk " + to_string(c) + " does not decompress to " + std::to_string(raw) + " bytes");
+      }
+    } else {
+      r.fail("unknown chunk kind " + std::to_string(kind));
+    }
+    coords.push_back(c);
+    data.push_back(std::move(voxels));
+  }
+  g.adopt_chunks(coords, std::move(data));
+  return g;
+}
+
+void put_field(Out& o, const DistanceField& f) {
+  const DistanceOptions& op = f.options;
+  o.put<std::uint8_t>(static_cast<std::uint8_t>(op.metric));
+  o.put<std::uint8_t>(op.signed_distance);
+  o.put<std::uint8_t>(static_cast<std::uint8_t>(op.storage));
+  o.put<std::uint8_t>(f.sites.has_value());
+  o.put<double>(op.max_distance);
+  for (double s : op.spacing) o.put<double>(s);
+  o.put<double>(op.fixed_point_scale);
+  for (int k = 0; k < 3; ++k) o.put<std::int32_t>(f.domain.begin[k]);
+  for (int k = 0; k < 3; ++k) o.put<std::int32_t>(f.domain.end[k]);
+  o.put<double>(f.encoding.scale);
+  o.put<std::int64_t>(f.encoding.bias);
+  std::visit([&](const auto& g) { put_grid(o, g); }, f.values);
+  if (f.sites) put_grid(o, *f.sites);
+}
+
+DistanceField get_field(detail::ByteReader& r) {
+  DistanceField f;
+  const auto metric = get<std::uint8_t>(r, "metric");
+  const auto is_signed = get<std::uint8_t>(r, "signed");
+  const auto storage = get<std::uint8_t>(r, "storage");
+  const auto has_sites = get<std::uint8_t>(r, "sites flag");
+  if (metric > 2 || storage > 2 || is_signed > 1 || has_sites > 1) r.fail("invalid distance field options");
+  f.options.metric = static_cast<Metric>(metric);
+  f.options.signed_distance = is_signed;
+  f.options.storage = static_cast<Storage>(storage);
+  f.options.nearest_sites = has_sites;
+  f.options.max_distance = get<double>(r, "max distance");
+  for (double& s : f.options.spacing) s = get<double>(r, "spacing");
+  f.options.fixed_point_scale = get<double>(r, "fixed-point scale");
+  for (int k = 0; k < 3; ++k) f.domain.begin[k] = get<std::int32_t>(r, "domain");
+  for (int k = 0; k < 3; ++k) f.domain.end[k] = get<std::int32_t>(r, "domain");
+  f.options.domain = f.domain;
+  f.encoding.scale = get<double>(r, "scale");
+  f.encoding.bias = get<std::int64_t>(r, "bias");
+  if (!(f.encoding.scale > 0)) r.fail("invalid field encoding");
+  switch (f.options.storage) {
+    case Storage::kU8: f.values = get_grid<std::uint8_t>(r); break;
+    case Storage::kU16: f.values = get_grid<std::uint16_t>(r); break;
+    case Storage::kF32: f.values = get_grid<float>(r); break;
+  }
+  if (has_sites) f.sites = get_grid<SiteOffset>(r);
+  return f;
+}
+
+void put_section(Out& file, std::uint32_t kind, const Out& payload) {
+  file.put<std::uint32_t>(kind);
+  file.put<std::uint64_t>(payload.b.size());
+  file.bytes(payload.b.data(), payload.b.size());
+  file.put<std::uint32_t>(crc(payload.b.data(), payload.b.size()));
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_world_file(const World& world, const std::vector<const DistanceField*>& fields) {
+  Out file;
+  file.bytes(kMagic, 8);
+  file.put<std::uint32_t>(kWorldFileVersion);
+  file.put<std::uint32_t>(static_cast<std::uint32_t>(1 + fields.size()));
+  file.put<std::uint32_t>(crc(file.b.data(), 16));
+  Out w;
+  for (const Rgba& c : world.palette) w.put(c);
+  put_grid(w, world.voxels);
+  put_section(file, kWorldSection, w);
+  for (const DistanceField* f : fields) {
+    Out p;
+    put_field(p, *f);
+    put_section(file, kFieldSection, p);
+  }
+  return std::move(file.b);
+}
+
+WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::string& name) {
+  detail::ByteReader r(bytes, name);
+  if (bytes.size() < 20 || std::memcmp(bytes.data(), kMagic, 8) != 0) r.fail_at(0, "not a voxfield world file (bad magic)");
+  r.skip(8, "magic");
+  WorldFile out;
+  out.version = get<std::uint32_t>(r, "version");
+  const auto sections = get<std::uint32_t>(r, "section count");
+  const auto header_crc = get<std::uint32_t>(r, "header checksum");
+  if (header_crc != crc(bytes.data(), 16)) r.fail_at(0, "header checksum mismatch (corrupt file)");
+  if (out.version > kWorldFileVersion) {
+    r.fail_at(8, "written by a newer voxfield (format version " + std::to_string(out.version) +
+                     "); this build reads versions up to " + std::to_string(kWorldFileVersion));
+  }
+  if (out.version == 0) r.fail_at(8, "invalid format version 0");
+  if (sections == 0 || sections > 1024) r.fail_at(12, "invalid section count " + std::to_string(sections));
+  for (std::uint32_t s = 0; s < sections; ++s) {
+    const std::uint64_t at = r.offset();
+    const auto kind = get<std::uint32_t>(r, "section kind");
+    const auto size = get<std::uint64_t>(r, "section size");
+    if (size > r.remaining()) r.fail_at(at, "section of " + std::to_string(size) + " bytes overruns the file");
+    detail::ByteReader payload = r.sub(static_cast<std::size_t>(size), "section");
+    const auto stored = get<std::uint32_t>(r, "section checksum");
+    if (stored != crc(bytes.data() + at + 12, static_cast<std::size_t>(size))) r.fail_at(at, "section checksum mismatch (corrupt file)");
+    if (kind == kWorldSection) {
+      if (s != 0) r.fail_at(at, "the world section must come first");
+      for (Rgba& c : out.world.palette) c = get<Rgba>(payload, "palette");
+      out.world.voxels = get_grid<std::uint8_t>(payload);
+    } else if (kind == kFieldSection) {
+      if (s == 0) r.fail_at(at, "a field section before the world");
+      out.fields.push_back(get_field(payload));
+    } else {
+      r.fail_at(at, "unknown section kind " + std::to_string(kind));
+    }
+    if (!payload.at_end()) r.fail_at(payload.offset(), "trailing bytes in a section");
+  }
+  if (!r.at_end()) r.fail("trailing bytes after the last section");
+  return out;
+}
+
+void write_world_file(const World& world, const std::filesystem::path& path, const std::vector<const DistanceField*>& fields) {
+  write_file_atomic(path, encode_world_file(world, fields));
+}
+
+WorldFile read_world_file(const std::filesystem::path& path) {
+  const auto bytes = read_file(path);
+  return parse_world_file(bytes, path.string());
+}
+
+}  // namespace voxfield
