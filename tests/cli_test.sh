@@ -206,6 +206,15 @@ head -c 3000 "$tmp/m.vfw" > "$tmp/cut.vfw"
 check "truncated vfw" 1 "$V" info "$tmp/cut.vfw"
 expect_grep "truncated vfw message" "$tmp/err" "cut.vfw"
 
+# The dissertation's edit stream, verified against full rebuilds after every edit.
+check "bench edits --verify" 0 "$V" bench edits --world 48 --chunk 16 --edits 40 --metric manhattan --max-distance 6 \
+    --verify --csv "$tmp/edits.csv" --json "$tmp/edits.json"
+expect_grep "bench edits verify line" "$tmp/out" "verify: 0 of 40"
+[ "$(wc -l < "$tmp/edits.csv")" -eq 41 ] && passes=$((passes+1)) || { echo "FAIL: bench edits CSV rows"; fails=$((fails+1)); }
+check "bench edits json" 0 $PY -c "
+import json; j = json.load(open('$tmp/edits.json'))
+assert j['edits'] == 40 and j['verify_mismatches'] == 0 and j['latency_ms']['p99'] >= j['latency_ms']['median'] > 0, j"
+
 check "field: lod without focus" 1 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --algorithm lod
 check "field: unknown metric" 2 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --metric taxicab
 check "field: spacing with manhattan" 1 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --spacing 1,2,3
