@@ -21,7 +21,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <functional>
 #include <type_traits>
 
 #include "field_plan.h"
@@ -262,8 +261,8 @@ void solve_line(const Kernel& k, int n, const V* f, V* out, std::int32_t* arg, s
   k(n, f, out, arg, s, t);
 }
 
-template <class Kernel, class V>
-void solve_slice_envelope(const Kernel& kx, const Kernel& ky, int X, int Y, SliceBuffers<V>& b, bool track_sites, V inf) {
+template <class KernelX, class KernelY, class V>
+void solve_slice_envelope2(const KernelX& kx, const KernelY& ky, int X, int Y, SliceBuffers<V>& b, bool track_sites, V inf) {
   std::int32_t* arg_x = track_sites ? b.arg_x.data() : nullptr;
   std::int32_t* targ = track_sites ? b.targ.data() : nullptr;
   for (int y = 0; y < Y; ++y) {
@@ -277,6 +276,11 @@ void solve_slice_envelope(const Kernel& kx, const Kernel& ky, int X, int Y, Slic
   }
   transpose(b.f.data(), b.h.data(), Y, X);
   if (track_sites) transpose(b.targ.data(), b.arg_y.data(), Y, X);
+}
+
+template <class Kernel, class V>
+void solve_slice_envelope(const Kernel& kx, const Kernel& ky, int X, int Y, SliceBuffers<V>& b, bool track_sites, V inf) {
+  solve_slice_envelope2(kx, ky, X, Y, b, track_sites, inf);
 }
 
 // 2-D solve of one slice for Manhattan: min-plus sweeps along x per row, then along y across whole
@@ -535,6 +539,52 @@ void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
   });
 }
 
+// Calls fn(value_tag, solve, inf) with the 2-D slice solver of the plan's metric: V (the type of
+// value_tag) is the cost type the passes minimise, solve(X, Y, SliceBuffers<V>&) solves one slice,
+// inf is V's "no site". `extent` decides whether 32-bit Euclidean costs are wide enough.
+template <class Fn>
+void dispatch_solver(const Plan& p, Vec3i extent, Fn&& fn) {
+  const bool sites = p.sites;
+  if (p.metric == Metric::kManhattan) {
+    auto solve = [sites](int X, int Y, SliceBuffers<std::int32_t>& b) { solve_slice_manhattan(X, Y, b, sites); };
+    fn(std::int32_t{}, solve, detail::kManhattanInf);
+  } else if (p.metric == Metric::kChebyshev) {
+    auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
+      detail::envelope_1d(Chebyshev{}, n, f, o, a, s, t);
+    };
+    auto solve = [k, sites](int X, int Y, SliceBuffers<std::int32_t>& b) { solve_slice_envelope(k, k, X, Y, b, sites, Chebyshev::kInf); };
+    fn(std::int32_t{}, solve, Chebyshev::kInf);
+  } else if (p.unit_spacing && static_cast<double>(extent.x) * extent.x + static_cast<double>(extent.y) * extent.y +
+                                       static_cast<double>(extent.z) * extent.z < (1 << 29)) {
+    auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
+      detail::envelope_1d(detail::EuclideanInt32{}, n, f, o, a, s, t);
+    };
+    auto solve = [k, sites](int X, int Y, SliceBuffers<std::int32_t>& b) {
+      solve_slice_envelope(k, k, X, Y, b, sites, detail::EuclideanInt32::kInf);
+    };
+    fn(std::int32_t{}, solve, detail::EuclideanInt32::kInf);
+  } else if (p.unit_spacing) {
+    auto k = [](int n, const std::int64_t* f, std::int64_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
+      detail::envelope_1d(EuclideanInt{}, n, f, o, a, s, t);
+    };
+    auto solve = [k, sites](int X, int Y, SliceBuffers<std::int64_t>& b) { solve_slice_envelope(k, k, X, Y, b, sites, EuclideanInt::kInf); };
+    fn(std::int64_t{}, solve, EuclideanInt::kInf);
+  } else {
+    const EuclideanReal ex{p.spacing[0] * p.spacing[0]}, ey{p.spacing[1] * p.spacing[1]};
+    auto kx = [ex](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
+      detail::envelope_1d(ex, n, f, o, a, s, t);
+    };
+    auto ky = [ey](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
+      detail::envelope_1d(ey, n, f, o, a, s, t);
+    };
+    auto solve = [kx, ky, sites](int X, int Y, SliceBuffers<double>& b) {
+      // The two axes weigh differently; the slice solver takes one kernel per axis.
+      solve_slice_envelope2(kx, ky, X, Y, b, sites, EuclideanReal::kInf);
+    };
+    fn(double{}, solve, EuclideanReal::kInf);
+  }
+}
+
 template <class T, class U>
 DistanceField run(const Grid<std::uint8_t>& occupancy, const DistanceOptions& options, const Plan& p,
                   const DistanceEncoding& enc, T background) {
@@ -602,42 +652,10 @@ DistanceField run(const Grid<std::uint8_t>& occupancy, const DistanceOptions& op
   const double none_value = std::isfinite(p.clamp) ? p.clamp : std::numeric_limits<double>::infinity();
   const Encoder<T> encoder{p, enc, none_value};
   ChunkedVolume<SiteOffset>* sp = sites ? &*sites : nullptr;
-  if (p.metric == Metric::kManhattan) {
-    const bool track = p.sites;
-    auto solve = [track](int X, int Y, SliceBuffers<std::int32_t>& b) { solve_slice_manhattan(X, Y, b, track); };
-    pass_slices<T, U, std::int32_t>(p, world, g, sp, solve, encoder, cap32, detail::kManhattanInf);
-  } else if (p.metric == Metric::kChebyshev) {
-    auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
-      detail::envelope_1d(Chebyshev{}, n, f, o, a, s, t);
-    };
-    auto solve = [k, &p](int X, int Y, SliceBuffers<std::int32_t>& b) { solve_slice_envelope(k, k, X, Y, b, p.sites, Chebyshev::kInf); };
-    pass_slices<T, U, std::int32_t>(p, world, g, sp, solve, encoder, cap32, Chebyshev::kInf);
-  } else if (p.unit_spacing && static_cast<double>(p.domain.size().x) * p.domain.size().x +
-                                       static_cast<double>(p.domain.size().y) * p.domain.size().y +
-                                       static_cast<double>(p.domain.size().z) * p.domain.size().z < (1 << 29)) {
-    auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
-      detail::envelope_1d(detail::EuclideanInt32{}, n, f, o, a, s, t);
-    };
-    auto solve = [k, &p](int X, int Y, SliceBuffers<std::int32_t>& b) { solve_slice_envelope(k, k, X, Y, b, p.sites, detail::EuclideanInt32::kInf); };
-    pass_slices<T, U, std::int32_t>(p, world, g, sp, solve, encoder, cap32, detail::EuclideanInt32::kInf);
-  } else if (p.unit_spacing) {
-    auto k = [](int n, const std::int64_t* f, std::int64_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
-      detail::envelope_1d(EuclideanInt{}, n, f, o, a, s, t);
-    };
-    auto solve = [k, &p](int X, int Y, SliceBuffers<std::int64_t>& b) { solve_slice_envelope(k, k, X, Y, b, p.sites, EuclideanInt::kInf); };
-    pass_slices<T, U, std::int64_t>(p, world, g, sp, solve, encoder, cap32, EuclideanInt::kInf);
-  } else {
-    const EuclideanReal ex{p.spacing[0] * p.spacing[0]}, ey{p.spacing[1] * p.spacing[1]};
-    using K = std::function<void(int, const double*, double*, std::int32_t*, std::int32_t*, std::int32_t*)>;
-    const K kx = [ex](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
-      detail::envelope_1d(ex, n, f, o, a, s, t);
-    };
-    const K ky = [ey](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
-      detail::envelope_1d(ey, n, f, o, a, s, t);
-    };
-    auto solve = [&](int X, int Y, SliceBuffers<double>& b) { solve_slice_envelope(kx, ky, X, Y, b, p.sites, EuclideanReal::kInf); };
-    pass_slices<T, U, double>(p, world, g, sp, solve, encoder, cap32, EuclideanReal::kInf);
-  }
+  dispatch_solver(p, p.domain.size(), [&](auto tag, const auto& solve, auto inf) {
+    using V = decltype(tag);
+    pass_slices<T, U, V>(p, world, g, sp, solve, encoder, cap32, inf);
+  });
 
   // Hand the chunks to the grids (uniform ones collapse).
   std::vector<std::unique_ptr<T[]>> typed(g.chunks.size());
@@ -647,6 +665,162 @@ DistanceField run(const Grid<std::uint8_t>& occupancy, const DistanceOptions& op
   out.values = std::move(values);
   out.sites = std::move(sites_grid);
   return out;
+}
+
+// ---- Local recomputation (incremental updates) -------------------------------------------------
+//
+// The values of a box `out` need only the sites within the clamp's reach of it, so they are
+// computed on a dense box `in` (out grown by the reach) with the same passes as the whole-field
+// transform: pass A over the columns of `in`, keeping g only for the slices of `out`; the slice
+// passes over `in`'s x-y extent for those slices; encoding of `out`'s part. No chunk is
+// allocated: the workspace is a few dense arrays of `in`'s size.
+
+template <bool kSigned>
+void region_pass_z(const std::uint8_t* solid, Vec3i n, int z0, int z1, std::uint32_t cap,
+                   std::uint32_t* g, std::int16_t* dz) {
+  const std::size_t nx = static_cast<std::size_t>(n.x), plane = nx * static_cast<std::size_t>(n.y);
+  std::vector<std::uint32_t> col(static_cast<std::size_t>(n.z) * nx), ds(nx), da(nx);
+  std::vector<std::int32_t> ls(nx), la(nx);
+  for (int y = 0; y < n.y; ++y) {
+    std::uint32_t* __restrict dsr = ds.data();
+    std::uint32_t* __restrict dar = da.data();
+    std::fill(ds.begin(), ds.end(), cap);
+    std::fill(da.begin(), da.end(), cap);
+    for (int z = 0; z < n.z; ++z) {
+      const std::uint8_t* __restrict w = solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx;
+      std::uint32_t* __restrict c = col.data() + static_cast<std::size_t>(z) * nx;
+      for (std::size_t i = 0; i < nx; ++i) {
+        const bool s = w[i] != 0;
+        dsr[i] = s ? 0u : std::min(dsr[i] + 1u, cap);
+        if constexpr (kSigned) {
+          dar[i] = s ? std::min(dar[i] + 1u, cap) : 0u;
+          c[i] = s ? dar[i] : dsr[i];
+        } else {
+          c[i] = dsr[i];
+        }
+      }
+    }
+    std::fill(ds.begin(), ds.end(), cap);
+    std::fill(da.begin(), da.end(), cap);
+    for (int z = n.z - 1; z >= z0; --z) {
+      const std::uint8_t* __restrict w = solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx;
+      const std::uint32_t* __restrict c = col.data() + static_cast<std::size_t>(z) * nx;
+      for (std::size_t i = 0; i < nx; ++i) {
+        const bool s = w[i] != 0;
+        dsr[i] = s ? 0u : std::min(dsr[i] + 1u, cap);
+        if constexpr (kSigned) dar[i] = s ? std::min(dar[i] + 1u, cap) : 0u;
+      }
+      if (z >= z1) continue;
+      std::uint32_t* __restrict out = g + static_cast<std::size_t>(z - z0) * plane + static_cast<std::size_t>(y) * nx;
+      for (std::size_t i = 0; i < nx; ++i) {
+        const std::uint32_t back = (kSigned && w[i] != 0) ? dar[i] : dsr[i];
+        out[i] = std::min(c[i], back);
+      }
+    }
+    if (!dz) continue;
+    // Nearest site along z, below winning ties, for the slices of `out`.
+    std::fill(ls.begin(), ls.end(), INT32_MIN / 2);
+    std::fill(la.begin(), la.end(), INT32_MIN / 2);
+    for (int z = 0; z < z1; ++z) {
+      const std::uint8_t* w = solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx;
+      for (std::size_t i = 0; i < nx; ++i) (w[i] != 0 ? ls[i] : la[i]) = z;
+      if (z < z0) continue;
+      std::int16_t* d = dz + static_cast<std::size_t>(z - z0) * plane + static_cast<std::size_t>(y) * nx;
+      for (std::size_t i = 0; i < nx; ++i) {
+        d[i] = static_cast<std::int16_t>(std::clamp((kSigned && w[i] != 0 ? la[i] : ls[i]) - z, -32768, 32767));
+      }
+    }
+    std::fill(ls.begin(), ls.end(), INT32_MAX / 2);
+    std::fill(la.begin(), la.end(), INT32_MAX / 2);
+    for (int z = n.z - 1; z >= z0; --z) {
+      const std::uint8_t* w = solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx;
+      for (std::size_t i = 0; i < nx; ++i) (w[i] != 0 ? ls[i] : la[i]) = z;
+      if (z >= z1) continue;
+      std::int16_t* d = dz + static_cast<std::size_t>(z - z0) * plane + static_cast<std::size_t>(y) * nx;
+      for (std::size_t i = 0; i < nx; ++i) {
+        const std::int32_t above = (kSigned && w[i] != 0 ? la[i] : ls[i]) - z;
+        if (above < -static_cast<std::int32_t>(d[i])) d[i] = static_cast<std::int16_t>(std::min(above, 32767));
+      }
+    }
+  }
+}
+
+template <class T>
+void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, const Box3i& in, const Box3i& out,
+                         T* values, SiteOffset* sites) {
+  const Vec3i n = in.size(), m = out.size();
+  const int z0 = out.begin.z - in.begin.z, z1 = out.end.z - in.begin.z;
+  const int ox = out.begin.x - in.begin.x, oy = out.begin.y - in.begin.y;
+  const std::size_t plane = static_cast<std::size_t>(n.x) * n.y;
+  std::vector<std::uint8_t> solid(static_cast<std::size_t>(in.volume()));
+  occupancy.copy_to_dense(in, solid.data());
+  std::uint64_t cap = std::numeric_limits<std::uint32_t>::max() - 1;
+  if (std::isfinite(p.clamp)) cap = std::min<std::uint64_t>(cap, static_cast<std::uint64_t>(std::floor(p.clamp / p.spacing[2]) + 1));
+  const auto cap32 = static_cast<std::uint32_t>(cap);
+  std::vector<std::uint32_t> g(static_cast<std::size_t>(m.z) * plane);
+  std::vector<std::int16_t> dz(sites ? g.size() : 0);
+  if (p.is_signed) {
+    region_pass_z<true>(solid.data(), n, z0, z1, cap32, g.data(), sites ? dz.data() : nullptr);
+  } else {
+    region_pass_z<false>(solid.data(), n, z0, z1, cap32, g.data(), sites ? dz.data() : nullptr);
+  }
+  const double none_value = std::isfinite(p.clamp) ? p.clamp : std::numeric_limits<double>::infinity();
+  const Encoder<T> encoder{p, p.encoding, none_value};
+  const double clamp_cost = p.metric == Metric::kEuclidean ? p.clamp * p.clamp : p.clamp;
+  const bool euclid = p.metric == Metric::kEuclidean;
+  dispatch_solver(p, n, [&](auto tag, const auto& solve, auto inf) {
+    using V = decltype(tag);
+    const V clamp_v = clamp_cost >= static_cast<double>(inf) ? inf : static_cast<V>(clamp_cost);
+    const int passes = p.is_signed ? 2 : 1;
+    parallel_for(static_cast<std::size_t>(m.z), 1, [&](std::size_t zb, std::size_t ze) {
+      SliceBuffers<V> buf[2];
+      for (int k = 0; k < passes; ++k) buf[k].resize(n.x, n.y);
+      for (std::size_t zi = zb; zi < ze; ++zi) {
+        const std::uint32_t* gs = g.data() + zi * plane;
+        const std::uint8_t* ws = solid.data() + (static_cast<std::size_t>(z0) + zi) * plane;
+        for (std::size_t i = 0; i < plane; ++i) {
+          V c;
+          if (gs[i] >= cap32) {
+            c = inf;
+          } else if (euclid) {
+            const double gz = p.unit_spacing ? static_cast<double>(gs[i]) : p.spacing[2] * gs[i];
+            c = gz * gz > clamp_cost ? inf : static_cast<V>(gz * gz);
+          } else {
+            c = static_cast<V>(gs[i]);
+          }
+          if (p.is_signed) {
+            buf[1].f[i] = ws[i] ? c : V(0);
+            buf[0].f[i] = ws[i] ? V(0) : c;
+          } else {
+            buf[0].f[i] = c;
+          }
+        }
+        for (int k = 0; k < passes; ++k) solve(n.x, n.y, buf[k]);
+        for (int y = 0; y < m.y; ++y)
+          for (int x = 0; x < m.x; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y + oy) * n.x + static_cast<std::size_t>(x + ox);
+            const std::size_t o = (zi * static_cast<std::size_t>(m.y) + static_cast<std::size_t>(y)) * m.x + static_cast<std::size_t>(x);
+            const bool inside = p.is_signed && ws[i];
+            const SliceBuffers<V>& b = buf[inside ? 1 : 0];
+            const V cost = b.h[i];
+            const bool has_site = cost < inf && cost <= clamp_v;
+            values[o] = encoder.encode(static_cast<double>(cost), has_site, inside);
+            if (!sites) continue;
+            SiteOffset so;
+            if (has_site) {
+              const std::int32_t ys = b.arg_y[i];
+              const std::int32_t xs = b.arg_x[static_cast<std::size_t>(ys) * n.x + static_cast<std::size_t>(x + ox)];
+              so.dx = static_cast<std::int16_t>(xs - (x + ox));
+              so.dy = static_cast<std::int16_t>(ys - (y + oy));
+              const std::size_t col = static_cast<std::size_t>(ys) * n.x + static_cast<std::size_t>(xs);
+              const bool column_is_site = p.is_signed ? (ws[col] != 0) != inside : ws[col] != 0;
+              so.dz = column_is_site ? std::int16_t{0} : dz[zi * plane + col];
+            }
+            sites[o] = so;
+          }
+      }
+    });
+  });
 }
 
 Box3i chunk_aligned(const Box3i& b, int shift) {
@@ -762,6 +936,17 @@ FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOpt
   }
   return p;
 }
+
+template <class T>
+void compute_region(const Grid<std::uint8_t>& occupancy, const FieldPlan& p, const Box3i& in, const Box3i& out,
+                    T* values, SiteOffset* sites) {
+  if (!in.contains(out)) throw InvalidArgument("compute_region: the input box must contain the output box");
+  if (out.empty()) return;
+  compute_region_impl<T>(occupancy, p, in, out, values, sites);
+}
+template void compute_region<std::uint8_t>(const Grid<std::uint8_t>&, const FieldPlan&, const Box3i&, const Box3i&, std::uint8_t*, SiteOffset*);
+template void compute_region<std::uint16_t>(const Grid<std::uint8_t>&, const FieldPlan&, const Box3i&, const Box3i&, std::uint16_t*, SiteOffset*);
+template void compute_region<float>(const Grid<std::uint8_t>&, const FieldPlan&, const Box3i&, const Box3i&, float*, SiteOffset*);
 
 }  // namespace detail
 

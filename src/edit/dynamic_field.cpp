@@ -27,13 +27,6 @@ std::vector<Box3i> merge_overlapping(std::vector<Box3i> boxes) {
   return boxes;
 }
 
-template <class T>
-void copy_region(const Grid<T>& from, Grid<T>& to, const Box3i& box) {
-  std::vector<T> dense(static_cast<std::size_t>(box.volume()));
-  from.copy_to_dense(box, dense.data());
-  to.copy_from_dense(box, dense.data());
-}
-
 }  // namespace
 
 DynamicDistanceField::DynamicDistanceField(const World& world, DistanceOptions options)
@@ -64,20 +57,23 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
     const Box3i r = grow(b, reach_).intersect(domain);
     if (!r.empty()) reach_boxes.push_back(r);
   }
+  const detail::FieldPlan plan = detail::make_field_plan(world_->voxels, options_);
   for (const Box3i& r : merge_overlapping(std::move(reach_boxes))) {
-    // Values inside r depend on sites within the reach of r: compute on that box, keep r.
-    DistanceOptions local = options_;
-    local.domain = grow(r, reach_).intersect(domain);
-    const DistanceField part = compute_distance_field(world_->voxels, local);
+    // Values inside r depend on sites within the reach of r: compute r from that box, densely,
+    // and write it into the field.
+    const Box3i in = grow(r, reach_).intersect(domain);
+    std::vector<SiteOffset> sites(field_.sites ? static_cast<std::size_t>(r.volume()) : 0);
     std::visit(
         [&](auto& target) {
-          using G = std::decay_t<decltype(target)>;
-          copy_region(std::get<G>(part.values), target, r);
+          using T = typename std::decay_t<decltype(target)>::value_type;
+          std::vector<T> values(static_cast<std::size_t>(r.volume()));
+          detail::compute_region<T>(world_->voxels, plan, in, r, values.data(), field_.sites ? sites.data() : nullptr);
+          target.copy_from_dense(r, values.data());
         },
         field_.values);
-    if (field_.sites) copy_region(*part.sites, *field_.sites, r);
+    if (field_.sites) field_.sites->copy_from_dense(r, sites.data());
     stats.voxels_recomputed += r.volume();
-    stats.voxels_read += local.domain->volume();
+    stats.voxels_read += in.volume();
     ++stats.regions;
   }
   return stats;
