@@ -73,7 +73,7 @@ int run_bench_edits(const BenchEditsSettings& s) {
   // materials 0..255 where 0 (air) deletes.
   std::mt19937_64 rng(s.seed);
   auto uniform_int = [&](int lo, int hi) { return lo + static_cast<int>(rng() % static_cast<std::uint64_t>(hi - lo + 1)); };
-  DirtyRegions dirty(world.voxels.chunk_edge());
+  DirtyRegions dirty(world.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
   std::vector<double> latency_ms, update_ms;
   std::vector<std::int64_t> recomputed;
   std::int64_t mismatches = 0;

@@ -105,7 +105,7 @@ int run_edit(const EditSettings& s) {
   DynamicDistanceField field(world, o);
   const double build_ms = ms_since(t_build);
 
-  DirtyRegions dirty(world.voxels.chunk_edge());
+  DirtyRegions dirty(world.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
   std::vector<double> edit_ms;
   std::vector<std::int64_t> recomputed, changed;
   for (const Edit& e : edits) {

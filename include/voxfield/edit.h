@@ -62,7 +62,12 @@ struct Edit {
 // Boxes of changed voxels, kept per chunk (the union of the changes inside that chunk).
 class DirtyRegions {
  public:
-  explicit DirtyRegions(int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge);
+  enum class Track {
+    kAnyChange,  // every material change (renderers, meshers)
+    kOccupancy,  // only solid <-> air changes: all a distance field depends on
+  };
+  explicit DirtyRegions(int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge, Track track = Track::kAnyChange);
+  Track track() const { return track_; }
   void add(const Box3i& changed);
   bool empty() const { return per_chunk_.empty(); }
   void clear() { per_chunk_.clear(); }
@@ -79,6 +84,7 @@ class DirtyRegions {
     }
   };
   int shift_;
+  Track track_;
   std::unordered_map<Vec3i, Box3i, Hash> per_chunk_;
 };
 

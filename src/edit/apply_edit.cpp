@@ -41,7 +41,7 @@ void validate(const Edit& e) {
 
 }  // namespace
 
-DirtyRegions::DirtyRegions(int chunk_edge) : shift_(0) {
+DirtyRegions::DirtyRegions(int chunk_edge, Track track) : shift_(0), track_(track) {
   if (chunk_edge < 1 || (chunk_edge & (chunk_edge - 1)) != 0) throw InvalidArgument("dirty-region chunk edge must be a power of two");
   while ((1 << shift_) < chunk_edge) ++shift_;
 }
@@ -106,6 +106,7 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
           if ((e.op == EditOp::kPlace && v == e.material) || (e.op != EditOp::kPlace && v == 0)) continue;
         }
         Vec3i clo = part.end, chi = part.begin - Vec3i::splat(1);  // changes inside this chunk
+        Vec3i olo = part.end, ohi = part.begin - Vec3i::splat(1);  // solid <-> air changes
         g.edit_chunk(coord, [&](std::uint8_t* voxels) {
           bool changed = false;
           for (int z = part.begin.z; z < part.end.z; ++z)
@@ -122,17 +123,25 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
                   case EditOp::kPaint: next = v != 0 ? paint : v; break;
                 }
                 if (next == v) continue;
+                const std::uint8_t v_before = v;
                 v = next;
                 changed = true;
                 ++result.voxels_changed;
                 clo = {std::min(clo.x, x), std::min(clo.y, y), std::min(clo.z, z)};
                 chi = {std::max(chi.x, x), std::max(chi.y, y), std::max(chi.z, z)};
+                if ((next != 0) != (v_before != 0)) {
+                  olo = {std::min(olo.x, x), std::min(olo.y, y), std::min(olo.z, z)};
+                  ohi = {std::max(ohi.x, x), std::max(ohi.y, y), std::max(ohi.z, z)};
+                }
               }
           return changed;
         });
         if (chi.x >= clo.x) {
           const Box3i changed = Box3i::from_inclusive(clo, chi);
-          if (dirty) dirty->add(changed);
+          if (dirty && dirty->track() == DirtyRegions::Track::kAnyChange) dirty->add(changed);
+          if (dirty && dirty->track() == DirtyRegions::Track::kOccupancy && ohi.x >= olo.x) {
+            dirty->add(Box3i::from_inclusive(olo, ohi));
+          }
           lo = {std::min(lo.x, clo.x), std::min(lo.y, clo.y), std::min(lo.z, clo.z)};
           hi = {std::max(hi.x, chi.x), std::max(hi.y, chi.y), std::max(hi.z, chi.z)};
         }
