@@ -98,6 +98,9 @@ struct EditResult {
   std::int64_t voxels_changed = 0;
 };
 
+// Throws InvalidArgument for a malformed edit (see apply_edit); does nothing otherwise.
+void validate_edit(const Edit& edit);
+
 // Applies an edit; records the changed voxels in `dirty` when given. Throws InvalidArgument for a
 // malformed edit (radius < 0, min > max, material 0 with place or paint, a stamp without a model)
 // before changing anything.

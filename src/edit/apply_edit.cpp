@@ -11,7 +11,9 @@ namespace {
 
 constexpr std::int64_t kMaxEditVoxels = std::int64_t{1} << 33;
 
-void validate(const Edit& e) {
+}  // namespace
+
+void validate_edit(const Edit& e) {
   struct Check {
     void operator()(const SphereBrush& s) const {
       if (!(s.radius >= 0) || !std::isfinite(s.radius)) throw InvalidArgument("sphere radius must be >= 0");
@@ -38,8 +40,6 @@ void validate(const Edit& e) {
     throw InvalidArgument("place and paint need a material 1..255 (carve sets air)");
   }
 }
-
-}  // namespace
 
 DirtyRegions::DirtyRegions(int chunk_edge, Track track) : shift_(0), track_(track) {
   if (chunk_edge < 1 || (chunk_edge & (chunk_edge - 1)) != 0) throw InvalidArgument("dirty-region chunk edge must be a power of two");
@@ -79,7 +79,7 @@ Box3i DirtyRegions::bounds() const {
 }
 
 EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
-  validate(e);
+  validate_edit(e);
   Box3i box = brush_bounds(e.brush);
   if (world.voxels.bounds()) box = box.intersect(*world.voxels.bounds());
   EditResult result;

@@ -1,0 +1,43 @@
+// voxfield — LiveWorld: edits from any thread, consistent snapshots for readers.
+#include "voxfield/live_world.h"
+
+namespace voxfield {
+
+LiveWorld::LiveWorld(World world, DistanceOptions options)
+    : world_(std::move(world)), field_(world_, std::move(options)) {}
+
+void LiveWorld::submit(const Edit& edit) {
+  // Validated in the caller's thread, so that a bad edit is reported to whoever made it rather
+  // than to the updating thread.
+  validate_edit(edit);
+  std::lock_guard lock(queue_mutex_);
+  queue_.push_back(edit);
+}
+
+std::size_t LiveWorld::pending() const {
+  std::lock_guard lock(queue_mutex_);
+  return queue_.size();
+}
+
+LiveWorld::UpdateStats LiveWorld::update() {
+  std::lock_guard one_at_a_time(update_mutex_);
+  std::vector<Edit> edits;
+  {
+    std::lock_guard lock(queue_mutex_);
+    edits.swap(queue_);
+  }
+  UpdateStats stats;
+  if (edits.empty()) return stats;
+  std::unique_lock exclusive(state_mutex_, std::defer_lock);
+  {
+    std::lock_guard turnstile(turnstile_);  // new readers wait here until the update is in
+    exclusive.lock();
+  }
+  DirtyRegions dirty(world_.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
+  for (const Edit& e : edits) stats.voxels_changed += apply_edit(world_, e, &dirty).voxels_changed;
+  stats.edits = edits.size();
+  stats.voxels_recomputed = field_.update(dirty).voxels_recomputed;
+  return stats;
+}
+
+}  // namespace voxfield
