@@ -1,5 +1,6 @@
 // voxfield showcase: the README's main job. Generates worlds, exercises what voxfield can do on
 // them and writes a Markdown report with the figures into the output directory.
+#include <algorithm>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -7,6 +8,8 @@
 
 #include "cli.h"
 #include "voxfield/algorithms.h"
+#include "voxfield/dynamic_field.h"
+#include "voxfield/world_file.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
 #include "voxfield/scene.h"
@@ -132,6 +135,57 @@ int run_showcase(const ShowcaseSettings& s) {
   }
   md << "\n*Unsafe* voxels hold a value above the exact distance: a ray marcher trusting them skips "
         "through geometry. `terrain-sdf.npy` is the signed Euclidean field of the terrain.\n";
+
+  // A seeded stream of edits on the terrain, each followed by an incremental update, checked
+  // against a full rebuild at the end; the edited world is saved as a .vfw file.
+  {
+    World edited = make_terrain(to);
+    DistanceOptions eo;
+    eo.metric = Metric::kEuclidean;
+    eo.max_distance = 16;
+    DynamicDistanceField live(edited, eo);
+    DirtyRegions dirty(edited.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
+    std::uint64_t state = s.seed;
+    auto next = [&](int lo, int hi) {  // SplitMix64 steps: the same stream on every machine
+      state += 0x9E3779B97F4A7C15ull;
+      std::uint64_t z = state;
+      z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+      z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+      return lo + static_cast<int>((z ^ (z >> 31)) % static_cast<std::uint64_t>(hi - lo + 1));
+    };
+    std::vector<double> latencies;
+    const int edits = 200;
+    for (int i = 0; i < edits; ++i) {
+      Edit e;
+      const int material = next(0, 8);
+      e.op = material == 0 ? EditOp::kCarve : EditOp::kPlace;
+      e.material = static_cast<std::uint8_t>(std::max(material, 1));
+      e.brush = SphereBrush{{static_cast<double>(next(0, s.size - 1)), static_cast<double>(next(0, s.size - 1)),
+                             static_cast<double>(next(0, s.size - 1))},
+                            static_cast<double>(next(1, 8))};
+      const auto t0 = std::chrono::steady_clock::now();
+      apply_edit(edited, e, &dirty);
+      live.update(dirty);
+      dirty.clear();
+      latencies.push_back(ms_since(t0));
+    }
+    std::sort(latencies.begin(), latencies.end());
+    const DistanceField full = compute_distance_field(edited, live.options());
+    std::vector<float> a(static_cast<std::size_t>(voxels)), b(a.size());
+    std::get<Grid<float>>(live.field().values).copy_to_dense(Box3i::from_size(to.size), a.data());
+    std::get<Grid<float>>(full.values).copy_to_dense(Box3i::from_size(to.size), b.data());
+    const bool exact = a == b;
+    write_world_file(edited, fs::path(s.out) / "terrain-edited.vfw", {&live.field()});
+    md << "\n## Editing the terrain\n\n" << edits << " seeded sphere edits (radius 1–8, one in nine carves), "
+       << "each followed by an incremental exact update of the Euclidean field clamped at 16: median "
+       << fixed(latencies[latencies.size() / 2], 2) << " ms, p99 " << fixed(latencies[latencies.size() * 99 / 100], 2)
+       << " ms per edit. After the stream the field is "
+       << (exact ? "bit-identical to a full rebuild" : "**different from a full rebuild**")
+       << ". The edited world and its field are in `terrain-edited.vfw`.\n";
+    std::cout << "voxfield showcase: " << edits << " edits, median " << fixed(latencies[latencies.size() / 2], 2)
+              << " ms, field " << (exact ? "identical to" : "DIFFERENT from") << " a full rebuild\n";
+    if (!exact) throw Error("showcase: the incrementally updated field differs from a full rebuild");
+  }
 
   const fs::path report = fs::path(s.out) / "report.md";
   std::ofstream(report) << md.str();
