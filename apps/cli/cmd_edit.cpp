@@ -122,14 +122,8 @@ int run_edit(const EditSettings& s) {
   if (!s.save_world.empty()) save_world(world, in.extent, s.save_world);
   const double total = std::accumulate(edit_ms.begin(), edit_ms.end(), 0.0);
   const Vec3i d = in.extent.size();
-  nlohmann::json j{{"metric", metric_name(o.metric)},
-                   {"signed", o.signed_distance},
-                   {"max_distance", o.max_distance},
-                   {"storage", storage_name(o.storage)},
-                   {"dims", {d.x, d.y, d.z}},
-                   {"threads", max_threads()},
-                   {"chunk", s.field.chunk_edge},
-                   {"build_ms", build_ms},
+  nlohmann::json j = s.field.describe(o, d);
+  j.update(nlohmann::json{{"build_ms", build_ms},
                    {"edits", edits.size()},
                    {"edit_ms", edit_ms},
                    {"voxels_recomputed", recomputed},
@@ -139,7 +133,7 @@ int run_edit(const EditSettings& s) {
                    {"p50_ms", percentile(edit_ms, 0.5)},
                    {"p99_ms", percentile(edit_ms, 0.99)},
                    {"max_ms", edit_ms.empty() ? 0 : *std::max_element(edit_ms.begin(), edit_ms.end())},
-                   {"total_voxels_recomputed", std::accumulate(recomputed.begin(), recomputed.end(), std::int64_t{0})}};
+                   {"total_voxels_recomputed", std::accumulate(recomputed.begin(), recomputed.end(), std::int64_t{0})}});
   if (!s.stats.empty()) write_json(j, s.stats);
   std::cerr << "voxfield: " << edits.size() << " edits, " << total << " ms in all (p50 " << percentile(edit_ms, 0.5)
             << " ms, p99 " << percentile(edit_ms, 0.99) << " ms), wrote " << s.out << "\n";

@@ -41,19 +41,13 @@ int run_field(const FieldSettings& s) {
     write_npy(make_npy(DType::kUInt32, f.domain.size(), packed.data()), s.packed);
   }
   const Vec3i d = f.domain.size();
-  nlohmann::json j{{"algorithm", s.algorithm},
-                   {"metric", metric_name(o.metric)},
-                   {"signed", o.signed_distance},
-                   {"max_distance", o.max_distance},
-                   {"storage", storage_name(o.storage)},
-                   {"dims", {d.x, d.y, d.z}},
-                   {"threads", max_threads()},
-                   {"chunk", s.field.chunk_edge},
+  nlohmann::json j = s.field.describe(o, d);
+  j.update(nlohmann::json{{"algorithm", s.algorithm},
                    {"ms", stats.ms},
                    {"mvox_per_s", static_cast<double>(f.domain.volume()) / (stats.ms * 1e3)},
                    {"passes", stats.passes},
                    {"iterations", stats.iterations},
-                   {"peak_rss_mb", static_cast<double>(peak_rss_bytes()) / 1048576.0}};
+                   {"peak_rss_mb", static_cast<double>(peak_rss_bytes()) / 1048576.0}});
   if (a.algorithm != Algorithm::kExact) {
     DistanceOptions exact_o = o;
     exact_o.nearest_sites = false;

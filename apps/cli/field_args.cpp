@@ -3,6 +3,8 @@
 
 #include <sys/resource.h>
 
+#include "voxfield/parallel.h"
+
 #include <cstring>
 
 namespace voxfield::cli {
@@ -33,6 +35,13 @@ DistanceOptions FieldArgs::options() const {
   o.storage = parse_storage(storage);
   if (!spacing.empty()) o.spacing = {spacing[0], spacing[1], spacing[2]};
   return o;
+}
+
+nlohmann::json FieldArgs::describe(const DistanceOptions& o, Vec3i dims) const {
+  return {{"metric", metric_name(o.metric)},  {"signed", o.signed_distance},
+          {"max_distance", o.max_distance},   {"storage", storage_name(o.storage)},
+          {"dims", {dims.x, dims.y, dims.z}}, {"threads", max_threads()},
+          {"chunk", chunk_edge}};
 }
 
 std::optional<Box3i> FieldArgs::focus_box() const {

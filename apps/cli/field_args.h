@@ -25,6 +25,9 @@ struct FieldArgs {
 
   void add_to(CLI::App* cmd);
   DistanceOptions options() const;
+  // The settings every stats file starts with: metric, signed, max_distance, storage, dims,
+  // threads, chunk.
+  nlohmann::json describe(const DistanceOptions& o, Vec3i dims) const;
   std::optional<Box3i> focus_box() const;
 };
 

@@ -114,6 +114,25 @@ class SolidRows {
 
 using Plan = detail::FieldPlan;
 
+// One step of a z sweep over `n` lanes: ds / da are the running distances (in voxels) to the
+// nearest solid / air voxel seen so far, saturating at cap; returns through `c` the one each voxel
+// stores (for signed fields the distance that is not trivially zero). Shared by the whole-field
+// and the local passes.
+template <bool kSigned>
+inline void z_sweep_step(const std::uint8_t* __restrict w, std::uint32_t* __restrict ds, std::uint32_t* __restrict da,
+                         std::uint32_t* __restrict c, std::size_t n, std::uint32_t cap) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool solid = w[i] != 0;
+    ds[i] = solid ? 0u : std::min(ds[i] + 1u, cap);
+    if constexpr (kSigned) {
+      da[i] = solid ? std::min(da[i] + 1u, cap) : 0u;
+      c[i] = solid ? da[i] : ds[i];
+    } else {
+      c[i] = ds[i];
+    }
+  }
+}
+
 // Pass A on one chunk column (cx, cy) of the domain: for rows y in the domain, sweep z up and down
 // over `edge` lanes along x at once. The column of a row (Z x edge values) lives in `col`, a
 // thread-local buffer small enough for the cache, so each output voxel is written exactly once.
@@ -137,18 +156,8 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, ChunkedV
     std::uint32_t* __restrict dsr = ds;
     std::uint32_t* __restrict dar = da;
     for (int z = z0; z < z1; ++z) {
-      const std::uint8_t* __restrict w = world.row(cx, y, z);
-      std::uint32_t* __restrict c = col.data() + static_cast<std::size_t>(z - z0) * e;
-      for (int i = 0; i < e; ++i) {
-        const bool solid = w[i] != 0;
-        dsr[i] = solid ? 0u : std::min(dsr[i] + 1u, cap);
-        if constexpr (kSigned) {
-          dar[i] = solid ? std::min(dar[i] + 1u, cap) : 0u;
-          c[i] = solid ? dar[i] : dsr[i];
-        } else {
-          c[i] = dsr[i];
-        }
-      }
+      z_sweep_step<kSigned>(world.row(cx, y, z), dsr, dar, col.data() + static_cast<std::size_t>(z - z0) * e,
+                            static_cast<std::size_t>(e), cap);
     }
     // Backward (decreasing z): keep the smaller, and store once.
     std::fill(ds, ds + e, cap);
@@ -228,15 +237,26 @@ struct SliceBuffers {
   }
 };
 
-// Blocked transpose of an X-by-Y row-major array (index y*X + x) into Y-by-X (index x*Y + y).
+// Blocked transpose of the columns x_lo..x_hi-1 of an X-by-Y row-major array (index y*X + x) into
+// column-major order (index x*Y + y), and back.
 template <class A>
-void transpose(const A* in, A* out, int X, int Y) {
+void to_columns(const A* in, A* out, int X, int Y, int x_lo, int x_hi) {
   constexpr int kBlock = 32;
   for (int y0 = 0; y0 < Y; y0 += kBlock)
-    for (int x0 = 0; x0 < X; x0 += kBlock)
+    for (int x0 = x_lo; x0 < x_hi; x0 += kBlock)
       for (int y = y0; y < std::min(Y, y0 + kBlock); ++y)
-        for (int x = x0; x < std::min(X, x0 + kBlock); ++x)
+        for (int x = x0; x < std::min(x_hi, x0 + kBlock); ++x)
           out[static_cast<std::size_t>(x) * Y + y] = in[static_cast<std::size_t>(y) * X + x];
+}
+
+template <class A>
+void to_rows(const A* in, A* out, int X, int Y, int x_lo, int x_hi) {
+  constexpr int kBlock = 32;
+  for (int x0 = x_lo; x0 < x_hi; x0 += kBlock)
+    for (int y0 = 0; y0 < Y; y0 += kBlock)
+      for (int x = x0; x < std::min(x_hi, x0 + kBlock); ++x)
+        for (int y = y0; y < std::min(Y, y0 + kBlock); ++y)
+          out[static_cast<std::size_t>(y) * X + x] = in[static_cast<std::size_t>(x) * Y + y];
 }
 
 // 2-D solve of one slice with an envelope kernel (Chebyshev, Euclidean): pass B along x on rows,
@@ -261,31 +281,35 @@ void solve_line(const Kernel& k, int n, const V* f, V* out, std::int32_t* arg, s
   k(n, f, out, arg, s, t);
 }
 
+// Results are needed only for the columns x_lo..x_hi-1 (all of them for whole fields; the output
+// window for local updates), so pass C runs on those columns only.
 template <class KernelX, class KernelY, class V>
-void solve_slice_envelope2(const KernelX& kx, const KernelY& ky, int X, int Y, SliceBuffers<V>& b, bool track_sites, V inf) {
+void solve_slice_envelope2(const KernelX& kx, const KernelY& ky, int X, int Y, SliceBuffers<V>& b, bool track_sites,
+                           V inf, int x_lo, int x_hi) {
   std::int32_t* arg_x = track_sites ? b.arg_x.data() : nullptr;
   std::int32_t* targ = track_sites ? b.targ.data() : nullptr;
   for (int y = 0; y < Y; ++y) {
     const std::size_t o = static_cast<std::size_t>(y) * X;
     solve_line(kx, X, b.f.data() + o, b.h.data() + o, arg_x ? arg_x + o : nullptr, b.s.data(), b.t.data(), inf);
   }
-  transpose(b.h.data(), b.tmp.data(), X, Y);
-  for (int x = 0; x < X; ++x) {
+  to_columns(b.h.data(), b.tmp.data(), X, Y, x_lo, x_hi);
+  for (int x = x_lo; x < x_hi; ++x) {
     const std::size_t o = static_cast<std::size_t>(x) * Y;
     solve_line(ky, Y, b.tmp.data() + o, b.f.data() + o, targ ? targ + o : nullptr, b.s.data(), b.t.data(), inf);
   }
-  transpose(b.f.data(), b.h.data(), Y, X);
-  if (track_sites) transpose(b.targ.data(), b.arg_y.data(), Y, X);
+  to_rows(b.f.data(), b.h.data(), X, Y, x_lo, x_hi);
+  if (track_sites) to_rows(b.targ.data(), b.arg_y.data(), X, Y, x_lo, x_hi);
 }
 
 template <class Kernel, class V>
-void solve_slice_envelope(const Kernel& kx, const Kernel& ky, int X, int Y, SliceBuffers<V>& b, bool track_sites, V inf) {
-  solve_slice_envelope2(kx, ky, X, Y, b, track_sites, inf);
+void solve_slice_envelope(const Kernel& kx, const Kernel& ky, int X, int Y, SliceBuffers<V>& b, bool track_sites, V inf,
+                          int x_lo, int x_hi) {
+  solve_slice_envelope2(kx, ky, X, Y, b, track_sites, inf, x_lo, x_hi);
 }
 
 // 2-D solve of one slice for Manhattan: min-plus sweeps along x per row, then along y across whole
 // rows at once (contiguous, vectorisable). Ties keep the smaller index, as the envelope does.
-inline void solve_slice_manhattan(int X, int Y, SliceBuffers<std::int32_t>& b, bool track_sites) {
+inline void solve_slice_manhattan(int X, int Y, SliceBuffers<std::int32_t>& b, bool track_sites, int x_lo, int x_hi) {
   constexpr std::int32_t kInf = detail::kManhattanInf;
   std::int32_t* h = b.h.data();
   if (track_sites) {
@@ -324,7 +348,7 @@ inline void solve_slice_manhattan(int X, int Y, SliceBuffers<std::int32_t>& b, b
   std::int32_t* ay = b.arg_y.data();
   if (track_sites) {
     for (int y = 0; y < Y; ++y)
-      for (int x = 0; x < X; ++x) {
+      for (int x = x_lo; x < x_hi; ++x) {
         const std::size_t i = static_cast<std::size_t>(y) * X + x;
         ay[i] = h[i] < kInf ? y : -1;
       }
@@ -335,14 +359,14 @@ inline void solve_slice_manhattan(int X, int Y, SliceBuffers<std::int32_t>& b, b
     if (track_sites) {
       std::int32_t* a = ay + static_cast<std::size_t>(y) * X;
       const std::int32_t* pa = a - X;
-      for (int x = 0; x < X; ++x) {
+      for (int x = x_lo; x < x_hi; ++x) {
         if (pa[x] >= 0 && prev[x] + 1 <= r[x]) {
           r[x] = prev[x] + 1;
           a[x] = pa[x];
         }
       }
     } else {
-      for (int x = 0; x < X; ++x) r[x] = std::min(r[x], std::min(prev[x] + 1, kInf));
+      for (int x = x_lo; x < x_hi; ++x) r[x] = std::min(r[x], std::min(prev[x] + 1, kInf));
     }
   }
   for (int y = Y - 2; y >= 0; --y) {
@@ -351,14 +375,14 @@ inline void solve_slice_manhattan(int X, int Y, SliceBuffers<std::int32_t>& b, b
     if (track_sites) {
       std::int32_t* a = ay + static_cast<std::size_t>(y) * X;
       const std::int32_t* na = a + X;
-      for (int x = 0; x < X; ++x) {
+      for (int x = x_lo; x < x_hi; ++x) {
         if (na[x] >= 0 && next[x] + 1 < r[x]) {
           r[x] = next[x] + 1;
           a[x] = na[x];
         }
       }
     } else {
-      for (int x = 0; x < X; ++x) r[x] = std::min(r[x], std::min(next[x] + 1, kInf));
+      for (int x = x_lo; x < x_hi; ++x) r[x] = std::min(r[x], std::min(next[x] + 1, kInf));
     }
   }
 }
@@ -483,7 +507,7 @@ void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
           }
         });
       }
-      for (int k = 0; k < passes; ++k) solve(X, Y, buf[k]);
+      for (int k = 0; k < passes; ++k) solve(X, Y, buf[k], 0, X);
       // Encode and write the final values back into the same slice.
       for (int y = 0; y < Y; ++y) {
         for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
@@ -540,34 +564,39 @@ void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
 }
 
 // Calls fn(value_tag, solve, inf) with the 2-D slice solver of the plan's metric: V (the type of
-// value_tag) is the cost type the passes minimise, solve(X, Y, SliceBuffers<V>&) solves one slice,
+// value_tag) is the cost type the passes minimise, solve(X, Y, SliceBuffers<V>&, x_lo, x_hi) solves
+// one slice for the columns x_lo..x_hi-1,
 // inf is V's "no site". `extent` decides whether 32-bit Euclidean costs are wide enough.
 template <class Fn>
 void dispatch_solver(const Plan& p, Vec3i extent, Fn&& fn) {
   const bool sites = p.sites;
   if (p.metric == Metric::kManhattan) {
-    auto solve = [sites](int X, int Y, SliceBuffers<std::int32_t>& b) { solve_slice_manhattan(X, Y, b, sites); };
+    auto solve = [sites](int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) { solve_slice_manhattan(X, Y, b, sites, lo, hi); };
     fn(std::int32_t{}, solve, detail::kManhattanInf);
   } else if (p.metric == Metric::kChebyshev) {
     auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(Chebyshev{}, n, f, o, a, s, t);
     };
-    auto solve = [k, sites](int X, int Y, SliceBuffers<std::int32_t>& b) { solve_slice_envelope(k, k, X, Y, b, sites, Chebyshev::kInf); };
+    auto solve = [k, sites](int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) {
+      solve_slice_envelope(k, k, X, Y, b, sites, Chebyshev::kInf, lo, hi);
+    };
     fn(std::int32_t{}, solve, Chebyshev::kInf);
   } else if (p.unit_spacing && static_cast<double>(extent.x) * extent.x + static_cast<double>(extent.y) * extent.y +
                                        static_cast<double>(extent.z) * extent.z < (1 << 29)) {
     auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(detail::EuclideanInt32{}, n, f, o, a, s, t);
     };
-    auto solve = [k, sites](int X, int Y, SliceBuffers<std::int32_t>& b) {
-      solve_slice_envelope(k, k, X, Y, b, sites, detail::EuclideanInt32::kInf);
+    auto solve = [k, sites](int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) {
+      solve_slice_envelope(k, k, X, Y, b, sites, detail::EuclideanInt32::kInf, lo, hi);
     };
     fn(std::int32_t{}, solve, detail::EuclideanInt32::kInf);
   } else if (p.unit_spacing) {
     auto k = [](int n, const std::int64_t* f, std::int64_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(EuclideanInt{}, n, f, o, a, s, t);
     };
-    auto solve = [k, sites](int X, int Y, SliceBuffers<std::int64_t>& b) { solve_slice_envelope(k, k, X, Y, b, sites, EuclideanInt::kInf); };
+    auto solve = [k, sites](int X, int Y, SliceBuffers<std::int64_t>& b, int lo, int hi) {
+      solve_slice_envelope(k, k, X, Y, b, sites, EuclideanInt::kInf, lo, hi);
+    };
     fn(std::int64_t{}, solve, EuclideanInt::kInf);
   } else {
     const EuclideanReal ex{p.spacing[0] * p.spacing[0]}, ey{p.spacing[1] * p.spacing[1]};
@@ -577,9 +606,9 @@ void dispatch_solver(const Plan& p, Vec3i extent, Fn&& fn) {
     auto ky = [ey](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(ey, n, f, o, a, s, t);
     };
-    auto solve = [kx, ky, sites](int X, int Y, SliceBuffers<double>& b) {
+    auto solve = [kx, ky, sites](int X, int Y, SliceBuffers<double>& b, int lo, int hi) {
       // The two axes weigh differently; the slice solver takes one kernel per axis.
-      solve_slice_envelope2(kx, ky, X, Y, b, sites, EuclideanReal::kInf);
+      solve_slice_envelope2(kx, ky, X, Y, b, sites, EuclideanReal::kInf, lo, hi);
     };
     fn(double{}, solve, EuclideanReal::kInf);
   }
@@ -687,18 +716,8 @@ void region_pass_z(const std::uint8_t* solid, Vec3i n, int z0, int z1, std::uint
     std::fill(ds.begin(), ds.end(), cap);
     std::fill(da.begin(), da.end(), cap);
     for (int z = 0; z < n.z; ++z) {
-      const std::uint8_t* __restrict w = solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx;
-      std::uint32_t* __restrict c = col.data() + static_cast<std::size_t>(z) * nx;
-      for (std::size_t i = 0; i < nx; ++i) {
-        const bool s = w[i] != 0;
-        dsr[i] = s ? 0u : std::min(dsr[i] + 1u, cap);
-        if constexpr (kSigned) {
-          dar[i] = s ? std::min(dar[i] + 1u, cap) : 0u;
-          c[i] = s ? dar[i] : dsr[i];
-        } else {
-          c[i] = dsr[i];
-        }
-      }
+      z_sweep_step<kSigned>(solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx, dsr, dar,
+                            col.data() + static_cast<std::size_t>(z) * nx, nx, cap);
     }
     std::fill(ds.begin(), ds.end(), cap);
     std::fill(da.begin(), da.end(), cap);
@@ -795,7 +814,7 @@ void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, con
             buf[0].f[i] = c;
           }
         }
-        for (int k = 0; k < passes; ++k) solve(n.x, n.y, buf[k]);
+        for (int k = 0; k < passes; ++k) solve(n.x, n.y, buf[k], ox, ox + m.x);
         for (int y = 0; y < m.y; ++y)
           for (int x = 0; x < m.x; ++x) {
             const std::size_t i = static_cast<std::size_t>(y + oy) * n.x + static_cast<std::size_t>(x + ox);
