@@ -168,6 +168,8 @@ TEST(DynamicField, IncrementalUpdatesEqualFullRebuilds) {
       {Metric::kChebyshev, true, 4, Storage::kU8, false},   {Metric::kEuclidean, false, 0, Storage::kU8, true},
       {Metric::kManhattan, true, 3, Storage::kU16, true},   {Metric::kEuclidean, false, 7.5, Storage::kU16, false},
       {Metric::kEuclidean, true, 6, Storage::kF32, false, {0.5, 1.0, 2.0}},
+      // Unsigned without sites: the local pass's fast encoding.
+      {Metric::kChebyshev, false, 5, Storage::kU8, false},  {Metric::kEuclidean, false, 6, Storage::kF32, false},
   };
   const Box3i bounds{{-9, 0, 4}, {43, 37, 33}};
   const auto model = small_model();

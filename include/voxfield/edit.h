@@ -90,8 +90,14 @@ class DirtyRegions {
 
 // The voxels a brush may touch (before clipping to a world).
 Box3i brush_bounds(const Brush& brush);
-// Whether voxel p is inside the brush (for stamps: the model voxel at p - offset is solid).
+// Whether voxel p is inside the brush (for stamps: the model voxel at p - offset is solid). The
+// per-shape overloads skip the variant dispatch in loops over many voxels.
 bool brush_contains(const Brush& brush, Vec3i p);
+bool brush_contains(const SphereBrush& brush, Vec3i p);
+bool brush_contains(const BoxBrush& brush, Vec3i p);
+bool brush_contains(const RotatedBoxBrush& brush, Vec3i p);
+bool brush_contains(const CapsuleBrush& brush, Vec3i p);
+bool brush_contains(const StampBrush& brush, Vec3i p);
 
 struct EditResult {
   Box3i changed_box;          // smallest box holding every changed voxel (empty if none)

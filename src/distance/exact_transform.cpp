@@ -787,6 +787,13 @@ void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, con
   const Encoder<T> encoder{p, p.encoding, none_value};
   const double clamp_cost = p.metric == Metric::kEuclidean ? p.clamp * p.clamp : p.clamp;
   const bool euclid = p.metric == Metric::kEuclidean;
+  // The fast encoding applies when the stored value is a plain function of the cost: unsigned, no
+  // sites, and either f32 or an integer metric (scale 1, bias 0); Euclidean integer storage needs
+  // the exact fixed-point rounding of the general path.
+  const bool fast_encode = !p.is_signed && !sites && (std::is_same_v<T, float> || !euclid);
+  const T none_stored = encoder.encode(0.0, false, false);
+  const float clamp_f = static_cast<float>(std::min(p.clamp, 3.0e38));
+  const double type_max = std::is_same_v<T, float> ? 0.0 : static_cast<double>(std::numeric_limits<T>::max());
   dispatch_solver(p, n, [&](auto tag, const auto& solve, auto inf) {
     using V = decltype(tag);
     const V clamp_v = clamp_cost >= static_cast<double>(inf) ? inf : static_cast<V>(clamp_cost);
@@ -815,6 +822,25 @@ void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, con
           }
         }
         for (int k = 0; k < passes; ++k) solve(n.x, n.y, buf[k], ox, ox + m.x);
+        if (fast_encode) {
+          // Unsigned, no sites, and a value that is the cost itself (integer metrics) or its
+          // square root in f32: encode rows without the general path's branches.
+          for (int y = 0; y < m.y; ++y) {
+            const V* h = buf[0].h.data() + static_cast<std::size_t>(y + oy) * n.x + static_cast<std::size_t>(ox);
+            T* row = values + (zi * static_cast<std::size_t>(m.y) + static_cast<std::size_t>(y)) * m.x;
+            for (int x = 0; x < m.x; ++x) {
+              const V cost = h[x];
+              if (!(cost < inf && cost <= clamp_v)) {
+                row[x] = none_stored;
+              } else if constexpr (std::is_same_v<T, float>) {
+                row[x] = std::min(euclid ? std::sqrt(static_cast<float>(cost)) : static_cast<float>(cost), clamp_f);
+              } else {
+                row[x] = static_cast<T>(std::min<double>(static_cast<double>(cost), type_max));
+              }
+            }
+          }
+          continue;
+        }
         for (int y = 0; y < m.y; ++y)
           for (int x = 0; x < m.x; ++x) {
             const std::size_t i = static_cast<std::size_t>(y + oy) * n.x + static_cast<std::size_t>(x + ox);

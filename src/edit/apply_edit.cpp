@@ -109,11 +109,13 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
         Vec3i olo = part.end, ohi = part.begin - Vec3i::splat(1);  // solid <-> air changes
         g.edit_chunk(coord, [&](std::uint8_t* voxels) {
           bool changed = false;
+          // The brush is resolved once per chunk, not once per voxel.
+          std::visit([&](const auto& shape) {
           for (int z = part.begin.z; z < part.end.z; ++z)
             for (int y = part.begin.y; y < part.end.y; ++y)
               for (int x = part.begin.x; x < part.end.x; ++x) {
                 const Vec3i p{x, y, z};
-                if (!brush_contains(e.brush, p)) continue;
+                if (!brush_contains(shape, p)) continue;
                 std::uint8_t& v = voxels[((z - cb.begin.z) * edge + (y - cb.begin.y)) * edge + (x - cb.begin.x)];
                 const std::uint8_t paint = stamp ? stamp->model->voxels.get(p - stamp->offset) : e.material;
                 std::uint8_t next = v;
@@ -134,6 +136,7 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
                   ohi = {std::max(ohi.x, x), std::max(ohi.y, y), std::max(ohi.z, z)};
                 }
               }
+          }, e.brush);
           return changed;
         });
         if (chi.x >= clo.x) {

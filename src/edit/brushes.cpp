@@ -105,5 +105,10 @@ struct Contains {
 Box3i brush_bounds(const Brush& brush) { return std::visit(Bounds{}, brush); }
 
 bool brush_contains(const Brush& brush, Vec3i p) { return std::visit(Contains{p}, brush); }
+bool brush_contains(const SphereBrush& b, Vec3i p) { return Contains{p}(b); }
+bool brush_contains(const BoxBrush& b, Vec3i p) { return Contains{p}(b); }
+bool brush_contains(const RotatedBoxBrush& b, Vec3i p) { return Contains{p}(b); }
+bool brush_contains(const CapsuleBrush& b, Vec3i p) { return Contains{p}(b); }
+bool brush_contains(const StampBrush& b, Vec3i p) { return Contains{p}(b); }
 
 }  // namespace voxfield
