@@ -65,10 +65,6 @@ struct ChunkedVolume {
     return chunks[ci].get() + (static_cast<std::size_t>(lz & mask) << (2 * shift)) +
            (static_cast<std::size_t>(ly & mask) << shift);
   }
-  T& at(int x, int y, int z) {
-    const int lx = x - box.begin.x;
-    return row(lx >> shift, y, z)[lx & (edge - 1)];
-  }
 };
 
 // Rows of the world's chunks as 0/1 solid flags, for the same chunk-aligned box.
@@ -98,11 +94,6 @@ class SolidRows {
     return chunks_[ci] + (static_cast<std::size_t>(lz & mask) << (2 * shift_)) +
            (static_cast<std::size_t>(ly & mask) << shift_);
   }
-  bool solid(int x, int y, int z) const {
-    const int lx = x - box_.begin.x;
-    return row(lx >> shift_, y, z)[lx & (edge_ - 1)] != 0;
-  }
-
  private:
   Box3i box_;
   int edge_, shift_;
@@ -395,42 +386,57 @@ std::uint64_t isqrt(std::uint64_t n) {
   return r;
 }
 
-// Turns results into stored values of type T.
+// Turns the costs the passes minimised into stored values of type T, everything derived from the
+// plan. The rounding rule itself lives in detail::encode_distance; only the exact integer square
+// root for unit-spacing Euclidean integer storage is added here.
 template <class T>
 struct Encoder {
-  const Plan& p;
-  DistanceEncoding enc;
-  double none_value;  // decoded value for "no site within reach"
+  explicit Encoder(const Plan& plan)
+      : p(plan),
+        none(detail::encode_distance<T>(std::numeric_limits<double>::infinity(), plan)),
+        clamp_f(static_cast<float>(std::min(plan.clamp, 3.0e38))),
+        // The stored value is a plain function of the cost for unsigned fields in f32 or with an
+        // integer metric (scale 1, bias 0): those rows take encode_row().
+        row_path(!plan.is_signed && (std::is_same_v<T, float> || plan.metric != Metric::kEuclidean)) {}
 
-  // d >= 0: the distance to the relevant site; `inside`: negate (signed field, solid voxel).
-  // `cost` is what the passes minimised (squared for Euclidean), for exact integer rounding.
+  const Plan& p;
+  T none;        // stored value for "no site within reach"
+  float clamp_f;
+  bool row_path;
+
+  // `cost` is what the passes minimised (squared for Euclidean); `inside`: a solid voxel of a
+  // signed field (negated).
   T encode(double cost, bool has_site, bool inside) const {
-    double d;
-    if (!has_site) {
-      d = none_value;
-    } else if (p.metric == Metric::kEuclidean) {
-      d = std::sqrt(cost);
-    } else {
-      d = cost;
-    }
-    d = std::min(d, p.clamp);
-    if constexpr (std::is_same_v<T, float>) {
-      return static_cast<float>(inside ? -d : d);
-    } else {
-      constexpr double kMax = static_cast<double>(std::numeric_limits<T>::max());
-      double scaled;
-      if (std::isinf(d)) {
-        scaled = inside ? -1e300 : 1e300;
-      } else if (p.metric == Metric::kEuclidean && p.unit_spacing && has_site && d < p.clamp &&
-                 enc.scale == std::floor(enc.scale)) {
+    if (!has_site) return detail::encode_distance<T>(inside ? -std::numeric_limits<double>::infinity()
+                                                            : std::numeric_limits<double>::infinity(), p);
+    const double d = p.metric == Metric::kEuclidean ? std::sqrt(cost) : cost;
+    if constexpr (!std::is_same_v<T, float>) {
+      if (p.metric == Metric::kEuclidean && p.unit_spacing && d < p.clamp &&
+          p.encoding.scale == std::floor(p.encoding.scale)) {
         // floor(sqrt(cost) * S) computed exactly in integers (cost is an integer here).
-        const std::uint64_t n = static_cast<std::uint64_t>(cost) * static_cast<std::uint64_t>(enc.scale * enc.scale);
+        constexpr double kMax = static_cast<double>(std::numeric_limits<T>::max());
+        const std::uint64_t n = static_cast<std::uint64_t>(cost) * static_cast<std::uint64_t>(p.encoding.scale * p.encoding.scale);
         const std::uint64_t r = isqrt(n);
-        scaled = inside ? -static_cast<double>(r + (r * r != n ? 1 : 0)) : static_cast<double>(r);
-      } else {
-        scaled = std::floor((inside ? -d : d) * enc.scale);
+        const double scaled = inside ? -static_cast<double>(r + (r * r != n ? 1 : 0)) : static_cast<double>(r);
+        return static_cast<T>(std::clamp(scaled + static_cast<double>(p.encoding.bias), 0.0, kMax));
       }
-      return static_cast<T>(std::clamp(scaled + static_cast<double>(enc.bias), 0.0, kMax));
+    }
+    return detail::encode_distance<T>(inside ? -d : d, p);
+  }
+
+  // Branch-light encoding of a row when row_path holds: the same values as encode().
+  template <class V>
+  void encode_row(const V* cost, T* out, int count, V inf, V clamp_v) const {
+    const bool euclid = p.metric == Metric::kEuclidean;
+    for (int i = 0; i < count; ++i) {
+      const V c = cost[i];
+      if (!(c < inf && c <= clamp_v)) {
+        out[i] = none;
+      } else if constexpr (std::is_same_v<T, float>) {
+        out[i] = std::min(euclid ? std::sqrt(static_cast<float>(c)) : static_cast<float>(c), clamp_f);
+      } else {
+        out[i] = static_cast<T>(std::min<double>(static_cast<double>(c), std::numeric_limits<T>::max()));
+      }
     }
   }
 };
@@ -513,22 +519,9 @@ void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
         for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
           T* out = reinterpret_cast<T*>(g.row(cx, by + y, z)) + lx;  // T and U have the same size
           const std::size_t o = static_cast<std::size_t>(y) * X + xo;
-          if constexpr (std::is_same_v<T, float>) {
-            if (!p.is_signed) {
-              // The common case, kept branch-light: float distance, clamp, +inf/D when none.
-              const V* h = buf[0].h.data() + o;
-              const float none = static_cast<float>(encoder.none_value);
-              const float clamp_f = static_cast<float>(std::min(p.clamp, 3.0e38));
-              for (int i = 0; i < count; ++i) {
-                const V cost = h[i];
-                const bool has_site = cost < inf && cost <= clamp_v;
-                const float d = euclid ? std::sqrt(static_cast<float>(static_cast<double>(cost)))
-                                       : static_cast<float>(cost);
-                out[i] = has_site ? std::min(d, clamp_f) : none;
-              }
-            }
-          }
-          if (!std::is_same_v<T, float> || p.is_signed) {
+          if (encoder.row_path) {
+            encoder.encode_row(buf[0].h.data() + o, out, count, inf, clamp_v);
+          } else {
             for (int i = 0; i < count; ++i) {
               const bool inside = p.is_signed && solid[o + i];
               const V cost = buf[inside ? 1 : 0].h[o + i];
@@ -615,12 +608,12 @@ void dispatch_solver(const Plan& p, Vec3i extent, Fn&& fn) {
 }
 
 template <class T, class U>
-DistanceField run(const Grid<std::uint8_t>& occupancy, const DistanceOptions& options, const Plan& p,
-                  const DistanceEncoding& enc, T background) {
+DistanceField run(const Grid<std::uint8_t>& occupancy, const DistanceOptions& options, const Plan& p) {
+  const T background = detail::field_background<T>(p);
   DistanceField out;
   out.options = options;
   out.domain = p.domain;
-  out.encoding = enc;
+  out.encoding = p.encoding;
   const int edge = occupancy.chunk_edge();
   Grid<T> values(edge, background, occupancy.bounds());
   std::optional<Grid<SiteOffset>> sites_grid;
@@ -678,8 +671,7 @@ DistanceField run(const Grid<std::uint8_t>& occupancy, const DistanceOptions& op
   });
 
   // Passes B and C, and encoding.
-  const double none_value = std::isfinite(p.clamp) ? p.clamp : std::numeric_limits<double>::infinity();
-  const Encoder<T> encoder{p, enc, none_value};
+  const Encoder<T> encoder(p);
   ChunkedVolume<SiteOffset>* sp = sites ? &*sites : nullptr;
   dispatch_solver(p, p.domain.size(), [&](auto tag, const auto& solve, auto inf) {
     using V = decltype(tag);
@@ -783,17 +775,9 @@ void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, con
   } else {
     region_pass_z<false>(solid.data(), n, z0, z1, cap32, g.data(), sites ? dz.data() : nullptr);
   }
-  const double none_value = std::isfinite(p.clamp) ? p.clamp : std::numeric_limits<double>::infinity();
-  const Encoder<T> encoder{p, p.encoding, none_value};
+  const Encoder<T> encoder(p);
   const double clamp_cost = p.metric == Metric::kEuclidean ? p.clamp * p.clamp : p.clamp;
   const bool euclid = p.metric == Metric::kEuclidean;
-  // The fast encoding applies when the stored value is a plain function of the cost: unsigned, no
-  // sites, and either f32 or an integer metric (scale 1, bias 0); Euclidean integer storage needs
-  // the exact fixed-point rounding of the general path.
-  const bool fast_encode = !p.is_signed && !sites && (std::is_same_v<T, float> || !euclid);
-  const T none_stored = encoder.encode(0.0, false, false);
-  const float clamp_f = static_cast<float>(std::min(p.clamp, 3.0e38));
-  const double type_max = std::is_same_v<T, float> ? 0.0 : static_cast<double>(std::numeric_limits<T>::max());
   dispatch_solver(p, n, [&](auto tag, const auto& solve, auto inf) {
     using V = decltype(tag);
     const V clamp_v = clamp_cost >= static_cast<double>(inf) ? inf : static_cast<V>(clamp_cost);
@@ -822,22 +806,11 @@ void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, con
           }
         }
         for (int k = 0; k < passes; ++k) solve(n.x, n.y, buf[k], ox, ox + m.x);
-        if (fast_encode) {
-          // Unsigned, no sites, and a value that is the cost itself (integer metrics) or its
-          // square root in f32: encode rows without the general path's branches.
+        if (encoder.row_path && !sites) {
           for (int y = 0; y < m.y; ++y) {
-            const V* h = buf[0].h.data() + static_cast<std::size_t>(y + oy) * n.x + static_cast<std::size_t>(ox);
-            T* row = values + (zi * static_cast<std::size_t>(m.y) + static_cast<std::size_t>(y)) * m.x;
-            for (int x = 0; x < m.x; ++x) {
-              const V cost = h[x];
-              if (!(cost < inf && cost <= clamp_v)) {
-                row[x] = none_stored;
-              } else if constexpr (std::is_same_v<T, float>) {
-                row[x] = std::min(euclid ? std::sqrt(static_cast<float>(cost)) : static_cast<float>(cost), clamp_f);
-              } else {
-                row[x] = static_cast<T>(std::min<double>(static_cast<double>(cost), type_max));
-              }
-            }
+            encoder.encode_row(buf[0].h.data() + static_cast<std::size_t>(y + oy) * n.x + static_cast<std::size_t>(ox),
+                               values + (zi * static_cast<std::size_t>(m.y) + static_cast<std::size_t>(y)) * m.x, m.x, inf,
+                               clamp_v);
           }
           continue;
         }
@@ -999,11 +972,11 @@ DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy, const 
   const Plan p = detail::make_field_plan(occupancy, o);
   switch (o.storage) {
     case Storage::kU8:
-      return run<std::uint8_t, std::uint8_t>(occupancy, o, p, p.encoding, detail::field_background<std::uint8_t>(p));
+      return run<std::uint8_t, std::uint8_t>(occupancy, o, p);
     case Storage::kU16:
-      return run<std::uint16_t, std::uint16_t>(occupancy, o, p, p.encoding, detail::field_background<std::uint16_t>(p));
+      return run<std::uint16_t, std::uint16_t>(occupancy, o, p);
     case Storage::kF32:
-      return run<float, std::uint32_t>(occupancy, o, p, p.encoding, detail::field_background<float>(p));
+      return run<float, std::uint32_t>(occupancy, o, p);
   }
   throw InvalidArgument("unknown storage");
 }
