@@ -1,4 +1,6 @@
 // voxfield — generated scenes: terrain with caves and towers, and random spheres.
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -36,6 +38,14 @@ void require_size(const SceneOptions& o) {
     if (o.size[k] < 1 || o.size[k] > (1 << 16)) {
       throw InvalidArgument("scene size " + to_string(o.size) + " must be 1..65536 on every axis");
     }
+  }
+  // Generation fills every chunk before collapsing the uniform ones: refuse sizes that cannot fit
+  // in this machine's memory, instead of running into the out-of-memory killer.
+  const double bytes = static_cast<double>(Box3i::from_size(o.size).volume());
+  const double physical = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  if (physical > 0 && bytes > physical) {
+    throw InvalidArgument("scene size " + to_string(o.size) + " needs " + std::to_string(bytes / 1e9) +
+                          " GB while generating; this machine has " + std::to_string(physical / 1e9) + " GB");
   }
 }
 
