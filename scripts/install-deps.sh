@@ -8,6 +8,7 @@ packages=(
   cmake ninja-build g++ pkg-config   # toolchain
   libtbb-dev                         # thread pool (oneTBB)
   zlib1g-dev                         # TDCZ models in .vox files
+  libpng-dev                         # PNG frames from the renderer
   nlohmann-json3-dev                 # JSON output of the CLI
   libcli11-dev                       # CLI parsing
   libgtest-dev                       # tests

@@ -28,6 +28,7 @@ void add_field(CLI::App& app, Action& action);
 void add_compare(CLI::App& app, Action& action);
 void add_edit(CLI::App& app, Action& action);
 void add_bench(CLI::App& app, Action& action);
+void add_render(CLI::App& app, Action& action);
 
 // A world read from any supported file, with what the file said about itself.
 struct LoadedWorld {

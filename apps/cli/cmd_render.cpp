@@ -1,0 +1,122 @@
+// voxfield render IN -o OUT.png: a frame of a world, ray-marched on the CPU through its distance
+// field, in one of four views (shaded, distance, error, chunks).
+#include <algorithm>
+#include <iostream>
+
+#include "cli.h"
+#include "field_args.h"
+#include "voxfield/parallel.h"
+#include "voxfield/render.h"
+
+namespace voxfield::cli {
+namespace {
+
+struct RenderSettings {
+  std::string in, out, camera = "auto", view = "shaded", algorithm = "jfa", metric = "manhattan",
+              skip = "distance", stats;
+  int width = 1280, height = 720, chunk_edge = 32, threads = 0, repeat = 1;
+  bool no_shadows = false, no_ao = false;
+  double fog = 0;
+  std::optional<int> slice;
+};
+
+int run_render(const RenderSettings& s) {
+  std::optional<ThreadLimit> limit;
+  if (s.threads > 0) limit.emplace(s.threads);
+  const LoadedWorld in = load_world(s.in, s.chunk_edge);
+  if (in.extent.empty()) throw InvalidArgument(s.in + ": the input holds no volume");
+
+  RenderSceneOptions so;
+  so.skip_metric = parse_metric(s.metric);
+  so.lighting_field = !(s.no_shadows && s.no_ao);
+  RenderOptions o;
+  o.width = s.width;
+  o.height = s.height;
+  o.view = parse_render_view(s.view);
+  o.skip = parse_skip_mode(s.skip);
+  o.soft_shadows = !s.no_shadows;
+  o.ambient_occlusion = !s.no_ao;
+  o.fog_density = s.fog;
+  o.slice_z = s.slice;
+  o.error_algorithm = parse_algorithm(s.algorithm);
+  const double aspect = static_cast<double>(s.width) / s.height;
+  // Automatic cameras frame what is there: the content, within the file's extent.
+  const Box3i content = in.world.voxels.content_bounds().intersect(in.extent);
+  const Camera camera = Camera::parse(s.camera, s.camera == "top" || content.empty() ? in.extent : content, aspect);
+
+  const RenderScene scene(in.world, so, in.extent);
+  // With --repeat, the frame is rendered several times and the median time reported (the
+  // image is the same every time: rendering is deterministic).
+  RenderStats st;
+  Image image;
+  std::vector<double> times;
+  for (int r = 0; r < s.repeat; ++r) {
+    image = render(scene, camera, o, &st);
+    times.push_back(st.ms);
+  }
+  std::sort(times.begin(), times.end());
+  st.ms = times[times.size() / 2];
+  write_png(image, s.out);
+  std::cout << "voxfield render: " << s.out << " (" << s.width << "x" << s.height << ", " << s.view << " view), "
+            << st.ms << " ms, " << st.rays_per_second() / 1e6 << " M primary rays/s, fields " << scene.field_ms()
+            << " ms\n";
+  if (o.view == RenderView::kError)
+    std::cout << "  " << s.algorithm << ": " << st.rays_through_geometry
+              << " rays skip through geometry, largest error on a ray " << st.max_error << " voxels\n";
+  if (!s.stats.empty()) {
+    auto counters = [](const TraversalCounters& c) {
+      return nlohmann::json{{"rays", c.rays},
+                            {"steps", c.steps},
+                            {"voxel_reads", c.voxel_reads},
+                            {"chunk_skips", c.chunk_skips},
+                            {"distance_skips", c.distance_skips}};
+    };
+    nlohmann::json j{{"input", s.in},
+                     {"ms", st.ms},
+                     {"width", st.width},
+                     {"height", st.height},
+                     {"view", s.view},
+                     {"skip", s.skip},
+                     {"skip_metric", s.metric},
+                     {"threads", max_threads()},
+                     {"field_ms", scene.field_ms()},
+                     {"primary_rays_per_second", st.rays_per_second()},
+                     {"primary", counters(st.primary)},
+                     {"shadow", counters(st.shadow)}};
+    if (o.view == RenderView::kError) {
+      j["algorithm"] = s.algorithm;
+      j["rays_through_geometry"] = st.rays_through_geometry;
+      j["max_error"] = st.max_error;
+    }
+    write_json(j, s.stats);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_render(CLI::App& app, Action& action) {
+  auto s = std::make_shared<RenderSettings>();
+  CLI::App* cmd = app.add_subcommand("render", "Ray-march a frame of a world on the CPU and write a PNG");
+  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
+  cmd->add_option("-o,--output", s->out, "output .png")->required();
+  cmd->add_option("--width", s->width, "image width in pixels")->check(CLI::Range(1, 16384));
+  cmd->add_option("--height", s->height, "image height in pixels")->check(CLI::Range(1, 16384));
+  cmd->add_option("--camera", s->camera,
+                  "auto | top | eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height] (voxel units, z up)");
+  cmd->add_option("--view", s->view, "shaded | distance | error | chunks");
+  cmd->add_option("--algorithm", s->algorithm, "error view: the approximation shown against the exact field");
+  cmd->add_option("--metric", s->metric, "field rays skip by: manhattan (default), chebyshev, euclidean");
+  cmd->add_option("--skip", s->skip, "none (plain DDA), chunks, distance (default)");
+  cmd->add_option("--slice", s->slice, "distance view: z of the cut plane (default: the middle)");
+  cmd->add_flag("--no-shadows", s->no_shadows, "no soft shadows");
+  cmd->add_flag("--no-ao", s->no_ao, "no ambient occlusion");
+  cmd->add_option("--fog", s->fog, "fog density per voxel of travel (e.g. 0.002)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--chunk", s->chunk_edge, "chunk edge (8..128, power of two)");
+  cmd->add_option("--threads", s->threads, "threads (default: all cores)")->check(CLI::Range(1, 1024));
+  cmd->add_option("--repeat", s->repeat, "render N times, report the median time")->check(CLI::Range(1, 1000));
+  cmd->add_option("--stats", s->stats, "write timings and traversal counters as JSON");
+  cmd->callback([s, &action] { action = [s] { return run_render(*s); }; });
+}
+
+}  // namespace voxfield::cli

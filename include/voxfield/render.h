@@ -1,0 +1,193 @@
+// voxfield — CPU ray-marched rendering of voxel worlds through their distance fields.
+//
+// Primary rays walk the voxel grid with Amanatides & Woo's DDA ("A Fast Voxel Traversal Algorithm
+// for Ray Tracing", Eurographics 1987) and skip ahead by the distance stored in an exact distance
+// field, as the reference dissertation does with Manhattan fields; empty chunks are crossed in one
+// step. Skipping never changes a result: the hit voxel and face are those of a plain DDA (see
+// src/render/dda.h for why, tests/test_render.cpp for the test). Shading adds palette colour, sun
+// and sky light, ambient occlusion and soft shadows from a Euclidean field, fog and a sky gradient.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "voxfield/algorithms.h"
+#include "voxfield/distance.h"
+#include "voxfield/image.h"
+#include "voxfield/world.h"
+
+namespace voxfield {
+
+struct Vec3d {
+  double x = 0, y = 0, z = 0;
+  double operator[](int axis) const { return axis == 0 ? x : axis == 1 ? y : z; }
+  friend Vec3d operator+(Vec3d a, Vec3d b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+  friend Vec3d operator-(Vec3d a, Vec3d b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+  friend Vec3d operator*(Vec3d a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+  friend double dot(Vec3d a, Vec3d b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+  friend Vec3d cross(Vec3d a, Vec3d b) {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+  }
+  double length() const { return std::sqrt(x * x + y * y + z * z); }
+  Vec3d normalized() const { const double l = length(); return {x / l, y / l, z / l}; }
+};
+
+// Rays in voxel coordinates: voxel v occupies the unit cube [v, v + 1).
+struct Ray {
+  Vec3d origin;
+  Vec3d direction;  // need not be normalised; t is measured in multiples of it
+};
+
+struct Camera {
+  enum class Projection { kPerspective, kOrthographic };
+  Projection projection = Projection::kPerspective;
+  Vec3d eye{0, 0, 0}, target{0, 0, -1}, up{0, 0, 1};  // z is up, as in MagicaVoxel
+  double fov_degrees = 60;  // perspective: vertical field of view
+  double ortho_height = 1;  // orthographic: world units spanned by the image height
+
+  // Perspective view from above one corner, as close as keeps all eight corners of the box in
+  // the image (3 % margin).
+  static Camera framing(const Box3i& box, double aspect, double fov_degrees = 50);
+  // Orthographic, looking down -z with +y up the image: the box's x and y extent fill the image
+  // exactly along the limiting axis (both, when the aspect ratios agree), centred on the other.
+  static Camera top(const Box3i& box, double aspect);
+  // "top", "auto" or "eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height]" (ortho=
+  // makes it orthographic). Throws InvalidArgument naming the bad part.
+  static Camera parse(const std::string& spec, const Box3i& box, double aspect);
+
+  // Rays through the pixels of a width x height image, with the camera's basis computed once.
+  struct Projector {
+    Projection projection = Projection::kPerspective;
+    Vec3d eye, forward, right, up;  // orthonormal basis
+    double scale = 1;               // tan(fov / 2), or ortho_height / 2
+    int width = 1, height = 1;
+    // The ray through (px, py) in pixels, (0, 0) the top-left corner: pixel centres are at +0.5.
+    // Directions are unit vectors, so t measures voxels.
+    Ray ray(double px, double py) const;
+    // Size of one pixel, in voxels, at distance t along a ray.
+    double footprint(double t) const { return (projection == Projection::kOrthographic ? 1 : t) * 2 * scale / height; }
+  };
+  Projector projector(int width, int height) const;
+  // The ray through the centre of pixel (px, py) of a width x height image (py = 0 at the top).
+  Ray ray(int px, int py, int width, int height) const { return projector(width, height).ray(px + 0.5, py + 0.5); }
+};
+
+// How far rays may skip. kNone is the plain DDA that visits every voxel (the reference the
+// skipping modes are tested against); kChunks skips empty chunks only; kDistance also skips by the
+// distance field.
+enum class SkipMode { kNone, kChunks, kDistance };
+const char* skip_mode_name(SkipMode m);
+SkipMode parse_skip_mode(const std::string& name);  // "none", "chunks", "distance"
+
+struct RenderSceneOptions {
+  // The field rays skip by. Manhattan is the dissertation's choice: k DDA steps stay within L1
+  // distance k. Chebyshev and Euclidean fields are offered to measure the trade-off.
+  Metric skip_metric = Metric::kManhattan;
+  // The Euclidean field behind ambient occlusion and soft shadows (clamped, u8 quarter voxels).
+  bool lighting_field = true;
+  double lighting_clamp = 16;
+};
+
+// A world prepared for rendering: the fields rays skip by and shade with, and a flat table of the
+// chunks inside the render box. Holds a reference to the world, which must outlive it and not
+// change while it is used.
+class RenderScene {
+ public:
+  // Renders the voxels inside `box` (default: the world's bounds, else its content box).
+  // Throws InvalidArgument for an empty box.
+  explicit RenderScene(const World& world, const RenderSceneOptions& options = {},
+                       std::optional<Box3i> box = std::nullopt);
+  ~RenderScene();
+  RenderScene(RenderScene&&) noexcept;
+  RenderScene& operator=(RenderScene&&) noexcept;
+
+  const World& world() const;
+  const Box3i& box() const;
+  const RenderSceneOptions& options() const;
+  const DistanceField& skip_field() const;
+  // Milliseconds spent computing the fields (skip, lighting).
+  double field_ms() const;
+
+  struct Impl;
+  const Impl& impl() const { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+struct RayHit {
+  bool hit = false;
+  Vec3i voxel{0, 0, 0};
+  // Axis of the face the ray entered through (0, 1, 2) and its outward normal sign (+1, -1);
+  // axis -1 when the ray starts inside a solid voxel.
+  int face_axis = -1;
+  int face_sign = 0;
+  double t = 0;  // ray parameter at the entry point
+  std::uint8_t material = 0;
+};
+
+// Work done by traversals, summed over rays.
+struct TraversalCounters {
+  std::int64_t rays = 0;
+  std::int64_t steps = 0;           // DDA state changes (a bulk skip counts once)
+  std::int64_t voxel_reads = 0;     // voxels whose material / distance was read
+  std::int64_t chunk_skips = 0;     // empty chunks crossed in one step
+  std::int64_t distance_skips = 0;  // skips of more than one voxel by the distance field
+  void add(const TraversalCounters& o) {
+    rays += o.rays; steps += o.steps; voxel_reads += o.voxel_reads;
+    chunk_skips += o.chunk_skips; distance_skips += o.distance_skips;
+  }
+};
+
+// The first solid voxel along the ray (t >= 0) inside the scene's box.
+RayHit trace_ray(const RenderScene& scene, const Ray& ray, SkipMode mode = SkipMode::kDistance,
+                 TraversalCounters* counters = nullptr);
+
+enum class RenderView {
+  kShaded,    // palette colour, sun, sky, ambient occlusion, soft shadows, fog
+  kDistance,  // cut-away at slice_z: the skip field as a heat map on the cut, the world below it
+  kError,     // |approximate - exact| along each ray; rays the approximation lets through
+              // geometry in magenta (needs RenderOptions::error_algorithm)
+  kChunks,    // shaded, with the chunk grid drawn on the surfaces and dense chunks tinted
+};
+const char* render_view_name(RenderView v);
+RenderView parse_render_view(const std::string& name);  // "shaded", "distance", "error", "chunks"
+
+struct RenderOptions {
+  int width = 1280, height = 720;
+  RenderView view = RenderView::kShaded;
+  SkipMode skip = SkipMode::kDistance;
+  bool ambient_occlusion = true;  // needs the scene's lighting field
+  bool soft_shadows = true;       // needs the scene's lighting field
+  double fog_density = 0;         // per voxel of travel; 0 = no fog
+  // Direction towards the sun (normalised internally).
+  Vec3d sun_direction{0.55, -0.35, 0.62};
+  // kDistance: the cut plane (voxels above it are hidden). Default: the middle of the box.
+  std::optional<int> slice_z;
+  // kError: the approximation to show against the exact skip field.
+  Algorithm error_algorithm = Algorithm::kJfa;
+  int tile_size = 16;
+};
+
+struct RenderStats {
+  double ms = 0;  // rendering only (fields, including the error view's approximation, excluded)
+  int width = 0, height = 0;
+  TraversalCounters primary, shadow;
+  // kError: rays whose hit the approximate field changed (skipped through geometry), and the
+  // largest |approximate - exact| met along any ray.
+  std::int64_t rays_through_geometry = 0;
+  double max_error = 0;
+  double rays_per_second() const { return ms > 0 ? static_cast<double>(primary.rays) * 1000.0 / ms : 0; }
+};
+
+// Renders one frame. Multi-threaded over tiles; the image does not depend on the thread count or
+// tile size. Throws InvalidArgument for bad options (size, a view that needs a field the scene
+// lacks).
+Image render(const RenderScene& scene, const Camera& camera, const RenderOptions& options,
+             RenderStats* stats = nullptr);
+
+}  // namespace voxfield

@@ -1,0 +1,345 @@
+// voxfield renderer — frames: primary rays per pixel over tiles, shading and the debug views.
+//
+// Shading goes beyond the dissertation's colour x local occlusion: palette albedo in linear light,
+// a sun with soft shadows and a sky dome with ambient occlusion — both read from a clamped Euclidean
+// field (the "distance field soft shadows" of Quilez's SDF rendering notes, made exact in occlusion
+// by tracing the shadow ray with the same DDA) — optional fog, and a sky gradient for misses.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+
+#include "traverse.h"
+#include "voxfield/error.h"
+#include "voxfield/parallel.h"
+
+namespace voxfield {
+
+const char* render_view_name(RenderView v) {
+  switch (v) {
+    case RenderView::kShaded: return "shaded";
+    case RenderView::kDistance: return "distance";
+    case RenderView::kError: return "error";
+    case RenderView::kChunks: return "chunks";
+  }
+  return "?";
+}
+
+RenderView parse_render_view(const std::string& name) {
+  for (RenderView v : {RenderView::kShaded, RenderView::kDistance, RenderView::kError, RenderView::kChunks})
+    if (name == render_view_name(v)) return v;
+  throw InvalidArgument("unknown view \"" + name + "\" (expected shaded, distance, error or chunks)");
+}
+
+namespace {
+
+using render_detail::ChunkTable;
+using render_detail::Dda;
+using render_detail::traverse;
+
+struct Rgb {
+  double r = 0, g = 0, b = 0;
+  friend Rgb operator+(Rgb a, Rgb b) { return {a.r + b.r, a.g + b.g, a.b + b.b}; }
+  friend Rgb operator*(Rgb a, double s) { return {a.r * s, a.g * s, a.b * s}; }
+  friend Rgb operator*(Rgb a, Rgb b) { return {a.r * b.r, a.g * b.g, a.b * b.b}; }
+};
+Rgb mix(Rgb a, Rgb b, double t) { return a * (1 - t) + b * t; }
+
+// Linear light of the sky and the sun (before exposure).
+constexpr Rgb kSunLight{2.4, 2.2, 1.9};
+constexpr Rgb kSkyZenith{0.22, 0.38, 0.78};
+constexpr Rgb kSkyHorizon{0.70, 0.80, 0.92};
+constexpr Rgb kGround{0.42, 0.45, 0.50};
+constexpr Rgb kSkyAmbient{0.42, 0.52, 0.70};
+
+Rgb sky(const Vec3d& dir) {
+  const double z = dir.z;
+  if (z < 0) return mix(kSkyHorizon, kGround, std::min(1.0, -z * 3));
+  return mix(kSkyHorizon, kSkyZenith, std::pow(z, 0.6));
+}
+
+// Exposure (1 - exp(-1.25 x)) then sRGB encoding, through one table over linear light in
+// [0, kMaxLinear) — no exp or pow per pixel.
+class ToneMap {
+ public:
+  ToneMap() {
+    for (int i = 0; i < kSteps; ++i) {
+      const double linear = kMaxLinear * i / (kSteps - 1);
+      const double v = 1 - std::exp(-1.25 * linear);
+      const double s = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
+      table_[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(std::lround(std::clamp(s, 0.0, 1.0) * 255));
+    }
+  }
+  std::uint8_t encode(double linear) const {
+    const double x = std::clamp(linear, 0.0, kMaxLinear) * ((kSteps - 1) / kMaxLinear);
+    return table_[static_cast<std::size_t>(x + 0.5)];
+  }
+  void write(Rgb c, std::uint8_t* px) const { px[0] = encode(c.r); px[1] = encode(c.g); px[2] = encode(c.b); }
+
+ private:
+  static constexpr int kSteps = 16384;
+  static constexpr double kMaxLinear = 8;  // exposes to 0.99995: white
+  std::array<std::uint8_t, kSteps> table_{};
+};
+const ToneMap& tone_map() {
+  static const ToneMap t;
+  return t;
+}
+
+// A perceptual heat ramp (dark blue, blue, green, yellow, red) for x in [0, 1], as sRGB bytes.
+void heat(double x, std::uint8_t* px) {
+  static constexpr double kStops[5][3] = {
+      {20, 12, 70}, {30, 100, 220}, {40, 190, 130}, {245, 215, 50}, {215, 40, 30}};
+  x = std::clamp(x, 0.0, 1.0) * 4;
+  const int i = std::min(3, static_cast<int>(x));
+  const double f = x - i;
+  for (int c = 0; c < 3; ++c)
+    px[c] = static_cast<std::uint8_t>(std::lround(kStops[i][c] * (1 - f) + kStops[i + 1][c] * f));
+}
+
+struct Frame {
+  const RenderScene::Impl& s;
+  const RenderOptions& o;
+  Camera::Projector projector;
+  Vec3d sun;
+  const SkipSource* approx = nullptr;  // the error view's approximate field
+  int slice_z = 0;
+  double heat_max = 1;
+
+  std::uint8_t read(const render_detail::VoxelLayer& layer, Vec3i v) const {
+    return ChunkTable::read(layer, s.table.chunk_index(v), s.table.local_index(v));
+  }
+
+  std::uint8_t skip_at(Vec3i v) const { return s.skip.distance(s.table.chunk_index(v), s.table.brick_index(v)); }
+
+  // The lighting field at a point, interpolated between voxel centres (clamped to the box).
+  double light_at(const Vec3d& q) const {
+    const Box3i& box = s.box;
+    const double fx = q.x - 0.5, fy = q.y - 0.5, fz = q.z - 0.5;
+    const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy)),
+              z0 = static_cast<int>(std::floor(fz));
+    const double tx = fx - x0, ty = fy - y0, tz = fz - z0;
+    double sum = 0;
+    for (int corner = 0; corner < 8; ++corner) {
+      const int dx = corner & 1, dy = (corner >> 1) & 1, dz = corner >> 2;
+      const Vec3i v{std::clamp(x0 + dx, box.begin.x, box.end.x - 1), std::clamp(y0 + dy, box.begin.y, box.end.y - 1),
+                    std::clamp(z0 + dz, box.begin.z, box.end.z - 1)};
+      const double w = (dx ? tx : 1 - tx) * (dy ? ty : 1 - ty) * (dz ? tz : 1 - tz);
+      sum += w * read(s.light, v);
+    }
+    return sum * s.light_inv_scale;
+  }
+
+  // Ambient occlusion: how much closer the nearest geometry is than it would be over an open
+  // plane, at three points along the normal. Over a flat open face the field grows exactly as
+  // s + 0.5 (voxel centres sit half a voxel behind the face), so open faces get no occlusion.
+  double ambient_occlusion(const Vec3d& p, const Vec3d& n) const {
+    static constexpr double kStep[3] = {0.5, 1.5, 3.0}, kWeight[3] = {0.5, 0.3, 0.2};
+    double occlusion = 0;
+    for (int i = 0; i < 3; ++i) {
+      const double open = kStep[i] + 0.5;
+      const double e = light_at(p + n * kStep[i]);
+      occlusion += kWeight[i] * std::clamp((open - e) / open, 0.0, 1.0);
+    }
+    return std::clamp(1 - 1.7 * occlusion, 0.0, 1.0);
+  }
+
+  // Soft shadow towards the sun: 0 when the DDA finds a solid voxel (exact occlusion), else the
+  // penumbra estimate min(k * clearance / t) over the voxels the shadow ray reads, the clearance
+  // coming from the Euclidean field (its distance to the nearest solid voxel centre, less the
+  // ~0.75 voxel a ray can pass from a voxel centre and a solid voxel's surface from its own).
+  double soft_shadow(const Vec3d& p, const Vec3d& n, TraversalCounters& c) const {
+    constexpr double kSoftness = 5, kNear = 1.5;
+    const Ray r{p + n * 1e-4, sun};
+    double lit = 1;
+    const RayHit hit = traverse(s, s.box, r, SkipMode::kDistance, s.skip, c,
+                                [&](const Dda& d, std::size_t chunk) {
+                                  if (d.t < kNear) return;
+                                  const double e = ChunkTable::read(s.light, chunk, s.table.local_index(d.v)) *
+                                                   s.light_inv_scale;
+                                  lit = std::min(lit, kSoftness * (e - 0.75) / d.t);
+                                });
+    if (hit.hit) return 0;
+    lit = std::clamp(lit, 0.0, 1.0);
+    return lit * lit * (3 - 2 * lit);
+  }
+
+  static Vec3d normal_of(const RayHit& h, const Vec3d& dir) {
+    int axis = h.face_axis, sign = h.face_sign;
+    if (axis < 0) {  // the ray started inside: face the viewer along its dominant axis
+      axis = std::abs(dir.x) >= std::abs(dir.y) && std::abs(dir.x) >= std::abs(dir.z) ? 0
+             : std::abs(dir.y) >= std::abs(dir.z)                                    ? 1
+                                                                                     : 2;
+      sign = dir[axis] > 0 ? -1 : 1;
+    }
+    Vec3d n;
+    (axis == 0 ? n.x : axis == 1 ? n.y : n.z) = sign;
+    return n;
+  }
+
+  Rgb shade(const RayHit& h, const Ray& ray, bool shadows, TraversalCounters& shadow_counters) const {
+    const Vec3d n = normal_of(h, ray.direction);
+    const Vec3d p = ray.origin + ray.direction * h.t;
+    const auto& a = s.albedo[h.material];
+    const Rgb albedo{a[0], a[1], a[2]};
+    const double ndotl = std::max(0.0, dot(n, sun));
+    double shadow = 1;
+    if (shadows && o.soft_shadows && ndotl > 0) shadow = soft_shadow(p, n, shadow_counters);
+    const double ao = o.ambient_occlusion ? ambient_occlusion(p, n) : 1;
+    const Rgb ambient = mix(kGround, kSkyAmbient, 0.5 + 0.5 * n.z) * (0.35 + 0.65 * ao);
+    Rgb c = albedo * (kSunLight * (ndotl * shadow) + ambient);
+    if (o.fog_density > 0) c = mix(c, sky(ray.direction), 1 - std::exp(-o.fog_density * h.t));
+    return c;
+  }
+
+  void chunk_overlay(const RayHit& h, const Ray& ray, Rgb& c) const {
+    const Vec3d p = ray.origin + ray.direction * h.t;
+    const double edge = s.table.chunk_edge();
+    const double width = std::max(0.04, 0.75 * projector.footprint(h.t));
+    bool line = false;
+    for (int a = 0; a < 3; ++a) {
+      if (a == h.face_axis) continue;
+      const double m = p[a] - edge * std::floor(p[a] / edge);
+      line = line || std::min(m, edge - m) < width;
+    }
+    const bool dense = s.material.dense[s.table.chunk_index(h.voxel)] != nullptr;
+    c = mix(c, dense ? Rgb{0.15, 0.35, 1.0} : Rgb{1.0, 0.55, 0.1}, 0.15);
+    if (line) c = mix(c, Rgb{0.02, 0.02, 0.02}, 0.85);
+  }
+
+  void pixel(int px, int py, std::uint8_t* out, RenderStats& st) const {
+    const Ray ray = projector.ray(px + 0.5, py + 0.5);
+    const auto noop = [](const Dda&, std::size_t) {};
+    switch (o.view) {
+      case RenderView::kShaded:
+      case RenderView::kChunks: {
+        const RayHit h = traverse(s, s.box, ray, o.skip, s.skip, st.primary, noop);
+        Rgb c = h.hit ? shade(h, ray, true, st.shadow) : sky(ray.direction);
+        if (h.hit && o.view == RenderView::kChunks) chunk_overlay(h, ray, c);
+        tone_map().write(c, out);
+        return;
+      }
+      case RenderView::kDistance: {
+        Box3i cut = s.box;
+        cut.end.z = slice_z + 1;
+        Dda first;
+        if (render_detail::start_in_box(cut, ray, first) && first.face_axis == 2 && first.step[2] < 0 &&
+            read(s.material, first.v) == 0) {
+          // The ray enters through the cut plane on an air voxel: show the field there, with a
+          // darker band every 8 voxels of distance.
+          ++st.primary.rays;
+          const std::uint8_t stored = skip_at(first.v);
+          heat(stored * s.skip.inv_scale / heat_max, out);
+          if (static_cast<int>(stored * s.skip.inv_scale) % 8 == 0)
+            for (int ch = 0; ch < 3; ++ch) out[ch] = static_cast<std::uint8_t>(out[ch] * 3 / 4);
+          return;
+        }
+        const RayHit h = traverse(s, cut, ray, o.skip, s.skip, st.primary, noop);
+        tone_map().write(h.hit ? shade(h, ray, false, st.shadow) : sky(ray.direction), out);
+        return;
+      }
+      case RenderView::kError: {
+        // The plain DDA visits every voxel up to the true hit: the largest error on the way...
+        double worst = 0;
+        const RayHit exact = traverse(s, s.box, ray, SkipMode::kNone, s.skip, st.primary,
+                                      [&](const Dda& d, std::size_t chunk) {
+                                        const std::uint32_t b = s.table.brick_index(d.v);
+                                        const double e = s.skip.distance(chunk, b) * s.skip.inv_scale;
+                                        const double a = approx->distance(chunk, b) * approx->inv_scale;
+                                        worst = std::max(worst, std::abs(a - e));
+                                      });
+        // ...and whether skipping by the approximate field still stops at that voxel.
+        TraversalCounters unused;
+        const RayHit skipped = traverse(s, s.box, ray, SkipMode::kDistance, *approx, unused, noop);
+        st.max_error = std::max(st.max_error, worst);
+        const Rgb c = exact.hit ? shade(exact, ray, false, st.shadow) : sky(ray.direction);
+        const double grey = 0.8 * (0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b);
+        tone_map().write({grey, grey, grey}, out);
+        if (skipped.hit != exact.hit || skipped.voxel != exact.voxel) {
+          ++st.rays_through_geometry;
+          out[0] = 255; out[1] = 0; out[2] = 255;
+        } else if (worst > 0) {
+          // Logarithmic: errors of one step and of dozens of voxels both stay readable.
+          std::uint8_t h[3];
+          heat(std::log2(1 + worst) / 6, h);
+          for (int ch = 0; ch < 3; ++ch) out[ch] = static_cast<std::uint8_t>((2 * out[ch] + 3 * h[ch]) / 5);
+        }
+        return;
+      }
+    }
+  }
+};
+
+}  // namespace
+
+Image render(const RenderScene& scene, const Camera& camera, const RenderOptions& o, RenderStats* stats) {
+  const RenderScene::Impl& s = scene.impl();
+  if (o.width <= 0 || o.height <= 0 || o.width > 16384 || o.height > 16384)
+    throw InvalidArgument("render: image size " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                          " is out of range (1..16384 per side)");
+  if (o.tile_size <= 0) throw InvalidArgument("render: tile size must be positive");
+  if ((o.ambient_occlusion || o.soft_shadows) && !s.light_field)
+    throw InvalidArgument("render: ambient occlusion and soft shadows need the scene's lighting field "
+                          "(RenderSceneOptions::lighting_field)");
+  if (!(o.fog_density >= 0)) throw InvalidArgument("render: fog density must be >= 0");
+  if (!(o.sun_direction.length() > 0)) throw InvalidArgument("render: the sun direction must be non-zero");
+
+  Image image(o.width, o.height);
+  Frame f{s, o, camera.projector(o.width, o.height), o.sun_direction.normalized()};
+
+  std::optional<DistanceField> approx_field;
+  SkipSource approx;
+  if (o.view == RenderView::kDistance) {
+    f.slice_z = o.slice_z ? *o.slice_z : (s.box.begin.z + s.box.end.z) / 2;
+    if (f.slice_z < s.box.begin.z || f.slice_z >= s.box.end.z)
+      throw InvalidArgument("render: slice z=" + std::to_string(f.slice_z) + " lies outside the box " + to_string(s.box));
+    // Normalise the heat map by the largest distance on the cut.
+    int top = 1;
+    for (int y = s.box.begin.y; y < s.box.end.y; ++y)
+      for (int x = s.box.begin.x; x < s.box.end.x; ++x) top = std::max<int>(top, f.skip_at({x, y, f.slice_z}));
+    f.heat_max = std::max(1.0, top * s.skip.inv_scale);
+  }
+  if (o.view == RenderView::kError) {
+    AlgorithmOptions ao;
+    ao.algorithm = o.error_algorithm;
+    if (ao.algorithm == Algorithm::kLod) {
+      // FIM in the middle of the box (3/8 to 5/8 of each extent, as `voxfield compare` does).
+      const Vec3i sz = s.box.size();
+      const Vec3i lo{sz.x * 3 / 8, sz.y * 3 / 8, sz.z * 3 / 8};
+      const Vec3i hi{std::max(sz.x * 5 / 8, lo.x + 1), std::max(sz.y * 5 / 8, lo.y + 1), std::max(sz.z * 5 / 8, lo.z + 1)};
+      ao.focus = Box3i{s.box.begin + lo, s.box.begin + hi};
+    }
+    approx_field = compute_distance_field(*s.world, skip_field_options(s.options.skip_metric, s.box), ao);
+    approx = s.make_skip_source(*approx_field);
+    f.approx = &approx;
+  }
+
+  const int ts = o.tile_size;
+  const int tiles_x = (o.width + ts - 1) / ts, tiles_y = (o.height + ts - 1) / ts;
+  std::vector<RenderStats> tile_stats(static_cast<std::size_t>(tiles_x) * tiles_y);
+  const auto t0 = std::chrono::steady_clock::now();
+  parallel_for(tile_stats.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t tile = b; tile < e; ++tile) {
+      const int x0 = static_cast<int>(tile % tiles_x) * ts, y0 = static_cast<int>(tile / tiles_x) * ts;
+      RenderStats& st = tile_stats[tile];
+      for (int y = y0; y < std::min(y0 + ts, o.height); ++y)
+        for (int x = x0; x < std::min(x0 + ts, o.width); ++x) f.pixel(x, y, image.pixel(x, y), st);
+    }
+  });
+  if (stats) {
+    RenderStats total;
+    total.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    total.width = o.width;
+    total.height = o.height;
+    for (const RenderStats& t : tile_stats) {
+      total.primary.add(t.primary);
+      total.shadow.add(t.shadow);
+      total.rays_through_geometry += t.rays_through_geometry;
+      total.max_error = std::max(total.max_error, t.max_error);
+    }
+    *stats = total;
+  }
+  return image;
+}
+
+}  // namespace voxfield

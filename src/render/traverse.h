@@ -1,0 +1,149 @@
+// voxfield renderer — walking one ray through the scene: clip to the box, then DDA with empty-chunk
+// and distance-field skips (dda.h), stopping at the first solid voxel.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "dda.h"
+#include "scene_impl.h"
+
+namespace voxfield::render_detail {
+
+// Per-ray constants turning a stored skip distance into the caps of a box free of solid voxels.
+struct SkipWeights {
+  double w[3] = {0, 0, 0};
+  SkipWeights(Metric metric, const Ray& ray) {
+    const double ax = std::abs(ray.direction.x), ay = std::abs(ray.direction.y), az = std::abs(ray.direction.z);
+    double norm = 1;
+    switch (metric) {
+      case Metric::kManhattan: norm = ax + ay + az; break;
+      case Metric::kChebyshev: norm = 0; break;
+      case Metric::kEuclidean: norm = std::sqrt(ax * ax + ay * ay + az * az); break;
+    }
+    if (norm == 0) {
+      w[0] = w[1] = w[2] = 1;
+    } else {
+      w[0] = ax / norm; w[1] = ay / norm; w[2] = az / norm;
+    }
+  }
+};
+
+// Caps of a box ahead of an air voxel v whose stored skip value is `stored` (see dda.h for how a
+// box is left). Why each box holds no solid voxel:
+//  * Manhattan: stored = d, the exact L1 distance from v to the nearest solid voxel (or the clamp,
+//    a lower bound), so every voxel u with |u - v|_1 <= d - 1 is air. Caps c_a = floor((d - 1) w_a)
+//    with w summing to 1 reach at most sum c_a <= d - 1 away: inside that ball. This is the
+//    dissertation's argument — k DDA steps stay within L1 distance k — applied to a whole box.
+//  * Chebyshev: every u with |u - v|_inf <= d - 1 is air: the cube of caps d - 1 on every axis.
+//  * Euclidean: stored = floor(4 d) so r = stored / 4 <= d; the box's farthest voxel lies at
+//    sqrt(sum c_a^2) <= r' |w| < d with c_a = floor(r' w_a), |w| = 1, r' just below r.
+// The caps follow the ray's direction so that it leaves the box through its far side.
+inline void skip_caps(const SkipSource& skip, const SkipWeights& sw, std::uint8_t stored, int caps[3]) {
+  double r;
+  if (skip.metric == Metric::kEuclidean) {
+    r = static_cast<double>(stored) * skip.inv_scale * (1 - 1e-9);
+  } else {
+    r = stored > 0 ? static_cast<double>(stored - 1) : 0.0;
+  }
+  for (int a = 0; a < 3; ++a) caps[a] = static_cast<int>(r * sw.w[a]);
+}
+
+// Clips the ray to `box` and starts the DDA at its first voxel. False when the ray misses.
+inline bool start_in_box(const Box3i& box, const Ray& ray, Dda& dda) {
+  double t0 = -Dda::kInf, t1 = Dda::kInf;
+  int axis0 = -1;
+  for (int a = 0; a < 3; ++a) {
+    const double o = ray.origin[a], d = ray.direction[a];
+    if (d == 0) {
+      if (o < box.begin[a] || o >= box.end[a]) return false;
+      continue;
+    }
+    double ta = (box.begin[a] - o) / d, tb = (box.end[a] - o) / d;
+    if (ta > tb) std::swap(ta, tb);
+    if (ta > t0) { t0 = ta; axis0 = a; }
+    t1 = std::min(t1, tb);
+  }
+  const double ts = std::max(t0, 0.0);
+  if (!(t1 > ts)) return false;
+  Vec3i v;
+  for (int a = 0; a < 3; ++a) {
+    const double p = ray.origin[a] + ray.direction[a] * ts;
+    v[a] = std::clamp(static_cast<int>(std::floor(p)), box.begin[a], box.end[a] - 1);
+  }
+  const int face = t0 > 0 ? axis0 : -1;
+  if (face >= 0) v[face] = ray.direction[face] > 0 ? box.begin[face] : box.end[face] - 1;
+  dda.start(ray, v, ts, face);
+  return true;
+}
+
+inline RayHit make_hit(const Dda& dda, std::uint8_t material) {
+  RayHit h;
+  h.hit = true;
+  h.voxel = dda.v;
+  h.face_axis = dda.face_axis;
+  h.face_sign = dda.face_axis >= 0 ? -dda.step[dda.face_axis] : 0;
+  h.t = dda.t;
+  h.material = material;
+  return h;
+}
+
+// The first solid voxel along the ray inside `box` (a sub-box of the scene's). on_air(dda, chunk)
+// is called at every air voxel the traversal stops at (with kNone: every air voxel on the ray).
+template <class OnAir>
+RayHit traverse(const RenderScene::Impl& s, const Box3i& box, const Ray& ray, SkipMode mode,
+                const SkipSource& skip, TraversalCounters& c, OnAir&& on_air) {
+  ++c.rays;
+  Dda dda;
+  if (!start_in_box(box, ray, dda)) return {};
+  const SkipWeights sw(skip.metric, ray);
+  const ChunkTable& table = s.table;
+  for (;;) {
+    if (!box.contains(dda.v)) return {};
+    const std::size_t chunk = table.chunk_index(dda.v);
+    if (mode != SkipMode::kNone && s.empty_chunk[chunk]) {
+      // Leave the chunk in one step, or farther when the field allows it. Every voxel of the
+      // chunk is at least the chunk's smallest value away from geometry, so that bound needs no
+      // voxel read.
+      const Box3i cb = table.chunk_box_of(dda.v);
+      int caps[3];
+      for (int a = 0; a < 3; ++a)
+        caps[a] = dda.step[a] > 0 ? cb.end[a] - 1 - dda.v[a] : dda.v[a] - cb.begin[a];
+      Dda::Exit exit = dda.exit_of(caps);
+      on_air(dda, chunk);
+      if (mode == SkipMode::kDistance) {
+        int dcaps[3];
+        skip_caps(skip, sw, skip.chunk_min[chunk], dcaps);
+        const Dda::Exit dexit = dda.exit_of(dcaps);
+        if (dexit.t > exit.t || (dexit.t == exit.t && dexit.axis > exit.axis)) {
+          dda.leave(dcaps, dexit);
+          ++c.steps;
+          ++c.distance_skips;
+          continue;
+        }
+      }
+      dda.leave(caps, exit);
+      ++c.steps;
+      ++c.chunk_skips;
+      continue;
+    }
+    ++c.voxel_reads;
+    const std::uint16_t cell = skip.read(chunk, table.brick_index(dda.v));
+    const auto material = static_cast<std::uint8_t>(cell >> 8);
+    if (material != 0) return make_hit(dda, material);
+    on_air(dda, chunk);
+    ++c.steps;
+    if (mode == SkipMode::kDistance) {
+      int caps[3];
+      skip_caps(skip, sw, static_cast<std::uint8_t>(cell & 0xFF), caps);
+      if (caps[0] + caps[1] + caps[2] > 0) {
+        dda.leave(caps, dda.exit_of(caps));
+        ++c.distance_skips;
+        continue;
+      }
+    }
+    dda.step_once();
+  }
+}
+
+}  // namespace voxfield::render_detail

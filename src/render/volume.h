@@ -1,0 +1,102 @@
+// voxfield renderer — the render box as a flat table of chunks, so a voxel read costs two shifts
+// and an array index instead of the sparse grid's hash lookup. Each "layer" (materials, the skip
+// field, the lighting field) points at the grids' own chunk storage: nothing is copied.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "voxfield/grid.h"
+
+namespace voxfield::render_detail {
+
+// A byte buffer for data read at random by every ray: 2 MiB aligned and, on Linux, backed by
+// transparent huge pages when the system allows it, so a read rarely misses the TLB as well as
+// the cache.
+class LargeBuffer {
+ public:
+  LargeBuffer() = default;
+  explicit LargeBuffer(std::size_t bytes);
+  ~LargeBuffer();
+  LargeBuffer(LargeBuffer&& o) noexcept : data_(std::exchange(o.data_, nullptr)), size_(std::exchange(o.size_, 0)) {}
+  LargeBuffer& operator=(LargeBuffer&& o) noexcept {
+    std::swap(data_, o.data_);
+    std::swap(size_, o.size_);
+    return *this;
+  }
+  std::uint8_t* data() { return data_; }
+  const std::uint8_t* data() const { return data_; }
+  std::size_t size() const { return size_; }
+
+ private:
+  std::uint8_t* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+// One u8 grid seen through the chunk table: per chunk, its dense voxels or its uniform value.
+struct VoxelLayer {
+  std::vector<const std::uint8_t*> dense;  // null for uniform (or absent) chunks
+  std::vector<std::uint8_t> uniform;
+};
+
+class ChunkTable {
+ public:
+  ChunkTable() = default;
+  ChunkTable(const Box3i& box, int chunk_edge);
+
+  const Box3i& box() const { return box_; }
+  int chunk_edge() const { return edge_; }
+  int shift() const { return shift_; }
+  std::size_t chunk_count() const { return static_cast<std::size_t>(dims_.x) * dims_.y * dims_.z; }
+
+  // Chunk index of voxel v, which must lie in box().
+  std::size_t chunk_index(Vec3i v) const {
+    return (static_cast<std::size_t>((v.z >> shift_) - first_.z) * dims_.y +
+            static_cast<std::size_t>((v.y >> shift_) - first_.y)) * dims_.x +
+           static_cast<std::size_t>((v.x >> shift_) - first_.x);
+  }
+  // Index of v inside its chunk (the Grid's layout: x fastest).
+  std::uint32_t local_index(Vec3i v) const {
+    const int m = edge_ - 1;
+    return (static_cast<std::uint32_t>(v.z & m) << (2 * shift_)) |
+           (static_cast<std::uint32_t>(v.y & m) << shift_) | static_cast<std::uint32_t>(v.x & m);
+  }
+  // Index of v inside its chunk in the renderer's bricked layout: 4x4x4 bricks of 64 bytes (one
+  // cache line), so the voxels a ray and its neighbouring pixels read near each other share lines
+  // in all three directions, not only along x rows.
+  std::uint32_t brick_index(Vec3i v) const {
+    const int m = edge_ - 1, bs = shift_ - 2;  // bricks per chunk edge: 2^bs
+    const auto bx = static_cast<std::uint32_t>((v.x & m) >> 2), by = static_cast<std::uint32_t>((v.y & m) >> 2),
+               bz = static_cast<std::uint32_t>((v.z & m) >> 2);
+    const std::uint32_t brick = (((bz << bs) | by) << bs) | bx;
+    return (brick << 6) | (static_cast<std::uint32_t>(v.z & 3) << 4) | (static_cast<std::uint32_t>(v.y & 3) << 2) |
+           static_cast<std::uint32_t>(v.x & 3);
+  }
+  // The voxel box of chunk c (by chunk index), clipped to nothing: whole chunks.
+  Box3i chunk_box_of(Vec3i v) const {
+    const Vec3i lo{(v.x >> shift_) << shift_, (v.y >> shift_) << shift_, (v.z >> shift_) << shift_};
+    return {lo, lo + Vec3i::splat(edge_)};
+  }
+  // Chunk coordinate of chunk index i.
+  Vec3i chunk_coord(std::size_t i) const {
+    const auto nx = static_cast<std::size_t>(dims_.x), ny = static_cast<std::size_t>(dims_.y);
+    return {first_.x + static_cast<int>(i % nx), first_.y + static_cast<int>((i / nx) % ny),
+            first_.z + static_cast<int>(i / (nx * ny))};
+  }
+
+  // Points a layer at a grid with this table's chunk edge.
+  VoxelLayer layer(const Grid<std::uint8_t>& grid) const;
+
+  static std::uint8_t read(const VoxelLayer& layer, std::size_t chunk, std::uint32_t local) {
+    const std::uint8_t* d = layer.dense[chunk];
+    return d ? d[local] : layer.uniform[chunk];
+  }
+
+ private:
+  Box3i box_;
+  int edge_ = 0, shift_ = 0;
+  Vec3i first_{0, 0, 0}, dims_{0, 0, 0};
+};
+
+}  // namespace voxfield::render_detail
