@@ -224,6 +224,32 @@ check "field: bad input" 1 "$V" field "$C/dotvox_not_a.vox" -o "$tmp/x.npy"
 [ ! -e "$tmp/x.npy" ] && passes=$((passes+1)) || { echo "FAIL: output written despite errors"; fails=$((fails+1)); }
 for cmd in field compare; do check "$cmd --help" 0 "$V" "$cmd" --help; done
 
+# Rendering: a PNG of the asked size (decoded with Python's zlib), the stats file, clear refusals.
+check "render top" 0 "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/knight.png" --camera top --width 120 --height 90 \
+    --stats "$tmp/render.json"
+check "render png decodes" 0 $PY -c "
+import json, struct, zlib
+d = open('$tmp/knight.png', 'rb').read()
+assert d[:8] == b'\x89PNG\r\n\x1a\n'
+w, h, depth, colour = struct.unpack('>IIBB', d[16:26])
+assert (w, h, depth, colour) == (120, 90, 8, 2), (w, h, depth, colour)
+pos, idat = 8, b''
+while pos < len(d):
+    n = struct.unpack('>I', d[pos:pos + 4])[0]
+    if d[pos + 4:pos + 8] == b'IDAT': idat += d[pos + 8:pos + 8 + n]
+    pos += 12 + n
+assert len(zlib.decompress(idat)) == h * (1 + 3 * w)
+j = json.load(open('$tmp/render.json'))
+assert j['width'] == 120 and j['height'] == 90 and j['ms'] > 0 and j['primary']['rays'] == 120 * 90, j"
+for view in distance error chunks; do
+  check "render $view view" 0 "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/knight-$view.png" --width 64 --height 48 --view $view
+done
+check "render: bad camera" 1 "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/bad.png" --camera "eye=1,2:target=0,0,0"
+expect_grep "render bad camera message" "$tmp/err" "three numbers"
+check "render: bad view" 1 "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/bad.png" --view xray
+check "render: missing input" 1 "$V" render "$tmp/nothing.vox" -o "$tmp/bad.png"
+[ ! -e "$tmp/bad.png" ] && passes=$((passes+1)) || { echo "FAIL: render wrote despite errors"; fails=$((fails+1)); }
+
 check "showcase (small)" 0 "$V" showcase --size 48 --out "$tmp/showcase"
 expect_grep "showcase report" "$tmp/showcase/report.md" "jfa-seed"
 expect_grep "showcase round trip" "$tmp/showcase/report.md" "identical"
