@@ -92,15 +92,22 @@ struct RenderSceneOptions {
   double lighting_clamp = 16;
 };
 
-// A world prepared for rendering: the fields rays skip by and shade with, and a flat table of the
-// chunks inside the render box. Holds a reference to the world, which must outlive it and not
-// change while it is used.
+// A world prepared for rendering: the fields rays skip by and shade with, copied with the
+// materials into a flat table of bricked chunks over the render box. A snapshot: edits to the
+// world after construction are not seen. Keeps a reference to the world (for the error view's
+// approximate field and the palette), which must outlive it.
 class RenderScene {
  public:
   // Renders the voxels inside `box` (default: the world's bounds, else its content box).
   // Throws InvalidArgument for an empty box.
   explicit RenderScene(const World& world, const RenderSceneOptions& options = {},
                        std::optional<Box3i> box = std::nullopt);
+  // Renders with fields the caller keeps (e.g. DynamicDistanceFields updated under edits): `skip`
+  // unsigned u8 of any metric, `light` (optional) unsigned u8 Euclidean, both covering the box and
+  // chunked like the world. Their values are copied; they need not outlive the scene. Throws
+  // InvalidArgument for fields that do not fit.
+  RenderScene(const World& world, const DistanceField& skip, const DistanceField* light,
+              std::optional<Box3i> box = std::nullopt);
   ~RenderScene();
   RenderScene(RenderScene&&) noexcept;
   RenderScene& operator=(RenderScene&&) noexcept;
@@ -108,7 +115,6 @@ class RenderScene {
   const World& world() const;
   const Box3i& box() const;
   const RenderSceneOptions& options() const;
-  const DistanceField& skip_field() const;
   // Milliseconds spent computing the fields (skip, lighting).
   double field_ms() const;
 

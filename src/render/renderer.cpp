@@ -33,7 +33,6 @@ RenderView parse_render_view(const std::string& name) {
 
 namespace {
 
-using render_detail::ChunkTable;
 using render_detail::Dda;
 using render_detail::traverse;
 
@@ -106,9 +105,7 @@ struct Frame {
   int slice_z = 0;
   double heat_max = 1;
 
-  std::uint8_t read(const render_detail::VoxelLayer& layer, Vec3i v) const {
-    return ChunkTable::read(layer, s.table.chunk_index(v), s.table.local_index(v));
-  }
+  std::uint8_t light_at_voxel(Vec3i v) const { return s.light.read(s.table.chunk_index(v), s.table.brick_index(v)); }
 
   std::uint8_t skip_at(Vec3i v) const { return s.skip.distance(s.table.chunk_index(v), s.table.brick_index(v)); }
 
@@ -125,7 +122,7 @@ struct Frame {
       const Vec3i v{std::clamp(x0 + dx, box.begin.x, box.end.x - 1), std::clamp(y0 + dy, box.begin.y, box.end.y - 1),
                     std::clamp(z0 + dz, box.begin.z, box.end.z - 1)};
       const double w = (dx ? tx : 1 - tx) * (dy ? ty : 1 - ty) * (dz ? tz : 1 - tz);
-      sum += w * read(s.light, v);
+      sum += w * light_at_voxel(v);
     }
     return sum * s.light_inv_scale;
   }
@@ -155,8 +152,7 @@ struct Frame {
     const RayHit hit = traverse(s, s.box, r, SkipMode::kDistance, s.skip, c,
                                 [&](const Dda& d, std::size_t chunk) {
                                   if (d.t < kNear) return;
-                                  const double e = ChunkTable::read(s.light, chunk, s.table.local_index(d.v)) *
-                                                   s.light_inv_scale;
+                                  const double e = s.light.read(chunk, s.table.brick_index(d.v)) * s.light_inv_scale;
                                   lit = std::min(lit, kSoftness * (e - 0.75) / d.t);
                                 });
     if (hit.hit) return 0;
@@ -202,7 +198,7 @@ struct Frame {
       const double m = p[a] - edge * std::floor(p[a] / edge);
       line = line || std::min(m, edge - m) < width;
     }
-    const bool dense = s.material.dense[s.table.chunk_index(h.voxel)] != nullptr;
+    const bool dense = s.dense_material[s.table.chunk_index(h.voxel)] != 0;
     c = mix(c, dense ? Rgb{0.15, 0.35, 1.0} : Rgb{1.0, 0.55, 0.1}, 0.15);
     if (line) c = mix(c, Rgb{0.02, 0.02, 0.02}, 0.85);
   }
@@ -224,7 +220,7 @@ struct Frame {
         cut.end.z = slice_z + 1;
         Dda first;
         if (render_detail::start_in_box(cut, ray, first) && first.face_axis == 2 && first.step[2] < 0 &&
-            read(s.material, first.v) == 0) {
+            s.skip.material(s.table.chunk_index(first.v), s.table.brick_index(first.v)) == 0) {
           // The ray enters through the cut plane on an air voxel: show the field there, with a
           // darker band every 8 voxels of distance.
           ++st.primary.rays;
@@ -278,7 +274,7 @@ Image render(const RenderScene& scene, const Camera& camera, const RenderOptions
     throw InvalidArgument("render: image size " + std::to_string(o.width) + "x" + std::to_string(o.height) +
                           " is out of range (1..16384 per side)");
   if (o.tile_size <= 0) throw InvalidArgument("render: tile size must be positive");
-  if ((o.ambient_occlusion || o.soft_shadows) && !s.light_field)
+  if ((o.ambient_occlusion || o.soft_shadows) && !s.has_light)
     throw InvalidArgument("render: ambient occlusion and soft shadows need the scene's lighting field "
                           "(RenderSceneOptions::lighting_field)");
   if (!(o.fog_density >= 0)) throw InvalidArgument("render: fog density must be >= 0");

@@ -1,4 +1,8 @@
 // voxfield renderer — what a RenderScene holds, shared by the tracer and the frame renderer.
+//
+// Everything a ray reads is copied out of the grids into bricked arenas (volume.h): a voxel read
+// costs one cache line and no hash lookup, and the scene does not depend on the fields it was
+// built from staying alive.
 #pragma once
 
 #include <array>
@@ -9,28 +13,38 @@
 
 namespace voxfield {
 
-// A field rays skip by, copied with the materials out of their grids into one arena of bricked
-// chunks (volume.h): per voxel 16 bits, the stored distance in the low byte and the material in the
-// high one, so a ray's read costs one cache line, no hash lookup, and tells both how far to skip
-// and, at a hit, what was hit. Chunks where both are uniform are not stored.
+// Values of type T per voxel of the chunk table, bricked; chunks whose values are all equal are
+// not stored.
+template <class T>
+struct BrickedChunks {
+  static constexpr std::uint32_t kUniform = 0xFFFFFFFFu;
+  std::vector<std::uint32_t> slot;  // per chunk: its place in the arena, or kUniform
+  std::vector<T> uniform;           // per chunk: the value of a chunk not stored
+  render_detail::LargeBuffer arena;
+  std::uint32_t chunk_volume = 0;
+
+  T read(std::size_t chunk, std::uint32_t brick_index) const {
+    const std::uint32_t s = slot[chunk];
+    if (s == kUniform) return uniform[chunk];
+    return reinterpret_cast<const T*>(arena.data())[static_cast<std::size_t>(s) * chunk_volume + brick_index];
+  }
+};
+
+// A field rays skip by, with the materials: per voxel 16 bits, the stored distance in the low
+// byte and the material in the high one, so one read tells both how far to skip and, at a hit,
+// what was hit.
 struct SkipSource {
   Metric metric = Metric::kManhattan;
   double inv_scale = 1;  // stored value * inv_scale = a lower bound of the distance in voxels
-  static constexpr std::uint32_t kUniform = 0xFFFFFFFFu;
-  std::vector<std::uint32_t> slot;        // per chunk: its place in the arena, or kUniform
-  std::vector<std::uint8_t> chunk_min;    // per chunk: its smallest distance (the value, if uniform)
-  std::vector<std::uint8_t> chunk_material;  // per uniform chunk: its material
-  render_detail::LargeBuffer arena;       // u16 per voxel
-  std::uint32_t chunk_volume = 0;
+  BrickedChunks<std::uint16_t> cells;
+  std::vector<std::uint8_t> chunk_min;  // per chunk: its smallest distance
 
-  // Distance (low byte) and material (high byte) of a voxel.
-  std::uint16_t read(std::size_t chunk, std::uint32_t brick_index) const {
-    const std::uint32_t s = slot[chunk];
-    if (s == kUniform) return static_cast<std::uint16_t>(chunk_min[chunk] | (chunk_material[chunk] << 8));
-    return reinterpret_cast<const std::uint16_t*>(arena.data())[static_cast<std::size_t>(s) * chunk_volume + brick_index];
-  }
+  std::uint16_t read(std::size_t chunk, std::uint32_t brick_index) const { return cells.read(chunk, brick_index); }
   std::uint8_t distance(std::size_t chunk, std::uint32_t brick_index) const {
     return static_cast<std::uint8_t>(read(chunk, brick_index) & 0xFF);
+  }
+  std::uint8_t material(std::size_t chunk, std::uint32_t brick_index) const {
+    return static_cast<std::uint8_t>(read(chunk, brick_index) >> 8);
   }
 };
 
@@ -38,18 +52,18 @@ struct RenderScene::Impl {
   const World* world = nullptr;
   Box3i box;
   RenderSceneOptions options;
-  DistanceField skip_field;
-  std::optional<DistanceField> light_field;
   double field_ms = 0;
 
   render_detail::ChunkTable table;
-  render_detail::VoxelLayer material;
-  render_detail::VoxelLayer light;  // empty vectors without a lighting field
-  double light_inv_scale = 0.25;
   SkipSource skip;
-  std::vector<std::uint8_t> empty_chunk;  // 1 where a chunk of the table holds no solid voxel
+  bool has_light = false;
+  BrickedChunks<std::uint8_t> light;  // the Euclidean lighting field
+  double light_inv_scale = 0.25;
+  std::vector<std::uint8_t> empty_chunk;     // 1 where a chunk holds no solid voxel
+  std::vector<std::uint8_t> dense_material;  // 1 where the world stores a chunk voxel by voxel
   std::array<std::array<float, 3>, 256> albedo{};  // palette in linear RGB
 
+  void build(const World& w, const DistanceField& skip_field, const DistanceField* light_field);
   SkipSource make_skip_source(const DistanceField& field) const;
 };
 

@@ -1,6 +1,6 @@
-// voxfield renderer — the render box as a flat table of chunks, so a voxel read costs two shifts
-// and an array index instead of the sparse grid's hash lookup. Each "layer" (materials, the skip
-// field, the lighting field) points at the grids' own chunk storage: nothing is copied.
+// voxfield renderer — the render box as a flat table of chunks, so finding a voxel's chunk costs
+// two shifts and an array index instead of the sparse grid's hash lookup, and the bricked layout
+// of the voxels inside a chunk.
 #pragma once
 
 #include <cstdint>
@@ -32,12 +32,6 @@ class LargeBuffer {
  private:
   std::uint8_t* data_ = nullptr;
   std::size_t size_ = 0;
-};
-
-// One u8 grid seen through the chunk table: per chunk, its dense voxels or its uniform value.
-struct VoxelLayer {
-  std::vector<const std::uint8_t*> dense;  // null for uniform (or absent) chunks
-  std::vector<std::uint8_t> uniform;
 };
 
 class ChunkTable {
@@ -83,14 +77,6 @@ class ChunkTable {
     const auto nx = static_cast<std::size_t>(dims_.x), ny = static_cast<std::size_t>(dims_.y);
     return {first_.x + static_cast<int>(i % nx), first_.y + static_cast<int>((i / nx) % ny),
             first_.z + static_cast<int>(i / (nx * ny))};
-  }
-
-  // Points a layer at a grid with this table's chunk edge.
-  VoxelLayer layer(const Grid<std::uint8_t>& grid) const;
-
-  static std::uint8_t read(const VoxelLayer& layer, std::size_t chunk, std::uint32_t local) {
-    const std::uint8_t* d = layer.dense[chunk];
-    return d ? d[local] : layer.uniform[chunk];
   }
 
  private:
