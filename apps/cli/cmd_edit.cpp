@@ -26,7 +26,7 @@ Vec3d vec3d(const nlohmann::json& j, const char* key) {
 
 Vec3i vec3i(const nlohmann::json& j, const char* key) {
   const Vec3d d = vec3d(j, key);
-  for (double c : d)
+  for (double c : {d.x, d.y, d.z})
     if (c != std::floor(c) || std::abs(c) > (1 << 30)) throw std::invalid_argument(std::string("\"") + key + "\" must hold integers");
   return {static_cast<int>(d[0]), static_cast<int>(d[1]), static_cast<int>(d[2])};
 }

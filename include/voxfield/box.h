@@ -7,6 +7,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -26,6 +27,23 @@ struct Vec3i {
 inline std::string to_string(Vec3i v) {
   return std::to_string(v.x) + "," + std::to_string(v.y) + "," + std::to_string(v.z);
 }
+
+// A point or direction in voxel space (voxel v spans [v, v + 1) on each axis).
+struct Vec3d {
+  double x = 0, y = 0, z = 0;
+  constexpr double operator[](int axis) const { return axis == 0 ? x : axis == 1 ? y : z; }
+  constexpr double& operator[](int axis) { return axis == 0 ? x : axis == 1 ? y : z; }
+  friend constexpr bool operator==(const Vec3d&, const Vec3d&) = default;
+  friend constexpr Vec3d operator+(Vec3d a, Vec3d b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+  friend constexpr Vec3d operator-(Vec3d a, Vec3d b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+  friend constexpr Vec3d operator*(Vec3d a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+  friend constexpr double dot(Vec3d a, Vec3d b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+  friend constexpr Vec3d cross(Vec3d a, Vec3d b) {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+  }
+  double length() const { return std::sqrt(x * x + y * y + z * z); }
+  Vec3d normalized() const { const double l = length(); return {x / l, y / l, z / l}; }
+};
 
 struct Box3i {
   Vec3i begin;  // inclusive

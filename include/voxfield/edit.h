@@ -19,7 +19,6 @@
 
 namespace voxfield {
 
-using Vec3d = std::array<double, 3>;
 
 // Voxels p with |p - center|^2 <= radius^2 (voxel centres at integer coordinates).
 struct SphereBrush {

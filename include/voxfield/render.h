@@ -22,20 +22,6 @@
 
 namespace voxfield {
 
-struct Vec3d {
-  double x = 0, y = 0, z = 0;
-  double operator[](int axis) const { return axis == 0 ? x : axis == 1 ? y : z; }
-  friend Vec3d operator+(Vec3d a, Vec3d b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-  friend Vec3d operator-(Vec3d a, Vec3d b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-  friend Vec3d operator*(Vec3d a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-  friend double dot(Vec3d a, Vec3d b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-  friend Vec3d cross(Vec3d a, Vec3d b) {
-    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-  }
-  double length() const { return std::sqrt(x * x + y * y + z * z); }
-  Vec3d normalized() const { const double l = length(); return {x / l, y / l, z / l}; }
-};
-
 // Rays in voxel coordinates: voxel v occupies the unit cube [v, v + 1).
 struct Ray {
   Vec3d origin;

@@ -24,7 +24,7 @@ void validate_edit(const Edit& e) {
       }
     }
     void operator()(const RotatedBoxBrush& b) const {
-      for (double h : b.half_extent)
+      for (double h : {b.half_extent.x, b.half_extent.y, b.half_extent.z})
         if (!(h >= 0) || !std::isfinite(h)) throw InvalidArgument("rotated box half extents must be >= 0");
     }
     void operator()(const CapsuleBrush& c) const {
