@@ -12,6 +12,7 @@
 #include "voxfield/world_file.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
+#include "voxfield/render.h"
 #include "voxfield/scene.h"
 
 namespace voxfield::cli {
@@ -29,8 +30,16 @@ std::string fixed(double v, int digits) {
   return os.str();
 }
 
+struct Timing {
+  std::string stage;
+  double ms;
+  std::string note;
+};
+
 int run_showcase(const ShowcaseSettings& s) {
   namespace fs = std::filesystem;
+  const auto t_start = std::chrono::steady_clock::now();
+  std::vector<Timing> timings;
   fs::create_directories(s.out);
   std::ostringstream md;
   md << "# voxfield showcase\n\n";
@@ -47,6 +56,7 @@ int run_showcase(const ShowcaseSettings& s) {
     auto t0 = std::chrono::steady_clock::now();
     const World w = make_scene(scene, o);
     const double gen_ms = ms_since(t0);
+    timings.push_back({std::string("generate ") + scene + " " + std::to_string(s.size) + "³", gen_ms, ""});
     const std::int64_t solid = w.solid_count();
     const GridMemory mem = w.voxels.memory();
 
@@ -88,6 +98,8 @@ int run_showcase(const ShowcaseSettings& s) {
       const auto t0 = std::chrono::steady_clock::now();
       const DistanceField f = compute_distance_field(terrain, o);
       const double ms = ms_since(t0);
+      timings.push_back({std::string("exact ") + (sgn ? "signed " : "") + metric_name(m) + " field, f32", ms,
+                         fixed(voxels / (ms * 1e3), 0) + " Mvox/s"});
       const Grid<float>& g = std::get<Grid<float>>(f.values);
       float max_d = 0;
       g.for_each_chunk([&](const ChunkView<float>& c) {
@@ -136,14 +148,97 @@ int run_showcase(const ShowcaseSettings& s) {
   md << "\n*Unsafe* voxels hold a value above the exact distance: a ray marcher trusting them skips "
         "through geometry. `terrain-sdf.npy` is the signed Euclidean field of the terrain.\n";
 
-  // A seeded stream of edits on the terrain, each followed by an incremental update, checked
-  // against a full rebuild at the end; the edited world is saved as a .vfw file.
+  // Pictures of the terrain, rendered through fields that are then kept exact under a seeded
+  // stream of edits: a Manhattan field to skip by (the dissertation's choice, clamped at 32 so an
+  // edit's reach stays local) and a Euclidean one for ambient occlusion and soft shadows.
+  World edited = make_terrain(to);
+  const Box3i box = Box3i::from_size(to.size);
+  DistanceOptions skip_o;
+  skip_o.metric = Metric::kManhattan;
+  skip_o.storage = Storage::kU8;
+  skip_o.max_distance = 32;
+  skip_o.domain = box;
+  DistanceOptions light_o = skip_o;
+  light_o.metric = Metric::kEuclidean;
+  light_o.max_distance = 16;
+  auto t_fields = std::chrono::steady_clock::now();
+  DynamicDistanceField skip_field(edited, skip_o);
+  DynamicDistanceField light_field(edited, light_o);
+  timings.push_back({"render fields (Manhattan u8 clamp 32 + Euclidean u8 clamp 16), " + std::to_string(s.size) + "³",
+                     ms_since(t_fields), ""});
+
+  const double aspect = 16.0 / 9.0;
+  const Camera hero = Camera::framing(edited.voxels.content_bounds(), aspect);
+  const Camera top = Camera::top(box, 1.0);
+  auto frame = [&](const RenderScene& scene, const Camera& cam, RenderOptions o, const std::string& file,
+                   const std::string& what) {
+    RenderStats st;
+    const Image img = render(scene, cam, o, &st);
+    write_png(img, fs::path(s.out) / file);
+    timings.push_back({"frame " + file + " (" + what + ", " + std::to_string(o.width) + "×" + std::to_string(o.height) + ")",
+                       st.ms, fixed(st.rays_per_second() / 1e6, 1) + " M primary rays/s"});
+    std::cout << "voxfield showcase: " << file << " in " << fixed(st.ms, 0) << " ms\n";
+    return st;
+  };
+  RenderOptions wide;
+  wide.width = 1280;
+  wide.height = 720;
+  RenderOptions square = wide;
+  square.width = square.height = 720;
   {
-    World edited = make_terrain(to);
-    DistanceOptions eo;
-    eo.metric = Metric::kEuclidean;
-    eo.max_distance = 16;
-    DynamicDistanceField live(edited, eo);
+    const RenderScene before(edited, skip_field.field(), &light_field.field());
+    frame(before, hero, wide, "terrain-before.png", "shaded");
+    frame(before, top, square, "terrain-top-before.png", "shaded, top");
+    RenderOptions chunks = wide;
+    chunks.view = RenderView::kChunks;
+    frame(before, hero, chunks, "terrain-chunks.png", "chunk grid");
+  }
+  {
+    // The distance view needs the field it shows: the exact Manhattan field, unclamped in u8.
+    const RenderScene exact_scene(edited, RenderSceneOptions{}, box);
+    RenderOptions cut = wide;
+    cut.view = RenderView::kDistance;
+    cut.slice_z = to.size.z * 3 / 10;  // through the caves
+    cut.soft_shadows = false;
+    frame(exact_scene, hero, cut, "terrain-distance.png", "distance cut at z = " + std::to_string(*cut.slice_z));
+  }
+  md << "\n## The terrain\n\n"
+     << "Rendered on the CPU by DDA ray marching through the Manhattan field (empty chunks and "
+        "distance-field skips), shaded with ambient occlusion and soft shadows from the Euclidean field.\n\n"
+     << "![terrain](terrain-before.png)\n\n"
+     << "| from above | chunk grid (blue: chunks stored voxel by voxel, orange: uniform chunks) |\n|---|---|\n"
+     << "| ![top](terrain-top-before.png) | ![chunks](terrain-chunks.png) |\n\n"
+     << "Cut through the caves at z = " << to.size.z * 3 / 10
+     << ": the exact Manhattan distance of every air voxel on the cut (blue near, red far; a darker band every 8 "
+        "voxels), the world below the cut shaded.\n\n![distance](terrain-distance.png)\n";
+
+  // Where the dissertation's approximations let rays skip through geometry, on the small terrain.
+  {
+    const RenderScene small_scene(sw, RenderSceneOptions{}, Box3i::from_size(small.size));
+    const Camera small_cam = Camera::framing(Box3i::from_size(small.size), aspect);
+    md << "\n## What the approximations get wrong, seen by a ray marcher (terrain " << small.size.x << "³)\n\n"
+       << "Each pixel shows the largest |approximate − exact| Manhattan distance along its ray (log scale, "
+          "blue small, red large); magenta marks rays that, skipping by the approximate field, pass through the "
+          "voxel they should hit.\n\n| algorithm | rays through geometry | largest error on a ray |\n|---|---|---|\n";
+    std::string images;
+    for (Algorithm a : {Algorithm::kJfaSeed, Algorithm::kBruteChunked, Algorithm::kJfa}) {
+      RenderOptions ev;
+      ev.width = 640;
+      ev.height = 360;
+      ev.view = RenderView::kError;
+      ev.error_algorithm = a;
+      const std::string file = std::string("error-") + algorithm_name(a) + ".png";
+      const RenderStats st = frame(small_scene, small_cam, ev, file, std::string("error view, ") + algorithm_name(a));
+      md << "| " << algorithm_name(a) << " | " << st.rays_through_geometry << " of " << ev.width * ev.height << " | "
+         << fixed(st.max_error, 0) << " voxels |\n";
+      images += "| " + std::string(algorithm_name(a)) + " | ![" + file + "](" + file + ") |\n";
+    }
+    md << "\n| algorithm | error view |\n|---|---|\n" << images;
+  }
+
+  // A seeded stream of edits on the terrain's surface — craters, boulders, pillars — each followed
+  // by incremental exact updates of both fields, checked against full rebuilds at the end.
+  {
     DirtyRegions dirty(edited.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
     std::uint64_t state = s.seed;
     auto next = [&](int lo, int hi) {  // SplitMix64 steps: the same stream on every machine
@@ -153,39 +248,86 @@ int run_showcase(const ShowcaseSettings& s) {
       z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
       return lo + static_cast<int>((z ^ (z >> 31)) % static_cast<std::uint64_t>(hi - lo + 1));
     };
+    auto surface = [&](int x, int y) {  // height of the highest solid voxel in a column, or 0
+      for (int z = to.size.z - 1; z >= 0; --z)
+        if (edited.voxels.get({x, y, z})) return z;
+      return 0;
+    };
     std::vector<double> latencies;
     const int edits = 200;
+    int craters = 0, boulders = 0, pillars = 0;
+    const auto t_stream = std::chrono::steady_clock::now();
     for (int i = 0; i < edits; ++i) {
+      const int x = next(0, s.size - 1), y = next(0, s.size - 1), kind = next(0, 19);
+      const double h = surface(x, y);
       Edit e;
-      const int material = next(0, 8);
-      e.op = material == 0 ? EditOp::kCarve : EditOp::kPlace;
-      e.material = static_cast<std::uint8_t>(std::max(material, 1));
-      e.brush = SphereBrush{{static_cast<double>(next(0, s.size - 1)), static_cast<double>(next(0, s.size - 1)),
-                             static_cast<double>(next(0, s.size - 1))},
-                            static_cast<double>(next(1, 8))};
+      if (kind < 11) {  // crater
+        const double r = next(3, std::max(4, s.size / 20));
+        e.op = EditOp::kCarve;
+        e.brush = SphereBrush{{double(x), double(y), h}, r};
+        ++craters;
+      } else if (kind < 17) {  // boulder sitting on the surface, in one of the palette's bright colours
+        const double r = next(2, std::max(3, s.size / 40));
+        e.op = EditOp::kPlace;
+        e.material = static_cast<std::uint8_t>(std::array<int, 4>{36, 5, 180, 215}[static_cast<std::size_t>(next(0, 3))]);
+        e.brush = SphereBrush{{double(x), double(y), h + r}, r};
+        ++boulders;
+      } else {  // pillar
+        const int half = next(1, 3), height = next(s.size / 16, s.size / 6);
+        e.op = EditOp::kPlace;
+        e.material = 121;
+        e.brush = BoxBrush{{x - half, y - half, static_cast<int>(h)},
+                           {x + half, y + half, std::min(to.size.z - 1, static_cast<int>(h) + height)}};
+        ++pillars;
+      }
       const auto t0 = std::chrono::steady_clock::now();
       apply_edit(edited, e, &dirty);
-      live.update(dirty);
+      skip_field.update(dirty);
+      light_field.update(dirty);
       dirty.clear();
       latencies.push_back(ms_since(t0));
     }
+    const double stream_ms = ms_since(t_stream);
     std::sort(latencies.begin(), latencies.end());
-    const DistanceField full = compute_distance_field(edited, live.options());
-    std::vector<float> a(static_cast<std::size_t>(voxels)), b(a.size());
-    std::get<Grid<float>>(live.field().values).copy_to_dense(Box3i::from_size(to.size), a.data());
-    std::get<Grid<float>>(full.values).copy_to_dense(Box3i::from_size(to.size), b.data());
-    const bool exact = a == b;
-    write_world_file(edited, fs::path(s.out) / "terrain-edited.vfw", {&live.field()});
-    md << "\n## Editing the terrain\n\n" << edits << " seeded sphere edits (radius 1–8, one in nine carves), "
-       << "each followed by an incremental exact update of the Euclidean field clamped at 16: median "
+    const auto t_check = std::chrono::steady_clock::now();
+    auto same = [&](const DynamicDistanceField& live) {
+      const DistanceField full = compute_distance_field(edited, live.options());
+      std::vector<std::uint8_t> a(static_cast<std::size_t>(voxels)), b(a.size());
+      std::get<Grid<std::uint8_t>>(live.field().values).copy_to_dense(box, a.data());
+      std::get<Grid<std::uint8_t>>(full.values).copy_to_dense(box, b.data());
+      return a == b;
+    };
+    const bool exact = same(skip_field) && same(light_field);
+    timings.push_back({std::to_string(edits) + " edits with incremental updates of both fields", stream_ms,
+                       "median " + fixed(latencies[latencies.size() / 2], 2) + " ms, p99 " +
+                           fixed(latencies[latencies.size() * 99 / 100], 2) + " ms per edit"});
+    timings.push_back({"full rebuilds of both fields, to check the updates", ms_since(t_check), ""});
+    write_world_file(edited, fs::path(s.out) / "terrain-edited.vfw", {&skip_field.field(), &light_field.field()});
+    {
+      const RenderScene after(edited, skip_field.field(), &light_field.field());
+      frame(after, hero, wide, "terrain-after.png", "shaded, after the edits");
+      frame(after, top, square, "terrain-top-after.png", "shaded, top, after the edits");
+    }
+    md << "\n## Editing the terrain\n\n" << edits << " seeded edits on the surface (" << craters << " craters, "
+       << boulders << " boulders, " << pillars << " pillars), each followed by incremental exact updates of both "
+          "render fields: median "
        << fixed(latencies[latencies.size() / 2], 2) << " ms, p99 " << fixed(latencies[latencies.size() * 99 / 100], 2)
-       << " ms per edit. After the stream the field is "
-       << (exact ? "bit-identical to a full rebuild" : "**different from a full rebuild**")
-       << ". The edited world and its field are in `terrain-edited.vfw`.\n";
+       << " ms per edit. After the stream both fields are "
+       << (exact ? "bit-identical to full rebuilds" : "**different from full rebuilds**")
+       << ", and the frames below are rendered from the incrementally updated fields. The edited world and "
+          "its fields are in `terrain-edited.vfw`.\n\n"
+       << "| before | after |\n|---|---|\n"
+       << "| ![before](terrain-before.png) | ![after](terrain-after.png) |\n"
+       << "| ![before](terrain-top-before.png) | ![after](terrain-top-after.png) |\n";
     std::cout << "voxfield showcase: " << edits << " edits, median " << fixed(latencies[latencies.size() / 2], 2)
-              << " ms, field " << (exact ? "identical to" : "DIFFERENT from") << " a full rebuild\n";
-    if (!exact) throw Error("showcase: the incrementally updated field differs from a full rebuild");
+              << " ms, fields " << (exact ? "identical to" : "DIFFERENT from") << " full rebuilds\n";
+    if (!exact) throw Error("showcase: the incrementally updated fields differ from full rebuilds");
   }
+
+  const double total_ms = ms_since(t_start);
+  md << "\n## Timings\n\n| stage | ms | |\n|---|---|---|\n";
+  for (const auto& [stage, ms, note] : timings) md << "| " << stage << " | " << fixed(ms, 1) << " | " << note << " |\n";
+  md << "| **whole showcase** | " << fixed(total_ms, 0) << " | " << max_threads() << " threads |\n";
 
   const fs::path report = fs::path(s.out) / "report.md";
   std::ofstream(report) << md.str();
