@@ -105,6 +105,23 @@ TEST(Render, SkippingNeverChangesAHit) {
   }
 }
 
+TEST(Render, BatchTracingEqualsSingleRays) {
+  const World w = random_world({50, 40, 30}, 8, 23, 20);
+  RenderSceneOptions so;
+  so.lighting_field = false;
+  const RenderScene scene(w, so);
+  const std::vector<Ray> rays = test_rays(scene.box(), 8, 2000);
+  std::vector<RayHit> hits(rays.size());
+  TraversalCounters batch, single;
+  trace_rays(scene, rays, hits, SkipMode::kDistance, &batch);
+  for (std::size_t i = 0; i < rays.size(); ++i)
+    expect_same_hit(hits[i], trace_ray(scene, rays[i], SkipMode::kDistance, &single), "ray " + std::to_string(i));
+  EXPECT_EQ(batch.voxel_reads, single.voxel_reads);
+  EXPECT_EQ(batch.rays, static_cast<std::int64_t>(rays.size()));
+  std::vector<RayHit> short_hits(3);
+  EXPECT_THROW(trace_rays(scene, rays, short_hits), InvalidArgument);
+}
+
 TEST(Render, DdaMatchesBruteForceRayBoxIntersection) {
   const Vec3i size{21, 17, 13};
   const World w = random_world(size, 8, 99, 14);

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "voxfield/algorithms.h"
@@ -138,6 +139,12 @@ struct TraversalCounters {
 // The first solid voxel along the ray (t >= 0) inside the scene's box.
 RayHit trace_ray(const RenderScene& scene, const Ray& ray, SkipMode mode = SkipMode::kDistance,
                  TraversalCounters* counters = nullptr);
+
+// The same for many rays at once (hits[i] for rays[i]), multi-threaded — for ray casts that are
+// not pictures (sensor simulation, visibility queries). Throws InvalidArgument when the spans
+// differ in size or a ray is degenerate.
+void trace_rays(const RenderScene& scene, std::span<const Ray> rays, std::span<RayHit> hits,
+                SkipMode mode = SkipMode::kDistance, TraversalCounters* counters = nullptr);
 
 enum class RenderView {
   kShaded,    // palette colour, sun, sky, ambient occlusion, soft shadows, fog

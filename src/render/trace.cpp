@@ -1,5 +1,9 @@
 // voxfield renderer — tracing single rays (the public entry point used by tests and tools).
+#include <algorithm>
+#include <vector>
+
 #include "traverse.h"
+#include "voxfield/parallel.h"
 #include "voxfield/error.h"
 
 namespace voxfield {
@@ -19,16 +23,41 @@ SkipMode parse_skip_mode(const std::string& name) {
   throw InvalidArgument("unknown skip mode \"" + name + "\" (expected none, chunks or distance)");
 }
 
+namespace {
+
+void check_ray(const Ray& ray) {
+  const double d = ray.direction.length(), o = ray.origin.length();
+  if (!(d > 0) || !std::isfinite(d) || !std::isfinite(o))
+    throw InvalidArgument("trace_ray: a ray needs a finite origin and a non-zero finite direction");
+}
+
+}  // namespace
+
 RayHit trace_ray(const RenderScene& scene, const Ray& ray, SkipMode mode, TraversalCounters* counters) {
-  if (!(ray.direction.length() > 0) || !std::isfinite(ray.direction.length()) ||
-      !std::isfinite(ray.origin.length()))
-    throw InvalidArgument("trace_ray: the ray needs a finite origin and a non-zero finite direction");
+  check_ray(ray);
   const RenderScene::Impl& s = scene.impl();
   TraversalCounters local;
   const RayHit hit = render_detail::traverse(s, s.box, ray, mode, s.skip, local,
                                              [](const render_detail::Dda&, std::size_t) {});
   if (counters) counters->add(local);
   return hit;
+}
+
+void trace_rays(const RenderScene& scene, std::span<const Ray> rays, std::span<RayHit> hits, SkipMode mode,
+                TraversalCounters* counters) {
+  if (hits.size() != rays.size()) throw InvalidArgument("trace_rays: as many hits as rays, please");
+  for (const Ray& ray : rays) check_ray(ray);
+  const RenderScene::Impl& s = scene.impl();
+  constexpr std::size_t kGrain = 256;
+  std::vector<TraversalCounters> parts((rays.size() + kGrain - 1) / kGrain);
+  parallel_for(parts.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t part = b; part < e; ++part)
+      for (std::size_t i = part * kGrain; i < std::min(rays.size(), (part + 1) * kGrain); ++i)
+        hits[i] = render_detail::traverse(s, s.box, rays[i], mode, s.skip, parts[part],
+                                          [](const render_detail::Dda&, std::size_t) {});
+  });
+  if (counters)
+    for (const TraversalCounters& p : parts) counters->add(p);
 }
 
 }  // namespace voxfield

@@ -13,6 +13,7 @@ namespace voxfield::render_detail {
 // Per-ray constants turning a stored skip distance into the caps of a box free of solid voxels.
 struct SkipWeights {
   double w[3] = {0, 0, 0};
+  SkipWeights() = default;
   SkipWeights(Metric metric, const Ray& ray) {
     const double ax = std::abs(ray.direction.x), ay = std::abs(ray.direction.y), az = std::abs(ray.direction.z);
     double norm = 1;
@@ -88,8 +89,63 @@ inline RayHit make_hit(const Dda& dda, std::uint8_t material) {
   return h;
 }
 
-// The first solid voxel along the ray inside `box` (a sub-box of the scene's). on_air(dda, chunk)
+enum class Step { kContinue, kHit, kMiss };
+
+// One iteration of the traversal at dda.v: a hit, a miss (the ray left `box`), or the DDA moved on
+// (one step, or a skip out of an empty chunk or a box the distance field clears). on_air(dda, chunk)
 // is called at every air voxel the traversal stops at (with kNone: every air voxel on the ray).
+template <class OnAir>
+inline Step visit(const RenderScene::Impl& s, const Box3i& box, SkipMode mode, const SkipSource& skip,
+                  const SkipWeights& sw, Dda& dda, TraversalCounters& c, OnAir& on_air, RayHit& hit) {
+  if (!box.contains(dda.v)) return Step::kMiss;
+  const ChunkTable& table = s.table;
+  const std::size_t chunk = table.chunk_index(dda.v);
+  if (mode != SkipMode::kNone && s.empty_chunk[chunk]) {
+    // Leave the chunk in one step, or farther when the field allows it. Every voxel of the chunk
+    // is at least the chunk's smallest value away from geometry, so that bound needs no voxel read.
+    const Box3i cb = table.chunk_box_of(dda.v);
+    int caps[3];
+    for (int a = 0; a < 3; ++a) caps[a] = dda.step[a] > 0 ? cb.end[a] - 1 - dda.v[a] : dda.v[a] - cb.begin[a];
+    const Dda::Exit exit = dda.exit_of(caps);
+    on_air(dda, chunk);
+    ++c.steps;
+    if (mode == SkipMode::kDistance) {
+      int dcaps[3];
+      skip_caps(skip, sw, skip.chunk_min[chunk], dcaps);
+      const Dda::Exit dexit = dda.exit_of(dcaps);
+      if (dexit.t > exit.t || (dexit.t == exit.t && dexit.axis > exit.axis)) {
+        dda.leave(dcaps, dexit);
+        ++c.distance_skips;
+        return Step::kContinue;
+      }
+    }
+    dda.leave(caps, exit);
+    ++c.chunk_skips;
+    return Step::kContinue;
+  }
+  ++c.voxel_reads;
+  const std::uint16_t cell = skip.read(chunk, table.brick_index(dda.v));
+  const auto material = static_cast<std::uint8_t>(cell >> 8);
+  if (material != 0) {
+    hit = make_hit(dda, material);
+    return Step::kHit;
+  }
+  on_air(dda, chunk);
+  ++c.steps;
+  if (mode == SkipMode::kDistance) {
+    int caps[3];
+    skip_caps(skip, sw, static_cast<std::uint8_t>(cell & 0xFF), caps);
+    if (caps[0] + caps[1] + caps[2] > 0) {
+      dda.leave(caps, dda.exit_of(caps));
+      ++c.distance_skips;
+      return Step::kContinue;
+    }
+  }
+  dda.step_once();
+  return Step::kContinue;
+}
+
+// The first solid voxel along the ray inside `box` (a sub-box of the scene's).
 template <class OnAir>
 RayHit traverse(const RenderScene::Impl& s, const Box3i& box, const Ray& ray, SkipMode mode,
                 const SkipSource& skip, TraversalCounters& c, OnAir&& on_air) {
@@ -97,52 +153,13 @@ RayHit traverse(const RenderScene::Impl& s, const Box3i& box, const Ray& ray, Sk
   Dda dda;
   if (!start_in_box(box, ray, dda)) return {};
   const SkipWeights sw(skip.metric, ray);
-  const ChunkTable& table = s.table;
+  RayHit hit;
   for (;;) {
-    if (!box.contains(dda.v)) return {};
-    const std::size_t chunk = table.chunk_index(dda.v);
-    if (mode != SkipMode::kNone && s.empty_chunk[chunk]) {
-      // Leave the chunk in one step, or farther when the field allows it. Every voxel of the
-      // chunk is at least the chunk's smallest value away from geometry, so that bound needs no
-      // voxel read.
-      const Box3i cb = table.chunk_box_of(dda.v);
-      int caps[3];
-      for (int a = 0; a < 3; ++a)
-        caps[a] = dda.step[a] > 0 ? cb.end[a] - 1 - dda.v[a] : dda.v[a] - cb.begin[a];
-      Dda::Exit exit = dda.exit_of(caps);
-      on_air(dda, chunk);
-      if (mode == SkipMode::kDistance) {
-        int dcaps[3];
-        skip_caps(skip, sw, skip.chunk_min[chunk], dcaps);
-        const Dda::Exit dexit = dda.exit_of(dcaps);
-        if (dexit.t > exit.t || (dexit.t == exit.t && dexit.axis > exit.axis)) {
-          dda.leave(dcaps, dexit);
-          ++c.steps;
-          ++c.distance_skips;
-          continue;
-        }
-      }
-      dda.leave(caps, exit);
-      ++c.steps;
-      ++c.chunk_skips;
-      continue;
+    switch (visit(s, box, mode, skip, sw, dda, c, on_air, hit)) {
+      case Step::kContinue: break;
+      case Step::kHit: return hit;
+      case Step::kMiss: return {};
     }
-    ++c.voxel_reads;
-    const std::uint16_t cell = skip.read(chunk, table.brick_index(dda.v));
-    const auto material = static_cast<std::uint8_t>(cell >> 8);
-    if (material != 0) return make_hit(dda, material);
-    on_air(dda, chunk);
-    ++c.steps;
-    if (mode == SkipMode::kDistance) {
-      int caps[3];
-      skip_caps(skip, sw, static_cast<std::uint8_t>(cell & 0xFF), caps);
-      if (caps[0] + caps[1] + caps[2] > 0) {
-        dda.leave(caps, dda.exit_of(caps));
-        ++c.distance_skips;
-        continue;
-      }
-    }
-    dda.step_once();
   }
 }
 
