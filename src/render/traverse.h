@@ -33,21 +33,40 @@ struct SkipWeights {
 // Caps of a box ahead of an air voxel v whose stored skip value is `stored` (see dda.h for how a
 // box is left). Why each box holds no solid voxel:
 //  * Manhattan: stored = d, the exact L1 distance from v to the nearest solid voxel (or the clamp,
-//    a lower bound), so every voxel u with |u - v|_1 <= d - 1 is air. Caps c_a = floor((d - 1) w_a)
-//    with w summing to 1 reach at most sum c_a <= d - 1 away: inside that ball. This is the
-//    dissertation's argument — k DDA steps stay within L1 distance k — applied to a whole box.
+//    a lower bound), so every voxel u with |u - v|_1 <= d - 1 is air. Caps with sum c_a = d - 1
+//    reach no farther than that from v: the box lies inside the ball. This is the dissertation's
+//    argument — k DDA steps stay within L1 distance k — applied to a whole box.
 //  * Chebyshev: every u with |u - v|_inf <= d - 1 is air: the cube of caps d - 1 on every axis.
 //  * Euclidean: stored = floor(4 d) so r = stored / 4 <= d; the box's farthest voxel lies at
 //    sqrt(sum c_a^2) <= r' |w| < d with c_a = floor(r' w_a), |w| = 1, r' just below r.
 // The caps follow the ray's direction so that it leaves the box through its far side.
 inline void skip_caps(const SkipSource& skip, const SkipWeights& sw, std::uint8_t stored, int caps[3]) {
-  double r;
   if (skip.metric == Metric::kEuclidean) {
-    r = static_cast<double>(stored) * skip.inv_scale * (1 - 1e-9);
-  } else {
-    r = stored > 0 ? static_cast<double>(stored - 1) : 0.0;
+    const double r = static_cast<double>(stored) * skip.inv_scale * (1 - 1e-9);
+    for (int a = 0; a < 3; ++a) caps[a] = static_cast<int>(r * sw.w[a]);
+    return;
   }
-  for (int a = 0; a < 3; ++a) caps[a] = static_cast<int>(r * sw.w[a]);
+  const int r = stored > 0 ? stored - 1 : 0;
+  if (skip.metric == Metric::kChebyshev) {
+    caps[0] = caps[1] = caps[2] = r;
+    return;
+  }
+  // Manhattan: split r over the axes in proportion to the direction, rounding by largest
+  // remainders so that the caps use all of r (sum c_a = r exactly): near surfaces, where r is a few
+  // voxels, plain rounding down would often leave nothing to skip.
+  double rest[3];
+  int used = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double share = r * sw.w[a];
+    caps[a] = static_cast<int>(share);
+    rest[a] = sw.w[a] > 0 ? share - caps[a] : -1;
+    used += caps[a];
+  }
+  for (int left = r - used; left > 0; --left) {
+    const int a = rest[0] >= rest[1] && rest[0] >= rest[2] ? 0 : rest[1] >= rest[2] ? 1 : 2;
+    ++caps[a];
+    rest[a] = -1;
+  }
 }
 
 // Clips the ray to `box` and starts the DDA at its first voxel. False when the ray misses.
