@@ -9,6 +9,8 @@ packages=(
   libtbb-dev                         # thread pool (oneTBB)
   zlib1g-dev                         # TDCZ models in .vox files
   libpng-dev                         # PNG frames from the renderer
+  libvulkan-dev libvulkan-volk-dev glslc   # the Vulkan backend: headers, run-time loader, GLSL -> SPIR-V
+  mesa-vulkan-drivers vulkan-validationlayers  # lavapipe (software Vulkan) and the validation layer, for tests
   nlohmann-json3-dev                 # JSON output of the CLI
   libcli11-dev                       # CLI parsing
   libgtest-dev                       # tests

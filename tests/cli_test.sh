@@ -250,6 +250,20 @@ check "render: bad view" 1 "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/bad
 check "render: missing input" 1 "$V" render "$tmp/nothing.vox" -o "$tmp/bad.png"
 [ ! -e "$tmp/bad.png" ] && passes=$((passes+1)) || { echo "FAIL: render wrote despite errors"; fails=$((fails+1)); }
 
+# The Vulkan backend (lavapipe in CI): the same file as the CPU, byte for byte.
+if "$V" field --help | grep -q -- "--backend"; then
+  check "field --backend vulkan" 0 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/kg.npy" --backend vulkan \
+      --metric euclidean --signed --max-distance 12 --storage u8 --stats "$tmp/kg.json"
+  check "field --backend cpu" 0 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/kc.npy" --backend cpu \
+      --metric euclidean --signed --max-distance 12 --storage u8
+  cmp -s "$tmp/kg.npy" "$tmp/kc.npy" && passes=$((passes+1)) || { echo "FAIL: vulkan and cpu fields differ"; fails=$((fails+1)); }
+  check "field gpu stats" 0 $PY -c "
+import json; j = json.load(open('$tmp/kg.json'))
+assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['gpu']['fence_waits'] == 1, j"
+  check "field: jfa on the gpu" 1 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --backend vulkan --algorithm jfa
+  check "field --backend auto" 0 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/ka.npy" --backend auto
+fi
+
 check "showcase (small)" 0 "$V" showcase --size 48 --out "$tmp/showcase"
 expect_grep "showcase report" "$tmp/showcase/report.md" "jfa-seed"
 expect_grep "showcase round trip" "$tmp/showcase/report.md" "identical"

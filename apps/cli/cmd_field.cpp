@@ -4,6 +4,7 @@
 
 #include "cli.h"
 #include "field_args.h"
+#include "voxfield/gpu.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
 
@@ -13,6 +14,7 @@ namespace {
 struct FieldSettings {
   std::string in, out, sites, stats, packed;
   std::string algorithm = "exact";
+  std::string backend = "cpu";
   FieldArgs field;
 };
 
@@ -29,7 +31,21 @@ int run_field(const FieldSettings& s) {
   if (a.algorithm == Algorithm::kLod && !a.focus) throw InvalidArgument("--algorithm lod needs --focus");
   if (o.domain->empty()) throw InvalidArgument(s.in + ": the input holds no volume");
   AlgorithmStats stats;
-  const DistanceField f = compute_distance_field(in.world, o, a, &stats);
+  std::string why;
+  const auto gpu_context = gpu::select_backend(parse_backend(s.backend), {}, &why);
+  std::cerr << "voxfield: " << why << "\n";
+  std::vector<gpu::PassTiming> pass_timings;
+  std::optional<DistanceField> computed;
+  if (gpu_context) {
+    if (a.algorithm != Algorithm::kExact)
+      throw InvalidArgument("--backend " + s.backend + ": only the exact algorithm runs on the GPU so far");
+    const auto t0 = std::chrono::steady_clock::now();
+    computed = gpu::compute_distance_field(*gpu_context, in.world, o, &pass_timings);
+    stats.ms = ms_since(t0);
+  } else {
+    computed = compute_distance_field(in.world, o, a, &stats);
+  }
+  const DistanceField& f = *computed;
 
   write_npy(field_volume(f, f.domain), s.out);
   if (!s.sites.empty()) {
@@ -48,6 +64,24 @@ int run_field(const FieldSettings& s) {
                    {"passes", stats.passes},
                    {"iterations", stats.iterations},
                    {"peak_rss_mb", static_cast<double>(peak_rss_bytes()) / 1048576.0}});
+  j["backend"] = gpu_context ? "vulkan" : "cpu";
+  if (gpu_context) {
+    const gpu::DeviceInfo& dev = gpu_context->device();
+    const gpu::Counters c = gpu_context->counters();
+    nlohmann::json passes = nlohmann::json::array();
+    for (const auto& t : pass_timings) passes.push_back({{"pass", t.pass}, {"ms", t.ms}});
+    j["gpu"] = {{"device", dev.name},
+                {"device_type", dev.type},
+                // Timestamps of a software device measure the CPU emulating it, not a GPU.
+                {"timings_are", dev.hardware ? "gpu" : "cpu emulation"},
+                {"passes", passes},
+                {"dispatches", c.dispatches},
+                {"pipeline_barriers", c.pipeline_barriers},
+                {"submits", c.submits},
+                {"fence_waits", c.fence_waits},
+                {"bytes_uploaded", c.bytes_uploaded},
+                {"bytes_downloaded", c.bytes_downloaded}};
+  }
   if (a.algorithm != Algorithm::kExact) {
     DistanceOptions exact_o = o;
     exact_o.nearest_sites = false;
@@ -69,6 +103,9 @@ void add_field(CLI::App& app, Action& action) {
   cmd->add_option("IN", s->in, "input .vox or .npy")->required();
   cmd->add_option("-o,--output", s->out, "output .npy")->required();
   s->field.add_to(cmd);
+  cmd->add_option("--backend", s->backend, "cpu (default), vulkan (any Vulkan device, software included) or auto "
+                                          "(a hardware GPU if there is one, else the CPU)")
+      ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
   cmd->add_option("--algorithm", s->algorithm,
                   "exact, brute, brute-chunked, fim, jfa-seed, jfa, jfa+1, jfa+2, hybrid, lod")
       ->capture_default_str();

@@ -1,0 +1,115 @@
+// voxfield — the GPU backend (Vulkan compute), and choosing between it and the CPU.
+//
+// Built when the Vulkan headers, volk and glslc are present (preset cpu-only builds without it);
+// at run time the Vulkan loader is opened dynamically, so a machine without Vulkan still runs
+// everything on the CPU. Nothing here includes Vulkan headers: applications that hand voxfield
+// their own Vulkan device use gpu_vulkan.h.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "voxfield/distance.h"
+#include "voxfield/error.h"
+
+namespace voxfield {
+
+// No usable GPU: no Vulkan loader, no device, a device without what voxfield needs, or a build
+// without the Vulkan backend. The message says which.
+class GpuUnavailable : public Error {
+ public:
+  using Error::Error;
+};
+
+enum class Backend { kCpu, kVulkan, kAuto };
+const char* backend_name(Backend b);              // "cpu", "vulkan", "auto"
+Backend parse_backend(const std::string& name);   // throws InvalidArgument
+
+namespace gpu {
+
+// True when this build has the Vulkan backend.
+bool built_with_vulkan();
+
+struct ContextOptions {
+  // Enable the Khronos validation layer with synchronisation validation, and collect its
+  // messages (validation_messages()). Throws GpuUnavailable when the layer is not installed.
+  bool validation = false;
+  // Accept CPU implementations of Vulkan such as Mesa's lavapipe.
+  bool allow_software = true;
+};
+
+struct DeviceInfo {
+  std::string name;        // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+  std::string type;        // "discrete", "integrated", "virtual", "cpu", "other"
+  bool hardware = false;   // a real GPU (not "cpu")
+  std::uint32_t api_version = 0;
+  std::string api_version_string() const;
+};
+
+// Hardware-independent work counters: what a GPU frame or update costs in API traffic.
+struct Counters {
+  std::int64_t dispatches = 0;
+  std::int64_t pipeline_barriers = 0;
+  std::int64_t submits = 0;
+  std::int64_t fence_waits = 0;
+  std::int64_t bytes_uploaded = 0;
+  std::int64_t bytes_downloaded = 0;
+};
+
+// GPU time of one pass from timestamp queries (on lavapipe: CPU emulation, not GPU speed).
+struct PassTiming {
+  std::string pass;
+  double ms = 0;
+};
+
+// A Vulkan instance, device and compute queue with voxfield's pipelines. Not thread-safe: one
+// thread at a time.
+class Context {
+ public:
+  // Creates its own instance and device (headless). Prefers a hardware GPU; accepts a software
+  // one when options.allow_software. Throws GpuUnavailable.
+  static std::shared_ptr<Context> create(const ContextOptions& options = {});
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  const DeviceInfo& device() const;
+  Counters counters() const;
+  void reset_counters();
+  // Messages of the validation layer since the last clear (warnings and errors).
+  std::vector<std::string> validation_messages() const;
+  void clear_validation_messages();
+  bool has_timestamps() const;
+
+  struct Impl;
+  Impl& impl() { return *impl_; }
+  explicit Context(std::unique_ptr<Impl> impl);
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// The backend to use: kCpu gives null; kVulkan a context on any Vulkan device, software included
+// (throws GpuUnavailable if there is none); kAuto a context on a hardware GPU if there is one,
+// otherwise null (the CPU). `why`, when given, receives one line saying what was chosen and why.
+std::shared_ptr<Context> select_backend(Backend backend, const ContextOptions& options = {},
+                                        std::string* why = nullptr);
+
+// The exact distance field computed on the GPU: the same values as voxfield::
+// compute_distance_field — bit for bit for u8 and u16 storage; for f32, Euclidean values may
+// differ from the CPU's by the GPU's square root (kF32Tolerance). Supported: every metric, signed
+// or not, clamped or not, every storage, unit spacing, domains up to 16384 voxels per axis.
+// Throws InvalidArgument for what it does not support (nearest sites, anisotropic spacing, a
+// fixed-point scale whose products overflow 32 bits), GpuUnavailable on device errors. One command
+// buffer, one submit, one fence wait.
+DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
+                                     std::vector<PassTiming>* timings = nullptr);
+
+// Largest |GPU - CPU| of f32 Euclidean values, relative to the distance: Vulkan allows sqrt an
+// error of a few ulps (the SPIR-V environment spec inherits it from 1/inversesqrt).
+constexpr double kF32Tolerance = 4e-7;
+
+}  // namespace gpu
+}  // namespace voxfield

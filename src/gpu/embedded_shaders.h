@@ -1,0 +1,14 @@
+// voxfield GPU backend — the compute shaders, compiled to SPIR-V by glslc at build time and
+// embedded by cmake/embed_spirv.cmake (sources in shaders/).
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+namespace voxfield::gpu::shaders {
+
+std::span<const std::uint32_t> edt_sites();
+std::span<const std::uint32_t> edt_lines();
+std::span<const std::uint32_t> edt_encode();
+
+}  // namespace voxfield::gpu::shaders

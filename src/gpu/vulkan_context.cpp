@@ -1,0 +1,385 @@
+// voxfield GPU backend — instance, device, queue, buffers, pipelines and submission.
+#include "vulkan_context.h"
+
+#include <algorithm>
+#include <cstring>
+#include <sstream>
+#include <utility>
+
+#include "embedded_shaders.h"
+
+namespace voxfield::gpu {
+
+void check(VkResult result, const char* what) {
+  if (result != VK_SUCCESS)
+    throw GpuUnavailable(std::string("Vulkan: ") + what + " failed (VkResult " + std::to_string(result) + ")");
+}
+
+bool built_with_vulkan() { return true; }
+
+// ---- buffers --------------------------------------------------------------------------------
+
+Buffer::Buffer(Context::Impl& ctx, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible)
+    : device_(ctx.device), size_(bytes) {
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = std::max<VkDeviceSize>(bytes, 4);
+  info.usage = usage;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  check(vkCreateBuffer(device_, &info, nullptr, &buffer_), "vkCreateBuffer");
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device_, buffer_, &req);
+  VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  alloc.allocationSize = req.size;
+  alloc.memoryTypeIndex = ctx.memory_type(
+      req.memoryTypeBits, host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                                       : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  const VkResult r = vkAllocateMemory(device_, &alloc, nullptr, &memory_);
+  if (r != VK_SUCCESS) {
+    vkDestroyBuffer(device_, buffer_, nullptr);
+    buffer_ = VK_NULL_HANDLE;
+    throw GpuUnavailable("Vulkan: cannot allocate " + std::to_string(req.size) + " bytes of " +
+                         (host_visible ? "host-visible" : "device") + " memory (VkResult " + std::to_string(r) + ")");
+  }
+  check(vkBindBufferMemory(device_, buffer_, memory_, 0), "vkBindBufferMemory");
+  if (host_visible) check(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
+}
+
+Buffer::~Buffer() { release(); }
+
+Buffer::Buffer(Buffer&& o) noexcept { *this = std::move(o); }
+
+Buffer& Buffer::operator=(Buffer&& o) noexcept {
+  if (this != &o) {
+    release();
+    device_ = std::exchange(o.device_, VK_NULL_HANDLE);
+    buffer_ = std::exchange(o.buffer_, VK_NULL_HANDLE);
+    memory_ = std::exchange(o.memory_, VK_NULL_HANDLE);
+    size_ = std::exchange(o.size_, 0);
+    mapped_ = std::exchange(o.mapped_, nullptr);
+  }
+  return *this;
+}
+
+void Buffer::release() {
+  if (device_ == VK_NULL_HANDLE) return;
+  if (buffer_) vkDestroyBuffer(device_, buffer_, nullptr);
+  if (memory_) vkFreeMemory(device_, memory_, nullptr);  // unmaps too
+  buffer_ = VK_NULL_HANDLE;
+  memory_ = VK_NULL_HANDLE;
+  mapped_ = nullptr;
+}
+
+std::uint32_t Context::Impl::memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags wanted) const {
+  for (std::uint32_t i = 0; i < memory.memoryTypeCount; ++i)
+    if ((type_bits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & wanted) == wanted) return i;
+  // Device-local was only a preference (integrated GPUs and lavapipe may not advertise it).
+  if (!(wanted & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT))
+    for (std::uint32_t i = 0; i < memory.memoryTypeCount; ++i)
+      if (type_bits & (1u << i)) return i;
+  throw GpuUnavailable("Vulkan: no suitable memory type");
+}
+
+Buffer& Context::Impl::upload_buffer(VkDeviceSize bytes) {
+  if (upload.size() < bytes)
+    upload = Buffer(*this, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, /*host_visible=*/true);
+  return upload;
+}
+
+Buffer& Context::Impl::readback_buffer(VkDeviceSize bytes) {
+  if (readback.size() < bytes)
+    readback = Buffer(*this, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, /*host_visible=*/true);
+  return readback;
+}
+
+// ---- pipelines ------------------------------------------------------------------------------
+
+Pipeline Context::Impl::make_pipeline(const char* name, std::span<const std::uint32_t> spirv) {
+  VkShaderModuleCreateInfo sm{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  sm.codeSize = spirv.size_bytes();
+  sm.pCode = spirv.data();
+  VkShaderModule module;
+  check(vkCreateShaderModule(device, &sm, nullptr, &module), "vkCreateShaderModule");
+  VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  info.stage.module = module;
+  info.stage.pName = "main";
+  info.layout = pipeline_layout;
+  Pipeline p;
+  p.name = name;
+  const VkResult r = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &p.pipeline);
+  vkDestroyShaderModule(device, module, nullptr);
+  check(r, "vkCreateComputePipelines");
+  return p;
+}
+
+void Context::Impl::create_pipelines() {
+  VkDescriptorSetLayoutBinding bindings[kBindings];
+  for (std::uint32_t b = 0; b < kBindings; ++b)
+    bindings[b] = {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  sl.bindingCount = kBindings;
+  sl.pBindings = bindings;
+  check(vkCreateDescriptorSetLayout(device, &sl, nullptr, &set_layout), "vkCreateDescriptorSetLayout");
+  VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, kPushBytes};
+  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pl.setLayoutCount = 1;
+  pl.pSetLayouts = &set_layout;
+  pl.pushConstantRangeCount = 1;
+  pl.pPushConstantRanges = &push;
+  check(vkCreatePipelineLayout(device, &pl, nullptr, &pipeline_layout), "vkCreatePipelineLayout");
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings * 4};
+  VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  dp.maxSets = 4;
+  dp.poolSizeCount = 1;
+  dp.pPoolSizes = &size;
+  check(vkCreateDescriptorPool(device, &dp, nullptr, &descriptor_pool), "vkCreateDescriptorPool");
+  edt_sites = make_pipeline("edt_sites", shaders::edt_sites());
+  edt_lines = make_pipeline("edt_lines", shaders::edt_lines());
+  edt_encode = make_pipeline("edt_encode", shaders::edt_encode());
+}
+
+// ---- submission -----------------------------------------------------------------------------
+
+void Context::Impl::submit_and_wait(VkCommandBuffer cmd) {
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cmd;
+  check(vkResetFences(device, 1, &fence), "vkResetFences");
+  check(vkQueueSubmit(queue, 1, &submit, fence), "vkQueueSubmit");
+  ++counters.submits;
+  check(vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+  ++counters.fence_waits;
+}
+
+void dispatch(Context::Impl& ctx, VkCommandBuffer cmd, std::uint64_t invocations) {
+  const std::uint64_t groups = (invocations + 63) / 64;
+  const std::uint64_t max_x = ctx.limits.maxComputeWorkGroupCount[0];
+  const std::uint64_t gx = std::min(groups, max_x), gy = (groups + gx - 1) / gx;
+  if (gy > ctx.limits.maxComputeWorkGroupCount[1])
+    throw InvalidArgument("GPU: " + std::to_string(invocations) + " invocations exceed the device's dispatch limits");
+  vkCmdDispatch(cmd, static_cast<std::uint32_t>(gx), static_cast<std::uint32_t>(std::max<std::uint64_t>(gy, 1)), 1);
+  ++ctx.counters.dispatches;
+}
+
+void barrier(Context::Impl& ctx, VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags src_access,
+             VkPipelineStageFlags dst, VkAccessFlags dst_access) {
+  VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  b.srcAccessMask = src_access;
+  b.dstAccessMask = dst_access;
+  vkCmdPipelineBarrier(cmd, src, dst, 0, 1, &b, 0, nullptr, 0, nullptr);
+  ++ctx.counters.pipeline_barriers;
+}
+
+// ---- instance and device --------------------------------------------------------------------
+
+namespace {
+
+VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                     VkDebugUtilsMessageTypeFlagsEXT,
+                                                     const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+  auto* impl = static_cast<Context::Impl*>(user);
+  const char* level = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning";
+  std::lock_guard lock(impl->messages_mutex);
+  impl->messages.push_back(std::string(level) + ": " + (data && data->pMessage ? data->pMessage : "?"));
+  return VK_FALSE;
+}
+
+bool has_layer(const char* name) {
+  std::uint32_t n = 0;
+  vkEnumerateInstanceLayerProperties(&n, nullptr);
+  std::vector<VkLayerProperties> layers(n);
+  vkEnumerateInstanceLayerProperties(&n, layers.data());
+  return std::any_of(layers.begin(), layers.end(), [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, name) == 0; });
+}
+
+const char* type_name(VkPhysicalDeviceType t) {
+  switch (t) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
+    default: return "other";
+  }
+}
+
+int preference(VkPhysicalDeviceType t) {
+  switch (t) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 4;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 3;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 1;
+    default: return 0;
+  }
+}
+
+std::once_flag volk_once;
+VkResult volk_status = VK_ERROR_INITIALIZATION_FAILED;
+
+}  // namespace
+
+std::string DeviceInfo::api_version_string() const {
+  std::ostringstream os;
+  os << VK_API_VERSION_MAJOR(api_version) << "." << VK_API_VERSION_MINOR(api_version) << "."
+     << VK_API_VERSION_PATCH(api_version);
+  return os.str();
+}
+
+void Context::Impl::destroy() {
+  if (device) {
+    vkDeviceWaitIdle(device);
+    upload = Buffer();
+    readback = Buffer();
+    for (Pipeline* p : {&edt_sites, &edt_lines, &edt_encode})
+      if (p->pipeline) vkDestroyPipeline(device, p->pipeline, nullptr);
+    if (descriptor_pool) vkDestroyDescriptorPool(device, descriptor_pool, nullptr);
+    if (pipeline_layout) vkDestroyPipelineLayout(device, pipeline_layout, nullptr);
+    if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, nullptr);
+    if (timestamps) vkDestroyQueryPool(device, timestamps, nullptr);
+    if (fence) vkDestroyFence(device, fence, nullptr);
+    if (command_pool) vkDestroyCommandPool(device, command_pool, nullptr);
+    if (owns_device) vkDestroyDevice(device, nullptr);
+    device = VK_NULL_HANDLE;
+  }
+  if (instance && owns_device) {
+    if (messenger) vkDestroyDebugUtilsMessengerEXT(instance, messenger, nullptr);
+    vkDestroyInstance(instance, nullptr);
+  }
+  instance = VK_NULL_HANDLE;
+}
+
+std::shared_ptr<Context> Context::create(const ContextOptions& options) {
+  std::call_once(volk_once, [] { volk_status = volkInitialize(); });
+  if (volk_status != VK_SUCCESS)
+    throw GpuUnavailable("Vulkan: no Vulkan loader (libvulkan.so.1) on this machine");
+
+  auto impl = std::make_unique<Impl>();
+  Impl& s = *impl;
+  struct Guard {  // destroys what was created if anything below throws
+    Impl* s;
+    ~Guard() { if (s) s->destroy(); }
+  } guard{&s};
+
+  constexpr const char* kValidation = "VK_LAYER_KHRONOS_validation";
+  std::vector<const char*> layers, extensions;
+  if (options.validation) {
+    if (!has_layer(kValidation))
+      throw GpuUnavailable("Vulkan: validation requested but VK_LAYER_KHRONOS_validation is not installed "
+                           "(Debian package vulkan-validationlayers)");
+    layers.push_back(kValidation);
+    extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    extensions.push_back(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+  }
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "voxfield";
+  app.pEngineName = "voxfield";
+  app.apiVersion = VK_API_VERSION_1_1;
+  VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  ici.pApplicationInfo = &app;
+  ici.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
+  ici.ppEnabledLayerNames = layers.data();
+  ici.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+  ici.ppEnabledExtensionNames = extensions.data();
+  const VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+  VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+  features.enabledValidationFeatureCount = 1;
+  features.pEnabledValidationFeatures = enables;
+  VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+  mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                    VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+  mci.pfnUserCallback = on_validation_message;
+  mci.pUserData = &s;
+  if (options.validation) {
+    features.pNext = &mci;  // also catches messages from instance creation itself
+    ici.pNext = &features;
+  }
+  check(vkCreateInstance(&ici, nullptr, &s.instance), "vkCreateInstance");
+  volkLoadInstance(s.instance);
+  if (options.validation)
+    check(vkCreateDebugUtilsMessengerEXT(s.instance, &mci, nullptr, &s.messenger), "vkCreateDebugUtilsMessengerEXT");
+
+  std::uint32_t count = 0;
+  vkEnumeratePhysicalDevices(s.instance, &count, nullptr);
+  std::vector<VkPhysicalDevice> devices(count);
+  vkEnumeratePhysicalDevices(s.instance, &count, devices.data());
+  int best = -1;
+  for (VkPhysicalDevice d : devices) {
+    VkPhysicalDeviceProperties props;
+    vkGetPhysicalDeviceProperties(d, &props);
+    if (props.apiVersion < VK_API_VERSION_1_1) continue;
+    if (!options.allow_software && props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU) continue;
+    std::uint32_t nq = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(d, &nq, nullptr);
+    std::vector<VkQueueFamilyProperties> families(nq);
+    vkGetPhysicalDeviceQueueFamilyProperties(d, &nq, families.data());
+    for (std::uint32_t f = 0; f < nq; ++f) {
+      if (!(families[f].queueFlags & VK_QUEUE_COMPUTE_BIT)) continue;
+      if (preference(props.deviceType) > best) {
+        best = preference(props.deviceType);
+        s.physical = d;
+        s.queue_family = f;
+        s.timestamp_period_ns = families[f].timestampValidBits ? props.limits.timestampPeriod : 0;
+      }
+      break;
+    }
+  }
+  if (!s.physical)
+    throw GpuUnavailable(std::string("Vulkan: no device with a compute queue") +
+                         (options.allow_software ? "" : " (software devices excluded)"));
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(s.physical, &props);
+  s.limits = props.limits;
+  vkGetPhysicalDeviceMemoryProperties(s.physical, &s.memory);
+  s.info.name = props.deviceName;
+  s.info.type = type_name(props.deviceType);
+  s.info.hardware = props.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
+  s.info.api_version = props.apiVersion;
+
+  const float priority = 1;
+  VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  qci.queueFamilyIndex = s.queue_family;
+  qci.queueCount = 1;
+  qci.pQueuePriorities = &priority;
+  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  dci.queueCreateInfoCount = 1;
+  dci.pQueueCreateInfos = &qci;
+  check(vkCreateDevice(s.physical, &dci, nullptr, &s.device), "vkCreateDevice");
+  volkLoadDevice(s.device);
+  vkGetDeviceQueue(s.device, s.queue_family, 0, &s.queue);
+
+  VkCommandPoolCreateInfo cp{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  cp.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  cp.queueFamilyIndex = s.queue_family;
+  check(vkCreateCommandPool(s.device, &cp, nullptr, &s.command_pool), "vkCreateCommandPool");
+  VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  check(vkCreateFence(s.device, &fi, nullptr, &s.fence), "vkCreateFence");
+  if (s.timestamp_period_ns > 0) {
+    VkQueryPoolCreateInfo qp{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    qp.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qp.queryCount = 64;
+    check(vkCreateQueryPool(s.device, &qp, nullptr, &s.timestamps), "vkCreateQueryPool");
+  }
+  s.create_pipelines();
+  guard.s = nullptr;
+  return std::make_shared<Context>(std::move(impl));
+}
+
+Context::Context(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Context::~Context() { if (impl_) impl_->destroy(); }
+const DeviceInfo& Context::device() const { return impl_->info; }
+Counters Context::counters() const { return impl_->counters; }
+void Context::reset_counters() { impl_->counters = {}; }
+bool Context::has_timestamps() const { return impl_->timestamps != VK_NULL_HANDLE; }
+
+std::vector<std::string> Context::validation_messages() const {
+  std::lock_guard lock(impl_->messages_mutex);
+  return impl_->messages;
+}
+
+void Context::clear_validation_messages() {
+  std::lock_guard lock(impl_->messages_mutex);
+  impl_->messages.clear();
+}
+
+}  // namespace voxfield::gpu

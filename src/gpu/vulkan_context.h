@@ -1,0 +1,101 @@
+// voxfield GPU backend — the Vulkan objects behind gpu::Context (internal).
+//
+// Vulkan functions come through volk, which opens the loader at run time: a machine without
+// libvulkan still starts, and gets GpuUnavailable instead of a failed dynamic link.
+#pragma once
+
+#include <volk.h>
+
+#include <cstdint>
+#include <mutex>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "voxfield/gpu.h"
+
+namespace voxfield::gpu {
+
+// Throws GpuUnavailable naming the call when a Vulkan call fails.
+void check(VkResult result, const char* what);
+
+// A buffer with its own memory (voxfield allocates a handful of large buffers, never one per
+// chunk, so a general-purpose allocator is not needed).
+class Buffer {
+ public:
+  Buffer() = default;
+  Buffer(Context::Impl& ctx, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible);
+  ~Buffer();
+  Buffer(Buffer&& o) noexcept;
+  Buffer& operator=(Buffer&& o) noexcept;
+
+  VkBuffer handle() const { return buffer_; }
+  VkDeviceSize size() const { return size_; }
+  // Host pointer of a host-visible buffer (persistently mapped, coherent).
+  void* mapped() const { return mapped_; }
+
+ private:
+  void release();
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkBuffer buffer_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  VkDeviceSize size_ = 0;
+  void* mapped_ = nullptr;
+};
+
+// A compute pipeline made from embedded SPIR-V, with the shared layout (storage buffers 0..N-1,
+// one push-constant range).
+struct Pipeline {
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  std::string name;
+};
+
+struct Context::Impl {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  VkPhysicalDevice physical = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;
+  std::uint32_t queue_family = 0;
+  VkCommandPool command_pool = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  VkQueryPool timestamps = VK_NULL_HANDLE;
+  double timestamp_period_ns = 0;  // 0: no timestamps on this queue
+  VkPhysicalDeviceMemoryProperties memory{};
+  VkPhysicalDeviceLimits limits{};
+  bool owns_device = true;
+
+  DeviceInfo info;
+  Counters counters;
+  mutable std::mutex messages_mutex;
+  std::vector<std::string> messages;
+
+  // The distance pipelines and their shared layout.
+  static constexpr std::uint32_t kBindings = 9;
+  static constexpr std::uint32_t kPushBytes = 96;
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+  VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
+  Pipeline edt_sites, edt_lines, edt_encode;
+
+  // Reusable host-visible buffers for uploads and read-backs (grown when too small).
+  Buffer upload, readback;
+  Buffer& upload_buffer(VkDeviceSize bytes);
+  Buffer& readback_buffer(VkDeviceSize bytes);
+
+  std::uint32_t memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags wanted) const;
+  void create_pipelines();
+  Pipeline make_pipeline(const char* name, std::span<const std::uint32_t> spirv);
+  // Submits one command buffer and waits for it (one submit, one fence wait).
+  void submit_and_wait(VkCommandBuffer cmd);
+  void destroy();
+};
+
+// Records a dispatch of `invocations` invocations of 64 (split over y when the x count would
+// exceed the device limit) and counts it.
+void dispatch(Context::Impl& ctx, VkCommandBuffer cmd, std::uint64_t invocations);
+// A compute-to-compute (and transfer) memory barrier, counted.
+void barrier(Context::Impl& ctx, VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags src_access,
+             VkPipelineStageFlags dst, VkAccessFlags dst_access);
+
+}  // namespace voxfield::gpu

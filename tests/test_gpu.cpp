@@ -1,0 +1,168 @@
+// The Vulkan backend against the CPU: the same test bodies on both backends. Integer fields must
+// be bit-identical, f32 fields within gpu::kF32Tolerance; sizes that are not multiples of the
+// workgroup or the chunk edge; the Khronos validation layer (with synchronisation validation) on,
+// and not a single message from it. In CI this runs on Mesa's lavapipe.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <random>
+
+#include "voxfield/gpu.h"
+
+using namespace voxfield;
+
+namespace {
+
+std::shared_ptr<gpu::Context> validated_context() {
+  static std::shared_ptr<gpu::Context> ctx = [] {
+    gpu::ContextOptions o;
+    o.validation = true;
+    return gpu::Context::create(o);
+  }();
+  return ctx;
+}
+
+bool gpu_tests_wanted() {
+  if (!gpu::built_with_vulkan()) return false;
+  return std::getenv("VOXFIELD_SKIP_GPU_TESTS") == nullptr;
+}
+
+World random_world(Vec3i size, int chunk_edge, double density, std::uint32_t seed) {
+  World w(chunk_edge, Box3i::from_size(size));
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int z = 0; z < size.z; ++z)
+    for (int y = 0; y < size.y; ++y)
+      for (int x = 0; x < size.x; ++x)
+        if (u(rng) < density) w.voxels.set({x, y, z}, static_cast<std::uint8_t>(1 + (x + y + z) % 200));
+  // A solid block so that some chunks are uniform and some signed distances are long.
+  w.voxels.fill(Box3i{{0, 0, 0}, {std::min(size.x, 16), std::min(size.y, 16), std::min(size.z, 9)}}, 7);
+  return w;
+}
+
+template <class T>
+std::vector<T> dense(const DistanceField& f) {
+  std::vector<T> v(static_cast<std::size_t>(f.domain.volume()));
+  std::get<Grid<T>>(f.values).copy_to_dense(f.domain, v.data());
+  return v;
+}
+
+void expect_same_field(const DistanceField& gpu_field, const DistanceField& cpu_field, const std::string& what) {
+  ASSERT_EQ(gpu_field.domain, cpu_field.domain) << what;
+  ASSERT_EQ(gpu_field.values.index(), cpu_field.values.index()) << what;
+  EXPECT_EQ(gpu_field.encoding.scale, cpu_field.encoding.scale) << what;
+  EXPECT_EQ(gpu_field.encoding.bias, cpu_field.encoding.bias) << what;
+  if (std::holds_alternative<Grid<std::uint8_t>>(cpu_field.values)) {
+    EXPECT_EQ(dense<std::uint8_t>(gpu_field), dense<std::uint8_t>(cpu_field)) << what;
+  } else if (std::holds_alternative<Grid<std::uint16_t>>(cpu_field.values)) {
+    EXPECT_EQ(dense<std::uint16_t>(gpu_field), dense<std::uint16_t>(cpu_field)) << what;
+  } else {
+    const auto a = dense<float>(gpu_field), b = dense<float>(cpu_field);
+    std::size_t off = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const bool same = a[i] == b[i] || std::abs(a[i] - b[i]) <= gpu::kF32Tolerance * std::abs(b[i]);
+      if (!same && off++ < 5) ADD_FAILURE() << what << ": voxel " << i << " gpu " << a[i] << " cpu " << b[i];
+    }
+    EXPECT_EQ(off, 0u) << what;
+  }
+  // Outside the domain both read the background.
+  const Vec3i outside = cpu_field.domain.end;
+  EXPECT_EQ(gpu_field.distance(outside), cpu_field.distance(outside)) << what;
+}
+
+}  // namespace
+
+TEST(Gpu, BackendNamesAndChoice) {
+  EXPECT_EQ(parse_backend("vulkan"), Backend::kVulkan);
+  EXPECT_THROW(parse_backend("metal"), InvalidArgument);
+  std::string why;
+  EXPECT_EQ(gpu::select_backend(Backend::kCpu, {}, &why), nullptr);
+  EXPECT_NE(why.find("cpu"), std::string::npos);
+  // auto never throws: a hardware GPU, or the CPU with the reason.
+  const auto chosen = gpu::select_backend(Backend::kAuto, {}, &why);
+  EXPECT_FALSE(why.empty());
+  if (chosen) {
+    EXPECT_TRUE(chosen->device().hardware);
+  }
+  if (!gpu::built_with_vulkan()) {
+    EXPECT_THROW(gpu::Context::create(), GpuUnavailable);
+  }
+}
+
+TEST(Gpu, ExactFieldsEqualTheCpu) {
+  if (!gpu_tests_wanted()) GTEST_SKIP() << "built without Vulkan, or VOXFIELD_SKIP_GPU_TESTS set";
+  auto ctx = validated_context();
+  ctx->clear_validation_messages();
+  for (const Vec3i size : {Vec3i{37, 29, 23}, Vec3i{70, 9, 65}}) {  // not multiples of 64 or 16
+    const World w = random_world(size, 16, 0.02, 11u + static_cast<std::uint32_t>(size.x));
+    for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
+      for (bool sgn : {false, true})
+        for (double clamp : {0.0, 6.0, 9.5})
+          for (Storage st : {Storage::kU8, Storage::kU16, Storage::kF32}) {
+            DistanceOptions o;
+            o.metric = m;
+            o.signed_distance = sgn;
+            o.max_distance = clamp;
+            o.storage = st;
+            const std::string what = to_string(size) + " " + metric_name(m) + (sgn ? " signed" : "") + " clamp " +
+                                     std::to_string(clamp) + " " + storage_name(st);
+            const gpu::Counters before = ctx->counters();
+            const DistanceField g = gpu::compute_distance_field(*ctx, w, o);
+            const gpu::Counters after = ctx->counters();
+            expect_same_field(g, compute_distance_field(w, o), what);
+            EXPECT_EQ(after.submits - before.submits, 1) << what;
+            EXPECT_EQ(after.fence_waits - before.fence_waits, 1) << what;
+          }
+  }
+  const auto messages = ctx->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
+}
+
+TEST(Gpu, UnboundedWorldsAndEmptyDomains) {
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = validated_context();
+  World w(8);  // unbounded: the domain is the content grown by the clamp
+  w.voxels.fill(Box3i{{-20, 3, 5}, {-12, 9, 7}}, 4);
+  w.voxels.set({30, -4, 2}, 9);
+  for (Metric m : {Metric::kManhattan, Metric::kEuclidean}) {
+    DistanceOptions o;
+    o.metric = m;
+    o.max_distance = 5;
+    o.storage = Storage::kU8;
+    expect_same_field(gpu::compute_distance_field(*ctx, w, o), compute_distance_field(w, o), metric_name(m));
+  }
+  const World empty(8);
+  const DistanceField e = gpu::compute_distance_field(*ctx, empty, DistanceOptions{});
+  EXPECT_TRUE(e.domain.empty());
+  EXPECT_TRUE(ctx->validation_messages().empty());
+}
+
+TEST(Gpu, UnsupportedRequestsAreRefusedClearly) {
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = validated_context();
+  const World w = random_world({12, 12, 12}, 8, 0.05, 3);
+  DistanceOptions sites;
+  sites.nearest_sites = true;
+  EXPECT_THROW(gpu::compute_distance_field(*ctx, w, sites), InvalidArgument);
+  DistanceOptions spacing;
+  spacing.metric = Metric::kEuclidean;
+  spacing.spacing = {1, 2, 1};
+  EXPECT_THROW(gpu::compute_distance_field(*ctx, w, spacing), InvalidArgument);
+}
+
+TEST(Gpu, TimestampsNameEveryPass) {
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = validated_context();
+  if (!ctx->has_timestamps()) GTEST_SKIP() << "no timestamps on this queue";
+  const World w = random_world({20, 20, 20}, 8, 0.05, 5);
+  DistanceOptions o;
+  o.metric = Metric::kEuclidean;
+  o.signed_distance = true;
+  std::vector<gpu::PassTiming> t;
+  gpu::compute_distance_field(*ctx, w, o, &t);
+  ASSERT_EQ(t.size(), 7u);  // x, y, z to solids; x, y, z to air; encode
+  EXPECT_EQ(t.front().pass, "rows x");
+  EXPECT_EQ(t.back().pass, "encode");
+  for (const auto& p : t) EXPECT_GE(p.ms, 0) << p.pass;
+}
