@@ -4,17 +4,18 @@
 
 layout(local_size_x = 64) in;
 
-layout(std430, set = 0, binding = 0) readonly buffer WorldBuf { WorldHeader world; };
+layout(std430, set = 0, binding = 0) readonly buffer HeaderBuf { Header h; };
 layout(std430, set = 0, binding = 1) readonly buffer PageBuf { uint pages[]; };
 layout(std430, set = 0, binding = 2) readonly buffer BrickBuf { uint bricks[]; };
-// Three cost buffers of one value per domain voxel (x fastest), used in turn by the passes.
+// Three cost buffers of one value per compute-box voxel (x fastest), used in turn by the passes.
 layout(std430, set = 0, binding = 3) buffer Cost0 { uint cost0[]; };
 layout(std430, set = 0, binding = 4) buffer Cost1 { uint cost1[]; };
 layout(std430, set = 0, binding = 5) buffer Cost2 { uint cost2[]; };
 // Per-line scratch of the envelope scans (Meijster's s and t arrays), one slot per voxel.
 layout(std430, set = 0, binding = 6) buffer ScratchS { int scratch_s[]; };
 layout(std430, set = 0, binding = 7) buffer ScratchT { int scratch_t[]; };
-layout(std430, set = 0, binding = 8) writeonly buffer OutBuf { uint out_values[]; };
+// The resident field: one stored value per voxel of the field's domain (x fastest).
+layout(std430, set = 0, binding = 8) writeonly buffer FieldBuf { uint field_values[]; };
 
 layout(push_constant) uniform Push { PassParams p; };
 
@@ -35,23 +36,23 @@ void store_cost(uint buffer_index, uint i, uint value) {
 
 // Material of voxel v (world coordinates), through the page table and the brick pool.
 uint material_at(ivec3 v) {
-  const int shift = int(world.chunk_shift);
-  const ivec3 rel = (v >> shift) - world.chunk_origin.xyz;
-  const uint entry = pages[(rel.z * world.chunk_dims.y + rel.y) * world.chunk_dims.x + rel.x];
+  const int shift = int(h.chunk_shift);
+  const ivec3 rel = (v >> shift) - h.chunk_origin.xyz;
+  const uint entry = pages[(rel.z * h.chunk_dims.y + rel.y) * h.chunk_dims.x + rel.x];
   if ((entry & VF_UNIFORM) != 0u) return entry & 0xFFu;
-  const ivec3 l = v & int(world.chunk_edge - 1u);
+  const ivec3 l = v & int(h.chunk_edge - 1u);
   const uint index = (uint(l.z) << (2 * shift)) | (uint(l.y) << shift) | uint(l.x);
-  return (bricks[entry * world.chunk_words + (index >> 2)] >> ((index & 3u) * 8u)) & 0xFFu;
+  return (bricks[entry * h.chunk_words + (index >> 2)] >> ((index & 3u) * 8u)) & 0xFFu;
 }
 
-// Index of a domain voxel (local coordinates) in the cost buffers.
+// Index of a compute-box voxel (coordinates relative to the box) in the cost buffers.
 uint voxel_index(ivec3 l) {
-  return uint((l.z * p.domain_size.y + l.y) * p.domain_size.x + l.x);
+  return uint((l.z * p.box_size.y + l.y) * p.box_size.x + l.x);
 }
 
 // The first voxel (local) and stride of line `line` along p.axis.
 void line_of(uint line, out ivec3 first, out ivec3 step) {
-  const ivec3 n = p.domain_size.xyz;
+  const ivec3 n = p.box_size.xyz;
   if (p.axis == 0u) {
     first = ivec3(0, int(line) % n.y, int(line) / n.y);
     step = ivec3(1, 0, 0);

@@ -1,5 +1,5 @@
 // voxfield — later passes of the separable exact distance transform (Meijster, Roerdink &
-// Hesselink 2000): along each line of the domain (axis p.axis), the lower envelope of the
+// Hesselink 2000): along each line of the compute box (axis p.axis), the lower envelope of the
 // functions f(x, i) = F(x - i, c(i)) over the line's voxels i, where c is the previous pass's cost:
 //   Manhattan  F = |x - i| + c(i)
 //   Chebyshev  F = max(|x - i|, c(i))
@@ -13,8 +13,8 @@
 
 int f(int x, int i, int c) {
   const int d = abs(x - i);
-  if (p.metric == VF_MANHATTAN) return d + c;
-  if (p.metric == VF_CHEBYSHEV) return max(d, c);
+  if (h.metric == VF_MANHATTAN) return d + c;
+  if (h.metric == VF_CHEBYSHEV) return max(d, c);
   return d * d + c;
 }
 
@@ -27,12 +27,12 @@ const int kMinusInf = -0x7FFFFFFF;
 
 // The first x at which f(., u) is below f(., i), for i < u.
 int sep(int i, int u, int ci, int cu) {
-  if (p.metric == VF_MANHATTAN) {
+  if (h.metric == VF_MANHATTAN) {
     if (cu >= ci + (u - i)) return kPlusInf;
     if (ci > cu + (u - i)) return kMinusInf;
     return floor_div(cu - ci + u + i, 2);
   }
-  if (p.metric == VF_CHEBYSHEV) {
+  if (h.metric == VF_CHEBYSHEV) {
     if (ci <= cu) return max(i + cu, floor_div(i + u, 2));
     return min(u - ci, floor_div(i + u, 2));
   }
@@ -41,7 +41,7 @@ int sep(int i, int u, int ci, int cu) {
 
 void main() {
   const uint line = invocation();
-  const ivec3 n = p.domain_size.xyz;
+  const ivec3 n = p.box_size.xyz;
   const int len = p.axis == 1u ? n.y : n.z;
   const int lines = (n.x * n.y * n.z) / len;
   if (int(line) >= lines) return;

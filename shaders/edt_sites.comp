@@ -1,6 +1,6 @@
 // voxfield — first pass of the separable exact distance transform (Meijster, Roerdink & Hesselink,
 // "A general algorithm for computing distance transforms in linear time", 2000): along each row
-// of the domain (x), the distance to the nearest site in that row, by one sweep each way. Sites
+// of the compute box (x), the distance to the nearest site in that row, by one sweep each way. Sites
 // are the solid voxels, or the air voxels for the inside half of a signed field. One invocation
 // per row. Writes cost p.dst: the distance (L1, L-infinity) or its square (L2), VF_INF when the row
 // holds no site.
@@ -9,12 +9,12 @@
 
 void main() {
   const uint row = invocation();
-  const ivec3 n = p.domain_size.xyz;
+  const ivec3 n = p.box_size.xyz;
   if (row >= uint(n.y * n.z)) return;
   ivec3 first, step;
   line_of(row, first, step);
   const int len = n.x;
-  const ivec3 origin = p.domain_begin.xyz;
+  const ivec3 origin = p.box_begin.xyz;
   // Forward: distance to the nearest site at or before x.
   int last = -1;
   for (int x = 0; x < len; ++x) {
@@ -31,7 +31,7 @@ void main() {
     uint d = load_cost(p.dst, i);
     if (d == 0u) next = x;
     if (next >= 0) d = min(d, uint(next - x));
-    if (d != VF_INF && p.metric == VF_EUCLIDEAN) d = d * d;
+    if (d != VF_INF && h.metric == VF_EUCLIDEAN) d = d * d;
     store_cost(p.dst, i, d);
   }
 }

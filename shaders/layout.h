@@ -1,6 +1,6 @@
 // voxfield GPU layout — the one description of GPU-side data, included by the C++ backend and by
 // every GLSL shader, so both sides agree on every offset. std430 rules: 4-byte scalars, 16-byte
-// vec4s; src/gpu/layout_check.cpp asserts the C++ sizes.
+// vec4s; the static_asserts at the end check the C++ side.
 //
 // The world on the GPU is one pooled buffer of chunk bricks plus a page table (never a buffer or
 // descriptor per chunk): the page table has one 32-bit entry per chunk of the domain's chunk grid,
@@ -35,43 +35,54 @@ VF_CONST(uint, VF_F32, 2u);
 
 VF_CONST(uint, VF_WORKGROUP, 64u);  // local_size_x of every compute shader
 
-// Where the world's chunks are: std430, 48 bytes.
-struct WorldHeader {
+// What stays fixed while a field lives on the GPU: where the world's chunks are, the field's
+// domain, and its encoding. std430, 128 bytes, in a storage buffer. The encoding reproduces the
+// CPU's exactly: the host precomputes every value that involves rounding a real number (the clamp
+// and "no site" values) and the cost below which a distance is inside the clamp, so shaders only
+// do integer arithmetic (and one float sqrt for f32 storage).
+struct Header {
   ivec4 chunk_origin;  // chunk coordinate of page-table entry 0
   ivec4 chunk_dims;    // page-table extent in chunks; w = number of entries
   uint chunk_edge;     // voxels per chunk edge (power of two, 8..128)
   uint chunk_shift;    // log2(chunk_edge)
   uint chunk_words;    // 32-bit words per brick: chunk_edge^3 / 4
   uint pad0;
-};
-
-// Per-dispatch parameters of the distance passes, as push constants: 96 bytes. The encode pass
-// reproduces the CPU's encoding exactly: the host precomputes every value that involves rounding
-// a real number (the clamp and "no site" values) and the cost below which a distance is inside
-// the clamp, so the shader only does integer arithmetic (and one float sqrt for f32 storage).
-struct PassParams {
-  ivec4 domain_begin;  // voxel coordinates of the domain's first voxel
-  ivec4 domain_size;   // extent of the domain in voxels
+  ivec4 field_begin;   // the resident field's domain (voxel coordinates)
+  ivec4 field_size;
   uint metric;         // VF_MANHATTAN...
-  uint axis;           // 0, 1, 2: the axis this pass's lines run along
-  uint sites_are_air;  // 1: sites are the air voxels (the inside half of a signed field)
-  uint is_signed;      // encode: 1 for signed fields
-  uint src;            // cost buffer read by this pass (0, 1, 2)
-  uint dst;            // cost buffer written by this pass
-  uint src2;           // encode: the inside cost buffer of a signed field
-  uint pad0;
-  uint clamp_cost;     // encode: costs >= this are at or beyond the clamp (VF_INF: unclamped)
-  uint scale_sq;       // encode: fixed-point scale squared (integer storage of Euclidean costs)
-  int bias;            // encode: offset of signed integer storage
-  uint storage;        // encode: VF_U8, VF_U16, VF_F32
-  uint clamp_pos;      // encode: stored bits for +clamp, -clamp, and no site outside / inside
+  uint is_signed;      // 1 for signed fields
+  uint storage;        // VF_U8, VF_U16, VF_F32
+  uint clamp_cost;     // costs >= this are at or beyond the clamp (VF_INF: unclamped)
+  uint scale_sq;       // fixed-point scale squared (integer storage of Euclidean costs)
+  int bias;            // offset of signed integer storage
+  uint pad1;
+  uint pad2;
+  uint clamp_pos;      // stored bits for +clamp, -clamp, and "no site" outside / inside
   uint clamp_neg;
   uint none_pos;
   uint none_neg;
 };
 
+// What changes from dispatch to dispatch, as push constants: 96 bytes. A pass works on a
+// "compute box" (the whole domain for a full build, an edit's reach grown by the clamp for an
+// update); the encode pass writes the "out box" inside it into the resident field.
+struct PassParams {
+  ivec4 box_begin;     // compute box, voxel coordinates
+  ivec4 box_size;
+  ivec4 out_begin;     // encode: the voxels written (inside the compute box)
+  ivec4 out_size;
+  uint axis;           // 0, 1, 2: the axis this pass's lines run along
+  uint sites_are_air;  // 1: sites are the air voxels (the inside half of a signed field)
+  uint src;            // cost buffer read by this pass (0, 1, 2)
+  uint dst;            // cost buffer written by this pass
+  uint src2;           // encode: the inside cost buffer of a signed field
+  uint pad0;
+  uint pad1;
+  uint pad2;
+};
+
 #ifdef __cplusplus
-static_assert(sizeof(WorldHeader) == 48, "std430 size of WorldHeader");
+static_assert(sizeof(Header) == 128, "std430 size of Header");
 static_assert(sizeof(PassParams) == 96, "push-constant size of PassParams");
 }  // namespace voxfield::gpu::layout
 #endif

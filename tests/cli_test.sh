@@ -262,6 +262,12 @@ import json; j = json.load(open('$tmp/kg.json'))
 assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['gpu']['fence_waits'] == 1, j"
   check "field: jfa on the gpu" 1 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --backend vulkan --algorithm jfa
   check "field --backend auto" 0 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/ka.npy" --backend auto
+  # Edits kept on the GPU: verified against full rebuilds after every edit, at most one submit each.
+  check "bench edits --backend vulkan --verify" 0 "$V" bench edits --world 40 --chunk 8 --edits 30 --metric euclidean \
+      --signed --max-distance 5 --storage u8 --verify --backend vulkan --json "$tmp/gedits.json"
+  check "gpu edits json" 0 $PY -c "
+import json; j = json.load(open('$tmp/gedits.json'))
+assert j['backend'] == 'vulkan' and j['verify_mismatches'] == 0, j"
 fi
 
 check "showcase (small)" 0 "$V" showcase --size 48 --out "$tmp/showcase"

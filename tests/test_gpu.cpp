@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <random>
 
+#include "voxfield/edit.h"
 #include "voxfield/gpu.h"
 
 using namespace voxfield;
@@ -165,4 +166,56 @@ TEST(Gpu, TimestampsNameEveryPass) {
   EXPECT_EQ(t.front().pass, "rows x");
   EXPECT_EQ(t.back().pass, "encode");
   for (const auto& p : t) EXPECT_GE(p.ms, 0) << p.pass;
+}
+
+TEST(Gpu, IncrementalUpdatesEqualAFullRebuild) {
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = validated_context();
+  ctx->clear_validation_messages();
+  struct Case {
+    Metric metric;
+    bool is_signed;
+    double clamp;
+    Storage storage;
+  };
+  for (const Case& c : {Case{Metric::kEuclidean, false, 6, Storage::kU8}, Case{Metric::kManhattan, true, 5, Storage::kU16},
+                        Case{Metric::kChebyshev, false, 4, Storage::kF32}, Case{Metric::kEuclidean, true, 0, Storage::kF32}}) {
+    World w = random_world({53, 40, 34}, 8, 0.01, 21);
+    DistanceOptions o;
+    o.metric = c.metric;
+    o.signed_distance = c.is_signed;
+    o.max_distance = c.clamp;
+    o.storage = c.storage;
+    const std::string what = std::string(metric_name(c.metric)) + (c.is_signed ? " signed" : "") + " clamp " +
+                             std::to_string(c.clamp) + " " + storage_name(c.storage);
+    gpu::DynamicField live(ctx, w, o);
+    DirtyRegions dirty(w.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<int> px(0, 52), py(0, 39), pz(0, 33), pr(1, 5), pm(0, 4);
+    for (int i = 0; i < 25; ++i) {
+      Edit e;
+      const int m = pm(rng);
+      e.op = m == 0 ? EditOp::kCarve : EditOp::kPlace;
+      e.material = static_cast<std::uint8_t>(std::max(m, 1));
+      e.brush = SphereBrush{{double(px(rng)), double(py(rng)), double(pz(rng))}, double(pr(rng))};
+      apply_edit(w, e, &dirty);
+      // Only the changed chunks travel: at most their bytes plus a page entry each.
+      std::int64_t changed_bytes = 0;
+      for (const Box3i& b : dirty.boxes()) {
+        (void)b;
+        changed_bytes += w.voxels.chunk_volume() + 4;
+      }
+      const gpu::Counters before = ctx->counters();
+      live.update(dirty);
+      const gpu::Counters after = ctx->counters();
+      dirty.clear();
+      EXPECT_LE(after.submits - before.submits, 1) << what;
+      EXPECT_LE(after.fence_waits - before.fence_waits, 1) << what;
+      EXPECT_EQ(after.bytes_downloaded, before.bytes_downloaded) << what << ": read-back inside an update";
+      EXPECT_LE(after.bytes_uploaded - before.bytes_uploaded, changed_bytes) << what;
+      if (i % 6 == 5 || i == 24) expect_same_field(live.download(), compute_distance_field(w, o), what + " after edit " + std::to_string(i));
+    }
+  }
+  const auto messages = ctx->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
 }

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "cli.h"
+#include "live_field.h"
 #include "field_args.h"
 #include "voxfield/dynamic_field.h"
 #include "voxfield/parallel.h"
@@ -14,7 +15,7 @@ namespace voxfield::cli {
 namespace {
 
 struct EditSettings {
-  std::string in, edits, out, stats, save_world;
+  std::string in, edits, out, stats, save_world, backend = "cpu";
   FieldArgs field;
 };
 
@@ -102,7 +103,7 @@ int run_edit(const EditSettings& s) {
   }
   DistanceOptions o = s.field.options();
   const auto t_build = std::chrono::steady_clock::now();
-  DynamicDistanceField field(world, o);
+  LiveField field(world, o, s.backend);
   const double build_ms = ms_since(t_build);
 
   DirtyRegions dirty(world.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
@@ -123,6 +124,8 @@ int run_edit(const EditSettings& s) {
   const double total = std::accumulate(edit_ms.begin(), edit_ms.end(), 0.0);
   const Vec3i d = in.extent.size();
   nlohmann::json j = s.field.describe(o, d);
+  j["backend"] = field.on_gpu() ? "vulkan" : "cpu";
+  if (field.on_gpu()) j["gpu"] = field.gpu_json();
   j.update(nlohmann::json{{"build_ms", build_ms},
                    {"edits", edits.size()},
                    {"edit_ms", edit_ms},
@@ -155,6 +158,8 @@ void add_edit(CLI::App& app, Action& action) {
       ->required();
   cmd->add_option("-o,--output", s->out, "output .npy of the final field")->required();
   s->field.add_to(cmd);
+  cmd->add_option("--backend", s->backend, "cpu (default), vulkan or auto: where the field lives and is updated")
+      ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
   cmd->add_option("--stats", s->stats, "write per-edit latency (edit_ms), voxels_recomputed and totals as JSON");
   cmd->add_option("--save-world", s->save_world, "also write the edited world (.npy or .vox)");
   cmd->callback([s, &action] { action = [s] { return run_edit(*s); }; });

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "voxfield/distance.h"
+#include "voxfield/dynamic_field.h"
 #include "voxfield/error.h"
 
 namespace voxfield {
@@ -106,6 +107,41 @@ std::shared_ptr<Context> select_backend(Backend backend, const ContextOptions& o
 // buffer, one submit, one fence wait.
 DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
                                      std::vector<PassTiming>* timings = nullptr);
+
+class FieldEngine;
+
+// A distance field that lives on the GPU and follows its world through edits, like
+// DynamicDistanceField: update() uploads the chunks that changed (only those, through a reusable
+// staging buffer, into the resident brick pool and page table) and recomputes the same regions the
+// CPU would, exactly — one command buffer, one submit, one fence wait, no read-back.
+class DynamicField {
+ public:
+  // Binds to `world` (which must outlive this object; the domain must stay fixed: a bounded world
+  // or options.domain) and builds the field on the GPU. Throws InvalidArgument as
+  // compute_distance_field(Context&...) does, GpuUnavailable on device errors.
+  DynamicField(std::shared_ptr<Context> context, const World& world, DistanceOptions options);
+  ~DynamicField();
+  DynamicField(const DynamicField&) = delete;
+  DynamicField& operator=(const DynamicField&) = delete;
+
+  void rebuild();
+  DynamicDistanceField::UpdateStats update(const DirtyRegions& dirty);
+  // Reads the resident field back (for saving, checking or CPU consumers).
+  DistanceField download();
+
+  const DistanceOptions& options() const;
+  Vec3i reach() const { return reach_; }
+  Context& context() { return *context_; }
+  // Timestamps of the last build or update's passes (empty without timestamp support).
+  const std::vector<PassTiming>& last_timings() const { return timings_; }
+
+ private:
+  std::shared_ptr<Context> context_;
+  std::unique_ptr<FieldEngine> engine_;
+  Vec3i reach_{0, 0, 0};
+  int chunk_shift_ = 0;
+  std::vector<PassTiming> timings_;
+};
 
 // Largest |GPU - CPU| of f32 Euclidean values, relative to the distance: Vulkan allows sqrt an
 // error of a few ulps (the SPIR-V environment spec inherits it from 1/inversesqrt).

@@ -3,9 +3,10 @@
 
 #include <cmath>
 
-#include "../distance/field_plan.h"
+#include "update_regions.h"
 
 namespace voxfield {
+namespace detail {
 namespace {
 
 Box3i grow(const Box3i& b, Vec3i by) { return {b.begin - by, b.end + by}; }
@@ -29,6 +30,28 @@ std::vector<Box3i> merge_overlapping(std::vector<Box3i> boxes) {
 
 }  // namespace
 
+Vec3i field_reach(const FieldPlan& plan) {
+  const Vec3i size = plan.domain.size();
+  Vec3i reach;
+  for (int k = 0; k < 3; ++k)
+    reach[k] = std::isfinite(plan.clamp) ? static_cast<int>(std::min<double>(std::ceil(plan.clamp / plan.spacing[k]), size[k]))
+                                         : size[k];
+  return reach;
+}
+
+std::vector<UpdateRegion> update_regions(const DirtyRegions& dirty, const Box3i& domain, Vec3i reach) {
+  std::vector<Box3i> reach_boxes;
+  for (const Box3i& b : dirty.boxes()) {
+    const Box3i r = grow(b, reach).intersect(domain);
+    if (!r.empty()) reach_boxes.push_back(r);
+  }
+  std::vector<UpdateRegion> regions;
+  for (const Box3i& r : merge_overlapping(std::move(reach_boxes))) regions.push_back({r, grow(r, reach).intersect(domain)});
+  return regions;
+}
+
+}  // namespace detail
+
 DynamicDistanceField::DynamicDistanceField(const World& world, DistanceOptions options)
     : world_(&world), options_(std::move(options)) {
   if (!options_.domain) {
@@ -37,12 +60,7 @@ DynamicDistanceField::DynamicDistanceField(const World& world, DistanceOptions o
     }
     options_.domain = *world.voxels.bounds();
   }
-  const detail::FieldPlan plan = detail::make_field_plan(world.voxels, options_);
-  const Vec3i size = plan.domain.size();
-  for (int k = 0; k < 3; ++k) {
-    reach_[k] = std::isfinite(plan.clamp) ? static_cast<int>(std::min<double>(std::ceil(plan.clamp / plan.spacing[k]), size[k]))
-                                          : size[k];
-  }
+  reach_ = detail::field_reach(detail::make_field_plan(world.voxels, options_));
   rebuild();
 }
 
@@ -51,17 +69,12 @@ void DynamicDistanceField::rebuild() { field_ = compute_distance_field(world_->v
 DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegions& dirty) {
   UpdateStats stats;
   if (dirty.empty()) return stats;
-  const Box3i domain = *options_.domain;
-  std::vector<Box3i> reach_boxes;
-  for (const Box3i& b : dirty.boxes()) {
-    const Box3i r = grow(b, reach_).intersect(domain);
-    if (!r.empty()) reach_boxes.push_back(r);
-  }
   const detail::FieldPlan plan = detail::make_field_plan(world_->voxels, options_);
-  for (const Box3i& r : merge_overlapping(std::move(reach_boxes))) {
+  for (const detail::UpdateRegion& region : detail::update_regions(dirty, *options_.domain, reach_)) {
     // Values inside r depend on sites within the reach of r: compute r from that box, densely,
     // and write it into the field.
-    const Box3i in = grow(r, reach_).intersect(domain);
+    const Box3i& r = region.out;
+    const Box3i& in = region.in;
     std::vector<SiteOffset> sites(field_.sites ? static_cast<std::size_t>(r.volume()) : 0);
     std::visit(
         [&](auto& target) {

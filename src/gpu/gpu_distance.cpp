@@ -1,18 +1,24 @@
-// voxfield GPU backend — the exact distance transform on Vulkan compute.
+// voxfield GPU backend — exact distance fields on Vulkan compute, built once and kept exact under
+// edits.
 //
 // The same separable algorithm as the CPU (Meijster, Roerdink & Hesselink 2000), as three kinds of
 // dispatch: edt_sites (distances along x to the nearest site), edt_lines (the lower envelope along
 // y, then z) and edt_encode (stored values, encoded exactly like the CPU's). Each pass reads what
-// the previous one wrote across the whole domain, so passes are separate dispatches with a
-// pipeline barrier between them — barrier() in GLSL only orders one workgroup, which is how the
-// dissertation's single-shader version raced. Everything — upload, every pass, read-back — is in
-// one command buffer: one submit, one fence wait.
+// the previous one wrote across its whole box, so passes are separate dispatches with a pipeline
+// barrier between them — barrier() in GLSL only orders one workgroup, which is how the
+// dissertation's single-shader version raced.
+//
+// A FieldEngine keeps the world (brick pool + page table) and the field resident. A full build
+// and an incremental update are the same operation: upload the chunks that changed, then for each
+// region recompute its compute box and encode its out box into the field — all in one command
+// buffer, one submit, one fence wait, no read-back unless asked for.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 
 #include "../../shaders/layout.h"
-#include "../distance/field_plan.h"
+#include "../edit/update_regions.h"
 #include "vulkan_context.h"
 
 namespace voxfield::gpu {
@@ -21,6 +27,8 @@ namespace {
 namespace L = layout;
 
 constexpr int kMaxExtent = 16384;  // keeps every cost of the passes within 31 bits
+constexpr VkBufferUsageFlags kStorage =
+    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
 
 template <class T>
 std::uint32_t bits(T value) {
@@ -30,11 +38,11 @@ std::uint32_t bits(T value) {
 }
 
 template <class T>
-void set_encoding(L::PassParams& pp, const detail::FieldPlan& plan) {
-  pp.clamp_pos = bits(detail::encode_distance<T>(plan.clamp, plan));
-  pp.clamp_neg = bits(detail::encode_distance<T>(-plan.clamp, plan));
-  pp.none_pos = bits(detail::encode_distance<T>(std::numeric_limits<double>::infinity(), plan));
-  pp.none_neg = bits(detail::encode_distance<T>(-std::numeric_limits<double>::infinity(), plan));
+void set_encoding(L::Header& h, const detail::FieldPlan& plan) {
+  h.clamp_pos = bits(detail::encode_distance<T>(plan.clamp, plan));
+  h.clamp_neg = bits(detail::encode_distance<T>(-plan.clamp, plan));
+  h.none_pos = bits(detail::encode_distance<T>(std::numeric_limits<double>::infinity(), plan));
+  h.none_neg = bits(detail::encode_distance<T>(-std::numeric_limits<double>::infinity(), plan));
 }
 
 // The smallest cost whose distance is at or beyond the clamp, with the CPU's own comparison
@@ -48,10 +56,11 @@ std::uint32_t clamp_cost(const detail::FieldPlan& plan) {
   return static_cast<std::uint32_t>(std::min<double>(c, L::VF_INF - 1.0));
 }
 
+// Bytes for the upload buffer, each piece 16-byte aligned.
 struct Staging {
   std::vector<std::uint8_t> bytes;
   VkDeviceSize add(const void* data, std::size_t n) {
-    const VkDeviceSize offset = (bytes.size() + 255) / 256 * 256;
+    const VkDeviceSize offset = (bytes.size() + 15) / 16 * 16;
     bytes.resize(offset + n);
     if (n > 0) std::memcpy(bytes.data() + offset, data, n);
     return offset;
@@ -82,214 +91,409 @@ DistanceField build_field(const World& world, const DistanceOptions& options, co
 
 }  // namespace
 
-DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
-                                     std::vector<PassTiming>* timings) {
-  Context::Impl& ctx = context.impl();
-  if (options.nearest_sites)
-    throw InvalidArgument("GPU: the Vulkan backend does not compute nearest sites yet (use the CPU backend)");
-  const detail::FieldPlan plan = detail::make_field_plan(world.voxels, options);
-  if (!plan.unit_spacing) throw InvalidArgument("GPU: the Vulkan backend supports unit voxel spacing only");
-  if (plan.domain.empty()) return voxfield::compute_distance_field(world, options);
-  const Vec3i n = plan.domain.size();
-  if (n.x > kMaxExtent || n.y > kMaxExtent || n.z > kMaxExtent)
-    throw InvalidArgument("GPU: domain " + to_string(plan.domain) + " exceeds " + std::to_string(kMaxExtent) +
-                          " voxels along an axis");
-  const std::uint64_t volume = static_cast<std::uint64_t>(plan.domain.volume());
-  const VkDeviceSize field_bytes = volume * 4;
-  if (field_bytes > ctx.limits.maxStorageBufferRange)
-    throw InvalidArgument("GPU: a " + to_string(n) + " domain needs " + std::to_string(field_bytes) +
-                          " bytes per buffer, more than this device's storage-buffer range (" +
-                          std::to_string(ctx.limits.maxStorageBufferRange) + ")");
-
-  // Encoding constants (see shaders/layout.h).
-  L::PassParams base{};
-  base.domain_begin = {plan.domain.begin.x, plan.domain.begin.y, plan.domain.begin.z, 0};
-  base.domain_size = {n.x, n.y, n.z, 0};
-  base.metric = static_cast<std::uint32_t>(plan.metric);
-  base.is_signed = plan.is_signed ? 1u : 0u;
-  base.clamp_cost = clamp_cost(plan);
-  base.bias = static_cast<std::int32_t>(plan.encoding.bias);
-  base.storage = options.storage == Storage::kU8 ? L::VF_U8 : options.storage == Storage::kU16 ? L::VF_U16 : L::VF_F32;
-  switch (options.storage) {
-    case Storage::kU8: set_encoding<std::uint8_t>(base, plan); break;
-    case Storage::kU16: set_encoding<std::uint16_t>(base, plan); break;
-    case Storage::kF32: set_encoding<float>(base, plan); break;
-  }
-  if (plan.metric == Metric::kEuclidean && options.storage != Storage::kF32) {
-    const double s = plan.encoding.scale;
-    if (s != std::floor(s))
-      throw InvalidArgument("GPU: Euclidean fixed point needs an integral scale on the Vulkan backend");
-    base.scale_sq = static_cast<std::uint32_t>(s * s);
-    const double largest = (static_cast<double>(std::min<std::uint32_t>(base.clamp_cost, 3u * kMaxExtent * kMaxExtent)) - 1) * s * s;
-    if (largest >= 4294967296.0)
-      throw InvalidArgument("GPU: fixed-point scale " + std::to_string(s) + " with this clamp overflows 32 bits");
+class FieldEngine {
+ public:
+  FieldEngine(Context::Impl& ctx, const World& world, const DistanceOptions& options)
+      : ctx_(ctx), world_(world), options_(options), plan_(detail::make_field_plan(world.voxels, options)) {
+    if (options.nearest_sites)
+      throw InvalidArgument("GPU: the Vulkan backend does not compute nearest sites yet (use the CPU backend)");
+    if (!plan_.unit_spacing) throw InvalidArgument("GPU: the Vulkan backend supports unit voxel spacing only");
+    if (plan_.domain.empty()) throw InvalidArgument("GPU: the field's domain is empty");
+    const Vec3i n = plan_.domain.size();
+    if (n.x > kMaxExtent || n.y > kMaxExtent || n.z > kMaxExtent)
+      throw InvalidArgument("GPU: domain " + to_string(plan_.domain) + " exceeds " + std::to_string(kMaxExtent) +
+                            " voxels along an axis");
+    field_bytes_ = static_cast<VkDeviceSize>(plan_.domain.volume()) * 4;
+    if (field_bytes_ > ctx.limits.maxStorageBufferRange)
+      throw InvalidArgument("GPU: a " + to_string(n) + " domain needs " + std::to_string(field_bytes_) +
+                            " bytes per buffer, more than this device's storage-buffer range (" +
+                            std::to_string(ctx.limits.maxStorageBufferRange) + ")");
+    make_header();
+    const int shift = world.voxels.chunk_shift();
+    chunk_origin_ = {plan_.domain.begin.x >> shift, plan_.domain.begin.y >> shift, plan_.domain.begin.z >> shift};
+    const Vec3i last{(plan_.domain.end.x - 1) >> shift, (plan_.domain.end.y - 1) >> shift,
+                     (plan_.domain.end.z - 1) >> shift};
+    chunk_dims_ = last - chunk_origin_ + Vec3i::splat(1);
+    header_.chunk_origin = {chunk_origin_.x, chunk_origin_.y, chunk_origin_.z, 0};
+    header_.chunk_dims = {chunk_dims_.x, chunk_dims_.y, chunk_dims_.z, chunk_dims_.x * chunk_dims_.y * chunk_dims_.z};
+    chunk_bytes_ = static_cast<std::size_t>(world.voxels.chunk_volume());
+    header_.chunk_edge = static_cast<std::uint32_t>(world.voxels.chunk_edge());
+    header_.chunk_shift = static_cast<std::uint32_t>(shift);
+    header_.chunk_words = static_cast<std::uint32_t>(chunk_bytes_ / 4);
+    pages_.assign(static_cast<std::size_t>(header_.chunk_dims.w), L::VF_UNIFORM);  // all air until uploaded
+    header_buf_ = Buffer(ctx, sizeof header_, kStorage, false);
+    pages_buf_ = Buffer(ctx, pages_.size() * 4, kStorage, false);
+    field_buf_ = Buffer(ctx, field_bytes_, kStorage, false);
   }
 
-  // The world as brick pool + page table over the chunks the domain touches.
-  const int edge = world.voxels.chunk_edge(), shift = world.voxels.chunk_shift();
-  const Vec3i c0{plan.domain.begin.x >> shift, plan.domain.begin.y >> shift, plan.domain.begin.z >> shift};
-  const Vec3i c1{(plan.domain.end.x - 1) >> shift, (plan.domain.end.y - 1) >> shift, (plan.domain.end.z - 1) >> shift};
-  const Vec3i cd = c1 - c0 + Vec3i::splat(1);
-  const std::size_t chunk_bytes = static_cast<std::size_t>(edge) * edge * edge;
-  std::vector<std::uint32_t> pages(static_cast<std::size_t>(cd.x) * cd.y * cd.z);
-  std::vector<std::uint8_t> bricks;
-  for (int z = 0; z < cd.z; ++z)
-    for (int y = 0; y < cd.y; ++y)
-      for (int x = 0; x < cd.x; ++x) {
-        const ChunkView<std::uint8_t> view = world.voxels.chunk_view(c0 + Vec3i{x, y, z});
-        std::uint32_t& entry = pages[(static_cast<std::size_t>(z) * cd.y + y) * cd.x + x];
-        if (!view.voxels) {
-          entry = L::VF_UNIFORM | view.uniform_value;
-          continue;
-        }
-        entry = static_cast<std::uint32_t>(bricks.size() / chunk_bytes);
-        bricks.insert(bricks.end(), view.voxels, view.voxels + chunk_bytes);
-      }
-  L::WorldHeader header{};
-  header.chunk_origin = {c0.x, c0.y, c0.z, 0};
-  header.chunk_dims = {cd.x, cd.y, cd.z, cd.x * cd.y * cd.z};
-  header.chunk_edge = static_cast<std::uint32_t>(edge);
-  header.chunk_shift = static_cast<std::uint32_t>(shift);
-  header.chunk_words = static_cast<std::uint32_t>(chunk_bytes / 4);
-  Staging up;
-  const VkDeviceSize header_at = up.add(&header, sizeof header);
-  const VkDeviceSize pages_at = up.add(pages.data(), pages.size() * 4);
-  const VkDeviceSize bricks_at = up.add(bricks.data(), bricks.size());
+  const detail::FieldPlan& plan() const { return plan_; }
+  const DistanceOptions& options() const { return options_; }
 
-  constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-                                          VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-  Buffer header_buf(ctx, sizeof header, kStorage, false);
-  Buffer pages_buf(ctx, pages.size() * 4, kStorage, false);
-  Buffer bricks_buf(ctx, std::max<std::size_t>(bricks.size(), 4), kStorage, false);
-  Buffer cost0(ctx, field_bytes, kStorage, false), cost1(ctx, field_bytes, kStorage, false);
-  Buffer cost2(ctx, plan.is_signed ? field_bytes : 4, kStorage, false);
-  Buffer scratch_s(ctx, field_bytes, kStorage, false), scratch_t(ctx, field_bytes, kStorage, false);
-  Buffer out(ctx, field_bytes, kStorage, false);
-  Buffer& upload = ctx.upload_buffer(up.bytes.size());
-  std::memcpy(upload.mapped(), up.bytes.data(), up.bytes.size());
-  Buffer& readback = ctx.readback_buffer(field_bytes);
-
-  // One descriptor set binds every buffer; passes differ by pipeline and push constants.
-  check(vkResetDescriptorPool(ctx.device, ctx.descriptor_pool, 0), "vkResetDescriptorPool");
-  VkDescriptorSetAllocateInfo dsa{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  dsa.descriptorPool = ctx.descriptor_pool;
-  dsa.descriptorSetCount = 1;
-  dsa.pSetLayouts = &ctx.set_layout;
-  VkDescriptorSet set;
-  check(vkAllocateDescriptorSets(ctx.device, &dsa, &set), "vkAllocateDescriptorSets");
-  const Buffer* bound[Context::Impl::kBindings] = {&header_buf, &pages_buf, &bricks_buf, &cost0, &cost1,
-                                                   &cost2,      &scratch_s, &scratch_t,  &out};
-  VkDescriptorBufferInfo infos[Context::Impl::kBindings];
-  VkWriteDescriptorSet writes[Context::Impl::kBindings];
-  for (std::uint32_t b = 0; b < Context::Impl::kBindings; ++b) {
-    infos[b] = {bound[b]->handle(), 0, VK_WHOLE_SIZE};
-    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[b].dstSet = set;
-    writes[b].dstBinding = b;
-    writes[b].descriptorCount = 1;
-    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[b].pBufferInfo = &infos[b];
+  // Every chunk the domain touches.
+  std::vector<Vec3i> all_chunks() const {
+    std::vector<Vec3i> chunks;
+    for (int z = 0; z < chunk_dims_.z; ++z)
+      for (int y = 0; y < chunk_dims_.y; ++y)
+        for (int x = 0; x < chunk_dims_.x; ++x) chunks.push_back(chunk_origin_ + Vec3i{x, y, z});
+    return chunks;
   }
-  vkUpdateDescriptorSets(ctx.device, Context::Impl::kBindings, writes, 0, nullptr);
 
-  VkCommandBufferAllocateInfo cba{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  cba.commandPool = ctx.command_pool;
-  cba.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  cba.commandBufferCount = 1;
-  VkCommandBuffer cmd;
-  check(vkAllocateCommandBuffers(ctx.device, &cba, &cmd), "vkAllocateCommandBuffers");
-  struct FreeCmd {
-    Context::Impl& ctx;
+  // Uploads `chunks` (those inside the page table), recomputes `regions`, optionally reads the
+  // whole field back: one command buffer, one submit, one fence wait.
+  void run(const std::vector<Vec3i>& chunks, const std::vector<detail::UpdateRegion>& regions, bool download,
+           std::vector<PassTiming>* timings) {
+    Staging up;
+    std::vector<VkBufferCopy> page_copies, brick_copies;
+    std::optional<Buffer> old_pool;  // kept alive until the copy out of it has run
+    VkDeviceSize old_pool_bytes = 0;
+    if (first_run_) {
+      const VkDeviceSize at = up.add(&header_, sizeof header_);
+      header_copy_ = VkBufferCopy{at, 0, sizeof header_};
+    }
+    sync_chunks(chunks, up, page_copies, brick_copies, old_pool, old_pool_bytes);
+    VkDeviceSize largest = 4;
+    for (const auto& r : regions) largest = std::max<VkDeviceSize>(largest, static_cast<VkDeviceSize>(r.in.volume()) * 4);
+    if (largest > work_bytes_) grow_work_buffers(largest);
+
+    Buffer& upload = ctx_.upload_buffer(std::max<VkDeviceSize>(up.bytes.size(), 16));
+    if (!up.bytes.empty()) std::memcpy(upload.mapped(), up.bytes.data(), up.bytes.size());
+    Buffer* readback = download ? &ctx_.readback_buffer(field_bytes_) : nullptr;
+    const VkDescriptorSet set = descriptor_set();
+
+    VkCommandBufferAllocateInfo cba{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    cba.commandPool = ctx_.command_pool;
+    cba.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    cba.commandBufferCount = 1;
     VkCommandBuffer cmd;
-    ~FreeCmd() { vkFreeCommandBuffers(ctx.device, ctx.command_pool, 1, &cmd); }
-  } free_cmd{ctx, cmd};
-  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+    check(vkAllocateCommandBuffers(ctx_.device, &cba, &cmd), "vkAllocateCommandBuffers");
+    struct FreeCmd {
+      Context::Impl& ctx;
+      VkCommandBuffer cmd;
+      ~FreeCmd() { vkFreeCommandBuffers(ctx.device, ctx.command_pool, 1, &cmd); }
+    } free_cmd{ctx_, cmd};
+    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+    const bool timed = timings && ctx_.timestamps != VK_NULL_HANDLE;
+    if (timed) vkCmdResetQueryPool(cmd, ctx_.timestamps, 0, 64);
 
-  std::vector<std::string> pass_names;
-  const bool timed = ctx.timestamps != VK_NULL_HANDLE;
-  if (timed) vkCmdResetQueryPool(cmd, ctx.timestamps, 0, 64);
-
-  const VkBufferCopy copies[3] = {{header_at, 0, sizeof header}, {pages_at, 0, pages.size() * 4},
-                                  {bricks_at, 0, bricks.size()}};
-  vkCmdCopyBuffer(cmd, upload.handle(), header_buf.handle(), 1, &copies[0]);
-  vkCmdCopyBuffer(cmd, upload.handle(), pages_buf.handle(), 1, &copies[1]);
-  if (!bricks.empty()) vkCmdCopyBuffer(cmd, upload.handle(), bricks_buf.handle(), 1, &copies[2]);
-  ctx.counters.bytes_uploaded += static_cast<std::int64_t>(sizeof header + pages.size() * 4 + bricks.size());
-  barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-          VK_ACCESS_SHADER_READ_BIT);
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.pipeline_layout, 0, 1, &set, 0, nullptr);
-
-  bool first_pass = true;
-  auto pass = [&](const Pipeline& pipeline, L::PassParams pp, std::uint64_t invocations, const std::string& name) {
-    if (!first_pass)
-      barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+    // Transfers first: a grown pool's old bricks, the header, changed page entries and bricks.
+    bool transferred = false;
+    if (old_pool) {
+      const VkBufferCopy keep{0, 0, old_pool_bytes};
+      vkCmdCopyBuffer(cmd, old_pool->handle(), bricks_buf_.handle(), 1, &keep);
+      barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+              VK_ACCESS_TRANSFER_WRITE_BIT);
+      transferred = true;
+    }
+    if (first_run_) {
+      vkCmdCopyBuffer(cmd, upload.handle(), header_buf_.handle(), 1, &header_copy_);
+      ctx_.counters.bytes_uploaded += sizeof header_;
+      transferred = true;
+    }
+    if (!page_copies.empty()) {
+      vkCmdCopyBuffer(cmd, upload.handle(), pages_buf_.handle(), static_cast<std::uint32_t>(page_copies.size()),
+                      page_copies.data());
+      transferred = true;
+    }
+    if (!brick_copies.empty()) {
+      vkCmdCopyBuffer(cmd, upload.handle(), bricks_buf_.handle(), static_cast<std::uint32_t>(brick_copies.size()),
+                      brick_copies.data());
+      transferred = true;
+    }
+    if (!first_run_) {
+      // The previous submission's shader accesses are complete (its fence was waited on), but
+      // this one's transfers and passes overwrite buffers those passes used: order them.
+      barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+              VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+              VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    }
+    if (transferred)
+      barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-    first_pass = false;
-    const auto q = static_cast<std::uint32_t>(2 * pass_names.size());
-    if (timed && q + 1 < 64) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx.timestamps, q);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
-    vkCmdPushConstants(cmd, ctx.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pp, &pp);
-    dispatch(ctx, cmd, invocations);
-    if (timed && q + 1 < 64) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx.timestamps, q + 1);
-    pass_names.push_back(name);
-  };
-  // One separable transform: sites along x into `result`, then y and z through the other buffer.
-  auto transform = [&](std::uint32_t result, std::uint32_t other, bool sites_are_air) {
-    const std::string what = sites_are_air ? " (to air)" : "";
-    L::PassParams pp = base;
-    pp.sites_are_air = sites_are_air ? 1u : 0u;
-    pp.axis = 0;
-    pp.dst = result;
-    pass(ctx.edt_sites, pp, static_cast<std::uint64_t>(n.y) * n.z, "rows x" + what);
-    pp.axis = 1;
-    pp.src = result;
-    pp.dst = other;
-    pass(ctx.edt_lines, pp, static_cast<std::uint64_t>(n.x) * n.z, "lines y" + what);
-    pp.axis = 2;
-    pp.src = other;
-    pp.dst = result;
-    pass(ctx.edt_lines, pp, static_cast<std::uint64_t>(n.x) * n.y, "lines z" + what);
-  };
-  transform(0, 1, false);
-  if (plan.is_signed) transform(2, 1, true);
-  L::PassParams enc = base;
-  enc.src = 0;
-  enc.src2 = 2;
-  pass(ctx.edt_encode, enc, volume, "encode");
+    first_run_ = false;
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.pipeline_layout, 0, 1, &set, 0, nullptr);
 
-  barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-          VK_ACCESS_TRANSFER_READ_BIT);
-  const VkBufferCopy down{0, 0, field_bytes};
-  vkCmdCopyBuffer(cmd, out.handle(), readback.handle(), 1, &down);
-  barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-          VK_ACCESS_HOST_READ_BIT);
-  ctx.counters.bytes_downloaded += static_cast<std::int64_t>(field_bytes);
-  check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
-  ctx.submit_and_wait(cmd);
+    std::vector<std::string> names;
+    bool first_pass = true;
+    auto pass = [&](const Pipeline& pipeline, const L::PassParams& pp, std::uint64_t invocations, std::string name) {
+      if (!first_pass)
+        barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+      first_pass = false;
+      const auto q = static_cast<std::uint32_t>(2 * names.size());
+      const bool stamp = timed && q + 1 < 64;
+      if (stamp) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx_.timestamps, q);
+      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
+      vkCmdPushConstants(cmd, ctx_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pp, &pp);
+      dispatch(ctx_, cmd, invocations);
+      if (stamp) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx_.timestamps, q + 1);
+      names.push_back(std::move(name));
+    };
+    for (const detail::UpdateRegion& r : regions) {
+      const Vec3i n = r.in.size();
+      L::PassParams pp{};
+      pp.box_begin = {r.in.begin.x, r.in.begin.y, r.in.begin.z, 0};
+      pp.box_size = {n.x, n.y, n.z, 0};
+      pp.out_begin = {r.out.begin.x, r.out.begin.y, r.out.begin.z, 0};
+      pp.out_size = {r.out.size().x, r.out.size().y, r.out.size().z, 0};
+      // One separable transform: sites along x into `result`, then y and z through `other`.
+      auto transform = [&](std::uint32_t result, std::uint32_t other, bool to_air) {
+        const std::string what = to_air ? " (to air)" : "";
+        L::PassParams t = pp;
+        t.sites_are_air = to_air ? 1u : 0u;
+        t.axis = 0;
+        t.dst = result;
+        pass(ctx_.edt_sites, t, static_cast<std::uint64_t>(n.y) * n.z, "rows x" + what);
+        t.axis = 1;
+        t.src = result;
+        t.dst = other;
+        pass(ctx_.edt_lines, t, static_cast<std::uint64_t>(n.x) * n.z, "lines y" + what);
+        t.axis = 2;
+        t.src = other;
+        t.dst = result;
+        pass(ctx_.edt_lines, t, static_cast<std::uint64_t>(n.x) * n.y, "lines z" + what);
+      };
+      transform(0, 1, false);
+      if (plan_.is_signed) transform(2, 1, true);
+      L::PassParams enc = pp;
+      enc.src = 0;
+      enc.src2 = 2;
+      pass(ctx_.edt_encode, enc, static_cast<std::uint64_t>(r.out.volume()), "encode");
+    }
+    if (readback) {
+      barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+              VK_ACCESS_TRANSFER_READ_BIT);
+      const VkBufferCopy down{0, 0, field_bytes_};
+      vkCmdCopyBuffer(cmd, field_buf_.handle(), readback->handle(), 1, &down);
+      barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+              VK_ACCESS_HOST_READ_BIT);
+      ctx_.counters.bytes_downloaded += static_cast<std::int64_t>(field_bytes_);
+    }
+    check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+    ctx_.submit_and_wait(cmd);
 
-  if (timings) {
-    timings->clear();
-    if (timed && !pass_names.empty()) {
-      const auto count = static_cast<std::uint32_t>(std::min<std::size_t>(2 * pass_names.size(), 64));
-      std::vector<std::uint64_t> ticks(count);
-      check(vkGetQueryPoolResults(ctx.device, ctx.timestamps, 0, count, ticks.size() * 8, ticks.data(), 8,
-                                  VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-            "vkGetQueryPoolResults");
-      for (std::size_t i = 0; 2 * i + 1 < count; ++i)
-        timings->push_back({pass_names[i], static_cast<double>(ticks[2 * i + 1] - ticks[2 * i]) *
-                                               ctx.timestamp_period_ns * 1e-6});
+    if (timings) {
+      timings->clear();
+      const auto count = static_cast<std::uint32_t>(std::min<std::size_t>(2 * names.size(), 64));
+      if (timed && count >= 2) {
+        std::vector<std::uint64_t> ticks(count);
+        check(vkGetQueryPoolResults(ctx_.device, ctx_.timestamps, 0, count, ticks.size() * 8, ticks.data(), 8,
+                                    VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+              "vkGetQueryPoolResults");
+        for (std::size_t i = 0; 2 * i + 1 < count; ++i)
+          timings->push_back({names[i], static_cast<double>(ticks[2 * i + 1] - ticks[2 * i]) * ctx_.timestamp_period_ns * 1e-6});
+      }
     }
   }
 
-  const auto* stored = static_cast<const std::uint32_t*>(readback.mapped());
-  switch (options.storage) {
-    case Storage::kU8: return build_field<std::uint8_t>(world, options, plan, stored);
-    case Storage::kU16: return build_field<std::uint16_t>(world, options, plan, stored);
-    case Storage::kF32: return build_field<float>(world, options, plan, stored);
+  // The field as last read back.
+  DistanceField read_back() const {
+    const auto* stored = static_cast<const std::uint32_t*>(ctx_.readback.mapped());
+    switch (options_.storage) {
+      case Storage::kU8: return build_field<std::uint8_t>(world_, options_, plan_, stored);
+      case Storage::kU16: return build_field<std::uint16_t>(world_, options_, plan_, stored);
+      case Storage::kF32: return build_field<float>(world_, options_, plan_, stored);
+    }
+    return {};
   }
-  return {};
+
+ private:
+  void make_header() {
+    header_ = {};
+    header_.field_begin = {plan_.domain.begin.x, plan_.domain.begin.y, plan_.domain.begin.z, 0};
+    header_.field_size = {plan_.domain.size().x, plan_.domain.size().y, plan_.domain.size().z, 0};
+    header_.metric = static_cast<std::uint32_t>(plan_.metric);
+    header_.is_signed = plan_.is_signed ? 1u : 0u;
+    header_.storage = options_.storage == Storage::kU8 ? L::VF_U8 : options_.storage == Storage::kU16 ? L::VF_U16 : L::VF_F32;
+    header_.clamp_cost = clamp_cost(plan_);
+    header_.bias = static_cast<std::int32_t>(plan_.encoding.bias);
+    switch (options_.storage) {
+      case Storage::kU8: set_encoding<std::uint8_t>(header_, plan_); break;
+      case Storage::kU16: set_encoding<std::uint16_t>(header_, plan_); break;
+      case Storage::kF32: set_encoding<float>(header_, plan_); break;
+    }
+    if (plan_.metric == Metric::kEuclidean && options_.storage != Storage::kF32) {
+      const double s = plan_.encoding.scale;
+      if (s != std::floor(s))
+        throw InvalidArgument("GPU: Euclidean fixed point needs an integral scale on the Vulkan backend");
+      header_.scale_sq = static_cast<std::uint32_t>(s * s);
+      const double costs = std::min<double>(header_.clamp_cost, 3.0 * kMaxExtent * kMaxExtent);
+      if ((costs - 1) * s * s >= 4294967296.0)
+        throw InvalidArgument("GPU: fixed-point scale " + std::to_string(s) + " with this clamp overflows 32 bits");
+    }
+  }
+
+  std::size_t page_index(Vec3i c) const {
+    const Vec3i r = c - chunk_origin_;
+    return (static_cast<std::size_t>(r.z) * chunk_dims_.y + r.y) * chunk_dims_.x + r.x;
+  }
+
+  // Brings the page table and brick pool in line with the world for `chunks`.
+  void sync_chunks(const std::vector<Vec3i>& chunks, Staging& up, std::vector<VkBufferCopy>& page_copies,
+                   std::vector<VkBufferCopy>& brick_copies, std::optional<Buffer>& old_pool, VkDeviceSize& old_bytes) {
+    struct Change {
+      std::size_t page;
+      const std::uint8_t* voxels;
+      std::uint8_t value;
+    };
+    std::vector<Change> changes;
+    std::uint32_t needed = used_slots_;
+    for (const Vec3i& c : chunks) {
+      if (c.x < chunk_origin_.x || c.y < chunk_origin_.y || c.z < chunk_origin_.z) continue;
+      const Vec3i r = c - chunk_origin_;
+      if (r.x >= chunk_dims_.x || r.y >= chunk_dims_.y || r.z >= chunk_dims_.z) continue;
+      const ChunkView<std::uint8_t> v = world_.voxels.chunk_view(c);
+      const std::size_t page = page_index(c);
+      changes.push_back({page, v.voxels, v.uniform_value});
+      const bool had_slot = (pages_[page] & L::VF_UNIFORM) == 0;
+      if (v.voxels && !had_slot && free_slots_.empty()) ++needed;
+    }
+    if (needed > slot_capacity_) {
+      // Grow the pool (amortised doubling); the old bricks are copied over on the GPU.
+      const std::uint32_t capacity = std::max<std::uint32_t>(needed + needed / 4 + 8, slot_capacity_ * 2);
+      Buffer grown(ctx_, static_cast<VkDeviceSize>(capacity) * chunk_bytes_, kStorage, false);
+      if (used_slots_ > 0) {
+        old_bytes = static_cast<VkDeviceSize>(used_slots_) * chunk_bytes_;
+        old_pool.emplace(std::move(bricks_buf_));
+      }
+      bricks_buf_ = std::move(grown);
+      slot_capacity_ = capacity;
+    }
+    for (const Change& ch : changes) {
+      std::uint32_t& entry = pages_[ch.page];
+      const bool had_slot = (entry & L::VF_UNIFORM) == 0;
+      std::uint32_t next;
+      if (!ch.voxels) {
+        if (had_slot) free_slots_.push_back(entry);
+        next = L::VF_UNIFORM | ch.value;
+      } else {
+        std::uint32_t slot;
+        if (had_slot) {
+          slot = entry;
+        } else if (!free_slots_.empty()) {
+          slot = free_slots_.back();
+          free_slots_.pop_back();
+        } else {
+          slot = used_slots_++;
+        }
+        brick_copies.push_back({up.add(ch.voxels, chunk_bytes_), static_cast<VkDeviceSize>(slot) * chunk_bytes_, chunk_bytes_});
+        ctx_.counters.bytes_uploaded += static_cast<std::int64_t>(chunk_bytes_);
+        next = slot;
+      }
+      if (next != entry || first_run_) {
+        entry = next;
+        page_copies.push_back({up.add(&entry, 4), ch.page * 4, 4});
+        ctx_.counters.bytes_uploaded += 4;
+      }
+    }
+  }
+
+  void grow_work_buffers(VkDeviceSize bytes) {
+    for (Buffer& b : cost_) b = Buffer(ctx_, bytes, kStorage, false);
+    scratch_s_ = Buffer(ctx_, bytes, kStorage, false);
+    scratch_t_ = Buffer(ctx_, bytes, kStorage, false);
+    work_bytes_ = bytes;
+  }
+
+  VkDescriptorSet descriptor_set() {
+    check(vkResetDescriptorPool(ctx_.device, ctx_.descriptor_pool, 0), "vkResetDescriptorPool");
+    VkDescriptorSetAllocateInfo dsa{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    dsa.descriptorPool = ctx_.descriptor_pool;
+    dsa.descriptorSetCount = 1;
+    dsa.pSetLayouts = &ctx_.set_layout;
+    VkDescriptorSet set;
+    check(vkAllocateDescriptorSets(ctx_.device, &dsa, &set), "vkAllocateDescriptorSets");
+    const Buffer* bound[Context::Impl::kBindings] = {&header_buf_, &pages_buf_, &bricks_buf_, &cost_[0], &cost_[1],
+                                                     &cost_[2],    &scratch_s_, &scratch_t_, &field_buf_};
+    VkDescriptorBufferInfo infos[Context::Impl::kBindings];
+    VkWriteDescriptorSet writes[Context::Impl::kBindings];
+    for (std::uint32_t b = 0; b < Context::Impl::kBindings; ++b) {
+      infos[b] = {bound[b]->handle(), 0, VK_WHOLE_SIZE};
+      writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+      writes[b].dstSet = set;
+      writes[b].dstBinding = b;
+      writes[b].descriptorCount = 1;
+      writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      writes[b].pBufferInfo = &infos[b];
+    }
+    vkUpdateDescriptorSets(ctx_.device, Context::Impl::kBindings, writes, 0, nullptr);
+    return set;
+  }
+
+  Context::Impl& ctx_;
+  const World& world_;
+  DistanceOptions options_;
+  detail::FieldPlan plan_;
+  L::Header header_{};
+  VkBufferCopy header_copy_{};
+  Vec3i chunk_origin_{0, 0, 0}, chunk_dims_{0, 0, 0};
+  std::size_t chunk_bytes_ = 0;
+  VkDeviceSize field_bytes_ = 0, work_bytes_ = 0;
+  std::vector<std::uint32_t> pages_;  // the host's copy of the page table
+  std::vector<std::uint32_t> free_slots_;
+  std::uint32_t used_slots_ = 0, slot_capacity_ = 0;
+  bool first_run_ = true;
+  Buffer header_buf_, pages_buf_, bricks_buf_ = {}, field_buf_, cost_[3], scratch_s_, scratch_t_;
+};
+
+DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
+                                     std::vector<PassTiming>* timings) {
+  const detail::FieldPlan plan = detail::make_field_plan(world.voxels, options);
+  if (plan.domain.empty()) {
+    if (options.nearest_sites) throw InvalidArgument("GPU: the Vulkan backend does not compute nearest sites yet");
+    return voxfield::compute_distance_field(world, options);
+  }
+  FieldEngine engine(context.impl(), world, options);
+  engine.run(engine.all_chunks(), {{plan.domain, plan.domain}}, /*download=*/true, timings);
+  return engine.read_back();
+}
+
+// ---- DynamicField ----------------------------------------------------------------------------
+
+DynamicField::DynamicField(std::shared_ptr<Context> context, const World& world, DistanceOptions options)
+    : context_(std::move(context)) {
+  if (!context_) throw InvalidArgument("gpu::DynamicField needs a context");
+  if (!options.domain) {
+    if (!world.voxels.bounds())
+      throw InvalidArgument("a dynamic distance field needs a fixed domain: bound the world or set options.domain");
+    options.domain = *world.voxels.bounds();
+  }
+  engine_ = std::make_unique<FieldEngine>(context_->impl(), world, options);
+  reach_ = detail::field_reach(engine_->plan());
+  chunk_shift_ = world.voxels.chunk_shift();
+  rebuild();
+}
+
+DynamicField::~DynamicField() = default;
+
+const DistanceOptions& DynamicField::options() const { return engine_->options(); }
+
+void DynamicField::rebuild() {
+  const Box3i domain = engine_->plan().domain;
+  engine_->run(engine_->all_chunks(), {{domain, domain}}, false, &timings_);
+}
+
+DynamicDistanceField::UpdateStats DynamicField::update(const DirtyRegions& dirty) {
+  DynamicDistanceField::UpdateStats stats;
+  if (dirty.empty()) return stats;
+  const std::vector<detail::UpdateRegion> regions = detail::update_regions(dirty, engine_->plan().domain, reach_);
+  // The chunks whose voxels changed: the dirty boxes are per chunk.
+  std::vector<Vec3i> chunks;
+  for (const Box3i& b : dirty.boxes())
+    chunks.push_back({b.begin.x >> chunk_shift_, b.begin.y >> chunk_shift_, b.begin.z >> chunk_shift_});
+  engine_->run(chunks, regions, false, &timings_);
+  for (const auto& r : regions) {
+    stats.voxels_recomputed += r.out.volume();
+    stats.voxels_read += r.in.volume();
+    ++stats.regions;
+  }
+  return stats;
+}
+
+DistanceField DynamicField::download() {
+  engine_->run({}, {}, /*download=*/true, nullptr);
+  return engine_->read_back();
 }
 
 }  // namespace voxfield::gpu

@@ -29,4 +29,12 @@ DistanceField compute_distance_field(Context&, const World&, const DistanceOptio
   unavailable();
 }
 
+class FieldEngine {};
+DynamicField::DynamicField(std::shared_ptr<Context>, const World&, DistanceOptions) { unavailable(); }
+DynamicField::~DynamicField() = default;
+void DynamicField::rebuild() { unavailable(); }
+DynamicDistanceField::UpdateStats DynamicField::update(const DirtyRegions&) { unavailable(); }
+DistanceField DynamicField::download() { unavailable(); }
+const DistanceOptions& DynamicField::options() const { unavailable(); }
+
 }  // namespace voxfield::gpu
