@@ -16,9 +16,13 @@ using uint = std::uint32_t;
 struct ivec4 {
   std::int32_t x, y, z, w;
 };
+struct vec4f {
+  float x, y, z, w;
+};
 #define VF_CONST(type, name, value) constexpr type name = value
 #else
 #define VF_CONST(type, name, value) const type name = value
+#define vec4f vec4
 #endif
 
 VF_CONST(uint, VF_UNIFORM, 0x80000000u);  // page-table entry flag: uniform chunk, value in bits 0-7
@@ -81,9 +85,35 @@ struct PassParams {
   uint pad2;
 };
 
+// The ray marcher's frame: camera, scene layout and shading options. std430, 176 bytes, in a
+// storage buffer. Per chunk of the render box, chunk_info holds 4 words: the skip arena slot (or
+// VF_UNIFORM), the uniform cell (distance | material << 8) in bits 0-15 with the chunk's smallest
+// distance in bits 16-23, bit 24 "no solid voxel", bit 25 "materials stored voxel by voxel"; then
+// the lighting arena slot and the uniform lighting value.
+struct RenderParams {
+  vec4f eye;           // xyz; w = 1 for orthographic
+  vec4f forward;       // unit vectors of the camera basis
+  vec4f right;
+  vec4f up;
+  vec4f sun;           // unit vector towards the sun; w = fog density
+  ivec4 box_begin;     // the render box
+  ivec4 box_end;
+  ivec4 first_chunk;   // chunk coordinate of chunk_info entry 0; w = chunk shift
+  ivec4 chunk_dims;    // chunks per axis; w = chunk voxels (edge^3)
+  uint width;
+  uint height;
+  float scale;         // tan(fov / 2), or ortho height / 2
+  uint metric;         // skip field metric (VF_MANHATTAN...)
+  float skip_inv_scale;
+  float light_inv_scale;
+  uint flags;          // bit 0 AO, bit 1 soft shadows, bit 2 chunk view, bit 3 has lighting field
+  uint pad0;
+};
+
 #ifdef __cplusplus
 static_assert(sizeof(Header) == 128, "std430 size of Header");
 static_assert(sizeof(PassParams) == 96, "push-constant size of PassParams");
+static_assert(sizeof(RenderParams) == 176, "std430 size of RenderParams");
 }  // namespace voxfield::gpu::layout
 #endif
 #undef VF_CONST

@@ -250,9 +250,13 @@ check "render: bad view" 1 "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/bad
 check "render: missing input" 1 "$V" render "$tmp/nothing.vox" -o "$tmp/bad.png"
 [ ! -e "$tmp/bad.png" ] && passes=$((passes+1)) || { echo "FAIL: render wrote despite errors"; fails=$((fails+1)); }
 
-# The Vulkan backend (lavapipe in CI): the same file as the CPU, byte for byte.
-if "$V" field --help | grep -q -- "--backend"; then
-  check "field --backend vulkan" 0 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/kg.npy" --backend vulkan \
+# The Vulkan backend (lavapipe in CI): the same file as the CPU, byte for byte. Mesa's drivers leak
+# at exit, unattributably (the loader unloads them first): no leak detection for these commands.
+GPU="env ASAN_OPTIONS=detect_leaks=0"
+if $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/probe.npy" --backend vulkan 2>&1 | grep -q "built without the Vulkan"; then
+  echo "skipping the Vulkan checks: this voxfield was built without the backend"
+else
+  check "field --backend vulkan" 0 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/kg.npy" --backend vulkan \
       --metric euclidean --signed --max-distance 12 --storage u8 --stats "$tmp/kg.json"
   check "field --backend cpu" 0 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/kc.npy" --backend cpu \
       --metric euclidean --signed --max-distance 12 --storage u8
@@ -260,11 +264,17 @@ if "$V" field --help | grep -q -- "--backend"; then
   check "field gpu stats" 0 $PY -c "
 import json; j = json.load(open('$tmp/kg.json'))
 assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['gpu']['fence_waits'] == 1, j"
-  check "field: jfa on the gpu" 1 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --backend vulkan --algorithm jfa
-  check "field --backend auto" 0 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/ka.npy" --backend auto
+  check "field: jfa on the gpu" 1 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --backend vulkan --algorithm jfa
+  check "field --backend auto" 0 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/ka.npy" --backend auto
   # Edits kept on the GPU: verified against full rebuilds after every edit, at most one submit each.
-  check "bench edits --backend vulkan --verify" 0 "$V" bench edits --world 40 --chunk 8 --edits 30 --metric euclidean \
+  check "bench edits --backend vulkan --verify" 0 $GPU "$V" bench edits --world 40 --chunk 8 --edits 30 --metric euclidean \
       --signed --max-distance 5 --storage u8 --verify --backend vulkan --json "$tmp/gedits.json"
+  check "render --backend vulkan" 0 $GPU "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/kgpu.png" --width 96 --height 64 \
+      --backend vulkan --stats "$tmp/rgpu.json"
+  check "render gpu stats" 0 $PY -c "
+import json; j = json.load(open('$tmp/rgpu.json'))
+assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['width'] == 96, j"
+  check "render: distance view on the gpu" 1 $GPU "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/x.png" --backend vulkan --view distance
   check "gpu edits json" 0 $PY -c "
 import json; j = json.load(open('$tmp/gedits.json'))
 assert j['backend'] == 'vulkan' and j['verify_mismatches'] == 0, j"

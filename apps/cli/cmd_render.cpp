@@ -6,6 +6,7 @@
 #include "cli.h"
 #include "field_args.h"
 #include "voxfield/parallel.h"
+#include "voxfield/gpu.h"
 #include "voxfield/render.h"
 
 namespace voxfield::cli {
@@ -13,7 +14,7 @@ namespace {
 
 struct RenderSettings {
   std::string in, out, camera = "auto", view = "shaded", algorithm = "jfa", metric = "manhattan",
-              skip = "distance", stats;
+              skip = "distance", stats, backend = "cpu";
   int width = 1280, height = 720, chunk_edge = 32, threads = 0, repeat = 1;
   bool no_shadows = false, no_ao = false;
   double fog = 0;
@@ -47,11 +48,15 @@ int run_render(const RenderSettings& s) {
   const RenderScene scene(in.world, so, in.extent);
   // With --repeat, the frame is rendered several times and the median time reported (the
   // image is the same every time: rendering is deterministic).
+  std::string why;
+  const auto gpu_context = gpu::select_backend(parse_backend(s.backend), {}, &why);
+  std::cerr << "voxfield: " << why << "\n";
   RenderStats st;
   Image image;
   std::vector<double> times;
+  std::vector<gpu::PassTiming> pass_timings;
   for (int r = 0; r < s.repeat; ++r) {
-    image = render(scene, camera, o, &st);
+    image = gpu_context ? gpu::render(*gpu_context, scene, camera, o, &st, &pass_timings) : render(scene, camera, o, &st);
     times.push_back(st.ms);
   }
   std::sort(times.begin(), times.end());
@@ -79,10 +84,19 @@ int run_render(const RenderSettings& s) {
                      {"skip", s.skip},
                      {"skip_metric", s.metric},
                      {"threads", max_threads()},
+                     {"backend", gpu_context ? "vulkan" : "cpu"},
                      {"field_ms", scene.field_ms()},
                      {"primary_rays_per_second", st.rays_per_second()},
                      {"primary", counters(st.primary)},
                      {"shadow", counters(st.shadow)}};
+    if (gpu_context) {
+      const gpu::Counters c = gpu_context->counters();
+      j["gpu"] = {{"device", gpu_context->device().name},
+                  {"timings_are", gpu_context->device().hardware ? "gpu" : "cpu emulation"},
+                  {"render_pass_ms", pass_timings.empty() ? nlohmann::json(nullptr) : nlohmann::json(pass_timings[0].ms)},
+                  {"dispatches", c.dispatches}, {"submits", c.submits}, {"fence_waits", c.fence_waits},
+                  {"bytes_uploaded", c.bytes_uploaded}, {"bytes_downloaded", c.bytes_downloaded}};
+    }
     if (o.view == RenderView::kError) {
       j["algorithm"] = s.algorithm;
       j["rays_through_geometry"] = st.rays_through_geometry;
@@ -107,6 +121,8 @@ void add_render(CLI::App& app, Action& action) {
   cmd->add_option("--view", s->view, "shaded | distance | error | chunks");
   cmd->add_option("--algorithm", s->algorithm, "error view: the approximation shown against the exact field");
   cmd->add_option("--metric", s->metric, "field rays skip by: manhattan (default), chebyshev, euclidean");
+  cmd->add_option("--backend", s->backend, "cpu (default), vulkan or auto; the GPU draws the shaded and chunks views")
+      ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
   cmd->add_option("--skip", s->skip, "none (plain DDA), chunks, distance (default)");
   cmd->add_option("--slice", s->slice, "distance view: z of the cut plane (default: the middle)");
   cmd->add_flag("--no-shadows", s->no_shadows, "no soft shadows");

@@ -13,6 +13,7 @@
 
 #include "voxfield/distance.h"
 #include "voxfield/dynamic_field.h"
+#include "voxfield/render.h"
 #include "voxfield/error.h"
 
 namespace voxfield {
@@ -142,6 +143,12 @@ class DynamicField {
   int chunk_shift_ = 0;
   std::vector<PassTiming> timings_;
 };
+
+// Renders a frame of `scene` with the ray-marching compute shader: the CPU renderer's traversal,
+// data and shading, in floats — images match the CPU's within kImageTolerance. Shaded and chunks
+// views (the others throw InvalidArgument for now). stats->ms covers upload, render and read-back.
+Image render(Context& context, const RenderScene& scene, const Camera& camera, const RenderOptions& options,
+             RenderStats* stats = nullptr, std::vector<PassTiming>* timings = nullptr);
 
 // Largest |GPU - CPU| of f32 Euclidean values, relative to the distance: Vulkan allows sqrt an
 // error of a few ulps (the SPIR-V environment spec inherits it from 1/inversesqrt).

@@ -10,5 +10,6 @@ namespace voxfield::gpu::shaders {
 std::span<const std::uint32_t> edt_sites();
 std::span<const std::uint32_t> edt_lines();
 std::span<const std::uint32_t> edt_encode();
+std::span<const std::uint32_t> render();
 
 }  // namespace voxfield::gpu::shaders

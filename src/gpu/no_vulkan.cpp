@@ -30,6 +30,9 @@ DistanceField compute_distance_field(Context&, const World&, const DistanceOptio
 }
 
 class FieldEngine {};
+Image render(Context&, const RenderScene&, const Camera&, const RenderOptions&, RenderStats*, std::vector<PassTiming>*) {
+  unavailable();
+}
 DynamicField::DynamicField(std::shared_ptr<Context>, const World&, DistanceOptions) { unavailable(); }
 DynamicField::~DynamicField() = default;
 void DynamicField::rebuild() { unavailable(); }

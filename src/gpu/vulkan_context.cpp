@@ -93,7 +93,7 @@ Buffer& Context::Impl::readback_buffer(VkDeviceSize bytes) {
 
 // ---- pipelines ------------------------------------------------------------------------------
 
-Pipeline Context::Impl::make_pipeline(const char* name, std::span<const std::uint32_t> spirv) {
+Pipeline Context::Impl::make_pipeline(const char* name, std::span<const std::uint32_t> spirv, VkPipelineLayout layout) {
   VkShaderModuleCreateInfo sm{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   sm.codeSize = spirv.size_bytes();
   sm.pCode = spirv.data();
@@ -104,7 +104,7 @@ Pipeline Context::Impl::make_pipeline(const char* name, std::span<const std::uin
   info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   info.stage.module = module;
   info.stage.pName = "main";
-  info.layout = pipeline_layout;
+  info.layout = layout;
   Pipeline p;
   p.name = name;
   const VkResult r = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &p.pipeline);
@@ -134,9 +134,28 @@ void Context::Impl::create_pipelines() {
   dp.poolSizeCount = 1;
   dp.pPoolSizes = &size;
   check(vkCreateDescriptorPool(device, &dp, nullptr, &descriptor_pool), "vkCreateDescriptorPool");
-  edt_sites = make_pipeline("edt_sites", shaders::edt_sites());
-  edt_lines = make_pipeline("edt_lines", shaders::edt_lines());
-  edt_encode = make_pipeline("edt_encode", shaders::edt_encode());
+  edt_sites = make_pipeline("edt_sites", shaders::edt_sites(), pipeline_layout);
+  edt_lines = make_pipeline("edt_lines", shaders::edt_lines(), pipeline_layout);
+  edt_encode = make_pipeline("edt_encode", shaders::edt_encode(), pipeline_layout);
+
+  VkDescriptorSetLayoutBinding rb[kRenderBindings];
+  for (std::uint32_t b = 0; b < kRenderBindings; ++b)
+    rb[b] = {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  VkDescriptorSetLayoutCreateInfo rsl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  rsl.bindingCount = kRenderBindings;
+  rsl.pBindings = rb;
+  check(vkCreateDescriptorSetLayout(device, &rsl, nullptr, &render_set_layout), "vkCreateDescriptorSetLayout");
+  VkPipelineLayoutCreateInfo rpl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  rpl.setLayoutCount = 1;
+  rpl.pSetLayouts = &render_set_layout;
+  check(vkCreatePipelineLayout(device, &rpl, nullptr, &render_pipeline_layout), "vkCreatePipelineLayout");
+  VkDescriptorPoolSize rsize{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRenderBindings * 2};
+  VkDescriptorPoolCreateInfo rdp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  rdp.maxSets = 2;
+  rdp.poolSizeCount = 1;
+  rdp.pPoolSizes = &rsize;
+  check(vkCreateDescriptorPool(device, &rdp, nullptr, &render_descriptor_pool), "vkCreateDescriptorPool");
+  render = make_pipeline("render", shaders::render(), render_pipeline_layout);
 }
 
 // ---- submission -----------------------------------------------------------------------------
@@ -230,8 +249,11 @@ void Context::Impl::destroy() {
     vkDeviceWaitIdle(device);
     upload = Buffer();
     readback = Buffer();
-    for (Pipeline* p : {&edt_sites, &edt_lines, &edt_encode})
+    for (Pipeline* p : {&edt_sites, &edt_lines, &edt_encode, &render})
       if (p->pipeline) vkDestroyPipeline(device, p->pipeline, nullptr);
+    if (render_descriptor_pool) vkDestroyDescriptorPool(device, render_descriptor_pool, nullptr);
+    if (render_pipeline_layout) vkDestroyPipelineLayout(device, render_pipeline_layout, nullptr);
+    if (render_set_layout) vkDestroyDescriptorSetLayout(device, render_set_layout, nullptr);
     if (descriptor_pool) vkDestroyDescriptorPool(device, descriptor_pool, nullptr);
     if (pipeline_layout) vkDestroyPipelineLayout(device, pipeline_layout, nullptr);
     if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, nullptr);

@@ -78,6 +78,13 @@ struct Context::Impl {
   VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
   Pipeline edt_sites, edt_lines, edt_encode;
 
+  // The ray marcher: its own layout (6 storage buffers, no push constants) and descriptor pool.
+  static constexpr std::uint32_t kRenderBindings = 6;
+  VkDescriptorSetLayout render_set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout render_pipeline_layout = VK_NULL_HANDLE;
+  VkDescriptorPool render_descriptor_pool = VK_NULL_HANDLE;
+  Pipeline render;
+
   // Reusable host-visible buffers for uploads and read-backs (grown when too small).
   Buffer upload, readback;
   Buffer& upload_buffer(VkDeviceSize bytes);
@@ -85,11 +92,35 @@ struct Context::Impl {
 
   std::uint32_t memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags wanted) const;
   void create_pipelines();
-  Pipeline make_pipeline(const char* name, std::span<const std::uint32_t> spirv);
+  Pipeline make_pipeline(const char* name, std::span<const std::uint32_t> spirv, VkPipelineLayout layout);
+  // Allocates a command buffer, lets `record` fill it, submits it and waits (freed after).
+  template <class F>
+  void run_commands(F&& record);
   // Submits one command buffer and waits for it (one submit, one fence wait).
   void submit_and_wait(VkCommandBuffer cmd);
   void destroy();
 };
+
+template <class F>
+void Context::Impl::run_commands(F&& record) {
+  VkCommandBufferAllocateInfo cba{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  cba.commandPool = command_pool;
+  cba.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cba.commandBufferCount = 1;
+  VkCommandBuffer cmd;
+  check(vkAllocateCommandBuffers(device, &cba, &cmd), "vkAllocateCommandBuffers");
+  struct FreeCmd {
+    Context::Impl& ctx;
+    VkCommandBuffer cmd;
+    ~FreeCmd() { vkFreeCommandBuffers(ctx.device, ctx.command_pool, 1, &cmd); }
+  } free_cmd{*this, cmd};
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+  record(cmd);
+  check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+  submit_and_wait(cmd);
+}
 
 // Records a dispatch of `invocations` invocations of 64 (split over y when the x count would
 // exceed the device limit) and counts it.

@@ -72,6 +72,9 @@ class ChunkTable {
     const Vec3i lo{(v.x >> shift_) << shift_, (v.y >> shift_) << shift_, (v.z >> shift_) << shift_};
     return {lo, lo + Vec3i::splat(edge_)};
   }
+  Vec3i first_chunk() const { return first_; }
+  Vec3i chunk_dims() const { return dims_; }
+
   // Chunk coordinate of chunk index i.
   Vec3i chunk_coord(std::size_t i) const {
     const auto nx = static_cast<std::size_t>(dims_.x), ny = static_cast<std::size_t>(dims_.y);
