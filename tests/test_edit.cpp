@@ -218,8 +218,17 @@ TEST(DynamicField, UpdatesStayLocal) {
   const auto stats = live.update(dirty);
   EXPECT_EQ(stats.regions, 1);
   EXPECT_EQ(stats.voxels_recomputed, 21 * 21 * 21);  // the 5^3 edit grown by 8 on every side
-  EXPECT_EQ(stats.voxels_read, 37 * 37 * 37);        // ... and by 8 more for the sites
+  EXPECT_EQ(stats.voxels_read, 21 * 21 * 21);        // placing only adds sites: the box's own suffice
   EXPECT_EQ(live.field().distance({64, 64, 71}), 5);
+  // Carving removes sites: values may rise, and need the sites up to 8 voxels farther.
+  dirty.clear();
+  apply_edit(w, {EditOp::kCarve, SphereBrush{{64, 64, 64}, 1}, 1}, &dirty);
+  EXPECT_TRUE(dirty.removes_solid());
+  const auto carved = live.update(dirty);
+  EXPECT_EQ(carved.voxels_recomputed, 19 * 19 * 19);  // the 3^3 carve grown by 8
+  EXPECT_EQ(carved.voxels_read, 35 * 35 * 35);        // ... and by 8 more for the sites
+  EXPECT_EQ(live.field().distance({64, 64, 71}), 5);
+  EXPECT_NEAR(live.field().distance({64, 64, 64}), std::sqrt(2.0), 1e-6);  // to (65, 65, 64), still solid
   // Unbounded worlds without a domain are refused.
   World open;
   EXPECT_THROW(DynamicDistanceField(open, o), InvalidArgument);

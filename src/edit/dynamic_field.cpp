@@ -1,6 +1,7 @@
 // voxfield — incremental exact distance updates by local recomputation (see dynamic_field.h).
 #include "voxfield/dynamic_field.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "update_regions.h"
@@ -70,17 +71,29 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
   UpdateStats stats;
   if (dirty.empty()) return stats;
   const detail::FieldPlan plan = detail::make_field_plan(world_->voxels, options_);
+  // Changes that only add sites (placing into air) can only lower an unsigned field: its new
+  // value is min(old value, distance to the sites inside the reach box), since the sites inside it
+  // include every new one. That needs the box's own sites only — not the box grown by the reach
+  // again, ~5x fewer voxels for r = 4, D = 16. Encodings are monotone, so the minimum can be taken
+  // on stored values. Signed fields (new solids need their distance to air) and nearest sites (the
+  // tie rule) take the general path, as does anything that removed a solid voxel.
+  const bool additions_only = !dirty.removes_solid() && !plan.is_signed && !field_.sites;
   for (const detail::UpdateRegion& region : detail::update_regions(dirty, *options_.domain, reach_)) {
     // Values inside r depend on sites within the reach of r: compute r from that box, densely,
     // and write it into the field.
     const Box3i& r = region.out;
-    const Box3i& in = region.in;
+    const Box3i& in = additions_only ? region.out : region.in;
     std::vector<SiteOffset> sites(field_.sites ? static_cast<std::size_t>(r.volume()) : 0);
     std::visit(
         [&](auto& target) {
           using T = typename std::decay_t<decltype(target)>::value_type;
           std::vector<T> values(static_cast<std::size_t>(r.volume()));
           detail::compute_region<T>(world_->voxels, plan, in, r, values.data(), field_.sites ? sites.data() : nullptr);
+          if (additions_only) {
+            std::vector<T> old(values.size());
+            target.copy_to_dense(r, old.data());
+            for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::min(values[i], old[i]);
+          }
           target.copy_from_dense(r, values.data());
         },
         field_.values);
