@@ -9,6 +9,7 @@
 #include <random>
 
 #include "voxfield/edit.h"
+#include "image_compare.h"
 #include "voxfield/gpu.h"
 
 using namespace voxfield;
@@ -228,20 +229,9 @@ namespace {
 void expect_images_close(const Image& gpu_image, const Image& cpu_image, const std::string& what) {
   ASSERT_EQ(gpu_image.width, cpu_image.width);
   ASSERT_EQ(gpu_image.height, cpu_image.height);
-  std::size_t off = 0;
-  double total = 0;
-  for (std::size_t i = 0; i < cpu_image.rgb.size(); i += 3) {
-    int worst = 0;
-    for (int c = 0; c < 3; ++c) {
-      const int d = std::abs(int(gpu_image.rgb[i + c]) - int(cpu_image.rgb[i + c]));
-      worst = std::max(worst, d);
-      total += d;
-    }
-    off += worst > 8;
-  }
-  const std::size_t pixels = cpu_image.rgb.size() / 3;
-  EXPECT_LE(off, pixels / 200) << what << ": " << off << " of " << pixels << " pixels differ by more than 8 levels";
-  EXPECT_LT(total / static_cast<double>(cpu_image.rgb.size()), 0.1) << what;
+  const test::ImageDiff d = test::compare_images(gpu_image, cpu_image, 8);
+  EXPECT_LE(d.off, d.pixels / 200) << what << ": " << d.off << " of " << d.pixels << " pixels differ by more than 8 levels";
+  EXPECT_LT(d.mean, 0.1) << what;
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <random>
 
+#include "image_compare.h"
 #include "voxfield/error.h"
 #include "voxfield/parallel.h"
 #include "voxfield/render.h"
@@ -68,7 +69,7 @@ std::vector<Ray> test_rays(const Box3i& box, std::uint32_t seed, int random_coun
   for (const Vec3d& d : dirs)
     for (int k = 0; k < 60; ++k) {
       const double half = (k % 2) * 0.5;
-      rays.push_back({{coord(rng) + half, coord(rng) + half, coord(rng)}, d});
+      rays.push_back({{coord(rng) + half, coord(rng) + half, static_cast<double>(coord(rng))}, d});
       rays.push_back({{box.begin.x - 5.0 + k % 7, box.begin.y + k % 13 + half, box.begin.z + k % 11 + 0.0}, d});
     }
   return rays;
@@ -163,7 +164,9 @@ TEST(Render, DdaMatchesBruteForceRayBoxIntersection) {
     EXPECT_EQ(h.voxel, best_voxel) << "ray " << i;
     EXPECT_EQ(h.face_axis, best_axis) << "ray " << i;
     EXPECT_NEAR(h.t, best, 1e-9 * (1 + best)) << "ray " << i;
-    if (best_axis >= 0) EXPECT_EQ(h.face_sign, r.direction[best_axis] > 0 ? -1 : 1);
+    if (best_axis >= 0) {
+      EXPECT_EQ(h.face_sign, r.direction[best_axis] > 0 ? -1 : 1);
+    }
     EXPECT_EQ(h.material, w.voxels.get(best_voxel));
   }
   EXPECT_GT(hits, 200);
@@ -276,20 +279,9 @@ void expect_matches_golden(const Image& got, const std::string& name) {
   const Image want = read_png(path);
   ASSERT_EQ(want.width, got.width);
   ASSERT_EQ(want.height, got.height);
-  std::size_t off = 0;
-  double total = 0;
-  for (std::size_t i = 0; i < want.rgb.size(); i += 3) {
-    int worst = 0;
-    for (int c = 0; c < 3; ++c) {
-      const int d = std::abs(int(want.rgb[i + c]) - int(got.rgb[i + c]));
-      worst = std::max(worst, d);
-      total += d;
-    }
-    off += worst > 8;
-  }
-  const std::size_t pixels = want.rgb.size() / 3;
-  EXPECT_LE(off, pixels / 200) << name << ": " << off << " pixels differ by more than 8 levels";
-  EXPECT_LT(total / static_cast<double>(want.rgb.size()), 0.5) << name;
+  const test::ImageDiff d = test::compare_images(got, want, 8);
+  EXPECT_LE(d.off, d.pixels / 200) << name << ": " << d.off << " pixels differ by more than 8 levels";
+  EXPECT_LT(d.mean, 0.5) << name;
   if (::testing::Test::HasFailure()) write_png(got, std::filesystem::temp_directory_path() / (name + "-actual.png"));
 }
 

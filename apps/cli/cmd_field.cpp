@@ -4,6 +4,7 @@
 
 #include "cli.h"
 #include "field_args.h"
+#include "live_field.h"
 #include "voxfield/gpu.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
@@ -66,21 +67,8 @@ int run_field(const FieldSettings& s) {
                    {"peak_rss_mb", static_cast<double>(peak_rss_bytes()) / 1048576.0}});
   j["backend"] = gpu_context ? "vulkan" : "cpu";
   if (gpu_context) {
-    const gpu::DeviceInfo& dev = gpu_context->device();
-    const gpu::Counters c = gpu_context->counters();
-    nlohmann::json passes = nlohmann::json::array();
-    for (const auto& t : pass_timings) passes.push_back({{"pass", t.pass}, {"ms", t.ms}});
-    j["gpu"] = {{"device", dev.name},
-                {"device_type", dev.type},
-                // Timestamps of a software device measure the CPU emulating it, not a GPU.
-                {"timings_are", dev.hardware ? "gpu" : "cpu emulation"},
-                {"passes", passes},
-                {"dispatches", c.dispatches},
-                {"pipeline_barriers", c.pipeline_barriers},
-                {"submits", c.submits},
-                {"fence_waits", c.fence_waits},
-                {"bytes_uploaded", c.bytes_uploaded},
-                {"bytes_downloaded", c.bytes_downloaded}};
+    j["gpu"] = gpu_json(*gpu_context);
+    j["gpu"]["passes"] = pass_timings_json(pass_timings);
   }
   if (a.algorithm != Algorithm::kExact) {
     DistanceOptions exact_o = o;

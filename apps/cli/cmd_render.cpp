@@ -5,6 +5,7 @@
 
 #include "cli.h"
 #include "field_args.h"
+#include "live_field.h"
 #include "voxfield/parallel.h"
 #include "voxfield/gpu.h"
 #include "voxfield/render.h"
@@ -90,12 +91,8 @@ int run_render(const RenderSettings& s) {
                      {"primary", counters(st.primary)},
                      {"shadow", counters(st.shadow)}};
     if (gpu_context) {
-      const gpu::Counters c = gpu_context->counters();
-      j["gpu"] = {{"device", gpu_context->device().name},
-                  {"timings_are", gpu_context->device().hardware ? "gpu" : "cpu emulation"},
-                  {"render_pass_ms", pass_timings.empty() ? nlohmann::json(nullptr) : nlohmann::json(pass_timings[0].ms)},
-                  {"dispatches", c.dispatches}, {"submits", c.submits}, {"fence_waits", c.fence_waits},
-                  {"bytes_uploaded", c.bytes_uploaded}, {"bytes_downloaded", c.bytes_downloaded}};
+      j["gpu"] = gpu_json(*gpu_context);
+      j["gpu"]["passes"] = pass_timings_json(pass_timings);
     }
     if (o.view == RenderView::kError) {
       j["algorithm"] = s.algorithm;

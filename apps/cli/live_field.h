@@ -13,6 +13,28 @@
 
 namespace voxfield::cli {
 
+// The device and the hardware-independent counters of a context, for stats files. Timestamps of a
+// software device measure the CPU emulating it: "timings_are" says which.
+inline nlohmann::json gpu_json(gpu::Context& ctx) {
+  const gpu::Counters c = ctx.counters();
+  const gpu::DeviceInfo& d = ctx.device();
+  return {{"device", d.name},
+          {"device_type", d.type},
+          {"timings_are", d.hardware ? "gpu" : "cpu emulation"},
+          {"dispatches", c.dispatches},
+          {"pipeline_barriers", c.pipeline_barriers},
+          {"submits", c.submits},
+          {"fence_waits", c.fence_waits},
+          {"bytes_uploaded", c.bytes_uploaded},
+          {"bytes_downloaded", c.bytes_downloaded}};
+}
+
+inline nlohmann::json pass_timings_json(const std::vector<gpu::PassTiming>& timings) {
+  nlohmann::json passes = nlohmann::json::array();
+  for (const auto& t : timings) passes.push_back({{"pass", t.pass}, {"ms", t.ms}});
+  return passes;
+}
+
 class LiveField {
  public:
   // backend: "cpu", "vulkan" or "auto". Says on stderr which one runs and why.
@@ -43,14 +65,7 @@ class LiveField {
   bool on_gpu() const { return gpu_.has_value(); }
 
   // What the GPU did so far (null on the CPU): device and hardware-independent counters.
-  nlohmann::json gpu_json() {
-    if (!gpu_) return nullptr;
-    const gpu::Counters c = gpu_->context().counters();
-    const gpu::DeviceInfo& d = gpu_->context().device();
-    return {{"device", d.name},        {"device_type", d.type},          {"dispatches", c.dispatches},
-            {"submits", c.submits},    {"fence_waits", c.fence_waits},   {"pipeline_barriers", c.pipeline_barriers},
-            {"bytes_uploaded", c.bytes_uploaded}, {"bytes_downloaded", c.bytes_downloaded}};
-  }
+  nlohmann::json gpu_json() { return gpu_ ? voxfield::cli::gpu_json(gpu_->context()) : nlohmann::json(nullptr); }
   gpu::Counters gpu_counters() { return gpu_ ? gpu_->context().counters() : gpu::Counters{}; }
 
  private:

@@ -212,7 +212,7 @@ class FieldEngine {
       barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
               VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     first_run_ = false;
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.pipeline_layout, 0, 1, &set, 0, nullptr);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.field_layout.pipeline, 0, 1, &set, 0, nullptr);
 
     std::vector<std::string> names;
     bool first_pass = true;
@@ -225,7 +225,7 @@ class FieldEngine {
       const bool stamp = timed && q + 1 < 64;
       if (stamp) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx_.timestamps, q);
       vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
-      vkCmdPushConstants(cmd, ctx_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pp, &pp);
+      vkCmdPushConstants(cmd, ctx_.field_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pp, &pp);
       dispatch(ctx_, cmd, invocations);
       if (stamp) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx_.timestamps, q + 1);
       names.push_back(std::move(name));
@@ -397,28 +397,9 @@ class FieldEngine {
   }
 
   VkDescriptorSet descriptor_set() {
-    check(vkResetDescriptorPool(ctx_.device, ctx_.descriptor_pool, 0), "vkResetDescriptorPool");
-    VkDescriptorSetAllocateInfo dsa{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    dsa.descriptorPool = ctx_.descriptor_pool;
-    dsa.descriptorSetCount = 1;
-    dsa.pSetLayouts = &ctx_.set_layout;
-    VkDescriptorSet set;
-    check(vkAllocateDescriptorSets(ctx_.device, &dsa, &set), "vkAllocateDescriptorSets");
     const Buffer* bound[Context::Impl::kBindings] = {&header_buf_, &pages_buf_, &bricks_buf_, &cost_[0], &cost_[1],
                                                      &cost_[2],    &scratch_s_, &scratch_t_, &field_buf_};
-    VkDescriptorBufferInfo infos[Context::Impl::kBindings];
-    VkWriteDescriptorSet writes[Context::Impl::kBindings];
-    for (std::uint32_t b = 0; b < Context::Impl::kBindings; ++b) {
-      infos[b] = {bound[b]->handle(), 0, VK_WHOLE_SIZE};
-      writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-      writes[b].dstSet = set;
-      writes[b].dstBinding = b;
-      writes[b].descriptorCount = 1;
-      writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-      writes[b].pBufferInfo = &infos[b];
-    }
-    vkUpdateDescriptorSets(ctx_.device, Context::Impl::kBindings, writes, 0, nullptr);
-    return set;
+    return ctx_.bind(ctx_.field_layout, bound);
   }
 
   Context::Impl& ctx_;

@@ -102,25 +102,9 @@ Image render(Context& context, const RenderScene& scene, const Camera& camera, c
   std::memcpy(upload.mapped(), up.bytes.data(), up.bytes.size());
   Buffer& readback = ctx.readback_buffer(image_bytes);
 
-  check(vkResetDescriptorPool(ctx.device, ctx.render_descriptor_pool, 0), "vkResetDescriptorPool");
-  VkDescriptorSetAllocateInfo dsa{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  dsa.descriptorPool = ctx.render_descriptor_pool;
-  dsa.descriptorSetCount = 1;
-  dsa.pSetLayouts = &ctx.render_set_layout;
-  VkDescriptorSet set;
-  check(vkAllocateDescriptorSets(ctx.device, &dsa, &set), "vkAllocateDescriptorSets");
-  VkDescriptorBufferInfo infos[Context::Impl::kRenderBindings];
-  VkWriteDescriptorSet writes[Context::Impl::kRenderBindings];
-  for (std::uint32_t b = 0; b < Context::Impl::kRenderBindings; ++b) {
-    infos[b] = {buffers[b].handle(), 0, VK_WHOLE_SIZE};
-    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[b].dstSet = set;
-    writes[b].dstBinding = b;
-    writes[b].descriptorCount = 1;
-    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[b].pBufferInfo = &infos[b];
-  }
-  vkUpdateDescriptorSets(ctx.device, Context::Impl::kRenderBindings, writes, 0, nullptr);
+  const Buffer* bound[Context::Impl::kRenderBindings] = {&buffers[0], &buffers[1], &buffers[2],
+                                                         &buffers[3], &buffers[4], &buffers[5]};
+  const VkDescriptorSet set = ctx.bind(ctx.render_layout, bound);
 
   const bool timed = timings && ctx.timestamps != VK_NULL_HANDLE;
   const auto t0 = std::chrono::steady_clock::now();
@@ -134,7 +118,7 @@ Image render(Context& context, const RenderScene& scene, const Camera& camera, c
     barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
             VK_ACCESS_SHADER_READ_BIT);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.render.pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.render_pipeline_layout, 0, 1, &set, 0, nullptr);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.render_layout.pipeline, 0, 1, &set, 0, nullptr);
     if (timed) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx.timestamps, 0);
     dispatch(ctx, cmd, static_cast<std::uint64_t>(o.width) * o.height);
     if (timed) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx.timestamps, 1);

@@ -113,49 +113,62 @@ Pipeline Context::Impl::make_pipeline(const char* name, std::span<const std::uin
   return p;
 }
 
-void Context::Impl::create_pipelines() {
-  VkDescriptorSetLayoutBinding bindings[kBindings];
-  for (std::uint32_t b = 0; b < kBindings; ++b)
+BindingLayout Context::Impl::make_binding_layout(std::uint32_t n, std::uint32_t push_bytes) {
+  BindingLayout l;
+  l.bindings = n;
+  std::vector<VkDescriptorSetLayoutBinding> bindings(n);
+  for (std::uint32_t b = 0; b < n; ++b)
     bindings[b] = {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
   VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  sl.bindingCount = kBindings;
-  sl.pBindings = bindings;
-  check(vkCreateDescriptorSetLayout(device, &sl, nullptr, &set_layout), "vkCreateDescriptorSetLayout");
-  VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, kPushBytes};
+  sl.bindingCount = n;
+  sl.pBindings = bindings.data();
+  check(vkCreateDescriptorSetLayout(device, &sl, nullptr, &l.set), "vkCreateDescriptorSetLayout");
+  VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes};
   VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   pl.setLayoutCount = 1;
-  pl.pSetLayouts = &set_layout;
-  pl.pushConstantRangeCount = 1;
-  pl.pPushConstantRanges = &push;
-  check(vkCreatePipelineLayout(device, &pl, nullptr, &pipeline_layout), "vkCreatePipelineLayout");
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings * 4};
+  pl.pSetLayouts = &l.set;
+  pl.pushConstantRangeCount = push_bytes > 0 ? 1 : 0;
+  pl.pPushConstantRanges = push_bytes > 0 ? &push : nullptr;
+  check(vkCreatePipelineLayout(device, &pl, nullptr, &l.pipeline), "vkCreatePipelineLayout");
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, n};
   VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  dp.maxSets = 4;
+  dp.maxSets = 1;
   dp.poolSizeCount = 1;
   dp.pPoolSizes = &size;
-  check(vkCreateDescriptorPool(device, &dp, nullptr, &descriptor_pool), "vkCreateDescriptorPool");
-  edt_sites = make_pipeline("edt_sites", shaders::edt_sites(), pipeline_layout);
-  edt_lines = make_pipeline("edt_lines", shaders::edt_lines(), pipeline_layout);
-  edt_encode = make_pipeline("edt_encode", shaders::edt_encode(), pipeline_layout);
+  check(vkCreateDescriptorPool(device, &dp, nullptr, &l.pool), "vkCreateDescriptorPool");
+  return l;
+}
 
-  VkDescriptorSetLayoutBinding rb[kRenderBindings];
-  for (std::uint32_t b = 0; b < kRenderBindings; ++b)
-    rb[b] = {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-  VkDescriptorSetLayoutCreateInfo rsl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  rsl.bindingCount = kRenderBindings;
-  rsl.pBindings = rb;
-  check(vkCreateDescriptorSetLayout(device, &rsl, nullptr, &render_set_layout), "vkCreateDescriptorSetLayout");
-  VkPipelineLayoutCreateInfo rpl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  rpl.setLayoutCount = 1;
-  rpl.pSetLayouts = &render_set_layout;
-  check(vkCreatePipelineLayout(device, &rpl, nullptr, &render_pipeline_layout), "vkCreatePipelineLayout");
-  VkDescriptorPoolSize rsize{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRenderBindings * 2};
-  VkDescriptorPoolCreateInfo rdp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  rdp.maxSets = 2;
-  rdp.poolSizeCount = 1;
-  rdp.pPoolSizes = &rsize;
-  check(vkCreateDescriptorPool(device, &rdp, nullptr, &render_descriptor_pool), "vkCreateDescriptorPool");
-  render = make_pipeline("render", shaders::render(), render_pipeline_layout);
+VkDescriptorSet Context::Impl::bind(const BindingLayout& layout, std::span<const Buffer* const> buffers) {
+  check(vkResetDescriptorPool(device, layout.pool, 0), "vkResetDescriptorPool");
+  VkDescriptorSetAllocateInfo dsa{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  dsa.descriptorPool = layout.pool;
+  dsa.descriptorSetCount = 1;
+  dsa.pSetLayouts = &layout.set;
+  VkDescriptorSet set;
+  check(vkAllocateDescriptorSets(device, &dsa, &set), "vkAllocateDescriptorSets");
+  std::vector<VkDescriptorBufferInfo> infos(buffers.size());
+  std::vector<VkWriteDescriptorSet> writes(buffers.size());
+  for (std::size_t b = 0; b < buffers.size(); ++b) {
+    infos[b] = {buffers[b]->handle(), 0, VK_WHOLE_SIZE};
+    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[b].dstSet = set;
+    writes[b].dstBinding = static_cast<std::uint32_t>(b);
+    writes[b].descriptorCount = 1;
+    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[b].pBufferInfo = &infos[b];
+  }
+  vkUpdateDescriptorSets(device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  return set;
+}
+
+void Context::Impl::create_pipelines() {
+  field_layout = make_binding_layout(kBindings, kPushBytes);
+  render_layout = make_binding_layout(kRenderBindings, 0);
+  edt_sites = make_pipeline("edt_sites", shaders::edt_sites(), field_layout.pipeline);
+  edt_lines = make_pipeline("edt_lines", shaders::edt_lines(), field_layout.pipeline);
+  edt_encode = make_pipeline("edt_encode", shaders::edt_encode(), field_layout.pipeline);
+  render = make_pipeline("render", shaders::render(), render_layout.pipeline);
 }
 
 // ---- submission -----------------------------------------------------------------------------
@@ -251,12 +264,11 @@ void Context::Impl::destroy() {
     readback = Buffer();
     for (Pipeline* p : {&edt_sites, &edt_lines, &edt_encode, &render})
       if (p->pipeline) vkDestroyPipeline(device, p->pipeline, nullptr);
-    if (render_descriptor_pool) vkDestroyDescriptorPool(device, render_descriptor_pool, nullptr);
-    if (render_pipeline_layout) vkDestroyPipelineLayout(device, render_pipeline_layout, nullptr);
-    if (render_set_layout) vkDestroyDescriptorSetLayout(device, render_set_layout, nullptr);
-    if (descriptor_pool) vkDestroyDescriptorPool(device, descriptor_pool, nullptr);
-    if (pipeline_layout) vkDestroyPipelineLayout(device, pipeline_layout, nullptr);
-    if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, nullptr);
+    for (BindingLayout* l : {&field_layout, &render_layout}) {
+      if (l->pool) vkDestroyDescriptorPool(device, l->pool, nullptr);
+      if (l->pipeline) vkDestroyPipelineLayout(device, l->pipeline, nullptr);
+      if (l->set) vkDestroyDescriptorSetLayout(device, l->set, nullptr);
+    }
     if (timestamps) vkDestroyQueryPool(device, timestamps, nullptr);
     if (fence) vkDestroyFence(device, fence, nullptr);
     if (command_pool) vkDestroyCommandPool(device, command_pool, nullptr);

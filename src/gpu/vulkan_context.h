@@ -43,8 +43,16 @@ class Buffer {
   void* mapped_ = nullptr;
 };
 
-// A compute pipeline made from embedded SPIR-V, with the shared layout (storage buffers 0..N-1,
-// one push-constant range).
+// Storage buffers 0..N-1 (and optionally push constants) for a family of compute pipelines, with
+// a descriptor pool that holds one set at a time (reset for each submission that binds).
+struct BindingLayout {
+  VkDescriptorSetLayout set = VK_NULL_HANDLE;
+  VkPipelineLayout pipeline = VK_NULL_HANDLE;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  std::uint32_t bindings = 0;
+};
+
+// A compute pipeline made from embedded SPIR-V.
 struct Pipeline {
   VkPipeline pipeline = VK_NULL_HANDLE;
   std::string name;
@@ -70,20 +78,12 @@ struct Context::Impl {
   mutable std::mutex messages_mutex;
   std::vector<std::string> messages;
 
-  // The distance pipelines and their shared layout.
+  // The distance pipelines (9 storage buffers, push constants) and the ray marcher (6 buffers).
   static constexpr std::uint32_t kBindings = 9;
   static constexpr std::uint32_t kPushBytes = 96;
-  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-  VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
-  VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
-  Pipeline edt_sites, edt_lines, edt_encode;
-
-  // The ray marcher: its own layout (6 storage buffers, no push constants) and descriptor pool.
   static constexpr std::uint32_t kRenderBindings = 6;
-  VkDescriptorSetLayout render_set_layout = VK_NULL_HANDLE;
-  VkPipelineLayout render_pipeline_layout = VK_NULL_HANDLE;
-  VkDescriptorPool render_descriptor_pool = VK_NULL_HANDLE;
-  Pipeline render;
+  BindingLayout field_layout, render_layout;
+  Pipeline edt_sites, edt_lines, edt_encode, render;
 
   // Reusable host-visible buffers for uploads and read-backs (grown when too small).
   Buffer upload, readback;
@@ -93,6 +93,10 @@ struct Context::Impl {
   std::uint32_t memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags wanted) const;
   void create_pipelines();
   Pipeline make_pipeline(const char* name, std::span<const std::uint32_t> spirv, VkPipelineLayout layout);
+  BindingLayout make_binding_layout(std::uint32_t bindings, std::uint32_t push_bytes);
+  // A descriptor set binding `buffers` (one per binding, in order) from the layout's pool, which is
+  // reset first: sets live until the next call for the same layout.
+  VkDescriptorSet bind(const BindingLayout& layout, std::span<const Buffer* const> buffers);
   // Allocates a command buffer, lets `record` fill it, submits it and waits (freed after).
   template <class F>
   void run_commands(F&& record);
