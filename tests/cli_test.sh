@@ -266,6 +266,12 @@ import json; j = json.load(open('$tmp/kg.json'))
 assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['gpu']['fence_waits'] == 1, j"
   check "field: jfa on the gpu" 1 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --backend vulkan --algorithm jfa
   check "field --backend auto" 0 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/ka.npy" --backend auto
+  # No Vulkan driver at all: a clear message, and the CPU does the work.
+  check "vulkan without a device" 0 env VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json $GPU \
+      "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/kn.npy" --backend vulkan --metric euclidean --signed \
+      --max-distance 12 --storage u8
+  expect_grep "vulkan without a device message" "$tmp/err" "using the cpu backend"
+  cmp -s "$tmp/kn.npy" "$tmp/kc.npy" && passes=$((passes+1)) || { echo "FAIL: cpu fallback field differs"; fails=$((fails+1)); }
   # Edits kept on the GPU: verified against full rebuilds after every edit, at most one submit each.
   check "bench edits --backend vulkan --verify" 0 $GPU "$V" bench edits --world 40 --chunk 8 --edits 30 --metric euclidean \
       --signed --max-distance 5 --storage u8 --verify --backend vulkan --json "$tmp/gedits.json"

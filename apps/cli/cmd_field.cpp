@@ -32,9 +32,7 @@ int run_field(const FieldSettings& s) {
   if (a.algorithm == Algorithm::kLod && !a.focus) throw InvalidArgument("--algorithm lod needs --focus");
   if (o.domain->empty()) throw InvalidArgument(s.in + ": the input holds no volume");
   AlgorithmStats stats;
-  std::string why;
-  const auto gpu_context = gpu::select_backend(parse_backend(s.backend), {}, &why);
-  std::cerr << "voxfield: " << why << "\n";
+  const auto gpu_context = choose_backend(s.backend);
   std::vector<gpu::PassTiming> pass_timings;
   std::optional<DistanceField> computed;
   if (gpu_context) {

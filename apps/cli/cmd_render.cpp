@@ -49,9 +49,7 @@ int run_render(const RenderSettings& s) {
   const RenderScene scene(in.world, so, in.extent);
   // With --repeat, the frame is rendered several times and the median time reported (the
   // image is the same every time: rendering is deterministic).
-  std::string why;
-  const auto gpu_context = gpu::select_backend(parse_backend(s.backend), {}, &why);
-  std::cerr << "voxfield: " << why << "\n";
+  const auto gpu_context = choose_backend(s.backend);
   RenderStats st;
   Image image;
   std::vector<double> times;

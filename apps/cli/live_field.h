@@ -35,13 +35,25 @@ inline nlohmann::json pass_timings_json(const std::vector<gpu::PassTiming>& timi
   return passes;
 }
 
+// The backend a command runs on, said on stderr. Asking for vulkan where there is no usable
+// device is not fatal: the command says why and runs on the CPU.
+inline std::shared_ptr<gpu::Context> choose_backend(const std::string& name) {
+  std::string why;
+  std::shared_ptr<gpu::Context> ctx;
+  try {
+    ctx = gpu::select_backend(parse_backend(name), {}, &why);
+  } catch (const GpuUnavailable& e) {
+    why = std::string("no usable Vulkan device (") + e.what() + "); using the cpu backend";
+  }
+  std::cerr << "voxfield: " << why << "\n";
+  return ctx;
+}
+
 class LiveField {
  public:
   // backend: "cpu", "vulkan" or "auto". Says on stderr which one runs and why.
   LiveField(const World& world, const DistanceOptions& options, const std::string& backend) {
-    std::string why;
-    auto ctx = gpu::select_backend(parse_backend(backend), {}, &why);
-    std::cerr << "voxfield: " << why << "\n";
+    auto ctx = choose_backend(backend);
     if (ctx) {
       gpu_.emplace(std::move(ctx), world, options);
     } else {

@@ -10,9 +10,26 @@
 
 namespace voxfield::gpu {
 
+namespace {
+
+std::string result_name(VkResult r) {
+  switch (r) {
+    case VK_ERROR_OUT_OF_HOST_MEMORY: return "VK_ERROR_OUT_OF_HOST_MEMORY";
+    case VK_ERROR_OUT_OF_DEVICE_MEMORY: return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
+    case VK_ERROR_INITIALIZATION_FAILED: return "VK_ERROR_INITIALIZATION_FAILED";
+    case VK_ERROR_DEVICE_LOST: return "VK_ERROR_DEVICE_LOST";
+    case VK_ERROR_LAYER_NOT_PRESENT: return "VK_ERROR_LAYER_NOT_PRESENT";
+    case VK_ERROR_EXTENSION_NOT_PRESENT: return "VK_ERROR_EXTENSION_NOT_PRESENT";
+    case VK_ERROR_FEATURE_NOT_PRESENT: return "VK_ERROR_FEATURE_NOT_PRESENT";
+    case VK_ERROR_INCOMPATIBLE_DRIVER: return "VK_ERROR_INCOMPATIBLE_DRIVER: no Vulkan driver found";
+    default: return "VkResult " + std::to_string(r);
+  }
+}
+
+}  // namespace
+
 void check(VkResult result, const char* what) {
-  if (result != VK_SUCCESS)
-    throw GpuUnavailable(std::string("Vulkan: ") + what + " failed (VkResult " + std::to_string(result) + ")");
+  if (result != VK_SUCCESS) throw GpuUnavailable(std::string("Vulkan: ") + what + " failed (" + result_name(result) + ")");
 }
 
 bool built_with_vulkan() { return true; }
