@@ -4,13 +4,16 @@
 // and not a single message from it. In CI this runs on Mesa's lavapipe.
 #include <gtest/gtest.h>
 
+#include <dlfcn.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <random>
 
-#include "voxfield/edit.h"
 #include "image_compare.h"
+#include "voxfield/edit.h"
 #include "voxfield/gpu.h"
+#include "voxfield/gpu_vulkan.h"
 
 using namespace voxfield;
 
@@ -272,4 +275,64 @@ TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
   RenderOptions distance = fog;
   distance.view = RenderView::kDistance;
   EXPECT_THROW(gpu::render(*ctx, scene, cam, distance), InvalidArgument);
+}
+
+// An application's own device (the demo's case), made here through the loader directly.
+TEST(Gpu, AdoptsAnApplicationsDevice) {
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  void* loader = dlopen("libvulkan.so.1", RTLD_NOW | RTLD_LOCAL);
+  ASSERT_NE(loader, nullptr);
+  const auto get_instance_proc = reinterpret_cast<PFN_vkGetInstanceProcAddr>(dlsym(loader, "vkGetInstanceProcAddr"));
+  ASSERT_NE(get_instance_proc, nullptr);
+  const auto create_instance = reinterpret_cast<PFN_vkCreateInstance>(get_instance_proc(nullptr, "vkCreateInstance"));
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.apiVersion = VK_API_VERSION_1_1;
+  VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  ici.pApplicationInfo = &app;
+  VkInstance instance = VK_NULL_HANDLE;
+  ASSERT_EQ(create_instance(&ici, nullptr, &instance), VK_SUCCESS);
+  auto fn = [&](const char* name) { return get_instance_proc(instance, name); };
+  const auto enumerate = reinterpret_cast<PFN_vkEnumeratePhysicalDevices>(fn("vkEnumeratePhysicalDevices"));
+  const auto families_of = reinterpret_cast<PFN_vkGetPhysicalDeviceQueueFamilyProperties>(
+      fn("vkGetPhysicalDeviceQueueFamilyProperties"));
+  const auto create_device = reinterpret_cast<PFN_vkCreateDevice>(fn("vkCreateDevice"));
+  const auto get_queue = reinterpret_cast<PFN_vkGetDeviceQueue>(fn("vkGetDeviceQueue"));
+  const auto destroy_device = reinterpret_cast<PFN_vkDestroyDevice>(fn("vkDestroyDevice"));
+  const auto destroy_instance = reinterpret_cast<PFN_vkDestroyInstance>(fn("vkDestroyInstance"));
+  std::uint32_t count = 1;
+  VkPhysicalDevice physical = VK_NULL_HANDLE;
+  enumerate(instance, &count, &physical);
+  ASSERT_NE(physical, VK_NULL_HANDLE);
+  std::uint32_t nq = 0;
+  families_of(physical, &nq, nullptr);
+  std::vector<VkQueueFamilyProperties> families(nq);
+  families_of(physical, &nq, families.data());
+  std::uint32_t family = 0;
+  while (family < nq && !(families[family].queueFlags & VK_QUEUE_COMPUTE_BIT)) ++family;
+  ASSERT_LT(family, nq);
+  const float priority = 1;
+  VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  qci.queueFamilyIndex = family;
+  qci.queueCount = 1;
+  qci.pQueuePriorities = &priority;
+  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  dci.queueCreateInfoCount = 1;
+  dci.pQueueCreateInfos = &qci;
+  VkDevice device = VK_NULL_HANDLE;
+  ASSERT_EQ(create_device(physical, &dci, nullptr, &device), VK_SUCCESS);
+  VkQueue queue = VK_NULL_HANDLE;
+  get_queue(device, family, 0, &queue);
+  {
+    const auto ctx = gpu::adopt({instance, physical, device, queue, family});
+    const World w = random_world({30, 22, 17}, 8, 0.03, 77);
+    DistanceOptions o;
+    o.metric = Metric::kEuclidean;
+    o.storage = Storage::kU16;
+    o.max_distance = 9;
+    expect_same_field(gpu::compute_distance_field(*ctx, w, o), compute_distance_field(w, o), "adopted device");
+    EXPECT_THROW(gpu::adopt({instance, physical, VK_NULL_HANDLE, queue, family}), InvalidArgument);
+  }  // the context is gone; the application's device and instance are still ours to destroy
+  destroy_device(device, nullptr);
+  destroy_instance(instance, nullptr);
+  dlclose(loader);
 }

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "embedded_shaders.h"
+#include "voxfield/gpu_vulkan.h"
 
 namespace voxfield::gpu {
 
@@ -370,7 +371,6 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
         best = preference(props.deviceType);
         s.physical = d;
         s.queue_family = f;
-        s.timestamp_period_ns = families[f].timestampValidBits ? props.limits.timestampPeriod : 0;
       }
       break;
     }
@@ -378,15 +378,6 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
   if (!s.physical)
     throw GpuUnavailable(std::string("Vulkan: no device with a compute queue") +
                          (options.allow_software ? "" : " (software devices excluded)"));
-  VkPhysicalDeviceProperties props;
-  vkGetPhysicalDeviceProperties(s.physical, &props);
-  s.limits = props.limits;
-  vkGetPhysicalDeviceMemoryProperties(s.physical, &s.memory);
-  s.info.name = props.deviceName;
-  s.info.type = type_name(props.deviceType);
-  s.info.hardware = props.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
-  s.info.api_version = props.apiVersion;
-
   const float priority = 1;
   VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
   qci.queueFamilyIndex = s.queue_family;
@@ -396,8 +387,32 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
   dci.queueCreateInfoCount = 1;
   dci.pQueueCreateInfos = &qci;
   check(vkCreateDevice(s.physical, &dci, nullptr, &s.device), "vkCreateDevice");
-  volkLoadDevice(s.device);
   vkGetDeviceQueue(s.device, s.queue_family, 0, &s.queue);
+  s.finish_setup();
+  guard.s = nullptr;
+  return std::make_shared<Context>(std::move(impl));
+}
+
+// What a created and an adopted device both need: properties, the command pool, the fence, the
+// timestamp pool and the pipelines. Device functions go through the loader's dispatch (volk's
+// instance-level table, never volkLoadDevice), so contexts on different devices can coexist.
+void Context::Impl::finish_setup() {
+  Impl& s = *this;
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(s.physical, &props);
+  s.limits = props.limits;
+  vkGetPhysicalDeviceMemoryProperties(s.physical, &s.memory);
+  s.info.name = props.deviceName;
+  s.info.type = type_name(props.deviceType);
+  s.info.hardware = props.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
+  s.info.api_version = props.apiVersion;
+  std::uint32_t nq = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(s.physical, &nq, nullptr);
+  std::vector<VkQueueFamilyProperties> families(nq);
+  vkGetPhysicalDeviceQueueFamilyProperties(s.physical, &nq, families.data());
+  if (s.queue_family >= nq || !(families[s.queue_family].queueFlags & VK_QUEUE_COMPUTE_BIT))
+    throw GpuUnavailable("Vulkan: queue family " + std::to_string(s.queue_family) + " has no compute queue");
+  s.timestamp_period_ns = families[s.queue_family].timestampValidBits ? props.limits.timestampPeriod : 0;
 
   VkCommandPoolCreateInfo cp{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   cp.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
@@ -412,6 +427,27 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
     check(vkCreateQueryPool(s.device, &qp, nullptr, &s.timestamps), "vkCreateQueryPool");
   }
   s.create_pipelines();
+}
+
+std::shared_ptr<Context> adopt(const AdoptedDevice& app) {
+  if (!app.instance || !app.physical || !app.device || !app.queue)
+    throw InvalidArgument("gpu::adopt: instance, physical device, device and queue are all needed");
+  std::call_once(volk_once, [] { volk_status = volkInitialize(); });
+  if (volk_status != VK_SUCCESS) throw GpuUnavailable("Vulkan: no Vulkan loader (libvulkan.so.1) on this machine");
+  volkLoadInstance(app.instance);
+  auto impl = std::make_unique<Context::Impl>();
+  Context::Impl& s = *impl;
+  s.owns_device = false;
+  s.instance = app.instance;
+  s.physical = app.physical;
+  s.device = app.device;
+  s.queue = app.queue;
+  s.queue_family = app.queue_family;
+  struct Guard {
+    Context::Impl* s;
+    ~Guard() { if (s) s->destroy(); }
+  } guard{&s};
+  s.finish_setup();
   guard.s = nullptr;
   return std::make_shared<Context>(std::move(impl));
 }

@@ -102,6 +102,7 @@ struct Context::Impl {
   void run_commands(F&& record);
   // Submits one command buffer and waits for it (one submit, one fence wait).
   void submit_and_wait(VkCommandBuffer cmd);
+  void finish_setup();
   void destroy();
 };
 

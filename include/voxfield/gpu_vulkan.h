@@ -1,0 +1,31 @@
+// voxfield — handing voxfield an application's own Vulkan device (the demo, an engine). Includes
+// the Vulkan headers for the handle types only; voxfield calls Vulkan through its own loader table.
+#pragma once
+
+#ifndef VK_NO_PROTOTYPES
+#define VK_NO_PROTOTYPES
+#endif
+#include <vulkan/vulkan_core.h>
+
+#include <cstdint>
+#include <memory>
+
+#include "voxfield/gpu.h"
+
+namespace voxfield::gpu {
+
+struct AdoptedDevice {
+  VkInstance instance = VK_NULL_HANDLE;  // created with Vulkan 1.1 or later
+  VkPhysicalDevice physical = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;        // a queue of `queue_family`, which must support compute
+  std::uint32_t queue_family = 0;
+};
+
+// A context on the application's device and queue: voxfield creates its command pool, pipelines
+// and buffers there and destroys only those; the application keeps its handles alive longer than
+// the context and does not use the queue from another thread while voxfield submits to it.
+// Throws InvalidArgument for missing handles, GpuUnavailable when the queue cannot compute.
+std::shared_ptr<Context> adopt(const AdoptedDevice& device);
+
+}  // namespace voxfield::gpu
