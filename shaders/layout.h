@@ -85,6 +85,15 @@ struct PassParams {
   uint pad2;
 };
 
+// Push constants of a jump-flooding pass: 32 bytes.
+struct JfaParams {
+  ivec4 size;    // the domain's extent; w unused
+  int step;      // this pass's jump, in voxels
+  uint metric;   // VF_MANHATTAN...
+  uint src;      // where the previous pass's sites start in the ping-pong buffer (elements)
+  uint dst;      // where this pass writes
+};
+
 // The ray marcher's frame: camera, scene layout and shading options. std430, 176 bytes, in a
 // storage buffer. Per chunk of the render box, chunk_info holds 4 words: the skip arena slot (or
 // VF_UNIFORM), the uniform cell (distance | material << 8) in bits 0-15 with the chunk's smallest
@@ -113,6 +122,7 @@ struct RenderParams {
 #ifdef __cplusplus
 static_assert(sizeof(Header) == 128, "std430 size of Header");
 static_assert(sizeof(PassParams) == 96, "push-constant size of PassParams");
+static_assert(sizeof(JfaParams) == 32, "push-constant size of JfaParams");
 static_assert(sizeof(RenderParams) == 176, "std430 size of RenderParams");
 }  // namespace voxfield::gpu::layout
 #endif

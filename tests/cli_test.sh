@@ -264,7 +264,13 @@ else
   check "field gpu stats" 0 $PY -c "
 import json; j = json.load(open('$tmp/kg.json'))
 assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['gpu']['fence_waits'] == 1, j"
-  check "field: jfa on the gpu" 1 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --backend vulkan --algorithm jfa
+  check "field: jfa+1 on the gpu" 0 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/jg.npy" --backend vulkan \
+      --algorithm jfa+1 --metric chebyshev --storage u8
+  check "field: jfa+1 on the cpu" 0 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/jc.npy" --algorithm jfa+1 \
+      --metric chebyshev --storage u8
+  cmp -s "$tmp/jg.npy" "$tmp/jc.npy" && passes=$((passes+1)) || { echo "FAIL: gpu and cpu jfa+1 differ"; fails=$((fails+1)); }
+  check "field: fim on the gpu" 1 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --backend vulkan --algorithm fim
+  expect_grep "fim on the gpu message" "$tmp/err" "not on the Vulkan backend yet"
   check "field --backend auto" 0 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/ka.npy" --backend auto
   # No Vulkan driver at all: a clear message, and the CPU does the work.
   check "vulkan without a device" 0 env VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json $GPU \

@@ -277,6 +277,38 @@ TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
   EXPECT_THROW(gpu::render(*ctx, scene, cam, distance), InvalidArgument);
 }
 
+TEST(Gpu, JumpFloodingEqualsTheCpu) {
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = validated_context();
+  ctx->clear_validation_messages();
+  const World w = random_world({45, 33, 27}, 16, 0.005, 41);
+  for (Algorithm alg : {Algorithm::kJfa, Algorithm::kJfa1, Algorithm::kJfa2})
+    for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
+      for (bool sgn : {false, true}) {
+        DistanceOptions o;
+        o.metric = m;
+        o.signed_distance = sgn;
+        o.storage = m == Metric::kEuclidean ? Storage::kF32 : Storage::kU16;
+        AlgorithmOptions a;
+        a.algorithm = alg;
+        AlgorithmStats gs, cs;
+        const std::string what = std::string(algorithm_name(alg)) + " " + metric_name(m) + (sgn ? " signed" : "");
+        const DistanceField g = gpu::compute_distance_field(*ctx, w, o, a, &gs);
+        const DistanceField c = compute_distance_field(w, o, a, &cs);
+        expect_same_field(g, c, what);
+        EXPECT_EQ(gs.passes, cs.passes) << what;
+        // Bit-identical, f32 included: the distances come from the same sites on both.
+        if (o.storage == Storage::kF32) {
+          EXPECT_EQ(dense<float>(g), dense<float>(c)) << what;
+        }
+      }
+  AlgorithmOptions fim;
+  fim.algorithm = Algorithm::kFim;
+  EXPECT_THROW(gpu::compute_distance_field(*ctx, w, DistanceOptions{}, fim), InvalidArgument);
+  const auto messages = ctx->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
+}
+
 // An application's own device (the demo's case), made here through the loader directly.
 TEST(Gpu, AdoptsAnApplicationsDevice) {
   if (!gpu_tests_wanted()) GTEST_SKIP();

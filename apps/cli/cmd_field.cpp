@@ -36,11 +36,7 @@ int run_field(const FieldSettings& s) {
   std::vector<gpu::PassTiming> pass_timings;
   std::optional<DistanceField> computed;
   if (gpu_context) {
-    if (a.algorithm != Algorithm::kExact)
-      throw InvalidArgument("--backend " + s.backend + ": only the exact algorithm runs on the GPU so far");
-    const auto t0 = std::chrono::steady_clock::now();
-    computed = gpu::compute_distance_field(*gpu_context, in.world, o, &pass_timings);
-    stats.ms = ms_since(t0);
+    computed = gpu::compute_distance_field(*gpu_context, in.world, o, a, &stats, &pass_timings);
   } else {
     computed = compute_distance_field(in.world, o, a, &stats);
   }

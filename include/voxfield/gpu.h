@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "voxfield/algorithms.h"
 #include "voxfield/distance.h"
 #include "voxfield/dynamic_field.h"
 #include "voxfield/render.h"
@@ -107,6 +108,14 @@ std::shared_ptr<Context> select_backend(Backend backend, const ContextOptions& o
 // fixed-point scale whose products overflow 32 bits), GpuUnavailable on device errors. One command
 // buffer, one submit, one fence wait.
 DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
+                                     std::vector<PassTiming>* timings = nullptr);
+
+// One of the dissertation's algorithms on the GPU: kExact (as above) and jump flooding — kJfa,
+// kJfa1, kJfa2 — whose fields are bit-identical to the CPU's (same passes, same tie rule, one
+// command buffer per sign). The others throw InvalidArgument for now (FIM, jfa-seed, hybrid and
+// lod run on the CPU).
+DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
+                                     const AlgorithmOptions& algorithm, AlgorithmStats* stats = nullptr,
                                      std::vector<PassTiming>* timings = nullptr);
 
 class FieldEngine;

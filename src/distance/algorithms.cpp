@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "family/dense_problem.h"
+#include "family_driver.h"
 #include "field_plan.h"
 #include "voxfield/parallel.h"
 
@@ -168,8 +169,10 @@ std::vector<Algorithm> all_algorithms() {
   return out;
 }
 
-DistanceField compute_distance_field(const World& world, const DistanceOptions& o, const AlgorithmOptions& a,
-                                     AlgorithmStats* stats_out) {
+namespace detail {
+
+DistanceField compute_with_solver(const World& world, const DistanceOptions& o, const AlgorithmOptions& a,
+                                  AlgorithmStats* stats_out, const DenseSolver& solver) {
   AlgorithmStats stats;
   const auto t0 = std::chrono::steady_clock::now();
   auto finish = [&](DistanceField f) {
@@ -177,20 +180,35 @@ DistanceField compute_distance_field(const World& world, const DistanceOptions& 
     if (stats_out) *stats_out = stats;
     return f;
   };
-  if (a.algorithm == Algorithm::kExact) return finish(compute_distance_field(world, o));
   if (a.algorithm == Algorithm::kLod && !a.focus) throw InvalidArgument("the lod algorithm needs a focus box");
   const detail::FieldPlan plan = detail::make_field_plan(world.voxels, o);
   std::vector<std::uint8_t> solid(static_cast<std::size_t>(plan.domain.volume()));
   world.voxels.copy_to_dense(plan.domain, solid.data());
-  const DenseSolution out = solve(make_problem(world, plan, true), a, stats);
+  const DenseSolution out = solver(make_problem(world, plan, true), a, stats);
   DenseSolution in;
-  if (plan.is_signed) in = solve(make_problem(world, plan, false), a, stats);
+  if (plan.is_signed) in = solver(make_problem(world, plan, false), a, stats);
   switch (o.storage) {
     case Storage::kU8: return finish(assemble<std::uint8_t>(world, o, plan, out, plan.is_signed ? &in : nullptr, solid));
     case Storage::kU16: return finish(assemble<std::uint16_t>(world, o, plan, out, plan.is_signed ? &in : nullptr, solid));
     case Storage::kF32: return finish(assemble<float>(world, o, plan, out, plan.is_signed ? &in : nullptr, solid));
   }
   throw InvalidArgument("unknown storage");
+}
+
+}  // namespace detail
+
+DistanceField compute_distance_field(const World& world, const DistanceOptions& o, const AlgorithmOptions& a,
+                                     AlgorithmStats* stats_out) {
+  if (a.algorithm == Algorithm::kExact) {
+    const auto t0 = std::chrono::steady_clock::now();
+    DistanceField f = compute_distance_field(world, o);
+    if (stats_out) {
+      *stats_out = AlgorithmStats{};
+      stats_out->ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    }
+    return f;
+  }
+  return detail::compute_with_solver(world, o, a, stats_out, solve);
 }
 
 FieldError compare_fields(const DistanceField& approx, const DistanceField& exact, const World& world) {

@@ -11,5 +11,6 @@ std::span<const std::uint32_t> edt_sites();
 std::span<const std::uint32_t> edt_lines();
 std::span<const std::uint32_t> edt_encode();
 std::span<const std::uint32_t> render();
+std::span<const std::uint32_t> jfa();
 
 }  // namespace voxfield::gpu::shaders

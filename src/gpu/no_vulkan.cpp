@@ -29,6 +29,10 @@ DistanceField compute_distance_field(Context&, const World&, const DistanceOptio
   unavailable();
 }
 
+DistanceField compute_distance_field(Context&, const World&, const DistanceOptions&, const AlgorithmOptions&,
+                                     AlgorithmStats*, std::vector<PassTiming>*) {
+  unavailable();
+}
 class FieldEngine {};
 Image render(Context&, const RenderScene&, const Camera&, const RenderOptions&, RenderStats*, std::vector<PassTiming>*) {
   unavailable();

@@ -187,6 +187,8 @@ void Context::Impl::create_pipelines() {
   edt_lines = make_pipeline("edt_lines", shaders::edt_lines(), field_layout.pipeline);
   edt_encode = make_pipeline("edt_encode", shaders::edt_encode(), field_layout.pipeline);
   render = make_pipeline("render", shaders::render(), render_layout.pipeline);
+  jfa_layout = make_binding_layout(1, 32);
+  jfa = make_pipeline("jfa", shaders::jfa(), jfa_layout.pipeline);
 }
 
 // ---- submission -----------------------------------------------------------------------------
@@ -280,9 +282,9 @@ void Context::Impl::destroy() {
     vkDeviceWaitIdle(device);
     upload = Buffer();
     readback = Buffer();
-    for (Pipeline* p : {&edt_sites, &edt_lines, &edt_encode, &render})
+    for (Pipeline* p : {&edt_sites, &edt_lines, &edt_encode, &render, &jfa})
       if (p->pipeline) vkDestroyPipeline(device, p->pipeline, nullptr);
-    for (BindingLayout* l : {&field_layout, &render_layout}) {
+    for (BindingLayout* l : {&field_layout, &render_layout, &jfa_layout}) {
       if (l->pool) vkDestroyDescriptorPool(device, l->pool, nullptr);
       if (l->pipeline) vkDestroyPipelineLayout(device, l->pipeline, nullptr);
       if (l->set) vkDestroyDescriptorSetLayout(device, l->set, nullptr);

@@ -61,6 +61,19 @@ void brute_chunked(const DenseProblem& p, DenseSolution& out, AlgorithmStats& st
 void jump_flood_seed(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats);
 // extra_steps: the steps of the correction passes after the standard ones ({}, {1} or {2, 1}).
 void jump_flood(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats, const std::vector<int>& extra_steps);
+
+// Jump flooding's pieces, shared with the GPU backend (which runs the passes itself).
+// A voxel's current nearest site, as coordinates in the domain (x < 0: none).
+struct JfaSite {
+  std::int16_t x = -1, y = -1, z = -1;
+};
+// The sites before the first pass: each site voxel is its own.
+std::vector<JfaSite> jfa_seeds(const DenseProblem& p);
+// The pass steps: halving from the largest power of two below the largest extent down to 1,
+// then extra_steps. Throws InvalidArgument for extents beyond 32767.
+std::vector<int> jfa_steps(const DenseProblem& p, const std::vector<int>& extra_steps);
+// Distances (and site indices) from the final sites.
+void jfa_solution(const DenseProblem& p, const std::vector<JfaSite>& sites, DenseSolution& out);
 // Refines `io` (initially +inf except 0 at sites, or an upper bound such as a JFA result) by the
 // Fast Iterative Method. Only voxels inside `region` (all when empty) are updated.
 void fast_iterative(const DenseProblem& p, DenseSolution& io, AlgorithmStats& stats, const Box3i& region);

@@ -17,11 +17,8 @@
 namespace voxfield::detail {
 namespace {
 
-// A voxel's current nearest site, as coordinates in the domain (x < 0: none). Coordinates rather
-// than indices keep the 27 candidate distances of a pass free of divisions.
-struct Site {
-  std::int16_t x = -1, y = -1, z = -1;
-};
+// Coordinates rather than indices keep the 27 candidate distances of a pass free of divisions.
+using Site = JfaSite;
 
 // Comparable distance of an offset: exact integers for unit spacing (squared for Euclidean).
 struct UnitCost {
@@ -81,20 +78,48 @@ void flood_pass(const DenseProblem& p, const Cost& cost, const std::vector<Site>
 
 }  // namespace
 
-void jump_flood(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats, const std::vector<int>& extra_steps) {
-  if (std::max({p.n.x, p.n.y, p.n.z}) > 32767) throw InvalidArgument("jump flooding supports domains up to 32767 voxels per axis");
-  std::vector<Site> a(p.size()), b(p.size());
+std::vector<JfaSite> jfa_seeds(const DenseProblem& p) {
+  std::vector<JfaSite> a(p.size());
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (!p.site[i]) continue;
     const Vec3i c = p.coord(i);
     a[i] = {static_cast<std::int16_t>(c.x), static_cast<std::int16_t>(c.y), static_cast<std::int16_t>(c.z)};
   }
+  return a;
+}
+
+std::vector<int> jfa_steps(const DenseProblem& p, const std::vector<int>& extra_steps) {
+  if (std::max({p.n.x, p.n.y, p.n.z}) > 32767) throw InvalidArgument("jump flooding supports domains up to 32767 voxels per axis");
   const int largest = std::max({p.n.x, p.n.y, p.n.z});
   std::vector<int> steps;
   int step = 1;
   while (step * 2 < largest) step *= 2;
   for (; step >= 1; step /= 2) steps.push_back(step);
   steps.insert(steps.end(), extra_steps.begin(), extra_steps.end());
+  return steps;
+}
+
+void jfa_solution(const DenseProblem& p, const std::vector<JfaSite>& sites, DenseSolution& out) {
+  out.d.resize(p.size());
+  out.site.resize(p.size());
+  parallel_for(p.size(), 4096, [&](std::size_t b0, std::size_t b1) {
+    for (std::size_t i = b0; i < b1; ++i) {
+      const JfaSite s = sites[i];
+      if (s.x < 0) {
+        out.d[i] = kFar;
+        out.site[i] = -1;
+        continue;
+      }
+      const Vec3i c = p.coord(i);
+      out.d[i] = static_cast<float>(p.distance(s.x - c.x, s.y - c.y, s.z - c.z));
+      out.site[i] = static_cast<std::int32_t>(p.index(s.x, s.y, s.z));
+    }
+  });
+}
+
+void jump_flood(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats, const std::vector<int>& extra_steps) {
+  const std::vector<int> steps = jfa_steps(p, extra_steps);
+  std::vector<Site> a = jfa_seeds(p), b(p.size());
   const bool unit = p.spacing == std::array<double, 3>{1, 1, 1};
   for (int k : steps) {
     if (unit) {
@@ -106,21 +131,7 @@ void jump_flood(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats
     ++stats.passes;
     stats.updates += static_cast<std::int64_t>(p.size()) * 27;
   }
-  out.d.resize(p.size());
-  out.site.resize(p.size());
-  parallel_for(p.size(), 4096, [&](std::size_t b0, std::size_t b1) {
-    for (std::size_t i = b0; i < b1; ++i) {
-      const Site s = a[i];
-      if (s.x < 0) {
-        out.d[i] = kFar;
-        out.site[i] = -1;
-        continue;
-      }
-      const Vec3i c = p.coord(i);
-      out.d[i] = static_cast<float>(p.distance(s.x - c.x, s.y - c.y, s.z - c.z));
-      out.site[i] = static_cast<std::int32_t>(p.index(s.x, s.y, s.z));
-    }
-  });
+  jfa_solution(p, a, out);
 }
 
 }  // namespace voxfield::detail

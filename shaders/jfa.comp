@@ -1,0 +1,55 @@
+// voxfield — one pass of jump flooding (Rong & Tan, "Jump flooding in GPU with applications to
+// Voronoi diagram and distance transform", I3D 2006), the CPU's src/distance/family/jump_flood.cpp
+// on the GPU: each voxel looks at the 26 voxels p + k * {-1, 0, 1}^3 of the previous pass's
+// buffer and keeps the nearest site, ties to the smaller (z, y, x) so the result does not depend
+// on the order of the look-ups. Each pass is its own dispatch (it reads the whole previous pass).
+// Sites are packed as (x | y << 16, z), VF_INF for none; integer costs (squared for Euclidean fit
+// 32 bits below 32768 voxels per axis).
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "layout.h"
+
+layout(local_size_x = 64) in;
+
+// Both halves of the ping-pong in one buffer: a pass reads [p.src, p.src + n) and writes at p.dst.
+layout(std430, set = 0, binding = 0) buffer Sites { uvec2 sites[]; };
+
+layout(push_constant) uniform Push { JfaParams p; };
+
+uint cost(ivec3 d) {
+  const uvec3 a = uvec3(abs(d));
+  if (p.metric == VF_MANHATTAN) return a.x + a.y + a.z;
+  if (p.metric == VF_CHEBYSHEV) return max(a.x, max(a.y, a.z));
+  return a.x * a.x + a.y * a.y + a.z * a.z;
+}
+
+ivec3 unpack(uvec2 s) { return ivec3(int(s.x & 0xFFFFu), int(s.x >> 16), int(s.y)); }
+
+bool smaller(ivec3 a, ivec3 b) {  // (z, y, x) order
+  if (a.z != b.z) return a.z < b.z;
+  if (a.y != b.y) return a.y < b.y;
+  return a.x < b.x;
+}
+
+void main() {
+  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * VF_WORKGROUP + gl_GlobalInvocationID.x;
+  const ivec3 n = p.size.xyz;
+  if (i >= uint(n.x * n.y * n.z)) return;
+  const ivec3 v = ivec3(int(i) % n.x, (int(i) / n.x) % n.y, int(i) / (n.x * n.y));
+  uvec2 best = sites[p.src + i];
+  uint best_cost = best.x == VF_INF ? VF_INF : cost(unpack(best) - v);
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const ivec3 q = v + ivec3(dx, dy, dz) * p.step;
+        if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, n))) continue;
+        const uvec2 s = sites[p.src + uint((q.z * n.y + q.y) * n.x + q.x)];
+        if (s.x == VF_INF) continue;
+        const uint c = cost(unpack(s) - v);
+        if (c < best_cost || (c == best_cost && smaller(unpack(s), unpack(best)))) {
+          best_cost = c;
+          best = s;
+        }
+      }
+  sites[p.dst + i] = best;
+}
