@@ -200,7 +200,10 @@ int run_showcase(const ShowcaseSettings& s) {
     cut.view = RenderView::kDistance;
     cut.slice_z = to.size.z * 3 / 10;  // through the caves
     cut.soft_shadows = false;
-    frame(exact_scene, hero, cut, "terrain-distance.png", "distance cut at z = " + std::to_string(*cut.slice_z));
+    Box3i below = box;  // frame what the cut leaves
+    below.end.z = *cut.slice_z + 1;
+    frame(exact_scene, Camera::framing(below, aspect), cut, "terrain-distance.png",
+          "distance cut at z = " + std::to_string(*cut.slice_z));
   }
   md << "\n## The terrain\n\n"
      << "Rendered on the CPU by DDA ray marching through the Manhattan field (empty chunks and "
