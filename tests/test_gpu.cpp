@@ -282,7 +282,7 @@ TEST(Gpu, JumpFloodingEqualsTheCpu) {
   auto ctx = validated_context();
   ctx->clear_validation_messages();
   const World w = random_world({45, 33, 27}, 16, 0.005, 41);
-  for (Algorithm alg : {Algorithm::kJfa, Algorithm::kJfa1, Algorithm::kJfa2})
+  for (Algorithm alg : {Algorithm::kJfaSeed, Algorithm::kJfa, Algorithm::kJfa1, Algorithm::kJfa2})
     for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
       for (bool sgn : {false, true}) {
         DistanceOptions o;

@@ -110,10 +110,10 @@ std::shared_ptr<Context> select_backend(Backend backend, const ContextOptions& o
 DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
                                      std::vector<PassTiming>* timings = nullptr);
 
-// One of the dissertation's algorithms on the GPU: kExact (as above) and jump flooding — kJfa,
-// kJfa1, kJfa2 — whose fields are bit-identical to the CPU's (same passes, same tie rule, one
-// command buffer per sign). The others throw InvalidArgument for now (FIM, jfa-seed, hybrid and
-// lod run on the CPU).
+// One of the dissertation's algorithms on the GPU: kExact (as above) and jump flooding — kJfaSeed,
+// kJfa, kJfa1, kJfa2 — whose fields are bit-identical to the CPU's (same passes, same tie rule, one
+// command buffer per sign). The others throw InvalidArgument for now (FIM, hybrid and lod run on
+// the CPU).
 DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
                                      const AlgorithmOptions& algorithm, AlgorithmStats* stats = nullptr,
                                      std::vector<PassTiming>* timings = nullptr);

@@ -12,5 +12,6 @@ std::span<const std::uint32_t> edt_lines();
 std::span<const std::uint32_t> edt_encode();
 std::span<const std::uint32_t> render();
 std::span<const std::uint32_t> jfa();
+std::span<const std::uint32_t> jfa_seed();
 
 }  // namespace voxfield::gpu::shaders

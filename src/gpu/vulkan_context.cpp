@@ -189,6 +189,7 @@ void Context::Impl::create_pipelines() {
   render = make_pipeline("render", shaders::render(), render_layout.pipeline);
   jfa_layout = make_binding_layout(1, 32);
   jfa = make_pipeline("jfa", shaders::jfa(), jfa_layout.pipeline);
+  jfa_seed = make_pipeline("jfa_seed", shaders::jfa_seed(), jfa_layout.pipeline);
 }
 
 // ---- submission -----------------------------------------------------------------------------
@@ -282,7 +283,7 @@ void Context::Impl::destroy() {
     vkDeviceWaitIdle(device);
     upload = Buffer();
     readback = Buffer();
-    for (Pipeline* p : {&edt_sites, &edt_lines, &edt_encode, &render, &jfa})
+    for (Pipeline* p : {&edt_sites, &edt_lines, &edt_encode, &render, &jfa, &jfa_seed})
       if (p->pipeline) vkDestroyPipeline(device, p->pipeline, nullptr);
     for (BindingLayout* l : {&field_layout, &render_layout, &jfa_layout}) {
       if (l->pool) vkDestroyDescriptorPool(device, l->pool, nullptr);

@@ -83,7 +83,7 @@ struct Context::Impl {
   static constexpr std::uint32_t kPushBytes = 96;
   static constexpr std::uint32_t kRenderBindings = 6;
   BindingLayout field_layout, render_layout, jfa_layout;
-  Pipeline edt_sites, edt_lines, edt_encode, render, jfa;
+  Pipeline edt_sites, edt_lines, edt_encode, render, jfa, jfa_seed;
 
   // Reusable host-visible buffers for uploads and read-backs (grown when too small).
   Buffer upload, readback;
