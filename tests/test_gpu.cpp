@@ -277,6 +277,33 @@ TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
   EXPECT_THROW(gpu::render(*ctx, scene, cam, distance), InvalidArgument);
 }
 
+TEST(Gpu, BrickPoolReusesAndGrowsCorrectly) {
+  // A chunk emptied, then many chunks filled in one update: the freed slot is reused and the pool
+  // must grow for the rest, within one submission and without touching memory out of range.
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = validated_context();
+  ctx->clear_validation_messages();
+  World w(8, Box3i::from_size({64, 64, 16}));
+  for (int i = 0; i < 6; ++i) w.voxels.set({i * 8 + 3, 5, 5}, 9);  // six dense chunks
+  DistanceOptions o;
+  o.metric = Metric::kChebyshev;
+  o.max_distance = 4;
+  o.storage = Storage::kU8;
+  gpu::DynamicField live(ctx, w, o);
+  DirtyRegions dirty(8, DirtyRegions::Track::kOccupancy);
+  apply_edit(w, {EditOp::kCarve, BoxBrush{{0, 0, 0}, {7, 7, 7}}, 1}, &dirty);  // frees one slot
+  live.update(dirty);
+  dirty.clear();
+  for (int x = 0; x < 8; ++x)
+    for (int y = 2; y < 8; ++y) apply_edit(w, {EditOp::kPlace, SphereBrush{{x * 8.0 + 4, y * 8.0 + 4, 12}, 1}, 3}, &dirty);
+  const gpu::Counters before = ctx->counters();
+  live.update(dirty);
+  EXPECT_EQ(ctx->counters().submits - before.submits, 1);
+  expect_same_field(live.download(), compute_distance_field(w, o), "after freeing one slot and filling 48 chunks");
+  const auto messages = ctx->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
+}
+
 TEST(Gpu, JumpFloodingEqualsTheCpu) {
   if (!gpu_tests_wanted()) GTEST_SKIP();
   auto ctx = validated_context();

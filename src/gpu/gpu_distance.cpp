@@ -338,7 +338,9 @@ class FieldEngine {
       std::uint8_t value;
     };
     std::vector<Change> changes;
-    std::uint32_t needed = used_slots_;
+    // Slots the update may need beyond the free list (frees within the update are not counted:
+    // the estimate can only be high, never low).
+    std::uint32_t new_dense = 0;
     for (const Vec3i& c : chunks) {
       if (c.x < chunk_origin_.x || c.y < chunk_origin_.y || c.z < chunk_origin_.z) continue;
       const Vec3i r = c - chunk_origin_;
@@ -347,8 +349,10 @@ class FieldEngine {
       const std::size_t page = page_index(c);
       changes.push_back({page, v.voxels, v.uniform_value});
       const bool had_slot = (pages_[page] & L::VF_UNIFORM) == 0;
-      if (v.voxels && !had_slot && free_slots_.empty()) ++needed;
+      if (v.voxels && !had_slot) ++new_dense;
     }
+    const std::uint32_t reusable = static_cast<std::uint32_t>(free_slots_.size());
+    const std::uint32_t needed = used_slots_ + (new_dense > reusable ? new_dense - reusable : 0);
     if (needed > slot_capacity_) {
       // Grow the pool (amortised doubling); the old bricks are copied over on the GPU.
       const std::uint32_t capacity = std::max<std::uint32_t>(needed + needed / 4 + 8, slot_capacity_ * 2);
@@ -377,6 +381,9 @@ class FieldEngine {
         } else {
           slot = used_slots_++;
         }
+        // The pool was sized above; a slot beyond it would be an out-of-range GPU copy.
+        if (slot >= slot_capacity_) throw Error("GPU: internal error: brick pool slot " + std::to_string(slot) +
+                                                " beyond its capacity " + std::to_string(slot_capacity_));
         brick_copies.push_back({up.add(ch.voxels, chunk_bytes_), static_cast<VkDeviceSize>(slot) * chunk_bytes_, chunk_bytes_});
         ctx_.counters.bytes_uploaded += static_cast<std::int64_t>(chunk_bytes_);
         next = slot;
