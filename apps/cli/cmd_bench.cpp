@@ -126,7 +126,7 @@ int run_bench_edits(const BenchEditsSettings& s) {
   }
   const gpu::Counters gpu_after = field.gpu_counters();
   const Summary lat = summarise(latency_ms), upd = summarise(update_ms);
-  const std::size_t field_bytes = std::visit([](const auto& g) { return g.memory().bytes; }, field.field().values);
+  const std::size_t field_bytes = field.memory_bytes();
   const std::size_t world_bytes = world.voxels.memory().bytes;
   const double voxels = std::pow(static_cast<double>(s.world), 3);
   const double within = static_cast<double>(std::count_if(latency_ms.begin(), latency_ms.end(),

@@ -74,6 +74,12 @@ class LiveField {
   }
 
   const DistanceOptions& options() const { return cpu_ ? cpu_->options() : gpu_->options(); }
+  // Bytes the field occupies where it lives: the CPU grid's chunks, or the GPU's resident buffer
+  // (4 bytes per voxel of the domain) — without reading a GPU field back to count it.
+  std::size_t memory_bytes() const {
+    if (cpu_) return std::visit([](const auto& g) { return g.memory().bytes; }, cpu_->field().values);
+    return static_cast<std::size_t>(gpu_->options().domain->volume()) * 4;
+  }
   bool on_gpu() const { return gpu_.has_value(); }
 
   // What the GPU did so far (null on the CPU): device and hardware-independent counters.
