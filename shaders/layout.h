@@ -33,6 +33,13 @@ VF_CONST(uint, VF_MANHATTAN, 0u);
 VF_CONST(uint, VF_CHEBYSHEV, 1u);
 VF_CONST(uint, VF_EUCLIDEAN, 2u);
 // Storage of encoded fields, as in voxfield::Storage.
+// RenderParams::flags
+VF_CONST(uint, VF_RENDER_AO, 1u);
+VF_CONST(uint, VF_RENDER_SHADOWS, 2u);
+VF_CONST(uint, VF_RENDER_CHUNKS, 4u);
+VF_CONST(uint, VF_RENDER_HAS_LIGHT, 8u);
+VF_CONST(uint, VF_RENDER_BGRA, 16u);  // pack pixels blue first (B8G8R8A8 swapchains)
+
 VF_CONST(uint, VF_U8, 0u);
 VF_CONST(uint, VF_U16, 1u);
 VF_CONST(uint, VF_F32, 2u);
@@ -115,7 +122,7 @@ struct RenderParams {
   uint metric;         // skip field metric (VF_MANHATTAN...)
   float skip_inv_scale;
   float light_inv_scale;
-  uint flags;          // bit 0 AO, bit 1 soft shadows, bit 2 chunk view, bit 3 has lighting field
+  uint flags;          // VF_RENDER_* bits
   uint pad0;
 };
 

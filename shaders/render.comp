@@ -269,7 +269,8 @@ uint encode(vec3 c) {
   const vec3 exposed = 1.0 - exp(-1.25 * max(c, vec3(0.0)));
   const vec3 s = mix(12.92 * exposed, 1.055 * pow(exposed, vec3(1.0 / 2.4)) - 0.055, greaterThan(exposed, vec3(0.0031308)));
   const uvec3 b = uvec3(clamp(s, 0.0, 1.0) * 255.0 + 0.5);
-  return b.x | (b.y << 8) | (b.z << 16) | (255u << 24);
+  return (rp.flags & VF_RENDER_BGRA) != 0u ? b.z | (b.y << 8) | (b.x << 16) | (255u << 24)
+                                           : b.x | (b.y << 8) | (b.z << 16) | (255u << 24);
 }
 
 void main() {
@@ -304,12 +305,12 @@ void main() {
     const vec3 p = origin + dir * t;
     const float ndotl = max(0.0, dot(n, rp.sun.xyz));
     float shadow = 1.0;
-    if ((rp.flags & 2u) != 0u && ndotl > 0.0) shadow = soft_shadow(p, n);
-    const float ao = (rp.flags & 1u) != 0u ? ambient_occlusion(p, n) : 1.0;
+    if ((rp.flags & VF_RENDER_SHADOWS) != 0u && ndotl > 0.0) shadow = soft_shadow(p, n);
+    const float ao = (rp.flags & VF_RENDER_AO) != 0u ? ambient_occlusion(p, n) : 1.0;
     const vec3 ambient = mix(kGround, kSkyAmbient, 0.5 + 0.5 * n.z) * (0.35 + 0.65 * ao);
     color = albedo[material].xyz * (kSunLight * (ndotl * shadow) + ambient);
     if (rp.sun.w > 0.0) color = mix(color, sky(dir), 1.0 - exp(-rp.sun.w * t));
-    if ((rp.flags & 4u) != 0u) {
+    if ((rp.flags & VF_RENDER_CHUNKS) != 0u) {
       // Chunk view: grid lines about a pixel wide, chunks tinted by storage.
       const float edge = float(1 << rp.first_chunk.w);
       const float foot = (rp.eye.w != 0.0 ? 1.0 : t) * 2.0 * rp.scale / float(rp.height);

@@ -28,4 +28,16 @@ struct AdoptedDevice {
 // Throws InvalidArgument for missing handles, GpuUnavailable when the queue cannot compute.
 std::shared_ptr<Context> adopt(const AdoptedDevice& device);
 
+enum class PixelOrder { kRgba, kBgra };  // byte order of a packed 32-bit pixel
+
+// Records a frame of `renderer`'s synced scene into the application's command buffer `cmd` (on
+// the adopted queue's family): frame parameters, the ray-marching dispatch, and a barrier that
+// makes the pixels readable by transfers. Returns the buffer holding them: width x height packed
+// 8-bit pixels in `order` (sRGB-encoded, alpha 255), top row first — ready for
+// vkCmdCopyBufferToImage into a UNORM swapchain image. The buffer and the frame's parameters are
+// reused by the next frame: submit and wait for `cmd` before recording another frame or syncing.
+// Throws InvalidArgument as SceneRenderer::render does.
+VkBuffer record_render(SceneRenderer& renderer, VkCommandBuffer cmd, const Camera& camera,
+                       const RenderOptions& options, PixelOrder order);
+
 }  // namespace voxfield::gpu

@@ -18,6 +18,7 @@
 
 #include "voxfield/algorithms.h"
 #include "voxfield/distance.h"
+#include "voxfield/dynamic_field.h"
 #include "voxfield/image.h"
 #include "voxfield/world.h"
 
@@ -74,6 +75,10 @@ struct RenderSceneOptions {
   // The field rays skip by. Manhattan is the dissertation's choice: k DDA steps stay within L1
   // distance k. Chebyshev and Euclidean fields are offered to measure the trade-off.
   Metric skip_metric = Metric::kManhattan;
+  // Clamp of the skip field in voxels; 0 = as far as u8 storage reaches (255 voxels for
+  // Manhattan and Chebyshev, 63 for Euclidean, stored in quarter voxels). A clamped field skips
+  // less far in open space but follows edits locally: DynamicRenderScene wants 16-32.
+  double skip_clamp = 0;
   // The Euclidean field behind ambient occlusion and soft shadows (clamped, u8 quarter voxels).
   bool lighting_field = true;
   double lighting_clamp = 16;
@@ -99,6 +104,15 @@ class RenderScene {
   RenderScene(RenderScene&&) noexcept;
   RenderScene& operator=(RenderScene&&) noexcept;
 
+  // Brings the scene up to date after edits to its world: re-reads the materials and the fields'
+  // values in every chunk of the render box that one of `boxes` touches — pass the edited boxes
+  // grown by the fields' reach (DynamicDistanceField::reach()), or the boxes of the regions the
+  // fields' updates recomputed. `skip` and `light` are as for the constructor taking fields, of the
+  // scene's metric and scales, `light` given exactly when the scene has a lighting field; the
+  // world's palette is re-read too. Cost proportional to the chunks touched, not the world. Returns
+  // how many of them changed. Throws InvalidArgument for fields that do not fit.
+  std::size_t update(const DistanceField& skip, const DistanceField* light, std::span<const Box3i> boxes);
+
   const World& world() const;
   const Box3i& box() const;
   const RenderSceneOptions& options() const;
@@ -110,6 +124,39 @@ class RenderScene {
 
  private:
   std::unique_ptr<Impl> impl_;
+};
+
+// A world being edited and what rendering it needs, kept exact: the skip and lighting fields
+// (DynamicDistanceFields, clamped so edits stay local) and a RenderScene that re-reads only the
+// chunks an edit reaches. The world must outlive this object and be bounded (its bounds are the
+// render box).
+class DynamicRenderScene {
+ public:
+  // Throws InvalidArgument for an unbounded world or bad options (a skip clamp beyond u8's reach).
+  explicit DynamicRenderScene(const World& world, RenderSceneOptions options = default_options());
+  // skip_clamp 32 (Manhattan) — the showcase's and the demo's choice.
+  static RenderSceneOptions default_options();
+
+  struct UpdateStats {
+    double field_ms = 0;   // both fields' incremental updates
+    double scene_ms = 0;   // re-reading the chunks they reached
+    std::int64_t voxels_recomputed = 0;
+    std::size_t chunks_changed = 0;  // chunks of the scene whose contents changed
+  };
+  // Brings fields and scene up to date after the edits recorded in `dirty` (tracking every
+  // material change, DirtyRegions::Track::kAnyChange, so that paint is seen). The caller clears
+  // `dirty` afterwards.
+  UpdateStats update(const DirtyRegions& dirty);
+
+  const RenderScene& scene() const { return scene_; }
+  const DistanceField& skip_field() const { return skip_.field(); }
+  const DistanceField* light_field() const { return light_ ? &light_->field() : nullptr; }
+
+ private:
+  const World* world_;
+  DynamicDistanceField skip_;
+  std::optional<DynamicDistanceField> light_;
+  RenderScene scene_;
 };
 
 struct RayHit {

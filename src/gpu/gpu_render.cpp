@@ -1,13 +1,18 @@
-// voxfield GPU backend — frames from the ray-marching compute shader (shaders/render.comp).
+// voxfield GPU backend — frames from the ray-marching compute shader (shaders/render.comp), over a
+// scene kept resident on the GPU.
 //
 // The scene's bricked arenas (src/render/scene_impl.h: distance + material cells, the lighting
-// field, per-chunk flags) are uploaded as they are, so the shader walks exactly the data the CPU
-// walks. Upload, one dispatch and the read-back of the image: one command buffer, one submit.
+// field, per-chunk flags) are copied as they are, so the shader walks exactly the data the CPU
+// walks. The first sync copies the whole scene; after RenderScene::update() only the chunks it
+// re-read (their slots in both arenas and their chunk-table entries) and the palette are copied.
+// Frame parameters travel inside the command buffer (vkCmdUpdateBuffer), so recording a frame
+// into an application's command buffer needs no host-visible memory of voxfield's.
 #include <chrono>
 #include <cstring>
 
 #include "../../shaders/layout.h"
 #include "../render/scene_impl.h"
+#include "voxfield/gpu_vulkan.h"
 #include "vulkan_context.h"
 
 namespace voxfield::gpu {
@@ -15,26 +20,27 @@ namespace {
 
 namespace L = layout;
 
-struct Upload {
-  std::vector<std::uint8_t> bytes;
-  VkDeviceSize add(const void* data, std::size_t n) {
-    const VkDeviceSize offset = (bytes.size() + 15) / 16 * 16;
-    bytes.resize(offset + std::max<std::size_t>(n, 4));
-    if (n > 0) std::memcpy(bytes.data() + offset, data, n);
-    return offset;
-  }
-};
-
 L::vec4f v4(const Vec3d& v, double w = 0) {
   return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), static_cast<float>(w)};
 }
 
-}  // namespace
+// The shader's four words per chunk: skip slot, (uniform cell | chunk min << 16 | empty << 24 |
+// dense << 25), light slot, light uniform value.
+std::array<std::uint32_t, 4> chunk_info(const RenderScene::Impl& s, std::size_t i) {
+  std::array<std::uint32_t, 4> w{};
+  w[0] = s.skip.cells.slot[i] == BrickedChunks<std::uint16_t>::kUniform ? L::VF_UNIFORM : s.skip.cells.slot[i];
+  w[1] = static_cast<std::uint32_t>(s.skip.cells.uniform[i]) | (std::uint32_t{s.skip.chunk_min[i]} << 16) |
+         (s.empty_chunk[i] ? 1u << 24 : 0u) | (s.dense_material[i] ? 1u << 25 : 0u);
+  if (s.has_light) {
+    w[2] = s.light.slot[i] == BrickedChunks<std::uint8_t>::kUniform ? L::VF_UNIFORM : s.light.slot[i];
+    w[3] = s.light.uniform[i];
+  } else {
+    w[2] = L::VF_UNIFORM;
+  }
+  return w;
+}
 
-Image render(Context& context, const RenderScene& scene, const Camera& camera, const RenderOptions& o,
-             RenderStats* stats, std::vector<PassTiming>* timings) {
-  Context::Impl& ctx = context.impl();
-  const RenderScene::Impl& s = scene.impl();
+void check_options(const RenderScene::Impl& s, const RenderOptions& o) {
   if (o.view != RenderView::kShaded && o.view != RenderView::kChunks)
     throw InvalidArgument(std::string("GPU: the ") + render_view_name(o.view) +
                           " view is not on the Vulkan backend yet (shaded and chunks are)");
@@ -44,6 +50,178 @@ Image render(Context& context, const RenderScene& scene, const Camera& camera, c
   if ((o.ambient_occlusion || o.soft_shadows) && !s.has_light)
     throw InvalidArgument("render: ambient occlusion and soft shadows need the scene's lighting field");
   if (!(o.sun_direction.length() > 0)) throw InvalidArgument("render: the sun direction must be non-zero");
+}
+
+}  // namespace
+
+// The GPU copy of a RenderScene and the buffers a frame writes.
+class ResidentScene {
+ public:
+  explicit ResidentScene(Context::Impl& ctx) : ctx_(ctx) {}
+  ~ResidentScene() {
+    if (pool_ != VK_NULL_HANDLE) vkDestroyDescriptorPool(ctx_.device, pool_, nullptr);
+  }
+  ResidentScene(const ResidentScene&) = delete;
+  ResidentScene& operator=(const ResidentScene&) = delete;
+
+  // Records the copies that bring the GPU copy up to date with `scene` (staged in the context's
+  // upload buffer) and the barrier before rendering. Returns false, recording nothing, when the
+  // copy is already current.
+  bool record_sync(VkCommandBuffer cmd, const RenderScene& scene);
+  // Whether the GPU copy already equals `scene` (record_sync would record nothing).
+  bool current(const RenderScene& scene) const {
+    const RenderScene::Impl& s = scene.impl();
+    return scene_ == &s && scene_id_ == s.id && synced_generation_ == s.chunk_generation &&
+           synced_palette_ == s.palette_generation &&
+           skip_.size() >= std::max<std::size_t>(s.skip.cells.arena.size(), 16) &&
+           light_.size() >= std::max<std::size_t>(s.has_light ? s.light.arena.size() : 0, 16);
+  }
+  // Records a frame: parameters, the dispatch, and a barrier making the pixels readable by
+  // transfers. Needs a synced scene.
+  void record_render(VkCommandBuffer cmd, const Camera& camera, const RenderOptions& o, bool bgra, bool timed);
+
+  const Buffer& pixels() const { return pixels_; }
+  const RenderScene::Impl* scene() const { return scene_; }
+
+ private:
+  void ensure_pixels(VkDeviceSize bytes);
+  void write_descriptors();
+
+  Context::Impl& ctx_;
+  const RenderScene::Impl* scene_ = nullptr;
+  std::uint64_t scene_id_ = 0;
+  std::vector<std::uint64_t> synced_generation_;
+  std::uint64_t synced_palette_ = 0;
+  Buffer params_, info_, skip_, light_, palette_, pixels_;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+  bool descriptors_stale_ = true;
+};
+
+namespace {
+
+constexpr VkBufferUsageFlags kUsage =
+    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+
+// Copy regions into one destination buffer, staged contiguously.
+struct Staged {
+  std::vector<VkBufferCopy> regions;
+  std::int64_t bytes = 0;
+};
+
+}  // namespace
+
+bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
+  const RenderScene::Impl& s = scene.impl();
+  const std::size_t chunks = s.table.chunk_count();
+  const std::size_t skip_live = std::size_t{s.skip.cells.slots_used} * s.skip.cells.slot_bytes();
+  const std::size_t light_live = s.has_light ? std::size_t{s.light.slots_used} * s.light.slot_bytes() : 0;
+  bool whole = scene_ != &s || scene_id_ != s.id || synced_generation_.size() != chunks;
+
+  // Device buffers as large as the host arenas' capacity, so growth is rare; a new buffer gets
+  // the whole scene.
+  auto ensure = [&](Buffer& b, std::size_t bytes) {
+    bytes = std::max<std::size_t>(bytes, 16);
+    if (b.handle() != VK_NULL_HANDLE && b.size() >= bytes) return;
+    b = Buffer(ctx_, bytes, kUsage, false);
+    whole = true;
+    descriptors_stale_ = true;
+  };
+  ensure(params_, sizeof(L::RenderParams));
+  ensure(info_, chunks * 16);
+  ensure(skip_, s.skip.cells.arena.size());
+  ensure(light_, s.has_light ? s.light.arena.size() : 0);
+  ensure(palette_, 256 * 16);
+
+  std::vector<std::size_t> changed;
+  const bool palette_changed = whole || synced_palette_ != s.palette_generation;
+  if (!whole) {
+    for (std::size_t i = 0; i < chunks; ++i)
+      if (s.chunk_generation[i] != synced_generation_[i]) changed.push_back(i);
+    if (changed.empty() && !palette_changed) return false;
+  }
+
+  // Stage: palette, then chunk-table entries, then slots of both arenas.
+  const std::size_t info_count = whole ? chunks : changed.size();
+  std::size_t staged_bytes = (palette_changed ? 256 * 16 : 0) + info_count * 16;
+  staged_bytes += whole ? skip_live + light_live
+                        : changed.size() * (s.skip.cells.slot_bytes() + (s.has_light ? s.light.slot_bytes() : 0));
+  Buffer& upload = ctx_.upload_buffer(staged_bytes);
+  auto* base = static_cast<std::uint8_t*>(upload.mapped());
+  VkDeviceSize at = 0;
+  auto stage = [&](Staged& into, VkDeviceSize dst, const void* data, std::size_t n) {
+    if (n == 0) return;
+    std::memcpy(base + at, data, n);
+    into.regions.push_back({at, dst, n});
+    into.bytes += static_cast<std::int64_t>(n);
+    at += n;
+  };
+  Staged palette_copy, info_copy, skip_copy, light_copy;
+  std::vector<float> palette(256 * 4, 0.0f);
+  for (int m = 0; m < 256; ++m)
+    for (int c = 0; c < 3; ++c) palette[static_cast<std::size_t>(4 * m + c)] = s.albedo[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)];
+  if (palette_changed) stage(palette_copy, 0, palette.data(), palette.size() * 4);
+  if (whole) {
+    std::vector<std::uint32_t> info(4 * chunks);
+    for (std::size_t i = 0; i < chunks; ++i) {
+      const auto w = chunk_info(s, i);
+      std::memcpy(&info[4 * i], w.data(), 16);
+    }
+    stage(info_copy, 0, info.data(), info.size() * 4);
+    stage(skip_copy, 0, s.skip.cells.arena.data(), skip_live);
+    if (s.has_light) stage(light_copy, 0, s.light.arena.data(), light_live);
+  } else {
+    for (std::size_t i : changed) {
+      const auto w = chunk_info(s, i);
+      stage(info_copy, i * 16, w.data(), 16);
+      const std::uint32_t slot = s.skip.cells.slot[i];
+      if (slot != BrickedChunks<std::uint16_t>::kUniform) {
+        const std::size_t n = s.skip.cells.slot_bytes();
+        stage(skip_copy, std::size_t{slot} * n, s.skip.cells.arena.data() + std::size_t{slot} * n, n);
+      }
+      if (s.has_light && s.light.slot[i] != BrickedChunks<std::uint8_t>::kUniform) {
+        const std::size_t n = s.light.slot_bytes();
+        stage(light_copy, std::size_t{s.light.slot[i]} * n, s.light.arena.data() + std::size_t{s.light.slot[i]} * n, n);
+      }
+    }
+  }
+  const std::pair<Staged*, Buffer*> copies[4] = {{&palette_copy, &palette_}, {&info_copy, &info_},
+                                                 {&skip_copy, &skip_}, {&light_copy, &light_}};
+  for (const auto& [staged, dst] : copies) {
+    if (staged->regions.empty()) continue;
+    vkCmdCopyBuffer(cmd, upload.handle(), dst->handle(), static_cast<std::uint32_t>(staged->regions.size()),
+                    staged->regions.data());
+    ctx_.counters.bytes_uploaded += staged->bytes;
+  }
+  barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_SHADER_READ_BIT);
+  scene_ = &s;
+  scene_id_ = s.id;
+  synced_generation_ = s.chunk_generation;
+  synced_palette_ = s.palette_generation;
+  return true;
+}
+
+void ResidentScene::ensure_pixels(VkDeviceSize bytes) {
+  if (pixels_.handle() != VK_NULL_HANDLE && pixels_.size() >= bytes) return;
+  pixels_ = Buffer(ctx_, bytes, kUsage, false);
+  descriptors_stale_ = true;
+}
+
+void ResidentScene::write_descriptors() {
+  if (pool_ == VK_NULL_HANDLE) pool_ = ctx_.make_descriptor_pool(Context::Impl::kRenderBindings);
+  const Buffer* bound[Context::Impl::kRenderBindings] = {&params_, &info_, &skip_, &light_, &palette_, &pixels_};
+  set_ = ctx_.allocate_set(pool_, ctx_.render_layout, bound);
+  descriptors_stale_ = false;
+}
+
+void ResidentScene::record_render(VkCommandBuffer cmd, const Camera& camera, const RenderOptions& o, bool bgra,
+                                  bool timed) {
+  if (!scene_) throw InvalidArgument("GPU render: no scene synced yet");
+  const RenderScene::Impl& s = *scene_;
+  check_options(s, o);
+  ensure_pixels(static_cast<VkDeviceSize>(o.width) * o.height * 4);
+  if (descriptors_stale_) write_descriptors();
 
   const Camera::Projector pj = camera.projector(o.width, o.height);
   L::RenderParams rp{};
@@ -63,69 +241,46 @@ Image render(Context& context, const RenderScene& scene, const Camera& camera, c
   rp.metric = static_cast<std::uint32_t>(s.skip.metric);
   rp.skip_inv_scale = static_cast<float>(s.skip.inv_scale);
   rp.light_inv_scale = static_cast<float>(s.light_inv_scale);
-  rp.flags = (o.ambient_occlusion ? 1u : 0u) | (o.soft_shadows ? 2u : 0u) | (o.view == RenderView::kChunks ? 4u : 0u) |
-             (s.has_light ? 8u : 0u);
+  rp.flags = (o.ambient_occlusion ? L::VF_RENDER_AO : 0u) | (o.soft_shadows ? L::VF_RENDER_SHADOWS : 0u) |
+             (o.view == RenderView::kChunks ? L::VF_RENDER_CHUNKS : 0u) | (s.has_light ? L::VF_RENDER_HAS_LIGHT : 0u) |
+             (bgra ? L::VF_RENDER_BGRA : 0u);
 
-  const std::size_t chunks = s.table.chunk_count();
-  std::vector<std::uint32_t> info(4 * chunks);
-  for (std::size_t i = 0; i < chunks; ++i) {
-    info[4 * i] = s.skip.cells.slot[i] == BrickedChunks<std::uint16_t>::kUniform ? L::VF_UNIFORM : s.skip.cells.slot[i];
-    info[4 * i + 1] = static_cast<std::uint32_t>(s.skip.cells.uniform[i]) | (std::uint32_t{s.skip.chunk_min[i]} << 16) |
-                      (s.empty_chunk[i] ? 1u << 24 : 0u) | (s.dense_material[i] ? 1u << 25 : 0u);
-    if (s.has_light) {
-      info[4 * i + 2] = s.light.slot[i] == BrickedChunks<std::uint8_t>::kUniform ? L::VF_UNIFORM : s.light.slot[i];
-      info[4 * i + 3] = s.light.uniform[i];
-    } else {
-      info[4 * i + 2] = L::VF_UNIFORM;
-      info[4 * i + 3] = 0;
-    }
+  // The previous frame's reads of the parameters and writes of the pixels come before these.
+  barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  vkCmdUpdateBuffer(cmd, params_.handle(), 0, sizeof rp, &rp);
+  ctx_.counters.bytes_uploaded += static_cast<std::int64_t>(sizeof rp);
+  barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_SHADER_READ_BIT);
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.render.pipeline);
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.render_layout.pipeline, 0, 1, &set_, 0, nullptr);
+  if (timed) {
+    vkCmdResetQueryPool(cmd, ctx_.timestamps, 0, 2);
+    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx_.timestamps, 0);
   }
-  std::vector<float> palette(256 * 4);
-  for (int m = 0; m < 256; ++m)
-    for (int c = 0; c < 3; ++c) palette[static_cast<std::size_t>(4 * m + c)] = s.albedo[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)];
+  dispatch(ctx_, cmd, static_cast<std::uint64_t>(o.width) * o.height);
+  if (timed) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx_.timestamps, 1);
+  barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+          VK_ACCESS_TRANSFER_READ_BIT);
+}
 
-  Upload up;
-  const std::size_t sizes[5] = {sizeof rp, info.size() * 4, s.skip.cells.arena.size(), s.has_light ? s.light.arena.size() : 0,
-                                palette.size() * 4};
-  const void* sources[5] = {&rp, info.data(), s.skip.cells.arena.data(), s.has_light ? s.light.arena.data() : nullptr,
-                            palette.data()};
-  VkDeviceSize offsets[5];
-  for (int b = 0; b < 5; ++b) offsets[b] = up.add(sources[b], sizes[b]);
+namespace {
+
+// Records the frame, reads it back and converts it to an Image: one submit.
+Image render_and_read(Context::Impl& ctx, ResidentScene& resident, const RenderScene* sync, const Camera& camera,
+                      const RenderOptions& o, RenderStats* stats, std::vector<PassTiming>* timings) {
+  if (!sync && !resident.scene()) throw InvalidArgument("GPU render: no scene synced yet");
+  check_options(sync ? sync->impl() : *resident.scene(), o);
   const VkDeviceSize image_bytes = static_cast<VkDeviceSize>(o.width) * o.height * 4;
-
-  constexpr VkBufferUsageFlags kUsage =
-      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-  Buffer buffers[6];
-  for (int b = 0; b < 5; ++b) buffers[b] = Buffer(ctx, std::max<std::size_t>(sizes[b], 4), kUsage, false);
-  buffers[5] = Buffer(ctx, image_bytes, kUsage, false);
-  Buffer& upload = ctx.upload_buffer(up.bytes.size());
-  std::memcpy(upload.mapped(), up.bytes.data(), up.bytes.size());
   Buffer& readback = ctx.readback_buffer(image_bytes);
-
-  const Buffer* bound[Context::Impl::kRenderBindings] = {&buffers[0], &buffers[1], &buffers[2],
-                                                         &buffers[3], &buffers[4], &buffers[5]};
-  const VkDescriptorSet set = ctx.bind(ctx.render_layout, bound);
-
   const bool timed = timings && ctx.timestamps != VK_NULL_HANDLE;
   const auto t0 = std::chrono::steady_clock::now();
   ctx.run_commands([&](VkCommandBuffer cmd) {
-    if (timed) vkCmdResetQueryPool(cmd, ctx.timestamps, 0, 2);
-    for (int b = 0; b < 5; ++b) {
-      const VkBufferCopy copy{offsets[b], 0, std::max<std::size_t>(sizes[b], 4)};
-      vkCmdCopyBuffer(cmd, upload.handle(), buffers[b].handle(), 1, &copy);
-      ctx.counters.bytes_uploaded += static_cast<std::int64_t>(sizes[b]);
-    }
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-            VK_ACCESS_SHADER_READ_BIT);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.render.pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.render_layout.pipeline, 0, 1, &set, 0, nullptr);
-    if (timed) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx.timestamps, 0);
-    dispatch(ctx, cmd, static_cast<std::uint64_t>(o.width) * o.height);
-    if (timed) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx.timestamps, 1);
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-            VK_ACCESS_TRANSFER_READ_BIT);
+    if (sync) resident.record_sync(cmd, *sync);
+    resident.record_render(cmd, camera, o, /*bgra=*/false, timed);
     const VkBufferCopy down{0, 0, image_bytes};
-    vkCmdCopyBuffer(cmd, buffers[5].handle(), readback.handle(), 1, &down);
+    vkCmdCopyBuffer(cmd, resident.pixels().handle(), readback.handle(), 1, &down);
     barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
             VK_ACCESS_HOST_READ_BIT);
     ctx.counters.bytes_downloaded += static_cast<std::int64_t>(image_bytes);
@@ -141,7 +296,6 @@ Image render(Context& context, const RenderScene& scene, const Camera& camera, c
       timings->push_back({"render", static_cast<double>(ticks[1] - ticks[0]) * ctx.timestamp_period_ns * 1e-6});
     }
   }
-
   Image image(o.width, o.height);
   const auto* px = static_cast<const std::uint32_t*>(readback.mapped());
   for (std::size_t i = 0; i < static_cast<std::size_t>(o.width) * o.height; ++i) {
@@ -151,12 +305,56 @@ Image render(Context& context, const RenderScene& scene, const Camera& camera, c
   }
   if (stats) {
     *stats = RenderStats{};
-    stats->ms = ms;  // upload + render + read-back, as the caller waits for it
+    stats->ms = ms;  // (upload +) render + read-back, as the caller waits for it
     stats->width = o.width;
     stats->height = o.height;
     stats->primary.rays = static_cast<std::int64_t>(o.width) * o.height;
   }
   return image;
+}
+
+}  // namespace
+
+Image render(Context& context, const RenderScene& scene, const Camera& camera, const RenderOptions& o,
+             RenderStats* stats, std::vector<PassTiming>* timings) {
+  check_options(scene.impl(), o);
+  ResidentScene resident(context.impl());
+  return render_and_read(context.impl(), resident, &scene, camera, o, stats, timings);
+}
+
+// ---- SceneRenderer ----------------------------------------------------------------------------------
+
+struct SceneRenderer::Impl {
+  std::shared_ptr<Context> context;
+  ResidentScene resident;
+  explicit Impl(std::shared_ptr<Context> c) : context(std::move(c)), resident(context->impl()) {}
+};
+
+SceneRenderer::SceneRenderer(std::shared_ptr<Context> context) {
+  if (!context) throw InvalidArgument("gpu::SceneRenderer: no context");
+  impl_ = std::make_unique<Impl>(std::move(context));
+}
+
+SceneRenderer::~SceneRenderer() = default;
+
+bool SceneRenderer::sync(const RenderScene& scene) {
+  if (impl_->resident.current(scene)) return false;
+  impl_->context->impl().run_commands([&](VkCommandBuffer cmd) { impl_->resident.record_sync(cmd, scene); });
+  return true;
+}
+
+Image SceneRenderer::render(const Camera& camera, const RenderOptions& options, RenderStats* stats,
+                            std::vector<PassTiming>* timings) {
+  return render_and_read(impl_->context->impl(), impl_->resident, nullptr, camera, options, stats, timings);
+}
+
+Context& SceneRenderer::context() { return *impl_->context; }
+
+VkBuffer record_render(SceneRenderer& renderer, VkCommandBuffer cmd, const Camera& camera, const RenderOptions& options,
+                       PixelOrder order) {
+  ResidentScene& r = renderer.impl().resident;
+  r.record_render(cmd, camera, options, order == PixelOrder::kBgra, /*timed=*/false);
+  return r.pixels().handle();
 }
 
 }  // namespace voxfield::gpu

@@ -43,5 +43,11 @@ void DynamicField::rebuild() { unavailable(); }
 DynamicDistanceField::UpdateStats DynamicField::update(const DirtyRegions&) { unavailable(); }
 DistanceField DynamicField::download() { unavailable(); }
 const DistanceOptions& DynamicField::options() const { unavailable(); }
+struct SceneRenderer::Impl {};
+SceneRenderer::SceneRenderer(std::shared_ptr<Context>) { unavailable(); }
+SceneRenderer::~SceneRenderer() = default;
+bool SceneRenderer::sync(const RenderScene&) { unavailable(); }
+Image SceneRenderer::render(const Camera&, const RenderOptions&, RenderStats*, std::vector<PassTiming>*) { unavailable(); }
+Context& SceneRenderer::context() { unavailable(); }
 
 }  // namespace voxfield::gpu

@@ -148,19 +148,30 @@ BindingLayout Context::Impl::make_binding_layout(std::uint32_t n, std::uint32_t 
   pl.pushConstantRangeCount = push_bytes > 0 ? 1 : 0;
   pl.pPushConstantRanges = push_bytes > 0 ? &push : nullptr;
   check(vkCreatePipelineLayout(device, &pl, nullptr, &l.pipeline), "vkCreatePipelineLayout");
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, n};
+  l.pool = make_descriptor_pool(n);
+  return l;
+}
+
+VkDescriptorPool Context::Impl::make_descriptor_pool(std::uint32_t buffers) {
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buffers};
   VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   dp.maxSets = 1;
   dp.poolSizeCount = 1;
   dp.pPoolSizes = &size;
-  check(vkCreateDescriptorPool(device, &dp, nullptr, &l.pool), "vkCreateDescriptorPool");
-  return l;
+  VkDescriptorPool pool;
+  check(vkCreateDescriptorPool(device, &dp, nullptr, &pool), "vkCreateDescriptorPool");
+  return pool;
 }
 
 VkDescriptorSet Context::Impl::bind(const BindingLayout& layout, std::span<const Buffer* const> buffers) {
-  check(vkResetDescriptorPool(device, layout.pool, 0), "vkResetDescriptorPool");
+  return allocate_set(layout.pool, layout, buffers);
+}
+
+VkDescriptorSet Context::Impl::allocate_set(VkDescriptorPool pool, const BindingLayout& layout,
+                                            std::span<const Buffer* const> buffers) {
+  check(vkResetDescriptorPool(device, pool, 0), "vkResetDescriptorPool");
   VkDescriptorSetAllocateInfo dsa{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  dsa.descriptorPool = layout.pool;
+  dsa.descriptorPool = pool;
   dsa.descriptorSetCount = 1;
   dsa.pSetLayouts = &layout.set;
   VkDescriptorSet set;

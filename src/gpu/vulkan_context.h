@@ -97,6 +97,11 @@ struct Context::Impl {
   // A descriptor set binding `buffers` (one per binding, in order) from the layout's pool, which is
   // reset first: sets live until the next call for the same layout.
   VkDescriptorSet bind(const BindingLayout& layout, std::span<const Buffer* const> buffers);
+  // A pool for one set of `buffers` storage buffers, for objects that keep their set across
+  // submissions (the resident render scene); the caller destroys it.
+  VkDescriptorPool make_descriptor_pool(std::uint32_t buffers);
+  // Resets `pool` and allocates from it a set of `layout` binding `buffers` in order.
+  VkDescriptorSet allocate_set(VkDescriptorPool pool, const BindingLayout& layout, std::span<const Buffer* const> buffers);
   // Allocates a command buffer, lets `record` fill it, submits it and waits (freed after).
   template <class F>
   void run_commands(F&& record);

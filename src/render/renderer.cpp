@@ -305,7 +305,7 @@ Image render(const RenderScene& scene, const Camera& camera, const RenderOptions
       const Vec3i hi{std::max(sz.x * 5 / 8, lo.x + 1), std::max(sz.y * 5 / 8, lo.y + 1), std::max(sz.z * 5 / 8, lo.z + 1)};
       ao.focus = Box3i{s.box.begin + lo, s.box.begin + hi};
     }
-    approx_field = compute_distance_field(*s.world, skip_field_options(s.options.skip_metric, s.box), ao);
+    approx_field = compute_distance_field(*s.world, s.skip_options, ao);
     approx = s.make_skip_source(*approx_field);
     f.approx = &approx;
   }

@@ -14,7 +14,9 @@
 namespace voxfield {
 
 // Values of type T per voxel of the chunk table, bricked; chunks whose values are all equal are
-// not stored.
+// not stored. Slots are handed out densely from 0; a chunk that becomes uniform after an edit
+// returns its slot to a free list, and the arena grows (by half again) when an edit makes more
+// chunks dense than it holds.
 template <class T>
 struct BrickedChunks {
   static constexpr std::uint32_t kUniform = 0xFFFFFFFFu;
@@ -22,6 +24,13 @@ struct BrickedChunks {
   std::vector<T> uniform;           // per chunk: the value of a chunk not stored
   render_detail::LargeBuffer arena;
   std::uint32_t chunk_volume = 0;
+  std::uint32_t slots_used = 0;          // slots ever handed out (the arena's live prefix)
+  std::vector<std::uint32_t> free_slots; // slots below slots_used no chunk holds
+
+  std::size_t slot_bytes() const { return std::size_t{chunk_volume} * sizeof(T); }
+  T* slot_data(std::uint32_t s) { return reinterpret_cast<T*>(arena.data()) + std::size_t{s} * chunk_volume; }
+  // A free slot for a chunk becoming dense (the arena grows when none is left).
+  std::uint32_t take_slot();
 
   T read(std::size_t chunk, std::uint32_t brick_index) const {
     const std::uint32_t s = slot[chunk];
@@ -49,6 +58,13 @@ struct SkipSource {
 };
 
 struct RenderScene::Impl {
+  // Identifies this scene's contents for GPU copies: a new id whenever the scene is built, and a
+  // per-chunk generation that increases whenever update() re-reads the chunk.
+  std::uint64_t id = 0;
+  std::uint64_t generation = 0;
+  std::vector<std::uint64_t> chunk_generation;
+  std::uint64_t palette_generation = 0;
+
   const World* world = nullptr;
   Box3i box;
   RenderSceneOptions options;
@@ -56,6 +72,7 @@ struct RenderScene::Impl {
 
   render_detail::ChunkTable table;
   SkipSource skip;
+  DistanceOptions skip_options;  // of the field `skip` was made from
   bool has_light = false;
   BrickedChunks<std::uint8_t> light;  // the Euclidean lighting field
   double light_inv_scale = 0.25;
@@ -64,11 +81,18 @@ struct RenderScene::Impl {
   std::array<std::array<float, 3>, 256> albedo{};  // palette in linear RGB
 
   void build(const World& w, const DistanceField& skip_field, const DistanceField* light_field);
+  // A skip source over this scene's table from another field (the error view's approximation).
   SkipSource make_skip_source(const DistanceField& field) const;
+  // Re-reads chunk i from the world and the fields (the fields already checked to fit).
+  // Returns whether anything of the chunk changed.
+  bool refresh_chunk(std::size_t i, const Grid<std::uint8_t>& skip_grid, const Grid<std::uint8_t>* light_grid);
 };
 
-// Options of the u8 skip field for a metric: Manhattan and Chebyshev distances are integers
-// stored as they are (clamp 255); Euclidean ones in quarter voxels (clamp 63).
-DistanceOptions skip_field_options(Metric metric, const Box3i& box);
+// Options of the u8 skip field: Manhattan and Chebyshev distances are integers stored as they are
+// (clamp at most 255); Euclidean ones in quarter voxels (clamp at most 63); clamp 0 = the most.
+// Throws InvalidArgument for a clamp out of that range.
+DistanceOptions skip_field_options(const RenderSceneOptions& options, const Box3i& box);
+// Options of the u8 Euclidean lighting field (throws InvalidArgument for a clamp out of (0, 63]).
+DistanceOptions light_field_options(const RenderSceneOptions& options, const Box3i& box);
 
 }  // namespace voxfield

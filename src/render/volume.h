@@ -11,18 +11,22 @@
 
 namespace voxfield::render_detail {
 
-// A byte buffer for data read at random by every ray: 2 MiB aligned and, on Linux, backed by
-// transparent huge pages when the system allows it, so a read rarely misses the TLB as well as
-// the cache.
+// A zero-initialised byte buffer for data read at random by every ray: 2 MiB aligned and, on
+// Linux, backed by transparent huge pages when the system allows it, so a read rarely misses the
+// TLB as well as the cache.
 class LargeBuffer {
  public:
   LargeBuffer() = default;
   explicit LargeBuffer(std::size_t bytes);
   ~LargeBuffer();
-  LargeBuffer(LargeBuffer&& o) noexcept : data_(std::exchange(o.data_, nullptr)), size_(std::exchange(o.size_, 0)) {}
+  LargeBuffer(LargeBuffer&& o) noexcept
+      : data_(std::exchange(o.data_, nullptr)), size_(std::exchange(o.size_, 0)),
+        map_(std::exchange(o.map_, nullptr)), map_bytes_(std::exchange(o.map_bytes_, 0)) {}
   LargeBuffer& operator=(LargeBuffer&& o) noexcept {
     std::swap(data_, o.data_);
     std::swap(size_, o.size_);
+    std::swap(map_, o.map_);
+    std::swap(map_bytes_, o.map_bytes_);
     return *this;
   }
   std::uint8_t* data() { return data_; }
@@ -32,6 +36,8 @@ class LargeBuffer {
  private:
   std::uint8_t* data_ = nullptr;
   std::size_t size_ = 0;
+  void* map_ = nullptr;  // the mapping data_ lies in (Linux)
+  std::size_t map_bytes_ = 0;
 };
 
 class ChunkTable {
