@@ -73,8 +73,7 @@ int run_bench_edits(const BenchEditsSettings& s) {
 
   // The dissertation's stream: seeded positions anywhere in the world, radii in [min, max],
   // materials 0..255 where 0 (air) deletes.
-  std::mt19937_64 rng(s.seed);
-  auto uniform_int = [&](int lo, int hi) { return lo + static_cast<int>(rng() % static_cast<std::uint64_t>(hi - lo + 1)); };
+  RandomEditStream stream(Box3i::from_size(Vec3i::splat(s.world)), s.seed, s.radius_min, radius_max);
   DirtyRegions dirty(world.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
   std::vector<double> latency_ms, update_ms;
   std::vector<std::int64_t> recomputed;
@@ -86,14 +85,9 @@ int run_bench_edits(const BenchEditsSettings& s) {
     csv << "edit,time_s,radius,material,voxels_changed,voxels_recomputed,edit_ms,update_ms,latency_ms\n";
   }
   for (int i = 0; i < s.edits; ++i) {
-    Edit e;
-    const int radius = uniform_int(s.radius_min, radius_max);
-    const int material = uniform_int(0, 255);
-    e.brush = SphereBrush{{static_cast<double>(uniform_int(0, s.world - 1)), static_cast<double>(uniform_int(0, s.world - 1)),
-                           static_cast<double>(uniform_int(0, s.world - 1))},
-                          static_cast<double>(radius)};
-    e.op = material == 0 ? EditOp::kCarve : EditOp::kPlace;
-    e.material = static_cast<std::uint8_t>(std::max(material, 1));
+    const Edit e = stream.next();
+    const int radius = static_cast<int>(std::get<SphereBrush>(e.brush).radius);
+    const int material = e.op == EditOp::kCarve ? 0 : e.material;
     const auto a = std::chrono::steady_clock::now();
     const EditResult r = apply_edit(world, e, &dirty);
     const auto b = std::chrono::steady_clock::now();

@@ -1,0 +1,86 @@
+// voxfield-demo — the world being painted.
+#include "demo_world.h"
+
+#include "../cli/cli.h"
+#include "voxfield/error.h"
+#include "voxfield/scene.h"
+
+namespace voxfield::demo {
+namespace {
+
+RenderSceneOptions scene_options(const WorldSettings& s) {
+  RenderSceneOptions o = DynamicRenderScene::default_options();
+  o.skip_metric = s.metric;
+  o.skip_clamp = s.clamp;
+  return o;
+}
+
+void check_settings(const WorldSettings& s) {
+  if (s.size < 16 || s.size > 1024) throw InvalidArgument("demo: --world must lie in 16..1024 voxels");
+  if (s.chunk_edge < 8 || s.chunk_edge > 128 || (s.chunk_edge & (s.chunk_edge - 1)) != 0)
+    throw InvalidArgument("demo: --chunk must be a power of two in 8..128");
+}
+
+}  // namespace
+
+DemoWorld::DemoWorld(const WorldSettings& settings)
+    : settings_(settings), dirty_(settings.chunk_edge, DirtyRegions::Track::kAnyChange) {
+  check_settings(settings);
+  SceneOptions so;
+  so.size = {settings.size, settings.size, std::max(16, settings.size / 2)};
+  so.seed = settings.seed;
+  so.chunk_edge = settings.chunk_edge;
+  world_ = std::make_unique<World>(make_terrain(so));
+  origin_ = "terrain " + std::to_string(so.size.x) + "x" + std::to_string(so.size.y) + "x" + std::to_string(so.size.z);
+  make_scene();
+}
+
+DemoWorld::DemoWorld(const WorldSettings& settings, const std::filesystem::path& file)
+    : settings_(settings), dirty_(settings.chunk_edge, DirtyRegions::Track::kAnyChange) {
+  check_settings(settings);
+  cli::LoadedWorld in = cli::load_world(file, settings.chunk_edge);
+  Box3i extent = in.extent.unite(in.world.voxels.content_bounds());
+  if (extent.empty()) throw InvalidArgument(file.string() + ": the world holds no voxels");
+  // Room to build on top and around: a quarter of the largest side.
+  const int margin = std::max({extent.size().x, extent.size().y, extent.size().z}) / 4;
+  extent = Box3i{extent.begin - Vec3i{margin, margin, 0}, extent.end + Vec3i::splat(margin)};
+  if (extent.volume() > std::int64_t{1024} * 1024 * 1024)
+    throw InvalidArgument(file.string() + ": the world's box " + to_string(extent) + " is too large for the demo");
+  world_ = std::make_unique<World>(settings.chunk_edge, extent);
+  world_->palette = in.world.palette;
+  const Box3i content = in.world.voxels.content_bounds();
+  std::vector<std::uint8_t> dense(static_cast<std::size_t>(content.volume()));
+  in.world.voxels.copy_to_dense(content, dense.data());
+  world_->voxels.copy_from_dense(content, dense.data());
+  origin_ = file.filename().string();
+  make_scene();
+}
+
+void DemoWorld::make_scene() {
+  live_ = std::make_unique<DynamicRenderScene>(*world_, scene_options(settings_));
+}
+
+DynamicRenderScene::UpdateStats DemoWorld::apply(const Edit& edit) {
+  dirty_.clear();
+  apply_edit(*world_, edit, &dirty_);
+  ++edits_;
+  DynamicRenderScene::UpdateStats st = live_->update(dirty_);
+  dirty_.clear();
+  return st;
+}
+
+void DemoWorld::set_field(Metric metric, double clamp) {
+  WorldSettings next = settings_;
+  next.metric = metric;
+  next.clamp = clamp;
+  // Build first: bad options leave the current scene as it was.
+  auto live = std::make_unique<DynamicRenderScene>(*world_, scene_options(next));
+  live_ = std::move(live);
+  settings_ = next;
+}
+
+void DemoWorld::save(const std::filesystem::path& path) const {
+  cli::save_world(*world_, *world_->voxels.bounds(), path);
+}
+
+}  // namespace voxfield::demo

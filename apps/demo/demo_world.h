@@ -1,0 +1,60 @@
+// voxfield-demo — the world being painted and what rendering it needs.
+//
+// Edits go through voxfield's incremental path: apply_edit records the changed boxes, and
+// DynamicRenderScene brings both render fields and the scene up to date in time proportional to
+// the edit. Only a change of metric, clamp, size or chunk edge rebuilds everything, and only when
+// the user asks for it.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "voxfield/edit.h"
+#include "voxfield/render.h"
+
+namespace voxfield::demo {
+
+struct WorldSettings {
+  int size = 128;        // terrain of size x size x size/2 voxels (ignored when loading)
+  int chunk_edge = 16;
+  Metric metric = Metric::kManhattan;  // the field rays skip by
+  double clamp = 32;     // its clamp (voxels): how far a skip reaches, and an edit's reach
+  std::uint64_t seed = 6683787;
+};
+
+class DemoWorld {
+ public:
+  // A generated terrain. Throws voxfield::Error for bad settings.
+  explicit DemoWorld(const WorldSettings& settings);
+  // A world read from a .vox, .npy or .vfw file, bounded to its extent with room above to build.
+  DemoWorld(const WorldSettings& settings, const std::filesystem::path& file);
+
+  // Applies an edit (clipped to the world) and updates fields and scene incrementally.
+  DynamicRenderScene::UpdateStats apply(const Edit& edit);
+  // Rebuilds the fields for new metric / clamp settings (a full computation).
+  void set_field(Metric metric, double clamp);
+
+  // Writes the world (.vfw keeps the palette and bounds; .vox and .npy as the CLI writes them),
+  // atomically.
+  void save(const std::filesystem::path& path) const;
+
+  const World& world() const { return *world_; }
+  const RenderScene& scene() const { return live_->scene(); }
+  const WorldSettings& settings() const { return settings_; }
+  std::int64_t edits() const { return edits_; }
+  const std::string& origin() const { return origin_; }
+
+ private:
+  void make_scene();
+
+  WorldSettings settings_;
+  std::unique_ptr<World> world_;  // fixed address: the scene refers to it
+  std::unique_ptr<DynamicRenderScene> live_;
+  DirtyRegions dirty_;
+  std::int64_t edits_ = 0;
+  std::string origin_;  // "terrain 128x128x64" or the file name
+};
+
+}  // namespace voxfield::demo

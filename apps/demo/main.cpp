@@ -1,0 +1,550 @@
+// voxfield-demo — paint a voxel world and watch its distance fields follow.
+//
+// The reference dissertation's demonstration application: a window, a world drawn by ray
+// marching through an exact distance field, sphere brushes that place, carve and paint, and a
+// benchmark mode replaying the dissertation's seeded stream of edits. Frames come from voxfield's
+// Vulkan ray marcher when there is a Vulkan device for it (--backend), otherwise from the CPU
+// renderer; the title and the panel say which.
+#include <CLI/CLI.hpp>
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_vulkan.h>
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <deque>
+#include <fstream>
+#include <iostream>
+#include <optional>
+
+#include "demo_world.h"
+#include "fly_camera.h"
+#include "voxfield/error.h"
+#include "voxfield/gpu.h"
+#include "voxfield/gpu_vulkan.h"
+#include "voxfield/image.h"
+#include "vulkan_window.h"
+
+namespace voxfield::demo {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
+
+struct Options {
+  WorldSettings world;
+  std::string load;
+  std::string backend = "auto";
+  int width = 1280, height = 720;
+  bool validation = false;
+  bool benchmark = false;
+  int frames = 300;
+  double interval_ms = 200;
+  std::string csv;
+  std::string screenshot;
+};
+
+// What draws the frames, and why.
+struct RenderPath {
+  std::shared_ptr<gpu::Context> context;  // null: the CPU renderer
+  std::unique_ptr<gpu::SceneRenderer> renderer;
+  std::string why;
+};
+
+struct Brush {
+  int radius = 4;
+  std::uint8_t material = 1;
+  bool paint = false;
+};
+
+struct Timings {
+  double frame_ms = 0, update_ms = 0, render_ms = 0;
+};
+
+class Demo {
+ public:
+  explicit Demo(const Options& o);
+  ~Demo();
+  int run();
+
+ private:
+  void choose_path(const std::string& backend);
+  void frame_camera();
+  void handle_input(double dt_s);
+  void edit_at_cursor(EditOp op);
+  bool draw(VulkanWindow::Screenshot* shot);
+  void panel();
+  void help();
+  void take_screenshot(const std::string& path);
+  bool gpu_can_draw() const { return path_.renderer && (view_ == RenderView::kShaded || view_ == RenderView::kChunks); }
+  std::string title() const;
+
+  Options options_;
+  VulkanWindow window_;
+  std::unique_ptr<DemoWorld> world_;
+  RenderPath path_;
+  FlyCamera camera_;
+  Brush brush_;
+  RenderView view_ = RenderView::kShaded;
+  Algorithm error_algorithm_ = Algorithm::kJfa;
+  bool show_help_ = false;
+  bool look_mode_ = false;  // Tab: the mouse turns the view, clicks edit at the centre
+  double last_x_ = 0, last_y_ = 0;
+  double scroll_ = 0;
+  Clock::time_point last_edit_ = Clock::now();
+  Timings last_;
+  std::deque<float> frame_history_;
+  std::string status_;
+  char save_path_[256] = "demo-world.vfw";
+  char load_path_[256] = "";
+  int ui_size_ = 128, ui_chunk_ = 16, ui_metric_ = 0, ui_backend_ = 0;
+  float ui_clamp_ = 32;
+  VkDescriptorPool imgui_pool_ = VK_NULL_HANDLE;
+  int screenshots_ = 0;
+};
+
+Demo::Demo(const Options& o)
+    : options_(o), window_(o.width, o.height, "voxfield-demo", o.validation) {
+  world_ = o.load.empty() ? std::make_unique<DemoWorld>(o.world) : std::make_unique<DemoWorld>(o.world, o.load);
+  ui_size_ = o.world.size;
+  ui_chunk_ = o.world.chunk_edge;
+  ui_clamp_ = static_cast<float>(o.world.clamp);
+  ui_metric_ = static_cast<int>(o.world.metric);
+  choose_path(o.backend);
+  frame_camera();
+
+  // Input callbacks first: the ImGui backend chains to them.
+  glfwSetWindowUserPointer(window_.window(), this);
+  glfwSetScrollCallback(window_.window(), [](GLFWwindow* w, double, double dy) {
+    static_cast<Demo*>(glfwGetWindowUserPointer(w))->scroll_ += dy;
+  });
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini beside the user's files
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForVulkan(window_.window(), true);
+  VkInstance instance = window_.instance();
+  ImGui_ImplVulkan_LoadFunctions(
+      [](const char* name, void* user) { return vkGetInstanceProcAddr(*static_cast<VkInstance*>(user), name); }, &instance);
+  VkDescriptorPoolSize sizes{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4};
+  VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  dp.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
+  dp.maxSets = 4;
+  dp.poolSizeCount = 1;
+  dp.pPoolSizes = &sizes;
+  if (vkCreateDescriptorPool(window_.device(), &dp, nullptr, &imgui_pool_) != VK_SUCCESS)
+    throw WindowError("cannot create the panel's descriptor pool");
+  ImGui_ImplVulkan_InitInfo info{};
+  info.Instance = window_.instance();
+  info.PhysicalDevice = window_.physical();
+  info.Device = window_.device();
+  info.QueueFamily = window_.queue_family();
+  info.Queue = window_.queue();
+  info.DescriptorPool = imgui_pool_;
+  info.MinImageCount = window_.min_image_count();
+  info.ImageCount = window_.image_count();
+  info.MSAASamples = VK_SAMPLE_COUNT_1_BIT;
+  ImGui_ImplVulkan_Init(&info, window_.render_pass());
+  window_.run_once([](VkCommandBuffer cmd) { ImGui_ImplVulkan_CreateFontsTexture(cmd); });
+  ImGui_ImplVulkan_DestroyFontUploadObjects();
+}
+
+Demo::~Demo() {
+  window_.wait_idle();
+  ImGui_ImplVulkan_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  path_ = RenderPath{};  // voxfield's objects on the device go before the device
+  if (imgui_pool_) vkDestroyDescriptorPool(window_.device(), imgui_pool_, nullptr);
+}
+
+void Demo::choose_path(const std::string& backend) {
+  window_.wait_idle();
+  path_ = RenderPath{};
+  const Backend b = parse_backend(backend);
+  if (b == Backend::kCpu) {
+    path_.why = "CPU renderer (--backend cpu)";
+  } else if (b == Backend::kAuto && !window_.device_is_hardware()) {
+    path_.why = "CPU renderer (auto: " + window_.device_name() + " is not a hardware GPU; --backend vulkan uses it)";
+  } else {
+    try {
+      path_.context = gpu::adopt({window_.instance(), window_.physical(), window_.device(), window_.queue(), window_.queue_family()});
+      path_.renderer = std::make_unique<gpu::SceneRenderer>(path_.context);
+      path_.why = "Vulkan ray marcher on " + window_.device_name();
+    } catch (const Error& e) {
+      path_ = RenderPath{};
+      path_.why = std::string("CPU renderer (no usable Vulkan compute: ") + e.what() + ")";
+    }
+  }
+  ui_backend_ = path_.renderer ? 1 : 0;
+  std::cerr << "voxfield-demo: " << path_.why << "\n";
+}
+
+void Demo::frame_camera() {
+  const Box3i box = world_->scene().box();
+  const Vec3i s = box.size();
+  const Vec3d centre{box.begin.x + s.x / 2.0, box.begin.y + s.y / 2.0, box.begin.z + s.z * 0.3};
+  camera_.look({box.begin.x - s.x * 0.25, box.begin.y - s.y * 0.25, box.begin.z + s.z * 1.1}, centre);
+}
+
+std::string Demo::title() const {
+  return "voxfield-demo — " + world_->origin() + " — " + (gpu_can_draw() ? "Vulkan ray marcher" : "CPU renderer");
+}
+
+void Demo::edit_at_cursor(EditOp op) {
+  double x = 0, y = 0;
+  if (look_mode_) {
+    x = window_.width() / 2.0;
+    y = window_.height() / 2.0;
+  } else {
+    glfwGetCursorPos(window_.window(), &x, &y);
+    int ww = 1, wh = 1;
+    glfwGetWindowSize(window_.window(), &ww, &wh);
+    x *= static_cast<double>(window_.width()) / std::max(ww, 1);
+    y *= static_cast<double>(window_.height()) / std::max(wh, 1);
+  }
+  const Ray ray = camera_.camera().projector(window_.width(), window_.height()).ray(x, y);
+  const RayHit hit = trace_ray(world_->scene(), ray);
+  if (!hit.hit) return;
+  Vec3d centre{static_cast<double>(hit.voxel.x), static_cast<double>(hit.voxel.y), static_cast<double>(hit.voxel.z)};
+  if (op == EditOp::kPlace && hit.face_axis >= 0) centre[hit.face_axis] += hit.face_sign * brush_.radius;
+  const auto t0 = Clock::now();
+  const auto st = world_->apply({op, SphereBrush{centre, static_cast<double>(brush_.radius)}, brush_.material});
+  last_.update_ms = ms_between(t0, Clock::now());
+  status_ = std::string(op == EditOp::kPlace ? "placed" : op == EditOp::kCarve ? "carved" : "painted") + " r " +
+            std::to_string(brush_.radius) + ": " + std::to_string(st.chunks_changed) + " chunks refreshed";
+}
+
+void Demo::handle_input(double dt_s) {
+  GLFWwindow* w = window_.window();
+  const ImGuiIO& io = ImGui::GetIO();
+  auto down = [&](int key) { return glfwGetKey(w, key) == GLFW_PRESS; };
+  // Keys that act once per press.
+  static std::array<bool, GLFW_KEY_LAST + 1> was{};
+  auto pressed = [&](int key) {
+    const bool now = down(key);
+    const bool edge = now && !was[static_cast<std::size_t>(key)];
+    was[static_cast<std::size_t>(key)] = now;
+    return edge;
+  };
+  if (pressed(GLFW_KEY_F1)) show_help_ = !show_help_;
+  if (pressed(GLFW_KEY_F12)) take_screenshot("voxfield-demo-" + std::to_string(++screenshots_) + ".png");
+  if (pressed(GLFW_KEY_TAB)) {
+    look_mode_ = !look_mode_;
+    glfwSetInputMode(w, GLFW_CURSOR, look_mode_ ? GLFW_CURSOR_DISABLED : GLFW_CURSOR_NORMAL);
+  }
+  if (pressed(GLFW_KEY_ESCAPE) && look_mode_) {
+    look_mode_ = false;
+    glfwSetInputMode(w, GLFW_CURSOR, GLFW_CURSOR_NORMAL);
+  }
+  if (!io.WantCaptureKeyboard) {
+    if (pressed(GLFW_KEY_P)) brush_.paint = !brush_.paint;
+    for (int k = 1; k <= 9; ++k)
+      if (pressed(GLFW_KEY_0 + k)) brush_.material = static_cast<std::uint8_t>(k);
+    const double speed = (down(GLFW_KEY_LEFT_CONTROL) || down(GLFW_KEY_RIGHT_CONTROL) ? 4.0 : 1.0) *
+                         std::max(16.0, world_->scene().box().size().x * 0.35);  // voxels per second
+    Vec3d move{0, 0, 0};
+    const Vec3d f = camera_.forward(), r = camera_.right();
+    if (down(GLFW_KEY_W)) move = move + f;
+    if (down(GLFW_KEY_S)) move = move - f;
+    if (down(GLFW_KEY_D)) move = move + r;
+    if (down(GLFW_KEY_A)) move = move - r;
+    if (down(GLFW_KEY_SPACE)) move = move + Vec3d{0, 0, 1};
+    if (down(GLFW_KEY_LEFT_SHIFT) || down(GLFW_KEY_RIGHT_SHIFT)) move = move - Vec3d{0, 0, 1};
+    if (move.length() > 0) camera_.eye = camera_.eye + move.normalized() * (speed * dt_s);
+  }
+  double x = 0, y = 0;
+  glfwGetCursorPos(w, &x, &y);
+  const bool turning = look_mode_ || (glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS && !io.WantCaptureMouse);
+  if (turning) camera_.turn(-(x - last_x_) * 0.004, -(y - last_y_) * 0.004);
+  last_x_ = x;
+  last_y_ = y;
+  if (!io.WantCaptureMouse) {
+    if (scroll_ != 0) brush_.radius = std::clamp(brush_.radius + static_cast<int>(std::lround(scroll_)), 0, 32);
+    // Held buttons repeat the edit ten times a second.
+    const bool left = glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+    const bool right = glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
+    if ((left || right) && ms_between(last_edit_, Clock::now()) >= 100) {
+      edit_at_cursor(right ? EditOp::kCarve : brush_.paint ? EditOp::kPaint : EditOp::kPlace);
+      last_edit_ = Clock::now();
+    }
+  }
+  scroll_ = 0;
+}
+
+bool Demo::draw(VulkanWindow::Screenshot* shot) {
+  ImGui_ImplVulkan_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  panel();
+  if (show_help_) help();
+  ImGui::Render();
+
+  RenderOptions ro;
+  ro.width = window_.width();
+  ro.height = window_.height();
+  ro.view = view_;
+  ro.error_algorithm = error_algorithm_;
+  const Camera cam = camera_.camera();
+  const auto t0 = Clock::now();
+  std::function<void(VkCommandBuffer, VkImage)> fill;
+  VkBufferImageCopy copy{};
+  copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  copy.imageExtent = {static_cast<std::uint32_t>(ro.width), static_cast<std::uint32_t>(ro.height), 1};
+  if (gpu_can_draw()) {
+    path_.renderer->sync(world_->scene());
+    fill = [&](VkCommandBuffer cmd, VkImage image) {
+      const VkBuffer pixels = gpu::record_render(*path_.renderer, cmd, cam, ro,
+                                                 window_.bgra() ? gpu::PixelOrder::kBgra : gpu::PixelOrder::kRgba);
+      vkCmdCopyBufferToImage(cmd, pixels, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+    };
+  } else {
+    const Image img = render(world_->scene(), cam, ro);
+    void* mapped = nullptr;
+    const VkBuffer staging = window_.staging(static_cast<VkDeviceSize>(ro.width) * ro.height * 4, &mapped);
+    auto* dst = static_cast<std::uint8_t*>(mapped);
+    const bool bgra = window_.bgra();
+    for (std::size_t i = 0; i < static_cast<std::size_t>(ro.width) * ro.height; ++i) {
+      dst[4 * i + 0] = img.rgb[3 * i + (bgra ? 2 : 0)];
+      dst[4 * i + 1] = img.rgb[3 * i + 1];
+      dst[4 * i + 2] = img.rgb[3 * i + (bgra ? 0 : 2)];
+      dst[4 * i + 3] = 255;
+    }
+    fill = [&, staging](VkCommandBuffer cmd, VkImage image) {
+      vkCmdCopyBufferToImage(cmd, staging, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+    };
+  }
+  const bool drawn = window_.draw_frame(fill, [](VkCommandBuffer cmd) { ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd); },
+                                        shot);
+  if (gpu_can_draw()) window_.wait_idle();  // the GPU frame's time includes its execution
+  last_.render_ms = ms_between(t0, Clock::now());
+  return drawn;
+}
+
+void Demo::panel() {
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
+  ImGui::Begin("voxfield");
+  ImGui::TextWrapped("%s", gpu_can_draw() ? path_.why.c_str()
+                                          : (path_.renderer ? "CPU renderer (this view is not on the GPU yet)" : path_.why.c_str()));
+  ImGui::Text("%s, chunk %d", world_->origin().c_str(), world_->settings().chunk_edge);
+  ImGui::Separator();
+  ImGui::Text("frame %.1f ms (%.1f FPS)", last_.frame_ms, last_.frame_ms > 0 ? 1000.0 / last_.frame_ms : 0.0);
+  ImGui::Text("render %.1f ms, last update %.2f ms", last_.render_ms, last_.update_ms);
+  std::vector<float> history(frame_history_.begin(), frame_history_.end());
+  if (!history.empty())
+    ImGui::PlotLines("##frames", history.data(), static_cast<int>(history.size()), 0, "frame ms", 0.0f, FLT_MAX, ImVec2(-1, 50));
+  ImGui::Text("%lld edits", static_cast<long long>(world_->edits()));
+  if (!status_.empty()) ImGui::TextWrapped("%s", status_.c_str());
+
+  if (ImGui::CollapsingHeader("Brush", ImGuiTreeNodeFlags_DefaultOpen)) {
+    ImGui::SliderInt("radius", &brush_.radius, 0, 32);
+    int material = brush_.material;
+    if (ImGui::SliderInt("material", &material, 1, 255)) brush_.material = static_cast<std::uint8_t>(material);
+    const Rgba c = world_->world().palette[brush_.material];
+    ImGui::ColorButton("##swatch", ImVec4(c.r / 255.0f, c.g / 255.0f, c.b / 255.0f, 1.0f));
+    ImGui::SameLine();
+    ImGui::Checkbox("paint (P)", &brush_.paint);
+  }
+  if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) {
+    const char* views[] = {"shaded", "distance", "error", "chunks"};
+    int v = static_cast<int>(view_);
+    if (ImGui::Combo("view", &v, views, 4)) view_ = static_cast<RenderView>(v);
+    const std::vector<Algorithm> algorithms = all_algorithms();
+    int a = static_cast<int>(std::find(algorithms.begin(), algorithms.end(), error_algorithm_) - algorithms.begin());
+    if (ImGui::BeginCombo("algorithm", algorithm_name(error_algorithm_))) {
+      for (std::size_t i = 0; i < algorithms.size(); ++i)
+        if (ImGui::Selectable(algorithm_name(algorithms[i]), static_cast<int>(i) == a)) error_algorithm_ = algorithms[i];
+      ImGui::EndCombo();
+    }
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("the approximation the error view measures against the exact field");
+    const char* backends[] = {"cpu", "vulkan"};
+    if (ImGui::Combo("backend", &ui_backend_, backends, 2)) choose_path(backends[ui_backend_]);
+  }
+  if (ImGui::CollapsingHeader("Field")) {
+    const char* metrics[] = {"manhattan", "chebyshev", "euclidean"};
+    ImGui::Combo("metric", &ui_metric_, metrics, 3);
+    ImGui::SliderFloat("clamp", &ui_clamp_, 1, ui_metric_ == 2 ? 63 : 255, "%.0f voxels");
+    if (ImGui::Button("rebuild the fields")) {
+      try {
+        world_->set_field(static_cast<Metric>(ui_metric_), ui_clamp_);
+        status_ = "fields rebuilt";
+      } catch (const Error& e) {
+        status_ = e.what();
+      }
+    }
+  }
+  if (ImGui::CollapsingHeader("World")) {
+    ImGui::SliderInt("size", &ui_size_, 32, 512);
+    const char* chunks[] = {"8", "16", "32", "64"};
+    int c = ui_chunk_ == 8 ? 0 : ui_chunk_ == 16 ? 1 : ui_chunk_ == 32 ? 2 : 3;
+    if (ImGui::Combo("chunk edge", &c, chunks, 4)) ui_chunk_ = 8 << c;
+    if (ImGui::Button("regenerate")) {
+      WorldSettings s = world_->settings();
+      s.size = ui_size_;
+      s.chunk_edge = ui_chunk_;
+      try {
+        window_.wait_idle();
+        world_ = std::make_unique<DemoWorld>(s);
+        frame_camera();
+        status_ = "regenerated";
+      } catch (const Error& e) {
+        status_ = e.what();
+      }
+    }
+    ImGui::InputText("save as", save_path_, sizeof save_path_);
+    if (ImGui::Button("save")) {
+      try {
+        world_->save(save_path_);
+        status_ = std::string("saved ") + save_path_;
+      } catch (const Error& e) {
+        status_ = e.what();
+      }
+    }
+    ImGui::InputText("load", load_path_, sizeof load_path_);
+    if (ImGui::Button("load .vox / .vfw / .npy")) {
+      try {
+        WorldSettings s = world_->settings();
+        s.chunk_edge = ui_chunk_;
+        auto loaded = std::make_unique<DemoWorld>(s, load_path_);
+        window_.wait_idle();
+        world_ = std::move(loaded);
+        frame_camera();
+        status_ = std::string("loaded ") + load_path_;
+      } catch (const Error& e) {
+        status_ = e.what();  // the current world stays
+      }
+    }
+  }
+  ImGui::End();
+}
+
+void Demo::help() {
+  ImGui::SetNextWindowPos(ImVec2(window_.width() * 0.5f, window_.height() * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  ImGui::Begin("help (F1)", &show_help_, ImGuiWindowFlags_AlwaysAutoResize);
+  ImGui::Text("W A S D       fly; Space / Shift up and down; Ctrl faster");
+  ImGui::Text("middle drag   look around; Tab toggles mouse look (edits at the centre)");
+  ImGui::Text("left click    place a sphere of the material (paint in paint mode)");
+  ImGui::Text("right click   carve a sphere");
+  ImGui::Text("scroll        brush radius");
+  ImGui::Text("1 .. 9        material; P toggles paint mode");
+  ImGui::Text("F12           screenshot (voxfield-demo-N.png)");
+  ImGui::Text("F1            this help");
+  ImGui::End();
+}
+
+void Demo::take_screenshot(const std::string& path) {
+  VulkanWindow::Screenshot shot;
+  while (!draw(&shot)) {
+  }
+  if (shot.rgb.empty()) {
+    status_ = "screenshots need a swapchain that transfers can read; this one cannot";
+    return;
+  }
+  Image img(shot.width, shot.height);
+  img.rgb = std::move(shot.rgb);
+  write_png(img, path);
+  status_ = "saved " + path;
+  std::cerr << "voxfield-demo: saved " << path << "\n";
+}
+
+int Demo::run() {
+  std::ofstream csv;
+  if (options_.benchmark && !options_.csv.empty()) {
+    csv.open(options_.csv);
+    if (!csv) throw IoError(options_.csv + ": cannot create");
+    csv << "frame,frame_ms,update_ms,render_ms,edits\n";
+  }
+  // Benchmark mode: the dissertation's seeded edits, one every interval of wall time, radii up to
+  // the chunk edge - 1, with the camera circling the world.
+  std::optional<RandomEditStream> stream;
+  if (options_.benchmark)
+    stream.emplace(world_->scene().box(), options_.world.seed, 1, world_->settings().chunk_edge - 1);
+  const auto start = Clock::now();
+  auto previous = start;
+  std::int64_t streamed = 0;
+  for (int frame = 0; !glfwWindowShouldClose(window_.window()); ++frame) {
+    if (options_.benchmark && frame >= options_.frames) break;
+    glfwPollEvents();
+    const auto t0 = Clock::now();
+    const double dt_s = std::min(0.1, ms_between(previous, t0) / 1000.0);
+    previous = t0;
+    double update_ms = 0;
+    if (stream) {
+      const Box3i box = world_->scene().box();
+      const Vec3i s = box.size();
+      const double angle = 0.6 + frame * 0.02;
+      const Vec3d centre{box.begin.x + s.x / 2.0, box.begin.y + s.y / 2.0, box.begin.z + s.z * 0.3};
+      const double r = 0.85 * std::max(s.x, s.y);
+      camera_.look(centre + Vec3d{r * std::cos(angle), r * std::sin(angle), s.z * 0.9}, centre);
+      const auto due = static_cast<std::int64_t>(ms_between(start, t0) / options_.interval_ms) + 1;
+      for (; streamed < due; ++streamed) {
+        const auto a = Clock::now();
+        world_->apply(stream->next());
+        update_ms += ms_between(a, Clock::now());
+      }
+      last_.update_ms = update_ms;
+    } else {
+      handle_input(dt_s);
+    }
+    const bool last_frame = options_.benchmark && frame + 1 == options_.frames;
+    if (last_frame && !options_.screenshot.empty()) {
+      take_screenshot(options_.screenshot);
+    } else {
+      while (!draw(nullptr)) {
+      }
+    }
+    glfwSetWindowTitle(window_.window(), title().c_str());
+    last_.frame_ms = ms_between(t0, Clock::now());
+    frame_history_.push_back(static_cast<float>(last_.frame_ms));
+    if (frame_history_.size() > 120) frame_history_.pop_front();
+    if (csv.is_open())
+      csv << frame << "," << last_.frame_ms << "," << update_ms << "," << last_.render_ms << "," << world_->edits() << "\n";
+  }
+  if (csv.is_open()) {
+    csv.close();
+    if (!csv) throw IoError(options_.csv + ": write failed");
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace voxfield::demo
+
+int main(int argc, char** argv) {
+  using namespace voxfield;
+  using namespace voxfield::demo;
+  Options o;
+  CLI::App app{"voxfield-demo: paint a voxel world and watch its distance fields follow"};
+  std::string metric = "manhattan";
+  app.add_option("--world", o.world.size, "terrain size N (N x N x N/2 voxels)")->check(CLI::Range(16, 1024));
+  app.add_option("--chunk", o.world.chunk_edge, "chunk edge (8, 16, 32, 64, 128)");
+  app.add_option("--load", o.load, "start from a .vox, .vfw or .npy file instead of the terrain");
+  app.add_option("--backend", o.backend, "who draws: cpu, vulkan, auto (a hardware GPU, else the CPU)")
+      ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
+  app.add_option("--metric", metric, "metric of the field rays skip by")->check(CLI::IsMember({"manhattan", "chebyshev", "euclidean"}));
+  app.add_option("--clamp", o.world.clamp, "its clamp in voxels (an edit's reach)");
+  app.add_option("--width", o.width, "window width")->check(CLI::Range(64, 8192));
+  app.add_option("--height", o.height, "window height")->check(CLI::Range(64, 8192));
+  app.add_flag("--validation", o.validation, "enable the Khronos validation layer (messages on stderr)");
+  app.add_flag("--benchmark", o.benchmark, "replay the dissertation's seeded edits and exit after --frames");
+  app.add_option("--frames", o.frames, "frames to run in benchmark mode")->check(CLI::Range(1, 1000000));
+  app.add_option("--seed", o.world.seed, "seed of the terrain and the benchmark's edits");
+  app.add_option("--interval-ms", o.interval_ms, "time between the benchmark's edits")->check(CLI::PositiveNumber);
+  app.add_option("--csv", o.csv, "benchmark: one row per frame (frame_ms, update_ms, render_ms, edits)");
+  app.add_option("--screenshot", o.screenshot, "benchmark: save the last frame as PNG");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    o.world.metric = parse_metric(metric);
+    Demo demo(o);
+    return demo.run();
+  } catch (const WindowError& e) {
+    std::cerr << "voxfield-demo: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "voxfield-demo: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# voxfield-demo end to end, under Xvfb: benchmark mode for 30 frames on the Vulkan ray marcher
+# (lavapipe in CI) with the validation layer, and on the CPU renderer. Each run must exit 0, write
+# a CSV with one row per frame, print no validation message, and leave a screenshot showing sky
+# and world. DEMO and FRAME_CHECK are set by CTest.
+set -u
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+
+run() {  # name, demo arguments...
+  local name=$1
+  shift
+  if ! xvfb-run -a -s "-screen 0 1024x768x24" "$DEMO" --benchmark --frames 30 --width 480 --height 270 --world 64 \
+      --csv "$out/$name.csv" --screenshot "$out/$name.png" "$@" >"$out/$name.out" 2>"$out/$name.err"; then
+    fail "$name: exit status $?: $(cat "$out/$name.err")"
+    return
+  fi
+  grep -q "validation:" "$out/$name.err" && fail "$name: validation messages: $(grep -m3 validation: "$out/$name.err")"
+  [ "$(head -1 "$out/$name.csv")" = "frame,frame_ms,update_ms,render_ms,edits" ] || fail "$name: CSV header"
+  local rows
+  rows=$(tail -n +2 "$out/$name.csv" | wc -l)
+  [ "$rows" -eq 30 ] || fail "$name: $rows CSV rows, expected 30"
+  # The benchmark's edits keep coming: the last row counts at least one.
+  awk -F, 'END { exit !($5 >= 1) }' "$out/$name.csv" || fail "$name: no edits were made"
+  "$FRAME_CHECK" "$out/$name.png" || fail "$name: the screenshot is not a frame of sky and world"
+  echo "ok: $name ($(tail -1 "$out/$name.err"))"
+}
+
+run vulkan --backend vulkan --validation
+grep -q "Vulkan ray marcher" "$out/vulkan.err" || fail "vulkan: the demo did not say it draws with the Vulkan ray marcher"
+run cpu --backend cpu
+grep -q "CPU renderer" "$out/cpu.err" || fail "cpu: the demo did not say it draws with the CPU renderer"
+
+# Bad arguments are refused with a message, not a crash.
+if "$DEMO" --world 3 >/dev/null 2>"$out/bad.err"; then fail "--world 3 was accepted"; fi
+if xvfb-run -a "$DEMO" --load /nonexistent.vox --benchmark --frames 1 >/dev/null 2>"$out/missing.err"; then
+  fail "a missing --load file was accepted"
+fi
+grep -q "nonexistent.vox" "$out/missing.err" || fail "the missing file is not named: $(cat "$out/missing.err")"
+
+[ "$failures" -eq 0 ] || { echo "$failures failure(s)"; exit 1; }
+echo "voxfield-demo: all checks passed"
