@@ -335,7 +335,7 @@ void Demo::panel() {
   ImGui::Text("render %.1f ms, last update %.2f ms", last_.render_ms, last_.update_ms);
   std::vector<float> history(frame_history_.begin(), frame_history_.end());
   if (!history.empty())
-    ImGui::PlotLines("##frames", history.data(), static_cast<int>(history.size()), 0, "frame ms", 0.0f, FLT_MAX, ImVec2(-1, 50));
+    ImGui::PlotLines("##frames", history.data(), static_cast<int>(history.size()), 0, "frame ms", 0.0f, FLT_MAX, ImVec2(0, 50));
   ImGui::Text("%lld edits", static_cast<long long>(world_->edits()));
   if (!status_.empty()) ImGui::TextWrapped("%s", status_.c_str());
 
