@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # voxfield-demo end to end, under Xvfb: benchmark mode for 30 frames on the Vulkan ray marcher
-# (lavapipe in CI) with the validation layer, and on the CPU renderer. Each run must exit 0, write
+# (lavapipe in CI) with the validation layer, on the CPU renderer, and with no Vulkan driver at
+# all (CPU frames presented through OpenGL). Each run must exit 0, write
 # a CSV with one row per frame, print no validation message, and leave a screenshot showing sky
 # and world. DEMO and FRAME_CHECK are set by CTest.
 set -u
@@ -12,7 +13,7 @@ fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 run() {  # name, demo arguments...
   local name=$1
   shift
-  if ! xvfb-run -a -s "-screen 0 1024x768x24" "$DEMO" --benchmark --frames 30 --width 480 --height 270 --world 64 \
+  if ! env ${RUN_ENV:-} xvfb-run -a -s "-screen 0 1024x768x24" "$DEMO" --benchmark --frames 30 --width 480 --height 270 --world 64 \
       --csv "$out/$name.csv" --screenshot "$out/$name.png" "$@" >"$out/$name.out" 2>"$out/$name.err"; then
     fail "$name: exit status $?: $(cat "$out/$name.err")"
     return
@@ -32,6 +33,9 @@ run vulkan --backend vulkan --validation
 grep -q "Vulkan ray marcher" "$out/vulkan.err" || fail "vulkan: the demo did not say it draws with the Vulkan ray marcher"
 run cpu --backend cpu
 grep -q "CPU renderer" "$out/cpu.err" || fail "cpu: the demo did not say it draws with the CPU renderer"
+# No Vulkan driver at all: the CPU renderer's frames, presented through OpenGL.
+RUN_ENV="VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json" run opengl --backend vulkan
+grep -q "shown through OpenGL" "$out/opengl.err" || fail "opengl: the demo did not say it fell back to OpenGL"
 
 # Bad arguments are refused with a message, not a crash.
 if "$DEMO" --world 3 >/dev/null 2>"$out/bad.err"; then fail "--world 3 was accepted"; fi

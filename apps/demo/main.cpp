@@ -4,10 +4,12 @@
 // marching through an exact distance field, sphere brushes that place, carve and paint, and a
 // benchmark mode replaying the dissertation's seeded stream of edits. Frames come from voxfield's
 // Vulkan ray marcher when there is a Vulkan device for it (--backend), otherwise from the CPU
-// renderer; the title and the panel say which.
+// renderer — presented through a Vulkan swapchain, or through OpenGL on machines with no usable
+// Vulkan device at all; the title and the panel say which.
 #include <CLI/CLI.hpp>
 #include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl2.h>
 #include <backends/imgui_impl_vulkan.h>
 
 #include <array>
@@ -21,6 +23,7 @@
 
 #include "demo_world.h"
 #include "fly_camera.h"
+#include "gl_window.h"
 #include "voxfield/error.h"
 #include "voxfield/gpu.h"
 #include "voxfield/gpu_vulkan.h"
@@ -80,9 +83,17 @@ class Demo {
   void take_screenshot(const std::string& path);
   bool gpu_can_draw() const { return path_.renderer && (view_ == RenderView::kShaded || view_ == RenderView::kChunks); }
   std::string title() const;
+  GLFWwindow* glfw() const { return vk_ ? vk_->window() : gl_->window(); }
+  int width() const { return vk_ ? vk_->width() : gl_->width(); }
+  int height() const { return vk_ ? vk_->height() : gl_->height(); }
+  void wait_idle() const {
+    if (vk_) vk_->wait_idle();
+  }
 
   Options options_;
-  VulkanWindow window_;
+  std::unique_ptr<VulkanWindow> vk_;  // the window, when Vulkan can present to it
+  std::unique_ptr<GlWindow> gl_;      // otherwise this one, showing CPU frames
+  std::string no_vulkan_;             // why there is no Vulkan window
   std::unique_ptr<DemoWorld> world_;
   RenderPath path_;
   FlyCamera camera_;
@@ -105,9 +116,15 @@ class Demo {
   int screenshots_ = 0;
 };
 
-Demo::Demo(const Options& o)
-    : options_(o), window_(o.width, o.height, "voxfield-demo", o.validation) {
+Demo::Demo(const Options& o) : options_(o) {
   world_ = o.load.empty() ? std::make_unique<DemoWorld>(o.world) : std::make_unique<DemoWorld>(o.world, o.load);
+  try {
+    vk_ = std::make_unique<VulkanWindow>(o.width, o.height, "voxfield-demo", o.validation);
+  } catch (const WindowError& e) {
+    no_vulkan_ = e.what();
+    std::cerr << "voxfield-demo: no Vulkan window (" << no_vulkan_ << "); showing the CPU renderer's frames through OpenGL\n";
+    gl_ = std::make_unique<GlWindow>(o.width, o.height, "voxfield-demo");
+  }
   ui_size_ = o.world.size;
   ui_chunk_ = o.world.chunk_edge;
   ui_clamp_ = static_cast<float>(o.world.clamp);
@@ -116,16 +133,22 @@ Demo::Demo(const Options& o)
   frame_camera();
 
   // Input callbacks first: the ImGui backend chains to them.
-  glfwSetWindowUserPointer(window_.window(), this);
-  glfwSetScrollCallback(window_.window(), [](GLFWwindow* w, double, double dy) {
+  glfwSetWindowUserPointer(glfw(), this);
+  glfwSetScrollCallback(glfw(), [](GLFWwindow* w, double, double dy) {
     static_cast<Demo*>(glfwGetWindowUserPointer(w))->scroll_ += dy;
   });
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini beside the user's files
   ImGui::StyleColorsDark();
-  ImGui_ImplGlfw_InitForVulkan(window_.window(), true);
-  VkInstance instance = window_.instance();
+  if (gl_) {
+    ImGui_ImplGlfw_InitForOpenGL(glfw(), true);
+    ImGui_ImplOpenGL2_Init();
+    return;
+  }
+  VulkanWindow& vw = *vk_;
+  ImGui_ImplGlfw_InitForVulkan(vw.window(), true);
+  VkInstance instance = vw.instance();
   ImGui_ImplVulkan_LoadFunctions(
       [](const char* name, void* user) { return vkGetInstanceProcAddr(*static_cast<VkInstance*>(user), name); }, &instance);
   VkDescriptorPoolSize sizes{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4};
@@ -134,45 +157,51 @@ Demo::Demo(const Options& o)
   dp.maxSets = 4;
   dp.poolSizeCount = 1;
   dp.pPoolSizes = &sizes;
-  if (vkCreateDescriptorPool(window_.device(), &dp, nullptr, &imgui_pool_) != VK_SUCCESS)
+  if (vkCreateDescriptorPool(vw.device(), &dp, nullptr, &imgui_pool_) != VK_SUCCESS)
     throw WindowError("cannot create the panel's descriptor pool");
   ImGui_ImplVulkan_InitInfo info{};
-  info.Instance = window_.instance();
-  info.PhysicalDevice = window_.physical();
-  info.Device = window_.device();
-  info.QueueFamily = window_.queue_family();
-  info.Queue = window_.queue();
+  info.Instance = vw.instance();
+  info.PhysicalDevice = vw.physical();
+  info.Device = vw.device();
+  info.QueueFamily = vw.queue_family();
+  info.Queue = vw.queue();
   info.DescriptorPool = imgui_pool_;
-  info.MinImageCount = window_.min_image_count();
-  info.ImageCount = window_.image_count();
+  info.MinImageCount = vw.min_image_count();
+  info.ImageCount = vw.image_count();
   info.MSAASamples = VK_SAMPLE_COUNT_1_BIT;
-  ImGui_ImplVulkan_Init(&info, window_.render_pass());
-  window_.run_once([](VkCommandBuffer cmd) { ImGui_ImplVulkan_CreateFontsTexture(cmd); });
+  ImGui_ImplVulkan_Init(&info, vw.render_pass());
+  vw.run_once([](VkCommandBuffer cmd) { ImGui_ImplVulkan_CreateFontsTexture(cmd); });
   ImGui_ImplVulkan_DestroyFontUploadObjects();
 }
 
 Demo::~Demo() {
-  window_.wait_idle();
-  ImGui_ImplVulkan_Shutdown();
+  wait_idle();
+  if (vk_) {
+    ImGui_ImplVulkan_Shutdown();
+  } else {
+    ImGui_ImplOpenGL2_Shutdown();
+  }
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();
   path_ = RenderPath{};  // voxfield's objects on the device go before the device
-  if (imgui_pool_) vkDestroyDescriptorPool(window_.device(), imgui_pool_, nullptr);
+  if (imgui_pool_) vkDestroyDescriptorPool(vk_->device(), imgui_pool_, nullptr);
 }
 
 void Demo::choose_path(const std::string& backend) {
-  window_.wait_idle();
+  wait_idle();
   path_ = RenderPath{};
   const Backend b = parse_backend(backend);
-  if (b == Backend::kCpu) {
+  if (!vk_) {
+    path_.why = "CPU renderer, shown through OpenGL (" + gl_->renderer_name() + "): no usable Vulkan device";
+  } else if (b == Backend::kCpu) {
     path_.why = "CPU renderer (--backend cpu)";
-  } else if (b == Backend::kAuto && !window_.device_is_hardware()) {
-    path_.why = "CPU renderer (auto: " + window_.device_name() + " is not a hardware GPU; --backend vulkan uses it)";
+  } else if (b == Backend::kAuto && !vk_->device_is_hardware()) {
+    path_.why = "CPU renderer (auto: " + vk_->device_name() + " is not a hardware GPU; --backend vulkan uses it)";
   } else {
     try {
-      path_.context = gpu::adopt({window_.instance(), window_.physical(), window_.device(), window_.queue(), window_.queue_family()});
+      path_.context = gpu::adopt({vk_->instance(), vk_->physical(), vk_->device(), vk_->queue(), vk_->queue_family()});
       path_.renderer = std::make_unique<gpu::SceneRenderer>(path_.context);
-      path_.why = "Vulkan ray marcher on " + window_.device_name();
+      path_.why = "Vulkan ray marcher on " + vk_->device_name();
     } catch (const Error& e) {
       path_ = RenderPath{};
       path_.why = std::string("CPU renderer (no usable Vulkan compute: ") + e.what() + ")";
@@ -196,16 +225,16 @@ std::string Demo::title() const {
 void Demo::edit_at_cursor(EditOp op) {
   double x = 0, y = 0;
   if (look_mode_) {
-    x = window_.width() / 2.0;
-    y = window_.height() / 2.0;
+    x = width() / 2.0;
+    y = height() / 2.0;
   } else {
-    glfwGetCursorPos(window_.window(), &x, &y);
+    glfwGetCursorPos(glfw(), &x, &y);
     int ww = 1, wh = 1;
-    glfwGetWindowSize(window_.window(), &ww, &wh);
-    x *= static_cast<double>(window_.width()) / std::max(ww, 1);
-    y *= static_cast<double>(window_.height()) / std::max(wh, 1);
+    glfwGetWindowSize(glfw(), &ww, &wh);
+    x *= static_cast<double>(width()) / std::max(ww, 1);
+    y *= static_cast<double>(height()) / std::max(wh, 1);
   }
-  const Ray ray = camera_.camera().projector(window_.width(), window_.height()).ray(x, y);
+  const Ray ray = camera_.camera().projector(width(), height()).ray(x, y);
   const RayHit hit = trace_ray(world_->scene(), ray);
   if (!hit.hit) return;
   Vec3d centre{static_cast<double>(hit.voxel.x), static_cast<double>(hit.voxel.y), static_cast<double>(hit.voxel.z)};
@@ -218,7 +247,7 @@ void Demo::edit_at_cursor(EditOp op) {
 }
 
 void Demo::handle_input(double dt_s) {
-  GLFWwindow* w = window_.window();
+  GLFWwindow* w = glfw();
   const ImGuiIO& io = ImGui::GetIO();
   auto down = [&](int key) { return glfwGetKey(w, key) == GLFW_PRESS; };
   // Keys that act once per press.
@@ -275,7 +304,11 @@ void Demo::handle_input(double dt_s) {
 }
 
 bool Demo::draw(VulkanWindow::Screenshot* shot) {
-  ImGui_ImplVulkan_NewFrame();
+  if (vk_) {
+    ImGui_ImplVulkan_NewFrame();
+  } else {
+    ImGui_ImplOpenGL2_NewFrame();
+  }
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
   panel();
@@ -283,12 +316,18 @@ bool Demo::draw(VulkanWindow::Screenshot* shot) {
   ImGui::Render();
 
   RenderOptions ro;
-  ro.width = window_.width();
-  ro.height = window_.height();
+  ro.width = width();
+  ro.height = height();
   ro.view = view_;
   ro.error_algorithm = error_algorithm_;
   const Camera cam = camera_.camera();
   const auto t0 = Clock::now();
+  if (gl_) {
+    const Image img = render(world_->scene(), cam, ro);
+    gl_->draw_frame(img, [] { ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData()); }, shot);
+    last_.render_ms = ms_between(t0, Clock::now());
+    return true;
+  }
   std::function<void(VkCommandBuffer, VkImage)> fill;
   VkBufferImageCopy copy{};
   copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
@@ -297,15 +336,15 @@ bool Demo::draw(VulkanWindow::Screenshot* shot) {
     path_.renderer->sync(world_->scene());
     fill = [&](VkCommandBuffer cmd, VkImage image) {
       const VkBuffer pixels = gpu::record_render(*path_.renderer, cmd, cam, ro,
-                                                 window_.bgra() ? gpu::PixelOrder::kBgra : gpu::PixelOrder::kRgba);
+                                                 vk_->bgra() ? gpu::PixelOrder::kBgra : gpu::PixelOrder::kRgba);
       vkCmdCopyBufferToImage(cmd, pixels, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
     };
   } else {
     const Image img = render(world_->scene(), cam, ro);
     void* mapped = nullptr;
-    const VkBuffer staging = window_.staging(static_cast<VkDeviceSize>(ro.width) * ro.height * 4, &mapped);
+    const VkBuffer staging = vk_->staging(static_cast<VkDeviceSize>(ro.width) * ro.height * 4, &mapped);
     auto* dst = static_cast<std::uint8_t*>(mapped);
-    const bool bgra = window_.bgra();
+    const bool bgra = vk_->bgra();
     for (std::size_t i = 0; i < static_cast<std::size_t>(ro.width) * ro.height; ++i) {
       dst[4 * i + 0] = img.rgb[3 * i + (bgra ? 2 : 0)];
       dst[4 * i + 1] = img.rgb[3 * i + 1];
@@ -316,9 +355,9 @@ bool Demo::draw(VulkanWindow::Screenshot* shot) {
       vkCmdCopyBufferToImage(cmd, staging, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
     };
   }
-  const bool drawn = window_.draw_frame(fill, [](VkCommandBuffer cmd) { ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd); },
-                                        shot);
-  if (gpu_can_draw()) window_.wait_idle();  // the GPU frame's time includes its execution
+  const bool drawn =
+      vk_->draw_frame(fill, [](VkCommandBuffer cmd) { ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd); }, shot);
+  if (gpu_can_draw()) wait_idle();  // the GPU frame's time includes its execution
   last_.render_ms = ms_between(t0, Clock::now());
   return drawn;
 }
@@ -361,7 +400,11 @@ void Demo::panel() {
     }
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("the approximation the error view measures against the exact field");
     const char* backends[] = {"cpu", "vulkan"};
-    if (ImGui::Combo("backend", &ui_backend_, backends, 2)) choose_path(backends[ui_backend_]);
+    if (vk_) {
+      if (ImGui::Combo("backend", &ui_backend_, backends, 2)) choose_path(backends[ui_backend_]);
+    } else {
+      ImGui::TextDisabled("backend: cpu (no usable Vulkan device)");
+    }
   }
   if (ImGui::CollapsingHeader("Field")) {
     const char* metrics[] = {"manhattan", "chebyshev", "euclidean"};
@@ -386,7 +429,7 @@ void Demo::panel() {
       s.size = ui_size_;
       s.chunk_edge = ui_chunk_;
       try {
-        window_.wait_idle();
+        wait_idle();
         world_ = std::make_unique<DemoWorld>(s);
         frame_camera();
         status_ = "regenerated";
@@ -409,7 +452,7 @@ void Demo::panel() {
         WorldSettings s = world_->settings();
         s.chunk_edge = ui_chunk_;
         auto loaded = std::make_unique<DemoWorld>(s, load_path_);
-        window_.wait_idle();
+        wait_idle();
         world_ = std::move(loaded);
         frame_camera();
         status_ = std::string("loaded ") + load_path_;
@@ -422,7 +465,7 @@ void Demo::panel() {
 }
 
 void Demo::help() {
-  ImGui::SetNextWindowPos(ImVec2(window_.width() * 0.5f, window_.height() * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowPos(ImVec2(width() * 0.5f, height() * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
   ImGui::Begin("help (F1)", &show_help_, ImGuiWindowFlags_AlwaysAutoResize);
   ImGui::Text("W A S D       fly; Space / Shift up and down; Ctrl faster");
   ImGui::Text("middle drag   look around; Tab toggles mouse look (edits at the centre)");
@@ -465,7 +508,7 @@ int Demo::run() {
   const auto start = Clock::now();
   auto previous = start;
   std::int64_t streamed = 0;
-  for (int frame = 0; !glfwWindowShouldClose(window_.window()); ++frame) {
+  for (int frame = 0; !glfwWindowShouldClose(glfw()); ++frame) {
     if (options_.benchmark && frame >= options_.frames) break;
     glfwPollEvents();
     const auto t0 = Clock::now();
@@ -496,7 +539,7 @@ int Demo::run() {
       while (!draw(nullptr)) {
       }
     }
-    glfwSetWindowTitle(window_.window(), title().c_str());
+    glfwSetWindowTitle(glfw(), title().c_str());
     last_.frame_ms = ms_between(t0, Clock::now());
     frame_history_.push_back(static_cast<float>(last_.frame_ms));
     if (frame_history_.size() > 120) frame_history_.pop_front();
@@ -536,8 +579,10 @@ int main(int argc, char** argv) {
   app.add_option("--csv", o.csv, "benchmark: one row per frame (frame_ms, update_ms, render_ms, edits)");
   app.add_option("--screenshot", o.screenshot, "benchmark: save the last frame as PNG");
   CLI11_PARSE(app, argc, argv);
+  glfwSetErrorCallback([](int code, const char* message) { std::cerr << "voxfield-demo: GLFW error " << code << ": " << message << "\n"; });
   try {
     o.world.metric = parse_metric(metric);
+    GlfwSession glfw;
     Demo demo(o);
     return demo.run();
   } catch (const WindowError& e) {

@@ -34,7 +34,15 @@ void image_barrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkIma
 }  // namespace
 
 VulkanWindow::VulkanWindow(int width, int height, const std::string& title, bool validation) {
-  if (!glfwInit()) throw WindowError("GLFW cannot start (no display? run under xvfb-run)");
+  try {
+    open(width, height, title, validation);
+  } catch (...) {
+    release();  // a constructor that throws runs no destructor
+    throw;
+  }
+}
+
+void VulkanWindow::open(int width, int height, const std::string& title, bool validation) {
   if (volkInitialize() != VK_SUCCESS) throw WindowError("no Vulkan loader (install libvulkan1)");
   if (!glfwVulkanSupported()) throw WindowError("GLFW finds no Vulkan support for windows");
   glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
@@ -136,7 +144,9 @@ VulkanWindow::VulkanWindow(int width, int height, const std::string& title, bool
   create_swapchain();
 }
 
-VulkanWindow::~VulkanWindow() {
+VulkanWindow::~VulkanWindow() { release(); }
+
+void VulkanWindow::release() {
   if (device_) {
     vkDeviceWaitIdle(device_);
     destroy_host_buffer(staging_);
@@ -152,7 +162,11 @@ VulkanWindow::~VulkanWindow() {
   if (messenger_) vkDestroyDebugUtilsMessengerEXT(instance_, messenger_, nullptr);
   if (instance_) vkDestroyInstance(instance_, nullptr);
   if (window_) glfwDestroyWindow(window_);
-  glfwTerminate();
+  device_ = VK_NULL_HANDLE;
+  surface_ = VK_NULL_HANDLE;
+  messenger_ = VK_NULL_HANDLE;
+  instance_ = VK_NULL_HANDLE;
+  window_ = nullptr;
 }
 
 void VulkanWindow::create_swapchain() {

@@ -25,9 +25,20 @@ class WindowError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// GLFW for the whole program: both kinds of window are opened inside one session, so falling back
+// from Vulkan to OpenGL does not reconnect to the display.
+struct GlfwSession {
+  GlfwSession() {
+    if (!glfwInit()) throw WindowError("GLFW cannot start (no display? run under xvfb-run)");
+  }
+  ~GlfwSession() { glfwTerminate(); }
+  GlfwSession(const GlfwSession&) = delete;
+  GlfwSession& operator=(const GlfwSession&) = delete;
+};
+
 class VulkanWindow {
  public:
-  // Opens a width x height window titled `title`. Throws WindowError when GLFW or Vulkan is not
+  // Opens a width x height window titled `title` (inside a GlfwSession). Throws WindowError when GLFW or Vulkan is not
   // usable (no display, no loader, no device that can present to the window).
   VulkanWindow(int width, int height, const std::string& title, bool validation);
   ~VulkanWindow();
@@ -68,6 +79,8 @@ class VulkanWindow {
   void wait_idle() const;
 
  private:
+  void open(int width, int height, const std::string& title, bool validation);
+  void release();
   void create_swapchain();
   void destroy_swapchain();
   void recreate_swapchain();
