@@ -33,6 +33,17 @@ VF_CONST(uint, VF_MANHATTAN, 0u);
 VF_CONST(uint, VF_CHEBYSHEV, 1u);
 VF_CONST(uint, VF_EUCLIDEAN, 2u);
 // Storage of encoded fields, as in voxfield::Storage.
+// FimParams::size.w
+VF_CONST(int, VF_FIM_UPDATE, 0);   // one Jacobi pass over the region (indirect: zero groups once converged)
+VF_CONST(int, VF_FIM_CONTROL, 1);  // one invocation: count the pass, stop the next ones if nothing moved
+VF_CONST(int, VF_FIM_RESOLVE, 2);  // copy the last pass's half to the first
+// The FIM control words (a storage and indirect-dispatch buffer of 8 uints).
+VF_CONST(uint, VF_FIM_MOVED, 0u);       // set by a pass when some voxel moved by more than eps
+VF_CONST(uint, VF_FIM_LAST, 1u);        // where the last pass that ran wrote (element offset)
+VF_CONST(uint, VF_FIM_PASSES, 2u);      // passes that ran
+VF_CONST(uint, VF_FIM_CONVERGED, 3u);   // 1 once a pass moved nothing
+VF_CONST(uint, VF_FIM_GROUPS, 4u);      // x, y, z workgroup counts of the next update pass
+
 // RenderParams::flags
 VF_CONST(uint, VF_RENDER_AO, 1u);
 VF_CONST(uint, VF_RENDER_SHADOWS, 2u);
@@ -101,6 +112,17 @@ struct JfaParams {
   uint dst;      // where this pass writes
 };
 
+// Push constants of a Fast Iterative Method pass (shaders/fim.comp): 64 bytes.
+struct FimParams {
+  ivec4 size;          // the domain's extent; w = mode: VF_FIM_UPDATE, VF_FIM_CONTROL, VF_FIM_RESOLVE
+  ivec4 region_begin;  // the voxels the passes update (the rest only feed them); w unused
+  ivec4 region_end;
+  uint src;            // where the previous pass's values start in the ping-pong buffer (elements)
+  uint dst;            // where this pass writes
+  uint metric;         // VF_MANHATTAN...
+  float eps;           // a voxel still moving by more than this keeps the iteration going
+};
+
 // The ray marcher's frame: camera, scene layout and shading options. std430, 176 bytes, in a
 // storage buffer. Per chunk of the render box, chunk_info holds 4 words: the skip arena slot (or
 // VF_UNIFORM), the uniform cell (distance | material << 8) in bits 0-15 with the chunk's smallest
@@ -130,6 +152,7 @@ struct RenderParams {
 static_assert(sizeof(Header) == 128, "std430 size of Header");
 static_assert(sizeof(PassParams) == 96, "push-constant size of PassParams");
 static_assert(sizeof(JfaParams) == 32, "push-constant size of JfaParams");
+static_assert(sizeof(FimParams) == 64, "push-constant size of FimParams");
 static_assert(sizeof(RenderParams) == 176, "std430 size of RenderParams");
 }  // namespace voxfield::gpu::layout
 #endif

@@ -13,5 +13,6 @@ std::span<const std::uint32_t> edt_encode();
 std::span<const std::uint32_t> render();
 std::span<const std::uint32_t> jfa();
 std::span<const std::uint32_t> jfa_seed();
+std::span<const std::uint32_t> fim();
 
 }  // namespace voxfield::gpu::shaders

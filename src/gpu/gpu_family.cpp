@@ -1,6 +1,8 @@
 // voxfield GPU backend — the dissertation's algorithm family on Vulkan: jump flooding (the
-// dissertation's value-propagating jfa-seed, and JFA, JFA+1, JFA+2) as one dispatch per pass with a pipeline barrier between passes, all passes of a
-// field in one command buffer (a fixed number of passes: no read-back to decide when to stop).
+// dissertation's value-propagating jfa-seed, and JFA, JFA+1, JFA+2) as one dispatch per pass with
+// a pipeline barrier between passes, all passes of a field in one command buffer (a fixed number
+// of passes: no read-back to decide when to stop); the Fast Iterative Method as Jacobi passes that
+// stop themselves through indirect dispatch (shaders/fim.comp); hybrid and LOD as JFA then FIM.
 // The problem set-up and the field assembly are the CPU's (src/distance/family_driver.h), and the
 // passes compute exactly what the CPU's do, so the fields are the same bit for bit.
 #include <chrono>
@@ -21,9 +23,12 @@ std::vector<int> extra_steps(Algorithm a) {
     case Algorithm::kJfa1: return {1};
     case Algorithm::kJfa2: return {2, 1};
     case Algorithm::kJfaSeed: return {};
+    case Algorithm::kFim: return {};
+    case Algorithm::kHybrid: return {};
+    case Algorithm::kLod: return {};
     default:
       throw InvalidArgument(std::string("GPU: the ") + algorithm_name(a) +
-                            " algorithm is not on the Vulkan backend yet (exact, jfa-seed, jfa, jfa+1 and jfa+2 are)");
+                            " algorithm is not on the Vulkan backend (brute force and brute-chunked are CPU references)");
   }
 }
 
@@ -140,6 +145,152 @@ detail::DenseSolution flood_values(Context::Impl& ctx, const detail::DenseProble
   return solution;
 }
 
+// The most Jacobi passes a field may need: values travel one voxel per pass, and a chain of
+// upwind dependencies cannot be longer than a path through the domain — twice over for the
+// Euclidean rule, whose chains may zig-zag. Converged passes cost an empty indirect dispatch.
+std::uint32_t fim_pass_bound(const detail::DenseProblem& p) {
+  const std::uint64_t sum = static_cast<std::uint64_t>(p.n.x) + p.n.y + p.n.z;
+  const std::uint64_t bound = p.metric == Metric::kChebyshev ? std::max({p.n.x, p.n.y, p.n.z}) + 2u
+                              : p.metric == Metric::kManhattan ? sum + 2
+                                                               : 2 * sum + 8;
+  return static_cast<std::uint32_t>(bound);
+}
+
+// The Fast Iterative Method as Jacobi passes over `region` from `initial` values (0 at sites),
+// stopping by itself once a pass moves nothing by more than the CPU's tolerance: one command
+// buffer, no read-back until the end.
+detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p, const std::vector<float>& initial,
+                              const Box3i& region, AlgorithmStats& stats, std::vector<PassTiming>* timings) {
+  const std::size_t n = p.size();
+  const VkDeviceSize half = static_cast<VkDeviceSize>(n) * 4;
+  if (2 * half > ctx.limits.maxStorageBufferRange)
+    throw InvalidArgument("GPU: " + std::to_string(n) + " voxels exceed this device's storage-buffer range for fim");
+  detail::DenseSolution solution;
+  solution.d = initial;
+  if (region.empty() || n == 0) return solution;
+  Buffer data(ctx, 2 * half,
+              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false);
+  constexpr VkDeviceSize kControlBytes = 8 * 4;
+  Buffer control(ctx, kControlBytes,
+                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                     VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                 false);
+  // The update pass's workgroups, split over y as dispatch() does.
+  const std::uint64_t groups = (n + 63) / 64;
+  const std::uint64_t gx = std::min<std::uint64_t>(groups, ctx.limits.maxComputeWorkGroupCount[0]);
+  const std::uint64_t gy = (groups + gx - 1) / gx;
+  if (gy > ctx.limits.maxComputeWorkGroupCount[1]) throw InvalidArgument("GPU: the domain exceeds the device's dispatch limits");
+  const std::uint32_t control_init[8] = {0, 0, 0, 0, static_cast<std::uint32_t>(gx), static_cast<std::uint32_t>(gy), 1, 0};
+  Buffer& upload = ctx.upload_buffer(half + kControlBytes);
+  std::memcpy(upload.mapped(), initial.data(), half);
+  std::memcpy(static_cast<std::uint8_t*>(upload.mapped()) + half, control_init, kControlBytes);
+  Buffer& readback = ctx.readback_buffer(half + kControlBytes);
+  const Buffer* bound[2] = {&data, &control};
+  const VkDescriptorSet set = ctx.bind(ctx.fim_layout, bound);
+  const std::uint32_t passes = fim_pass_bound(p);
+  const bool timed = timings && ctx.timestamps != VK_NULL_HANDLE;
+
+  L::FimParams fp{};
+  fp.size = {p.n.x, p.n.y, p.n.z, L::VF_FIM_UPDATE};
+  fp.region_begin = {region.begin.x, region.begin.y, region.begin.z, 0};
+  fp.region_end = {region.end.x, region.end.y, region.end.z, 0};
+  fp.metric = static_cast<std::uint32_t>(p.metric);
+  fp.eps = p.metric == Metric::kEuclidean ? 1e-5f : 0.0f;  // the CPU's tolerance
+  constexpr VkPipelineStageFlags kNext = VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+  constexpr VkAccessFlags kNextAccess =
+      VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  ctx.run_commands([&](VkCommandBuffer cmd) {
+    if (timed) {
+      vkCmdResetQueryPool(cmd, ctx.timestamps, 0, 2);
+      vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx.timestamps, 0);
+    }
+    const VkBufferCopy in{0, 0, half};
+    vkCmdCopyBuffer(cmd, upload.handle(), data.handle(), 1, &in);
+    const VkBufferCopy in_control{half, 0, kControlBytes};
+    vkCmdCopyBuffer(cmd, upload.handle(), control.handle(), 1, &in_control);
+    ctx.counters.bytes_uploaded += static_cast<std::int64_t>(half + kControlBytes);
+    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, kNext, kNextAccess);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.fim.pipeline);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.fim_layout.pipeline, 0, 1, &set, 0, nullptr);
+    std::uint32_t src = 0;
+    for (std::uint32_t k = 0; k < passes; ++k) {
+      fp.size.w = L::VF_FIM_UPDATE;
+      fp.src = src;
+      fp.dst = src == 0 ? static_cast<std::uint32_t>(n) : 0u;
+      vkCmdPushConstants(cmd, ctx.fim_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof fp, &fp);
+      vkCmdDispatchIndirect(cmd, control.handle(), L::VF_FIM_GROUPS * 4);
+      ++ctx.counters.dispatches;
+      barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+      fp.size.w = L::VF_FIM_CONTROL;
+      vkCmdPushConstants(cmd, ctx.fim_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof fp, &fp);
+      vkCmdDispatch(cmd, 1, 1, 1);
+      ++ctx.counters.dispatches;
+      barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT, kNext,
+              kNextAccess);
+      src = fp.dst;
+    }
+    fp.size.w = L::VF_FIM_RESOLVE;
+    vkCmdPushConstants(cmd, ctx.fim_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof fp, &fp);
+    dispatch(ctx, cmd, n);
+    if (timed) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx.timestamps, 1);
+    barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+            VK_ACCESS_TRANSFER_READ_BIT);
+    const VkBufferCopy out{0, 0, half};
+    vkCmdCopyBuffer(cmd, data.handle(), readback.handle(), 1, &out);
+    const VkBufferCopy out_control{0, half, kControlBytes};
+    vkCmdCopyBuffer(cmd, control.handle(), readback.handle(), 1, &out_control);
+    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+            VK_ACCESS_HOST_READ_BIT);
+    ctx.counters.bytes_downloaded += static_cast<std::int64_t>(half + kControlBytes);
+  });
+  std::uint32_t words[8];
+  std::memcpy(words, static_cast<const std::uint8_t*>(readback.mapped()) + half, sizeof words);
+  if (words[L::VF_FIM_CONVERGED] != 1u)
+    throw Error("GPU: fim did not converge within " + std::to_string(passes) + " passes");  // the bound says it must
+  std::memcpy(solution.d.data(), readback.mapped(), half);
+  stats.iterations += static_cast<int>(words[L::VF_FIM_PASSES]);
+  stats.updates += static_cast<std::int64_t>(region.volume()) * words[L::VF_FIM_PASSES];
+  if (timed) {
+    std::uint64_t ticks[2];
+    check(vkGetQueryPoolResults(ctx.device, ctx.timestamps, 0, 2, sizeof ticks, ticks, 8,
+                                VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+          "vkGetQueryPoolResults");
+    timings->push_back({"fim (" + std::to_string(words[L::VF_FIM_PASSES]) + " passes)",
+                        static_cast<double>(ticks[1] - ticks[0]) * ctx.timestamp_period_ns * 1e-6});
+  }
+  return solution;
+}
+
+// The CPU's LOD region: the world's chunks that meet the focus box, in domain coordinates.
+Box3i lod_region(const detail::DenseProblem& p, const Box3i& focus) {
+  const int e = p.chunk_edge;
+  auto down = [e](int v) { return (v >= 0 ? v / e : -((-v + e - 1) / e)) * e; };
+  const Box3i chunks{{down(focus.begin.x), down(focus.begin.y), down(focus.begin.z)},
+                     {down(focus.end.x - 1) + e, down(focus.end.y - 1) + e, down(focus.end.z - 1) + e}};
+  return Box3i{chunks.begin - p.box.begin, chunks.end - p.box.begin}.intersect(Box3i::from_size(p.n));
+}
+
+detail::DenseSolution solve(Context::Impl& ctx, const detail::DenseProblem& p, const AlgorithmOptions& a,
+                            const std::vector<int>& extra, AlgorithmStats& st, std::vector<PassTiming>* timings) {
+  switch (a.algorithm) {
+    case Algorithm::kJfaSeed: return flood_values(ctx, p, st, timings);
+    case Algorithm::kFim: {
+      std::vector<float> initial(p.size());
+      for (std::size_t i = 0; i < p.size(); ++i) initial[i] = p.site[i] ? 0.0f : detail::kFar;
+      return iterate(ctx, p, initial, Box3i::from_size(p.n), st, timings);
+    }
+    case Algorithm::kHybrid:
+    case Algorithm::kLod: {
+      // Jump flooding, then FIM from its values (everywhere, or in the focus chunks): two submits.
+      const detail::DenseSolution jfa = flood(ctx, p, extra, st, timings);
+      const Box3i region = a.algorithm == Algorithm::kHybrid ? Box3i::from_size(p.n) : lod_region(p, *a.focus);
+      return iterate(ctx, p, jfa.d, region, st, timings);
+    }
+    default: return flood(ctx, p, extra, st, timings);
+  }
+}
+
 }  // namespace
 
 DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
@@ -157,13 +308,16 @@ DistanceField compute_distance_field(Context& context, const World& world, const
   }
   const std::vector<int> extra = extra_steps(algorithm.algorithm);
   if (options.spacing != std::array<double, 3>{1, 1, 1})
-    throw InvalidArgument("GPU: jump flooding on the Vulkan backend supports unit voxel spacing only");
+    throw InvalidArgument("GPU: the algorithm family on the Vulkan backend supports unit voxel spacing only");
+  const Algorithm alg = algorithm.algorithm;
+  if (options.nearest_sites && (alg == Algorithm::kFim || alg == Algorithm::kHybrid || alg == Algorithm::kLod))
+    throw InvalidArgument(std::string("GPU: ") + algorithm_name(alg) +
+                          " on the Vulkan backend does not track nearest sites (its Jacobi passes carry distances only)");
   Context::Impl& ctx = context.impl();
-  return detail::compute_with_solver(
-      world, options, algorithm, stats,
-      [&](const detail::DenseProblem& p, const AlgorithmOptions& a, AlgorithmStats& st) {
-        return a.algorithm == Algorithm::kJfaSeed ? flood_values(ctx, p, st, timings) : flood(ctx, p, extra, st, timings);
-      });
+  return detail::compute_with_solver(world, options, algorithm, stats,
+                                     [&](const detail::DenseProblem& p, const AlgorithmOptions& a, AlgorithmStats& st) {
+                                       return solve(ctx, p, a, extra, st, timings);
+                                     });
 }
 
 }  // namespace voxfield::gpu

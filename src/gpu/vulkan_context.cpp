@@ -201,6 +201,8 @@ void Context::Impl::create_pipelines() {
   jfa_layout = make_binding_layout(1, 32);
   jfa = make_pipeline("jfa", shaders::jfa(), jfa_layout.pipeline);
   jfa_seed = make_pipeline("jfa_seed", shaders::jfa_seed(), jfa_layout.pipeline);
+  fim_layout = make_binding_layout(2, 64);
+  fim = make_pipeline("fim", shaders::fim(), fim_layout.pipeline);
 }
 
 // ---- submission -----------------------------------------------------------------------------
@@ -294,9 +296,9 @@ void Context::Impl::destroy() {
     vkDeviceWaitIdle(device);
     upload = Buffer();
     readback = Buffer();
-    for (Pipeline* p : {&edt_sites, &edt_lines, &edt_encode, &render, &jfa, &jfa_seed})
+    for (Pipeline* p : {&edt_sites, &edt_lines, &edt_encode, &render, &jfa, &jfa_seed, &fim})
       if (p->pipeline) vkDestroyPipeline(device, p->pipeline, nullptr);
-    for (BindingLayout* l : {&field_layout, &render_layout, &jfa_layout}) {
+    for (BindingLayout* l : {&field_layout, &render_layout, &jfa_layout, &fim_layout}) {
       if (l->pool) vkDestroyDescriptorPool(device, l->pool, nullptr);
       if (l->pipeline) vkDestroyPipelineLayout(device, l->pipeline, nullptr);
       if (l->set) vkDestroyDescriptorSetLayout(device, l->set, nullptr);

@@ -82,8 +82,8 @@ struct Context::Impl {
   static constexpr std::uint32_t kBindings = 9;
   static constexpr std::uint32_t kPushBytes = 96;
   static constexpr std::uint32_t kRenderBindings = 6;
-  BindingLayout field_layout, render_layout, jfa_layout;
-  Pipeline edt_sites, edt_lines, edt_encode, render, jfa, jfa_seed;
+  BindingLayout field_layout, render_layout, jfa_layout, fim_layout;
+  Pipeline edt_sites, edt_lines, edt_encode, render, jfa, jfa_seed, fim;
 
   // Reusable host-visible buffers for uploads and read-backs (grown when too small).
   Buffer upload, readback;
