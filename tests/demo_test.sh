@@ -13,9 +13,11 @@ fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 run() {  # name, demo arguments...
   local name=$1
   shift
-  if ! env ${RUN_ENV:-} xvfb-run -a -s "-screen 0 1024x768x24" "$DEMO" --benchmark --frames 30 --width 480 --height 270 --world 64 \
-      --csv "$out/$name.csv" --screenshot "$out/$name.png" "$@" >"$out/$name.out" 2>"$out/$name.err"; then
-    fail "$name: exit status $?: $(cat "$out/$name.err")"
+  local status=0
+  env ${RUN_ENV:-} xvfb-run -a -s "-screen 0 1024x768x24" "$DEMO" --benchmark --frames 30 --width 480 --height 270 --world 64 \
+      --csv "$out/$name.csv" --screenshot "$out/$name.png" "$@" >"$out/$name.out" 2>"$out/$name.err" || status=$?
+  if [ "$status" -ne 0 ]; then
+    fail "$name: exit status $status: $(tail -5 "$out/$name.err")"
     return
   fi
   grep -q "validation:" "$out/$name.err" && fail "$name: validation messages: $(grep -m3 validation: "$out/$name.err")"
