@@ -50,6 +50,7 @@ VF_CONST(uint, VF_RENDER_SHADOWS, 2u);
 VF_CONST(uint, VF_RENDER_CHUNKS, 4u);
 VF_CONST(uint, VF_RENDER_HAS_LIGHT, 8u);
 VF_CONST(uint, VF_RENDER_BGRA, 16u);  // pack pixels blue first (B8G8R8A8 swapchains)
+VF_CONST(uint, VF_RENDER_DISTANCE, 32u);  // the distance view: a cut at slice_z, the field as a heat map on it
 
 VF_CONST(uint, VF_U8, 0u);
 VF_CONST(uint, VF_U16, 1u);
@@ -123,7 +124,7 @@ struct FimParams {
   float eps;           // a voxel still moving by more than this keeps the iteration going
 };
 
-// The ray marcher's frame: camera, scene layout and shading options. std430, 176 bytes, in a
+// The ray marcher's frame: camera, scene layout and shading options. std430, 192 bytes, in a
 // storage buffer. Per chunk of the render box, chunk_info holds 4 words: the skip arena slot (or
 // VF_UNIFORM), the uniform cell (distance | material << 8) in bits 0-15 with the chunk's smallest
 // distance in bits 16-23, bit 24 "no solid voxel", bit 25 "materials stored voxel by voxel"; then
@@ -145,7 +146,9 @@ struct RenderParams {
   float skip_inv_scale;
   float light_inv_scale;
   uint flags;          // VF_RENDER_* bits
-  uint pad0;
+  int slice_z;         // distance view: the cut plane (voxels above it are hidden)
+  float heat_max;      // distance view: the distance at the top of the heat ramp
+  uint pad0, pad1, pad2;
 };
 
 #ifdef __cplusplus
@@ -153,7 +156,7 @@ static_assert(sizeof(Header) == 128, "std430 size of Header");
 static_assert(sizeof(PassParams) == 96, "push-constant size of PassParams");
 static_assert(sizeof(JfaParams) == 32, "push-constant size of JfaParams");
 static_assert(sizeof(FimParams) == 64, "push-constant size of FimParams");
-static_assert(sizeof(RenderParams) == 176, "std430 size of RenderParams");
+static_assert(sizeof(RenderParams) == 192, "std430 size of RenderParams");
 }  // namespace voxfield::gpu::layout
 #endif
 #undef VF_CONST

@@ -155,11 +155,14 @@ vec3 skip_weights(vec3 dir) {
   return a / norm;
 }
 
+// The box rays walk: the render box, or in the distance view the part below the cut.
+ivec3 g_lo, g_hi;
+
 bool start_in_box(vec3 o, vec3 dir) {
   float t0 = -kInf, t1 = kInf;
   int axis0 = -1;
   for (int a = 0; a < 3; ++a) {
-    const float lo = float(rp.box_begin[a]), hi = float(rp.box_end[a]);
+    const float lo = float(g_lo[a]), hi = float(g_hi[a]);
     if (dir[a] == 0.0) {
       if (o[a] < lo || o[a] >= hi) return false;
       continue;
@@ -172,14 +175,14 @@ bool start_in_box(vec3 o, vec3 dir) {
   const float ts = max(t0, 0.0);
   if (!(t1 > ts)) return false;
   ivec3 v;
-  for (int a = 0; a < 3; ++a) v[a] = clamp(int(floor(o[a] + dir[a] * ts)), rp.box_begin[a], rp.box_end[a] - 1);
+  for (int a = 0; a < 3; ++a) v[a] = clamp(int(floor(o[a] + dir[a] * ts)), g_lo[a], g_hi[a] - 1);
   const int face = t0 > 0.0 ? axis0 : -1;
-  if (face >= 0) v[face] = dir[face] > 0.0 ? rp.box_begin[face] : rp.box_end[face] - 1;
+  if (face >= 0) v[face] = dir[face] > 0.0 ? g_lo[face] : g_hi[face] - 1;
   d_start(o, dir, v, ts, face);
   return true;
 }
 
-bool in_box(ivec3 v) { return all(greaterThanEqual(v, rp.box_begin.xyz)) && all(lessThan(v, rp.box_end.xyz)); }
+bool in_box(ivec3 v) { return all(greaterThanEqual(v, g_lo)) && all(lessThan(v, g_hi)); }
 
 // Traces from the current DDA state to the first solid voxel. shadow: track the soft-shadow
 // penumbra at the air voxels visited (min k * (e - 0.75) / t beyond t = 1.5).
@@ -265,12 +268,27 @@ float soft_shadow(vec3 p, vec3 n) {
   return lit * lit * (3.0 - 2.0 * lit);
 }
 
+// sRGB bytes as one packed pixel, in the order the frame asks for.
+uint pack_bytes(uvec3 b) {
+  return (rp.flags & VF_RENDER_BGRA) != 0u ? b.z | (b.y << 8) | (b.x << 16) | (255u << 24)
+                                           : b.x | (b.y << 8) | (b.z << 16) | (255u << 24);
+}
+
 uint encode(vec3 c) {
   const vec3 exposed = 1.0 - exp(-1.25 * max(c, vec3(0.0)));
   const vec3 s = mix(12.92 * exposed, 1.055 * pow(exposed, vec3(1.0 / 2.4)) - 0.055, greaterThan(exposed, vec3(0.0031308)));
-  const uvec3 b = uvec3(clamp(s, 0.0, 1.0) * 255.0 + 0.5);
-  return (rp.flags & VF_RENDER_BGRA) != 0u ? b.z | (b.y << 8) | (b.x << 16) | (255u << 24)
-                                           : b.x | (b.y << 8) | (b.z << 16) | (255u << 24);
+  return pack_bytes(uvec3(clamp(s, 0.0, 1.0) * 255.0 + 0.5));
+}
+
+// The heat ramp of the distance view (dark blue, blue, green, yellow, red) for x in [0, 1], as
+// sRGB bytes (src/render/renderer.cpp: heat()).
+uvec3 heat(float x) {
+  const vec3 stops[5] = vec3[5](vec3(20, 12, 70), vec3(30, 100, 220), vec3(40, 190, 130), vec3(245, 215, 50),
+                                vec3(215, 40, 30));
+  x = clamp(x, 0.0, 1.0) * 4.0;
+  const int i = min(3, int(x));
+  const float f = x - float(i);
+  return uvec3(floor(stops[i] * (1.0 - f) + stops[i + 1] * f + 0.5));
 }
 
 void main() {
@@ -285,6 +303,23 @@ void main() {
     dir = rp.forward.xyz;
   } else {
     dir = normalize(rp.forward.xyz + rp.right.xyz * sx + rp.up.xyz * sy);
+  }
+  g_lo = rp.box_begin.xyz;
+  g_hi = rp.box_end.xyz;
+  if ((rp.flags & VF_RENDER_DISTANCE) != 0u) {
+    g_hi.z = rp.slice_z + 1;
+    // A ray entering the cut through its top face on an air voxel shows the field there, with a
+    // darker band every 8 voxels of distance.
+    if (start_in_box(origin, dir) && d_face == 2 && d_step.z < 0) {
+      const uint cell = skip_cell(chunk_index(d_v), d_v);
+      if ((cell >> 8) == 0u) {
+        const float distance = float(cell & 0xFFu) * rp.skip_inv_scale;
+        uvec3 b = heat(distance / rp.heat_max);
+        if (int(distance) % 8 == 0) b = b * 3u / 4u;
+        pixels[i] = pack_bytes(b);
+        return;
+      }
+    }
   }
   vec3 color;
   if (!start_in_box(origin, dir) || !trace(dir, false)) {

@@ -252,7 +252,7 @@ TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
     RenderOptions o;
     o.width = 160;
     o.height = 96;
-    for (RenderView view : {RenderView::kShaded, RenderView::kChunks}) {
+    for (RenderView view : {RenderView::kShaded, RenderView::kChunks, RenderView::kDistance}) {
       o.view = view;
       for (const Camera& cam : {Camera::framing(scene.box(), 160.0 / 96), Camera::top(scene.box(), 160.0 / 96)}) {
         const std::string what = std::string(metric_name(m)) + " " + render_view_name(view);
@@ -272,9 +272,18 @@ TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
   expect_images_close(gpu::render(*ctx, scene, cam, fog), render(scene, cam, fog), "fog");
   const auto messages = ctx->validation_messages();
   EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
-  RenderOptions distance = fog;
-  distance.view = RenderView::kDistance;
-  EXPECT_THROW(gpu::render(*ctx, scene, cam, distance), InvalidArgument);
+  RenderOptions cut = fog;
+  cut.view = RenderView::kDistance;
+  for (int z : {3, 7, 39}) {  // just above the floor, a middle cut, the top layer
+    cut.slice_z = z;
+    expect_images_close(gpu::render(*ctx, scene, Camera::top(scene.box(), 1.5), cut),
+                        render(scene, Camera::top(scene.box(), 1.5), cut), "distance cut z=" + std::to_string(z));
+  }
+  cut.slice_z = 40;  // outside the box
+  EXPECT_THROW(gpu::render(*ctx, scene, cam, cut), InvalidArgument);
+  RenderOptions error = fog;
+  error.view = RenderView::kError;
+  EXPECT_THROW(gpu::render(*ctx, scene, cam, error), InvalidArgument);
 }
 
 TEST(Gpu, BrickPoolReusesAndGrowsCorrectly) {

@@ -41,9 +41,9 @@ std::array<std::uint32_t, 4> chunk_info(const RenderScene::Impl& s, std::size_t 
 }
 
 void check_options(const RenderScene::Impl& s, const RenderOptions& o) {
-  if (o.view != RenderView::kShaded && o.view != RenderView::kChunks)
-    throw InvalidArgument(std::string("GPU: the ") + render_view_name(o.view) +
-                          " view is not on the Vulkan backend yet (shaded and chunks are)");
+  if (o.view == RenderView::kError)
+    throw InvalidArgument("GPU: the error view is not on the Vulkan backend yet (shaded, distance and chunks are)");
+  if (o.view == RenderView::kDistance) s.slice_z(o);  // throws for a cut outside the box
   if (o.skip != SkipMode::kDistance) throw InvalidArgument("GPU: the Vulkan ray marcher always skips by distance");
   if (o.width <= 0 || o.height <= 0 || o.width > 16384 || o.height > 16384)
     throw InvalidArgument("render: image size out of range (1..16384 per side)");
@@ -241,9 +241,15 @@ void ResidentScene::record_render(VkCommandBuffer cmd, const Camera& camera, con
   rp.metric = static_cast<std::uint32_t>(s.skip.metric);
   rp.skip_inv_scale = static_cast<float>(s.skip.inv_scale);
   rp.light_inv_scale = static_cast<float>(s.light_inv_scale);
-  rp.flags = (o.ambient_occlusion ? L::VF_RENDER_AO : 0u) | (o.soft_shadows ? L::VF_RENDER_SHADOWS : 0u) |
+  const bool distance = o.view == RenderView::kDistance;
+  // The distance view shades what lies below the cut without shadows, as the CPU's does.
+  rp.flags = (o.ambient_occlusion ? L::VF_RENDER_AO : 0u) | (o.soft_shadows && !distance ? L::VF_RENDER_SHADOWS : 0u) |
              (o.view == RenderView::kChunks ? L::VF_RENDER_CHUNKS : 0u) | (s.has_light ? L::VF_RENDER_HAS_LIGHT : 0u) |
-             (bgra ? L::VF_RENDER_BGRA : 0u);
+             (bgra ? L::VF_RENDER_BGRA : 0u) | (distance ? L::VF_RENDER_DISTANCE : 0u);
+  if (distance) {
+    rp.slice_z = s.slice_z(o);
+    rp.heat_max = static_cast<float>(s.heat_max(rp.slice_z));
+  }
 
   // The previous frame's reads of the parameters and writes of the pixels come before these.
   barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,

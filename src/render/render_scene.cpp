@@ -247,6 +247,23 @@ void check_fields(const RenderScene::Impl& s, const DistanceField& skip_field, c
 
 }  // namespace
 
+int RenderScene::Impl::slice_z(const RenderOptions& o) const {
+  const int z = o.slice_z ? *o.slice_z : (box.begin.z + box.end.z) / 2;
+  if (z < box.begin.z || z >= box.end.z)
+    throw InvalidArgument("render: slice z=" + std::to_string(z) + " lies outside the box " + to_string(box));
+  return z;
+}
+
+double RenderScene::Impl::heat_max(int z) const {
+  int top = 1;
+  for (int y = box.begin.y; y < box.end.y; ++y)
+    for (int x = box.begin.x; x < box.end.x; ++x) {
+      const Vec3i v{x, y, z};
+      top = std::max<int>(top, skip.distance(table.chunk_index(v), table.brick_index(v)));
+    }
+  return std::max(1.0, top * skip.inv_scale);
+}
+
 SkipSource RenderScene::Impl::make_skip_source(const DistanceField& field) const {
   SkipSource src;
   src.metric = field.options.metric;

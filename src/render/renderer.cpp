@@ -286,14 +286,8 @@ Image render(const RenderScene& scene, const Camera& camera, const RenderOptions
   std::optional<DistanceField> approx_field;
   SkipSource approx;
   if (o.view == RenderView::kDistance) {
-    f.slice_z = o.slice_z ? *o.slice_z : (s.box.begin.z + s.box.end.z) / 2;
-    if (f.slice_z < s.box.begin.z || f.slice_z >= s.box.end.z)
-      throw InvalidArgument("render: slice z=" + std::to_string(f.slice_z) + " lies outside the box " + to_string(s.box));
-    // Normalise the heat map by the largest distance on the cut.
-    int top = 1;
-    for (int y = s.box.begin.y; y < s.box.end.y; ++y)
-      for (int x = s.box.begin.x; x < s.box.end.x; ++x) top = std::max<int>(top, f.skip_at({x, y, f.slice_z}));
-    f.heat_max = std::max(1.0, top * s.skip.inv_scale);
+    f.slice_z = s.slice_z(o);
+    f.heat_max = s.heat_max(f.slice_z);
   }
   if (o.view == RenderView::kError) {
     AlgorithmOptions ao;

@@ -81,6 +81,10 @@ struct RenderScene::Impl {
   std::array<std::array<float, 3>, 256> albedo{};  // palette in linear RGB
 
   void build(const World& w, const DistanceField& skip_field, const DistanceField* light_field);
+  // The distance view's cut plane (RenderOptions::slice_z, default the middle of the box; throws
+  // InvalidArgument outside it) and the largest distance on it, which the heat map is scaled by.
+  int slice_z(const RenderOptions& o) const;
+  double heat_max(int slice_z) const;
   // A skip source over this scene's table from another field (the error view's approximation).
   SkipSource make_skip_source(const DistanceField& field) const;
   // Re-reads chunk i from the world and the fields (the fields already checked to fit).
