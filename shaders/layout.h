@@ -51,6 +51,7 @@ VF_CONST(uint, VF_RENDER_CHUNKS, 4u);
 VF_CONST(uint, VF_RENDER_HAS_LIGHT, 8u);
 VF_CONST(uint, VF_RENDER_BGRA, 16u);  // pack pixels blue first (B8G8R8A8 swapchains)
 VF_CONST(uint, VF_RENDER_DISTANCE, 32u);  // the distance view: a cut at slice_z, the field as a heat map on it
+VF_CONST(uint, VF_RENDER_ERROR, 64u);     // the error view: |approximate - exact| along each ray
 
 VF_CONST(uint, VF_U8, 0u);
 VF_CONST(uint, VF_U16, 1u);
@@ -148,7 +149,8 @@ struct RenderParams {
   uint flags;          // VF_RENDER_* bits
   int slice_z;         // distance view: the cut plane (voxels above it are hidden)
   float heat_max;      // distance view: the distance at the top of the heat ramp
-  uint pad0, pad1, pad2;
+  float approx_inv_scale;  // error view: stored approximate value * this = voxels
+  uint pad1, pad2;
 };
 
 #ifdef __cplusplus

@@ -17,6 +17,10 @@ layout(std430, set = 0, binding = 2) readonly buffer SkipArena { uint skip_words
 layout(std430, set = 0, binding = 3) readonly buffer LightArena { uint light_words[]; };  // u8 per voxel
 layout(std430, set = 0, binding = 4) readonly buffer Palette { vec4 albedo[]; };         // linear RGB
 layout(std430, set = 0, binding = 5) writeonly buffer Image { uint pixels[]; };          // RGBA8
+// The error view's approximate field: per chunk its slot (or VF_UNIFORM) and its uniform cell |
+// smallest distance << 16; cells as in SkipArena.
+layout(std430, set = 0, binding = 6) readonly buffer ApproxInfo { uint approx_info[]; };
+layout(std430, set = 0, binding = 7) readonly buffer ApproxArena { uint approx_words[]; };
 
 const float kInf = 1.0 / 0.0;
 
@@ -44,6 +48,16 @@ uint skip_cell(uint chunk, ivec3 v) {
 }
 
 uint chunk_min(uint chunk) { return (chunk_info[4 * chunk + 1] >> 16) & 0xFFu; }
+
+// The same reads from the exact skip field or the error view's approximation.
+uint cell_of(bool approx, uint chunk, ivec3 v) {
+  if (!approx) return skip_cell(chunk, v);
+  const uint slot = approx_info[2 * chunk];
+  if (slot == VF_UNIFORM) return approx_info[2 * chunk + 1] & 0xFFFFu;
+  const uint i = slot * uint(rp.chunk_dims.w) + brick_index(v);
+  return (approx_words[i >> 1] >> ((i & 1u) * 16u)) & 0xFFFFu;
+}
+uint min_of(bool approx, uint chunk) { return approx ? (approx_info[2 * chunk + 1] >> 16) & 0xFFu : chunk_min(chunk); }
 bool chunk_empty(uint chunk) { return (chunk_info[4 * chunk + 1] & (1u << 24)) != 0u; }
 bool chunk_dense(uint chunk) { return (chunk_info[4 * chunk + 1] & (1u << 25)) != 0u; }
 
@@ -188,7 +202,7 @@ bool in_box(ivec3 v) { return all(greaterThanEqual(v, g_lo)) && all(lessThan(v, 
 // penumbra at the air voxels visited (min k * (e - 0.75) / t beyond t = 1.5).
 uint g_material;
 float g_penumbra;
-bool trace(vec3 dir, bool shadow) {
+bool trace(vec3 dir, bool shadow, bool approx) {
   const vec3 w = skip_weights(dir);
   for (int guard = 0; guard < 100000; ++guard) {
     if (!in_box(d_v)) return false;
@@ -201,13 +215,13 @@ bool trace(vec3 dir, bool shadow) {
       for (int a = 0; a < 3; ++a) caps[a] = d_step[a] > 0 ? hi[a] - 1 - d_v[a] : d_v[a] - lo[a];
       float et; int ea;
       exit_of(caps, et, ea);
-      const ivec3 dcaps = skip_caps(w, chunk_min(chunk));
+      const ivec3 dcaps = skip_caps(w, min_of(approx, chunk));
       float dt; int da;
       exit_of(dcaps, dt, da);
       if (dt > et || (dt == et && da > ea)) leave(dcaps, dt, da); else leave(caps, et, ea);
       continue;
     }
-    const uint cell = skip_cell(chunk, d_v);
+    const uint cell = cell_of(approx, chunk, d_v);
     const uint material = cell >> 8;
     if (material != 0u) { g_material = material; return true; }
     const ivec3 caps = skip_caps(w, cell & 0xFFu);
@@ -263,7 +277,7 @@ float soft_shadow(vec3 p, vec3 n) {
   const vec3 o = p + n * 1e-3;
   if (!start_in_box(o, rp.sun.xyz)) return 1.0;
   g_penumbra = 1.0;
-  if (trace(rp.sun.xyz, true)) return 0.0;
+  if (trace(rp.sun.xyz, true, false)) return 0.0;
   const float lit = clamp(g_penumbra, 0.0, 1.0);
   return lit * lit * (3.0 - 2.0 * lit);
 }
@@ -274,11 +288,14 @@ uint pack_bytes(uvec3 b) {
                                            : b.x | (b.y << 8) | (b.z << 16) | (255u << 24);
 }
 
-uint encode(vec3 c) {
+// Exposure and the sRGB curve, as bytes.
+uvec3 tone_bytes(vec3 c) {
   const vec3 exposed = 1.0 - exp(-1.25 * max(c, vec3(0.0)));
   const vec3 s = mix(12.92 * exposed, 1.055 * pow(exposed, vec3(1.0 / 2.4)) - 0.055, greaterThan(exposed, vec3(0.0031308)));
-  return pack_bytes(uvec3(clamp(s, 0.0, 1.0) * 255.0 + 0.5));
+  return uvec3(clamp(s, 0.0, 1.0) * 255.0 + 0.5);
 }
+
+uint encode(vec3 c) { return pack_bytes(tone_bytes(c)); }
 
 // The heat ramp of the distance view (dark blue, blue, green, yellow, red) for x in [0, 1], as
 // sRGB bytes (src/render/renderer.cpp: heat()).
@@ -321,8 +338,31 @@ void main() {
       }
     }
   }
+  // The error view: the plain DDA visits every voxel up to the true hit, recording the largest
+  // |approximate - exact| on the way; then the approximation's own skipping walk must stop at
+  // the same voxel, or the pixel is magenta (a ray let through geometry).
+  float worst = 0.0;
+  bool through = false;
+  if ((rp.flags & VF_RENDER_ERROR) != 0u) {
+    bool exact_hit = false;
+    ivec3 exact_voxel = ivec3(0);
+    if (start_in_box(origin, dir)) {
+      for (int guard = 0; guard < 100000; ++guard) {
+        if (!in_box(d_v)) break;
+        const uint chunk = chunk_index(d_v);
+        const uint cell = skip_cell(chunk, d_v);
+        if ((cell >> 8) != 0u) { exact_hit = true; exact_voxel = d_v; break; }
+        const float e = float(cell & 0xFFu) * rp.skip_inv_scale;
+        const float a = float(cell_of(true, chunk, d_v) & 0xFFu) * rp.approx_inv_scale;
+        worst = max(worst, abs(a - e));
+        step_once();
+      }
+    }
+    const bool skipped_hit = start_in_box(origin, dir) && trace(dir, false, true);
+    through = skipped_hit != exact_hit || (exact_hit && d_v != exact_voxel);
+  }
   vec3 color;
-  if (!start_in_box(origin, dir) || !trace(dir, false)) {
+  if (!start_in_box(origin, dir) || !trace(dir, false, false)) {
     color = sky(dir);
   } else {
     const ivec3 voxel = d_v;
@@ -359,6 +399,19 @@ void main() {
       color = mix(color, chunk_dense(chunk_index(voxel)) ? vec3(0.15, 0.35, 1.0) : vec3(1.0, 0.55, 0.1), 0.15);
       if (line) color = mix(color, vec3(0.02), 0.85);
     }
+  }
+  if ((rp.flags & VF_RENDER_ERROR) != 0u) {
+    // Grey shading under the error: magenta where the approximation passes the true hit, else a
+    // heat tint, logarithmic so that one step and dozens of voxels both stay readable.
+    const float grey = 0.8 * dot(color, vec3(0.2126, 0.7152, 0.0722));
+    uvec3 b = tone_bytes(vec3(grey));
+    if (through) {
+      b = uvec3(255u, 0u, 255u);
+    } else if (worst > 0.0) {
+      b = (2u * b + 3u * heat(log2(1.0 + worst) / 6.0)) / 5u;
+    }
+    pixels[i] = pack_bytes(b);
+    return;
   }
   pixels[i] = encode(color);
 }

@@ -281,9 +281,17 @@ TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
   }
   cut.slice_z = 40;  // outside the box
   EXPECT_THROW(gpu::render(*ctx, scene, cam, cut), InvalidArgument);
+  // The error view: the approximations' errors along each ray and the rays they let through
+  // geometry (magenta), as the CPU draws them.
   RenderOptions error = fog;
   error.view = RenderView::kError;
-  EXPECT_THROW(gpu::render(*ctx, scene, cam, error), InvalidArgument);
+  for (Algorithm alg : {Algorithm::kJfaSeed, Algorithm::kJfa, Algorithm::kExact}) {
+    error.error_algorithm = alg;
+    RenderStats cpu_stats;
+    const Image cpu_image = render(scene, cam, error, &cpu_stats);
+    expect_images_close(gpu::render(*ctx, scene, cam, error), cpu_image, std::string("error view ") + algorithm_name(alg));
+    if (alg == Algorithm::kJfaSeed) EXPECT_GT(cpu_stats.max_error, 0);  // the view has something to show
+  }
 }
 
 TEST(Gpu, BrickPoolReusesAndGrowsCorrectly) {

@@ -81,7 +81,7 @@ class Demo {
   void panel();
   void help();
   void take_screenshot(const std::string& path);
-  bool gpu_can_draw() const { return path_.renderer && view_ != RenderView::kError; }
+  bool gpu_can_draw() const { return path_.renderer != nullptr; }
   std::string title() const;
   GLFWwindow* glfw() const { return vk_ ? vk_->window() : gl_->window(); }
   int width() const { return vk_ ? vk_->width() : gl_->width(); }

@@ -155,7 +155,8 @@ class DynamicField {
 
 // Renders a frame of `scene` with the ray-marching compute shader: the CPU renderer's traversal,
 // data and shading, in floats — images match the CPU's within the tolerance tests/test_gpu.cpp
-// states. Shaded, distance and chunks views (the error view throws InvalidArgument for now). One submit; stats->ms
+// states. Every view (the error view's counts, rays_through_geometry and max_error, stay zero:
+// the CPU renderer reports them). One submit; stats->ms
 // covers upload, render and read-back. For many frames of a changing scene, use SceneRenderer.
 Image render(Context& context, const RenderScene& scene, const Camera& camera, const RenderOptions& options,
              RenderStats* stats = nullptr, std::vector<PassTiming>* timings = nullptr);

@@ -41,8 +41,6 @@ std::array<std::uint32_t, 4> chunk_info(const RenderScene::Impl& s, std::size_t 
 }
 
 void check_options(const RenderScene::Impl& s, const RenderOptions& o) {
-  if (o.view == RenderView::kError)
-    throw InvalidArgument("GPU: the error view is not on the Vulkan backend yet (shaded, distance and chunks are)");
   if (o.view == RenderView::kDistance) s.slice_z(o);  // throws for a cut outside the box
   if (o.skip != SkipMode::kDistance) throw InvalidArgument("GPU: the Vulkan ray marcher always skips by distance");
   if (o.width <= 0 || o.height <= 0 || o.width > 16384 || o.height > 16384)
@@ -86,6 +84,10 @@ class ResidentScene {
  private:
   void ensure_pixels(VkDeviceSize bytes);
   void write_descriptors();
+  // Records the copy of the error view's approximation when the scene or the algorithm changed
+  // since the last one (computed on the CPU as the CPU renderer does, staged in a buffer of its
+  // own so a sync in the same command buffer does not overwrite it).
+  void record_approximation(VkCommandBuffer cmd, Algorithm algorithm);
 
   Context::Impl& ctx_;
   const RenderScene::Impl* scene_ = nullptr;
@@ -93,6 +95,10 @@ class ResidentScene {
   std::vector<std::uint64_t> synced_generation_;
   std::uint64_t synced_palette_ = 0;
   Buffer params_, info_, skip_, light_, palette_, pixels_;
+  Buffer approx_info_, approx_arena_, approx_staging_;
+  std::uint64_t approx_scene_ = 0, approx_generation_ = 0;  // what the resident approximation was made from
+  int approx_algorithm_ = -1;
+  double approx_inv_scale_ = 1;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   bool descriptors_stale_ = true;
@@ -210,9 +216,52 @@ void ResidentScene::ensure_pixels(VkDeviceSize bytes) {
 
 void ResidentScene::write_descriptors() {
   if (pool_ == VK_NULL_HANDLE) pool_ = ctx_.make_descriptor_pool(Context::Impl::kRenderBindings);
-  const Buffer* bound[Context::Impl::kRenderBindings] = {&params_, &info_, &skip_, &light_, &palette_, &pixels_};
+  for (Buffer* b : {&approx_info_, &approx_arena_})
+    if (b->handle() == VK_NULL_HANDLE) *b = Buffer(ctx_, 16, kUsage, false);  // bound even when unused
+  const Buffer* bound[Context::Impl::kRenderBindings] = {&params_,  &info_,   &skip_,        &light_,
+                                                         &palette_, &pixels_, &approx_info_, &approx_arena_};
   set_ = ctx_.allocate_set(pool_, ctx_.render_layout, bound);
   descriptors_stale_ = false;
+}
+
+void ResidentScene::record_approximation(VkCommandBuffer cmd, Algorithm algorithm) {
+  const RenderScene::Impl& s = *scene_;
+  if (approx_scene_ == s.id && approx_generation_ == s.generation && approx_algorithm_ == static_cast<int>(algorithm))
+    return;
+  const SkipSource approx = s.approximation(algorithm);
+  const std::size_t chunks = s.table.chunk_count();
+  std::vector<std::uint32_t> info(2 * chunks);
+  for (std::size_t i = 0; i < chunks; ++i) {
+    const std::uint32_t slot = approx.cells.slot[i];
+    info[2 * i] = slot == BrickedChunks<std::uint16_t>::kUniform ? L::VF_UNIFORM : slot;
+    info[2 * i + 1] = static_cast<std::uint32_t>(approx.cells.uniform[i]) | (std::uint32_t{approx.chunk_min[i]} << 16);
+  }
+  const std::size_t info_bytes = info.size() * 4;
+  const std::size_t arena_bytes = std::size_t{approx.cells.slots_used} * approx.cells.slot_bytes();
+  if (approx_info_.size() < std::max<std::size_t>(info_bytes, 16) || approx_arena_.size() < std::max<std::size_t>(arena_bytes, 16)) {
+    approx_info_ = Buffer(ctx_, std::max<std::size_t>(info_bytes, 16), kUsage, false);
+    approx_arena_ = Buffer(ctx_, std::max<std::size_t>(arena_bytes, 16), kUsage, false);
+    descriptors_stale_ = true;
+  }
+  if (approx_staging_.size() < info_bytes + arena_bytes)
+    approx_staging_ = Buffer(ctx_, info_bytes + arena_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, /*host_visible=*/true);
+  auto* base = static_cast<std::uint8_t*>(approx_staging_.mapped());
+  std::memcpy(base, info.data(), info_bytes);
+  if (arena_bytes > 0) std::memcpy(base + info_bytes, approx.cells.arena.data(), arena_bytes);
+  // The previous frame's reads of these buffers come before the copies.
+  barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+          VK_ACCESS_TRANSFER_WRITE_BIT);
+  const VkBufferCopy to_info{0, 0, info_bytes};
+  vkCmdCopyBuffer(cmd, approx_staging_.handle(), approx_info_.handle(), 1, &to_info);
+  if (arena_bytes > 0) {
+    const VkBufferCopy to_arena{info_bytes, 0, arena_bytes};
+    vkCmdCopyBuffer(cmd, approx_staging_.handle(), approx_arena_.handle(), 1, &to_arena);
+  }
+  ctx_.counters.bytes_uploaded += static_cast<std::int64_t>(info_bytes + arena_bytes);
+  approx_scene_ = s.id;
+  approx_generation_ = s.generation;
+  approx_algorithm_ = static_cast<int>(algorithm);
+  approx_inv_scale_ = approx.inv_scale;
 }
 
 void ResidentScene::record_render(VkCommandBuffer cmd, const Camera& camera, const RenderOptions& o, bool bgra,
@@ -221,6 +270,8 @@ void ResidentScene::record_render(VkCommandBuffer cmd, const Camera& camera, con
   const RenderScene::Impl& s = *scene_;
   check_options(s, o);
   ensure_pixels(static_cast<VkDeviceSize>(o.width) * o.height * 4);
+  const bool error = o.view == RenderView::kError;
+  if (error) record_approximation(cmd, o.error_algorithm);
   if (descriptors_stale_) write_descriptors();
 
   const Camera::Projector pj = camera.projector(o.width, o.height);
@@ -242,19 +293,23 @@ void ResidentScene::record_render(VkCommandBuffer cmd, const Camera& camera, con
   rp.skip_inv_scale = static_cast<float>(s.skip.inv_scale);
   rp.light_inv_scale = static_cast<float>(s.light_inv_scale);
   const bool distance = o.view == RenderView::kDistance;
-  // The distance view shades what lies below the cut without shadows, as the CPU's does.
-  rp.flags = (o.ambient_occlusion ? L::VF_RENDER_AO : 0u) | (o.soft_shadows && !distance ? L::VF_RENDER_SHADOWS : 0u) |
+  // The distance and error views shade without shadows, as the CPU's do.
+  rp.flags = (o.ambient_occlusion ? L::VF_RENDER_AO : 0u) |
+             (o.soft_shadows && !distance && !error ? L::VF_RENDER_SHADOWS : 0u) |
              (o.view == RenderView::kChunks ? L::VF_RENDER_CHUNKS : 0u) | (s.has_light ? L::VF_RENDER_HAS_LIGHT : 0u) |
-             (bgra ? L::VF_RENDER_BGRA : 0u) | (distance ? L::VF_RENDER_DISTANCE : 0u);
+             (bgra ? L::VF_RENDER_BGRA : 0u) | (distance ? L::VF_RENDER_DISTANCE : 0u) | (error ? L::VF_RENDER_ERROR : 0u);
+  rp.approx_inv_scale = static_cast<float>(approx_inv_scale_);
   if (distance) {
     rp.slice_z = s.slice_z(o);
     rp.heat_max = static_cast<float>(s.heat_max(rp.slice_z));
   }
 
-  // The previous frame's reads of the parameters and writes of the pixels come before these.
+  // The approximation's copies, and the previous frame's reads of the parameters and writes of
+  // the pixels, come before these.
   barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-          VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
+          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   vkCmdUpdateBuffer(cmd, params_.handle(), 0, sizeof rp, &rp);
   ctx_.counters.bytes_uploaded += static_cast<std::int64_t>(sizeof rp);
   barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,

@@ -78,10 +78,10 @@ struct Context::Impl {
   mutable std::mutex messages_mutex;
   std::vector<std::string> messages;
 
-  // The distance pipelines (9 storage buffers, push constants) and the ray marcher (6 buffers).
+  // The distance pipelines (9 storage buffers, push constants) and the ray marcher (8 buffers).
   static constexpr std::uint32_t kBindings = 9;
   static constexpr std::uint32_t kPushBytes = 96;
-  static constexpr std::uint32_t kRenderBindings = 6;
+  static constexpr std::uint32_t kRenderBindings = 8;
   BindingLayout field_layout, render_layout, jfa_layout, fim_layout;
   Pipeline edt_sites, edt_lines, edt_encode, render, jfa, jfa_seed, fim;
 

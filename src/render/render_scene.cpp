@@ -264,6 +264,19 @@ double RenderScene::Impl::heat_max(int z) const {
   return std::max(1.0, top * skip.inv_scale);
 }
 
+SkipSource RenderScene::Impl::approximation(Algorithm algorithm) const {
+  AlgorithmOptions ao;
+  ao.algorithm = algorithm;
+  if (algorithm == Algorithm::kLod) {
+    // FIM in the middle of the box (3/8 to 5/8 of each extent, as `voxfield compare` does).
+    const Vec3i sz = box.size();
+    const Vec3i lo{sz.x * 3 / 8, sz.y * 3 / 8, sz.z * 3 / 8};
+    const Vec3i hi{std::max(sz.x * 5 / 8, lo.x + 1), std::max(sz.y * 5 / 8, lo.y + 1), std::max(sz.z * 5 / 8, lo.z + 1)};
+    ao.focus = Box3i{box.begin + lo, box.begin + hi};
+  }
+  return make_skip_source(compute_distance_field(*world, skip_options, ao));
+}
+
 SkipSource RenderScene::Impl::make_skip_source(const DistanceField& field) const {
   SkipSource src;
   src.metric = field.options.metric;

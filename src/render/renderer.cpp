@@ -283,24 +283,13 @@ Image render(const RenderScene& scene, const Camera& camera, const RenderOptions
   Image image(o.width, o.height);
   Frame f{s, o, camera.projector(o.width, o.height), o.sun_direction.normalized()};
 
-  std::optional<DistanceField> approx_field;
   SkipSource approx;
   if (o.view == RenderView::kDistance) {
     f.slice_z = s.slice_z(o);
     f.heat_max = s.heat_max(f.slice_z);
   }
   if (o.view == RenderView::kError) {
-    AlgorithmOptions ao;
-    ao.algorithm = o.error_algorithm;
-    if (ao.algorithm == Algorithm::kLod) {
-      // FIM in the middle of the box (3/8 to 5/8 of each extent, as `voxfield compare` does).
-      const Vec3i sz = s.box.size();
-      const Vec3i lo{sz.x * 3 / 8, sz.y * 3 / 8, sz.z * 3 / 8};
-      const Vec3i hi{std::max(sz.x * 5 / 8, lo.x + 1), std::max(sz.y * 5 / 8, lo.y + 1), std::max(sz.z * 5 / 8, lo.z + 1)};
-      ao.focus = Box3i{s.box.begin + lo, s.box.begin + hi};
-    }
-    approx_field = compute_distance_field(*s.world, s.skip_options, ao);
-    approx = s.make_skip_source(*approx_field);
+    approx = s.approximation(o.error_algorithm);
     f.approx = &approx;
   }
 

@@ -85,8 +85,11 @@ struct RenderScene::Impl {
   // InvalidArgument outside it) and the largest distance on it, which the heat map is scaled by.
   int slice_z(const RenderOptions& o) const;
   double heat_max(int slice_z) const;
-  // A skip source over this scene's table from another field (the error view's approximation).
+  // A skip source over this scene's table from another field.
   SkipSource make_skip_source(const DistanceField& field) const;
+  // The error view's approximation: the skip field's options computed by `algorithm` (lod: FIM
+  // in the middle of the box), as a skip source.
+  SkipSource approximation(Algorithm algorithm) const;
   // Re-reads chunk i from the world and the fields (the fields already checked to fit).
   // Returns whether anything of the chunk changed.
   bool refresh_chunk(std::size_t i, const Grid<std::uint8_t>& skip_grid, const Grid<std::uint8_t>* light_grid);
