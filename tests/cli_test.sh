@@ -269,8 +269,14 @@ assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['gpu']['fence
   check "field: jfa+1 on the cpu" 0 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/jc.npy" --algorithm jfa+1 \
       --metric chebyshev --storage u8
   cmp -s "$tmp/jg.npy" "$tmp/jc.npy" && passes=$((passes+1)) || { echo "FAIL: gpu and cpu jfa+1 differ"; fails=$((fails+1)); }
-  check "field: fim on the gpu" 1 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --backend vulkan --algorithm fim
-  expect_grep "fim on the gpu message" "$tmp/err" "not on the Vulkan backend yet"
+  check "field: hybrid on the gpu" 0 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/hg.npy" --backend vulkan \
+      --algorithm hybrid --metric manhattan --storage u16
+  check "field: hybrid on the cpu" 0 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/hc.npy" --algorithm hybrid \
+      --metric manhattan --storage u16
+  cmp -s "$tmp/hg.npy" "$tmp/hc.npy" && passes=$((passes+1)) || { echo "FAIL: gpu and cpu hybrid differ"; fails=$((fails+1)); }
+  check "field: brute-chunked on the gpu" 1 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --backend vulkan \
+      --algorithm brute-chunked
+  expect_grep "brute-chunked on the gpu message" "$tmp/err" "not on the Vulkan backend"
   check "field --backend auto" 0 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/ka.npy" --backend auto
   # No Vulkan driver at all: a clear message, and the CPU does the work.
   check "vulkan without a device" 0 env VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json $GPU \
@@ -286,7 +292,11 @@ assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['gpu']['fence
   check "render gpu stats" 0 $PY -c "
 import json; j = json.load(open('$tmp/rgpu.json'))
 assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['width'] == 96, j"
-  check "render: distance view on the gpu" 1 $GPU "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/x.png" --backend vulkan --view distance
+  check "render: error view on the gpu" 0 $GPU "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/rerr.png" --backend vulkan \
+      --view error --algorithm jfa-seed --width 96 --height 64
+  check "render: a cut outside the box on the gpu" 1 $GPU "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/x.png" \
+      --backend vulkan --view distance --slice 100000
+  expect_grep "cut outside the box message" "$tmp/err" "lies outside the box"
   check "gpu edits json" 0 $PY -c "
 import json; j = json.load(open('$tmp/gedits.json'))
 assert j['backend'] == 'vulkan' and j['verify_mismatches'] == 0, j"
