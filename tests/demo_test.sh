@@ -21,7 +21,8 @@ run() {  # name, demo arguments...
     return
   fi
   grep -q "validation:" "$out/$name.err" && fail "$name: validation messages: $(grep -m3 validation: "$out/$name.err")"
-  [ "$(head -1 "$out/$name.csv")" = "frame,frame_ms,update_ms,render_ms,edits" ] || fail "$name: CSV header"
+  [ "$(head -1 "$out/$name.csv")" = "frame,frame_ms,update_ms,render_ms,edits,gpu_submits,gpu_dispatches,gpu_bytes_up,gpu_bytes_down" ] ||
+    fail "$name: CSV header"
   local rows
   rows=$(tail -n +2 "$out/$name.csv" | wc -l)
   [ "$rows" -eq 30 ] || fail "$name: $rows CSV rows, expected 30"
@@ -33,6 +34,12 @@ run() {  # name, demo arguments...
 
 run vulkan --backend vulkan --validation
 grep -q "Vulkan ray marcher" "$out/vulkan.err" || fail "vulkan: the demo did not say it draws with the Vulkan ray marcher"
+# Every frame dispatches the ray marcher; frames copy at most what edits changed (the first frame
+# copies the scene); nothing is ever read back.
+awk -F, 'NR > 1 && ($7 < 1 || $9 != 0 || $6 > 1) { bad = 1 } END { exit bad }' "$out/vulkan.csv" ||
+  fail "vulkan: a frame without a dispatch, with more than one submit of voxfield's, or with a read-back"
+awk -F, 'NR == 2 { first = $8 } NR > 2 && $8 > max { max = $8 } END { exit !(max < first) }' "$out/vulkan.csv" ||
+  fail "vulkan: a later frame copied as much as the whole scene"
 run cpu --backend cpu
 grep -q "CPU renderer" "$out/cpu.err" || fail "cpu: the demo did not say it draws with the CPU renderer"
 # No Vulkan driver at all: the CPU renderer's frames, presented through OpenGL.

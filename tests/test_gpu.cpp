@@ -525,4 +525,26 @@ TEST(Gpu, ResidentScenesFollowEditsWithOnlyTheirChunksCopied) {
   EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
   gpu::SceneRenderer unsynced(ctx);
   EXPECT_THROW(unsynced.render(cam, o), InvalidArgument);
+
+  // Arenas outgrowing their device buffers: a nearly empty world where one edit makes dozens of
+  // chunks dense. The buffers move on the GPU; still only the changed chunks travel.
+  World sparse(8, Box3i::from_size({64, 64, 32}));
+  sparse.voxels.set({5, 5, 5}, 3);
+  DynamicRenderScene growing(sparse, so);
+  gpu::SceneRenderer r2(ctx);
+  r2.sync(growing.scene());
+  for (int round = 0; round < 3; ++round) {
+    DirtyRegions d(8, DirtyRegions::Track::kAnyChange);
+    apply_edit(sparse, {EditOp::kPlace, SphereBrush{{12.0 + 20 * round, 30, 12}, 9 + 2.0 * round}, 40}, &d);
+    const DynamicRenderScene::UpdateStats st = growing.update(d);
+    before = ctx->counters();
+    r2.sync(growing.scene());
+    EXPECT_LE(ctx->counters().bytes_uploaded - before.bytes_uploaded,
+              static_cast<std::int64_t>(st.chunks_changed) * (chunk_bytes + 16) + 256 * 16)
+        << "round " << round;
+    const RenderScene fresh(sparse, growing.skip_field(), growing.light_field());
+    EXPECT_EQ(r2.render(cam, o).rgb, gpu::render(*ctx, fresh, cam, o).rgb) << "round " << round;
+  }
+  const auto late = ctx->validation_messages();
+  EXPECT_TRUE(late.empty()) << late.size() << " validation messages, first: " << late.front();
 }

@@ -95,6 +95,7 @@ class ResidentScene {
   std::vector<std::uint64_t> synced_generation_;
   std::uint64_t synced_palette_ = 0;
   Buffer params_, info_, skip_, light_, palette_, pixels_;
+  std::vector<Buffer> retired_;  // outgrown arenas, kept until the copy out of them has run
   Buffer approx_info_, approx_arena_, approx_staging_;
   std::uint64_t approx_scene_ = 0, approx_generation_ = 0;  // what the resident approximation was made from
   int approx_algorithm_ = -1;
@@ -124,20 +125,40 @@ bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
   const std::size_t light_live = s.has_light ? std::size_t{s.light.slots_used} * s.light.slot_bytes() : 0;
   bool whole = scene_ != &s || scene_id_ != s.id || synced_generation_.size() != chunks;
 
-  // Device buffers as large as the host arenas' capacity, so growth is rare; a new buffer gets
-  // the whole scene.
-  auto ensure = [&](Buffer& b, std::size_t bytes) {
+  // Device buffers as large as the host arenas' capacity, so growth is rare. A new scene gets
+  // everything copied; an arena that outgrew its buffer moves to a larger one on the GPU (the old
+  // buffer is retired until this submission has completed), so only the changed chunks travel.
+  retired_.clear();  // the submission that used them was waited for
+  std::vector<std::pair<Buffer*, Buffer>> grown;
+  auto ensure = [&](Buffer& b, std::size_t bytes, bool keep) {
     bytes = std::max<std::size_t>(bytes, 16);
     if (b.handle() != VK_NULL_HANDLE && b.size() >= bytes) return;
-    b = Buffer(ctx_, bytes, kUsage, false);
-    whole = true;
+    Buffer bigger(ctx_, bytes, kUsage, false);
+    if (keep && !whole && b.handle() != VK_NULL_HANDLE) {
+      grown.emplace_back(&b, std::move(b));
+    } else {
+      whole = true;
+    }
+    b = std::move(bigger);
     descriptors_stale_ = true;
   };
-  ensure(params_, sizeof(L::RenderParams));
-  ensure(info_, chunks * 16);
-  ensure(skip_, s.skip.cells.arena.size());
-  ensure(light_, s.has_light ? s.light.arena.size() : 0);
-  ensure(palette_, 256 * 16);
+  ensure(params_, sizeof(L::RenderParams), false);
+  ensure(info_, chunks * 16, false);
+  ensure(palette_, 256 * 16, false);
+  ensure(skip_, s.skip.cells.arena.size(), true);
+  ensure(light_, s.has_light ? s.light.arena.size() : 0, true);
+  if (whole) grown.clear();  // everything is copied from the host anyway
+  if (!grown.empty())  // earlier submissions' writes of the old arenas come before reading them
+    barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+            VK_ACCESS_TRANSFER_READ_BIT);
+  for (auto& [now, old] : grown) {
+    const VkBufferCopy keep{0, 0, old.size()};
+    vkCmdCopyBuffer(cmd, old.handle(), now->handle(), 1, &keep);
+    retired_.push_back(std::move(old));
+  }
+  if (!grown.empty())  // the moved contents come before the changed chunks are written over them
+    barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+            VK_ACCESS_TRANSFER_WRITE_BIT);
 
   std::vector<std::size_t> changed;
   const bool palette_changed = whole || synced_palette_ != s.palette_generation;
