@@ -15,7 +15,7 @@ layout(std430, set = 0, binding = 5) buffer Cost2 { uint cost2[]; };
 layout(std430, set = 0, binding = 6) buffer ScratchS { int scratch_s[]; };
 layout(std430, set = 0, binding = 7) buffer ScratchT { int scratch_t[]; };
 // The resident field: one stored value per voxel of the field's domain (x fastest).
-layout(std430, set = 0, binding = 8) writeonly buffer FieldBuf { uint field_values[]; };
+layout(std430, set = 0, binding = 8) buffer FieldBuf { uint field_values[]; };  // packed (edt_encode.comp)
 
 layout(push_constant) uniform Push { PassParams p; };
 

@@ -72,7 +72,7 @@ struct Header {
   uint chunk_words;    // 32-bit words per brick: chunk_edge^3 / 4
   uint pad0;
   ivec4 field_begin;   // the resident field's domain (voxel coordinates)
-  ivec4 field_size;
+  ivec4 field_size;    // w: voxels per stored row (x padded to whole words of packed values)
   uint metric;         // VF_MANHATTAN...
   uint is_signed;      // 1 for signed fields
   uint storage;        // VF_U8, VF_U16, VF_F32

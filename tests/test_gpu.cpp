@@ -307,6 +307,7 @@ TEST(Gpu, BrickPoolReusesAndGrowsCorrectly) {
   o.max_distance = 4;
   o.storage = Storage::kU8;
   gpu::DynamicField live(ctx, w, o);
+  EXPECT_EQ(live.field_bytes(), 64u * 64 * 16);  // u8 resident as on the CPU: one byte per voxel
   DirtyRegions dirty(8, DirtyRegions::Track::kOccupancy);
   apply_edit(w, {EditOp::kCarve, BoxBrush{{0, 0, 0}, {7, 7, 7}}, 1}, &dirty);  // frees one slot
   live.update(dirty);

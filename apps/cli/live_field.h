@@ -75,10 +75,10 @@ class LiveField {
 
   const DistanceOptions& options() const { return cpu_ ? cpu_->options() : gpu_->options(); }
   // Bytes the field occupies where it lives: the CPU grid's chunks, or the GPU's resident buffer
-  // (4 bytes per voxel of the domain) — without reading a GPU field back to count it.
+  // (packed: 1, 2 or 4 bytes per voxel of the domain) — without reading a GPU field back.
   std::size_t memory_bytes() const {
     if (cpu_) return std::visit([](const auto& g) { return g.memory().bytes; }, cpu_->field().values);
-    return static_cast<std::size_t>(gpu_->options().domain->volume()) * 4;
+    return gpu_->field_bytes();
   }
   bool on_gpu() const { return gpu_.has_value(); }
 

@@ -140,6 +140,9 @@ class DynamicField {
   DistanceField download();
 
   const DistanceOptions& options() const;
+  // Bytes of the resident field: 1, 2 or 4 per voxel of the domain (u8, u16, f32), as on the CPU,
+  // rows padded to whole 32-bit words.
+  std::size_t field_bytes() const;
   Vec3i reach() const { return reach_; }
   Context& context() { return *context_; }
   // Timestamps of the last build or update's passes (empty without timestamp support).

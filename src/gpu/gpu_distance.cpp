@@ -67,22 +67,29 @@ struct Staging {
   }
 };
 
+// Values of T per word of the resident field (u8: 4, u16: 2, f32: 1).
+std::size_t lanes_of(Storage s) { return s == Storage::kU8 ? 4 : s == Storage::kU16 ? 2 : 1; }
+
+// Voxels per stored row: x padded to whole words.
+int row_pitch(const detail::FieldPlan& plan, Storage s) {
+  const int lanes = static_cast<int>(lanes_of(s));
+  return (plan.domain.size().x + lanes - 1) / lanes * lanes;
+}
+
+// The field from the resident buffer's bytes: rows of row_pitch() values of T, packed.
 template <class T>
 DistanceField build_field(const World& world, const DistanceOptions& options, const detail::FieldPlan& plan,
-                          const std::uint32_t* stored) {
+                          const std::uint8_t* stored) {
   DistanceField out;
   out.options = options;
   out.domain = plan.domain;
   out.encoding = plan.encoding;
   Grid<T> values(world.voxels.chunk_edge(), detail::field_background<T>(plan), world.voxels.bounds());
+  const Vec3i n = plan.domain.size();
+  const std::size_t pitch = static_cast<std::size_t>(row_pitch(plan, options.storage));
   std::vector<T> dense(static_cast<std::size_t>(plan.domain.volume()));
-  for (std::size_t i = 0; i < dense.size(); ++i) {
-    if constexpr (std::is_same_v<T, float>) {
-      std::memcpy(&dense[i], &stored[i], sizeof(float));
-    } else {
-      dense[i] = static_cast<T>(stored[i]);
-    }
-  }
+  for (std::size_t row = 0; row < static_cast<std::size_t>(n.y) * n.z; ++row)  // little-endian lanes: bytes in x order
+    std::memcpy(&dense[row * n.x], stored + row * pitch * sizeof(T), static_cast<std::size_t>(n.x) * sizeof(T));
   values.copy_from_dense(plan.domain, dense.data());
   values.compact();
   out.values = std::move(values);
@@ -103,7 +110,9 @@ class FieldEngine {
     if (n.x > kMaxExtent || n.y > kMaxExtent || n.z > kMaxExtent)
       throw InvalidArgument("GPU: domain " + to_string(plan_.domain) + " exceeds " + std::to_string(kMaxExtent) +
                             " voxels along an axis");
-    field_bytes_ = static_cast<VkDeviceSize>(plan_.domain.volume()) * 4;
+    // Packed as stored on the CPU (1, 2 or 4 bytes per voxel), rows padded to whole words.
+    field_bytes_ = static_cast<VkDeviceSize>(n.y) * n.z * static_cast<VkDeviceSize>(row_pitch(plan_, options.storage)) *
+                   (4 / lanes_of(options.storage));
     if (field_bytes_ > ctx.limits.maxStorageBufferRange)
       throw InvalidArgument("GPU: a " + to_string(n) + " domain needs " + std::to_string(field_bytes_) +
                             " bytes per buffer, more than this device's storage-buffer range (" +
@@ -127,6 +136,7 @@ class FieldEngine {
   }
 
   const detail::FieldPlan& plan() const { return plan_; }
+  std::size_t field_bytes() const { return static_cast<std::size_t>(field_bytes_); }
   const DistanceOptions& options() const { return options_; }
 
   // Every chunk the domain touches.
@@ -259,7 +269,11 @@ class FieldEngine {
       L::PassParams enc = pp;
       enc.src = 0;
       enc.src2 = 2;
-      pass(ctx_.edt_encode, enc, static_cast<std::uint64_t>(r.out.volume()), "encode");
+      // One invocation per word of packed values that the out box touches.
+      const std::int64_t lanes = static_cast<std::int64_t>(lanes_of(options_.storage));
+      const std::int64_t ox = r.out.begin.x - plan_.domain.begin.x;
+      const std::int64_t words = (ox + r.out.size().x - 1) / lanes - ox / lanes + 1;
+      pass(ctx_.edt_encode, enc, static_cast<std::uint64_t>(words * r.out.size().y * r.out.size().z), "encode");
     }
     if (readback) {
       barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
@@ -289,7 +303,7 @@ class FieldEngine {
 
   // The field as last read back.
   DistanceField read_back() const {
-    const auto* stored = static_cast<const std::uint32_t*>(ctx_.readback.mapped());
+    const auto* stored = static_cast<const std::uint8_t*>(ctx_.readback.mapped());
     switch (options_.storage) {
       case Storage::kU8: return build_field<std::uint8_t>(world_, options_, plan_, stored);
       case Storage::kU16: return build_field<std::uint16_t>(world_, options_, plan_, stored);
@@ -302,7 +316,8 @@ class FieldEngine {
   void make_header() {
     header_ = {};
     header_.field_begin = {plan_.domain.begin.x, plan_.domain.begin.y, plan_.domain.begin.z, 0};
-    header_.field_size = {plan_.domain.size().x, plan_.domain.size().y, plan_.domain.size().z, 0};
+    header_.field_size = {plan_.domain.size().x, plan_.domain.size().y, plan_.domain.size().z,
+                          row_pitch(plan_, options_.storage)};
     header_.metric = static_cast<std::uint32_t>(plan_.metric);
     header_.is_signed = plan_.is_signed ? 1u : 0u;
     header_.storage = options_.storage == Storage::kU8 ? L::VF_U8 : options_.storage == Storage::kU16 ? L::VF_U16 : L::VF_F32;
@@ -461,6 +476,8 @@ void DynamicField::rebuild() {
   const Box3i domain = engine_->plan().domain;
   engine_->run(engine_->all_chunks(), {{domain, domain}}, false, &timings_);
 }
+
+std::size_t DynamicField::field_bytes() const { return engine_->field_bytes(); }
 
 DynamicDistanceField::UpdateStats DynamicField::update(const DirtyRegions& dirty) {
   DynamicDistanceField::UpdateStats stats;

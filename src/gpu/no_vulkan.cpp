@@ -43,6 +43,7 @@ void DynamicField::rebuild() { unavailable(); }
 DynamicDistanceField::UpdateStats DynamicField::update(const DirtyRegions&) { unavailable(); }
 DistanceField DynamicField::download() { unavailable(); }
 const DistanceOptions& DynamicField::options() const { unavailable(); }
+std::size_t DynamicField::field_bytes() const { unavailable(); }
 struct SceneRenderer::Impl {};
 SceneRenderer::SceneRenderer(std::shared_ptr<Context>) { unavailable(); }
 SceneRenderer::~SceneRenderer() = default;
