@@ -12,7 +12,7 @@ packages=(
   libvulkan-dev libvulkan-volk-dev glslc   # the Vulkan backend: headers, run-time loader, GLSL -> SPIR-V
   mesa-vulkan-drivers vulkan-validationlayers  # lavapipe (software Vulkan) and the validation layer, for tests
   libglfw3-dev libimgui-dev          # voxfield-demo: window and input (GLFW), the panel (Dear ImGui)
-  xvfb xauth                         # a virtual display for the demo's tests (xvfb-run)
+  xvfb xauth xdotool                 # a virtual display for the demo's tests (xvfb-run), input events
   nlohmann-json3-dev                 # JSON output of the CLI
   libcli11-dev                       # CLI parsing
   libgtest-dev                       # tests

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # voxfield-demo end to end, under Xvfb: benchmark mode for 30 frames on the Vulkan ray marcher
 # (lavapipe in CI) with the validation layer, on the CPU renderer, and with no Vulkan driver at
-# all (CPU frames presented through OpenGL). Each run must exit 0, write
+# all (CPU frames presented through OpenGL); then clicks and a key sent with xdotool. Each run must exit 0, write
 # a CSV with one row per frame, print no validation message, and leave a screenshot showing sky
 # and world. DEMO and FRAME_CHECK are set by CTest.
 set -u
@@ -45,6 +45,33 @@ grep -q "CPU renderer" "$out/cpu.err" || fail "cpu: the demo did not say it draw
 # No Vulkan driver at all: the CPU renderer's frames, presented through OpenGL.
 RUN_ENV="VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json" run opengl --backend vulkan
 grep -q "shown through OpenGL" "$out/opengl.err" || fail "opengl: the demo did not say it fell back to OpenGL"
+
+# Interactive: real input events through the window system (xdotool). A left click places and a
+# right click carves at the ray hit, each a separate edit; F12 saves a screenshot.
+if command -v xdotool >/dev/null; then
+  mkdir -p "$out/interactive"
+  status=0
+  (cd "$out/interactive" && DEMO="$DEMO" xvfb-run -a -s "-screen 0 1024x768x24" bash -c '
+    "$DEMO" --world 64 --width 640 --height 360 --backend cpu --frames 120 --csv i.csv 2>i.err &
+    pid=$!
+    win=$(timeout 60 xdotool search --sync --name voxfield-demo | head -1)
+    sleep 1
+    xdotool mousemove --window "$win" 480 220 click 1   # right of the panel, on the terrain
+    sleep 0.5
+    xdotool mousemove --window "$win" 480 220 click 3
+    sleep 0.3
+    xdotool key --window "$win" F12
+    wait $pid') || status=$?
+  if [ "$status" -ne 0 ]; then
+    fail "interactive: exit status $status: $(tail -3 "$out/interactive/i.err" 2>/dev/null)"
+  else
+    awk -F, 'END { exit !($5 >= 2) }' "$out/interactive/i.csv" || fail "interactive: the clicks did not edit (edits: $(tail -1 "$out/interactive/i.csv"))"
+    "$FRAME_CHECK" "$out/interactive/voxfield-demo-1.png" || fail "interactive: no F12 screenshot of the world"
+    echo "ok: interactive (clicks placed and carved; F12 saved a screenshot)"
+  fi
+else
+  fail "xdotool is missing (scripts/install-deps.sh installs it)"
+fi
 
 # Bad arguments are refused with a message, not a crash.
 if "$DEMO" --world 3 >/dev/null 2>"$out/bad.err"; then fail "--world 3 was accepted"; fi

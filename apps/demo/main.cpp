@@ -12,6 +12,7 @@
 #include <backends/imgui_impl_opengl2.h>
 #include <backends/imgui_impl_vulkan.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -20,6 +21,8 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "demo_world.h"
 #include "fly_camera.h"
@@ -43,7 +46,7 @@ struct Options {
   int width = 1280, height = 720;
   bool validation = false;
   bool benchmark = false;
-  int frames = 300;
+  int frames = 0;  // exit after this many frames (0: benchmark 300, interactive until closed)
   double interval_ms = 200;
   std::string csv;
   std::string screenshot;
@@ -104,6 +107,7 @@ class Demo {
   bool look_mode_ = false;  // Tab: the mouse turns the view, clicks edit at the centre
   double last_x_ = 0, last_y_ = 0;
   double scroll_ = 0;
+  std::vector<int> keys_pressed_, clicks_;  // since the last frame
   Clock::time_point last_edit_ = Clock::now();
   Timings last_;
   std::deque<float> frame_history_;
@@ -136,6 +140,14 @@ Demo::Demo(const Options& o) : options_(o) {
   glfwSetWindowUserPointer(glfw(), this);
   glfwSetScrollCallback(glfw(), [](GLFWwindow* w, double, double dy) {
     static_cast<Demo*>(glfwGetWindowUserPointer(w))->scroll_ += dy;
+  });
+  // Presses are queued from the callbacks, so a click or a key tap shorter than a frame (frames
+  // are slow on software Vulkan) is never lost between two polls of the button state.
+  glfwSetKeyCallback(glfw(), [](GLFWwindow* w, int key, int, int action, int) {
+    if (action == GLFW_PRESS) static_cast<Demo*>(glfwGetWindowUserPointer(w))->keys_pressed_.push_back(key);
+  });
+  glfwSetMouseButtonCallback(glfw(), [](GLFWwindow* w, int button, int action, int) {
+    if (action == GLFW_PRESS) static_cast<Demo*>(glfwGetWindowUserPointer(w))->clicks_.push_back(button);
   });
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -251,13 +263,8 @@ void Demo::handle_input(double dt_s) {
   const ImGuiIO& io = ImGui::GetIO();
   auto down = [&](int key) { return glfwGetKey(w, key) == GLFW_PRESS; };
   // Keys that act once per press.
-  static std::array<bool, GLFW_KEY_LAST + 1> was{};
-  auto pressed = [&](int key) {
-    const bool now = down(key);
-    const bool edge = now && !was[static_cast<std::size_t>(key)];
-    was[static_cast<std::size_t>(key)] = now;
-    return edge;
-  };
+  const std::vector<int> keys = std::exchange(keys_pressed_, {});
+  auto pressed = [&](int key) { return std::find(keys.begin(), keys.end(), key) != keys.end(); };
   if (pressed(GLFW_KEY_F1)) show_help_ = !show_help_;
   if (pressed(GLFW_KEY_F12)) take_screenshot("voxfield-demo-" + std::to_string(++screenshots_) + ".png");
   if (pressed(GLFW_KEY_TAB)) {
@@ -290,13 +297,20 @@ void Demo::handle_input(double dt_s) {
   if (turning) camera_.turn(-(x - last_x_) * 0.004, -(y - last_y_) * 0.004);
   last_x_ = x;
   last_y_ = y;
+  const std::vector<int> clicks = std::exchange(clicks_, {});
   if (!io.WantCaptureMouse) {
     if (scroll_ != 0) brush_.radius = std::clamp(brush_.radius + static_cast<int>(std::lround(scroll_)), 0, 32);
-    // Held buttons repeat the edit ten times a second.
+    const EditOp left_op = brush_.paint ? EditOp::kPaint : EditOp::kPlace;
+    // Every click edits once; held buttons repeat the edit ten times a second.
+    for (int button : clicks)
+      if (button == GLFW_MOUSE_BUTTON_LEFT || button == GLFW_MOUSE_BUTTON_RIGHT)
+        edit_at_cursor(button == GLFW_MOUSE_BUTTON_RIGHT ? EditOp::kCarve : left_op);
     const bool left = glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
     const bool right = glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
-    if ((left || right) && ms_between(last_edit_, Clock::now()) >= 100) {
-      edit_at_cursor(right ? EditOp::kCarve : brush_.paint ? EditOp::kPaint : EditOp::kPlace);
+    if (!clicks.empty()) {
+      last_edit_ = Clock::now();
+    } else if ((left || right) && ms_between(last_edit_, Clock::now()) >= 100) {
+      edit_at_cursor(right ? EditOp::kCarve : left_op);
       last_edit_ = Clock::now();
     }
   }
@@ -495,7 +509,7 @@ void Demo::take_screenshot(const std::string& path) {
 
 int Demo::run() {
   std::ofstream csv;
-  if (options_.benchmark && !options_.csv.empty()) {
+  if (!options_.csv.empty()) {
     csv.open(options_.csv);
     if (!csv) throw IoError(options_.csv + ": cannot create");
     // The GPU columns are voxfield's own traffic in the frame (scene copies and the ray marcher's
@@ -511,7 +525,7 @@ int Demo::run() {
   auto previous = start;
   std::int64_t streamed = 0;
   for (int frame = 0; !glfwWindowShouldClose(glfw()); ++frame) {
-    if (options_.benchmark && frame >= options_.frames) break;
+    if (options_.frames > 0 && frame >= options_.frames) break;
     glfwPollEvents();
     const auto t0 = Clock::now();
     const gpu::Counters gpu_before = path_.context ? path_.context->counters() : gpu::Counters{};
@@ -535,7 +549,7 @@ int Demo::run() {
     } else {
       handle_input(dt_s);
     }
-    const bool last_frame = options_.benchmark && frame + 1 == options_.frames;
+    const bool last_frame = options_.frames > 0 && frame + 1 == options_.frames;
     if (last_frame && !options_.screenshot.empty()) {
       take_screenshot(options_.screenshot);
     } else {
@@ -580,12 +594,13 @@ int main(int argc, char** argv) {
   app.add_option("--height", o.height, "window height")->check(CLI::Range(64, 8192));
   app.add_flag("--validation", o.validation, "enable the Khronos validation layer (messages on stderr)");
   app.add_flag("--benchmark", o.benchmark, "replay the dissertation's seeded edits and exit after --frames");
-  app.add_option("--frames", o.frames, "frames to run in benchmark mode")->check(CLI::Range(1, 1000000));
+  app.add_option("--frames", o.frames, "exit after N frames (benchmark mode: 300 by default)")->check(CLI::Range(1, 1000000));
   app.add_option("--seed", o.world.seed, "seed of the terrain and the benchmark's edits");
   app.add_option("--interval-ms", o.interval_ms, "time between the benchmark's edits")->check(CLI::PositiveNumber);
-  app.add_option("--csv", o.csv, "benchmark: one row per frame (frame_ms, update_ms, render_ms, edits)");
-  app.add_option("--screenshot", o.screenshot, "benchmark: save the last frame as PNG");
+  app.add_option("--csv", o.csv, "one row per frame (frame_ms, update_ms, render_ms, edits, GPU traffic)");
+  app.add_option("--screenshot", o.screenshot, "with --frames: save the last frame as PNG");
   CLI11_PARSE(app, argc, argv);
+  if (o.benchmark && o.frames == 0) o.frames = 300;
   glfwSetErrorCallback([](int code, const char* message) { std::cerr << "voxfield-demo: GLFW error " << code << ": " << message << "\n"; });
   try {
     o.world.metric = parse_metric(metric);
