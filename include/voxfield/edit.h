@@ -68,16 +68,18 @@ class DirtyRegions {
   };
   explicit DirtyRegions(int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge, Track track = Track::kAnyChange);
   Track track() const { return track_; }
-  // Records a change. `removes_solid`: whether it may have turned solid voxels into air (when
-  // false, a distance field may treat the change as new sites only, which is cheaper to update).
-  void add(const Box3i& changed, bool removes_solid = true);
+  // Records a change. `removes_solid` / `adds_solid`: whether it may have turned solid voxels into
+  // air / air into solid (a distance field updates changes of one kind only more cheaply).
+  void add(const Box3i& changed, bool removes_solid = true, bool adds_solid = true);
   bool empty() const { return per_chunk_.empty(); }
   void clear() {
     per_chunk_.clear();
     removes_solid_ = false;
+    adds_solid_ = false;
   }
-  // Whether any recorded change may have removed a solid voxel.
+  // Whether any recorded change may have removed / added a solid voxel.
   bool removes_solid() const { return removes_solid_; }
+  bool adds_solid() const { return adds_solid_; }
   // Per-chunk boxes, sorted by chunk (z, y, x).
   std::vector<Box3i> boxes() const;
   // The union of everything recorded (empty box if nothing).
@@ -93,6 +95,7 @@ class DirtyRegions {
   int shift_;
   Track track_;
   bool removes_solid_ = false;
+  bool adds_solid_ = false;
   std::unordered_map<Vec3i, Box3i, Hash> per_chunk_;
 };
 

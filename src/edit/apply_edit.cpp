@@ -46,8 +46,11 @@ DirtyRegions::DirtyRegions(int chunk_edge, Track track) : shift_(0), track_(trac
   while ((1 << shift_) < chunk_edge) ++shift_;
 }
 
-void DirtyRegions::add(const Box3i& changed, bool removes_solid) {
-  if (!changed.empty()) removes_solid_ = removes_solid_ || removes_solid;
+void DirtyRegions::add(const Box3i& changed, bool removes_solid, bool adds_solid) {
+  if (!changed.empty()) {
+    removes_solid_ = removes_solid_ || removes_solid;
+    adds_solid_ = adds_solid_ || adds_solid;
+  }
   if (changed.empty()) return;
   const Vec3i lo{changed.begin.x >> shift_, changed.begin.y >> shift_, changed.begin.z >> shift_};
   const Vec3i hi{(changed.end.x - 1) >> shift_, (changed.end.y - 1) >> shift_, (changed.end.z - 1) >> shift_};
@@ -109,6 +112,7 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
         Vec3i clo = part.end, chi = part.begin - Vec3i::splat(1);  // changes inside this chunk
         Vec3i olo = part.end, ohi = part.begin - Vec3i::splat(1);  // solid <-> air changes
         bool removed = false;                                       // any solid -> air
+        bool added = false;                                         // any air -> solid
         g.edit_chunk(coord, [&](std::uint8_t* voxels) {
           bool changed = false;
           // The brush is resolved once per chunk, not once per voxel.
@@ -135,6 +139,7 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
                 chi = {std::max(chi.x, x), std::max(chi.y, y), std::max(chi.z, z)};
                 if ((next != 0) != (v_before != 0)) {
                   removed = removed || next == 0;
+                  added = added || next != 0;
                   olo = {std::min(olo.x, x), std::min(olo.y, y), std::min(olo.z, z)};
                   ohi = {std::max(ohi.x, x), std::max(ohi.y, y), std::max(ohi.z, z)};
                 }
@@ -144,9 +149,9 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
         });
         if (chi.x >= clo.x) {
           const Box3i changed = Box3i::from_inclusive(clo, chi);
-          if (dirty && dirty->track() == DirtyRegions::Track::kAnyChange) dirty->add(changed, removed);
+          if (dirty && dirty->track() == DirtyRegions::Track::kAnyChange) dirty->add(changed, removed, added);
           if (dirty && dirty->track() == DirtyRegions::Track::kOccupancy && ohi.x >= olo.x) {
-            dirty->add(Box3i::from_inclusive(olo, ohi), removed);
+            dirty->add(Box3i::from_inclusive(olo, ohi), removed, added);
           }
           lo = {std::min(lo.x, clo.x), std::min(lo.y, clo.y), std::min(lo.z, clo.z)};
           hi = {std::max(hi.x, chi.x), std::max(hi.y, chi.y), std::max(hi.z, chi.z)};
