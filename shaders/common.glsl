@@ -16,6 +16,11 @@ layout(std430, set = 0, binding = 6) buffer ScratchS { int scratch_s[]; };
 layout(std430, set = 0, binding = 7) buffer ScratchT { int scratch_t[]; };
 // The resident field: one stored value per voxel of the field's domain (x fastest).
 layout(std430, set = 0, binding = 8) buffer FieldBuf { uint field_values[]; };  // packed (edt_encode.comp)
+// Nearest sites (Header::track_sites): per compute-box voxel and cost buffer, the site's
+// coordinates relative to the compute box packed as (x | y << 16, z), VF_INF for none; and the
+// resident field's site offsets, (dx | dy << 16, dz) as int16s, x fastest over the field's domain.
+layout(std430, set = 0, binding = 9) buffer WorkSites { uvec2 work_sites[]; };
+layout(std430, set = 0, binding = 10) buffer FieldSites { uvec2 field_sites[]; };
 
 layout(push_constant) uniform Push { PassParams p; };
 
@@ -33,6 +38,12 @@ void store_cost(uint buffer_index, uint i, uint value) {
   else if (buffer_index == 1u) cost1[i] = value;
   else cost2[i] = value;
 }
+
+uint box_volume() { return uint(p.box_size.x * p.box_size.y * p.box_size.z); }
+uvec2 load_site(uint buffer_index, uint i) { return work_sites[buffer_index * box_volume() + i]; }
+void store_site(uint buffer_index, uint i, uvec2 s) { work_sites[buffer_index * box_volume() + i] = s; }
+uvec2 pack_site(ivec3 l) { return uvec2(uint(l.x) | (uint(l.y) << 16), uint(l.z)); }
+ivec3 unpack_site(uvec2 s) { return ivec3(int(s.x & 0xFFFFu), int(s.x >> 16), int(s.y)); }
 
 // Material of voxel v (world coordinates), through the page table and the brick pool.
 uint material_at(ivec3 v) {

@@ -39,6 +39,22 @@ uint stored_value(ivec3 v) {
   return clamp_storage((inside ? -int(cost) : int(cost)) + h.bias);
 }
 
+// The nearest site of voxel v (world coordinates) as offsets from v, in the field's site buffer
+// (the CPU's rule: none when no site is within the clamp).
+void store_site_offset(ivec3 v) {
+  const uint c = voxel_index(v - p.box_begin.xyz);
+  const bool inside = h.is_signed != 0u && material_at(v) != 0u;
+  const uint from = inside ? p.src2 : p.src;
+  const uint cost = load_cost(from, c);
+  uvec2 packed = uvec2(0x80008000u, 0x8000u);  // SiteOffset::kNone (-32768) in all three
+  if (cost != VF_INF && cost <= h.site_cost_max) {
+    const ivec3 d = p.box_begin.xyz + unpack_site(load_site(from, c)) - v;
+    packed = uvec2((uint(d.x) & 0xFFFFu) | (uint(d.y) << 16), uint(d.z) & 0xFFFFu);
+  }
+  const ivec3 f = v - h.field_begin.xyz;
+  field_sites[uint((f.z * h.field_size.y + f.y) * h.field_size.x + f.x)] = packed;
+}
+
 // The resident field is packed: 4 u8 or 2 u16 values per word along x (rows padded to
 // field_size.w voxels, a whole number of words), so one invocation owns one word of the out box
 // and keeps the lanes outside it — no two invocations write the same word.
@@ -53,6 +69,7 @@ void main() {
   const uint word_index = uint((z * h.field_size.y + y) * (h.field_size.w / lanes) + wx);
   if (lanes == 1) {
     field_values[word_index] = stored_value(h.field_begin.xyz + ivec3(wx, y, z));
+    if (h.track_sites != 0u) store_site_offset(h.field_begin.xyz + ivec3(wx, y, z));
     return;
   }
   const uint bits = 32u / uint(lanes), mask = (1u << bits) - 1u;
@@ -62,6 +79,7 @@ void main() {
     if (x < o.x || x >= o.x + p.out_size.x) continue;
     const uint shift = uint(j) * bits;
     word = (word & ~(mask << shift)) | ((stored_value(h.field_begin.xyz + ivec3(x, y, z)) & mask) << shift);
+    if (h.track_sites != 0u) store_site_offset(h.field_begin.xyz + ivec3(x, y, z));
   }
   field_values[word_index] = word;
 }

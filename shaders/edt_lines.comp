@@ -6,6 +6,8 @@
 //   Euclidean  F = (x - i)^2 + c(i)      (c already squared)
 // found by the forward scan that builds the envelope (Sep: where a later function starts to win)
 // and the backward scan that reads it. Voxels with no site in reach (VF_INF) add no function.
+// Where two functions tie, the earlier (smaller coordinate) keeps the voxel, as on the CPU; with
+// nearest sites, each voxel takes the site of the function it took.
 // One invocation per line; the s and t stacks live in this line's slice of the scratch buffers.
 // Integer arithmetic only: with domain extents up to 16384, every value fits 31 bits.
 #version 450
@@ -42,7 +44,7 @@ int sep(int i, int u, int ci, int cu) {
 void main() {
   const uint line = invocation();
   const ivec3 n = p.box_size.xyz;
-  const int len = p.axis == 1u ? n.y : n.z;
+  const int len = n[p.axis];
   const int lines = (n.x * n.y * n.z) / len;
   if (int(line) >= lines) return;
   ivec3 first, step;
@@ -78,11 +80,14 @@ void main() {
     const uint i = voxel_index(first + step * u);
     if (q < 0) {
       store_cost(p.dst, i, VF_INF);
+      if (h.track_sites != 0u) store_site(p.dst, i, uvec2(VF_INF, 0u));
       continue;
     }
     const int sq = scratch_s[base + uint(q)];
-    const int cs = int(load_cost(p.src, voxel_index(first + step * sq)));
+    const uint source = voxel_index(first + step * sq);
+    const int cs = int(load_cost(p.src, source));
     store_cost(p.dst, i, uint(f(u, sq, cs)));
+    if (h.track_sites != 0u) store_site(p.dst, i, load_site(p.src, source));
     if (u == scratch_t[base + uint(q)]) --q;
   }
 }

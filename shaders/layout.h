@@ -70,7 +70,7 @@ struct Header {
   uint chunk_edge;     // voxels per chunk edge (power of two, 8..128)
   uint chunk_shift;    // log2(chunk_edge)
   uint chunk_words;    // 32-bit words per brick: chunk_edge^3 / 4
-  uint pad0;
+  uint track_sites;    // 1: the passes carry each voxel's nearest site, encode writes offsets
   ivec4 field_begin;   // the resident field's domain (voxel coordinates)
   ivec4 field_size;    // w: voxels per stored row (x padded to whole words of packed values)
   uint metric;         // VF_MANHATTAN...
@@ -79,7 +79,7 @@ struct Header {
   uint clamp_cost;     // costs >= this are at or beyond the clamp (VF_INF: unclamped)
   uint scale_sq;       // fixed-point scale squared (integer storage of Euclidean costs)
   int bias;            // offset of signed integer storage
-  uint pad1;
+  uint site_cost_max;  // nearest sites: a site is kept when its cost is at most this (the clamp)
   uint pad2;
   uint clamp_pos;      // stored bits for +clamp, -clamp, and "no site" outside / inside
   uint clamp_neg;

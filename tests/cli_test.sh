@@ -269,6 +269,12 @@ assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['gpu']['fence
   check "field: jfa+1 on the cpu" 0 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/jc.npy" --algorithm jfa+1 \
       --metric chebyshev --storage u8
   cmp -s "$tmp/jg.npy" "$tmp/jc.npy" && passes=$((passes+1)) || { echo "FAIL: gpu and cpu jfa+1 differ"; fails=$((fails+1)); }
+  check "field: nearest sites on the gpu" 0 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/sg.npy" --backend vulkan \
+      --metric euclidean --signed --max-distance 12 --storage u16 --sites "$tmp/sgs.npy"
+  check "field: nearest sites on the cpu" 0 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/sc.npy" \
+      --metric euclidean --signed --max-distance 12 --storage u16 --sites "$tmp/scs.npy"
+  cmp -s "$tmp/sg.npy" "$tmp/sc.npy" && cmp -s "$tmp/sgs.npy" "$tmp/scs.npy" && passes=$((passes+1)) ||
+    { echo "FAIL: gpu and cpu nearest sites differ"; fails=$((fails+1)); }
   check "field: hybrid on the gpu" 0 $GPU "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/hg.npy" --backend vulkan \
       --algorithm hybrid --metric manhattan --storage u16
   check "field: hybrid on the cpu" 0 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/hc.npy" --algorithm hybrid \

@@ -74,6 +74,19 @@ void expect_same_field(const DistanceField& gpu_field, const DistanceField& cpu_
   // Outside the domain both read the background.
   const Vec3i outside = cpu_field.domain.end;
   EXPECT_EQ(gpu_field.distance(outside), cpu_field.distance(outside)) << what;
+  // Nearest sites: the same site for every voxel, ties included.
+  ASSERT_EQ(gpu_field.sites.has_value(), cpu_field.sites.has_value()) << what;
+  if (cpu_field.sites) {
+    std::vector<SiteOffset> a(static_cast<std::size_t>(cpu_field.domain.volume())), b(a.size());
+    gpu_field.sites->copy_to_dense(gpu_field.domain, a.data());
+    cpu_field.sites->copy_to_dense(cpu_field.domain, b.data());
+    std::size_t off = 0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (!(a[i] == b[i]) && off++ < 5)
+        ADD_FAILURE() << what << ": voxel " << i << " site gpu (" << a[i].dx << "," << a[i].dy << "," << a[i].dz << ") cpu ("
+                      << b[i].dx << "," << b[i].dy << "," << b[i].dz << ")";
+    EXPECT_EQ(off, 0u) << what << ": voxels with another nearest site";
+  }
 }
 
 }  // namespace
@@ -110,8 +123,9 @@ TEST(Gpu, ExactFieldsEqualTheCpu) {
             o.signed_distance = sgn;
             o.max_distance = clamp;
             o.storage = st;
+            o.nearest_sites = st == Storage::kU16;  // sites once per metric, sign and clamp
             const std::string what = to_string(size) + " " + metric_name(m) + (sgn ? " signed" : "") + " clamp " +
-                                     std::to_string(clamp) + " " + storage_name(st);
+                                     std::to_string(clamp) + " " + storage_name(st) + (o.nearest_sites ? " sites" : "");
             const gpu::Counters before = ctx->counters();
             const DistanceField g = gpu::compute_distance_field(*ctx, w, o);
             const gpu::Counters after = ctx->counters();
@@ -147,9 +161,6 @@ TEST(Gpu, UnsupportedRequestsAreRefusedClearly) {
   if (!gpu_tests_wanted()) GTEST_SKIP();
   auto ctx = validated_context();
   const World w = random_world({12, 12, 12}, 8, 0.05, 3);
-  DistanceOptions sites;
-  sites.nearest_sites = true;
-  EXPECT_THROW(gpu::compute_distance_field(*ctx, w, sites), InvalidArgument);
   DistanceOptions spacing;
   spacing.metric = Metric::kEuclidean;
   spacing.spacing = {1, 2, 1};
@@ -166,8 +177,8 @@ TEST(Gpu, TimestampsNameEveryPass) {
   o.signed_distance = true;
   std::vector<gpu::PassTiming> t;
   gpu::compute_distance_field(*ctx, w, o, &t);
-  ASSERT_EQ(t.size(), 7u);  // x, y, z to solids; x, y, z to air; encode
-  EXPECT_EQ(t.front().pass, "rows x");
+  ASSERT_EQ(t.size(), 7u);  // z, x, y to solids; z, x, y to air; encode
+  EXPECT_EQ(t.front().pass, "columns z");
   EXPECT_EQ(t.back().pass, "encode");
   for (const auto& p : t) EXPECT_GE(p.ms, 0) << p.pass;
 }
@@ -183,15 +194,17 @@ TEST(Gpu, IncrementalUpdatesEqualAFullRebuild) {
     Storage storage;
   };
   for (const Case& c : {Case{Metric::kEuclidean, false, 6, Storage::kU8}, Case{Metric::kManhattan, true, 5, Storage::kU16},
-                        Case{Metric::kChebyshev, false, 4, Storage::kF32}, Case{Metric::kEuclidean, true, 0, Storage::kF32}}) {
+                        Case{Metric::kChebyshev, false, 4, Storage::kF32}, Case{Metric::kEuclidean, true, 0, Storage::kF32},
+                        Case{Metric::kChebyshev, true, 5, Storage::kU8}}) {
     World w = random_world({53, 40, 34}, 8, 0.01, 21);
     DistanceOptions o;
     o.metric = c.metric;
     o.signed_distance = c.is_signed;
     o.max_distance = c.clamp;
     o.storage = c.storage;
+    o.nearest_sites = c.storage != Storage::kF32;  // and with sites kept up to date too
     const std::string what = std::string(metric_name(c.metric)) + (c.is_signed ? " signed" : "") + " clamp " +
-                             std::to_string(c.clamp) + " " + storage_name(c.storage);
+                             std::to_string(c.clamp) + " " + storage_name(c.storage) + (o.nearest_sites ? " sites" : "");
     gpu::DynamicField live(ctx, w, o);
     DirtyRegions dirty(w.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
     std::mt19937 rng(7);

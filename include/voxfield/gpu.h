@@ -104,7 +104,8 @@ std::shared_ptr<Context> select_backend(Backend backend, const ContextOptions& o
 // compute_distance_field — bit for bit for u8 and u16 storage; for f32, Euclidean values may
 // differ from the CPU's by the GPU's square root (kF32Tolerance). Supported: every metric, signed
 // or not, clamped or not, every storage, unit spacing, domains up to 16384 voxels per axis.
-// Throws InvalidArgument for what it does not support (nearest sites, anisotropic spacing, a
+// Nearest sites too, the same site as the CPU's for every voxel (ties included).
+// Throws InvalidArgument for what it does not support (anisotropic spacing, a
 // fixed-point scale whose products overflow 32 bits), GpuUnavailable on device errors. One command
 // buffer, one submit, one fence wait.
 DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,

@@ -102,8 +102,8 @@ class FieldEngine {
  public:
   FieldEngine(Context::Impl& ctx, const World& world, const DistanceOptions& options)
       : ctx_(ctx), world_(world), options_(options), plan_(detail::make_field_plan(world.voxels, options)) {
-    if (options.nearest_sites)
-      throw InvalidArgument("GPU: the Vulkan backend does not compute nearest sites yet (use the CPU backend)");
+    if (options.nearest_sites && (plan_.domain.size().x > 32767 || plan_.domain.size().y > 32767 || plan_.domain.size().z > 32767))
+      throw InvalidArgument("GPU: nearest sites need a domain of at most 32767 voxels per axis");
     if (!plan_.unit_spacing) throw InvalidArgument("GPU: the Vulkan backend supports unit voxel spacing only");
     if (plan_.domain.empty()) throw InvalidArgument("GPU: the field's domain is empty");
     const Vec3i n = plan_.domain.size();
@@ -133,6 +133,9 @@ class FieldEngine {
     header_buf_ = Buffer(ctx, sizeof header_, kStorage, false);
     pages_buf_ = Buffer(ctx, pages_.size() * 4, kStorage, false);
     field_buf_ = Buffer(ctx, field_bytes_, kStorage, false);
+    // Nearest sites: 8 bytes per voxel of the domain (three int16 offsets, padded).
+    site_bytes_ = options.nearest_sites ? static_cast<VkDeviceSize>(plan_.domain.volume()) * 8 : 0;
+    field_sites_buf_ = Buffer(ctx, std::max<VkDeviceSize>(site_bytes_, 16), kStorage, false);
   }
 
   const detail::FieldPlan& plan() const { return plan_; }
@@ -167,7 +170,7 @@ class FieldEngine {
 
     Buffer& upload = ctx_.upload_buffer(std::max<VkDeviceSize>(up.bytes.size(), 16));
     if (!up.bytes.empty()) std::memcpy(upload.mapped(), up.bytes.data(), up.bytes.size());
-    Buffer* readback = download ? &ctx_.readback_buffer(field_bytes_) : nullptr;
+    Buffer* readback = download ? &ctx_.readback_buffer(field_bytes_ + site_bytes_) : nullptr;
     const VkDescriptorSet set = descriptor_set();
 
     VkCommandBufferAllocateInfo cba{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
@@ -247,22 +250,23 @@ class FieldEngine {
       pp.box_size = {n.x, n.y, n.z, 0};
       pp.out_begin = {r.out.begin.x, r.out.begin.y, r.out.begin.z, 0};
       pp.out_size = {r.out.size().x, r.out.size().y, r.out.size().z, 0};
-      // One separable transform: sites along x into `result`, then y and z through `other`.
+      // One separable transform: sites along z into `result`, then x and y through `other` —
+      // the CPU's order, so that nearest sites break ties the same way (docs/distance.md).
       auto transform = [&](std::uint32_t result, std::uint32_t other, bool to_air) {
         const std::string what = to_air ? " (to air)" : "";
         L::PassParams t = pp;
         t.sites_are_air = to_air ? 1u : 0u;
-        t.axis = 0;
+        t.axis = 2;
         t.dst = result;
-        pass(ctx_.edt_sites, t, static_cast<std::uint64_t>(n.y) * n.z, "rows x" + what);
-        t.axis = 1;
+        pass(ctx_.edt_sites, t, static_cast<std::uint64_t>(n.x) * n.y, "columns z" + what);
+        t.axis = 0;
         t.src = result;
         t.dst = other;
-        pass(ctx_.edt_lines, t, static_cast<std::uint64_t>(n.x) * n.z, "lines y" + what);
-        t.axis = 2;
+        pass(ctx_.edt_lines, t, static_cast<std::uint64_t>(n.y) * n.z, "lines x" + what);
+        t.axis = 1;
         t.src = other;
         t.dst = result;
-        pass(ctx_.edt_lines, t, static_cast<std::uint64_t>(n.x) * n.y, "lines z" + what);
+        pass(ctx_.edt_lines, t, static_cast<std::uint64_t>(n.x) * n.z, "lines y" + what);
       };
       transform(0, 1, false);
       if (plan_.is_signed) transform(2, 1, true);
@@ -280,9 +284,13 @@ class FieldEngine {
               VK_ACCESS_TRANSFER_READ_BIT);
       const VkBufferCopy down{0, 0, field_bytes_};
       vkCmdCopyBuffer(cmd, field_buf_.handle(), readback->handle(), 1, &down);
+      if (site_bytes_ > 0) {
+        const VkBufferCopy down_sites{0, field_bytes_, site_bytes_};
+        vkCmdCopyBuffer(cmd, field_sites_buf_.handle(), readback->handle(), 1, &down_sites);
+      }
       barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
               VK_ACCESS_HOST_READ_BIT);
-      ctx_.counters.bytes_downloaded += static_cast<std::int64_t>(field_bytes_);
+      ctx_.counters.bytes_downloaded += static_cast<std::int64_t>(field_bytes_ + site_bytes_);
     }
     check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
     ctx_.submit_and_wait(cmd);
@@ -304,12 +312,23 @@ class FieldEngine {
   // The field as last read back.
   DistanceField read_back() const {
     const auto* stored = static_cast<const std::uint8_t*>(ctx_.readback.mapped());
+    DistanceField f;
     switch (options_.storage) {
-      case Storage::kU8: return build_field<std::uint8_t>(world_, options_, plan_, stored);
-      case Storage::kU16: return build_field<std::uint16_t>(world_, options_, plan_, stored);
-      case Storage::kF32: return build_field<float>(world_, options_, plan_, stored);
+      case Storage::kU8: f = build_field<std::uint8_t>(world_, options_, plan_, stored); break;
+      case Storage::kU16: f = build_field<std::uint16_t>(world_, options_, plan_, stored); break;
+      case Storage::kF32: f = build_field<float>(world_, options_, plan_, stored); break;
     }
-    return {};
+    if (options_.nearest_sites) {
+      // Three int16 offsets and a pad per voxel, x fastest over the domain: the CPU's SiteOffset.
+      std::vector<SiteOffset> dense(static_cast<std::size_t>(plan_.domain.volume()));
+      const auto* words = reinterpret_cast<const std::int16_t*>(stored + field_bytes_);
+      for (std::size_t i = 0; i < dense.size(); ++i) dense[i] = {words[4 * i], words[4 * i + 1], words[4 * i + 2]};
+      Grid<SiteOffset> sites(world_.voxels.chunk_edge(), SiteOffset{}, world_.voxels.bounds());
+      sites.copy_from_dense(plan_.domain, dense.data());
+      sites.compact();
+      f.sites = std::move(sites);
+    }
+    return f;
   }
 
  private:
@@ -322,6 +341,11 @@ class FieldEngine {
     header_.is_signed = plan_.is_signed ? 1u : 0u;
     header_.storage = options_.storage == Storage::kU8 ? L::VF_U8 : options_.storage == Storage::kU16 ? L::VF_U16 : L::VF_F32;
     header_.clamp_cost = clamp_cost(plan_);
+    header_.track_sites = options_.nearest_sites ? 1u : 0u;
+    // The CPU keeps a site when its cost is at most the clamp's cost, rounded down.
+    const double clamp_c = plan_.metric == Metric::kEuclidean ? plan_.clamp * plan_.clamp : plan_.clamp;
+    header_.site_cost_max = std::isfinite(clamp_c) ? static_cast<std::uint32_t>(std::min<double>(std::floor(clamp_c), L::VF_INF - 1.0))
+                                                   : L::VF_INF - 1;
     header_.bias = static_cast<std::int32_t>(plan_.encoding.bias);
     switch (options_.storage) {
       case Storage::kU8: set_encoding<std::uint8_t>(header_, plan_); break;
@@ -413,14 +437,17 @@ class FieldEngine {
 
   void grow_work_buffers(VkDeviceSize bytes) {
     for (Buffer& b : cost_) b = Buffer(ctx_, bytes, kStorage, false);
+    // Nearest sites: 8 bytes per voxel for each of the three cost buffers.
+    work_sites_ = Buffer(ctx_, options_.nearest_sites ? bytes * 6 : 16, kStorage, false);
     scratch_s_ = Buffer(ctx_, bytes, kStorage, false);
     scratch_t_ = Buffer(ctx_, bytes, kStorage, false);
     work_bytes_ = bytes;
   }
 
   VkDescriptorSet descriptor_set() {
-    const Buffer* bound[Context::Impl::kBindings] = {&header_buf_, &pages_buf_, &bricks_buf_, &cost_[0], &cost_[1],
-                                                     &cost_[2],    &scratch_s_, &scratch_t_, &field_buf_};
+    const Buffer* bound[Context::Impl::kBindings] = {&header_buf_, &pages_buf_,  &bricks_buf_, &cost_[0],
+                                                     &cost_[1],    &cost_[2],    &scratch_s_,  &scratch_t_,
+                                                     &field_buf_,  &work_sites_, &field_sites_buf_};
     return ctx_.bind(ctx_.field_layout, bound);
   }
 
@@ -432,12 +459,13 @@ class FieldEngine {
   VkBufferCopy header_copy_{};
   Vec3i chunk_origin_{0, 0, 0}, chunk_dims_{0, 0, 0};
   std::size_t chunk_bytes_ = 0;
-  VkDeviceSize field_bytes_ = 0, work_bytes_ = 0;
+  VkDeviceSize field_bytes_ = 0, work_bytes_ = 0, site_bytes_ = 0;
   std::vector<std::uint32_t> pages_;  // the host's copy of the page table
   std::vector<std::uint32_t> free_slots_;
   std::uint32_t used_slots_ = 0, slot_capacity_ = 0;
   bool first_run_ = true;
   Buffer header_buf_, pages_buf_, bricks_buf_ = {}, field_buf_, cost_[3], scratch_s_, scratch_t_;
+  Buffer work_sites_, field_sites_buf_;
 };
 
 DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,

@@ -78,8 +78,8 @@ struct Context::Impl {
   mutable std::mutex messages_mutex;
   std::vector<std::string> messages;
 
-  // The distance pipelines (9 storage buffers, push constants) and the ray marcher (8 buffers).
-  static constexpr std::uint32_t kBindings = 9;
+  // The distance pipelines (11 storage buffers, push constants) and the ray marcher (8 buffers).
+  static constexpr std::uint32_t kBindings = 11;
   static constexpr std::uint32_t kPushBytes = 96;
   static constexpr std::uint32_t kRenderBindings = 8;
   BindingLayout field_layout, render_layout, jfa_layout, fim_layout;
