@@ -60,10 +60,12 @@ void DemoWorld::make_scene() {
   live_ = std::make_unique<DynamicRenderScene>(*world_, scene_options(settings_));
 }
 
-DynamicRenderScene::UpdateStats DemoWorld::apply(const Edit& edit) {
+DynamicRenderScene::UpdateStats DemoWorld::apply(std::span<const Edit> edits) {
   dirty_.clear();
-  apply_edit(*world_, edit, &dirty_);
-  ++edits_;
+  for (const Edit& edit : edits) {
+    apply_edit(*world_, edit, &dirty_);
+    ++edits_;
+  }
   DynamicRenderScene::UpdateStats st = live_->update(dirty_);
   dirty_.clear();
   return st;

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "voxfield/edit.h"
@@ -31,8 +32,10 @@ class DemoWorld {
   // A world read from a .vox, .npy or .vfw file, bounded to its extent with room above to build.
   DemoWorld(const WorldSettings& settings, const std::filesystem::path& file);
 
-  // Applies an edit (clipped to the world) and updates fields and scene incrementally.
-  DynamicRenderScene::UpdateStats apply(const Edit& edit);
+  // Applies edits (clipped to the world) in order, then updates fields and scene incrementally
+  // once for all of them (overlapping edits are recomputed once).
+  DynamicRenderScene::UpdateStats apply(std::span<const Edit> edits);
+  DynamicRenderScene::UpdateStats apply(const Edit& edit) { return apply(std::span<const Edit>(&edit, 1)); }
   // Rebuilds the fields for new metric / clamp settings (a full computation).
   void set_field(Metric metric, double clamp);
 

@@ -539,11 +539,14 @@ int Demo::run() {
       const Vec3d centre{box.begin.x + s.x / 2.0, box.begin.y + s.y / 2.0, box.begin.z + s.z * 0.3};
       const double r = 0.85 * std::max(s.x, s.y);
       camera_.look(centre + Vec3d{r * std::cos(angle), r * std::sin(angle), s.z * 0.9}, centre);
+      // The edits due by now (one per interval), applied together with one incremental update.
       const auto due = static_cast<std::int64_t>(ms_between(start, t0) / options_.interval_ms) + 1;
-      for (; streamed < due; ++streamed) {
+      std::vector<Edit> batch;
+      for (; streamed < due; ++streamed) batch.push_back(stream->next());
+      if (!batch.empty()) {
         const auto a = Clock::now();
-        world_->apply(stream->next());
-        update_ms += ms_between(a, Clock::now());
+        world_->apply(batch);
+        update_ms = ms_between(a, Clock::now());
       }
       last_.update_ms = update_ms;
     } else {
