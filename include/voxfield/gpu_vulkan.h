@@ -35,7 +35,9 @@ enum class PixelOrder { kRgba, kBgra };  // byte order of a packed 32-bit pixel
 // makes the pixels readable by transfers. Returns the buffer holding them: width x height packed
 // 8-bit pixels in `order` (sRGB-encoded, alpha 255), top row first — ready for
 // vkCmdCopyBufferToImage into a UNORM swapchain image. The buffer and the frame's parameters are
-// reused by the next frame: submit and wait for `cmd` before recording another frame or syncing.
+// reused by the next frame: wait for `cmd` before recording another frame. SceneRenderer::sync()
+// may run while the frame executes (its copies wait for it on the queue; buffers it replaces live
+// until the sync after).
 // Throws InvalidArgument as SceneRenderer::render does.
 VkBuffer record_render(SceneRenderer& renderer, VkCommandBuffer cmd, const Camera& camera,
                        const RenderOptions& options, PixelOrder order);

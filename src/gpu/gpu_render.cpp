@@ -95,7 +95,9 @@ class ResidentScene {
   std::vector<std::uint64_t> synced_generation_;
   std::uint64_t synced_palette_ = 0;
   Buffer params_, info_, skip_, light_, palette_, pixels_;
-  std::vector<Buffer> retired_;  // outgrown arenas, kept until the copy out of them has run
+  // Replaced buffers, kept until the next sync: by then the copies out of them and the frames
+  // that read them have completed (one frame in flight).
+  std::vector<Buffer> retired_;
   Buffer approx_info_, approx_arena_, approx_staging_;
   std::uint64_t approx_scene_ = 0, approx_generation_ = 0;  // what the resident approximation was made from
   int approx_algorithm_ = -1;
@@ -128,7 +130,7 @@ bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
   // Device buffers as large as the host arenas' capacity, so growth is rare. A new scene gets
   // everything copied; an arena that outgrew its buffer moves to a larger one on the GPU (the old
   // buffer is retired until this submission has completed), so only the changed chunks travel.
-  retired_.clear();  // the submission that used them was waited for
+  retired_.clear();
   std::vector<std::pair<Buffer*, Buffer>> grown;
   auto ensure = [&](Buffer& b, std::size_t bytes, bool keep) {
     bytes = std::max<std::size_t>(bytes, 16);
@@ -138,6 +140,7 @@ bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
       grown.emplace_back(&b, std::move(b));
     } else {
       whole = true;
+      if (b.handle() != VK_NULL_HANDLE) retired_.push_back(std::move(b));  // a frame may still read it
     }
     b = std::move(bigger);
     descriptors_stale_ = true;
@@ -148,6 +151,12 @@ bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
   ensure(skip_, s.skip.cells.arena.size(), true);
   ensure(light_, s.has_light ? s.light.arena.size() : 0, true);
   if (whole) grown.clear();  // everything is copied from the host anyway
+  // A frame submitted earlier may still be reading the buffers these copies write (an application
+  // that records frames into its own command buffers need not wait for one before syncing): the
+  // barrier's first scope covers every command submitted before it on this queue.
+  barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+          VK_ACCESS_TRANSFER_WRITE_BIT);
   if (!grown.empty())  // earlier submissions' writes of the old arenas come before reading them
     barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
             VK_ACCESS_TRANSFER_READ_BIT);
