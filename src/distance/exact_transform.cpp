@@ -763,13 +763,23 @@ void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, con
   const int z0 = out.begin.z - in.begin.z, z1 = out.end.z - in.begin.z;
   const int ox = out.begin.x - in.begin.x, oy = out.begin.y - in.begin.y;
   const std::size_t plane = static_cast<std::size_t>(n.x) * n.y;
-  std::vector<std::uint8_t> solid(static_cast<std::size_t>(in.volume()));
+  // Scratch kept per thread across calls: incremental updates call this for every edit, and fresh
+  // allocations of this size come from mmap, paying a page fault per 4 KiB every time.
+  // (Named through references: a lambda naming a thread_local directly would reach the worker
+  // thread's own copy, not this one.)
+  thread_local std::vector<std::uint8_t> solid_scratch;
+  thread_local std::vector<std::uint32_t> g_scratch;
+  thread_local std::vector<std::int16_t> dz_scratch;
+  std::vector<std::uint8_t>& solid = solid_scratch;
+  std::vector<std::uint32_t>& g = g_scratch;
+  std::vector<std::int16_t>& dz = dz_scratch;
+  solid.resize(static_cast<std::size_t>(in.volume()));
   occupancy.copy_to_dense(in, solid.data());
   std::uint64_t cap = std::numeric_limits<std::uint32_t>::max() - 1;
   if (std::isfinite(p.clamp)) cap = std::min<std::uint64_t>(cap, static_cast<std::uint64_t>(std::floor(p.clamp / p.spacing[2]) + 1));
   const auto cap32 = static_cast<std::uint32_t>(cap);
-  std::vector<std::uint32_t> g(static_cast<std::size_t>(m.z) * plane);
-  std::vector<std::int16_t> dz(sites ? g.size() : 0);
+  g.resize(static_cast<std::size_t>(m.z) * plane);
+  dz.resize(sites ? g.size() : 0);
   if (p.is_signed) {
     region_pass_z<true>(solid.data(), n, z0, z1, cap32, g.data(), sites ? dz.data() : nullptr);
   } else {

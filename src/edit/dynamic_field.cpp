@@ -188,7 +188,10 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
         [&](auto& target) {
           using T = typename std::decay_t<decltype(target)>::value_type;
           Box3i r = region.out;
-          std::vector<T> old;
+          // Scratch reused across updates (fresh buffers this size cost a page fault per 4 KiB).
+          thread_local std::vector<T> old_scratch, values_scratch;
+          std::vector<T>& old = old_scratch;
+          std::vector<T>& values = values_scratch;
           if (shrink || additions_only) {
             old.resize(static_cast<std::size_t>(r.volume()));
             target.copy_to_dense(r, old.data());
@@ -203,9 +206,8 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
             const Box3i a = detail::affected_box(plan, r, old, near, kind);
             if (a.empty()) return;
             if (a != r) {  // keep the old values of the shrunk box only
-              std::vector<T> kept(static_cast<std::size_t>(a.volume()));
-              target.copy_to_dense(a, kept.data());
-              old = std::move(kept);
+              old.resize(static_cast<std::size_t>(a.volume()));
+              target.copy_to_dense(a, old.data());
               r = a;
             }
           }
@@ -213,7 +215,7 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
           // and write it into the field (additions: from r's own sites, then the minimum with the old).
           const Box3i in = additions_only ? r : Box3i{r.begin - reach_, r.end + reach_}.intersect(*options_.domain);
           std::vector<SiteOffset> sites(field_.sites ? static_cast<std::size_t>(r.volume()) : 0);
-          std::vector<T> values(static_cast<std::size_t>(r.volume()));
+          values.resize(static_cast<std::size_t>(r.volume()));
           detail::compute_region<T>(world_->voxels, plan, in, r, values.data(), field_.sites ? sites.data() : nullptr);
           if (additions_only)
             for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::min(values[i], old[i]);

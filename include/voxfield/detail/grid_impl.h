@@ -220,17 +220,31 @@ void Grid<T>::copy_from_dense(const Box3i& box, const T* in) {
   for (const Vec3i coord : chunks_overlapping(box)) {
     const Box3i part = chunk_box(coord).intersect(box);
     auto it = chunks_.find(coord);
-    if (it == chunks_.end()) {
-      Chunk c;
-      c.uniform = background_;
-      it = chunks_.emplace(coord, std::move(c)).first;
+    const int run = part.end.x - part.begin.x;
+    auto row = [&](int y, int z) { return in + (z - box.begin.z) * sxy + (y - box.begin.y) * sx + (part.begin.x - box.begin.x); };
+    if (it == chunks_.end() || !it->second.voxels) {
+      // A uniform chunk (or an absent one, which holds the background) written with its own value
+      // stays as it is: no expansion, no collapse scan — incremental field updates rewrite large
+      // stretches of "clamp" in open air.
+      const T uniform = it == chunks_.end() ? background_ : it->second.uniform;
+      bool same = true;
+      for (int z = part.begin.z; z < part.end.z && same; ++z)
+        for (int y = part.begin.y; y < part.end.y && same; ++y) {
+          const T* src = row(y, z);
+          same = std::all_of(src, src + run, [&](const T& v) { return v == uniform; });
+        }
+      if (same) continue;
+      if (it == chunks_.end()) {
+        Chunk c;
+        c.uniform = background_;
+        it = chunks_.emplace(coord, std::move(c)).first;
+      }
+      expand(it->second);
     }
     Chunk& c = it->second;
-    if (!c.voxels) expand(c);
-    const int run = part.end.x - part.begin.x;
     for (int z = part.begin.z; z < part.end.z; ++z)
       for (int y = part.begin.y; y < part.end.y; ++y) {
-        const T* src = in + (z - box.begin.z) * sxy + (y - box.begin.y) * sx + (part.begin.x - box.begin.x);
+        const T* src = row(y, z);
         std::copy(src, src + run, c.voxels.get() + local_index({part.begin.x, y, z}));
       }
     collapse_if_uniform(it);
