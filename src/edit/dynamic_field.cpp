@@ -203,7 +203,19 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
             const detail::Changes kind = !dirty.adds_solid()     ? detail::Changes::kRemovals
                                          : !dirty.removes_solid() ? detail::Changes::kAdditions
                                                                   : detail::Changes::kBoth;
-            const Box3i a = detail::affected_box(plan, r, old, near, kind);
+            // Open space far from everything (every chunk of r uniform at the clamp) needs no scan:
+            // every voxel of r is in reach of an addition, and no removal can raise a value there.
+            const T clamp_stored = detail::encode_distance<T>(plan.clamp, plan);
+            bool all_clamped = true;
+            const int shift = target.chunk_shift();
+            for (int cz = r.begin.z >> shift; all_clamped && cz <= (r.end.z - 1) >> shift; ++cz)
+              for (int cy = r.begin.y >> shift; all_clamped && cy <= (r.end.y - 1) >> shift; ++cy)
+                for (int cx = r.begin.x >> shift; all_clamped && cx <= (r.end.x - 1) >> shift; ++cx) {
+                  const auto view = target.chunk_view({cx, cy, cz});
+                  all_clamped = view.uniform() && view.uniform_value == clamp_stored;
+                }
+            const Box3i a = all_clamped ? (kind == detail::Changes::kRemovals ? Box3i{} : r)
+                                        : detail::affected_box(plan, r, old, near, kind);
             if (a.empty()) return;
             if (a != r) {  // keep the old values of the shrunk box only
               old.resize(static_cast<std::size_t>(a.volume()));

@@ -242,12 +242,31 @@ void Grid<T>::copy_from_dense(const Box3i& box, const T* in) {
       expand(it->second);
     }
     Chunk& c = it->second;
+    // The O(1) collapse counter (voxels equal to c.ref) follows the writes, so a chunk written
+    // with varied values needs no scan of its own: it can only have become uniform at c.ref (the
+    // counter says so) or, when everything written was one value, at that value (then scan).
+    const T first = *row(part.begin.y, part.begin.z);
+    bool written_uniform = true;
     for (int z = part.begin.z; z < part.end.z; ++z)
       for (int y = part.begin.y; y < part.end.y; ++y) {
         const T* src = row(y, z);
-        std::copy(src, src + run, c.voxels.get() + local_index({part.begin.x, y, z}));
+        T* dst = c.voxels.get() + local_index({part.begin.x, y, z});
+        for (int x = 0; x < run; ++x) {
+          written_uniform = written_uniform && src[x] == first;
+          c.ref_count += (src[x] == c.ref ? 1 : 0) - (dst[x] == c.ref ? 1 : 0);
+          dst[x] = src[x];
+        }
       }
-    collapse_if_uniform(it);
+    if (c.ref_count == chunk_volume()) {
+      if (c.ref == background_) {
+        chunks_.erase(it);
+      } else {
+        c.voxels.reset();
+        c.uniform = c.ref;
+      }
+    } else if (written_uniform) {
+      collapse_if_uniform(it);
+    }
   }
 }
 
