@@ -111,10 +111,12 @@ std::shared_ptr<Context> select_backend(Backend backend, const ContextOptions& o
 DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
                                      std::vector<PassTiming>* timings = nullptr);
 
-// One of the dissertation's algorithms on the GPU: kExact (as above) and jump flooding — kJfaSeed,
-// kJfa, kJfa1, kJfa2 — whose fields are bit-identical to the CPU's (same passes, same tie rule, one
-// command buffer per sign). The others throw InvalidArgument for now (FIM, hybrid and lod run on
-// the CPU).
+// One of the dissertation's algorithms on the GPU: kExact (as above); jump flooding — kJfaSeed,
+// kJfa, kJfa1, kJfa2 — bit-identical to the CPU's (same passes, same tie rule, one command buffer
+// per sign); kFim as Jacobi passes that stop themselves (indirect dispatch, one submit; L1 and
+// L-inf bit-identical, Euclidean within 1e-4 voxels of the CPU's), kHybrid and kLod as JFA then
+// FIM (two submits). kBrute and kBruteChunked (CPU references) throw InvalidArgument, as do FIM,
+// hybrid and lod with nearest sites; unit spacing only.
 DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
                                      const AlgorithmOptions& algorithm, AlgorithmStats* stats = nullptr,
                                      std::vector<PassTiming>* timings = nullptr);
