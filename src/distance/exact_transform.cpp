@@ -273,15 +273,21 @@ void solve_line(const Kernel& k, int n, const V* f, V* out, std::int32_t* arg, s
 }
 
 // Results are needed only for the columns x_lo..x_hi-1 (all of them for whole fields; the output
-// window for local updates), so pass C runs on those columns only.
+// window for local updates), so pass C runs on those columns only. `drop_above`: the clamp's cost —
+// a pass-B value above it cannot bring any voxel within the clamp (pass C only adds to it), so it
+// is dropped as "none", which leaves pass C fewer functions and more lines it skips outright.
 template <class KernelX, class KernelY, class V>
 void solve_slice_envelope2(const KernelX& kx, const KernelY& ky, int X, int Y, SliceBuffers<V>& b, bool track_sites,
-                           V inf, int x_lo, int x_hi) {
+                           V inf, int x_lo, int x_hi, V drop_above) {
   std::int32_t* arg_x = track_sites ? b.arg_x.data() : nullptr;
   std::int32_t* targ = track_sites ? b.targ.data() : nullptr;
   for (int y = 0; y < Y; ++y) {
     const std::size_t o = static_cast<std::size_t>(y) * X;
     solve_line(kx, X, b.f.data() + o, b.h.data() + o, arg_x ? arg_x + o : nullptr, b.s.data(), b.t.data(), inf);
+  }
+  if (drop_above < inf) {
+    V* h = b.h.data();
+    for (std::size_t i = 0; i < static_cast<std::size_t>(X) * Y; ++i) h[i] = h[i] > drop_above ? inf : h[i];
   }
   to_columns(b.h.data(), b.tmp.data(), X, Y, x_lo, x_hi);
   for (int x = x_lo; x < x_hi; ++x) {
@@ -294,8 +300,8 @@ void solve_slice_envelope2(const KernelX& kx, const KernelY& ky, int X, int Y, S
 
 template <class Kernel, class V>
 void solve_slice_envelope(const Kernel& kx, const Kernel& ky, int X, int Y, SliceBuffers<V>& b, bool track_sites, V inf,
-                          int x_lo, int x_hi) {
-  solve_slice_envelope2(kx, ky, X, Y, b, track_sites, inf, x_lo, x_hi);
+                          int x_lo, int x_hi, V drop_above) {
+  solve_slice_envelope2(kx, ky, X, Y, b, track_sites, inf, x_lo, x_hi, drop_above);
 }
 
 // 2-D solve of one slice for Manhattan: min-plus sweeps along x per row, then along y across whole
@@ -563,6 +569,15 @@ void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
 template <class Fn>
 void dispatch_solver(const Plan& p, Vec3i extent, Fn&& fn) {
   const bool sites = p.sites;
+  // The clamp as a cost of each kernel (squared for Euclidean), rounded down where costs are
+  // integers: pass-B values above it are dropped (solve_slice_envelope2).
+  const double clamp_cost = p.metric == Metric::kEuclidean ? p.clamp * p.clamp : p.clamp;
+  auto drop = [&](auto inf) {
+    using V = decltype(inf);
+    if (!(clamp_cost < static_cast<double>(inf))) return inf;
+    if constexpr (std::is_integral_v<V>) return static_cast<V>(std::floor(clamp_cost));
+    return static_cast<V>(clamp_cost);
+  };
   if (p.metric == Metric::kManhattan) {
     auto solve = [sites](int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) { solve_slice_manhattan(X, Y, b, sites, lo, hi); };
     fn(std::int32_t{}, solve, detail::kManhattanInf);
@@ -570,8 +585,8 @@ void dispatch_solver(const Plan& p, Vec3i extent, Fn&& fn) {
     auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(Chebyshev{}, n, f, o, a, s, t);
     };
-    auto solve = [k, sites](int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) {
-      solve_slice_envelope(k, k, X, Y, b, sites, Chebyshev::kInf, lo, hi);
+    auto solve = [k, sites, d = drop(Chebyshev::kInf)](int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) {
+      solve_slice_envelope(k, k, X, Y, b, sites, Chebyshev::kInf, lo, hi, d);
     };
     fn(std::int32_t{}, solve, Chebyshev::kInf);
   } else if (p.unit_spacing && static_cast<double>(extent.x) * extent.x + static_cast<double>(extent.y) * extent.y +
@@ -579,16 +594,16 @@ void dispatch_solver(const Plan& p, Vec3i extent, Fn&& fn) {
     auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(detail::EuclideanInt32{}, n, f, o, a, s, t);
     };
-    auto solve = [k, sites](int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) {
-      solve_slice_envelope(k, k, X, Y, b, sites, detail::EuclideanInt32::kInf, lo, hi);
+    auto solve = [k, sites, d = drop(detail::EuclideanInt32::kInf)](int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) {
+      solve_slice_envelope(k, k, X, Y, b, sites, detail::EuclideanInt32::kInf, lo, hi, d);
     };
     fn(std::int32_t{}, solve, detail::EuclideanInt32::kInf);
   } else if (p.unit_spacing) {
     auto k = [](int n, const std::int64_t* f, std::int64_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(EuclideanInt{}, n, f, o, a, s, t);
     };
-    auto solve = [k, sites](int X, int Y, SliceBuffers<std::int64_t>& b, int lo, int hi) {
-      solve_slice_envelope(k, k, X, Y, b, sites, EuclideanInt::kInf, lo, hi);
+    auto solve = [k, sites, d = drop(EuclideanInt::kInf)](int X, int Y, SliceBuffers<std::int64_t>& b, int lo, int hi) {
+      solve_slice_envelope(k, k, X, Y, b, sites, EuclideanInt::kInf, lo, hi, d);
     };
     fn(std::int64_t{}, solve, EuclideanInt::kInf);
   } else {
@@ -599,9 +614,9 @@ void dispatch_solver(const Plan& p, Vec3i extent, Fn&& fn) {
     auto ky = [ey](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
       detail::envelope_1d(ey, n, f, o, a, s, t);
     };
-    auto solve = [kx, ky, sites](int X, int Y, SliceBuffers<double>& b, int lo, int hi) {
+    auto solve = [kx, ky, sites, d = drop(EuclideanReal::kInf)](int X, int Y, SliceBuffers<double>& b, int lo, int hi) {
       // The two axes weigh differently; the slice solver takes one kernel per axis.
-      solve_slice_envelope2(kx, ky, X, Y, b, sites, EuclideanReal::kInf, lo, hi);
+      solve_slice_envelope2(kx, ky, X, Y, b, sites, EuclideanReal::kInf, lo, hi, d);
     };
     fn(double{}, solve, EuclideanReal::kInf);
   }
