@@ -187,6 +187,9 @@ class Grid {
   void require_in_bounds(const Box3i& box, const char* what) const;
   Chunk& expand(Chunk& chunk);  // makes a uniform chunk dense
   void collapse_if_uniform(typename ChunkMap::iterator it);
+  // A chunk whose every voxel equals its collapse counter's value (ref_count == volume) stored
+  // as that one value (or dropped when it is the background).
+  void collapse_to_ref(typename ChunkMap::iterator it);
   std::vector<Vec3i> chunks_overlapping(const Box3i& box) const;
 
   int chunk_edge_;

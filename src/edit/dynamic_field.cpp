@@ -217,9 +217,19 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
             const Box3i a = all_clamped ? (kind == detail::Changes::kRemovals ? Box3i{} : r)
                                         : detail::affected_box(plan, r, old, near, kind);
             if (a.empty()) return;
-            if (a != r) {  // keep the old values of the shrunk box only
+            if (a != r) {  // keep the old values of the shrunk box only, moved to the front in place
+              const Vec3i rs = r.size(), as = a.size();
+              std::size_t k = 0;
+              for (int z = a.begin.z; z < a.end.z; ++z)
+                for (int y = a.begin.y; y < a.end.y; ++y) {
+                  const std::size_t from = (static_cast<std::size_t>(z - r.begin.z) * rs.y + static_cast<std::size_t>(y - r.begin.y)) * rs.x +
+                                           static_cast<std::size_t>(a.begin.x - r.begin.x);
+                  if (from != k)  // from > k: rows only move towards the front
+                    std::copy(old.begin() + static_cast<std::ptrdiff_t>(from),
+                              old.begin() + static_cast<std::ptrdiff_t>(from) + as.x, old.begin() + static_cast<std::ptrdiff_t>(k));
+                  k += static_cast<std::size_t>(as.x);
+                }
               old.resize(static_cast<std::size_t>(a.volume()));
-              target.copy_to_dense(a, old.data());
               r = a;
             }
           }

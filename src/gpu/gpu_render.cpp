@@ -193,10 +193,12 @@ bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
     at += n;
   };
   Staged palette_copy, info_copy, skip_copy, light_copy;
-  std::vector<float> palette(256 * 4, 0.0f);
-  for (int m = 0; m < 256; ++m)
-    for (int c = 0; c < 3; ++c) palette[static_cast<std::size_t>(4 * m + c)] = s.albedo[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)];
-  if (palette_changed) stage(palette_copy, 0, palette.data(), palette.size() * 4);
+  if (palette_changed) {
+    std::vector<float> palette(256 * 4, 0.0f);
+    for (int m = 0; m < 256; ++m)
+      for (int c = 0; c < 3; ++c) palette[static_cast<std::size_t>(4 * m + c)] = s.albedo[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)];
+    stage(palette_copy, 0, palette.data(), palette.size() * 4);
+  }
   if (whole) {
     std::vector<std::uint32_t> info(4 * chunks);
     for (std::size_t i = 0; i < chunks; ++i) {

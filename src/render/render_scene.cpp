@@ -323,6 +323,7 @@ void RenderScene::Impl::build(const World& w, const DistanceField& skip_field, c
   parallel_for(n, 4, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) refresh_chunk(i, skip_grid, light_grid);
   });
+  palette = w.palette;
   albedo = linear_albedo(w);
 }
 
@@ -373,9 +374,9 @@ std::size_t RenderScene::update(const DistanceField& skip_field, const DistanceF
       s.chunk_generation[chunks[k]] = s.generation;
       ++count;
     }
-  const auto albedo = linear_albedo(*s.world);
-  if (albedo != s.albedo) {
-    s.albedo = albedo;
+  if (s.world->palette != s.palette) {  // decoded only when it changed, not on every edit
+    s.palette = s.world->palette;
+    s.albedo = linear_albedo(*s.world);
     s.palette_generation = s.generation;
   }
   return count;

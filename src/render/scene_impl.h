@@ -78,6 +78,7 @@ struct RenderScene::Impl {
   double light_inv_scale = 0.25;
   std::vector<std::uint8_t> empty_chunk;     // 1 where a chunk holds no solid voxel
   std::vector<std::uint8_t> dense_material;  // 1 where the world stores a chunk voxel by voxel
+  Palette palette{};                                // the world's palette the albedo was decoded from
   std::array<std::array<float, 3>, 256> albedo{};  // palette in linear RGB
 
   void build(const World& w, const DistanceField& skip_field, const DistanceField* light_field);

@@ -102,14 +102,18 @@ void Grid<T>::set(Vec3i p, T value) {
   if (slot == c.ref) --c.ref_count;
   if (value == c.ref) ++c.ref_count;
   slot = value;
-  if (c.ref_count == chunk_volume()) {
-    // Every voxel is back to the value the chunk was expanded from: store it as that value again.
-    if (c.ref == background_) {
-      chunks_.erase(it);
-    } else {
-      c.voxels.reset();
-      c.uniform = c.ref;
-    }
+  // Every voxel is back to the value the chunk was expanded from: store it as that value again.
+  if (c.ref_count == chunk_volume()) collapse_to_ref(it);
+}
+
+template <class T>
+void Grid<T>::collapse_to_ref(typename ChunkMap::iterator it) {
+  Chunk& c = it->second;
+  if (c.ref == background_) {
+    chunks_.erase(it);
+  } else {
+    c.voxels.reset();
+    c.uniform = c.ref;
   }
 }
 
@@ -258,12 +262,7 @@ void Grid<T>::copy_from_dense(const Box3i& box, const T* in) {
         }
       }
     if (c.ref_count == chunk_volume()) {
-      if (c.ref == background_) {
-        chunks_.erase(it);
-      } else {
-        c.voxels.reset();
-        c.uniform = c.ref;
-      }
+      collapse_to_ref(it);
     } else if (written_uniform) {
       collapse_if_uniform(it);
     }
