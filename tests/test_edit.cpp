@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "edit/update_regions.h"  // internal: the affected-box search, tested directly
 #include "voxfield/dynamic_field.h"
 #include "voxfield/edit.h"
 
@@ -170,6 +171,12 @@ TEST(DynamicField, IncrementalUpdatesEqualFullRebuilds) {
       {Metric::kEuclidean, true, 6, Storage::kF32, false, {0.5, 1.0, 2.0}},
       // Unsigned without sites: the local pass's fast encoding.
       {Metric::kChebyshev, false, 5, Storage::kU8, false},  {Metric::kEuclidean, false, 6, Storage::kF32, false},
+      {Metric::kManhattan, false, 9, Storage::kU16, false},
+      // Unclamped, and unequal spacings (Euclidean only): the affected-box search's rounding slack
+      // and the bound on new values after removals depend on the metric and the spacing.
+      {Metric::kEuclidean, false, 0, Storage::kF32, false, {1.0, 0.5, 2.0}},
+      {Metric::kEuclidean, false, 5, Storage::kU16, false, {0.5, 1.0, 1.0}},
+      {Metric::kChebyshev, false, 0, Storage::kF32, false},
   };
   const Box3i bounds{{-9, 0, 4}, {43, 37, 33}};
   const auto model = small_model();
@@ -204,6 +211,106 @@ TEST(DynamicField, IncrementalUpdatesEqualFullRebuilds) {
     }
   }
   EXPECT_GT(total_edits, 2000);
+}
+
+// Edits in and under solid ground: holes whose new values are bounded by the ground around them
+// (the update reads only the sites that bound allows), placements and carves at the surface and
+// in caves, one per update, against full rebuilds.
+TEST(DynamicField, EditsInSolidGroundEqualFullRebuilds) {
+  const Box3i bounds = Box3i::from_size({70, 44, 66});
+  const FieldCase cases[] = {
+      {Metric::kEuclidean, false, 12, Storage::kF32, false},  {Metric::kManhattan, false, 10, Storage::kU8, false},
+      {Metric::kChebyshev, false, 8, Storage::kU16, false},   {Metric::kEuclidean, false, 0, Storage::kU8, false},
+      {Metric::kEuclidean, false, 9, Storage::kU16, false, {1.0, 0.5, 1.5}},
+  };
+  std::uint32_t seed = 7;
+  for (const FieldCase& c : cases) {
+    SCOPED_TRACE(std::string(metric_name(c.metric)) + " clamp " + std::to_string(c.clamp) + " " + storage_name(c.storage));
+    std::mt19937 rng(seed++);
+    World w(16, bounds);
+    // Ground up to a wavy height with a few caves.
+    for (int z = 0; z < 66; ++z)
+      for (int x = 0; x < 70; ++x) {
+        const int h = 28 + static_cast<int>(4 * std::sin(x * 0.21) + 3 * std::cos(z * 0.17));
+        apply_edit(w, {EditOp::kPlace, BoxBrush{{x, 0, z}, {x, h, z}}, 2});
+      }
+    for (int i = 0; i < 6; ++i)
+      apply_edit(w, {EditOp::kCarve, SphereBrush{{5.0 + rng() % 60, 4.0 + rng() % 20, 5.0 + rng() % 56}, 2.0 + rng() % 4}, 1});
+    DistanceOptions o;
+    o.metric = c.metric;
+    o.max_distance = c.clamp;
+    o.storage = c.storage;
+    o.spacing = c.spacing;
+    DynamicDistanceField live(w, o);
+    DirtyRegions dirty(16, DirtyRegions::Track::kOccupancy);
+    for (int i = 0; i < 120; ++i) {
+      const double radius = static_cast<double>(rng() % 6);
+      const Vec3d at{static_cast<double>(rng() % 70), static_cast<double>(rng() % 40), static_cast<double>(rng() % 66)};
+      Edit e{i % 3 == 2 ? EditOp::kPlace : EditOp::kCarve, SphereBrush{at, radius}, 3};
+      if (i % 5 == 4) e.brush = BoxBrush{Vec3i{static_cast<int>(at.x), static_cast<int>(at.y), static_cast<int>(at.z)},
+                                         Vec3i{static_cast<int>(at.x) + 4, static_cast<int>(at.y) + 1, static_cast<int>(at.z) + 6}};
+      apply_edit(w, e, &dirty);
+      live.update(dirty);
+      dirty.clear();
+      expect_same_field(live.field(), compute_distance_field(w, live.options()), bounds, i);
+      if (HasFatalFailure()) return;
+    }
+  }
+  // A hole carved deep in the ground: the new values inside it are at most 4 (the ground around
+  // it is at 0), so only sites within 4 voxels of the 7^3 hole are read, not the clamp's 12.
+  World w(16, bounds);
+  apply_edit(w, {EditOp::kPlace, BoxBrush{{0, 0, 0}, {69, 43, 65}}, 2});
+  DistanceOptions o;
+  o.metric = Metric::kEuclidean;
+  o.max_distance = 12;
+  DynamicDistanceField live(w, o);
+  DirtyRegions dirty(16, DirtyRegions::Track::kOccupancy);
+  apply_edit(w, {EditOp::kCarve, SphereBrush{{35, 22, 33}, 3}, 1}, &dirty);
+  const auto stats = live.update(dirty);
+  EXPECT_EQ(stats.voxels_recomputed, 7 * 7 * 7);
+  EXPECT_EQ(stats.voxels_read, 15 * 15 * 15);
+  expect_same_field(live.field(), compute_distance_field(w, o), bounds, 0);
+  EXPECT_NEAR(live.field().distance({35, 22, 33}), std::sqrt(10.0), 1e-6);  // to (35, 25, 32) and kin
+}
+
+// The voxels nearer a new site than to every old one need not be 26-connected on the grid (the
+// discrete Voronoi cells that make propagation methods inexact). Here part of the new site's cell
+// is cut off from it; the update's search for the affected box must still reach it (its rounding
+// slack does: without it the box misses voxels that change). The search runs without the volume
+// cap that updates give it, which would hide a miss behind a fall-back to the whole region.
+TEST(DynamicField, AffectedBoxSearchReachesDisconnectedPartsOfANewSitesCell) {
+  const Box3i bounds = Box3i::from_size({40, 40, 40});
+  World w(16, bounds);
+  w.voxels.set({6, 11, 26}, 1);
+  w.voxels.set({7, 27, 23}, 1);
+  DistanceOptions o;
+  o.metric = Metric::kEuclidean;
+  o.domain = bounds;
+  const DistanceField before = compute_distance_field(w, o);
+  const Box3i placed = Box3i::from_inclusive({6, 23, 25}, {6, 23, 25});
+  w.voxels.set(placed.begin, 1);
+  const DistanceField after = compute_distance_field(w, o);
+  const Box3i box = detail::grow_affected(detail::make_field_plan(w.voxels, o), std::get<Grid<float>>(before.values), bounds,
+                                          placed, bounds.volume());
+  int changed = 0;
+  for (int z = 0; z < 40; ++z)
+    for (int y = 0; y < 40; ++y)
+      for (int x = 0; x < 40; ++x)
+        if (before.distance({x, y, z}) != after.distance({x, y, z})) {
+          ++changed;
+          ASSERT_TRUE(box.contains(Vec3i{x, y, z})) << "voxel " << to_string(Vec3i{x, y, z}) << " changed outside " << to_string(box);
+        }
+  EXPECT_GT(changed, 1000);
+  EXPECT_LT(box.volume(), bounds.volume());  // the search did not just return the whole region
+  // And end to end, through an update.
+  World w2(16, bounds);
+  w2.voxels.set({6, 11, 26}, 1);
+  w2.voxels.set({7, 27, 23}, 1);
+  DynamicDistanceField live(w2, o);
+  DirtyRegions dirty(16, DirtyRegions::Track::kOccupancy);
+  apply_edit(w2, {EditOp::kPlace, BoxBrush{placed.begin, placed.begin}, 1}, &dirty);
+  live.update(dirty);
+  expect_same_field(live.field(), after, bounds, 0);
 }
 
 TEST(DynamicField, UpdatesStayLocal) {

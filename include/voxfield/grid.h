@@ -140,10 +140,42 @@ class Grid {
   // generate_chunks. Throws InvalidArgument (changing nothing) when the sizes disagree.
   void adopt_chunks(const std::vector<Vec3i>& chunks, std::vector<std::unique_ptr<T[]>> data);
 
+  // Writes the voxels of one dense chunk inside edit_chunk, by local index (x fastest). Writes keep
+  // the chunk's O(1) collapse counter up to date, so an edit of a few voxels costs a few voxels —
+  // no scan of the whole chunk afterwards.
+  class ChunkEdit {
+   public:
+    T get(std::int64_t i) const { return voxels_[i]; }
+    // Sets voxel i; returns whether its value changed.
+    bool set(std::int64_t i, T value) {
+      T& slot = voxels_[i];
+      if (slot == value) return false;
+      ref_count_ += (value == ref_ ? 1 : 0) - (slot == ref_ ? 1 : 0);
+      if (writes_ == 0) first_ = value;
+      one_value_ = one_value_ && value == first_;
+      ++writes_;
+      slot = value;
+      return true;
+    }
+    std::int64_t writes() const { return writes_; }
+
+   private:
+    friend class Grid;
+    ChunkEdit(T* voxels, T ref, std::int64_t ref_count) : voxels_(voxels), ref_(ref), ref_count_(ref_count) {}
+    T* voxels_;
+    T ref_;
+    std::int64_t ref_count_;
+    std::int64_t writes_ = 0;
+    T first_{};
+    bool one_value_ = true;
+  };
+
   // Edits one chunk in place: makes it dense (expanding a uniform or absent chunk), calls
-  // f(T* voxels) on its edge^3 values (x fastest), which returns whether it changed anything, and
-  // collapses the chunk again if it came out uniform. Throws InvalidArgument for a chunk wholly
-  // outside a bounded grid; f must not write voxels beyond the bounds.
+  // f(ChunkEdit&) to read and write its edge^3 voxels, and collapses the chunk again if it came
+  // out uniform (known in O(1) when it returned to the value it was expanded from; a scan, which
+  // stops at the first differing voxel, only when every write stored one value). Throws
+  // InvalidArgument for a chunk wholly outside a bounded grid; f must not write voxels beyond the
+  // bounds. If f throws, the voxels it wrote stay written (the chunk is left consistent).
   template <class F>
   void edit_chunk(Vec3i coord, F&& f);
 

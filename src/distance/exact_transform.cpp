@@ -204,7 +204,12 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, ChunkedV
 template <class A>
 struct Scratch {
   std::unique_ptr<A[]> p;
-  void resize(std::size_t n) { p.reset(new A[n]); }
+  std::size_t capacity = 0;
+  void resize(std::size_t n) {  // contents are not kept; the storage is, when large enough
+    if (n <= capacity) return;
+    p.reset(new A[n]);
+    capacity = n;
+  }
   A* data() { return p.get(); }
   const A* data() const { return p.get(); }
   A& operator[](std::size_t i) { return p[i]; }
@@ -773,7 +778,7 @@ void region_pass_z(const std::uint8_t* solid, Vec3i n, int z0, int z1, std::uint
 
 template <class T>
 void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, const Box3i& in, const Box3i& out,
-                         T* values, SiteOffset* sites) {
+                         T* values, SiteOffset* sites, const Box3i* sites_within) {
   const Vec3i n = in.size(), m = out.size();
   const int z0 = out.begin.z - in.begin.z, z1 = out.end.z - in.begin.z;
   const int ox = out.begin.x - in.begin.x, oy = out.begin.y - in.begin.y;
@@ -789,7 +794,25 @@ void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, con
   std::vector<std::uint32_t>& g = g_scratch;
   std::vector<std::int16_t>& dz = dz_scratch;
   solid.resize(static_cast<std::size_t>(in.volume()));
-  occupancy.copy_to_dense(in, solid.data());
+  const Box3i site_box = sites_within ? sites_within->intersect(in) : in;
+  if (site_box == in) {
+    occupancy.copy_to_dense(in, solid.data());
+  } else {  // empty everywhere but the sites' box, copied row by row into place
+    std::fill(solid.begin(), solid.end(), std::uint8_t{0});
+    if (!site_box.empty()) {
+      thread_local std::vector<std::uint8_t> part_scratch;
+      std::vector<std::uint8_t>& part = part_scratch;
+      part.resize(static_cast<std::size_t>(site_box.volume()));
+      occupancy.copy_to_dense(site_box, part.data());
+      const Vec3i sn = site_box.size();
+      for (int z = 0; z < sn.z; ++z)
+        for (int y = 0; y < sn.y; ++y)
+          std::copy_n(part.data() + (static_cast<std::size_t>(z) * sn.y + static_cast<std::size_t>(y)) * sn.x, sn.x,
+                      solid.data() + (static_cast<std::size_t>(site_box.begin.z - in.begin.z + z) * n.y +
+                                      static_cast<std::size_t>(site_box.begin.y - in.begin.y + y)) * n.x +
+                          static_cast<std::size_t>(site_box.begin.x - in.begin.x));
+    }
+  }
   std::uint64_t cap = std::numeric_limits<std::uint32_t>::max() - 1;
   if (std::isfinite(p.clamp)) cap = std::min<std::uint64_t>(cap, static_cast<std::uint64_t>(std::floor(p.clamp / p.spacing[2]) + 1));
   const auto cap32 = static_cast<std::uint32_t>(cap);
@@ -807,8 +830,13 @@ void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, con
     using V = decltype(tag);
     const V clamp_v = clamp_cost >= static_cast<double>(inf) ? inf : static_cast<V>(clamp_cost);
     const int passes = p.is_signed ? 2 : 1;
-    parallel_for(static_cast<std::size_t>(m.z), 1, [&](std::size_t zb, std::size_t ze) {
-      SliceBuffers<V> buf[2];
+    // Small regions (most edits) run on the calling thread: handing ~10 slices to a pool costs
+    // more than computing them. Slice buffers of moderate size are kept per thread across calls.
+    const std::size_t grain = std::max<std::size_t>(1, (std::size_t{1} << 14) / plane);
+    parallel_for(static_cast<std::size_t>(m.z), grain, [&](std::size_t zb, std::size_t ze) {
+      thread_local SliceBuffers<V> kept[2];
+      SliceBuffers<V> own[2];
+      SliceBuffers<V>* buf = plane <= (std::size_t{1} << 16) ? kept : own;
       for (int k = 0; k < passes; ++k) buf[k].resize(n.x, n.y);
       for (std::size_t zi = zb; zi < ze; ++zi) {
         const std::uint32_t* gs = g.data() + zi * plane;
@@ -982,14 +1010,14 @@ FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOpt
 
 template <class T>
 void compute_region(const Grid<std::uint8_t>& occupancy, const FieldPlan& p, const Box3i& in, const Box3i& out,
-                    T* values, SiteOffset* sites) {
+                    T* values, SiteOffset* sites, const Box3i* sites_within) {
   if (!in.contains(out)) throw InvalidArgument("compute_region: the input box must contain the output box");
   if (out.empty()) return;
-  compute_region_impl<T>(occupancy, p, in, out, values, sites);
+  compute_region_impl<T>(occupancy, p, in, out, values, sites, sites_within);
 }
-template void compute_region<std::uint8_t>(const Grid<std::uint8_t>&, const FieldPlan&, const Box3i&, const Box3i&, std::uint8_t*, SiteOffset*);
-template void compute_region<std::uint16_t>(const Grid<std::uint8_t>&, const FieldPlan&, const Box3i&, const Box3i&, std::uint16_t*, SiteOffset*);
-template void compute_region<float>(const Grid<std::uint8_t>&, const FieldPlan&, const Box3i&, const Box3i&, float*, SiteOffset*);
+template void compute_region<std::uint8_t>(const Grid<std::uint8_t>&, const FieldPlan&, const Box3i&, const Box3i&, std::uint8_t*, SiteOffset*, const Box3i*);
+template void compute_region<std::uint16_t>(const Grid<std::uint8_t>&, const FieldPlan&, const Box3i&, const Box3i&, std::uint16_t*, SiteOffset*, const Box3i*);
+template void compute_region<float>(const Grid<std::uint8_t>&, const FieldPlan&, const Box3i&, const Box3i&, float*, SiteOffset*, const Box3i*);
 
 }  // namespace detail
 

@@ -29,10 +29,11 @@ FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOpt
 // Exact field values of `out` computed from the sites inside `in` (which must contain `out`; for
 // values equal to the whole-domain field's, `in` must hold `out` grown by the clamp's reach,
 // clipped to the domain). Writes out.volume() encoded values and, when `sites` is not null, as many
-// nearest-site offsets, x fastest.
+// nearest-site offsets, x fastest. `sites_within`, when given, limits the sites to that box (solid
+// voxels of `in` outside it count as empty): the distance to a handful of new sites.
 template <class T>
 void compute_region(const Grid<std::uint8_t>& occupancy, const FieldPlan& plan, const Box3i& in, const Box3i& out,
-                    T* values, SiteOffset* sites);
+                    T* values, SiteOffset* sites, const Box3i* sites_within = nullptr);
 
 // Stored value for a distance d (negative inside a signed field; +-inf when no site is in reach),
 // clamped and rounded down as documented in distance.h.

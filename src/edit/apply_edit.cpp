@@ -11,6 +11,35 @@ namespace {
 
 constexpr std::int64_t kMaxEditVoxels = std::int64_t{1} << 33;
 
+// The voxels of the row (y, z), x in [x0, x1), that a brush may cover, and whether each still
+// needs testing. A row of a ball is an interval around the centre's x: its ends are estimated,
+// then settled with the exact test, so the voxels between need none (an edit visits its voxels,
+// not its bounding box, at a few nanoseconds each).
+struct RowSpan {
+  int begin, end;
+  bool test_each;
+};
+
+RowSpan row_span(const SphereBrush& s, int y, int z, int x0, int x1) {
+  auto in = [&](int x) { return brush_contains(s, Vec3i{x, y, z}); };
+  const int mid = std::clamp(static_cast<int>(std::lround(s.center[0])), x0, x1 - 1);
+  if (!in(mid)) return {x0, x0, false};  // the row's voxel nearest the centre is outside
+  const double dy = y - s.center[1], dz = z - s.center[2];
+  const double half = std::sqrt(std::max(0.0, s.radius * s.radius - dy * dy - dz * dz));
+  int lo = std::clamp(static_cast<int>(std::floor(s.center[0] - half)), x0, mid);
+  int hi = std::clamp(static_cast<int>(std::ceil(s.center[0] + half)), mid, x1 - 1);
+  while (lo < mid && !in(lo)) ++lo;
+  while (lo > x0 && in(lo - 1)) --lo;
+  while (hi > mid && !in(hi)) --hi;
+  while (hi < x1 - 1 && in(hi + 1)) ++hi;
+  return {lo, hi + 1, false};
+}
+
+template <class Shape>
+RowSpan row_span(const Shape&, int, int, int x0, int x1) {
+  return {x0, x1, true};
+}
+
 }  // namespace
 
 void validate_edit(const Edit& e) {
@@ -113,39 +142,37 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
         Vec3i olo = part.end, ohi = part.begin - Vec3i::splat(1);  // solid <-> air changes
         bool removed = false;                                       // any solid -> air
         bool added = false;                                         // any air -> solid
-        g.edit_chunk(coord, [&](std::uint8_t* voxels) {
-          bool changed = false;
+        g.edit_chunk(coord, [&](Grid<std::uint8_t>::ChunkEdit& voxels) {
           // The brush is resolved once per chunk, not once per voxel.
           std::visit([&](const auto& shape) {
           for (int z = part.begin.z; z < part.end.z; ++z)
-            for (int y = part.begin.y; y < part.end.y; ++y)
-              for (int x = part.begin.x; x < part.end.x; ++x) {
+            for (int y = part.begin.y; y < part.end.y; ++y) {
+              const RowSpan span = row_span(shape, y, z, part.begin.x, part.end.x);
+              for (int x = span.begin; x < span.end; ++x) {
                 const Vec3i p{x, y, z};
-                if (!brush_contains(shape, p)) continue;
-                std::uint8_t& v = voxels[((z - cb.begin.z) * edge + (y - cb.begin.y)) * edge + (x - cb.begin.x)];
+                if (span.test_each && !brush_contains(shape, p)) continue;
+                const std::int64_t i = (std::int64_t{z - cb.begin.z} * edge + (y - cb.begin.y)) * edge + (x - cb.begin.x);
+                const std::uint8_t before = voxels.get(i);
                 const std::uint8_t paint = stamp ? stamp->model->voxels.get(p - stamp->offset) : e.material;
-                std::uint8_t next = v;
+                std::uint8_t next = before;
                 switch (e.op) {
                   case EditOp::kPlace: next = paint; break;
                   case EditOp::kCarve: next = 0; break;
-                  case EditOp::kPaint: next = v != 0 ? paint : v; break;
+                  case EditOp::kPaint: next = before != 0 ? paint : before; break;
                 }
-                if (next == v) continue;
-                const std::uint8_t v_before = v;
-                v = next;
-                changed = true;
+                if (!voxels.set(i, next)) continue;
                 ++result.voxels_changed;
                 clo = {std::min(clo.x, x), std::min(clo.y, y), std::min(clo.z, z)};
                 chi = {std::max(chi.x, x), std::max(chi.y, y), std::max(chi.z, z)};
-                if ((next != 0) != (v_before != 0)) {
+                if ((next != 0) != (before != 0)) {
                   removed = removed || next == 0;
                   added = added || next != 0;
                   olo = {std::min(olo.x, x), std::min(olo.y, y), std::min(olo.z, z)};
                   ohi = {std::max(ohi.x, x), std::max(ohi.y, y), std::max(ohi.z, z)};
                 }
               }
+            }
           }, e.brush);
-          return changed;
         });
         if (chi.x >= clo.x) {
           const Box3i changed = Box3i::from_inclusive(clo, chi);

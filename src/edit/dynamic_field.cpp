@@ -42,7 +42,22 @@ double upper_distance(const FieldPlan& plan, T stored, T clamp_stored) {
   }
 }
 
-}  // namespace
+// Cost-space helpers shared by the searches below: distances are compared as costs (squared for
+// Euclidean, so no square root per voxel), per-axis gaps to the changed box combined per metric.
+struct GapCost {
+  Metric metric;
+  Box3i changed;
+  std::array<double, 3> spacing;
+  float axis(int k, int v) const {  // the gap along axis k, as a cost term
+    const float g = static_cast<float>(std::max({0, changed.begin[k] - v, v - (changed.end[k] - 1)}) * spacing[k]);
+    return metric == Metric::kEuclidean ? g * g : g;
+  }
+  float combine(float a, float b) const { return metric == Metric::kChebyshev ? std::max(a, b) : a + b; }
+  float of_distance(double d) const {  // rounded up a little: in doubt, a voxel is let through
+    const double c = metric == Metric::kEuclidean ? d * d : d;
+    return static_cast<float>(c * (1 + 1e-5) + 1e-5);
+  }
+};
 
 // `kind`: what the changes did — only removed solids (values can only rise, so voxels already at
 // the clamp stay there), only added them (values can only fall, so voxels at 0 stay there), or
@@ -58,11 +73,7 @@ Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& 
   //
   // Distances are compared as "costs" (squared for Euclidean, so no square root per voxel) in
   // floats, with the bound rounded up a little: a voxel is let through whenever in doubt.
-  const bool euclid = plan.metric == Metric::kEuclidean;
-  const auto cost_of = [euclid](double d) {
-    const double c = euclid ? d * d : d;
-    return static_cast<float>(c * (1 + 1e-5) + 1e-5);
-  };
+  const GapCost gap{plan.metric, changed, plan.spacing};
   const T clamp_stored = encode_distance<T>(plan.clamp, plan);
   // A bound below every cost excludes a value that cannot change.
   const float never = -1.0f;
@@ -75,24 +86,18 @@ Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& 
     table.resize(std::size_t{std::numeric_limits<T>::max()} + 1);
     for (std::size_t v = 0; v < table.size(); ++v) {
       const auto stored = static_cast<T>(v);
-      table[v] = frozen(stored) ? never : cost_of(upper_distance<T>(plan, stored, clamp_stored));
+      table[v] = frozen(stored) ? never : gap.of_distance(upper_distance<T>(plan, stored, clamp_stored));
     }
   }
-  auto gap = [&](int k, int v) {  // distance along axis k from coordinate v to the changed box
-    return static_cast<float>(std::max({0, changed.begin[k] - v, v - (changed.end[k] - 1)}) * plan.spacing[k]);
-  };
   const int nx = r.size().x;
   std::vector<float> gx(static_cast<std::size_t>(nx)), bound(static_cast<std::size_t>(nx));
-  for (int x = 0; x < nx; ++x) {
-    const float g = gap(0, r.begin.x + x);
-    gx[static_cast<std::size_t>(x)] = euclid ? g * g : g;
-  }
+  for (int x = 0; x < nx; ++x) gx[static_cast<std::size_t>(x)] = gap.axis(0, r.begin.x + x);
   Box3i box{r.end, r.begin};  // empty
   std::size_t i = 0;
   for (int z = r.begin.z; z < r.end.z; ++z) {
-    const float gz = gap(2, z);
+    const float gz = gap.axis(2, z);
     for (int y = r.begin.y; y < r.end.y; ++y, i += static_cast<std::size_t>(nx)) {
-      const float gy = gap(1, y);
+      const float gy = gap.axis(1, y);
       // The row's bounds, then the test as one branch-free pass per metric.
       const T* row = old.data() + i;
       for (int x = 0; x < nx; ++x) {
@@ -100,7 +105,7 @@ Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& 
           const float o = row[x];
           bound[static_cast<std::size_t>(x)] = frozen(o)              ? never
                                                : o == clamp_stored ? std::numeric_limits<float>::infinity()
-                                                                   : cost_of(o);
+                                                                   : gap.of_distance(o);
         } else {
           bound[static_cast<std::size_t>(x)] = table[row[x]];
         }
@@ -113,15 +118,11 @@ Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& 
             last = x;
           }
       };
-      if (euclid) {
-        const float rest = gy * gy + gz * gz;
-        scan([rest](float g2) { return g2 + rest; });
-      } else if (plan.metric == Metric::kManhattan) {
-        const float rest = gy + gz;
-        scan([rest](float g) { return g + rest; });
-      } else {
-        const float rest = std::max(gy, gz);
+      const float rest = gap.combine(gy, gz);
+      if (plan.metric == Metric::kChebyshev) {
         scan([rest](float g) { return std::max(g, rest); });
+      } else {
+        scan([rest](float g) { return g + rest; });
       }
       if (last < 0) continue;
       box = {{std::min(box.begin.x, r.begin.x + first), std::min(box.begin.y, y), std::min(box.begin.z, z)},
@@ -130,6 +131,195 @@ Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& 
   }
   return box;
 }
+
+// Reads rows of a field grid inside a box, chunk by chunk, with the box's chunks looked up once.
+template <class T>
+class RowReader {
+ public:
+  RowReader(const Grid<T>& grid, const Box3i& box) : shift_(grid.chunk_shift()), edge_(grid.chunk_edge()) {
+    lo_ = grid.chunk_of(box.begin);
+    const Vec3i hi = grid.chunk_of(box.end - Vec3i::splat(1));
+    n_ = hi - lo_ + Vec3i::splat(1);
+    views_.reserve(static_cast<std::size_t>(n_.x) * n_.y * n_.z);
+    for (int z = lo_.z; z <= hi.z; ++z)
+      for (int y = lo_.y; y <= hi.y; ++y)
+        for (int x = lo_.x; x <= hi.x; ++x) views_.push_back(grid.chunk_view({x, y, z}));
+  }
+  // Calls run(x_begin, x_end, value) for runs of one value (a uniform chunk's part of the row) and
+  // each(x, value) for the voxels of dense chunks, over x in [x0, x1) of the row (y, z).
+  template <class Run, class Each>
+  void row(int x0, int x1, int y, int z, Run&& run, Each&& each) const {
+    const std::size_t base = (static_cast<std::size_t>((z >> shift_) - lo_.z) * n_.y + static_cast<std::size_t>((y >> shift_) - lo_.y)) * n_.x;
+    for (int x = x0; x < x1;) {
+      const ChunkView<T>& v = views_[base + static_cast<std::size_t>((x >> shift_) - lo_.x)];
+      const int end = std::min(x1, v.box.end.x);
+      if (v.uniform()) {
+        run(x, end, v.uniform_value);
+      } else {
+        const T* row = v.voxels + (static_cast<std::size_t>(z - v.box.begin.z) * edge_ + static_cast<std::size_t>(y - v.box.begin.y)) * edge_;
+        for (int i = x; i < end; ++i) each(i, row[i - v.box.begin.x]);
+      }
+      x = end;
+    }
+  }
+
+ private:
+  int shift_, edge_;
+  Vec3i lo_, n_;
+  std::vector<ChunkView<T>> views_;
+};
+
+// The distance a rounding of a point to its nearest voxel can add, twice (see grow_affected).
+double rounding_slack(const FieldPlan& plan) {
+  const double hx = plan.spacing[0] / 2, hy = plan.spacing[1] / 2, hz = plan.spacing[2] / 2;
+  switch (plan.metric) {
+    case Metric::kManhattan: return 2 * (hx + hy + hz);
+    case Metric::kChebyshev: return 2 * std::max({hx, hy, hz});
+    case Metric::kEuclidean: break;
+  }
+  return 2 * std::sqrt(hx * hx + hy * hy + hz * hz);
+}
+
+}  // namespace
+
+template <class T>
+Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r, const Box3i& changed, std::int64_t max_volume) {
+  // Every voxel p that an edit can change has g(p) <= old(p), g being its distance to the changed
+  // box C (see affected_box). Walk from p straight to its nearest point c of C, rounding each point
+  // of the segment to its nearest voxel q: g falls exactly as fast as the walk advances, the old
+  // field (a distance, clamped or not) falls at most that fast, and the rounding moves each by at
+  // most half a voxel diagonal. So every q on the walk has g(q) <= old(q) + s, s = twice that
+  // half-diagonal in the field's metric, and consecutive q are 26-neighbours: p is joined to C by
+  // voxels passing the relaxed test. A box that no passing voxel just outside it extends therefore
+  // holds every voxel the edit can change. It is found by growing C one shell at a time, reading
+  // each voxel at most once: work in proportion to the affected voxels, not to the reach box.
+  const GapCost gap{plan.metric, changed, plan.spacing};
+  const double slack = rounding_slack(plan);
+  const T clamp_stored = encode_distance<T>(plan.clamp, plan);
+  const float inf = std::numeric_limits<float>::infinity();
+  auto pass_bound = [&](T stored) {
+    return stored == clamp_stored ? inf : gap.of_distance(upper_distance<T>(plan, stored, clamp_stored) + slack);
+  };
+  std::vector<float> table;  // integer storage: the bound of each stored value, decoded once
+  if constexpr (!std::is_same_v<T, float>) {
+    table.resize(std::size_t{std::numeric_limits<T>::max()} + 1);
+    for (std::size_t v = 0; v < table.size(); ++v) table[v] = pass_bound(static_cast<T>(v));
+  }
+  const RowReader<T> reader(field, r);
+  Box3i box = changed.intersect(r), scanned = box;
+  while (box != r) {
+    if (box.volume() > max_volume) return r;
+    const Box3i outer = Box3i{box.begin - Vec3i::splat(1), box.end + Vec3i::splat(1)}.intersect(r);
+    Box3i grown = box;
+    for (int z = outer.begin.z; z < outer.end.z; ++z) {
+      const float gz = gap.axis(2, z);
+      for (int y = outer.begin.y; y < outer.end.y; ++y) {
+        const float rest = gap.combine(gap.axis(1, y), gz);
+        int lo = INT32_MAX, hi = INT32_MIN;
+        auto each = [&](int x, T stored) {
+          float bound;
+          if constexpr (std::is_same_v<T, float>) {
+            bound = pass_bound(stored);
+          } else {
+            bound = table[stored];
+          }
+          if (gap.combine(gap.axis(0, x), rest) <= bound) {
+            lo = std::min(lo, x);
+            hi = std::max(hi, x);
+          }
+        };
+        auto run = [&](int x0, int x1, T stored) {
+          // A run at the clamp passes whole (open space); otherwise the passing voxels of a run of
+          // one bound form an interval around the changed box's x range, so its ends are found by
+          // walking in from the run's ends.
+          const float bound = pass_bound(stored);
+          if (bound == inf) {
+            lo = std::min(lo, x0);
+            hi = std::max(hi, x1 - 1);
+            return;
+          }
+          const int nearest = std::clamp(changed.begin.x, x0, x1 - 1);  // the run's voxel nearest C
+          const int nearest2 = std::clamp(changed.end.x - 1, x0, x1 - 1);
+          if (gap.combine(std::min(gap.axis(0, nearest), gap.axis(0, nearest2)), rest) > bound) return;
+          int a = x0, b = x1 - 1;
+          while (a <= b && gap.combine(gap.axis(0, a), rest) > bound) ++a;
+          while (b >= a && gap.combine(gap.axis(0, b), rest) > bound) --b;
+          if (a <= b) {
+            lo = std::min(lo, a);
+            hi = std::max(hi, b);
+          }
+        };
+        const bool inner_row = y >= scanned.begin.y && y < scanned.end.y && z >= scanned.begin.z && z < scanned.end.z;
+        if (inner_row) {  // only the ends of this row are new
+          reader.row(outer.begin.x, scanned.begin.x, y, z, run, each);
+          reader.row(scanned.end.x, outer.end.x, y, z, run, each);
+        } else {
+          reader.row(outer.begin.x, outer.end.x, y, z, run, each);
+        }
+        if (lo <= hi) grown = grown.unite(Box3i{{lo, y, z}, {hi + 1, y + 1, z + 1}});
+      }
+    }
+    scanned = outer;
+    if (grown == box) break;
+    box = grown;
+  }
+  return box;
+}
+
+template Box3i grow_affected<std::uint8_t>(const FieldPlan&, const Grid<std::uint8_t>&, const Box3i&, const Box3i&, std::int64_t);
+template Box3i grow_affected<std::uint16_t>(const FieldPlan&, const Grid<std::uint16_t>&, const Box3i&, const Box3i&, std::int64_t);
+template Box3i grow_affected<float>(const FieldPlan&, const Grid<float>&, const Box3i&, const Box3i&, std::int64_t);
+
+namespace {
+
+// After removals, the new values inside the affected box `a` are bounded by the unchanged values
+// around it: new(p) <= old(q) + |p - q| for every q outside `a` (distances are 1-Lipschitz, and q
+// keeps its value). Using q straight across each face of `a` gives a bound M on every new value
+// in `a`, so only sites within M of `a` matter — for a hole carved in solid ground, a few voxels
+// instead of the clamp. Faces on the edge of the region `r` (beyond it another region may change
+// values) or of the domain give no bound. Returns +inf when no face does.
+template <class T>
+double new_value_bound(const FieldPlan& plan, const Grid<T>& field, const Box3i& r, const Box3i& a) {
+  const T clamp_stored = encode_distance<T>(plan.clamp, plan);
+  const double inf = std::numeric_limits<double>::infinity();
+  const RowReader<T> reader(field, r);
+  // The largest upper bound of the old values on the face slab `f` (inf if any is at the clamp).
+  auto face_max = [&](const Box3i& f) {
+    double m = 0;
+    for (int z = f.begin.z; z < f.end.z && m < inf; ++z)
+      for (int y = f.begin.y; y < f.end.y && m < inf; ++y)
+        reader.row(
+            f.begin.x, f.end.x, y, z, [&](int, int, T stored) { m = std::max(m, upper_distance<T>(plan, stored, clamp_stored)); },
+            [&](int, T stored) { m = std::max(m, upper_distance<T>(plan, stored, clamp_stored)); });
+    return m;
+  };
+  double bound = inf;
+  for (int k = 0; k < 3; ++k) {
+    double lo_face = inf, hi_face = inf;
+    if (a.begin[k] > r.begin[k]) {
+      Box3i f = a;
+      f.begin[k] = a.begin[k] - 1;
+      f.end[k] = a.begin[k];
+      lo_face = face_max(f);
+    }
+    if (a.end[k] < r.end[k]) {
+      Box3i f = a;
+      f.begin[k] = a.end[k];
+      f.end[k] = a.end[k] + 1;
+      hi_face = face_max(f);
+    }
+    if (lo_face == inf && hi_face == inf) continue;
+    // The worst voxel along axis k, each bounded through the nearer-valued face.
+    double worst = 0;
+    for (int v = a.begin[k]; v < a.end[k]; ++v)
+      worst = std::max(worst, std::min(lo_face + (v - a.begin[k] + 1) * plan.spacing[k], hi_face + (a.end[k] - v) * plan.spacing[k]));
+    // max over p of min over axes = min over axes of each axis's max (the axes vary independently).
+    bound = std::min(bound, worst);
+  }
+  return bound;
+}
+
+}  // namespace
 
 Vec3i field_reach(const FieldPlan& plan) {
   const Vec3i size = plan.domain.size();
@@ -192,18 +382,15 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
           thread_local std::vector<T> old_scratch, values_scratch;
           std::vector<T>& old = old_scratch;
           std::vector<T>& values = values_scratch;
-          if (shrink || additions_only) {
-            old.resize(static_cast<std::size_t>(r.volume()));
-            target.copy_to_dense(r, old.data());
-          }
+          Box3i in;    // the sites r's new values can depend on
+          Box3i near;  // the changes this region holds
           if (shrink) {
-            Box3i near;  // the changes this region holds
             for (const Box3i& b : changed)
               if (!Box3i{b.begin - reach_, b.end + reach_}.intersect(r).empty()) near = near.unite(b);
             const detail::Changes kind = !dirty.adds_solid()     ? detail::Changes::kRemovals
                                          : !dirty.removes_solid() ? detail::Changes::kAdditions
                                                                   : detail::Changes::kBoth;
-            // Open space far from everything (every chunk of r uniform at the clamp) needs no scan:
+            // Open space far from everything (every chunk of r uniform at the clamp) needs no search:
             // every voxel of r is in reach of an addition, and no removal can raise a value there.
             const T clamp_stored = detail::encode_distance<T>(plan.clamp, plan);
             bool all_clamped = true;
@@ -214,31 +401,53 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
                   const auto view = target.chunk_view({cx, cy, cz});
                   all_clamped = view.uniform() && view.uniform_value == clamp_stored;
                 }
-            const Box3i a = all_clamped ? (kind == detail::Changes::kRemovals ? Box3i{} : r)
-                                        : detail::affected_box(plan, r, old, near, kind);
+            if (all_clamped && kind == detail::Changes::kRemovals) return;
+            // The box holding every voxel that can change (a superset found by a search that reads
+            // only around the changes), then the exact test on its voxels.
+            // Once the search has covered a sixteenth of the region, the rest is read faster front to
+            // back (its shells read a cache line per voxel on their x faces): the whole region it is.
+            const Box3i grown = all_clamped ? r : detail::grow_affected(plan, target, r, near, r.volume() / 16);
+            old.resize(static_cast<std::size_t>(grown.volume()));
+            target.copy_to_dense(grown, old.data());
+            const Box3i a = all_clamped ? r : detail::affected_box(plan, grown, old, near, kind);
             if (a.empty()) return;
-            if (a != r) {  // keep the old values of the shrunk box only, moved to the front in place
-              const Vec3i rs = r.size(), as = a.size();
+            if (a != grown) {  // keep the old values of the shrunk box only, moved to the front in place
+              const Vec3i gs = grown.size(), as = a.size();
               std::size_t k = 0;
               for (int z = a.begin.z; z < a.end.z; ++z)
                 for (int y = a.begin.y; y < a.end.y; ++y) {
-                  const std::size_t from = (static_cast<std::size_t>(z - r.begin.z) * rs.y + static_cast<std::size_t>(y - r.begin.y)) * rs.x +
-                                           static_cast<std::size_t>(a.begin.x - r.begin.x);
+                  const std::size_t from = (static_cast<std::size_t>(z - grown.begin.z) * gs.y + static_cast<std::size_t>(y - grown.begin.y)) * gs.x +
+                                           static_cast<std::size_t>(a.begin.x - grown.begin.x);
                   if (from != k)  // from > k: rows only move towards the front
                     std::copy(old.begin() + static_cast<std::ptrdiff_t>(from),
                               old.begin() + static_cast<std::ptrdiff_t>(from) + as.x, old.begin() + static_cast<std::ptrdiff_t>(k));
                   k += static_cast<std::size_t>(as.x);
                 }
               old.resize(static_cast<std::size_t>(a.volume()));
-              r = a;
             }
+            const Box3i region = r;
+            r = a;
+            if (additions_only) {
+              in = r;
+            } else {
+              // Sites farther than every new value of r cannot be anyone's nearest.
+              Vec3i by = reach_;
+              const double m = detail::new_value_bound(plan, target, region, r);
+              if (std::isfinite(m))
+                for (int k = 0; k < 3; ++k)
+                  by[k] = std::min(by[k], static_cast<int>(std::floor(m / plan.spacing[k] + 1e-9)));  // m is a bound already
+              in = Box3i{r.begin - by, r.end + by}.intersect(*options_.domain);
+            }
+          } else {
+            in = Box3i{r.begin - reach_, r.end + reach_}.intersect(*options_.domain);
           }
-          // Values inside r depend on sites within the reach of r: compute r from that box, densely,
-          // and write it into the field (additions: from r's own sites, then the minimum with the old).
-          const Box3i in = additions_only ? r : Box3i{r.begin - reach_, r.end + reach_}.intersect(*options_.domain);
+          // Compute r from the sites in `in`, densely, and write it into the field (additions: from
+          // r's own sites, then the minimum with the old).
           std::vector<SiteOffset> sites(field_.sites ? static_cast<std::size_t>(r.volume()) : 0);
           values.resize(static_cast<std::size_t>(r.volume()));
-          detail::compute_region<T>(world_->voxels, plan, in, r, values.data(), field_.sites ? sites.data() : nullptr);
+          // Additions: the distance to the new sites (inside `near`) is all the minimum needs.
+          detail::compute_region<T>(world_->voxels, plan, in, r, values.data(), field_.sites ? sites.data() : nullptr,
+                                    additions_only ? &near : nullptr);
           if (additions_only)
             for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::min(values[i], old[i]);
           target.copy_from_dense(r, values.data());

@@ -22,4 +22,11 @@ Vec3i field_reach(const FieldPlan& plan);
 // overlap (so no voxel is computed twice), each with the box of sites it needs.
 std::vector<UpdateRegion> update_regions(const DirtyRegions& dirty, const Box3i& domain, Vec3i reach);
 
+// A box inside the region `r` holding every voxel of an unsigned field whose value changes in the
+// box `changed` can move (`field` holding the values before them), found by growing `changed` a
+// shell at a time and reading only the voxels around it; `r` itself once the box exceeds
+// `max_volume` voxels.
+template <class T>
+Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r, const Box3i& changed, std::int64_t max_volume);
+
 }  // namespace voxfield::detail

@@ -441,24 +441,34 @@ void Grid<T>::edit_chunk(Vec3i coord, F&& f) {
                           to_string(*bounds_));
   }
   auto it = chunks_.find(coord);
-  const bool existed = it != chunks_.end();
-  if (!existed) {
+  if (it == chunks_.end()) {
     Chunk c;
     c.uniform = background_;
     it = chunks_.emplace(coord, std::move(c)).first;
   }
   Chunk& c = it->second;
-  const bool was_uniform = !c.voxels;
-  if (was_uniform) expand(c);
-  bool changed = false;
+  if (!c.voxels) expand(c);
+  ChunkEdit edit(c.voxels.get(), c.ref, c.ref_count);
   try {
-    changed = f(c.voxels.get());
+    f(edit);
   } catch (...) {
-    if (was_uniform) c.voxels.reset();  // nothing was meant to change: restore the single value
-    if (!existed) chunks_.erase(it);
+    c.ref_count = edit.ref_count_;
+    if (c.ref_count == chunk_volume()) collapse_to_ref(it);
     throw;
   }
-  if (changed || was_uniform) collapse_if_uniform(it);
+  c.ref_count = edit.ref_count_;
+  if (c.ref_count == chunk_volume()) {
+    collapse_to_ref(it);  // back to the value it was expanded from (an untouched expansion too)
+  } else if (edit.writes_ > 0 && edit.one_value_) {
+    // Only uniform at the value written, if at all: check, stopping at the first other voxel,
+    // and if so re-anchor the counter there.
+    const T* v = c.voxels.get();
+    if (std::all_of(v, v + chunk_volume(), [&](const T& x) { return x == edit.first_; })) {
+      c.ref = edit.first_;
+      c.ref_count = chunk_volume();
+      collapse_to_ref(it);
+    }
+  }
 }
 
 template <class T>
