@@ -172,8 +172,8 @@ class Grid {
 
   // Edits one chunk in place: makes it dense (expanding a uniform or absent chunk), calls
   // f(ChunkEdit&) to read and write its edge^3 voxels, and collapses the chunk again if it came
-  // out uniform (known in O(1) when it returned to the value it was expanded from; a scan, which
-  // stops at the first differing voxel, only when every write stored one value). Throws
+  // out uniform (known in O(1) from the chunk's collapse counter; when every write stored one value
+  // other than the counter's, a check that stops at the first voxel holding another). Throws
   // InvalidArgument for a chunk wholly outside a bounded grid; f must not write voxels beyond the
   // bounds. If f throws, the voxels it wrote stay written (the chunk is left consistent).
   template <class F>
@@ -222,6 +222,10 @@ class Grid {
   // A chunk whose every voxel equals its collapse counter's value (ref_count == volume) stored
   // as that one value (or dropped when it is the background).
   void collapse_to_ref(typename ChunkMap::iterator it);
+  // Re-anchors a dense chunk's collapse counter on `value` (one pass counting it) and collapses
+  // the chunk if every voxel holds it. Run after writes of a single value that differs from the
+  // counter's: later writes of the same value then need no pass at all.
+  void reanchor(typename ChunkMap::iterator it, T value);
   std::vector<Vec3i> chunks_overlapping(const Box3i& box) const;
 
   int chunk_edge_;

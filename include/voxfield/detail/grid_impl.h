@@ -118,6 +118,15 @@ void Grid<T>::collapse_to_ref(typename ChunkMap::iterator it) {
 }
 
 template <class T>
+void Grid<T>::reanchor(typename ChunkMap::iterator it, T value) {
+  Chunk& c = it->second;
+  const T* v = c.voxels.get();
+  c.ref = value;
+  c.ref_count = std::count(v, v + chunk_volume(), value);
+  if (c.ref_count == chunk_volume()) collapse_to_ref(it);
+}
+
+template <class T>
 void Grid<T>::collapse_if_uniform(typename ChunkMap::iterator it) {
   Chunk& c = it->second;
   if (!c.voxels) {
@@ -263,8 +272,8 @@ void Grid<T>::copy_from_dense(const Box3i& box, const T* in) {
       }
     if (c.ref_count == chunk_volume()) {
       collapse_to_ref(it);
-    } else if (written_uniform) {
-      collapse_if_uniform(it);
+    } else if (written_uniform && !(first == c.ref)) {
+      reanchor(it, first);
     }
   }
 }
@@ -459,15 +468,11 @@ void Grid<T>::edit_chunk(Vec3i coord, F&& f) {
   c.ref_count = edit.ref_count_;
   if (c.ref_count == chunk_volume()) {
     collapse_to_ref(it);  // back to the value it was expanded from (an untouched expansion too)
-  } else if (edit.writes_ > 0 && edit.one_value_) {
-    // Only uniform at the value written, if at all: check, stopping at the first other voxel,
-    // and if so re-anchor the counter there.
+  } else if (edit.writes_ > 0 && edit.one_value_ && !(edit.first_ == c.ref)) {
+    // Only uniform at the value written, if at all: a check that stops at the first other voxel
+    // (a count to re-anchor the counter would read the whole chunk on every small edit).
     const T* v = c.voxels.get();
-    if (std::all_of(v, v + chunk_volume(), [&](const T& x) { return x == edit.first_; })) {
-      c.ref = edit.first_;
-      c.ref_count = chunk_volume();
-      collapse_to_ref(it);
-    }
+    if (std::all_of(v, v + chunk_volume(), [&](const T& x) { return x == edit.first_; })) reanchor(it, edit.first_);
   }
 }
 
