@@ -2,6 +2,7 @@
 #include "voxfield/dynamic_field.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "update_regions.h"
@@ -81,14 +82,15 @@ Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& 
   auto frozen = [&](T stored) {
     return (kind == Changes::kRemovals && stored == clamp_stored) || (kind == Changes::kAdditions && stored == lowest);
   };
-  std::vector<float> table;  // integer storage: the bound of each stored value, decoded once
-  if constexpr (!std::is_same_v<T, float>) {
-    table.resize(std::size_t{std::numeric_limits<T>::max()} + 1);
-    for (std::size_t v = 0; v < table.size(); ++v) {
-      const auto stored = static_cast<T>(v);
-      table[v] = frozen(stored) ? never : gap.of_distance(upper_distance<T>(plan, stored, clamp_stored));
-    }
-  }
+  auto bound_of = [&](T stored) {
+    return frozen(stored) ? never : gap.of_distance(upper_distance<T>(plan, stored, clamp_stored));
+  };
+  // 8-bit storage: the bound of each stored value, decoded once (for 16 bits the table would cost
+  // more to fill than the voxels it serves).
+  constexpr bool kTable = sizeof(T) == 1;
+  std::array<float, 256> table{};
+  if constexpr (kTable)
+    for (std::size_t v = 0; v < table.size(); ++v) table[v] = bound_of(static_cast<T>(v));
   const int nx = r.size().x;
   std::vector<float> gx(static_cast<std::size_t>(nx)), bound(static_cast<std::size_t>(nx));
   for (int x = 0; x < nx; ++x) gx[static_cast<std::size_t>(x)] = gap.axis(0, r.begin.x + x);
@@ -101,13 +103,10 @@ Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& 
       // The row's bounds, then the test as one branch-free pass per metric.
       const T* row = old.data() + i;
       for (int x = 0; x < nx; ++x) {
-        if constexpr (std::is_same_v<T, float>) {
-          const float o = row[x];
-          bound[static_cast<std::size_t>(x)] = frozen(o)              ? never
-                                               : o == clamp_stored ? std::numeric_limits<float>::infinity()
-                                                                   : gap.of_distance(o);
-        } else {
+        if constexpr (kTable) {
           bound[static_cast<std::size_t>(x)] = table[row[x]];
+        } else {
+          bound[static_cast<std::size_t>(x)] = bound_of(row[x]);
         }
       }
       int first = nx, last = -1;
@@ -200,11 +199,10 @@ Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
   auto pass_bound = [&](T stored) {
     return stored == clamp_stored ? inf : gap.of_distance(upper_distance<T>(plan, stored, clamp_stored) + slack);
   };
-  std::vector<float> table;  // integer storage: the bound of each stored value, decoded once
-  if constexpr (!std::is_same_v<T, float>) {
-    table.resize(std::size_t{std::numeric_limits<T>::max()} + 1);
+  constexpr bool kTable = sizeof(T) == 1;  // 8-bit storage: each value's bound decoded once
+  std::array<float, 256> table{};
+  if constexpr (kTable)
     for (std::size_t v = 0; v < table.size(); ++v) table[v] = pass_bound(static_cast<T>(v));
-  }
   const RowReader<T> reader(field, r);
   Box3i box = changed.intersect(r), scanned = box;
   while (box != r) {
@@ -218,10 +216,10 @@ Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
         int lo = INT32_MAX, hi = INT32_MIN;
         auto each = [&](int x, T stored) {
           float bound;
-          if constexpr (std::is_same_v<T, float>) {
-            bound = pass_bound(stored);
-          } else {
+          if constexpr (kTable) {
             bound = table[stored];
+          } else {
+            bound = pass_bound(stored);
           }
           if (gap.combine(gap.axis(0, x), rest) <= bound) {
             lo = std::min(lo, x);
