@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Packages only the benchmarks need: the peers voxfield is compared with, and plotting.
 set -euo pipefail
-packages=(python3-scipy python3-matplotlib libopenvdb-dev)
+packages=(python3-scipy python3-matplotlib libopenvdb-dev libdynamicedt3d-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

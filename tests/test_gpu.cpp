@@ -303,7 +303,9 @@ TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
     RenderStats cpu_stats;
     const Image cpu_image = render(scene, cam, error, &cpu_stats);
     expect_images_close(gpu::render(*ctx, scene, cam, error), cpu_image, std::string("error view ") + algorithm_name(alg));
-    if (alg == Algorithm::kJfaSeed) EXPECT_GT(cpu_stats.max_error, 0);  // the view has something to show
+    if (alg == Algorithm::kJfaSeed) {
+      EXPECT_GT(cpu_stats.max_error, 0);  // the view has something to show
+    }
   }
 }
 

@@ -8,8 +8,14 @@
 //   changes values only inside B grown by D (the "reach"), and recomputing those needs the sites
 //   inside B grown by 2D. Integer storage clamps at its range even without an explicit D.
 //
-// Unclamped f32 fields have an unbounded reach: every update recomputes the whole domain (cost
-// proportional to the world, not the edit). Clamp the field to make updates local.
+// Unsigned fields without nearest sites do much less (docs/distance.md, "Incremental updates"):
+// only voxels whose old distance reaches the edit can change, and the box holding them is found
+// by a search that reads around the edit; placements take the distance to the new sites alone;
+// carves read only the sites their new values can reach (a hole in solid ground: a few voxels).
+//
+// Unclamped f32 fields have an unbounded reach: an update may have to recompute the whole domain
+// (cost proportional to the world, not the edit) — unsigned ones only where values really move.
+// Clamp the field to bound every update.
 #pragma once
 
 #include "voxfield/distance.h"
@@ -24,8 +30,8 @@ class DynamicDistanceField {
   DynamicDistanceField(const World& world, DistanceOptions options);
 
   struct UpdateStats {
-    std::int64_t voxels_recomputed = 0;  // voxels whose values were recomputed (the reach boxes)
-    std::int64_t voxels_read = 0;        // voxels the kernel ran over (reach boxes grown by D)
+    std::int64_t voxels_recomputed = 0;  // voxels whose values were recomputed
+    std::int64_t voxels_read = 0;        // voxels the kernel ran over (recomputed boxes and the sites around them)
     int regions = 0;                     // merged boxes recomputed
   };
 

@@ -360,15 +360,17 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
   if (dirty.empty()) return stats;
   const detail::FieldPlan plan = detail::make_field_plan(world_->voxels, options_);
   // Changes that only add sites (placing into air) can only lower an unsigned field: its new
-  // value is min(old value, distance to the sites inside the reach box), since the sites inside it
-  // include every new one. That needs the box's own sites only — not the box grown by the reach
-  // again, ~5x fewer voxels for r = 4, D = 16. Encodings are monotone, so the minimum can be taken
-  // on stored values. Signed fields (new solids need their distance to air) and nearest sites (the
-  // tie rule) take the general path, as does anything that removed a solid voxel.
+  // value is min(old value, distance to the new sites), and the new sites lie in the changed
+  // boxes. So the transform runs over the recomputed box with those boxes' voxels as its only
+  // sites — no sites from the box grown by the reach. Encodings are monotone, so the minimum can be
+  // taken on stored values. Signed fields (new solids need their distance to air) and nearest sites
+  // (the tie rule) take the general path, as does anything that removed a solid voxel.
   const bool additions_only = !dirty.removes_solid() && !plan.is_signed && !field_.sites;
-  // Unsigned fields without sites also shrink each region to the voxels the changes can reach
-  // (detail::affected_box); signed fields (a new solid changes distances inside it to air) and
-  // nearest sites keep the whole reach box.
+  // Unsigned fields without sites also shrink each region to the voxels the changes can move
+  // (detail::grow_affected finds a box holding them, detail::affected_box tests its voxels), and
+  // removals read only the sites their new values can reach (detail::new_value_bound). Signed
+  // fields (a new solid changes distances inside it to air) and nearest sites keep the whole reach
+  // box and read the sites up to the reach beyond it.
   const bool shrink = !plan.is_signed && !field_.sites;
   const std::vector<Box3i> changed = dirty.boxes();
   for (const detail::UpdateRegion& region : detail::update_regions(dirty, *options_.domain, reach_)) {
@@ -440,10 +442,9 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
             in = Box3i{r.begin - reach_, r.end + reach_}.intersect(*options_.domain);
           }
           // Compute r from the sites in `in`, densely, and write it into the field (additions: from
-          // r's own sites, then the minimum with the old).
+          // the new sites, then the minimum with the old).
           std::vector<SiteOffset> sites(field_.sites ? static_cast<std::size_t>(r.volume()) : 0);
           values.resize(static_cast<std::size_t>(r.volume()));
-          // Additions: the distance to the new sites (inside `near`) is all the minimum needs.
           detail::compute_region<T>(world_->voxels, plan, in, r, values.data(), field_.sites ? sites.data() : nullptr,
                                     additions_only ? &near : nullptr);
           if (additions_only)
