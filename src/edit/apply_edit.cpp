@@ -22,12 +22,14 @@ struct RowSpan {
 
 RowSpan row_span(const SphereBrush& s, int y, int z, int x0, int x1) {
   auto in = [&](int x) { return brush_contains(s, Vec3i{x, y, z}); };
-  const int mid = std::clamp(static_cast<int>(std::lround(s.center[0])), x0, x1 - 1);
+  // Clamped as doubles, then converted: centres may lie far outside the row (finite, validated).
+  auto to_row = [&](double v) { return static_cast<int>(std::clamp(v, static_cast<double>(x0), static_cast<double>(x1 - 1))); };
+  const int mid = to_row(std::round(s.center[0]));
   if (!in(mid)) return {x0, x0, false};  // the row's voxel nearest the centre is outside
   const double dy = y - s.center[1], dz = z - s.center[2];
   const double half = std::sqrt(std::max(0.0, s.radius * s.radius - dy * dy - dz * dz));
-  int lo = std::clamp(static_cast<int>(std::floor(s.center[0] - half)), x0, mid);
-  int hi = std::clamp(static_cast<int>(std::ceil(s.center[0] + half)), mid, x1 - 1);
+  int lo = std::min(to_row(std::floor(s.center[0] - half)), mid);
+  int hi = std::max(to_row(std::ceil(s.center[0] + half)), mid);
   while (lo < mid && !in(lo)) ++lo;
   while (lo > x0 && in(lo - 1)) --lo;
   while (hi > mid && !in(hi)) --hi;
@@ -44,8 +46,14 @@ RowSpan row_span(const Shape&, int, int, int x0, int x1) {
 
 void validate_edit(const Edit& e) {
   struct Check {
+    static void finite(const Vec3d& p, const char* what) {
+      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+        throw InvalidArgument(std::string(what) + " must be finite");
+      }
+    }
     void operator()(const SphereBrush& s) const {
       if (!(s.radius >= 0) || !std::isfinite(s.radius)) throw InvalidArgument("sphere radius must be >= 0");
+      finite(s.center, "sphere centre");
     }
     void operator()(const BoxBrush& b) const {
       if (b.min.x > b.max.x || b.min.y > b.max.y || b.min.z > b.max.z) {
@@ -55,9 +63,13 @@ void validate_edit(const Edit& e) {
     void operator()(const RotatedBoxBrush& b) const {
       for (double h : {b.half_extent.x, b.half_extent.y, b.half_extent.z})
         if (!(h >= 0) || !std::isfinite(h)) throw InvalidArgument("rotated box half extents must be >= 0");
+      finite(b.center, "rotated box centre");
+      finite(b.rotation_deg, "rotated box rotation");
     }
     void operator()(const CapsuleBrush& c) const {
       if (!(c.radius >= 0) || !std::isfinite(c.radius)) throw InvalidArgument("capsule radius must be >= 0");
+      finite(c.a, "capsule end");
+      finite(c.b, "capsule end");
     }
     void operator()(const StampBrush& s) const {
       if (!s.model) throw InvalidArgument("stamp without a model");

@@ -317,6 +317,22 @@ double new_value_bound(const FieldPlan& plan, const Grid<T>& field, const Box3i&
   return bound;
 }
 
+// A box holding every solid voxel of `box` (empty if it holds none), from the chunks alone: a
+// chunk of air is skipped, any other adds its part of `box` — no voxel is read.
+Box3i solid_bounds(const Grid<std::uint8_t>& occupancy, const Box3i& box) {
+  Box3i bounds;
+  if (box.empty()) return bounds;
+  const Vec3i lo = occupancy.chunk_of(box.begin), hi = occupancy.chunk_of(box.end - Vec3i::splat(1));
+  for (int z = lo.z; z <= hi.z; ++z)
+    for (int y = lo.y; y <= hi.y; ++y)
+      for (int x = lo.x; x <= hi.x; ++x) {
+        const ChunkView<std::uint8_t> view = occupancy.chunk_view({x, y, z});
+        if (view.uniform() && view.uniform_value == 0) continue;
+        bounds = bounds.unite(view.box.intersect(box));
+      }
+  return bounds;
+}
+
 }  // namespace
 
 Vec3i field_reach(const FieldPlan& plan) {
@@ -437,6 +453,9 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
                 for (int k = 0; k < 3; ++k)
                   by[k] = std::min(by[k], static_cast<int>(std::floor(m / plan.spacing[k] + 1e-9)));  // m is a bound already
               in = Box3i{r.begin - by, r.end + by}.intersect(*options_.domain);
+              // Air is no site: the box needs to hold r and the solid voxels around it only (after
+              // a carve in open air, often little more than r).
+              in = detail::solid_bounds(world_->voxels, in).unite(r);
             }
           } else {
             in = Box3i{r.begin - reach_, r.end + reach_}.intersect(*options_.domain);
