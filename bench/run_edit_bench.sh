@@ -21,6 +21,11 @@ for n in 128 256 512; do
       --json "$out/r4-euclid-c16-$n-run$k.json" | tee "$out/r4-euclid-c16-$n-run$k.txt" | sed -n 2,3p | sed "s/^/$n run $k: /"
   done
 done
+# The same at 512^3 with 8-bit storage (a quarter of the field memory to fill when chunks turn dense).
+for k in $(seq 1 "$runs"); do
+  $B bench edits --world 512 --edits 500 --metric euclidean --max-distance 16 --radius-min 4 --radius-max 4 --storage u8 \
+    --json "$out/r4-euclid-c16-u8-512-run$k.json" | tee "$out/r4-euclid-c16-u8-512-run$k.txt" | sed -n 2,3p | sed "s/^/512 u8 run $k: /"
+done
 # The same stream at 1024^3, once (the world-size independence target).
 $B bench edits --world 1024 --edits 500 --metric euclidean --max-distance 16 --radius-min 4 --radius-max 4 \
   --json "$out/r4-euclid-c16-1024.json" | tee "$out/r4-euclid-c16-1024.txt" | sed -n 2,3p | sed "s/^/1024: /"
