@@ -7,9 +7,12 @@
 //  * A chunk absent from the map reads as the grid's background value. A chunk whose voxels all
 //    hold one value is stored as that value alone, with no voxel allocation ("uniform chunk").
 //    Other chunks own a dense array of edge^3 values, x fastest, then y, then z.
-//  * A dense chunk made uniform by per-voxel set() collapses back in O(1) when its voxels all return
-//    to the value it held when it was expanded; any other uniform chunk is collapsed by compact(),
-//    which the bulk writers (fill, copy_from_dense, generate_chunks) run on what they touched.
+//  * Each dense chunk counts the voxels holding one reference value (at first the value it was
+//    expanded from), so set(), edit_chunk() and copy_from_dense() collapse a chunk that returns to
+//    it in O(1). After writes of one other value, copy_from_dense() re-anchors the count on it (one
+//    pass) and edit_chunk() checks for uniformity (a pass that stops at the first other voxel).
+//    Other chunks that come out uniform are collapsed by compact() and by the bulk writers (fill,
+//    generate_chunks, adopt_chunks) on what they touched.
 //  * Coordinates are signed 32-bit. A grid may be unbounded or bounded by a box; writes outside the
 //    bounds throw InvalidArgument and change nothing, reads outside return the background.
 //
