@@ -7,13 +7,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-3}
-bash scripts/install-deps.sh
-bash scripts/install-bench-deps.sh
-cmake --preset release >/dev/null
-cmake --build --preset release
-out=bench/results/edits-$(date +%Y%m%d-%H%M)
-mkdir -p "$out"
-{ echo "machine: $(lscpu | sed -n 's/^Model name:\s*//p'), $(nproc) cores"; date -u; git rev-parse HEAD; } > "$out/machine.txt"
+source bench/common.sh
+bench_prepare --peers
+bench_results edits
 B=build/release/bin/voxfield
 for n in 128 256 512; do
   for k in $(seq 1 "$runs"); do

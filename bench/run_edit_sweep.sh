@@ -8,13 +8,9 @@ cd "$(dirname "$0")/.."
 edits=${1:-200}
 sizes=${2:-"64 128 256 512"}
 chunks=${3:-"8 16 32 64 128"}
-bash scripts/install-deps.sh
-bash scripts/install-bench-deps.sh
-cmake --preset release >/dev/null
-cmake --build --preset release
-out=bench/results/edit-sweep-$(date +%Y%m%d-%H%M)
-mkdir -p "$out"
-{ echo "machine: $(lscpu | sed -n 's/^Model name:\s*//p'), $(nproc) cores"; date -u; } > "$out/machine.txt"
+source bench/common.sh
+bench_prepare --peers
+bench_results edit-sweep
 for n in $sizes; do
   for c in $chunks; do
     [ "$c" -le "$n" ] || continue

@@ -5,12 +5,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-5}
-bash scripts/install-deps.sh
-bash scripts/install-bench-deps.sh
-cmake --preset release >/dev/null
-cmake --build --preset release
+source bench/common.sh
+bench_prepare --peers
 bin=build/release/bin
-out=bench/results/field-$(date +%Y%m%d-%H%M)
+bench_results field >/dev/null
 mkdir -p "$out/inputs"
 inputs=()
 for scene in spheres terrain; do
@@ -24,7 +22,7 @@ for f in ephtracy_monu3 qinzhuo_teapot1 mmmm_scene_store8; do
   inputs+=("$out/inputs/$f.npy")
 done
 list=$(IFS=,; echo "${inputs[*]}")
-{ echo "machine: $(lscpu | sed -n 's/^Model name:\s*//p'), $(nproc) cores"; date -u; } | tee "$out/machine.txt"
+cat "$out/machine.txt"
 "$bin/voxfield-bench-field" --scenes "" --inputs "$list" --threads 1,2 --runs "$runs" --json "$out/records.jsonl"
 unset OPENBLAS_CORETYPE OPENBLAS_L2_SIZE
 /usr/bin/python3 bench/peers/scipy_peer.py --runs "$runs" --json "$out/records.jsonl" "${inputs[@]}"

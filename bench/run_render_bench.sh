@@ -6,12 +6,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-7}
-bash scripts/install-deps.sh
-cmake --preset release >/dev/null
-cmake --build --preset release
-out=bench/results/render-$(date +%Y%m%d-%H%M)
-mkdir -p "$out"
-{ echo "machine: $(lscpu | sed -n 's/^Model name:\s*//p'), $(nproc) cores"; date -u; } | tee "$out/machine.txt"
+source bench/common.sh
+bench_prepare
+bench_results render
 build/release/bin/voxfield-bench-render --size 512 --runs "$runs" --json "$out/records.jsonl" | tee "$out/table.txt"
 build/release/bin/voxfield-bench-render --size 512 --runs "$runs" --threads 1 --resolutions 640x360 \
     --only "flat shading, manhattan" --json "$out/records.jsonl" | tee -a "$out/table.txt"

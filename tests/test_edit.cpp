@@ -133,8 +133,7 @@ TEST(Edit, ShapesByHand) {
   EXPECT_THROW(apply_edit(s, {EditOp::kCarve, CapsuleBrush{{0, 0, 0}, {inf, 0, 0}, 1}, 1}), InvalidArgument);
   EXPECT_THROW(apply_edit(s, {EditOp::kPlace, RotatedBoxBrush{{0, 0, 0}, {1, 1, 1}, {0, nan, 0}}, 1}), InvalidArgument);
   EXPECT_EQ(s.solid_count(), 7);
-  // A sphere centred far outside the world covers exactly its cap inside (rows are visited as spans
-  // found from the centre: a far centre must not upset them).
+  // A sphere centred far outside the world covers exactly its cap inside.
   World cap(8, Box3i{{-20, -20, -20}, {20, 20, 20}});
   const SphereBrush far{{1000.5, 0.25, -3}, 990};
   std::int64_t expected = 0;

@@ -21,8 +21,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <memory>
-#include <vector>
 #include <type_traits>
 
 #include "field_plan.h"
@@ -410,37 +408,22 @@ struct Encoder {
         clamp_f(static_cast<float>(std::min(plan.clamp, 3.0e38))),
         // The stored value is a plain function of the cost for unsigned fields in f32 or with an
         // integer metric (scale 1, bias 0): those rows take encode_row().
-        row_path(!plan.is_signed && (std::is_same_v<T, float> || plan.metric != Metric::kEuclidean)) {
-    if constexpr (!std::is_same_v<T, float>) table = cost_table();
-  }
+        row_path(!plan.is_signed && (std::is_same_v<T, float> || plan.metric != Metric::kEuclidean)) {}
 
   const Plan& p;
   T none;        // stored value for "no site within reach"
   float clamp_f;
   bool row_path;
-  // Integer Euclidean storage: the stored value of every integer cost up to the clamp's (an
-  // integer square root per voxel otherwise — most of a small update of a u8 field).
-  struct CostTable {
-    double scale, bias, clamp;
-    std::vector<T> values;
-  };
-  std::shared_ptr<const CostTable> table;
 
   // `cost` is what the passes minimised (squared for Euclidean); `inside`: a solid voxel of a
   // signed field (negated).
   T encode(double cost, bool has_site, bool inside) const {
-    if (table && has_site && !inside && cost < static_cast<double>(table->values.size())) {
-      return table->values[static_cast<std::size_t>(cost)];
-    }
-    return encode_exact(cost, has_site, inside);
-  }
-
-  T encode_exact(double cost, bool has_site, bool inside) const {
     if (!has_site) return detail::encode_distance<T>(inside ? -std::numeric_limits<double>::infinity()
                                                             : std::numeric_limits<double>::infinity(), p);
     const double d = p.metric == Metric::kEuclidean ? std::sqrt(cost) : cost;
     if constexpr (!std::is_same_v<T, float>) {
-      if (integer_sqrt_path() && d < p.clamp) {
+      if (p.metric == Metric::kEuclidean && p.unit_spacing && d < p.clamp &&
+          p.encoding.scale == std::floor(p.encoding.scale)) {
         // floor(sqrt(cost) * S) computed exactly in integers (cost is an integer here).
         constexpr double kMax = static_cast<double>(std::numeric_limits<T>::max());
         const std::uint64_t n = static_cast<std::uint64_t>(cost) * static_cast<std::uint64_t>(p.encoding.scale * p.encoding.scale);
@@ -450,29 +433,6 @@ struct Encoder {
       }
     }
     return detail::encode_distance<T>(inside ? -d : d, p);
-  }
-
-  bool integer_sqrt_path() const {
-    return p.metric == Metric::kEuclidean && p.unit_spacing && p.encoding.scale == std::floor(p.encoding.scale);
-  }
-
-  // The table for this plan: kept per thread and rebuilt only when the encoding or clamp change
-  // (a shared pointer, so that an encoder still in use keeps the table it was given). Built by
-  // encode_exact() itself, so the values are the same by construction. None for clamps of 256
-  // voxels and more (the table would cost more than it saves).
-  std::shared_ptr<const CostTable> cost_table() const {
-    // Unit-spacing Euclidean costs are integers (squared voxel distances).
-    if (p.metric != Metric::kEuclidean || !p.unit_spacing || !(p.clamp * p.clamp < 65536.0)) return nullptr;
-    thread_local std::shared_ptr<const CostTable> kept;
-    if (kept && kept->scale == p.encoding.scale && kept->bias == p.encoding.bias && kept->clamp == p.clamp) return kept;
-    auto t = std::make_shared<CostTable>();
-    t->scale = p.encoding.scale;
-    t->bias = p.encoding.bias;
-    t->clamp = p.clamp;
-    t->values.resize(static_cast<std::size_t>(std::floor(p.clamp * p.clamp)) + 1);
-    for (std::size_t c = 0; c < t->values.size(); ++c) t->values[c] = encode_exact(static_cast<double>(c), true, false);
-    kept = std::move(t);
-    return kept;
   }
 
   // Branch-light encoding of a row when row_path holds: the same values as encode().

@@ -11,37 +11,6 @@ namespace {
 
 constexpr std::int64_t kMaxEditVoxels = std::int64_t{1} << 33;
 
-// The voxels of the row (y, z), x in [x0, x1), that a brush may cover, and whether each still
-// needs testing. A row of a ball is an interval around the centre's x: its ends are estimated,
-// then settled with the exact test, so the voxels between need none (an edit visits its voxels,
-// not its bounding box, at a few nanoseconds each).
-struct RowSpan {
-  int begin, end;
-  bool test_each;
-};
-
-RowSpan row_span(const SphereBrush& s, int y, int z, int x0, int x1) {
-  auto in = [&](int x) { return brush_contains(s, Vec3i{x, y, z}); };
-  // Clamped as doubles, then converted: centres may lie far outside the row (finite, validated).
-  auto to_row = [&](double v) { return static_cast<int>(std::clamp(v, static_cast<double>(x0), static_cast<double>(x1 - 1))); };
-  const int mid = to_row(std::round(s.center[0]));
-  if (!in(mid)) return {x0, x0, false};  // the row's voxel nearest the centre is outside
-  const double dy = y - s.center[1], dz = z - s.center[2];
-  const double half = std::sqrt(std::max(0.0, s.radius * s.radius - dy * dy - dz * dz));
-  int lo = std::min(to_row(std::floor(s.center[0] - half)), mid);
-  int hi = std::max(to_row(std::ceil(s.center[0] + half)), mid);
-  while (lo < mid && !in(lo)) ++lo;
-  while (lo > x0 && in(lo - 1)) --lo;
-  while (hi > mid && !in(hi)) --hi;
-  while (hi < x1 - 1 && in(hi + 1)) ++hi;
-  return {lo, hi + 1, false};
-}
-
-template <class Shape>
-RowSpan row_span(const Shape&, int, int, int x0, int x1) {
-  return {x0, x1, true};
-}
-
 }  // namespace
 
 void validate_edit(const Edit& e) {
@@ -158,11 +127,10 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
           // The brush is resolved once per chunk, not once per voxel.
           std::visit([&](const auto& shape) {
           for (int z = part.begin.z; z < part.end.z; ++z)
-            for (int y = part.begin.y; y < part.end.y; ++y) {
-              const RowSpan span = row_span(shape, y, z, part.begin.x, part.end.x);
-              for (int x = span.begin; x < span.end; ++x) {
+            for (int y = part.begin.y; y < part.end.y; ++y)
+              for (int x = part.begin.x; x < part.end.x; ++x) {
                 const Vec3i p{x, y, z};
-                if (span.test_each && !brush_contains(shape, p)) continue;
+                if (!brush_contains(shape, p)) continue;
                 const std::int64_t i = (std::int64_t{z - cb.begin.z} * edge + (y - cb.begin.y)) * edge + (x - cb.begin.x);
                 const std::uint8_t before = voxels.get(i);
                 const std::uint8_t paint = stamp ? stamp->model->voxels.get(p - stamp->offset) : e.material;
@@ -183,7 +151,6 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
                   ohi = {std::max(ohi.x, x), std::max(ohi.y, y), std::max(ohi.z, z)};
                 }
               }
-            }
           }, e.brush);
         });
         if (chi.x >= clo.x) {
