@@ -192,6 +192,9 @@ TEST(DynamicField, IncrementalUpdatesEqualFullRebuilds) {
       {Metric::kEuclidean, false, 0, Storage::kF32, false, {1.0, 0.5, 2.0}},
       {Metric::kEuclidean, false, 5, Storage::kU16, false, {0.5, 1.0, 1.0}},
       {Metric::kChebyshev, false, 0, Storage::kF32, false},
+      // Signed Euclidean with unit spacing and no sites: the truncated min-convolution's two
+      // transforms (to solid, to air), a small clamp and one past the world's extent.
+      {Metric::kEuclidean, true, 6, Storage::kU8, false},  {Metric::kEuclidean, true, 40.5, Storage::kF32, false},
   };
   const Box3i bounds{{-9, 0, 4}, {43, 37, 33}};
   const auto model = small_model();

@@ -25,6 +25,7 @@
 
 #include "field_plan.h"
 #include "line_transforms.h"
+#include "truncated_min_convolution.h"
 #include "voxfield/distance.h"
 #include "voxfield/parallel.h"
 
@@ -34,6 +35,7 @@ namespace {
 using detail::Chebyshev;
 using detail::EuclideanInt;
 using detail::EuclideanReal;
+using detail::TruncatedMinConvolution;
 
 // Chunk arrays covering a chunk-aligned box, addressed by voxel.
 template <class T>
@@ -776,6 +778,59 @@ void region_pass_z(const std::uint8_t* solid, Vec3i n, int z0, int z1, std::uint
   }
 }
 
+// The slice passes and encoding of compute_region_impl through TruncatedMinConvolution: for
+// unit-spacing Euclidean fields without nearest sites whose clamp D is below kMaxReach + 1.
+template <class T>
+void region_slices_truncated(const Plan& p, const Encoder<T>& encoder, Vec3i n, const Box3i& out, int ox, int oy, int z0,
+                             std::uint32_t cap, const std::uint8_t* solid, const std::uint32_t* g, T* values) {
+  using Conv = TruncatedMinConvolution;
+  const Vec3i m = out.size();
+  const std::size_t plane = static_cast<std::size_t>(n.x) * n.y;
+  const int reach = static_cast<int>(std::floor(p.clamp));               // |k| beyond it costs more than D²
+  const auto drop = static_cast<Conv::Cost>(std::floor(p.clamp * p.clamp));  // integer costs above D² are beyond D
+  const std::size_t grain = std::max<std::size_t>(1, (std::size_t{1} << 14) / plane);
+  parallel_for(static_cast<std::size_t>(m.z), grain, [&](std::size_t zb, std::size_t ze) {
+    thread_local Conv kept[2];
+    Conv* conv = kept;
+    const int passes = p.is_signed ? 2 : 1;
+    for (int k = 0; k < passes; ++k) conv[k].prepare(n.x, n.y, ox, oy, m.x, m.y, reach, drop);
+    for (std::size_t zi = zb; zi < ze; ++zi) {
+      const std::uint32_t* gs = g + zi * plane;
+      const std::uint8_t* ws = solid + (static_cast<std::size_t>(z0) + zi) * plane;
+      // g (voxels along z, `cap` or more for none) -> its square; g <= reach whenever below cap.
+      for (int y = 0; y < n.y; ++y) {
+        const std::uint32_t* gr = gs + static_cast<std::size_t>(y) * n.x;
+        const std::uint8_t* wr = ws + static_cast<std::size_t>(y) * n.x;
+        Conv::Cost* f0 = conv[0].f_row(y);
+        if (p.is_signed) {
+          Conv::Cost* f1 = conv[1].f_row(y);
+          for (int x = 0; x < n.x; ++x) {
+            const Conv::Cost c = gr[x] < cap ? static_cast<Conv::Cost>(gr[x] * gr[x]) : Conv::kInf;
+            f1[x] = wr[x] ? c : Conv::Cost{0};  // distance to air
+            f0[x] = wr[x] ? Conv::Cost{0} : c;  // distance to solid
+          }
+        } else {
+          for (int x = 0; x < n.x; ++x) f0[x] = gr[x] < cap ? static_cast<Conv::Cost>(gr[x] * gr[x]) : Conv::kInf;
+        }
+      }
+      for (int k = 0; k < passes; ++k) conv[k].solve();
+      for (int y = 0; y < m.y; ++y) {
+        T* row = values + (zi * static_cast<std::size_t>(m.y) + static_cast<std::size_t>(y)) * m.x;
+        if (encoder.row_path) {
+          encoder.encode_row(conv[0].out_row(y), row, m.x, Conv::kInf, drop);
+          continue;
+        }
+        const std::uint8_t* wr = ws + static_cast<std::size_t>(y + oy) * n.x + static_cast<std::size_t>(ox);
+        for (int x = 0; x < m.x; ++x) {
+          const bool inside = p.is_signed && wr[x];
+          const Conv::Cost cost = conv[inside ? 1 : 0].out_row(y)[x];
+          row[x] = encoder.encode(static_cast<double>(cost), cost < Conv::kInf, inside);
+        }
+      }
+    }
+  });
+}
+
 template <class T>
 void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, const Box3i& in, const Box3i& out,
                          T* values, SiteOffset* sites, const Box3i* sites_within) {
@@ -826,6 +881,13 @@ void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, con
   const Encoder<T> encoder(p);
   const double clamp_cost = p.metric == Metric::kEuclidean ? p.clamp * p.clamp : p.clamp;
   const bool euclid = p.metric == Metric::kEuclidean;
+  // Small clamps (the usual case for editable worlds), unit spacing, no nearest sites: the 2-D
+  // passes as truncated min-convolutions on the window alone (truncated_min_convolution.h).
+  if (euclid && p.unit_spacing && !sites && std::isfinite(p.clamp) && p.clamp >= 1 &&
+      p.clamp < TruncatedMinConvolution::kMaxReach + 1) {
+    region_slices_truncated(p, encoder, n, out, ox, oy, z0, cap32, solid.data(), g.data(), values);
+    return;
+  }
   dispatch_solver(p, n, [&](auto tag, const auto& solve, auto inf) {
     using V = decltype(tag);
     const V clamp_v = clamp_cost >= static_cast<double>(inf) ? inf : static_cast<V>(clamp_cost);
