@@ -76,54 +76,57 @@ Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& 
   // floats, with the bound rounded up a little: a voxel is let through whenever in doubt.
   const GapCost gap{plan.metric, changed, plan.spacing};
   const T clamp_stored = encode_distance<T>(plan.clamp, plan);
-  // A bound below every cost excludes a value that cannot change.
-  const float never = -1.0f;
-  const T lowest{0};
-  auto frozen = [&](T stored) {
-    return (kind == Changes::kRemovals && stored == clamp_stored) || (kind == Changes::kAdditions && stored == lowest);
-  };
-  auto bound_of = [&](T stored) {
-    return frozen(stored) ? never : gap.of_distance(upper_distance<T>(plan, stored, clamp_stored));
-  };
-  // 8-bit storage: the bound of each stored value, decoded once (for 16 bits the table would cost
-  // more to fill than the voxels it serves).
-  constexpr bool kTable = sizeof(T) == 1;
-  std::array<float, 256> table{};
-  if constexpr (kTable)
-    for (std::size_t v = 0; v < table.size(); ++v) table[v] = bound_of(static_cast<T>(v));
+  // The bound each stored value allows, as a few float operations per voxel that vectorise:
+  // upper_distance() is (stored + off) * mul and GapCost::of_distance() a square (Euclidean) plus
+  // a margin; both margins here are wider than theirs, and far wider than float rounding, so the
+  // bound is never below the exact one (a voxel is let through whenever in doubt).
+  const float off = std::is_same_v<T, float> ? 1e-5f : 1.0f;
+  const float mul = static_cast<float>((std::is_same_v<T, float> ? 1.0 : 1.0 / plan.encoding.scale) * (1 + 1e-5));
+  const float inf = std::numeric_limits<float>::infinity();
+  const float never = -1.0f;  // below every cost: the value cannot change
+  // Values can only rise after removals (one at the clamp stays there) and only fall after
+  // additions (one at 0 stays there).
+  const float at_clamp = kind == Changes::kRemovals ? never : inf;
+  const bool zero_frozen = kind == Changes::kAdditions;
   const int nx = r.size().x;
-  std::vector<float> gx(static_cast<std::size_t>(nx)), bound(static_cast<std::size_t>(nx));
+  std::vector<float> gx(static_cast<std::size_t>(nx));
+  std::vector<std::uint32_t> pass(static_cast<std::size_t>(nx));  // 32-bit flags: the same lanes as the floats
   for (int x = 0; x < nx; ++x) gx[static_cast<std::size_t>(x)] = gap.axis(0, r.begin.x + x);
   Box3i box{r.end, r.begin};  // empty
+  // One branch-free pass per row and metric: cost(x) combines x's gap with the row's. (Locals and
+  // __restrict pointers: nothing the loop reads may be thought to alias its stores, or it stays scalar.)
+  auto scan_row = [off, mul, at_clamp, zero_frozen, clamp_stored, never, nx, g = gx.data(), out = pass.data()](
+                      const T* __restrict row, float rest, auto combine, auto square) {
+    const float* __restrict gxs = g;
+    std::uint32_t* __restrict flags = out;
+    for (int x = 0; x < nx; ++x) {
+      const T s = row[x];
+      const float d = (static_cast<float>(s) + off) * mul;
+      float b = square(d) * 1.0001f + 1e-4f;
+      b = s == clamp_stored ? at_clamp : b;
+      b = (zero_frozen & (s == T{0})) ? never : b;
+      flags[x] = combine(gxs[x], rest) <= b ? 1u : 0u;
+    }
+  };
+  auto sum = [](float a, float b) { return a + b; };
+  auto max = [](float a, float b) { return std::max(a, b); };
+  auto squared = [](float d) { return d * d; };
+  auto plain = [](float d) { return d; };
   std::size_t i = 0;
   for (int z = r.begin.z; z < r.end.z; ++z) {
     const float gz = gap.axis(2, z);
     for (int y = r.begin.y; y < r.end.y; ++y, i += static_cast<std::size_t>(nx)) {
-      const float gy = gap.axis(1, y);
-      // The row's bounds, then the test as one branch-free pass per metric.
+      const float rest = gap.combine(gap.axis(1, y), gz);
       const T* row = old.data() + i;
-      for (int x = 0; x < nx; ++x) {
-        if constexpr (kTable) {
-          bound[static_cast<std::size_t>(x)] = table[row[x]];
-        } else {
-          bound[static_cast<std::size_t>(x)] = bound_of(row[x]);
-        }
+      switch (plan.metric) {
+        case Metric::kEuclidean: scan_row(row, rest, sum, squared); break;
+        case Metric::kManhattan: scan_row(row, rest, sum, plain); break;
+        case Metric::kChebyshev: scan_row(row, rest, max, plain); break;
       }
-      int first = nx, last = -1;
-      auto scan = [&](auto cost) {
-        for (int x = 0; x < nx; ++x)
-          if (cost(gx[static_cast<std::size_t>(x)]) <= bound[static_cast<std::size_t>(x)]) {
-            first = std::min(first, x);
-            last = x;
-          }
-      };
-      const float rest = gap.combine(gy, gz);
-      if (plan.metric == Metric::kChebyshev) {
-        scan([rest](float g) { return std::max(g, rest); });
-      } else {
-        scan([rest](float g) { return g + rest; });
-      }
-      if (last < 0) continue;
+      int first = 0, last = nx - 1;
+      while (first < nx && !pass[static_cast<std::size_t>(first)]) ++first;
+      if (first == nx) continue;
+      while (!pass[static_cast<std::size_t>(last)]) --last;
       box = {{std::min(box.begin.x, r.begin.x + first), std::min(box.begin.y, y), std::min(box.begin.z, z)},
              {std::max(box.end.x, r.begin.x + last + 1), std::max(box.end.y, y + 1), std::max(box.end.z, z + 1)}};
     }
