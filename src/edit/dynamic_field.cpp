@@ -54,16 +54,80 @@ struct GapCost {
     return metric == Metric::kEuclidean ? g * g : g;
   }
   float combine(float a, float b) const { return metric == Metric::kChebyshev ? std::max(a, b) : a + b; }
-  float of_distance(double d) const {  // rounded up a little: in doubt, a voxel is let through
-    const double c = metric == Metric::kEuclidean ? d * d : d;
-    return static_cast<float>(c * (1 + 1e-5) + 1e-5);
-  }
 };
 
 // `kind`: what the changes did — only removed solids (values can only rise, so voxels already at
 // the clamp stay there), only added them (values can only fall, so voxels at 0 stay there), or
 // both.
 enum class Changes { kRemovals, kAdditions, kBoth };
+
+// The largest gap cost (GapCost's units) from a change at which a voxel holding `stored` can still
+// be moved by it: its distance bound upper_distance() plus `extra`, as (stored + off) * mul + extra,
+// then squared for Euclidean. A few float operations per voxel that vectorise, with margins wider
+// than upper_distance()'s and far wider than float rounding, so the bound is never below the exact
+// one (a voxel is let through whenever in doubt). Values that cannot change get kNever.
+template <class T>
+struct StoredBound {
+  static constexpr float kNever = -1.0f;  // below every cost
+  float off, mul, extra;
+  T clamp_stored;
+  float at_clamp;    // +inf (the clamp value stands for "at least the clamp"), or kNever
+  bool zero_frozen;  // a voxel at 0 keeps its value (the changes only added sites)
+  bool squared;      // Euclidean costs are squared distances
+
+  // `extra`: a distance added to every bound. `clamp_frozen`: values at the clamp cannot change
+  // (the changes only removed sites, so values can only rise).
+  StoredBound(const FieldPlan& plan, double extra_distance, bool clamp_frozen, bool zero_frozen_value)
+      : off(std::is_same_v<T, float> ? 1e-5f : 1.0f),
+        mul(static_cast<float>((std::is_same_v<T, float> ? 1.0 : 1.0 / plan.encoding.scale) * (1 + 1e-5))),
+        extra(static_cast<float>(extra_distance * (1 + 1e-5))),
+        clamp_stored(encode_distance<T>(plan.clamp, plan)),
+        at_clamp(clamp_frozen ? kNever : std::numeric_limits<float>::infinity()),
+        zero_frozen(zero_frozen_value),
+        squared(plan.metric == Metric::kEuclidean) {}
+
+  template <bool kSquared>
+  float at(T s) const {
+    const float d = (static_cast<float>(s) + off) * mul + extra;
+    float b = (kSquared ? d * d : d) * 1.0001f + 1e-4f;
+    b = s == clamp_stored ? at_clamp : b;
+    return (zero_frozen & (s == T{0})) ? kNever : b;
+  }
+  float operator()(T s) const { return squared ? at<true>(s) : at<false>(s); }
+};
+
+// flags[i] = 1 when voxel i of a row segment passes: the combination of its gap cost along x
+// (gx[i]) with the rest of its gap (`rest`) is within the bound of its stored value v[i]. One
+// branch-free loop per metric. (Arguments by value and __restrict pointers: nothing the loop reads
+// may be thought to alias its stores, or it stays scalar.)
+template <bool kSquared, bool kChebyshev, class T>
+void test_loop(const StoredBound<T> sb, const T* __restrict v, const float* __restrict gx, int count, float rest,
+               std::uint32_t* __restrict flags) {
+  for (int i = 0; i < count; ++i) {
+    const float cost = kChebyshev ? std::max(gx[i], rest) : gx[i] + rest;
+    flags[i] = cost <= sb.template at<kSquared>(v[i]) ? 1u : 0u;
+  }
+}
+
+template <class T>
+void test_segment(Metric metric, const StoredBound<T>& sb, const T* v, const float* gx, int count, float rest,
+                  std::uint32_t* flags) {
+  switch (metric) {
+    case Metric::kEuclidean: test_loop<true, false>(sb, v, gx, count, rest, flags); break;
+    case Metric::kManhattan: test_loop<false, false>(sb, v, gx, count, rest, flags); break;
+    case Metric::kChebyshev: test_loop<false, true>(sb, v, gx, count, rest, flags); break;
+  }
+}
+
+// The first and last set flags of flags[0..count); false when none is set.
+inline bool flagged_span(const std::uint32_t* flags, int count, int& first, int& last) {
+  first = 0;
+  while (first < count && !flags[first]) ++first;
+  if (first == count) return false;
+  last = count - 1;
+  while (!flags[last]) --last;
+  return true;
+}
 
 template <class T>
 Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& old, const Box3i& changed, Changes kind) {
@@ -75,58 +139,21 @@ Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& 
   // Distances are compared as "costs" (squared for Euclidean, so no square root per voxel) in
   // floats, with the bound rounded up a little: a voxel is let through whenever in doubt.
   const GapCost gap{plan.metric, changed, plan.spacing};
-  const T clamp_stored = encode_distance<T>(plan.clamp, plan);
-  // The bound each stored value allows, as a few float operations per voxel that vectorise:
-  // upper_distance() is (stored + off) * mul and GapCost::of_distance() a square (Euclidean) plus
-  // a margin; both margins here are wider than theirs, and far wider than float rounding, so the
-  // bound is never below the exact one (a voxel is let through whenever in doubt).
-  const float off = std::is_same_v<T, float> ? 1e-5f : 1.0f;
-  const float mul = static_cast<float>((std::is_same_v<T, float> ? 1.0 : 1.0 / plan.encoding.scale) * (1 + 1e-5));
-  const float inf = std::numeric_limits<float>::infinity();
-  const float never = -1.0f;  // below every cost: the value cannot change
   // Values can only rise after removals (one at the clamp stays there) and only fall after
   // additions (one at 0 stays there).
-  const float at_clamp = kind == Changes::kRemovals ? never : inf;
-  const bool zero_frozen = kind == Changes::kAdditions;
+  const StoredBound<T> bound(plan, 0.0, kind == Changes::kRemovals, kind == Changes::kAdditions);
   const int nx = r.size().x;
   std::vector<float> gx(static_cast<std::size_t>(nx));
-  std::vector<std::uint32_t> pass(static_cast<std::size_t>(nx));  // 32-bit flags: the same lanes as the floats
+  std::vector<std::uint32_t> pass(static_cast<std::size_t>(nx));
   for (int x = 0; x < nx; ++x) gx[static_cast<std::size_t>(x)] = gap.axis(0, r.begin.x + x);
   Box3i box{r.end, r.begin};  // empty
-  // One branch-free pass per row and metric: cost(x) combines x's gap with the row's. (Locals and
-  // __restrict pointers: nothing the loop reads may be thought to alias its stores, or it stays scalar.)
-  auto scan_row = [off, mul, at_clamp, zero_frozen, clamp_stored, never, nx, g = gx.data(), out = pass.data()](
-                      const T* __restrict row, float rest, auto combine, auto square) {
-    const float* __restrict gxs = g;
-    std::uint32_t* __restrict flags = out;
-    for (int x = 0; x < nx; ++x) {
-      const T s = row[x];
-      const float d = (static_cast<float>(s) + off) * mul;
-      float b = square(d) * 1.0001f + 1e-4f;
-      b = s == clamp_stored ? at_clamp : b;
-      b = (zero_frozen & (s == T{0})) ? never : b;
-      flags[x] = combine(gxs[x], rest) <= b ? 1u : 0u;
-    }
-  };
-  auto sum = [](float a, float b) { return a + b; };
-  auto max = [](float a, float b) { return std::max(a, b); };
-  auto squared = [](float d) { return d * d; };
-  auto plain = [](float d) { return d; };
   std::size_t i = 0;
   for (int z = r.begin.z; z < r.end.z; ++z) {
     const float gz = gap.axis(2, z);
     for (int y = r.begin.y; y < r.end.y; ++y, i += static_cast<std::size_t>(nx)) {
-      const float rest = gap.combine(gap.axis(1, y), gz);
-      const T* row = old.data() + i;
-      switch (plan.metric) {
-        case Metric::kEuclidean: scan_row(row, rest, sum, squared); break;
-        case Metric::kManhattan: scan_row(row, rest, sum, plain); break;
-        case Metric::kChebyshev: scan_row(row, rest, max, plain); break;
-      }
-      int first = 0, last = nx - 1;
-      while (first < nx && !pass[static_cast<std::size_t>(first)]) ++first;
-      if (first == nx) continue;
-      while (!pass[static_cast<std::size_t>(last)]) --last;
+      test_segment(plan.metric, bound, old.data() + i, gx.data(), nx, gap.combine(gap.axis(1, y), gz), pass.data());
+      int first, last;
+      if (!flagged_span(pass.data(), nx, first, last)) continue;
       box = {{std::min(box.begin.x, r.begin.x + first), std::min(box.begin.y, y), std::min(box.begin.z, z)},
              {std::max(box.end.x, r.begin.x + last + 1), std::max(box.end.y, y + 1), std::max(box.end.z, z + 1)}};
     }
@@ -148,9 +175,10 @@ class RowReader {
         for (int x = lo_.x; x <= hi.x; ++x) views_.push_back(grid.chunk_view({x, y, z}));
   }
   // Calls run(x_begin, x_end, value) for runs of one value (a uniform chunk's part of the row) and
-  // each(x, value) for the voxels of dense chunks, over x in [x0, x1) of the row (y, z).
-  template <class Run, class Each>
-  void row(int x0, int x1, int y, int z, Run&& run, Each&& each) const {
+  // segment(x_begin, x_end, values) for the parts in dense chunks (values[0] at x_begin), over x in
+  // [x0, x1) of the row (y, z).
+  template <class Run, class Segment>
+  void row(int x0, int x1, int y, int z, Run&& run, Segment&& segment) const {
     const std::size_t base = (static_cast<std::size_t>((z >> shift_) - lo_.z) * n_.y + static_cast<std::size_t>((y >> shift_) - lo_.y)) * n_.x;
     for (int x = x0; x < x1;) {
       const ChunkView<T>& v = views_[base + static_cast<std::size_t>((x >> shift_) - lo_.x)];
@@ -159,7 +187,7 @@ class RowReader {
         run(x, end, v.uniform_value);
       } else {
         const T* row = v.voxels + (static_cast<std::size_t>(z - v.box.begin.z) * edge_ + static_cast<std::size_t>(y - v.box.begin.y)) * edge_;
-        for (int i = x; i < end; ++i) each(i, row[i - v.box.begin.x]);
+        segment(x, end, row + (x - v.box.begin.x));
       }
       x = end;
     }
@@ -196,16 +224,12 @@ Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
   // holds every voxel the edit can change. It is found by growing C one shell at a time, reading
   // each voxel at most once: work in proportion to the affected voxels, not to the reach box.
   const GapCost gap{plan.metric, changed, plan.spacing};
-  const double slack = rounding_slack(plan);
-  const T clamp_stored = encode_distance<T>(plan.clamp, plan);
+  // Every value relaxed by the rounding slack; nothing is frozen (a search must pass through).
+  const StoredBound<T> bound_of(plan, rounding_slack(plan), false, false);
   const float inf = std::numeric_limits<float>::infinity();
-  auto pass_bound = [&](T stored) {
-    return stored == clamp_stored ? inf : gap.of_distance(upper_distance<T>(plan, stored, clamp_stored) + slack);
-  };
-  constexpr bool kTable = sizeof(T) == 1;  // 8-bit storage: each value's bound decoded once
-  std::array<float, 256> table{};
-  if constexpr (kTable)
-    for (std::size_t v = 0; v < table.size(); ++v) table[v] = pass_bound(static_cast<T>(v));
+  const int nx = r.size().x;
+  std::vector<float> gx(static_cast<std::size_t>(nx));  // gap costs along x, index x - r.begin.x
+  for (int x = 0; x < nx; ++x) gx[static_cast<std::size_t>(x)] = gap.axis(0, r.begin.x + x);
   const RowReader<T> reader(field, r);
   Box3i box = changed.intersect(r), scanned = box;
   while (box != r) {
@@ -217,14 +241,10 @@ Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
       for (int y = outer.begin.y; y < outer.end.y; ++y) {
         const float rest = gap.combine(gap.axis(1, y), gz);
         int lo = INT32_MAX, hi = INT32_MIN;
-        auto each = [&](int x, T stored) {
-          float bound;
-          if constexpr (kTable) {
-            bound = table[stored];
-          } else {
-            bound = pass_bound(stored);
-          }
-          if (gap.combine(gap.axis(0, x), rest) <= bound) {
+        auto segment = [&](int x0, int x1, const T* values) {
+          // Mostly a voxel or two at the ends of rows already scanned: tested one by one.
+          for (int x = x0; x < x1; ++x) {
+            if (gap.combine(gx[static_cast<std::size_t>(x - r.begin.x)], rest) > bound_of(values[x - x0])) continue;
             lo = std::min(lo, x);
             hi = std::max(hi, x);
           }
@@ -233,7 +253,7 @@ Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
           // A run at the clamp passes whole (open space); otherwise the passing voxels of a run of
           // one bound form an interval around the changed box's x range, so its ends are found by
           // walking in from the run's ends.
-          const float bound = pass_bound(stored);
+          const float bound = bound_of(stored);
           if (bound == inf) {
             lo = std::min(lo, x0);
             hi = std::max(hi, x1 - 1);
@@ -252,10 +272,10 @@ Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
         };
         const bool inner_row = y >= scanned.begin.y && y < scanned.end.y && z >= scanned.begin.z && z < scanned.end.z;
         if (inner_row) {  // only the ends of this row are new
-          reader.row(outer.begin.x, scanned.begin.x, y, z, run, each);
-          reader.row(scanned.end.x, outer.end.x, y, z, run, each);
+          reader.row(outer.begin.x, scanned.begin.x, y, z, run, segment);
+          reader.row(scanned.end.x, outer.end.x, y, z, run, segment);
         } else {
-          reader.row(outer.begin.x, outer.end.x, y, z, run, each);
+          reader.row(outer.begin.x, outer.end.x, y, z, run, segment);
         }
         if (lo <= hi) grown = grown.unite(Box3i{{lo, y, z}, {hi + 1, y + 1, z + 1}});
       }
@@ -291,7 +311,9 @@ double new_value_bound(const FieldPlan& plan, const Grid<T>& field, const Box3i&
       for (int y = f.begin.y; y < f.end.y && m < inf; ++y)
         reader.row(
             f.begin.x, f.end.x, y, z, [&](int, int, T stored) { m = std::max(m, upper_distance<T>(plan, stored, clamp_stored)); },
-            [&](int, T stored) { m = std::max(m, upper_distance<T>(plan, stored, clamp_stored)); });
+            [&](int x0, int x1, const T* values) {
+              for (int i = 0; i < x1 - x0; ++i) m = std::max(m, upper_distance<T>(plan, values[i], clamp_stored));
+            });
     return m;
   };
   double bound = inf;
