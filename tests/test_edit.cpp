@@ -274,8 +274,9 @@ TEST(DynamicField, EditsInSolidGroundEqualFullRebuilds) {
       if (HasFatalFailure()) return;
     }
   }
-  // A hole carved deep in the ground: the new values inside it are at most 4 (the ground around
-  // it is at 0), so only sites within 4 voxels of the 7^3 hole are read, not the clamp's 12.
+  // A hole carved deep in the ground: the ground around it is at 0, so the new values inside it
+  // are at most 4 and, face by face, no nearest site lies more than one voxel beyond the 7^3 hole's
+  // box: a 9^3 read, not the clamp's 31^3 (nor the 15^3 that the bound of 4 alone would give).
   World w(16, bounds);
   apply_edit(w, {EditOp::kPlace, BoxBrush{{0, 0, 0}, {69, 43, 65}}, 2});
   DistanceOptions o;
@@ -286,7 +287,7 @@ TEST(DynamicField, EditsInSolidGroundEqualFullRebuilds) {
   apply_edit(w, {EditOp::kCarve, SphereBrush{{35, 22, 33}, 3}, 1}, &dirty);
   const auto stats = live.update(dirty);
   EXPECT_EQ(stats.voxels_recomputed, 7 * 7 * 7);
-  EXPECT_EQ(stats.voxels_read, 15 * 15 * 15);
+  EXPECT_EQ(stats.voxels_read, 9 * 9 * 9);
   expect_same_field(live.field(), compute_distance_field(w, o), bounds, 0);
   EXPECT_NEAR(live.field().distance({35, 22, 33}), std::sqrt(10.0), 1e-6);  // to (35, 25, 32) and kin
 }

@@ -297,10 +297,22 @@ namespace {
 // around it: new(p) <= old(q) + |p - q| for every q outside `a` (distances are 1-Lipschitz, and q
 // keeps its value). Using q straight across each face of `a` gives a bound M on every new value
 // in `a`, so only sites within M of `a` matter — for a hole carved in solid ground, a few voxels
-// instead of the clamp. Faces on the edge of the region `r` (beyond it another region may change
-// values) or of the domain give no bound. Returns +inf when no face does.
+// instead of the clamp. Each face also bounds on its own how far beyond it a nearest site can lie:
+// with F the largest old value on the face below `a` along axis k and p's nearest site s,
+//     (p_k - s_k) * spacing_k <= |p - s| = new(p) <= F + (p_k - a.begin_k + 1) * spacing_k,
+// so s_k >= a.begin_k - 1 - F / spacing_k whatever p is (every metric bounds each axis's step by
+// the distance) — after a carve at the ground's surface, the face in the ground (F near 0) lets
+// the sites below it be skipped, where M reaches the clamp through the face in the open air.
+// Faces on the edge of the region `r` (beyond it another region may change values) or of the
+// domain give no bound: +inf.
+struct NewValueBounds {
+  double all = std::numeric_limits<double>::infinity();  // M: every new value in `a`
+  // The largest old value on the face just below / above `a` along each axis.
+  std::array<double, 3> lo_face{all, all, all}, hi_face{all, all, all};
+};
+
 template <class T>
-double new_value_bound(const FieldPlan& plan, const Grid<T>& field, const Box3i& r, const Box3i& a) {
+NewValueBounds new_value_bound(const FieldPlan& plan, const Grid<T>& field, const Box3i& r, const Box3i& a) {
   const T clamp_stored = encode_distance<T>(plan.clamp, plan);
   const double inf = std::numeric_limits<double>::infinity();
   const RowReader<T> reader(field, r);
@@ -316,9 +328,10 @@ double new_value_bound(const FieldPlan& plan, const Grid<T>& field, const Box3i&
             });
     return m;
   };
-  double bound = inf;
+  NewValueBounds bounds;
   for (int k = 0; k < 3; ++k) {
-    double lo_face = inf, hi_face = inf;
+    double& lo_face = bounds.lo_face[static_cast<std::size_t>(k)];
+    double& hi_face = bounds.hi_face[static_cast<std::size_t>(k)];
     if (a.begin[k] > r.begin[k]) {
       Box3i f = a;
       f.begin[k] = a.begin[k] - 1;
@@ -337,9 +350,9 @@ double new_value_bound(const FieldPlan& plan, const Grid<T>& field, const Box3i&
     for (int v = a.begin[k]; v < a.end[k]; ++v)
       worst = std::max(worst, std::min(lo_face + (v - a.begin[k] + 1) * plan.spacing[k], hi_face + (a.end[k] - v) * plan.spacing[k]));
     // max over p of min over axes = min over axes of each axis's max (the axes vary independently).
-    bound = std::min(bound, worst);
+    bounds.all = std::min(bounds.all, worst);
   }
-  return bound;
+  return bounds;
 }
 
 // A box holding every solid voxel of `box` (empty if it holds none), from the chunks alone: a
@@ -471,13 +484,20 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
             if (additions_only) {
               in = r;
             } else {
-              // Sites farther than every new value of r cannot be anyone's nearest.
-              Vec3i by = reach_;
-              const double m = detail::new_value_bound(plan, target, region, r);
-              if (std::isfinite(m))
-                for (int k = 0; k < 3; ++k)
-                  by[k] = std::min(by[k], static_cast<int>(std::floor(m / plan.spacing[k] + 1e-9)));  // m is a bound already
-              in = Box3i{r.begin - by, r.end + by}.intersect(*options_.domain);
+              // Sites farther than every new value of r cannot be anyone's nearest, nor sites
+              // beyond a face farther than its own bound allows (detail::NewValueBounds).
+              Vec3i below = reach_, above = reach_;
+              const detail::NewValueBounds m = detail::new_value_bound(plan, target, region, r);
+              auto voxels = [](double d, double spacing) { return static_cast<int>(std::floor(d / spacing + 1e-9)); };  // d is a bound already
+              for (int k = 0; k < 3; ++k) {
+                const double s = plan.spacing[static_cast<std::size_t>(k)];
+                if (std::isfinite(m.all)) below[k] = above[k] = std::min(reach_[k], voxels(m.all, s));
+                if (std::isfinite(m.lo_face[static_cast<std::size_t>(k)]))
+                  below[k] = std::min(below[k], 1 + voxels(m.lo_face[static_cast<std::size_t>(k)], s));
+                if (std::isfinite(m.hi_face[static_cast<std::size_t>(k)]))
+                  above[k] = std::min(above[k], 1 + voxels(m.hi_face[static_cast<std::size_t>(k)], s));
+              }
+              in = Box3i{r.begin - below, r.end + above}.intersect(*options_.domain);
               // Air is no site: the box needs to hold r and the solid voxels around it only (after
               // a carve in open air, often little more than r).
               in = detail::solid_bounds(world_->voxels, in).unite(r);
