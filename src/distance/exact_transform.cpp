@@ -111,14 +111,15 @@ using Plan = detail::FieldPlan;
 // nearest solid / air voxel seen so far, saturating at cap; returns through `c` the one each voxel
 // stores (for signed fields the distance that is not trivially zero). Shared by the whole-field
 // and the local passes.
-template <bool kSigned>
-inline void z_sweep_step(const std::uint8_t* __restrict w, std::uint32_t* __restrict ds, std::uint32_t* __restrict da,
-                         std::uint32_t* __restrict c, std::size_t n, std::uint32_t cap) {
+// G: the lane type (32 bits in general; 8 bits when cap fits, for four times the lanes per step).
+template <bool kSigned, class G = std::uint32_t>
+inline void z_sweep_step(const std::uint8_t* __restrict w, G* __restrict ds, G* __restrict da, G* __restrict c, std::size_t n,
+                         G cap) {
   for (std::size_t i = 0; i < n; ++i) {
     const bool solid = w[i] != 0;
-    ds[i] = solid ? 0u : std::min(ds[i] + 1u, cap);
+    ds[i] = solid ? G{0} : std::min(static_cast<G>(ds[i] + 1u), cap);
     if constexpr (kSigned) {
-      da[i] = solid ? std::min(da[i] + 1u, cap) : 0u;
+      da[i] = solid ? std::min(static_cast<G>(da[i] + 1u), cap) : G{0};
       c[i] = solid ? da[i] : ds[i];
     } else {
       c[i] = ds[i];
@@ -718,35 +719,41 @@ DistanceField run(const Grid<std::uint8_t>& occupancy, const DistanceOptions& op
 // passes over `in`'s x-y extent for those slices; encoding of `out`'s part. No chunk is
 // allocated: the workspace is a few dense arrays of `in`'s size.
 
-template <bool kSigned>
-void region_pass_z(const std::uint8_t* solid, Vec3i n, int z0, int z1, std::uint32_t cap,
-                   std::uint32_t* g, std::int16_t* dz) {
+// G: the type g is kept in (8 bits when cap < 256, see z_sweep_step); dz only with 32 bits.
+template <bool kSigned, class G>
+void region_pass_z(const std::uint8_t* solid, Vec3i n, int z0, int z1, G cap, G* g, std::int16_t* dz) {
   const std::size_t nx = static_cast<std::size_t>(n.x), plane = nx * static_cast<std::size_t>(n.y);
-  std::vector<std::uint32_t> col(static_cast<std::size_t>(n.z) * nx), ds(nx), da(nx);
-  std::vector<std::int32_t> ls(nx), la(nx);
+  thread_local std::vector<G> col_scratch, ds_scratch, da_scratch;  // kept: see compute_region_impl
+  std::vector<G>& col = col_scratch;
+  std::vector<G>& ds = ds_scratch;
+  std::vector<G>& da = da_scratch;
+  col.resize(static_cast<std::size_t>(n.z) * nx);
+  ds.resize(nx);
+  da.resize(nx);
+  std::vector<std::int32_t> ls(dz ? nx : 0), la(dz ? nx : 0);
   for (int y = 0; y < n.y; ++y) {
-    std::uint32_t* __restrict dsr = ds.data();
-    std::uint32_t* __restrict dar = da.data();
+    G* __restrict dsr = ds.data();
+    G* __restrict dar = da.data();
     std::fill(ds.begin(), ds.end(), cap);
     std::fill(da.begin(), da.end(), cap);
     for (int z = 0; z < n.z; ++z) {
-      z_sweep_step<kSigned>(solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx, dsr, dar,
-                            col.data() + static_cast<std::size_t>(z) * nx, nx, cap);
+      z_sweep_step<kSigned, G>(solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx, dsr, dar,
+                               col.data() + static_cast<std::size_t>(z) * nx, nx, cap);
     }
     std::fill(ds.begin(), ds.end(), cap);
     std::fill(da.begin(), da.end(), cap);
     for (int z = n.z - 1; z >= z0; --z) {
       const std::uint8_t* __restrict w = solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx;
-      const std::uint32_t* __restrict c = col.data() + static_cast<std::size_t>(z) * nx;
+      const G* __restrict c = col.data() + static_cast<std::size_t>(z) * nx;
       for (std::size_t i = 0; i < nx; ++i) {
         const bool s = w[i] != 0;
-        dsr[i] = s ? 0u : std::min(dsr[i] + 1u, cap);
-        if constexpr (kSigned) dar[i] = s ? std::min(dar[i] + 1u, cap) : 0u;
+        dsr[i] = s ? G{0} : std::min(static_cast<G>(dsr[i] + 1u), cap);
+        if constexpr (kSigned) dar[i] = s ? std::min(static_cast<G>(dar[i] + 1u), cap) : G{0};
       }
       if (z >= z1) continue;
-      std::uint32_t* __restrict out = g + static_cast<std::size_t>(z - z0) * plane + static_cast<std::size_t>(y) * nx;
+      G* __restrict out = g + static_cast<std::size_t>(z - z0) * plane + static_cast<std::size_t>(y) * nx;
       for (std::size_t i = 0; i < nx; ++i) {
-        const std::uint32_t back = (kSigned && w[i] != 0) ? dar[i] : dsr[i];
+        const G back = (kSigned && w[i] != 0) ? dar[i] : dsr[i];
         out[i] = std::min(c[i], back);
       }
     }
@@ -782,7 +789,7 @@ void region_pass_z(const std::uint8_t* solid, Vec3i n, int z0, int z1, std::uint
 // unit-spacing Euclidean fields without nearest sites whose clamp D is below kMaxReach + 1.
 template <class T>
 void region_slices_truncated(const Plan& p, const Encoder<T>& encoder, Vec3i n, const Box3i& out, int ox, int oy, int z0,
-                             std::uint32_t cap, const std::uint8_t* solid, const std::uint32_t* g, T* values) {
+                             std::uint8_t cap, const std::uint8_t* solid, const std::uint8_t* g, T* values) {
   using Conv = TruncatedMinConvolution;
   const Vec3i m = out.size();
   const std::size_t plane = static_cast<std::size_t>(n.x) * n.y;
@@ -795,11 +802,11 @@ void region_slices_truncated(const Plan& p, const Encoder<T>& encoder, Vec3i n, 
     const int passes = p.is_signed ? 2 : 1;
     for (int k = 0; k < passes; ++k) conv[k].prepare(n.x, n.y, ox, oy, m.x, m.y, reach, drop);
     for (std::size_t zi = zb; zi < ze; ++zi) {
-      const std::uint32_t* gs = g + zi * plane;
+      const std::uint8_t* gs = g + zi * plane;
       const std::uint8_t* ws = solid + (static_cast<std::size_t>(z0) + zi) * plane;
-      // g (voxels along z, `cap` or more for none) -> its square; g <= reach whenever below cap.
+      // g (voxels along z, `cap` for none) -> its square; g <= reach whenever below cap.
       for (int y = 0; y < n.y; ++y) {
-        const std::uint32_t* gr = gs + static_cast<std::size_t>(y) * n.x;
+        const std::uint8_t* gr = gs + static_cast<std::size_t>(y) * n.x;
         const std::uint8_t* wr = ws + static_cast<std::size_t>(y) * n.x;
         Conv::Cost* f0 = conv[0].f_row(y);
         if (p.is_signed) {
@@ -871,22 +878,32 @@ void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, con
   std::uint64_t cap = std::numeric_limits<std::uint32_t>::max() - 1;
   if (std::isfinite(p.clamp)) cap = std::min<std::uint64_t>(cap, static_cast<std::uint64_t>(std::floor(p.clamp / p.spacing[2]) + 1));
   const auto cap32 = static_cast<std::uint32_t>(cap);
+  const Encoder<T> encoder(p);
+  const double clamp_cost = p.metric == Metric::kEuclidean ? p.clamp * p.clamp : p.clamp;
+  const bool euclid = p.metric == Metric::kEuclidean;
+  // Small clamps (the usual case for editable worlds), unit spacing, no nearest sites: the 2-D
+  // passes as truncated min-convolutions on the window alone (truncated_min_convolution.h), and g
+  // in 8-bit lanes (cap <= kMaxReach + 1).
+  if (euclid && p.unit_spacing && !sites && std::isfinite(p.clamp) && p.clamp >= 1 &&
+      p.clamp < TruncatedMinConvolution::kMaxReach + 1) {
+    thread_local std::vector<std::uint8_t> g8_scratch;
+    std::vector<std::uint8_t>& g8 = g8_scratch;
+    g8.resize(static_cast<std::size_t>(m.z) * plane);
+    const auto cap8 = static_cast<std::uint8_t>(cap);
+    if (p.is_signed) {
+      region_pass_z<true>(solid.data(), n, z0, z1, cap8, g8.data(), nullptr);
+    } else {
+      region_pass_z<false>(solid.data(), n, z0, z1, cap8, g8.data(), nullptr);
+    }
+    region_slices_truncated(p, encoder, n, out, ox, oy, z0, cap8, solid.data(), g8.data(), values);
+    return;
+  }
   g.resize(static_cast<std::size_t>(m.z) * plane);
   dz.resize(sites ? g.size() : 0);
   if (p.is_signed) {
     region_pass_z<true>(solid.data(), n, z0, z1, cap32, g.data(), sites ? dz.data() : nullptr);
   } else {
     region_pass_z<false>(solid.data(), n, z0, z1, cap32, g.data(), sites ? dz.data() : nullptr);
-  }
-  const Encoder<T> encoder(p);
-  const double clamp_cost = p.metric == Metric::kEuclidean ? p.clamp * p.clamp : p.clamp;
-  const bool euclid = p.metric == Metric::kEuclidean;
-  // Small clamps (the usual case for editable worlds), unit spacing, no nearest sites: the 2-D
-  // passes as truncated min-convolutions on the window alone (truncated_min_convolution.h).
-  if (euclid && p.unit_spacing && !sites && std::isfinite(p.clamp) && p.clamp >= 1 &&
-      p.clamp < TruncatedMinConvolution::kMaxReach + 1) {
-    region_slices_truncated(p, encoder, n, out, ox, oy, z0, cap32, solid.data(), g.data(), values);
-    return;
   }
   dispatch_solver(p, n, [&](auto tag, const auto& solve, auto inf) {
     using V = decltype(tag);
