@@ -106,6 +106,35 @@ TEST(Edit, EveryBrushAndOperationMatchesItsDefinition) {
   EXPECT_EQ(c.voxels.chunk_count(), 0u);
 }
 
+// Spheres are applied a row run at a time (their ends settled with the test): the runs must hold
+// exactly the voxels brush_contains accepts, including where voxels lie on the sphere itself
+// (integer and half-integer centres with integer radii, where rounding decides), for tiny radii and
+// for centres outside the world.
+TEST(Edit, SphereRunsMatchTheVoxelTest) {
+  const Box3i bounds{{-13, -9, -11}, {27, 29, 25}};
+  World w(8, bounds);
+  std::mt19937 rng(77);
+  auto uni = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
+  for (int i = 0; i < 1500; ++i) {
+    Vec3d c{uni(-20, 35), uni(-15, 35), uni(-18, 32)};
+    double radius = uni(0, 18);
+    switch (i % 4) {  // centres on voxels or half-way between them, radii whole or their squares
+      case 0: c = {std::round(c[0]), std::round(c[1]), std::round(c[2])}; radius = std::round(radius); break;
+      case 1: c = {std::round(c[0]) + 0.5, std::round(c[1]), std::round(c[2]) + 0.5}; radius = std::round(radius); break;
+      case 2: radius = std::sqrt(std::round(radius * radius)); break;
+      default: break;
+    }
+    const SphereBrush sphere{c, radius};
+    std::int64_t expected = 0;
+    for (int z = bounds.begin.z; z < bounds.end.z; ++z)
+      for (int y = bounds.begin.y; y < bounds.end.y; ++y)
+        for (int x = bounds.begin.x; x < bounds.end.x; ++x) expected += brush_contains(sphere, Vec3i{x, y, z}) ? 1 : 0;
+    ASSERT_EQ(apply_edit(w, {EditOp::kPlace, sphere, 1}).voxels_changed, expected) << "sphere " << i;
+    ASSERT_EQ(w.solid_count(), expected) << "sphere " << i;
+    ASSERT_EQ(apply_edit(w, {EditOp::kCarve, sphere, 1}).voxels_changed, expected) << "sphere " << i;
+  }
+}
+
 TEST(Edit, ShapesByHand) {
   World w(8, Box3i{{-20, -20, -20}, {20, 20, 20}});
   EXPECT_EQ(apply_edit(w, {EditOp::kPlace, SphereBrush{{0, 0, 0}, 1}, 2}).voxels_changed, 7);  // centre + 6

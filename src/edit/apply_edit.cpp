@@ -124,31 +124,54 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
         bool removed = false;                                       // any solid -> air
         bool added = false;                                         // any air -> solid
         g.edit_chunk(coord, [&](Grid<std::uint8_t>::ChunkEdit& voxels) {
+          // One voxel the brush covers.
+          auto visit = [&](int x, int y, int z) {
+            const Vec3i p{x, y, z};
+            const std::int64_t i = (std::int64_t{z - cb.begin.z} * edge + (y - cb.begin.y)) * edge + (x - cb.begin.x);
+            const std::uint8_t before = voxels.get(i);
+            const std::uint8_t paint = stamp ? stamp->model->voxels.get(p - stamp->offset) : e.material;
+            std::uint8_t next = before;
+            switch (e.op) {
+              case EditOp::kPlace: next = paint; break;
+              case EditOp::kCarve: next = 0; break;
+              case EditOp::kPaint: next = before != 0 ? paint : before; break;
+            }
+            if (!voxels.set(i, next)) return;
+            ++result.voxels_changed;
+            clo = {std::min(clo.x, x), std::min(clo.y, y), std::min(clo.z, z)};
+            chi = {std::max(chi.x, x), std::max(chi.y, y), std::max(chi.z, z)};
+            if ((next != 0) != (before != 0)) {
+              removed = removed || next == 0;
+              added = added || next != 0;
+              olo = {std::min(olo.x, x), std::min(olo.y, y), std::min(olo.z, z)};
+              ohi = {std::max(ohi.x, x), std::max(ohi.y, y), std::max(ohi.z, z)};
+            }
+          };
           // The brush is resolved once per chunk, not once per voxel.
           std::visit([&](const auto& shape) {
-          for (int z = part.begin.z; z < part.end.z; ++z)
-            for (int y = part.begin.y; y < part.end.y; ++y)
-              for (int x = part.begin.x; x < part.end.x; ++x) {
-                const Vec3i p{x, y, z};
-                if (!brush_contains(shape, p)) continue;
-                const std::int64_t i = (std::int64_t{z - cb.begin.z} * edge + (y - cb.begin.y)) * edge + (x - cb.begin.x);
-                const std::uint8_t before = voxels.get(i);
-                const std::uint8_t paint = stamp ? stamp->model->voxels.get(p - stamp->offset) : e.material;
-                std::uint8_t next = before;
-                switch (e.op) {
-                  case EditOp::kPlace: next = paint; break;
-                  case EditOp::kCarve: next = 0; break;
-                  case EditOp::kPaint: next = before != 0 ? paint : before; break;
-                }
-                if (!voxels.set(i, next)) continue;
-                ++result.voxels_changed;
-                clo = {std::min(clo.x, x), std::min(clo.y, y), std::min(clo.z, z)};
-                chi = {std::max(chi.x, x), std::max(chi.y, y), std::max(chi.z, z)};
-                if ((next != 0) != (before != 0)) {
-                  removed = removed || next == 0;
-                  added = added || next != 0;
-                  olo = {std::min(olo.x, x), std::min(olo.y, y), std::min(olo.z, z)};
-                  ohi = {std::max(ohi.x, x), std::max(ohi.y, y), std::max(ohi.z, z)};
+            using Shape = std::decay_t<decltype(shape)>;
+            for (int z = part.begin.z; z < part.end.z; ++z)
+              for (int y = part.begin.y; y < part.end.y; ++y) {
+                if constexpr (std::is_same_v<Shape, SphereBrush>) {
+                  // A sphere covers one run of each row: its test grows with |x - centre.x| alone
+                  // (rounding keeps that monotone), so the run holds the row's voxel nearest the
+                  // centre, m, or the row holds none. The run's ends are estimated, then settled
+                  // with the test itself: exactly the voxels the test accepts.
+                  const double x0 = part.begin.x, x1 = part.end.x - 1;
+                  const int m = static_cast<int>(std::clamp(std::round(shape.center[0]), x0, x1));
+                  if (!brush_contains(shape, {m, y, z})) continue;
+                  const double dy = y - shape.center[1], dz = z - shape.center[2];
+                  const double half = std::sqrt(std::max(0.0, shape.radius * shape.radius - dy * dy - dz * dz));
+                  int a = static_cast<int>(std::clamp(std::ceil(shape.center[0] - half), x0, static_cast<double>(m)));
+                  int b = static_cast<int>(std::clamp(std::floor(shape.center[0] + half), static_cast<double>(m), x1));
+                  while (a > part.begin.x && brush_contains(shape, {a - 1, y, z})) --a;
+                  while (!brush_contains(shape, {a, y, z})) ++a;  // stops at m at the latest
+                  while (b < part.end.x - 1 && brush_contains(shape, {b + 1, y, z})) ++b;
+                  while (!brush_contains(shape, {b, y, z})) --b;
+                  for (int x = a; x <= b; ++x) visit(x, y, z);
+                } else {
+                  for (int x = part.begin.x; x < part.end.x; ++x)
+                    if (brush_contains(shape, {x, y, z})) visit(x, y, z);
                 }
               }
           }, e.brush);
