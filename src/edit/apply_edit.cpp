@@ -147,6 +147,39 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
               ohi = {std::max(ohi.x, x), std::max(ohi.y, y), std::max(ohi.z, z)};
             }
           };
+          // A run of covered voxels [a, b] of row (y, z). Placing and carving write one value, so the
+          // run's bookkeeping (changed boxes, what changed) is settled once per run.
+          auto visit_run = [&](int a, int b, int y, int z) {
+            if (stamp || e.op == EditOp::kPaint) {
+              for (int x = a; x <= b; ++x) visit(x, y, z);
+              return;
+            }
+            const std::uint8_t next = e.op == EditOp::kPlace ? e.material : std::uint8_t{0};
+            const std::int64_t row = (std::int64_t{z - cb.begin.z} * edge + (y - cb.begin.y)) * edge - cb.begin.x;
+            int first = INT32_MAX, last = INT32_MIN, first_flip = INT32_MAX, last_flip = INT32_MIN;
+            std::int64_t changed = 0;
+            for (int x = a; x <= b; ++x) {
+              const std::uint8_t before = voxels.get(row + x);
+              if (!voxels.set(row + x, next)) continue;
+              ++changed;
+              first = std::min(first, x);
+              last = x;
+              if ((before != 0) != (next != 0)) {
+                first_flip = std::min(first_flip, x);
+                last_flip = x;
+              }
+            }
+            if (changed == 0) return;
+            result.voxels_changed += changed;
+            clo = {std::min(clo.x, first), std::min(clo.y, y), std::min(clo.z, z)};
+            chi = {std::max(chi.x, last), std::max(chi.y, y), std::max(chi.z, z)};
+            if (first_flip <= last_flip) {
+              removed = removed || next == 0;
+              added = added || next != 0;
+              olo = {std::min(olo.x, first_flip), std::min(olo.y, y), std::min(olo.z, z)};
+              ohi = {std::max(ohi.x, last_flip), std::max(ohi.y, y), std::max(ohi.z, z)};
+            }
+          };
           // The brush is resolved once per chunk, not once per voxel.
           std::visit([&](const auto& shape) {
             using Shape = std::decay_t<decltype(shape)>;
@@ -168,7 +201,7 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
                   while (!brush_contains(shape, {a, y, z})) ++a;  // stops at m at the latest
                   while (b < part.end.x - 1 && brush_contains(shape, {b + 1, y, z})) ++b;
                   while (!brush_contains(shape, {b, y, z})) --b;
-                  for (int x = a; x <= b; ++x) visit(x, y, z);
+                  visit_run(a, b, y, z);
                 } else {
                   for (int x = part.begin.x; x < part.end.x; ++x)
                     if (brush_contains(shape, {x, y, z})) visit(x, y, z);
