@@ -202,6 +202,9 @@ EditResult apply_edit(World& world, const Edit& e, DirtyRegions* dirty) {
                   while (b < part.end.x - 1 && brush_contains(shape, {b + 1, y, z})) ++b;
                   while (!brush_contains(shape, {b, y, z})) --b;
                   visit_run(a, b, y, z);
+                } else if constexpr (std::is_same_v<Shape, BoxBrush>) {
+                  // The part of the chunk is already clipped to the box: every row is one run.
+                  visit_run(part.begin.x, part.end.x - 1, y, z);
                 } else {
                   for (int x = part.begin.x; x < part.end.x; ++x)
                     if (brush_contains(shape, {x, y, z})) visit(x, y, z);

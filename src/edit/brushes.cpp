@@ -1,6 +1,7 @@
 // voxfield — brush shapes: which voxels a brush covers, and the box it may touch.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "voxfield/edit.h"
 
@@ -71,7 +72,20 @@ struct Contains {
   }
   bool operator()(const BoxBrush& b) const { return Box3i::from_inclusive(b.min, b.max).contains(p); }
   bool operator()(const RotatedBoxBrush& b) const {
-    const Mat3 r = rotation(b.rotation_deg);
+    // Applying a brush tests thousands of voxels with one rotation: its matrix is kept per thread
+    // for the last angles seen, compared bit for bit (the same function of the same bits).
+    struct Cached {
+      bool valid = false;
+      Vec3d deg;
+      Mat3 r;
+    };
+    thread_local Cached cached;
+    if (!cached.valid || std::memcmp(&cached.deg, &b.rotation_deg, sizeof(Vec3d)) != 0) {
+      cached.r = rotation(b.rotation_deg);
+      cached.deg = b.rotation_deg;
+      cached.valid = true;
+    }
+    const Mat3& r = cached.r;
     const Vec3d d{p.x - b.center[0], p.y - b.center[1], p.z - b.center[2]};
     for (int j = 0; j < 3; ++j) {
       // Coordinate along the box's axis j: column j of R dotted with d.
