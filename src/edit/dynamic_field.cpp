@@ -259,12 +259,13 @@ Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
             hi = std::max(hi, x1 - 1);
             return;
           }
+          const float* g = gx.data() - r.begin.x;  // g[x]: x's gap cost along x
           const int nearest = std::clamp(changed.begin.x, x0, x1 - 1);  // the run's voxel nearest C
           const int nearest2 = std::clamp(changed.end.x - 1, x0, x1 - 1);
-          if (gap.combine(std::min(gap.axis(0, nearest), gap.axis(0, nearest2)), rest) > bound) return;
+          if (gap.combine(std::min(g[nearest], g[nearest2]), rest) > bound) return;
           int a = x0, b = x1 - 1;
-          while (a <= b && gap.combine(gap.axis(0, a), rest) > bound) ++a;
-          while (b >= a && gap.combine(gap.axis(0, b), rest) > bound) --b;
+          while (a <= b && gap.combine(g[a], rest) > bound) ++a;
+          while (b >= a && gap.combine(g[b], rest) > bound) --b;
           if (a <= b) {
             lo = std::min(lo, a);
             hi = std::max(hi, b);
