@@ -2,7 +2,8 @@
 // of sphere edits (as `voxfield bench edits`), applied to voxfield's DynamicDistanceField and to
 // dynamicEDT3D (Lau, Sprunk & Burgard 2013; Debian libdynamicedt3d-dev) in one run, with the same
 // Euclidean clamp. Per-edit latency (cell changes + update) is reported separately for
-// placements and deletions, as medians and p99, with voxfield / dynamicEDT3D ratios.
+// placements and deletions, as medians, p99 and means (the mean is the total time of the same
+// edits), with dynamicEDT3D / voxfield ratios.
 //
 // usage: edits_peer WORLD EDITS RADIUS_MIN RADIUS_MAX CLAMP THREADS OUT.json
 #include <dynamicEDT3D/dynamicEDT3D.h>
@@ -30,6 +31,12 @@ double pct(std::vector<double> v, double q) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
   return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
+}
+
+double mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0 : s / static_cast<double>(v.size());
 }
 
 }  // namespace
@@ -115,11 +122,12 @@ int main(int argc, char** argv) {
   std::printf("world %d^3 terrain, %d sphere edits r %d..%d, Euclidean clamp %d, %d threads for voxfield\n", n, edits, rmin,
               rmax, clamp, max_threads());
   std::printf("build: voxfield %.1f ms, dynamicEDT3D %.1f ms\n", vf_build, peer_build);
-  std::printf("%-10s %6s %12s %12s %14s %14s %10s %10s\n", "edits", "count", "voxfield p50", "voxfield p99",
-              "dynEDT3D p50", "dynEDT3D p99", "p50 ratio", "p99 ratio");
+  std::printf("%-10s %6s %12s %12s %13s %14s %14s %14s %10s %10s %10s\n", "edits", "count", "voxfield p50", "voxfield p99",
+              "voxfield mean", "dynEDT3D p50", "dynEDT3D p99", "dynEDT3D mean", "p50 ratio", "p99 ratio", "mean ratio");
   auto row = [&](const char* what, const std::vector<double>& v, const std::vector<double>& d) {
-    std::printf("%-10s %6zu %12.3f %12.3f %14.3f %14.3f %9.2fx %9.2fx\n", what, v.size(), pct(v, 0.5), pct(v, 0.99),
-                pct(d, 0.5), pct(d, 0.99), pct(d, 0.5) / std::max(1e-9, pct(v, 0.5)), pct(d, 0.99) / std::max(1e-9, pct(v, 0.99)));
+    std::printf("%-10s %6zu %12.3f %12.3f %13.3f %14.3f %14.3f %14.3f %9.2fx %9.2fx %9.2fx\n", what, v.size(), pct(v, 0.5),
+                pct(v, 0.99), mean(v), pct(d, 0.5), pct(d, 0.99), mean(d), pct(d, 0.5) / std::max(1e-9, pct(v, 0.5)),
+                pct(d, 0.99) / std::max(1e-9, pct(v, 0.99)), mean(d) / std::max(1e-9, mean(v)));
   };
   row("place", vf_place, peer_place);
   row("carve", vf_carve, peer_carve);
@@ -127,6 +135,8 @@ int main(int argc, char** argv) {
                          << ", \"radius_max\": " << rmax << ", \"clamp\": " << clamp << ", \"threads\": " << max_threads()
                          << ", \"voxfield_place_p50\": " << pct(vf_place, 0.5) << ", \"voxfield_place_p99\": " << pct(vf_place, 0.99)
                          << ", \"voxfield_carve_p50\": " << pct(vf_carve, 0.5) << ", \"voxfield_carve_p99\": " << pct(vf_carve, 0.99)
+                         << ", \"voxfield_place_mean\": " << mean(vf_place) << ", \"voxfield_carve_mean\": " << mean(vf_carve)
+                         << ", \"dynamicedt3d_place_mean\": " << mean(peer_place) << ", \"dynamicedt3d_carve_mean\": " << mean(peer_carve)
                          << ", \"dynamicedt3d_place_p50\": " << pct(peer_place, 0.5) << ", \"dynamicedt3d_place_p99\": " << pct(peer_place, 0.99)
                          << ", \"dynamicedt3d_carve_p50\": " << pct(peer_carve, 0.5) << ", \"dynamicedt3d_carve_p99\": " << pct(peer_carve, 0.99)
                          << "}\n";
