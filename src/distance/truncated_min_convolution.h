@@ -1,5 +1,6 @@
 // voxfield — the 2-D passes of a clamped Euclidean transform on a window of one slice, by
-// truncated min-convolution (internal; used by local recomputation, exact_transform.cpp).
+// truncated min-convolution (internal; used by exact_transform.cpp for local recomputation, and
+// for whole fields with the whole slice as the window).
 //
 // After the z pass, a slice holds f(x, y) = dz², the squared distance to the nearest site in each
 // column. The squared Euclidean distance transform then is two min-convolutions with the parabola
@@ -12,7 +13,8 @@
 // cost above floor(D²) is "no site within the clamp" anyway — so the truncated sums give exactly
 // the envelope's clamped results (integer costs, one minimum: no ties to break). For the small
 // clamps of editable worlds (D of 16 or 32) the truncated form wins by a wide margin on the small
-// boxes an edit recomputes:
+// boxes an edit recomputes, and stays ahead on whole slices up to kMaxReach (measurements in
+// docs/benchmarks.md):
 //  - only the window's columns (pass along x) and rows (pass along y) are computed, where the
 //    envelope must scan and fill whole lines;
 //  - costs fit 16-bit lanes (D <= kMaxReach), so each step is an add and a min over 8 voxels at
