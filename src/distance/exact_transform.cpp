@@ -581,6 +581,43 @@ bool truncated_passes(const Plan& p, bool sites) {
          p.clamp < TruncatedMinConvolution::kMaxReach + 1;
 }
 
+// One row of a slice into TruncatedMinConvolution's inputs: g (voxels along z, `cap` or more for
+// none) becomes its square; signed fields split it into the distance to solid (f0, for air
+// voxels) and to air (f1, for solid ones) and note which voxels are solid in `solid`.
+template <class G>
+void gather_truncated_row(const G* g, const std::uint8_t* world, int count, std::uint32_t cap, bool is_signed,
+                          TruncatedMinConvolution::Cost* f0, TruncatedMinConvolution::Cost* f1, std::uint8_t* solid) {
+  using Cost = TruncatedMinConvolution::Cost;
+  if (!is_signed) {
+    for (int i = 0; i < count; ++i) f0[i] = g[i] < cap ? static_cast<Cost>(g[i] * g[i]) : TruncatedMinConvolution::kInf;
+    return;
+  }
+  for (int i = 0; i < count; ++i) {
+    const Cost c = g[i] < cap ? static_cast<Cost>(g[i] * g[i]) : TruncatedMinConvolution::kInf;
+    const bool s = world[i] != 0;
+    if (solid) solid[i] = s;
+    f1[i] = s ? c : Cost{0};  // distance to air
+    f0[i] = s ? Cost{0} : c;  // distance to solid
+  }
+}
+
+// Encodes `count` solved costs of row y from column x0 of `conv` (conv[1] for the solid voxels
+// of signed fields, `solid` giving them) into `out`.
+template <class T>
+void encode_truncated_row(const Encoder<T>& encoder, const TruncatedMinConvolution* conv, int y, int x0, int count,
+                          const std::uint8_t* solid, T* out, TruncatedMinConvolution::Cost drop) {
+  using Conv = TruncatedMinConvolution;
+  if (encoder.row_path) {
+    encoder.encode_row(conv[0].out_row(y) + x0, out, count, Conv::kInf, drop);
+    return;
+  }
+  for (int i = 0; i < count; ++i) {
+    const bool inside = encoder.p.is_signed && solid[i];
+    const Conv::Cost cost = conv[inside ? 1 : 0].out_row(y)[x0 + i];
+    out[i] = encoder.encode(static_cast<double>(cost), cost < Conv::kInf, inside);
+  }
+}
+
 // Passes B and C and encoding of a whole field through TruncatedMinConvolution: pass_slices'
 // work, slice by slice, with the window the whole slice.
 template <class T, class U>
@@ -600,25 +637,12 @@ void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<
     for (int k = 0; k < passes; ++k) conv[k].prepare(X, Y, 0, 0, X, Y, reach, drop);
     for (std::size_t zi = zb; zi < ze; ++zi) {
       const int z = p.domain.begin.z + static_cast<int>(zi);
-      // Gather: g (voxels along z, `cap` or more for none) -> its square.
       for (int y = 0; y < Y; ++y) {
         for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
-          const U* gs = g.row(cx, by + y, z) + lx;
-          Conv::Cost* f0 = conv[0].f_row(y) + xo;
-          if (p.is_signed) {
-            const std::uint8_t* ws = world.row(cx, by + y, z) + lx;
-            Conv::Cost* f1 = conv[1].f_row(y) + xo;
-            std::uint8_t* so = solid.data() + static_cast<std::size_t>(y) * X + xo;
-            for (int i = 0; i < count; ++i) {
-              const Conv::Cost c = gs[i] < cap ? static_cast<Conv::Cost>(gs[i] * gs[i]) : Conv::kInf;
-              const bool s = ws[i] != 0;
-              so[i] = s;
-              f1[i] = s ? c : Conv::Cost{0};  // distance to air
-              f0[i] = s ? Conv::Cost{0} : c;  // distance to solid
-            }
-          } else {
-            for (int i = 0; i < count; ++i) f0[i] = gs[i] < cap ? static_cast<Conv::Cost>(gs[i] * gs[i]) : Conv::kInf;
-          }
+          const std::size_t o = static_cast<std::size_t>(y) * X + xo;
+          gather_truncated_row(g.row(cx, by + y, z) + lx, world.row(cx, by + y, z) + lx, count, cap, p.is_signed,
+                               conv[0].f_row(y) + xo, p.is_signed ? conv[1].f_row(y) + xo : nullptr,
+                               p.is_signed ? solid.data() + o : nullptr);
         });
       }
       for (int k = 0; k < passes; ++k) conv[k].solve();
@@ -626,16 +650,8 @@ void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<
       for (int y = 0; y < Y; ++y) {
         for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
           T* out = reinterpret_cast<T*>(g.row(cx, by + y, z)) + lx;  // T and U have the same size
-          if (encoder.row_path) {
-            encoder.encode_row(conv[0].out_row(y) + xo, out, count, Conv::kInf, drop);
-            return;
-          }
-          const std::uint8_t* so = solid.data() + static_cast<std::size_t>(y) * X + xo;
-          for (int i = 0; i < count; ++i) {
-            const bool inside = p.is_signed && so[i];
-            const Conv::Cost cost = conv[inside ? 1 : 0].out_row(y)[xo + i];
-            out[i] = encoder.encode(static_cast<double>(cost), cost < Conv::kInf, inside);
-          }
+          encode_truncated_row(encoder, conv, y, xo, count, p.is_signed ? solid.data() + static_cast<std::size_t>(y) * X + xo : nullptr,
+                               out, drop);
         });
       }
     }
@@ -880,36 +896,14 @@ void region_slices_truncated(const Plan& p, const Encoder<T>& encoder, Vec3i n, 
     for (std::size_t zi = zb; zi < ze; ++zi) {
       const std::uint8_t* gs = g + zi * plane;
       const std::uint8_t* ws = solid + (static_cast<std::size_t>(z0) + zi) * plane;
-      // g (voxels along z, `cap` for none) -> its square; g <= reach whenever below cap.
-      for (int y = 0; y < n.y; ++y) {
-        const std::uint8_t* gr = gs + static_cast<std::size_t>(y) * n.x;
-        const std::uint8_t* wr = ws + static_cast<std::size_t>(y) * n.x;
-        Conv::Cost* f0 = conv[0].f_row(y);
-        if (p.is_signed) {
-          Conv::Cost* f1 = conv[1].f_row(y);
-          for (int x = 0; x < n.x; ++x) {
-            const Conv::Cost c = gr[x] < cap ? static_cast<Conv::Cost>(gr[x] * gr[x]) : Conv::kInf;
-            f1[x] = wr[x] ? c : Conv::Cost{0};  // distance to air
-            f0[x] = wr[x] ? Conv::Cost{0} : c;  // distance to solid
-          }
-        } else {
-          for (int x = 0; x < n.x; ++x) f0[x] = gr[x] < cap ? static_cast<Conv::Cost>(gr[x] * gr[x]) : Conv::kInf;
-        }
-      }
+      // `ws` already says which voxels are solid: no copy of it is needed.
+      for (int y = 0; y < n.y; ++y)
+        gather_truncated_row(gs + static_cast<std::size_t>(y) * n.x, ws + static_cast<std::size_t>(y) * n.x, n.x, cap,
+                             p.is_signed, conv[0].f_row(y), p.is_signed ? conv[1].f_row(y) : nullptr, nullptr);
       for (int k = 0; k < passes; ++k) conv[k].solve();
-      for (int y = 0; y < m.y; ++y) {
-        T* row = values + (zi * static_cast<std::size_t>(m.y) + static_cast<std::size_t>(y)) * m.x;
-        if (encoder.row_path) {
-          encoder.encode_row(conv[0].out_row(y), row, m.x, Conv::kInf, drop);
-          continue;
-        }
-        const std::uint8_t* wr = ws + static_cast<std::size_t>(y + oy) * n.x + static_cast<std::size_t>(ox);
-        for (int x = 0; x < m.x; ++x) {
-          const bool inside = p.is_signed && wr[x];
-          const Conv::Cost cost = conv[inside ? 1 : 0].out_row(y)[x];
-          row[x] = encoder.encode(static_cast<double>(cost), cost < Conv::kInf, inside);
-        }
-      }
+      for (int y = 0; y < m.y; ++y)
+        encode_truncated_row(encoder, conv, y, 0, m.x, ws + static_cast<std::size_t>(y + oy) * n.x + static_cast<std::size_t>(ox),
+                             values + (zi * static_cast<std::size_t>(m.y) + static_cast<std::size_t>(y)) * m.x, drop);
     }
   });
 }
