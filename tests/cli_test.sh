@@ -244,9 +244,9 @@ assert j['width'] == 120 and j['height'] == 90 and j['ms'] > 0 and j['primary'][
 for view in distance error chunks; do
   check "render $view view" 0 "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/knight-$view.png" --width 64 --height 48 --view $view
 done
-check "render: bad camera" 1 "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/bad.png" --camera "eye=1,2:target=0,0,0"
+check "render: bad camera" 2 "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/bad.png" --camera "eye=1,2:target=0,0,0"
 expect_grep "render bad camera message" "$tmp/err" "three numbers"
-check "render: bad view" 1 "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/bad.png" --view xray
+check "render: bad view" 2 "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/bad.png" --view xray
 check "render: missing input" 1 "$V" render "$tmp/nothing.vox" -o "$tmp/bad.png"
 [ ! -e "$tmp/bad.png" ] && passes=$((passes+1)) || { echo "FAIL: render wrote despite errors"; fails=$((fails+1)); }
 
@@ -307,6 +307,58 @@ assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['width'] == 9
 import json; j = json.load(open('$tmp/gedits.json'))
 assert j['backend'] == 'vulkan' and j['verify_mismatches'] == 0, j"
 fi
+
+
+# Issue 14: a failed command writes no output, the same mistake gets the same answer.
+K="$C/ephtracy_chr_knight.vox"
+mkdir -p "$tmp/aon"; cd "$tmp/aon"
+printf '{"op":"place","shape":"sphere","center":[4,4,4],"radius":2,"material":3}\n' > edits.jsonl
+check "edit: bad --save-world type writes nothing" 1 "$V" edit "$K" -e edits.jsonl -o f.npy --save-world w.txt
+[ ! -e f.npy ] && passes=$((passes+1)) || { echo "FAIL: f.npy written by a failed edit"; fails=$((fails+1)); }
+check "edit: --stats into a missing directory writes nothing" 1 "$V" edit "$K" -e edits.jsonl -o f.npy --stats nodir/s.json
+expect_grep "missing directory named" "$tmp/err" "nodir"
+[ ! -e f.npy ] && passes=$((passes+1)) || { echo "FAIL: f.npy written before --stats failed"; fails=$((fails+1)); }
+check "field: --sites with an algorithm without sites writes nothing" 1 "$V" field "$K" -o o.npy --algorithm brute-chunked --sites s.npy
+expect_grep "sites refusal" "$tmp/err" "does not track nearest sites"
+[ ! -e o.npy ] && [ ! -e s.npy ] && passes=$((passes+1)) || { echo "FAIL: field wrote output before refusing --sites"; fails=$((fails+1)); }
+check "edit: a directory as the script" 1 "$V" edit "$K" -e "$tmp/aon" -o f.npy
+expect_grep "directory script refused" "$tmp/err" "not a regular file"
+printf '{"op":"place","shape":"sphere","center":[4,4,4],"radius":2}\n{"op":"paint","shape":"sphere","center":[1,1,1],"radius":1,"material":1.5}\n' > bad.jsonl
+check "edit: fractional material" 1 "$V" edit "$K" -e bad.jsonl -o f.npy
+expect_grep "edit error names the line" "$tmp/err" "bad.jsonl: at byte 60: line 2: "
+check "convert to .npy" 0 "$V" convert "$K" w.npy
+cp w.npy w0.npy
+check "field refuses to overwrite its input" 1 "$V" field w.npy -o w.npy
+expect_grep "input overwrite refused" "$tmp/err" "also an input"
+cmp -s w.npy w0.npy && passes=$((passes+1)) || { echo "FAIL: field damaged its input"; fails=$((fails+1)); }
+check "convert onto itself is safe" 0 "$V" convert w.npy w.npy
+cmp -s w.npy w0.npy && passes=$((passes+1)) || { echo "FAIL: convert onto itself changed the file"; fails=$((fails+1)); }
+ln -s w.npy link.npy
+check "convert writes through a symlink" 0 "$V" convert "$K" link.npy
+[ -L link.npy ] && passes=$((passes+1)) || { echo "FAIL: the symlink was replaced"; fails=$((fails+1)); }
+check "stats to stdout" 0 "$V" field "$K" -o o2.npy --stats -
+expect_grep "stats on stdout" "$tmp/out" '"algorithm": "exact"'
+mkfifo fifo.vox
+check "a FIFO as input does not block" 1 timeout 10 "$V" info fifo.vox
+expect_grep "fifo refused" "$tmp/err" "not a regular file"
+check "--memory-limit refuses with the file named" 1 "$V" --memory-limit 1M info "$C/ephtracy_monu3.vox"
+expect_grep "memory refusal names the file" "$tmp/err" "ephtracy_monu3.vox"
+expect_grep "memory refusal names the limit" "$tmp/err" "limit of 1.0 MiB"
+check "bad --memory-limit is a usage error" 2 "$V" --memory-limit 12Q info "$K"
+check "render --chunk 7 is a usage error" 2 "$V" render "$K" -o x.png --chunk 7
+check "field --chunk 7 is a usage error" 2 "$V" field "$K" -o x.npy --chunk 7
+check "render --fog nan is a usage error" 2 "$V" render "$K" -o x.png --fog nan
+check "render --metric bad is a usage error" 2 "$V" render "$K" -o x.png --metric taxicab
+check "bench --interval-ms nan is a usage error" 2 "$V" bench edits --interval-ms nan
+check "--threads 0 says what is allowed" 2 "$V" field "$K" -o x.npy --threads 0
+expect_grep "threads range" "$tmp/err" "1 to 1024"
+check "unknown command named" 2 "$V" frobnicate
+expect_grep "unknown command message" "$tmp/err" 'unknown command "frobnicate"'
+for cmd in info convert; do check "$cmd --help mentions .vfw" 0 "$V" "$cmd" --help; expect_grep "$cmd help vfw" "$tmp/out" ".vfw"; done
+check "edit --help mentions .vfw" 0 "$V" edit --help
+expect_grep "save-world help vfw" "$tmp/out" "save-world.*vfw"
+ls -a | grep -q vftmp && { echo "FAIL: temporaries left behind"; fails=$((fails+1)); } || passes=$((passes+1))
+cd - >/dev/null
 
 check "showcase (small)" 0 "$V" showcase --size 48 --out "$tmp/showcase"
 expect_grep "showcase report" "$tmp/showcase/report.md" "jfa-seed"

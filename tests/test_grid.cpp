@@ -231,13 +231,21 @@ TEST(Grid, BoundedGridRejectsWritesOutsideAndChangesNothing) {
   EXPECT_THROW(g.generate_chunks({{3, 0, 0}}, [](Vec3i, std::uint8_t*) {}), InvalidArgument);
 }
 
+// The corners of the supported coordinate range (box.h) are stored and read back; one step beyond
+// is refused, and reads beyond it (any int32) return the background without overflowing.
 TEST(Grid, ExtremeCoordinates) {
   Grid<std::uint8_t> g(128);
-  const Vec3i far_lo{INT32_MIN, INT32_MIN, INT32_MIN};
-  const Vec3i far_hi{INT32_MAX, INT32_MAX, INT32_MAX};
+  const Vec3i far_lo = Vec3i::splat(-kCoordLimit);
+  const Vec3i far_hi = Vec3i::splat(kCoordLimit - 1);
   g.set(far_lo, 1);
   g.set(far_hi, 2);
   EXPECT_EQ(g.get(far_lo), 1);
   EXPECT_EQ(g.get(far_hi), 2);
+  EXPECT_EQ(g.count_non_background(), 2);
+  EXPECT_EQ(g.content_bounds(), (Box3i{far_lo, Vec3i::splat(kCoordLimit)}));
+  EXPECT_THROW(g.set(Vec3i::splat(INT32_MIN), 3), InvalidArgument);
+  EXPECT_THROW(g.set(Vec3i::splat(kCoordLimit), 3), InvalidArgument);
+  EXPECT_EQ(g.get(Vec3i::splat(INT32_MIN)), 0);
+  EXPECT_EQ(g.get(Vec3i::splat(INT32_MAX)), 0);
   EXPECT_EQ(g.count_non_background(), 2);
 }

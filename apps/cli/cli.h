@@ -13,7 +13,9 @@
 #include <functional>
 #include <string>
 
+#include "outputs.h"
 #include "voxfield/vox.h"
+#include "voxfield/world_io.h"
 
 namespace voxfield::cli {
 
@@ -30,20 +32,15 @@ void add_edit(CLI::App& app, Action& action);
 void add_bench(CLI::App& app, Action& action);
 void add_render(CLI::App& app, Action& action);
 
-// A world read from any supported file, with what the file said about itself.
-struct LoadedWorld {
-  World world;
-  std::string format;       // "vox" or "npy"
-  Box3i extent;             // the volume the file declares (npy shape, model or scene box)
-  std::string description;  // one line: format, version, dtype...
-  std::optional<VoxFileInfo> vox;
-};
+// What the command is doing now ("loading world.vox"), so that a failure no library error
+// describes (out of memory) still names the file and the step.
+void set_activity(std::string what);
+const std::string& activity();
 
-// Loads a .vox or .npy file, chosen by extension. Throws voxfield::Error.
-LoadedWorld load_world(const std::filesystem::path& path, int chunk_edge);
-// Writes a world as .vox or .npy (chosen by extension); for .npy the box `extent` united with
-// the content is written. Throws voxfield::Error.
-void save_world(const World& world, const Box3i& extent, const std::filesystem::path& path);
+// CLI11 validators whose messages read well: finite numbers >= 0 (NaN and infinity refused), and
+// camera specifications (checked for syntax when the command line is parsed).
+CLI::Validator finite_non_negative();
+CLI::Validator camera_spec();
 
 // "N" or "X,Y,Z" as given to --size.
 Vec3i parse_size(const std::vector<int>& values);

@@ -8,6 +8,7 @@
 #include <iomanip>
 #include <iostream>
 #include <numeric>
+#include <sstream>
 #include <random>
 
 #include "cli.h"
@@ -58,6 +59,9 @@ int run_bench_edits(const BenchEditsSettings& s) {
   if (s.field.threads > 0) limit.emplace(s.field.threads);
   const int radius_max = s.radius_max > 0 ? s.radius_max : s.field.chunk_edge - 1;
   if (s.radius_min < 0 || radius_max < s.radius_min) throw InvalidArgument("need 0 <= --radius-min <= --radius-max");
+  Outputs outputs;
+  outputs.expect(s.csv, "--csv");
+  outputs.expect(s.json, "--json");
   SceneOptions so;
   so.size = Vec3i::splat(s.world);
   so.seed = s.seed;
@@ -78,12 +82,10 @@ int run_bench_edits(const BenchEditsSettings& s) {
   std::vector<double> latency_ms, update_ms;
   std::vector<std::int64_t> recomputed;
   std::int64_t mismatches = 0;
-  std::ofstream csv;
-  if (!s.csv.empty()) {
-    csv.open(s.csv);
-    if (!csv) throw IoError(s.csv + ": cannot create");
-    csv << "edit,time_s,radius,material,voxels_changed,voxels_recomputed,edit_ms,update_ms,latency_ms\n";
-  }
+  // Rows are kept in memory and written with the other outputs at the end (all or nothing).
+  std::ostringstream csv;
+  const bool want_csv = !s.csv.empty();
+  if (want_csv) csv << "edit,time_s,radius,material,voxels_changed,voxels_recomputed,edit_ms,update_ms,latency_ms\n";
   for (int i = 0; i < s.edits; ++i) {
     const Edit e = stream.next();
     const int radius = static_cast<int>(std::get<SphereBrush>(e.brush).radius);
@@ -99,7 +101,7 @@ int run_bench_edits(const BenchEditsSettings& s) {
     latency_ms.push_back(em + um);
     update_ms.push_back(um);
     recomputed.push_back(st.voxels_recomputed);
-    if (csv) {
+    if (want_csv) {
       csv << i << "," << i * s.interval_ms / 1000.0 << "," << radius << "," << material << "," << r.voxels_changed << ","
           << st.voxels_recomputed << "," << em << "," << um << "," << em + um << "\n";
     }
@@ -154,16 +156,17 @@ int run_bench_edits(const BenchEditsSettings& s) {
     auto summary_json = [](const Summary& x) {
       return nlohmann::json{{"mean", x.mean}, {"median", x.median}, {"std", x.stddev}, {"ci95", x.ci95}, {"p99", x.p99}, {"max", x.max}};
     };
-    write_json({{"scene", s.scene}, {"world", s.world}, {"chunk", s.field.chunk_edge}, {"edits", s.edits},
+    outputs.stage_json(s.json, {{"scene", s.scene}, {"world", s.world}, {"chunk", s.field.chunk_edge}, {"edits", s.edits},
                 {"seed", s.seed}, {"radius_min", s.radius_min}, {"radius_max", radius_max},
                 {"metric", metric_name(o.metric)}, {"signed", o.signed_distance}, {"max_distance", o.max_distance},
                 {"storage", storage_name(o.storage)}, {"threads", max_threads()}, {"generate_ms", generate_ms},
                 {"build_ms", build_ms}, {"latency_ms", summary_json(lat)}, {"update_ms", summary_json(upd)},
                 {"mean_voxels_recomputed", std::accumulate(recomputed.begin(), recomputed.end(), 0.0) / std::max(1, s.edits)},
                 {"world_bytes_per_voxel", world_bytes / voxels}, {"field_bytes_per_voxel", field_bytes / voxels},
-                {"within_interval", within}, {"backend", field.on_gpu() ? "vulkan" : "cpu"}, {"gpu", gpu_stats}, {"verify_mismatches", s.verify ? nlohmann::json(mismatches) : nlohmann::json(nullptr)}},
-               s.json);
+                {"within_interval", within}, {"backend", field.on_gpu() ? "vulkan" : "cpu"}, {"gpu", gpu_stats}, {"verify_mismatches", s.verify ? nlohmann::json(mismatches) : nlohmann::json(nullptr)}});
   }
+  if (want_csv) outputs.stage(s.csv, std::string_view(csv.str()));
+  outputs.commit();
   return s.verify && mismatches > 0 ? 1 : 0;
 }
 
@@ -178,7 +181,8 @@ void add_bench(CLI::App& app, Action& action) {
   cmd->add_option("--world", s->world, "world edge in voxels")->check(CLI::Range(8, 4096));
   cmd->add_option("--scene", s->scene, "terrain or spheres")->check(CLI::IsMember({"terrain", "spheres"}));
   cmd->add_option("--edits", s->edits, "number of edits")->check(CLI::Range(1, 10000000));
-  cmd->add_option("--interval-ms", s->interval_ms, "time between edits in the stream (reported against)");
+  cmd->add_option("--interval-ms", s->interval_ms, "time between edits in the stream (reported against)")
+      ->check(finite_non_negative());
   cmd->add_option("--seed", s->seed, "random seed");
   cmd->add_option("--radius-min", s->radius_min, "smallest sphere radius");
   cmd->add_option("--radius-max", s->radius_max, "largest sphere radius (default: chunk edge - 1)");

@@ -28,7 +28,12 @@ double median(std::vector<double> v) {
 int run_compare(const CompareSettings& s) {
   std::optional<ThreadLimit> limit;
   if (s.field.threads > 0) limit.emplace(s.field.threads);
-  const LoadedWorld in = load_world(s.in, s.field.chunk_edge);
+  Outputs outputs({s.in});
+  outputs.expect(s.json, "--json");
+  for (const auto& name : s.algorithms) (void)parse_algorithm(name);
+  set_activity("loading " + s.in);
+  const LoadedWorld in = load_world(s.in, {s.field.chunk_edge});
+  set_activity("comparing the algorithms on " + s.in);
   DistanceOptions o = s.field.options();
   o.domain = in.extent;
   if (o.domain->empty()) throw InvalidArgument(s.in + ": the input holds no volume");
@@ -97,8 +102,9 @@ int run_compare(const CompareSettings& s) {
                      {"threads", max_threads()},
                      {"focus", {focus.begin.x, focus.begin.y, focus.begin.z, focus.end.x, focus.end.y, focus.end.z}},
                      {"algorithms", rows}};
-    write_json(j, s.json);
+    outputs.stage_json(s.json, j);
   }
+  outputs.commit();
   return 0;
 }
 
@@ -107,7 +113,7 @@ int run_compare(const CompareSettings& s) {
 void add_compare(CLI::App& app, Action& action) {
   auto s = std::make_shared<CompareSettings>();
   CLI::App* cmd = app.add_subcommand("compare", "Run every algorithm on one input: time and error against the exact field");
-  cmd->add_option("IN", s->in, "input .vox or .npy")->required();
+  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
   s->field.add_to(cmd);
   cmd->add_option("--algorithms", s->algorithms, "comma-separated subset (default: all)")->delimiter(',');
   cmd->add_option("--runs", s->runs, "runs per algorithm; the median time is shown")->check(CLI::Range(1, 100));

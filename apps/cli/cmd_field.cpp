@@ -22,19 +22,30 @@ struct FieldSettings {
 int run_field(const FieldSettings& s) {
   std::optional<ThreadLimit> limit;
   if (s.field.threads > 0) limit.emplace(s.field.threads);
-  const LoadedWorld in = load_world(s.in, s.field.chunk_edge);
+  // Everything that can be wrong with the options is found before the world is loaded.
+  Outputs outputs({s.in});
+  outputs.expect(s.out, "-o");
+  outputs.expect(s.sites, "--sites");
+  outputs.expect(s.packed, "--packed");
+  outputs.expect(s.stats, "--stats");
   DistanceOptions o = s.field.options();
-  o.domain = in.extent;  // the output covers the input's volume, indexed like it
   o.nearest_sites = !s.sites.empty();
   AlgorithmOptions a;
   a.algorithm = parse_algorithm(s.algorithm);
   a.focus = s.field.focus_box();
   if (a.algorithm == Algorithm::kLod && !a.focus) throw InvalidArgument("--algorithm lod needs --focus");
+  if (o.nearest_sites && !algorithm_tracks_sites(a, o)) {
+    throw InvalidArgument("--sites: the " + s.algorithm + " algorithm does not track nearest sites");
+  }
+  set_activity("loading " + s.in);
+  const LoadedWorld in = load_world(s.in, {s.field.chunk_edge});
+  o.domain = in.extent;  // the output covers the input's volume, indexed like it
   if (o.domain->empty()) throw InvalidArgument(s.in + ": the input holds no volume");
   AlgorithmStats stats;
   const auto gpu_context = choose_backend(s.backend);
   std::vector<gpu::PassTiming> pass_timings;
   std::optional<DistanceField> computed;
+  set_activity("computing the field of " + s.in);
   if (gpu_context) {
     computed = gpu::compute_distance_field(*gpu_context, in.world, o, a, &stats, &pass_timings);
   } else {
@@ -42,14 +53,15 @@ int run_field(const FieldSettings& s) {
   }
   const DistanceField& f = *computed;
 
-  write_npy(field_volume(f, f.domain), s.out);
+  set_activity("writing " + s.out);
+  outputs.stage(s.out, encode_npy(field_volume(f, f.domain)));
   if (!s.sites.empty()) {
     if (!f.sites) throw InvalidArgument("--sites: the " + s.algorithm + " algorithm does not track nearest sites");
-    write_npy(sites_volume(*f.sites, f.domain), s.sites);
+    outputs.stage(s.sites, encode_npy(sites_volume(*f.sites, f.domain)));
   }
   if (!s.packed.empty()) {
     const auto packed = pack_dissertation_format(in.world, f, f.domain);
-    write_npy(make_npy(DType::kUInt32, f.domain.size(), packed.data()), s.packed);
+    outputs.stage(s.packed, encode_npy(make_npy(DType::kUInt32, f.domain.size(), packed.data())));
   }
   const Vec3i d = f.domain.size();
   nlohmann::json j = s.field.describe(o, d);
@@ -69,9 +81,8 @@ int run_field(const FieldSettings& s) {
     exact_o.nearest_sites = false;
     j["error"] = error_json(compare_fields(f, compute_distance_field(in.world, exact_o), in.world));
   }
-  if (!s.stats.empty()) {
-    write_json(j, s.stats);
-  }
+  if (!s.stats.empty()) outputs.stage_json(s.stats, j);
+  outputs.commit();
   std::cerr << "voxfield: " << s.algorithm << " " << metric_name(o.metric) << " field of " << d.x << "x" << d.y << "x"
             << d.z << " in " << stats.ms << " ms, wrote " << s.out << "\n";
   return 0;
@@ -82,7 +93,7 @@ int run_field(const FieldSettings& s) {
 void add_field(CLI::App& app, Action& action) {
   auto s = std::make_shared<FieldSettings>();
   CLI::App* cmd = app.add_subcommand("field", "Compute a distance field and write it as .npy (a[x, y, z], like the input)");
-  cmd->add_option("IN", s->in, "input .vox or .npy")->required();
+  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
   cmd->add_option("-o,--output", s->out, "output .npy")->required();
   s->field.add_to(cmd);
   cmd->add_option("--backend", s->backend, "cpu (default), vulkan (any Vulkan device, software included) or auto "
@@ -90,6 +101,7 @@ void add_field(CLI::App& app, Action& action) {
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
   cmd->add_option("--algorithm", s->algorithm,
                   "exact, brute, brute-chunked, fim, jfa-seed, jfa, jfa+1, jfa+2, hybrid, lod")
+      ->check(CLI::IsMember(algorithm_names()))
       ->capture_default_str();
   cmd->add_option("--sites", s->sites, "also write nearest-site offsets as int16 a[x, y, z, 3] to this .npy");
   cmd->add_option("--packed", s->packed, "also write the dissertation's packed uint32 voxels to this .npy");

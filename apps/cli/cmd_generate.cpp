@@ -30,9 +30,11 @@ void add_generate(CLI::App& app, Action& action) {
   cmd->add_option("--size", s->size, "N or X,Y,Z voxels")->delimiter(',')->expected(1, 3);
   cmd->add_option("--seed", s->seed, "random seed");
   cmd->add_option("--chunk", s->chunk_edge, "chunk edge (8..128)")->check(CLI::IsMember({8, 16, 32, 64, 128}));
-  cmd->add_option("-o,--output", s->out, "output .vox or .npy")->required();
+  cmd->add_option("-o,--output", s->out, "output .vox, .npy or .vfw")->required();
   cmd->callback([s, &action] {
     action = [s] {
+      Outputs outputs;
+      outputs.expect_world(s->out, "-o");
       SceneOptions o;
       o.size = parse_size(s->size);
       o.seed = s->seed;
@@ -40,7 +42,8 @@ void add_generate(CLI::App& app, Action& action) {
       const auto t0 = std::chrono::steady_clock::now();
       const World w = make_scene(s->scene, o);
       const double gen_ms = ms_since(t0);
-      save_world(w, Box3i::from_size(o.size), s->out);
+      outputs.stage(s->out, encode_world(w, Box3i::from_size(o.size), world_format_of(s->out)));
+      outputs.commit();
       std::cerr << "voxfield: " << s->scene << " " << to_string(o.size) << " generated in " << gen_ms
                 << " ms, " << w.solid_count() << " solid voxels, wrote " << s->out << "\n";
       return 0;

@@ -39,8 +39,15 @@ std::string bytes_text(std::size_t bytes) {
   return os.str();
 }
 
+int print_text(const InfoSettings& s, const LoadedWorld& in);
+
 int run_info(const InfoSettings& s) {
-  const LoadedWorld in = load_world(s.path, s.chunk_edge);
+  set_activity("loading " + s.path);
+  LoadOptions lo;
+  lo.chunk_edge = s.chunk_edge;
+  const LoadedWorld in = load_world(s.path, lo);
+  set_activity("describing " + s.path);
+  if (!s.json) return print_text(s, in);
   const Grid<std::uint8_t>& g = in.world.voxels;
   const Box3i content = g.content_bounds();
   const GridMemory mem = g.memory();
@@ -51,7 +58,7 @@ int run_info(const InfoSettings& s) {
 
   nlohmann::json j;
   j["file"] = s.path;
-  j["format"] = in.format;
+  j["format"] = world_format_name(in.format);
   j["description"] = in.description;
   j["dims"] = {in.extent.size().x, in.extent.size().y, in.extent.size().z};
   j["extent"] = box_json(in.extent);
@@ -75,18 +82,34 @@ int run_info(const InfoSettings& s) {
                         {"compressed", m.compressed}});
     }
     j["models"] = models;
-    nlohmann::json instances = nlohmann::json::array();
-    for (const auto& i : v.instances) {
-      instances.push_back({{"model", i.model}, {"name", i.name}, {"hidden", i.hidden},
-                           {"box", box_json(i.world_box)}});
-    }
-    j["instances"] = instances;
     j["vox"]["chunk_counts"] = v.chunk_counts;
   }
-  if (s.json) {
-    std::cout << j.dump(2) << "\n";
+  // Instances are streamed one by one: a scene graph may hold a million of them.
+  std::string head = j.dump(2);
+  if (!in.vox) {
+    std::cout << head << "\n";
     return 0;
   }
+  head.resize(head.size() - 2);  // drop "\n}"
+  std::cout << head << ",\n  \"instances\": [";
+  bool first = true;
+  for (const auto& i : in.vox->instances) {
+    const nlohmann::json one{{"model", i.model}, {"name", i.name}, {"hidden", i.hidden}, {"box", box_json(i.world_box)}};
+    std::cout << (first ? "\n    " : ",\n    ") << one.dump();
+    first = false;
+  }
+  std::cout << (first ? "]\n}\n" : "\n  ]\n}\n");
+  return 0;
+}
+
+int print_text(const InfoSettings& s, const LoadedWorld& in) {
+  const Grid<std::uint8_t>& g = in.world.voxels;
+  const Box3i content = g.content_bounds();
+  const GridMemory mem = g.memory();
+  const auto histogram = in.world.material_histogram();
+  int materials_used = 0;
+  for (int m = 1; m < 256; ++m) materials_used += histogram[m] > 0;
+  const std::int64_t solid = in.world.solid_count();
   std::cout << "file:          " << s.path << " (" << in.description << ")\n";
   std::cout << "dimensions:    " << dims_text(in.extent.size()) << "\n";
   std::cout << "bounding box:  " << (content.empty() ? std::string("(empty)") : to_string(content)) << "\n";
@@ -123,9 +146,9 @@ int run_info(const InfoSettings& s) {
 
 void add_info(CLI::App& app, Action& action) {
   auto s = std::make_shared<InfoSettings>();
-  CLI::App* cmd = app.add_subcommand("info", "Describe a .vox or .npy file: dimensions, bounding box, "
+  CLI::App* cmd = app.add_subcommand("info", "Describe a .vox, .npy or .vfw file: dimensions, bounding box, "
                                              "solid voxels, models, chunks, memory, palette");
-  cmd->add_option("FILE", s->path, "input .vox or .npy")->required();
+  cmd->add_option("FILE", s->path, "input .vox, .npy or .vfw")->required();
   cmd->add_flag("--json", s->json, "print JSON instead of text");
   cmd->add_option("--chunk", s->chunk_edge, "chunk edge used to load the world (8..128)")
       ->check(CLI::IsMember({8, 16, 32, 64, 128}));

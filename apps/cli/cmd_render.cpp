@@ -25,7 +25,12 @@ struct RenderSettings {
 int run_render(const RenderSettings& s) {
   std::optional<ThreadLimit> limit;
   if (s.threads > 0) limit.emplace(s.threads);
-  const LoadedWorld in = load_world(s.in, s.chunk_edge);
+  Outputs outputs({s.in});
+  outputs.expect(s.out, "-o");
+  outputs.expect(s.stats, "--stats");
+  set_activity("loading " + s.in);
+  const LoadedWorld in = load_world(s.in, {s.chunk_edge});
+  set_activity("rendering " + s.in);
   if (in.extent.empty()) throw InvalidArgument(s.in + ": the input holds no volume");
 
   RenderSceneOptions so;
@@ -60,7 +65,7 @@ int run_render(const RenderSettings& s) {
   }
   std::sort(times.begin(), times.end());
   st.ms = times[times.size() / 2];
-  write_png(image, s.out);
+  outputs.stage(s.out, encode_png(image));
   std::cout << "voxfield render: " << s.out << " (" << s.width << "x" << s.height << ", " << s.view << " view), "
             << st.ms << " ms, " << st.rays_per_second() / 1e6 << " M primary rays/s, fields " << scene.field_ms()
             << " ms\n";
@@ -97,8 +102,9 @@ int run_render(const RenderSettings& s) {
       j["rays_through_geometry"] = st.rays_through_geometry;
       j["max_error"] = st.max_error;
     }
-    write_json(j, s.stats);
+    outputs.stage_json(s.stats, j);
   }
+  outputs.commit();
   return 0;
 }
 
@@ -112,19 +118,24 @@ void add_render(CLI::App& app, Action& action) {
   cmd->add_option("--width", s->width, "image width in pixels")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", s->height, "image height in pixels")->check(CLI::Range(1, 16384));
   cmd->add_option("--camera", s->camera,
-                  "auto | top | eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height] (voxel units, z up)");
-  cmd->add_option("--view", s->view, "shaded | distance | error | chunks");
-  cmd->add_option("--algorithm", s->algorithm, "error view: the approximation shown against the exact field");
-  cmd->add_option("--metric", s->metric, "field rays skip by: manhattan (default), chebyshev, euclidean");
+                  "auto | top | eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height] (voxel units, z up)")
+      ->check(camera_spec());
+  cmd->add_option("--view", s->view, "shaded | distance | error | chunks")
+      ->check(CLI::IsMember({"shaded", "distance", "error", "chunks"}));
+  cmd->add_option("--algorithm", s->algorithm, "error view: the approximation shown against the exact field")
+      ->check(CLI::IsMember(algorithm_names()));
+  cmd->add_option("--metric", s->metric, "field rays skip by: manhattan (default), chebyshev, euclidean")
+      ->check(CLI::IsMember({"manhattan", "chebyshev", "euclidean"}));
   cmd->add_option("--backend", s->backend, "cpu (default), vulkan or auto; the GPU draws the shaded and chunks views")
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
-  cmd->add_option("--skip", s->skip, "none (plain DDA), chunks, distance (default)");
+  cmd->add_option("--skip", s->skip, "none (plain DDA), chunks, distance (default)")
+      ->check(CLI::IsMember({"none", "chunks", "distance"}));
   cmd->add_option("--slice", s->slice, "distance view: z of the cut plane (default: the middle)");
   cmd->add_flag("--no-shadows", s->no_shadows, "no soft shadows");
   cmd->add_flag("--no-ao", s->no_ao, "no ambient occlusion");
-  cmd->add_option("--fog", s->fog, "fog density per voxel of travel (e.g. 0.002)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--chunk", s->chunk_edge, "chunk edge (8..128, power of two)");
-  cmd->add_option("--threads", s->threads, "threads (default: all cores)")->check(CLI::Range(1, 1024));
+  cmd->add_option("--fog", s->fog, "fog density per voxel of travel (e.g. 0.002)")->check(finite_non_negative());
+  cmd->add_option("--chunk", s->chunk_edge, "chunk edge: 8, 16, 32, 64 or 128")->check(CLI::IsMember({8, 16, 32, 64, 128}));
+  cmd->add_option("--threads", s->threads, "threads, 1..1024 (default: all cores)")->check(CLI::Range(1, 1024));
   cmd->add_option("--repeat", s->repeat, "render N times, report the median time")->check(CLI::Range(1, 1000));
   cmd->add_option("--stats", s->stats, "write timings and traversal counters as JSON");
   cmd->callback([s, &action] { action = [s] { return run_render(*s); }; });

@@ -3,6 +3,7 @@
 
 #include <sys/resource.h>
 
+#include "cli.h"
 #include "voxfield/parallel.h"
 
 #include <cstring>
@@ -15,16 +16,19 @@ void FieldArgs::add_to(CLI::App* cmd) {
       ->capture_default_str();
   cmd->add_flag("--signed", is_signed, "negative distances inside solids (to the nearest air voxel)");
   cmd->add_option("--max-distance", max_distance, "clamp D: values beyond D read D (0 = no clamp)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_non_negative());
   cmd->add_option("--storage", storage, "u8, u16 or f32 (integer Euclidean: fixed point, rounded down)")
       ->check(CLI::IsMember({"u8", "u16", "f32"}))
       ->capture_default_str();
-  cmd->add_option("--spacing", spacing, "voxel size sx,sy,sz (euclidean only)")->delimiter(',')->expected(3);
+  cmd->add_option("--spacing", spacing, "voxel size sx,sy,sz (euclidean only)")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(finite_non_negative());
   cmd->add_option("--focus", focus, "focus box x0,y0,z0,x1,y1,z1 for lod (min inclusive, max exclusive)")
       ->delimiter(',')
       ->expected(6);
-  cmd->add_option("--chunk", chunk_edge, "chunk edge 8..128")->check(CLI::IsMember({8, 16, 32, 64, 128}));
-  cmd->add_option("--threads", threads, "threads to use (default: all cores)")->check(CLI::PositiveNumber);
+  cmd->add_option("--chunk", chunk_edge, "chunk edge: 8, 16, 32, 64 or 128")->check(CLI::IsMember({8, 16, 32, 64, 128}));
+  cmd->add_option("--threads", threads, "threads to use, 1..1024 (default: all cores)")->check(CLI::Range(1, 1024));
 }
 
 DistanceOptions FieldArgs::options() const {
@@ -51,6 +55,23 @@ std::optional<Box3i> FieldArgs::focus_box() const {
   return b;
 }
 
+std::vector<std::string> algorithm_names() {
+  std::vector<std::string> out;
+  for (Algorithm a : all_algorithms()) out.push_back(algorithm_name(a));
+  return out;
+}
+
+bool algorithm_tracks_sites(const AlgorithmOptions& a, const DistanceOptions& o) {
+  World probe(8);
+  probe.voxels.set({1, 1, 1}, 1);
+  DistanceOptions po = o;
+  po.nearest_sites = true;
+  po.domain = Box3i::from_size({3, 3, 3});
+  AlgorithmOptions pa = a;
+  if (pa.focus) pa.focus = Box3i::from_size({3, 3, 3});
+  return compute_distance_field(probe, po, pa).sites.has_value();
+}
+
 std::size_t peak_rss_bytes() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
@@ -66,11 +87,6 @@ nlohmann::json error_json(const FieldError& e) {
           {"unsafe_voxels", e.too_large},
           {"percent_unsafe", e.percent_unsafe()},
           {"too_small_voxels", e.too_small}};
-}
-
-void write_json(const nlohmann::json& j, const std::string& path) {
-  const std::string text = j.dump(2) + "\n";
-  write_file_atomic(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
 }
 
 // The field's values over `box` as an .npy volume of the storage's dtype.

@@ -31,6 +31,12 @@ struct FieldArgs {
   std::optional<Box3i> focus_box() const;
 };
 
+// Every algorithm's name, for --algorithm's check.
+std::vector<std::string> algorithm_names();
+// Whether an algorithm gives nearest sites with these options (asked of the algorithm itself, on
+// a 3^3 world: no table to fall out of date).
+bool algorithm_tracks_sites(const AlgorithmOptions& a, const DistanceOptions& o);
+
 // Resident-set high-water mark of this process, in bytes.
 std::size_t peak_rss_bytes();
 
@@ -41,7 +47,5 @@ NpyVolume field_volume(const DistanceField& f, const Box3i& box);
 // Nearest-site offsets as int16 a[x, y, z, 3]; -32768 where there is none.
 NpyVolume sites_volume(const Grid<SiteOffset>& g, const Box3i& box);
 
-// Writes `j` (indented) to `path` atomically.
-void write_json(const nlohmann::json& j, const std::string& path);
 
 }  // namespace voxfield::cli

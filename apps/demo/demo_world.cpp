@@ -1,7 +1,7 @@
 // voxfield-demo — the world being painted.
 #include "demo_world.h"
 
-#include "../cli/cli.h"
+#include "voxfield/world_io.h"
 #include "voxfield/error.h"
 #include "voxfield/scene.h"
 
@@ -38,7 +38,9 @@ DemoWorld::DemoWorld(const WorldSettings& settings)
 DemoWorld::DemoWorld(const WorldSettings& settings, const std::filesystem::path& file)
     : settings_(settings), dirty_(settings.chunk_edge, DirtyRegions::Track::kAnyChange) {
   check_settings(settings);
-  cli::LoadedWorld in = cli::load_world(file, settings.chunk_edge);
+  LoadOptions lo;
+  lo.chunk_edge = settings.chunk_edge;
+  LoadedWorld in = load_world(file, lo);
   Box3i extent = in.extent.unite(in.world.voxels.content_bounds());
   if (extent.empty()) throw InvalidArgument(file.string() + ": the world holds no voxels");
   // Room to build on top and around: a quarter of the largest side.
@@ -48,10 +50,7 @@ DemoWorld::DemoWorld(const WorldSettings& settings, const std::filesystem::path&
     throw InvalidArgument(file.string() + ": the world's box " + to_string(extent) + " is too large for the demo");
   world_ = std::make_unique<World>(settings.chunk_edge, extent);
   world_->palette = in.world.palette;
-  const Box3i content = in.world.voxels.content_bounds();
-  std::vector<std::uint8_t> dense(static_cast<std::size_t>(content.volume()));
-  in.world.voxels.copy_to_dense(content, dense.data());
-  world_->voxels.copy_from_dense(content, dense.data());
+  world_->voxels = in.world.voxels.rechunked(settings.chunk_edge, extent);
   origin_ = file.filename().string();
   make_scene();
 }
@@ -82,7 +81,7 @@ void DemoWorld::set_field(Metric metric, double clamp) {
 }
 
 void DemoWorld::save(const std::filesystem::path& path) const {
-  cli::save_world(*world_, *world_->voxels.bounds(), path);
+  save_world(*world_, *world_->voxels.bounds(), path);
 }
 
 }  // namespace voxfield::demo

@@ -2,8 +2,14 @@
 //
 // Coordinates are signed 32-bit voxel indices. A Box3i is half-open: it holds the voxels p with
 // begin <= p < end on every axis (so its extent is end - begin, and an empty box has
-// end <= begin on some axis). Sizes are computed in 64-bit so that boxes spanning most of the
-// int32 range do not overflow.
+// end <= begin on some axis).
+//
+// The supported range (docs/limits.md): every voxel a grid stores, every grid bound and every
+// coordinate a file may carry lies in kCoordRange, -2^29 <= p < 2^29 on each axis. Extents of
+// boxes inside it fit in 31 bits with room to grow a box by any clamp without overflow, so
+// size() of such a box is exact; readers and grids refuse anything outside. For boxes outside
+// the range size() and volume() still never overflow: they are computed in 64 (128) bits and
+// saturate at INT32_MAX / INT64_MAX.
 #pragma once
 
 #include <algorithm>
@@ -45,6 +51,14 @@ struct Vec3d {
   Vec3d normalized() const { const double l = length(); return {x / l, y / l, z / l}; }
 };
 
+// The supported coordinate range: -kCoordLimit <= p < kCoordLimit on every axis.
+inline constexpr std::int32_t kCoordLimit = std::int32_t{1} << 29;
+
+// Whether v lies in the supported range (voxel coordinates) / whether a box bound does (a box's
+// end may equal kCoordLimit).
+constexpr bool coord_in_range(std::int64_t v) { return v >= -kCoordLimit && v < kCoordLimit; }
+constexpr bool bound_in_range(std::int64_t v) { return v >= -kCoordLimit && v <= kCoordLimit; }
+
 struct Box3i {
   Vec3i begin;  // inclusive
   Vec3i end;    // exclusive
@@ -57,14 +71,32 @@ struct Box3i {
   }
 
   constexpr bool empty() const { return end.x <= begin.x || end.y <= begin.y || end.z <= begin.z; }
-  // Extent along each axis; zero (never negative) for an empty box.
-  constexpr Vec3i size() const {
-    return {std::max(0, end.x - begin.x), std::max(0, end.y - begin.y),
-            std::max(0, end.z - begin.z)};
+  // Extent along one axis in 64 bits; zero (never negative) for an empty box.
+  constexpr std::int64_t extent(int axis) const {
+    return std::max<std::int64_t>(0, std::int64_t{end[axis]} - begin[axis]);
   }
+  // Extent along each axis; zero (never negative) for an empty box. Exact for boxes inside
+  // kCoordRange; saturates at INT32_MAX beyond it.
+  constexpr Vec3i size() const {
+    auto s = [&](int k) {
+      return static_cast<std::int32_t>(std::min<std::int64_t>(extent(k), INT32_MAX));
+    };
+    return {s(0), s(1), s(2)};
+  }
+  // Number of voxels; saturates at INT64_MAX (a box of 2^29 on every side holds 2^87).
   constexpr std::int64_t volume() const {
-    const Vec3i s = size();
-    return std::int64_t{s.x} * s.y * s.z;
+    // Each extent is below 2^32, so the first product fits in 64 unsigned bits.
+    const std::uint64_t xy = static_cast<std::uint64_t>(extent(0)) * static_cast<std::uint64_t>(extent(1));
+    const std::uint64_t z = static_cast<std::uint64_t>(extent(2));
+    if (z != 0 && xy > static_cast<std::uint64_t>(INT64_MAX) / z) return INT64_MAX;
+    return static_cast<std::int64_t>(xy * z);
+  }
+  // Whether every bound lies in the supported range (an empty box always does).
+  constexpr bool in_range() const {
+    if (empty()) return true;
+    for (int k = 0; k < 3; ++k)
+      if (!bound_in_range(begin[k]) || !bound_in_range(end[k])) return false;
+    return true;
   }
   constexpr bool contains(Vec3i p) const {
     return p.x >= begin.x && p.x < end.x && p.y >= begin.y && p.y < end.y && p.z >= begin.z &&
@@ -93,6 +125,8 @@ struct Box3i {
   }
   friend constexpr bool operator==(const Box3i& a, const Box3i& b) = default;
 };
+
+inline constexpr Box3i kCoordRange{Vec3i::splat(-kCoordLimit), Vec3i::splat(kCoordLimit)};
 
 inline std::string to_string(const Box3i& b) {
   return "[" + to_string(b.begin) + " .. " + to_string(b.end) + ")";

@@ -31,6 +31,14 @@ class IoError : public Error {
   using Error::Error;
 };
 
+// An operation would need more memory than the limit allows (voxfield/limits.h): a file whose
+// content would take too much once decoded, a dense buffer over a huge box. The message names the
+// file or operation, what it needs and the limit; nothing was allocated for it.
+class ResourceLimitError : public Error {
+ public:
+  using Error::Error;
+};
+
 // A file was read but its contents are malformed. The message names the file, the byte offset at
 // which the problem was found and what is wrong; offset() returns that offset.
 class FormatError : public Error {

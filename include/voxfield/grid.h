@@ -13,8 +13,10 @@
 //    pass) and edit_chunk() checks for uniformity (a pass that stops at the first other voxel).
 //    Other chunks that come out uniform are collapsed by compact() and by the bulk writers (fill,
 //    generate_chunks, adopt_chunks) on what they touched.
-//  * Coordinates are signed 32-bit. A grid may be unbounded or bounded by a box; writes outside the
-//    bounds throw InvalidArgument and change nothing, reads outside return the background.
+//  * Coordinates are signed 32-bit, within the supported range kCoordRange (box.h). A grid may be
+//    unbounded or bounded by a box inside that range; writes outside the bounds (or, unbounded,
+//    outside the range) throw InvalidArgument and change nothing, reads outside return the
+//    background.
 //
 // Thread safety: const member functions may run concurrently with each other; any write needs
 // exclusive access. The parallel helpers run on voxfield's thread pool (see parallel.h).
@@ -90,6 +92,22 @@ class Grid {
     const Vec3i lo{chunk.x * chunk_edge_, chunk.y * chunk_edge_, chunk.z * chunk_edge_};
     return {lo, lo + Vec3i::splat(chunk_edge_)};
   }
+
+  // Whether chunk `coord` lies inside the supported coordinate range (computed without overflow
+  // for any coordinate, e.g. one read from a file).
+  bool chunk_in_range(Vec3i coord) const {
+    for (int k = 0; k < 3; ++k) {
+      const std::int64_t lo = std::int64_t{coord[k]} * chunk_edge_;
+      if (!coord_in_range(lo) || !bound_in_range(lo + chunk_edge_)) return false;
+    }
+    return true;
+  }
+
+  // A copy of this grid in chunks of another edge and with other bounds (nullopt: unbounded); the
+  // same voxels and background, those outside the new bounds dropped. Made chunk by chunk:
+  // memory follows the content, not its bounding box. Throws InvalidArgument like the
+  // constructor.
+  Grid rechunked(int chunk_edge, std::optional<Box3i> bounds) const;
 
   // Per-voxel access. get() outside the bounds returns the background; set() outside throws.
   T get(Vec3i p) const;
@@ -220,6 +238,7 @@ class Grid {
            (std::int64_t{p.y & mask} << chunk_shift_) | (p.x & mask);
   }
   void require_in_bounds(const Box3i& box, const char* what) const;
+  void require_chunk_in_range(Vec3i coord, const char* what) const;
   Chunk& expand(Chunk& chunk);  // makes a uniform chunk dense
   void collapse_if_uniform(typename ChunkMap::iterator it);
   // A chunk whose every voxel equals its collapse counter's value (ref_count == volume) stored

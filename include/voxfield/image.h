@@ -22,6 +22,8 @@ struct Image {
   }
 };
 
+// The bytes of an 8-bit RGB PNG of the image. Throws InvalidArgument / Error.
+std::vector<std::uint8_t> encode_png(const Image& image);
 // Writes an 8-bit RGB PNG atomically (the old file or the new one, never a mix). Throws IoError.
 void write_png(const Image& image, const std::filesystem::path& path);
 // Reads any PNG (grey, palette, RGB, with or without alpha, 8 or 16 bits) as 8-bit RGB; alpha is

@@ -1,10 +1,14 @@
 // voxfield — NumPy .npy volumes.
 //
 // Reads format versions 1.0, 2.0 and 3.0 with dtypes bool, int8, uint8, int16, uint16, int32,
-// uint32, float32 and float64, either byte order, C or Fortran order. A volume is a 3-D array
-// indexed a[x, y, z]; in memory voxfield keeps it x fastest (Fortran order), which is also how it
-// writes it, so that reading back in NumPy gives the same a[x, y, z]. Other shapes and dtypes are
-// rejected with a FormatError.
+// uint32, int64 (NumPy's default integer), uint64, float32 and float64, either byte order, C or
+// Fortran order. A volume is a 3-D array indexed a[x, y, z]; in memory voxfield keeps it x fastest
+// (Fortran order), which is also how it writes it, so that reading back in NumPy gives the same
+// a[x, y, z]. Each dimension is 1..2^29 (the coordinate range, box.h). Refused with a FormatError:
+// other shapes and dtypes, a header key given twice, data shorter than the shape needs, and bytes
+// after the data (NumPy never writes them; they mean a damaged or concatenated file). A volume
+// whose decoded size passes the memory limit (limits.h) is refused with ResourceLimitError before
+// anything is allocated for it.
 #pragma once
 
 #include <cstdint>
@@ -18,7 +22,7 @@
 
 namespace voxfield {
 
-enum class DType { kBool, kInt8, kUInt8, kInt16, kUInt16, kInt32, kUInt32, kFloat32, kFloat64 };
+enum class DType { kBool, kInt8, kUInt8, kInt16, kUInt16, kInt32, kUInt32, kInt64, kUInt64, kFloat32, kFloat64 };
 
 std::size_t dtype_size(DType t);
 const char* dtype_name(DType t);  // NumPy's name: "bool", "uint8", "float32", ...
@@ -32,14 +36,25 @@ struct NpyVolume {
   // (Fortran order): bytes hold `components` whole volumes one after another. Written only;
   // parse_npy reads 3-D volumes.
   int components = 1;
+  // Where the data came from, for error messages: the byte offset of the array data in the file
+  // and whether the file stored it in C order (z fastest). Zero / false for volumes built in code.
+  std::uint64_t file_data_offset = 0;
+  bool file_c_order = false;
 
   std::int64_t count() const { return Box3i::from_size(dims).volume(); }
   // Value i (x fastest) converted to double, whatever the dtype.
   double value(std::int64_t i) const;
+  // Byte offset in the file of value i (x fastest), following the file's order.
+  std::uint64_t file_offset_of(std::int64_t i) const;
 };
 
-NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name);
-NpyVolume read_npy(const std::filesystem::path& path);
+struct NpyReadOptions {
+  std::uint64_t memory_limit_bytes = 0;  // 0: the process default (limits.h)
+};
+
+NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name,
+                    const NpyReadOptions& options = {});
+NpyVolume read_npy(const std::filesystem::path& path, const NpyReadOptions& options = {});
 // Encodes as format 1.0 (2.0 when the header needs it), Fortran order, little-endian.
 std::vector<std::uint8_t> encode_npy(const NpyVolume& volume);
 void write_npy(const NpyVolume& volume, const std::filesystem::path& path);
@@ -55,9 +70,12 @@ NpyVolume make_npy(DType dtype, Vec3i dims, const T* values) {
 }
 
 // Volume -> World: every non-zero value is that material, placed with a[x, y, z] at voxel (x, y, z).
-// Throws FormatError when a value is not an integer in 0..255 (bool counts as material 1).
+// Throws FormatError naming the element a[x, y, z] and its byte offset in the file when a value is
+// not an integer in 0..255 (bool counts as material 1), ResourceLimitError when the world would
+// pass the memory limit.
 World world_from_npy(const NpyVolume& volume, const std::string& name,
-                     int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge);
+                     int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge,
+                     std::uint64_t memory_limit_bytes = 0);
 // World -> uint8 volume of the materials in `box` (a[x, y, z] is voxel box.begin + (x, y, z)).
 NpyVolume npy_from_world(const World& world, const Box3i& box);
 

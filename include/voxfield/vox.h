@@ -13,7 +13,11 @@
 // instances overlap, the one visited later in the scene graph wins.
 //
 // Malformed files throw FormatError naming the file, the byte offset and what is wrong; nothing is
-// ever read out of bounds, and absurd sizes are rejected before anything is allocated.
+// ever read out of bounds, and absurd sizes are rejected before anything is allocated. What the
+// file will cost (models, instances, the world chunks its voxels touch) is counted before it is
+// allocated; past the memory limit the reader throws ResourceLimitError. Deliberate leniencies
+// (docs/limits.md): any version from 150 up is read (the chunk container is self-describing and
+// unknown chunks are skipped); bytes after the MAIN chunk are refused.
 #pragma once
 
 #include <cstdint>
@@ -53,6 +57,9 @@ struct VoxImportOptions {
   int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge;
   bool include_hidden = false;  // also import hidden nodes and layers
   int frame = 0;                // model placed when the file has no scene graph
+  // Refuse (ResourceLimitError) a file whose models, instances and world chunks would need more;
+  // 0: the process default (limits.h).
+  std::uint64_t memory_limit_bytes = 0;
 };
 
 struct VoxImport {

@@ -27,6 +27,7 @@
 #include "line_transforms.h"
 #include "truncated_min_convolution.h"
 #include "voxfield/distance.h"
+#include "voxfield/limits.h"
 #include "voxfield/parallel.h"
 
 namespace voxfield {
@@ -1152,6 +1153,12 @@ FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOpt
                             (o.nearest_sites ? std::string(" for 16-bit nearest-site offsets") : std::string()));
     }
     p.aligned = chunk_aligned(p.domain, occupancy.chunk_shift());
+    // The values over the domain (and the sites) are what the field holds at most: refuse a
+    // domain they cannot fit in before anything is allocated.
+    const std::uint64_t per_voxel = (o.storage == Storage::kU8 ? 1 : o.storage == Storage::kU16 ? 2 : 4) +
+                                    (o.nearest_sites ? sizeof(SiteOffset) : 0);
+    require_memory(dense_bytes(p.domain, per_voxel), 0, "distance field",
+                   "the domain " + to_string(p.domain) + " of " + std::to_string(p.domain.volume()) + " voxels");
   }
   return p;
 }

@@ -8,10 +8,12 @@
 #include <bit>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "byte_reader.h"
 #include "voxfield/file.h"
+#include "voxfield/limits.h"
 #include "voxfield/npy.h"
 
 namespace voxfield {
@@ -27,7 +29,8 @@ constexpr DTypeInfo kDTypes[] = {
     {DType::kBool, 'b', 1, "bool"},      {DType::kInt8, 'i', 1, "int8"},
     {DType::kUInt8, 'u', 1, "uint8"},    {DType::kInt16, 'i', 2, "int16"},
     {DType::kUInt16, 'u', 2, "uint16"},  {DType::kInt32, 'i', 4, "int32"},
-    {DType::kUInt32, 'u', 4, "uint32"},  {DType::kFloat32, 'f', 4, "float32"},
+    {DType::kUInt32, 'u', 4, "uint32"},  {DType::kInt64, 'i', 8, "int64"},
+    {DType::kUInt64, 'u', 8, "uint64"},  {DType::kFloat32, 'f', 4, "float32"},
     {DType::kFloat64, 'f', 8, "float64"},
 };
 
@@ -116,6 +119,10 @@ class HeaderParser {
     while (!eat('}')) {
       const std::string key = quoted();
       expect(':');
+      for (const std::string& seen : keys_) {
+        if (seen == key) fail("key '" + key + "' given twice");
+      }
+      keys_.push_back(key);
       if (key == "descr") {
         descr = quoted();
         have_descr = true;
@@ -141,7 +148,19 @@ class HeaderParser {
   const std::string& name_;
   std::uint64_t base_;
   std::size_t pos_ = 0;
+  std::vector<std::string> keys_;
 };
+
+// A value as users wrote it: integers without a fraction, others with enough digits.
+std::string number_text(double m) {
+  char buf[40];
+  if (std::isfinite(m) && std::floor(m) == m && std::abs(m) < 1e15) {
+    std::snprintf(buf, sizeof buf, "%.0f", m);
+  } else {
+    std::snprintf(buf, sizeof buf, "%.9g", m);
+  }
+  return buf;
+}
 
 template <class T>
 double load_as_double(const std::uint8_t* p) {
@@ -165,13 +184,22 @@ double NpyVolume::value(std::int64_t i) const {
     case DType::kUInt16: return load_as_double<std::uint16_t>(p);
     case DType::kInt32: return load_as_double<std::int32_t>(p);
     case DType::kUInt32: return load_as_double<std::uint32_t>(p);
+    case DType::kInt64: return load_as_double<std::int64_t>(p);
+    case DType::kUInt64: return load_as_double<std::uint64_t>(p);
     case DType::kFloat32: return load_as_double<float>(p);
     case DType::kFloat64: return load_as_double<double>(p);
   }
   return 0.0;
 }
 
-NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name) {
+std::uint64_t NpyVolume::file_offset_of(std::int64_t i) const {
+  const std::int64_t X = dims.x, Y = dims.y, Z = dims.z;
+  const std::int64_t x = i % X, y = (i / X) % Y, z = i / (X * Y);
+  const std::int64_t in_file = file_c_order ? (x * Y + y) * Z + z : i;
+  return file_data_offset + static_cast<std::uint64_t>(in_file) * dtype_size(dtype);
+}
+
+NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name, const NpyReadOptions& options) {
   detail::ByteReader r(bytes, name);
   static constexpr std::uint8_t kMagic[6] = {0x93, 'N', 'U', 'M', 'P', 'Y'};
   auto magic = r.take(6, "magic");
@@ -207,7 +235,7 @@ NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name
     if (d.kind == kind && d.size == size) found = &d;
   if (!found || (order != '<' && order != '>' && order != '|' && order != '=')) {
     r.fail_at(header_at, "unsupported dtype '" + h.descr +
-                             "' (voxfield reads bool, int8/16/32, uint8/16/32, float32, float64)");
+                             "' (voxfield reads bool, int8/16/32/64, uint8/16/32/64, float32, float64)");
   }
   if (h.shape.size() != 3) {
     r.fail_at(header_at, "expected a 3-D array a[x, y, z], got " + std::to_string(h.shape.size()) +
@@ -216,17 +244,29 @@ NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name
   NpyVolume v;
   v.dtype = found->type;
   for (int k = 0; k < 3; ++k) {
-    if (h.shape[k] < 1 || h.shape[k] > (std::int64_t{1} << 30)) {
-      r.fail_at(header_at, "dimension " + std::to_string(h.shape[k]) + " outside 1..2^30");
+    if (h.shape[k] < 1 || h.shape[k] > kCoordLimit) {
+      r.fail_at(header_at, "dimension " + std::to_string(k) + " is " + std::to_string(h.shape[k]) +
+                               ", outside 1..2^29 (the supported coordinate range)");
     }
     v.dims[k] = static_cast<std::int32_t>(h.shape[k]);
   }
-  const std::uint64_t n = static_cast<std::uint64_t>(v.count());
-  const std::uint64_t data_bytes = n * static_cast<std::uint64_t>(size);
-  if (data_bytes / static_cast<std::uint64_t>(size) != n || data_bytes > r.remaining()) {
-    r.fail("array data of " + std::to_string(data_bytes) + " bytes but only " +
-           std::to_string(r.remaining()) + " bytes follow the header");
+  // Each dimension is below 2^30, but their product may not fit in 64 bits: saturate, then compare.
+  const std::uint64_t n = mul_sat(mul_sat(static_cast<std::uint64_t>(h.shape[0]), static_cast<std::uint64_t>(h.shape[1])),
+                                  static_cast<std::uint64_t>(h.shape[2]));
+  const std::uint64_t data_bytes = mul_sat(n, static_cast<std::uint64_t>(size));
+  if (data_bytes > r.remaining()) {
+    r.fail("the shape (" + std::to_string(h.shape[0]) + ", " + std::to_string(h.shape[1]) + ", " +
+           std::to_string(h.shape[2]) + ") of " + found->name + " needs " +
+           (data_bytes == UINT64_MAX ? std::string("more than 2^64") : std::to_string(data_bytes)) +
+           " bytes of data but only " + std::to_string(r.remaining()) + " bytes follow the header");
   }
+  if (data_bytes < r.remaining()) {
+    r.fail_at(r.offset() + data_bytes, std::to_string(r.remaining() - data_bytes) +
+                                           " bytes after the array data (a damaged or concatenated file?)");
+  }
+  require_memory(data_bytes, options.memory_limit_bytes, name, "the array of " + std::to_string(n) + " values");
+  v.file_data_offset = r.offset();
+  v.file_c_order = !h.fortran;
   auto data = r.take(static_cast<std::size_t>(data_bytes), "array data");
   v.bytes.resize(data.size());
   const bool swap = size > 1 && order == '>';
@@ -254,9 +294,11 @@ NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name
   return v;
 }
 
-NpyVolume read_npy(const std::filesystem::path& path) {
-  const auto bytes = read_file(path);
-  return parse_npy(bytes, path.string());
+NpyVolume read_npy(const std::filesystem::path& path, const NpyReadOptions& options) {
+  // The file is read whole (its data is the volume), so it counts against the limit too.
+  const std::uint64_t limit = effective_memory_limit(options.memory_limit_bytes);
+  const auto bytes = read_file(path, limit);
+  return parse_npy(bytes, path.string(), options);
 }
 
 std::vector<std::uint8_t> encode_npy(const NpyVolume& v) {
@@ -298,16 +340,26 @@ void write_npy(const NpyVolume& volume, const std::filesystem::path& path) {
   write_file_atomic(path, encode_npy(volume));
 }
 
-World world_from_npy(const NpyVolume& v, const std::string& name, int chunk_edge) {
+World world_from_npy(const NpyVolume& v, const std::string& name, int chunk_edge, std::uint64_t memory_limit_bytes) {
   World world(chunk_edge);
+  // The dense materials, then the grid (at most one byte per voxel of the chunks it covers).
+  const Box3i box = Box3i::from_size(v.dims);
+  const std::uint64_t chunk_edge_u = static_cast<std::uint64_t>(chunk_edge);
+  std::uint64_t chunk_voxels = 1;
+  for (int k = 0; k < 3; ++k) {
+    chunk_voxels = mul_sat(chunk_voxels, (static_cast<std::uint64_t>(v.dims[k]) + chunk_edge_u - 1) / chunk_edge_u * chunk_edge_u);
+  }
+  require_memory(add_sat(dense_bytes(box, 1), chunk_voxels), memory_limit_bytes, name,
+                 "a world of " + std::to_string(v.dims.x) + " x " + std::to_string(v.dims.y) + " x " +
+                     std::to_string(v.dims.z) + " voxels");
   std::vector<std::uint8_t> materials(static_cast<std::size_t>(v.count()));
   for (std::int64_t i = 0; i < v.count(); ++i) {
     const double m = v.value(i);
     if (!(m >= 0 && m <= 255 && std::floor(m) == m)) {
       const std::int64_t x = i % v.dims.x, y = (i / v.dims.x) % v.dims.y, z = i / (std::int64_t{v.dims.x} * v.dims.y);
-      throw FormatError(name, 0, "value " + std::to_string(m) + " at a[" + std::to_string(x) + ", " +
-                                     std::to_string(y) + ", " + std::to_string(z) +
-                                     "] is not a material index 0..255");
+      throw FormatError(name, v.file_offset_of(i),
+                        "element a[" + std::to_string(x) + ", " + std::to_string(y) + ", " + std::to_string(z) +
+                            "] holds " + number_text(m) + ", not a material index (an integer 0..255)");
     }
     materials[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(m);
   }

@@ -18,10 +18,10 @@ Image::Image(int w, int h) : width(w), height(h) {
   rgb.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3, 0);
 }
 
-void write_png(const Image& image, const std::filesystem::path& path) {
+std::vector<std::uint8_t> encode_png(const Image& image) {
   if (image.width <= 0 || image.height <= 0 ||
       image.rgb.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3)
-    throw InvalidArgument(path.string() + ": image buffer does not match its size");
+    throw InvalidArgument("encode_png: image buffer does not match its size");
   png_image png;
   std::memset(&png, 0, sizeof png);
   png.version = PNG_IMAGE_VERSION;
@@ -31,11 +31,21 @@ void write_png(const Image& image, const std::filesystem::path& path) {
   // First call sizes the buffer, second fills it.
   png_alloc_size_t bytes = 0;
   if (!png_image_write_to_memory(&png, nullptr, &bytes, 0, image.rgb.data(), 0, nullptr))
-    throw IoError(path.string() + ": PNG encoding failed: " + png.message);
+    throw Error(std::string("PNG encoding failed: ") + png.message);
   std::vector<std::uint8_t> out(bytes);
   if (!png_image_write_to_memory(&png, out.data(), &bytes, 0, image.rgb.data(), 0, nullptr))
-    throw IoError(path.string() + ": PNG encoding failed: " + png.message);
+    throw Error(std::string("PNG encoding failed: ") + png.message);
   out.resize(bytes);
+  return out;
+}
+
+void write_png(const Image& image, const std::filesystem::path& path) {
+  std::vector<std::uint8_t> out;
+  try {
+    out = encode_png(image);
+  } catch (const Error& e) {
+    throw IoError(path.string() + ": " + e.what());
+  }
   write_file_atomic(path, out);
 }
 

@@ -12,9 +12,11 @@
 #include <charconv>
 #include <optional>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "byte_reader.h"
 #include "voxfield/file.h"
+#include "voxfield/limits.h"
 #include "voxfield/vox.h"
 
 namespace voxfield {
@@ -27,7 +29,14 @@ constexpr int kMaxSceneDepth = 64;         // nesting of nTRN/nGRP; real files u
 constexpr std::int64_t kMaxInstances = 1 << 20;
 constexpr std::int64_t kMaxVisits = 1 << 22;  // node visits: bounds DAGs that instance exponentially
 constexpr std::int64_t kMaxPlacedVoxels = std::int64_t{1} << 32;
-constexpr std::int64_t kMaxWorldCoord = std::int64_t{1} << 30;
+constexpr std::int64_t kMaxTranslation = std::int64_t{1} << 30;  // one nTRN's _t component
+constexpr int kMinVersion = 150;                                 // the oldest documented format
+// What the reader itself keeps per item, for the memory estimate (the world's chunks are
+// counted separately): a stored voxel of an XYZI model, a placed instance (its record and
+// placement), a chunk of the world beyond its voxels (hash node and bookkeeping).
+constexpr std::uint64_t kBytesPerStoredVoxel = 8;
+constexpr std::uint64_t kBytesPerInstance = 192;
+constexpr std::uint64_t kBytesPerChunkNode = 96;
 
 using Dict = std::vector<std::pair<std::string, std::string>>;
 
@@ -115,7 +124,25 @@ struct ModelData {
     std::uint16_t x, y, z;
     std::uint8_t c;
   };
-  std::vector<Voxel> voxels;
+  std::vector<Voxel> voxels;  // XYZI models
+  // TDCZ models: one colour index per voxel of the SIZE box, x fastest (kept dense: a voxel list
+  // would take 8 bytes per solid voxel of a model that can hold 2^30).
+  std::vector<std::uint8_t> dense;
+
+  std::int64_t solid_count() const { return info.voxel_count; }
+  // Calls f(x, y, z, colour) for every solid voxel.
+  template <class F>
+  void for_each_voxel(F&& f) const {
+    if (!info.compressed) {
+      for (const Voxel& v : voxels) f(v.x, v.y, v.z, v.c);
+      return;
+    }
+    std::size_t i = 0;
+    for (int z = 0; z < info.size.z; ++z)
+      for (int y = 0; y < info.size.y; ++y)
+        for (int x = 0; x < info.size.x; ++x, ++i)
+          if (dense[i] != 0) f(x, y, z, dense[i]);
+  }
 };
 
 struct Node {
@@ -139,7 +166,9 @@ Affine parse_frame(const Dict& frame, ByteReader& r) {
   if (auto rot = lookup(frame, "_r")) {
     int bits = -1;
     auto [p, ec] = std::from_chars(rot->data(), rot->data() + rot->size(), bits);
-    if (ec != std::errc() || bits < 0 || bits > 127) r.fail("bad rotation \"" + *rot + "\"");
+    if (ec != std::errc() || p != rot->data() + rot->size() || bits < 0 || bits > 127) {
+      r.fail("bad rotation \"" + *rot + "\" (expected an integer 0..127)");
+    }
     const int c0 = bits & 3, c1 = (bits >> 2) & 3;
     if (c0 > 2 || c1 > 2 || c0 == c1) r.fail("rotation " + *rot + " is not a permutation");
     const int c2 = 3 - c0 - c1;
@@ -156,12 +185,14 @@ Affine parse_frame(const Dict& frame, ByteReader& r) {
       while (p < end && *p == ' ') ++p;
       std::int64_t v = 0;
       auto res = std::from_chars(p, end, v);
-      if (res.ec != std::errc() || v < -kMaxWorldCoord || v > kMaxWorldCoord) {
-        r.fail("bad translation \"" + *tr + "\"");
+      if (res.ec != std::errc() || v < -kMaxTranslation || v > kMaxTranslation) {
+        r.fail("bad translation \"" + *tr + "\" (expected three integers within +-2^30)");
       }
       a.t[k] = v;
       p = res.ptr;
     }
+    while (p < end && *p == ' ') ++p;
+    if (p != end) r.fail("bad translation \"" + *tr + "\" (expected three integers within +-2^30)");
   }
   return a;
 }
@@ -181,11 +212,18 @@ class VoxParser {
                                       ", expected \"VOX \"");
     }
     result_.info.version = r.i32("version");
+    if (result_.info.version < kMinVersion) {
+      r.fail_at(4, "format version " + std::to_string(result_.info.version) + " is older than the oldest documented (" +
+                       std::to_string(kMinVersion) + ")");
+    }
     const std::uint64_t main_at = r.offset();
     const auto [id, content, children] = chunk_header(r);
     if (id != "MAIN") r.fail_at(main_at, "first chunk is \"" + id + "\", expected MAIN");
     r.skip(content, "MAIN content");
     ByteReader body = r.sub(children, "MAIN children");
+    if (!r.at_end()) {
+      r.fail(std::to_string(r.remaining()) + " bytes after the MAIN chunk (a damaged or concatenated file?)");
+    }
     while (!body.at_end()) read_chunk(body);
     finish();
     return std::move(result_);
@@ -276,7 +314,7 @@ class VoxParser {
     ModelData m;
     m.info.size = take_size(c, at, "XYZI");
     const std::int32_t n = read_count(c, 4, "voxel count");
-    m.info.voxel_count = n;
+    charge(mul_sat(static_cast<std::uint64_t>(n), kBytesPerStoredVoxel), c, at, "its models");
     m.voxels.reserve(static_cast<std::size_t>(n));
     for (std::int32_t i = 0; i < n; ++i) {
       const std::uint64_t vat = c.offset();
@@ -288,6 +326,7 @@ class VoxParser {
       }
       if (v[3] != 0) m.voxels.push_back({v[0], v[1], v[2], v[3]});
     }
+    m.info.voxel_count = static_cast<std::int64_t>(m.voxels.size());
     models_.push_back(std::move(m));
   }
 
@@ -309,6 +348,7 @@ class VoxParser {
       c.fail_at(at, "TDCZ model of " + std::to_string(n) + " voxels cannot come from " +
                         std::to_string(packed.size()) + " compressed bytes");
     }
+    charge(static_cast<std::uint64_t>(n), c, at, "its models");
     std::vector<std::uint8_t> dense(static_cast<std::size_t>(n));
     z_stream z{};
     if (inflateInit(&z) != Z_OK) c.fail("cannot initialise zlib");
@@ -324,15 +364,8 @@ class VoxParser {
                         (z.msg ? std::string(z.msg) : std::string("no zlib message")) +
                         "), expected " + std::to_string(n));
     }
-    std::size_t i = 0;
-    for (int zc = 0; zc < s.z; ++zc)
-      for (int y = 0; y < s.y; ++y)
-        for (int x = 0; x < s.x; ++x, ++i)
-          if (dense[i] != 0) {
-            m.voxels.push_back({static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
-                                static_cast<std::uint16_t>(zc), dense[i]});
-          }
-    m.info.voxel_count = static_cast<std::int64_t>(m.voxels.size());
+    m.info.voxel_count = static_cast<std::int64_t>(dense.size() - static_cast<std::size_t>(std::count(dense.begin(), dense.end(), 0)));
+    m.dense = std::move(dense);
     models_.push_back(std::move(m));
   }
 
@@ -444,6 +477,7 @@ class VoxParser {
     }
   }
 
+  // Records an instance; its voxels are placed by finish() once the whole scene's cost is known.
   void place_instance(const Node& n, const Affine& xf, bool hidden, const std::string& name) {
     ByteReader r(bytes_, name_);
     if (n.model < 0 || static_cast<std::size_t>(n.model) >= models_.size()) {
@@ -453,14 +487,16 @@ class VoxParser {
     if (static_cast<std::int64_t>(result_.info.instances.size()) >= kMaxInstances) {
       r.fail_at(n.offset, "more than " + std::to_string(kMaxInstances) + " instances");
     }
+    charge(kBytesPerInstance + name.size(), r, n.offset, "its scene graph's instances");
     const ModelData& m = models_[static_cast<std::size_t>(n.model)];
     const std::array<std::int64_t, 3> pivot{m.info.size.x / 2, m.info.size.y / 2, m.info.size.z / 2};
     const auto a = xf.place({0, 0, 0}, pivot);
     const auto b = xf.place({m.info.size.x - 1, m.info.size.y - 1, m.info.size.z - 1}, pivot);
     for (int k = 0; k < 3; ++k) {
-      if (std::min(a[k], b[k]) < -kMaxWorldCoord || std::max(a[k], b[k]) > kMaxWorldCoord) {
-        r.fail_at(n.offset, "instance of model " + std::to_string(n.model) +
-                                " lands outside the supported coordinate range");
+      if (!coord_in_range(std::min(a[k], b[k])) || !coord_in_range(std::max(a[k], b[k]))) {
+        r.fail_at(n.offset, "instance of model " + std::to_string(n.model) + " spans " + std::to_string(std::min(a[k], b[k])) +
+                                ".." + std::to_string(std::max(a[k], b[k])) + " on axis " + "xyz"[k] +
+                                ", outside the supported coordinate range -2^29..2^29-1");
       }
     }
     VoxInstanceInfo inst;
@@ -474,14 +510,57 @@ class VoxParser {
          static_cast<int>(std::max(a[2], b[2]))});
     result_.info.instances.push_back(inst);
     if (hidden && !options_.include_hidden) return;
-    placed_voxels_ += static_cast<std::int64_t>(m.voxels.size());
+    placed_voxels_ += m.solid_count();
     if (placed_voxels_ > kMaxPlacedVoxels) {
       r.fail_at(n.offset, "scene places more than " + std::to_string(kMaxPlacedVoxels) + " voxels");
     }
-    for (const auto& v : m.voxels) {
-      const auto p = xf.place({v.x, v.y, v.z}, pivot);
-      result_.world.voxels.set({static_cast<int>(p[0]), static_cast<int>(p[1]), static_cast<int>(p[2])}, v.c);
+    placements_.push_back({n.model, xf, n.offset, result_.info.instances.back().world_box});
+  }
+
+  // The world's chunks every placement touches, counted before any is allocated: while voxels are
+  // placed each touched chunk is dense (chunk_edge^3 bytes). An instance with fewer voxels than
+  // chunks in its box adds the chunks of its voxels, others every chunk of the box: an upper bound
+  // within one instance's box, exact where instances are sparse (the case that costs most).
+  void check_world_memory() {
+    ByteReader r(bytes_, name_);
+    const Grid<std::uint8_t>& g = result_.world.voxels;
+    const int shift = g.chunk_shift();
+    const std::uint64_t per_chunk = static_cast<std::uint64_t>(g.chunk_volume()) + kBytesPerChunkNode;
+    const std::uint64_t limit = effective_memory_limit(options_.memory_limit_bytes);
+    const std::uint64_t budget = limit > reader_bytes_ ? limit - reader_bytes_ : 0;
+    const std::uint64_t max_chunks = budget / per_chunk;
+    auto key = [](std::int64_t x, std::int64_t y, std::int64_t z) {
+      // Chunk coordinates of the supported range fit in 21 bits each.
+      return (static_cast<std::uint64_t>(x + (1 << 20)) << 42) | (static_cast<std::uint64_t>(y + (1 << 20)) << 21) |
+             static_cast<std::uint64_t>(z + (1 << 20));
+    };
+    std::unordered_set<std::uint64_t> chunks;
+    auto add = [&](std::uint64_t k, std::uint64_t at) {
+      if (chunks.insert(k).second && chunks.size() > max_chunks) {
+        require_memory(add_sat(reader_bytes_, mul_sat(chunks.size(), per_chunk)), limit, name_,
+                       "placing its voxels (at least " + std::to_string(chunks.size()) + " chunks of " +
+                           std::to_string(g.chunk_edge()) + "^3 touched, from the instance at byte " +
+                           std::to_string(at) + " on)");
+      }
+    };
+    for (const Placement& pl : placements_) {
+      const ModelData& m = models_[static_cast<std::size_t>(pl.model)];
+      const Vec3i lo = g.chunk_of(pl.box.begin), hi = g.chunk_of(pl.box.end - Vec3i::splat(1));
+      const std::int64_t box_chunks =
+          std::int64_t{hi.x - lo.x + 1} * (hi.y - lo.y + 1) * (hi.z - lo.z + 1);
+      if (m.solid_count() < box_chunks) {
+        const std::array<std::int64_t, 3> pivot{m.info.size.x / 2, m.info.size.y / 2, m.info.size.z / 2};
+        m.for_each_voxel([&](int x, int y, int z, std::uint8_t) {
+          const auto p = pl.frame.place({x, y, z}, pivot);
+          add(key(p[0] >> shift, p[1] >> shift, p[2] >> shift), pl.offset);
+        });
+      } else {
+        for (int z = lo.z; z <= hi.z; ++z)
+          for (int y = lo.y; y <= hi.y; ++y)
+            for (int x = lo.x; x <= hi.x; ++x) add(key(x, y, z), pl.offset);
+      }
     }
+    (void)r;
   }
 
   void finish() {
@@ -499,12 +578,40 @@ class VoxParser {
                               " requested but the file has " + std::to_string(models_.size()) +
                               " models");
       }
-      for (const auto& v : models_[static_cast<std::size_t>(options_.frame)].voxels) {
-        result_.world.voxels.set({v.x, v.y, v.z}, v.c);
-      }
+      // Placed with voxel v at v: the transform that does so for the model's size.
+      const ModelData& m = models_[static_cast<std::size_t>(options_.frame)];
+      Affine identity;
+      for (int k = 0; k < 3; ++k) identity.t[k] = m.info.size[k] / 2;
+      placements_.push_back({options_.frame, identity, 8, Box3i::from_size(m.info.size)});
+    }
+    check_world_memory();
+    for (const Placement& pl : placements_) {
+      const ModelData& m = models_[static_cast<std::size_t>(pl.model)];
+      const std::array<std::int64_t, 3> pivot{m.info.size.x / 2, m.info.size.y / 2, m.info.size.z / 2};
+      m.for_each_voxel([&](int x, int y, int z, std::uint8_t c) {
+        const auto p = pl.frame.place({x, y, z}, pivot);
+        result_.world.voxels.set({static_cast<int>(p[0]), static_cast<int>(p[1]), static_cast<int>(p[2])}, c);
+      });
     }
     result_.world.voxels.compact();
   }
+
+  // Adds what the reader keeps in memory and refuses past the limit.
+  void charge(std::uint64_t bytes, ByteReader& r, std::uint64_t at, const char* what) {
+    reader_bytes_ = add_sat(reader_bytes_, bytes);
+    if (reader_bytes_ > effective_memory_limit(options_.memory_limit_bytes)) {
+      require_memory(reader_bytes_, options_.memory_limit_bytes, name_,
+                     std::string("reading ") + what + " (up to byte " + std::to_string(at) + ")");
+    }
+    (void)r;
+  }
+
+  struct Placement {
+    int model;
+    Affine frame;
+    std::uint64_t offset;  // of the shape node, for messages
+    Box3i box;             // where the model's SIZE box lands
+  };
 
   std::span<const std::uint8_t> bytes_;
   const std::string& name_;
@@ -514,8 +621,10 @@ class VoxParser {
   std::vector<ModelData> models_;
   std::unordered_map<std::int32_t, Node> nodes_;
   std::unordered_map<std::int32_t, bool> hidden_layers_;
+  std::vector<Placement> placements_;
   std::int64_t placed_voxels_ = 0;
   std::int64_t visits_ = 0;
+  std::uint64_t reader_bytes_ = 0;  // what the reader holds besides the world's chunks
 };
 
 }  // namespace
@@ -526,7 +635,7 @@ VoxImport parse_vox(std::span<const std::uint8_t> bytes, const std::string& name
 }
 
 VoxImport read_vox(const std::filesystem::path& path, const VoxImportOptions& options) {
-  const std::vector<std::uint8_t> bytes = read_file(path);
+  const std::vector<std::uint8_t> bytes = read_file(path, effective_memory_limit(options.memory_limit_bytes));
   return parse_vox(bytes, path.string(), options);
 }
 

@@ -11,14 +11,25 @@
 
 #include <zlib.h>
 
+#include <cmath>
 #include <cstring>
 #include <type_traits>
+#include <unordered_set>
 
 #include "byte_reader.h"
 #include "voxfield/file.h"
+#include "voxfield/limits.h"
 
 namespace voxfield {
 namespace {
+
+struct CoordHash {
+  std::size_t operator()(const Vec3i& c) const noexcept {
+    return static_cast<std::size_t>(static_cast<std::uint32_t>(c.x)) * 73856093u ^
+           static_cast<std::size_t>(static_cast<std::uint32_t>(c.y)) * 19349663u ^
+           static_cast<std::size_t>(static_cast<std::uint32_t>(c.z)) * 83492791u;
+  }
+};
 
 constexpr char kMagic[8] = {'V', 'X', 'F', 'W', 'O', 'R', 'L', 'D'};
 enum SectionKind : std::uint32_t { kWorldSection = 1, kFieldSection = 2 };
@@ -90,24 +101,79 @@ T get(detail::ByteReader& r, const char* what) {
   return v;
 }
 
+// What a file will cost once decoded, counted before it is allocated.
+class Budget {
+ public:
+  Budget(const std::string& name, std::uint64_t limit) : name_(name), limit_(effective_memory_limit(limit)) {}
+  void charge(std::uint64_t bytes, const std::string& what) {
+    used_ = add_sat(used_, bytes);
+    require_memory(used_, limit_, name_, what);
+  }
+
+ private:
+  const std::string& name_;
+  std::uint64_t limit_;
+  std::uint64_t used_ = 0;
+};
+
+constexpr std::uint64_t kBytesPerChunkNode = 96;  // hash node and bookkeeping of a stored chunk
+
 template <class T>
-Grid<T> get_grid(detail::ByteReader& r) {
+Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
   const auto edge = get<std::uint32_t>(r, "chunk edge");
   if (edge < 8 || edge > 128 || (edge & (edge - 1)) != 0) r.fail("chunk edge " + std::to_string(edge) + " is not a power of two in 8..128");
   if (get<std::uint32_t>(r, "value size") != sizeof(T)) r.fail("value size does not match the grid's type");
   const T background = get<T>(r, "background");
   std::optional<Box3i> bounds;
   if (get<std::uint8_t>(r, "bounds flag")) {
+    const std::uint64_t at = r.offset();
     Box3i b;
     for (int k = 0; k < 3; ++k) b.begin[k] = get<std::int32_t>(r, "bounds");
     for (int k = 0; k < 3; ++k) b.end[k] = get<std::int32_t>(r, "bounds");
-    if (b.empty()) r.fail("empty grid bounds " + to_string(b));
+    if (b.empty()) r.fail_at(at, "empty grid bounds " + to_string(b));
+    if (!kCoordRange.contains(b)) {
+      r.fail_at(at, "grid bounds " + to_string(b) + " reach outside the supported coordinate range " + to_string(kCoordRange));
+    }
     bounds = b;
   }
   Grid<T> g(static_cast<int>(edge), background, bounds);
   const auto count = get<std::uint64_t>(r, "chunk count");
   if (count > r.remaining() / 13) r.fail("chunk count " + std::to_string(count) + " overruns the section");
   const std::size_t raw = static_cast<std::size_t>(g.chunk_volume()) * sizeof(T);
+
+  // First pass over the chunk records (headers only): coordinates checked, duplicates refused and
+  // the decoded size counted before any chunk is decompressed.
+  {
+    detail::ByteReader scan = r;
+    std::unordered_set<Vec3i, CoordHash> seen;
+    std::uint64_t dense = 0;
+    for (std::uint64_t i = 0; i < count; ++i) {
+      const std::uint64_t at = scan.offset();
+      Vec3i c;
+      c.x = get<std::int32_t>(scan, "chunk coordinate");
+      c.y = get<std::int32_t>(scan, "chunk coordinate");
+      c.z = get<std::int32_t>(scan, "chunk coordinate");
+      const auto kind = get<std::uint8_t>(scan, "chunk kind");
+      if (!g.chunk_in_range(c)) {
+        scan.fail_at(at, "chunk " + to_string(c) + " of edge " + std::to_string(edge) +
+                             " lies outside the supported coordinate range " + to_string(kCoordRange));
+      }
+      if (bounds && g.chunk_box(c).intersect(*bounds).empty()) scan.fail_at(at, "chunk " + to_string(c) + " lies outside the grid bounds");
+      if (!seen.insert(c).second) scan.fail_at(at, "chunk " + to_string(c) + " appears twice");
+      if (kind == 0) {
+        scan.skip(sizeof(T), "uniform value");
+      } else if (kind == 1) {
+        scan.skip(get<std::uint32_t>(scan, "chunk size"), "chunk data");
+        ++dense;
+      } else {
+        scan.fail_at(at + 12, "unknown chunk kind " + std::to_string(kind));
+      }
+    }
+    budget.charge(add_sat(mul_sat(dense, raw), mul_sat(count, kBytesPerChunkNode)),
+                  "a grid of " + std::to_string(count) + " chunks (" + std::to_string(dense) + " dense, " +
+                      std::to_string(raw) + " bytes each)");
+  }
+
   std::vector<Vec3i> coords;
   std::vector<std::unique_ptr<T[]>> data;
   for (std::uint64_t i = 0; i < count; ++i) {
@@ -116,7 +182,6 @@ Grid<T> get_grid(detail::ByteReader& r) {
     c.y = get<std::int32_t>(r, "chunk coordinate");
     c.z = get<std::int32_t>(r, "chunk coordinate");
     const auto kind = get<std::uint8_t>(r, "chunk kind");
-    if (bounds && g.chunk_box(c).intersect(*bounds).empty()) r.fail("chunk " + to_string(c) + " lies outside the grid bounds");
     if (kind == 0) {
       // Uniform chunks stay single values: no voxel array is allocated for them.
       const T v = get<T>(r, "uniform value");
@@ -124,15 +189,11 @@ Grid<T> get_grid(detail::ByteReader& r) {
       continue;
     }
     std::unique_ptr<T[]> voxels(new T[static_cast<std::size_t>(g.chunk_volume())]);
-    if (kind == 1) {
-      const auto size = get<std::uint32_t>(r, "chunk size");
-      auto packed = r.take(size, "chunk data");
-      uLongf out = static_cast<uLongf>(raw);
-      if (uncompress(reinterpret_cast<Bytef*>(voxels.get()), &out, packed.data(), size) != Z_OK || out != raw) {
-        r.fail("chunk " + to_string(c) + " does not decompress to " + std::to_string(raw) + " bytes");
-      }
-    } else {
-      r.fail("unknown chunk kind " + std::to_string(kind));
+    const auto size = get<std::uint32_t>(r, "chunk size");
+    auto packed = r.take(size, "chunk data");
+    uLongf out = static_cast<uLongf>(raw);
+    if (uncompress(reinterpret_cast<Bytef*>(voxels.get()), &out, packed.data(), size) != Z_OK || out != raw) {
+      r.fail("chunk " + to_string(c) + " does not decompress to " + std::to_string(raw) + " bytes");
     }
     coords.push_back(c);
     data.push_back(std::move(voxels));
@@ -158,7 +219,10 @@ void put_field(Out& o, const DistanceField& f) {
   if (f.sites) put_grid(o, *f.sites);
 }
 
-DistanceField get_field(detail::ByteReader& r) {
+bool finite_positive(double v) { return std::isfinite(v) && v > 0; }
+
+DistanceField get_field(detail::ByteReader& r, Budget& budget) {
+  const std::uint64_t at = r.offset();
   DistanceField f;
   const auto metric = get<std::uint8_t>(r, "metric");
   const auto is_signed = get<std::uint8_t>(r, "signed");
@@ -177,13 +241,30 @@ DistanceField get_field(detail::ByteReader& r) {
   f.options.domain = f.domain;
   f.encoding.scale = get<double>(r, "scale");
   f.encoding.bias = get<std::int64_t>(r, "bias");
-  if (!(f.encoding.scale > 0)) r.fail("invalid field encoding");
-  switch (f.options.storage) {
-    case Storage::kU8: f.values = get_grid<std::uint8_t>(r); break;
-    case Storage::kU16: f.values = get_grid<std::uint16_t>(r); break;
-    case Storage::kF32: f.values = get_grid<float>(r); break;
+  // The options as compute_distance_field would accept them: a file is not a way around them.
+  if (!std::isfinite(f.options.max_distance) || f.options.max_distance < 0) {
+    r.fail_at(at + 4, "invalid clamp " + std::to_string(f.options.max_distance) + " (a finite value >= 0)");
   }
-  if (has_sites) f.sites = get_grid<SiteOffset>(r);
+  for (double sp : f.options.spacing)
+    if (!finite_positive(sp)) r.fail_at(at + 12, "invalid voxel spacing " + std::to_string(sp) + " (finite, > 0)");
+  if (!std::isfinite(f.options.fixed_point_scale) || f.options.fixed_point_scale < 0) {
+    r.fail_at(at + 36, "invalid fixed-point scale " + std::to_string(f.options.fixed_point_scale));
+  }
+  for (int k = 0; k < 3; ++k) {
+    if (f.domain.end[k] < f.domain.begin[k]) r.fail_at(at + 44, "inverted field domain " + to_string(f.domain));
+  }
+  if (!f.domain.in_range()) {
+    r.fail_at(at + 44, "field domain " + to_string(f.domain) + " reaches outside the supported coordinate range");
+  }
+  if (!finite_positive(f.encoding.scale) || f.encoding.bias < 0 || f.encoding.bias > 65535) {
+    r.fail_at(at + 68, "invalid field encoding");
+  }
+  switch (f.options.storage) {
+    case Storage::kU8: f.values = get_grid<std::uint8_t>(r, budget); break;
+    case Storage::kU16: f.values = get_grid<std::uint16_t>(r, budget); break;
+    case Storage::kF32: f.values = get_grid<float>(r, budget); break;
+  }
+  if (has_sites) f.sites = get_grid<SiteOffset>(r, budget);
   return f;
 }
 
@@ -214,8 +295,10 @@ std::vector<std::uint8_t> encode_world_file(const World& world, const std::vecto
   return std::move(file.b);
 }
 
-WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::string& name) {
+WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::string& name,
+                           const WorldFileReadOptions& options) {
   detail::ByteReader r(bytes, name);
+  Budget budget(name, options.memory_limit_bytes);
   if (bytes.size() < 20 || std::memcmp(bytes.data(), kMagic, 8) != 0) r.fail_at(0, "not a voxfield world file (bad magic)");
   r.skip(8, "magic");
   WorldFile out;
@@ -240,10 +323,15 @@ WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::strin
     if (kind == kWorldSection) {
       if (s != 0) r.fail_at(at, "the world section must come first");
       for (Rgba& c : out.world.palette) c = get<Rgba>(payload, "palette");
-      out.world.voxels = get_grid<std::uint8_t>(payload);
+      out.world.voxels = get_grid<std::uint8_t>(payload, budget);
     } else if (kind == kFieldSection) {
       if (s == 0) r.fail_at(at, "a field section before the world");
-      out.fields.push_back(get_field(payload));
+      out.fields.push_back(get_field(payload, budget));
+      const DistanceField& f = out.fields.back();
+      const int edge = out.world.voxels.chunk_edge();
+      if (f.chunk_edge() != edge || (f.sites && f.sites->chunk_edge() != edge)) {
+        r.fail_at(at, "a field stored in chunks of another edge than its world's (" + std::to_string(edge) + ")");
+      }
     } else {
       r.fail_at(at, "unknown section kind " + std::to_string(kind));
     }
@@ -257,9 +345,9 @@ void write_world_file(const World& world, const std::filesystem::path& path, con
   write_file_atomic(path, encode_world_file(world, fields));
 }
 
-WorldFile read_world_file(const std::filesystem::path& path) {
-  const auto bytes = read_file(path);
-  return parse_world_file(bytes, path.string());
+WorldFile read_world_file(const std::filesystem::path& path, const WorldFileReadOptions& options) {
+  const auto bytes = read_file(path, effective_memory_limit(options.memory_limit_bytes));
+  return parse_world_file(bytes, path.string(), options);
 }
 
 }  // namespace voxfield

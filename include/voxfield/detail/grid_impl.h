@@ -22,6 +22,10 @@ Grid<T>::Grid(int chunk_edge, T background, std::optional<Box3i> bounds)
   if (bounds_ && bounds_->empty()) {
     throw InvalidArgument("grid bounds " + to_string(*bounds_) + " are empty");
   }
+  if (bounds_ && !kCoordRange.contains(*bounds_)) {
+    throw InvalidArgument("grid bounds " + to_string(*bounds_) + " reach outside the supported coordinate range " +
+                          to_string(kCoordRange));
+  }
   chunk_shift_ = std::countr_zero(static_cast<unsigned>(chunk_edge));
 }
 
@@ -54,6 +58,10 @@ Grid<T>& Grid<T>::operator=(const Grid& other) {
 
 template <class T>
 void Grid<T>::require_in_bounds(const Box3i& box, const char* what) const {
+  if (!bounds_ && !kCoordRange.contains(box)) {
+    throw InvalidArgument(std::string(what) + ": box " + to_string(box) +
+                          " reaches outside the supported coordinate range " + to_string(kCoordRange));
+  }
   if (bounds_ && !bounds_->contains(box)) {
     throw InvalidArgument(std::string(what) + ": box " + to_string(box) +
                           " reaches outside the grid bounds " + to_string(*bounds_));
@@ -83,6 +91,10 @@ void Grid<T>::set(Vec3i p, T value) {
   if (bounds_ && !bounds_->contains(p)) {
     throw InvalidArgument("set: voxel " + to_string(p) + " is outside the grid bounds " +
                           to_string(*bounds_));
+  }
+  if (!kCoordRange.contains(p)) {
+    throw InvalidArgument("set: voxel " + to_string(p) + " is outside the supported coordinate range " +
+                          to_string(kCoordRange));
   }
   const Vec3i coord = chunk_of(p);
   auto it = chunks_.find(coord);
@@ -204,6 +216,10 @@ void Grid<T>::fill(const Box3i& box, T value) {
 template <class T>
 void Grid<T>::copy_to_dense(const Box3i& box, T* out) const {
   if (box.empty()) return;
+  if (!kCoordRange.contains(box)) {
+    throw InvalidArgument("copy_to_dense: box " + to_string(box) + " reaches outside the supported coordinate range " +
+                          to_string(kCoordRange));
+  }
   const Vec3i size = box.size();
   const std::int64_t sx = size.x, sxy = std::int64_t{size.x} * size.y;
   for (const Vec3i coord : chunks_overlapping(box)) {
@@ -378,6 +394,7 @@ std::vector<Vec3i> Grid<T>::chunk_coords() const {
 template <class T>
 void Grid<T>::generate_chunks(const std::vector<Vec3i>& chunks,
                               const std::function<void(Vec3i, T*)>& f) {
+  for (const Vec3i c : chunks) require_chunk_in_range(c, "generate_chunks");
   const std::int64_t n = chunk_volume();
   // Produce every chunk into fresh storage first, so that a throwing f leaves the grid unchanged.
   std::vector<std::unique_ptr<T[]>> produced(chunks.size());
@@ -396,6 +413,7 @@ void Grid<T>::adopt_chunks(const std::vector<Vec3i>& chunks, std::vector<std::un
   }
   for (std::size_t i = 0; i < chunks.size(); ++i) {
     if (!data[i]) throw InvalidArgument("adopt_chunks: null array for chunk " + to_string(chunks[i]));
+    require_chunk_in_range(chunks[i], "adopt_chunks");
     if (bounds_ && chunk_box(chunks[i]).intersect(*bounds_).empty()) {
       throw InvalidArgument("adopt_chunks: chunk " + to_string(chunks[i]) +
                             " lies outside the grid bounds " + to_string(*bounds_));
@@ -445,6 +463,7 @@ void Grid<T>::adopt_chunks(const std::vector<Vec3i>& chunks, std::vector<std::un
 template <class T>
 template <class F>
 void Grid<T>::edit_chunk(Vec3i coord, F&& f) {
+  require_chunk_in_range(coord, "edit_chunk");
   if (bounds_ && chunk_box(coord).intersect(*bounds_).empty()) {
     throw InvalidArgument("edit_chunk: chunk " + to_string(coord) + " lies outside the grid bounds " +
                           to_string(*bounds_));
@@ -474,6 +493,38 @@ void Grid<T>::edit_chunk(Vec3i coord, F&& f) {
     const T* v = c.voxels.get();
     if (std::all_of(v, v + chunk_volume(), [&](const T& x) { return x == edit.first_; })) reanchor(it, edit.first_);
   }
+}
+
+template <class T>
+void Grid<T>::require_chunk_in_range(Vec3i coord, const char* what) const {
+  if (!chunk_in_range(coord)) {
+    throw InvalidArgument(std::string(what) + ": chunk " + to_string(coord) + " of edge " + std::to_string(chunk_edge_) +
+                          " lies outside the supported coordinate range " + to_string(kCoordRange));
+  }
+}
+
+template <class T>
+Grid<T> Grid<T>::rechunked(int chunk_edge, std::optional<Box3i> bounds) const {
+  Grid out(chunk_edge, background_, bounds);
+  // Chunk by chunk, so that memory follows the content: uniform chunks become uniform fills (no
+  // allocation where the new chunks lie wholly inside), dense ones are copied as they are.
+  std::vector<T> part;
+  for (const Vec3i coord : chunk_coords()) {
+    const ChunkView<T> v = chunk_view(coord);
+    Box3i box = bounds_ ? v.box.intersect(*bounds_) : v.box;
+    if (bounds) box = box.intersect(*bounds);
+    if (box.empty()) continue;
+    if (v.uniform()) {
+      out.fill(box, v.uniform_value);
+    } else if (box == v.box) {
+      out.copy_from_dense(box, v.voxels);
+    } else {
+      part.resize(static_cast<std::size_t>(box.volume()));
+      copy_to_dense(box, part.data());
+      out.copy_from_dense(box, part.data());
+    }
+  }
+  return out;
 }
 
 template <class T>

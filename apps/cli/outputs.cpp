@@ -1,0 +1,53 @@
+// voxfield CLI — outputs checked first, written all or nothing (outputs.h), and small helpers.
+#include "outputs.h"
+
+#include <filesystem>
+
+#include "cli.h"
+
+namespace voxfield::cli {
+namespace {
+
+// Two names for one file: the same existing file, or the same path once made absolute.
+bool same_target(const std::string& a, const std::string& b) {
+  if (a == "-" || b == "-") return false;
+  if (same_file(a, b)) return true;
+  std::error_code ea, eb;
+  const auto ca = std::filesystem::weakly_canonical(a, ea), cb = std::filesystem::weakly_canonical(b, eb);
+  return !ea && !eb && ca == cb;
+}
+
+}  // namespace
+
+void Outputs::expect(const std::string& path, const std::string& option, bool may_be_input) {
+  if (path.empty()) return;
+  check_output_path(path);
+  if (!may_be_input) {
+    for (const std::string& in : inputs_) {
+      if (same_target(path, in)) {
+        throw InvalidArgument(option + " " + path + " is also an input of this command; writing it would destroy " +
+                              in + " (choose another output)");
+      }
+    }
+  }
+  for (const std::string& out : outputs_) {
+    if (same_target(path, out)) throw InvalidArgument(option + " " + path + " is given as two outputs");
+  }
+  outputs_.push_back(path);
+}
+
+void Outputs::expect_world(const std::string& path, const std::string& option, bool may_be_input) {
+  if (path.empty()) return;
+  (void)world_format_of(path);
+  expect(path, option, may_be_input);
+}
+
+void Outputs::stage_json(const std::string& path, const nlohmann::json& j) {
+  tx_.stage(path, std::string_view(j.dump(2) + "\n"));
+}
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace voxfield::cli

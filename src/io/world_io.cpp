@@ -1,0 +1,137 @@
+// voxfield — loading and saving worlds by file type (voxfield/world_io.h).
+#include "voxfield/world_io.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstring>
+
+#include "voxfield/file.h"
+#include "voxfield/limits.h"
+#include "voxfield/npy.h"
+#include "voxfield/world_file.h"
+
+namespace voxfield {
+namespace {
+
+std::string extension(const std::filesystem::path& p) {
+  std::string e = p.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+  return e;
+}
+
+// Checks the first bytes against the format's magic; a mismatch is reported by the format's own
+// parser (which names what it found), run on those bytes alone.
+void check_magic(const std::filesystem::path& path, WorldFormat f) {
+  const std::vector<std::uint8_t> head = read_file_prefix(path, 8);
+  const std::string name = path.string();
+  switch (f) {
+    case WorldFormat::kVox:
+      if (head.size() < 4 || std::memcmp(head.data(), "VOX ", 4) != 0) (void)parse_vox(head, name);
+      break;
+    case WorldFormat::kNpy:
+      if (head.size() < 6 || std::memcmp(head.data(), "\x93NUMPY", 6) != 0) (void)parse_npy(head, name);
+      break;
+    case WorldFormat::kVfw:
+      if (head.size() < 8 || std::memcmp(head.data(), "VXFWORLD", 8) != 0) (void)parse_world_file(head, name);
+      break;
+  }
+}
+
+}  // namespace
+
+WorldFormat world_format_of(const std::filesystem::path& path) {
+  const std::string ext = extension(path);
+  if (ext == ".vox") return WorldFormat::kVox;
+  if (ext == ".npy") return WorldFormat::kNpy;
+  if (ext == ".vfw") return WorldFormat::kVfw;
+  throw InvalidArgument(path.string() + ": unknown file type \"" + ext + "\" (expected .vox, .npy or .vfw)");
+}
+
+const char* world_format_name(WorldFormat f) {
+  switch (f) {
+    case WorldFormat::kVox: return "vox";
+    case WorldFormat::kNpy: return "npy";
+    case WorldFormat::kVfw: return "vfw";
+  }
+  return "?";
+}
+
+LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& options) {
+  const WorldFormat format = world_format_of(path);
+  check_magic(path, format);
+  const std::uint64_t limit = effective_memory_limit(options.memory_limit_bytes);
+  const int edge = options.chunk_edge != 0 ? options.chunk_edge : Grid<std::uint8_t>::kDefaultChunkEdge;
+  LoadedWorld out;
+  out.format = format;
+  switch (format) {
+    case WorldFormat::kVox: {
+      VoxImportOptions vo;
+      vo.chunk_edge = edge;
+      vo.memory_limit_bytes = limit;
+      VoxImport in = read_vox(path, vo);
+      out.world = std::move(in.world);
+      const VoxFileInfo& info = in.info;
+      if (info.has_scene_graph) {
+        for (const auto& inst : info.instances)
+          if (!inst.hidden) out.extent = out.extent.unite(inst.world_box);
+      } else if (!info.models.empty()) {
+        out.extent = Box3i::from_size(info.models[0].size);
+      }
+      out.description = "MagicaVoxel .vox, version " + std::to_string(info.version);
+      out.vox = std::move(in.info);
+      break;
+    }
+    case WorldFormat::kNpy: {
+      NpyReadOptions no;
+      no.memory_limit_bytes = limit;
+      const NpyVolume v = read_npy(path, no);
+      out.world = world_from_npy(v, path.string(), edge, limit);
+      out.extent = Box3i::from_size(v.dims);
+      out.description = std::string("NumPy .npy, ") + dtype_name(v.dtype);
+      break;
+    }
+    case WorldFormat::kVfw: {
+      WorldFileReadOptions wo;
+      wo.memory_limit_bytes = limit;
+      WorldFile f = read_world_file(path, wo);
+      const Grid<std::uint8_t>& g = f.world.voxels;
+      out.extent = g.bounds() ? *g.bounds() : g.content_bounds();
+      out.description = "voxfield world, format " + std::to_string(f.version) + ", " +
+                        std::to_string(f.fields.size()) + " distance field(s)";
+      if (options.chunk_edge != 0 && g.chunk_edge() != options.chunk_edge) {
+        // Re-chunked chunk by chunk (the saved fields keep the edge they were saved with, so they
+        // are dropped: they would no longer match the world's chunks).
+        World w(options.chunk_edge);
+        w.voxels = g.rechunked(options.chunk_edge, g.bounds());
+        w.palette = f.world.palette;
+        out.world = std::move(w);
+      } else {
+        out.world = std::move(f.world);
+        out.fields = std::move(f.fields);
+      }
+      break;
+    }
+  }
+  out.extent = out.extent.unite(out.world.voxels.content_bounds());
+  return out;
+}
+
+std::vector<std::uint8_t> encode_world(const World& world, const Box3i& extent, WorldFormat format) {
+  switch (format) {
+    case WorldFormat::kVox: return encode_vox(world);
+    case WorldFormat::kNpy: {
+      Box3i box = extent.unite(world.voxels.content_bounds());
+      if (box.empty()) box = Box3i::from_size({1, 1, 1});
+      require_memory(dense_bytes(box, 2), 0, "npy output", "a dense volume of " + std::to_string(box.volume()) + " voxels");
+      return encode_npy(npy_from_world(world, box));
+    }
+    case WorldFormat::kVfw: return encode_world_file(world);
+  }
+  throw InvalidArgument("encode_world: unknown format");
+}
+
+void save_world(const World& world, const Box3i& extent, const std::filesystem::path& path) {
+  write_file_atomic(path, encode_world(world, extent, world_format_of(path)));
+}
+
+}  // namespace voxfield
