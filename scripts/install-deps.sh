@@ -16,6 +16,7 @@ packages=(
   nlohmann-json3-dev                 # JSON output of the CLI
   libcli11-dev                       # CLI parsing
   libgtest-dev                       # tests
+  clang libclang-rt-14-dev           # the fuzz preset: libFuzzer with ASan + UBSan (CI's fuzz smoke)
   python3 python3-numpy python3-scipy # test oracles: NumPy reads and writes .npy, SciPy's distance transforms
 )
 

@@ -217,7 +217,7 @@ check "bench edits json" 0 $PY -c "
 import json; j = json.load(open('$tmp/edits.json'))
 assert j['edits'] == 40 and j['verify_mismatches'] == 0 and j['latency_ms']['p99'] >= j['latency_ms']['median'] > 0, j"
 
-check "field: lod without focus" 1 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --algorithm lod
+check "field: lod without focus" 2 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --algorithm lod
 check "field: unknown metric" 2 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --metric taxicab
 check "field: spacing with manhattan" 1 "$V" field "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --spacing 1,2,3
 check "field: bad input" 1 "$V" field "$C/dotvox_not_a.vox" -o "$tmp/x.npy"
@@ -334,8 +334,10 @@ cmp -s w.npy w0.npy && passes=$((passes+1)) || { echo "FAIL: field damaged its i
 check "convert onto itself is safe" 0 "$V" convert w.npy w.npy
 cmp -s w.npy w0.npy && passes=$((passes+1)) || { echo "FAIL: convert onto itself changed the file"; fails=$((fails+1)); }
 ln -s w.npy link.npy
-check "convert writes through a symlink" 0 "$V" convert "$K" link.npy
+check "convert writes through a symlink" 0 "$V" convert "$C/ephtracy_chr_cat.vox" link.npy
 [ -L link.npy ] && passes=$((passes+1)) || { echo "FAIL: the symlink was replaced"; fails=$((fails+1)); }
+check "convert cat" 0 "$V" convert "$C/ephtracy_chr_cat.vox" cat.npy
+cmp -s w.npy cat.npy && passes=$((passes+1)) || { echo "FAIL: the symlink's target was not written"; fails=$((fails+1)); }
 check "stats to stdout" 0 "$V" field "$K" -o o2.npy --stats -
 expect_grep "stats on stdout" "$tmp/out" '"algorithm": "exact"'
 mkfifo fifo.vox

@@ -114,8 +114,13 @@ TEST(HostileVox, InstancesOutsideTheCoordinateRangeAreRefused) {
 
 // Class 3: 2^12 one-voxel instances in distinct chunks touch 2^12 chunks (128 MiB at edge 32):
 // refused under a 64 MiB limit before the chunks are allocated, read under a larger one.
-TEST(HostileVox, ManyInstancesInDistinctChunksAreCountedBeforePlacing) {
-  std::vector<Bytes> parts{size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}), transform_chunk(0, 1, -1, {})};
+// The same below z = -2^28, where packed chunk keys used to collide and count one chunk.
+class HostileVoxSwarm : public ::testing::TestWithParam<int> {};
+INSTANTIATE_TEST_SUITE_P(RootOffsets, HostileVoxSwarm, ::testing::Values(0, -(1 << 28), (1 << 28) + 12345));
+
+TEST_P(HostileVoxSwarm, ManyInstancesInDistinctChunksAreCountedBeforePlacing) {
+  std::vector<Bytes> parts{size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}),
+                           transform_chunk(0, 1, -1, {{"_t", "0 0 " + std::to_string(GetParam())}})};
   std::vector<int> children;
   const int n = 4096;
   for (int i = 0; i < n; ++i) children.push_back(2 + 2 * i);
@@ -245,6 +250,39 @@ TEST(HostileWorldFile, DecodedSizeIsCountedBeforeDecompressing) {
   EXPECT_NE(msg.find("dense.vfw"), std::string::npos) << msg;
   EXPECT_NE(msg.find("64 dense"), std::string::npos) << msg;
   EXPECT_EQ(parse_world_file(file, "dense.vfw").world.solid_count(), 64);
+}
+
+TEST(HostileWorldFile, UniformChunksCutByTheBoundsAreCountedAsDense) {
+  // Bounds one voxel thick through 64 chunks of edge 128, each chunk a 14-byte uniform record:
+  // every one becomes a dense 2 MiB chunk (the part outside the bounds reads the background).
+  Bytes grid;
+  auto put = [&](const void* p, std::size_t n) { grid.insert(grid.end(), (const std::uint8_t*)p, (const std::uint8_t*)p + n); };
+  const std::uint32_t edge = 128, vsize = 1;
+  const std::uint8_t background = 0, flag = 1, uniform = 0, value = 5;
+  const std::int32_t bounds[6] = {0, 0, 0, 1, 1024, 1024};
+  const std::uint64_t count = 64;
+  put(&edge, 4), put(&vsize, 4), put(&background, 1), put(&flag, 1), put(bounds, 24), put(&count, 8);
+  for (std::int32_t y = 0; y < 8; ++y)
+    for (std::int32_t z = 0; z < 8; ++z) {
+      const std::int32_t c[3] = {0, y, z};
+      put(c, 12), put(&uniform, 1), put(&value, 1);
+    }
+  Bytes file{'V', 'X', 'F', 'W', 'O', 'R', 'L', 'D'};
+  const std::uint32_t header[3] = {1, 1, 0};
+  file.insert(file.end(), (const std::uint8_t*)header, (const std::uint8_t*)header + 12);
+  const std::uint32_t kind = 1;
+  const std::uint64_t size = 1024 + grid.size();
+  file.insert(file.end(), (const std::uint8_t*)&kind, (const std::uint8_t*)&kind + 4);
+  file.insert(file.end(), (const std::uint8_t*)&size, (const std::uint8_t*)&size + 8);
+  file.insert(file.end(), 1024, 0);  // palette
+  file.insert(file.end(), grid.begin(), grid.end());
+  file.insert(file.end(), 4, 0);  // checksum, fixed below
+  fix_checksums(file);
+  WorldFileReadOptions tight;
+  tight.memory_limit_bytes = 32 * kMiB;
+  const std::string msg = error_of([&] { parse_world_file(file, "cut.vfw", tight); });
+  EXPECT_NE(msg.find("64 dense"), std::string::npos) << msg;
+  EXPECT_EQ(parse_world_file(file, "cut.vfw").world.solid_count(), 1024 * 1024);
 }
 
 TEST(HostileWorldFile, FieldOptionsAreValidated) {

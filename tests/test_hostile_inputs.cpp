@@ -161,3 +161,20 @@ TEST(LoadWorld, ReChunkingFollowsTheContentNotItsBox) {
   EXPECT_EQ(in.extent.size().x, (1 << 28) - 3 + 1);  // x from 3 to 2^28
   fs::remove_all(dir);
 }
+
+TEST(LoadWorld, ReChunkingIsCountedAgainstTheLimit) {
+  // 200 one-voxel chunks of edge 8, 32 voxels apart (a few KB on disk): at edge 128 they make 50
+  // dense chunks of 2 MiB.
+  World w(8);
+  for (int i = 0; i < 200; ++i) w.voxels.set({32 * i, 0, 0}, 1);
+  const fs::path dir = temp_dir("rechunk_limit");
+  write_world_file(w, dir / "sparse.vfw");
+  LoadOptions o;
+  o.chunk_edge = 128;
+  o.memory_limit_bytes = 32u << 20;
+  const std::string msg = error_of([&] { load_world(dir / "sparse.vfw", o); });
+  EXPECT_NE(msg.find("chunks of 128^3"), std::string::npos) << msg;
+  o.memory_limit_bytes = 256u << 20;
+  EXPECT_EQ(load_world(dir / "sparse.vfw", o).world.voxels.chunk_count(), 50u);
+  fs::remove_all(dir);
+}

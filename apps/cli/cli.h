@@ -32,6 +32,13 @@ void add_edit(CLI::App& app, Action& action);
 void add_bench(CLI::App& app, Action& action);
 void add_render(CLI::App& app, Action& action);
 
+// A mistake in the command line found after CLI11's checks (options that contradict each other):
+// exits 2 like every other usage error.
+class UsageError : public InvalidArgument {
+ public:
+  using InvalidArgument::InvalidArgument;
+};
+
 // What the command is doing now ("loading world.vox"), so that a failure no library error
 // describes (out of memory) still names the file and the step.
 void set_activity(std::string what);
@@ -40,6 +47,7 @@ const std::string& activity();
 // CLI11 validators whose messages read well: finite numbers >= 0 (NaN and infinity refused), and
 // camera specifications (checked for syntax when the command line is parsed).
 CLI::Validator finite_non_negative();
+CLI::Validator finite_positive();
 CLI::Validator camera_spec();
 
 // "N" or "X,Y,Z" as given to --size.

@@ -58,7 +58,7 @@ int run_bench_edits(const BenchEditsSettings& s) {
   std::optional<ThreadLimit> limit;
   if (s.field.threads > 0) limit.emplace(s.field.threads);
   const int radius_max = s.radius_max > 0 ? s.radius_max : s.field.chunk_edge - 1;
-  if (s.radius_min < 0 || radius_max < s.radius_min) throw InvalidArgument("need 0 <= --radius-min <= --radius-max");
+  if (s.radius_min < 0 || radius_max < s.radius_min) throw UsageError("need 0 <= --radius-min <= --radius-max");
   Outputs outputs;
   outputs.expect(s.csv, "--csv");
   outputs.expect(s.json, "--json");

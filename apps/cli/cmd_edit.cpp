@@ -45,9 +45,7 @@ int run_edit(const EditSettings& s) {
   set_activity("loading " + s.in);
   const LoadedWorld in = load_world(s.in, {s.field.chunk_edge});
   if (in.extent.empty()) throw InvalidArgument(s.in + ": the input holds no volume");
-  World world(s.field.chunk_edge);
-  world.voxels = in.world.voxels.rechunked(s.field.chunk_edge, in.extent);
-  world.palette = in.world.palette;
+  World world = rechunk_world(in.world, s.field.chunk_edge, in.extent, s.in);
   set_activity("building the field of " + s.in);
   const auto t_build = std::chrono::steady_clock::now();
   LiveField field(world, o, s.backend);

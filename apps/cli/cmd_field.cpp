@@ -33,7 +33,7 @@ int run_field(const FieldSettings& s) {
   AlgorithmOptions a;
   a.algorithm = parse_algorithm(s.algorithm);
   a.focus = s.field.focus_box();
-  if (a.algorithm == Algorithm::kLod && !a.focus) throw InvalidArgument("--algorithm lod needs --focus");
+  if (a.algorithm == Algorithm::kLod && !a.focus) throw UsageError("--algorithm lod needs --focus");
   if (o.nearest_sites && !algorithm_tracks_sites(a, o)) {
     throw InvalidArgument("--sites: the " + s.algorithm + " algorithm does not track nearest sites");
   }

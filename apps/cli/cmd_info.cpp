@@ -85,7 +85,8 @@ int run_info(const InfoSettings& s) {
     j["vox"]["chunk_counts"] = v.chunk_counts;
   }
   // Instances are streamed one by one: a scene graph may hold a million of them.
-  std::string head = j.dump(2);
+  // Names and chunk ids come from the file: bytes that are not UTF-8 are replaced, not fatal.
+  std::string head = j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
   if (!in.vox) {
     std::cout << head << "\n";
     return 0;
@@ -95,7 +96,7 @@ int run_info(const InfoSettings& s) {
   bool first = true;
   for (const auto& i : in.vox->instances) {
     const nlohmann::json one{{"model", i.model}, {"name", i.name}, {"hidden", i.hidden}, {"box", box_json(i.world_box)}};
-    std::cout << (first ? "\n    " : ",\n    ") << one.dump();
+    std::cout << (first ? "\n    " : ",\n    ") << one.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     first = false;
   }
   std::cout << (first ? "]\n}\n" : "\n  ]\n}\n");

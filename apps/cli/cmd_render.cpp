@@ -66,11 +66,13 @@ int run_render(const RenderSettings& s) {
   std::sort(times.begin(), times.end());
   st.ms = times[times.size() / 2];
   outputs.stage(s.out, encode_png(image));
-  std::cout << "voxfield render: " << s.out << " (" << s.width << "x" << s.height << ", " << s.view << " view), "
+  // The status goes to stderr when the frame itself goes to standard output.
+  std::ostream& status = s.out == "-" ? std::cerr : std::cout;
+  status << "voxfield render: " << s.out << " (" << s.width << "x" << s.height << ", " << s.view << " view), "
             << st.ms << " ms, " << st.rays_per_second() / 1e6 << " M primary rays/s, fields " << scene.field_ms()
             << " ms\n";
   if (o.view == RenderView::kError)
-    std::cout << "  " << s.algorithm << ": " << st.rays_through_geometry
+    status << "  " << s.algorithm << ": " << st.rays_through_geometry
               << " rays skip through geometry, largest error on a ray " << st.max_error << " voxels\n";
   if (!s.stats.empty()) {
     auto counters = [](const TraversalCounters& c) {

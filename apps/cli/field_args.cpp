@@ -23,7 +23,7 @@ void FieldArgs::add_to(CLI::App* cmd) {
   cmd->add_option("--spacing", spacing, "voxel size sx,sy,sz (euclidean only)")
       ->delimiter(',')
       ->expected(3)
-      ->check(finite_non_negative());
+      ->check(finite_positive());
   cmd->add_option("--focus", focus, "focus box x0,y0,z0,x1,y1,z1 for lod (min inclusive, max exclusive)")
       ->delimiter(',')
       ->expected(6);
@@ -51,7 +51,7 @@ nlohmann::json FieldArgs::describe(const DistanceOptions& o, Vec3i dims) const {
 std::optional<Box3i> FieldArgs::focus_box() const {
   if (focus.empty()) return std::nullopt;
   const Box3i b{{focus[0], focus[1], focus[2]}, {focus[3], focus[4], focus[5]}};
-  if (b.empty()) throw InvalidArgument("--focus box " + to_string(b) + " is empty");
+  if (b.empty()) throw UsageError("--focus box " + to_string(b) + " is empty");
   return b;
 }
 

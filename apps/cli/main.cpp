@@ -33,6 +33,18 @@ CLI::Validator finite_non_negative() {
       "NUMBER >= 0");
 }
 
+CLI::Validator finite_positive() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::string copy = text;
+        const std::string e = finite_non_negative().operator()(copy);
+        if (!e.empty()) return e;
+        if (std::stod(text) == 0) return "must be a finite number > 0, got " + text;
+        return {};
+      },
+      "NUMBER > 0");
+}
+
 CLI::Validator camera_spec() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
@@ -100,8 +112,16 @@ int main(int argc, char** argv) {
         return 2;
       }
     }
-    (void)voxfield::default_memory_limit();  // a malformed VOXFIELD_MEMORY_LIMIT is reported here
+    try {
+      (void)voxfield::default_memory_limit();  // a malformed VOXFIELD_MEMORY_LIMIT is reported here
+    } catch (const voxfield::InvalidArgument& e) {
+      std::cerr << "voxfield: " << e.what() << "\n";
+      return 2;
+    }
     return action ? action() : 2;
+  } catch (const voxfield::cli::UsageError& e) {
+    std::cerr << "voxfield: " << e.what() << "\n";
+    return 2;
   } catch (const voxfield::Error& e) {
     std::cerr << "voxfield: error: " << e.what() << "\n";
     return 1;

@@ -10,7 +10,7 @@ namespace {
 
 // Two names for one file: the same existing file, or the same path once made absolute.
 bool same_target(const std::string& a, const std::string& b) {
-  if (a == "-" || b == "-") return false;
+  if (a == "-" || b == "-") return a == b;  // standard output once at most
   if (same_file(a, b)) return true;
   std::error_code ea, eb;
   const auto ca = std::filesystem::weakly_canonical(a, ea), cb = std::filesystem::weakly_canonical(b, eb);

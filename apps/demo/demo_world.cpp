@@ -48,9 +48,7 @@ DemoWorld::DemoWorld(const WorldSettings& settings, const std::filesystem::path&
   extent = Box3i{extent.begin - Vec3i{margin, margin, 0}, extent.end + Vec3i::splat(margin)};
   if (extent.volume() > std::int64_t{1024} * 1024 * 1024)
     throw InvalidArgument(file.string() + ": the world's box " + to_string(extent) + " is too large for the demo");
-  world_ = std::make_unique<World>(settings.chunk_edge, extent);
-  world_->palette = in.world.palette;
-  world_->voxels = in.world.voxels.rechunked(settings.chunk_edge, extent);
+  world_ = std::make_unique<World>(rechunk_world(in.world, settings.chunk_edge, extent, file.string()));
   origin_ = file.filename().string();
   make_scene();
 }

@@ -28,6 +28,7 @@
 #include "fly_camera.h"
 #include "gl_window.h"
 #include "voxfield/error.h"
+#include "voxfield/file.h"
 #include "voxfield/gpu.h"
 #include "voxfield/gpu_vulkan.h"
 #include "voxfield/image.h"
@@ -583,6 +584,7 @@ int Demo::run() {
 int main(int argc, char** argv) {
   using namespace voxfield;
   using namespace voxfield::demo;
+  install_signal_cleanup();  // a save interrupted by Ctrl-C leaves no temporary behind
   Options o;
   CLI::App app{"voxfield-demo: paint a voxel world and watch its distance fields follow"};
   std::string metric = "manhattan";

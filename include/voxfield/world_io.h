@@ -44,6 +44,12 @@ struct LoadedWorld {
 // Throws FormatError / IoError / ResourceLimitError naming the file.
 LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& options = {});
 
+// The world in chunks of another edge and other bounds (Grid::rechunked), after counting what the
+// copy will allocate against the memory limit (0: the process default): a target chunk is dense
+// unless it lies inside one uniform source chunk. Throws ResourceLimitError naming `who`.
+World rechunk_world(const World& world, int chunk_edge, std::optional<Box3i> bounds, const std::string& who,
+                    std::uint64_t memory_limit_bytes = 0);
+
 // The bytes of `world` in a format; for .npy the box `extent` united with the content is written
 // (a 1^3 box when both are empty).
 std::vector<std::uint8_t> encode_world(const World& world, const Box3i& extent, WorldFormat format);

@@ -377,11 +377,14 @@ void FileTransaction::commit() {
   }
   std::vector<std::pair<fs::path, fs::path>> directories;  // each with the first target in it
   try {
+    // In-place outputs (standard output, devices, FIFOs) first: they are the ones that can fail
+    // at this point (a full device, a closed pipe) and cannot be undone, so a failure among them
+    // leaves every renamed target untouched. The renames that follow do not fail in practice.
     for (Staged& s : impl_->staged) {
-      if (s.temporary.empty()) {
-        write_in_place(s);
-        continue;
-      }
+      if (s.temporary.empty()) write_in_place(s);
+    }
+    for (Staged& s : impl_->staged) {
+      if (s.temporary.empty()) continue;
       if (::rename(s.temporary.c_str(), s.out.target.c_str()) != 0) {
         throw IoError(s.path.string() + ": cannot replace " + s.out.target.string() + ": " +
                       errno_text());

@@ -124,16 +124,16 @@ struct ModelData {
     std::uint16_t x, y, z;
     std::uint8_t c;
   };
-  std::vector<Voxel> voxels;  // XYZI models
-  // TDCZ models: one colour index per voxel of the SIZE box, x fastest (kept dense: a voxel list
-  // would take 8 bytes per solid voxel of a model that can hold 2^30).
-  std::vector<std::uint8_t> dense;
+  std::vector<Voxel> voxels;  // XYZI models, and TDCZ models that are mostly air
+  // TDCZ models at least an eighth solid: one colour index per voxel of the SIZE box, x fastest
+  // (a voxel list would take 8 bytes per solid voxel of a model that can hold 2^30).
+  std::vector<std::uint8_t> dense;  // empty: the model is in `voxels`
 
   std::int64_t solid_count() const { return info.voxel_count; }
   // Calls f(x, y, z, colour) for every solid voxel.
   template <class F>
   void for_each_voxel(F&& f) const {
-    if (!info.compressed) {
+    if (dense.empty()) {
       for (const Voxel& v : voxels) f(v.x, v.y, v.z, v.c);
       return;
     }
@@ -364,8 +364,21 @@ class VoxParser {
                         (z.msg ? std::string(z.msg) : std::string("no zlib message")) +
                         "), expected " + std::to_string(n));
     }
-    m.info.voxel_count = static_cast<std::int64_t>(dense.size() - static_cast<std::size_t>(std::count(dense.begin(), dense.end(), 0)));
-    m.dense = std::move(dense);
+    const std::size_t solid = dense.size() - static_cast<std::size_t>(std::count(dense.begin(), dense.end(), 0));
+    m.info.voxel_count = static_cast<std::int64_t>(solid);
+    if (solid * sizeof(ModelData::Voxel) <= dense.size()) {
+      // Mostly air: a voxel list, so that placing the model costs its solid voxels, not its box
+      // (a DAG may place one model a million times).
+      std::size_t i = 0;
+      for (int zc = 0; zc < s.z; ++zc)
+        for (int y = 0; y < s.y; ++y)
+          for (int x = 0; x < s.x; ++x, ++i)
+            if (dense[i] != 0) {
+              m.voxels.push_back({static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), static_cast<std::uint16_t>(zc), dense[i]});
+            }
+    } else {
+      m.dense = std::move(dense);  // at least an eighth solid: placing costs at most 8x its solid voxels
+    }
     models_.push_back(std::move(m));
   }
 
@@ -529,13 +542,16 @@ class VoxParser {
     const std::uint64_t limit = effective_memory_limit(options_.memory_limit_bytes);
     const std::uint64_t budget = limit > reader_bytes_ ? limit - reader_bytes_ : 0;
     const std::uint64_t max_chunks = budget / per_chunk;
-    auto key = [](std::int64_t x, std::int64_t y, std::int64_t z) {
-      // Chunk coordinates of the supported range fit in 21 bits each.
-      return (static_cast<std::uint64_t>(x + (1 << 20)) << 42) | (static_cast<std::uint64_t>(y + (1 << 20)) << 21) |
-             static_cast<std::uint64_t>(z + (1 << 20));
+    struct Hash {
+      std::size_t operator()(const Vec3i& c) const noexcept {
+        std::uint64_t h = static_cast<std::uint32_t>(c.x) * 0x9E3779B185EBCA87ull;
+        h ^= static_cast<std::uint32_t>(c.y) * 0xC2B2AE3D27D4EB4Full + (h << 6) + (h >> 2);
+        h ^= static_cast<std::uint32_t>(c.z) * 0x165667B19E3779F9ull + (h << 6) + (h >> 2);
+        return static_cast<std::size_t>(h ^ (h >> 29));
+      }
     };
-    std::unordered_set<std::uint64_t> chunks;
-    auto add = [&](std::uint64_t k, std::uint64_t at) {
+    std::unordered_set<Vec3i, Hash> chunks;
+    auto add = [&](Vec3i k, std::uint64_t at) {
       if (chunks.insert(k).second && chunks.size() > max_chunks) {
         require_memory(add_sat(reader_bytes_, mul_sat(chunks.size(), per_chunk)), limit, name_,
                        "placing its voxels (at least " + std::to_string(chunks.size()) + " chunks of " +
@@ -552,12 +568,12 @@ class VoxParser {
         const std::array<std::int64_t, 3> pivot{m.info.size.x / 2, m.info.size.y / 2, m.info.size.z / 2};
         m.for_each_voxel([&](int x, int y, int z, std::uint8_t) {
           const auto p = pl.frame.place({x, y, z}, pivot);
-          add(key(p[0] >> shift, p[1] >> shift, p[2] >> shift), pl.offset);
+          add({static_cast<int>(p[0] >> shift), static_cast<int>(p[1] >> shift), static_cast<int>(p[2] >> shift)}, pl.offset);
         });
       } else {
         for (int z = lo.z; z <= hi.z; ++z)
           for (int y = lo.y; y <= hi.y; ++y)
-            for (int x = lo.x; x <= hi.x; ++x) add(key(x, y, z), pl.offset);
+            for (int x = lo.x; x <= hi.x; ++x) add({x, y, z}, pl.offset);
       }
     }
     (void)r;

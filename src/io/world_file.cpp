@@ -161,7 +161,10 @@ Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
       if (bounds && g.chunk_box(c).intersect(*bounds).empty()) scan.fail_at(at, "chunk " + to_string(c) + " lies outside the grid bounds");
       if (!seen.insert(c).second) scan.fail_at(at, "chunk " + to_string(c) + " appears twice");
       if (kind == 0) {
-        scan.skip(sizeof(T), "uniform value");
+        // A uniform chunk the bounds cut through is stored densely (the part outside holds the
+        // background), unless it holds the background itself.
+        const T v = get<T>(scan, "uniform value");
+        if (bounds && !bounds->contains(g.chunk_box(c)) && !(v == background)) ++dense;
       } else if (kind == 1) {
         scan.skip(get<std::uint32_t>(scan, "chunk size"), "chunk data");
         ++dense;

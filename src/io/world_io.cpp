@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstring>
+#include <unordered_set>
 
 #include "voxfield/file.h"
 #include "voxfield/limits.h"
@@ -101,10 +102,7 @@ LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& opt
       if (options.chunk_edge != 0 && g.chunk_edge() != options.chunk_edge) {
         // Re-chunked chunk by chunk (the saved fields keep the edge they were saved with, so they
         // are dropped: they would no longer match the world's chunks).
-        World w(options.chunk_edge);
-        w.voxels = g.rechunked(options.chunk_edge, g.bounds());
-        w.palette = f.world.palette;
-        out.world = std::move(w);
+        out.world = rechunk_world(f.world, options.chunk_edge, g.bounds(), path.string(), limit);
       } else {
         out.world = std::move(f.world);
         out.fields = std::move(f.fields);
@@ -113,6 +111,46 @@ LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& opt
     }
   }
   out.extent = out.extent.unite(out.world.voxels.content_bounds());
+  return out;
+}
+
+World rechunk_world(const World& world, int chunk_edge, std::optional<Box3i> bounds, const std::string& who,
+                    std::uint64_t memory_limit_bytes) {
+  const Grid<std::uint8_t>& g = world.voxels;
+  World out(chunk_edge, bounds);  // checks the edge and the bounds
+  const std::uint64_t limit = effective_memory_limit(memory_limit_bytes);
+  const std::uint64_t per_chunk = static_cast<std::uint64_t>(chunk_edge) * chunk_edge * chunk_edge + 96;
+  const int shift = out.voxels.chunk_shift();
+  struct Hash {
+    std::size_t operator()(const Vec3i& c) const noexcept {
+      return static_cast<std::size_t>(static_cast<std::uint32_t>(c.x)) * 73856093u ^
+             static_cast<std::size_t>(static_cast<std::uint32_t>(c.y)) * 19349663u ^
+             static_cast<std::size_t>(static_cast<std::uint32_t>(c.z)) * 83492791u;
+    }
+  };
+  std::unordered_set<Vec3i, Hash> dense;
+  for (const Vec3i c : g.chunk_coords()) {
+    const ChunkView<std::uint8_t> v = g.chunk_view(c);
+    Box3i box = g.bounds() ? v.box.intersect(*g.bounds()) : v.box;
+    if (bounds) box = box.intersect(*bounds);
+    if (box.empty()) continue;
+    const Vec3i lo = out.voxels.chunk_of(box.begin), hi = out.voxels.chunk_of(box.end - Vec3i::splat(1));
+    for (int z = lo.z; z <= hi.z; ++z)
+      for (int y = lo.y; y <= hi.y; ++y)
+        for (int x = lo.x; x <= hi.x; ++x) {
+          const Box3i target{{x << shift, y << shift, z << shift},
+                             {(x + 1) << shift, (y + 1) << shift, (z + 1) << shift}};
+          const Box3i kept = bounds ? target.intersect(*bounds) : target;
+          if (v.uniform() && box.contains(kept)) continue;  // a uniform fill: no voxel array
+          if (dense.insert({x, y, z}).second && dense.size() * per_chunk > limit) {
+            require_memory(dense.size() * per_chunk, limit, who,
+                           "its world in chunks of " + std::to_string(chunk_edge) + "^3 (at least " +
+                               std::to_string(dense.size()) + " dense chunks)");
+          }
+        }
+  }
+  out.voxels = g.rechunked(chunk_edge, bounds);
+  out.palette = world.palette;
   return out;
 }
 

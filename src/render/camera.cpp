@@ -32,8 +32,12 @@ Vec3d parse_vec(const std::string& key, const std::string& text) {
     }
   }
   if (v.size() != 3) throw InvalidArgument("camera: " + key + "=" + text + ": expected three numbers x,y,z");
+  // Bounded so that ray positions stay exactly representable next to voxel coordinates (the
+  // supported range is 2^29; beyond about 2^40 the traversal's conversions to int lose meaning).
   for (double x : v)
-    if (!std::isfinite(x)) throw InvalidArgument("camera: " + key + "=" + text + ": not finite");
+    if (!std::isfinite(x) || std::abs(x) > 1e12) {
+      throw InvalidArgument("camera: " + key + "=" + text + ": each coordinate must be finite and within +-1e12");
+    }
   return {v[0], v[1], v[2]};
 }
 
