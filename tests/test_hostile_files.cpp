@@ -8,6 +8,7 @@
 #include <string>
 
 #include "vox_builder.h"
+#include "error_text.h"
 #include "voxfield/limits.h"
 #include "voxfield/npy.h"
 #include "voxfield/vox.h"
@@ -30,16 +31,6 @@ Bytes npy(std::string header, const Bytes& data) {
   b.insert(b.end(), header.begin(), header.end());
   b.insert(b.end(), data.begin(), data.end());
   return b;
-}
-
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 }  // namespace

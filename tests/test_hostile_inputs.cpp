@@ -8,24 +8,16 @@
 
 #include "voxfield/edit_script.h"
 #include "voxfield/file.h"
+#include "error_text.h"
 #include "voxfield/limits.h"
 #include "voxfield/world_file.h"
 #include "voxfield/world_io.h"
 
 using namespace voxfield;
+using voxfield::test::error_of;
 namespace fs = std::filesystem;
 
 namespace {
-
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 fs::path temp_dir(const char* name) {
   const fs::path d = fs::temp_directory_path() / ("voxfield_hostile_" + std::string(name) + "_" + std::to_string(::getpid()));

@@ -39,7 +39,20 @@ std::string bytes_text(std::size_t bytes) {
   return os.str();
 }
 
-int print_text(const InfoSettings& s, const LoadedWorld& in);
+// What both outputs report, computed once.
+struct Summary {
+  Box3i content;
+  GridMemory memory;
+  int materials_used = 0;
+  std::int64_t solid = 0;
+
+  explicit Summary(const World& w) : content(w.voxels.content_bounds()), memory(w.voxels.memory()), solid(w.solid_count()) {
+    const auto histogram = w.material_histogram();
+    for (int m = 1; m < 256; ++m) materials_used += histogram[m] > 0;
+  }
+};
+
+int print_text(const InfoSettings& s, const LoadedWorld& in, const Summary& sum);
 
 int run_info(const InfoSettings& s) {
   set_activity("loading " + s.path);
@@ -47,14 +60,13 @@ int run_info(const InfoSettings& s) {
   lo.chunk_edge = s.chunk_edge;
   const LoadedWorld in = load_world(s.path, lo);
   set_activity("describing " + s.path);
-  if (!s.json) return print_text(s, in);
+  const Summary sum(in.world);
+  if (!s.json) return print_text(s, in, sum);
   const Grid<std::uint8_t>& g = in.world.voxels;
-  const Box3i content = g.content_bounds();
-  const GridMemory mem = g.memory();
-  const auto histogram = in.world.material_histogram();
-  int materials_used = 0;
-  for (int m = 1; m < 256; ++m) materials_used += histogram[m] > 0;
-  const std::int64_t solid = in.world.solid_count();
+  const Box3i& content = sum.content;
+  const GridMemory& mem = sum.memory;
+  const int materials_used = sum.materials_used;
+  const std::int64_t solid = sum.solid;
 
   nlohmann::json j;
   j["file"] = s.path;
@@ -103,14 +115,12 @@ int run_info(const InfoSettings& s) {
   return 0;
 }
 
-int print_text(const InfoSettings& s, const LoadedWorld& in) {
+int print_text(const InfoSettings& s, const LoadedWorld& in, const Summary& sum) {
   const Grid<std::uint8_t>& g = in.world.voxels;
-  const Box3i content = g.content_bounds();
-  const GridMemory mem = g.memory();
-  const auto histogram = in.world.material_histogram();
-  int materials_used = 0;
-  for (int m = 1; m < 256; ++m) materials_used += histogram[m] > 0;
-  const std::int64_t solid = in.world.solid_count();
+  const Box3i& content = sum.content;
+  const GridMemory& mem = sum.memory;
+  const int materials_used = sum.materials_used;
+  const std::int64_t solid = sum.solid;
   std::cout << "file:          " << s.path << " (" << in.description << ")\n";
   std::cout << "dimensions:    " << dims_text(in.extent.size()) << "\n";
   std::cout << "bounding box:  " << (content.empty() ? std::string("(empty)") : to_string(content)) << "\n";

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -124,6 +125,16 @@ struct Box3i {
     return {begin - Vec3i::splat(voxels), end + Vec3i::splat(voxels)};
   }
   friend constexpr bool operator==(const Box3i& a, const Box3i& b) = default;
+};
+
+// Hash of a coordinate for unordered containers (chunk maps, sets of chunks).
+struct Vec3iHash {
+  std::size_t operator()(const Vec3i& c) const noexcept {
+    std::uint64_t h = static_cast<std::uint32_t>(c.x) * 0x9E3779B185EBCA87ull;
+    h ^= static_cast<std::uint32_t>(c.y) * 0xC2B2AE3D27D4EB4Full + (h << 6) + (h >> 2);
+    h ^= static_cast<std::uint32_t>(c.z) * 0x165667B19E3779F9ull + (h << 6) + (h >> 2);
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
 };
 
 inline constexpr Box3i kCoordRange{Vec3i::splat(-kCoordLimit), Vec3i::splat(kCoordLimit)};

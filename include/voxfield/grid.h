@@ -222,15 +222,7 @@ class Grid {
     T ref{};
     std::int64_t ref_count = 0;
   };
-  struct CoordHash {
-    std::size_t operator()(const Vec3i& c) const noexcept {
-      std::uint64_t h = static_cast<std::uint32_t>(c.x) * 0x9E3779B185EBCA87ull;
-      h ^= static_cast<std::uint32_t>(c.y) * 0xC2B2AE3D27D4EB4Full + (h << 6) + (h >> 2);
-      h ^= static_cast<std::uint32_t>(c.z) * 0x165667B19E3779F9ull + (h << 6) + (h >> 2);
-      return static_cast<std::size_t>(h ^ (h >> 29));
-    }
-  };
-  using ChunkMap = std::unordered_map<Vec3i, Chunk, CoordHash>;
+  using ChunkMap = std::unordered_map<Vec3i, Chunk, Vec3iHash>;
 
   std::int64_t local_index(Vec3i p) const {
     const int mask = chunk_edge_ - 1;

@@ -17,6 +17,7 @@
 
 #include "file_temporaries.h"
 #include "voxfield/error.h"
+#include "voxfield/limits.h"
 
 namespace voxfield {
 namespace {
@@ -52,21 +53,6 @@ int open_retrying(const char* path, int flags, mode_t mode = 0) {
   do fd = ::open(path, flags, mode);
   while (fd < 0 && errno == EINTR);
   return fd;
-}
-
-// "1.5 KiB", "256.0 MiB"; plain bytes below 1 KiB.
-std::string readable_size(std::uint64_t bytes) {
-  if (bytes < 1024) return std::to_string(bytes) + " bytes";
-  static const char* const kUnits[] = {"KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
-  double value = static_cast<double>(bytes) / 1024.0;
-  int unit = 0;
-  while (value >= 1024.0 && unit < 5) {
-    value /= 1024.0;
-    ++unit;
-  }
-  char text[32];
-  std::snprintf(text, sizeof text, "%.1f %s", value, kUnits[unit]);
-  return text;
 }
 
 const char* kind_of(mode_t mode) {
@@ -296,8 +282,8 @@ std::vector<std::uint8_t> read_file(const std::filesystem::path& path, std::uint
   const Fd fd = open_regular(path, st);
   const auto size = static_cast<std::uint64_t>(st.st_size);
   if (size > max_bytes) {
-    throw IoError(path.string() + ": file of " + readable_size(size) + " exceeds the limit of " +
-                  readable_size(max_bytes));
+    throw IoError(path.string() + ": file of " + format_bytes(size) + " exceeds the limit of " +
+                  format_bytes(max_bytes));
   }
   return read_up_to(fd, path, static_cast<std::size_t>(size));
 }

@@ -15,6 +15,7 @@
 #include <unordered_set>
 
 #include "byte_reader.h"
+#include "vox_affine.h"
 #include "voxfield/file.h"
 #include "voxfield/limits.h"
 #include "voxfield/vox.h"
@@ -22,6 +23,7 @@
 namespace voxfield {
 namespace {
 
+using detail::Affine;
 using detail::ByteReader;
 
 constexpr int kMaxModelEdge = 1024;        // MagicaVoxel writes at most 256; leave room for others
@@ -80,42 +82,6 @@ std::int32_t read_count(ByteReader& r, std::size_t bytes_each, const char* what)
   }
   return n;
 }
-
-// A proper rotation or reflection of the axes, as MagicaVoxel stores it in one byte: bits 0-1 give
-// the column of the non-zero entry of row 0, bits 2-3 that of row 1 (row 2 takes the remaining
-// column) and bits 4, 5, 6 make rows 0, 1, 2 negative.
-struct Affine {
-  std::array<std::array<int, 3>, 3> r{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
-  std::array<std::int64_t, 3> t{0, 0, 0};
-
-  Affine then_child(const Affine& c) const {  // this * c
-    Affine out;
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) {
-        int s = 0;
-        for (int k = 0; k < 3; ++k) s += r[i][k] * c.r[k][j];
-        out.r[i][j] = s;
-      }
-      std::int64_t s = t[i];
-      for (int k = 0; k < 3; ++k) s += r[i][k] * c.t[k];
-      out.t[i] = s;
-    }
-    return out;
-  }
-  // floor(T + R * (v - pivot + 0.5)) computed exactly in integers: with q = 2(v - pivot) + 1 (odd),
-  // R q is odd on every axis and the floor of (R q) / 2 is an arithmetic shift.
-  std::array<std::int64_t, 3> place(const std::array<std::int64_t, 3>& v,
-                                    const std::array<std::int64_t, 3>& pivot) const {
-    std::array<std::int64_t, 3> q{}, out{};
-    for (int k = 0; k < 3; ++k) q[k] = 2 * (v[k] - pivot[k]) + 1;
-    for (int i = 0; i < 3; ++i) {
-      std::int64_t s = 0;
-      for (int k = 0; k < 3; ++k) s += r[i][k] * q[k];
-      out[i] = t[i] + (s >> 1);
-    }
-    return out;
-  }
-};
 
 struct ModelData {
   VoxModelInfo info;
@@ -542,15 +508,7 @@ class VoxParser {
     const std::uint64_t limit = effective_memory_limit(options_.memory_limit_bytes);
     const std::uint64_t budget = limit > reader_bytes_ ? limit - reader_bytes_ : 0;
     const std::uint64_t max_chunks = budget / per_chunk;
-    struct Hash {
-      std::size_t operator()(const Vec3i& c) const noexcept {
-        std::uint64_t h = static_cast<std::uint32_t>(c.x) * 0x9E3779B185EBCA87ull;
-        h ^= static_cast<std::uint32_t>(c.y) * 0xC2B2AE3D27D4EB4Full + (h << 6) + (h >> 2);
-        h ^= static_cast<std::uint32_t>(c.z) * 0x165667B19E3779F9ull + (h << 6) + (h >> 2);
-        return static_cast<std::size_t>(h ^ (h >> 29));
-      }
-    };
-    std::unordered_set<Vec3i, Hash> chunks;
+    std::unordered_set<Vec3i, Vec3iHash> chunks;
     auto add = [&](Vec3i k, std::uint64_t at) {
       if (chunks.insert(k).second && chunks.size() > max_chunks) {
         require_memory(add_sat(reader_bytes_, mul_sat(chunks.size(), per_chunk)), limit, name_,

@@ -23,14 +23,6 @@
 namespace voxfield {
 namespace {
 
-struct CoordHash {
-  std::size_t operator()(const Vec3i& c) const noexcept {
-    return static_cast<std::size_t>(static_cast<std::uint32_t>(c.x)) * 73856093u ^
-           static_cast<std::size_t>(static_cast<std::uint32_t>(c.y)) * 19349663u ^
-           static_cast<std::size_t>(static_cast<std::uint32_t>(c.z)) * 83492791u;
-  }
-};
-
 constexpr char kMagic[8] = {'V', 'X', 'F', 'W', 'O', 'R', 'L', 'D'};
 enum SectionKind : std::uint32_t { kWorldSection = 1, kFieldSection = 2 };
 
@@ -145,7 +137,7 @@ Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
   // the decoded size counted before any chunk is decompressed.
   {
     detail::ByteReader scan = r;
-    std::unordered_set<Vec3i, CoordHash> seen;
+    std::unordered_set<Vec3i, Vec3iHash> seen;
     std::uint64_t dense = 0;
     for (std::uint64_t i = 0; i < count; ++i) {
       const std::uint64_t at = scan.offset();

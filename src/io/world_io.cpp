@@ -121,14 +121,7 @@ World rechunk_world(const World& world, int chunk_edge, std::optional<Box3i> bou
   const std::uint64_t limit = effective_memory_limit(memory_limit_bytes);
   const std::uint64_t per_chunk = static_cast<std::uint64_t>(chunk_edge) * chunk_edge * chunk_edge + 96;
   const int shift = out.voxels.chunk_shift();
-  struct Hash {
-    std::size_t operator()(const Vec3i& c) const noexcept {
-      return static_cast<std::size_t>(static_cast<std::uint32_t>(c.x)) * 73856093u ^
-             static_cast<std::size_t>(static_cast<std::uint32_t>(c.y)) * 19349663u ^
-             static_cast<std::size_t>(static_cast<std::uint32_t>(c.z)) * 83492791u;
-    }
-  };
-  std::unordered_set<Vec3i, Hash> dense;
+  std::unordered_set<Vec3i, Vec3iHash> dense;
   for (const Vec3i c : g.chunk_coords()) {
     const ChunkView<std::uint8_t> v = g.chunk_view(c);
     Box3i box = g.bounds() ? v.box.intersect(*g.bounds()) : v.box;
