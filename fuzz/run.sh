@@ -5,6 +5,7 @@
 # fuzz/seeds/. New inputs libFuzzer finds go to a scratch corpus, not into the repository; a
 # crash stops the run with the harness's report and the crashing input under $FUZZ_OUT.
 # Usage: bash fuzz/run.sh [SECONDS] [HARNESS...]   (needs build/fuzz and build/release/bin/voxfield)
+# FUZZ_RUNS=N stops each harness after N executions instead (with SECONDS still the cap).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-25}; shift || true
@@ -33,8 +34,9 @@ for h in $harnesses; do
   esac
   work="$out/corpus-$h"; mkdir -p "$work"
   echo "=== fuzz_$h: ${seconds}s ==="
-  "$bin/fuzz_$h" -max_total_time="$seconds" -max_len="$max_len" -timeout=20 -rss_limit_mb=2560 \
+  runs=${FUZZ_RUNS:+-runs=$FUZZ_RUNS}
+  "$bin/fuzz_$h" -max_total_time="$seconds" $runs -max_len="$max_len" -timeout=20 -rss_limit_mb=2560 \
       -artifact_prefix="$out/crash-$h-" -print_final_stats=1 "$work" $dirs 2>"$out/log-$h.txt" || {
     echo "fuzz_$h FAILED; its log:" >&2; tail -60 "$out/log-$h.txt" >&2; exit 1; }
-  grep -E "stat::number_of_executed_units|stat::peak_rss_mb|cov: " "$out/log-$h.txt" | tail -4
+  grep -E "stat::number_of_executed_units|stat::peak_rss_mb|cov: " "$out/log-$h.txt" | tail -3
 done

@@ -338,6 +338,10 @@ check "convert writes through a symlink" 0 "$V" convert "$C/ephtracy_chr_cat.vox
 [ -L link.npy ] && passes=$((passes+1)) || { echo "FAIL: the symlink was replaced"; fails=$((fails+1)); }
 check "convert cat" 0 "$V" convert "$C/ephtracy_chr_cat.vox" cat.npy
 cmp -s w.npy cat.npy && passes=$((passes+1)) || { echo "FAIL: the symlink's target was not written"; fails=$((fails+1)); }
+printf '{"op":"place","shape":"stamp","file":"cat.npy","offset":[0,0,0]}\n' > stamp.jsonl
+check "edit refuses to overwrite a stamp it reads" 1 "$V" edit "$K" -e stamp.jsonl -o cat.npy
+expect_grep "stamp overwrite refused" "$tmp/err" "also an input"
+cmp -s w.npy cat.npy && passes=$((passes+1)) || { echo "FAIL: the stamp was overwritten"; fails=$((fails+1)); }
 check "stats to stdout" 0 "$V" field "$K" -o o2.npy --stats -
 expect_grep "stats on stdout" "$tmp/out" '"algorithm": "exact"'
 mkfifo fifo.vox

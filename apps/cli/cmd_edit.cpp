@@ -30,13 +30,21 @@ int run_edit(const EditSettings& s) {
   std::optional<ThreadLimit> limit;
   if (s.field.threads > 0) limit.emplace(s.field.threads);
   // Outputs, options and the whole script are checked before the world is loaded: a mistake
-  // anywhere costs nothing and writes nothing.
-  Outputs outputs({s.in, s.edits});
+  // anywhere costs nothing and writes nothing. A first reading of the script checks it and names
+  // the stamps' files, which are inputs too; the second loads the stamps.
+  DistanceOptions o = s.field.options();
+  set_activity("reading the edit script " + s.edits);
+  std::vector<std::filesystem::path> stamps;
+  EditScriptOptions check;
+  check.load_stamps = false;
+  check.stamp_files = &stamps;
+  (void)read_edit_script(s.edits, check);
+  std::vector<std::string> inputs{s.in, s.edits};
+  for (const auto& p : stamps) inputs.push_back(p.string());
+  Outputs outputs(inputs);
   outputs.expect(s.out, "-o");
   outputs.expect(s.stats, "--stats");
   outputs.expect_world(s.save_world, "--save-world");
-  DistanceOptions o = s.field.options();
-  set_activity("reading the edit script " + s.edits);
   EditScriptOptions eo;
   eo.chunk_edge = s.field.chunk_edge;
   const std::vector<Edit> edits = read_edit_script(s.edits, eo);

@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include "cli.h"
+#include "voxfield/limits.h"
 #include "voxfield/parallel.h"
 
 #include <cstring>
@@ -94,6 +95,9 @@ NpyVolume field_volume(const DistanceField& f, const Box3i& box) {
   return std::visit(
       [&](const auto& g) {
         using T = typename std::decay_t<decltype(g)>::value_type;
+        // A dense copy, the volume made of it and its encoding are alive at once.
+        require_memory(mul_sat(dense_bytes(box, sizeof(T)), 3), 0, "field output",
+                       "a dense copy of " + std::to_string(box.volume()) + " values");
         std::vector<T> dense(static_cast<std::size_t>(box.volume()));
         g.copy_to_dense(box, dense.data());
         const DType t = std::is_same_v<T, float> ? DType::kFloat32
@@ -106,6 +110,9 @@ NpyVolume field_volume(const DistanceField& f, const Box3i& box) {
 
 // Nearest-site offsets as int16 a[x, y, z, 3]; -32768 where there is none.
 NpyVolume sites_volume(const Grid<SiteOffset>& g, const Box3i& box) {
+  // The offsets, their planes, the volume and its encoding are alive at once.
+  require_memory(mul_sat(dense_bytes(box, sizeof(SiteOffset)), 4), 0, "--sites output",
+                 "a dense copy of " + std::to_string(box.volume()) + " nearest-site offsets");
   const std::size_t n = static_cast<std::size_t>(box.volume());
   std::vector<SiteOffset> dense(n);
   g.copy_to_dense(box, dense.data());

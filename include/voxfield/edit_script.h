@@ -31,6 +31,9 @@ struct EditScriptOptions {
   int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge;  // of loaded stamp models
   bool load_stamps = true;               // false: stamps keep a null model (syntax checks only)
   std::uint64_t memory_limit_bytes = 0;  // for stamp models; 0: the process default
+  // When set, receives the file of every stamp (resolved against base_dir), loaded or not: the
+  // inputs a command must not overwrite.
+  std::vector<std::filesystem::path>* stamp_files = nullptr;
 };
 
 // One line (without its newline). Throws InvalidArgument saying what is wrong (no file or line:

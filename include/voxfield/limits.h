@@ -43,6 +43,14 @@ std::string format_bytes(std::uint64_t bytes);
 void require_memory(std::uint64_t need_bytes, std::uint64_t limit_bytes, const std::string& who,
                     const std::string& what);
 
+// What is left of a limit (0: the process default) once `used` bytes are held: at least 1, so
+// that the result is never read as "the default". Readers hand it on for the decoded data while
+// they hold the file's bytes.
+inline std::uint64_t remaining_memory(std::uint64_t limit, std::uint64_t used) {
+  const std::uint64_t l = effective_memory_limit(limit);
+  return used < l ? l - used : 1;
+}
+
 // Saturating arithmetic for sizes that come from files: never wraps, caps at UINT64_MAX.
 constexpr std::uint64_t mul_sat(std::uint64_t a, std::uint64_t b) {
   return (a != 0 && b > UINT64_MAX / a) ? UINT64_MAX : a * b;

@@ -113,9 +113,10 @@ Edit parse_edit_line(std::string_view line, const EditScriptOptions& options) {
     if (!f.is_string() || f.get<std::string>().empty()) bad("\"file\" must be a file name");
     const Vec3i offset = j.contains("offset") ? integer_point(j, "offset") : Vec3i{0, 0, 0};
     std::shared_ptr<World> model;
+    std::filesystem::path file = f.get<std::string>();
+    if (file.is_relative()) file = options.base_dir / file;
+    if (options.stamp_files) options.stamp_files->push_back(file);
     if (options.load_stamps) {
-      std::filesystem::path file = f.get<std::string>();
-      if (file.is_relative()) file = options.base_dir / file;
       LoadOptions lo;
       lo.chunk_edge = options.chunk_edge;
       lo.memory_limit_bytes = options.memory_limit_bytes;

@@ -295,10 +295,11 @@ NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name
 }
 
 NpyVolume read_npy(const std::filesystem::path& path, const NpyReadOptions& options) {
-  // The file is read whole (its data is the volume), so it counts against the limit too.
-  const std::uint64_t limit = effective_memory_limit(options.memory_limit_bytes);
-  const auto bytes = read_file(path, limit);
-  return parse_npy(bytes, path.string(), options);
+  // The file is read whole and held while its data is reordered: both count against the limit.
+  const auto bytes = read_file(path, effective_memory_limit(options.memory_limit_bytes));
+  NpyReadOptions rest = options;
+  rest.memory_limit_bytes = remaining_memory(options.memory_limit_bytes, bytes.size());
+  return parse_npy(bytes, path.string(), rest);
 }
 
 std::vector<std::uint8_t> encode_npy(const NpyVolume& v) {

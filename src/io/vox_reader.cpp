@@ -610,7 +610,9 @@ VoxImport parse_vox(std::span<const std::uint8_t> bytes, const std::string& name
 
 VoxImport read_vox(const std::filesystem::path& path, const VoxImportOptions& options) {
   const std::vector<std::uint8_t> bytes = read_file(path, effective_memory_limit(options.memory_limit_bytes));
-  return parse_vox(bytes, path.string(), options);
+  VoxImportOptions rest = options;  // what the file's bytes leave for what they decode to
+  rest.memory_limit_bytes = remaining_memory(options.memory_limit_bytes, bytes.size());
+  return parse_vox(bytes, path.string(), rest);
 }
 
 }  // namespace voxfield

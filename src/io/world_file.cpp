@@ -342,7 +342,9 @@ void write_world_file(const World& world, const std::filesystem::path& path, con
 
 WorldFile read_world_file(const std::filesystem::path& path, const WorldFileReadOptions& options) {
   const auto bytes = read_file(path, effective_memory_limit(options.memory_limit_bytes));
-  return parse_world_file(bytes, path.string(), options);
+  WorldFileReadOptions rest = options;  // what the file's bytes leave for what they decode to
+  rest.memory_limit_bytes = remaining_memory(options.memory_limit_bytes, bytes.size());
+  return parse_world_file(bytes, path.string(), rest);
 }
 
 }  // namespace voxfield

@@ -86,7 +86,8 @@ LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& opt
       NpyReadOptions no;
       no.memory_limit_bytes = limit;
       const NpyVolume v = read_npy(path, no);
-      out.world = world_from_npy(v, path.string(), edge, limit);
+      // The volume is held while the world is built from it.
+      out.world = world_from_npy(v, path.string(), edge, remaining_memory(limit, v.bytes.size()));
       out.extent = Box3i::from_size(v.dims);
       out.description = std::string("NumPy .npy, ") + dtype_name(v.dtype);
       break;
