@@ -108,6 +108,10 @@ TEST(EditScripts, SemanticsAreCheckedAtParseTimeWithTheLine) {
       {R"({"op":"place","shape":"capsule","a":[0,0,0],"b":[1,1,1]})", "missing \"radius\""},
       {R"({"op":"melt","shape":"sphere"})", "unknown op"},
       {R"({"op":"place","shape":"sphere","center":[0,0,0],"radius":1)", "not valid JSON"},
+      // fuzz_edit_script's first finding: a number beyond double's range escaped as nlohmann's
+      // out_of_range instead of a voxfield error.
+      {R"({"op":"place","shape":"sphere","center":[777777777777777777777777e000000000000006714515034139233898,0,0],"radius":1})",
+       "number overflow"},
   };
   for (const auto& b : bad) {
     const std::string msg = error_of([&] { parse(ok + "\n" + b.line + "\n"); });

@@ -62,8 +62,9 @@ Edit parse_edit_line(std::string_view line, const EditScriptOptions& options) {
   json j;
   try {
     j = json::parse(line.begin(), line.end());
-  } catch (const json::parse_error& e) {
-    // nlohmann's message starts with its own error id; keep what it says about the position.
+  } catch (const json::exception& e) {
+    // A syntax error, or a number too large for a double (out_of_range 406, found by
+    // fuzz_edit_script). nlohmann's message starts with its own error id; keep what follows.
     const std::string what = e.what();
     const auto colon = what.find("]: ");
     bad("not valid JSON: " + (colon == std::string::npos ? what : what.substr(colon + 3)));
