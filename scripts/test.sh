@@ -1,19 +1,24 @@
 #!/usr/bin/env bash
-# Quick start, command 2: set up, build and run every test — the optimised build first, then the
-# same suite under AddressSanitizer + UndefinedBehaviorSanitizer (the parsers face untrusted files),
-# then the concurrency tests under ThreadSanitizer.
-# then every libFuzzer harness for a short smoke on its seeds (a parser regression fails CI).
+# Quick start, command 2: set up, build and run every test — the optimised build first (with the
+# layering check and the installed-package consumer), then the build without any GPU dependency
+# (cpu-only), then the same suite under AddressSanitizer + UndefinedBehaviorSanitizer (the parsers
+# face untrusted files), then the concurrency tests under ThreadSanitizer, then every libFuzzer
+# harness for a short smoke on its seeds (a parser regression fails CI).
 # Set VOXFIELD_TEST_PRESETS to choose, e.g. VOXFIELD_TEST_PRESETS=release; VOXFIELD_FUZZ_SECONDS
-# sets the smoke's length per harness (0 skips it).
+# sets the smoke's length per harness (0 skips it). Each phase prints its wall time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
-presets=${VOXFIELD_TEST_PRESETS:-"release asan-ubsan tsan"}
+phase_start=$SECONDS
+phase_done() { echo "=== $1: $((SECONDS - phase_start)) s ==="; phase_start=$SECONDS; }
+presets=${VOXFIELD_TEST_PRESETS:-"release cpu-only asan-ubsan tsan"}
 for preset in $presets; do
   echo "=== voxfield tests: $preset ==="
   cmake --preset "$preset" >/dev/null
   cmake --build --preset "$preset"
+  phase_done "$preset build"
   ctest --preset "$preset" -j "$(nproc)"
+  phase_done "$preset tests"
 done
 fuzz_seconds=${VOXFIELD_FUZZ_SECONDS:-20}
 if [ "$fuzz_seconds" -gt 0 ]; then
@@ -21,5 +26,7 @@ if [ "$fuzz_seconds" -gt 0 ]; then
   cmake --preset release >/dev/null && cmake --build --preset release --target voxfield_cli  # makes the seeds
   cmake --preset fuzz >/dev/null
   cmake --build --preset fuzz
+  phase_done "fuzz build"
   bash fuzz/run.sh "$fuzz_seconds"
+  phase_done "fuzz smoke"
 fi

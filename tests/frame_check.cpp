@@ -9,6 +9,7 @@
 
 #include "voxfield/error.h"
 #include "voxfield/image.h"
+#include "voxfield/png.h"
 
 int main(int argc, char** argv) {
   if (argc != 2) {

@@ -4,6 +4,7 @@
 
 #include <random>
 
+#include "voxfield/dissertation_format.h"
 #include "voxfield/algorithms.h"
 
 using namespace voxfield;

@@ -12,8 +12,9 @@
 
 #include "image_compare.h"
 #include "voxfield/edit.h"
-#include "voxfield/gpu.h"
-#include "voxfield/gpu_vulkan.h"
+#include "voxfield/gpu_distance.h"
+#include "voxfield/gpu_render.h"
+#include "voxfield/gpu_render_vulkan.h"
 
 using namespace voxfield;
 

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "image_compare.h"
+#include "voxfield/png.h"
 #include "voxfield/error.h"
 #include "voxfield/edit.h"
 #include "voxfield/parallel.h"

@@ -14,6 +14,7 @@
 #include "cli.h"
 #include "live_field.h"
 #include "field_args.h"
+#include "voxfield/edit_stream.h"
 #include "voxfield/dynamic_field.h"
 #include "voxfield/parallel.h"
 #include "voxfield/scene.h"

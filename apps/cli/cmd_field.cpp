@@ -5,7 +5,8 @@
 #include "cli.h"
 #include "field_args.h"
 #include "live_field.h"
-#include "voxfield/gpu.h"
+#include "voxfield/dissertation_format.h"
+#include "voxfield/gpu_distance.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
 

@@ -6,8 +6,9 @@
 #include "cli.h"
 #include "field_args.h"
 #include "live_field.h"
+#include "voxfield/png.h"
 #include "voxfield/parallel.h"
-#include "voxfield/gpu.h"
+#include "voxfield/gpu_render.h"
 #include "voxfield/render.h"
 
 namespace voxfield::cli {

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "cli.h"
+#include "voxfield/png.h"
 #include "voxfield/algorithms.h"
 #include "voxfield/dynamic_field.h"
 #include "voxfield/world_file.h"

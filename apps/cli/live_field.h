@@ -9,7 +9,7 @@
 #include <string>
 
 #include "voxfield/dynamic_field.h"
-#include "voxfield/gpu.h"
+#include "voxfield/gpu_distance.h"
 
 namespace voxfield::cli {
 

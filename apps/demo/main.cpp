@@ -27,11 +27,13 @@
 #include "demo_world.h"
 #include "fly_camera.h"
 #include "gl_window.h"
+#include "voxfield/edit_stream.h"
 #include "voxfield/error.h"
 #include "voxfield/file.h"
-#include "voxfield/gpu.h"
-#include "voxfield/gpu_vulkan.h"
+#include "voxfield/gpu_render.h"
+#include "voxfield/gpu_render_vulkan.h"
 #include "voxfield/image.h"
+#include "voxfield/png.h"
 #include "vulkan_window.h"
 
 namespace voxfield::demo {

@@ -69,8 +69,4 @@ struct FieldError {
 // Tolerance: one fixed-point step for integer storage, 1e-4 relative for f32.
 FieldError compare_fields(const DistanceField& approx, const DistanceField& exact, const World& world);
 
-// The dissertation's packed 32-bit voxel: bits 8-15 the Manhattan distance (0..255, clamped),
-// bits 0-7 the voxel's palette colour as RGB332 (0 for air). Dense, x fastest, over `box`.
-std::vector<std::uint32_t> pack_dissertation_format(const World& world, const DistanceField& field, const Box3i& box);
-
 }  // namespace voxfield

@@ -11,7 +11,6 @@
 
 #include <array>
 #include <memory>
-#include <random>
 #include <unordered_map>
 #include <variant>
 #include <vector>
@@ -113,23 +112,6 @@ bool brush_contains(const StampBrush& brush, Vec3i p);
 struct EditResult {
   Box3i changed_box;          // smallest box holding every changed voxel (empty if none)
   std::int64_t voxels_changed = 0;
-};
-
-// The reference dissertation's automated edits: sphere brushes centred anywhere in `box`, radii
-// uniform in [radius_min, radius_max], materials uniform in 0..255 where 0 (air) carves and the
-// rest place — the same stream for the same seed on every machine (`voxfield bench edits`, the
-// demo's benchmark mode).
-class RandomEditStream {
- public:
-  // Throws InvalidArgument for an empty box or radii outside 0 <= min <= max.
-  RandomEditStream(const Box3i& box, std::uint64_t seed, int radius_min, int radius_max);
-  Edit next();
-
- private:
-  int uniform(int lo, int hi);
-  Box3i box_;
-  std::mt19937_64 rng_;  // specified bit for bit by the standard (the distributions are not: unused)
-  int radius_min_, radius_max_;
 };
 
 // Throws InvalidArgument for a malformed edit (see apply_edit); does nothing otherwise.

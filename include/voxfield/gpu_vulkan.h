@@ -1,5 +1,7 @@
-// voxfield — handing voxfield an application's own Vulkan device (the demo, an engine). Includes
-// the Vulkan headers for the handle types only; voxfield calls Vulkan through its own loader table.
+// voxfield — handing voxfield an application's own Vulkan device (the demo, an engine): the GPU
+// compute layer's side; recording frames into the application's command buffers is in
+// gpu_render_vulkan.h. Includes the Vulkan headers for the handle types only; voxfield calls
+// Vulkan through its own loader table.
 #pragma once
 
 #ifndef VK_NO_PROTOTYPES
@@ -27,19 +29,5 @@ struct AdoptedDevice {
 // the context and does not use the queue from another thread while voxfield submits to it.
 // Throws InvalidArgument for missing handles, GpuUnavailable when the queue cannot compute.
 std::shared_ptr<Context> adopt(const AdoptedDevice& device);
-
-enum class PixelOrder { kRgba, kBgra };  // byte order of a packed 32-bit pixel
-
-// Records a frame of `renderer`'s synced scene into the application's command buffer `cmd` (on
-// the adopted queue's family): frame parameters, the ray-marching dispatch, and a barrier that
-// makes the pixels readable by transfers. Returns the buffer holding them: width x height packed
-// 8-bit pixels in `order` (sRGB-encoded, alpha 255), top row first — ready for
-// vkCmdCopyBufferToImage into a UNORM swapchain image. The buffer and the frame's parameters are
-// reused by the next frame: wait for `cmd` before recording another frame. SceneRenderer::sync()
-// may run while the frame executes (its copies wait for it on the queue; buffers it replaces live
-// until the sync after).
-// Throws InvalidArgument as SceneRenderer::render does.
-VkBuffer record_render(SceneRenderer& renderer, VkCommandBuffer cmd, const Camera& camera,
-                       const RenderOptions& options, PixelOrder order);
 
 }  // namespace voxfield::gpu

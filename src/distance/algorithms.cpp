@@ -1,4 +1,5 @@
 // voxfield — runs the dissertation's algorithm family and measures it against the exact field.
+#include "voxfield/dissertation_format.h"
 #include "voxfield/algorithms.h"
 
 #include <chrono>

@@ -1,6 +1,7 @@
 // voxfield — the reference dissertation's seeded stream of random sphere edits.
 #include <string>
 
+#include "voxfield/edit_stream.h"
 #include "voxfield/edit.h"
 #include "voxfield/error.h"
 

@@ -8,9 +8,10 @@
 #include <chrono>
 #include <cstring>
 
-#include "../../shaders/layout.h"
-#include "../distance/family_driver.h"
-#include "vulkan_context.h"
+#include "shaders/layout.h"
+#include "../family_driver.h"
+#include "gpu/vulkan_context.h"
+#include "voxfield/gpu_distance.h"
 
 namespace voxfield::gpu {
 namespace {

@@ -10,10 +10,10 @@
 #include <chrono>
 #include <cstring>
 
-#include "../../shaders/layout.h"
-#include "../render/scene_impl.h"
-#include "voxfield/gpu_vulkan.h"
-#include "vulkan_context.h"
+#include "shaders/layout.h"
+#include "../scene_impl.h"
+#include "voxfield/gpu_render_vulkan.h"
+#include "gpu/vulkan_context.h"
 
 namespace voxfield::gpu {
 namespace {

@@ -17,9 +17,10 @@
 #include <cmath>
 #include <cstring>
 
-#include "../../shaders/layout.h"
-#include "../edit/update_regions.h"
-#include "vulkan_context.h"
+#include "shaders/layout.h"
+#include "edit/update_regions.h"
+#include "gpu/vulkan_context.h"
+#include "voxfield/gpu_distance.h"
 
 namespace voxfield::gpu {
 namespace {

@@ -1,0 +1,24 @@
+// voxfield — the ray marcher recorded into an application's own command buffer (on a device
+// handed over with gpu::adopt, gpu_vulkan.h). Includes the Vulkan headers for the handle types only.
+#pragma once
+
+#include "voxfield/gpu_render.h"
+#include "voxfield/gpu_vulkan.h"
+
+namespace voxfield::gpu {
+
+enum class PixelOrder { kRgba, kBgra };  // byte order of a packed 32-bit pixel
+
+// Records a frame of `renderer`'s synced scene into the application's command buffer `cmd` (on
+// the adopted queue's family): frame parameters, the ray-marching dispatch, and a barrier that
+// makes the pixels readable by transfers. Returns the buffer holding them: width x height packed
+// 8-bit pixels in `order` (sRGB-encoded, alpha 255), top row first — ready for
+// vkCmdCopyBufferToImage into a UNORM swapchain image. The buffer and the frame's parameters are
+// reused by the next frame: wait for `cmd` before recording another frame. SceneRenderer::sync()
+// may run while the frame executes (its copies wait for it on the queue; buffers it replaces live
+// until the sync after).
+// Throws InvalidArgument as SceneRenderer::render does.
+VkBuffer record_render(SceneRenderer& renderer, VkCommandBuffer cmd, const Camera& camera,
+                       const RenderOptions& options, PixelOrder order);
+
+}  // namespace voxfield::gpu
