@@ -17,6 +17,7 @@ packages=(
   libcli11-dev                       # CLI parsing
   libgtest-dev                       # tests
   clang libclang-rt-14-dev           # the fuzz preset: libFuzzer with ASan + UBSan (CI's fuzz smoke)
+  clang-format                       # the format check (scripts/check_format.sh, a test)
   python3 python3-numpy python3-scipy # test oracles: NumPy reads and writes .npy, SciPy's distance transforms
 )
 

@@ -18,10 +18,30 @@
 namespace voxfield {
 
 // No usable GPU: no Vulkan loader, no device, a device without what voxfield needs, or a build
-// without the Vulkan backend. The message says which.
+// without the Vulkan backend. The message says which. Callers that fall back to the CPU catch this
+// class, which also covers the two failures below. Nothing the call was given has changed.
 class GpuUnavailable : public Error {
  public:
   using Error::Error;
+};
+
+// The device was lost during the call (a driver reset, a hang, a removed GPU). Everything on the
+// device is gone: the Context reports lost() from then on, every later call on it or on an object
+// made with it throws GpuDeviceLost again, and those objects can only be destroyed — make a new
+// Context (or fall back to the CPU). CPU-side objects (worlds, fields handed in) are unchanged.
+class GpuDeviceLost : public GpuUnavailable {
+ public:
+  using GpuUnavailable::GpuUnavailable;
+};
+
+// The device (or the host memory the driver needs) ran out of memory. The call's own allocations
+// are freed and the Context stays usable; an object that keeps data resident on the device
+// (gpu::DynamicField, gpu::SceneRenderer) may hold a partly updated copy afterwards, so it must be
+// rebuilt — DynamicField::rebuild(), SceneRenderer::sync() of a newly made scene — before its next
+// use, or destroyed.
+class GpuOutOfMemory : public GpuUnavailable {
+ public:
+  using GpuUnavailable::GpuUnavailable;
 };
 
 enum class Backend { kCpu, kVulkan, kAuto };
@@ -83,6 +103,8 @@ class Context {
   std::vector<std::string> validation_messages() const;
   void clear_validation_messages();
   bool has_timestamps() const;
+  // True once the device was lost (see GpuDeviceLost): the context can only be destroyed.
+  bool lost() const;
 
   struct Impl;
   Impl& impl() { return *impl_; }

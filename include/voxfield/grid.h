@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "voxfield/box.h"
+#include "voxfield/detail/assert.h"
 #include "voxfield/error.h"
 
 namespace voxfield {

@@ -23,5 +23,6 @@ void Context::reset_counters() {}
 std::vector<std::string> Context::validation_messages() const { return {}; }
 void Context::clear_validation_messages() {}
 bool Context::has_timestamps() const { return false; }
+bool Context::lost() const { return false; }
 
 }  // namespace voxfield::gpu

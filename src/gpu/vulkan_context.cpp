@@ -30,7 +30,16 @@ std::string result_name(VkResult r) {
 }  // namespace
 
 void check(VkResult result, const char* what) {
-  if (result != VK_SUCCESS) throw GpuUnavailable(std::string("Vulkan: ") + what + " failed (" + result_name(result) + ")");
+  if (result == VK_SUCCESS) return;
+  const std::string message = std::string("Vulkan: ") + what + " failed (" + result_name(result) + ")";
+  switch (result) {
+    case VK_ERROR_DEVICE_LOST: throw GpuDeviceLost(message);
+    case VK_ERROR_OUT_OF_DEVICE_MEMORY:
+    case VK_ERROR_OUT_OF_HOST_MEMORY:
+    case VK_ERROR_OUT_OF_POOL_MEMORY:
+    case VK_ERROR_FRAGMENTED_POOL: throw GpuOutOfMemory(message);
+    default: throw GpuUnavailable(message);
+  }
 }
 
 bool built_with_vulkan() { return true; }
@@ -55,8 +64,10 @@ Buffer::Buffer(Context::Impl& ctx, VkDeviceSize bytes, VkBufferUsageFlags usage,
   if (r != VK_SUCCESS) {
     vkDestroyBuffer(device_, buffer_, nullptr);
     buffer_ = VK_NULL_HANDLE;
-    throw GpuUnavailable("Vulkan: cannot allocate " + std::to_string(req.size) + " bytes of " +
-                         (host_visible ? "host-visible" : "device") + " memory (VkResult " + std::to_string(r) + ")");
+    const std::string message = "Vulkan: cannot allocate " + std::to_string(req.size) + " bytes of " +
+                                (host_visible ? "host-visible" : "device") + " memory (" + result_name(r) + ")";
+    if (r == VK_ERROR_DEVICE_LOST) throw GpuDeviceLost(message);
+    throw GpuOutOfMemory(message);
   }
   check(vkBindBufferMemory(device_, buffer_, memory_, 0), "vkBindBufferMemory");
   if (host_visible) check(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
@@ -207,15 +218,25 @@ void Context::Impl::create_pipelines() {
 
 // ---- submission -----------------------------------------------------------------------------
 
+void Context::Impl::require_device() const {
+  if (lost) throw GpuDeviceLost("Vulkan: the device " + info.name + " was lost earlier; make a new context");
+}
+
 void Context::Impl::submit_and_wait(VkCommandBuffer cmd) {
+  require_device();
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;
   submit.pCommandBuffers = &cmd;
-  check(vkResetFences(device, 1, &fence), "vkResetFences");
-  check(vkQueueSubmit(queue, 1, &submit, fence), "vkQueueSubmit");
-  ++counters.submits;
-  check(vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-  ++counters.fence_waits;
+  try {
+    check(vkResetFences(device, 1, &fence), "vkResetFences");
+    check(vkQueueSubmit(queue, 1, &submit, fence), "vkQueueSubmit");
+    ++counters.submits;
+    check(vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+    ++counters.fence_waits;
+  } catch (const GpuDeviceLost&) {
+    lost = true;  // every later submission refuses at once instead of touching a dead device
+    throw;
+  }
 }
 
 void dispatch(Context::Impl& ctx, VkCommandBuffer cmd, std::uint64_t invocations) {
@@ -474,6 +495,7 @@ const DeviceInfo& Context::device() const { return impl_->info; }
 Counters Context::counters() const { return impl_->counters; }
 void Context::reset_counters() { impl_->counters = {}; }
 bool Context::has_timestamps() const { return impl_->timestamps != VK_NULL_HANDLE; }
+bool Context::lost() const { return impl_->lost; }
 
 std::vector<std::string> Context::validation_messages() const {
   std::lock_guard lock(impl_->messages_mutex);

@@ -16,7 +16,8 @@
 
 namespace voxfield::gpu {
 
-// Throws GpuUnavailable naming the call when a Vulkan call fails.
+// Throws naming the call when a Vulkan call fails: GpuDeviceLost for a lost device, GpuOutOfMemory
+// for exhausted device, host or pool memory, GpuUnavailable otherwise.
 void check(VkResult result, const char* what);
 
 // A buffer with its own memory (voxfield allocates a handful of large buffers, never one per
@@ -72,6 +73,7 @@ struct Context::Impl {
   VkPhysicalDeviceMemoryProperties memory{};
   VkPhysicalDeviceLimits limits{};
   bool owns_device = true;
+  bool lost = false;  // the device was lost (GpuDeviceLost): nothing more is submitted
 
   DeviceInfo info;
   Counters counters;
@@ -105,14 +107,18 @@ struct Context::Impl {
   // Allocates a command buffer, lets `record` fill it, submits it and waits (freed after).
   template <class F>
   void run_commands(F&& record);
-  // Submits one command buffer and waits for it (one submit, one fence wait).
+  // Submits one command buffer and waits for it (one submit, one fence wait). Throws
+  // GpuDeviceLost (and marks the context lost) when the device is lost.
   void submit_and_wait(VkCommandBuffer cmd);
+  // Throws GpuDeviceLost when the device was lost earlier.
+  void require_device() const;
   void finish_setup();
   void destroy();
 };
 
 template <class F>
 void Context::Impl::run_commands(F&& record) {
+  require_device();
   VkCommandBufferAllocateInfo cba{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   cba.commandPool = command_pool;
   cba.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;

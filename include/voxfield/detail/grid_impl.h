@@ -113,6 +113,7 @@ void Grid<T>::set(Vec3i p, T value) {
   if (slot == value) return;
   if (slot == c.ref) --c.ref_count;
   if (value == c.ref) ++c.ref_count;
+  VOXFIELD_ASSERT(c.ref_count >= 0 && c.ref_count <= chunk_volume());  // counts voxels equal to ref
   slot = value;
   // Every voxel is back to the value the chunk was expanded from: store it as that value again.
   if (c.ref_count == chunk_volume()) collapse_to_ref(it);
@@ -224,6 +225,7 @@ void Grid<T>::copy_to_dense(const Box3i& box, T* out) const {
   const std::int64_t sx = size.x, sxy = std::int64_t{size.x} * size.y;
   for (const Vec3i coord : chunks_overlapping(box)) {
     const Box3i part = chunk_box(coord).intersect(box);
+    VOXFIELD_ASSERT(!part.empty());  // chunks_overlapping yields only chunks that meet the box
     auto it = chunks_.find(coord);
     const Chunk* c = it == chunks_.end() ? nullptr : &it->second;
     const int run = part.end.x - part.begin.x;

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Checks that every C++ source in the repository is formatted by its .clang-format (Debian's
+# clang-format 14): prints the files that are not and exits 1. `bash scripts/check_format.sh --fix`
+# formats them in place.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+format=$(command -v clang-format-14 || command -v clang-format || true)
+[ -n "$format" ] || { echo "check_format: clang-format is not installed (scripts/install-deps.sh)" >&2; exit 1; }
+if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
+  mapfile -t files < <(git ls-files '*.h' '*.cpp')
+else
+  mapfile -t files < <(find apps bench fuzz include src tests shaders \( -name '*.h' -o -name '*.cpp' \) | sort)
+fi
+if [ "${1:-}" = "--fix" ]; then
+  "$format" -i "${files[@]}"
+  exit 0
+fi
+bad=()
+for f in "${files[@]}"; do
+  "$format" --dry-run -Werror "$f" >/dev/null 2>&1 || bad+=("$f")
+done
+if [ ${#bad[@]} -gt 0 ]; then
+  printf 'not formatted (clang-format -i, or bash scripts/check_format.sh --fix):\n'; printf '  %s\n' "${bad[@]}"
+  exit 1
+fi
+echo "format: ${#files[@]} files formatted"
