@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "cli.h"
+#include "progress.h"
 #include "voxfield/scene.h"
 
 namespace voxfield::cli {
@@ -40,7 +41,7 @@ void add_generate(CLI::App& app, Action& action) {
       o.seed = s->seed;
       o.chunk_edge = s->chunk_edge;
       const auto t0 = std::chrono::steady_clock::now();
-      const World w = make_scene(s->scene, o);
+      const World w = make_scene(s->scene, o, progress());
       const double gen_ms = ms_since(t0);
       outputs.stage(s->out, encode_world(w, Box3i::from_size(o.size), world_format_of(s->out)));
       outputs.commit();

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "cli.h"
+#include "progress.h"
 #include "field_args.h"
 #include "live_field.h"
 #include "voxfield/png.h"
@@ -61,7 +62,7 @@ int run_render(const RenderSettings& s) {
   std::vector<double> times;
   std::vector<gpu::PassTiming> pass_timings;
   for (int r = 0; r < s.repeat; ++r) {
-    image = gpu_context ? gpu::render(*gpu_context, scene, camera, o, &st, &pass_timings) : render(scene, camera, o, &st);
+    image = gpu_context ? gpu::render(*gpu_context, scene, camera, o, &st, &pass_timings) : render(scene, camera, o, &st, progress());
     times.push_back(st.ms);
   }
   std::sort(times.begin(), times.end());

@@ -20,6 +20,7 @@
 #include "voxfield/distance.h"
 #include "voxfield/dynamic_field.h"
 #include "voxfield/image.h"
+#include "voxfield/interrupt.h"
 #include "voxfield/world.h"
 
 namespace voxfield {
@@ -232,8 +233,8 @@ struct RenderStats {
 
 // Renders one frame. Multi-threaded over tiles; the image does not depend on the thread count or
 // tile size. Throws InvalidArgument for bad options (size, a view that needs a field the scene
-// lacks).
+// lacks), Cancelled when `interrupter` asks (progress: tiles finished).
 Image render(const RenderScene& scene, const Camera& camera, const RenderOptions& options,
-             RenderStats* stats = nullptr);
+             RenderStats* stats = nullptr, Interrupter* interrupter = nullptr);
 
 }  // namespace voxfield

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string_view>
 
+#include "voxfield/interrupt.h"
 #include "voxfield/world.h"
 
 namespace voxfield {
@@ -19,13 +20,14 @@ struct SceneOptions {
 
 // Rolling heightfield terrain (z up) with grass, dirt, stone and sand layers, winding caves and a
 // few hollow towers with roofs standing on the surface: about half the volume is solid.
-World make_terrain(const SceneOptions& options);
+World make_terrain(const SceneOptions& options, Interrupter* interrupter = nullptr);
 
 // Random solid spheres in an empty box, adding spheres until about `solid_fraction` of the volume
 // is covered (overlaps make the true fraction slightly lower).
-World make_spheres(const SceneOptions& options, double solid_fraction = 0.10);
+World make_spheres(const SceneOptions& options, double solid_fraction = 0.10, Interrupter* interrupter = nullptr);
 
-// By name: "terrain" or "spheres". Throws InvalidArgument for other names.
-World make_scene(std::string_view name, const SceneOptions& options);
+// By name: "terrain" or "spheres". Throws InvalidArgument for other names. Each generator reports
+// its chunks to `interrupter` and throws Cancelled when it asks.
+World make_scene(std::string_view name, const SceneOptions& options, Interrupter* interrupter = nullptr);
 
 }  // namespace voxfield

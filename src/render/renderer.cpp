@@ -268,7 +268,8 @@ struct Frame {
 
 }  // namespace
 
-Image render(const RenderScene& scene, const Camera& camera, const RenderOptions& o, RenderStats* stats) {
+Image render(const RenderScene& scene, const Camera& camera, const RenderOptions& o, RenderStats* stats,
+             Interrupter* interrupter) {
   const RenderScene::Impl& s = scene.impl();
   if (o.width <= 0 || o.height <= 0 || o.width > 16384 || o.height > 16384)
     throw InvalidArgument("render: image size " + std::to_string(o.width) + "x" + std::to_string(o.height) +
@@ -296,15 +297,19 @@ Image render(const RenderScene& scene, const Camera& camera, const RenderOptions
   const int ts = o.tile_size;
   const int tiles_x = (o.width + ts - 1) / ts, tiles_y = (o.height + ts - 1) / ts;
   std::vector<RenderStats> tile_stats(static_cast<std::size_t>(tiles_x) * tiles_y);
+  Progress progress(interrupter, "render", static_cast<std::int64_t>(tile_stats.size()));
   const auto t0 = std::chrono::steady_clock::now();
   parallel_for(tile_stats.size(), 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t tile = b; tile < e; ++tile) {
+      if (progress.cancelled()) return;
       const int x0 = static_cast<int>(tile % tiles_x) * ts, y0 = static_cast<int>(tile / tiles_x) * ts;
       RenderStats& st = tile_stats[tile];
       for (int y = y0; y < std::min(y0 + ts, o.height); ++y)
         for (int x = x0; x < std::min(x0 + ts, o.width); ++x) f.pixel(x, y, image.pixel(x, y), st);
+      progress.advance();
     }
   });
+  progress.throw_if_cancelled();
   if (stats) {
     RenderStats total;
     total.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

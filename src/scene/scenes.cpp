@@ -142,13 +142,19 @@ class Terrain {
 
 }  // namespace
 
-World make_terrain(const SceneOptions& o) {
+World make_terrain(const SceneOptions& o, Interrupter* interrupter) {
   require_size(o);
   World world(o.chunk_edge, Box3i::from_size(o.size));
   set_terrain_palette(world.palette);
   const Terrain terrain(o);
   const int e = o.chunk_edge;
-  world.voxels.generate_chunks(chunks_of(world, o.size), [&](Vec3i c, std::uint8_t* out) {
+  const std::vector<Vec3i> chunks = chunks_of(world, o.size);
+  Progress progress(interrupter, "terrain scene", static_cast<std::int64_t>(chunks.size()));
+  world.voxels.generate_chunks(chunks, [&](Vec3i c, std::uint8_t* out) {
+    if (!progress.advance()) {  // cancelled: the world is discarded, any content will do
+      std::fill(out, out + static_cast<std::size_t>(e) * e * e, kAir);
+      return;
+    }
     const Vec3i lo{c.x * e, c.y * e, c.z * e};
     for (int y = 0; y < e; ++y)
       for (int x = 0; x < e; ++x) {
@@ -160,10 +166,11 @@ World make_terrain(const SceneOptions& o) {
         }
       }
   });
+  progress.throw_if_cancelled();
   return world;
 }
 
-World make_spheres(const SceneOptions& o, double solid_fraction) {
+World make_spheres(const SceneOptions& o, double solid_fraction, Interrupter* interrupter) {
   require_size(o);
   if (!(solid_fraction > 0 && solid_fraction < 1)) {
     throw InvalidArgument("solid fraction must be in (0, 1), got " + std::to_string(solid_fraction));
@@ -191,9 +198,12 @@ World make_spheres(const SceneOptions& o, double solid_fraction) {
   World world(o.chunk_edge, Box3i::from_size(o.size));
   set_terrain_palette(world.palette);
   const int e = o.chunk_edge;
-  world.voxels.generate_chunks(chunks_of(world, o.size), [&](Vec3i c, std::uint8_t* out) {
+  const std::vector<Vec3i> chunks = chunks_of(world, o.size);
+  Progress progress(interrupter, "spheres scene", static_cast<std::int64_t>(chunks.size()));
+  world.voxels.generate_chunks(chunks, [&](Vec3i c, std::uint8_t* out) {
     const Box3i box = world.voxels.chunk_box(c);
     std::fill(out, out + static_cast<std::size_t>(e) * e * e, kAir);
+    if (!progress.advance()) return;  // cancelled: the world is discarded
     for (const Sphere& s : spheres) {
       const Box3i sb = Box3i::from_inclusive({s.cx - s.r, s.cy - s.r, s.cz - s.r}, {s.cx + s.r, s.cy + s.r, s.cz + s.r});
       const Box3i part = sb.intersect(box);
@@ -209,12 +219,13 @@ World make_spheres(const SceneOptions& o, double solid_fraction) {
           }
     }
   });
+  progress.throw_if_cancelled();
   return world;
 }
 
-World make_scene(std::string_view name, const SceneOptions& options) {
-  if (name == "terrain") return make_terrain(options);
-  if (name == "spheres") return make_spheres(options);
+World make_scene(std::string_view name, const SceneOptions& options, Interrupter* interrupter) {
+  if (name == "terrain") return make_terrain(options, interrupter);
+  if (name == "spheres") return make_spheres(options, 0.10, interrupter);
   throw InvalidArgument("unknown scene \"" + std::string(name) + "\" (known: terrain, spheres)");
 }
 

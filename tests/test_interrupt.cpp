@@ -1,0 +1,106 @@
+// Progress and cancellation (voxfield/interrupt.h): long operations report their work to an
+// Interrupter from their worker threads, and stop with Cancelled — their inputs untouched — when it
+// asks.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <mutex>
+#include <vector>
+
+#include "voxfield/interrupt.h"
+#include "voxfield/render.h"
+#include "voxfield/scene.h"
+
+using namespace voxfield;
+
+namespace {
+
+// Records what it is told; cancels once progress reaches `cancel_at` percent (never when > 100).
+class Recorder : public Interrupter {
+ public:
+  explicit Recorder(int cancel_at = 101) : cancel_at_(cancel_at) {}
+  void start(std::string_view name) override {
+    std::lock_guard lock(mutex_);
+    names.emplace_back(name);
+    ++starts;
+  }
+  void end() override { ++ends; }
+  bool was_interrupted(int percent) override {
+    std::lock_guard lock(mutex_);
+    percents.push_back(percent);
+    return percent >= cancel_at_;
+  }
+  std::vector<std::string> names;
+  std::vector<int> percents;
+  std::atomic<int> starts{0}, ends{0};
+
+ private:
+  int cancel_at_;
+  std::mutex mutex_;
+};
+
+}  // namespace
+
+TEST(Interrupt, ProgressCountsUnitsAndReachesAHundred) {
+  Recorder r;
+  {
+    Progress p(&r, "units", 8);
+    for (int i = 0; i < 8; ++i) EXPECT_TRUE(p.advance());
+    EXPECT_NO_THROW(p.throw_if_cancelled());
+  }
+  EXPECT_EQ(r.names, std::vector<std::string>{"units"});
+  EXPECT_EQ(r.starts, 1);
+  EXPECT_EQ(r.ends, 1);
+  // 0 at the start, then 12, 25, ... as units finish (integer percent of 8 units).
+  EXPECT_EQ(r.percents, (std::vector<int>{0, 12, 25, 37, 50, 62, 75, 87, 100}));
+}
+
+TEST(Interrupt, ANullInterrupterNeverCancels) {
+  Progress p(nullptr, "nothing watches", 3);
+  EXPECT_TRUE(p.advance(5));
+  EXPECT_TRUE(p.keep_going());
+  EXPECT_FALSE(p.cancelled());
+}
+
+TEST(Interrupt, CancellingStopsSceneGenerationWithCancelled) {
+  SceneOptions o;
+  o.size = {128, 128, 64};
+  o.chunk_edge = 16;
+  Recorder r(/*cancel_at=*/30);
+  try {
+    make_terrain(o, &r);
+    FAIL() << "make_terrain finished although cancelled";
+  } catch (const Cancelled& e) {
+    EXPECT_NE(std::string(e.what()).find("terrain scene"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(r.ends, 1);  // end() is called on the way out of a cancelled operation too
+  // The generator stopped asking soon after it was told to stop (a few chunks in flight per thread).
+  int asked_after = 0;
+  for (int p : r.percents) asked_after += p > 40;
+  EXPECT_LT(asked_after, 8);
+
+  Recorder watch;  // the same operation, watched but not cancelled, gives the plain result
+  const World watched = make_terrain(o, &watch);
+  EXPECT_EQ(watched.solid_count(), make_terrain(o).solid_count());
+  EXPECT_EQ(watch.percents.back(), 100);
+}
+
+TEST(Interrupt, CancellingARenderThrowsAndAWatchedRenderIsUnchanged) {
+  SceneOptions so;
+  so.size = {64, 64, 64};
+  const World w = make_terrain(so);
+  const RenderScene scene(w);
+  const Camera camera = Camera::framing(Box3i::from_size(so.size), 4.0 / 3.0);
+  RenderOptions o;
+  o.width = 96;
+  o.height = 72;
+  o.tile_size = 8;  // 12 x 9 tiles
+  Recorder cancel(/*cancel_at=*/50);
+  EXPECT_THROW(render(scene, camera, o, nullptr, &cancel), Cancelled);
+  Recorder watch;
+  const Image watched = render(scene, camera, o, nullptr, &watch);
+  EXPECT_EQ(watched.rgb, render(scene, camera, o).rgb);
+  EXPECT_EQ(watch.names, std::vector<std::string>{"render"});
+  EXPECT_EQ(watch.percents.size(), 12u * 9u + 1u);  // one question per tile, and one at the start
+  EXPECT_EQ(watch.percents.back(), 100);
+}
