@@ -18,7 +18,7 @@
 #include <cstring>
 
 #include "../../shaders/layout.h"
-#include "../edit/update_regions.h"
+#include "../distance/incremental/update_regions.h"
 #include "vulkan_context.h"
 
 namespace voxfield::gpu {

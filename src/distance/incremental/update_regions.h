@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "../distance/field_plan.h"
+#include "../field_plan.h"
 #include "voxfield/edit.h"
 
 namespace voxfield::detail {
