@@ -1,9 +1,16 @@
-// voxfield — incremental exact distance updates by local recomputation (see dynamic_field.h).
+// voxfield — incremental exact distance updates by local recomputation (see dynamic_field.h):
+// DynamicDistanceField, and the regions an update recomputes (update_regions.h, shared with the
+// GPU). With clamp D an edit in box B changes values only in B grown by D, computed from the sites
+// in B grown by 2D; update() takes each such region in four steps: shrink it to the voxels the
+// edit can move (affected_voxels.cpp), find the box of sites their values can reach, recompute
+// them with the exact kernel (exact/local_region.cpp), and write them back.
 #include "voxfield/dynamic_field.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
+#include <optional>
+#include <variant>
+#include <vector>
 
 #include "update_regions.h"
 
@@ -30,348 +37,6 @@ std::vector<Box3i> merge_overlapping(std::vector<Box3i> boxes) {
   return boxes;
 }
 
-// An upper bound of the distance an unsigned stored value stands for: integer storage rounds
-// down (d < (stored + 1) / scale) and the clamp value stands for "at least the clamp" (+inf);
-// f32 is exact up to its rounding.
-template <class T>
-double upper_distance(const FieldPlan& plan, T stored, T clamp_stored) {
-  if (stored == clamp_stored) return std::numeric_limits<double>::infinity();
-  if constexpr (std::is_same_v<T, float>) {
-    return static_cast<double>(stored) * (1 + 1e-6) + 1e-6;
-  } else {
-    return (static_cast<double>(stored) + 1) / plan.encoding.scale;
-  }
-}
-
-// Cost-space helpers shared by the searches below: distances are compared as costs (squared for
-// Euclidean, so no square root per voxel), per-axis gaps to the changed box combined per metric.
-struct GapCost {
-  Metric metric;
-  Box3i changed;
-  std::array<double, 3> spacing;
-  float axis(int k, int v) const {  // the gap along axis k, as a cost term
-    const float g = static_cast<float>(std::max({0, changed.begin[k] - v, v - (changed.end[k] - 1)}) * spacing[k]);
-    return metric == Metric::kEuclidean ? g * g : g;
-  }
-  float combine(float a, float b) const { return metric == Metric::kChebyshev ? std::max(a, b) : a + b; }
-};
-
-// `kind`: what the changes did — only removed solids (values can only rise, so voxels already at
-// the clamp stay there), only added them (values can only fall, so voxels at 0 stay there), or
-// both.
-enum class Changes { kRemovals, kAdditions, kBoth };
-
-// The largest gap cost (GapCost's units) from a change at which a voxel holding `stored` can still
-// be moved by it: its distance bound upper_distance() plus `extra`, as (stored + off) * mul + extra,
-// then squared for Euclidean. A few float operations per voxel that vectorise, with margins wider
-// than upper_distance()'s and far wider than float rounding, so the bound is never below the exact
-// one (a voxel is let through whenever in doubt). Values that cannot change get kNever.
-template <class T>
-struct StoredBound {
-  static constexpr float kNever = -1.0f;  // below every cost
-  float off, mul, extra;
-  T clamp_stored;
-  float at_clamp;    // +inf (the clamp value stands for "at least the clamp"), or kNever
-  bool zero_frozen;  // a voxel at 0 keeps its value (the changes only added sites)
-  bool squared;      // Euclidean costs are squared distances
-
-  // `extra`: a distance added to every bound. `clamp_frozen`: values at the clamp cannot change
-  // (the changes only removed sites, so values can only rise).
-  StoredBound(const FieldPlan& plan, double extra_distance, bool clamp_frozen, bool zero_frozen_value)
-      : off(std::is_same_v<T, float> ? 1e-5f : 1.0f),
-        mul(static_cast<float>((std::is_same_v<T, float> ? 1.0 : 1.0 / plan.encoding.scale) * (1 + 1e-5))),
-        extra(static_cast<float>(extra_distance * (1 + 1e-5))),
-        clamp_stored(encode_distance<T>(plan.clamp, plan)),
-        at_clamp(clamp_frozen ? kNever : std::numeric_limits<float>::infinity()),
-        zero_frozen(zero_frozen_value),
-        squared(plan.metric == Metric::kEuclidean) {}
-
-  template <bool kSquared>
-  float at(T s) const {
-    const float d = (static_cast<float>(s) + off) * mul + extra;
-    float b = (kSquared ? d * d : d) * 1.0001f + 1e-4f;
-    b = s == clamp_stored ? at_clamp : b;
-    return (zero_frozen & (s == T{0})) ? kNever : b;
-  }
-  float operator()(T s) const { return squared ? at<true>(s) : at<false>(s); }
-};
-
-// flags[i] = 1 when voxel i of a row segment passes: the combination of its gap cost along x
-// (gx[i]) with the rest of its gap (`rest`) is within the bound of its stored value v[i]. One
-// branch-free loop per metric. (Arguments by value and __restrict pointers: nothing the loop reads
-// may be thought to alias its stores, or it stays scalar.)
-template <bool kSquared, bool kChebyshev, class T>
-void test_loop(const StoredBound<T> sb, const T* __restrict v, const float* __restrict gx, int count, float rest,
-               std::uint32_t* __restrict flags) {
-  for (int i = 0; i < count; ++i) {
-    const float cost = kChebyshev ? std::max(gx[i], rest) : gx[i] + rest;
-    flags[i] = cost <= sb.template at<kSquared>(v[i]) ? 1u : 0u;
-  }
-}
-
-template <class T>
-void test_segment(Metric metric, const StoredBound<T>& sb, const T* v, const float* gx, int count, float rest,
-                  std::uint32_t* flags) {
-  switch (metric) {
-    case Metric::kEuclidean: test_loop<true, false>(sb, v, gx, count, rest, flags); break;
-    case Metric::kManhattan: test_loop<false, false>(sb, v, gx, count, rest, flags); break;
-    case Metric::kChebyshev: test_loop<false, true>(sb, v, gx, count, rest, flags); break;
-  }
-}
-
-// The first and last set flags of flags[0..count); false when none is set.
-inline bool flagged_span(const std::uint32_t* flags, int count, int& first, int& last) {
-  first = 0;
-  while (first < count && !flags[first]) ++first;
-  if (first == count) return false;
-  last = count - 1;
-  while (!flags[last]) --last;
-  return true;
-}
-
-template <class T>
-Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& old, const Box3i& changed, Changes kind) {
-  // Only a voxel whose old distance reaches the changed voxels can change: a removed site that
-  // was its nearest lies at least that far away, and a new site nearer than its old distance lies
-  // at least that far away too. Everything else keeps its value — bit for bit — so the
-  // recomputation shrinks to the bounding box of the voxels that pass this test.
-  //
-  // Distances are compared as "costs" (squared for Euclidean, so no square root per voxel) in
-  // floats, with the bound rounded up a little: a voxel is let through whenever in doubt.
-  const GapCost gap{plan.metric, changed, plan.spacing};
-  // Values can only rise after removals (one at the clamp stays there) and only fall after
-  // additions (one at 0 stays there).
-  const StoredBound<T> bound(plan, 0.0, kind == Changes::kRemovals, kind == Changes::kAdditions);
-  const int nx = r.size().x;
-  std::vector<float> gx(static_cast<std::size_t>(nx));
-  std::vector<std::uint32_t> pass(static_cast<std::size_t>(nx));
-  for (int x = 0; x < nx; ++x) gx[static_cast<std::size_t>(x)] = gap.axis(0, r.begin.x + x);
-  Box3i box{r.end, r.begin};  // empty
-  std::size_t i = 0;
-  for (int z = r.begin.z; z < r.end.z; ++z) {
-    const float gz = gap.axis(2, z);
-    for (int y = r.begin.y; y < r.end.y; ++y, i += static_cast<std::size_t>(nx)) {
-      test_segment(plan.metric, bound, old.data() + i, gx.data(), nx, gap.combine(gap.axis(1, y), gz), pass.data());
-      int first, last;
-      if (!flagged_span(pass.data(), nx, first, last)) continue;
-      box = {{std::min(box.begin.x, r.begin.x + first), std::min(box.begin.y, y), std::min(box.begin.z, z)},
-             {std::max(box.end.x, r.begin.x + last + 1), std::max(box.end.y, y + 1), std::max(box.end.z, z + 1)}};
-    }
-  }
-  return box;
-}
-
-// Reads rows of a field grid inside a box, chunk by chunk, with the box's chunks looked up once.
-template <class T>
-class RowReader {
- public:
-  RowReader(const Grid<T>& grid, const Box3i& box) : shift_(grid.chunk_shift()), edge_(grid.chunk_edge()) {
-    lo_ = grid.chunk_of(box.begin);
-    const Vec3i hi = grid.chunk_of(box.end - Vec3i::splat(1));
-    n_ = hi - lo_ + Vec3i::splat(1);
-    views_.reserve(static_cast<std::size_t>(n_.x) * n_.y * n_.z);
-    for (int z = lo_.z; z <= hi.z; ++z)
-      for (int y = lo_.y; y <= hi.y; ++y)
-        for (int x = lo_.x; x <= hi.x; ++x) views_.push_back(grid.chunk_view({x, y, z}));
-  }
-  // Calls run(x_begin, x_end, value) for runs of one value (a uniform chunk's part of the row) and
-  // segment(x_begin, x_end, values) for the parts in dense chunks (values[0] at x_begin), over x in
-  // [x0, x1) of the row (y, z).
-  template <class Run, class Segment>
-  void row(int x0, int x1, int y, int z, Run&& run, Segment&& segment) const {
-    const std::size_t base = (static_cast<std::size_t>((z >> shift_) - lo_.z) * n_.y + static_cast<std::size_t>((y >> shift_) - lo_.y)) * n_.x;
-    for (int x = x0; x < x1;) {
-      const ChunkView<T>& v = views_[base + static_cast<std::size_t>((x >> shift_) - lo_.x)];
-      const int end = std::min(x1, v.box.end.x);
-      if (v.uniform()) {
-        run(x, end, v.uniform_value);
-      } else {
-        const T* row = v.voxels + (static_cast<std::size_t>(z - v.box.begin.z) * edge_ + static_cast<std::size_t>(y - v.box.begin.y)) * edge_;
-        segment(x, end, row + (x - v.box.begin.x));
-      }
-      x = end;
-    }
-  }
-
- private:
-  int shift_, edge_;
-  Vec3i lo_, n_;
-  std::vector<ChunkView<T>> views_;
-};
-
-// The distance a rounding of a point to its nearest voxel can add, twice (see grow_affected).
-double rounding_slack(const FieldPlan& plan) {
-  const double hx = plan.spacing[0] / 2, hy = plan.spacing[1] / 2, hz = plan.spacing[2] / 2;
-  switch (plan.metric) {
-    case Metric::kManhattan: return 2 * (hx + hy + hz);
-    case Metric::kChebyshev: return 2 * std::max({hx, hy, hz});
-    case Metric::kEuclidean: break;
-  }
-  return 2 * std::sqrt(hx * hx + hy * hy + hz * hz);
-}
-
-}  // namespace
-
-template <class T>
-Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r, const Box3i& changed, std::int64_t max_volume) {
-  // Every voxel p that an edit can change has g(p) <= old(p), g being its distance to the changed
-  // box C (see affected_box). Walk from p straight to its nearest point c of C, rounding each point
-  // of the segment to its nearest voxel q: g falls exactly as fast as the walk advances, the old
-  // field (a distance, clamped or not) falls at most that fast, and the rounding moves each by at
-  // most half a voxel diagonal. So every q on the walk has g(q) <= old(q) + s, s = twice that
-  // half-diagonal in the field's metric, and consecutive q are 26-neighbours: p is joined to C by
-  // voxels passing the relaxed test. A box that no passing voxel just outside it extends therefore
-  // holds every voxel the edit can change. It is found by growing C one shell at a time, reading
-  // each voxel at most once: work in proportion to the affected voxels, not to the reach box.
-  const GapCost gap{plan.metric, changed, plan.spacing};
-  // Every value relaxed by the rounding slack; nothing is frozen (a search must pass through).
-  const StoredBound<T> bound_of(plan, rounding_slack(plan), false, false);
-  const float inf = std::numeric_limits<float>::infinity();
-  const int nx = r.size().x;
-  std::vector<float> gx(static_cast<std::size_t>(nx));  // gap costs along x, index x - r.begin.x
-  for (int x = 0; x < nx; ++x) gx[static_cast<std::size_t>(x)] = gap.axis(0, r.begin.x + x);
-  const RowReader<T> reader(field, r);
-  Box3i box = changed.intersect(r), scanned = box;
-  while (box != r) {
-    if (box.volume() > max_volume) return r;
-    const Box3i outer = Box3i{box.begin - Vec3i::splat(1), box.end + Vec3i::splat(1)}.intersect(r);
-    Box3i grown = box;
-    for (int z = outer.begin.z; z < outer.end.z; ++z) {
-      const float gz = gap.axis(2, z);
-      for (int y = outer.begin.y; y < outer.end.y; ++y) {
-        const float rest = gap.combine(gap.axis(1, y), gz);
-        int lo = INT32_MAX, hi = INT32_MIN;
-        auto segment = [&](int x0, int x1, const T* values) {
-          // Mostly a voxel or two at the ends of rows already scanned: tested one by one.
-          for (int x = x0; x < x1; ++x) {
-            if (gap.combine(gx[static_cast<std::size_t>(x - r.begin.x)], rest) > bound_of(values[x - x0])) continue;
-            lo = std::min(lo, x);
-            hi = std::max(hi, x);
-          }
-        };
-        auto run = [&](int x0, int x1, T stored) {
-          // A run at the clamp passes whole (open space); otherwise the passing voxels of a run of
-          // one bound form an interval around the changed box's x range, so its ends are found by
-          // walking in from the run's ends.
-          const float bound = bound_of(stored);
-          if (bound == inf) {
-            lo = std::min(lo, x0);
-            hi = std::max(hi, x1 - 1);
-            return;
-          }
-          const float* g = gx.data() - r.begin.x;  // g[x]: x's gap cost along x
-          const int nearest = std::clamp(changed.begin.x, x0, x1 - 1);  // the run's voxel nearest C
-          const int nearest2 = std::clamp(changed.end.x - 1, x0, x1 - 1);
-          if (gap.combine(std::min(g[nearest], g[nearest2]), rest) > bound) return;
-          int a = x0, b = x1 - 1;
-          while (a <= b && gap.combine(g[a], rest) > bound) ++a;
-          while (b >= a && gap.combine(g[b], rest) > bound) --b;
-          if (a <= b) {
-            lo = std::min(lo, a);
-            hi = std::max(hi, b);
-          }
-        };
-        const bool inner_row = y >= scanned.begin.y && y < scanned.end.y && z >= scanned.begin.z && z < scanned.end.z;
-        if (inner_row) {  // only the ends of this row are new
-          reader.row(outer.begin.x, scanned.begin.x, y, z, run, segment);
-          reader.row(scanned.end.x, outer.end.x, y, z, run, segment);
-        } else {
-          reader.row(outer.begin.x, outer.end.x, y, z, run, segment);
-        }
-        if (lo <= hi) grown = grown.unite(Box3i{{lo, y, z}, {hi + 1, y + 1, z + 1}});
-      }
-    }
-    scanned = outer;
-    if (grown == box) break;
-    box = grown;
-  }
-  return box;
-}
-
-template Box3i grow_affected<std::uint8_t>(const FieldPlan&, const Grid<std::uint8_t>&, const Box3i&, const Box3i&, std::int64_t);
-template Box3i grow_affected<std::uint16_t>(const FieldPlan&, const Grid<std::uint16_t>&, const Box3i&, const Box3i&, std::int64_t);
-template Box3i grow_affected<float>(const FieldPlan&, const Grid<float>&, const Box3i&, const Box3i&, std::int64_t);
-
-namespace {
-
-// After removals, the new values inside the affected box `a` are bounded by the unchanged values
-// around it: new(p) <= old(q) + |p - q| for every q outside `a` (distances are 1-Lipschitz, and q
-// keeps its value). Using q straight across each face of `a` gives a bound M on every new value
-// in `a`, so only sites within M of `a` matter — for a hole carved in solid ground, a few voxels
-// instead of the clamp. Each face also bounds on its own how far beyond it a nearest site can lie:
-// with F the largest old value on the face below `a` along axis k and p's nearest site s,
-//     (p_k - s_k) * spacing_k <= |p - s| = new(p) <= F + (p_k - a.begin_k + 1) * spacing_k,
-// so s_k >= a.begin_k - 1 - F / spacing_k whatever p is (every metric bounds each axis's step by
-// the distance) — after a carve at the ground's surface, the face in the ground (F near 0) lets
-// the sites below it be skipped, where M reaches the clamp through the face in the open air.
-// Faces on the edge of the region `r` (beyond it another region may change values) or of the
-// domain give no bound: +inf.
-struct NewValueBounds {
-  double all = std::numeric_limits<double>::infinity();  // M: every new value in `a`
-  // The largest old value on the face just below / above `a` along each axis.
-  std::array<double, 3> lo_face{all, all, all}, hi_face{all, all, all};
-};
-
-template <class T>
-NewValueBounds new_value_bound(const FieldPlan& plan, const Grid<T>& field, const Box3i& r, const Box3i& a) {
-  const T clamp_stored = encode_distance<T>(plan.clamp, plan);
-  const double inf = std::numeric_limits<double>::infinity();
-  const RowReader<T> reader(field, r);
-  // The largest upper bound of the old values on the face slab `f` (inf if any is at the clamp).
-  auto face_max = [&](const Box3i& f) {
-    double m = 0;
-    for (int z = f.begin.z; z < f.end.z && m < inf; ++z)
-      for (int y = f.begin.y; y < f.end.y && m < inf; ++y)
-        reader.row(
-            f.begin.x, f.end.x, y, z, [&](int, int, T stored) { m = std::max(m, upper_distance<T>(plan, stored, clamp_stored)); },
-            [&](int x0, int x1, const T* values) {
-              for (int i = 0; i < x1 - x0; ++i) m = std::max(m, upper_distance<T>(plan, values[i], clamp_stored));
-            });
-    return m;
-  };
-  NewValueBounds bounds;
-  for (int k = 0; k < 3; ++k) {
-    double& lo_face = bounds.lo_face[static_cast<std::size_t>(k)];
-    double& hi_face = bounds.hi_face[static_cast<std::size_t>(k)];
-    if (a.begin[k] > r.begin[k]) {
-      Box3i f = a;
-      f.begin[k] = a.begin[k] - 1;
-      f.end[k] = a.begin[k];
-      lo_face = face_max(f);
-    }
-    if (a.end[k] < r.end[k]) {
-      Box3i f = a;
-      f.begin[k] = a.end[k];
-      f.end[k] = a.end[k] + 1;
-      hi_face = face_max(f);
-    }
-    if (lo_face == inf && hi_face == inf) continue;
-    // The worst voxel along axis k, each bounded through the nearer-valued face.
-    double worst = 0;
-    for (int v = a.begin[k]; v < a.end[k]; ++v)
-      worst = std::max(worst, std::min(lo_face + (v - a.begin[k] + 1) * plan.spacing[k], hi_face + (a.end[k] - v) * plan.spacing[k]));
-    // max over p of min over axes = min over axes of each axis's max (the axes vary independently).
-    bounds.all = std::min(bounds.all, worst);
-  }
-  return bounds;
-}
-
-// A box holding every solid voxel of `box` (empty if it holds none), from the chunks alone: a
-// chunk of air is skipped, any other adds its part of `box` — no voxel is read.
-Box3i solid_bounds(const Grid<std::uint8_t>& occupancy, const Box3i& box) {
-  Box3i bounds;
-  if (box.empty()) return bounds;
-  const Vec3i lo = occupancy.chunk_of(box.begin), hi = occupancy.chunk_of(box.end - Vec3i::splat(1));
-  for (int z = lo.z; z <= hi.z; ++z)
-    for (int y = lo.y; y <= hi.y; ++y)
-      for (int x = lo.x; x <= hi.x; ++x) {
-        const ChunkView<std::uint8_t> view = occupancy.chunk_view({x, y, z});
-        if (view.uniform() && view.uniform_value == 0) continue;
-        bounds = bounds.unite(view.box.intersect(box));
-      }
-  return bounds;
-}
-
 }  // namespace
 
 Vec3i field_reach(const FieldPlan& plan) {
@@ -393,6 +58,131 @@ std::vector<UpdateRegion> update_regions(const DirtyRegions& dirty, const Box3i&
   for (const Box3i& r : merge_overlapping(std::move(reach_boxes))) regions.push_back({r, grow(r, reach).intersect(domain)});
   return regions;
 }
+
+namespace {
+
+// ---- The steps of DynamicDistanceField::update, one region at a time ---------------------------
+
+// What an update asks of every region it recomputes.
+struct RegionUpdate {
+  const FieldPlan& plan;
+  const Grid<std::uint8_t>& occupancy;
+  Box3i domain;
+  Vec3i reach;
+  Changes kind;
+  // The changes only placed solids into air, in an unsigned field without nearest sites: the new
+  // values are the minimum of the old ones and the distance to the new sites (see update()).
+  bool additions_only;
+};
+
+// The changes whose reach touches the region `r`, as one box.
+Box3i changes_near(const std::vector<Box3i>& changed, const Box3i& r, Vec3i reach) {
+  Box3i near;
+  for (const Box3i& b : changed)
+    if (!Box3i{b.begin - reach, b.end + reach}.intersect(r).empty()) near = near.unite(b);
+  return near;
+}
+
+// Whether every chunk of `r` is uniform at the clamp: open space far from everything.
+template <class T>
+bool all_at_clamp(const FieldPlan& plan, const Grid<T>& field, const Box3i& r) {
+  const T clamp_stored = encode_distance<T>(plan.clamp, plan);
+  const int shift = field.chunk_shift();
+  for (int cz = r.begin.z >> shift; cz <= (r.end.z - 1) >> shift; ++cz)
+    for (int cy = r.begin.y >> shift; cy <= (r.end.y - 1) >> shift; ++cy)
+      for (int cx = r.begin.x >> shift; cx <= (r.end.x - 1) >> shift; ++cx) {
+        const auto view = field.chunk_view({cx, cy, cz});
+        if (!(view.uniform() && view.uniform_value == clamp_stored)) return false;
+      }
+  return true;
+}
+
+// Keeps of `old` (the values of the box `from`, x fastest) those of the box `to` inside it, moved
+// to the front in place.
+template <class T>
+void keep_box(std::vector<T>& old, const Box3i& from, const Box3i& to) {
+  const Vec3i fs = from.size(), ts = to.size();
+  std::size_t k = 0;
+  for (int z = to.begin.z; z < to.end.z; ++z)
+    for (int y = to.begin.y; y < to.end.y; ++y) {
+      const std::size_t at = (static_cast<std::size_t>(z - from.begin.z) * fs.y + static_cast<std::size_t>(y - from.begin.y)) * fs.x +
+                             static_cast<std::size_t>(to.begin.x - from.begin.x);
+      if (at != k)  // at > k: rows only move towards the front
+        std::copy(old.begin() + static_cast<std::ptrdiff_t>(at), old.begin() + static_cast<std::ptrdiff_t>(at) + ts.x,
+                  old.begin() + static_cast<std::ptrdiff_t>(k));
+      k += static_cast<std::size_t>(ts.x);
+    }
+  old.resize(static_cast<std::size_t>(to.volume()));
+}
+
+// Step 1, shrink (unsigned fields without nearest sites): the box inside the region `r` holding
+// every voxel the changes `near` can move, empty when none can; `old` receives its old values.
+template <class T>
+Box3i shrink_region(const RegionUpdate& u, const Grid<T>& field, const Box3i& r, const Box3i& near, std::vector<T>& old) {
+  // Open space far from everything needs no search: every voxel of r is in reach of an addition,
+  // and no removal can raise a value there.
+  const bool all_clamped = all_at_clamp(u.plan, field, r);
+  if (all_clamped && u.kind == Changes::kRemovals) return {};
+  // The box holding every voxel that can change (a superset found by a search that reads only
+  // around the changes), then the exact test on its voxels. Once the search has covered a
+  // sixteenth of the region, the rest is read faster front to back (its shells read a cache line
+  // per voxel on their x faces): the whole region it is.
+  const Box3i grown = all_clamped ? r : grow_affected(u.plan, field, r, near, r.volume() / 16);
+  old.resize(static_cast<std::size_t>(grown.volume()));
+  field.copy_to_dense(grown, old.data());
+  const Box3i a = all_clamped ? r : affected_box(u.plan, grown, old, near, u.kind);
+  if (!a.empty() && a != grown) keep_box(old, grown, a);
+  return a;
+}
+
+// Step 2, site box: the sites the new values of `r` can depend on. `r` is the region `region`
+// itself, or the box shrink_region() found inside it (`shrunk`).
+template <class T>
+Box3i site_box(const RegionUpdate& u, const Grid<T>& field, const Box3i& region, const Box3i& r, bool shrunk) {
+  if (!shrunk) return Box3i{r.begin - u.reach, r.end + u.reach}.intersect(u.domain);
+  if (u.additions_only) return r;  // the new sites alone, all inside the changed boxes
+  // Sites farther than every new value of r cannot be anyone's nearest, nor sites beyond a face
+  // farther than its own bound allows (NewValueBounds).
+  Vec3i below = u.reach, above = u.reach;
+  const NewValueBounds m = new_value_bound(u.plan, field, region, r);
+  auto voxels = [](double d, double spacing) { return static_cast<int>(std::floor(d / spacing + 1e-9)); };  // d is a bound already
+  for (int k = 0; k < 3; ++k) {
+    const double s = u.plan.spacing[static_cast<std::size_t>(k)];
+    if (std::isfinite(m.all)) below[k] = above[k] = std::min(u.reach[k], voxels(m.all, s));
+    if (std::isfinite(m.lo_face[static_cast<std::size_t>(k)]))
+      below[k] = std::min(below[k], 1 + voxels(m.lo_face[static_cast<std::size_t>(k)], s));
+    if (std::isfinite(m.hi_face[static_cast<std::size_t>(k)]))
+      above[k] = std::min(above[k], 1 + voxels(m.hi_face[static_cast<std::size_t>(k)], s));
+  }
+  const Box3i in = Box3i{r.begin - below, r.end + above}.intersect(u.domain);
+  // Air is no site: the box needs to hold r and the solid voxels around it only (after a carve in
+  // open air, often little more than r).
+  return solid_bounds(u.occupancy, in).unite(r);
+}
+
+// Step 3, recompute: the new values of `r` (and nearest sites, when `sites` is not null) from the
+// sites in `in`, densely. Additions take the distance to the new sites in `near`, then the minimum
+// with the old values.
+template <class T>
+void recompute(const RegionUpdate& u, const Box3i& in, const Box3i& r, const Box3i& near, const std::vector<T>& old,
+               std::vector<T>& values, std::vector<SiteOffset>* sites) {
+  values.resize(static_cast<std::size_t>(r.volume()));
+  if (sites) sites->resize(static_cast<std::size_t>(r.volume()));
+  compute_region<T>(u.occupancy, u.plan, in, r, values.data(), sites ? sites->data() : nullptr,
+                    u.additions_only ? &near : nullptr);
+  if (u.additions_only)
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::min(values[i], old[i]);
+}
+
+// Step 4, write back: the recomputed box into the field's grids.
+template <class T>
+void write_back(const Box3i& r, const std::vector<T>& values, const std::vector<SiteOffset>& sites, Grid<T>& field,
+                std::optional<Grid<SiteOffset>>& field_sites) {
+  field.copy_from_dense(r, values.data());
+  if (field_sites) field_sites->copy_from_dense(r, sites.data());
+}
+
+}  // namespace
 
 }  // namespace detail
 
@@ -427,95 +217,31 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
   // fields (a new solid changes distances inside it to air) and nearest sites keep the whole reach
   // box and read the sites up to the reach beyond it.
   const bool shrink = !plan.is_signed && !field_.sites;
+  // `kind`: values can only rise after removals and only fall after additions.
+  const detail::Changes kind = !dirty.adds_solid()     ? detail::Changes::kRemovals
+                               : !dirty.removes_solid() ? detail::Changes::kAdditions
+                                                        : detail::Changes::kBoth;
+  const detail::RegionUpdate u{plan, world_->voxels, *options_.domain, reach_, kind, additions_only};
   const std::vector<Box3i> changed = dirty.boxes();
   for (const detail::UpdateRegion& region : detail::update_regions(dirty, *options_.domain, reach_)) {
     std::visit(
         [&](auto& target) {
           using T = typename std::decay_t<decltype(target)>::value_type;
-          Box3i r = region.out;
           // Scratch reused across updates (fresh buffers this size cost a page fault per 4 KiB).
           thread_local std::vector<T> old_scratch, values_scratch;
           std::vector<T>& old = old_scratch;
           std::vector<T>& values = values_scratch;
-          Box3i in;    // the sites r's new values can depend on
-          Box3i near;  // the changes this region holds
+          Box3i r = region.out;  // the values recomputed
+          Box3i near;            // the changes this region holds (shrink only)
           if (shrink) {
-            for (const Box3i& b : changed)
-              if (!Box3i{b.begin - reach_, b.end + reach_}.intersect(r).empty()) near = near.unite(b);
-            const detail::Changes kind = !dirty.adds_solid()     ? detail::Changes::kRemovals
-                                         : !dirty.removes_solid() ? detail::Changes::kAdditions
-                                                                  : detail::Changes::kBoth;
-            // Open space far from everything (every chunk of r uniform at the clamp) needs no search:
-            // every voxel of r is in reach of an addition, and no removal can raise a value there.
-            const T clamp_stored = detail::encode_distance<T>(plan.clamp, plan);
-            bool all_clamped = true;
-            const int shift = target.chunk_shift();
-            for (int cz = r.begin.z >> shift; all_clamped && cz <= (r.end.z - 1) >> shift; ++cz)
-              for (int cy = r.begin.y >> shift; all_clamped && cy <= (r.end.y - 1) >> shift; ++cy)
-                for (int cx = r.begin.x >> shift; all_clamped && cx <= (r.end.x - 1) >> shift; ++cx) {
-                  const auto view = target.chunk_view({cx, cy, cz});
-                  all_clamped = view.uniform() && view.uniform_value == clamp_stored;
-                }
-            if (all_clamped && kind == detail::Changes::kRemovals) return;
-            // The box holding every voxel that can change (a superset found by a search that reads
-            // only around the changes), then the exact test on its voxels.
-            // Once the search has covered a sixteenth of the region, the rest is read faster front to
-            // back (its shells read a cache line per voxel on their x faces): the whole region it is.
-            const Box3i grown = all_clamped ? r : detail::grow_affected(plan, target, r, near, r.volume() / 16);
-            old.resize(static_cast<std::size_t>(grown.volume()));
-            target.copy_to_dense(grown, old.data());
-            const Box3i a = all_clamped ? r : detail::affected_box(plan, grown, old, near, kind);
-            if (a.empty()) return;
-            if (a != grown) {  // keep the old values of the shrunk box only, moved to the front in place
-              const Vec3i gs = grown.size(), as = a.size();
-              std::size_t k = 0;
-              for (int z = a.begin.z; z < a.end.z; ++z)
-                for (int y = a.begin.y; y < a.end.y; ++y) {
-                  const std::size_t from = (static_cast<std::size_t>(z - grown.begin.z) * gs.y + static_cast<std::size_t>(y - grown.begin.y)) * gs.x +
-                                           static_cast<std::size_t>(a.begin.x - grown.begin.x);
-                  if (from != k)  // from > k: rows only move towards the front
-                    std::copy(old.begin() + static_cast<std::ptrdiff_t>(from),
-                              old.begin() + static_cast<std::ptrdiff_t>(from) + as.x, old.begin() + static_cast<std::ptrdiff_t>(k));
-                  k += static_cast<std::size_t>(as.x);
-                }
-              old.resize(static_cast<std::size_t>(a.volume()));
-            }
-            const Box3i region = r;
-            r = a;
-            if (additions_only) {
-              in = r;
-            } else {
-              // Sites farther than every new value of r cannot be anyone's nearest, nor sites
-              // beyond a face farther than its own bound allows (detail::NewValueBounds).
-              Vec3i below = reach_, above = reach_;
-              const detail::NewValueBounds m = detail::new_value_bound(plan, target, region, r);
-              auto voxels = [](double d, double spacing) { return static_cast<int>(std::floor(d / spacing + 1e-9)); };  // d is a bound already
-              for (int k = 0; k < 3; ++k) {
-                const double s = plan.spacing[static_cast<std::size_t>(k)];
-                if (std::isfinite(m.all)) below[k] = above[k] = std::min(reach_[k], voxels(m.all, s));
-                if (std::isfinite(m.lo_face[static_cast<std::size_t>(k)]))
-                  below[k] = std::min(below[k], 1 + voxels(m.lo_face[static_cast<std::size_t>(k)], s));
-                if (std::isfinite(m.hi_face[static_cast<std::size_t>(k)]))
-                  above[k] = std::min(above[k], 1 + voxels(m.hi_face[static_cast<std::size_t>(k)], s));
-              }
-              in = Box3i{r.begin - below, r.end + above}.intersect(*options_.domain);
-              // Air is no site: the box needs to hold r and the solid voxels around it only (after
-              // a carve in open air, often little more than r).
-              in = detail::solid_bounds(world_->voxels, in).unite(r);
-            }
-          } else {
-            in = Box3i{r.begin - reach_, r.end + reach_}.intersect(*options_.domain);
+            near = detail::changes_near(changed, r, reach_);
+            r = detail::shrink_region(u, target, region.out, near, old);
+            if (r.empty()) return;  // nothing in the region can change
           }
-          // Compute r from the sites in `in`, densely, and write it into the field (additions: from
-          // the new sites, then the minimum with the old).
-          std::vector<SiteOffset> sites(field_.sites ? static_cast<std::size_t>(r.volume()) : 0);
-          values.resize(static_cast<std::size_t>(r.volume()));
-          detail::compute_region<T>(world_->voxels, plan, in, r, values.data(), field_.sites ? sites.data() : nullptr,
-                                    additions_only ? &near : nullptr);
-          if (additions_only)
-            for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::min(values[i], old[i]);
-          target.copy_from_dense(r, values.data());
-          if (field_.sites) field_.sites->copy_from_dense(r, sites.data());
+          const Box3i in = detail::site_box(u, target, region.out, r, shrink);
+          std::vector<SiteOffset> sites;
+          detail::recompute(u, in, r, near, old, values, field_.sites ? &sites : nullptr);
+          detail::write_back(r, values, sites, target, field_.sites);
           stats.voxels_recomputed += r.volume();
           stats.voxels_read += in.volume();
           ++stats.regions;
