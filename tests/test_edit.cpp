@@ -6,7 +6,7 @@
 #include <limits>
 #include <random>
 
-#include "edit/update_regions.h"  // internal: the affected-box search, tested directly
+#include "distance/incremental/update_regions.h"  // internal: the affected-box search, tested directly
 #include "voxfield/dynamic_field.h"
 #include "voxfield/edit.h"
 

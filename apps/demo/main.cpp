@@ -17,111 +17,21 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <deque>
 #include <fstream>
 #include <iostream>
 #include <optional>
 #include <utility>
 #include <vector>
 
-#include "demo_world.h"
-#include "fly_camera.h"
-#include "gl_window.h"
+#include "demo.h"
 #include "voxfield/edit_stream.h"
 #include "voxfield/error.h"
 #include "voxfield/file.h"
-#include "voxfield/gpu_render.h"
 #include "voxfield/gpu_render_vulkan.h"
 #include "voxfield/image.h"
 #include "voxfield/png.h"
-#include "vulkan_window.h"
 
 namespace voxfield::demo {
-namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
-
-struct Options {
-  WorldSettings world;
-  std::string load;
-  std::string backend = "auto";
-  int width = 1280, height = 720;
-  bool validation = false;
-  bool benchmark = false;
-  int frames = 0;  // exit after this many frames (0: benchmark 300, interactive until closed)
-  double interval_ms = 200;
-  std::string csv;
-  std::string screenshot;
-};
-
-// What draws the frames, and why.
-struct RenderPath {
-  std::shared_ptr<gpu::Context> context;  // null: the CPU renderer
-  std::unique_ptr<gpu::SceneRenderer> renderer;
-  std::string why;
-};
-
-struct Brush {
-  int radius = 4;
-  std::uint8_t material = 1;
-  bool paint = false;
-};
-
-struct Timings {
-  double frame_ms = 0, update_ms = 0, render_ms = 0;
-};
-
-class Demo {
- public:
-  explicit Demo(const Options& o);
-  ~Demo();
-  int run();
-
- private:
-  void choose_path(const std::string& backend);
-  void frame_camera();
-  void handle_input(double dt_s);
-  void edit_at_cursor(EditOp op);
-  bool draw(VulkanWindow::Screenshot* shot);
-  void panel();
-  void help();
-  void take_screenshot(const std::string& path);
-  bool gpu_can_draw() const { return path_.renderer != nullptr; }
-  std::string title() const;
-  GLFWwindow* glfw() const { return vk_ ? vk_->window() : gl_->window(); }
-  int width() const { return vk_ ? vk_->width() : gl_->width(); }
-  int height() const { return vk_ ? vk_->height() : gl_->height(); }
-  void wait_idle() const {
-    if (vk_) vk_->wait_idle();
-  }
-
-  Options options_;
-  std::unique_ptr<VulkanWindow> vk_;  // the window, when Vulkan can present to it
-  std::unique_ptr<GlWindow> gl_;      // otherwise this one, showing CPU frames
-  std::string no_vulkan_;             // why there is no Vulkan window
-  std::unique_ptr<DemoWorld> world_;
-  RenderPath path_;
-  FlyCamera camera_;
-  Brush brush_;
-  RenderView view_ = RenderView::kShaded;
-  Algorithm error_algorithm_ = Algorithm::kJfa;
-  bool show_help_ = false;
-  bool look_mode_ = false;  // Tab: the mouse turns the view, clicks edit at the centre
-  double last_x_ = 0, last_y_ = 0;
-  double scroll_ = 0;
-  std::vector<int> keys_pressed_, clicks_;  // since the last frame
-  Clock::time_point last_edit_ = Clock::now();
-  Timings last_;
-  std::deque<float> frame_history_;
-  std::string status_;
-  char save_path_[256] = "demo-world.vfw";
-  char load_path_[256] = "";
-  int ui_size_ = 128, ui_chunk_ = 16, ui_metric_ = 0, ui_backend_ = 0;
-  float ui_clamp_ = 32;
-  VkDescriptorPool imgui_pool_ = VK_NULL_HANDLE;
-  int screenshots_ = 0;
-};
 
 Demo::Demo(const Options& o) : options_(o) {
   world_ = o.load.empty() ? std::make_unique<DemoWorld>(o.world) : std::make_unique<DemoWorld>(o.world, o.load);
@@ -379,122 +289,6 @@ bool Demo::draw(VulkanWindow::Screenshot* shot) {
   return drawn;
 }
 
-void Demo::panel() {
-  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
-  ImGui::Begin("voxfield");
-  ImGui::TextWrapped("%s", gpu_can_draw() ? path_.why.c_str()
-                                          : (path_.renderer ? "CPU renderer (this view is not on the GPU yet)" : path_.why.c_str()));
-  ImGui::Text("%s, chunk %d", world_->origin().c_str(), world_->settings().chunk_edge);
-  ImGui::Separator();
-  ImGui::Text("frame %.1f ms (%.1f FPS)", last_.frame_ms, last_.frame_ms > 0 ? 1000.0 / last_.frame_ms : 0.0);
-  ImGui::Text("render %.1f ms, last update %.2f ms", last_.render_ms, last_.update_ms);
-  std::vector<float> history(frame_history_.begin(), frame_history_.end());
-  if (!history.empty())
-    ImGui::PlotLines("##frames", history.data(), static_cast<int>(history.size()), 0, "frame ms", 0.0f, FLT_MAX, ImVec2(0, 50));
-  ImGui::Text("%lld edits", static_cast<long long>(world_->edits()));
-  if (!status_.empty()) ImGui::TextWrapped("%s", status_.c_str());
-
-  if (ImGui::CollapsingHeader("Brush", ImGuiTreeNodeFlags_DefaultOpen)) {
-    ImGui::SliderInt("radius", &brush_.radius, 0, 32);
-    int material = brush_.material;
-    if (ImGui::SliderInt("material", &material, 1, 255)) brush_.material = static_cast<std::uint8_t>(material);
-    const Rgba c = world_->world().palette[brush_.material];
-    ImGui::ColorButton("##swatch", ImVec4(c.r / 255.0f, c.g / 255.0f, c.b / 255.0f, 1.0f));
-    ImGui::SameLine();
-    ImGui::Checkbox("paint (P)", &brush_.paint);
-  }
-  if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) {
-    const char* views[] = {"shaded", "distance", "error", "chunks"};
-    int v = static_cast<int>(view_);
-    if (ImGui::Combo("view", &v, views, 4)) view_ = static_cast<RenderView>(v);
-    const std::vector<Algorithm> algorithms = all_algorithms();
-    int a = static_cast<int>(std::find(algorithms.begin(), algorithms.end(), error_algorithm_) - algorithms.begin());
-    if (ImGui::BeginCombo("algorithm", algorithm_name(error_algorithm_))) {
-      for (std::size_t i = 0; i < algorithms.size(); ++i)
-        if (ImGui::Selectable(algorithm_name(algorithms[i]), static_cast<int>(i) == a)) error_algorithm_ = algorithms[i];
-      ImGui::EndCombo();
-    }
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("the approximation the error view measures against the exact field");
-    const char* backends[] = {"cpu", "vulkan"};
-    if (vk_) {
-      if (ImGui::Combo("backend", &ui_backend_, backends, 2)) choose_path(backends[ui_backend_]);
-    } else {
-      ImGui::TextDisabled("backend: cpu (no usable Vulkan device)");
-    }
-  }
-  if (ImGui::CollapsingHeader("Field")) {
-    const char* metrics[] = {"manhattan", "chebyshev", "euclidean"};
-    ImGui::Combo("metric", &ui_metric_, metrics, 3);
-    ImGui::SliderFloat("clamp", &ui_clamp_, 1, ui_metric_ == 2 ? 63 : 255, "%.0f voxels");
-    if (ImGui::Button("rebuild the fields")) {
-      try {
-        world_->set_field(static_cast<Metric>(ui_metric_), ui_clamp_);
-        status_ = "fields rebuilt";
-      } catch (const Error& e) {
-        status_ = e.what();
-      }
-    }
-  }
-  if (ImGui::CollapsingHeader("World")) {
-    ImGui::SliderInt("size", &ui_size_, 32, 512);
-    const char* chunks[] = {"8", "16", "32", "64"};
-    int c = ui_chunk_ == 8 ? 0 : ui_chunk_ == 16 ? 1 : ui_chunk_ == 32 ? 2 : 3;
-    if (ImGui::Combo("chunk edge", &c, chunks, 4)) ui_chunk_ = 8 << c;
-    if (ImGui::Button("regenerate")) {
-      WorldSettings s = world_->settings();
-      s.size = ui_size_;
-      s.chunk_edge = ui_chunk_;
-      try {
-        wait_idle();
-        world_ = std::make_unique<DemoWorld>(s);
-        frame_camera();
-        status_ = "regenerated";
-      } catch (const Error& e) {
-        status_ = e.what();
-      }
-    }
-    ImGui::InputText("save as", save_path_, sizeof save_path_);
-    if (ImGui::Button("save")) {
-      try {
-        world_->save(save_path_);
-        status_ = std::string("saved ") + save_path_;
-      } catch (const Error& e) {
-        status_ = e.what();
-      }
-    }
-    ImGui::InputText("load", load_path_, sizeof load_path_);
-    if (ImGui::Button("load .vox / .vfw / .npy")) {
-      try {
-        WorldSettings s = world_->settings();
-        s.chunk_edge = ui_chunk_;
-        auto loaded = std::make_unique<DemoWorld>(s, load_path_);
-        wait_idle();
-        world_ = std::move(loaded);
-        frame_camera();
-        status_ = std::string("loaded ") + load_path_;
-      } catch (const Error& e) {
-        status_ = e.what();  // the current world stays
-      }
-    }
-  }
-  ImGui::End();
-}
-
-void Demo::help() {
-  ImGui::SetNextWindowPos(ImVec2(width() * 0.5f, height() * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
-  ImGui::Begin("help (F1)", &show_help_, ImGuiWindowFlags_AlwaysAutoResize);
-  ImGui::Text("W A S D       fly; Space / Shift up and down; Ctrl faster");
-  ImGui::Text("middle drag   look around; Tab toggles mouse look (edits at the centre)");
-  ImGui::Text("left click    place a sphere of the material (paint in paint mode)");
-  ImGui::Text("right click   carve a sphere");
-  ImGui::Text("scroll        brush radius");
-  ImGui::Text("1 .. 9        material; P toggles paint mode");
-  ImGui::Text("F12           screenshot (voxfield-demo-N.png)");
-  ImGui::Text("F1            this help");
-  ImGui::End();
-}
-
 void Demo::take_screenshot(const std::string& path) {
   VulkanWindow::Screenshot shot;
   while (!draw(&shot)) {
@@ -580,7 +374,6 @@ int Demo::run() {
   return 0;
 }
 
-}  // namespace
 }  // namespace voxfield::demo
 
 int main(int argc, char** argv) {

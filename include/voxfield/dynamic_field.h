@@ -38,6 +38,10 @@ class DynamicDistanceField {
   // Recomputes the whole field.
   void rebuild();
   // Recomputes what the recorded changes can affect. The caller clears `dirty` afterwards.
+  // Not the strong exception guarantee: the field is written region by region, so if update()
+  // throws (out of memory, while recomputing or storing a region) the regions before hold their
+  // new values, the one being stored may hold some, the rest their old ones — a valid field, but
+  // no longer exact for the world. rebuild() makes it exact again.
   UpdateStats update(const DirtyRegions& dirty);
 
   const DistanceField& field() const { return field_; }

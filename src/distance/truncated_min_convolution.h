@@ -1,6 +1,6 @@
 // voxfield — the 2-D passes of a clamped Euclidean transform on a window of one slice, by
-// truncated min-convolution (internal; used by exact_transform.cpp for local recomputation, and
-// for whole fields with the whole slice as the window).
+// truncated min-convolution (internal; used by exact/local_region.cpp for local recomputation, and
+// by exact/whole_field.cpp for whole fields with the whole slice as the window).
 //
 // After the z pass, a slice holds f(x, y) = dz², the squared distance to the nearest site in each
 // column. The squared Euclidean distance transform then is two min-convolutions with the parabola

@@ -4,18 +4,16 @@
 // in 200), read defensively: every length is checked against its parent before use, counts are
 // checked against the bytes that could hold them before anything is allocated, and the scene graph
 // is walked with a depth and instance budget so that cycles and exponential instancing fail
-// cleanly instead of hanging.
+// cleanly instead of hanging (the walk and the world's memory estimate: vox_scene.cpp).
 #include <zlib.h>
 
 #include <algorithm>
-#include <array>
 #include <charconv>
 #include <optional>
-#include <unordered_map>
-#include <unordered_set>
 
 #include "byte_reader.h"
 #include "vox_affine.h"
+#include "vox_scene.h"
 #include "voxfield/file.h"
 #include "voxfield/limits.h"
 #include "voxfield/vox.h"
@@ -25,28 +23,17 @@ namespace {
 
 using detail::Affine;
 using detail::ByteReader;
+using detail::vox::Dict;
+using detail::vox::lookup;
+using detail::vox::ModelData;
+using detail::vox::Node;
 
 constexpr int kMaxModelEdge = 1024;        // MagicaVoxel writes at most 256; leave room for others
-constexpr int kMaxSceneDepth = 64;         // nesting of nTRN/nGRP; real files use < 10
-constexpr std::int64_t kMaxInstances = 1 << 20;
-constexpr std::int64_t kMaxVisits = 1 << 22;  // node visits: bounds DAGs that instance exponentially
-constexpr std::int64_t kMaxPlacedVoxels = std::int64_t{1} << 32;
 constexpr std::int64_t kMaxTranslation = std::int64_t{1} << 30;  // one nTRN's _t component
 constexpr int kMinVersion = 150;                                 // the oldest documented format
-// What the reader itself keeps per item, for the memory estimate (the world's chunks are
-// counted separately): a stored voxel of an XYZI model, a placed instance (its record and
-// placement), a chunk of the world beyond its voxels (hash node and bookkeeping).
+// What the reader itself keeps per stored voxel of an XYZI model, for the memory estimate (the
+// scene's instances and the world's chunks are counted by vox_scene.cpp).
 constexpr std::uint64_t kBytesPerStoredVoxel = 8;
-constexpr std::uint64_t kBytesPerInstance = 192;
-constexpr std::uint64_t kBytesPerChunkNode = 96;
-
-using Dict = std::vector<std::pair<std::string, std::string>>;
-
-std::optional<std::string> lookup(const Dict& d, std::string_view key) {
-  for (const auto& [k, v] : d)
-    if (k == key) return v;
-  return std::nullopt;
-}
 
 std::string read_string(ByteReader& r) {
   const std::int32_t n = r.i32("string length");
@@ -82,50 +69,6 @@ std::int32_t read_count(ByteReader& r, std::size_t bytes_each, const char* what)
   }
   return n;
 }
-
-struct ModelData {
-  VoxModelInfo info;
-  // Solid voxels as (x, y, z, colour index); colour 0 (air) is dropped at load.
-  struct Voxel {
-    std::uint16_t x, y, z;
-    std::uint8_t c;
-  };
-  std::vector<Voxel> voxels;  // XYZI models, and TDCZ models that are mostly air
-  // TDCZ models at least an eighth solid: one colour index per voxel of the SIZE box, x fastest
-  // (a voxel list would take 8 bytes per solid voxel of a model that can hold 2^30).
-  std::vector<std::uint8_t> dense;  // empty: the model is in `voxels`
-
-  std::int64_t solid_count() const { return info.voxel_count; }
-  // Calls f(x, y, z, colour) for every solid voxel.
-  template <class F>
-  void for_each_voxel(F&& f) const {
-    if (dense.empty()) {
-      for (const Voxel& v : voxels) f(v.x, v.y, v.z, v.c);
-      return;
-    }
-    std::size_t i = 0;
-    for (int z = 0; z < info.size.z; ++z)
-      for (int y = 0; y < info.size.y; ++y)
-        for (int x = 0; x < info.size.x; ++x, ++i)
-          if (dense[i] != 0) f(x, y, z, dense[i]);
-  }
-};
-
-struct Node {
-  enum Kind { kTransform, kGroup, kShape };
-  Node(Kind k, std::uint64_t at) : kind(k), offset(at) {}
-  Kind kind;
-  std::uint64_t offset;  // of its chunk, for error messages
-  Dict attributes;
-  // transform
-  std::int32_t child = -1;
-  std::int32_t layer = -1;
-  Affine frame0;
-  // group
-  std::vector<std::int32_t> children;
-  // shape
-  std::int32_t model = -1;
-};
 
 Affine parse_frame(const Dict& frame, ByteReader& r) {
   Affine a;
@@ -167,7 +110,7 @@ class VoxParser {
  public:
   VoxParser(std::span<const std::uint8_t> bytes, const std::string& name,
             const VoxImportOptions& options)
-      : bytes_(bytes), name_(name), options_(options), result_{World(options.chunk_edge), {}} {}
+      : bytes_(bytes), name_(name), options_(options), result_{World(options.chunk_edge), {}}, scene_(bytes, name, options_) {}
 
   VoxImport run() {
     ByteReader r(bytes_, name_);
@@ -280,7 +223,7 @@ class VoxParser {
     ModelData m;
     m.info.size = take_size(c, at, "XYZI");
     const std::int32_t n = read_count(c, 4, "voxel count");
-    charge(mul_sat(static_cast<std::uint64_t>(n), kBytesPerStoredVoxel), c, at, "its models");
+    scene_.charge(mul_sat(static_cast<std::uint64_t>(n), kBytesPerStoredVoxel), at, "its models");
     m.voxels.reserve(static_cast<std::size_t>(n));
     for (std::int32_t i = 0; i < n; ++i) {
       const std::uint64_t vat = c.offset();
@@ -293,7 +236,7 @@ class VoxParser {
       if (v[3] != 0) m.voxels.push_back({v[0], v[1], v[2], v[3]});
     }
     m.info.voxel_count = static_cast<std::int64_t>(m.voxels.size());
-    models_.push_back(std::move(m));
+    scene_.models.push_back(std::move(m));
   }
 
   // Teardown's variant: the SIZE again, then a zlib stream (ended by a sync flush rather than a
@@ -314,7 +257,7 @@ class VoxParser {
       c.fail_at(at, "TDCZ model of " + std::to_string(n) + " voxels cannot come from " +
                         std::to_string(packed.size()) + " compressed bytes");
     }
-    charge(static_cast<std::uint64_t>(n), c, at, "its models");
+    scene_.charge(static_cast<std::uint64_t>(n), at, "its models");
     std::vector<std::uint8_t> dense(static_cast<std::size_t>(n));
     z_stream z{};
     if (inflateInit(&z) != Z_OK) c.fail("cannot initialise zlib");
@@ -345,7 +288,7 @@ class VoxParser {
     } else {
       m.dense = std::move(dense);  // at least an eighth solid: placing costs at most 8x its solid voxels
     }
-    models_.push_back(std::move(m));
+    scene_.models.push_back(std::move(m));
   }
 
   void read_rgba(ByteReader& c) {
@@ -365,8 +308,8 @@ class VoxParser {
 
   void add_node(std::int32_t id, Node node, ByteReader& c) {
     if (id < 0) c.fail_at(node.offset, "negative node id " + std::to_string(id));
-    if (!nodes_.emplace(id, std::move(node)).second) {
-      c.fail_at(nodes_.at(id).offset, "duplicate scene node id " + std::to_string(id));
+    if (!scene_.nodes.emplace(id, std::move(node)).second) {
+      c.fail_at(scene_.nodes.at(id).offset, "duplicate scene node id " + std::to_string(id));
     }
   }
 
@@ -416,189 +359,24 @@ class VoxParser {
     const std::int32_t id = c.i32("layer id");
     const Dict d = read_dict(c);
     const auto hidden = lookup(d, "_hidden");
-    hidden_layers_[id] = hidden && *hidden == "1";
-  }
-
-  static bool is_hidden(const Dict& d) {
-    const auto h = lookup(d, "_hidden");
-    return h && *h == "1";
-  }
-
-  // Walks the scene graph depth first; `name` is the _name of the nearest transform above.
-  void visit(std::int32_t id, const Affine& parent, bool hidden, int depth, std::uint64_t from,
-             const std::string& name) {
-    ByteReader r(bytes_, name_);
-    if (depth > kMaxSceneDepth) {
-      r.fail_at(from, "scene graph nested deeper than " + std::to_string(kMaxSceneDepth) +
-                          " levels (a cycle?)");
-    }
-    if (++visits_ > kMaxVisits) {
-      r.fail_at(from, "scene graph walk exceeds " + std::to_string(kMaxVisits) + " node visits");
-    }
-    auto it = nodes_.find(id);
-    if (it == nodes_.end()) r.fail_at(from, "reference to missing scene node " + std::to_string(id));
-    const Node& n = it->second;
-    hidden = hidden || is_hidden(n.attributes);
-    switch (n.kind) {
-      case Node::kTransform: {
-        auto layer = hidden_layers_.find(n.layer);
-        hidden = hidden || (layer != hidden_layers_.end() && layer->second);
-        visit(n.child, parent.then_child(n.frame0), hidden, depth + 1, n.offset,
-              lookup(n.attributes, "_name").value_or(""));
-        break;
-      }
-      case Node::kGroup:
-        for (std::int32_t child : n.children) visit(child, parent, hidden, depth + 1, n.offset, name);
-        break;
-      case Node::kShape:
-        place_instance(n, parent, hidden, name);
-        break;
-    }
-  }
-
-  // Records an instance; its voxels are placed by finish() once the whole scene's cost is known.
-  void place_instance(const Node& n, const Affine& xf, bool hidden, const std::string& name) {
-    ByteReader r(bytes_, name_);
-    if (n.model < 0 || static_cast<std::size_t>(n.model) >= models_.size()) {
-      r.fail_at(n.offset, "shape references model " + std::to_string(n.model) + " but the file has " +
-                              std::to_string(models_.size()));
-    }
-    if (static_cast<std::int64_t>(result_.info.instances.size()) >= kMaxInstances) {
-      r.fail_at(n.offset, "more than " + std::to_string(kMaxInstances) + " instances");
-    }
-    charge(kBytesPerInstance + name.size(), r, n.offset, "its scene graph's instances");
-    const ModelData& m = models_[static_cast<std::size_t>(n.model)];
-    const std::array<std::int64_t, 3> pivot{m.info.size.x / 2, m.info.size.y / 2, m.info.size.z / 2};
-    const auto a = xf.place({0, 0, 0}, pivot);
-    const auto b = xf.place({m.info.size.x - 1, m.info.size.y - 1, m.info.size.z - 1}, pivot);
-    for (int k = 0; k < 3; ++k) {
-      if (!coord_in_range(std::min(a[k], b[k])) || !coord_in_range(std::max(a[k], b[k]))) {
-        r.fail_at(n.offset, "instance of model " + std::to_string(n.model) + " spans " + std::to_string(std::min(a[k], b[k])) +
-                                ".." + std::to_string(std::max(a[k], b[k])) + " on axis " + "xyz"[k] +
-                                ", outside the supported coordinate range -2^29..2^29-1");
-      }
-    }
-    VoxInstanceInfo inst;
-    inst.model = n.model;
-    inst.hidden = hidden;
-    inst.name = name;
-    inst.world_box = Box3i::from_inclusive(
-        {static_cast<int>(std::min(a[0], b[0])), static_cast<int>(std::min(a[1], b[1])),
-         static_cast<int>(std::min(a[2], b[2]))},
-        {static_cast<int>(std::max(a[0], b[0])), static_cast<int>(std::max(a[1], b[1])),
-         static_cast<int>(std::max(a[2], b[2]))});
-    result_.info.instances.push_back(inst);
-    if (hidden && !options_.include_hidden) return;
-    placed_voxels_ += m.solid_count();
-    if (placed_voxels_ > kMaxPlacedVoxels) {
-      r.fail_at(n.offset, "scene places more than " + std::to_string(kMaxPlacedVoxels) + " voxels");
-    }
-    placements_.push_back({n.model, xf, n.offset, result_.info.instances.back().world_box});
-  }
-
-  // The world's chunks every placement touches, counted before any is allocated: while voxels are
-  // placed each touched chunk is dense (chunk_edge^3 bytes). An instance with fewer voxels than
-  // chunks in its box adds the chunks of its voxels, others every chunk of the box: an upper bound
-  // within one instance's box, exact where instances are sparse (the case that costs most).
-  void check_world_memory() {
-    ByteReader r(bytes_, name_);
-    const Grid<std::uint8_t>& g = result_.world.voxels;
-    const int shift = g.chunk_shift();
-    const std::uint64_t per_chunk = static_cast<std::uint64_t>(g.chunk_volume()) + kBytesPerChunkNode;
-    const std::uint64_t limit = effective_memory_limit(options_.memory_limit_bytes);
-    const std::uint64_t budget = limit > reader_bytes_ ? limit - reader_bytes_ : 0;
-    const std::uint64_t max_chunks = budget / per_chunk;
-    std::unordered_set<Vec3i, Vec3iHash> chunks;
-    auto add = [&](Vec3i k, std::uint64_t at) {
-      if (chunks.insert(k).second && chunks.size() > max_chunks) {
-        require_memory(add_sat(reader_bytes_, mul_sat(chunks.size(), per_chunk)), limit, name_,
-                       "placing its voxels (at least " + std::to_string(chunks.size()) + " chunks of " +
-                           std::to_string(g.chunk_edge()) + "^3 touched, from the instance at byte " +
-                           std::to_string(at) + " on)");
-      }
-    };
-    for (const Placement& pl : placements_) {
-      const ModelData& m = models_[static_cast<std::size_t>(pl.model)];
-      const Vec3i lo = g.chunk_of(pl.box.begin), hi = g.chunk_of(pl.box.end - Vec3i::splat(1));
-      const std::int64_t box_chunks =
-          std::int64_t{hi.x - lo.x + 1} * (hi.y - lo.y + 1) * (hi.z - lo.z + 1);
-      if (m.solid_count() < box_chunks) {
-        const std::array<std::int64_t, 3> pivot{m.info.size.x / 2, m.info.size.y / 2, m.info.size.z / 2};
-        m.for_each_voxel([&](int x, int y, int z, std::uint8_t) {
-          const auto p = pl.frame.place({x, y, z}, pivot);
-          add({static_cast<int>(p[0] >> shift), static_cast<int>(p[1] >> shift), static_cast<int>(p[2] >> shift)}, pl.offset);
-        });
-      } else {
-        for (int z = lo.z; z <= hi.z; ++z)
-          for (int y = lo.y; y <= hi.y; ++y)
-            for (int x = lo.x; x <= hi.x; ++x) add({x, y, z}, pl.offset);
-      }
-    }
-    (void)r;
+    scene_.hidden_layers[id] = hidden && *hidden == "1";
   }
 
   void finish() {
     ByteReader r(bytes_, name_);
     if (pending_size_) r.fail_at(bytes_.size(), "SIZE chunk without voxel data at end of file");
-    for (const auto& m : models_) result_.info.models.push_back(m.info);
-    result_.info.has_scene_graph = !nodes_.empty();
-    if (!nodes_.empty()) {
-      // The root is transform node 0 by convention.
-      if (nodes_.find(0) == nodes_.end()) r.fail_at(8, "scene graph has no root node 0");
-      visit(0, Affine{}, false, 0, nodes_.at(0).offset, "");
-    } else if (!models_.empty()) {
-      if (options_.frame < 0 || static_cast<std::size_t>(options_.frame) >= models_.size()) {
-        throw InvalidArgument(name_ + ": frame " + std::to_string(options_.frame) +
-                              " requested but the file has " + std::to_string(models_.size()) +
-                              " models");
-      }
-      // Placed with voxel v at v: the transform that does so for the model's size.
-      const ModelData& m = models_[static_cast<std::size_t>(options_.frame)];
-      Affine identity;
-      for (int k = 0; k < 3; ++k) identity.t[k] = m.info.size[k] / 2;
-      placements_.push_back({options_.frame, identity, 8, Box3i::from_size(m.info.size)});
-    }
-    check_world_memory();
-    for (const Placement& pl : placements_) {
-      const ModelData& m = models_[static_cast<std::size_t>(pl.model)];
-      const std::array<std::int64_t, 3> pivot{m.info.size.x / 2, m.info.size.y / 2, m.info.size.z / 2};
-      m.for_each_voxel([&](int x, int y, int z, std::uint8_t c) {
-        const auto p = pl.frame.place({x, y, z}, pivot);
-        result_.world.voxels.set({static_cast<int>(p[0]), static_cast<int>(p[1]), static_cast<int>(p[2])}, c);
-      });
-    }
+    for (const auto& m : scene_.models) result_.info.models.push_back(m.info);
+    result_.info.has_scene_graph = !scene_.nodes.empty();
+    scene_.place(result_.world, result_.info);
     result_.world.voxels.compact();
   }
-
-  // Adds what the reader keeps in memory and refuses past the limit.
-  void charge(std::uint64_t bytes, ByteReader& r, std::uint64_t at, const char* what) {
-    reader_bytes_ = add_sat(reader_bytes_, bytes);
-    if (reader_bytes_ > effective_memory_limit(options_.memory_limit_bytes)) {
-      require_memory(reader_bytes_, options_.memory_limit_bytes, name_,
-                     std::string("reading ") + what + " (up to byte " + std::to_string(at) + ")");
-    }
-    (void)r;
-  }
-
-  struct Placement {
-    int model;
-    Affine frame;
-    std::uint64_t offset;  // of the shape node, for messages
-    Box3i box;             // where the model's SIZE box lands
-  };
 
   std::span<const std::uint8_t> bytes_;
   const std::string& name_;
   VoxImportOptions options_;
   VoxImport result_;
   std::optional<Vec3i> pending_size_;
-  std::vector<ModelData> models_;
-  std::unordered_map<std::int32_t, Node> nodes_;
-  std::unordered_map<std::int32_t, bool> hidden_layers_;
-  std::vector<Placement> placements_;
-  std::int64_t placed_voxels_ = 0;
-  std::int64_t visits_ = 0;
-  std::uint64_t reader_bytes_ = 0;  // what the reader holds besides the world's chunks
+  detail::vox::Scene scene_;  // the models and graph read so far, and the memory they hold
 };
 
 }  // namespace

@@ -17,9 +17,9 @@
 #include <cmath>
 #include <cstring>
 
-#include "shaders/layout.h"
-#include "edit/update_regions.h"
+#include "../incremental/update_regions.h"
 #include "gpu/vulkan_context.h"
+#include "shaders/layout.h"
 #include "voxfield/gpu_distance.h"
 
 namespace voxfield::gpu {
@@ -157,157 +157,24 @@ class FieldEngine {
   void run(const std::vector<Vec3i>& chunks, const std::vector<detail::UpdateRegion>& regions, bool download,
            std::vector<PassTiming>* timings) {
     Staging up;
-    std::vector<VkBufferCopy> page_copies, brick_copies;
-    std::optional<Buffer> old_pool;  // kept alive until the copy out of it has run
-    VkDeviceSize old_pool_bytes = 0;
-    if (first_run_) {
-      const VkDeviceSize at = up.add(&header_, sizeof header_);
-      header_copy_ = VkBufferCopy{at, 0, sizeof header_};
-    }
-    sync_chunks(chunks, up, page_copies, brick_copies, old_pool, old_pool_bytes);
-    VkDeviceSize largest = 4;
-    for (const auto& r : regions) largest = std::max<VkDeviceSize>(largest, static_cast<VkDeviceSize>(r.in.volume()) * 4);
-    if (largest > work_bytes_) grow_work_buffers(largest);
-
+    Uploads uploads;
+    stage(chunks, regions, up, uploads);
     Buffer& upload = ctx_.upload_buffer(std::max<VkDeviceSize>(up.bytes.size(), 16));
     if (!up.bytes.empty()) std::memcpy(upload.mapped(), up.bytes.data(), up.bytes.size());
     Buffer* readback = download ? &ctx_.readback_buffer(field_bytes_ + site_bytes_) : nullptr;
     const VkDescriptorSet set = descriptor_set();
-
-    VkCommandBufferAllocateInfo cba{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    cba.commandPool = ctx_.command_pool;
-    cba.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    cba.commandBufferCount = 1;
-    VkCommandBuffer cmd;
-    check(vkAllocateCommandBuffers(ctx_.device, &cba, &cmd), "vkAllocateCommandBuffers");
-    struct FreeCmd {
-      Context::Impl& ctx;
-      VkCommandBuffer cmd;
-      ~FreeCmd() { vkFreeCommandBuffers(ctx.device, ctx.command_pool, 1, &cmd); }
-    } free_cmd{ctx_, cmd};
-    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
     const bool timed = timings && ctx_.timestamps != VK_NULL_HANDLE;
-    if (timed) vkCmdResetQueryPool(cmd, ctx_.timestamps, 0, 64);
-
-    // Transfers first: a grown pool's old bricks, the header, changed page entries and bricks.
-    bool transferred = false;
-    if (old_pool) {
-      const VkBufferCopy keep{0, 0, old_pool_bytes};
-      vkCmdCopyBuffer(cmd, old_pool->handle(), bricks_buf_.handle(), 1, &keep);
-      barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-              VK_ACCESS_TRANSFER_WRITE_BIT);
-      transferred = true;
-    }
-    if (first_run_) {
-      vkCmdCopyBuffer(cmd, upload.handle(), header_buf_.handle(), 1, &header_copy_);
-      ctx_.counters.bytes_uploaded += sizeof header_;
-      transferred = true;
-    }
-    if (!page_copies.empty()) {
-      vkCmdCopyBuffer(cmd, upload.handle(), pages_buf_.handle(), static_cast<std::uint32_t>(page_copies.size()),
-                      page_copies.data());
-      transferred = true;
-    }
-    if (!brick_copies.empty()) {
-      vkCmdCopyBuffer(cmd, upload.handle(), bricks_buf_.handle(), static_cast<std::uint32_t>(brick_copies.size()),
-                      brick_copies.data());
-      transferred = true;
-    }
-    if (!first_run_) {
-      // The previous submission's shader accesses are complete (its fence was waited on), but
-      // this one's transfers and passes overwrite buffers those passes used: order them.
-      barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-              VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-              VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-    }
-    if (transferred)
-      barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-    first_run_ = false;
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.field_layout.pipeline, 0, 1, &set, 0, nullptr);
-
     std::vector<std::string> names;
-    bool first_pass = true;
-    auto pass = [&](const Pipeline& pipeline, const L::PassParams& pp, std::uint64_t invocations, std::string name) {
-      if (!first_pass)
-        barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-      first_pass = false;
-      const auto q = static_cast<std::uint32_t>(2 * names.size());
-      const bool stamp = timed && q + 1 < 64;
-      if (stamp) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx_.timestamps, q);
-      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
-      vkCmdPushConstants(cmd, ctx_.field_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pp, &pp);
-      dispatch(ctx_, cmd, invocations);
-      if (stamp) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx_.timestamps, q + 1);
-      names.push_back(std::move(name));
-    };
-    for (const detail::UpdateRegion& r : regions) {
-      const Vec3i n = r.in.size();
-      L::PassParams pp{};
-      pp.box_begin = {r.in.begin.x, r.in.begin.y, r.in.begin.z, 0};
-      pp.box_size = {n.x, n.y, n.z, 0};
-      pp.out_begin = {r.out.begin.x, r.out.begin.y, r.out.begin.z, 0};
-      pp.out_size = {r.out.size().x, r.out.size().y, r.out.size().z, 0};
-      // One separable transform: sites along z into `result`, then x and y through `other` —
-      // the CPU's order, so that nearest sites break ties the same way (docs/distance.md).
-      auto transform = [&](std::uint32_t result, std::uint32_t other, bool to_air) {
-        const std::string what = to_air ? " (to air)" : "";
-        L::PassParams t = pp;
-        t.sites_are_air = to_air ? 1u : 0u;
-        t.axis = 2;
-        t.dst = result;
-        pass(ctx_.edt_sites, t, static_cast<std::uint64_t>(n.x) * n.y, "columns z" + what);
-        t.axis = 0;
-        t.src = result;
-        t.dst = other;
-        pass(ctx_.edt_lines, t, static_cast<std::uint64_t>(n.y) * n.z, "lines x" + what);
-        t.axis = 1;
-        t.src = other;
-        t.dst = result;
-        pass(ctx_.edt_lines, t, static_cast<std::uint64_t>(n.x) * n.z, "lines y" + what);
-      };
-      transform(0, 1, false);
-      if (plan_.is_signed) transform(2, 1, true);
-      L::PassParams enc = pp;
-      enc.src = 0;
-      enc.src2 = 2;
-      // One invocation per word of packed values that the out box touches.
-      const std::int64_t lanes = static_cast<std::int64_t>(lanes_of(options_.storage));
-      const std::int64_t ox = r.out.begin.x - plan_.domain.begin.x;
-      const std::int64_t words = (ox + r.out.size().x - 1) / lanes - ox / lanes + 1;
-      pass(ctx_.edt_encode, enc, static_cast<std::uint64_t>(words * r.out.size().y * r.out.size().z), "encode");
-    }
-    if (readback) {
-      barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-              VK_ACCESS_TRANSFER_READ_BIT);
-      const VkBufferCopy down{0, 0, field_bytes_};
-      vkCmdCopyBuffer(cmd, field_buf_.handle(), readback->handle(), 1, &down);
-      if (site_bytes_ > 0) {
-        const VkBufferCopy down_sites{0, field_bytes_, site_bytes_};
-        vkCmdCopyBuffer(cmd, field_sites_buf_.handle(), readback->handle(), 1, &down_sites);
-      }
-      barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-              VK_ACCESS_HOST_READ_BIT);
-      ctx_.counters.bytes_downloaded += static_cast<std::int64_t>(field_bytes_ + site_bytes_);
-    }
-    check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
-    ctx_.submit_and_wait(cmd);
-
-    if (timings) {
-      timings->clear();
-      const auto count = static_cast<std::uint32_t>(std::min<std::size_t>(2 * names.size(), 64));
-      if (timed && count >= 2) {
-        std::vector<std::uint64_t> ticks(count);
-        check(vkGetQueryPoolResults(ctx_.device, ctx_.timestamps, 0, count, ticks.size() * 8, ticks.data(), 8,
-                                    VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-              "vkGetQueryPoolResults");
-        for (std::size_t i = 0; 2 * i + 1 < count; ++i)
-          timings->push_back({names[i], static_cast<double>(ticks[2 * i + 1] - ticks[2 * i]) * ctx_.timestamp_period_ns * 1e-6});
-      }
-    }
+    ctx_.run_commands([&](VkCommandBuffer cmd) {
+      if (timed) vkCmdResetQueryPool(cmd, ctx_.timestamps, 0, kTimestamps);
+      record_transfers(cmd, upload, uploads);
+      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.field_layout.pipeline, 0, 1, &set, 0, nullptr);
+      PassRecorder passes(ctx_, cmd, timed);
+      for (const detail::UpdateRegion& r : regions) record_region(passes, r);
+      if (readback) record_readback(cmd, *readback);
+      names = passes.take_names();
+    });
+    if (timings) read_timings(names, timed, *timings);
   }
 
   // The field as last read back.
@@ -333,6 +200,164 @@ class FieldEngine {
   }
 
  private:
+  static constexpr std::uint32_t kTimestamps = 64;  // queries in the context's pool: 32 timed passes
+
+  // What a run copies from the upload buffer, and the old pool a grown one copies its bricks from
+  // (kept alive until the copy out of it has run).
+  struct Uploads {
+    std::vector<VkBufferCopy> page_copies, brick_copies;
+    std::optional<Buffer> old_pool;
+    VkDeviceSize old_pool_bytes = 0;
+  };
+
+  // Records compute passes into one command buffer, each ordered after the previous one's writes
+  // (barrier() in GLSL only orders one workgroup), with a timestamp pair around each while the
+  // pool has queries left.
+  class PassRecorder {
+   public:
+    PassRecorder(Context::Impl& ctx, VkCommandBuffer cmd, bool timed) : ctx_(ctx), cmd_(cmd), timed_(timed) {}
+    void pass(const Pipeline& pipeline, const L::PassParams& pp, std::uint64_t invocations, std::string name) {
+      if (!names_.empty())
+        barrier(ctx_, cmd_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+      const auto q = static_cast<std::uint32_t>(2 * names_.size());
+      const bool stamp = timed_ && q + 1 < kTimestamps;
+      if (stamp) vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx_.timestamps, q);
+      vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
+      vkCmdPushConstants(cmd_, ctx_.field_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pp, &pp);
+      dispatch(ctx_, cmd_, invocations);
+      if (stamp) vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx_.timestamps, q + 1);
+      names_.push_back(std::move(name));
+    }
+    // The passes' names in recording order (pass i has timestamps 2i and 2i + 1).
+    std::vector<std::string> take_names() { return std::move(names_); }
+
+   private:
+    Context::Impl& ctx_;
+    VkCommandBuffer cmd_;
+    bool timed_;
+    std::vector<std::string> names_;
+  };
+
+  // Step 1, stage: the header (first run only), the changed page entries and bricks into `up`,
+  // and work buffers large enough for the largest region.
+  void stage(const std::vector<Vec3i>& chunks, const std::vector<detail::UpdateRegion>& regions, Staging& up,
+             Uploads& uploads) {
+    if (first_run_) {
+      const VkDeviceSize at = up.add(&header_, sizeof header_);
+      header_copy_ = VkBufferCopy{at, 0, sizeof header_};
+    }
+    sync_chunks(chunks, up, uploads.page_copies, uploads.brick_copies, uploads.old_pool, uploads.old_pool_bytes);
+    VkDeviceSize largest = 4;
+    for (const auto& r : regions) largest = std::max<VkDeviceSize>(largest, static_cast<VkDeviceSize>(r.in.volume()) * 4);
+    if (largest > work_bytes_) grow_work_buffers(largest);
+  }
+
+  // Step 2, transfers, recorded before every pass: a grown pool's old bricks, the header, changed
+  // page entries and bricks.
+  void record_transfers(VkCommandBuffer cmd, const Buffer& upload, const Uploads& uploads) {
+    bool transferred = false;
+    if (uploads.old_pool) {
+      const VkBufferCopy keep{0, 0, uploads.old_pool_bytes};
+      vkCmdCopyBuffer(cmd, uploads.old_pool->handle(), bricks_buf_.handle(), 1, &keep);
+      barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+              VK_ACCESS_TRANSFER_WRITE_BIT);
+      transferred = true;
+    }
+    if (first_run_) {
+      vkCmdCopyBuffer(cmd, upload.handle(), header_buf_.handle(), 1, &header_copy_);
+      ctx_.counters.bytes_uploaded += sizeof header_;
+      transferred = true;
+    }
+    if (!uploads.page_copies.empty()) {
+      vkCmdCopyBuffer(cmd, upload.handle(), pages_buf_.handle(), static_cast<std::uint32_t>(uploads.page_copies.size()),
+                      uploads.page_copies.data());
+      transferred = true;
+    }
+    if (!uploads.brick_copies.empty()) {
+      vkCmdCopyBuffer(cmd, upload.handle(), bricks_buf_.handle(), static_cast<std::uint32_t>(uploads.brick_copies.size()),
+                      uploads.brick_copies.data());
+      transferred = true;
+    }
+    if (!first_run_) {
+      // The previous submission's shader accesses are complete (its fence was waited on), but
+      // this one's transfers and passes overwrite buffers those passes used: order them.
+      barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+              VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+              VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    }
+    if (transferred)
+      barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    first_run_ = false;
+  }
+
+  // Step 3, one region's passes: recompute its compute box, encode its out box into the field.
+  void record_region(PassRecorder& passes, const detail::UpdateRegion& r) {
+    const Vec3i n = r.in.size();
+    L::PassParams pp{};
+    pp.box_begin = {r.in.begin.x, r.in.begin.y, r.in.begin.z, 0};
+    pp.box_size = {n.x, n.y, n.z, 0};
+    pp.out_begin = {r.out.begin.x, r.out.begin.y, r.out.begin.z, 0};
+    pp.out_size = {r.out.size().x, r.out.size().y, r.out.size().z, 0};
+    // One separable transform: sites along z into `result`, then x and y through `other` —
+    // the CPU's order, so that nearest sites break ties the same way (docs/distance.md).
+    auto transform = [&](std::uint32_t result, std::uint32_t other, bool to_air) {
+      const std::string what = to_air ? " (to air)" : "";
+      L::PassParams t = pp;
+      t.sites_are_air = to_air ? 1u : 0u;
+      t.axis = 2;
+      t.dst = result;
+      passes.pass(ctx_.edt_sites, t, static_cast<std::uint64_t>(n.x) * n.y, "columns z" + what);
+      t.axis = 0;
+      t.src = result;
+      t.dst = other;
+      passes.pass(ctx_.edt_lines, t, static_cast<std::uint64_t>(n.y) * n.z, "lines x" + what);
+      t.axis = 1;
+      t.src = other;
+      t.dst = result;
+      passes.pass(ctx_.edt_lines, t, static_cast<std::uint64_t>(n.x) * n.z, "lines y" + what);
+    };
+    transform(0, 1, false);
+    if (plan_.is_signed) transform(2, 1, true);
+    L::PassParams enc = pp;
+    enc.src = 0;
+    enc.src2 = 2;
+    // One invocation per word of packed values that the out box touches.
+    const std::int64_t lanes = static_cast<std::int64_t>(lanes_of(options_.storage));
+    const std::int64_t ox = r.out.begin.x - plan_.domain.begin.x;
+    const std::int64_t words = (ox + r.out.size().x - 1) / lanes - ox / lanes + 1;
+    passes.pass(ctx_.edt_encode, enc, static_cast<std::uint64_t>(words * r.out.size().y * r.out.size().z), "encode");
+  }
+
+  // Step 4, read-back (when asked): the field and its sites into `readback`, visible to the host.
+  void record_readback(VkCommandBuffer cmd, const Buffer& readback) {
+    barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+            VK_ACCESS_TRANSFER_READ_BIT);
+    const VkBufferCopy down{0, 0, field_bytes_};
+    vkCmdCopyBuffer(cmd, field_buf_.handle(), readback.handle(), 1, &down);
+    if (site_bytes_ > 0) {
+      const VkBufferCopy down_sites{0, field_bytes_, site_bytes_};
+      vkCmdCopyBuffer(cmd, field_sites_buf_.handle(), readback.handle(), 1, &down_sites);
+    }
+    barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+            VK_ACCESS_HOST_READ_BIT);
+    ctx_.counters.bytes_downloaded += static_cast<std::int64_t>(field_bytes_ + site_bytes_);
+  }
+
+  // Step 5, after the fence: each timed pass's duration from its timestamp pair.
+  void read_timings(const std::vector<std::string>& names, bool timed, std::vector<PassTiming>& timings) const {
+    timings.clear();
+    const auto count = static_cast<std::uint32_t>(std::min<std::size_t>(2 * names.size(), kTimestamps));
+    if (!timed || count < 2) return;
+    std::vector<std::uint64_t> ticks(count);
+    check(vkGetQueryPoolResults(ctx_.device, ctx_.timestamps, 0, count, ticks.size() * 8, ticks.data(), 8,
+                                VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+          "vkGetQueryPoolResults");
+    for (std::size_t i = 0; 2 * i + 1 < count; ++i)
+      timings.push_back({names[i], static_cast<double>(ticks[2 * i + 1] - ticks[2 * i]) * ctx_.timestamp_period_ns * 1e-6});
+  }
+
   void make_header() {
     header_ = {};
     header_.field_begin = {plan_.domain.begin.x, plan_.domain.begin.y, plan_.domain.begin.z, 0};

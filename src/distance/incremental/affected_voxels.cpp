@@ -1,34 +1,24 @@
-// voxfield — incremental exact distance updates by local recomputation (see dynamic_field.h).
-#include "voxfield/dynamic_field.h"
-
+// voxfield — which voxels of an update region an edit can move, and which sites their new values
+// can reach (internal; update_regions.h): the searches that let DynamicDistanceField::update
+// recompute in proportion to the edit rather than to the clamp's reach box.
+//
+// Distances are 1-Lipschitz: a voxel whose old distance does not reach a changed voxel keeps its
+// value bit for bit, and new values are bounded by the unchanged values around them. The
+// searches compare distances as costs (squared for Euclidean, so no square root per voxel) in
+// floats with bounds rounded up, so a voxel is let through whenever in doubt; the exact kernel
+// (exact/local_region.cpp) then recomputes what they let through. docs/distance.md,
+// "Incremental updates", explains the bounds.
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
+#include <type_traits>
+#include <vector>
 
 #include "update_regions.h"
 
-namespace voxfield {
-namespace detail {
+namespace voxfield::detail {
 namespace {
-
-Box3i grow(const Box3i& b, Vec3i by) { return {b.begin - by, b.end + by}; }
-
-// Merges boxes that overlap until none do, so that no voxel is recomputed twice.
-std::vector<Box3i> merge_overlapping(std::vector<Box3i> boxes) {
-  bool merged = true;
-  while (merged) {
-    merged = false;
-    for (std::size_t i = 0; i < boxes.size() && !merged; ++i)
-      for (std::size_t j = i + 1; j < boxes.size(); ++j) {
-        if (boxes[i].intersect(boxes[j]).empty()) continue;
-        boxes[i] = boxes[i].unite(boxes[j]);
-        boxes.erase(boxes.begin() + static_cast<std::ptrdiff_t>(j));
-        merged = true;
-        break;
-      }
-  }
-  return boxes;
-}
 
 // An upper bound of the distance an unsigned stored value stands for: integer storage rounds
 // down (d < (stored + 1) / scale) and the clamp value stands for "at least the clamp" (+inf);
@@ -55,11 +45,6 @@ struct GapCost {
   }
   float combine(float a, float b) const { return metric == Metric::kChebyshev ? std::max(a, b) : a + b; }
 };
-
-// `kind`: what the changes did — only removed solids (values can only rise, so voxels already at
-// the clamp stay there), only added them (values can only fall, so voxels at 0 stay there), or
-// both.
-enum class Changes { kRemovals, kAdditions, kBoth };
 
 // The largest gap cost (GapCost's units) from a change at which a voxel holding `stored` can still
 // be moved by it: its distance bound upper_distance() plus `extra`, as (stored + off) * mul + extra,
@@ -129,6 +114,8 @@ inline bool flagged_span(const std::uint32_t* flags, int count, int& first, int&
   return true;
 }
 
+}  // namespace
+
 template <class T>
 Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& old, const Box3i& changed, Changes kind) {
   // Only a voxel whose old distance reaches the changed voxels can change: a removed site that
@@ -160,6 +147,8 @@ Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& 
   }
   return box;
 }
+
+namespace {
 
 // Reads rows of a field grid inside a box, chunk by chunk, with the box's chunks looked up once.
 template <class T>
@@ -292,26 +281,6 @@ template Box3i grow_affected<std::uint8_t>(const FieldPlan&, const Grid<std::uin
 template Box3i grow_affected<std::uint16_t>(const FieldPlan&, const Grid<std::uint16_t>&, const Box3i&, const Box3i&, std::int64_t);
 template Box3i grow_affected<float>(const FieldPlan&, const Grid<float>&, const Box3i&, const Box3i&, std::int64_t);
 
-namespace {
-
-// After removals, the new values inside the affected box `a` are bounded by the unchanged values
-// around it: new(p) <= old(q) + |p - q| for every q outside `a` (distances are 1-Lipschitz, and q
-// keeps its value). Using q straight across each face of `a` gives a bound M on every new value
-// in `a`, so only sites within M of `a` matter — for a hole carved in solid ground, a few voxels
-// instead of the clamp. Each face also bounds on its own how far beyond it a nearest site can lie:
-// with F the largest old value on the face below `a` along axis k and p's nearest site s,
-//     (p_k - s_k) * spacing_k <= |p - s| = new(p) <= F + (p_k - a.begin_k + 1) * spacing_k,
-// so s_k >= a.begin_k - 1 - F / spacing_k whatever p is (every metric bounds each axis's step by
-// the distance) — after a carve at the ground's surface, the face in the ground (F near 0) lets
-// the sites below it be skipped, where M reaches the clamp through the face in the open air.
-// Faces on the edge of the region `r` (beyond it another region may change values) or of the
-// domain give no bound: +inf.
-struct NewValueBounds {
-  double all = std::numeric_limits<double>::infinity();  // M: every new value in `a`
-  // The largest old value on the face just below / above `a` along each axis.
-  std::array<double, 3> lo_face{all, all, all}, hi_face{all, all, all};
-};
-
 template <class T>
 NewValueBounds new_value_bound(const FieldPlan& plan, const Grid<T>& field, const Box3i& r, const Box3i& a) {
   const T clamp_stored = encode_distance<T>(plan.clamp, plan);
@@ -372,157 +341,11 @@ Box3i solid_bounds(const Grid<std::uint8_t>& occupancy, const Box3i& box) {
   return bounds;
 }
 
-}  // namespace
+template Box3i affected_box<std::uint8_t>(const FieldPlan&, const Box3i&, const std::vector<std::uint8_t>&, const Box3i&, Changes);
+template Box3i affected_box<std::uint16_t>(const FieldPlan&, const Box3i&, const std::vector<std::uint16_t>&, const Box3i&, Changes);
+template Box3i affected_box<float>(const FieldPlan&, const Box3i&, const std::vector<float>&, const Box3i&, Changes);
+template NewValueBounds new_value_bound<std::uint8_t>(const FieldPlan&, const Grid<std::uint8_t>&, const Box3i&, const Box3i&);
+template NewValueBounds new_value_bound<std::uint16_t>(const FieldPlan&, const Grid<std::uint16_t>&, const Box3i&, const Box3i&);
+template NewValueBounds new_value_bound<float>(const FieldPlan&, const Grid<float>&, const Box3i&, const Box3i&);
 
-Vec3i field_reach(const FieldPlan& plan) {
-  const Vec3i size = plan.domain.size();
-  Vec3i reach;
-  for (int k = 0; k < 3; ++k)
-    reach[k] = std::isfinite(plan.clamp) ? static_cast<int>(std::min<double>(std::ceil(plan.clamp / plan.spacing[k]), size[k]))
-                                         : size[k];
-  return reach;
-}
-
-std::vector<UpdateRegion> update_regions(const DirtyRegions& dirty, const Box3i& domain, Vec3i reach) {
-  std::vector<Box3i> reach_boxes;
-  for (const Box3i& b : dirty.boxes()) {
-    const Box3i r = grow(b, reach).intersect(domain);
-    if (!r.empty()) reach_boxes.push_back(r);
-  }
-  std::vector<UpdateRegion> regions;
-  for (const Box3i& r : merge_overlapping(std::move(reach_boxes))) regions.push_back({r, grow(r, reach).intersect(domain)});
-  return regions;
-}
-
-}  // namespace detail
-
-DynamicDistanceField::DynamicDistanceField(const World& world, DistanceOptions options)
-    : world_(&world), options_(std::move(options)) {
-  if (!options_.domain) {
-    if (!world.voxels.bounds()) {
-      throw InvalidArgument("a dynamic distance field needs a fixed domain: bound the world or set options.domain");
-    }
-    options_.domain = *world.voxels.bounds();
-  }
-  reach_ = detail::field_reach(detail::make_field_plan(world.voxels, options_));
-  rebuild();
-}
-
-void DynamicDistanceField::rebuild() { field_ = compute_distance_field(world_->voxels, options_); }
-
-DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegions& dirty) {
-  UpdateStats stats;
-  if (dirty.empty()) return stats;
-  const detail::FieldPlan plan = detail::make_field_plan(world_->voxels, options_);
-  // Changes that only add sites (placing into air) can only lower an unsigned field: its new
-  // value is min(old value, distance to the new sites), and the new sites lie in the changed
-  // boxes. So the transform runs over the recomputed box with those boxes' voxels as its only
-  // sites — no sites from the box grown by the reach. Encodings are monotone, so the minimum can be
-  // taken on stored values. Signed fields (new solids need their distance to air) and nearest sites
-  // (the tie rule) take the general path, as does anything that removed a solid voxel.
-  const bool additions_only = !dirty.removes_solid() && !plan.is_signed && !field_.sites;
-  // Unsigned fields without sites also shrink each region to the voxels the changes can move
-  // (detail::grow_affected finds a box holding them, detail::affected_box tests its voxels), and
-  // removals read only the sites their new values can reach (detail::new_value_bound). Signed
-  // fields (a new solid changes distances inside it to air) and nearest sites keep the whole reach
-  // box and read the sites up to the reach beyond it.
-  const bool shrink = !plan.is_signed && !field_.sites;
-  const std::vector<Box3i> changed = dirty.boxes();
-  for (const detail::UpdateRegion& region : detail::update_regions(dirty, *options_.domain, reach_)) {
-    std::visit(
-        [&](auto& target) {
-          using T = typename std::decay_t<decltype(target)>::value_type;
-          Box3i r = region.out;
-          // Scratch reused across updates (fresh buffers this size cost a page fault per 4 KiB).
-          thread_local std::vector<T> old_scratch, values_scratch;
-          std::vector<T>& old = old_scratch;
-          std::vector<T>& values = values_scratch;
-          Box3i in;    // the sites r's new values can depend on
-          Box3i near;  // the changes this region holds
-          if (shrink) {
-            for (const Box3i& b : changed)
-              if (!Box3i{b.begin - reach_, b.end + reach_}.intersect(r).empty()) near = near.unite(b);
-            const detail::Changes kind = !dirty.adds_solid()     ? detail::Changes::kRemovals
-                                         : !dirty.removes_solid() ? detail::Changes::kAdditions
-                                                                  : detail::Changes::kBoth;
-            // Open space far from everything (every chunk of r uniform at the clamp) needs no search:
-            // every voxel of r is in reach of an addition, and no removal can raise a value there.
-            const T clamp_stored = detail::encode_distance<T>(plan.clamp, plan);
-            bool all_clamped = true;
-            const int shift = target.chunk_shift();
-            for (int cz = r.begin.z >> shift; all_clamped && cz <= (r.end.z - 1) >> shift; ++cz)
-              for (int cy = r.begin.y >> shift; all_clamped && cy <= (r.end.y - 1) >> shift; ++cy)
-                for (int cx = r.begin.x >> shift; all_clamped && cx <= (r.end.x - 1) >> shift; ++cx) {
-                  const auto view = target.chunk_view({cx, cy, cz});
-                  all_clamped = view.uniform() && view.uniform_value == clamp_stored;
-                }
-            if (all_clamped && kind == detail::Changes::kRemovals) return;
-            // The box holding every voxel that can change (a superset found by a search that reads
-            // only around the changes), then the exact test on its voxels.
-            // Once the search has covered a sixteenth of the region, the rest is read faster front to
-            // back (its shells read a cache line per voxel on their x faces): the whole region it is.
-            const Box3i grown = all_clamped ? r : detail::grow_affected(plan, target, r, near, r.volume() / 16);
-            old.resize(static_cast<std::size_t>(grown.volume()));
-            target.copy_to_dense(grown, old.data());
-            const Box3i a = all_clamped ? r : detail::affected_box(plan, grown, old, near, kind);
-            if (a.empty()) return;
-            if (a != grown) {  // keep the old values of the shrunk box only, moved to the front in place
-              const Vec3i gs = grown.size(), as = a.size();
-              std::size_t k = 0;
-              for (int z = a.begin.z; z < a.end.z; ++z)
-                for (int y = a.begin.y; y < a.end.y; ++y) {
-                  const std::size_t from = (static_cast<std::size_t>(z - grown.begin.z) * gs.y + static_cast<std::size_t>(y - grown.begin.y)) * gs.x +
-                                           static_cast<std::size_t>(a.begin.x - grown.begin.x);
-                  if (from != k)  // from > k: rows only move towards the front
-                    std::copy(old.begin() + static_cast<std::ptrdiff_t>(from),
-                              old.begin() + static_cast<std::ptrdiff_t>(from) + as.x, old.begin() + static_cast<std::ptrdiff_t>(k));
-                  k += static_cast<std::size_t>(as.x);
-                }
-              old.resize(static_cast<std::size_t>(a.volume()));
-            }
-            const Box3i region = r;
-            r = a;
-            if (additions_only) {
-              in = r;
-            } else {
-              // Sites farther than every new value of r cannot be anyone's nearest, nor sites
-              // beyond a face farther than its own bound allows (detail::NewValueBounds).
-              Vec3i below = reach_, above = reach_;
-              const detail::NewValueBounds m = detail::new_value_bound(plan, target, region, r);
-              auto voxels = [](double d, double spacing) { return static_cast<int>(std::floor(d / spacing + 1e-9)); };  // d is a bound already
-              for (int k = 0; k < 3; ++k) {
-                const double s = plan.spacing[static_cast<std::size_t>(k)];
-                if (std::isfinite(m.all)) below[k] = above[k] = std::min(reach_[k], voxels(m.all, s));
-                if (std::isfinite(m.lo_face[static_cast<std::size_t>(k)]))
-                  below[k] = std::min(below[k], 1 + voxels(m.lo_face[static_cast<std::size_t>(k)], s));
-                if (std::isfinite(m.hi_face[static_cast<std::size_t>(k)]))
-                  above[k] = std::min(above[k], 1 + voxels(m.hi_face[static_cast<std::size_t>(k)], s));
-              }
-              in = Box3i{r.begin - below, r.end + above}.intersect(*options_.domain);
-              // Air is no site: the box needs to hold r and the solid voxels around it only (after
-              // a carve in open air, often little more than r).
-              in = detail::solid_bounds(world_->voxels, in).unite(r);
-            }
-          } else {
-            in = Box3i{r.begin - reach_, r.end + reach_}.intersect(*options_.domain);
-          }
-          // Compute r from the sites in `in`, densely, and write it into the field (additions: from
-          // the new sites, then the minimum with the old).
-          std::vector<SiteOffset> sites(field_.sites ? static_cast<std::size_t>(r.volume()) : 0);
-          values.resize(static_cast<std::size_t>(r.volume()));
-          detail::compute_region<T>(world_->voxels, plan, in, r, values.data(), field_.sites ? sites.data() : nullptr,
-                                    additions_only ? &near : nullptr);
-          if (additions_only)
-            for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::min(values[i], old[i]);
-          target.copy_from_dense(r, values.data());
-          if (field_.sites) field_.sites->copy_from_dense(r, sites.data());
-          stats.voxels_recomputed += r.volume();
-          stats.voxels_read += in.volume();
-          ++stats.regions;
-        },
-        field_.values);
-  }
-  return stats;
-}
-
-}  // namespace voxfield
+}  // namespace voxfield::detail

@@ -1,0 +1,103 @@
+// voxfield-demo — the application object: the window, the world, the render path and the panel's
+// state, shared by the frame loop (main.cpp) and the ImGui panel (panel.cpp).
+#pragma once
+
+#include <chrono>
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "demo_world.h"
+#include "fly_camera.h"
+#include "gl_window.h"
+#include "voxfield/gpu_render.h"
+#include "vulkan_window.h"
+
+namespace voxfield::demo {
+
+using Clock = std::chrono::steady_clock;
+inline double ms_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
+
+struct Options {
+  WorldSettings world;
+  std::string load;
+  std::string backend = "auto";
+  int width = 1280, height = 720;
+  bool validation = false;
+  bool benchmark = false;
+  int frames = 0;  // exit after this many frames (0: benchmark 300, interactive until closed)
+  double interval_ms = 200;
+  std::string csv;
+  std::string screenshot;
+};
+
+// What draws the frames, and why.
+struct RenderPath {
+  std::shared_ptr<gpu::Context> context;  // null: the CPU renderer
+  std::unique_ptr<gpu::SceneRenderer> renderer;
+  std::string why;
+};
+
+struct Brush {
+  int radius = 4;
+  std::uint8_t material = 1;
+  bool paint = false;
+};
+
+struct Timings {
+  double frame_ms = 0, update_ms = 0, render_ms = 0;
+};
+
+class Demo {
+ public:
+  explicit Demo(const Options& o);
+  ~Demo();
+  int run();
+
+ private:
+  void choose_path(const std::string& backend);
+  void frame_camera();
+  void handle_input(double dt_s);
+  void edit_at_cursor(EditOp op);
+  bool draw(VulkanWindow::Screenshot* shot);
+  void panel();
+  void help();
+  void take_screenshot(const std::string& path);
+  bool gpu_can_draw() const { return path_.renderer != nullptr; }
+  std::string title() const;
+  GLFWwindow* glfw() const { return vk_ ? vk_->window() : gl_->window(); }
+  int width() const { return vk_ ? vk_->width() : gl_->width(); }
+  int height() const { return vk_ ? vk_->height() : gl_->height(); }
+  void wait_idle() const {
+    if (vk_) vk_->wait_idle();
+  }
+
+  Options options_;
+  std::unique_ptr<VulkanWindow> vk_;  // the window, when Vulkan can present to it
+  std::unique_ptr<GlWindow> gl_;      // otherwise this one, showing CPU frames
+  std::string no_vulkan_;             // why there is no Vulkan window
+  std::unique_ptr<DemoWorld> world_;
+  RenderPath path_;
+  FlyCamera camera_;
+  Brush brush_;
+  RenderView view_ = RenderView::kShaded;
+  Algorithm error_algorithm_ = Algorithm::kJfa;
+  bool show_help_ = false;
+  bool look_mode_ = false;  // Tab: the mouse turns the view, clicks edit at the centre
+  double last_x_ = 0, last_y_ = 0;
+  double scroll_ = 0;
+  std::vector<int> keys_pressed_, clicks_;  // since the last frame
+  Clock::time_point last_edit_ = Clock::now();
+  Timings last_;
+  std::deque<float> frame_history_;
+  std::string status_;
+  char save_path_[256] = "demo-world.vfw";
+  char load_path_[256] = "";
+  int ui_size_ = 128, ui_chunk_ = 16, ui_metric_ = 0, ui_backend_ = 0;
+  float ui_clamp_ = 32;
+  VkDescriptorPool imgui_pool_ = VK_NULL_HANDLE;
+  int screenshots_ = 0;
+};
+
+}  // namespace voxfield::demo

@@ -1,0 +1,238 @@
+// voxfield — exact distance transforms of whole fields (Manhattan, Chebyshev, Euclidean; signed;
+// clamped; nearest sites) by separable passes: compute_distance_field.
+//
+// Meijster, Roerdink & Hesselink, "A general algorithm for computing distance transforms in linear
+// time" (2000), with the line kernels in ../line_transforms.h. The passes run in this order:
+//
+//  A. along z, per column (z_pass.h): g(x,y,z) = distance in voxels to the nearest site in the
+//     column (x, y, *). Runs on rows of chunk-edge voxels along x at once (vectorisable), and
+//     stores g in the output chunks themselves, so no volume-sized scratch is needed (peak memory
+//     beyond input and output is a few slices).
+//  B. along x and C. along y, per z-slice (slice_solvers.h): a slice only needs its own g values,
+//     so each slice is gathered into thread-local buffers, solved in 2-D, and written back in
+//     place as final values (slice_io.h, shared with local recomputation: local_region.cpp).
+//
+// With a clamp D, a g whose contribution alone exceeds D is dropped as "none": any site reached
+// through it is farther than D, so the clamped result is unchanged. This also lets integer
+// storage hold g in place when the clamp (explicit, or implied by the type's range) fits.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include "chunk_rows.h"
+#include "encoder.h"
+#include "slice_io.h"
+#include "slice_solvers.h"
+#include "voxfield/distance.h"
+#include "voxfield/parallel.h"
+#include "z_pass.h"
+
+namespace voxfield {
+namespace {
+
+using detail::TruncatedMinConvolution;
+using detail::exact::ChunkedVolume;
+using detail::exact::dispatch_solver;
+using detail::exact::Encoder;
+using detail::exact::encode_truncated_row;
+using detail::exact::for_each_row_segment;
+using detail::exact::gather_row;
+using detail::exact::gather_truncated_row;
+using detail::exact::pass_z;
+using detail::exact::Plan;
+using detail::exact::SliceBuffers;
+using detail::exact::SliceCosts;
+using detail::exact::SolidRows;
+using detail::exact::truncated_passes;
+using detail::exact::write_row;
+
+// Passes B and C and encoding of the whole field, slice by slice, through a solver of
+// slice_solvers.h: each slice's g is gathered from the chunk rows, solved, and written back into
+// the same rows as final values (T and U have the same size).
+template <class T, class U, class V, class Solve>
+void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, ChunkedVolume<SiteOffset>* sites,
+                 const Solve& solve, const Encoder<T>& encoder, std::uint32_t cap_vox, V inf) {
+  constexpr U kInfU = std::numeric_limits<U>::max();
+  const int X = p.domain.size().x, Y = p.domain.size().y;
+  const int by = p.domain.begin.y;
+  const SliceCosts<V> costs(p, inf);
+  const U cap_u = static_cast<U>(std::min<std::uint64_t>(cap_vox, kInfU));
+  const int passes = p.is_signed ? 2 : 1;
+  // Ranges of several slices each, so that the buffers are allocated a few times per thread only.
+  const std::size_t Z = static_cast<std::size_t>(p.domain.size().z);
+  const std::size_t grain = std::max<std::size_t>(1, Z / (4 * static_cast<std::size_t>(max_threads())));
+  parallel_for(Z, grain, [&](std::size_t zb, std::size_t ze) {
+    SliceBuffers<V> buf[2];
+    std::vector<std::uint8_t> solid(static_cast<std::size_t>(X) * Y);
+    std::vector<std::int16_t> dz(sites ? static_cast<std::size_t>(X) * Y : 0);
+    for (int k = 0; k < passes; ++k) buf[k].resize(X, Y);
+    for (std::size_t zi = zb; zi < ze; ++zi) {
+      const int z = p.domain.begin.z + static_cast<int>(zi);
+      for (int y = 0; y < Y; ++y) {
+        for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
+          const std::size_t o = static_cast<std::size_t>(y) * X + xo;
+          gather_row(costs, g.row(cx, by + y, z) + lx, cap_u, world.row(cx, by + y, z) + lx, count, buf[0].f.data() + o,
+                     p.is_signed ? buf[1].f.data() + o : nullptr, p.is_signed || sites ? solid.data() + o : nullptr);
+          if (sites) {
+            const SiteOffset* ss = sites->row(cx, by + y, z) + lx;
+            for (int i = 0; i < count; ++i) dz[o + i] = ss[i].dz;
+          }
+        });
+      }
+      for (int k = 0; k < passes; ++k) solve(X, Y, buf[k], 0, X);
+      for (int y = 0; y < Y; ++y) {
+        for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
+          write_row(encoder, costs, buf, solid.data(), dz.data(), X, y, xo, count,
+                    reinterpret_cast<T*>(g.row(cx, by + y, z)) + lx, sites ? sites->row(cx, by + y, z) + lx : nullptr);
+        });
+      }
+    }
+  });
+}
+
+
+// Passes B and C and encoding of a whole field through TruncatedMinConvolution: pass_slices'
+// work, slice by slice, with the window the whole slice.
+template <class T, class U>
+void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, const Encoder<T>& encoder,
+                           std::uint32_t cap) {
+  using Conv = TruncatedMinConvolution;
+  const int X = p.domain.size().x, Y = p.domain.size().y;
+  const int by = p.domain.begin.y;
+  const int reach = static_cast<int>(std::floor(p.clamp));
+  const auto drop = static_cast<Conv::Cost>(std::floor(p.clamp * p.clamp));
+  const int passes = p.is_signed ? 2 : 1;
+  const std::size_t Z = static_cast<std::size_t>(p.domain.size().z);
+  const std::size_t grain = std::max<std::size_t>(1, Z / (4 * static_cast<std::size_t>(max_threads())));
+  parallel_for(Z, grain, [&](std::size_t zb, std::size_t ze) {
+    Conv conv[2];
+    std::vector<std::uint8_t> solid(p.is_signed ? static_cast<std::size_t>(X) * Y : 0);
+    for (int k = 0; k < passes; ++k) conv[k].prepare(X, Y, 0, 0, X, Y, reach, drop);
+    for (std::size_t zi = zb; zi < ze; ++zi) {
+      const int z = p.domain.begin.z + static_cast<int>(zi);
+      for (int y = 0; y < Y; ++y) {
+        for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
+          const std::size_t o = static_cast<std::size_t>(y) * X + xo;
+          gather_truncated_row(g.row(cx, by + y, z) + lx, world.row(cx, by + y, z) + lx, count, cap, p.is_signed,
+                               conv[0].f_row(y) + xo, p.is_signed ? conv[1].f_row(y) + xo : nullptr,
+                               p.is_signed ? solid.data() + o : nullptr);
+        });
+      }
+      for (int k = 0; k < passes; ++k) conv[k].solve();
+      // Encode and write the final values back into the same slice.
+      for (int y = 0; y < Y; ++y) {
+        for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
+          T* out = reinterpret_cast<T*>(g.row(cx, by + y, z)) + lx;  // T and U have the same size
+          encode_truncated_row(encoder, conv, y, xo, count, p.is_signed ? solid.data() + static_cast<std::size_t>(y) * X + xo : nullptr,
+                               out, drop);
+        });
+      }
+    }
+  });
+}
+
+// The whole field of storage T, g held in place in U (T's size) between the passes.
+template <class T, class U>
+DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy, const DistanceOptions& options, const Plan& p) {
+  const T background = detail::field_background<T>(p);
+  DistanceField out;
+  out.options = options;
+  out.domain = p.domain;
+  out.encoding = p.encoding;
+  const int edge = occupancy.chunk_edge();
+  Grid<T> values(edge, background, occupancy.bounds());
+  std::optional<Grid<SiteOffset>> sites_grid;
+  if (p.sites) sites_grid.emplace(edge, SiteOffset{}, occupancy.bounds());
+  if (p.domain.empty()) {
+    out.values = std::move(values);
+    out.sites = std::move(sites_grid);
+    return out;
+  }
+
+  ChunkedVolume<U> g(p.aligned, edge);
+  std::optional<ChunkedVolume<SiteOffset>> sites;
+  if (p.sites) sites.emplace(p.aligned, edge);
+  const SolidRows world(occupancy, p.aligned);
+
+  // Chunks reaching outside the domain keep the background there.
+  {
+    U bg;
+    std::memcpy(&bg, &background, sizeof(U));
+    const std::size_t volume = std::size_t{1} << (3 * g.shift);
+    parallel_for(g.chunks.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const Vec3i lo{g.coords[i].x * edge, g.coords[i].y * edge, g.coords[i].z * edge};
+        if (!p.domain.contains(Box3i{lo, lo + Vec3i::splat(edge)})) {
+          std::fill(g.chunks[i].get(), g.chunks[i].get() + volume, bg);
+          if (sites) std::fill(sites->chunks[i].get(), sites->chunks[i].get() + volume, SiteOffset{});
+        }
+      }
+    });
+  }
+
+  // Largest g worth keeping: beyond it a column's site is farther than the clamp.
+  constexpr std::uint64_t kInfU = std::numeric_limits<U>::max();
+  std::uint64_t cap = kInfU;
+  if (std::isfinite(p.clamp)) {
+    const double vox = std::floor(p.clamp / p.spacing[2]) + 1;
+    cap = static_cast<std::uint64_t>(std::min<double>(vox, static_cast<double>(kInfU)));
+  }
+  cap = std::min<std::uint64_t>(cap, std::numeric_limits<std::uint32_t>::max() - 1);
+  const std::uint32_t cap32 = static_cast<std::uint32_t>(cap);
+
+  // Pass A.
+  const int ncx = g.nchunks.x, ncy = g.nchunks.y;
+  parallel_for(static_cast<std::size_t>(ncx) * ncy, 1, [&](std::size_t b, std::size_t e) {
+    std::vector<std::uint32_t> col;
+    ChunkedVolume<SiteOffset>* sp = sites ? &*sites : nullptr;
+    for (std::size_t i = b; i < e; ++i) {
+      const int cx = static_cast<int>(i % ncx), cy = static_cast<int>(i / ncx);
+      if (p.is_signed) {
+        pass_z<U, true>(p, world, g, sp, cx, cy, cap32, col);
+      } else {
+        pass_z<U, false>(p, world, g, sp, cx, cy, cap32, col);
+      }
+    }
+  });
+
+  // Passes B and C, and encoding.
+  const Encoder<T> encoder(p);
+  ChunkedVolume<SiteOffset>* sp = sites ? &*sites : nullptr;
+  if (truncated_passes(p, p.sites)) {
+    pass_slices_truncated<T, U>(p, world, g, encoder, cap32);
+  } else {
+    dispatch_solver(p, p.domain.size(), [&](auto tag, const auto& solve, auto inf) {
+      using V = decltype(tag);
+      pass_slices<T, U, V>(p, world, g, sp, solve, encoder, cap32, inf);
+    });
+  }
+
+  // Hand the chunks to the grids (uniform ones collapse).
+  std::vector<std::unique_ptr<T[]>> typed(g.chunks.size());
+  for (std::size_t i = 0; i < g.chunks.size(); ++i) typed[i].reset(reinterpret_cast<T*>(g.chunks[i].release()));
+  values.adopt_chunks(g.coords, std::move(typed));
+  if (sites) sites_grid->adopt_chunks(sites->coords, std::move(sites->chunks));
+  out.values = std::move(values);
+  out.sites = std::move(sites_grid);
+  return out;
+}
+
+}  // namespace
+
+DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o) {
+  const Plan p = detail::make_field_plan(occupancy, o);
+  switch (o.storage) {
+    case Storage::kU8:
+      return compute_whole_field<std::uint8_t, std::uint8_t>(occupancy, o, p);
+    case Storage::kU16:
+      return compute_whole_field<std::uint16_t, std::uint16_t>(occupancy, o, p);
+    case Storage::kF32:
+      return compute_whole_field<float, std::uint32_t>(occupancy, o, p);
+  }
+  throw InvalidArgument("unknown storage");
+}
+
+}  // namespace voxfield
