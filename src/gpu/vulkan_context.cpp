@@ -302,6 +302,24 @@ int preference(VkPhysicalDeviceType t) {
 
 std::once_flag volk_once;
 VkResult volk_status = VK_ERROR_INITIALIZATION_FAILED;
+std::mutex volk_table_mutex;
+
+// Loads the Vulkan loader (once per process) and fills volk's process-wide table of core entry
+// points from the first instance voxfield sees, never again: those entry points are the loader's
+// trampolines, which dispatch on the handle they are given and so serve every instance and device
+// in the process. Reloading per context would race with other threads' calls and would replace
+// the table an application (or an earlier context) relies on. Extension entry points are per
+// instance and stay with their context (Impl::destroy_messenger).
+void load_vulkan(VkInstance instance) {
+  std::lock_guard lock(volk_table_mutex);
+  if (volkGetLoadedInstance() == VK_NULL_HANDLE) volkLoadInstance(instance);
+}
+
+void require_loader() {
+  std::call_once(volk_once, [] { volk_status = volkInitialize(); });
+  if (volk_status != VK_SUCCESS)
+    throw GpuUnavailable("Vulkan: no Vulkan loader (libvulkan.so.1) on this machine");
+}
 
 }  // namespace
 
@@ -331,16 +349,14 @@ void Context::Impl::destroy() {
     device = VK_NULL_HANDLE;
   }
   if (instance && owns_device) {
-    if (messenger) vkDestroyDebugUtilsMessengerEXT(instance, messenger, nullptr);
+    if (messenger && destroy_messenger) destroy_messenger(instance, messenger, nullptr);
     vkDestroyInstance(instance, nullptr);
   }
   instance = VK_NULL_HANDLE;
 }
 
 std::shared_ptr<Context> Context::create(const ContextOptions& options) {
-  std::call_once(volk_once, [] { volk_status = volkInitialize(); });
-  if (volk_status != VK_SUCCESS)
-    throw GpuUnavailable("Vulkan: no Vulkan loader (libvulkan.so.1) on this machine");
+  require_loader();
 
   auto impl = std::make_unique<Impl>();
   Impl& s = *impl;
@@ -384,9 +400,16 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
     ici.pNext = &features;
   }
   check(vkCreateInstance(&ici, nullptr, &s.instance), "vkCreateInstance");
-  volkLoadInstance(s.instance);
-  if (options.validation)
-    check(vkCreateDebugUtilsMessengerEXT(s.instance, &mci, nullptr, &s.messenger), "vkCreateDebugUtilsMessengerEXT");
+  load_vulkan(s.instance);
+  if (options.validation) {
+    const auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(s.instance, "vkCreateDebugUtilsMessengerEXT"));
+    s.destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(s.instance, "vkDestroyDebugUtilsMessengerEXT"));
+    if (!create_messenger || !s.destroy_messenger)
+      throw GpuUnavailable("Vulkan: the validation layer is on but VK_EXT_debug_utils is missing");
+    check(create_messenger(s.instance, &mci, nullptr, &s.messenger), "vkCreateDebugUtilsMessengerEXT");
+  }
 
   std::uint32_t count = 0;
   vkEnumeratePhysicalDevices(s.instance, &count, nullptr);
@@ -469,9 +492,8 @@ void Context::Impl::finish_setup() {
 std::shared_ptr<Context> adopt(const AdoptedDevice& app) {
   if (!app.instance || !app.physical || !app.device || !app.queue)
     throw InvalidArgument("gpu::adopt: instance, physical device, device and queue are all needed");
-  std::call_once(volk_once, [] { volk_status = volkInitialize(); });
-  if (volk_status != VK_SUCCESS) throw GpuUnavailable("Vulkan: no Vulkan loader (libvulkan.so.1) on this machine");
-  volkLoadInstance(app.instance);
+  require_loader();
+  load_vulkan(app.instance);
   auto impl = std::make_unique<Context::Impl>();
   Context::Impl& s = *impl;
   s.owns_device = false;

@@ -62,6 +62,9 @@ struct Pipeline {
 struct Context::Impl {
   VkInstance instance = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  // The messenger's destructor, fetched from this context's own instance: extension entry points
+  // exist only on instances that enabled the extension, so volk's shared table cannot hold them.
+  PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger = nullptr;
   VkPhysicalDevice physical = VK_NULL_HANDLE;
   VkDevice device = VK_NULL_HANDLE;
   VkQueue queue = VK_NULL_HANDLE;
