@@ -19,6 +19,7 @@ packages=(
   clang libclang-rt-14-dev           # the fuzz preset: libFuzzer with ASan + UBSan (CI's fuzz smoke)
   clang-format                       # the format check (scripts/check_format.sh, a test)
   python3 python3-numpy python3-scipy # test oracles: NumPy reads and writes .npy, SciPy's distance transforms
+  python3-skimage                    # test oracle: scikit-image's marching_cubes for the meshers
 )
 
 missing=()

@@ -1,0 +1,109 @@
+// voxfield — triangle meshes of iso-surfaces: marching cubes and surface nets, per chunk and
+// seamless.
+//
+// A mesher reads a scalar field sampled on a lattice (a ScalarVolume: a float volume, or the exact
+// signed distance field of a World) and returns one indexed triangle mesh of the surface where the
+// field crosses `iso`. The work is split into chunks of cells meshed in parallel; vertices on chunk
+// borders are computed the same way on both sides and welded, so the mesh has no cracks and no
+// duplicate triangles, and its triangle set does not depend on the chunk edge or the thread count.
+//
+// Conventions, for every mesher:
+//  * triangles wind counter-clockwise seen from outside (the side the field marks as outside), so
+//    their right-hand normals point out; `normals` are the field's normalised gradient, pointing out;
+//  * positions are in the volume's frame: sample (x, y, z) sits at origin + (x, y, z) * spacing;
+//  * vertices are shared between the triangles that meet there (indexed mesh, no unreferenced
+//    vertices). A surface inside the volume gives a closed mesh (no boundary edge); marching cubes
+//    gives a closed oriented 2-manifold (every edge in exactly two triangles, traversed both ways:
+//    mesh_stats() checks), while surface nets, which joins all the sheets crossing a cell into one
+//    vertex, has edges in four triangles where the surface pinches within a cell.
+// Algorithms: docs/meshing.md; each opens its source file with its paper.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "voxfield/box.h"
+#include "voxfield/world.h"
+
+namespace voxfield {
+
+class Interrupter;
+
+// A read-only view of a dense scalar volume: size.x * size.y * size.z samples, x fastest (the
+// layout of NpyVolume and Grid::copy_to_dense). NaN samples are refused by the meshers.
+struct ScalarVolume {
+  Vec3i size;
+  const float* values = nullptr;
+  // Where sample (x, y, z) sits: origin + (x, y, z) * spacing (scikit-image's spacing convention).
+  std::array<double, 3> origin_units{0, 0, 0};
+  std::array<double, 3> spacing_units{1, 1, 1};
+
+  std::int64_t count() const { return Box3i::from_size(size).volume(); }
+  float at(int x, int y, int z) const {
+    return values[static_cast<std::size_t>(x) +
+                  static_cast<std::size_t>(size.x) * (static_cast<std::size_t>(y) + static_cast<std::size_t>(size.y) * static_cast<std::size_t>(z))];
+  }
+};
+
+enum class Mesher {
+  kMarchingCubes,  // Lorensen & Cline 1987; faces decided by Nielson & Hamann's asymptotic decider
+  kSurfaceNets,    // Gibson 1998, the naive variant: one vertex per cell the surface crosses
+};
+const char* mesher_name(Mesher m);         // "mc", "sn"
+Mesher parse_mesher(const std::string& name);  // "mc"/"marching-cubes", "sn"/"surface-nets"; else InvalidArgument
+
+struct MeshOptions {
+  Mesher algorithm = Mesher::kMarchingCubes;
+  double iso = 0;
+  // Which side of iso is inside: values below it (the default, a signed distance field's
+  // convention) or above it (density volumes, the thesis's positive-inside terrain).
+  bool inside_above = false;
+  // Cells per chunk edge (each chunk is meshed as one unit of parallel work), 2..1024.
+  int chunk_edge = 32;
+  Interrupter* interrupter = nullptr;  // progress per chunk; cancelling throws Cancelled
+};
+
+struct Mesh {
+  std::vector<std::array<float, 3>> positions;
+  std::vector<std::array<float, 3>> normals;        // one per position, unit length, pointing out
+  std::vector<std::array<std::uint8_t, 3>> colors;  // one per position, or empty (no colours)
+  std::vector<std::uint32_t> indices;               // three per triangle, counter-clockwise from outside
+
+  std::size_t vertex_count() const { return positions.size(); }
+  std::size_t triangle_count() const { return indices.size() / 3; }
+};
+
+// Meshes `volume` at options.iso. Throws InvalidArgument for options out of range, a volume
+// smaller than 2 samples along an axis, NaN samples, or more vertices than 32-bit indices hold;
+// Cancelled when the interrupter asks.
+Mesh mesh_volume(const ScalarVolume& volume, const MeshOptions& options);
+
+// Meshes a World through its exact signed Euclidean distance field (solid voxels read -(distance
+// to air), air +(distance to solid)) at iso 0 (options.iso and inside_above are ignored): the
+// surface runs between solid and air voxel centres. Voxel (x, y, z) spans [x, x+1)^3 in world
+// units, so its sample sits at its centre (x + 0.5, y + 0.5, z + 0.5). The domain is the world's
+// content grown by one voxel of air (beyond a bounded world's bounds is air, so its surface closes
+// there too). Vertex colours come from the palette: the material of the solid voxel the vertex
+// was made from (an edge's solid end; a cell's solid corner nearest the vertex).
+Mesh mesh_world(const World& world, const MeshOptions& options);
+
+// What a mesh is, topologically and geometrically.
+struct MeshStats {
+  std::size_t vertices = 0, triangles = 0;
+  std::size_t edges = 0;             // distinct undirected edges
+  std::size_t boundary_edges = 0;    // in one triangle only
+  std::size_t nonmanifold_edges = 0; // in three or more triangles
+  std::size_t misoriented_edges = 0; // shared by two triangles that traverse it the same way
+  std::size_t degenerate_triangles = 0;  // a repeated vertex index
+  // Every edge in exactly two triangles, traversed in opposite directions: closed and oriented.
+  bool watertight() const { return triangles > 0 && boundary_edges == 0 && nonmanifold_edges == 0 && misoriented_edges == 0; }
+  std::int64_t euler_characteristic = 0;  // V - E + F (2 for a sphere, 0 for a torus)
+  double area_units2 = 0;
+  double signed_volume_units3 = 0;  // positive when the triangles face out (closed meshes only)
+};
+MeshStats mesh_stats(const Mesh& mesh);
+
+}  // namespace voxfield

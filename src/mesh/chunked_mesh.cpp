@@ -1,0 +1,162 @@
+// voxfield — the chunk partition, a chunk's sample block and the weld (see chunked_mesh.h).
+#include "chunked_mesh.h"
+
+#include <algorithm>
+#include <limits>
+#include <string>
+#include <unordered_map>
+
+#include "voxfield/error.h"
+
+namespace voxfield::detail::mesh {
+
+ChunkGrid::ChunkGrid(Vec3i samples, int chunk_edge)
+    : cells{samples.x - 1, samples.y - 1, samples.z - 1}, edge(chunk_edge) {
+  for (int a = 0; a < 3; ++a) count[a] = (cells[a] + edge - 1) / edge;
+}
+
+Vec3i ChunkGrid::coord(std::int64_t i) const {
+  const std::int64_t x = i % count.x, yz = i / count.x;
+  return {static_cast<int>(x), static_cast<int>(yz % count.y), static_cast<int>(yz / count.y)};
+}
+
+Box3i ChunkGrid::cells_of(Vec3i chunk) const {
+  Box3i b;
+  for (int a = 0; a < 3; ++a) {
+    b.begin[a] = chunk[a] * edge;
+    b.end[a] = std::min(cells[a], b.begin[a] + edge);
+  }
+  return b;
+}
+
+int ChunkGrid::owner(int axis, int v) const { return std::min(v / edge, count[axis] - 1); }
+
+bool Block::load(const Lattice& lattice, const Box3i& cells) {
+  lattice_ = &lattice;
+  for (int a = 0; a < 3; ++a) {
+    lo_[a] = std::max(cells.begin[a] - 1, 0);
+    hi_[a] = std::min(cells.end[a] + 1, lattice.n[a] - 1);
+  }
+  dx_ = static_cast<std::size_t>(hi_.x - lo_.x + 1);
+  dy_ = static_cast<std::size_t>(hi_.y - lo_.y + 1);
+  s_.resize(dx_ * dy_ * static_cast<std::size_t>(hi_.z - lo_.z + 1));
+  const float iso = static_cast<float>(lattice.iso);
+  const bool negate = lattice.sign < 0;
+  bool any_inside = false, any_outside = false;
+  float* out = s_.data();
+  for (int z = lo_.z; z <= hi_.z; ++z)
+    for (int y = lo_.y; y <= hi_.y; ++y) {
+      const float* row = lattice.values + lattice.index(lo_.x, y, z);
+      for (std::size_t i = 0; i < dx_; ++i) {
+        const float v = row[i];
+        if (std::isnan(v))
+          throw InvalidArgument("mesh: sample (" + std::to_string(lo_.x + static_cast<int>(i)) + ", " + std::to_string(y) +
+                                ", " + std::to_string(z) + ") is NaN");
+        const float s = negate ? iso - v : v - iso;
+        any_inside |= s < 0;
+        any_outside |= s >= 0;
+        *out++ = s;
+      }
+    }
+  return any_inside && any_outside;
+}
+
+std::array<double, 3> Block::gradient(int x, int y, int z) const {
+  const Vec3i p{x, y, z};
+  std::array<double, 3> g{};
+  for (int a = 0; a < 3; ++a) {
+    Vec3i lo = p, hi = p;
+    if (p[a] > 0) --lo[a];
+    if (p[a] < lattice_->n[a] - 1) ++hi[a];
+    const double span = (hi[a] - lo[a]) * lattice_->spacing[static_cast<std::size_t>(a)];
+    g[static_cast<std::size_t>(a)] = (static_cast<double>(s(hi.x, hi.y, hi.z)) - s(lo.x, lo.y, lo.z)) / span;
+  }
+  return g;
+}
+
+void ChunkPart::clear() {
+  positions.clear();
+  normals.clear();
+  keys.clear();
+  sources.clear();
+  owned.clear();
+  shared.clear();
+  indices.clear();
+}
+
+std::uint32_t ChunkPart::add(const std::array<double, 3>& position, std::array<double, 3> normal, std::uint64_t key,
+                             std::uint64_t source, bool is_owned, bool is_shared) {
+  const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+  if (length > 0)
+    for (double& c : normal) c /= length;
+  positions.push_back({static_cast<float>(position[0]), static_cast<float>(position[1]), static_cast<float>(position[2])});
+  normals.push_back({static_cast<float>(normal[0]), static_cast<float>(normal[1]), static_cast<float>(normal[2])});
+  keys.push_back(key);
+  sources.push_back(source);
+  owned.push_back(is_owned);
+  shared.push_back(is_shared);
+  return static_cast<std::uint32_t>(positions.size() - 1);
+}
+
+Mesh weld(std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sources) {
+  // Global numbers of owned vertices, chunk by chunk; the shared ones also by key.
+  std::vector<std::uint64_t> base(parts.size() + 1, 0);
+  std::size_t shared_count = 0;
+  for (std::size_t c = 0; c < parts.size(); ++c) {
+    std::uint64_t owned = 0;
+    for (std::size_t i = 0; i < parts[c].owned.size(); ++i) {
+      owned += parts[c].owned[i];
+      shared_count += parts[c].shared[i];
+    }
+    base[c + 1] = base[c] + owned;
+  }
+  if (base.back() > std::numeric_limits<std::uint32_t>::max())
+    throw InvalidArgument("mesh: " + std::to_string(base.back()) + " vertices do not fit 32-bit indices; mesh a smaller volume");
+  std::unordered_map<std::uint64_t, std::uint32_t> by_key;
+  by_key.reserve(shared_count);
+  Mesh mesh;
+  const std::size_t vertices = base.back();
+  mesh.positions.resize(vertices);
+  mesh.normals.resize(vertices);
+  if (sources) sources->resize(vertices);
+  std::vector<std::vector<std::uint32_t>> global(parts.size());
+  for (std::size_t c = 0; c < parts.size(); ++c) {
+    ChunkPart& p = parts[c];
+    global[c].resize(p.positions.size());
+    std::uint64_t next = base[c];
+    for (std::size_t i = 0; i < p.positions.size(); ++i) {
+      if (!p.owned[i]) continue;
+      const auto g = static_cast<std::uint32_t>(next++);
+      global[c][i] = g;
+      mesh.positions[g] = p.positions[i];
+      mesh.normals[g] = p.normals[i];
+      if (sources) (*sources)[g] = p.sources[i];
+      if (p.shared[i]) by_key.emplace(p.keys[i], g);
+    }
+  }
+  std::size_t index_count = 0;
+  for (const ChunkPart& p : parts) index_count += p.indices.size();
+  mesh.indices.reserve(index_count);
+  for (std::size_t c = 0; c < parts.size(); ++c) {
+    ChunkPart& p = parts[c];
+    for (std::size_t i = 0; i < p.positions.size(); ++i) {
+      if (p.owned[i]) continue;
+      // A vertex its owner never used (surface nets: a cell only a neighbour's quads reach) is
+      // taken from the first chunk that uses it; every chunk computes it bit for bit the same.
+      const auto [it, orphan] = by_key.emplace(p.keys[i], static_cast<std::uint32_t>(mesh.positions.size()));
+      if (orphan) {
+        if (mesh.positions.size() == std::numeric_limits<std::uint32_t>::max())
+          throw InvalidArgument("mesh: the vertices do not fit 32-bit indices; mesh a smaller volume");
+        mesh.positions.push_back(p.positions[i]);
+        mesh.normals.push_back(p.normals[i]);
+        if (sources) sources->push_back(p.sources[i]);
+      }
+      global[c][i] = it->second;
+    }
+    for (const std::uint32_t local : p.indices) mesh.indices.push_back(global[c][local]);
+    p.clear();
+  }
+  return mesh;
+}
+
+}  // namespace voxfield::detail::mesh

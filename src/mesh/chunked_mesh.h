@@ -1,0 +1,97 @@
+// voxfield — what the meshers share (internal to the mesh module): the chunk partition of a
+// sample lattice, a chunk's block of samples, the per-chunk output and the weld that joins chunks.
+//
+// Seams. Chunks partition the lattice's cells. Every vertex belongs to one lattice element (an
+// edge for marching cubes, a cell for surface nets) and that element to one chunk, its owner. A
+// chunk creates the vertices its triangles use; those of elements it does not own are computed the
+// same way as their owner does (same samples, same arithmetic, same rounding) and are replaced by
+// the owner's at the weld (or, where the owner has no triangle using it, by the first user's copy),
+// so chunks meet without cracks and the mesh does not depend on the partition. The weld looks vertices up by element key only for the owned vertices a mesher marks
+// `shared` (those on a chunk border a neighbour can reach), a few per cent of the total.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "voxfield/box.h"
+#include "voxfield/mesh.h"
+
+namespace voxfield::detail::mesh {
+
+// The sampled field, with the inside convention folded in: s = sign * (value - iso) is negative
+// inside and >= 0 outside (a sample exactly at iso counts as outside).
+struct Lattice {
+  Vec3i n;  // samples per axis (each >= 2)
+  const float* values = nullptr;
+  std::array<double, 3> origin{}, spacing{};
+  double iso = 0;
+  double sign = 1;
+  std::size_t index(int x, int y, int z) const {
+    return static_cast<std::size_t>(x) + static_cast<std::size_t>(n.x) * (static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * static_cast<std::size_t>(z));
+  }
+};
+
+struct ChunkGrid {
+  Vec3i cells;  // n - 1 per axis
+  int edge = 32;
+  Vec3i count;  // chunks per axis
+  ChunkGrid(Vec3i samples, int chunk_edge);
+  std::int64_t total() const { return static_cast<std::int64_t>(count.x) * count.y * count.z; }
+  Vec3i coord(std::int64_t i) const;
+  Box3i cells_of(Vec3i chunk) const;  // the chunk's cells
+  // The chunk coordinate along `axis` owning lattice coordinate v (a sample or a cell): the last
+  // chunk also owns the samples on the lattice's upper face.
+  int owner(int axis, int v) const;
+};
+
+// A chunk's samples as s values, from one sample before its cells to two past them (clamped to
+// the lattice): the cells' corners plus the neighbours central differences read.
+class Block {
+ public:
+  // Loads the block for `cells`; false when no sample changes sign (the chunk has no surface).
+  // Throws InvalidArgument for a NaN sample.
+  bool load(const Lattice& lattice, const Box3i& cells);
+  float s(int x, int y, int z) const {
+    return s_[static_cast<std::size_t>(x - lo_.x) + dx_ * (static_cast<std::size_t>(y - lo_.y) + dy_ * static_cast<std::size_t>(z - lo_.z))];
+  }
+  // Gradient of s at a sample (central differences; one-sided on the lattice's faces), per unit.
+  std::array<double, 3> gradient(int x, int y, int z) const;
+
+ private:
+  const Lattice* lattice_ = nullptr;
+  Vec3i lo_, hi_;
+  std::size_t dx_ = 0, dy_ = 0;
+  std::vector<float> s_;
+};
+
+// One chunk's triangles over its own vertex numbering.
+struct ChunkPart {
+  std::vector<std::array<float, 3>> positions, normals;
+  std::vector<std::uint64_t> keys;     // the vertex's lattice element
+  std::vector<std::uint64_t> sources;  // the inside sample the vertex came from (colours)
+  std::vector<std::uint8_t> owned;     // 1: this chunk owns the element; 0: a neighbour does
+  std::vector<std::uint8_t> shared;    // owned and possibly used by a neighbour
+  std::vector<std::uint32_t> indices;
+  void clear();
+  std::uint32_t add(const std::array<double, 3>& position, std::array<double, 3> normal, std::uint64_t key,
+                    std::uint64_t source, bool is_owned, bool is_shared);
+};
+
+// Joins the chunks' parts (in chunk order) into one mesh; `sources`, when given, receives each
+// vertex's source sample. Throws InvalidArgument when the mesh needs more than 2^32 - 1 vertices.
+Mesh weld(std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sources);
+
+// Position of lattice point p + t along `axis` (t in [0, 1]) in the volume's frame.
+inline std::array<double, 3> lattice_position(const Lattice& l, const std::array<double, 3>& p) {
+  return {l.origin[0] + p[0] * l.spacing[0], l.origin[1] + p[1] * l.spacing[1], l.origin[2] + p[2] * l.spacing[2]};
+}
+
+// The meshers: fill `part` with the triangles of `chunk`'s cells. `block` holds its samples.
+void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,
+                          std::vector<std::int32_t>& scratch, ChunkPart& part);
+void surface_nets_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,
+                        std::vector<std::int32_t>& scratch, ChunkPart& part);
+
+}  // namespace voxfield::detail::mesh

@@ -1,0 +1,67 @@
+// voxfield — the marching-cubes case table (internal to the mesh module).
+//
+// Instead of the 256-entry table of Lorensen & Cline ("Marching Cubes: A High Resolution 3D Surface
+// Construction Algorithm", SIGGRAPH 1987), which joins the crossings of an ambiguous face one way
+// in one cell and the other way in its neighbour (cracks), the table is derived from the cell's
+// faces: on each face the crossings are joined into segments, and the segments on the cube's six
+// faces chain into closed loops, each triangulated as a fan. A face with two crossings has one
+// segment; a face with four (diagonal corners alike) is ambiguous and is decided by Nielson &
+// Hamann's asymptotic decider ("The Asymptotic Decider: Resolving the Ambiguity in Marching Cubes",
+// IEEE Visualization 1991) from that face's four samples only, so the two cells sharing it decide
+// alike. Hence every segment belongs to exactly the two polygons either side of the face (no
+// cracks), every crossing to exactly one loop per cell (manifold vertices), and segments are
+// oriented from the face's geometry so that loops wind counter-clockwise seen from outside.
+// Interior ambiguity (the tunnel of cases 4, 6, 7, 10, 12 and 13 in Chernyaev's 33) is not
+// resolved: separate loops stay separate sheets, which keeps the surface a closed 2-manifold.
+// Loops are triangulated without diagonals lying in a face (see triangulate_loop in the .cpp).
+//
+// Numbering: corner c = (c & 1, c >> 1 & 1, c >> 2 & 1). Edge 4a + j runs along axis a from the
+// corner with bit a clear to the one with it set; j holds the other two axes' bits, lower axis
+// first. Face 2a + s is the face at coordinate s along axis a.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+namespace voxfield::detail::mesh {
+
+struct CubeEdge {
+  std::uint8_t from, to;  // corners, `to` = `from` with bit `axis` set
+  std::uint8_t axis;
+};
+const std::array<CubeEdge, 12>& cube_edges();
+
+// The triangles of one cell as crossing edges: up to 12 (a loop through all 12 edges fanned from
+// a centre vertex). Index kCentre + c stands for centre vertex c, the mean of the crossings of
+// centre_edges[c] (the loop it fans).
+struct CubeCase {
+  static constexpr int kCentre = 12;
+  std::uint8_t triangle_count = 0;
+  std::array<std::uint8_t, 36> edges{};
+  std::uint8_t centre_count = 0;
+  std::array<std::uint8_t, 2> centre_sizes{};
+  std::array<std::array<std::uint8_t, 12>, 2> centre_edges{};
+};
+
+class CubeCases {
+ public:
+  static const CubeCases& get();  // built once, on first use (thread-safe)
+
+  // Faces (bit 2a + s) with four crossings for corner mask `inside` (bit c: corner c inside).
+  std::uint8_t ambiguous_faces(unsigned inside) const { return ambiguous_[inside]; }
+  // The triangulation for `inside` where `joined` (one bit per ambiguous face, in face order,
+  // compacted to the ambiguous faces only) says on which faces the two outside corners connect.
+  const CubeCase& lookup(unsigned inside, unsigned joined) const { return cases_[offset_[inside] + joined]; }
+
+  // For one ambiguous face: corners in cyclic order around it (so 0/2 and 1/3 are the diagonals),
+  // starting at the face's lowest corner and going first along the face's lower axis.
+  static std::array<std::uint8_t, 4> face_corners(int face);
+
+ private:
+  CubeCases();
+  std::array<std::uint8_t, 256> ambiguous_{};
+  std::array<std::uint16_t, 257> offset_{};
+  std::array<CubeCase, 1024> cases_{};
+};
+
+}  // namespace voxfield::detail::mesh

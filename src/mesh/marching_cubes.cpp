@@ -1,0 +1,120 @@
+// voxfield — marching cubes on one chunk of cells.
+//
+// W. E. Lorensen & H. E. Cline, "Marching Cubes: A High Resolution 3D Surface Construction
+// Algorithm", SIGGRAPH 1987: each cell's corner signs index a triangulation of the surface inside
+// it, with vertices where the surface crosses the cell's edges (linear interpolation of the
+// samples). The triangulation comes from cube_cases.h, whose ambiguous faces are settled by Nielson
+// & Hamann's asymptotic decider (1991), so the output is crack-free and manifold.
+//
+// Vertices live on lattice edges and are shared by the up to four cells around each edge; a
+// chunk numbers the edges it meets in `scratch` (one slot per axis per sample of its cells).
+// Crossings are interpolated from the edge's lower sample to its upper one and normals blend the
+// central-difference gradients at both ends, so a chunk and its neighbour compute identical
+// vertices for the edges on their common face.
+#include <cstdint>
+#include <vector>
+
+#include "chunked_mesh.h"
+#include "cube_cases.h"
+
+namespace voxfield::detail::mesh {
+
+namespace {
+
+constexpr Vec3i corner_offset(int c) { return {c & 1, c >> 1 & 1, c >> 2 & 1}; }
+
+// On an ambiguous face, whether the two outside corners connect across it: the asymptotic decider
+// puts the bilinear interpolant's saddle outside when the product of the outside diagonal's values
+// is at least that of the inside diagonal's. Products of the same four samples are computed
+// whichever cell asks, so both cells sharing the face decide alike (ties join the outside).
+bool outside_joined(const float* v, const std::array<std::uint8_t, 4>& corners, unsigned inside) {
+  const double d02 = static_cast<double>(v[corners[0]]) * v[corners[2]];
+  const double d13 = static_cast<double>(v[corners[1]]) * v[corners[3]];
+  const bool diagonal02_inside = (inside >> corners[0] & 1) != 0;
+  return diagonal02_inside ? d13 >= d02 : d02 >= d13;
+}
+
+}  // namespace
+
+void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,
+                          std::vector<std::int32_t>& scratch, ChunkPart& part) {
+  const Box3i cells = grid.cells_of(chunk);
+  const Vec3i b = cells.begin;
+  const std::size_t ex = static_cast<std::size_t>(cells.end.x - b.x + 1), ey = static_cast<std::size_t>(cells.end.y - b.y + 1);
+  scratch.assign(3 * ex * ey * static_cast<std::size_t>(cells.end.z - b.z + 1), -1);
+  const CubeCases& table = CubeCases::get();
+  const auto& edges = cube_edges();
+
+  auto vertex = [&](Vec3i p, int axis) -> std::uint32_t {
+    std::int32_t& slot = scratch[3 * (static_cast<std::size_t>(p.x - b.x) + ex * (static_cast<std::size_t>(p.y - b.y) + ey * static_cast<std::size_t>(p.z - b.z))) +
+                                 static_cast<std::size_t>(axis)];
+    if (slot >= 0) return static_cast<std::uint32_t>(slot);
+    Vec3i q = p;
+    ++q[axis];
+    const double s0 = block.s(p.x, p.y, p.z), s1 = block.s(q.x, q.y, q.z);
+    const double t = s0 / (s0 - s1);  // the signs differ, so s0 != s1
+    std::array<double, 3> at{static_cast<double>(p.x), static_cast<double>(p.y), static_cast<double>(p.z)};
+    at[static_cast<std::size_t>(axis)] += t;
+    const auto g0 = block.gradient(p.x, p.y, p.z), g1 = block.gradient(q.x, q.y, q.z);
+    std::array<double, 3> normal{g0[0] + t * (g1[0] - g0[0]), g0[1] + t * (g1[1] - g0[1]), g0[2] + t * (g1[2] - g0[2])};
+    if (normal[0] == 0 && normal[1] == 0 && normal[2] == 0) normal[static_cast<std::size_t>(axis)] = s0 < 0 ? 1 : -1;
+    bool owned = true, shared = false;
+    for (int a = 0; a < 3; ++a) {
+      owned &= grid.owner(a, p[a]) == chunk[a];
+      if (a != axis && p[a] == b[a] && b[a] > 0) shared = true;
+    }
+    const std::uint64_t source = s0 < 0 ? lattice.index(p.x, p.y, p.z) : lattice.index(q.x, q.y, q.z);
+    const std::uint32_t id = part.add(lattice_position(lattice, at), normal,
+                                      3 * static_cast<std::uint64_t>(lattice.index(p.x, p.y, p.z)) + static_cast<std::uint64_t>(axis),
+                                      source, owned, owned && shared);
+    slot = static_cast<std::int32_t>(id);
+    return id;
+  };
+
+  float v[8];
+  for (int z = cells.begin.z; z < cells.end.z; ++z)
+    for (int y = cells.begin.y; y < cells.end.y; ++y)
+      for (int x = cells.begin.x; x < cells.end.x; ++x) {
+        unsigned inside = 0;
+        for (int c = 0; c < 8; ++c) {
+          v[c] = block.s(x + (c & 1), y + (c >> 1 & 1), z + (c >> 2 & 1));
+          inside |= static_cast<unsigned>(v[c] < 0) << c;
+        }
+        if (inside == 0 || inside == 255) continue;
+        unsigned joined = 0;
+        const unsigned ambiguous = table.ambiguous_faces(inside);
+        for (int face = 0, bit = 0; face < 6; ++face)
+          if (ambiguous >> face & 1) {
+            if (outside_joined(v, CubeCases::face_corners(face), inside)) joined |= 1u << bit;
+            ++bit;
+          }
+        const CubeCase& cc = table.lookup(inside, joined);
+        const Vec3i cell{x, y, z};
+        auto edge_vertex = [&](int edge) {
+          const CubeEdge& e = edges[static_cast<std::size_t>(edge)];
+          return vertex(cell + corner_offset(e.from), e.axis);
+        };
+        // Centre vertices belong to this cell alone (owned, never looked up by a neighbour).
+        std::array<std::uint32_t, 2> centre{};
+        for (int c = 0; c < cc.centre_count; ++c) {
+          std::array<double, 3> mean{0, 0, 0}, normal{0, 0, 0};
+          const int n = cc.centre_sizes[static_cast<std::size_t>(c)];
+          std::uint32_t first = 0;
+          for (int i = 0; i < n; ++i) {
+            const std::uint32_t id = edge_vertex(cc.centre_edges[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)]);
+            if (i == 0) first = id;
+            for (std::size_t a = 0; a < 3; ++a) {
+              mean[a] += part.positions[id][a] / static_cast<double>(n);
+              normal[a] += part.normals[id][a];
+            }
+          }
+          centre[static_cast<std::size_t>(c)] = part.add(mean, normal, ~std::uint64_t{0}, part.sources[first], true, false);
+        }
+        for (int k = 0; k < 3 * cc.triangle_count; ++k) {
+          const int edge = cc.edges[static_cast<std::size_t>(k)];
+          part.indices.push_back(edge >= CubeCase::kCentre ? centre[static_cast<std::size_t>(edge - CubeCase::kCentre)] : edge_vertex(edge));
+        }
+      }
+}
+
+}  // namespace voxfield::detail::mesh

@@ -1,0 +1,76 @@
+// voxfield — meshing a sampled volume: checks the request, meshes the chunks in parallel on
+// voxfield's pool and welds them (chunked_mesh.h).
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "chunked_mesh.h"
+#include "mesh_internal.h"
+#include "voxfield/error.h"
+#include "voxfield/interrupt.h"
+#include "voxfield/parallel.h"
+
+namespace voxfield {
+
+const char* mesher_name(Mesher m) { return m == Mesher::kMarchingCubes ? "mc" : "sn"; }
+
+Mesher parse_mesher(const std::string& name) {
+  if (name == "mc" || name == "marching-cubes") return Mesher::kMarchingCubes;
+  if (name == "sn" || name == "surface-nets") return Mesher::kSurfaceNets;
+  throw InvalidArgument("unknown mesher '" + name + "' (expected mc or sn)");
+}
+
+namespace detail::mesh {
+
+Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::vector<std::uint64_t>* sources) {
+  if (!volume.values) throw InvalidArgument("mesh: the volume has no samples");
+  for (int a = 0; a < 3; ++a) {
+    if (volume.size[a] < 2)
+      throw InvalidArgument("mesh: the volume needs at least 2 samples along each axis (it has " +
+                            std::to_string(volume.size.x) + " x " + std::to_string(volume.size.y) + " x " +
+                            std::to_string(volume.size.z) + ")");
+    const double s = volume.spacing_units[static_cast<std::size_t>(a)];
+    if (!(s > 0) || !std::isfinite(s)) throw InvalidArgument("mesh: spacing must be positive and finite");
+    if (!std::isfinite(volume.origin_units[static_cast<std::size_t>(a)])) throw InvalidArgument("mesh: origin must be finite");
+  }
+  if (!std::isfinite(options.iso)) throw InvalidArgument("mesh: iso must be finite");
+  if (options.chunk_edge < 2 || options.chunk_edge > 1024)
+    throw InvalidArgument("mesh: chunk edge " + std::to_string(options.chunk_edge) + " is outside 2..1024");
+
+  Lattice lattice;
+  lattice.n = volume.size;
+  lattice.values = volume.values;
+  lattice.origin = volume.origin_units;
+  lattice.spacing = volume.spacing_units;
+  lattice.iso = options.iso;
+  lattice.sign = options.inside_above ? -1 : 1;
+  const ChunkGrid grid(volume.size, options.chunk_edge);
+  std::vector<ChunkPart> parts(static_cast<std::size_t>(grid.total()));
+  Progress progress(options.interrupter,
+                    options.algorithm == Mesher::kMarchingCubes ? "marching cubes" : "surface nets", grid.total());
+  parallel_for(parts.size(), 1, [&](std::size_t begin, std::size_t end) {
+    Block block;
+    std::vector<std::int32_t> scratch;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!progress.keep_going()) return;
+      const Vec3i chunk = grid.coord(static_cast<std::int64_t>(i));
+      if (block.load(lattice, grid.cells_of(chunk))) {
+        if (options.algorithm == Mesher::kMarchingCubes)
+          marching_cubes_chunk(lattice, grid, chunk, block, scratch, parts[i]);
+        else
+          surface_nets_chunk(lattice, grid, chunk, block, scratch, parts[i]);
+      }
+      progress.advance();
+    }
+  });
+  progress.throw_if_cancelled();
+  return weld(parts, sources);
+}
+
+}  // namespace detail::mesh
+
+Mesh mesh_volume(const ScalarVolume& volume, const MeshOptions& options) {
+  return detail::mesh::mesh_lattice(volume, options, nullptr);
+}
+
+}  // namespace voxfield

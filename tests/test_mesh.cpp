@@ -1,0 +1,283 @@
+// The meshers against analytic shapes (topology, enclosed volume and area, distance of every vertex
+// to the true surface, orientation), exact counts on voxel blocks, every corner configuration of a
+// cell and of random lattices (closed, oriented 2-manifolds), and independence from the chunk edge
+// and the thread count (the same triangle set).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <random>
+#include <set>
+#include <vector>
+
+#include "voxfield/error.h"
+#include "voxfield/mesh.h"
+#include "voxfield/parallel.h"
+#include "voxfield/primitives.h"
+
+using namespace voxfield;
+
+namespace {
+
+const Mesher kMeshers[] = {Mesher::kMarchingCubes, Mesher::kSurfaceNets};
+
+// An analytic field sampled on n^3 points spaced `h` apart, centred on the origin.
+struct Sampled {
+  std::vector<float> values;
+  ScalarVolume volume;
+  Sampled(int n, double h, const std::function<double(Vec3d)>& f) {
+    values.resize(static_cast<std::size_t>(n) * n * n);
+    const double o = -0.5 * (n - 1) * h;
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+          values[static_cast<std::size_t>(x + n * (y + n * z))] = static_cast<float>(f({o + x * h, o + y * h, o + z * h}));
+    volume.size = Vec3i::splat(n);
+    volume.values = values.data();
+    volume.origin_units = {o, o, o};
+    volume.spacing_units = {h, h, h};
+  }
+};
+
+Vec3d at(const std::array<float, 3>& p) { return {p[0], p[1], p[2]}; }
+
+MeshOptions with(Mesher m, int chunk_edge = 32) {
+  MeshOptions o;
+  o.algorithm = m;
+  o.chunk_edge = chunk_edge;
+  return o;
+}
+
+// Each triangle as its three positions, rotated to start at the smallest (orientation kept).
+using Tri = std::array<std::array<float, 3>, 3>;
+std::multiset<Tri> triangle_set(const Mesh& m) {
+  std::multiset<Tri> s;
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    Tri tri{m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]};
+    const auto first = std::min_element(tri.begin(), tri.end()) - tri.begin();
+    std::rotate(tri.begin(), tri.begin() + first, tri.end());
+    s.insert(tri);
+  }
+  return s;
+}
+
+void expect_closed_manifold(const Mesh& m, std::int64_t euler, const char* what) {
+  const MeshStats s = mesh_stats(m);
+  EXPECT_GT(s.triangles, 0u) << what;
+  EXPECT_EQ(s.boundary_edges, 0u) << what;
+  EXPECT_EQ(s.nonmanifold_edges, 0u) << what;
+  EXPECT_EQ(s.misoriented_edges, 0u) << what;
+  EXPECT_EQ(s.degenerate_triangles, 0u) << what;
+  EXPECT_EQ(s.euler_characteristic, euler) << what;
+  EXPECT_GT(s.signed_volume_units3, 0) << what << ": triangles face inwards";
+  std::vector<bool> used(m.vertex_count());
+  for (std::uint32_t i : m.indices) used[i] = true;
+  EXPECT_EQ(std::count(used.begin(), used.end(), false), 0) << what << ": unreferenced vertices";
+}
+
+}  // namespace
+
+// A sphere of radius 10 on a grid of spacing 0.5: closed genus-0 surface, volume and area close to
+// the analytic ones, every vertex near the sphere, normals radial.
+TEST(Mesh, SphereIsAClosedSurfaceNearTheTrueOne) {
+  const double r = 10;
+  Sampled s(48, 0.5, [&](Vec3d p) { return sdf::sphere(p, r); });
+  for (Mesher m : kMeshers) {
+    SCOPED_TRACE(mesher_name(m));
+    const Mesh mesh = mesh_volume(s.volume, with(m, 16));
+    expect_closed_manifold(mesh, 2, "sphere");
+    const MeshStats st = mesh_stats(mesh);
+    // Inscribed polyhedra lose a little volume and area: within 1 % at 20 samples per radius.
+    EXPECT_NEAR(st.signed_volume_units3, sdf::sphere_volume(r), 0.01 * sdf::sphere_volume(r));
+    EXPECT_NEAR(st.area_units2, sdf::sphere_area(r), 0.01 * sdf::sphere_area(r));
+    // Marching cubes interpolates an exact distance along edges: within 1 % of the spacing. Surface
+    // nets averages crossings, which sits inside a convex surface by up to ~ h^2 / r.
+    const double tolerance = m == Mesher::kMarchingCubes ? 0.005 : 0.05;
+    double worst = 0, worst_normal = 1;
+    for (std::size_t i = 0; i < mesh.vertex_count(); ++i) {
+      const Vec3d p = at(mesh.positions[i]);
+      worst = std::max(worst, std::abs(p.length() - r));
+      worst_normal = std::min(worst_normal, dot(at(mesh.normals[i]), p.normalized()));
+    }
+    EXPECT_LT(worst, tolerance);
+    EXPECT_GT(worst_normal, 0.999);
+  }
+}
+
+TEST(Mesh, TorusHasEulerCharacteristicZero) {
+  const double major = 8, minor = 3;
+  Sampled s(48, 0.5, [&](Vec3d p) { return sdf::torus(p, major, minor); });
+  for (Mesher m : kMeshers) {
+    SCOPED_TRACE(mesher_name(m));
+    const Mesh mesh = mesh_volume(s.volume, with(m, 8));
+    expect_closed_manifold(mesh, 0, "torus");
+    const MeshStats st = mesh_stats(mesh);
+    EXPECT_NEAR(st.signed_volume_units3, sdf::torus_volume(major, minor), 0.02 * sdf::torus_volume(major, minor));
+    EXPECT_NEAR(st.area_units2, sdf::torus_area(major, minor), 0.02 * sdf::torus_area(major, minor));
+  }
+}
+
+TEST(Mesh, CapsuleAndBoxAreClosedWithTheirVolume) {
+  const Vec3d a{-5, -2, 1}, b{4, 3, -1};
+  const double radius = 3, length = (b - a).length();
+  Sampled capsule(40, 0.5, [&](Vec3d p) { return sdf::capsule(p, a, b, radius); });
+  Sampled box(40, 0.5, [&](Vec3d p) { return sdf::box(p, {6.3, 4.2, 3.1}); });
+  for (Mesher m : kMeshers) {
+    SCOPED_TRACE(mesher_name(m));
+    const Mesh c = mesh_volume(capsule.volume, with(m));
+    expect_closed_manifold(c, 2, "capsule");
+    EXPECT_NEAR(mesh_stats(c).signed_volume_units3, sdf::capsule_volume(length, radius), 0.02 * sdf::capsule_volume(length, radius));
+    const Mesh bx = mesh_volume(box.volume, with(m));
+    expect_closed_manifold(bx, 2, "box");
+    // Both meshers bevel the box's edges by up to half a cell: within 3 % of 8 * 6.3 * 4.2 * 3.1.
+    EXPECT_NEAR(mesh_stats(bx).signed_volume_units3, 8 * 6.3 * 4.2 * 3.1, 0.03 * 8 * 6.3 * 4.2 * 3.1);
+  }
+}
+
+// Surface nets of a filled 6^3 block: one quad per exposed voxel face, 6 * 36 = 216.
+TEST(Mesh, SurfaceNetsOfABlockHasOneQuadPerVoxelFace) {
+  World w(16);
+  w.voxels.fill(Box3i::from_size({6, 6, 6}), 7);
+  const Mesh sn = mesh_world(w, with(Mesher::kSurfaceNets));
+  EXPECT_EQ(sn.triangle_count(), 2u * 216);
+  expect_closed_manifold(sn, 2, "block, surface nets");
+  const Mesh mc = mesh_world(w, with(Mesher::kMarchingCubes));
+  expect_closed_manifold(mc, 2, "block, marching cubes");
+  // The block's 8 corner voxels cut off by one triangle each, the rest two per voxel face.
+  const Rgba c = w.palette[7];
+  for (const auto& col : sn.colors) EXPECT_EQ(col, (std::array<std::uint8_t, 3>{c.r, c.g, c.b}));
+  // Surfaces run halfway between voxel centres: on the block's faces, at 0 and 6 (+-0.5 margins).
+  for (const auto& p : mc.positions)
+    for (int a = 0; a < 3; ++a) EXPECT_TRUE(p[static_cast<std::size_t>(a)] >= -0.01f && p[static_cast<std::size_t>(a)] <= 6.01f);
+}
+
+// Every one of the 256 corner configurations of a lone cell, with random magnitudes (so ambiguous
+// faces go both ways), inside a lattice of outside samples: a closed, oriented surface each time.
+TEST(Mesh, EveryCellConfigurationGivesAClosedOrientedSurface) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> magnitude(0.05f, 1.0f);
+  for (unsigned mask = 1; mask < 256; ++mask)
+    for (int trial = 0; trial < 8; ++trial) {
+      std::vector<float> v(4 * 4 * 4, 1.0f);
+      for (int c = 0; c < 8; ++c) {
+        const int x = 1 + (c & 1), y = 1 + (c >> 1 & 1), z = 1 + (c >> 2 & 1);
+        const float m = magnitude(rng);
+        v[static_cast<std::size_t>(x + 4 * (y + 4 * z))] = (mask >> c & 1) ? -m : m;
+      }
+      ScalarVolume vol{Vec3i::splat(4), v.data()};
+      const Mesh mesh = mesh_volume(vol, with(Mesher::kMarchingCubes, 2));
+      const MeshStats s = mesh_stats(mesh);
+      ASSERT_TRUE(s.watertight()) << "mask " << mask << " trial " << trial << ": " << s.boundary_edges << " boundary, "
+                                  << s.nonmanifold_edges << " non-manifold, " << s.misoriented_edges << " misoriented";
+      ASSERT_GT(s.signed_volume_units3, 0) << "mask " << mask;
+    }
+}
+
+// Random lattices are full of ambiguous faces and interior configurations: marching cubes gives a
+// closed oriented manifold, surface nets a closed surface, and both the same triangles for every
+// chunk edge and thread count.
+TEST(Mesh, RandomFieldsAreWatertightAndIndependentOfChunksAndThreads) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1, 1);
+  const int n = 27;
+  std::vector<float> v(static_cast<std::size_t>(n) * n * n);
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const bool border = x == 0 || y == 0 || z == 0 || x == n - 1 || y == n - 1 || z == n - 1;
+        v[static_cast<std::size_t>(x + n * (y + n * z))] = border ? 1.0f : u(rng);  // closed inside the lattice
+      }
+  ScalarVolume vol{Vec3i::splat(n), v.data()};
+  for (Mesher m : kMeshers) {
+    SCOPED_TRACE(mesher_name(m));
+    const Mesh reference = mesh_volume(vol, with(m, 1024));
+    const MeshStats s = mesh_stats(reference);
+    // Surface nets joins every sheet crossing a cell into its one vertex, so where the surface
+    // pinches within a cell an edge gets four triangles (Gibson's nets are closed, not manifold);
+    // marching cubes keeps the sheets apart.
+    auto closed = [&](const MeshStats& st) {
+      return m == Mesher::kMarchingCubes ? st.watertight() : st.boundary_edges == 0 && st.degenerate_triangles == 0;
+    };
+    EXPECT_TRUE(closed(s)) << s.boundary_edges << " boundary, " << s.nonmanifold_edges << " non-manifold, "
+                           << s.misoriented_edges << " misoriented";
+    if (m == Mesher::kSurfaceNets) {
+      EXPECT_GT(s.nonmanifold_edges, 0u);  // so this lattice does pinch
+    }
+    const auto expected = triangle_set(reference);
+    for (int edge : {2, 3, 5, 8, 16, 25}) {
+      for (int threads : {1, 2}) {
+        ThreadLimit limit(threads);
+        const Mesh mesh = mesh_volume(vol, with(m, edge));
+        EXPECT_EQ(mesh.vertex_count(), reference.vertex_count()) << "chunk edge " << edge;
+        EXPECT_TRUE(triangle_set(mesh) == expected) << "chunk edge " << edge << ", " << threads << " threads";
+        EXPECT_TRUE(closed(mesh_stats(mesh))) << "chunk edge " << edge;
+      }
+    }
+  }
+}
+
+TEST(Mesh, InsideAboveIsTheMirroredConvention) {
+  Sampled s(24, 1, [](Vec3d p) { return sdf::sphere(p, 7); });
+  std::vector<float> density(s.values.size());
+  for (std::size_t i = 0; i < density.size(); ++i) density[i] = 5.0f - s.values[i];  // > 5 inside
+  ScalarVolume d = s.volume;
+  d.values = density.data();
+  for (Mesher m : kMeshers) {
+    MeshOptions o = with(m);
+    const Mesh below = mesh_volume(s.volume, o);
+    o.iso = 5;
+    o.inside_above = true;
+    const Mesh above = mesh_volume(d, o);
+    ASSERT_EQ(below.triangle_count(), above.triangle_count());
+    EXPECT_GT(mesh_stats(above).signed_volume_units3, 0);
+    EXPECT_NEAR(mesh_stats(above).signed_volume_units3, mesh_stats(below).signed_volume_units3, 1e-3);
+  }
+}
+
+// A World: the surface runs halfway between solid and air voxel centres whatever the bounds, with
+// each vertex coloured by the material of the solid voxel it came from.
+TEST(Mesh, WorldsAreMeshedThroughTheirSignedFieldWithPaletteColours) {
+  World w(8, Box3i::from_size({10, 10, 10}));  // content touching the bounds: still closed
+  w.voxels.fill(Box3i{{0, 0, 0}, {5, 10, 10}}, 1);
+  w.voxels.fill(Box3i{{5, 0, 0}, {10, 10, 10}}, 2);
+  for (Mesher m : kMeshers) {
+    SCOPED_TRACE(mesher_name(m));
+    const Mesh mesh = mesh_world(w, with(m, 4));
+    expect_closed_manifold(mesh, 2, "two-material slab");
+    EXPECT_NEAR(mesh_stats(mesh).signed_volume_units3, 1000, 60);  // bevelled edges and corners
+    ASSERT_EQ(mesh.colors.size(), mesh.vertex_count());
+    for (std::size_t i = 0; i < mesh.vertex_count(); ++i) {
+      const Rgba c = w.palette[mesh.positions[i][0] < 5 ? 1 : 2];
+      if (std::abs(mesh.positions[i][0] - 5) < 0.6f) continue;  // vertices on the material border
+      EXPECT_EQ(mesh.colors[i], (std::array<std::uint8_t, 3>{c.r, c.g, c.b})) << "vertex " << i;
+    }
+  }
+  EXPECT_EQ(mesh_world(World(16), with(Mesher::kMarchingCubes)).triangle_count(), 0u);
+}
+
+TEST(Mesh, BadRequestsAreRefusedClearly) {
+  std::vector<float> v(8, 1.0f);
+  ScalarVolume vol{Vec3i::splat(2), v.data()};
+  MeshOptions o;
+  EXPECT_EQ(mesh_volume(vol, o).triangle_count(), 0u);  // no surface: an empty mesh
+  v[3] = std::numeric_limits<float>::quiet_NaN();
+  try {
+    mesh_volume(vol, o);
+    FAIL() << "NaN accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("(1, 1, 0) is NaN"), std::string::npos) << e.what();
+  }
+  v[3] = 1;
+  o.chunk_edge = 1;
+  EXPECT_THROW(mesh_volume(vol, o), InvalidArgument);
+  o.chunk_edge = 32;
+  vol.spacing_units = {1, 0, 1};
+  EXPECT_THROW(mesh_volume(vol, o), InvalidArgument);
+  vol.spacing_units = {1, 1, 1};
+  vol.size = {2, 1, 4};
+  EXPECT_THROW(mesh_volume(vol, o), InvalidArgument);
+  EXPECT_THROW(parse_mesher("dc2"), InvalidArgument);
+  EXPECT_EQ(parse_mesher("surface-nets"), Mesher::kSurfaceNets);
+}
