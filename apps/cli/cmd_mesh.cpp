@@ -1,0 +1,126 @@
+// voxfield mesh IN -o OUT: the iso-surface of a world (through its exact signed Euclidean field)
+// or of a float volume, as PLY, OBJ, STL or glTF binary.
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <optional>
+
+#include "cli.h"
+#include "voxfield/mesh.h"
+#include "voxfield/mesh_files.h"
+#include "voxfield/npy.h"
+#include "voxfield/parallel.h"
+
+namespace voxfield::cli {
+namespace {
+
+struct MeshSettings {
+  std::string in, out, stats, algorithm = "mc", inside = "below";
+  std::optional<double> iso;
+  std::vector<double> spacing;
+  int chunk = 32, threads = 0;
+};
+
+bool is_float(DType t) { return t == DType::kFloat32 || t == DType::kFloat64; }
+
+int run_mesh(const MeshSettings& s) {
+  MeshOptions options;
+  options.algorithm = parse_mesher(s.algorithm);
+  options.chunk_edge = s.chunk;
+  if (s.inside != "below" && s.inside != "above") throw UsageError("--inside must be below or above, not " + s.inside);
+  options.inside_above = s.inside == "above";
+  options.iso = s.iso.value_or(0);
+  if (!s.spacing.empty() && s.spacing.size() != 3) throw UsageError("--spacing takes three values: sx,sy,sz");
+  const MeshFormat format = mesh_format_of(s.out);
+  Outputs outputs({s.in});
+  outputs.expect(s.out, "-o");
+  outputs.expect(s.stats, "--stats");
+  std::optional<ThreadLimit> limit;
+  if (s.threads > 0) limit.emplace(s.threads);
+
+  auto start = std::chrono::steady_clock::now();
+  set_activity("loading " + s.in);
+  std::optional<NpyVolume> npy;
+  if (std::filesystem::path(s.in).extension() == ".npy") npy = read_npy(s.in);
+  const bool volume_input = npy && is_float(npy->dtype);
+  const double load_ms = ms_since(start);
+  Mesh mesh;
+  std::int64_t chunks = 0;
+  set_activity("meshing " + s.in);
+  double mesh_ms = 0;
+  if (volume_input) {
+    std::vector<float> values(static_cast<std::size_t>(npy->count()));
+    for (std::int64_t i = 0; i < npy->count(); ++i) values[static_cast<std::size_t>(i)] = static_cast<float>(npy->value(i));
+    ScalarVolume volume{npy->dims, values.data()};
+    if (!s.spacing.empty()) volume.spacing_units = {s.spacing[0], s.spacing[1], s.spacing[2]};
+    for (int a = 0; a < 3; ++a) chunks = (a ? chunks : 1) * ((npy->dims[a] - 1 + s.chunk - 1) / std::max(1, s.chunk));
+    start = std::chrono::steady_clock::now();
+    mesh = mesh_volume(volume, options);
+    mesh_ms = ms_since(start);
+  } else {
+    if (s.iso || s.inside != "below" || !s.spacing.empty())
+      throw UsageError("--iso, --inside and --spacing are for float volumes; a world is meshed at its surface "
+                       "(solid voxels inside, one unit per voxel)");
+    LoadOptions lo;
+    const World world = npy ? world_from_npy(*npy, s.in) : load_world(s.in, lo).world;
+    const Vec3i size = world.voxels.content_bounds().grown(1).size();
+    for (int a = 0; a < 3; ++a) chunks = (a ? chunks : 1) * ((size[a] - 1 + s.chunk - 1) / std::max(1, s.chunk));
+    start = std::chrono::steady_clock::now();
+    mesh = mesh_world(world, options);
+    mesh_ms = ms_since(start);
+  }
+  set_activity("writing " + s.out);
+  start = std::chrono::steady_clock::now();
+  outputs.stage(s.out, encode_mesh(mesh, format));
+  const double write_ms = ms_since(start);
+  const MeshStats st = mesh_stats(mesh);
+  if (!s.stats.empty()) {
+    nlohmann::json j;
+    j["input"] = s.in;
+    j["output"] = s.out;
+    j["algorithm"] = mesher_name(options.algorithm);
+    j["ms"] = mesh_ms;
+    j["phases_ms"] = {{"load", load_ms}, {"mesh", mesh_ms}, {"encode", write_ms}};
+    j["threads"] = max_threads();
+    j["chunk_edge"] = s.chunk;
+    j["chunks"] = chunks;
+    j["vertices"] = st.vertices;
+    j["triangles"] = st.triangles;
+    j["watertight"] = st.watertight();
+    j["boundary_edges"] = st.boundary_edges;
+    j["nonmanifold_edges"] = st.nonmanifold_edges;
+    j["euler_characteristic"] = st.euler_characteristic;
+    j["area_units2"] = st.area_units2;
+    j["volume_units3"] = st.signed_volume_units3;
+    outputs.stage_json(s.stats, j);
+  }
+  outputs.commit();
+  std::cerr << "voxfield: wrote " << s.out << " (" << st.triangles << " triangles, " << st.vertices << " vertices, "
+            << mesher_name(options.algorithm) << ", " << std::lround(mesh_ms) << " ms"
+            << (st.watertight() ? ", watertight" : "") << ")\n";
+  return 0;
+}
+
+}  // namespace
+
+void add_mesh(CLI::App& app, Action& action) {
+  auto s = std::make_shared<MeshSettings>();
+  CLI::App* cmd = app.add_subcommand("mesh", "Mesh the surface of a world (.vox, .vfw, integer .npy: through its exact "
+                                             "signed distance field) or the iso-surface of a float .npy volume");
+  cmd->add_option("IN", s->in, "input world or float32/float64 .npy volume")->required();
+  cmd->add_option("-o,--output", s->out, "output .ply, .obj, .stl or .glb (written atomically)")->required();
+  cmd->add_option("--algorithm", s->algorithm, "mc (marching cubes) or sn (surface nets)")
+      ->check(CLI::IsMember({"mc", "sn", "marching-cubes", "surface-nets"}));
+  cmd->add_option("--iso", s->iso, "iso value of a float volume (default 0)")->check(CLI::Number);
+  cmd->add_option("--inside", s->inside, "which values of a float volume are inside: below (default) or above iso")
+      ->check(CLI::IsMember({"below", "above"}));
+  cmd->add_option("--spacing", s->spacing, "sample spacing of a float volume: sx,sy,sz (sample a[x,y,z] at (x,y,z) * spacing)")
+      ->delimiter(',')
+      ->check(finite_positive());
+  cmd->add_option("--chunk", s->chunk, "cells per chunk edge (2..1024, default 32)")->check(CLI::Range(2, 1024));
+  cmd->add_option("--threads", s->threads, "threads (default: all)")->check(CLI::Range(1, 1024));
+  cmd->add_option("--stats", s->stats, "write counts, topology and timings as JSON");
+  cmd->callback([s, &action] { action = [s] { return run_mesh(*s); }; });
+}
+
+}  // namespace voxfield::cli
