@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Packages only the benchmarks need: the peers voxfield is compared with, and plotting.
 set -euo pipefail
-packages=(python3-scipy python3-matplotlib libopenvdb-dev libdynamicedt3d-dev)
+packages=(python3-scipy python3-matplotlib libopenvdb-dev libdynamicedt3d-dev
+          python3-vtk9 python3-skimage)  # meshing peers: VTK's flying edges, scikit-image's marching cubes
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -4,6 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
+bash scripts/install-bench-deps.sh  # the peers the report sets voxfield beside
 cmake --preset release >/dev/null
 cmake --build --preset release
 ./build/release/bin/voxfield showcase --out out "$@"

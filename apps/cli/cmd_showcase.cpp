@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "cli.h"
+#include "showcase.h"
 #include "voxfield/png.h"
 #include "voxfield/algorithms.h"
 #include "voxfield/dynamic_field.h"
@@ -23,18 +24,7 @@ struct ShowcaseSettings {
   int size = 256;
   std::uint64_t seed = 6683787;
   std::string out = "out";
-};
-
-std::string fixed(double v, int digits) {
-  std::ostringstream os;
-  os << std::fixed << std::setprecision(digits) << v;
-  return os.str();
-}
-
-struct Timing {
-  std::string stage;
-  double ms;
-  std::string note;
+  std::string peers = VOXFIELD_PEERS_DIR "/mesh_peers.py";
 };
 
 int run_showcase(const ShowcaseSettings& s) {
@@ -216,6 +206,8 @@ int run_showcase(const ShowcaseSettings& s) {
      << ": the exact Manhattan distance of every air voxel on the cut (blue near, red far; a darker band every 8 "
         "voxels), the world below the cut shaded.\n\n![distance](terrain-distance.png)\n";
 
+  showcase_meshing(terrain, s.out, fs::path(s.out) / "terrain-sdf.npy", s.peers, hero, md, timings);
+
   // Where the dissertation's approximations let rays skip through geometry, on the small terrain.
   {
     const RenderScene small_scene(sw, RenderSceneOptions{}, Box3i::from_size(small.size));
@@ -347,6 +339,7 @@ void add_showcase(CLI::App& app, Action& action) {
   cmd->add_option("--size", s->size, "world edge in voxels")->check(CLI::Range(8, 1024));
   cmd->add_option("--seed", s->seed, "random seed");
   cmd->add_option("--out", s->out, "output directory");
+  cmd->add_option("--peers", s->peers, "the peers' meshing script (bench/peers/mesh_peers.py), run when it exists");
   cmd->callback([s, &action] { action = [s] { return run_showcase(*s); }; });
 }
 

@@ -42,23 +42,32 @@ bool Block::load(const Lattice& lattice, const Box3i& cells) {
   s_.resize(dx_ * dy_ * static_cast<std::size_t>(hi_.z - lo_.z + 1));
   const float iso = static_cast<float>(lattice.iso);
   const bool negate = lattice.sign < 0;
-  bool any_inside = false, any_outside = false;
+  signs_.resize(dy_ * static_cast<std::size_t>(hi_.z - lo_.z + 1));
+  std::uint8_t all = 0;
   float* out = s_.data();
+  std::uint8_t* signs = signs_.data();
   for (int z = lo_.z; z <= hi_.z; ++z)
     for (int y = lo_.y; y <= hi_.y; ++y) {
       const float* row = lattice.values + lattice.index(lo_.x, y, z);
+      bool inside = false, outside = false, nan = false;
       for (std::size_t i = 0; i < dx_; ++i) {
         const float v = row[i];
-        if (std::isnan(v))
-          throw InvalidArgument("mesh: sample (" + std::to_string(lo_.x + static_cast<int>(i)) + ", " + std::to_string(y) +
-                                ", " + std::to_string(z) + ") is NaN");
+        nan |= std::isnan(v);
         const float s = negate ? iso - v : v - iso;
-        any_inside |= s < 0;
-        any_outside |= s >= 0;
-        *out++ = s;
+        inside |= s < 0;
+        outside |= s >= 0;
+        out[i] = s;
       }
+      if (nan)
+        for (std::size_t i = 0; i < dx_; ++i)
+          if (std::isnan(row[i]))
+            throw InvalidArgument("mesh: sample (" + std::to_string(lo_.x + static_cast<int>(i)) + ", " + std::to_string(y) +
+                                  ", " + std::to_string(z) + ") is NaN");
+      out += dx_;
+      *signs = static_cast<std::uint8_t>(inside | outside << 1);
+      all |= *signs++;
     }
-  return any_inside && any_outside;
+  return all == 3;
 }
 
 std::array<double, 3> Block::gradient(int x, int y, int z) const {

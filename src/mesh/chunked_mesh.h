@@ -56,6 +56,10 @@ class Block {
   float s(int x, int y, int z) const {
     return s_[static_cast<std::size_t>(x - lo_.x) + dx_ * (static_cast<std::size_t>(y - lo_.y) + dy_ * static_cast<std::size_t>(z - lo_.z))];
   }
+  // The samples of row (y, z) from x on (x fastest), for walking a row without index arithmetic.
+  const float* row(int x, int y, int z) const { return &s_[static_cast<std::size_t>(x - lo_.x) + dx_ * (static_cast<std::size_t>(y - lo_.y) + dy_ * static_cast<std::size_t>(z - lo_.z))]; }
+  // Which signs row (y, z) holds: bit 0 some sample inside, bit 1 some outside.
+  std::uint8_t row_signs(int y, int z) const { return signs_[static_cast<std::size_t>(y - lo_.y) + dy_ * static_cast<std::size_t>(z - lo_.z)]; }
   // Gradient of s at a sample (central differences; one-sided on the lattice's faces), per unit.
   std::array<double, 3> gradient(int x, int y, int z) const;
 
@@ -64,6 +68,7 @@ class Block {
   Vec3i lo_, hi_;
   std::size_t dx_ = 0, dy_ = 0;
   std::vector<float> s_;
+  std::vector<std::uint8_t> signs_;
 };
 
 // One chunk's triangles over its own vertex numbering.

@@ -11,6 +11,7 @@
 // Crossings are interpolated from the edge's lower sample to its upper one and normals blend the
 // central-difference gradients at both ends, so a chunk and its neighbour compute identical
 // vertices for the edges on their common face.
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -71,16 +72,32 @@ void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i c
     return id;
   };
 
+  // A cell's corner mask from the signs at its two x faces: nibble bit k (row k of the four
+  // below) is corner 2k at x and corner 2k + 1 at x + 1.
+  static constexpr auto spread = [] {
+    std::array<std::uint8_t, 16> t{};
+    for (unsigned n = 0; n < 16; ++n) t[n] = static_cast<std::uint8_t>((n & 1) | (n & 2) << 1 | (n & 4) << 2 | (n & 8) << 3);
+    return t;
+  }();
   float v[8];
   for (int z = cells.begin.z; z < cells.end.z; ++z)
-    for (int y = cells.begin.y; y < cells.end.y; ++y)
+    for (int y = cells.begin.y; y < cells.end.y; ++y) {
+      // Rows whose four sample rows hold one sign only have no surface: most rows, away from it.
+      if ((block.row_signs(y, z) | block.row_signs(y + 1, z) | block.row_signs(y, z + 1) | block.row_signs(y + 1, z + 1)) != 3)
+        continue;
+      const float* r[4] = {block.row(b.x, y, z), block.row(b.x, y + 1, z), block.row(b.x, y, z + 1), block.row(b.x, y + 1, z + 1)};
+      auto face = [&](int i) {
+        return static_cast<unsigned>(r[0][i] < 0) | static_cast<unsigned>(r[1][i] < 0) << 1 |
+               static_cast<unsigned>(r[2][i] < 0) << 2 | static_cast<unsigned>(r[3][i] < 0) << 3;
+      };
+      unsigned left = face(0);
       for (int x = cells.begin.x; x < cells.end.x; ++x) {
-        unsigned inside = 0;
-        for (int c = 0; c < 8; ++c) {
-          v[c] = block.s(x + (c & 1), y + (c >> 1 & 1), z + (c >> 2 & 1));
-          inside |= static_cast<unsigned>(v[c] < 0) << c;
-        }
+        const int i = x - b.x;
+        const unsigned right = face(i + 1);
+        const unsigned inside = spread[left] | static_cast<unsigned>(spread[right]) << 1;
+        left = right;
         if (inside == 0 || inside == 255) continue;
+        for (int c = 0; c < 8; ++c) v[c] = r[c >> 1][i + (c & 1)];
         unsigned joined = 0;
         const unsigned ambiguous = table.ambiguous_faces(inside);
         for (int face = 0, bit = 0; face < 6; ++face)
@@ -90,9 +107,16 @@ void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i c
           }
         const CubeCase& cc = table.lookup(inside, joined);
         const Vec3i cell{x, y, z};
+        // The cell's crossing edges, each looked up (or made) once however many triangles use it.
+        std::array<std::uint32_t, 12> ids;
+        std::uint32_t known = 0;
         auto edge_vertex = [&](int edge) {
-          const CubeEdge& e = edges[static_cast<std::size_t>(edge)];
-          return vertex(cell + corner_offset(e.from), e.axis);
+          if (!(known >> edge & 1)) {
+            const CubeEdge& e = edges[static_cast<std::size_t>(edge)];
+            ids[static_cast<std::size_t>(edge)] = vertex(cell + corner_offset(e.from), e.axis);
+            known |= 1u << edge;
+          }
+          return ids[static_cast<std::size_t>(edge)];
         };
         // Centre vertices belong to this cell alone (owned, never looked up by a neighbour).
         std::array<std::uint32_t, 2> centre{};
@@ -115,6 +139,7 @@ void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i c
           part.indices.push_back(edge >= CubeCase::kCentre ? centre[static_cast<std::size_t>(edge - CubeCase::kCentre)] : edge_vertex(edge));
         }
       }
+    }
 }
 
 }  // namespace voxfield::detail::mesh

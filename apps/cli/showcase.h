@@ -1,0 +1,36 @@
+// voxfield showcase — what its sections share (the command is cmd_showcase.cpp; each larger
+// section has its own showcase_*.cpp).
+#pragma once
+
+#include <filesystem>
+#include <iomanip>
+#include <ostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "voxfield/render.h"
+#include "voxfield/world.h"
+
+namespace voxfield::cli {
+
+struct Timing {
+  std::string stage;
+  double ms;
+  std::string note;
+};
+
+inline std::string fixed(double v, int digits) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(digits) << v;
+  return os.str();
+}
+
+// Meshes of the terrain: both meshers, their topology and cost, the peers on the same field (when
+// `peers_script` exists and Debian's Python runs it), pictures, a .glb and a .ply. `sdf_npy` is
+// the terrain's signed Euclidean field over its box, already written.
+void showcase_meshing(const World& terrain, const std::filesystem::path& out, const std::filesystem::path& sdf_npy,
+                      const std::filesystem::path& peers_script, const Camera& hero, std::ostream& md,
+                      std::vector<Timing>& timings);
+
+}  // namespace voxfield::cli

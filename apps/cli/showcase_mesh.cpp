@@ -1,0 +1,144 @@
+// voxfield showcase — the meshing section: the terrain through marching cubes and surface nets,
+// checked closed and seamless, pictured, exported, and set beside scikit-image and VTK on the same
+// signed distance field.
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "showcase.h"
+#include "voxfield/mesh.h"
+#include "voxfield/mesh_files.h"
+#include "voxfield/mesh_render.h"
+#include "voxfield/npy.h"
+#include "voxfield/png.h"
+
+namespace voxfield::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+double mesh_bytes_per_triangle(const Mesh& m) {
+  const double bytes = static_cast<double>(m.positions.size() * 12 + m.normals.size() * 12 + m.colors.size() * 3 +
+                                           m.indices.size() * 4);
+  return m.triangle_count() ? bytes / static_cast<double>(m.triangle_count()) : 0;
+}
+
+// Runs the peers' script on the field; null when Python, the script or the peers are missing.
+nlohmann::json run_peers(const fs::path& script, const fs::path& sdf_npy, const fs::path& out) {
+  if (!fs::exists(script) || !fs::exists("/usr/bin/python3")) return nullptr;
+  const fs::path result = out / "mesh-peers.json";
+  const std::string command = "/usr/bin/python3 '" + script.string() + "' '" + sdf_npy.string() + "' 0 --runs 2 --json '" +
+                              result.string() + "' 2>/dev/null";
+  if (std::system(command.c_str()) != 0 || !fs::exists(result)) return nullptr;
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(result));
+  fs::remove(result);
+  return j;
+}
+
+}  // namespace
+
+void showcase_meshing(const World& terrain, const fs::path& out, const fs::path& sdf_npy, const fs::path& peers_script,
+                      const Camera& hero, std::ostream& md, std::vector<Timing>& timings) {
+  md << "\n## Meshes of the terrain\n\n"
+     << "The terrain's surface as triangles, through its exact signed Euclidean field (`voxfield mesh`): marching "
+        "cubes with ambiguous faces settled by the asymptotic decider (a closed, oriented 2-manifold), and naive "
+        "surface nets (one vertex per cell, closed, not always manifold). Meshed in chunks of 32 cells on "
+        "all threads; the same triangles come out for every chunk edge.\n\n"
+     << "| mesher | triangles | vertices | ms | watertight | Euler characteristic | area (voxel faces) | bytes/triangle | "
+        "chunk edge 8: same triangles |\n|---|---|---|---|---|---|---|---|---|\n";
+  const Vec3i size = terrain.voxels.content_bounds().size();
+  Mesh meshes[2];
+  const Mesher kinds[2] = {Mesher::kMarchingCubes, Mesher::kSurfaceNets};
+  for (int i = 0; i < 2; ++i) {
+    MeshOptions o;
+    o.algorithm = kinds[i];
+    const auto t0 = std::chrono::steady_clock::now();
+    meshes[i] = mesh_world(terrain, o);
+    const double ms = ms_since(t0);
+    const MeshStats st = mesh_stats(meshes[i]);
+    o.chunk_edge = 8;
+    const Mesh small_chunks = mesh_world(terrain, o);
+    const bool same = small_chunks.triangle_count() == meshes[i].triangle_count() &&
+                      small_chunks.vertex_count() == meshes[i].vertex_count() && mesh_stats(small_chunks).edges == st.edges;
+    timings.push_back({std::string("mesh the terrain, ") + mesher_name(kinds[i]) + " (field included)", ms,
+                       fixed(static_cast<double>(st.triangles) / (ms * 1e3), 1) + " M triangles/s"});
+    md << "| " << (i == 0 ? "marching cubes" : "surface nets") << " | " << st.triangles << " | " << st.vertices << " | "
+       << fixed(ms, 0) << " | " << (st.watertight() ? "yes" : (st.boundary_edges == 0 ? "closed" : "**no**")) << " | "
+       << st.euler_characteristic << " | " << fixed(st.area_units2, 0) << " | " << fixed(mesh_bytes_per_triangle(meshes[i]), 1)
+       << " | " << (same ? "yes" : "**no**") << " |\n";
+    std::cout << "voxfield showcase: " << mesher_name(kinds[i]) << " mesh of the terrain: " << st.triangles
+              << " triangles in " << fixed(ms, 0) << " ms\n";
+    if (!same) throw Error("showcase: meshing in chunks of 8 changed the terrain's mesh");
+  }
+  write_mesh(meshes[0], out / "terrain.glb");
+  write_mesh(meshes[1], out / "terrain-sn.ply");
+  static_cast<void>(size);
+
+  // The peers, on the very same field (the terrain's signed Euclidean field over its box).
+  const NpyVolume sdf = read_npy(sdf_npy);
+  std::vector<float> values(static_cast<std::size_t>(sdf.count()));
+  std::memcpy(values.data(), sdf.bytes.data(), values.size() * sizeof(float));
+  ScalarVolume volume{sdf.dims, values.data()};
+  MeshOptions mo;
+  double ours_ms = 1e300;
+  std::size_t ours_triangles = 0;
+  for (int run = 0; run < 2; ++run) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const Mesh m = mesh_volume(volume, mo);
+    ours_ms = std::min(ours_ms, ms_since(t0));
+    ours_triangles = m.triangle_count();
+  }
+  const nlohmann::json peers = run_peers(peers_script, sdf_npy, out);
+  md << "\nMarching cubes of `terrain-sdf.npy` at level 0 (" << sdf.dims.x << "³ samples), voxfield beside its peers "
+        "in this run (best of 2):\n\n| library | threads | ms | triangles | voxfield's speed-up |\n|---|---|---|---|---|\n"
+     << "| voxfield " << mesher_name(Mesher::kMarchingCubes) << " | " << max_threads() << " | " << fixed(ours_ms, 0) << " | "
+     << ours_triangles << " | |\n";
+  bool any_peer = false;
+  if (!peers.is_null())
+    for (const char* name : {"scikit-image", "vtk-flying-edges"}) {
+      if (!peers.contains(name) || peers[name].is_null()) continue;
+      const auto& p = peers[name];
+      any_peer = true;
+      md << "| " << name << " " << p["version"].get<std::string>() << " | " << p["threads"].get<int>() << " | "
+         << fixed(p["ms"].get<double>(), 0) << " | " << p["triangles"].get<std::int64_t>() << " | "
+         << fixed(p["ms"].get<double>() / ours_ms, 1) << "× |\n";
+    }
+  if (!any_peer)
+    md << "\n(The peers were not run: Debian's python3-skimage / python3-vtk9 are not installed, see "
+          "scripts/install-bench-deps.sh.)\n";
+
+  // Pictures: the whole terrain from the hero camera, and a close-up with the triangles' edges.
+  MeshRenderOptions ro;
+  const Box3i content = terrain.voxels.content_bounds();
+  const int cx = (content.begin.x + content.end.x) / 2, cy = (content.begin.y + content.end.y) / 2;
+  const int r = std::max(6, content.size().x / 16);
+  Box3i close{{cx - r, cy - r, content.begin.z}, {cx + r, cy + r, content.end.z}};
+  for (int z = content.end.z - 1; z >= content.begin.z; --z)  // frame the surface around the centre
+    if (terrain.voxels.get({cx, cy, z})) {
+      close.begin.z = std::max(content.begin.z, z - r);
+      close.end.z = std::min(content.end.z, z + r);
+      break;
+    }
+  const Camera near = Camera::framing(close, 16.0 / 9.0);
+  for (int i = 0; i < 2; ++i) {
+    const std::string tag = mesher_name(kinds[i]);
+    MeshRenderStats st;
+    write_png(render_mesh(meshes[i], hero, ro, &st), out / ("terrain-mesh-" + tag + ".png"));
+    timings.push_back({"picture of the " + tag + " mesh (CPU rasteriser, 1280×720)", st.ms, ""});
+    MeshRenderOptions edges = ro;
+    edges.edges = true;
+    write_png(render_mesh(meshes[i], near, edges), out / ("terrain-mesh-" + tag + "-edges.png"));
+  }
+  md << "\n| marching cubes | surface nets |\n|---|---|\n"
+     << "| ![mc](terrain-mesh-mc.png) | ![sn](terrain-mesh-sn.png) |\n"
+     << "| ![mc edges](terrain-mesh-mc-edges.png) | ![sn edges](terrain-mesh-sn-edges.png) |\n\n"
+     << "Files: `terrain.glb` (marching cubes, glTF binary with vertex colours: drop it into any glTF viewer) and "
+        "`terrain-sn.ply` (surface nets).\n";
+}
+
+}  // namespace voxfield::cli
