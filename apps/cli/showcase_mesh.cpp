@@ -116,7 +116,7 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
   MeshRenderOptions ro;
   const Box3i content = terrain.voxels.content_bounds();
   const int cx = (content.begin.x + content.end.x) / 2, cy = (content.begin.y + content.end.y) / 2;
-  const int r = std::max(6, content.size().x / 16);
+  const int r = std::max(8, content.size().x / 8);
   Box3i close{{cx - r, cy - r, content.begin.z}, {cx + r, cy + r, content.end.z}};
   for (int z = content.end.z - 1; z >= content.begin.z; --z)  // frame the surface around the centre
     if (terrain.voxels.get({cx, cy, z})) {
