@@ -21,7 +21,7 @@ using namespace voxfield;
 
 namespace {
 
-const Mesher kMeshers[] = {Mesher::kMarchingCubes, Mesher::kSurfaceNets};
+const Mesher kMeshers[] = {Mesher::kMarchingCubes, Mesher::kSurfaceNets, Mesher::kDualContouring};
 
 // An analytic field sampled on n^3 points spaced `h` apart, centred on the origin.
 struct Sampled {
@@ -93,7 +93,8 @@ TEST(Mesh, SphereIsAClosedSurfaceNearTheTrueOne) {
     EXPECT_NEAR(st.signed_volume_units3, sdf::sphere_volume(r), 0.01 * sdf::sphere_volume(r));
     EXPECT_NEAR(st.area_units2, sdf::sphere_area(r), 0.01 * sdf::sphere_area(r));
     // Marching cubes interpolates an exact distance along edges: within 1 % of the spacing. Surface
-    // nets averages crossings, which sits inside a convex surface by up to ~ h^2 / r.
+    // nets averages crossings, which sits inside a convex surface by up to ~ h^2 / r; dual
+    // contouring's tangent planes meet just outside it.
     const double tolerance = m == Mesher::kMarchingCubes ? 0.005 : 0.05;
     double worst = 0, worst_normal = 1;
     for (std::size_t i = 0; i < mesh.vertex_count(); ++i) {
@@ -145,6 +146,23 @@ TEST(Mesh, SurfaceNetsOfABlockHasOneQuadPerVoxelFace) {
   expect_closed_manifold(sn, 2, "block, surface nets");
   const Mesh mc = mesh_world(w, with(Mesher::kMarchingCubes));
   expect_closed_manifold(mc, 2, "block, marching cubes");
+  // Dual contouring with the faces' exact normals rebuilds the block itself: its 8 corners are
+  // vertices, every vertex lies on a face of [0, 6]^3, and the volume is exactly 216.
+  const Mesh dc = mesh_world(w, with(Mesher::kDualContouring));
+  EXPECT_EQ(dc.triangle_count(), 2u * 216);
+  EXPECT_NEAR(mesh_stats(dc).signed_volume_units3, 216.0, 1e-3);
+  int corners = 0;
+  for (const auto& p : dc.positions) {
+    int on_face = 0, at_corner = 0;
+    for (int a = 0; a < 3; ++a) {
+      const float c = p[static_cast<std::size_t>(a)];
+      on_face += c == 0.0f || c == 6.0f;
+      at_corner += c == 0.0f || c == 6.0f;
+    }
+    EXPECT_GE(on_face, 1);
+    corners += at_corner == 3;
+  }
+  EXPECT_EQ(corners, 8);
   // The block's 8 corner voxels cut off by one triangle each, the rest two per voxel face.
   const Rgba c = w.palette[7];
   for (const auto& col : sn.colors) EXPECT_EQ(col, (std::array<std::uint8_t, 3>{c.r, c.g, c.b}));
@@ -202,7 +220,7 @@ TEST(Mesh, RandomFieldsAreWatertightAndIndependentOfChunksAndThreads) {
     };
     EXPECT_TRUE(closed(s)) << s.boundary_edges << " boundary, " << s.nonmanifold_edges << " non-manifold, "
                            << s.misoriented_edges << " misoriented";
-    if (m == Mesher::kSurfaceNets) {
+    if (m != Mesher::kMarchingCubes) {
       EXPECT_GT(s.nonmanifold_edges, 0u);  // so this lattice does pinch
     }
     const auto expected = triangle_set(reference);
@@ -280,4 +298,38 @@ TEST(Mesh, BadRequestsAreRefusedClearly) {
   EXPECT_THROW(mesh_volume(vol, o), InvalidArgument);
   EXPECT_THROW(parse_mesher("dc2"), InvalidArgument);
   EXPECT_EQ(parse_mesher("surface-nets"), Mesher::kSurfaceNets);
+}
+
+// Dual contouring keeps a box's corners and edges where marching cubes bevels them: on a box not
+// aligned with the lattice (spacing 0.5), its vertices sit on the box and nearer its corners. From
+// samples alone a crease cannot be exact: crossings near it are interpolated across the kink of
+// the distance field, so corners come within half a sample (marching cubes: up to 1.3 samples).
+TEST(Mesh, DualContouringKeepsSharpCorners) {
+  const Vec3d half{5.3, 4.15, 3.35}, centre{0.11, -0.07, 0.13};
+  Sampled box(32, 0.5, [&](Vec3d p) { return sdf::box(p - centre, half); });
+  auto corner_errors = [&](const Mesh& mesh) {
+    double worst = 0, sum = 0;
+    for (int c = 0; c < 8; ++c) {
+      const Vec3d corner{centre.x + ((c & 1) ? half.x : -half.x), centre.y + ((c >> 1 & 1) ? half.y : -half.y),
+                         centre.z + ((c >> 2 & 1) ? half.z : -half.z)};
+      double best = 1e9;
+      for (const auto& p : mesh.positions) best = std::min(best, (at(p) - corner).length());
+      worst = std::max(worst, best);
+      sum += best;
+    }
+    return std::pair{worst, sum / 8};
+  };
+  const Mesh dc = mesh_volume(box.volume, with(Mesher::kDualContouring, 8));
+  const Mesh mc = mesh_volume(box.volume, with(Mesher::kMarchingCubes, 8));
+  expect_closed_manifold(dc, 2, "box, dual contouring");
+  const double volume = 8 * half.x * half.y * half.z;
+  EXPECT_NEAR(mesh_stats(dc).signed_volume_units3, volume, 0.005 * volume);
+  EXPECT_LT(std::abs(mesh_stats(dc).signed_volume_units3 - volume), std::abs(mesh_stats(mc).signed_volume_units3 - volume));
+  const auto [dc_worst, dc_mean] = corner_errors(dc);
+  const auto [mc_worst, mc_mean] = corner_errors(mc);
+  EXPECT_LT(dc_worst, 0.25) << "a corner is farther than half a sample from every vertex";
+  EXPECT_LT(dc_mean, 0.4 * mc_mean) << "dual contouring " << dc_mean << ", marching cubes " << mc_mean;
+  double off = 0;
+  for (const auto& p : dc.positions) off = std::max(off, std::abs(sdf::box(at(p) - centre, half)));
+  EXPECT_LT(off, 0.03);  // every vertex within 6 % of a sample of the box
 }

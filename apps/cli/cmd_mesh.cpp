@@ -109,8 +109,8 @@ void add_mesh(CLI::App& app, Action& action) {
                                              "signed distance field) or the iso-surface of a float .npy volume");
   cmd->add_option("IN", s->in, "input world or float32/float64 .npy volume")->required();
   cmd->add_option("-o,--output", s->out, "output .ply, .obj, .stl or .glb (written atomically)")->required();
-  cmd->add_option("--algorithm", s->algorithm, "mc (marching cubes) or sn (surface nets)")
-      ->check(CLI::IsMember({"mc", "sn", "marching-cubes", "surface-nets"}));
+  cmd->add_option("--algorithm", s->algorithm, "mc (marching cubes), sn (surface nets) or dc (dual contouring)")
+      ->check(CLI::IsMember({"mc", "sn", "dc", "marching-cubes", "surface-nets", "dual-contouring"}));
   cmd->add_option("--iso", s->iso, "iso value of a float volume (default 0)")->check(CLI::Number);
   cmd->add_option("--inside", s->inside, "which values of a float volume are inside: below (default) or above iso")
       ->check(CLI::IsMember({"below", "above"}));

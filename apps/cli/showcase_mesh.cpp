@@ -1,6 +1,6 @@
-// voxfield showcase — the meshing section: the terrain through marching cubes and surface nets,
-// checked closed and seamless, pictured, exported, and set beside scikit-image and VTK on the same
-// signed distance field.
+// voxfield showcase — the meshing section: the terrain through marching cubes, surface nets and
+// dual contouring, checked closed and seamless, pictured, exported, and set beside scikit-image and
+// VTK on the same signed distance field.
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -46,15 +46,18 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
                       const Camera& hero, std::ostream& md, std::vector<Timing>& timings) {
   md << "\n## Meshes of the terrain\n\n"
      << "The terrain's surface as triangles, through its exact signed Euclidean field (`voxfield mesh`): marching "
-        "cubes with ambiguous faces settled by the asymptotic decider (a closed, oriented 2-manifold), and naive "
-        "surface nets (one vertex per cell, closed, not always manifold). Meshed in chunks of 32 cells on "
-        "all threads; the same triangles come out for every chunk edge.\n\n"
+        "cubes with ambiguous faces settled by the asymptotic decider (a closed, oriented 2-manifold), naive "
+        "surface nets (one vertex per cell, closed, not always manifold) and dual contouring (surface nets' "
+        "topology, each vertex where the crossings' tangent planes meet: the voxels' edges and corners stay "
+        "sharp). Meshed in chunks of 32 cells on all threads; the same triangles come out for every chunk "
+        "edge.\n\n"
      << "| mesher | triangles | vertices | ms | watertight | Euler characteristic | area (voxel faces) | bytes/triangle | "
         "chunk edge 8: same triangles |\n|---|---|---|---|---|---|---|---|---|\n";
   const Vec3i size = terrain.voxels.content_bounds().size();
-  Mesh meshes[2];
-  const Mesher kinds[2] = {Mesher::kMarchingCubes, Mesher::kSurfaceNets};
-  for (int i = 0; i < 2; ++i) {
+  Mesh meshes[3];
+  const Mesher kinds[3] = {Mesher::kMarchingCubes, Mesher::kSurfaceNets, Mesher::kDualContouring};
+  const char* names[3] = {"marching cubes", "surface nets", "dual contouring"};
+  for (int i = 0; i < 3; ++i) {
     MeshOptions o;
     o.algorithm = kinds[i];
     const auto t0 = std::chrono::steady_clock::now();
@@ -67,7 +70,7 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
                       small_chunks.vertex_count() == meshes[i].vertex_count() && mesh_stats(small_chunks).edges == st.edges;
     timings.push_back({std::string("mesh the terrain, ") + mesher_name(kinds[i]) + " (field included)", ms,
                        fixed(static_cast<double>(st.triangles) / (ms * 1e3), 1) + " M triangles/s"});
-    md << "| " << (i == 0 ? "marching cubes" : "surface nets") << " | " << st.triangles << " | " << st.vertices << " | "
+    md << "| " << names[i] << " | " << st.triangles << " | " << st.vertices << " | "
        << fixed(ms, 0) << " | " << (st.watertight() ? "yes" : (st.boundary_edges == 0 ? "closed" : "**no**")) << " | "
        << st.euler_characteristic << " | " << fixed(st.area_units2, 0) << " | " << fixed(mesh_bytes_per_triangle(meshes[i]), 1)
        << " | " << (same ? "yes" : "**no**") << " |\n";
@@ -77,6 +80,7 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
   }
   write_mesh(meshes[0], out / "terrain.glb");
   write_mesh(meshes[1], out / "terrain-sn.ply");
+  write_mesh(meshes[2], out / "terrain-dc.obj");
   static_cast<void>(size);
 
   // The peers, on the very same field (the terrain's signed Euclidean field over its box).
@@ -125,7 +129,7 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
       break;
     }
   const Camera near = Camera::framing(close, 16.0 / 9.0);
-  for (int i = 0; i < 2; ++i) {
+  for (int i = 0; i < 3; ++i) {
     const std::string tag = mesher_name(kinds[i]);
     MeshRenderStats st;
     write_png(render_mesh(meshes[i], hero, ro, &st), out / ("terrain-mesh-" + tag + ".png"));
@@ -134,11 +138,12 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
     edges.edges = true;
     write_png(render_mesh(meshes[i], near, edges), out / ("terrain-mesh-" + tag + "-edges.png"));
   }
-  md << "\n| marching cubes | surface nets |\n|---|---|\n"
-     << "| ![mc](terrain-mesh-mc.png) | ![sn](terrain-mesh-sn.png) |\n"
-     << "| ![mc edges](terrain-mesh-mc-edges.png) | ![sn edges](terrain-mesh-sn-edges.png) |\n\n"
+  md << "\n| marching cubes | surface nets | dual contouring |\n|---|---|---|\n"
+     << "| ![mc](terrain-mesh-mc.png) | ![sn](terrain-mesh-sn.png) | ![dc](terrain-mesh-dc.png) |\n"
+     << "| ![mc edges](terrain-mesh-mc-edges.png) | ![sn edges](terrain-mesh-sn-edges.png) | "
+        "![dc edges](terrain-mesh-dc-edges.png) |\n\n"
      << "Files: `terrain.glb` (marching cubes, glTF binary with vertex colours: drop it into any glTF viewer) and "
-        "`terrain-sn.ply` (surface nets).\n";
+        "`terrain-sn.ply` (surface nets), `terrain-dc.obj` (dual contouring).\n";
 }
 
 }  // namespace voxfield::cli

@@ -1,5 +1,5 @@
-// voxfield — triangle meshes of iso-surfaces: marching cubes and surface nets, per chunk and
-// seamless.
+// voxfield — triangle meshes of iso-surfaces: marching cubes, surface nets and dual contouring,
+// per chunk and seamless.
 //
 // A mesher reads a scalar field sampled on a lattice (a ScalarVolume: a float volume, or the exact
 // signed distance field of a World) and returns one indexed triangle mesh of the surface where the
@@ -14,8 +14,9 @@
 //  * vertices are shared between the triangles that meet there (indexed mesh, no unreferenced
 //    vertices). A surface inside the volume gives a closed mesh (no boundary edge); marching cubes
 //    gives a closed oriented 2-manifold (every edge in exactly two triangles, traversed both ways:
-//    mesh_stats() checks), while surface nets, which joins all the sheets crossing a cell into one
-//    vertex, has edges in four triangles where the surface pinches within a cell.
+//    mesh_stats() checks), while surface nets and dual contouring, which join all the sheets
+//    crossing a cell into one vertex, have edges in four triangles where the surface pinches
+//    within a cell.
 // Algorithms: docs/meshing.md; each opens its source file with its paper.
 #pragma once
 
@@ -51,9 +52,11 @@ struct ScalarVolume {
 enum class Mesher {
   kMarchingCubes,  // Lorensen & Cline 1987; faces decided by Nielson & Hamann's asymptotic decider
   kSurfaceNets,    // Gibson 1998, the naive variant: one vertex per cell the surface crosses
+  kDualContouring, // Ju et al. 2002: surface nets' topology, vertices on the crossings' tangent planes
 };
-const char* mesher_name(Mesher m);         // "mc", "sn"
-Mesher parse_mesher(const std::string& name);  // "mc"/"marching-cubes", "sn"/"surface-nets"; else InvalidArgument
+const char* mesher_name(Mesher m);             // "mc", "sn", "dc"
+// "mc"/"marching-cubes", "sn"/"surface-nets", "dc"/"dual-contouring"; else InvalidArgument.
+Mesher parse_mesher(const std::string& name);
 
 struct MeshOptions {
   Mesher algorithm = Mesher::kMarchingCubes;

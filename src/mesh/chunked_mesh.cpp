@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "voxfield/error.h"
+#include "voxfield/parallel.h"
 
 namespace voxfield::detail::mesh {
 
@@ -33,38 +34,34 @@ int ChunkGrid::owner(int axis, int v) const { return std::min(v / edge, count[ax
 
 bool Block::load(const Lattice& lattice, const Box3i& cells) {
   lattice_ = &lattice;
+  iso_ = static_cast<float>(lattice.iso);
+  negate_ = lattice.sign < 0;
   for (int a = 0; a < 3; ++a) {
     lo_[a] = std::max(cells.begin[a] - 1, 0);
     hi_[a] = std::min(cells.end[a] + 1, lattice.n[a] - 1);
   }
-  dx_ = static_cast<std::size_t>(hi_.x - lo_.x + 1);
+  const std::size_t dx = static_cast<std::size_t>(hi_.x - lo_.x + 1);
   dy_ = static_cast<std::size_t>(hi_.y - lo_.y + 1);
-  s_.resize(dx_ * dy_ * static_cast<std::size_t>(hi_.z - lo_.z + 1));
-  const float iso = static_cast<float>(lattice.iso);
-  const bool negate = lattice.sign < 0;
   signs_.resize(dy_ * static_cast<std::size_t>(hi_.z - lo_.z + 1));
   std::uint8_t all = 0;
-  float* out = s_.data();
   std::uint8_t* signs = signs_.data();
   for (int z = lo_.z; z <= hi_.z; ++z)
     for (int y = lo_.y; y <= hi_.y; ++y) {
       const float* row = lattice.values + lattice.index(lo_.x, y, z);
-      bool inside = false, outside = false, nan = false;
-      for (std::size_t i = 0; i < dx_; ++i) {
+      bool in = false, out = false, nan = false;
+      for (std::size_t i = 0; i < dx; ++i) {  // no early exit: this loop vectorises
         const float v = row[i];
-        nan |= std::isnan(v);
-        const float s = negate ? iso - v : v - iso;
-        inside |= s < 0;
-        outside |= s >= 0;
-        out[i] = s;
+        nan |= v != v;
+        const bool inside_v = negate_ ? v > iso_ : v < iso_;
+        in |= inside_v;
+        out |= !inside_v;
       }
       if (nan)
-        for (std::size_t i = 0; i < dx_; ++i)
+        for (std::size_t i = 0; i < dx; ++i)
           if (std::isnan(row[i]))
             throw InvalidArgument("mesh: sample (" + std::to_string(lo_.x + static_cast<int>(i)) + ", " + std::to_string(y) +
                                   ", " + std::to_string(z) + ") is NaN");
-      out += dx_;
-      *signs = static_cast<std::uint8_t>(inside | outside << 1);
+      *signs = static_cast<std::uint8_t>(in | out << 1);
       all |= *signs++;
     }
   return all == 3;
@@ -79,6 +76,35 @@ std::array<double, 3> Block::gradient(int x, int y, int z) const {
     if (p[a] < lattice_->n[a] - 1) ++hi[a];
     const double span = (hi[a] - lo[a]) * lattice_->spacing[static_cast<std::size_t>(a)];
     g[static_cast<std::size_t>(a)] = (static_cast<double>(s(hi.x, hi.y, hi.z)) - s(lo.x, lo.y, lo.z)) / span;
+  }
+  return g;
+}
+
+std::array<double, 3> Block::one_sided_gradient(int x, int y, int z) const {
+  const Vec3i p{x, y, z};
+  std::array<double, 3> g{};
+  for (int a = 0; a < 3; ++a) {
+    const int n = lattice_->n[a];
+    auto at = [&](int offset) {
+      Vec3i q = p;
+      q[a] = std::clamp(p[a] + offset, 0, n - 1);
+      return static_cast<double>(s(q.x, q.y, q.z));
+    };
+    const double h = lattice_->spacing[static_cast<std::size_t>(a)];
+    const double s0 = at(0);
+    const bool has_left = p[a] > 0, has_right = p[a] < n - 1;
+    double d;
+    if (!has_left) {
+      d = at(1) - s0;
+    } else if (!has_right) {
+      d = s0 - at(-1);
+    } else {
+      const double left = s0 - at(-1), right = at(1) - s0;
+      const double curve_left = p[a] > 1 ? std::abs(left - (at(-1) - at(-2))) : std::abs(right - left);
+      const double curve_right = p[a] < n - 2 ? std::abs((at(2) - at(1)) - right) : std::abs(right - left);
+      d = curve_left <= curve_right ? left : right;
+    }
+    g[static_cast<std::size_t>(a)] = d / h;
   }
   return g;
 }
@@ -108,53 +134,68 @@ std::uint32_t ChunkPart::add(const std::array<double, 3>& position, std::array<d
 }
 
 Mesh weld(std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sources) {
-  // Global numbers of owned vertices, chunk by chunk; the shared ones also by key.
-  std::vector<std::uint64_t> base(parts.size() + 1, 0);
+  // Global numbers of owned vertices, chunk by chunk (a prefix sum); the shared ones also by key.
+  const std::size_t chunks = parts.size();
+  std::vector<std::uint64_t> base(chunks + 1, 0), index_base(chunks + 1, 0);
   std::size_t shared_count = 0;
-  for (std::size_t c = 0; c < parts.size(); ++c) {
+  for (std::size_t c = 0; c < chunks; ++c) {
     std::uint64_t owned = 0;
     for (std::size_t i = 0; i < parts[c].owned.size(); ++i) {
       owned += parts[c].owned[i];
       shared_count += parts[c].shared[i];
     }
     base[c + 1] = base[c] + owned;
+    index_base[c + 1] = index_base[c] + parts[c].indices.size();
   }
   if (base.back() > std::numeric_limits<std::uint32_t>::max())
     throw InvalidArgument("mesh: " + std::to_string(base.back()) + " vertices do not fit 32-bit indices; mesh a smaller volume");
   std::unordered_map<std::uint64_t, std::uint32_t> by_key;
   by_key.reserve(shared_count);
-  Mesh mesh;
-  const std::size_t vertices = base.back();
-  mesh.positions.resize(vertices);
-  mesh.normals.resize(vertices);
-  if (sources) sources->resize(vertices);
-  std::vector<std::vector<std::uint32_t>> global(parts.size());
-  for (std::size_t c = 0; c < parts.size(); ++c) {
-    ChunkPart& p = parts[c];
-    global[c].resize(p.positions.size());
+  for (std::size_t c = 0; c < chunks; ++c) {
+    const ChunkPart& p = parts[c];
     std::uint64_t next = base[c];
     for (std::size_t i = 0; i < p.positions.size(); ++i) {
       if (!p.owned[i]) continue;
-      const auto g = static_cast<std::uint32_t>(next++);
-      global[c][i] = g;
-      mesh.positions[g] = p.positions[i];
-      mesh.normals[g] = p.normals[i];
-      if (sources) (*sources)[g] = p.sources[i];
-      if (p.shared[i]) by_key.emplace(p.keys[i], g);
+      if (p.shared[i]) by_key.emplace(p.keys[i], static_cast<std::uint32_t>(next));
+      ++next;
     }
   }
-  std::size_t index_count = 0;
-  for (const ChunkPart& p : parts) index_count += p.indices.size();
-  mesh.indices.reserve(index_count);
-  for (std::size_t c = 0; c < parts.size(); ++c) {
-    ChunkPart& p = parts[c];
+  Mesh mesh;
+  mesh.positions.resize(base.back());
+  mesh.normals.resize(base.back());
+  if (sources) sources->resize(base.back());
+  constexpr std::uint32_t kUnresolved = std::numeric_limits<std::uint32_t>::max();
+  // Each chunk's numbering to the global one: owned vertices copied out, borrowed ones found by
+  // key, chunks in parallel (the map is only read).
+  std::vector<std::vector<std::uint32_t>> global(chunks);
+  parallel_for(chunks, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) {
+      const ChunkPart& p = parts[c];
+      global[c].resize(p.positions.size());
+      std::uint64_t next = base[c];
+      for (std::size_t i = 0; i < p.positions.size(); ++i) {
+        if (p.owned[i]) {
+          const auto g = static_cast<std::uint32_t>(next++);
+          global[c][i] = g;
+          mesh.positions[g] = p.positions[i];
+          mesh.normals[g] = p.normals[i];
+          if (sources) (*sources)[g] = p.sources[i];
+        } else {
+          const auto it = by_key.find(p.keys[i]);
+          global[c][i] = it == by_key.end() ? kUnresolved : it->second;
+        }
+      }
+    }
+  });
+  // A vertex its owner never used (surface nets: a cell only a neighbour's quads reach) is taken
+  // from the first chunk that uses it; every chunk computes it bit for bit the same.
+  for (std::size_t c = 0; c < chunks; ++c) {
+    const ChunkPart& p = parts[c];
     for (std::size_t i = 0; i < p.positions.size(); ++i) {
-      if (p.owned[i]) continue;
-      // A vertex its owner never used (surface nets: a cell only a neighbour's quads reach) is
-      // taken from the first chunk that uses it; every chunk computes it bit for bit the same.
+      if (global[c][i] != kUnresolved) continue;
       const auto [it, orphan] = by_key.emplace(p.keys[i], static_cast<std::uint32_t>(mesh.positions.size()));
       if (orphan) {
-        if (mesh.positions.size() == std::numeric_limits<std::uint32_t>::max())
+        if (mesh.positions.size() >= kUnresolved)
           throw InvalidArgument("mesh: the vertices do not fit 32-bit indices; mesh a smaller volume");
         mesh.positions.push_back(p.positions[i]);
         mesh.normals.push_back(p.normals[i]);
@@ -162,9 +203,15 @@ Mesh weld(std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sources) {
       }
       global[c][i] = it->second;
     }
-    for (const std::uint32_t local : p.indices) mesh.indices.push_back(global[c][local]);
-    p.clear();
   }
+  mesh.indices.resize(index_base.back());
+  parallel_for(chunks, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) {
+      std::uint32_t* out = mesh.indices.data() + index_base[c];
+      for (const std::uint32_t local : parts[c].indices) *out++ = global[c][local];
+      parts[c].clear();
+    }
+  });
   return mesh;
 }
 

@@ -28,6 +28,10 @@ struct Lattice {
   std::array<double, 3> origin{}, spacing{};
   double iso = 0;
   double sign = 1;
+  // A voxel world's field: the surface is the union of the voxels' cubes, so every crossing lies
+  // on the face between two voxel centres and its exact normal is its edge's axis (dual
+  // contouring then rebuilds the cubes' edges and corners exactly).
+  bool voxel_faces = false;
   std::size_t index(int x, int y, int z) const {
     return static_cast<std::size_t>(x) + static_cast<std::size_t>(n.x) * (static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * static_cast<std::size_t>(z));
   }
@@ -46,28 +50,38 @@ struct ChunkGrid {
   int owner(int axis, int v) const;
 };
 
-// A chunk's samples as s values, from one sample before its cells to two past them (clamped to
-// the lattice): the cells' corners plus the neighbours central differences read.
+// A chunk's view of the samples, from one sample before its cells to two past them (clamped to
+// the lattice): the cells' corners plus the neighbours central differences read. Loading scans the
+// rows once for their signs (and NaN); samples are then read in place.
 class Block {
  public:
   // Loads the block for `cells`; false when no sample changes sign (the chunk has no surface).
   // Throws InvalidArgument for a NaN sample.
   bool load(const Lattice& lattice, const Box3i& cells);
-  float s(int x, int y, int z) const {
-    return s_[static_cast<std::size_t>(x - lo_.x) + dx_ * (static_cast<std::size_t>(y - lo_.y) + dy_ * static_cast<std::size_t>(z - lo_.z))];
+  // The value with the inside convention folded in (negative inside).
+  float s_of(float value) const { return negate_ ? iso_ - value : value - iso_; }
+  bool inside(float value) const { return negate_ ? value > iso_ : value < iso_; }
+  float s(int x, int y, int z) const { return s_of(lattice_->values[lattice_->index(x, y, z)]); }
+  // The raw samples of row (y, z) from x on (x fastest).
+  const float* row(int x, int y, int z) const { return lattice_->values + lattice_->index(x, y, z); }
+  // Which signs row (y, z) holds over the block: bit 0 some sample inside, bit 1 some outside.
+  std::uint8_t row_signs(int y, int z) const {
+    return signs_[static_cast<std::size_t>(y - lo_.y) + dy_ * static_cast<std::size_t>(z - lo_.z)];
   }
-  // The samples of row (y, z) from x on (x fastest), for walking a row without index arithmetic.
-  const float* row(int x, int y, int z) const { return &s_[static_cast<std::size_t>(x - lo_.x) + dx_ * (static_cast<std::size_t>(y - lo_.y) + dy_ * static_cast<std::size_t>(z - lo_.z))]; }
-  // Which signs row (y, z) holds: bit 0 some sample inside, bit 1 some outside.
-  std::uint8_t row_signs(int y, int z) const { return signs_[static_cast<std::size_t>(y - lo_.y) + dy_ * static_cast<std::size_t>(z - lo_.z)]; }
   // Gradient of s at a sample (central differences; one-sided on the lattice's faces), per unit.
   std::array<double, 3> gradient(int x, int y, int z) const;
+  // Gradient for Hermite data: per axis the one-sided difference from the smoother side (the side
+  // whose second difference is smaller: essentially non-oscillatory, Harten & Osher 1987), so that
+  // near a crease the estimate stays on one face instead of averaging across it. Reads up to two
+  // samples away (clamped to the lattice).
+  std::array<double, 3> one_sided_gradient(int x, int y, int z) const;
 
  private:
   const Lattice* lattice_ = nullptr;
+  float iso_ = 0;
+  bool negate_ = false;
   Vec3i lo_, hi_;
-  std::size_t dx_ = 0, dy_ = 0;
-  std::vector<float> s_;
+  std::size_t dy_ = 0;
   std::vector<std::uint8_t> signs_;
 };
 
@@ -96,7 +110,13 @@ inline std::array<double, 3> lattice_position(const Lattice& l, const std::array
 // The meshers: fill `part` with the triangles of `chunk`'s cells. `block` holds its samples.
 void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,
                           std::vector<std::int32_t>& scratch, ChunkPart& part);
-void surface_nets_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,
-                        std::vector<std::int32_t>& scratch, ChunkPart& part);
+// Where a dual mesher puts the vertex of a cell the surface crosses, in the cell's coordinates
+// ([0, 1]^3 from its lowest corner), from the cell's eight s values (corner c at (c & 1, c >> 1 & 1,
+// c >> 2 & 1)).
+using CellVertex = std::array<double, 3> (*)(const Block& block, const Lattice& lattice, Vec3i cell, const double* v);
+std::array<double, 3> surface_nets_vertex(const Block& block, const Lattice& lattice, Vec3i cell, const double* v);
+std::array<double, 3> dual_contouring_vertex(const Block& block, const Lattice& lattice, Vec3i cell, const double* v);
+void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,
+                     std::vector<std::int32_t>& scratch, ChunkPart& part, CellVertex place);
 
 }  // namespace voxfield::detail::mesh

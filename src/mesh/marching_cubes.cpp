@@ -87,8 +87,8 @@ void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i c
         continue;
       const float* r[4] = {block.row(b.x, y, z), block.row(b.x, y + 1, z), block.row(b.x, y, z + 1), block.row(b.x, y + 1, z + 1)};
       auto face = [&](int i) {
-        return static_cast<unsigned>(r[0][i] < 0) | static_cast<unsigned>(r[1][i] < 0) << 1 |
-               static_cast<unsigned>(r[2][i] < 0) << 2 | static_cast<unsigned>(r[3][i] < 0) << 3;
+        return static_cast<unsigned>(block.inside(r[0][i])) | static_cast<unsigned>(block.inside(r[1][i])) << 1 |
+               static_cast<unsigned>(block.inside(r[2][i])) << 2 | static_cast<unsigned>(block.inside(r[3][i])) << 3;
       };
       unsigned left = face(0);
       for (int x = cells.begin.x; x < cells.end.x; ++x) {
@@ -97,7 +97,7 @@ void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i c
         const unsigned inside = spread[left] | static_cast<unsigned>(spread[right]) << 1;
         left = right;
         if (inside == 0 || inside == 255) continue;
-        for (int c = 0; c < 8; ++c) v[c] = r[c >> 1][i + (c & 1)];
+        for (int c = 0; c < 8; ++c) v[c] = block.s_of(r[c >> 1][i + (c & 1)]);
         unsigned joined = 0;
         const unsigned ambiguous = table.ambiguous_faces(inside);
         for (int face = 0, bit = 0; face < 6; ++face)

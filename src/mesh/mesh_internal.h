@@ -10,6 +10,8 @@ namespace voxfield::detail::mesh {
 
 // mesh_volume(), also giving each vertex's source sample (the inside sample it was made from,
 // as an index x fastest) when `sources` is not null.
-Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::vector<std::uint64_t>* sources);
+// `voxel_faces`: the volume is a voxel world's signed field (see Lattice::voxel_faces).
+Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::vector<std::uint64_t>* sources,
+                  bool voxel_faces = false);
 
 }  // namespace voxfield::detail::mesh

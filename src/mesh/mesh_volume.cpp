@@ -12,17 +12,26 @@
 
 namespace voxfield {
 
-const char* mesher_name(Mesher m) { return m == Mesher::kMarchingCubes ? "mc" : "sn"; }
+const char* mesher_name(Mesher m) {
+  switch (m) {
+    case Mesher::kMarchingCubes: return "mc";
+    case Mesher::kSurfaceNets: return "sn";
+    case Mesher::kDualContouring: return "dc";
+  }
+  return "?";
+}
 
 Mesher parse_mesher(const std::string& name) {
   if (name == "mc" || name == "marching-cubes") return Mesher::kMarchingCubes;
   if (name == "sn" || name == "surface-nets") return Mesher::kSurfaceNets;
-  throw InvalidArgument("unknown mesher '" + name + "' (expected mc or sn)");
+  if (name == "dc" || name == "dual-contouring") return Mesher::kDualContouring;
+  throw InvalidArgument("unknown mesher '" + name + "' (expected mc, sn or dc)");
 }
 
 namespace detail::mesh {
 
-Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::vector<std::uint64_t>* sources) {
+Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::vector<std::uint64_t>* sources,
+                  bool voxel_faces) {
   if (!volume.values) throw InvalidArgument("mesh: the volume has no samples");
   for (int a = 0; a < 3; ++a) {
     if (volume.size[a] < 2)
@@ -44,10 +53,12 @@ Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::v
   lattice.spacing = volume.spacing_units;
   lattice.iso = options.iso;
   lattice.sign = options.inside_above ? -1 : 1;
+  lattice.voxel_faces = voxel_faces;
   const ChunkGrid grid(volume.size, options.chunk_edge);
   std::vector<ChunkPart> parts(static_cast<std::size_t>(grid.total()));
   Progress progress(options.interrupter,
-                    options.algorithm == Mesher::kMarchingCubes ? "marching cubes" : "surface nets", grid.total());
+                    options.algorithm == Mesher::kMarchingCubes ? "marching cubes"
+                    : options.algorithm == Mesher::kSurfaceNets ? "surface nets" : "dual contouring", grid.total());
   parallel_for(parts.size(), 1, [&](std::size_t begin, std::size_t end) {
     Block block;
     std::vector<std::int32_t> scratch;
@@ -58,7 +69,8 @@ Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::v
         if (options.algorithm == Mesher::kMarchingCubes)
           marching_cubes_chunk(lattice, grid, chunk, block, scratch, parts[i]);
         else
-          surface_nets_chunk(lattice, grid, chunk, block, scratch, parts[i]);
+          dual_grid_chunk(lattice, grid, chunk, block, scratch, parts[i],
+                          options.algorithm == Mesher::kSurfaceNets ? surface_nets_vertex : dual_contouring_vertex);
       }
       progress.advance();
     }

@@ -47,7 +47,7 @@ Mesh mesh_world(const World& world, const MeshOptions& options) {
   o.iso = 0;
   o.inside_above = false;
   std::vector<std::uint64_t> sources;
-  Mesh mesh = detail::mesh::mesh_lattice(volume, o, &sources);
+  Mesh mesh = detail::mesh::mesh_lattice(volume, o, &sources, /*voxel_faces=*/true);
   mesh.colors.resize(mesh.positions.size());
   const std::uint64_t nx = static_cast<std::uint64_t>(size.x), nxy = nx * static_cast<std::uint64_t>(size.y);
   for (std::size_t i = 0; i < sources.size(); ++i) {

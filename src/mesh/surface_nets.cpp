@@ -1,113 +1,26 @@
-// voxfield — surface nets on one chunk of cells.
+// voxfield — surface nets' vertex placement.
 //
 // S. F. F. Gibson, "Constrained Elastic Surface Nets: Generating Smooth Surfaces from Binary
-// Segmented Data", MICCAI 1998, in its naive form (no relaxation): every cell the surface crosses
-// gets one vertex, the mean of the crossings on its edges, and every lattice edge the surface
-// crosses joins the four cells around it into a quad, split into two triangles along its shorter
-// diagonal. Normals are the gradient of the cell's trilinear interpolant at the vertex.
-//
-// A chunk emits the quads of the edges starting in its own cells; the cells around them reach one
-// cell before the chunk, whose vertices the chunk computes (identically to their owner, for the
-// diagonal test) and the weld replaces with the owner's.
-#include <cstdint>
-#include <vector>
-
+// Segmented Data", MICCAI 1998, in its naive form (no relaxation): the vertex of a cell the
+// surface crosses is the mean of the crossings on its edges (linear interpolation of the samples).
+// The quads around it come from the dual grid (dual_grid.cpp).
 #include "chunked_mesh.h"
 #include "cube_cases.h"
 
 namespace voxfield::detail::mesh {
 
-void surface_nets_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,
-                        std::vector<std::int32_t>& scratch, ChunkPart& part) {
-  const Box3i cells = grid.cells_of(chunk);
-  Vec3i lo;  // cells with a vertex slot: one before the chunk where the lattice has it
-  for (int a = 0; a < 3; ++a) lo[a] = std::max(cells.begin[a] - 1, 0);
-  const std::size_t ex = static_cast<std::size_t>(cells.end.x - lo.x), ey = static_cast<std::size_t>(cells.end.y - lo.y);
-  scratch.assign(ex * ey * static_cast<std::size_t>(cells.end.z - lo.z), -1);
-  const auto& edges = cube_edges();
-
-  auto vertex = [&](Vec3i q) -> std::uint32_t {
-    std::int32_t& slot = scratch[static_cast<std::size_t>(q.x - lo.x) + ex * (static_cast<std::size_t>(q.y - lo.y) + ey * static_cast<std::size_t>(q.z - lo.z))];
-    if (slot >= 0) return static_cast<std::uint32_t>(slot);
-    double v[8];
-    for (int c = 0; c < 8; ++c) v[c] = block.s(q.x + (c & 1), q.y + (c >> 1 & 1), q.z + (c >> 2 & 1));
-    std::array<double, 3> mean{0, 0, 0};
-    int crossings = 0;
-    for (const CubeEdge& e : edges) {
-      const double s0 = v[e.from], s1 = v[e.to];
-      if ((s0 < 0) == (s1 < 0)) continue;
-      const double t = s0 / (s0 - s1);
-      for (int a = 0; a < 3; ++a) mean[static_cast<std::size_t>(a)] += a == e.axis ? t : (e.from >> a & 1);
-      ++crossings;
-    }
-    for (double& m : mean) m /= crossings;  // the cell has a crossing: a quad reached it
-    const double u = mean[0], w1 = mean[1], w2 = mean[2];
-    // Gradient of the trilinear interpolant: along each axis, the corner differences blended by
-    // the other two local coordinates.
-    auto blend = [](double d00, double d10, double d01, double d11, double s, double t) {
-      return (1 - s) * (1 - t) * d00 + s * (1 - t) * d10 + (1 - s) * t * d01 + s * t * d11;
-    };
-    std::array<double, 3> normal{
-        blend(v[1] - v[0], v[3] - v[2], v[5] - v[4], v[7] - v[6], w1, w2) / lattice.spacing[0],
-        blend(v[2] - v[0], v[3] - v[1], v[6] - v[4], v[7] - v[5], u, w2) / lattice.spacing[1],
-        blend(v[4] - v[0], v[5] - v[1], v[6] - v[2], v[7] - v[3], u, w1) / lattice.spacing[2]};
-    // The colour source: the inside corner nearest the vertex (the lowest-numbered on a tie).
-    int nearest = -1;
-    double best = 1e9;
-    for (int c = 0; c < 8; ++c) {
-      if (!(v[c] < 0)) continue;
-      const double dx = (c & 1) - u, dy = (c >> 1 & 1) - w1, dz = (c >> 2 & 1) - w2;
-      const double d = dx * dx + dy * dy + dz * dz;
-      if (d < best) best = d, nearest = c;
-    }
-    bool owned = true, shared = false;
-    for (int a = 0; a < 3; ++a) {
-      owned &= grid.owner(a, q[a]) == chunk[a];
-      if (q[a] == cells.end[a] - 1 && cells.end[a] < grid.cells[a]) shared = true;
-    }
-    const std::uint64_t source = lattice.index(q.x + (nearest & 1), q.y + (nearest >> 1 & 1), q.z + (nearest >> 2 & 1));
-    const std::array<double, 3> at{q.x + u, q.y + w1, q.z + w2};
-    const std::uint32_t id = part.add(lattice_position(lattice, at), normal, lattice.index(q.x, q.y, q.z), source, owned,
-                                      owned && shared);
-    slot = static_cast<std::int32_t>(id);
-    return id;
-  };
-  auto distance2 = [&](std::uint32_t i, std::uint32_t j) {
-    double d = 0;
-    for (int a = 0; a < 3; ++a) {
-      const double c = static_cast<double>(part.positions[i][static_cast<std::size_t>(a)]) - part.positions[j][static_cast<std::size_t>(a)];
-      d += c * c;
-    }
-    return d;
-  };
-
-  for (int z = cells.begin.z; z < cells.end.z; ++z)
-    for (int y = cells.begin.y; y < cells.end.y; ++y)
-      for (int x = cells.begin.x; x < cells.end.x; ++x) {
-        const Vec3i p{x, y, z};
-        const bool in0 = block.s(x, y, z) < 0;
-        for (int a = 0; a < 3; ++a) {
-          const int b = (a + 1) % 3, c = (a + 2) % 3;  // e_b x e_c = e_a
-          if (p[b] == 0 || p[c] == 0) continue;        // the quad would leave the lattice
-          Vec3i q = p;
-          ++q[a];
-          if (in0 == (block.s(q.x, q.y, q.z) < 0)) continue;
-          Vec3i pb = p, pc = p, pbc = p;
-          --pb[b];
-          --pc[c];
-          --pbc[b];
-          --pbc[c];
-          // Counter-clockwise seen from +a: (0,0), (1,0), (1,1), (0,1) in (b, c) offsets.
-          const std::uint32_t v00 = vertex(pbc), v10 = vertex(pc), v11 = vertex(p), v01 = vertex(pb);
-          std::array<std::uint32_t, 6> t;
-          if (distance2(v00, v11) <= distance2(v10, v01))
-            t = {v00, v10, v11, v00, v11, v01};
-          else
-            t = {v00, v10, v01, v10, v11, v01};
-          if (!in0) std::swap(t[1], t[2]), std::swap(t[4], t[5]);  // the outside is towards -a
-          part.indices.insert(part.indices.end(), t.begin(), t.end());
-        }
-      }
+std::array<double, 3> surface_nets_vertex(const Block&, const Lattice&, Vec3i, const double* v) {
+  std::array<double, 3> mean{0, 0, 0};
+  int crossings = 0;
+  for (const CubeEdge& e : cube_edges()) {
+    const double s0 = v[e.from], s1 = v[e.to];
+    if ((s0 < 0) == (s1 < 0)) continue;
+    const double t = s0 / (s0 - s1);
+    for (int a = 0; a < 3; ++a) mean[static_cast<std::size_t>(a)] += a == e.axis ? t : (e.from >> a & 1);
+    ++crossings;
+  }
+  for (double& m : mean) m /= crossings;  // the cell has a crossing: a quad reached it
+  return mean;
 }
 
 }  // namespace voxfield::detail::mesh

@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# Reproduces the meshing figures in docs/benchmarks.md: marching cubes and surface nets of
+# voxfield on the terrain's signed Euclidean field (256³ and 512³) and on a scan-sized smooth float
+# volume, beside scikit-image's marching_cubes (one thread) and VTK's vtkFlyingEdges3D (all
+# threads) on the same arrays in the same run. Results go to bench/results/mesh-DATE/table.md.
+# Usage: bash bench/run_mesh_bench.sh [RUNS] [SIZES]   (default 3 runs, sizes "256 512")
+set -euo pipefail
+cd "$(dirname "$0")/.."
+runs=${1:-3}
+sizes=${2:-"256 512"}
+source bench/common.sh
+bench_prepare --peers
+bin=build/release/bin
+bench_results mesh >/dev/null
+mkdir -p "$out/inputs"
+inputs=()
+for n in $sizes; do
+  "$bin/voxfield" generate terrain --size "$n" -o "$out/inputs/terrain-$n.npy" 2>/dev/null
+  "$bin/voxfield" field "$out/inputs/terrain-$n.npy" -o "$out/inputs/terrain-sdf-$n.npy" --metric euclidean --signed 2>/dev/null
+  inputs+=("$out/inputs/terrain-sdf-$n.npy")
+done
+# A scan-sized volume: smooth noise (Gaussian-filtered white noise), 384 x 384 x 256 like a CT stack.
+/usr/bin/python3 - "$out/inputs/scan.npy" <<'PY'
+import sys
+import numpy as np
+from scipy.ndimage import gaussian_filter
+rng = np.random.default_rng(7)
+v = gaussian_filter(rng.standard_normal((384, 384, 256)).astype(np.float32), 3)
+np.save(sys.argv[1], (v / v.std()).astype(np.float32))
+PY
+inputs+=("$out/inputs/scan.npy")
+cat "$out/machine.txt"
+{
+  echo "| volume | library | threads | best ms of $runs | triangles | Mcells/s |"
+  echo "|---|---|---|---|---|---|"
+} > "$out/table.md"
+for f in "${inputs[@]}"; do
+  name=$(basename "$f" .npy)
+  cells=$(/usr/bin/python3 -c "import numpy as np,sys; s=np.load(sys.argv[1], mmap_mode='r').shape; print((s[0]-1)*(s[1]-1)*(s[2]-1))" "$f")
+  for algo in mc sn; do
+    for threads in 1 2; do
+      best=""
+      for r in $(seq "$runs"); do
+        "$bin/voxfield" mesh "$f" -o "$out/m.stl" --algorithm "$algo" --threads "$threads" --stats "$out/s.json" 2>/dev/null
+        ms=$(/usr/bin/python3 -c "import json; print(json.load(open('$out/s.json'))['ms'])")
+        best=$(/usr/bin/python3 -c "print(min(float(x) for x in '$best $ms'.split()))")
+      done
+      tris=$(/usr/bin/python3 -c "import json; print(json.load(open('$out/s.json'))['triangles'])")
+      echo "| $name | voxfield $algo | $threads | $(printf %.0f "$best") | $tris | $(/usr/bin/python3 -c "print(round($cells/($best*1e3)))") |" >> "$out/table.md"
+    done
+  done
+  /usr/bin/python3 bench/peers/mesh_peers.py "$f" 0 --runs "$runs" --json "$out/peers.json"
+  /usr/bin/python3 - "$out/peers.json" "$name" "$cells" >> "$out/table.md" <<'PY'
+import json, sys
+d, name, cells = json.load(open(sys.argv[1])), sys.argv[2], int(sys.argv[3])
+for peer in ["scikit-image", "vtk-flying-edges"]:
+    p = d.get(peer)
+    if p:
+        print(f"| {name} | {peer} {p['version']} | {p['threads']} | {p['ms']:.0f} | {p['triangles']} | {cells / (p['ms'] * 1e3):.0f} |")
+PY
+done
+rm -rf "$out/inputs" "$out/m.stl" "$out/s.json" "$out/peers.json"
+cat "$out/table.md"
+echo "results in $out"
