@@ -69,36 +69,45 @@ class TruncatedMinConvolution {
   // Both passes. Afterwards out_row(j) holds the squared distances (kInf when beyond the clamp) of
   // the window's row j, columns 0..mx-1.
   void solve() {
-    const int lo = ox_ - reach_, hi = ox_ + mw_ + reach_;  // columns of f the window's results read
+    // Members are read once into locals: the stores to live_ are through unsigned char, which may
+    // alias anything, so otherwise every member would be reloaded after each of them.
+    const int reach = reach_, mw = mw_, ox = ox_, oy = oy_, ny = ny_, my = my_;
+    const Cost drop = drop_;
+    const std::size_t row_h = static_cast<std::size_t>(mw), row_f = static_cast<std::size_t>(stride_);
+    const Cost* const f_all = f_.data() + reach;
+    Cost* const h_all = h_.data();
+    Cost* const out_all = out_.data();
+    std::uint8_t* const live = live_.data();
+    const int lo = ox - reach, hi = ox + mw + reach;  // columns of f the window's results read
     // Pass along x, on the window's columns only, for every row with a site in reach of it.
-    for (int y = 0; y < ny_; ++y) {
-      const Cost* __restrict f = f_row(y);
+    for (int y = 0; y < ny; ++y) {
+      const Cost* __restrict f = f_all + static_cast<std::size_t>(y) * row_f;
       Cost m = kInf;
       for (int x = lo; x < hi; ++x) m = std::min(m, f[x]);
-      live_[static_cast<std::size_t>(y)] = m < kInf;
+      live[y] = m < kInf;
       if (m >= kInf) continue;
-      Cost* __restrict h = h_.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(mw_);
-      std::fill(h, h + mw_, kInf);
-      for (int k = -reach_; k <= reach_; ++k) {
+      Cost* __restrict h = h_all + static_cast<std::size_t>(y) * row_h;
+      std::fill(h, h + mw, kInf);
+      for (int k = -reach; k <= reach; ++k) {
         const Cost w = static_cast<Cost>(k * k);
-        const Cost* __restrict src = f + ox_ + k;
-        for (int j = 0; j < mw_; ++j) h[j] = std::min(h[j], static_cast<Cost>(src[j] + w));
+        const Cost* __restrict src = f + ox + k;
+        for (int j = 0; j < mw; ++j) h[j] = std::min(h[j], static_cast<Cost>(src[j] + w));
       }
       // A cost above the clamp cannot come back within it: one less term for the next pass.
-      for (int j = 0; j < mw_; ++j) h[j] = h[j] > drop_ ? kInf : h[j];
+      for (int j = 0; j < mw; ++j) h[j] = h[j] > drop ? kInf : h[j];
     }
     // Pass along y, whole rows at a time, for the window's rows.
-    for (int j = 0; j < my_; ++j) {
-      const int y = oy_ + j;
-      Cost* __restrict d = out_.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(mw_);
-      std::fill(d, d + mw_, kInf);
-      for (int k = std::max(-reach_, -y); k <= std::min(reach_, ny_ - 1 - y); ++k) {
-        if (!live_[static_cast<std::size_t>(y + k)]) continue;
+    for (int j = 0; j < my; ++j) {
+      const int y = oy + j;
+      Cost* __restrict d = out_all + static_cast<std::size_t>(j) * row_h;
+      std::fill(d, d + mw, kInf);
+      for (int k = std::max(-reach, -y); k <= std::min(reach, ny - 1 - y); ++k) {
+        if (!live[y + k]) continue;
         const Cost w = static_cast<Cost>(k * k);
-        const Cost* __restrict src = h_.data() + static_cast<std::size_t>(y + k) * static_cast<std::size_t>(mw_);
-        for (int i = 0; i < mw_; ++i) d[i] = std::min(d[i], static_cast<Cost>(src[i] + w));
+        const Cost* __restrict src = h_all + static_cast<std::size_t>(y + k) * row_h;
+        for (int i = 0; i < mw; ++i) d[i] = std::min(d[i], static_cast<Cost>(src[i] + w));
       }
-      for (int i = 0; i < mw_; ++i) d[i] = d[i] > drop_ ? kInf : d[i];
+      for (int i = 0; i < mw; ++i) d[i] = d[i] > drop ? kInf : d[i];
     }
   }
 
