@@ -133,7 +133,7 @@ std::uint32_t ChunkPart::add(const std::array<double, 3>& position, std::array<d
   return static_cast<std::uint32_t>(positions.size() - 1);
 }
 
-Mesh weld(std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sources) {
+Mesh weld(const std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sources) {
   // Global numbers of owned vertices, chunk by chunk (a prefix sum); the shared ones also by key.
   const std::size_t chunks = parts.size();
   std::vector<std::uint64_t> base(chunks + 1, 0), index_base(chunks + 1, 0);
@@ -209,7 +209,6 @@ Mesh weld(std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sources) {
     for (std::size_t c = begin; c < end; ++c) {
       std::uint32_t* out = mesh.indices.data() + index_base[c];
       for (const std::uint32_t local : parts[c].indices) *out++ = global[c][local];
-      parts[c].clear();
     }
   });
   return mesh;

@@ -100,7 +100,7 @@ struct ChunkPart {
 
 // Joins the chunks' parts (in chunk order) into one mesh; `sources`, when given, receives each
 // vertex's source sample. Throws InvalidArgument when the mesh needs more than 2^32 - 1 vertices.
-Mesh weld(std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sources);
+Mesh weld(const std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sources);
 
 // Position of lattice point p + t along `axis` (t in [0, 1]) in the volume's frame.
 inline std::array<double, 3> lattice_position(const Lattice& l, const std::array<double, 3>& p) {

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "chunked_mesh.h"
 #include "voxfield/mesh.h"
 
 namespace voxfield::detail::mesh {
@@ -13,5 +14,13 @@ namespace voxfield::detail::mesh {
 // `voxel_faces`: the volume is a voxel world's signed field (see Lattice::voxel_faces).
 Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::vector<std::uint64_t>* sources,
                   bool voxel_faces = false);
+
+// The lattice of a request, after checking it (InvalidArgument for a bad volume or options).
+Lattice checked_lattice(const ScalarVolume& volume, const MeshOptions& options, bool voxel_faces);
+
+// Meshes the chunks numbered `chunks` (ChunkGrid::coord order) into parts[i], in parallel, with
+// progress and cancellation through options.interrupter.
+void mesh_chunks(const Lattice& lattice, const ChunkGrid& grid, const MeshOptions& options,
+                 const std::vector<std::int64_t>& chunks, std::vector<ChunkPart>& parts);
 
 }  // namespace voxfield::detail::mesh

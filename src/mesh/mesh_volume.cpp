@@ -30,8 +30,7 @@ Mesher parse_mesher(const std::string& name) {
 
 namespace detail::mesh {
 
-Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::vector<std::uint64_t>* sources,
-                  bool voxel_faces) {
+Lattice checked_lattice(const ScalarVolume& volume, const MeshOptions& options, bool voxel_faces) {
   if (!volume.values) throw InvalidArgument("mesh: the volume has no samples");
   for (int a = 0; a < 3; ++a) {
     if (volume.size[a] < 2)
@@ -45,7 +44,6 @@ Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::v
   if (!std::isfinite(options.iso)) throw InvalidArgument("mesh: iso must be finite");
   if (options.chunk_edge < 2 || options.chunk_edge > 1024)
     throw InvalidArgument("mesh: chunk edge " + std::to_string(options.chunk_edge) + " is outside 2..1024");
-
   Lattice lattice;
   lattice.n = volume.size;
   lattice.values = volume.values;
@@ -54,28 +52,44 @@ Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::v
   lattice.iso = options.iso;
   lattice.sign = options.inside_above ? -1 : 1;
   lattice.voxel_faces = voxel_faces;
-  const ChunkGrid grid(volume.size, options.chunk_edge);
-  std::vector<ChunkPart> parts(static_cast<std::size_t>(grid.total()));
+  return lattice;
+}
+
+void mesh_chunks(const Lattice& lattice, const ChunkGrid& grid, const MeshOptions& options,
+                 const std::vector<std::int64_t>& chunks, std::vector<ChunkPart>& parts) {
   Progress progress(options.interrupter,
                     options.algorithm == Mesher::kMarchingCubes ? "marching cubes"
-                    : options.algorithm == Mesher::kSurfaceNets ? "surface nets" : "dual contouring", grid.total());
-  parallel_for(parts.size(), 1, [&](std::size_t begin, std::size_t end) {
+                    : options.algorithm == Mesher::kSurfaceNets ? "surface nets" : "dual contouring",
+                    static_cast<std::int64_t>(chunks.size()));
+  parallel_for(chunks.size(), 1, [&](std::size_t begin, std::size_t end) {
     Block block;
     std::vector<std::int32_t> scratch;
     for (std::size_t i = begin; i < end; ++i) {
       if (!progress.keep_going()) return;
-      const Vec3i chunk = grid.coord(static_cast<std::int64_t>(i));
+      const Vec3i chunk = grid.coord(chunks[i]);
+      ChunkPart& part = parts[i];
+      part.clear();
       if (block.load(lattice, grid.cells_of(chunk))) {
         if (options.algorithm == Mesher::kMarchingCubes)
-          marching_cubes_chunk(lattice, grid, chunk, block, scratch, parts[i]);
+          marching_cubes_chunk(lattice, grid, chunk, block, scratch, part);
         else
-          dual_grid_chunk(lattice, grid, chunk, block, scratch, parts[i],
+          dual_grid_chunk(lattice, grid, chunk, block, scratch, part,
                           options.algorithm == Mesher::kSurfaceNets ? surface_nets_vertex : dual_contouring_vertex);
       }
       progress.advance();
     }
   });
   progress.throw_if_cancelled();
+}
+
+Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::vector<std::uint64_t>* sources,
+                  bool voxel_faces) {
+  const Lattice lattice = checked_lattice(volume, options, voxel_faces);
+  const ChunkGrid grid(volume.size, options.chunk_edge);
+  std::vector<std::int64_t> all(static_cast<std::size_t>(grid.total()));
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::int64_t>(i);
+  std::vector<ChunkPart> parts(all.size());
+  mesh_chunks(lattice, grid, options, all, parts);
   return weld(parts, sources);
 }
 

@@ -1,0 +1,93 @@
+// voxfield — MeshChunks: the per-chunk parts of the chunked driver (chunked_mesh.h), kept between
+// edits. Which chunks an edit reaches follows from what a chunk reads: its cells' corners, one
+// cell before it (the dual meshers' apron) and the gradient stencils around them — samples from
+// three before its first cell to two past its last corner (dual contouring's one-sided
+// differences reach two samples out).
+#include "voxfield/mesh_chunks.h"
+
+#include <string>
+
+#include "mesh_internal.h"
+#include "voxfield/error.h"
+
+namespace voxfield {
+
+struct MeshChunks::Impl {
+  MeshOptions options;
+  ScalarVolume frame;  // size, origin and spacing the chunks were meshed with
+  detail::mesh::ChunkGrid grid{{2, 2, 2}, 2};
+  std::vector<detail::mesh::ChunkPart> parts;
+};
+
+MeshChunks::MeshChunks(const ScalarVolume& volume, const MeshOptions& options) : impl_(std::make_unique<Impl>()) {
+  using namespace detail::mesh;
+  const Lattice lattice = checked_lattice(volume, options, false);
+  impl_->options = options;
+  impl_->frame = volume;
+  impl_->grid = ChunkGrid(volume.size, options.chunk_edge);
+  std::vector<std::int64_t> all(static_cast<std::size_t>(impl_->grid.total()));
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::int64_t>(i);
+  impl_->parts.resize(all.size());
+  mesh_chunks(lattice, impl_->grid, options, all, impl_->parts);
+}
+
+MeshChunks::~MeshChunks() = default;
+MeshChunks::MeshChunks(MeshChunks&&) noexcept = default;
+MeshChunks& MeshChunks::operator=(MeshChunks&&) noexcept = default;
+
+std::vector<Vec3i> MeshChunks::update(const ScalarVolume& volume, const Box3i& changed) {
+  using namespace detail::mesh;
+  Impl& s = *impl_;
+  if (!(volume.size == s.frame.size) || volume.origin_units != s.frame.origin_units || volume.spacing_units != s.frame.spacing_units)
+    throw InvalidArgument("MeshChunks::update: the volume's size or frame changed; build a new MeshChunks");
+  const Lattice lattice = checked_lattice(volume, s.options, false);
+  const Box3i region = changed.intersect(Box3i::from_size(volume.size));
+  std::vector<std::int64_t> dirty;
+  std::vector<Vec3i> coords;
+  if (!region.empty()) {
+    // Chunk k along an axis reads samples [k * edge - 3, end + 2], end its last cell's upper corner.
+    Vec3i lo, hi;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(0, (region.begin[a] - 2) / s.grid.edge - 1);
+      hi[a] = std::min(s.grid.count[a] - 1, (region.end[a] - 1 + 3) / s.grid.edge);
+    }
+    for (int z = lo.z; z <= hi.z; ++z)
+      for (int y = lo.y; y <= hi.y; ++y)
+        for (int x = lo.x; x <= hi.x; ++x) {
+          const Box3i cells = s.grid.cells_of({x, y, z});
+          Box3i reads;
+          for (int a = 0; a < 3; ++a) {
+            reads.begin[a] = cells.begin[a] - 3;
+            reads.end[a] = cells.end[a] + 3;  // exclusive: corners up to end, stencils two past
+          }
+          if (reads.intersect(region).empty()) continue;
+          dirty.push_back(x + static_cast<std::int64_t>(s.grid.count.x) * (y + static_cast<std::int64_t>(s.grid.count.y) * z));
+          coords.push_back({x, y, z});
+        }
+  }
+  std::vector<ChunkPart> fresh(dirty.size());
+  mesh_chunks(lattice, s.grid, s.options, dirty, fresh);  // built aside: a throw changes nothing
+  for (std::size_t i = 0; i < dirty.size(); ++i) std::swap(s.parts[static_cast<std::size_t>(dirty[i])], fresh[i]);
+  return coords;
+}
+
+Vec3i MeshChunks::chunk_count() const { return impl_->grid.count; }
+
+Mesh MeshChunks::chunk_mesh(Vec3i c) const {
+  const Impl& s = *impl_;
+  for (int a = 0; a < 3; ++a)
+    if (c[a] < 0 || c[a] >= s.grid.count[a])
+      throw InvalidArgument("MeshChunks::chunk_mesh: chunk " + to_string(c) + " is outside the " + to_string(s.grid.count) +
+                            " chunks");
+  const auto& p = s.parts[static_cast<std::size_t>(c.x + static_cast<std::int64_t>(s.grid.count.x) *
+                                                         (c.y + static_cast<std::int64_t>(s.grid.count.y) * c.z))];
+  Mesh m;
+  m.positions = p.positions;
+  m.normals = p.normals;
+  m.indices = p.indices;
+  return m;
+}
+
+Mesh MeshChunks::merged() const { return detail::mesh::weld(impl_->parts, nullptr); }
+
+}  // namespace voxfield
