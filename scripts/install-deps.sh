@@ -15,6 +15,7 @@ packages=(
   xvfb xauth xdotool                 # a virtual display for the demo's tests (xvfb-run), input events
   nlohmann-json3-dev                 # JSON output of the CLI
   libcli11-dev                       # CLI parsing
+  libmeshoptimizer-dev               # mesh simplification and vertex-cache ordering (voxfield mesh --simplify)
   libgtest-dev                       # tests
   clang libclang-rt-14-dev           # the fuzz preset: libFuzzer with ASan + UBSan (CI's fuzz smoke)
   clang-format                       # the format check (scripts/check_format.sh, a test)

@@ -8,6 +8,7 @@
 #include "cli.h"
 #include "voxfield/mesh.h"
 #include "voxfield/mesh_files.h"
+#include "voxfield/mesh_optimize.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
 
@@ -19,6 +20,8 @@ struct MeshSettings {
   std::optional<double> iso;
   std::vector<double> spacing;
   int chunk = 32, threads = 0;
+  std::optional<double> simplify, simplify_error;
+  bool optimize = false;
 };
 
 bool is_float(DType t) { return t == DType::kFloat32 || t == DType::kFloat64; }
@@ -69,6 +72,19 @@ int run_mesh(const MeshSettings& s) {
     mesh = mesh_world(world, options);
     mesh_ms = ms_since(start);
   }
+  std::optional<SimplifyStats> simplified;
+  double simplify_ms = 0;
+  if (s.simplify || s.simplify_error) {
+    set_activity("simplifying the mesh of " + s.in);
+    SimplifyOptions so;
+    so.triangle_ratio = s.simplify.value_or(1.0);
+    so.max_error_units = s.simplify_error.value_or(0);
+    start = std::chrono::steady_clock::now();
+    simplified.emplace();
+    mesh = simplify_mesh(mesh, so, &*simplified);
+    simplify_ms = ms_since(start);
+  }
+  if (s.optimize) optimize_mesh(mesh);
   set_activity("writing " + s.out);
   start = std::chrono::steady_clock::now();
   outputs.stage(s.out, encode_mesh(mesh, format));
@@ -80,7 +96,12 @@ int run_mesh(const MeshSettings& s) {
     j["output"] = s.out;
     j["algorithm"] = mesher_name(options.algorithm);
     j["ms"] = mesh_ms;
-    j["phases_ms"] = {{"load", load_ms}, {"mesh", mesh_ms}, {"encode", write_ms}};
+    j["phases_ms"] = {{"load", load_ms}, {"mesh", mesh_ms}, {"simplify", simplify_ms}, {"encode", write_ms}};
+    if (simplified)
+      j["simplify"] = {{"triangles_before", simplified->triangles_before},
+                       {"triangles_after", simplified->triangles_after},
+                       {"error_units", simplified->error_units}};
+    j["optimized"] = s.optimize;
     j["threads"] = max_threads();
     j["chunk_edge"] = s.chunk;
     j["chunks"] = chunks;
@@ -119,6 +140,12 @@ void add_mesh(CLI::App& app, Action& action) {
       ->check(finite_positive());
   cmd->add_option("--chunk", s->chunk, "cells per chunk edge (2..1024, default 32)")->check(CLI::Range(2, 1024));
   cmd->add_option("--threads", s->threads, "threads (default: all)")->check(CLI::Range(1, 1024));
+  cmd->add_option("--simplify", s->simplify, "keep about this fraction of the triangles (0 < R <= 1; meshoptimizer)")
+      ->check(CLI::Range(1e-6, 1.0));
+  cmd->add_option("--simplify-error", s->simplify_error,
+                  "simplify no farther than this from the surface, in output units (default 1 % of the extent)")
+      ->check(finite_positive());
+  cmd->add_flag("--optimize", s->optimize, "reorder triangles and vertices for the GPU's vertex cache (meshoptimizer)");
   cmd->add_option("--stats", s->stats, "write counts, topology and timings as JSON");
   cmd->callback([s, &action] { action = [s] { return run_mesh(*s); }; });
 }
