@@ -22,7 +22,8 @@ Timing time_runs(int runs, Fn&& fn) {
   for (int r = 0; r < runs; ++r) {
     const auto t0 = std::chrono::steady_clock::now();
     fn();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   std::sort(ms.begin(), ms.end());
   return {ms[ms.size() / 2], ms.front(), ms.back()};
@@ -40,6 +41,8 @@ inline std::size_t proc_status_bytes(const char* name) {
 }
 
 // Resets the peak resident set size (VmHWM) to the current one (Linux "clear_refs" 5).
-inline void reset_peak_rss() { std::ofstream("/proc/self/clear_refs") << "5"; }
+inline void reset_peak_rss() {
+  std::ofstream("/proc/self/clear_refs") << "5";
+}
 
 }  // namespace voxfield::bench

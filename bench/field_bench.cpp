@@ -4,17 +4,17 @@
 // the threads used, and the memory the transform needed beyond its input and its output (peak
 // resident set during the run, minus the resident set before it, minus the output's own bytes).
 // Output: a table on stdout and, with --json, one record per line for bench/report.py.
-#include <CLI/CLI.hpp>
 #include <malloc.h>
+#include <CLI/CLI.hpp>
 
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "bench_util.h"
 #include "voxfield/distance.h"
+#include "voxfield/npy.h"
 #include "voxfield/parallel.h"
 #include "voxfield/scene.h"
-#include "voxfield/npy.h"
 #include "voxfield/vox.h"
 
 using namespace voxfield;
@@ -33,7 +33,8 @@ int main(int argc, char** argv) {
   app.add_option("--sizes", sizes)->delimiter(',');
   app.add_option("--metrics", metrics)->delimiter(',');
   app.add_option("--threads", threads)->delimiter(',');
-  app.add_option("--inputs", files, ".vox or .npy files to include (named by their stem)")->delimiter(',');
+  app.add_option("--inputs", files, ".vox or .npy files to include (named by their stem)")
+      ->delimiter(',');
   app.add_option("--storage", storage);
   app.add_option("--max-distance", clamp);
   app.add_option("--runs", runs)->check(CLI::Range(1, 1000));
@@ -60,8 +61,9 @@ int main(int argc, char** argv) {
       loaded = std::move(read_vox(f).world);
     }
     // Bound the world so that the domain is the file's volume (npy) or content box (vox).
-    const Box3i box = std::filesystem::path(f).extension() == ".npy" ? Box3i::from_size(read_npy(f).dims)
-                                                                      : loaded.voxels.content_bounds();
+    const Box3i box = std::filesystem::path(f).extension() == ".npy"
+                          ? Box3i::from_size(read_npy(f).dims)
+                          : loaded.voxels.content_bounds();
     World w(32, box);
     std::vector<std::uint8_t> dense(static_cast<std::size_t>(box.volume()));
     loaded.voxels.copy_to_dense(box, dense.data());
@@ -70,8 +72,8 @@ int main(int argc, char** argv) {
   }
   std::ofstream json;
   if (!json_path.empty()) json.open(json_path, std::ios::app);
-  std::printf("%-26s %-10s %4s %9s %9s %9s %10s %12s\n", "input", "metric", "thr", "median", "min", "max", "Mvox/s",
-              "extra B/vox");
+  std::printf("%-26s %-10s %4s %9s %9s %9s %10s %12s\n", "input", "metric", "thr", "median", "min",
+              "max", "Mvox/s", "extra B/vox");
   for (const auto& in : inputs) {
     const Box3i domain = *in.world.voxels.bounds();
     const double voxels = static_cast<double>(domain.volume());
@@ -82,23 +84,29 @@ int main(int argc, char** argv) {
         o.storage = parse_storage(storage);
         o.max_distance = clamp;
         ThreadLimit limit(t);
-        const bench::Timing tm = bench::time_runs(runs, [&] { (void)compute_distance_field(in.world, o); });
+        const bench::Timing tm =
+            bench::time_runs(runs, [&] { (void)compute_distance_field(in.world, o); });
         // Memory: one more run with the peak reset.
         malloc_trim(0);  // return freed pages, so that the baseline is what is really in use
         bench::reset_peak_rss();
         const std::size_t before = bench::proc_status_bytes("VmRSS");
         const DistanceField f = compute_distance_field(in.world, o);
         const std::size_t peak = bench::proc_status_bytes("VmHWM");
-        const std::size_t out_bytes = std::visit([](const auto& g) { return g.memory().bytes; }, f.values);
-        const double extra = (static_cast<double>(peak) - static_cast<double>(before) - static_cast<double>(out_bytes)) / voxels;
-        std::printf("%-26s %-10s %4d %9.1f %9.1f %9.1f %10.0f %12.3f\n", in.name.c_str(), m.c_str(), t, tm.median_ms,
-                    tm.min_ms, tm.max_ms, voxels / (tm.median_ms * 1e3), extra);
+        const std::size_t out_bytes =
+            std::visit([](const auto& g) { return g.memory().bytes; }, f.values);
+        const double extra = (static_cast<double>(peak) - static_cast<double>(before) -
+                              static_cast<double>(out_bytes)) /
+                             voxels;
+        std::printf("%-26s %-10s %4d %9.1f %9.1f %9.1f %10.0f %12.3f\n", in.name.c_str(), m.c_str(),
+                    t, tm.median_ms, tm.min_ms, tm.max_ms, voxels / (tm.median_ms * 1e3), extra);
         std::fflush(stdout);
         if (json) {
-          json << nlohmann::json{{"tool", "voxfield"}, {"input", in.name},     {"metric", m},
-                                 {"threads", t},       {"storage", storage},   {"max_distance", clamp},
-                                 {"voxels", voxels},   {"median_ms", tm.median_ms}, {"min_ms", tm.min_ms},
-                                 {"max_ms", tm.max_ms}, {"runs", runs},        {"extra_bytes_per_voxel", extra}}
+          json << nlohmann::json{{"tool", "voxfield"},  {"input", in.name},
+                                 {"metric", m},         {"threads", t},
+                                 {"storage", storage},  {"max_distance", clamp},
+                                 {"voxels", voxels},    {"median_ms", tm.median_ms},
+                                 {"min_ms", tm.min_ms}, {"max_ms", tm.max_ms},
+                                 {"runs", runs},        {"extra_bytes_per_voxel", extra}}
                       .dump()
                << "\n";
         }

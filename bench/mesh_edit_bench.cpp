@@ -2,8 +2,8 @@
 // signed Euclidean field (a float volume) takes a stream of seeded smooth sphere edits on its
 // surface — each blended in with a polynomial smooth minimum (add) or maximum (carve) of blend
 // radius 2 — and after each one MeshChunks re-meshes the chunks it reaches. Prints, per edit, the
-// time to write the field, to re-mesh, and both (mean / p50 / p99), and the chunks re-meshed; at the
-// end checks the kept mesh against meshing the edited volume from scratch.
+// time to write the field, to re-mesh, and both (mean / p50 / p99), and the chunks re-meshed; at
+// the end checks the kept mesh against meshing the edited volume from scratch.
 //
 // usage: voxfield-bench-mesh-edits [EDGE] [EDITS] [RADIUS] [CHUNK] [MESHER]   (512 200 8 32 mc)
 #include <algorithm>
@@ -37,8 +37,9 @@ void report(const char* what, std::vector<double> v) {
   std::sort(v.begin(), v.end());
   double sum = 0;
   for (double x : v) sum += x;
-  std::printf("%-28s mean %8.3f ms   p50 %8.3f ms   p99 %8.3f ms\n", what, sum / static_cast<double>(v.size()),
-              v[v.size() / 2], v[std::min(v.size() - 1, v.size() * 99 / 100)]);
+  std::printf("%-28s mean %8.3f ms   p50 %8.3f ms   p99 %8.3f ms\n", what,
+              sum / static_cast<double>(v.size()), v[v.size() / 2],
+              v[std::min(v.size() - 1, v.size() * 99 / 100)]);
 }
 
 }  // namespace
@@ -50,7 +51,9 @@ int main(int argc, char** argv) {
   const int chunk = argc > 4 ? std::atoi(argv[4]) : 32;
   const Mesher mesher = parse_mesher(argc > 5 ? argv[5] : "mc");
   if (n < 32 || edits < 1 || !(radius > 0) || chunk < 2) {
-    std::fprintf(stderr, "usage: voxfield-bench-mesh-edits [EDGE >= 32] [EDITS >= 1] [RADIUS > 0] [CHUNK >= 2] [mc|sn|dc]\n");
+    std::fprintf(stderr,
+                 "usage: voxfield-bench-mesh-edits [EDGE >= 32] [EDITS >= 1] [RADIUS > 0] [CHUNK "
+                 ">= 2] [mc|sn|dc]\n");
     return 2;
   }
   SceneOptions so;
@@ -70,12 +73,17 @@ int main(int argc, char** argv) {
   mo.chunk_edge = chunk;
   auto t0 = std::chrono::steady_clock::now();
   MeshChunks chunks(volume, mo);
-  std::printf("voxfield-bench-mesh-edits: terrain %d^3, %s, chunks of %d, first mesh %.0f ms, %d smooth spheres of radius %.1f\n",
-              n, mesher_name(mesher), chunk, ms_since(t0), edits, radius);
+  std::printf(
+      "voxfield-bench-mesh-edits: terrain %d^3, %s, chunks of %d, first mesh %.0f ms, %d smooth "
+      "spheres of radius %.1f\n",
+      n, mesher_name(mesher), chunk, ms_since(t0), edits, radius);
   // Surface heights, to put each edit on the terrain.
   auto surface = [&](int x, int y) {
     for (int z = n - 1; z > 0; --z)
-      if (values[static_cast<std::size_t>(x) + static_cast<std::size_t>(n) * (static_cast<std::size_t>(y) + static_cast<std::size_t>(n) * static_cast<std::size_t>(z))] < 0)
+      if (values[static_cast<std::size_t>(x) +
+                 static_cast<std::size_t>(n) *
+                     (static_cast<std::size_t>(y) +
+                      static_cast<std::size_t>(n) * static_cast<std::size_t>(z))] < 0)
         return z;
     return n / 2;
   };
@@ -84,11 +92,13 @@ int main(int argc, char** argv) {
   std::size_t remeshed = 0;
   const float k = 2;
   for (int e = 0; e < edits; ++e) {
-    const int cx = static_cast<int>(rng() % static_cast<unsigned>(n)), cy = static_cast<int>(rng() % static_cast<unsigned>(n));
+    const int cx = static_cast<int>(rng() % static_cast<unsigned>(n)),
+              cy = static_cast<int>(rng() % static_cast<unsigned>(n));
     const bool add = rng() % 2 == 0;
     const double cz = surface(cx, cy);
     const int r = static_cast<int>(std::ceil(radius + k)) + 1;
-    const Box3i box = Box3i{{cx - r, cy - r, static_cast<int>(cz) - r}, {cx + r + 1, cy + r + 1, static_cast<int>(cz) + r + 1}}
+    const Box3i box = Box3i{{cx - r, cy - r, static_cast<int>(cz) - r},
+                            {cx + r + 1, cy + r + 1, static_cast<int>(cz) + r + 1}}
                           .intersect(Box3i::from_size(so.size));
     t0 = std::chrono::steady_clock::now();
     for (int z = box.begin.z; z < box.end.z; ++z)
@@ -96,8 +106,12 @@ int main(int argc, char** argv) {
         for (int x = box.begin.x; x < box.end.x; ++x) {
           const double dx = x - cx, dy = y - cy, dz = z - cz;
           const float d = static_cast<float>(std::sqrt(dx * dx + dy * dy + dz * dz) - radius);
-          float& v = values[static_cast<std::size_t>(x) + static_cast<std::size_t>(n) * (static_cast<std::size_t>(y) + static_cast<std::size_t>(n) * static_cast<std::size_t>(z))];
-          v = add ? smooth_min(v, d, k) : -smooth_min(-v, d, k);  // carve: the smooth maximum of v and -d
+          float& v = values[static_cast<std::size_t>(x) +
+                            static_cast<std::size_t>(n) *
+                                (static_cast<std::size_t>(y) +
+                                 static_cast<std::size_t>(n) * static_cast<std::size_t>(z))];
+          v = add ? smooth_min(v, d, k)
+                  : -smooth_min(-v, d, k);  // carve: the smooth maximum of v and -d
         }
     const double w = ms_since(t0);
     t0 = std::chrono::steady_clock::now();
@@ -114,6 +128,7 @@ int main(int argc, char** argv) {
               chunks.chunk_count().x * chunks.chunk_count().y * chunks.chunk_count().z);
   const Mesh kept = chunks.merged(), fresh = mesh_volume(volume, mo);
   const bool same = kept.positions == fresh.positions && kept.indices == fresh.indices;
-  std::printf("kept mesh %s a full re-mesh (%zu triangles)\n", same ? "equals" : "DIFFERS FROM", kept.triangle_count());
+  std::printf("kept mesh %s a full re-mesh (%zu triangles)\n", same ? "equals" : "DIFFERS FROM",
+              kept.triangle_count());
   return same ? 0 : 1;
 }

@@ -72,8 +72,10 @@ int main(int argc, char** argv) {
     return *scenes[i];
   };
 
-  std::cout << "terrain " << size << "^3, " << max_threads() << " threads, median of " << runs << " frames\n";
-  std::cout << "resolution  configuration                                   ms   Mrays/s  steps/ray  reads/ray\n";
+  std::cout << "terrain " << size << "^3, " << max_threads() << " threads, median of " << runs
+            << " frames\n";
+  std::cout << "resolution  configuration                                   ms   Mrays/s  "
+               "steps/ray  reads/ray\n";
   for (const std::string& res : resolutions) {
     const auto x = res.find('x');
     const int w = std::stoi(res.substr(0, x)), h = std::stoi(res.substr(x + 1));
@@ -97,7 +99,8 @@ int main(int argc, char** argv) {
           parallel_for(static_cast<std::size_t>(h), 4, [&](std::size_t b, std::size_t e) {
             for (std::size_t y = b; y < e; ++y) {
               TraversalCounters local;
-              for (int px = 0; px < w; ++px) trace_ray(scene, proj.ray(px + 0.5, y + 0.5), c.skip, &local);
+              for (int px = 0; px < w; ++px)
+                trace_ray(scene, proj.ray(px + 0.5, y + 0.5), c.skip, &local);
               rows[y] = local;
             }
           });
@@ -108,15 +111,23 @@ int main(int argc, char** argv) {
       }
       const double rays = static_cast<double>(w) * h;
       const double mrays = rays / (t.median_ms * 1e3);
-      std::printf("%-10s  %-42s %7.1f %8.2f %10.2f %10.2f\n", res.c_str(), c.name.c_str(), t.median_ms, mrays,
-                  st.primary.steps / rays, st.primary.voxel_reads / rays);
+      std::printf("%-10s  %-42s %7.1f %8.2f %10.2f %10.2f\n", res.c_str(), c.name.c_str(),
+                  t.median_ms, mrays, st.primary.steps / rays, st.primary.voxel_reads / rays);
       if (!json_path.empty()) {
-        nlohmann::json j{{"size", size},         {"resolution", res},     {"config", c.name},
-                         {"metric", metric_name(c.metric)}, {"skip", skip_mode_name(c.skip)},
-                         {"ms", t.median_ms},     {"min_ms", t.min_ms},    {"max_ms", t.max_ms},
-                         {"mrays_per_s", mrays},  {"threads", max_threads()},
-                         {"steps_per_ray", st.primary.steps / rays}, {"reads_per_ray", st.primary.voxel_reads / rays},
-                         {"shadow_rays", st.shadow.rays}, {"field_ms", field_ms[static_cast<int>(c.metric)]}};
+        nlohmann::json j{{"size", size},
+                         {"resolution", res},
+                         {"config", c.name},
+                         {"metric", metric_name(c.metric)},
+                         {"skip", skip_mode_name(c.skip)},
+                         {"ms", t.median_ms},
+                         {"min_ms", t.min_ms},
+                         {"max_ms", t.max_ms},
+                         {"mrays_per_s", mrays},
+                         {"threads", max_threads()},
+                         {"steps_per_ray", st.primary.steps / rays},
+                         {"reads_per_ray", st.primary.voxel_reads / rays},
+                         {"shadow_rays", st.shadow.rays},
+                         {"field_ms", field_ms[static_cast<int>(c.metric)]}};
         std::ofstream(json_path, std::ios::app) << j.dump() << "\n";
       }
     }

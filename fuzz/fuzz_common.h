@@ -9,6 +9,8 @@
 
 namespace voxfield::fuzz {
 
-inline void init_limits() { set_default_memory_limit(std::uint64_t{256} << 20); }
+inline void init_limits() {
+  set_default_memory_limit(std::uint64_t{256} << 20);
+}
 
 }  // namespace voxfield::fuzz

@@ -15,7 +15,8 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
     const voxfield::NpyVolume v = voxfield::parse_npy({data, size}, "fuzz.npy");
-    const voxfield::NpyVolume back = voxfield::parse_npy(voxfield::encode_npy(v), "fuzz-reencoded.npy");
+    const voxfield::NpyVolume back =
+        voxfield::parse_npy(voxfield::encode_npy(v), "fuzz-reencoded.npy");
     if (back.bytes != v.bytes || !(back.dims == v.dims)) std::abort();
     (void)voxfield::world_from_npy(v, "fuzz.npy", 8);
   } catch (const voxfield::Error&) {

@@ -49,8 +49,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const voxfield::WorldFile f = voxfield::parse_world_file(bytes, "fuzz.vfw");
     std::vector<const voxfield::DistanceField*> fields;
     for (const auto& field : f.fields) fields.push_back(&field);
-    const voxfield::WorldFile back = voxfield::parse_world_file(voxfield::encode_world_file(f.world, fields), "fuzz-reencoded.vfw");
-    if (back.world.solid_count() != f.world.solid_count() || back.fields.size() != f.fields.size()) std::abort();
+    const voxfield::WorldFile back = voxfield::parse_world_file(
+        voxfield::encode_world_file(f.world, fields), "fuzz-reencoded.vfw");
+    if (back.world.solid_count() != f.world.solid_count() || back.fields.size() != f.fields.size())
+      std::abort();
   } catch (const voxfield::Error&) {
   }
   return 0;

@@ -19,7 +19,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // The round trip through the writer (which tiles the content in 256^3 models) is checked for
     // worlds of a few hundred chunks: beyond, it measures the writer's speed, not the parser.
     if (in.world.voxels.chunk_count() > 256) return 0;
-    const voxfield::VoxImport back = voxfield::parse_vox(voxfield::encode_vox(in.world), "fuzz-reencoded.vox");
+    const voxfield::VoxImport back =
+        voxfield::parse_vox(voxfield::encode_vox(in.world), "fuzz-reencoded.vox");
     if (back.world.solid_count() != in.world.solid_count() ||
         !(back.world.voxels.content_bounds() == in.world.voxels.content_bounds())) {
       std::abort();

@@ -34,15 +34,17 @@ VF_CONST(uint, VF_CHEBYSHEV, 1u);
 VF_CONST(uint, VF_EUCLIDEAN, 2u);
 // Storage of encoded fields, as in voxfield::Storage.
 // FimParams::size.w
-VF_CONST(int, VF_FIM_UPDATE, 0);   // one Jacobi pass over the region (indirect: zero groups once converged)
-VF_CONST(int, VF_FIM_CONTROL, 1);  // one invocation: count the pass, stop the next ones if nothing moved
+VF_CONST(int, VF_FIM_UPDATE,
+         0);  // one Jacobi pass over the region (indirect: zero groups once converged)
+VF_CONST(int, VF_FIM_CONTROL,
+         1);  // one invocation: count the pass, stop the next ones if nothing moved
 VF_CONST(int, VF_FIM_RESOLVE, 2);  // copy the last pass's half to the first
 // The FIM control words (a storage and indirect-dispatch buffer of 8 uints).
-VF_CONST(uint, VF_FIM_MOVED, 0u);       // set by a pass when some voxel moved by more than eps
-VF_CONST(uint, VF_FIM_LAST, 1u);        // where the last pass that ran wrote (element offset)
-VF_CONST(uint, VF_FIM_PASSES, 2u);      // passes that ran
-VF_CONST(uint, VF_FIM_CONVERGED, 3u);   // 1 once a pass moved nothing
-VF_CONST(uint, VF_FIM_GROUPS, 4u);      // x, y, z workgroup counts of the next update pass
+VF_CONST(uint, VF_FIM_MOVED, 0u);      // set by a pass when some voxel moved by more than eps
+VF_CONST(uint, VF_FIM_LAST, 1u);       // where the last pass that ran wrote (element offset)
+VF_CONST(uint, VF_FIM_PASSES, 2u);     // passes that ran
+VF_CONST(uint, VF_FIM_CONVERGED, 3u);  // 1 once a pass moved nothing
+VF_CONST(uint, VF_FIM_GROUPS, 4u);     // x, y, z workgroup counts of the next update pass
 
 // RenderParams::flags
 VF_CONST(uint, VF_RENDER_AO, 1u);
@@ -50,8 +52,9 @@ VF_CONST(uint, VF_RENDER_SHADOWS, 2u);
 VF_CONST(uint, VF_RENDER_CHUNKS, 4u);
 VF_CONST(uint, VF_RENDER_HAS_LIGHT, 8u);
 VF_CONST(uint, VF_RENDER_BGRA, 16u);  // pack pixels blue first (B8G8R8A8 swapchains)
-VF_CONST(uint, VF_RENDER_DISTANCE, 32u);  // the distance view: a cut at slice_z, the field as a heat map on it
-VF_CONST(uint, VF_RENDER_ERROR, 64u);     // the error view: |approximate - exact| along each ray
+VF_CONST(uint, VF_RENDER_DISTANCE,
+         32u);  // the distance view: a cut at slice_z, the field as a heat map on it
+VF_CONST(uint, VF_RENDER_ERROR, 64u);  // the error view: |approximate - exact| along each ray
 
 VF_CONST(uint, VF_U8, 0u);
 VF_CONST(uint, VF_U16, 1u);
@@ -81,7 +84,7 @@ struct Header {
   int bias;            // offset of signed integer storage
   uint site_cost_max;  // nearest sites: a site is kept when its cost is at most this (the clamp)
   uint pad2;
-  uint clamp_pos;      // stored bits for +clamp, -clamp, and "no site" outside / inside
+  uint clamp_pos;  // stored bits for +clamp, -clamp, and "no site" outside / inside
   uint clamp_neg;
   uint none_pos;
   uint none_neg;
@@ -91,9 +94,9 @@ struct Header {
 // "compute box" (the whole domain for a full build, an edit's reach grown by the clamp for an
 // update); the encode pass writes the "out box" inside it into the resident field.
 struct PassParams {
-  ivec4 box_begin;     // compute box, voxel coordinates
+  ivec4 box_begin;  // compute box, voxel coordinates
   ivec4 box_size;
-  ivec4 out_begin;     // encode: the voxels written (inside the compute box)
+  ivec4 out_begin;  // encode: the voxels written (inside the compute box)
   ivec4 out_size;
   uint axis;           // 0, 1, 2: the axis this pass's lines run along
   uint sites_are_air;  // 1: sites are the air voxels (the inside half of a signed field)
@@ -107,22 +110,22 @@ struct PassParams {
 
 // Push constants of a jump-flooding pass: 32 bytes.
 struct JfaParams {
-  ivec4 size;    // the domain's extent; w unused
-  int step;      // this pass's jump, in voxels
-  uint metric;   // VF_MANHATTAN...
-  uint src;      // where the previous pass's sites start in the ping-pong buffer (elements)
-  uint dst;      // where this pass writes
+  ivec4 size;   // the domain's extent; w unused
+  int step;     // this pass's jump, in voxels
+  uint metric;  // VF_MANHATTAN...
+  uint src;     // where the previous pass's sites start in the ping-pong buffer (elements)
+  uint dst;     // where this pass writes
 };
 
 // Push constants of a Fast Iterative Method pass (shaders/fim.comp): 64 bytes.
 struct FimParams {
-  ivec4 size;          // the domain's extent; w = mode: VF_FIM_UPDATE, VF_FIM_CONTROL, VF_FIM_RESOLVE
+  ivec4 size;  // the domain's extent; w = mode: VF_FIM_UPDATE, VF_FIM_CONTROL, VF_FIM_RESOLVE
   ivec4 region_begin;  // the voxels the passes update (the rest only feed them); w unused
   ivec4 region_end;
-  uint src;            // where the previous pass's values start in the ping-pong buffer (elements)
-  uint dst;            // where this pass writes
-  uint metric;         // VF_MANHATTAN...
-  float eps;           // a voxel still moving by more than this keeps the iteration going
+  uint src;     // where the previous pass's values start in the ping-pong buffer (elements)
+  uint dst;     // where this pass writes
+  uint metric;  // VF_MANHATTAN...
+  float eps;    // a voxel still moving by more than this keeps the iteration going
 };
 
 // The ray marcher's frame: camera, scene layout and shading options. std430, 192 bytes, in a
@@ -131,24 +134,24 @@ struct FimParams {
 // distance in bits 16-23, bit 24 "no solid voxel", bit 25 "materials stored voxel by voxel"; then
 // the lighting arena slot and the uniform lighting value.
 struct RenderParams {
-  vec4f eye;           // xyz; w = 1 for orthographic
-  vec4f forward;       // unit vectors of the camera basis
+  vec4f eye;      // xyz; w = 1 for orthographic
+  vec4f forward;  // unit vectors of the camera basis
   vec4f right;
   vec4f up;
-  vec4f sun;           // unit vector towards the sun; w = fog density
-  ivec4 box_begin;     // the render box
+  vec4f sun;        // unit vector towards the sun; w = fog density
+  ivec4 box_begin;  // the render box
   ivec4 box_end;
-  ivec4 first_chunk;   // chunk coordinate of chunk_info entry 0; w = chunk shift
-  ivec4 chunk_dims;    // chunks per axis; w = chunk voxels (edge^3)
+  ivec4 first_chunk;  // chunk coordinate of chunk_info entry 0; w = chunk shift
+  ivec4 chunk_dims;   // chunks per axis; w = chunk voxels (edge^3)
   uint width;
   uint height;
-  float scale;         // tan(fov / 2), or ortho height / 2
-  uint metric;         // skip field metric (VF_MANHATTAN...)
+  float scale;  // tan(fov / 2), or ortho height / 2
+  uint metric;  // skip field metric (VF_MANHATTAN...)
   float skip_inv_scale;
   float light_inv_scale;
-  uint flags;          // VF_RENDER_* bits
-  int slice_z;         // distance view: the cut plane (voxels above it are hidden)
-  float heat_max;      // distance view: the distance at the top of the heat ramp
+  uint flags;              // VF_RENDER_* bits
+  int slice_z;             // distance view: the cut plane (voxels above it are hidden)
+  float heat_max;          // distance view: the distance at the top of the heat ramp
   float approx_inv_scale;  // error view: stored approximate value * this = voxels
   uint pad1, pad2;
 };

@@ -20,7 +20,8 @@ int main(int argc, char** argv) {
     const voxfield::Image img = voxfield::read_png(argv[1]);
     std::map<std::uint32_t, std::size_t> counts;
     for (std::size_t i = 0; i + 2 < img.rgb.size(); i += 3)
-      ++counts[(std::uint32_t{img.rgb[i]} << 16) | (std::uint32_t{img.rgb[i + 1]} << 8) | img.rgb[i + 2]];
+      ++counts[(std::uint32_t{img.rgb[i]} << 16) | (std::uint32_t{img.rgb[i + 1]} << 8) |
+               img.rgb[i + 2]];
     std::size_t largest = 0;
     for (const auto& [colour, n] : counts) largest = std::max(largest, n);
     const std::size_t pixels = static_cast<std::size_t>(img.width) * img.height;
@@ -33,12 +34,20 @@ int main(int argc, char** argv) {
     const int w = img.width, h = img.height;
     double difference = 0;
     for (int c = 0; c < 3; ++c)
-      difference += std::abs(mean(w * 9 / 10, 0, w, h / 10, c) - mean(w * 2 / 5, h * 2 / 5, w * 3 / 5, h * 3 / 5, c));
-    std::printf("%dx%d, %zu colours, the commonest covers %.1f %%, sky corner vs centre differ by %.0f levels\n", w, h,
-                counts.size(), 100.0 * static_cast<double>(largest) / static_cast<double>(pixels), difference);
-    if (counts.size() < 64) return std::fprintf(stderr, "too few colours: not a rendered frame\n"), 1;
-    if (largest * 2 > pixels) return std::fprintf(stderr, "one colour covers most of the frame\n"), 1;
-    if (difference < 40) return std::fprintf(stderr, "the sky corner looks like the centre: is the world missing?\n"), 1;
+      difference += std::abs(mean(w * 9 / 10, 0, w, h / 10, c) -
+                             mean(w * 2 / 5, h * 2 / 5, w * 3 / 5, h * 3 / 5, c));
+    std::printf(
+        "%dx%d, %zu colours, the commonest covers %.1f %%, sky corner vs centre differ by %.0f "
+        "levels\n",
+        w, h, counts.size(), 100.0 * static_cast<double>(largest) / static_cast<double>(pixels),
+        difference);
+    if (counts.size() < 64)
+      return std::fprintf(stderr, "too few colours: not a rendered frame\n"), 1;
+    if (largest * 2 > pixels)
+      return std::fprintf(stderr, "one colour covers most of the frame\n"), 1;
+    if (difference < 40)
+      return std::fprintf(stderr, "the sky corner looks like the centre: is the world missing?\n"),
+             1;
     return 0;
   } catch (const voxfield::Error& e) {
     std::cerr << "frame_check: " << e.what() << "\n";

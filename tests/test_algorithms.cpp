@@ -4,8 +4,8 @@
 
 #include <random>
 
-#include "voxfield/dissertation_format.h"
 #include "voxfield/algorithms.h"
+#include "voxfield/dissertation_format.h"
 
 using namespace voxfield;
 
@@ -17,12 +17,13 @@ World random_world(Vec3i size, double density, std::uint32_t seed, int edge = 16
   for (int z = 0; z < size.z; ++z)
     for (int y = 0; y < size.y; ++y)
       for (int x = 0; x < size.x; ++x)
-        if (std::uniform_real_distribution<double>(0, 1)(rng) < density) w.voxels.set({x, y, z}, 1 + rng() % 9);
+        if (std::uniform_real_distribution<double>(0, 1)(rng) < density)
+          w.voxels.set({x, y, z}, 1 + rng() % 9);
   return w;
 }
 
-FieldError run(const World& w, Metric m, Algorithm a, bool sgn = false, std::optional<Box3i> focus = {},
-               AlgorithmStats* stats = nullptr) {
+FieldError run(const World& w, Metric m, Algorithm a, bool sgn = false,
+               std::optional<Box3i> focus = {}, AlgorithmStats* stats = nullptr) {
   DistanceOptions o;
   o.metric = m;
   o.signed_distance = sgn;
@@ -144,7 +145,8 @@ TEST(Algorithms, LevelOfDetailIsExactInsideTheFocus) {
           ASSERT_EQ(lod.distance({x, y, z}), want) << x << "," << y << "," << z;
         }
       }
-  EXPECT_THROW(compute_distance_field(w, o, AlgorithmOptions{Algorithm::kLod, std::nullopt}), InvalidArgument);
+  EXPECT_THROW(compute_distance_field(w, o, AlgorithmOptions{Algorithm::kLod, std::nullopt}),
+               InvalidArgument);
 }
 
 TEST(Algorithms, CompareReportsNothingForTheExactField) {

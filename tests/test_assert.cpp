@@ -16,7 +16,8 @@ bool counted(bool value) {
 #ifdef VOXFIELD_ENABLE_ASSERTS
 TEST(InternalAssert, ABrokenInvariantStopsWithItsConditionAndPlace) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
-  EXPECT_DEATH(VOXFIELD_ASSERT(counted(1 + 1 == 3)), "internal invariant broken: counted\\(1 \\+ 1 == 3\\) \\(.*test_assert.cpp:[0-9]+");
+  EXPECT_DEATH(VOXFIELD_ASSERT(counted(1 + 1 == 3)),
+               "internal invariant broken: counted\\(1 \\+ 1 == 3\\) \\(.*test_assert.cpp:[0-9]+");
   evaluations = 0;
   VOXFIELD_ASSERT(counted(true));
   EXPECT_EQ(evaluations, 1);  // evaluated exactly once

@@ -23,20 +23,24 @@ struct OracleResult {
   double distance;  // signed when requested; +inf when no site
   bool has_site;
   SiteOffset site;
-  double cost;      // squared distance for Euclidean
+  double cost;  // squared distance for Euclidean
 };
 
 double metric_cost(Metric m, const std::array<double, 3>& sp, int dx, int dy, int dz) {
   const double ax = std::abs(dx) * sp[0], ay = std::abs(dy) * sp[1], az = std::abs(dz) * sp[2];
   switch (m) {
-    case Metric::kManhattan: return ax + ay + az;
-    case Metric::kChebyshev: return std::max({ax, ay, az});
-    case Metric::kEuclidean: return ax * ax + ay * ay + az * az;
+    case Metric::kManhattan:
+      return ax + ay + az;
+    case Metric::kChebyshev:
+      return std::max({ax, ay, az});
+    case Metric::kEuclidean:
+      return ax * ax + ay * ay + az * az;
   }
   return 0;
 }
 
-std::vector<OracleResult> oracle(const std::vector<char>& solid, const Box3i& domain, const DistanceOptions& o) {
+std::vector<OracleResult> oracle(const std::vector<char>& solid, const Box3i& domain,
+                                 const DistanceOptions& o) {
   const Vec3i n = domain.size();
   auto idx = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * n.y + y) * n.x + x; };
   std::vector<Vec3i> solids, airs;
@@ -59,12 +63,17 @@ std::vector<OracleResult> oracle(const std::vector<char>& solid, const Box3i& do
         for (const Vec3i s : sites) {
           const int dx = s.x - x, dy = s.y - y, dz = s.z - z;
           const std::tuple<double, int, double, int, int, int> key{
-              metric_cost(o.metric, o.spacing, dx, dy, dz), s.y, metric_cost(o.metric, o.spacing, dx, 0, dz), s.x,
-              std::abs(dz), s.z};
+              metric_cost(o.metric, o.spacing, dx, dy, dz),
+              s.y,
+              metric_cost(o.metric, o.spacing, dx, 0, dz),
+              s.x,
+              std::abs(dz),
+              s.z};
           if (key < best) {
             best = key;
             r.has_site = true;
-            r.site = {static_cast<std::int16_t>(dx), static_cast<std::int16_t>(dy), static_cast<std::int16_t>(dz)};
+            r.site = {static_cast<std::int16_t>(dx), static_cast<std::int16_t>(dy),
+                      static_cast<std::int16_t>(dz)};
           }
         }
         if (r.has_site) {
@@ -83,8 +92,10 @@ std::uint64_t isqrt_ref(std::uint64_t v) {
 }
 
 // What the field must store for an oracle result, given the options.
-double expected_stored(const OracleResult& r, bool inside, const DistanceOptions& o, const DistanceField& f) {
-  const double clamp = o.max_distance > 0 ? o.max_distance : std::numeric_limits<double>::infinity();
+double expected_stored(const OracleResult& r, bool inside, const DistanceOptions& o,
+                       const DistanceField& f) {
+  const double clamp =
+      o.max_distance > 0 ? o.max_distance : std::numeric_limits<double>::infinity();
   const bool unit = o.spacing == std::array<double, 3>{1, 1, 1};
   double d = r.has_site ? r.distance : std::numeric_limits<double>::infinity();
   if (o.storage == Storage::kF32) {
@@ -121,14 +132,16 @@ struct Case {
   std::array<double, 3> spacing;
   int chunk_edge;
   int threads;
-  bool sites = true;  // nearest sites too (without them, clamped Euclidean fields take other 2-D passes)
+  bool sites =
+      true;  // nearest sites too (without them, clamped Euclidean fields take other 2-D passes)
 };
 
 std::string describe(const Case& c) {
   return std::string(metric_name(c.metric)) + (c.is_signed ? " signed" : " unsigned") + " clamp " +
-         std::to_string(c.clamp) + " " + storage_name(c.storage) + " spacing " + std::to_string(c.spacing[0]) + "," +
-         std::to_string(c.spacing[1]) + "," + std::to_string(c.spacing[2]) + " edge " + std::to_string(c.chunk_edge) +
-         " threads " + std::to_string(c.threads) + (c.sites ? " with sites" : "");
+         std::to_string(c.clamp) + " " + storage_name(c.storage) + " spacing " +
+         std::to_string(c.spacing[0]) + "," + std::to_string(c.spacing[1]) + "," +
+         std::to_string(c.spacing[2]) + " edge " + std::to_string(c.chunk_edge) + " threads " +
+         std::to_string(c.threads) + (c.sites ? " with sites" : "");
 }
 
 // Builds a random bounded world, runs the field and compares every voxel and site with the oracle.
@@ -170,9 +183,12 @@ void check_case(const Case& c, std::uint32_t seed, Vec3i size, double density) {
         const double got = stored_at(f, p);
         // Anisotropic Euclidean sums squares in another order than the oracle: allow rounding
         // (relative 1e-6 on the f32 value; one fixed-point step for integer storage).
-        const double tol = unit ? 0.0 : (c.storage == Storage::kF32 ? 1e-6 * std::max(1.0, std::abs(want)) : 1.0);
-        if (!(std::abs(got - want) <= tol) && !(std::isinf(got) && std::isinf(want) && got == want)) {
-          if (reported++ < 5) ADD_FAILURE() << "value at " << to_string(p) << ": got " << got << " want " << want;
+        const double tol =
+            unit ? 0.0 : (c.storage == Storage::kF32 ? 1e-6 * std::max(1.0, std::abs(want)) : 1.0);
+        if (!(std::abs(got - want) <= tol) &&
+            !(std::isinf(got) && std::isinf(want) && got == want)) {
+          if (reported++ < 5)
+            ADD_FAILURE() << "value at " << to_string(p) << ": got " << got << " want " << want;
         }
         // Sites: exact offsets wherever the distance is within the clamp (ties make anisotropic
         // rounding ambiguous, so there only the distance to the reported site is checked).
@@ -180,22 +196,25 @@ void check_case(const Case& c, std::uint32_t seed, Vec3i size, double density) {
         const SiteOffset s = f.sites->get(p);
         const bool within = r.has_site && r.distance <= clamp;
         if (!within) {
-          if (!s.none() && reported++ < 5) ADD_FAILURE() << "site at " << to_string(p) << " should be none";
+          if (!s.none() && reported++ < 5)
+            ADD_FAILURE() << "site at " << to_string(p) << " should be none";
           continue;
         }
         if (solid[i] && !c.is_signed) {
-          if (!(s == SiteOffset{0, 0, 0}) && reported++ < 5) ADD_FAILURE() << "solid voxel site not itself";
+          if (!(s == SiteOffset{0, 0, 0}) && reported++ < 5)
+            ADD_FAILURE() << "solid voxel site not itself";
           continue;
         }
         if (unit) {
           if (!(s == r.site) && reported++ < 5) {
-            ADD_FAILURE() << "site at " << to_string(p) << ": got " << s.dx << "," << s.dy << "," << s.dz << " want "
-                          << r.site.dx << "," << r.site.dy << "," << r.site.dz;
+            ADD_FAILURE() << "site at " << to_string(p) << ": got " << s.dx << "," << s.dy << ","
+                          << s.dz << " want " << r.site.dx << "," << r.site.dy << "," << r.site.dz;
           }
         } else if (!s.none()) {
           const double d = std::sqrt(metric_cost(c.metric, c.spacing, s.dx, s.dy, s.dz));
           if (std::abs(d - r.distance) > 1e-9 * std::max(1.0, r.distance) && reported++ < 5) {
-            ADD_FAILURE() << "site at " << to_string(p) << " is at " << d << ", nearest at " << r.distance;
+            ADD_FAILURE() << "site at " << to_string(p) << " is at " << d << ", nearest at "
+                          << r.distance;
           }
         } else if (reported++ < 5) {
           ADD_FAILURE() << "missing site at " << to_string(p);
@@ -215,11 +234,13 @@ TEST(ExactDistance, RandomWorldsAgainstBruteForce) {
         for (Storage st : {Storage::kF32, Storage::kU8, Storage::kU16}) {
           const int edge = (seed % 3 == 0) ? 8 : (seed % 3 == 1 ? 16 : 32);
           const int threads = seed % 2 ? 2 : 1;
-          const double density = (seed % 4 == 0) ? 0.02 : (seed % 4 == 1 ? 0.1 : (seed % 4 == 2 ? 0.3 : 0.6));
+          const double density =
+              (seed % 4 == 0) ? 0.02 : (seed % 4 == 1 ? 0.1 : (seed % 4 == 2 ? 0.3 : 0.6));
           check_case({m, sgn, clamp, st, unit, edge, threads}, seed, {23, 17, 19}, density);
           // Clamped unit-spacing Euclidean fields without sites: truncated min-convolutions.
           if (m == Metric::kEuclidean && clamp > 0)
-            check_case({m, sgn, clamp, st, unit, edge, threads, false}, seed + 1000, {23, 17, 19}, density);
+            check_case({m, sgn, clamp, st, unit, edge, threads, false}, seed + 1000, {23, 17, 19},
+                       density);
           ++seed;
         }
   for (bool sgn : {false, true})
@@ -240,7 +261,9 @@ TEST(ExactDistance, IdenticalForEveryChunkEdgeAndThreadCount) {
         World w(edge, bounds);
         std::mt19937 r2(5);
         for (int k = 0; k < 300; ++k) {
-          w.voxels.set({static_cast<int>(r2() % 45), static_cast<int>(r2() % 38), static_cast<int>(r2() % 70)}, 1);
+          w.voxels.set({static_cast<int>(r2() % 45), static_cast<int>(r2() % 38),
+                        static_cast<int>(r2() % 70)},
+                       1);
         }
         DistanceOptions o;
         o.metric = m;
@@ -252,7 +275,8 @@ TEST(ExactDistance, IdenticalForEveryChunkEdgeAndThreadCount) {
         if (reference.empty()) {
           reference = dense;
         } else {
-          EXPECT_EQ(dense, reference) << metric_name(m) << " edge " << edge << " threads " << threads;
+          EXPECT_EQ(dense, reference)
+              << metric_name(m) << " edge " << edge << " threads " << threads;
         }
       }
     }
@@ -363,7 +387,9 @@ TEST(ExactDistance, RejectsBadOptions) {
 TEST(ExactDistance, WideDomainsUseTheSixtyFourBitKernel) {
   // Squared distances beyond 2^29 select the 64-bit Euclidean kernel; check it on a long line.
   const int n = 24000;
-  World w(8, Box3i::from_size({n, 1, 1}));  // small chunks: a thin domain in 128^3 chunks would be mostly padding
+  World w(8,
+          Box3i::from_size(
+              {n, 1, 1}));  // small chunks: a thin domain in 128^3 chunks would be mostly padding
   w.voxels.set({0, 0, 0}, 1);
   w.voxels.set({n - 1, 0, 0}, 1);
   w.voxels.set({9000, 0, 0}, 1);
@@ -390,7 +416,8 @@ TEST(TruncatedMinConvolution, EqualsTheClampedTwoDimensionalTransform) {
   for (int trial = 0; trial < 60; ++trial) {
     const int nx = 1 + static_cast<int>(rng() % 90), ny = 1 + static_cast<int>(rng() % 90);
     const int mx = 1 + static_cast<int>(rng() % nx), my = 1 + static_cast<int>(rng() % ny);
-    const int ox = static_cast<int>(rng() % (nx - mx + 1)), oy = static_cast<int>(rng() % (ny - my + 1));
+    const int ox = static_cast<int>(rng() % (nx - mx + 1)),
+              oy = static_cast<int>(rng() % (ny - my + 1));
     const int reaches[] = {1, 3, 16, 33, Conv::kMaxReach};
     const int reach = reaches[trial % 5];
     const double clamp = reach + (trial % 2 ? 0.5 : 0.0);
@@ -417,11 +444,13 @@ TEST(TruncatedMinConvolution, EqualsTheClampedTwoDimensionalTransform) {
           for (int x = 0; x < nx; ++x) {
             const int v = f[static_cast<std::size_t>(y) * nx + x];
             if (v < 0) continue;
-            const long c = v + static_cast<long>(x - (ox + i)) * (x - (ox + i)) + static_cast<long>(y - (oy + j)) * (y - (oy + j));
+            const long c = v + static_cast<long>(x - (ox + i)) * (x - (ox + i)) +
+                           static_cast<long>(y - (oy + j)) * (y - (oy + j));
             if (best < 0 || c < best) best = c;
           }
         const long expected = best < 0 || best > drop ? Conv::kInf : best;
-        ASSERT_EQ(conv.out_row(j)[i], expected) << "trial " << trial << " at (" << ox + i << ", " << oy + j << ")";
+        ASSERT_EQ(conv.out_row(j)[i], expected)
+            << "trial " << trial << " at (" << ox + i << ", " << oy + j << ")";
         ++checked;
       }
   }

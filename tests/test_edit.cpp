@@ -39,28 +39,45 @@ void apply_by_definition(World& w, const Edit& e) {
 }
 
 Edit random_edit(std::mt19937& rng, const Box3i& area, const std::shared_ptr<const World>& model) {
-  auto uni = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
+  auto uni = [&](double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(rng);
+  };
   auto coord = [&](int axis) { return uni(area.begin[axis] - 4, area.end[axis] + 4); };
   Edit e;
   e.op = static_cast<EditOp>(rng() % 3);
   e.material = static_cast<std::uint8_t>(1 + rng() % 5);
   switch (rng() % 5) {
-    case 0: e.brush = SphereBrush{{coord(0), coord(1), coord(2)}, uni(0, 7)}; break;
+    case 0:
+      e.brush = SphereBrush{{coord(0), coord(1), coord(2)}, uni(0, 7)};
+      break;
     case 1: {
-      const Vec3i a{static_cast<int>(coord(0)), static_cast<int>(coord(1)), static_cast<int>(coord(2))};
-      e.brush = BoxBrush{a, a + Vec3i{static_cast<int>(rng() % 9), static_cast<int>(rng() % 9), static_cast<int>(rng() % 9)}};
+      const Vec3i a{static_cast<int>(coord(0)), static_cast<int>(coord(1)),
+                    static_cast<int>(coord(2))};
+      e.brush = BoxBrush{a, a + Vec3i{static_cast<int>(rng() % 9), static_cast<int>(rng() % 9),
+                                      static_cast<int>(rng() % 9)}};
       break;
     }
-    case 2: e.brush = RotatedBoxBrush{{coord(0), coord(1), coord(2)}, {uni(0, 5), uni(0, 3), uni(0, 4)}, {uni(0, 90), uni(0, 90), uni(0, 90)}}; break;
-    case 3: e.brush = CapsuleBrush{{coord(0), coord(1), coord(2)}, {coord(0), coord(1), coord(2)}, uni(0, 3)}; break;
-    default: e.brush = StampBrush{model, {static_cast<int>(coord(0)), static_cast<int>(coord(1)), static_cast<int>(coord(2))}};
+    case 2:
+      e.brush = RotatedBoxBrush{{coord(0), coord(1), coord(2)},
+                                {uni(0, 5), uni(0, 3), uni(0, 4)},
+                                {uni(0, 90), uni(0, 90), uni(0, 90)}};
+      break;
+    case 3:
+      e.brush =
+          CapsuleBrush{{coord(0), coord(1), coord(2)}, {coord(0), coord(1), coord(2)}, uni(0, 3)};
+      break;
+    default:
+      e.brush = StampBrush{
+          model,
+          {static_cast<int>(coord(0)), static_cast<int>(coord(1)), static_cast<int>(coord(2))}};
   }
   return e;
 }
 
 std::shared_ptr<const World> small_model() {
   auto m = std::make_shared<World>(8);
-  for (int i = 0; i < 5; ++i) m->voxels.set({i, i % 2, 2 * (i % 3)}, static_cast<std::uint8_t>(10 + i));
+  for (int i = 0; i < 5; ++i)
+    m->voxels.set({i, i % 2, 2 * (i % 3)}, static_cast<std::uint8_t>(10 + i));
   return m;
 }
 
@@ -71,7 +88,8 @@ TEST(Edit, EveryBrushAndOperationMatchesItsDefinition) {
   const Box3i bounds{{-7, 3, -20}, {40, 35, 13}};  // odd, negative, not chunk aligned
   World a(16, bounds), b(16, bounds);
   const auto model = small_model();
-  DirtyRegions any(16, DirtyRegions::Track::kAnyChange), occupancy(16, DirtyRegions::Track::kOccupancy);
+  DirtyRegions any(16, DirtyRegions::Track::kAnyChange),
+      occupancy(16, DirtyRegions::Track::kOccupancy);
   for (int i = 0; i < 400; ++i) {
     const Edit e = random_edit(rng, bounds, model);
     const std::vector<std::uint8_t> before = dense(a, bounds);
@@ -90,7 +108,9 @@ TEST(Edit, EveryBrushAndOperationMatchesItsDefinition) {
           if (before[k] == after[k]) continue;
           ++changed;
           ASSERT_TRUE(r.changed_box.contains(Vec3i{x, y, z}));
-          if (dirty.track() == DirtyRegions::Track::kOccupancy && (before[k] != 0) == (after[k] != 0)) continue;
+          if (dirty.track() == DirtyRegions::Track::kOccupancy &&
+              (before[k] != 0) == (after[k] != 0))
+            continue;
           bool covered = false;
           for (const Box3i& d : dirty.boxes()) covered |= d.contains(Vec3i{x, y, z});
           ASSERT_TRUE(covered);
@@ -114,53 +134,75 @@ TEST(Edit, SphereRunsMatchTheVoxelTest) {
   const Box3i bounds{{-13, -9, -11}, {27, 29, 25}};
   World w(8, bounds);
   std::mt19937 rng(77);
-  auto uni = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
+  auto uni = [&](double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(rng);
+  };
   for (int i = 0; i < 1500; ++i) {
     Vec3d c{uni(-20, 35), uni(-15, 35), uni(-18, 32)};
     double radius = uni(0, 18);
     switch (i % 4) {  // centres on voxels or half-way between them, radii whole or their squares
-      case 0: c = {std::round(c[0]), std::round(c[1]), std::round(c[2])}; radius = std::round(radius); break;
-      case 1: c = {std::round(c[0]) + 0.5, std::round(c[1]), std::round(c[2]) + 0.5}; radius = std::round(radius); break;
-      case 2: radius = std::sqrt(std::round(radius * radius)); break;
-      default: break;
+      case 0:
+        c = {std::round(c[0]), std::round(c[1]), std::round(c[2])};
+        radius = std::round(radius);
+        break;
+      case 1:
+        c = {std::round(c[0]) + 0.5, std::round(c[1]), std::round(c[2]) + 0.5};
+        radius = std::round(radius);
+        break;
+      case 2:
+        radius = std::sqrt(std::round(radius * radius));
+        break;
+      default:
+        break;
     }
     const SphereBrush sphere{c, radius};
     std::int64_t expected = 0;
     for (int z = bounds.begin.z; z < bounds.end.z; ++z)
       for (int y = bounds.begin.y; y < bounds.end.y; ++y)
-        for (int x = bounds.begin.x; x < bounds.end.x; ++x) expected += brush_contains(sphere, Vec3i{x, y, z}) ? 1 : 0;
-    ASSERT_EQ(apply_edit(w, {EditOp::kPlace, sphere, 1}).voxels_changed, expected) << "sphere " << i;
+        for (int x = bounds.begin.x; x < bounds.end.x; ++x)
+          expected += brush_contains(sphere, Vec3i{x, y, z}) ? 1 : 0;
+    ASSERT_EQ(apply_edit(w, {EditOp::kPlace, sphere, 1}).voxels_changed, expected)
+        << "sphere " << i;
     ASSERT_EQ(w.solid_count(), expected) << "sphere " << i;
-    ASSERT_EQ(apply_edit(w, {EditOp::kCarve, sphere, 1}).voxels_changed, expected) << "sphere " << i;
+    ASSERT_EQ(apply_edit(w, {EditOp::kCarve, sphere, 1}).voxels_changed, expected)
+        << "sphere " << i;
   }
 }
 
 TEST(Edit, ShapesByHand) {
   World w(8, Box3i{{-20, -20, -20}, {20, 20, 20}});
-  EXPECT_EQ(apply_edit(w, {EditOp::kPlace, SphereBrush{{0, 0, 0}, 1}, 2}).voxels_changed, 7);  // centre + 6
-  EXPECT_EQ(apply_edit(w, {EditOp::kPlace, BoxBrush{{5, 5, 5}, {6, 7, 8}}, 2}).voxels_changed, 2 * 3 * 4);
+  EXPECT_EQ(apply_edit(w, {EditOp::kPlace, SphereBrush{{0, 0, 0}, 1}, 2}).voxels_changed,
+            7);  // centre + 6
+  EXPECT_EQ(apply_edit(w, {EditOp::kPlace, BoxBrush{{5, 5, 5}, {6, 7, 8}}, 2}).voxels_changed,
+            2 * 3 * 4);
   // A box rotated 90 degrees about z swaps its x and y extents.
   World r(8, Box3i{{-20, -20, -20}, {20, 20, 20}});
   apply_edit(r, {EditOp::kPlace, RotatedBoxBrush{{0, 0, 0}, {3, 1, 0}, {0, 0, 90}}, 1});
   EXPECT_EQ(r.voxels.content_bounds(), (Box3i::from_inclusive({-1, -3, 0}, {1, 3, 0})));
   // A capsule of radius 0 is the voxels on its segment.
   World s(8, Box3i{{-20, -20, -20}, {20, 20, 20}});
-  EXPECT_EQ(apply_edit(s, {EditOp::kPlace, CapsuleBrush{{0, 0, 0}, {5, 0, 0}, 0}, 1}).voxels_changed, 6);
+  EXPECT_EQ(
+      apply_edit(s, {EditOp::kPlace, CapsuleBrush{{0, 0, 0}, {5, 0, 0}, 0}, 1}).voxels_changed, 6);
   // Paint never creates matter.
   EXPECT_EQ(apply_edit(s, {EditOp::kPaint, SphereBrush{{2, 0, 0}, 3}, 9}).voxels_changed, 6);
   EXPECT_EQ(s.solid_count(), 6);
   // Clipped at the bounds; out-of-bounds edits change nothing.
-  EXPECT_EQ(apply_edit(s, {EditOp::kPlace, BoxBrush{{19, 19, 19}, {30, 30, 30}}, 1}).voxels_changed, 1);
+  EXPECT_EQ(apply_edit(s, {EditOp::kPlace, BoxBrush{{19, 19, 19}, {30, 30, 30}}, 1}).voxels_changed,
+            1);
   EXPECT_EQ(apply_edit(s, {EditOp::kPlace, SphereBrush{{100, 0, 0}, 5}, 1}).voxels_changed, 0);
   // Malformed edits are refused before anything changes.
   EXPECT_THROW(apply_edit(s, {EditOp::kPlace, SphereBrush{{0, 0, 0}, -1}, 1}), InvalidArgument);
   EXPECT_THROW(apply_edit(s, {EditOp::kPlace, BoxBrush{{1, 0, 0}, {0, 0, 0}}, 1}), InvalidArgument);
   EXPECT_THROW(apply_edit(s, {EditOp::kPlace, SphereBrush{{0, 0, 0}, 2}, 0}), InvalidArgument);
   EXPECT_THROW(apply_edit(s, {EditOp::kPlace, StampBrush{nullptr, {0, 0, 0}}, 1}), InvalidArgument);
-  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN(),
+               inf = std::numeric_limits<double>::infinity();
   EXPECT_THROW(apply_edit(s, {EditOp::kPlace, SphereBrush{{nan, 0, 0}, 2}, 1}), InvalidArgument);
-  EXPECT_THROW(apply_edit(s, {EditOp::kCarve, CapsuleBrush{{0, 0, 0}, {inf, 0, 0}, 1}, 1}), InvalidArgument);
-  EXPECT_THROW(apply_edit(s, {EditOp::kPlace, RotatedBoxBrush{{0, 0, 0}, {1, 1, 1}, {0, nan, 0}}, 1}), InvalidArgument);
+  EXPECT_THROW(apply_edit(s, {EditOp::kCarve, CapsuleBrush{{0, 0, 0}, {inf, 0, 0}, 1}, 1}),
+               InvalidArgument);
+  EXPECT_THROW(
+      apply_edit(s, {EditOp::kPlace, RotatedBoxBrush{{0, 0, 0}, {1, 1, 1}, {0, nan, 0}}, 1}),
+      InvalidArgument);
   EXPECT_EQ(s.solid_count(), 7);
   // A sphere centred far outside the world covers exactly its cap inside.
   World cap(8, Box3i{{-20, -20, -20}, {20, 20, 20}});
@@ -190,10 +232,12 @@ void expect_same_field(const DistanceField& a, const DistanceField& b, const Box
       [&](const auto& ga) {
         using G = std::decay_t<decltype(ga)>;
         const G& gb = std::get<G>(b.values);
-        std::vector<typename G::value_type> va(static_cast<std::size_t>(box.volume())), vb(va.size());
+        std::vector<typename G::value_type> va(static_cast<std::size_t>(box.volume())),
+            vb(va.size());
         ga.copy_to_dense(box, va.data());
         gb.copy_to_dense(box, vb.data());
-        ASSERT_TRUE(std::memcmp(va.data(), vb.data(), va.size() * sizeof(va[0])) == 0) << "values differ after edit " << step;
+        ASSERT_TRUE(std::memcmp(va.data(), vb.data(), va.size() * sizeof(va[0])) == 0)
+            << "values differ after edit " << step;
       },
       a.values);
   ASSERT_EQ(a.sites.has_value(), b.sites.has_value());
@@ -209,12 +253,16 @@ void expect_same_field(const DistanceField& a, const DistanceField& b, const Box
 
 TEST(DynamicField, IncrementalUpdatesEqualFullRebuilds) {
   const FieldCase cases[] = {
-      {Metric::kManhattan, false, 6, Storage::kF32, true},  {Metric::kEuclidean, true, 5, Storage::kF32, true},
-      {Metric::kChebyshev, true, 4, Storage::kU8, false},   {Metric::kEuclidean, false, 0, Storage::kU8, true},
-      {Metric::kManhattan, true, 3, Storage::kU16, true},   {Metric::kEuclidean, false, 7.5, Storage::kU16, false},
+      {Metric::kManhattan, false, 6, Storage::kF32, true},
+      {Metric::kEuclidean, true, 5, Storage::kF32, true},
+      {Metric::kChebyshev, true, 4, Storage::kU8, false},
+      {Metric::kEuclidean, false, 0, Storage::kU8, true},
+      {Metric::kManhattan, true, 3, Storage::kU16, true},
+      {Metric::kEuclidean, false, 7.5, Storage::kU16, false},
       {Metric::kEuclidean, true, 6, Storage::kF32, false, {0.5, 1.0, 2.0}},
       // Unsigned without sites: the local pass's fast encoding.
-      {Metric::kChebyshev, false, 5, Storage::kU8, false},  {Metric::kEuclidean, false, 6, Storage::kF32, false},
+      {Metric::kChebyshev, false, 5, Storage::kU8, false},
+      {Metric::kEuclidean, false, 6, Storage::kF32, false},
       {Metric::kManhattan, false, 9, Storage::kU16, false},
       // Unclamped, and unequal spacings (Euclidean only): the affected-box search's rounding slack
       // and the bound on new values after removals depend on the metric and the spacing.
@@ -223,7 +271,8 @@ TEST(DynamicField, IncrementalUpdatesEqualFullRebuilds) {
       {Metric::kChebyshev, false, 0, Storage::kF32, false},
       // Signed Euclidean with unit spacing and no sites: the truncated min-convolution's two
       // transforms (to solid, to air), a small clamp and one past the world's extent.
-      {Metric::kEuclidean, true, 6, Storage::kU8, false},  {Metric::kEuclidean, true, 40.5, Storage::kF32, false},
+      {Metric::kEuclidean, true, 6, Storage::kU8, false},
+      {Metric::kEuclidean, true, 40.5, Storage::kF32, false},
   };
   const Box3i bounds{{-9, 0, 4}, {43, 37, 33}};
   const auto model = small_model();
@@ -243,7 +292,8 @@ TEST(DynamicField, IncrementalUpdatesEqualFullRebuilds) {
     o.nearest_sites = c.sites;
     o.spacing = c.spacing;
     DynamicDistanceField live(w, o);
-    DirtyRegions dirty(16, seed % 2 ? DirtyRegions::Track::kOccupancy : DirtyRegions::Track::kAnyChange);
+    DirtyRegions dirty(
+        16, seed % 2 ? DirtyRegions::Track::kOccupancy : DirtyRegions::Track::kAnyChange);
     for (int i = 0; i < 250; ++i) {
       // One to three edits between updates: placements, deletions and paints, across chunk
       // borders and reaching past the world's bounds.
@@ -266,13 +316,16 @@ TEST(DynamicField, IncrementalUpdatesEqualFullRebuilds) {
 TEST(DynamicField, EditsInSolidGroundEqualFullRebuilds) {
   const Box3i bounds = Box3i::from_size({70, 44, 66});
   const FieldCase cases[] = {
-      {Metric::kEuclidean, false, 12, Storage::kF32, false},  {Metric::kManhattan, false, 10, Storage::kU8, false},
-      {Metric::kChebyshev, false, 8, Storage::kU16, false},   {Metric::kEuclidean, false, 0, Storage::kU8, false},
+      {Metric::kEuclidean, false, 12, Storage::kF32, false},
+      {Metric::kManhattan, false, 10, Storage::kU8, false},
+      {Metric::kChebyshev, false, 8, Storage::kU16, false},
+      {Metric::kEuclidean, false, 0, Storage::kU8, false},
       {Metric::kEuclidean, false, 9, Storage::kU16, false, {1.0, 0.5, 1.5}},
   };
   std::uint32_t seed = 7;
   for (const FieldCase& c : cases) {
-    SCOPED_TRACE(std::string(metric_name(c.metric)) + " clamp " + std::to_string(c.clamp) + " " + storage_name(c.storage));
+    SCOPED_TRACE(std::string(metric_name(c.metric)) + " clamp " + std::to_string(c.clamp) + " " +
+                 storage_name(c.storage));
     std::mt19937 rng(seed++);
     World w(16, bounds);
     // Ground up to a wavy height with a few caves.
@@ -282,7 +335,10 @@ TEST(DynamicField, EditsInSolidGroundEqualFullRebuilds) {
         apply_edit(w, {EditOp::kPlace, BoxBrush{{x, 0, z}, {x, h, z}}, 2});
       }
     for (int i = 0; i < 6; ++i)
-      apply_edit(w, {EditOp::kCarve, SphereBrush{{5.0 + rng() % 60, 4.0 + rng() % 20, 5.0 + rng() % 56}, 2.0 + rng() % 4}, 1});
+      apply_edit(
+          w, {EditOp::kCarve,
+              SphereBrush{{5.0 + rng() % 60, 4.0 + rng() % 20, 5.0 + rng() % 56}, 2.0 + rng() % 4},
+              1});
     DistanceOptions o;
     o.metric = c.metric;
     o.max_distance = c.clamp;
@@ -292,10 +348,14 @@ TEST(DynamicField, EditsInSolidGroundEqualFullRebuilds) {
     DirtyRegions dirty(16, DirtyRegions::Track::kOccupancy);
     for (int i = 0; i < 120; ++i) {
       const double radius = static_cast<double>(rng() % 6);
-      const Vec3d at{static_cast<double>(rng() % 70), static_cast<double>(rng() % 40), static_cast<double>(rng() % 66)};
+      const Vec3d at{static_cast<double>(rng() % 70), static_cast<double>(rng() % 40),
+                     static_cast<double>(rng() % 66)};
       Edit e{i % 3 == 2 ? EditOp::kPlace : EditOp::kCarve, SphereBrush{at, radius}, 3};
-      if (i % 5 == 4) e.brush = BoxBrush{Vec3i{static_cast<int>(at.x), static_cast<int>(at.y), static_cast<int>(at.z)},
-                                         Vec3i{static_cast<int>(at.x) + 4, static_cast<int>(at.y) + 1, static_cast<int>(at.z) + 6}};
+      if (i % 5 == 4)
+        e.brush =
+            BoxBrush{Vec3i{static_cast<int>(at.x), static_cast<int>(at.y), static_cast<int>(at.z)},
+                     Vec3i{static_cast<int>(at.x) + 4, static_cast<int>(at.y) + 1,
+                           static_cast<int>(at.z) + 6}};
       apply_edit(w, e, &dirty);
       live.update(dirty);
       dirty.clear();
@@ -318,7 +378,8 @@ TEST(DynamicField, EditsInSolidGroundEqualFullRebuilds) {
   EXPECT_EQ(stats.voxels_recomputed, 7 * 7 * 7);
   EXPECT_EQ(stats.voxels_read, 9 * 9 * 9);
   expect_same_field(live.field(), compute_distance_field(w, o), bounds, 0);
-  EXPECT_NEAR(live.field().distance({35, 22, 33}), std::sqrt(10.0), 1e-6);  // to (35, 25, 32) and kin
+  EXPECT_NEAR(live.field().distance({35, 22, 33}), std::sqrt(10.0),
+              1e-6);  // to (35, 25, 32) and kin
 }
 
 // The voxels nearer a new site than to every old one need not be 26-connected on the grid (the
@@ -338,15 +399,17 @@ TEST(DynamicField, AffectedBoxSearchReachesDisconnectedPartsOfANewSitesCell) {
   const Box3i placed = Box3i::from_inclusive({6, 23, 25}, {6, 23, 25});
   w.voxels.set(placed.begin, 1);
   const DistanceField after = compute_distance_field(w, o);
-  const Box3i box = detail::grow_affected(detail::make_field_plan(w.voxels, o), std::get<Grid<float>>(before.values), bounds,
-                                          placed, bounds.volume());
+  const Box3i box =
+      detail::grow_affected(detail::make_field_plan(w.voxels, o),
+                            std::get<Grid<float>>(before.values), bounds, placed, bounds.volume());
   int changed = 0;
   for (int z = 0; z < 40; ++z)
     for (int y = 0; y < 40; ++y)
       for (int x = 0; x < 40; ++x)
         if (before.distance({x, y, z}) != after.distance({x, y, z})) {
           ++changed;
-          ASSERT_TRUE(box.contains(Vec3i{x, y, z})) << "voxel " << to_string(Vec3i{x, y, z}) << " changed outside " << to_string(box);
+          ASSERT_TRUE(box.contains(Vec3i{x, y, z}))
+              << "voxel " << to_string(Vec3i{x, y, z}) << " changed outside " << to_string(box);
         }
   EXPECT_GT(changed, 1000);
   EXPECT_LT(box.volume(), bounds.volume());  // the search did not just return the whole region
@@ -373,7 +436,7 @@ TEST(DynamicField, UpdatesStayLocal) {
   const auto stats = live.update(dirty);
   EXPECT_EQ(stats.regions, 1);
   EXPECT_EQ(stats.voxels_recomputed, 21 * 21 * 21);  // the 5^3 edit grown by 8 on every side
-  EXPECT_EQ(stats.voxels_read, 21 * 21 * 21);        // placing only adds sites: the box's own suffice
+  EXPECT_EQ(stats.voxels_read, 21 * 21 * 21);  // placing only adds sites: the box's own suffice
   EXPECT_EQ(live.field().distance({64, 64, 71}), 5);
   // Carving removes sites: values may rise, and need the sites up to 8 voxels farther. Only voxels
   // whose old distance reaches the carve can change, so the recomputed box is at most the 3^3
@@ -388,18 +451,21 @@ TEST(DynamicField, UpdatesStayLocal) {
   for (int z = 40; z < 90; ++z)
     for (int y = 40; y < 90; ++y)
       for (int x = 40; x < 90; ++x)
-        if (before.distance({x, y, z}) != after.distance({x, y, z})) moved = moved.unite(Box3i::from_inclusive({x, y, z}, {x, y, z}));
+        if (before.distance({x, y, z}) != after.distance({x, y, z}))
+          moved = moved.unite(Box3i::from_inclusive({x, y, z}, {x, y, z}));
   ASSERT_FALSE(moved.empty());
   const auto carved = live.update(dirty);
   EXPECT_LE(carved.voxels_recomputed, 19 * 19 * 19);
   EXPECT_GE(carved.voxels_recomputed, moved.volume());
-  const int side = static_cast<int>(std::lround(std::cbrt(static_cast<double>(carved.voxels_recomputed))));
-  EXPECT_EQ(carved.voxels_recomputed, side * side * side);      // a cube, by symmetry
+  const int side =
+      static_cast<int>(std::lround(std::cbrt(static_cast<double>(carved.voxels_recomputed))));
+  EXPECT_EQ(carved.voxels_recomputed, side * side * side);  // a cube, by symmetry
   // The sites: at most the box grown by 8 (less where whole chunks of it are air).
   EXPECT_LE(carved.voxels_read, (side + 16) * (side + 16) * (side + 16));
   EXPECT_GE(carved.voxels_read, carved.voxels_recomputed);
   EXPECT_EQ(live.field().distance({64, 64, 71}), 5);
-  EXPECT_NEAR(live.field().distance({64, 64, 64}), std::sqrt(2.0), 1e-6);  // to (65, 65, 64), still solid
+  EXPECT_NEAR(live.field().distance({64, 64, 64}), std::sqrt(2.0),
+              1e-6);  // to (65, 65, 64), still solid
   // Unbounded worlds without a domain are refused.
   World open;
   EXPECT_THROW(DynamicDistanceField(open, o), InvalidArgument);

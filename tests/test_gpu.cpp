@@ -41,9 +41,11 @@ World random_world(Vec3i size, int chunk_edge, double density, std::uint32_t see
   for (int z = 0; z < size.z; ++z)
     for (int y = 0; y < size.y; ++y)
       for (int x = 0; x < size.x; ++x)
-        if (u(rng) < density) w.voxels.set({x, y, z}, static_cast<std::uint8_t>(1 + (x + y + z) % 200));
+        if (u(rng) < density)
+          w.voxels.set({x, y, z}, static_cast<std::uint8_t>(1 + (x + y + z) % 200));
   // A solid block so that some chunks are uniform and some signed distances are long.
-  w.voxels.fill(Box3i{{0, 0, 0}, {std::min(size.x, 16), std::min(size.y, 16), std::min(size.z, 9)}}, 7);
+  w.voxels.fill(Box3i{{0, 0, 0}, {std::min(size.x, 16), std::min(size.y, 16), std::min(size.z, 9)}},
+                7);
   return w;
 }
 
@@ -54,7 +56,8 @@ std::vector<T> dense(const DistanceField& f) {
   return v;
 }
 
-void expect_same_field(const DistanceField& gpu_field, const DistanceField& cpu_field, const std::string& what) {
+void expect_same_field(const DistanceField& gpu_field, const DistanceField& cpu_field,
+                       const std::string& what) {
   ASSERT_EQ(gpu_field.domain, cpu_field.domain) << what;
   ASSERT_EQ(gpu_field.values.index(), cpu_field.values.index()) << what;
   EXPECT_EQ(gpu_field.encoding.scale, cpu_field.encoding.scale) << what;
@@ -67,8 +70,10 @@ void expect_same_field(const DistanceField& gpu_field, const DistanceField& cpu_
     const auto a = dense<float>(gpu_field), b = dense<float>(cpu_field);
     std::size_t off = 0;
     for (std::size_t i = 0; i < a.size(); ++i) {
-      const bool same = a[i] == b[i] || std::abs(a[i] - b[i]) <= gpu::kF32Tolerance * std::abs(b[i]);
-      if (!same && off++ < 5) ADD_FAILURE() << what << ": voxel " << i << " gpu " << a[i] << " cpu " << b[i];
+      const bool same =
+          a[i] == b[i] || std::abs(a[i] - b[i]) <= gpu::kF32Tolerance * std::abs(b[i]);
+      if (!same && off++ < 5)
+        ADD_FAILURE() << what << ": voxel " << i << " gpu " << a[i] << " cpu " << b[i];
     }
     EXPECT_EQ(off, 0u) << what;
   }
@@ -84,8 +89,9 @@ void expect_same_field(const DistanceField& gpu_field, const DistanceField& cpu_
     std::size_t off = 0;
     for (std::size_t i = 0; i < a.size(); ++i)
       if (!(a[i] == b[i]) && off++ < 5)
-        ADD_FAILURE() << what << ": voxel " << i << " site gpu (" << a[i].dx << "," << a[i].dy << "," << a[i].dz << ") cpu ("
-                      << b[i].dx << "," << b[i].dy << "," << b[i].dz << ")";
+        ADD_FAILURE() << what << ": voxel " << i << " site gpu (" << a[i].dx << "," << a[i].dy
+                      << "," << a[i].dz << ") cpu (" << b[i].dx << "," << b[i].dy << "," << b[i].dz
+                      << ")";
     EXPECT_EQ(off, 0u) << what << ": voxels with another nearest site";
   }
 }
@@ -125,8 +131,9 @@ TEST(Gpu, ExactFieldsEqualTheCpu) {
             o.max_distance = clamp;
             o.storage = st;
             o.nearest_sites = st == Storage::kU16;  // sites once per metric, sign and clamp
-            const std::string what = to_string(size) + " " + metric_name(m) + (sgn ? " signed" : "") + " clamp " +
-                                     std::to_string(clamp) + " " + storage_name(st) + (o.nearest_sites ? " sites" : "");
+            const std::string what = to_string(size) + " " + metric_name(m) +
+                                     (sgn ? " signed" : "") + " clamp " + std::to_string(clamp) +
+                                     " " + storage_name(st) + (o.nearest_sites ? " sites" : "");
             const gpu::Counters before = ctx->counters();
             const DistanceField g = gpu::compute_distance_field(*ctx, w, o);
             const gpu::Counters after = ctx->counters();
@@ -136,7 +143,8 @@ TEST(Gpu, ExactFieldsEqualTheCpu) {
           }
   }
   const auto messages = ctx->validation_messages();
-  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
 }
 
 TEST(Gpu, UnboundedWorldsAndEmptyDomains) {
@@ -150,7 +158,8 @@ TEST(Gpu, UnboundedWorldsAndEmptyDomains) {
     o.metric = m;
     o.max_distance = 5;
     o.storage = Storage::kU8;
-    expect_same_field(gpu::compute_distance_field(*ctx, w, o), compute_distance_field(w, o), metric_name(m));
+    expect_same_field(gpu::compute_distance_field(*ctx, w, o), compute_distance_field(w, o),
+                      metric_name(m));
   }
   const World empty(8);
   const DistanceField e = gpu::compute_distance_field(*ctx, empty, DistanceOptions{});
@@ -194,8 +203,10 @@ TEST(Gpu, IncrementalUpdatesEqualAFullRebuild) {
     double clamp;
     Storage storage;
   };
-  for (const Case& c : {Case{Metric::kEuclidean, false, 6, Storage::kU8}, Case{Metric::kManhattan, true, 5, Storage::kU16},
-                        Case{Metric::kChebyshev, false, 4, Storage::kF32}, Case{Metric::kEuclidean, true, 0, Storage::kF32},
+  for (const Case& c : {Case{Metric::kEuclidean, false, 6, Storage::kU8},
+                        Case{Metric::kManhattan, true, 5, Storage::kU16},
+                        Case{Metric::kChebyshev, false, 4, Storage::kF32},
+                        Case{Metric::kEuclidean, true, 0, Storage::kF32},
                         Case{Metric::kChebyshev, true, 5, Storage::kU8}}) {
     World w = random_world({53, 40, 34}, 8, 0.01, 21);
     DistanceOptions o;
@@ -204,8 +215,9 @@ TEST(Gpu, IncrementalUpdatesEqualAFullRebuild) {
     o.max_distance = c.clamp;
     o.storage = c.storage;
     o.nearest_sites = c.storage != Storage::kF32;  // and with sites kept up to date too
-    const std::string what = std::string(metric_name(c.metric)) + (c.is_signed ? " signed" : "") + " clamp " +
-                             std::to_string(c.clamp) + " " + storage_name(c.storage) + (o.nearest_sites ? " sites" : "");
+    const std::string what = std::string(metric_name(c.metric)) + (c.is_signed ? " signed" : "") +
+                             " clamp " + std::to_string(c.clamp) + " " + storage_name(c.storage) +
+                             (o.nearest_sites ? " sites" : "");
     gpu::DynamicField live(ctx, w, o);
     DirtyRegions dirty(w.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
     std::mt19937 rng(7);
@@ -229,13 +241,17 @@ TEST(Gpu, IncrementalUpdatesEqualAFullRebuild) {
       dirty.clear();
       EXPECT_LE(after.submits - before.submits, 1) << what;
       EXPECT_LE(after.fence_waits - before.fence_waits, 1) << what;
-      EXPECT_EQ(after.bytes_downloaded, before.bytes_downloaded) << what << ": read-back inside an update";
+      EXPECT_EQ(after.bytes_downloaded, before.bytes_downloaded)
+          << what << ": read-back inside an update";
       EXPECT_LE(after.bytes_uploaded - before.bytes_uploaded, changed_bytes) << what;
-      if (i % 6 == 5 || i == 24) expect_same_field(live.download(), compute_distance_field(w, o), what + " after edit " + std::to_string(i));
+      if (i % 6 == 5 || i == 24)
+        expect_same_field(live.download(), compute_distance_field(w, o),
+                          what + " after edit " + std::to_string(i));
     }
   }
   const auto messages = ctx->validation_messages();
-  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
 }
 
 namespace {
@@ -247,7 +263,8 @@ void expect_images_close(const Image& gpu_image, const Image& cpu_image, const s
   ASSERT_EQ(gpu_image.width, cpu_image.width);
   ASSERT_EQ(gpu_image.height, cpu_image.height);
   const test::ImageDiff d = test::compare_images(gpu_image, cpu_image, 8);
-  EXPECT_LE(d.off, d.pixels / 200) << what << ": " << d.off << " of " << d.pixels << " pixels differ by more than 8 levels";
+  EXPECT_LE(d.off, d.pixels / 200)
+      << what << ": " << d.off << " of " << d.pixels << " pixels differ by more than 8 levels";
   EXPECT_LT(d.mean, 0.1) << what;
 }
 
@@ -268,7 +285,8 @@ TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
     o.height = 96;
     for (RenderView view : {RenderView::kShaded, RenderView::kChunks, RenderView::kDistance}) {
       o.view = view;
-      for (const Camera& cam : {Camera::framing(scene.box(), 160.0 / 96), Camera::top(scene.box(), 160.0 / 96)}) {
+      for (const Camera& cam :
+           {Camera::framing(scene.box(), 160.0 / 96), Camera::top(scene.box(), 160.0 / 96)}) {
         const std::string what = std::string(metric_name(m)) + " " + render_view_name(view);
         const gpu::Counters before = ctx->counters();
         const Image g = gpu::render(*ctx, scene, cam, o);
@@ -285,13 +303,15 @@ TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
   const Camera cam = Camera::framing(scene.box(), 1.5);
   expect_images_close(gpu::render(*ctx, scene, cam, fog), render(scene, cam, fog), "fog");
   const auto messages = ctx->validation_messages();
-  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
   RenderOptions cut = fog;
   cut.view = RenderView::kDistance;
   for (int z : {3, 7, 39}) {  // just above the floor, a middle cut, the top layer
     cut.slice_z = z;
     expect_images_close(gpu::render(*ctx, scene, Camera::top(scene.box(), 1.5), cut),
-                        render(scene, Camera::top(scene.box(), 1.5), cut), "distance cut z=" + std::to_string(z));
+                        render(scene, Camera::top(scene.box(), 1.5), cut),
+                        "distance cut z=" + std::to_string(z));
   }
   cut.slice_z = 40;  // outside the box
   EXPECT_THROW(gpu::render(*ctx, scene, cam, cut), InvalidArgument);
@@ -303,7 +323,8 @@ TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
     error.error_algorithm = alg;
     RenderStats cpu_stats;
     const Image cpu_image = render(scene, cam, error, &cpu_stats);
-    expect_images_close(gpu::render(*ctx, scene, cam, error), cpu_image, std::string("error view ") + algorithm_name(alg));
+    expect_images_close(gpu::render(*ctx, scene, cam, error), cpu_image,
+                        std::string("error view ") + algorithm_name(alg));
     if (alg == Algorithm::kJfaSeed) {
       EXPECT_GT(cpu_stats.max_error, 0);  // the view has something to show
     }
@@ -329,13 +350,16 @@ TEST(Gpu, BrickPoolReusesAndGrowsCorrectly) {
   live.update(dirty);
   dirty.clear();
   for (int x = 0; x < 8; ++x)
-    for (int y = 2; y < 8; ++y) apply_edit(w, {EditOp::kPlace, SphereBrush{{x * 8.0 + 4, y * 8.0 + 4, 12}, 1}, 3}, &dirty);
+    for (int y = 2; y < 8; ++y)
+      apply_edit(w, {EditOp::kPlace, SphereBrush{{x * 8.0 + 4, y * 8.0 + 4, 12}, 1}, 3}, &dirty);
   const gpu::Counters before = ctx->counters();
   live.update(dirty);
   EXPECT_EQ(ctx->counters().submits - before.submits, 1);
-  expect_same_field(live.download(), compute_distance_field(w, o), "after freeing one slot and filling 48 chunks");
+  expect_same_field(live.download(), compute_distance_field(w, o),
+                    "after freeing one slot and filling 48 chunks");
   const auto messages = ctx->validation_messages();
-  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
 }
 
 TEST(Gpu, JumpFloodingEqualsTheCpu) {
@@ -353,7 +377,8 @@ TEST(Gpu, JumpFloodingEqualsTheCpu) {
         AlgorithmOptions a;
         a.algorithm = alg;
         AlgorithmStats gs, cs;
-        const std::string what = std::string(algorithm_name(alg)) + " " + metric_name(m) + (sgn ? " signed" : "");
+        const std::string what =
+            std::string(algorithm_name(alg)) + " " + metric_name(m) + (sgn ? " signed" : "");
         const DistanceField g = gpu::compute_distance_field(*ctx, w, o, a, &gs);
         const DistanceField c = compute_distance_field(w, o, a, &cs);
         expect_same_field(g, c, what);
@@ -367,7 +392,8 @@ TEST(Gpu, JumpFloodingEqualsTheCpu) {
   brute.algorithm = Algorithm::kBruteChunked;
   EXPECT_THROW(gpu::compute_distance_field(*ctx, w, DistanceOptions{}, brute), InvalidArgument);
   const auto messages = ctx->validation_messages();
-  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
 }
 
 TEST(Gpu, IterativeMethodsEqualTheCpu) {
@@ -392,13 +418,15 @@ TEST(Gpu, IterativeMethodsEqualTheCpu) {
         a.algorithm = alg;
         a.focus = Box3i{{10, 8, 4}, {22, 17, 12}};
         AlgorithmStats gs, cs;
-        const std::string what = std::string(algorithm_name(alg)) + " " + metric_name(m) + (sgn ? " signed" : "");
+        const std::string what =
+            std::string(algorithm_name(alg)) + " " + metric_name(m) + (sgn ? " signed" : "");
         const gpu::Counters before = ctx->counters();
         const DistanceField g = gpu::compute_distance_field(*ctx, w, o, a, &gs);
         const gpu::Counters after = ctx->counters();
         const DistanceField c = compute_distance_field(w, o, a, &cs);
         // No read-back decides anything: FIM is one submit per sign, hybrid and LOD add JFA's.
-        EXPECT_LE(after.submits - before.submits, (alg == Algorithm::kFim ? 1 : 2) * (sgn ? 2 : 1)) << what;
+        EXPECT_LE(after.submits - before.submits, (alg == Algorithm::kFim ? 1 : 2) * (sgn ? 2 : 1))
+            << what;
         EXPECT_GT(gs.iterations, 0) << what;
         if (m != Metric::kEuclidean) {
           expect_same_field(g, c, what);
@@ -407,7 +435,8 @@ TEST(Gpu, IterativeMethodsEqualTheCpu) {
         const auto a_values = dense<float>(g), b_values = dense<float>(c);
         ASSERT_EQ(a_values.size(), b_values.size());
         double worst = 0;
-        for (std::size_t i = 0; i < a_values.size(); ++i) worst = std::max(worst, std::abs(double{a_values[i]} - b_values[i]));
+        for (std::size_t i = 0; i < a_values.size(); ++i)
+          worst = std::max(worst, std::abs(double{a_values[i]} - b_values[i]));
         EXPECT_LE(worst, kFimTolerance) << what;
         // And a quantised copy moves by at most one step.
         o.storage = Storage::kU16;
@@ -422,12 +451,14 @@ TEST(Gpu, IterativeMethodsEqualTheCpu) {
   AlgorithmOptions fim;
   fim.algorithm = Algorithm::kFim;
   DistanceOptions o;
-  expect_same_field(gpu::compute_distance_field(*ctx, empty, o, fim), compute_distance_field(empty, o, fim), "no sites");
+  expect_same_field(gpu::compute_distance_field(*ctx, empty, o, fim),
+                    compute_distance_field(empty, o, fim), "no sites");
   DistanceOptions sites;
   sites.nearest_sites = true;
   EXPECT_THROW(gpu::compute_distance_field(*ctx, w, sites, fim), InvalidArgument);
   const auto messages = ctx->validation_messages();
-  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
 }
 
 // An application's own device (the demo's case), made here through the loader directly.
@@ -435,9 +466,11 @@ TEST(Gpu, AdoptsAnApplicationsDevice) {
   if (!gpu_tests_wanted()) GTEST_SKIP();
   void* loader = dlopen("libvulkan.so.1", RTLD_NOW | RTLD_LOCAL);
   ASSERT_NE(loader, nullptr);
-  const auto get_instance_proc = reinterpret_cast<PFN_vkGetInstanceProcAddr>(dlsym(loader, "vkGetInstanceProcAddr"));
+  const auto get_instance_proc =
+      reinterpret_cast<PFN_vkGetInstanceProcAddr>(dlsym(loader, "vkGetInstanceProcAddr"));
   ASSERT_NE(get_instance_proc, nullptr);
-  const auto create_instance = reinterpret_cast<PFN_vkCreateInstance>(get_instance_proc(nullptr, "vkCreateInstance"));
+  const auto create_instance =
+      reinterpret_cast<PFN_vkCreateInstance>(get_instance_proc(nullptr, "vkCreateInstance"));
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.apiVersion = VK_API_VERSION_1_1;
   VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
@@ -445,7 +478,8 @@ TEST(Gpu, AdoptsAnApplicationsDevice) {
   VkInstance instance = VK_NULL_HANDLE;
   ASSERT_EQ(create_instance(&ici, nullptr, &instance), VK_SUCCESS);
   auto fn = [&](const char* name) { return get_instance_proc(instance, name); };
-  const auto enumerate = reinterpret_cast<PFN_vkEnumeratePhysicalDevices>(fn("vkEnumeratePhysicalDevices"));
+  const auto enumerate =
+      reinterpret_cast<PFN_vkEnumeratePhysicalDevices>(fn("vkEnumeratePhysicalDevices"));
   const auto families_of = reinterpret_cast<PFN_vkGetPhysicalDeviceQueueFamilyProperties>(
       fn("vkGetPhysicalDeviceQueueFamilyProperties"));
   const auto create_device = reinterpret_cast<PFN_vkCreateDevice>(fn("vkCreateDevice"));
@@ -482,7 +516,8 @@ TEST(Gpu, AdoptsAnApplicationsDevice) {
     o.metric = Metric::kEuclidean;
     o.storage = Storage::kU16;
     o.max_distance = 9;
-    expect_same_field(gpu::compute_distance_field(*ctx, w, o), compute_distance_field(w, o), "adopted device");
+    expect_same_field(gpu::compute_distance_field(*ctx, w, o), compute_distance_field(w, o),
+                      "adopted device");
     EXPECT_THROW(gpu::adopt({instance, physical, VK_NULL_HANDLE, queue, family}), InvalidArgument);
   }  // the context is gone; the application's device and instance are still ours to destroy
   destroy_device(device, nullptr);
@@ -512,15 +547,21 @@ TEST(Gpu, ResidentScenesFollowEditsWithOnlyTheirChunksCopied) {
   gpu::Counters before = ctx->counters();
   EXPECT_FALSE(renderer.sync(live.scene()));
   EXPECT_EQ(ctx->counters().submits, before.submits);
-  const std::int64_t chunk_bytes = 8 * 8 * 8 * (2 + 1);  // skip cells (u16) + lighting (u8) per chunk
+  const std::int64_t chunk_bytes =
+      8 * 8 * 8 * (2 + 1);  // skip cells (u16) + lighting (u8) per chunk
   std::mt19937 rng(8);
   auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
   DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
   for (int batch = 0; batch < 6; ++batch) {
     for (int k = 0; k < 3; ++k) {
-      const EditOp op = uni(0, 2) == 0 ? EditOp::kCarve : uni(0, 1) ? EditOp::kPlace : EditOp::kPaint;
-      apply_edit(w, {op, SphereBrush{{uni(0, 63) * 1.0, uni(0, 47) * 1.0, uni(0, 20) * 1.0}, uni(1, 5) * 1.0},
-                     static_cast<std::uint8_t>(uni(1, 255))}, &dirty);
+      const EditOp op = uni(0, 2) == 0 ? EditOp::kCarve
+                        : uni(0, 1)    ? EditOp::kPlace
+                                       : EditOp::kPaint;
+      apply_edit(
+          w,
+          {op, SphereBrush{{uni(0, 63) * 1.0, uni(0, 47) * 1.0, uni(0, 20) * 1.0}, uni(1, 5) * 1.0},
+           static_cast<std::uint8_t>(uni(1, 255))},
+          &dirty);
     }
     const DynamicRenderScene::UpdateStats st = live.update(dirty);
     dirty.clear();
@@ -539,7 +580,8 @@ TEST(Gpu, ResidentScenesFollowEditsWithOnlyTheirChunksCopied) {
     EXPECT_EQ(incremental.rgb, gpu::render(*ctx, fresh, cam, o).rgb) << "batch " << batch;
   }
   const auto messages = ctx->validation_messages();
-  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: " << messages.front();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
   gpu::SceneRenderer unsynced(ctx);
   EXPECT_THROW(unsynced.render(cam, o), InvalidArgument);
 
@@ -552,7 +594,8 @@ TEST(Gpu, ResidentScenesFollowEditsWithOnlyTheirChunksCopied) {
   r2.sync(growing.scene());
   for (int round = 0; round < 3; ++round) {
     DirtyRegions d(8, DirtyRegions::Track::kAnyChange);
-    apply_edit(sparse, {EditOp::kPlace, SphereBrush{{12.0 + 20 * round, 30, 12}, 9 + 2.0 * round}, 40}, &d);
+    apply_edit(sparse,
+               {EditOp::kPlace, SphereBrush{{12.0 + 20 * round, 30, 12}, 9 + 2.0 * round}, 40}, &d);
     const DynamicRenderScene::UpdateStats st = growing.update(d);
     before = ctx->counters();
     r2.sync(growing.scene());

@@ -36,7 +36,8 @@ TEST(GpuErrors, VulkanResultsMapToTheirTier) {
 }
 
 TEST(GpuErrors, ALostDeviceRefusesEveryLaterCall) {
-  if (!gpu::built_with_vulkan() || std::getenv("VOXFIELD_SKIP_GPU_TESTS")) GTEST_SKIP() << "no Vulkan backend";
+  if (!gpu::built_with_vulkan() || std::getenv("VOXFIELD_SKIP_GPU_TESTS"))
+    GTEST_SKIP() << "no Vulkan backend";
   std::shared_ptr<gpu::Context> ctx;
   try {
     ctx = gpu::Context::create();
@@ -115,7 +116,8 @@ double manhattan_at(gpu::Context& ctx, const World& world, Vec3i p) {
 // entry points whatever the order (adopting once replaced the process-wide table, and the first
 // context's teardown then called a null vkDestroyDebugUtilsMessengerEXT).
 TEST(GpuErrors, ContextsOnDifferentInstancesComputeAndTearDownInAnyOrder) {
-  if (!gpu::built_with_vulkan() || std::getenv("VOXFIELD_SKIP_GPU_TESTS")) GTEST_SKIP() << "no Vulkan backend";
+  if (!gpu::built_with_vulkan() || std::getenv("VOXFIELD_SKIP_GPU_TESTS"))
+    GTEST_SKIP() << "no Vulkan backend";
   std::shared_ptr<gpu::Context> validated;
   try {
     gpu::ContextOptions o;
@@ -127,7 +129,8 @@ TEST(GpuErrors, ContextsOnDifferentInstancesComputeAndTearDownInAnyOrder) {
   World world(16, Box3i::from_size({16, 16, 16}));
   world.voxels.set({3, 4, 5}, 9);
   for (const bool adopted_first_out : {true, false}) {
-    SCOPED_TRACE(adopted_first_out ? "adopted context destroyed first" : "validated context destroyed first");
+    SCOPED_TRACE(adopted_first_out ? "adopted context destroyed first"
+                                   : "validated context destroyed first");
     if (!validated) {
       gpu::ContextOptions o;
       o.validation = true;
@@ -140,11 +143,14 @@ TEST(GpuErrors, ContextsOnDifferentInstancesComputeAndTearDownInAnyOrder) {
     EXPECT_EQ(manhattan_at(*validated, world, {3, 4, 8}), 3.0);
     if (adopted_first_out) {
       adopted.reset();
-      EXPECT_EQ(manhattan_at(*validated, world, {5, 4, 5}), 2.0);  // still works on its own instance
-      EXPECT_TRUE(validated->validation_messages().empty()) << validated->validation_messages().front();
+      EXPECT_EQ(manhattan_at(*validated, world, {5, 4, 5}),
+                2.0);  // still works on its own instance
+      EXPECT_TRUE(validated->validation_messages().empty())
+          << validated->validation_messages().front();
       validated.reset();
     } else {
-      EXPECT_TRUE(validated->validation_messages().empty()) << validated->validation_messages().front();
+      EXPECT_TRUE(validated->validation_messages().empty())
+          << validated->validation_messages().front();
       validated.reset();
       EXPECT_EQ(manhattan_at(*adopted, world, {5, 4, 5}), 2.0);
       adopted.reset();

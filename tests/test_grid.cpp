@@ -178,7 +178,8 @@ TEST_P(GridEdges, GenerateChunksAndParallelIteration) {
   std::vector<Vec3i> coords{{0, 0, 0}, {-1, 2, 0}, {3, -4, 1}};
   g.generate_chunks(coords, [&](Vec3i c, float* v) {
     const std::int64_t n = std::int64_t{edge} * edge * edge;
-    for (std::int64_t i = 0; i < n; ++i) v[i] = c.x == 3 ? 2.0f : (c.x == 0 ? 1.5f : static_cast<float>(i % 7));
+    for (std::int64_t i = 0; i < n; ++i)
+      v[i] = c.x == 3 ? 2.0f : (c.x == 0 ? 1.5f : static_cast<float>(i % 7));
   });
   // Chunk (0,0,0) came out uniform background: not stored. (3,-4,1) uniform 2: one value.
   EXPECT_EQ(g.chunk_count(), 2u);

@@ -7,8 +7,8 @@
 #include <cstring>
 #include <string>
 
-#include "vox_builder.h"
 #include "error_text.h"
+#include "vox_builder.h"
 #include "voxfield/limits.h"
 #include "voxfield/npy.h"
 #include "voxfield/vox.h"
@@ -35,16 +35,24 @@ Bytes npy(std::string header, const Bytes& data) {
 
 }  // namespace
 
-// Class 1: a shape whose product wraps past 2^64 used to pass the size check and overrun the reorder.
+// Class 1: a shape whose product wraps past 2^64 used to pass the size check and overrun the
+// reorder.
 TEST(HostileNpy, ShapeProductsNeverWrap) {
   // 2^22 x 2^21 x 2^21 = 2^64 exactly: wraps to 0 in 64 bits, which used to pass the size check.
-  const std::string wraps = "{'descr': '|u1', 'fortran_order': False, 'shape': (4194304, 2097152, 2097152), }";
-  EXPECT_NE(error_of([&] { parse_npy(npy(wraps, Bytes(64, 1)), "wrap.npy"); }).find("more than 2^64"), std::string::npos);
+  const std::string wraps =
+      "{'descr': '|u1', 'fortran_order': False, 'shape': (4194304, 2097152, 2097152), }";
+  EXPECT_NE(
+      error_of([&] { parse_npy(npy(wraps, Bytes(64, 1)), "wrap.npy"); }).find("more than 2^64"),
+      std::string::npos);
   // A dimension beyond the coordinate range is refused on its own.
-  const std::string wide = "{'descr': '|u1', 'fortran_order': False, 'shape': (1073741824, 1, 1), }";
-  EXPECT_NE(error_of([&] { parse_npy(npy(wide, Bytes(64, 1)), "wide.npy"); }).find("outside 1..2^29"), std::string::npos);
+  const std::string wide =
+      "{'descr': '|u1', 'fortran_order': False, 'shape': (1073741824, 1, 1), }";
+  EXPECT_NE(
+      error_of([&] { parse_npy(npy(wide, Bytes(64, 1)), "wide.npy"); }).find("outside 1..2^29"),
+      std::string::npos);
   // Every dimension in range, the product 2^87 bytes: refused as data the file does not hold.
-  const std::string big = "{'descr': '<f8', 'fortran_order': False, 'shape': (536870912, 536870912, 536870912), }";
+  const std::string big =
+      "{'descr': '<f8', 'fortran_order': False, 'shape': (536870912, 536870912, 536870912), }";
   const std::string msg = error_of([&] { parse_npy(npy(big, Bytes(64, 1)), "big.npy"); });
   EXPECT_NE(msg.find("big.npy"), std::string::npos) << msg;
   EXPECT_NE(msg.find("more than 2^64"), std::string::npos) << msg;
@@ -52,23 +60,32 @@ TEST(HostileNpy, ShapeProductsNeverWrap) {
   const std::string fits = "{'descr': '|u1', 'fortran_order': True, 'shape': (1024, 1024, 64), }";
   NpyReadOptions tight;
   tight.memory_limit_bytes = 16 * kMiB;
-  EXPECT_THROW(parse_npy(npy(fits, Bytes(std::size_t{1024} * 1024 * 64, 0)), "fits.npy", tight), ResourceLimitError);
+  EXPECT_THROW(parse_npy(npy(fits, Bytes(std::size_t{1024} * 1024 * 64, 0)), "fits.npy", tight),
+               ResourceLimitError);
 }
 
 TEST(HostileNpy, DeliberateAcceptancesAndRefusals) {
   // int64 (NumPy's default integer) is read.
   Bytes d(8 * 8, 0);
   d[8] = 3;  // element 1 = 3
-  const NpyVolume v = parse_npy(npy("{'descr': '<i8', 'fortran_order': True, 'shape': (2, 2, 2), }", d), "i8.npy");
+  const NpyVolume v =
+      parse_npy(npy("{'descr': '<i8', 'fortran_order': True, 'shape': (2, 2, 2), }", d), "i8.npy");
   EXPECT_EQ(v.dtype, DType::kInt64);
   EXPECT_EQ(v.value(1), 3.0);
   // A key given twice, and bytes after the data, are refused.
+  EXPECT_NE(
+      error_of([] {
+        parse_npy(
+            npy("{'descr': '|u1', 'descr': '|u1', 'fortran_order': True, 'shape': (1, 1, 1), }",
+                Bytes(1, 0)),
+            "dup.npy");
+      }).find("given twice"),
+      std::string::npos);
   EXPECT_NE(error_of([] {
-              parse_npy(npy("{'descr': '|u1', 'descr': '|u1', 'fortran_order': True, 'shape': (1, 1, 1), }", Bytes(1, 0)), "dup.npy");
-            }).find("given twice"),
-            std::string::npos);
-  EXPECT_NE(error_of([] { parse_npy(npy("{'descr': '|u1', 'fortran_order': True, 'shape': (1, 1, 1), }", Bytes(5, 0)), "t.npy"); })
-                .find("4 bytes after the array data"),
+              parse_npy(
+                  npy("{'descr': '|u1', 'fortran_order': True, 'shape': (1, 1, 1), }", Bytes(5, 0)),
+                  "t.npy");
+            }).find("4 bytes after the array data"),
             std::string::npos);
 }
 
@@ -88,10 +105,11 @@ TEST(HostileNpy, ValueErrorsNameTheElementAndItsByteOffset) {
 // Class 2: two legal one-voxel instances at -2^30 and +2^30 made a world 2^31 + 1 wide.
 TEST(HostileVox, InstancesOutsideTheCoordinateRangeAreRefused) {
   auto scene = [](int a, int b) {
-    return vox_file({size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}),
-                     transform_chunk(0, 1, -1, {}), group_chunk(1, {2, 4}),
-                     transform_chunk(2, 3, 0, {{"_t", std::to_string(a) + " 0 0"}}), shape_chunk(3, 0),
-                     transform_chunk(4, 5, 0, {{"_t", std::to_string(b) + " 0 0"}}), shape_chunk(5, 0)});
+    return vox_file(
+        {size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}), transform_chunk(0, 1, -1, {}),
+         group_chunk(1, {2, 4}), transform_chunk(2, 3, 0, {{"_t", std::to_string(a) + " 0 0"}}),
+         shape_chunk(3, 0), transform_chunk(4, 5, 0, {{"_t", std::to_string(b) + " 0 0"}}),
+         shape_chunk(5, 0)});
   };
   const std::string msg = error_of([&] { parse_vox(scene(-(1 << 30), 1 << 30), "far.vox"); });
   EXPECT_NE(msg.find("far.vox"), std::string::npos) << msg;
@@ -107,17 +125,21 @@ TEST(HostileVox, InstancesOutsideTheCoordinateRangeAreRefused) {
 // refused under a 64 MiB limit before the chunks are allocated, read under a larger one.
 // The same below z = -2^28, where packed chunk keys used to collide and count one chunk.
 class HostileVoxSwarm : public ::testing::TestWithParam<int> {};
-INSTANTIATE_TEST_SUITE_P(RootOffsets, HostileVoxSwarm, ::testing::Values(0, -(1 << 28), (1 << 28) + 12345));
+INSTANTIATE_TEST_SUITE_P(RootOffsets, HostileVoxSwarm,
+                         ::testing::Values(0, -(1 << 28), (1 << 28) + 12345));
 
 TEST_P(HostileVoxSwarm, ManyInstancesInDistinctChunksAreCountedBeforePlacing) {
-  std::vector<Bytes> parts{size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}),
-                           transform_chunk(0, 1, -1, {{"_t", "0 0 " + std::to_string(GetParam())}})};
+  std::vector<Bytes> parts{
+      size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}),
+      transform_chunk(0, 1, -1, {{"_t", "0 0 " + std::to_string(GetParam())}})};
   std::vector<int> children;
   const int n = 4096;
   for (int i = 0; i < n; ++i) children.push_back(2 + 2 * i);
   parts.push_back(group_chunk(1, children));
   for (int i = 0; i < n; ++i) {
-    parts.push_back(transform_chunk(2 + 2 * i, 3 + 2 * i, 0, {{"_t", std::to_string(64 * (i % 64)) + " " + std::to_string(64 * (i / 64)) + " 0"}}));
+    parts.push_back(transform_chunk(
+        2 + 2 * i, 3 + 2 * i, 0,
+        {{"_t", std::to_string(64 * (i % 64)) + " " + std::to_string(64 * (i / 64)) + " 0"}}));
     parts.push_back(shape_chunk(3 + 2 * i, 0));
   }
   const Bytes file = vox_file(parts);
@@ -138,7 +160,9 @@ TEST(HostileVox, CompressedModelsAreCountedBeforeInflating) {
   Bytes zeros(static_cast<std::size_t>(e) * e * e, 0);
   uLongf packed_size = compressBound(static_cast<uLong>(zeros.size()));
   Bytes packed(packed_size);
-  ASSERT_EQ(compress2(packed.data(), &packed_size, zeros.data(), static_cast<uLong>(zeros.size()), 9), Z_OK);
+  ASSERT_EQ(
+      compress2(packed.data(), &packed_size, zeros.data(), static_cast<uLong>(zeros.size()), 9),
+      Z_OK);
   packed.resize(packed_size);
   Bytes c;
   for (int k = 0; k < 3; ++k) put32(c, e);
@@ -155,23 +179,31 @@ TEST(HostileVox, CompressedModelsAreCountedBeforeInflating) {
 TEST(HostileVox, DeliberateLeniencies) {
   const Bytes model_chunks[] = {size_chunk(2, 2, 2), xyzi_chunk({{1, 1, 1, 5}})};
   auto with_rotation = [&](const std::string& r) {
-    return vox_file({model_chunks[0], model_chunks[1], transform_chunk(0, 1, -1, {{"_r", r}}), shape_chunk(1, 0)});
+    return vox_file({model_chunks[0], model_chunks[1], transform_chunk(0, 1, -1, {{"_r", r}}),
+                     shape_chunk(1, 0)});
   };
   EXPECT_NO_THROW(parse_vox(with_rotation("4"), "r.vox"));
-  EXPECT_NE(error_of([&] { parse_vox(with_rotation("4x"), "r.vox"); }).find("bad rotation"), std::string::npos);
+  EXPECT_NE(error_of([&] { parse_vox(with_rotation("4x"), "r.vox"); }).find("bad rotation"),
+            std::string::npos);
   // Bytes after MAIN are refused; old versions are refused; newer ones are read.
   Bytes trailing = vox_file({model_chunks[0], model_chunks[1]});
   trailing.push_back(0);
-  EXPECT_NE(error_of([&] { parse_vox(trailing, "t.vox"); }).find("1 bytes after the MAIN chunk"), std::string::npos);
-  EXPECT_THROW(parse_vox(vox_file({model_chunks[0], model_chunks[1]}, 100), "old.vox"), FormatError);
-  EXPECT_EQ(parse_vox(vox_file({model_chunks[0], model_chunks[1]}, 201), "new.vox").world.solid_count(), 1);
+  EXPECT_NE(error_of([&] { parse_vox(trailing, "t.vox"); }).find("1 bytes after the MAIN chunk"),
+            std::string::npos);
+  EXPECT_THROW(parse_vox(vox_file({model_chunks[0], model_chunks[1]}, 100), "old.vox"),
+               FormatError);
+  EXPECT_EQ(
+      parse_vox(vox_file({model_chunks[0], model_chunks[1]}, 201), "new.vox").world.solid_count(),
+      1);
 }
 
 namespace {
 
 // Recomputes a .vfw's header and section checksums after a test has patched its bytes.
 void fix_checksums(Bytes& b) {
-  auto crc = [](const std::uint8_t* p, std::size_t n) { return static_cast<std::uint32_t>(crc32(0, p, static_cast<uInt>(n))); };
+  auto crc = [](const std::uint8_t* p, std::size_t n) {
+    return static_cast<std::uint32_t>(crc32(0, p, static_cast<uInt>(n)));
+  };
   std::uint32_t sections;
   std::memcpy(&sections, b.data() + 12, 4);
   const std::uint32_t h = crc(b.data(), 16);
@@ -189,7 +221,9 @@ void fix_checksums(Bytes& b) {
 // The world section's grid starts after the section header (12 bytes) and the palette (1024).
 constexpr std::size_t kGridAt = 20 + 12 + 1024;
 
-void put_i32(Bytes& b, std::size_t at, std::int32_t v) { std::memcpy(b.data() + at, &v, 4); }
+void put_i32(Bytes& b, std::size_t at, std::int32_t v) {
+  std::memcpy(b.data() + at, &v, 4);
+}
 
 }  // namespace
 
@@ -206,7 +240,10 @@ TEST(HostileWorldFile, CoordinatesBoundsAndDuplicatesAreChecked) {
   put_i32(b, bounds_at, INT32_MIN);
   put_i32(b, bounds_at + 12, INT32_MAX);
   fix_checksums(b);
-  EXPECT_NE(error_of([&] { parse_world_file(b, "b.vfw"); }).find("outside the supported coordinate range"), std::string::npos);
+  EXPECT_NE(error_of([&] {
+              parse_world_file(b, "b.vfw");
+            }).find("outside the supported coordinate range"),
+            std::string::npos);
 
   // Unbounded copies: a uniform chunk at (-2^31, 0, 0) must not appear at the origin.
   World u(8);
@@ -217,7 +254,10 @@ TEST(HostileWorldFile, CoordinatesBoundsAndDuplicatesAreChecked) {
   b = ugood;
   put_i32(b, uchunk_at, INT32_MIN);
   fix_checksums(b);
-  EXPECT_NE(error_of([&] { parse_world_file(b, "far.vfw"); }).find("outside the supported coordinate range"), std::string::npos);
+  EXPECT_NE(error_of([&] {
+              parse_world_file(b, "far.vfw");
+            }).find("outside the supported coordinate range"),
+            std::string::npos);
   b = ugood;  // a chunk coordinate whose voxels overflow 32 bits (2^28 chunks of 8)
   put_i32(b, uchunk_at, 1 << 28);
   fix_checksums(b);
@@ -225,7 +265,8 @@ TEST(HostileWorldFile, CoordinatesBoundsAndDuplicatesAreChecked) {
   b = ugood;  // the second chunk given the first one's coordinate
   put_i32(b, uchunk_at + 12 + 1 + 1, 0);
   fix_checksums(b);
-  EXPECT_NE(error_of([&] { parse_world_file(b, "dup.vfw"); }).find("appears twice"), std::string::npos);
+  EXPECT_NE(error_of([&] { parse_world_file(b, "dup.vfw"); }).find("appears twice"),
+            std::string::npos);
   (void)chunk_at;
 }
 
@@ -247,12 +288,15 @@ TEST(HostileWorldFile, UniformChunksCutByTheBoundsAreCountedAsDense) {
   // Bounds one voxel thick through 64 chunks of edge 128, each chunk a 14-byte uniform record:
   // every one becomes a dense 2 MiB chunk (the part outside the bounds reads the background).
   Bytes grid;
-  auto put = [&](const void* p, std::size_t n) { grid.insert(grid.end(), (const std::uint8_t*)p, (const std::uint8_t*)p + n); };
+  auto put = [&](const void* p, std::size_t n) {
+    grid.insert(grid.end(), (const std::uint8_t*)p, (const std::uint8_t*)p + n);
+  };
   const std::uint32_t edge = 128, vsize = 1;
   const std::uint8_t background = 0, flag = 1, uniform = 0, value = 5;
   const std::int32_t bounds[6] = {0, 0, 0, 1, 1024, 1024};
   const std::uint64_t count = 64;
-  put(&edge, 4), put(&vsize, 4), put(&background, 1), put(&flag, 1), put(bounds, 24), put(&count, 8);
+  put(&edge, 4), put(&vsize, 4), put(&background, 1), put(&flag, 1), put(bounds, 24),
+      put(&count, 8);
   for (std::int32_t y = 0; y < 8; ++y)
     for (std::int32_t z = 0; z < 8; ++z) {
       const std::int32_t c[3] = {0, y, z};
@@ -300,5 +344,6 @@ TEST(HostileWorldFile, FieldOptionsAreValidated) {
   Bytes inv = good;  // domain begin.x = 9 > end.x = 8
   put_i32(inv, field_at + 44, 9);
   fix_checksums(inv);
-  EXPECT_NE(error_of([&] { parse_world_file(inv, "f.vfw"); }).find("inverted field domain"), std::string::npos);
+  EXPECT_NE(error_of([&] { parse_world_file(inv, "f.vfw"); }).find("inverted field domain"),
+            std::string::npos);
 }

@@ -6,9 +6,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include "error_text.h"
 #include "voxfield/edit_script.h"
 #include "voxfield/file.h"
-#include "error_text.h"
 #include "voxfield/limits.h"
 #include "voxfield/world_file.h"
 #include "voxfield/world_io.h"
@@ -20,7 +20,8 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path temp_dir(const char* name) {
-  const fs::path d = fs::temp_directory_path() / ("voxfield_hostile_" + std::string(name) + "_" + std::to_string(::getpid()));
+  const fs::path d = fs::temp_directory_path() /
+                     ("voxfield_hostile_" + std::string(name) + "_" + std::to_string(::getpid()));
   fs::create_directories(d);
   return d;
 }
@@ -35,7 +36,8 @@ TEST(CoordinateRange, SizesAndVolumesNeverOverflow) {
   EXPECT_FALSE(all.in_range());
   EXPECT_EQ(kCoordRange.size().x, 1 << 30);  // exact inside the range
   EXPECT_TRUE(kCoordRange.in_range());
-  EXPECT_EQ((Box3i{{0, 0, 0}, {1 << 21, 1 << 21, 1 << 21}}.volume()), INT64_MAX);  // 2^63 does not fit
+  EXPECT_EQ((Box3i{{0, 0, 0}, {1 << 21, 1 << 21, 1 << 21}}.volume()),
+            INT64_MAX);  // 2^63 does not fit
   EXPECT_EQ((Box3i{{0, 0, 0}, {1 << 20, 1 << 20, 1 << 20}}.volume()), std::int64_t{1} << 60);
 }
 
@@ -50,7 +52,8 @@ TEST(CoordinateRange, GridsRefuseVoxelsChunksAndBoundsOutside) {
   EXPECT_FALSE(g.chunk_in_range({kCoordLimit >> 3, 0, 0}));
   EXPECT_FALSE(g.chunk_in_range({INT32_MIN, 0, 0}));
   EXPECT_THROW(g.edit_chunk({INT32_MIN, 0, 0}, [](auto&) {}), InvalidArgument);
-  EXPECT_THROW(Grid<std::uint8_t>(8, 0, Box3i{{0, 0, 0}, {kCoordLimit + 1, 1, 1}}), InvalidArgument);
+  EXPECT_THROW(Grid<std::uint8_t>(8, 0, Box3i{{0, 0, 0}, {kCoordLimit + 1, 1, 1}}),
+               InvalidArgument);
 }
 
 TEST(CoordinateRange, FieldsOverHugeDomainsAreRefusedBeforeAllocating) {
@@ -80,18 +83,22 @@ TEST(MemoryLimit, SizesParseAndRefusalsSayWhatAndWhy) {
   EXPECT_EQ(default_memory_limit(), 1000u);
   set_default_memory_limit(0);
   EXPECT_NE(default_memory_limit(), 1000u);
-  const std::string msg = error_of([] { require_memory(3u << 30, 1u << 30, "x.vox", "its chunks"); });
-  EXPECT_EQ(msg, "x.vox: its chunks needs 3.0 GiB, more than the memory limit of 1.0 GiB "
-                 "(raise it with --memory-limit or VOXFIELD_MEMORY_LIMIT)");
+  const std::string msg =
+      error_of([] { require_memory(3u << 30, 1u << 30, "x.vox", "its chunks"); });
+  EXPECT_EQ(msg,
+            "x.vox: its chunks needs 3.0 GiB, more than the memory limit of 1.0 GiB "
+            "(raise it with --memory-limit or VOXFIELD_MEMORY_LIMIT)");
 }
 
 TEST(EditScripts, SemanticsAreCheckedAtParseTimeWithTheLine) {
   auto parse = [](const std::string& text) {
     EditScriptOptions o;
     o.load_stamps = false;
-    return parse_edit_script(std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()), "e.jsonl", o);
+    return parse_edit_script(
+        std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()), "e.jsonl", o);
   };
-  const std::string ok = R"({"op":"place","shape":"sphere","center":[1,2,3],"radius":2,"material":4})";
+  const std::string ok =
+      R"({"op":"place","shape":"sphere","center":[1,2,3],"radius":2,"material":4})";
   ASSERT_EQ(parse(ok + "\n\n" + ok).size(), 2u);
   const struct {
     const char* line;
@@ -99,11 +106,16 @@ TEST(EditScripts, SemanticsAreCheckedAtParseTimeWithTheLine) {
   } bad[] = {
       {R"({"op":"place","shape":"sphere","center":[1,2,3],"radius":-1})", "\"radius\" is -1"},
       {R"({"op":"place","shape":"box","min":[5,0,0],"max":[4,3,3]})", "exceeds \"max\""},
-      {R"({"op":"place","shape":"rotated-box","center":[0,0,0],"half_extent":[1,-2,1]})", "\"half_extent\" is -2"},
-      {R"({"op":"paint","shape":"sphere","center":[0,0,0],"radius":1,"material":0})", "\"material\" 0 is air"},
-      {R"({"op":"place","shape":"sphere","center":[0,0,0],"radius":1,"material":1.5})", "must be an integer"},
-      {R"({"op":"place","shape":"sphere","center":[2147483648,0,0],"radius":1})", "\"center\" is 2147483648"},
-      {R"({"op":"place","shape":"sphere","center":[1e300,0,0],"radius":1})", "\"center\" is 1e+300"},
+      {R"({"op":"place","shape":"rotated-box","center":[0,0,0],"half_extent":[1,-2,1]})",
+       "\"half_extent\" is -2"},
+      {R"({"op":"paint","shape":"sphere","center":[0,0,0],"radius":1,"material":0})",
+       "\"material\" 0 is air"},
+      {R"({"op":"place","shape":"sphere","center":[0,0,0],"radius":1,"material":1.5})",
+       "must be an integer"},
+      {R"({"op":"place","shape":"sphere","center":[2147483648,0,0],"radius":1})",
+       "\"center\" is 2147483648"},
+      {R"({"op":"place","shape":"sphere","center":[1e300,0,0],"radius":1})",
+       "\"center\" is 1e+300"},
       {R"({"op":"place","shape":"sphere","centre":[0,0,0],"radius":1})", "unknown key \"centre\""},
       {R"({"op":"place","shape":"capsule","a":[0,0,0],"b":[1,1,1]})", "missing \"radius\""},
       {R"({"op":"melt","shape":"sphere"})", "unknown op"},
@@ -115,11 +127,14 @@ TEST(EditScripts, SemanticsAreCheckedAtParseTimeWithTheLine) {
   };
   for (const auto& b : bad) {
     const std::string msg = error_of([&] { parse(ok + "\n" + b.line + "\n"); });
-    EXPECT_NE(msg.find("e.jsonl: at byte " + std::to_string(ok.size() + 1) + ": line 2: "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("e.jsonl: at byte " + std::to_string(ok.size() + 1) + ": line 2: "),
+              std::string::npos)
+        << msg;
     EXPECT_NE(msg.find(b.says), std::string::npos) << b.line << " -> " << msg;
   }
   const fs::path dir = temp_dir("script");
-  EXPECT_THROW(read_edit_script(dir), IoError);  // a directory is not a script (it used to be "0 edits")
+  EXPECT_THROW(read_edit_script(dir),
+               IoError);  // a directory is not a script (it used to be "0 edits")
   fs::remove_all(dir);
 }
 
@@ -139,7 +154,8 @@ TEST(LoadWorld, MagicIsCheckedBeforeTheFileIsRead) {
 }
 
 TEST(LoadWorld, ReChunkingFollowsTheContentNotItsBox) {
-  // Two chunks 2^28 voxels apart saved at edge 16; loading at edge 32 used to copy their box densely.
+  // Two chunks 2^28 voxels apart saved at edge 16; loading at edge 32 used to copy their box
+  // densely.
   World w(16);
   w.voxels.set({3, 4, 5}, 7);
   w.voxels.set({1 << 28, 9, 2}, 9);

@@ -74,7 +74,8 @@ TEST(Interrupt, CancellingStopsSceneGenerationWithCancelled) {
     EXPECT_NE(std::string(e.what()).find("terrain scene"), std::string::npos) << e.what();
   }
   EXPECT_EQ(r.ends, 1);  // end() is called on the way out of a cancelled operation too
-  // The generator stopped asking soon after it was told to stop (a few chunks in flight per thread).
+  // The generator stopped asking soon after it was told to stop (a few chunks in flight per
+  // thread).
   int asked_after = 0;
   for (int p : r.percents) asked_after += p > 40;
   EXPECT_LT(asked_after, 8);

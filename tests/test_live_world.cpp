@@ -52,7 +52,8 @@ TEST(LiveWorld, ConcurrentEditsUpdatesAndReadersStayConsistent) {
         Edit e;
         e.op = rng() % 3 == 0 ? EditOp::kCarve : EditOp::kPlace;
         e.material = static_cast<std::uint8_t>(1 + rng() % 9);
-        e.brush = SphereBrush{{static_cast<double>(rng() % 48), static_cast<double>(rng() % 40), static_cast<double>(rng() % 32)},
+        e.brush = SphereBrush{{static_cast<double>(rng() % 48), static_cast<double>(rng() % 40),
+                               static_cast<double>(rng() % 32)},
                               static_cast<double>(1 + rng() % 4)};
         live.submit(e);
         // Spread the submissions out so that they interleave with many updates.
@@ -71,7 +72,8 @@ TEST(LiveWorld, ConcurrentEditsUpdatesAndReadersStayConsistent) {
       while (!stop_readers.load()) {
         live.read([&](const World& w, const DistanceField& f) {
           for (int k = 0; k < 20; ++k) {
-            const Vec3i p{static_cast<int>(rng() % 48), static_cast<int>(rng() % 40), static_cast<int>(rng() % 32)};
+            const Vec3i p{static_cast<int>(rng() % 48), static_cast<int>(rng() % 40),
+                          static_cast<int>(rng() % 32)};
             if (f.distance(p) != manhattan_at(w, p, bounds)) ++inconsistent;
           }
           return 0;
@@ -80,7 +82,8 @@ TEST(LiveWorld, ConcurrentEditsUpdatesAndReadersStayConsistent) {
       }
     });
   }
-  for (int t = 0; t <= kWriters; ++t) threads[static_cast<std::size_t>(t)].join();  // writers and updater
+  for (int t = 0; t <= kWriters; ++t)
+    threads[static_cast<std::size_t>(t)].join();  // writers and updater
   stop_readers = true;
   for (std::size_t t = kWriters + 1; t < threads.size(); ++t) threads[t].join();
   EXPECT_EQ(live.pending(), 0u);

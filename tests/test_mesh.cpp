@@ -33,7 +33,8 @@ struct Sampled {
     for (int z = 0; z < n; ++z)
       for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x)
-          values[static_cast<std::size_t>(x + n * (y + n * z))] = static_cast<float>(f({o + x * h, o + y * h, o + z * h}));
+          values[static_cast<std::size_t>(x + n * (y + n * z))] =
+              static_cast<float>(f({o + x * h, o + y * h, o + z * h}));
     volume.size = Vec3i::splat(n);
     volume.values = values.data();
     volume.origin_units = {o, o, o};
@@ -41,7 +42,9 @@ struct Sampled {
   }
 };
 
-Vec3d at(const std::array<float, 3>& p) { return {p[0], p[1], p[2]}; }
+Vec3d at(const std::array<float, 3>& p) {
+  return {p[0], p[1], p[2]};
+}
 
 MeshOptions with(Mesher m, int chunk_edge = 32) {
   MeshOptions o;
@@ -55,7 +58,8 @@ using Tri = std::array<std::array<float, 3>, 3>;
 std::multiset<Tri> triangle_set(const Mesh& m) {
   std::multiset<Tri> s;
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-    Tri tri{m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]};
+    Tri tri{m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]],
+            m.positions[m.indices[3 * t + 2]]};
     const auto first = std::min_element(tri.begin(), tri.end()) - tri.begin();
     std::rotate(tri.begin(), tri.begin() + first, tri.end());
     s.insert(tri);
@@ -115,8 +119,10 @@ TEST(Mesh, TorusHasEulerCharacteristicZero) {
     const Mesh mesh = mesh_volume(s.volume, with(m, 8));
     expect_closed_manifold(mesh, 0, "torus");
     const MeshStats st = mesh_stats(mesh);
-    EXPECT_NEAR(st.signed_volume_units3, sdf::torus_volume(major, minor), 0.02 * sdf::torus_volume(major, minor));
-    EXPECT_NEAR(st.area_units2, sdf::torus_area(major, minor), 0.02 * sdf::torus_area(major, minor));
+    EXPECT_NEAR(st.signed_volume_units3, sdf::torus_volume(major, minor),
+                0.02 * sdf::torus_volume(major, minor));
+    EXPECT_NEAR(st.area_units2, sdf::torus_area(major, minor),
+                0.02 * sdf::torus_area(major, minor));
   }
 }
 
@@ -129,11 +135,13 @@ TEST(Mesh, CapsuleAndBoxAreClosedWithTheirVolume) {
     SCOPED_TRACE(mesher_name(m));
     const Mesh c = mesh_volume(capsule.volume, with(m));
     expect_closed_manifold(c, 2, "capsule");
-    EXPECT_NEAR(mesh_stats(c).signed_volume_units3, sdf::capsule_volume(length, radius), 0.02 * sdf::capsule_volume(length, radius));
+    EXPECT_NEAR(mesh_stats(c).signed_volume_units3, sdf::capsule_volume(length, radius),
+                0.02 * sdf::capsule_volume(length, radius));
     const Mesh bx = mesh_volume(box.volume, with(m));
     expect_closed_manifold(bx, 2, "box");
     // Both meshers bevel the box's edges by up to half a cell: within 3 % of 8 * 6.3 * 4.2 * 3.1.
-    EXPECT_NEAR(mesh_stats(bx).signed_volume_units3, 8 * 6.3 * 4.2 * 3.1, 0.03 * 8 * 6.3 * 4.2 * 3.1);
+    EXPECT_NEAR(mesh_stats(bx).signed_volume_units3, 8 * 6.3 * 4.2 * 3.1,
+                0.03 * 8 * 6.3 * 4.2 * 3.1);
   }
 }
 
@@ -168,7 +176,9 @@ TEST(Mesh, SurfaceNetsOfABlockHasOneQuadPerVoxelFace) {
   for (const auto& col : sn.colors) EXPECT_EQ(col, (std::array<std::uint8_t, 3>{c.r, c.g, c.b}));
   // Surfaces run halfway between voxel centres: on the block's faces, at 0 and 6 (+-0.5 margins).
   for (const auto& p : mc.positions)
-    for (int a = 0; a < 3; ++a) EXPECT_TRUE(p[static_cast<std::size_t>(a)] >= -0.01f && p[static_cast<std::size_t>(a)] <= 6.01f);
+    for (int a = 0; a < 3; ++a)
+      EXPECT_TRUE(p[static_cast<std::size_t>(a)] >= -0.01f &&
+                  p[static_cast<std::size_t>(a)] <= 6.01f);
 }
 
 // Every one of the 256 corner configurations of a lone cell, with random magnitudes (so ambiguous
@@ -187,8 +197,9 @@ TEST(Mesh, EveryCellConfigurationGivesAClosedOrientedSurface) {
       ScalarVolume vol{Vec3i::splat(4), v.data()};
       const Mesh mesh = mesh_volume(vol, with(Mesher::kMarchingCubes, 2));
       const MeshStats s = mesh_stats(mesh);
-      ASSERT_TRUE(s.watertight()) << "mask " << mask << " trial " << trial << ": " << s.boundary_edges << " boundary, "
-                                  << s.nonmanifold_edges << " non-manifold, " << s.misoriented_edges << " misoriented";
+      ASSERT_TRUE(s.watertight()) << "mask " << mask << " trial " << trial << ": "
+                                  << s.boundary_edges << " boundary, " << s.nonmanifold_edges
+                                  << " non-manifold, " << s.misoriented_edges << " misoriented";
       ASSERT_GT(s.signed_volume_units3, 0) << "mask " << mask;
     }
 }
@@ -205,7 +216,8 @@ TEST(Mesh, RandomFieldsAreWatertightAndIndependentOfChunksAndThreads) {
     for (int y = 0; y < n; ++y)
       for (int x = 0; x < n; ++x) {
         const bool border = x == 0 || y == 0 || z == 0 || x == n - 1 || y == n - 1 || z == n - 1;
-        v[static_cast<std::size_t>(x + n * (y + n * z))] = border ? 1.0f : u(rng);  // closed inside the lattice
+        v[static_cast<std::size_t>(x + n * (y + n * z))] =
+            border ? 1.0f : u(rng);  // closed inside the lattice
       }
   ScalarVolume vol{Vec3i::splat(n), v.data()};
   for (Mesher m : kMeshers) {
@@ -216,10 +228,11 @@ TEST(Mesh, RandomFieldsAreWatertightAndIndependentOfChunksAndThreads) {
     // pinches within a cell an edge gets four triangles (Gibson's nets are closed, not manifold);
     // marching cubes keeps the sheets apart.
     auto closed = [&](const MeshStats& st) {
-      return m == Mesher::kMarchingCubes ? st.watertight() : st.boundary_edges == 0 && st.degenerate_triangles == 0;
+      return m == Mesher::kMarchingCubes ? st.watertight()
+                                         : st.boundary_edges == 0 && st.degenerate_triangles == 0;
     };
-    EXPECT_TRUE(closed(s)) << s.boundary_edges << " boundary, " << s.nonmanifold_edges << " non-manifold, "
-                           << s.misoriented_edges << " misoriented";
+    EXPECT_TRUE(closed(s)) << s.boundary_edges << " boundary, " << s.nonmanifold_edges
+                           << " non-manifold, " << s.misoriented_edges << " misoriented";
     if (m != Mesher::kMarchingCubes) {
       EXPECT_GT(s.nonmanifold_edges, 0u);  // so this lattice does pinch
     }
@@ -229,7 +242,8 @@ TEST(Mesh, RandomFieldsAreWatertightAndIndependentOfChunksAndThreads) {
         ThreadLimit limit(threads);
         const Mesh mesh = mesh_volume(vol, with(m, edge));
         EXPECT_EQ(mesh.vertex_count(), reference.vertex_count()) << "chunk edge " << edge;
-        EXPECT_TRUE(triangle_set(mesh) == expected) << "chunk edge " << edge << ", " << threads << " threads";
+        EXPECT_TRUE(triangle_set(mesh) == expected)
+            << "chunk edge " << edge << ", " << threads << " threads";
         EXPECT_TRUE(closed(mesh_stats(mesh))) << "chunk edge " << edge;
       }
     }
@@ -250,7 +264,8 @@ TEST(Mesh, InsideAboveIsTheMirroredConvention) {
     const Mesh above = mesh_volume(d, o);
     ASSERT_EQ(below.triangle_count(), above.triangle_count());
     EXPECT_GT(mesh_stats(above).signed_volume_units3, 0);
-    EXPECT_NEAR(mesh_stats(above).signed_volume_units3, mesh_stats(below).signed_volume_units3, 1e-3);
+    EXPECT_NEAR(mesh_stats(above).signed_volume_units3, mesh_stats(below).signed_volume_units3,
+                1e-3);
   }
 }
 
@@ -310,7 +325,8 @@ TEST(Mesh, DualContouringKeepsSharpCorners) {
   auto corner_errors = [&](const Mesh& mesh) {
     double worst = 0, sum = 0;
     for (int c = 0; c < 8; ++c) {
-      const Vec3d corner{centre.x + ((c & 1) ? half.x : -half.x), centre.y + ((c >> 1 & 1) ? half.y : -half.y),
+      const Vec3d corner{centre.x + ((c & 1) ? half.x : -half.x),
+                         centre.y + ((c >> 1 & 1) ? half.y : -half.y),
                          centre.z + ((c >> 2 & 1) ? half.z : -half.z)};
       double best = 1e9;
       for (const auto& p : mesh.positions) best = std::min(best, (at(p) - corner).length());
@@ -324,11 +340,13 @@ TEST(Mesh, DualContouringKeepsSharpCorners) {
   expect_closed_manifold(dc, 2, "box, dual contouring");
   const double volume = 8 * half.x * half.y * half.z;
   EXPECT_NEAR(mesh_stats(dc).signed_volume_units3, volume, 0.005 * volume);
-  EXPECT_LT(std::abs(mesh_stats(dc).signed_volume_units3 - volume), std::abs(mesh_stats(mc).signed_volume_units3 - volume));
+  EXPECT_LT(std::abs(mesh_stats(dc).signed_volume_units3 - volume),
+            std::abs(mesh_stats(mc).signed_volume_units3 - volume));
   const auto [dc_worst, dc_mean] = corner_errors(dc);
   const auto [mc_worst, mc_mean] = corner_errors(mc);
   EXPECT_LT(dc_worst, 0.25) << "a corner is farther than half a sample from every vertex";
-  EXPECT_LT(dc_mean, 0.4 * mc_mean) << "dual contouring " << dc_mean << ", marching cubes " << mc_mean;
+  EXPECT_LT(dc_mean, 0.4 * mc_mean)
+      << "dual contouring " << dc_mean << ", marching cubes " << mc_mean;
   double off = 0;
   for (const auto& p : dc.positions) off = std::max(off, std::abs(sdf::box(at(p) - centre, half)));
   EXPECT_LT(off, 0.03);  // every vertex within 6 % of a sample of the box

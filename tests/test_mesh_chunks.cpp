@@ -36,22 +36,27 @@ struct Terrain {
     for (int z = 0; z < n; ++z)
       for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x)
-          values[index(x, y, z)] = static_cast<float>(z - (20 + 4 * std::sin(x * 0.3) + 3 * std::cos(y * 0.25)));
+          values[index(x, y, z)] =
+              static_cast<float>(z - (20 + 4 * std::sin(x * 0.3) + 3 * std::cos(y * 0.25)));
     volume.size = Vec3i::splat(n);
     volume.values = values.data();
   }
-  std::size_t index(int x, int y, int z) const { return static_cast<std::size_t>(x + n * (y + n * z)); }
+  std::size_t index(int x, int y, int z) const {
+    return static_cast<std::size_t>(x + n * (y + n * z));
+  }
   // Carves (or adds) a sphere: the field's minimum (union) or maximum with the negated sphere.
   Box3i sphere(Vec3d c, double r, bool add) {
-    const Box3i box = Box3i{{static_cast<int>(std::floor(c.x - r)) - 1, static_cast<int>(std::floor(c.y - r)) - 1,
-                             static_cast<int>(std::floor(c.z - r)) - 1},
-                            {static_cast<int>(std::ceil(c.x + r)) + 2, static_cast<int>(std::ceil(c.y + r)) + 2,
-                             static_cast<int>(std::ceil(c.z + r)) + 2}}
-                          .intersect(Box3i::from_size(volume.size));
+    const Box3i box = Box3i{
+        {static_cast<int>(std::floor(c.x - r)) - 1, static_cast<int>(std::floor(c.y - r)) - 1,
+         static_cast<int>(std::floor(c.z - r)) - 1},
+        {static_cast<int>(std::ceil(c.x + r)) + 2, static_cast<int>(std::ceil(c.y + r)) + 2,
+         static_cast<int>(std::ceil(c.z + r)) +
+             2}}.intersect(Box3i::from_size(volume.size));
     for (int z = box.begin.z; z < box.end.z; ++z)
       for (int y = box.begin.y; y < box.end.y; ++y)
         for (int x = box.begin.x; x < box.end.x; ++x) {
-          const float d = static_cast<float>(sdf::sphere(Vec3d{double(x), double(y), double(z)} - c, r));
+          const float d =
+              static_cast<float>(sdf::sphere(Vec3d{double(x), double(y), double(z)} - c, r));
           float& v = values[index(x, y, z)];
           v = add ? std::min(v, d) : std::max(v, -d);
         }
@@ -76,7 +81,8 @@ TEST(MeshChunks, EditsReMeshOnlyReachedChunksAndEqualAFullMesh) {
     for (int edit = 0; edit < 12; ++edit) {
       const Box3i changed = t.sphere({u(rng), u(rng), h(rng)}, r(rng), edit % 3 != 0);
       const std::vector<Vec3i> remeshed = chunks.update(t.volume, changed);
-      EXPECT_LT(remeshed.size(), static_cast<std::size_t>(count.x * count.y * count.z) / 4) << "edit " << edit;
+      EXPECT_LT(remeshed.size(), static_cast<std::size_t>(count.x * count.y * count.z) / 4)
+          << "edit " << edit;
       for (const Vec3i& c : remeshed)  // each within reach of the change: 3 samples before, 2 after
         for (int a = 0; a < 3; ++a) {
           EXPECT_LT(c[a] * o.chunk_edge - 3, changed.end[a]);
@@ -108,7 +114,8 @@ TEST(MeshChunks, ChunkMeshesMeetWithoutCracks) {
   const Mesh whole = chunks.merged();
   EXPECT_EQ(triangles, whole.triangle_count());
   const std::set<std::array<float, 3>> welded(whole.positions.begin(), whole.positions.end());
-  EXPECT_TRUE(all == welded) << all.size() << " distinct chunk vertices, " << welded.size() << " welded";
+  EXPECT_TRUE(all == welded) << all.size() << " distinct chunk vertices, " << welded.size()
+                             << " welded";
   EXPECT_THROW(chunks.chunk_mesh(count), InvalidArgument);
 }
 
@@ -127,5 +134,6 @@ TEST(MeshChunks, AFailedUpdateKeepsEveryChunk) {
   ScalarVolume moved = t.volume;
   moved.spacing_units = {2, 2, 2};
   EXPECT_THROW(chunks.update(moved, Box3i{{0, 0, 0}, {4, 4, 4}}), InvalidArgument);
-  EXPECT_TRUE(chunks.update(t.volume, Box3i{{100, 100, 100}, {104, 104, 104}}).empty());  // outside: nothing
+  EXPECT_TRUE(chunks.update(t.volume, Box3i{{100, 100, 100}, {104, 104, 104}})
+                  .empty());  // outside: nothing
 }

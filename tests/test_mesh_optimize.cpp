@@ -25,7 +25,8 @@ Mesh sphere_mesh(double r, std::vector<float>& values) {
   for (int z = 0; z < n; ++z)
     for (int y = 0; y < n; ++y)
       for (int x = 0; x < n; ++x)
-        values[static_cast<std::size_t>(x + n * (y + n * z))] = static_cast<float>(sdf::sphere({o + x * h, o + y * h, o + z * h}, r));
+        values[static_cast<std::size_t>(x + n * (y + n * z))] =
+            static_cast<float>(sdf::sphere({o + x * h, o + y * h, o + z * h}, r));
   ScalarVolume v{Vec3i::splat(n), values.data(), {o, o, o}, {h, h, h}};
   return mesh_volume(v, MeshOptions{});
 }
@@ -62,7 +63,8 @@ TEST(MeshOptimize, SimplifiedSphereKeepsItsShape) {
   const MeshStats ms = mesh_stats(simple);
   EXPECT_EQ(ms.boundary_edges, 0u);
   EXPECT_NEAR(ms.signed_volume_units3, sdf::sphere_volume(r), 0.02 * sdf::sphere_volume(r));
-  for (const auto& p : simple.positions) EXPECT_LT(std::abs(Vec3d{p[0], p[1], p[2]}.length() - r), 0.06);
+  for (const auto& p : simple.positions)
+    EXPECT_LT(std::abs(Vec3d{p[0], p[1], p[2]}.length() - r), 0.06);
   ASSERT_EQ(simple.normals.size(), simple.vertex_count());
   std::vector<bool> used(simple.vertex_count());
   for (std::uint32_t i : simple.indices) used[i] = true;
@@ -77,13 +79,17 @@ TEST(MeshOptimize, OptimizingKeepsTrianglesAndImprovesCacheReuse) {
   Mesh m = sphere_mesh(10, values);
   // Scramble the triangle order first, so the chunked order's locality does not help.
   std::vector<std::array<std::uint32_t, 3>> tris(m.triangle_count());
-  for (std::size_t t = 0; t < tris.size(); ++t) tris[t] = {m.indices[3 * t], m.indices[3 * t + 1], m.indices[3 * t + 2]};
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    tris[t] = {m.indices[3 * t], m.indices[3 * t + 1], m.indices[3 * t + 2]};
   for (std::size_t t = 0; t < tris.size(); ++t) std::swap(tris[t], tris[(t * 7919) % tris.size()]);
-  for (std::size_t t = 0; t < tris.size(); ++t) std::copy(tris[t].begin(), tris[t].end(), m.indices.begin() + static_cast<std::ptrdiff_t>(3 * t));
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    std::copy(tris[t].begin(), tris[t].end(),
+              m.indices.begin() + static_cast<std::ptrdiff_t>(3 * t));
   auto triangle_set = [](const Mesh& mesh) {
     std::multiset<std::array<std::array<float, 3>, 3>> s;
     for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-      std::array<std::array<float, 3>, 3> tri{mesh.positions[mesh.indices[3 * t]], mesh.positions[mesh.indices[3 * t + 1]],
+      std::array<std::array<float, 3>, 3> tri{mesh.positions[mesh.indices[3 * t]],
+                                              mesh.positions[mesh.indices[3 * t + 1]],
                                               mesh.positions[mesh.indices[3 * t + 2]]};
       std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end()), tri.end());
       s.insert(tri);

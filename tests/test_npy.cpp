@@ -9,8 +9,8 @@ using namespace voxfield;
 
 namespace {
 
-std::vector<std::uint8_t> npy_bytes(const std::string& header_dict, const std::vector<std::uint8_t>& data,
-                                    int major = 1) {
+std::vector<std::uint8_t> npy_bytes(const std::string& header_dict,
+                                    const std::vector<std::uint8_t>& data, int major = 1) {
   std::string h = header_dict;
   const std::size_t prefix = major == 1 ? 10 : 12;
   while ((prefix + h.size() + 1) % 64) h.push_back(' ');
@@ -31,9 +31,11 @@ std::vector<std::uint8_t> npy_bytes(const std::string& header_dict, const std::v
 // a = zeros((3, 2, 2), uint8); a[1,0,0] = 5; a[2,1,1] = 7; a[0,1,0] = 9
 // np.save of np.asfortranarray(a) and of a (C order), as NumPy 1.24 wrote them.
 const std::string kFortranHeader = "{'descr': '|u1', 'fortran_order': True, 'shape': (3, 2, 2), }";
-const std::vector<std::uint8_t> kFortranData{0x00, 0x05, 0x00, 0x09, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x07};
+const std::vector<std::uint8_t> kFortranData{0x00, 0x05, 0x00, 0x09, 0x00, 0x00,
+                                             0x00, 0x00, 0x00, 0x00, 0x00, 0x07};
 const std::string kCHeader = "{'descr': '|u1', 'fortran_order': False, 'shape': (3, 2, 2), }";
-const std::vector<std::uint8_t> kCData{0x00, 0x00, 0x09, 0x00, 0x05, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x07};
+const std::vector<std::uint8_t> kCData{0x00, 0x00, 0x09, 0x00, 0x05, 0x00,
+                                       0x00, 0x00, 0x00, 0x00, 0x00, 0x07};
 
 void expect_reference_volume(const NpyVolume& v) {
   EXPECT_EQ(v.dtype, DType::kUInt8);
@@ -67,7 +69,8 @@ TEST(Npy, BigEndianAndVersion2) {
   for (int i = 0; i < 12; ++i) data.insert(data.end(), {0, static_cast<std::uint8_t>(i)});
   for (int major : {1, 2, 3}) {
     const NpyVolume v = parse_npy(
-        npy_bytes("{'descr': '>i2', 'fortran_order': False, 'shape': (3, 2, 2), }", data, major), "be.npy");
+        npy_bytes("{'descr': '>i2', 'fortran_order': False, 'shape': (3, 2, 2), }", data, major),
+        "be.npy");
     EXPECT_EQ(v.dtype, DType::kInt16);
     for (int z = 0; z < 2; ++z)
       for (int y = 0; y < 2; ++y)
@@ -76,11 +79,13 @@ TEST(Npy, BigEndianAndVersion2) {
 }
 
 TEST(Npy, EveryDtypeRoundTrips) {
-  const DType all[] = {DType::kBool, DType::kInt8, DType::kUInt8, DType::kInt16, DType::kUInt16,
-                       DType::kInt32, DType::kUInt32, DType::kFloat32, DType::kFloat64};
+  const DType all[] = {DType::kBool,   DType::kInt8,    DType::kUInt8,
+                       DType::kInt16,  DType::kUInt16,  DType::kInt32,
+                       DType::kUInt32, DType::kFloat32, DType::kFloat64};
   for (DType t : all) {
     NpyVolume v{t, {5, 3, 2}, std::vector<std::uint8_t>(30 * dtype_size(t))};
-    for (std::size_t i = 0; i < v.bytes.size(); ++i) v.bytes[i] = static_cast<std::uint8_t>(i * 7 % 3);
+    for (std::size_t i = 0; i < v.bytes.size(); ++i)
+      v.bytes[i] = static_cast<std::uint8_t>(i * 7 % 3);
     if (t == DType::kBool)
       for (auto& b : v.bytes) b = b ? 1 : 0;
     const NpyVolume back = parse_npy(encode_npy(v), "rt.npy");
@@ -92,16 +97,42 @@ TEST(Npy, EveryDtypeRoundTrips) {
 
 TEST(Npy, RejectsOtherShapesDtypesAndTruncation) {
   const std::vector<std::uint8_t> d(12);
-  EXPECT_THROW(parse_npy(npy_bytes("{'descr': '|u1', 'fortran_order': False, 'shape': (12,), }", d), "a"), FormatError);
-  EXPECT_THROW(parse_npy(npy_bytes("{'descr': '|u1', 'fortran_order': False, 'shape': (3, 2, 2, 1), }", d), "a"), FormatError);
-  EXPECT_THROW(parse_npy(npy_bytes("{'descr': '<c8', 'fortran_order': False, 'shape': (3, 1, 1), }", std::vector<std::uint8_t>(24)), "a"), FormatError);
-  EXPECT_THROW(parse_npy(npy_bytes("{'descr': '|O', 'fortran_order': False, 'shape': (3, 2, 2), }", d), "a"), FormatError);
-  // 64-bit integers (NumPy's default) are read, on purpose (docs/limits.md); 16-byte floats are not.
-  EXPECT_EQ(parse_npy(npy_bytes("{'descr': '<i8', 'fortran_order': False, 'shape': (3, 1, 1), }", std::vector<std::uint8_t>(24)), "a").dtype,
+  EXPECT_THROW(
+      parse_npy(npy_bytes("{'descr': '|u1', 'fortran_order': False, 'shape': (12,), }", d), "a"),
+      FormatError);
+  EXPECT_THROW(
+      parse_npy(npy_bytes("{'descr': '|u1', 'fortran_order': False, 'shape': (3, 2, 2, 1), }", d),
+                "a"),
+      FormatError);
+  EXPECT_THROW(parse_npy(npy_bytes("{'descr': '<c8', 'fortran_order': False, 'shape': (3, 1, 1), }",
+                                   std::vector<std::uint8_t>(24)),
+                         "a"),
+               FormatError);
+  EXPECT_THROW(
+      parse_npy(npy_bytes("{'descr': '|O', 'fortran_order': False, 'shape': (3, 2, 2), }", d), "a"),
+      FormatError);
+  // 64-bit integers (NumPy's default) are read, on purpose (docs/limits.md); 16-byte floats are
+  // not.
+  EXPECT_EQ(parse_npy(npy_bytes("{'descr': '<i8', 'fortran_order': False, 'shape': (3, 1, 1), }",
+                                std::vector<std::uint8_t>(24)),
+                      "a")
+                .dtype,
             DType::kInt64);
-  EXPECT_THROW(parse_npy(npy_bytes("{'descr': '<f16', 'fortran_order': False, 'shape': (3, 1, 1), }", std::vector<std::uint8_t>(48)), "a"), FormatError);
-  EXPECT_THROW(parse_npy(npy_bytes("{'descr': '|u1', 'fortran_order': False, 'shape': (0, 2, 2), }", {}), "a"), FormatError);
-  EXPECT_THROW(parse_npy(npy_bytes("{'descr': '|u1', 'fortran_order': False, 'shape': (99999, 99999, 99999), }", d), "a"), FormatError);
+  EXPECT_THROW(
+      parse_npy(npy_bytes("{'descr': '<f16', 'fortran_order': False, 'shape': (3, 1, 1), }",
+                          std::vector<std::uint8_t>(48)),
+                "a"),
+      FormatError);
+  EXPECT_THROW(
+      parse_npy(npy_bytes("{'descr': '|u1', 'fortran_order': False, 'shape': (0, 2, 2), }", {}),
+                "a"),
+      FormatError);
+  EXPECT_THROW(
+      parse_npy(
+          npy_bytes("{'descr': '|u1', 'fortran_order': False, 'shape': (99999, 99999, 99999), }",
+                    d),
+          "a"),
+      FormatError);
   EXPECT_THROW(parse_npy(npy_bytes("{'descr': '|u1', 'shape': (3, 2, 2), }", d), "a"), FormatError);
   const auto good = npy_bytes(kFortranHeader, kFortranData);
   for (std::size_t n = 0; n < good.size(); ++n) {

@@ -11,10 +11,10 @@
 #include <random>
 
 #include "image_compare.h"
-#include "voxfield/png.h"
-#include "voxfield/error.h"
 #include "voxfield/edit.h"
+#include "voxfield/error.h"
 #include "voxfield/parallel.h"
+#include "voxfield/png.h"
 #include "voxfield/render.h"
 
 using namespace voxfield;
@@ -22,7 +22,8 @@ using namespace voxfield;
 namespace {
 
 // Clusters of boxes centred at x < max_x, leaving whole chunks empty beyond.
-World random_world(Vec3i size, int chunk_edge, std::uint32_t seed, int clusters, int max_x = 1 << 30) {
+World random_world(Vec3i size, int chunk_edge, std::uint32_t seed, int clusters,
+                   int max_x = 1 << 30) {
   World w(chunk_edge, Box3i::from_size(size));
   std::mt19937 rng(seed);
   auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
@@ -57,7 +58,8 @@ std::vector<Ray> test_rays(const Box3i& box, std::uint32_t seed, int random_coun
   std::vector<Ray> rays;
   const Vec3i s = box.size();
   for (int i = 0; i < random_count; ++i) {
-    const Vec3d o{box.begin.x + (s.x / 2.0) + pos(rng) * s.x / 16, box.begin.y + (s.y / 2.0) + pos(rng) * s.y / 16,
+    const Vec3d o{box.begin.x + (s.x / 2.0) + pos(rng) * s.x / 16,
+                  box.begin.y + (s.y / 2.0) + pos(rng) * s.y / 16,
                   box.begin.z + (s.z / 2.0) + pos(rng) * s.z / 16};
     Vec3d d{unit(rng), unit(rng), unit(rng)};
     if (d.length() < 1e-3) d = {1, 0.5, 0.25};
@@ -65,14 +67,16 @@ std::vector<Ray> test_rays(const Box3i& box, std::uint32_t seed, int random_coun
   }
   // Degenerate directions whose events tie exactly (edges and corners crossed at once), from
   // integer and half-integer origins.
-  const Vec3d dirs[] = {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}, {1, 1, 1}, {-1, 1, -1}, {1, -1, 0},
-                        {2, 1, 0}, {0, 3, -1}, {1, 1, 2}, {-4, 2, 1}};
+  const Vec3d dirs[] = {{1, 0, 0},  {0, -1, 0}, {0, 0, 1},  {1, 1, 1}, {-1, 1, -1},
+                        {1, -1, 0}, {2, 1, 0},  {0, 3, -1}, {1, 1, 2}, {-4, 2, 1}};
   std::uniform_int_distribution<int> coord(-3, 40);
   for (const Vec3d& d : dirs)
     for (int k = 0; k < 60; ++k) {
       const double half = (k % 2) * 0.5;
       rays.push_back({{coord(rng) + half, coord(rng) + half, static_cast<double>(coord(rng))}, d});
-      rays.push_back({{box.begin.x - 5.0 + k % 7, box.begin.y + k % 13 + half, box.begin.z + k % 11 + 0.0}, d});
+      rays.push_back(
+          {{box.begin.x - 5.0 + k % 7, box.begin.y + k % 13 + half, box.begin.z + k % 11 + 0.0},
+           d});
     }
   return rays;
 }
@@ -94,7 +98,8 @@ TEST(Render, SkippingNeverChangesAHit) {
         const RayHit a = trace_ray(scene, r, SkipMode::kNone, &plain);
         const RayHit b = trace_ray(scene, r, SkipMode::kChunks, &chunks);
         const RayHit c = trace_ray(scene, r, SkipMode::kDistance, &skipping);
-        const std::string what = std::string(metric_name(metric)) + " edge " + std::to_string(chunk_edge);
+        const std::string what =
+            std::string(metric_name(metric)) + " edge " + std::to_string(chunk_edge);
         expect_same_hit(a, b, what + " chunks");
         expect_same_hit(a, c, what + " distance");
         hits += a.hit;
@@ -118,7 +123,8 @@ TEST(Render, BatchTracingEqualsSingleRays) {
   TraversalCounters batch, single;
   trace_rays(scene, rays, hits, SkipMode::kDistance, &batch);
   for (std::size_t i = 0; i < rays.size(); ++i)
-    expect_same_hit(hits[i], trace_ray(scene, rays[i], SkipMode::kDistance, &single), "ray " + std::to_string(i));
+    expect_same_hit(hits[i], trace_ray(scene, rays[i], SkipMode::kDistance, &single),
+                    "ray " + std::to_string(i));
   EXPECT_EQ(batch.voxel_reads, single.voxel_reads);
   EXPECT_EQ(batch.rays, static_cast<std::int64_t>(rays.size()));
   std::vector<RayHit> short_hits(3);
@@ -150,14 +156,22 @@ TEST(Render, DdaMatchesBruteForceRayBoxIntersection) {
       double t0 = -1e300, t1 = 1e300;
       int axis = -1;
       for (int a = 0; a < 3; ++a) {
-        double ta = (v[a] - r.origin[a]) / r.direction[a], tb = (v[a] + 1 - r.origin[a]) / r.direction[a];
+        double ta = (v[a] - r.origin[a]) / r.direction[a],
+               tb = (v[a] + 1 - r.origin[a]) / r.direction[a];
         if (ta > tb) std::swap(ta, tb);
-        if (ta > t0) { t0 = ta; axis = a; }
+        if (ta > t0) {
+          t0 = ta;
+          axis = a;
+        }
         t1 = std::min(t1, tb);
       }
       if (t1 <= std::max(t0, 0.0)) continue;
       const double t = std::max(t0, 0.0);
-      if (t < best) { best = t; best_voxel = v; best_axis = t0 > 0 ? axis : -1; }
+      if (t < best) {
+        best = t;
+        best_voxel = v;
+        best_axis = t0 > 0 ? axis : -1;
+      }
     }
     const RayHit h = trace_ray(scene, r, SkipMode::kDistance);
     ASSERT_EQ(h.hit, std::isfinite(best)) << "ray " << i;
@@ -182,7 +196,8 @@ TEST(Render, TopCameraSeesTheHighestVoxelOfEveryColumn) {
   for (int y = 0; y < size.y; ++y)
     for (int x = 0; x < size.x; ++x) {
       const int h = std::uniform_int_distribution<int>(-1, size.z - 1)(rng);
-      if (h >= 0) w.voxels.fill(Box3i{{x, y, 0}, {x + 1, y + 1, h + 1}}, static_cast<std::uint8_t>(1 + h));
+      if (h >= 0)
+        w.voxels.fill(Box3i{{x, y, 0}, {x + 1, y + 1, h + 1}}, static_cast<std::uint8_t>(1 + h));
       top[static_cast<std::size_t>(y * size.x + x)] = h;
     }
   RenderSceneOptions so;
@@ -221,12 +236,14 @@ TEST(Render, AutomaticFramingKeepsTheBoxInViewAndFillsIt) {
       const auto p = c.projector(100, 100);
       double widest = 0;
       for (int k = 0; k < 8; ++k) {
-        const Vec3d corner{double(k & 1 ? box.end.x : box.begin.x), double(k & 2 ? box.end.y : box.begin.y),
+        const Vec3d corner{double(k & 1 ? box.end.x : box.begin.x),
+                           double(k & 2 ? box.end.y : box.begin.y),
                            double(k & 4 ? box.end.z : box.begin.z)};
         const Vec3d q = corner - p.eye;
         const double depth = dot(q, p.forward);
         ASSERT_GT(depth, 0);
-        const double x = dot(q, p.right) / depth / (p.scale * aspect), y = dot(q, p.up) / depth / p.scale;
+        const double x = dot(q, p.right) / depth / (p.scale * aspect),
+                     y = dot(q, p.up) / depth / p.scale;
         EXPECT_LE(std::abs(x), 1.0) << to_string(box) << " aspect " << aspect;
         EXPECT_LE(std::abs(y), 1.0) << to_string(box) << " aspect " << aspect;
         widest = std::max({widest, std::abs(x), std::abs(y)});
@@ -245,8 +262,9 @@ TEST(Render, CameraStrings) {
   EXPECT_DOUBLE_EQ(c.fov_degrees, 40);
   EXPECT_EQ(Camera::parse("eye=0,0,20:target=0,0,0:up=0,1,0:ortho=12", box, 1).projection,
             Camera::Projection::kOrthographic);
-  for (const char* bad : {"eye=1,2:target=0,0,0", "eye=1,2,3", "eye=1,2,x:target=0,0,0", "eye=0,0,0:target=0,0,0",
-                          "eye=0,0,1:target=0,0,0:fov=200", "eye=0,0,1:target=0,0,0", "zoom=2", "sideways"})
+  for (const char* bad :
+       {"eye=1,2:target=0,0,0", "eye=1,2,3", "eye=1,2,x:target=0,0,0", "eye=0,0,0:target=0,0,0",
+        "eye=0,0,1:target=0,0,0:fov=200", "eye=0,0,1:target=0,0,0", "zoom=2", "sideways"})
     EXPECT_THROW(Camera::parse(bad, box, 1), InvalidArgument) << bad;
 }
 
@@ -256,10 +274,10 @@ namespace {
 // that casts a shadow, a ball, a concave corner for ambient occlusion.
 World tiny_scene() {
   World w(8, Box3i::from_size({32, 28, 20}));
-  w.voxels.fill(Box3i{{0, 0, 0}, {32, 28, 2}}, 200);                 // floor
-  w.voxels.fill(Box3i{{3, 3, 2}, {6, 6, 14}}, 30);                    // pillar
-  w.voxels.fill(Box3i{{3, 3, 14}, {20, 8, 16}}, 30);                  // overhang
-  w.voxels.fill(Box3i{{24, 2, 2}, {30, 26, 8}}, 120);                 // wall: concave corner with the floor
+  w.voxels.fill(Box3i{{0, 0, 0}, {32, 28, 2}}, 200);   // floor
+  w.voxels.fill(Box3i{{3, 3, 2}, {6, 6, 14}}, 30);     // pillar
+  w.voxels.fill(Box3i{{3, 3, 14}, {20, 8, 16}}, 30);   // overhang
+  w.voxels.fill(Box3i{{24, 2, 2}, {30, 26, 8}}, 120);  // wall: concave corner with the floor
   for (int z = 2; z < 20; ++z)
     for (int y = 0; y < 28; ++y)
       for (int x = 0; x < 32; ++x) {
@@ -269,7 +287,9 @@ World tiny_scene() {
   return w;
 }
 
-std::filesystem::path golden_dir() { return VOXFIELD_GOLDEN_DIR; }
+std::filesystem::path golden_dir() {
+  return VOXFIELD_GOLDEN_DIR;
+}
 
 // Within tolerance: every channel within 8 levels on 99.5 % of pixels, mean difference < 0.5.
 void expect_matches_golden(const Image& got, const std::string& name) {
@@ -282,9 +302,11 @@ void expect_matches_golden(const Image& got, const std::string& name) {
   ASSERT_EQ(want.width, got.width);
   ASSERT_EQ(want.height, got.height);
   const test::ImageDiff d = test::compare_images(got, want, 8);
-  EXPECT_LE(d.off, d.pixels / 200) << name << ": " << d.off << " pixels differ by more than 8 levels";
+  EXPECT_LE(d.off, d.pixels / 200)
+      << name << ": " << d.off << " pixels differ by more than 8 levels";
   EXPECT_LT(d.mean, 0.5) << name;
-  if (::testing::Test::HasFailure()) write_png(got, std::filesystem::temp_directory_path() / (name + "-actual.png"));
+  if (::testing::Test::HasFailure())
+    write_png(got, std::filesystem::temp_directory_path() / (name + "-actual.png"));
 }
 
 }  // namespace
@@ -335,8 +357,9 @@ TEST(Render, ShadowsDarkenWhatTheOverhangCovers) {
   o.sun_direction = {0, 0, 1};
   o.ambient_occlusion = false;
   auto floor_brightness = [&](double x, double y) {
-    const std::string spec = "eye=" + std::to_string(x) + "," + std::to_string(y) + ",10:target=" +
-                             std::to_string(x) + "," + std::to_string(y) + ",0:up=0,1,0:ortho=2";
+    const std::string spec = "eye=" + std::to_string(x) + "," + std::to_string(y) +
+                             ",10:target=" + std::to_string(x) + "," + std::to_string(y) +
+                             ",0:up=0,1,0:ortho=2";
     const Image img = render(scene, Camera::parse(spec, scene.box(), 1), o);
     const std::uint8_t* p = img.pixel(2, 2);
     return p[0] + p[1] + p[2];
@@ -346,7 +369,8 @@ TEST(Render, ShadowsDarkenWhatTheOverhangCovers) {
   // darker is a clear shadow, unshadowed floors differ by nothing.
   EXPECT_LT(under * 4, open * 3) << "the floor under the overhang is not in shadow";
   o.soft_shadows = false;
-  EXPECT_EQ(floor_brightness(12.5, 5.5), floor_brightness(20.5, 22.5)) << "without shadows both are lit alike";
+  EXPECT_EQ(floor_brightness(12.5, 5.5), floor_brightness(20.5, 22.5))
+      << "without shadows both are lit alike";
 }
 
 TEST(Render, ErrorViewOfTheExactFieldFindsNoError) {
@@ -400,13 +424,12 @@ TEST(Png, RoundTripAndMalformedFiles) {
   EXPECT_EQ(back.width, 7);
   EXPECT_EQ(back.height, 5);
   EXPECT_EQ(back.rgb, img.rgb);
-  {
-    std::ofstream(dir / "bad.png") << "not a png at all";
-  }
+  { std::ofstream(dir / "bad.png") << "not a png at all"; }
   EXPECT_THROW(read_png(dir / "bad.png"), FormatError);
   // A truncated file: the header survives, the pixels do not.
   const auto size = std::filesystem::file_size(dir / "a.png");
-  std::filesystem::copy_file(dir / "a.png", dir / "cut.png", std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::copy_file(dir / "a.png", dir / "cut.png",
+                             std::filesystem::copy_options::overwrite_existing);
   std::filesystem::resize_file(dir / "cut.png", size / 2);
   EXPECT_THROW(read_png(dir / "cut.png"), FormatError);
   EXPECT_THROW(read_png(dir / "missing.png"), IoError);
@@ -436,11 +459,16 @@ TEST(Render, ScenesFollowEditsExactly) {
     const std::vector<Ray> rays = test_rays(live.scene().box(), 3, 300);
     const std::size_t chunks = 9 * 7 * 5;
     for (int e = 1; e <= 60; ++e) {
-      const Vec3d c{static_cast<double>(uni(-3, 74)), static_cast<double>(uni(-3, 58)), static_cast<double>(uni(-3, 42))};
+      const Vec3d c{static_cast<double>(uni(-3, 74)), static_cast<double>(uni(-3, 58)),
+                    static_cast<double>(uni(-3, 42))};
       const int op = uni(0, 2);
-      Edit edit{op == 0 ? EditOp::kPlace : op == 1 ? EditOp::kCarve : EditOp::kPaint, SphereBrush{c, uni(1, 7) * 1.0},
-                static_cast<std::uint8_t>(uni(1, 255))};
-      if (e % 7 == 0) edit.brush = BoxBrush{{uni(0, 60), uni(0, 40), uni(0, 30)}, {uni(60, 80), uni(40, 60), uni(30, 45)}};
+      Edit edit{op == 0   ? EditOp::kPlace
+                : op == 1 ? EditOp::kCarve
+                          : EditOp::kPaint,
+                SphereBrush{c, uni(1, 7) * 1.0}, static_cast<std::uint8_t>(uni(1, 255))};
+      if (e % 7 == 0)
+        edit.brush =
+            BoxBrush{{uni(0, 60), uni(0, 40), uni(0, 30)}, {uni(60, 80), uni(40, 60), uni(30, 45)}};
       apply_edit(w, edit, &dirty);
       const DynamicRenderScene::UpdateStats st = live.update(dirty);
       dirty.clear();
@@ -455,7 +483,8 @@ TEST(Render, ScenesFollowEditsExactly) {
       std::vector<RayHit> a(rays.size()), b(rays.size());
       trace_rays(live.scene(), rays, a);
       trace_rays(fresh, rays, b);
-      for (std::size_t i = 0; i < rays.size(); ++i) expect_same_hit(a[i], b[i], what + " ray " + std::to_string(i));
+      for (std::size_t i = 0; i < rays.size(); ++i)
+        expect_same_hit(a[i], b[i], what + " ray " + std::to_string(i));
       // And the fields behind it are those of full rebuilds.
       const DistanceField skip = compute_distance_field(w, live.skip_field().options);
       const Box3i box = live.scene().box();

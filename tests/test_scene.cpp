@@ -47,7 +47,8 @@ TEST(Scene, SolidFractions) {
   EXPECT_THROW(make_scene("mountains", o), InvalidArgument);
   o.size = {0, 5, 5};
   EXPECT_THROW(make_terrain(o), InvalidArgument);
-  o.size = {65536, 65536, 65536};  // 2.8e14 voxels: refused up front, not by the out-of-memory killer
+  o.size = {65536, 65536,
+            65536};  // 2.8e14 voxels: refused up front, not by the out-of-memory killer
   EXPECT_THROW(make_terrain(o), InvalidArgument);
   EXPECT_THROW(make_spheres(o), InvalidArgument);
 }

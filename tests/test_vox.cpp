@@ -20,7 +20,7 @@ const std::filesystem::path kCorpus = VOXFIELD_VOX_CORPUS;
 struct CorpusFile {
   const char* name;
   int models;
-  std::int64_t voxels;       // sum of the models' stored voxel counts
+  std::int64_t voxels;          // sum of the models' stored voxel counts
   std::optional<Vec3i> extent;  // scene-graph world extent, when the README gives one
 };
 
@@ -65,7 +65,9 @@ std::vector<std::uint8_t> dense_of(const World& w, const Box3i& box) {
 class Corpus : public ::testing::TestWithParam<CorpusFile> {};
 
 // Readable test parameter names in failure messages.
-[[maybe_unused]] void PrintTo(const CorpusFile& f, std::ostream* os) { *os << f.name; }
+[[maybe_unused]] void PrintTo(const CorpusFile& f, std::ostream* os) {
+  *os << f.name;
+}
 
 }  // namespace
 
@@ -98,13 +100,12 @@ TEST_P(Corpus, MatchesTheCorpusReadme) {
   for (int m = 1; m < 256; ++m) EXPECT_EQ(back.world.palette[m], in.world.palette[m]) << m;
 }
 
-INSTANTIATE_TEST_SUITE_P(SharedCorpus, Corpus, ::testing::ValuesIn(kFiles),
-                         [](const auto& info) {
-                           std::string n = info.param.name;
-                           for (char& c : n)
-                             if (!isalnum(static_cast<unsigned char>(c))) c = '_';
-                           return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(SharedCorpus, Corpus, ::testing::ValuesIn(kFiles), [](const auto& info) {
+  std::string n = info.param.name;
+  for (char& c : n)
+    if (!isalnum(static_cast<unsigned char>(c))) c = '_';
+  return n;
+});
 
 TEST(Vox, MengerSpongeHasExactly160000Voxels) {
   const VoxImport in = read_vox(kCorpus / "ephtracy_menger.vox");
@@ -130,8 +131,8 @@ TEST(Vox, MissingRgbaMeansTheDefaultPalette) {
   const Palette p = default_palette();
   EXPECT_EQ(p[1], (Rgba{255, 255, 255, 255}));  // first cube entry: white
   EXPECT_EQ(p[2], (Rgba{255, 255, 0xCC, 255}));
-  EXPECT_EQ(p[215], (Rgba{0, 0, 0x33, 255}));   // last cube entry before black
-  EXPECT_EQ(p[216], (Rgba{0xEE, 0, 0, 255}));   // red ramp
+  EXPECT_EQ(p[215], (Rgba{0, 0, 0x33, 255}));  // last cube entry before black
+  EXPECT_EQ(p[216], (Rgba{0xEE, 0, 0, 255}));  // red ramp
   EXPECT_EQ(p[255], (Rgba{0x11, 0x11, 0x11, 255}));
   const VoxImport knight = read_vox(kCorpus / "ephtracy_chr_knight.vox");
   EXPECT_TRUE(knight.info.has_palette);
@@ -184,7 +185,8 @@ TEST(Vox, EveryTruncationIsAFormatError) {
                            "vengi_teardown.vox"}) {
     const auto bytes = read_file(kCorpus / name);
     for (std::size_t n = 0; n < bytes.size(); n += (n < 2000 ? 1 : 97)) {
-      EXPECT_THROW(parse_vox(std::span(bytes.data(), n), name), FormatError) << name << " cut at " << n;
+      EXPECT_THROW(parse_vox(std::span(bytes.data(), n), name), FormatError)
+          << name << " cut at " << n;
     }
   }
 }
@@ -245,21 +247,26 @@ TEST(Vox, AbsurdSizesAndCountsAreRejectedBeforeAllocating) {
 
 TEST(Vox, SceneGraphCyclesAndDanglingReferencesAreRejected) {
   // 0 -> group 1 -> transform 2 -> group 1 ...
-  const Bytes cycle = vox_file({size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}), transform_chunk(0, 1, -1, {}),
-                                group_chunk(1, {2}), transform_chunk(2, 1, -1, {})});
+  const Bytes cycle =
+      vox_file({size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}), transform_chunk(0, 1, -1, {}),
+                group_chunk(1, {2}), transform_chunk(2, 1, -1, {})});
   EXPECT_THROW(parse_vox(cycle, "cycle.vox"), FormatError);
-  const Bytes dangling = vox_file({size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}), transform_chunk(0, 7, -1, {})});
+  const Bytes dangling =
+      vox_file({size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}), transform_chunk(0, 7, -1, {})});
   EXPECT_THROW(parse_vox(dangling, "dangling.vox"), FormatError);
-  const Bytes bad_model = vox_file({size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}), transform_chunk(0, 1, -1, {}),
-                                    shape_chunk(1, 5)});
+  const Bytes bad_model = vox_file({size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}),
+                                    transform_chunk(0, 1, -1, {}), shape_chunk(1, 5)});
   EXPECT_THROW(parse_vox(bad_model, "model.vox"), FormatError);
   // A doubling DAG 40 levels deep would visit 2^40 nodes: the walk budget stops it.
-  std::vector<Bytes> parts{size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}), transform_chunk(0, 1, -1, {})};
-  for (int level = 1; level <= 40; ++level) parts.push_back(group_chunk(level, {level + 1, level + 1}));
+  std::vector<Bytes> parts{size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}),
+                           transform_chunk(0, 1, -1, {})};
+  for (int level = 1; level <= 40; ++level)
+    parts.push_back(group_chunk(level, {level + 1, level + 1}));
   parts.push_back(group_chunk(41, {}));
   EXPECT_THROW(parse_vox(vox_file(parts), "dag.vox"), FormatError);
-  const Bytes bad_rotation = vox_file({size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}),
-                                       transform_chunk(0, 1, -1, {{"_r", "5"}}), shape_chunk(1, 0)});
+  const Bytes bad_rotation =
+      vox_file({size_chunk(1, 1, 1), xyzi_chunk({{0, 0, 0, 1}}),
+                transform_chunk(0, 1, -1, {{"_r", "5"}}), shape_chunk(1, 0)});
   EXPECT_THROW(parse_vox(bad_rotation, "rot.vox"), FormatError);  // rows 0 and 1 both pick column 1
 }
 
@@ -272,11 +279,12 @@ TEST(Vox, TranslationRotationAndHiddenLayers) {
   // Instance B rotated 90 degrees about z (rows: x' = -y, y' = x; byte: row0 column 1,
   // row1 column 0, row0 negative = 1 | 0 << 2 | 1 << 4 = 17), at (0, 0, 0).
   // Instance C on a hidden layer.
-  const Bytes f = vox_file({model_size, model, transform_chunk(0, 1, -1, {}), group_chunk(1, {2, 4, 6}),
-                            transform_chunk(2, 3, 0, {{"_t", "10 20 30"}}, {{"_name", "A"}}), shape_chunk(3, 0),
-                            transform_chunk(4, 5, 0, {{"_r", "17"}}), shape_chunk(5, 0),
-                            transform_chunk(6, 7, 1, {{"_t", "-50 0 0"}}), shape_chunk(7, 0),
-                            layer_chunk(0, false), layer_chunk(1, true)});
+  const Bytes f =
+      vox_file({model_size, model, transform_chunk(0, 1, -1, {}), group_chunk(1, {2, 4, 6}),
+                transform_chunk(2, 3, 0, {{"_t", "10 20 30"}}, {{"_name", "A"}}), shape_chunk(3, 0),
+                transform_chunk(4, 5, 0, {{"_r", "17"}}), shape_chunk(5, 0),
+                transform_chunk(6, 7, 1, {{"_t", "-50 0 0"}}), shape_chunk(7, 0),
+                layer_chunk(0, false), layer_chunk(1, true)});
   const VoxImport in = parse_vox(f, "scene.vox");
   ASSERT_EQ(in.info.instances.size(), 3u);
   EXPECT_EQ(in.info.instances[0].name, "A");
@@ -285,7 +293,8 @@ TEST(Vox, TranslationRotationAndHiddenLayers) {
   EXPECT_EQ(g.get({9, 19, 30}), 1);
   EXPECT_EQ(g.get({11, 19, 30}), 2);
   EXPECT_EQ(g.get({9, 20, 30}), 3);
-  // Rotated: centre offsets q = 2(v - pivot) + 1; v=(0,0,0) -> q=(-1,-1,1) -> Rq=(1,-1,1) -> (0,-1,0).
+  // Rotated: centre offsets q = 2(v - pivot) + 1; v=(0,0,0) -> q=(-1,-1,1) -> Rq=(1,-1,1) ->
+  // (0,-1,0).
   EXPECT_EQ(g.get({0, -1, 0}), 1);
   // v=(2,0,0) -> q=(3,-1,1) -> Rq=(1,3,1) -> floor/2 = (0,1,0).
   EXPECT_EQ(g.get({0, 1, 0}), 2);
@@ -324,9 +333,12 @@ TEST(Vox, GoldenBytesOfATinyWorld) {
   w.palette[5] = {1, 2, 3, 4};
   w.voxels.set({0, 0, 0}, 5);
   w.voxels.set({1, 0, 2}, 7);
-  std::vector<Bytes> parts{size_chunk(2, 1, 3), xyzi_chunk({{0, 0, 0, 5}, {1, 0, 2, 7}}),
-                           transform_chunk(0, 1, -1, {}), group_chunk(1, {2}),
-                           transform_chunk(2, 3, 0, {{"_t", "1 0 1"}}), shape_chunk(3, 0),
+  std::vector<Bytes> parts{size_chunk(2, 1, 3),
+                           xyzi_chunk({{0, 0, 0, 5}, {1, 0, 2, 7}}),
+                           transform_chunk(0, 1, -1, {}),
+                           group_chunk(1, {2}),
+                           transform_chunk(2, 3, 0, {{"_t", "1 0 1"}}),
+                           shape_chunk(3, 0),
                            layer_chunk(0, false)};
   Bytes rgba;
   for (int i = 0; i < 256; ++i) {

@@ -95,7 +95,8 @@ TEST(WorldFile, CorruptionTruncationAndFutureVersionsAreRejected) {
   // A future version: patch the version and fix the header checksum so only the version is wrong.
   auto future = good;
   future[8] = 2;
-  const std::uint32_t c = static_cast<std::uint32_t>(crc32(crc32(0, nullptr, 0), future.data(), 16));
+  const std::uint32_t c =
+      static_cast<std::uint32_t>(crc32(crc32(0, nullptr, 0), future.data(), 16));
   std::memcpy(future.data() + 16, &c, 4);
   try {
     parse_world_file(future, "future.vfw");

@@ -55,8 +55,9 @@ inline Bytes xyzi_chunk(const std::vector<V>& voxels) {
   }
   return chunk("XYZI", c);
 }
-inline Bytes transform_chunk(int id, int child, int layer, const std::vector<std::pair<std::string, std::string>>& frame,
-                             const std::vector<std::pair<std::string, std::string>>& attributes = {}) {
+inline Bytes transform_chunk(
+    int id, int child, int layer, const std::vector<std::pair<std::string, std::string>>& frame,
+    const std::vector<std::pair<std::string, std::string>>& attributes = {}) {
   Bytes c;
   put32(c, static_cast<std::uint32_t>(id));
   put_dict(c, attributes);

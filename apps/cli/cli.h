@@ -7,11 +7,11 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
-#include <optional>
-#include <vector>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "outputs.h"
 #include "voxfield/vox.h"

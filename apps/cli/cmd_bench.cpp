@@ -8,14 +8,14 @@
 #include <iomanip>
 #include <iostream>
 #include <numeric>
-#include <sstream>
 #include <random>
+#include <sstream>
 
 #include "cli.h"
-#include "live_field.h"
 #include "field_args.h"
-#include "voxfield/edit_stream.h"
+#include "live_field.h"
 #include "voxfield/dynamic_field.h"
+#include "voxfield/edit_stream.h"
 #include "voxfield/parallel.h"
 #include "voxfield/scene.h"
 
@@ -59,7 +59,8 @@ int run_bench_edits(const BenchEditsSettings& s) {
   std::optional<ThreadLimit> limit;
   if (s.field.threads > 0) limit.emplace(s.field.threads);
   const int radius_max = s.radius_max > 0 ? s.radius_max : s.field.chunk_edge - 1;
-  if (s.radius_min < 0 || radius_max < s.radius_min) throw UsageError("need 0 <= --radius-min <= --radius-max");
+  if (s.radius_min < 0 || radius_max < s.radius_min)
+    throw UsageError("need 0 <= --radius-min <= --radius-max");
   Outputs outputs;
   outputs.expect(s.csv, "--csv");
   outputs.expect(s.json, "--json");
@@ -78,7 +79,8 @@ int run_bench_edits(const BenchEditsSettings& s) {
 
   // The dissertation's stream: seeded positions anywhere in the world, radii in [min, max],
   // materials 0..255 where 0 (air) deletes.
-  RandomEditStream stream(Box3i::from_size(Vec3i::splat(s.world)), s.seed, s.radius_min, radius_max);
+  RandomEditStream stream(Box3i::from_size(Vec3i::splat(s.world)), s.seed, s.radius_min,
+                          radius_max);
   DirtyRegions dirty(world.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
   std::vector<double> latency_ms, update_ms;
   std::vector<std::int64_t> recomputed;
@@ -86,7 +88,9 @@ int run_bench_edits(const BenchEditsSettings& s) {
   // Rows are kept in memory and written with the other outputs at the end (all or nothing).
   std::ostringstream csv;
   const bool want_csv = !s.csv.empty();
-  if (want_csv) csv << "edit,time_s,radius,material,voxels_changed,voxels_recomputed,edit_ms,update_ms,latency_ms\n";
+  if (want_csv)
+    csv << "edit,time_s,radius,material,voxels_changed,voxels_recomputed,edit_ms,update_ms,latency_"
+           "ms\n";
   for (int i = 0; i < s.edits; ++i) {
     const Edit e = stream.next();
     const int radius = static_cast<int>(std::get<SphereBrush>(e.brush).radius);
@@ -103,8 +107,9 @@ int run_bench_edits(const BenchEditsSettings& s) {
     update_ms.push_back(um);
     recomputed.push_back(st.voxels_recomputed);
     if (want_csv) {
-      csv << i << "," << i * s.interval_ms / 1000.0 << "," << radius << "," << material << "," << r.voxels_changed << ","
-          << st.voxels_recomputed << "," << em << "," << um << "," << em + um << "\n";
+      csv << i << "," << i * s.interval_ms / 1000.0 << "," << radius << "," << material << ","
+          << r.voxels_changed << "," << st.voxels_recomputed << "," << em << "," << um << ","
+          << em + um << "\n";
     }
     if (s.verify) {
       // Compare the whole field with a full rebuild, bit for bit.
@@ -113,7 +118,8 @@ int run_bench_edits(const BenchEditsSettings& s) {
       std::visit(
           [&](const auto& g) {
             using G = std::decay_t<decltype(g)>;
-            std::vector<typename G::value_type> x(static_cast<std::size_t>(box.volume())), y(x.size());
+            std::vector<typename G::value_type> x(static_cast<std::size_t>(box.volume())),
+                y(x.size());
             g.copy_to_dense(box, x.data());
             std::get<G>(full.values).copy_to_dense(box, y.data());
             mismatches += std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) != 0;
@@ -126,45 +132,75 @@ int run_bench_edits(const BenchEditsSettings& s) {
   const std::size_t field_bytes = field.memory_bytes();
   const std::size_t world_bytes = world.voxels.memory().bytes;
   const double voxels = std::pow(static_cast<double>(s.world), 3);
-  const double within = static_cast<double>(std::count_if(latency_ms.begin(), latency_ms.end(),
-                                                          [&](double x) { return x <= s.interval_ms; })) /
-                        std::max<double>(1, static_cast<double>(latency_ms.size()));
-  std::cout << std::fixed << std::setprecision(3) << "voxfield bench edits: " << s.scene << " " << s.world << "^3, chunk "
-            << s.field.chunk_edge << ", " << s.edits << " sphere edits r " << s.radius_min << ".." << radius_max
-            << ", seed " << s.seed << ", " << metric_name(o.metric) << (o.signed_distance ? " signed" : "")
-            << " clamp " << o.max_distance << " " << storage_name(o.storage) << ", " << max_threads() << " threads\n"
-            << "  build " << build_ms << " ms; per edit (edit + update) ms: mean " << lat.mean << " +- " << lat.ci95
-            << " (95% CI), median " << lat.median << ", std " << lat.stddev << ", p99 " << lat.p99 << ", max " << lat.max
-            << "\n  update only: median " << upd.median << ", p99 " << upd.p99 << "; voxels recomputed per edit: mean "
-            << std::accumulate(recomputed.begin(), recomputed.end(), 0.0) / std::max(1, s.edits) << "\n  memory: world "
-            << world_bytes / voxels << " + field " << field_bytes / voxels << " bytes/voxel; "
-            << 100.0 * within << "% of updates within the " << s.interval_ms << " ms interval\n";
-  if (s.verify) std::cout << "  verify: " << mismatches << " of " << s.edits << " updates differ from a full rebuild\n";
+  const double within =
+      static_cast<double>(std::count_if(latency_ms.begin(), latency_ms.end(),
+                                        [&](double x) { return x <= s.interval_ms; })) /
+      std::max<double>(1, static_cast<double>(latency_ms.size()));
+  std::cout << std::fixed << std::setprecision(3) << "voxfield bench edits: " << s.scene << " "
+            << s.world << "^3, chunk " << s.field.chunk_edge << ", " << s.edits
+            << " sphere edits r " << s.radius_min << ".." << radius_max << ", seed " << s.seed
+            << ", " << metric_name(o.metric) << (o.signed_distance ? " signed" : "") << " clamp "
+            << o.max_distance << " " << storage_name(o.storage) << ", " << max_threads()
+            << " threads\n"
+            << "  build " << build_ms << " ms; per edit (edit + update) ms: mean " << lat.mean
+            << " +- " << lat.ci95 << " (95% CI), median " << lat.median << ", std " << lat.stddev
+            << ", p99 " << lat.p99 << ", max " << lat.max << "\n  update only: median "
+            << upd.median << ", p99 " << upd.p99 << "; voxels recomputed per edit: mean "
+            << std::accumulate(recomputed.begin(), recomputed.end(), 0.0) / std::max(1, s.edits)
+            << "\n  memory: world " << world_bytes / voxels << " + field " << field_bytes / voxels
+            << " bytes/voxel; " << 100.0 * within << "% of updates within the " << s.interval_ms
+            << " ms interval\n";
+  if (s.verify)
+    std::cout << "  verify: " << mismatches << " of " << s.edits
+              << " updates differ from a full rebuild\n";
   nlohmann::json gpu_stats = nullptr;
   if (field.on_gpu()) {
     // Per update, hardware-independent: what the dissertation's design spent a fence on per pass.
     const double n = std::max(1, s.edits);
     gpu_stats = field.gpu_json();
-    gpu_stats["per_update"] = {{"submits", (gpu_after.submits - gpu_before.submits) / n},
-                               {"fence_waits", (gpu_after.fence_waits - gpu_before.fence_waits) / n},
-                               {"dispatches", (gpu_after.dispatches - gpu_before.dispatches) / n},
-                               {"bytes_uploaded", (gpu_after.bytes_uploaded - gpu_before.bytes_uploaded) / n},
-                               {"bytes_downloaded_outside_verify",
-                                s.verify ? nlohmann::json(nullptr) : nlohmann::json((gpu_after.bytes_downloaded - gpu_before.bytes_downloaded) / n)}};
-    std::cout << "  gpu (" << gpu_stats["device"].get<std::string>() << "): per update " << gpu_stats["per_update"].dump() << "\n";
+    gpu_stats["per_update"] = {
+        {"submits", (gpu_after.submits - gpu_before.submits) / n},
+        {"fence_waits", (gpu_after.fence_waits - gpu_before.fence_waits) / n},
+        {"dispatches", (gpu_after.dispatches - gpu_before.dispatches) / n},
+        {"bytes_uploaded", (gpu_after.bytes_uploaded - gpu_before.bytes_uploaded) / n},
+        {"bytes_downloaded_outside_verify",
+         s.verify
+             ? nlohmann::json(nullptr)
+             : nlohmann::json((gpu_after.bytes_downloaded - gpu_before.bytes_downloaded) / n)}};
+    std::cout << "  gpu (" << gpu_stats["device"].get<std::string>() << "): per update "
+              << gpu_stats["per_update"].dump() << "\n";
   }
   if (!s.json.empty()) {
     auto summary_json = [](const Summary& x) {
-      return nlohmann::json{{"mean", x.mean}, {"median", x.median}, {"std", x.stddev}, {"ci95", x.ci95}, {"p99", x.p99}, {"max", x.max}};
+      return nlohmann::json{{"mean", x.mean}, {"median", x.median}, {"std", x.stddev},
+                            {"ci95", x.ci95}, {"p99", x.p99},       {"max", x.max}};
     };
-    outputs.stage_json(s.json, {{"scene", s.scene}, {"world", s.world}, {"chunk", s.field.chunk_edge}, {"edits", s.edits},
-                {"seed", s.seed}, {"radius_min", s.radius_min}, {"radius_max", radius_max},
-                {"metric", metric_name(o.metric)}, {"signed", o.signed_distance}, {"max_distance", o.max_distance},
-                {"storage", storage_name(o.storage)}, {"threads", max_threads()}, {"generate_ms", generate_ms},
-                {"build_ms", build_ms}, {"latency_ms", summary_json(lat)}, {"update_ms", summary_json(upd)},
-                {"mean_voxels_recomputed", std::accumulate(recomputed.begin(), recomputed.end(), 0.0) / std::max(1, s.edits)},
-                {"world_bytes_per_voxel", world_bytes / voxels}, {"field_bytes_per_voxel", field_bytes / voxels},
-                {"within_interval", within}, {"backend", field.on_gpu() ? "vulkan" : "cpu"}, {"gpu", gpu_stats}, {"verify_mismatches", s.verify ? nlohmann::json(mismatches) : nlohmann::json(nullptr)}});
+    outputs.stage_json(
+        s.json,
+        {{"scene", s.scene},
+         {"world", s.world},
+         {"chunk", s.field.chunk_edge},
+         {"edits", s.edits},
+         {"seed", s.seed},
+         {"radius_min", s.radius_min},
+         {"radius_max", radius_max},
+         {"metric", metric_name(o.metric)},
+         {"signed", o.signed_distance},
+         {"max_distance", o.max_distance},
+         {"storage", storage_name(o.storage)},
+         {"threads", max_threads()},
+         {"generate_ms", generate_ms},
+         {"build_ms", build_ms},
+         {"latency_ms", summary_json(lat)},
+         {"update_ms", summary_json(upd)},
+         {"mean_voxels_recomputed",
+          std::accumulate(recomputed.begin(), recomputed.end(), 0.0) / std::max(1, s.edits)},
+         {"world_bytes_per_voxel", world_bytes / voxels},
+         {"field_bytes_per_voxel", field_bytes / voxels},
+         {"within_interval", within},
+         {"backend", field.on_gpu() ? "vulkan" : "cpu"},
+         {"gpu", gpu_stats},
+         {"verify_mismatches", s.verify ? nlohmann::json(mismatches) : nlohmann::json(nullptr)}});
   }
   if (want_csv) outputs.stage(s.csv, std::string_view(csv.str()));
   outputs.commit();
@@ -178,18 +214,23 @@ void add_bench(CLI::App& app, Action& action) {
   bench->require_subcommand(1);
   auto s = std::make_shared<BenchEditsSettings>();
   s->field.max_distance = 16;
-  CLI::App* cmd = bench->add_subcommand("edits", "The dissertation's stream of random sphere edits with incremental updates");
+  CLI::App* cmd = bench->add_subcommand(
+      "edits", "The dissertation's stream of random sphere edits with incremental updates");
   cmd->add_option("--world", s->world, "world edge in voxels")->check(CLI::Range(8, 4096));
-  cmd->add_option("--scene", s->scene, "terrain or spheres")->check(CLI::IsMember({"terrain", "spheres"}));
+  cmd->add_option("--scene", s->scene, "terrain or spheres")
+      ->check(CLI::IsMember({"terrain", "spheres"}));
   cmd->add_option("--edits", s->edits, "number of edits")->check(CLI::Range(1, 10000000));
-  cmd->add_option("--interval-ms", s->interval_ms, "time between edits in the stream (reported against)")
+  cmd->add_option("--interval-ms", s->interval_ms,
+                  "time between edits in the stream (reported against)")
       ->check(finite_non_negative());
   cmd->add_option("--seed", s->seed, "random seed");
   cmd->add_option("--radius-min", s->radius_min, "smallest sphere radius");
   cmd->add_option("--radius-max", s->radius_max, "largest sphere radius (default: chunk edge - 1)");
   s->field.add_to(cmd);
-  cmd->add_option("--backend", s->backend, "cpu (default), vulkan or auto")->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
-  cmd->add_flag("--verify", s->verify, "compare the field with a full rebuild after every edit (exit 1 on a mismatch)");
+  cmd->add_option("--backend", s->backend, "cpu (default), vulkan or auto")
+      ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
+  cmd->add_flag("--verify", s->verify,
+                "compare the field with a full rebuild after every edit (exit 1 on a mismatch)");
   cmd->add_option("--csv", s->csv, "one row per edit");
   cmd->add_option("--json", s->json, "summary as JSON");
   cmd->callback([s, &action] { action = [s] { return run_bench_edits(*s); }; });

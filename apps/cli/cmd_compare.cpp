@@ -51,17 +51,21 @@ int run_compare(const CompareSettings& s) {
     const Box3i d = *o.domain;
     const Vec3i sz = d.size();
     focus = {d.begin + Vec3i{sz.x * 3 / 8, sz.y * 3 / 8, sz.z * 3 / 8},
-             d.begin + Vec3i{std::max(sz.x * 5 / 8, sz.x * 3 / 8 + 1), std::max(sz.y * 5 / 8, sz.y * 3 / 8 + 1),
+             d.begin + Vec3i{std::max(sz.x * 5 / 8, sz.x * 3 / 8 + 1),
+                             std::max(sz.y * 5 / 8, sz.y * 3 / 8 + 1),
                              std::max(sz.z * 5 / 8, sz.z * 3 / 8 + 1)}};
   }
   const DistanceField exact = compute_distance_field(in.world, o);
   const Vec3i d = o.domain->size();
-  std::cout << "voxfield compare: " << s.in << ", " << d.x << "x" << d.y << "x" << d.z << ", " << metric_name(o.metric)
-            << (o.signed_distance ? " signed" : "") << (o.max_distance > 0 ? ", clamp " + std::to_string(o.max_distance) : "")
-            << ", " << max_threads() << " threads, median of " << s.runs << " run(s)\n\n";
-  std::cout << std::left << std::setw(14) << "algorithm" << std::right << std::setw(10) << "ms" << std::setw(8)
-            << "passes" << std::setw(7) << "iters" << std::setw(10) << "% wrong" << std::setw(10) << "max over"
-            << std::setw(10) << "max under" << std::setw(10) << "% unsafe" << "\n";
+  std::cout << "voxfield compare: " << s.in << ", " << d.x << "x" << d.y << "x" << d.z << ", "
+            << metric_name(o.metric) << (o.signed_distance ? " signed" : "")
+            << (o.max_distance > 0 ? ", clamp " + std::to_string(o.max_distance) : "") << ", "
+            << max_threads() << " threads, median of " << s.runs << " run(s)\n\n";
+  std::cout << std::left << std::setw(14) << "algorithm" << std::right << std::setw(10) << "ms"
+            << std::setw(8) << "passes" << std::setw(7) << "iters" << std::setw(10) << "% wrong"
+            << std::setw(10) << "max over" << std::setw(10) << "max under" << std::setw(10)
+            << "% unsafe"
+            << "\n";
   nlohmann::json rows = nlohmann::json::array();
   for (Algorithm alg : algs) {
     AlgorithmOptions a;
@@ -76,16 +80,18 @@ int run_compare(const CompareSettings& s) {
         times.push_back(stats.ms);
       }
     } catch (const InvalidArgument& e) {
-      std::cout << std::left << std::setw(14) << algorithm_name(alg) << "  skipped: " << e.what() << "\n";
+      std::cout << std::left << std::setw(14) << algorithm_name(alg) << "  skipped: " << e.what()
+                << "\n";
       rows.push_back({{"algorithm", algorithm_name(alg)}, {"skipped", e.what()}});
       continue;
     }
     const FieldError e = compare_fields(*f, exact, in.world);
     const double ms = median(times);
-    std::cout << std::left << std::setw(14) << algorithm_name(alg) << std::right << std::fixed << std::setprecision(1)
-              << std::setw(10) << ms << std::setw(8) << stats.passes << std::setw(7) << stats.iterations
-              << std::setprecision(3) << std::setw(10) << e.percent_wrong() << std::setprecision(2) << std::setw(10)
-              << e.max_over << std::setw(10) << e.max_under << std::setprecision(3) << std::setw(10)
+    std::cout << std::left << std::setw(14) << algorithm_name(alg) << std::right << std::fixed
+              << std::setprecision(1) << std::setw(10) << ms << std::setw(8) << stats.passes
+              << std::setw(7) << stats.iterations << std::setprecision(3) << std::setw(10)
+              << e.percent_wrong() << std::setprecision(2) << std::setw(10) << e.max_over
+              << std::setw(10) << e.max_under << std::setprecision(3) << std::setw(10)
               << e.percent_unsafe() << "\n";
     rows.push_back({{"algorithm", algorithm_name(alg)},
                     {"ms", ms},
@@ -94,14 +100,16 @@ int run_compare(const CompareSettings& s) {
                     {"error", error_json(e)}});
   }
   if (!s.json.empty()) {
-    nlohmann::json j{{"input", s.in},
-                     {"dims", {d.x, d.y, d.z}},
-                     {"metric", metric_name(o.metric)},
-                     {"signed", o.signed_distance},
-                     {"max_distance", o.max_distance},
-                     {"threads", max_threads()},
-                     {"focus", {focus.begin.x, focus.begin.y, focus.begin.z, focus.end.x, focus.end.y, focus.end.z}},
-                     {"algorithms", rows}};
+    nlohmann::json j{
+        {"input", s.in},
+        {"dims", {d.x, d.y, d.z}},
+        {"metric", metric_name(o.metric)},
+        {"signed", o.signed_distance},
+        {"max_distance", o.max_distance},
+        {"threads", max_threads()},
+        {"focus",
+         {focus.begin.x, focus.begin.y, focus.begin.z, focus.end.x, focus.end.y, focus.end.z}},
+        {"algorithms", rows}};
     outputs.stage_json(s.json, j);
   }
   outputs.commit();
@@ -112,11 +120,14 @@ int run_compare(const CompareSettings& s) {
 
 void add_compare(CLI::App& app, Action& action) {
   auto s = std::make_shared<CompareSettings>();
-  CLI::App* cmd = app.add_subcommand("compare", "Run every algorithm on one input: time and error against the exact field");
+  CLI::App* cmd = app.add_subcommand(
+      "compare", "Run every algorithm on one input: time and error against the exact field");
   cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
   s->field.add_to(cmd);
-  cmd->add_option("--algorithms", s->algorithms, "comma-separated subset (default: all)")->delimiter(',');
-  cmd->add_option("--runs", s->runs, "runs per algorithm; the median time is shown")->check(CLI::Range(1, 100));
+  cmd->add_option("--algorithms", s->algorithms, "comma-separated subset (default: all)")
+      ->delimiter(',');
+  cmd->add_option("--runs", s->runs, "runs per algorithm; the median time is shown")
+      ->check(CLI::Range(1, 100));
   cmd->add_option("--json", s->json, "also write the table as JSON");
   cmd->callback([s, &action] { action = [s] { return run_compare(*s); }; });
 }

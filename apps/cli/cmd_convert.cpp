@@ -29,8 +29,9 @@ int run_convert(const ConvertSettings& s) {
 
 void add_convert(CLI::App& app, Action& action) {
   auto s = std::make_shared<ConvertSettings>();
-  CLI::App* cmd = app.add_subcommand("convert", "Convert a world between .vox, .npy and .vfw (chosen by "
-                                                "extension); the output is written atomically");
+  CLI::App* cmd = app.add_subcommand("convert",
+                                     "Convert a world between .vox, .npy and .vfw (chosen by "
+                                     "extension); the output is written atomically");
   cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
   cmd->add_option("OUT", s->out, "output .vox, .npy or .vfw")->required();
   cmd->callback([s, &action] { action = [s] { return run_convert(*s); }; });

@@ -6,8 +6,8 @@
 #include <numeric>
 
 #include "cli.h"
-#include "live_field.h"
 #include "field_args.h"
+#include "live_field.h"
 #include "voxfield/dynamic_field.h"
 #include "voxfield/edit_script.h"
 #include "voxfield/parallel.h"
@@ -23,7 +23,8 @@ struct EditSettings {
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
+  return v[std::min(v.size() - 1,
+                    static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
 }
 
 int run_edit(const EditSettings& s) {
@@ -75,27 +76,31 @@ int run_edit(const EditSettings& s) {
 
   set_activity("writing " + s.out);
   outputs.stage(s.out, encode_npy(field_volume(field.field(), field.field().domain)));
-  if (!s.save_world.empty()) outputs.stage(s.save_world, encode_world(world, in.extent, world_format_of(s.save_world)));
+  if (!s.save_world.empty())
+    outputs.stage(s.save_world, encode_world(world, in.extent, world_format_of(s.save_world)));
   const double total = std::accumulate(edit_ms.begin(), edit_ms.end(), 0.0);
   const Vec3i d = in.extent.size();
   nlohmann::json j = s.field.describe(o, d);
   j["backend"] = field.on_gpu() ? "vulkan" : "cpu";
   if (field.on_gpu()) j["gpu"] = field.gpu_json();
-  j.update(nlohmann::json{{"build_ms", build_ms},
-                   {"edits", edits.size()},
-                   {"edit_ms", edit_ms},
-                   {"voxels_recomputed", recomputed},
-                   {"voxels_changed", changed},
-                   {"total_ms", total},
-                   {"mean_ms", edit_ms.empty() ? 0 : total / static_cast<double>(edit_ms.size())},
-                   {"p50_ms", percentile(edit_ms, 0.5)},
-                   {"p99_ms", percentile(edit_ms, 0.99)},
-                   {"max_ms", edit_ms.empty() ? 0 : *std::max_element(edit_ms.begin(), edit_ms.end())},
-                   {"total_voxels_recomputed", std::accumulate(recomputed.begin(), recomputed.end(), std::int64_t{0})}});
+  j.update(nlohmann::json{
+      {"build_ms", build_ms},
+      {"edits", edits.size()},
+      {"edit_ms", edit_ms},
+      {"voxels_recomputed", recomputed},
+      {"voxels_changed", changed},
+      {"total_ms", total},
+      {"mean_ms", edit_ms.empty() ? 0 : total / static_cast<double>(edit_ms.size())},
+      {"p50_ms", percentile(edit_ms, 0.5)},
+      {"p99_ms", percentile(edit_ms, 0.99)},
+      {"max_ms", edit_ms.empty() ? 0 : *std::max_element(edit_ms.begin(), edit_ms.end())},
+      {"total_voxels_recomputed",
+       std::accumulate(recomputed.begin(), recomputed.end(), std::int64_t{0})}});
   if (!s.stats.empty()) outputs.stage_json(s.stats, j);
   outputs.commit();
-  std::cerr << "voxfield: " << edits.size() << " edits, " << total << " ms in all (p50 " << percentile(edit_ms, 0.5)
-            << " ms, p99 " << percentile(edit_ms, 0.99) << " ms), wrote " << s.out << "\n";
+  std::cerr << "voxfield: " << edits.size() << " edits, " << total << " ms in all (p50 "
+            << percentile(edit_ms, 0.5) << " ms, p99 " << percentile(edit_ms, 0.99)
+            << " ms), wrote " << s.out << "\n";
   return 0;
 }
 
@@ -103,21 +108,28 @@ int run_edit(const EditSettings& s) {
 
 void add_edit(CLI::App& app, Action& action) {
   auto s = std::make_shared<EditSettings>();
-  CLI::App* cmd = app.add_subcommand(
-      "edit", "Apply scripted edits (JSON lines) with incremental exact distance updates; write the final field");
-  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw (the world is bounded to its volume)")->required();
-  cmd->add_option("-e,--edits", s->edits,
-                  "edit script, one JSON object per line, e.g. "
-                  "{\"op\":\"place\",\"shape\":\"sphere\",\"center\":[40,12,7],\"radius\":6,\"material\":3}; "
-                  "ops place/carve/paint; shapes sphere(center,radius), box(min,max inclusive), "
-                  "rotated-box(center,half_extent,rotation_deg), capsule(a,b,radius), stamp(file,offset)")
+  CLI::App* cmd = app.add_subcommand("edit",
+                                     "Apply scripted edits (JSON lines) with incremental exact "
+                                     "distance updates; write the final field");
+  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw (the world is bounded to its volume)")
+      ->required();
+  cmd->add_option(
+         "-e,--edits", s->edits,
+         "edit script, one JSON object per line, e.g. "
+         "{\"op\":\"place\",\"shape\":\"sphere\",\"center\":[40,12,7],\"radius\":6,\"material\":3};"
+         " "
+         "ops place/carve/paint; shapes sphere(center,radius), box(min,max inclusive), "
+         "rotated-box(center,half_extent,rotation_deg), capsule(a,b,radius), stamp(file,offset)")
       ->required();
   cmd->add_option("-o,--output", s->out, "output .npy of the final field")->required();
   s->field.add_to(cmd);
-  cmd->add_option("--backend", s->backend, "cpu (default), vulkan or auto: where the field lives and is updated")
+  cmd->add_option("--backend", s->backend,
+                  "cpu (default), vulkan or auto: where the field lives and is updated")
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
-  cmd->add_option("--stats", s->stats, "write per-edit latency (edit_ms), voxels_recomputed and totals as JSON");
-  cmd->add_option("--save-world", s->save_world, "also write the edited world (.vox, .npy or .vfw, by extension)");
+  cmd->add_option("--stats", s->stats,
+                  "write per-edit latency (edit_ms), voxels_recomputed and totals as JSON");
+  cmd->add_option("--save-world", s->save_world,
+                  "also write the edited world (.vox, .npy or .vfw, by extension)");
   cmd->callback([s, &action] { action = [s] { return run_edit(*s); }; });
 }
 

@@ -36,7 +36,8 @@ int run_field(const FieldSettings& s) {
   a.focus = s.field.focus_box();
   if (a.algorithm == Algorithm::kLod && !a.focus) throw UsageError("--algorithm lod needs --focus");
   if (o.nearest_sites && !algorithm_tracks_sites(a, o)) {
-    throw InvalidArgument("--sites: the " + s.algorithm + " algorithm does not track nearest sites");
+    throw InvalidArgument("--sites: the " + s.algorithm +
+                          " algorithm does not track nearest sites");
   }
   set_activity("loading " + s.in);
   const LoadedWorld in = load_world(s.in, {s.field.chunk_edge});
@@ -57,7 +58,9 @@ int run_field(const FieldSettings& s) {
   set_activity("writing " + s.out);
   outputs.stage(s.out, encode_npy(field_volume(f, f.domain)));
   if (!s.sites.empty()) {
-    if (!f.sites) throw InvalidArgument("--sites: the " + s.algorithm + " algorithm does not track nearest sites");
+    if (!f.sites)
+      throw InvalidArgument("--sites: the " + s.algorithm +
+                            " algorithm does not track nearest sites");
     outputs.stage(s.sites, encode_npy(sites_volume(*f.sites, f.domain)));
   }
   if (!s.packed.empty()) {
@@ -67,11 +70,11 @@ int run_field(const FieldSettings& s) {
   const Vec3i d = f.domain.size();
   nlohmann::json j = s.field.describe(o, d);
   j.update(nlohmann::json{{"algorithm", s.algorithm},
-                   {"ms", stats.ms},
-                   {"mvox_per_s", static_cast<double>(f.domain.volume()) / (stats.ms * 1e3)},
-                   {"passes", stats.passes},
-                   {"iterations", stats.iterations},
-                   {"peak_rss_mb", static_cast<double>(peak_rss_bytes()) / 1048576.0}});
+                          {"ms", stats.ms},
+                          {"mvox_per_s", static_cast<double>(f.domain.volume()) / (stats.ms * 1e3)},
+                          {"passes", stats.passes},
+                          {"iterations", stats.iterations},
+                          {"peak_rss_mb", static_cast<double>(peak_rss_bytes()) / 1048576.0}});
   j["backend"] = gpu_context ? "vulkan" : "cpu";
   if (gpu_context) {
     j["gpu"] = gpu_json(*gpu_context);
@@ -84,8 +87,8 @@ int run_field(const FieldSettings& s) {
   }
   if (!s.stats.empty()) outputs.stage_json(s.stats, j);
   outputs.commit();
-  std::cerr << "voxfield: " << s.algorithm << " " << metric_name(o.metric) << " field of " << d.x << "x" << d.y << "x"
-            << d.z << " in " << stats.ms << " ms, wrote " << s.out << "\n";
+  std::cerr << "voxfield: " << s.algorithm << " " << metric_name(o.metric) << " field of " << d.x
+            << "x" << d.y << "x" << d.z << " in " << stats.ms << " ms, wrote " << s.out << "\n";
   return 0;
 }
 
@@ -93,19 +96,23 @@ int run_field(const FieldSettings& s) {
 
 void add_field(CLI::App& app, Action& action) {
   auto s = std::make_shared<FieldSettings>();
-  CLI::App* cmd = app.add_subcommand("field", "Compute a distance field and write it as .npy (a[x, y, z], like the input)");
+  CLI::App* cmd = app.add_subcommand(
+      "field", "Compute a distance field and write it as .npy (a[x, y, z], like the input)");
   cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
   cmd->add_option("-o,--output", s->out, "output .npy")->required();
   s->field.add_to(cmd);
-  cmd->add_option("--backend", s->backend, "cpu (default), vulkan (any Vulkan device, software included) or auto "
-                                          "(a hardware GPU if there is one, else the CPU)")
+  cmd->add_option("--backend", s->backend,
+                  "cpu (default), vulkan (any Vulkan device, software included) or auto "
+                  "(a hardware GPU if there is one, else the CPU)")
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
   cmd->add_option("--algorithm", s->algorithm,
                   "exact, brute, brute-chunked, fim, jfa-seed, jfa, jfa+1, jfa+2, hybrid, lod")
       ->check(CLI::IsMember(algorithm_names()))
       ->capture_default_str();
-  cmd->add_option("--sites", s->sites, "also write nearest-site offsets as int16 a[x, y, z, 3] to this .npy");
-  cmd->add_option("--packed", s->packed, "also write the dissertation's packed uint32 voxels to this .npy");
+  cmd->add_option("--sites", s->sites,
+                  "also write nearest-site offsets as int16 a[x, y, z, 3] to this .npy");
+  cmd->add_option("--packed", s->packed,
+                  "also write the dissertation's packed uint32 voxels to this .npy");
   cmd->add_option("--stats", s->stats, "write timing (ms: compute only) and error figures as JSON");
   cmd->callback([s, &action] { action = [s] { return run_field(*s); }; });
 }

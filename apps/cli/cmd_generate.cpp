@@ -27,10 +27,12 @@ Vec3i parse_size(const std::vector<int>& v) {
 void add_generate(CLI::App& app, Action& action) {
   auto s = std::make_shared<GenerateSettings>();
   CLI::App* cmd = app.add_subcommand("generate", "Write a deterministic generated scene");
-  cmd->add_option("SCENE", s->scene, "terrain or spheres")->check(CLI::IsMember({"terrain", "spheres"}));
+  cmd->add_option("SCENE", s->scene, "terrain or spheres")
+      ->check(CLI::IsMember({"terrain", "spheres"}));
   cmd->add_option("--size", s->size, "N or X,Y,Z voxels")->delimiter(',')->expected(1, 3);
   cmd->add_option("--seed", s->seed, "random seed");
-  cmd->add_option("--chunk", s->chunk_edge, "chunk edge (8..128)")->check(CLI::IsMember({8, 16, 32, 64, 128}));
+  cmd->add_option("--chunk", s->chunk_edge, "chunk edge (8..128)")
+      ->check(CLI::IsMember({8, 16, 32, 64, 128}));
   cmd->add_option("-o,--output", s->out, "output .vox, .npy or .vfw")->required();
   cmd->callback([s, &action] {
     action = [s] {
@@ -45,8 +47,9 @@ void add_generate(CLI::App& app, Action& action) {
       const double gen_ms = ms_since(t0);
       outputs.stage(s->out, encode_world(w, Box3i::from_size(o.size), world_format_of(s->out)));
       outputs.commit();
-      std::cerr << "voxfield: " << s->scene << " " << to_string(o.size) << " generated in " << gen_ms
-                << " ms, " << w.solid_count() << " solid voxels, wrote " << s->out << "\n";
+      std::cerr << "voxfield: " << s->scene << " " << to_string(o.size) << " generated in "
+                << gen_ms << " ms, " << w.solid_count() << " solid voxels, wrote " << s->out
+                << "\n";
       return 0;
     };
   });

@@ -46,7 +46,8 @@ struct Summary {
   int materials_used = 0;
   std::int64_t solid = 0;
 
-  explicit Summary(const World& w) : content(w.voxels.content_bounds()), memory(w.voxels.memory()), solid(w.solid_count()) {
+  explicit Summary(const World& w)
+      : content(w.voxels.content_bounds()), memory(w.voxels.memory()), solid(w.solid_count()) {
     const auto histogram = w.material_histogram();
     for (int m = 1; m < 256; ++m) materials_used += histogram[m] > 0;
   }
@@ -107,8 +108,10 @@ int run_info(const InfoSettings& s) {
   std::cout << head << ",\n  \"instances\": [";
   bool first = true;
   for (const auto& i : in.vox->instances) {
-    const nlohmann::json one{{"model", i.model}, {"name", i.name}, {"hidden", i.hidden}, {"box", box_json(i.world_box)}};
-    std::cout << (first ? "\n    " : ",\n    ") << one.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    const nlohmann::json one{
+        {"model", i.model}, {"name", i.name}, {"hidden", i.hidden}, {"box", box_json(i.world_box)}};
+    std::cout << (first ? "\n    " : ",\n    ")
+              << one.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     first = false;
   }
   std::cout << (first ? "]\n}\n" : "\n  ]\n}\n");
@@ -123,7 +126,8 @@ int print_text(const InfoSettings& s, const LoadedWorld& in, const Summary& sum)
   const std::int64_t solid = sum.solid;
   std::cout << "file:          " << s.path << " (" << in.description << ")\n";
   std::cout << "dimensions:    " << dims_text(in.extent.size()) << "\n";
-  std::cout << "bounding box:  " << (content.empty() ? std::string("(empty)") : to_string(content)) << "\n";
+  std::cout << "bounding box:  " << (content.empty() ? std::string("(empty)") : to_string(content))
+            << "\n";
   std::cout << "solid voxels:  " << solid << "\n";
   if (in.vox) {
     const VoxFileInfo& v = *in.vox;
@@ -140,15 +144,16 @@ int print_text(const InfoSettings& s, const LoadedWorld& in, const Summary& sum)
     std::cout << "\n";
     for (std::size_t i = 0; i < v.models.size() && i < 16; ++i) {
       const auto& m = v.models[i];
-      std::cout << "  model " << i << ": " << dims_text(m.size) << ", " << m.voxel_count << " voxels"
-                << (m.compressed ? " (TDCZ, zlib)" : "") << "\n";
+      std::cout << "  model " << i << ": " << dims_text(m.size) << ", " << m.voxel_count
+                << " voxels" << (m.compressed ? " (TDCZ, zlib)" : "") << "\n";
     }
     if (v.models.size() > 16) std::cout << "  ... " << v.models.size() - 16 << " more\n";
   }
-  std::cout << "chunks:        " << g.chunk_count() << " of " << g.chunk_edge() << "^3 (" << mem.dense_chunks
-            << " dense, " << mem.uniform_chunks << " uniform)\n";
-  std::cout << "memory:        " << bytes_text(mem.bytes) << " (" << std::fixed << std::setprecision(3)
-            << mem.bytes_per_voxel() << " bytes/voxel over stored chunks)\n";
+  std::cout << "chunks:        " << g.chunk_count() << " of " << g.chunk_edge() << "^3 ("
+            << mem.dense_chunks << " dense, " << mem.uniform_chunks << " uniform)\n";
+  std::cout << "memory:        " << bytes_text(mem.bytes) << " (" << std::fixed
+            << std::setprecision(3) << mem.bytes_per_voxel()
+            << " bytes/voxel over stored chunks)\n";
   std::cout << "palette used:  " << materials_used << " entries\n";
   return 0;
 }
@@ -157,8 +162,10 @@ int print_text(const InfoSettings& s, const LoadedWorld& in, const Summary& sum)
 
 void add_info(CLI::App& app, Action& action) {
   auto s = std::make_shared<InfoSettings>();
-  CLI::App* cmd = app.add_subcommand("info", "Describe a .vox, .npy or .vfw file: dimensions, bounding box, "
-                                             "solid voxels, models, chunks, memory, palette");
+  CLI::App* cmd =
+      app.add_subcommand("info",
+                         "Describe a .vox, .npy or .vfw file: dimensions, bounding box, "
+                         "solid voxels, models, chunks, memory, palette");
   cmd->add_option("FILE", s->path, "input .vox, .npy or .vfw")->required();
   cmd->add_flag("--json", s->json, "print JSON instead of text");
   cmd->add_option("--chunk", s->chunk_edge, "chunk edge used to load the world (8..128)")

@@ -24,16 +24,20 @@ struct MeshSettings {
   bool optimize = false;
 };
 
-bool is_float(DType t) { return t == DType::kFloat32 || t == DType::kFloat64; }
+bool is_float(DType t) {
+  return t == DType::kFloat32 || t == DType::kFloat64;
+}
 
 int run_mesh(const MeshSettings& s) {
   MeshOptions options;
   options.algorithm = parse_mesher(s.algorithm);
   options.chunk_edge = s.chunk;
-  if (s.inside != "below" && s.inside != "above") throw UsageError("--inside must be below or above, not " + s.inside);
+  if (s.inside != "below" && s.inside != "above")
+    throw UsageError("--inside must be below or above, not " + s.inside);
   options.inside_above = s.inside == "above";
   options.iso = s.iso.value_or(0);
-  if (!s.spacing.empty() && s.spacing.size() != 3) throw UsageError("--spacing takes three values: sx,sy,sz");
+  if (!s.spacing.empty() && s.spacing.size() != 3)
+    throw UsageError("--spacing takes three values: sx,sy,sz");
   const MeshFormat format = mesh_format_of(s.out);
   Outputs outputs({s.in});
   outputs.expect(s.out, "-o");
@@ -53,21 +57,25 @@ int run_mesh(const MeshSettings& s) {
   double mesh_ms = 0;
   if (volume_input) {
     std::vector<float> values(static_cast<std::size_t>(npy->count()));
-    for (std::int64_t i = 0; i < npy->count(); ++i) values[static_cast<std::size_t>(i)] = static_cast<float>(npy->value(i));
+    for (std::int64_t i = 0; i < npy->count(); ++i)
+      values[static_cast<std::size_t>(i)] = static_cast<float>(npy->value(i));
     ScalarVolume volume{npy->dims, values.data()};
     if (!s.spacing.empty()) volume.spacing_units = {s.spacing[0], s.spacing[1], s.spacing[2]};
-    for (int a = 0; a < 3; ++a) chunks = (a ? chunks : 1) * ((npy->dims[a] - 1 + s.chunk - 1) / std::max(1, s.chunk));
+    for (int a = 0; a < 3; ++a)
+      chunks = (a ? chunks : 1) * ((npy->dims[a] - 1 + s.chunk - 1) / std::max(1, s.chunk));
     start = std::chrono::steady_clock::now();
     mesh = mesh_volume(volume, options);
     mesh_ms = ms_since(start);
   } else {
     if (s.iso || s.inside != "below" || !s.spacing.empty())
-      throw UsageError("--iso, --inside and --spacing are for float volumes; a world is meshed at its surface "
-                       "(solid voxels inside, one unit per voxel)");
+      throw UsageError(
+          "--iso, --inside and --spacing are for float volumes; a world is meshed at its surface "
+          "(solid voxels inside, one unit per voxel)");
     LoadOptions lo;
     const World world = npy ? world_from_npy(*npy, s.in) : load_world(s.in, lo).world;
     const Vec3i size = world.voxels.content_bounds().grown(1).size();
-    for (int a = 0; a < 3; ++a) chunks = (a ? chunks : 1) * ((size[a] - 1 + s.chunk - 1) / std::max(1, s.chunk));
+    for (int a = 0; a < 3; ++a)
+      chunks = (a ? chunks : 1) * ((size[a] - 1 + s.chunk - 1) / std::max(1, s.chunk));
     start = std::chrono::steady_clock::now();
     mesh = mesh_world(world, options);
     mesh_ms = ms_since(start);
@@ -96,7 +104,8 @@ int run_mesh(const MeshSettings& s) {
     j["output"] = s.out;
     j["algorithm"] = mesher_name(options.algorithm);
     j["ms"] = mesh_ms;
-    j["phases_ms"] = {{"load", load_ms}, {"mesh", mesh_ms}, {"simplify", simplify_ms}, {"encode", write_ms}};
+    j["phases_ms"] = {
+        {"load", load_ms}, {"mesh", mesh_ms}, {"simplify", simplify_ms}, {"encode", write_ms}};
     if (simplified)
       j["simplify"] = {{"triangles_before", simplified->triangles_before},
                        {"triangles_after", simplified->triangles_after},
@@ -116,9 +125,9 @@ int run_mesh(const MeshSettings& s) {
     outputs.stage_json(s.stats, j);
   }
   outputs.commit();
-  std::cerr << "voxfield: wrote " << s.out << " (" << st.triangles << " triangles, " << st.vertices << " vertices, "
-            << mesher_name(options.algorithm) << ", " << std::lround(mesh_ms) << " ms"
-            << (st.watertight() ? ", watertight" : "") << ")\n";
+  std::cerr << "voxfield: wrote " << s.out << " (" << st.triangles << " triangles, " << st.vertices
+            << " vertices, " << mesher_name(options.algorithm) << ", " << std::lround(mesh_ms)
+            << " ms" << (st.watertight() ? ", watertight" : "") << ")\n";
   return 0;
 }
 
@@ -126,26 +135,38 @@ int run_mesh(const MeshSettings& s) {
 
 void add_mesh(CLI::App& app, Action& action) {
   auto s = std::make_shared<MeshSettings>();
-  CLI::App* cmd = app.add_subcommand("mesh", "Mesh the surface of a world (.vox, .vfw, integer .npy: through its exact "
-                                             "signed distance field) or the iso-surface of a float .npy volume");
+  CLI::App* cmd =
+      app.add_subcommand("mesh",
+                         "Mesh the surface of a world (.vox, .vfw, integer .npy: through its exact "
+                         "signed distance field) or the iso-surface of a float .npy volume");
   cmd->add_option("IN", s->in, "input world or float32/float64 .npy volume")->required();
-  cmd->add_option("-o,--output", s->out, "output .ply, .obj, .stl or .glb (written atomically)")->required();
-  cmd->add_option("--algorithm", s->algorithm, "mc (marching cubes), sn (surface nets) or dc (dual contouring)")
-      ->check(CLI::IsMember({"mc", "sn", "dc", "marching-cubes", "surface-nets", "dual-contouring"}));
+  cmd->add_option("-o,--output", s->out, "output .ply, .obj, .stl or .glb (written atomically)")
+      ->required();
+  cmd->add_option("--algorithm", s->algorithm,
+                  "mc (marching cubes), sn (surface nets) or dc (dual contouring)")
+      ->check(
+          CLI::IsMember({"mc", "sn", "dc", "marching-cubes", "surface-nets", "dual-contouring"}));
   cmd->add_option("--iso", s->iso, "iso value of a float volume (default 0)")->check(CLI::Number);
-  cmd->add_option("--inside", s->inside, "which values of a float volume are inside: below (default) or above iso")
+  cmd->add_option("--inside", s->inside,
+                  "which values of a float volume are inside: below (default) or above iso")
       ->check(CLI::IsMember({"below", "above"}));
-  cmd->add_option("--spacing", s->spacing, "sample spacing of a float volume: sx,sy,sz (sample a[x,y,z] at (x,y,z) * spacing)")
+  cmd->add_option(
+         "--spacing", s->spacing,
+         "sample spacing of a float volume: sx,sy,sz (sample a[x,y,z] at (x,y,z) * spacing)")
       ->delimiter(',')
       ->check(finite_positive());
-  cmd->add_option("--chunk", s->chunk, "cells per chunk edge (2..1024, default 32)")->check(CLI::Range(2, 1024));
+  cmd->add_option("--chunk", s->chunk, "cells per chunk edge (2..1024, default 32)")
+      ->check(CLI::Range(2, 1024));
   cmd->add_option("--threads", s->threads, "threads (default: all)")->check(CLI::Range(1, 1024));
-  cmd->add_option("--simplify", s->simplify, "keep about this fraction of the triangles (0 < R <= 1; meshoptimizer)")
+  cmd->add_option("--simplify", s->simplify,
+                  "keep about this fraction of the triangles (0 < R <= 1; meshoptimizer)")
       ->check(CLI::Range(1e-6, 1.0));
   cmd->add_option("--simplify-error", s->simplify_error,
-                  "simplify no farther than this from the surface, in output units (default 1 % of the extent)")
+                  "simplify no farther than this from the surface, in output units (default 1 % of "
+                  "the extent)")
       ->check(finite_positive());
-  cmd->add_flag("--optimize", s->optimize, "reorder triangles and vertices for the GPU's vertex cache (meshoptimizer)");
+  cmd->add_flag("--optimize", s->optimize,
+                "reorder triangles and vertices for the GPU's vertex cache (meshoptimizer)");
   cmd->add_option("--stats", s->stats, "write counts, topology and timings as JSON");
   cmd->callback([s, &action] { action = [s] { return run_mesh(*s); }; });
 }

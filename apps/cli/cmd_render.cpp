@@ -4,12 +4,12 @@
 #include <iostream>
 
 #include "cli.h"
-#include "progress.h"
 #include "field_args.h"
 #include "live_field.h"
-#include "voxfield/png.h"
-#include "voxfield/parallel.h"
+#include "progress.h"
 #include "voxfield/gpu_render.h"
+#include "voxfield/parallel.h"
+#include "voxfield/png.h"
 #include "voxfield/render.h"
 
 namespace voxfield::cli {
@@ -17,7 +17,7 @@ namespace {
 
 struct RenderSettings {
   std::string in, out, camera = "auto", view = "shaded", algorithm = "jfa", metric = "manhattan",
-              skip = "distance", stats, backend = "cpu";
+                       skip = "distance", stats, backend = "cpu";
   int width = 1280, height = 720, chunk_edge = 32, threads = 0, repeat = 1;
   bool no_shadows = false, no_ao = false;
   double fog = 0;
@@ -51,7 +51,8 @@ int run_render(const RenderSettings& s) {
   const double aspect = static_cast<double>(s.width) / s.height;
   // Automatic cameras frame what is there: the content, within the file's extent.
   const Box3i content = in.world.voxels.content_bounds().intersect(in.extent);
-  const Camera camera = Camera::parse(s.camera, s.camera == "top" || content.empty() ? in.extent : content, aspect);
+  const Camera camera =
+      Camera::parse(s.camera, s.camera == "top" || content.empty() ? in.extent : content, aspect);
 
   const RenderScene scene(in.world, so, in.extent);
   // With --repeat, the frame is rendered several times and the median time reported (the
@@ -62,7 +63,8 @@ int run_render(const RenderSettings& s) {
   std::vector<double> times;
   std::vector<gpu::PassTiming> pass_timings;
   for (int r = 0; r < s.repeat; ++r) {
-    image = gpu_context ? gpu::render(*gpu_context, scene, camera, o, &st, &pass_timings) : render(scene, camera, o, &st, progress());
+    image = gpu_context ? gpu::render(*gpu_context, scene, camera, o, &st, &pass_timings)
+                        : render(scene, camera, o, &st, progress());
     times.push_back(st.ms);
   }
   std::sort(times.begin(), times.end());
@@ -70,12 +72,12 @@ int run_render(const RenderSettings& s) {
   outputs.stage(s.out, encode_png(image));
   // The status goes to stderr when the frame itself goes to standard output.
   std::ostream& status = s.out == "-" ? std::cerr : std::cout;
-  status << "voxfield render: " << s.out << " (" << s.width << "x" << s.height << ", " << s.view << " view), "
-            << st.ms << " ms, " << st.rays_per_second() / 1e6 << " M primary rays/s, fields " << scene.field_ms()
-            << " ms\n";
+  status << "voxfield render: " << s.out << " (" << s.width << "x" << s.height << ", " << s.view
+         << " view), " << st.ms << " ms, " << st.rays_per_second() / 1e6
+         << " M primary rays/s, fields " << scene.field_ms() << " ms\n";
   if (o.view == RenderView::kError)
     status << "  " << s.algorithm << ": " << st.rays_through_geometry
-              << " rays skip through geometry, largest error on a ray " << st.max_error << " voxels\n";
+           << " rays skip through geometry, largest error on a ray " << st.max_error << " voxels\n";
   if (!s.stats.empty()) {
     auto counters = [](const TraversalCounters& c) {
       return nlohmann::json{{"rays", c.rays},
@@ -116,31 +118,40 @@ int run_render(const RenderSettings& s) {
 
 void add_render(CLI::App& app, Action& action) {
   auto s = std::make_shared<RenderSettings>();
-  CLI::App* cmd = app.add_subcommand("render", "Ray-march a frame of a world on the CPU and write a PNG");
+  CLI::App* cmd =
+      app.add_subcommand("render", "Ray-march a frame of a world on the CPU and write a PNG");
   cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
   cmd->add_option("-o,--output", s->out, "output .png")->required();
   cmd->add_option("--width", s->width, "image width in pixels")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", s->height, "image height in pixels")->check(CLI::Range(1, 16384));
   cmd->add_option("--camera", s->camera,
-                  "auto | top | eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height] (voxel units, z up)")
+                  "auto | top | eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height] (voxel "
+                  "units, z up)")
       ->check(camera_spec());
   cmd->add_option("--view", s->view, "shaded | distance | error | chunks")
       ->check(CLI::IsMember({"shaded", "distance", "error", "chunks"}));
-  cmd->add_option("--algorithm", s->algorithm, "error view: the approximation shown against the exact field")
+  cmd->add_option("--algorithm", s->algorithm,
+                  "error view: the approximation shown against the exact field")
       ->check(CLI::IsMember(algorithm_names()));
-  cmd->add_option("--metric", s->metric, "field rays skip by: manhattan (default), chebyshev, euclidean")
+  cmd->add_option("--metric", s->metric,
+                  "field rays skip by: manhattan (default), chebyshev, euclidean")
       ->check(CLI::IsMember({"manhattan", "chebyshev", "euclidean"}));
-  cmd->add_option("--backend", s->backend, "cpu (default), vulkan or auto; the GPU draws the shaded and chunks views")
+  cmd->add_option("--backend", s->backend,
+                  "cpu (default), vulkan or auto; the GPU draws the shaded and chunks views")
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
   cmd->add_option("--skip", s->skip, "none (plain DDA), chunks, distance (default)")
       ->check(CLI::IsMember({"none", "chunks", "distance"}));
   cmd->add_option("--slice", s->slice, "distance view: z of the cut plane (default: the middle)");
   cmd->add_flag("--no-shadows", s->no_shadows, "no soft shadows");
   cmd->add_flag("--no-ao", s->no_ao, "no ambient occlusion");
-  cmd->add_option("--fog", s->fog, "fog density per voxel of travel (e.g. 0.002)")->check(finite_non_negative());
-  cmd->add_option("--chunk", s->chunk_edge, "chunk edge: 8, 16, 32, 64 or 128")->check(CLI::IsMember({8, 16, 32, 64, 128}));
-  cmd->add_option("--threads", s->threads, "threads, 1..1024 (default: all cores)")->check(CLI::Range(1, 1024));
-  cmd->add_option("--repeat", s->repeat, "render N times, report the median time")->check(CLI::Range(1, 1000));
+  cmd->add_option("--fog", s->fog, "fog density per voxel of travel (e.g. 0.002)")
+      ->check(finite_non_negative());
+  cmd->add_option("--chunk", s->chunk_edge, "chunk edge: 8, 16, 32, 64 or 128")
+      ->check(CLI::IsMember({8, 16, 32, 64, 128}));
+  cmd->add_option("--threads", s->threads, "threads, 1..1024 (default: all cores)")
+      ->check(CLI::Range(1, 1024));
+  cmd->add_option("--repeat", s->repeat, "render N times, report the median time")
+      ->check(CLI::Range(1, 1000));
   cmd->add_option("--stats", s->stats, "write timings and traversal counters as JSON");
   cmd->callback([s, &action] { action = [s] { return run_render(*s); }; });
 }

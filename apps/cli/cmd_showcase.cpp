@@ -8,14 +8,14 @@
 
 #include "cli.h"
 #include "showcase.h"
-#include "voxfield/png.h"
 #include "voxfield/algorithms.h"
 #include "voxfield/dynamic_field.h"
-#include "voxfield/world_file.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
+#include "voxfield/png.h"
 #include "voxfield/render.h"
 #include "voxfield/scene.h"
+#include "voxfield/world_file.h"
 
 namespace voxfield::cli {
 namespace {
@@ -38,7 +38,8 @@ int run_showcase(const ShowcaseSettings& s) {
      << max_threads() << " threads.\n\n";
 
   md << "## Generated worlds\n\n";
-  md << "| scene | size | solid voxels | solid % | generate ms | chunks (dense/uniform) | bytes/voxel |"
+  md << "| scene | size | solid voxels | solid % | generate ms | chunks (dense/uniform) | "
+        "bytes/voxel |"
         " .vox bytes | .vox round trip |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const char* scene : {"terrain", "spheres"}) {
     SceneOptions o;
@@ -47,7 +48,8 @@ int run_showcase(const ShowcaseSettings& s) {
     auto t0 = std::chrono::steady_clock::now();
     const World w = make_scene(scene, o);
     const double gen_ms = ms_since(t0);
-    timings.push_back({std::string("generate ") + scene + " " + std::to_string(s.size) + "³", gen_ms, ""});
+    timings.push_back(
+        {std::string("generate ") + scene + " " + std::to_string(s.size) + "³", gen_ms, ""});
     const std::int64_t solid = w.solid_count();
     const GridMemory mem = w.voxels.memory();
 
@@ -57,18 +59,23 @@ int run_showcase(const ShowcaseSettings& s) {
     write_npy(npy_from_world(w, Box3i::from_size(o.size)), npy_path);
     // Round trip: what we wrote must read back voxel for voxel.
     const World back = read_vox(vox_path).world;
-    std::vector<std::uint8_t> a(static_cast<std::size_t>(Box3i::from_size(o.size).volume())), b(a.size());
+    std::vector<std::uint8_t> a(static_cast<std::size_t>(Box3i::from_size(o.size).volume())),
+        b(a.size());
     w.voxels.copy_to_dense(Box3i::from_size(o.size), a.data());
     back.voxels.copy_to_dense(Box3i::from_size(o.size), b.data());
     const bool same = a == b && back.solid_count() == solid;
 
     md << "| " << scene << " | " << s.size << "³ | " << solid << " | "
        << fixed(100.0 * solid / Box3i::from_size(o.size).volume(), 1) << " | " << fixed(gen_ms, 0)
-       << " | " << mem.dense_chunks << "/" << mem.uniform_chunks << " | " << fixed(mem.bytes_per_voxel(), 3)
-       << " | " << fs::file_size(vox_path) << " | " << (same ? "identical" : "**DIFFERENT**") << " |\n";
-    std::cout << "voxfield showcase: " << scene << " " << s.size << "^3: " << solid << " solid voxels, "
-              << fixed(gen_ms, 0) << " ms, .vox round trip " << (same ? "identical" : "DIFFERENT") << "\n";
-    if (!same) throw Error("showcase: .vox round trip of the " + std::string(scene) + " scene changed the world");
+       << " | " << mem.dense_chunks << "/" << mem.uniform_chunks << " | "
+       << fixed(mem.bytes_per_voxel(), 3) << " | " << fs::file_size(vox_path) << " | "
+       << (same ? "identical" : "**DIFFERENT**") << " |\n";
+    std::cout << "voxfield showcase: " << scene << " " << s.size << "^3: " << solid
+              << " solid voxels, " << fixed(gen_ms, 0) << " ms, .vox round trip "
+              << (same ? "identical" : "DIFFERENT") << "\n";
+    if (!same)
+      throw Error("showcase: .vox round trip of the " + std::string(scene) +
+                  " scene changed the world");
   }
   md << "\nFiles: `terrain.vox`, `terrain.npy`, `spheres.vox`, `spheres.npy` (open the .vox in "
         "MagicaVoxel; load the .npy with `numpy.load`, indexed `a[x, y, z]`).\n";
@@ -80,7 +87,8 @@ int run_showcase(const ShowcaseSettings& s) {
   const World terrain = make_terrain(to);
   const double voxels = static_cast<double>(Box3i::from_size(to.size).volume());
   md << "\n## Exact distance fields of the terrain\n\n";
-  md << "| metric | signed | ms | Mvox/s | max distance | field memory (bytes/voxel) |\n|---|---|---|---|---|---|\n";
+  md << "| metric | signed | ms | Mvox/s | max distance | field memory (bytes/voxel) "
+        "|\n|---|---|---|---|---|---|\n";
   for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
     for (bool sgn : {false, true}) {
       DistanceOptions o;
@@ -89,8 +97,9 @@ int run_showcase(const ShowcaseSettings& s) {
       const auto t0 = std::chrono::steady_clock::now();
       const DistanceField f = compute_distance_field(terrain, o);
       const double ms = ms_since(t0);
-      timings.push_back({std::string("exact ") + (sgn ? "signed " : "") + metric_name(m) + " field, f32", ms,
-                         fixed(voxels / (ms * 1e3), 0) + " Mvox/s"});
+      timings.push_back(
+          {std::string("exact ") + (sgn ? "signed " : "") + metric_name(m) + " field, f32", ms,
+           fixed(voxels / (ms * 1e3), 0) + " Mvox/s"});
       const Grid<float>& g = std::get<Grid<float>>(f.values);
       float max_d = 0;
       g.for_each_chunk([&](const ChunkView<float>& c) {
@@ -100,15 +109,16 @@ int run_showcase(const ShowcaseSettings& s) {
         }
         for (std::int64_t i = 0; i < g.chunk_volume(); ++i) max_d = std::max(max_d, c.voxels[i]);
       });
-      md << "| " << metric_name(m) << " | " << (sgn ? "yes" : "no") << " | " << fixed(ms, 1) << " | "
-         << fixed(voxels / (ms * 1e3), 0) << " | " << fixed(max_d, 2) << " | " << fixed(g.memory().bytes_per_voxel(), 2)
-         << " |\n";
-      std::cout << "voxfield showcase: " << metric_name(m) << (sgn ? " signed" : "") << " field in " << fixed(ms, 1)
-                << " ms\n";
+      md << "| " << metric_name(m) << " | " << (sgn ? "yes" : "no") << " | " << fixed(ms, 1)
+         << " | " << fixed(voxels / (ms * 1e3), 0) << " | " << fixed(max_d, 2) << " | "
+         << fixed(g.memory().bytes_per_voxel(), 2) << " |\n";
+      std::cout << "voxfield showcase: " << metric_name(m) << (sgn ? " signed" : "") << " field in "
+                << fixed(ms, 1) << " ms\n";
       if (m == Metric::kEuclidean && sgn) {
         std::vector<float> dense(static_cast<std::size_t>(voxels));
         g.copy_to_dense(Box3i::from_size(to.size), dense.data());
-        write_npy(make_npy(DType::kFloat32, to.size, dense.data()), fs::path(s.out) / "terrain-sdf.npy");
+        write_npy(make_npy(DType::kFloat32, to.size, dense.data()),
+                  fs::path(s.out) / "terrain-sdf.npy");
       }
     }
 
@@ -121,22 +131,25 @@ int run_showcase(const ShowcaseSettings& s) {
   lo.metric = Metric::kManhattan;
   const DistanceField exact = compute_distance_field(sw, lo);
   md << "\n## The dissertation's algorithms, Manhattan, terrain " << small.size.x << "³\n\n";
-  md << "| algorithm | ms | passes | iterations | % voxels wrong | max over | max under | % unsafe |\n"
+  md << "| algorithm | ms | passes | iterations | % voxels wrong | max over | max under | % unsafe "
+        "|\n"
         "|---|---|---|---|---|---|---|---|\n";
   for (Algorithm a : all_algorithms()) {
     if (a == Algorithm::kBrute) continue;  // hours at this size
     AlgorithmOptions ao;
     ao.algorithm = a;
     const Vec3i c = small.size;
-    ao.focus = Box3i{{c.x * 3 / 8, c.y * 3 / 8, c.z * 3 / 8}, {c.x * 5 / 8, c.y * 5 / 8, c.z * 5 / 8}};
+    ao.focus =
+        Box3i{{c.x * 3 / 8, c.y * 3 / 8, c.z * 3 / 8}, {c.x * 5 / 8, c.y * 5 / 8, c.z * 5 / 8}};
     AlgorithmStats st;
     const DistanceField f = compute_distance_field(sw, lo, ao, &st);
     const FieldError e = compare_fields(f, exact, sw);
-    md << "| " << algorithm_name(a) << " | " << fixed(st.ms, 1) << " | " << st.passes << " | " << st.iterations << " | "
-       << fixed(e.percent_wrong(), 2) << " | " << fixed(e.max_over, 1) << " | " << fixed(e.max_under, 1) << " | "
-       << fixed(e.percent_unsafe(), 2) << " |\n";
+    md << "| " << algorithm_name(a) << " | " << fixed(st.ms, 1) << " | " << st.passes << " | "
+       << st.iterations << " | " << fixed(e.percent_wrong(), 2) << " | " << fixed(e.max_over, 1)
+       << " | " << fixed(e.max_under, 1) << " | " << fixed(e.percent_unsafe(), 2) << " |\n";
   }
-  md << "\n*Unsafe* voxels hold a value above the exact distance: a ray marcher trusting them skips "
+  md << "\n*Unsafe* voxels hold a value above the exact distance: a ray marcher trusting them "
+        "skips "
         "through geometry. `terrain-sdf.npy` is the signed Euclidean field of the terrain.\n";
 
   // Pictures of the terrain, rendered through fields that are then kept exact under a seeded
@@ -155,18 +168,20 @@ int run_showcase(const ShowcaseSettings& s) {
   auto t_fields = std::chrono::steady_clock::now();
   DynamicDistanceField skip_field(edited, skip_o);
   DynamicDistanceField light_field(edited, light_o);
-  timings.push_back({"render fields (Manhattan u8 clamp 32 + Euclidean u8 clamp 16), " + std::to_string(s.size) + "³",
+  timings.push_back({"render fields (Manhattan u8 clamp 32 + Euclidean u8 clamp 16), " +
+                         std::to_string(s.size) + "³",
                      ms_since(t_fields), ""});
 
   const double aspect = 16.0 / 9.0;
   const Camera hero = Camera::framing(edited.voxels.content_bounds(), aspect);
   const Camera top = Camera::top(box, 1.0);
-  auto frame = [&](const RenderScene& scene, const Camera& cam, RenderOptions o, const std::string& file,
-                   const std::string& what) {
+  auto frame = [&](const RenderScene& scene, const Camera& cam, RenderOptions o,
+                   const std::string& file, const std::string& what) {
     RenderStats st;
     const Image img = render(scene, cam, o, &st);
     write_png(img, fs::path(s.out) / file);
-    timings.push_back({"frame " + file + " (" + what + ", " + std::to_string(o.width) + "×" + std::to_string(o.height) + ")",
+    timings.push_back({"frame " + file + " (" + what + ", " + std::to_string(o.width) + "×" +
+                           std::to_string(o.height) + ")",
                        st.ms, fixed(st.rays_per_second() / 1e6, 1) + " M primary rays/s"});
     std::cout << "voxfield showcase: " << file << " in " << fixed(st.ms, 0) << " ms\n";
     return st;
@@ -198,12 +213,15 @@ int run_showcase(const ShowcaseSettings& s) {
   }
   md << "\n## The terrain\n\n"
      << "Rendered on the CPU by DDA ray marching through the Manhattan field (empty chunks and "
-        "distance-field skips), shaded with ambient occlusion and soft shadows from the Euclidean field.\n\n"
+        "distance-field skips), shaded with ambient occlusion and soft shadows from the Euclidean "
+        "field.\n\n"
      << "![terrain](terrain-before.png)\n\n"
-     << "| from above | chunk grid (blue: chunks stored voxel by voxel, orange: uniform chunks) |\n|---|---|\n"
+     << "| from above | chunk grid (blue: chunks stored voxel by voxel, orange: uniform chunks) "
+        "|\n|---|---|\n"
      << "| ![top](terrain-top-before.png) | ![chunks](terrain-chunks.png) |\n\n"
      << "Cut through the caves at z = " << to.size.z * 3 / 10
-     << ": the exact Manhattan distance of every air voxel on the cut (blue near, red far; a darker band every 8 "
+     << ": the exact Manhattan distance of every air voxel on the cut (blue near, red far; a "
+        "darker band every 8 "
         "voxels), the world below the cut shaded.\n\n![distance](terrain-distance.png)\n";
 
   showcase_meshing(terrain, s.out, fs::path(s.out) / "terrain-sdf.npy", s.peers, hero, md, timings);
@@ -212,10 +230,14 @@ int run_showcase(const ShowcaseSettings& s) {
   {
     const RenderScene small_scene(sw, RenderSceneOptions{}, Box3i::from_size(small.size));
     const Camera small_cam = Camera::framing(Box3i::from_size(small.size), aspect);
-    md << "\n## What the approximations get wrong, seen by a ray marcher (terrain " << small.size.x << "³)\n\n"
-       << "Each pixel shows the largest |approximate − exact| Manhattan distance along its ray (log scale, "
-          "blue small, red large); magenta marks rays that, skipping by the approximate field, pass through the "
-          "voxel they should hit.\n\n| algorithm | rays through geometry | largest error on a ray |\n|---|---|---|\n";
+    md << "\n## What the approximations get wrong, seen by a ray marcher (terrain " << small.size.x
+       << "³)\n\n"
+       << "Each pixel shows the largest |approximate − exact| Manhattan distance along its ray "
+          "(log scale, "
+          "blue small, red large); magenta marks rays that, skipping by the approximate field, "
+          "pass through the "
+          "voxel they should hit.\n\n| algorithm | rays through geometry | largest error on a ray "
+          "|\n|---|---|---|\n";
     std::string images;
     for (Algorithm a : {Algorithm::kJfaSeed, Algorithm::kBruteChunked, Algorithm::kJfa}) {
       RenderOptions ev;
@@ -224,9 +246,10 @@ int run_showcase(const ShowcaseSettings& s) {
       ev.view = RenderView::kError;
       ev.error_algorithm = a;
       const std::string file = std::string("error-") + algorithm_name(a) + ".png";
-      const RenderStats st = frame(small_scene, small_cam, ev, file, std::string("error view, ") + algorithm_name(a));
-      md << "| " << algorithm_name(a) << " | " << st.rays_through_geometry << " of " << ev.width * ev.height << " | "
-         << fixed(st.max_error, 0) << " voxels |\n";
+      const RenderStats st =
+          frame(small_scene, small_cam, ev, file, std::string("error view, ") + algorithm_name(a));
+      md << "| " << algorithm_name(a) << " | " << st.rays_through_geometry << " of "
+         << ev.width * ev.height << " | " << fixed(st.max_error, 0) << " voxels |\n";
       images += "| " + std::string(algorithm_name(a)) + " | ![" + file + "](" + file + ") |\n";
     }
     md << "\n| algorithm | error view |\n|---|---|\n" << images;
@@ -262,18 +285,21 @@ int run_showcase(const ShowcaseSettings& s) {
         e.op = EditOp::kCarve;
         e.brush = SphereBrush{{double(x), double(y), h}, r};
         ++craters;
-      } else if (kind < 17) {  // boulder sitting on the surface, in one of the palette's bright colours
+      } else if (kind <
+                 17) {  // boulder sitting on the surface, in one of the palette's bright colours
         const double r = next(2, std::max(3, s.size / 40));
         e.op = EditOp::kPlace;
-        e.material = static_cast<std::uint8_t>(std::array<int, 4>{36, 5, 180, 215}[static_cast<std::size_t>(next(0, 3))]);
+        e.material = static_cast<std::uint8_t>(
+            std::array<int, 4>{36, 5, 180, 215}[static_cast<std::size_t>(next(0, 3))]);
         e.brush = SphereBrush{{double(x), double(y), h + r}, r};
         ++boulders;
       } else {  // pillar
         const int half = next(1, 3), height = next(s.size / 16, s.size / 6);
         e.op = EditOp::kPlace;
         e.material = 121;
-        e.brush = BoxBrush{{x - half, y - half, static_cast<int>(h)},
-                           {x + half, y + half, std::min(to.size.z - 1, static_cast<int>(h) + height)}};
+        e.brush =
+            BoxBrush{{x - half, y - half, static_cast<int>(h)},
+                     {x + half, y + half, std::min(to.size.z - 1, static_cast<int>(h) + height)}};
         ++pillars;
       }
       const auto t0 = std::chrono::steady_clock::now();
@@ -294,35 +320,44 @@ int run_showcase(const ShowcaseSettings& s) {
       return a == b;
     };
     const bool exact = same(skip_field) && same(light_field);
-    timings.push_back({std::to_string(edits) + " edits with incremental updates of both fields", stream_ms,
+    timings.push_back({std::to_string(edits) + " edits with incremental updates of both fields",
+                       stream_ms,
                        "median " + fixed(latencies[latencies.size() / 2], 2) + " ms, p99 " +
                            fixed(latencies[latencies.size() * 99 / 100], 2) + " ms per edit"});
-    timings.push_back({"full rebuilds of both fields, to check the updates", ms_since(t_check), ""});
-    write_world_file(edited, fs::path(s.out) / "terrain-edited.vfw", {&skip_field.field(), &light_field.field()});
+    timings.push_back(
+        {"full rebuilds of both fields, to check the updates", ms_since(t_check), ""});
+    write_world_file(edited, fs::path(s.out) / "terrain-edited.vfw",
+                     {&skip_field.field(), &light_field.field()});
     {
       const RenderScene after(edited, skip_field.field(), &light_field.field());
       frame(after, hero, wide, "terrain-after.png", "shaded, after the edits");
       frame(after, top, square, "terrain-top-after.png", "shaded, top, after the edits");
     }
-    md << "\n## Editing the terrain\n\n" << edits << " seeded edits on the surface (" << craters << " craters, "
-       << boulders << " boulders, " << pillars << " pillars), each followed by incremental exact updates of both "
+    md << "\n## Editing the terrain\n\n"
+       << edits << " seeded edits on the surface (" << craters << " craters, " << boulders
+       << " boulders, " << pillars
+       << " pillars), each followed by incremental exact updates of both "
           "render fields: median "
-       << fixed(latencies[latencies.size() / 2], 2) << " ms, p99 " << fixed(latencies[latencies.size() * 99 / 100], 2)
+       << fixed(latencies[latencies.size() / 2], 2) << " ms, p99 "
+       << fixed(latencies[latencies.size() * 99 / 100], 2)
        << " ms per edit. After the stream both fields are "
        << (exact ? "bit-identical to full rebuilds" : "**different from full rebuilds**")
-       << ", and the frames below are rendered from the incrementally updated fields. The edited world and "
+       << ", and the frames below are rendered from the incrementally updated fields. The edited "
+          "world and "
           "its fields are in `terrain-edited.vfw`.\n\n"
        << "| before | after |\n|---|---|\n"
        << "| ![before](terrain-before.png) | ![after](terrain-after.png) |\n"
        << "| ![before](terrain-top-before.png) | ![after](terrain-top-after.png) |\n";
-    std::cout << "voxfield showcase: " << edits << " edits, median " << fixed(latencies[latencies.size() / 2], 2)
-              << " ms, fields " << (exact ? "identical to" : "DIFFERENT from") << " full rebuilds\n";
+    std::cout << "voxfield showcase: " << edits << " edits, median "
+              << fixed(latencies[latencies.size() / 2], 2) << " ms, fields "
+              << (exact ? "identical to" : "DIFFERENT from") << " full rebuilds\n";
     if (!exact) throw Error("showcase: the incrementally updated fields differ from full rebuilds");
   }
 
   const double total_ms = ms_since(t_start);
   md << "\n## Timings\n\n| stage | ms | |\n|---|---|---|\n";
-  for (const auto& [stage, ms, note] : timings) md << "| " << stage << " | " << fixed(ms, 1) << " | " << note << " |\n";
+  for (const auto& [stage, ms, note] : timings)
+    md << "| " << stage << " | " << fixed(ms, 1) << " | " << note << " |\n";
   md << "| **whole showcase** | " << fixed(total_ms, 0) << " | " << max_threads() << " threads |\n";
 
   const fs::path report = fs::path(s.out) / "report.md";
@@ -339,7 +374,8 @@ void add_showcase(CLI::App& app, Action& action) {
   cmd->add_option("--size", s->size, "world edge in voxels")->check(CLI::Range(8, 1024));
   cmd->add_option("--seed", s->seed, "random seed");
   cmd->add_option("--out", s->out, "output directory");
-  cmd->add_option("--peers", s->peers, "the peers' meshing script (bench/peers/mesh_peers.py), run when it exists");
+  cmd->add_option("--peers", s->peers,
+                  "the peers' meshing script (bench/peers/mesh_peers.py), run when it exists");
   cmd->callback([s, &action] { action = [s] { return run_showcase(*s); }; });
 }
 

@@ -15,21 +15,26 @@ void FieldArgs::add_to(CLI::App* cmd) {
   cmd->add_option("--metric", metric, "manhattan, chebyshev or euclidean")
       ->check(CLI::IsMember({"manhattan", "chebyshev", "euclidean"}))
       ->capture_default_str();
-  cmd->add_flag("--signed", is_signed, "negative distances inside solids (to the nearest air voxel)");
+  cmd->add_flag("--signed", is_signed,
+                "negative distances inside solids (to the nearest air voxel)");
   cmd->add_option("--max-distance", max_distance, "clamp D: values beyond D read D (0 = no clamp)")
       ->check(finite_non_negative());
-  cmd->add_option("--storage", storage, "u8, u16 or f32 (integer Euclidean: fixed point, rounded down)")
+  cmd->add_option("--storage", storage,
+                  "u8, u16 or f32 (integer Euclidean: fixed point, rounded down)")
       ->check(CLI::IsMember({"u8", "u16", "f32"}))
       ->capture_default_str();
   cmd->add_option("--spacing", spacing, "voxel size sx,sy,sz (euclidean only)")
       ->delimiter(',')
       ->expected(3)
       ->check(finite_positive());
-  cmd->add_option("--focus", focus, "focus box x0,y0,z0,x1,y1,z1 for lod (min inclusive, max exclusive)")
+  cmd->add_option("--focus", focus,
+                  "focus box x0,y0,z0,x1,y1,z1 for lod (min inclusive, max exclusive)")
       ->delimiter(',')
       ->expected(6);
-  cmd->add_option("--chunk", chunk_edge, "chunk edge: 8, 16, 32, 64 or 128")->check(CLI::IsMember({8, 16, 32, 64, 128}));
-  cmd->add_option("--threads", threads, "threads to use, 1..1024 (default: all cores)")->check(CLI::Range(1, 1024));
+  cmd->add_option("--chunk", chunk_edge, "chunk edge: 8, 16, 32, 64 or 128")
+      ->check(CLI::IsMember({8, 16, 32, 64, 128}));
+  cmd->add_option("--threads", threads, "threads to use, 1..1024 (default: all cores)")
+      ->check(CLI::Range(1, 1024));
 }
 
 DistanceOptions FieldArgs::options() const {
@@ -43,9 +48,12 @@ DistanceOptions FieldArgs::options() const {
 }
 
 nlohmann::json FieldArgs::describe(const DistanceOptions& o, Vec3i dims) const {
-  return {{"metric", metric_name(o.metric)},  {"signed", o.signed_distance},
-          {"max_distance", o.max_distance},   {"storage", storage_name(o.storage)},
-          {"dims", {dims.x, dims.y, dims.z}}, {"threads", max_threads()},
+  return {{"metric", metric_name(o.metric)},
+          {"signed", o.signed_distance},
+          {"max_distance", o.max_distance},
+          {"storage", storage_name(o.storage)},
+          {"dims", {dims.x, dims.y, dims.z}},
+          {"threads", max_threads()},
           {"chunk", chunk_edge}};
 }
 
@@ -100,7 +108,7 @@ NpyVolume field_volume(const DistanceField& f, const Box3i& box) {
                        "a dense copy of " + std::to_string(box.volume()) + " values");
         std::vector<T> dense(static_cast<std::size_t>(box.volume()));
         g.copy_to_dense(box, dense.data());
-        const DType t = std::is_same_v<T, float> ? DType::kFloat32
+        const DType t = std::is_same_v<T, float>           ? DType::kFloat32
                         : std::is_same_v<T, std::uint16_t> ? DType::kUInt16
                                                            : DType::kUInt8;
         return make_npy(t, box.size(), dense.data());

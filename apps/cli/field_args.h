@@ -47,5 +47,4 @@ NpyVolume field_volume(const DistanceField& f, const Box3i& box);
 // Nearest-site offsets as int16 a[x, y, z, 3]; -32768 where there is none.
 NpyVolume sites_volume(const Grid<SiteOffset>& g, const Box3i& box);
 
-
 }  // namespace voxfield::cli

@@ -77,13 +77,16 @@ class LiveField {
   // Bytes the field occupies where it lives: the CPU grid's chunks, or the GPU's resident buffer
   // (packed: 1, 2 or 4 bytes per voxel of the domain) — without reading a GPU field back.
   std::size_t memory_bytes() const {
-    if (cpu_) return std::visit([](const auto& g) { return g.memory().bytes; }, cpu_->field().values);
+    if (cpu_)
+      return std::visit([](const auto& g) { return g.memory().bytes; }, cpu_->field().values);
     return gpu_->field_bytes();
   }
   bool on_gpu() const { return gpu_.has_value(); }
 
   // What the GPU did so far (null on the CPU): device and hardware-independent counters.
-  nlohmann::json gpu_json() { return gpu_ ? voxfield::cli::gpu_json(gpu_->context()) : nlohmann::json(nullptr); }
+  nlohmann::json gpu_json() {
+    return gpu_ ? voxfield::cli::gpu_json(gpu_->context()) : nlohmann::json(nullptr);
+  }
   gpu::Counters gpu_counters() { return gpu_ ? gpu_->context().counters() : gpu::Counters{}; }
 
  private:

@@ -13,8 +13,12 @@ namespace {
 std::string g_activity;
 }  // namespace
 
-void set_activity(std::string what) { g_activity = std::move(what); }
-const std::string& activity() { return g_activity; }
+void set_activity(std::string what) {
+  g_activity = std::move(what);
+}
+const std::string& activity() {
+  return g_activity;
+}
 
 CLI::Validator finite_non_negative() {
   return CLI::Validator(
@@ -98,7 +102,8 @@ int main(int argc, char** argv) {
       known = known || (argc > 1 && sub->get_name() == argv[1]);
     }
     if (argc > 1 && argv[1][0] != '-' && !known) {
-      std::cerr << "voxfield: unknown command \"" << argv[1] << "\" (commands: " << names << "; see --help)\n";
+      std::cerr << "voxfield: unknown command \"" << argv[1] << "\" (commands: " << names
+                << "; see --help)\n";
       return 2;
     }
     app.exit(e);  // prints the message and usage
@@ -107,7 +112,8 @@ int main(int argc, char** argv) {
   try {
     if (!memory_limit.empty()) {
       try {
-        voxfield::set_default_memory_limit(voxfield::parse_byte_size(memory_limit, "--memory-limit"));
+        voxfield::set_default_memory_limit(
+            voxfield::parse_byte_size(memory_limit, "--memory-limit"));
       } catch (const voxfield::InvalidArgument& e) {
         std::cerr << "voxfield: " << e.what() << "\n";
         return 2;
@@ -128,8 +134,9 @@ int main(int argc, char** argv) {
     return 1;
   } catch (const std::bad_alloc&) {
     const std::string& doing = voxfield::cli::activity();
-    std::cerr << "voxfield: error: out of memory" << (doing.empty() ? std::string() : " while " + doing)
-              << " (the memory limit is " << voxfield::format_bytes(voxfield::default_memory_limit())
+    std::cerr << "voxfield: error: out of memory"
+              << (doing.empty() ? std::string() : " while " + doing) << " (the memory limit is "
+              << voxfield::format_bytes(voxfield::default_memory_limit())
               << "; the machine or the process's own limits ran out first)\n";
     return 1;
   } catch (const std::exception& e) {

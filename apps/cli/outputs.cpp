@@ -13,7 +13,8 @@ bool same_target(const std::string& a, const std::string& b) {
   if (a == "-" || b == "-") return a == b;  // standard output once at most
   if (same_file(a, b)) return true;
   std::error_code ea, eb;
-  const auto ca = std::filesystem::weakly_canonical(a, ea), cb = std::filesystem::weakly_canonical(b, eb);
+  const auto ca = std::filesystem::weakly_canonical(a, ea),
+             cb = std::filesystem::weakly_canonical(b, eb);
   return !ea && !eb && ca == cb;
 }
 
@@ -25,13 +26,15 @@ void Outputs::expect(const std::string& path, const std::string& option, bool ma
   if (!may_be_input) {
     for (const std::string& in : inputs_) {
       if (same_target(path, in)) {
-        throw InvalidArgument(option + " " + path + " is also an input of this command; writing it would destroy " +
-                              in + " (choose another output)");
+        throw InvalidArgument(option + " " + path +
+                              " is also an input of this command; writing it would destroy " + in +
+                              " (choose another output)");
       }
     }
   }
   for (const std::string& out : outputs_) {
-    if (same_target(path, out)) throw InvalidArgument(option + " " + path + " is given as two outputs");
+    if (same_target(path, out))
+      throw InvalidArgument(option + " " + path + " is given as two outputs");
   }
   outputs_.push_back(path);
 }
@@ -47,7 +50,8 @@ void Outputs::stage_json(const std::string& path, const nlohmann::json& j) {
 }
 
 double ms_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
 }
 
 }  // namespace voxfield::cli

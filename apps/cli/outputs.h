@@ -28,7 +28,9 @@ class Outputs {
   // The same for a world file, whose format is checked from its extension too.
   void expect_world(const std::string& path, const std::string& option, bool may_be_input = false);
 
-  void stage(const std::string& path, std::span<const std::uint8_t> bytes) { tx_.stage(path, bytes); }
+  void stage(const std::string& path, std::span<const std::uint8_t> bytes) {
+    tx_.stage(path, bytes);
+  }
   void stage(const std::string& path, std::string_view text) { tx_.stage(path, text); }
   void stage_json(const std::string& path, const nlohmann::json& j);
   void commit() { tx_.commit(); }

@@ -29,13 +29,14 @@ bool TerminalProgress::was_interrupted(int percent) {
   const Clock::time_point now = Clock::now();
   std::unique_lock lock(mutex_, std::try_to_lock);  // a worker busy drawing: the others go on
   if (!lock.owns_lock()) return false;
-  if (now - started_ < std::chrono::seconds(1) || (visible_ && now - drawn_ < std::chrono::milliseconds(100))) {
+  if (now - started_ < std::chrono::seconds(1) ||
+      (visible_ && now - drawn_ < std::chrono::milliseconds(100))) {
     return false;
   }
   constexpr int kWidth = 30;
   const int filled = percent * kWidth / 100;
-  std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%", name_.c_str(), filled, "##############################",
-               kWidth - filled, "", percent);
+  std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%", name_.c_str(), filled,
+               "##############################", kWidth - filled, "", percent);
   std::fflush(stderr);
   drawn_ = now;
   visible_ = true;

@@ -24,8 +24,8 @@ namespace fs = std::filesystem;
 namespace {
 
 double mesh_bytes_per_triangle(const Mesh& m) {
-  const double bytes = static_cast<double>(m.positions.size() * 12 + m.normals.size() * 12 + m.colors.size() * 3 +
-                                           m.indices.size() * 4);
+  const double bytes = static_cast<double>(m.positions.size() * 12 + m.normals.size() * 12 +
+                                           m.colors.size() * 3 + m.indices.size() * 4);
   return m.triangle_count() ? bytes / static_cast<double>(m.triangle_count()) : 0;
 }
 
@@ -33,8 +33,8 @@ double mesh_bytes_per_triangle(const Mesh& m) {
 nlohmann::json run_peers(const fs::path& script, const fs::path& sdf_npy, const fs::path& out) {
   if (!fs::exists(script) || !fs::exists("/usr/bin/python3")) return nullptr;
   const fs::path result = out / "mesh-peers.json";
-  const std::string command = "/usr/bin/python3 '" + script.string() + "' '" + sdf_npy.string() + "' 0 --runs 2 --json '" +
-                              result.string() + "' 2>/dev/null";
+  const std::string command = "/usr/bin/python3 '" + script.string() + "' '" + sdf_npy.string() +
+                              "' 0 --runs 2 --json '" + result.string() + "' 2>/dev/null";
   if (std::system(command.c_str()) != 0 || !fs::exists(result)) return nullptr;
   nlohmann::json j = nlohmann::json::parse(std::ifstream(result));
   fs::remove(result);
@@ -43,16 +43,23 @@ nlohmann::json run_peers(const fs::path& script, const fs::path& sdf_npy, const 
 
 }  // namespace
 
-void showcase_meshing(const World& terrain, const fs::path& out, const fs::path& sdf_npy, const fs::path& peers_script,
-                      const Camera& hero, std::ostream& md, std::vector<Timing>& timings) {
+void showcase_meshing(const World& terrain, const fs::path& out, const fs::path& sdf_npy,
+                      const fs::path& peers_script, const Camera& hero, std::ostream& md,
+                      std::vector<Timing>& timings) {
   md << "\n## Meshes of the terrain\n\n"
-     << "The terrain's surface as triangles, through its exact signed Euclidean field (`voxfield mesh`): marching "
-        "cubes with ambiguous faces settled by the asymptotic decider (a closed, oriented 2-manifold), naive "
-        "surface nets (one vertex per cell, closed, not always manifold) and dual contouring (surface nets' "
-        "topology, each vertex where the crossings' tangent planes meet: the voxels' edges and corners stay "
-        "sharp). Meshed in chunks of 32 cells on all threads; the same triangles come out for every chunk "
+     << "The terrain's surface as triangles, through its exact signed Euclidean field (`voxfield "
+        "mesh`): marching "
+        "cubes with ambiguous faces settled by the asymptotic decider (a closed, oriented "
+        "2-manifold), naive "
+        "surface nets (one vertex per cell, closed, not always manifold) and dual contouring "
+        "(surface nets' "
+        "topology, each vertex where the crossings' tangent planes meet: the voxels' edges and "
+        "corners stay "
+        "sharp). Meshed in chunks of 32 cells on all threads; the same triangles come out for "
+        "every chunk "
         "edge.\n\n"
-     << "| mesher | triangles | vertices | ms | watertight | Euler characteristic | area (voxel faces) | bytes/triangle | "
+     << "| mesher | triangles | vertices | ms | watertight | Euler characteristic | area (voxel "
+        "faces) | bytes/triangle | "
         "chunk edge 8: same triangles |\n|---|---|---|---|---|---|---|---|---|\n";
   const Vec3i size = terrain.voxels.content_bounds().size();
   Mesh meshes[3];
@@ -68,15 +75,19 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
     o.chunk_edge = 8;
     const Mesh small_chunks = mesh_world(terrain, o);
     const bool same = small_chunks.triangle_count() == meshes[i].triangle_count() &&
-                      small_chunks.vertex_count() == meshes[i].vertex_count() && mesh_stats(small_chunks).edges == st.edges;
-    timings.push_back({std::string("mesh the terrain, ") + mesher_name(kinds[i]) + " (field included)", ms,
-                       fixed(static_cast<double>(st.triangles) / (ms * 1e3), 1) + " M triangles/s"});
-    md << "| " << names[i] << " | " << st.triangles << " | " << st.vertices << " | "
-       << fixed(ms, 0) << " | " << (st.watertight() ? "yes" : (st.boundary_edges == 0 ? "closed" : "**no**")) << " | "
-       << st.euler_characteristic << " | " << fixed(st.area_units2, 0) << " | " << fixed(mesh_bytes_per_triangle(meshes[i]), 1)
-       << " | " << (same ? "yes" : "**no**") << " |\n";
-    std::cout << "voxfield showcase: " << mesher_name(kinds[i]) << " mesh of the terrain: " << st.triangles
-              << " triangles in " << fixed(ms, 0) << " ms\n";
+                      small_chunks.vertex_count() == meshes[i].vertex_count() &&
+                      mesh_stats(small_chunks).edges == st.edges;
+    timings.push_back(
+        {std::string("mesh the terrain, ") + mesher_name(kinds[i]) + " (field included)", ms,
+         fixed(static_cast<double>(st.triangles) / (ms * 1e3), 1) + " M triangles/s"});
+    md << "| " << names[i] << " | " << st.triangles << " | " << st.vertices << " | " << fixed(ms, 0)
+       << " | " << (st.watertight() ? "yes" : (st.boundary_edges == 0 ? "closed" : "**no**"))
+       << " | " << st.euler_characteristic << " | " << fixed(st.area_units2, 0) << " | "
+       << fixed(mesh_bytes_per_triangle(meshes[i]), 1) << " | " << (same ? "yes" : "**no**")
+       << " |\n";
+    std::cout << "voxfield showcase: " << mesher_name(kinds[i])
+              << " mesh of the terrain: " << st.triangles << " triangles in " << fixed(ms, 0)
+              << " ms\n";
     if (!same) throw Error("showcase: meshing in chunks of 8 changed the terrain's mesh");
   }
   write_mesh(meshes[0], out / "terrain.glb");
@@ -99,22 +110,26 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
     ours_triangles = m.triangle_count();
   }
   const nlohmann::json peers = run_peers(peers_script, sdf_npy, out);
-  md << "\nMarching cubes of `terrain-sdf.npy` at level 0 (" << sdf.dims.x << "³ samples), voxfield beside its peers "
-        "in this run (best of 2):\n\n| library | threads | ms | triangles | voxfield's speed-up |\n|---|---|---|---|---|\n"
-     << "| voxfield " << mesher_name(Mesher::kMarchingCubes) << " | " << max_threads() << " | " << fixed(ours_ms, 0) << " | "
-     << ours_triangles << " | |\n";
+  md << "\nMarching cubes of `terrain-sdf.npy` at level 0 (" << sdf.dims.x
+     << "³ samples), voxfield beside its peers "
+        "in this run (best of 2):\n\n| library | threads | ms | triangles | voxfield's speed-up "
+        "|\n|---|---|---|---|---|\n"
+     << "| voxfield " << mesher_name(Mesher::kMarchingCubes) << " | " << max_threads() << " | "
+     << fixed(ours_ms, 0) << " | " << ours_triangles << " | |\n";
   bool any_peer = false;
   if (!peers.is_null())
     for (const char* name : {"scikit-image", "vtk-flying-edges"}) {
       if (!peers.contains(name) || peers[name].is_null()) continue;
       const auto& p = peers[name];
       any_peer = true;
-      md << "| " << name << " " << p["version"].get<std::string>() << " | " << p["threads"].get<int>() << " | "
-         << fixed(p["ms"].get<double>(), 0) << " | " << p["triangles"].get<std::int64_t>() << " | "
-         << fixed(p["ms"].get<double>() / ours_ms, 1) << "× |\n";
+      md << "| " << name << " " << p["version"].get<std::string>() << " | "
+         << p["threads"].get<int>() << " | " << fixed(p["ms"].get<double>(), 0) << " | "
+         << p["triangles"].get<std::int64_t>() << " | " << fixed(p["ms"].get<double>() / ours_ms, 1)
+         << "× |\n";
     }
   if (!any_peer)
-    md << "\n(The peers were not run: Debian's python3-skimage / python3-vtk9 are not installed, see "
+    md << "\n(The peers were not run: Debian's python3-skimage / python3-vtk9 are not installed, "
+          "see "
           "scripts/install-bench-deps.sh.)\n";
 
   // Pictures: the whole terrain from the hero camera, and a close-up with the triangles' edges.
@@ -148,20 +163,24 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
   Mesh simple = simplify_mesh(meshes[0], so, &sst);
   optimize_mesh(simple);
   const double simplify_ms = ms_since(ts);
-  timings.push_back({"simplify the marching-cubes mesh to 10 % and order it for the vertex cache", simplify_ms, ""});
+  timings.push_back({"simplify the marching-cubes mesh to 10 % and order it for the vertex cache",
+                     simplify_ms, ""});
   write_png(render_mesh(simple, hero, ro), out / "terrain-mesh-simplified.png");
   write_mesh(simple, out / "terrain-simplified.glb");
-  md << "\nSimplified to a tenth with meshoptimizer (quadric edge collapse, borders locked; error limit 1 % of "
+  md << "\nSimplified to a tenth with meshoptimizer (quadric edge collapse, borders locked; error "
+        "limit 1 % of "
         "the extent): "
-     << sst.triangles_before << " → " << sst.triangles_after << " triangles in " << fixed(simplify_ms, 0)
-     << " ms, largest deviation " << fixed(sst.error_units, 2) << " voxels (`terrain-simplified.glb`).\n\n"
+     << sst.triangles_before << " → " << sst.triangles_after << " triangles in "
+     << fixed(simplify_ms, 0) << " ms, largest deviation " << fixed(sst.error_units, 2)
+     << " voxels (`terrain-simplified.glb`).\n\n"
      << "![simplified](terrain-mesh-simplified.png)\n";
 
   md << "\n| marching cubes | surface nets | dual contouring |\n|---|---|---|\n"
      << "| ![mc](terrain-mesh-mc.png) | ![sn](terrain-mesh-sn.png) | ![dc](terrain-mesh-dc.png) |\n"
      << "| ![mc edges](terrain-mesh-mc-edges.png) | ![sn edges](terrain-mesh-sn-edges.png) | "
         "![dc edges](terrain-mesh-dc-edges.png) |\n\n"
-     << "Files: `terrain.glb` (marching cubes, glTF binary with vertex colours: drop it into any glTF viewer) and "
+     << "Files: `terrain.glb` (marching cubes, glTF binary with vertex colours: drop it into any "
+        "glTF viewer) and "
         "`terrain-sn.ply` (surface nets), `terrain-dc.obj` (dual contouring).\n";
 }
 

@@ -1,9 +1,9 @@
 // voxfield-demo — the world being painted.
 #include "demo_world.h"
 
-#include "voxfield/world_io.h"
 #include "voxfield/error.h"
 #include "voxfield/scene.h"
+#include "voxfield/world_io.h"
 
 namespace voxfield::demo {
 namespace {
@@ -16,7 +16,8 @@ RenderSceneOptions scene_options(const WorldSettings& s) {
 }
 
 void check_settings(const WorldSettings& s) {
-  if (s.size < 16 || s.size > 1024) throw InvalidArgument("demo: --world must lie in 16..1024 voxels");
+  if (s.size < 16 || s.size > 1024)
+    throw InvalidArgument("demo: --world must lie in 16..1024 voxels");
   if (s.chunk_edge < 8 || s.chunk_edge > 128 || (s.chunk_edge & (s.chunk_edge - 1)) != 0)
     throw InvalidArgument("demo: --chunk must be a power of two in 8..128");
 }
@@ -31,7 +32,8 @@ DemoWorld::DemoWorld(const WorldSettings& settings)
   so.seed = settings.seed;
   so.chunk_edge = settings.chunk_edge;
   world_ = std::make_unique<World>(make_terrain(so));
-  origin_ = "terrain " + std::to_string(so.size.x) + "x" + std::to_string(so.size.y) + "x" + std::to_string(so.size.z);
+  origin_ = "terrain " + std::to_string(so.size.x) + "x" + std::to_string(so.size.y) + "x" +
+            std::to_string(so.size.z);
   make_scene();
 }
 
@@ -47,8 +49,10 @@ DemoWorld::DemoWorld(const WorldSettings& settings, const std::filesystem::path&
   const int margin = std::max({extent.size().x, extent.size().y, extent.size().z}) / 4;
   extent = Box3i{extent.begin - Vec3i{margin, margin, 0}, extent.end + Vec3i::splat(margin)};
   if (extent.volume() > std::int64_t{1024} * 1024 * 1024)
-    throw InvalidArgument(file.string() + ": the world's box " + to_string(extent) + " is too large for the demo");
-  world_ = std::make_unique<World>(rechunk_world(in.world, settings.chunk_edge, extent, file.string()));
+    throw InvalidArgument(file.string() + ": the world's box " + to_string(extent) +
+                          " is too large for the demo");
+  world_ =
+      std::make_unique<World>(rechunk_world(in.world, settings.chunk_edge, extent, file.string()));
   origin_ = file.filename().string();
   make_scene();
 }

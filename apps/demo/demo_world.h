@@ -18,10 +18,10 @@
 namespace voxfield::demo {
 
 struct WorldSettings {
-  int size = 128;        // terrain of size x size x size/2 voxels (ignored when loading)
+  int size = 128;  // terrain of size x size x size/2 voxels (ignored when loading)
   int chunk_edge = 16;
   Metric metric = Metric::kManhattan;  // the field rays skip by
-  double clamp = 32;     // its clamp (voxels): how far a skip reaches, and an edit's reach
+  double clamp = 32;  // its clamp (voxels): how far a skip reaches, and an edit's reach
   std::uint64_t seed = 6683787;
 };
 
@@ -35,7 +35,9 @@ class DemoWorld {
   // Applies edits (clipped to the world) in order, then updates fields and scene incrementally
   // once for all of them (overlapping edits are recomputed once).
   DynamicRenderScene::UpdateStats apply(std::span<const Edit> edits);
-  DynamicRenderScene::UpdateStats apply(const Edit& edit) { return apply(std::span<const Edit>(&edit, 1)); }
+  DynamicRenderScene::UpdateStats apply(const Edit& edit) {
+    return apply(std::span<const Edit>(&edit, 1));
+  }
   // Rebuilds the fields for new metric / clamp settings (a full computation).
   void set_field(Metric metric, double clamp);
 

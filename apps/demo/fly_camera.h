@@ -15,7 +15,8 @@ struct FlyCamera {
   double fov_degrees = 60;
 
   Vec3d forward() const {
-    return {std::cos(pitch_rad) * std::cos(yaw_rad), std::cos(pitch_rad) * std::sin(yaw_rad), std::sin(pitch_rad)};
+    return {std::cos(pitch_rad) * std::cos(yaw_rad), std::cos(pitch_rad) * std::sin(yaw_rad),
+            std::sin(pitch_rad)};
   }
   Vec3d right() const { return Vec3d{std::sin(yaw_rad), -std::cos(yaw_rad), 0}; }
 

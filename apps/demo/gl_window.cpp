@@ -33,7 +33,8 @@ int GlWindow::height() const {
   return std::max(h, 1);
 }
 
-void GlWindow::draw_frame(const Image& frame, const std::function<void()>& overlay, VulkanWindow::Screenshot* screenshot) {
+void GlWindow::draw_frame(const Image& frame, const std::function<void()>& overlay,
+                          VulkanWindow::Screenshot* screenshot) {
   glViewport(0, 0, width(), height());
   glClearColor(0, 0, 0, 1);
   glClear(GL_COLOR_BUFFER_BIT);
@@ -60,7 +61,8 @@ void GlWindow::draw_frame(const Image& frame, const std::function<void()>& overl
     screenshot->rgb.resize(rows.size());
     const std::size_t stride = static_cast<std::size_t>(w) * 3;
     for (int y = 0; y < h; ++y)  // bottom row first -> top row first
-      std::copy_n(rows.data() + static_cast<std::size_t>(h - 1 - y) * stride, stride, screenshot->rgb.data() + y * stride);
+      std::copy_n(rows.data() + static_cast<std::size_t>(h - 1 - y) * stride, stride,
+                  screenshot->rgb.data() + y * stride);
   }
   glfwSwapBuffers(window_);
 }

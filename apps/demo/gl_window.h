@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "vulkan_window.h"  // WindowError, Screenshot
 #include "voxfield/image.h"
+#include "vulkan_window.h"  // WindowError, Screenshot
 
 namespace voxfield::demo {
 
@@ -27,7 +27,8 @@ class GlWindow {
   std::string renderer_name() const { return renderer_; }
   // Shows `frame` (the framebuffer's size), then lets `overlay` draw (the panel), and swaps; with
   // `screenshot`, the shown image is read back first.
-  void draw_frame(const Image& frame, const std::function<void()>& overlay, VulkanWindow::Screenshot* screenshot);
+  void draw_frame(const Image& frame, const std::function<void()>& overlay,
+                  VulkanWindow::Screenshot* screenshot);
 
  private:
   GLFWwindow* window_ = nullptr;

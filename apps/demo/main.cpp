@@ -6,11 +6,11 @@
 // Vulkan ray marcher when there is a Vulkan device for it (--backend), otherwise from the CPU
 // renderer — presented through a Vulkan swapchain, or through OpenGL on machines with no usable
 // Vulkan device at all; the title and the panel say which.
-#include <CLI/CLI.hpp>
-#include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl2.h>
 #include <backends/imgui_impl_vulkan.h>
+#include <imgui.h>
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <array>
@@ -34,12 +34,14 @@
 namespace voxfield::demo {
 
 Demo::Demo(const Options& o) : options_(o) {
-  world_ = o.load.empty() ? std::make_unique<DemoWorld>(o.world) : std::make_unique<DemoWorld>(o.world, o.load);
+  world_ = o.load.empty() ? std::make_unique<DemoWorld>(o.world)
+                          : std::make_unique<DemoWorld>(o.world, o.load);
   try {
     vk_ = std::make_unique<VulkanWindow>(o.width, o.height, "voxfield-demo", o.validation);
   } catch (const WindowError& e) {
     no_vulkan_ = e.what();
-    std::cerr << "voxfield-demo: no Vulkan window (" << no_vulkan_ << "); showing the CPU renderer's frames through OpenGL\n";
+    std::cerr << "voxfield-demo: no Vulkan window (" << no_vulkan_
+              << "); showing the CPU renderer's frames through OpenGL\n";
     gl_ = std::make_unique<GlWindow>(o.width, o.height, "voxfield-demo");
   }
   ui_size_ = o.world.size;
@@ -57,10 +59,12 @@ Demo::Demo(const Options& o) : options_(o) {
   // Presses are queued from the callbacks, so a click or a key tap shorter than a frame (frames
   // are slow on software Vulkan) is never lost between two polls of the button state.
   glfwSetKeyCallback(glfw(), [](GLFWwindow* w, int key, int, int action, int) {
-    if (action == GLFW_PRESS) static_cast<Demo*>(glfwGetWindowUserPointer(w))->keys_pressed_.push_back(key);
+    if (action == GLFW_PRESS)
+      static_cast<Demo*>(glfwGetWindowUserPointer(w))->keys_pressed_.push_back(key);
   });
   glfwSetMouseButtonCallback(glfw(), [](GLFWwindow* w, int button, int action, int) {
-    if (action == GLFW_PRESS) static_cast<Demo*>(glfwGetWindowUserPointer(w))->clicks_.push_back(button);
+    if (action == GLFW_PRESS)
+      static_cast<Demo*>(glfwGetWindowUserPointer(w))->clicks_.push_back(button);
   });
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -75,7 +79,10 @@ Demo::Demo(const Options& o) : options_(o) {
   ImGui_ImplGlfw_InitForVulkan(vw.window(), true);
   VkInstance instance = vw.instance();
   ImGui_ImplVulkan_LoadFunctions(
-      [](const char* name, void* user) { return vkGetInstanceProcAddr(*static_cast<VkInstance*>(user), name); }, &instance);
+      [](const char* name, void* user) {
+        return vkGetInstanceProcAddr(*static_cast<VkInstance*>(user), name);
+      },
+      &instance);
   VkDescriptorPoolSize sizes{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4};
   VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   dp.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
@@ -117,14 +124,17 @@ void Demo::choose_path(const std::string& backend) {
   path_ = RenderPath{};
   const Backend b = parse_backend(backend);
   if (!vk_) {
-    path_.why = "CPU renderer, shown through OpenGL (" + gl_->renderer_name() + "): no usable Vulkan device";
+    path_.why = "CPU renderer, shown through OpenGL (" + gl_->renderer_name() +
+                "): no usable Vulkan device";
   } else if (b == Backend::kCpu) {
     path_.why = "CPU renderer (--backend cpu)";
   } else if (b == Backend::kAuto && !vk_->device_is_hardware()) {
-    path_.why = "CPU renderer (auto: " + vk_->device_name() + " is not a hardware GPU; --backend vulkan uses it)";
+    path_.why = "CPU renderer (auto: " + vk_->device_name() +
+                " is not a hardware GPU; --backend vulkan uses it)";
   } else {
     try {
-      path_.context = gpu::adopt({vk_->instance(), vk_->physical(), vk_->device(), vk_->queue(), vk_->queue_family()});
+      path_.context = gpu::adopt(
+          {vk_->instance(), vk_->physical(), vk_->device(), vk_->queue(), vk_->queue_family()});
       path_.renderer = std::make_unique<gpu::SceneRenderer>(path_.context);
       path_.why = "Vulkan ray marcher on " + vk_->device_name();
     } catch (const Error& e) {
@@ -140,11 +150,13 @@ void Demo::frame_camera() {
   const Box3i box = world_->scene().box();
   const Vec3i s = box.size();
   const Vec3d centre{box.begin.x + s.x / 2.0, box.begin.y + s.y / 2.0, box.begin.z + s.z * 0.3};
-  camera_.look({box.begin.x - s.x * 0.25, box.begin.y - s.y * 0.25, box.begin.z + s.z * 1.1}, centre);
+  camera_.look({box.begin.x - s.x * 0.25, box.begin.y - s.y * 0.25, box.begin.z + s.z * 1.1},
+               centre);
 }
 
 std::string Demo::title() const {
-  return "voxfield-demo — " + world_->origin() + " — " + (gpu_can_draw() ? "Vulkan ray marcher" : "CPU renderer");
+  return "voxfield-demo — " + world_->origin() + " — " +
+         (gpu_can_draw() ? "Vulkan ray marcher" : "CPU renderer");
 }
 
 void Demo::edit_at_cursor(EditOp op) {
@@ -162,13 +174,19 @@ void Demo::edit_at_cursor(EditOp op) {
   const Ray ray = camera_.camera().projector(width(), height()).ray(x, y);
   const RayHit hit = trace_ray(world_->scene(), ray);
   if (!hit.hit) return;
-  Vec3d centre{static_cast<double>(hit.voxel.x), static_cast<double>(hit.voxel.y), static_cast<double>(hit.voxel.z)};
-  if (op == EditOp::kPlace && hit.face_axis >= 0) centre[hit.face_axis] += hit.face_sign * brush_.radius;
+  Vec3d centre{static_cast<double>(hit.voxel.x), static_cast<double>(hit.voxel.y),
+               static_cast<double>(hit.voxel.z)};
+  if (op == EditOp::kPlace && hit.face_axis >= 0)
+    centre[hit.face_axis] += hit.face_sign * brush_.radius;
   const auto t0 = Clock::now();
-  const auto st = world_->apply({op, SphereBrush{centre, static_cast<double>(brush_.radius)}, brush_.material});
+  const auto st =
+      world_->apply({op, SphereBrush{centre, static_cast<double>(brush_.radius)}, brush_.material});
   last_.update_ms = ms_between(t0, Clock::now());
-  status_ = std::string(op == EditOp::kPlace ? "placed" : op == EditOp::kCarve ? "carved" : "painted") + " r " +
-            std::to_string(brush_.radius) + ": " + std::to_string(st.chunks_changed) + " chunks refreshed";
+  status_ = std::string(op == EditOp::kPlace   ? "placed"
+                        : op == EditOp::kCarve ? "carved"
+                                               : "painted") +
+            " r " + std::to_string(brush_.radius) + ": " + std::to_string(st.chunks_changed) +
+            " chunks refreshed";
 }
 
 void Demo::handle_input(double dt_s) {
@@ -179,7 +197,8 @@ void Demo::handle_input(double dt_s) {
   const std::vector<int> keys = std::exchange(keys_pressed_, {});
   auto pressed = [&](int key) { return std::find(keys.begin(), keys.end(), key) != keys.end(); };
   if (pressed(GLFW_KEY_F1)) show_help_ = !show_help_;
-  if (pressed(GLFW_KEY_F12)) take_screenshot("voxfield-demo-" + std::to_string(++screenshots_) + ".png");
+  if (pressed(GLFW_KEY_F12))
+    take_screenshot("voxfield-demo-" + std::to_string(++screenshots_) + ".png");
   if (pressed(GLFW_KEY_TAB)) {
     look_mode_ = !look_mode_;
     glfwSetInputMode(w, GLFW_CURSOR, look_mode_ ? GLFW_CURSOR_DISABLED : GLFW_CURSOR_NORMAL);
@@ -192,8 +211,9 @@ void Demo::handle_input(double dt_s) {
     if (pressed(GLFW_KEY_P)) brush_.paint = !brush_.paint;
     for (int k = 1; k <= 9; ++k)
       if (pressed(GLFW_KEY_0 + k)) brush_.material = static_cast<std::uint8_t>(k);
-    const double speed = (down(GLFW_KEY_LEFT_CONTROL) || down(GLFW_KEY_RIGHT_CONTROL) ? 4.0 : 1.0) *
-                         std::max(16.0, world_->scene().box().size().x * 0.35);  // voxels per second
+    const double speed =
+        (down(GLFW_KEY_LEFT_CONTROL) || down(GLFW_KEY_RIGHT_CONTROL) ? 4.0 : 1.0) *
+        std::max(16.0, world_->scene().box().size().x * 0.35);  // voxels per second
     Vec3d move{0, 0, 0};
     const Vec3d f = camera_.forward(), r = camera_.right();
     if (down(GLFW_KEY_W)) move = move + f;
@@ -206,13 +226,16 @@ void Demo::handle_input(double dt_s) {
   }
   double x = 0, y = 0;
   glfwGetCursorPos(w, &x, &y);
-  const bool turning = look_mode_ || (glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS && !io.WantCaptureMouse);
+  const bool turning =
+      look_mode_ ||
+      (glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS && !io.WantCaptureMouse);
   if (turning) camera_.turn(-(x - last_x_) * 0.004, -(y - last_y_) * 0.004);
   last_x_ = x;
   last_y_ = y;
   const std::vector<int> clicks = std::exchange(clicks_, {});
   if (!io.WantCaptureMouse) {
-    if (scroll_ != 0) brush_.radius = std::clamp(brush_.radius + static_cast<int>(std::lround(scroll_)), 0, 32);
+    if (scroll_ != 0)
+      brush_.radius = std::clamp(brush_.radius + static_cast<int>(std::lround(scroll_)), 0, 32);
     const EditOp left_op = brush_.paint ? EditOp::kPaint : EditOp::kPlace;
     // Every click edits once; held buttons repeat the edit ten times a second.
     for (int button : clicks)
@@ -251,25 +274,29 @@ bool Demo::draw(VulkanWindow::Screenshot* shot) {
   const auto t0 = Clock::now();
   if (gl_) {
     const Image img = render(world_->scene(), cam, ro);
-    gl_->draw_frame(img, [] { ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData()); }, shot);
+    gl_->draw_frame(
+        img, [] { ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData()); }, shot);
     last_.render_ms = ms_between(t0, Clock::now());
     return true;
   }
   std::function<void(VkCommandBuffer, VkImage)> fill;
   VkBufferImageCopy copy{};
   copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-  copy.imageExtent = {static_cast<std::uint32_t>(ro.width), static_cast<std::uint32_t>(ro.height), 1};
+  copy.imageExtent = {static_cast<std::uint32_t>(ro.width), static_cast<std::uint32_t>(ro.height),
+                      1};
   if (gpu_can_draw()) {
     path_.renderer->sync(world_->scene());
     fill = [&](VkCommandBuffer cmd, VkImage image) {
-      const VkBuffer pixels = gpu::record_render(*path_.renderer, cmd, cam, ro,
-                                                 vk_->bgra() ? gpu::PixelOrder::kBgra : gpu::PixelOrder::kRgba);
+      const VkBuffer pixels =
+          gpu::record_render(*path_.renderer, cmd, cam, ro,
+                             vk_->bgra() ? gpu::PixelOrder::kBgra : gpu::PixelOrder::kRgba);
       vkCmdCopyBufferToImage(cmd, pixels, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
     };
   } else {
     const Image img = render(world_->scene(), cam, ro);
     void* mapped = nullptr;
-    const VkBuffer staging = vk_->staging(static_cast<VkDeviceSize>(ro.width) * ro.height * 4, &mapped);
+    const VkBuffer staging =
+        vk_->staging(static_cast<VkDeviceSize>(ro.width) * ro.height * 4, &mapped);
     auto* dst = static_cast<std::uint8_t*>(mapped);
     const bool bgra = vk_->bgra();
     for (std::size_t i = 0; i < static_cast<std::size_t>(ro.width) * ro.height; ++i) {
@@ -282,8 +309,9 @@ bool Demo::draw(VulkanWindow::Screenshot* shot) {
       vkCmdCopyBufferToImage(cmd, staging, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
     };
   }
-  const bool drawn =
-      vk_->draw_frame(fill, [](VkCommandBuffer cmd) { ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd); }, shot);
+  const bool drawn = vk_->draw_frame(
+      fill, [](VkCommandBuffer cmd) { ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd); },
+      shot);
   if (gpu_can_draw()) wait_idle();  // the GPU frame's time includes its execution
   last_.render_ms = ms_between(t0, Clock::now());
   return drawn;
@@ -311,13 +339,15 @@ int Demo::run() {
     if (!csv) throw IoError(options_.csv + ": cannot create");
     // The GPU columns are voxfield's own traffic in the frame (scene copies and the ray marcher's
     // work; the demo's swapchain submission is not voxfield's): zero on the CPU renderer.
-    csv << "frame,frame_ms,update_ms,render_ms,edits,gpu_submits,gpu_dispatches,gpu_bytes_up,gpu_bytes_down\n";
+    csv << "frame,frame_ms,update_ms,render_ms,edits,gpu_submits,gpu_dispatches,gpu_bytes_up,gpu_"
+           "bytes_down\n";
   }
   // Benchmark mode: the dissertation's seeded edits, one every interval of wall time, radii up to
   // the chunk edge - 1, with the camera circling the world.
   std::optional<RandomEditStream> stream;
   if (options_.benchmark)
-    stream.emplace(world_->scene().box(), options_.world.seed, 1, world_->settings().chunk_edge - 1);
+    stream.emplace(world_->scene().box(), options_.world.seed, 1,
+                   world_->settings().chunk_edge - 1);
   const auto start = Clock::now();
   auto previous = start;
   std::int64_t streamed = 0;
@@ -362,9 +392,11 @@ int Demo::run() {
     if (frame_history_.size() > 120) frame_history_.pop_front();
     if (csv.is_open()) {
       const gpu::Counters g = path_.context ? path_.context->counters() : gpu::Counters{};
-      csv << frame << "," << last_.frame_ms << "," << update_ms << "," << last_.render_ms << "," << world_->edits() << ","
-          << g.submits - gpu_before.submits << "," << g.dispatches - gpu_before.dispatches << ","
-          << g.bytes_uploaded - gpu_before.bytes_uploaded << "," << g.bytes_downloaded - gpu_before.bytes_downloaded << "\n";
+      csv << frame << "," << last_.frame_ms << "," << update_ms << "," << last_.render_ms << ","
+          << world_->edits() << "," << g.submits - gpu_before.submits << ","
+          << g.dispatches - gpu_before.dispatches << ","
+          << g.bytes_uploaded - gpu_before.bytes_uploaded << ","
+          << g.bytes_downloaded - gpu_before.bytes_downloaded << "\n";
     }
   }
   if (csv.is_open()) {
@@ -383,25 +415,35 @@ int main(int argc, char** argv) {
   Options o;
   CLI::App app{"voxfield-demo: paint a voxel world and watch its distance fields follow"};
   std::string metric = "manhattan";
-  app.add_option("--world", o.world.size, "terrain size N (N x N x N/2 voxels)")->check(CLI::Range(16, 1024));
+  app.add_option("--world", o.world.size, "terrain size N (N x N x N/2 voxels)")
+      ->check(CLI::Range(16, 1024));
   app.add_option("--chunk", o.world.chunk_edge, "chunk edge (8, 16, 32, 64, 128)");
   app.add_option("--load", o.load, "start from a .vox, .vfw or .npy file instead of the terrain");
-  app.add_option("--backend", o.backend, "who draws: cpu, vulkan, auto (a hardware GPU, else the CPU)")
+  app.add_option("--backend", o.backend,
+                 "who draws: cpu, vulkan, auto (a hardware GPU, else the CPU)")
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
-  app.add_option("--metric", metric, "metric of the field rays skip by")->check(CLI::IsMember({"manhattan", "chebyshev", "euclidean"}));
+  app.add_option("--metric", metric, "metric of the field rays skip by")
+      ->check(CLI::IsMember({"manhattan", "chebyshev", "euclidean"}));
   app.add_option("--clamp", o.world.clamp, "its clamp in voxels (an edit's reach)");
   app.add_option("--width", o.width, "window width")->check(CLI::Range(64, 8192));
   app.add_option("--height", o.height, "window height")->check(CLI::Range(64, 8192));
-  app.add_flag("--validation", o.validation, "enable the Khronos validation layer (messages on stderr)");
-  app.add_flag("--benchmark", o.benchmark, "replay the dissertation's seeded edits and exit after --frames");
-  app.add_option("--frames", o.frames, "exit after N frames (benchmark mode: 300 by default)")->check(CLI::Range(1, 1000000));
+  app.add_flag("--validation", o.validation,
+               "enable the Khronos validation layer (messages on stderr)");
+  app.add_flag("--benchmark", o.benchmark,
+               "replay the dissertation's seeded edits and exit after --frames");
+  app.add_option("--frames", o.frames, "exit after N frames (benchmark mode: 300 by default)")
+      ->check(CLI::Range(1, 1000000));
   app.add_option("--seed", o.world.seed, "seed of the terrain and the benchmark's edits");
-  app.add_option("--interval-ms", o.interval_ms, "time between the benchmark's edits")->check(CLI::PositiveNumber);
-  app.add_option("--csv", o.csv, "one row per frame (frame_ms, update_ms, render_ms, edits, GPU traffic)");
+  app.add_option("--interval-ms", o.interval_ms, "time between the benchmark's edits")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--csv", o.csv,
+                 "one row per frame (frame_ms, update_ms, render_ms, edits, GPU traffic)");
   app.add_option("--screenshot", o.screenshot, "with --frames: save the last frame as PNG");
   CLI11_PARSE(app, argc, argv);
   if (o.benchmark && o.frames == 0) o.frames = 300;
-  glfwSetErrorCallback([](int code, const char* message) { std::cerr << "voxfield-demo: GLFW error " << code << ": " << message << "\n"; });
+  glfwSetErrorCallback([](int code, const char* message) {
+    std::cerr << "voxfield-demo: GLFW error " << code << ": " << message << "\n";
+  });
   try {
     o.world.metric = parse_metric(metric);
     GlfwSession glfw;

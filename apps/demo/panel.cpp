@@ -17,22 +17,27 @@ void Demo::panel() {
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
   ImGui::Begin("voxfield");
-  ImGui::TextWrapped("%s", gpu_can_draw() ? path_.why.c_str()
-                                          : (path_.renderer ? "CPU renderer (this view is not on the GPU yet)" : path_.why.c_str()));
+  ImGui::TextWrapped("%s", gpu_can_draw()
+                               ? path_.why.c_str()
+                               : (path_.renderer ? "CPU renderer (this view is not on the GPU yet)"
+                                                 : path_.why.c_str()));
   ImGui::Text("%s, chunk %d", world_->origin().c_str(), world_->settings().chunk_edge);
   ImGui::Separator();
-  ImGui::Text("frame %.1f ms (%.1f FPS)", last_.frame_ms, last_.frame_ms > 0 ? 1000.0 / last_.frame_ms : 0.0);
+  ImGui::Text("frame %.1f ms (%.1f FPS)", last_.frame_ms,
+              last_.frame_ms > 0 ? 1000.0 / last_.frame_ms : 0.0);
   ImGui::Text("render %.1f ms, last update %.2f ms", last_.render_ms, last_.update_ms);
   std::vector<float> history(frame_history_.begin(), frame_history_.end());
   if (!history.empty())
-    ImGui::PlotLines("##frames", history.data(), static_cast<int>(history.size()), 0, "frame ms", 0.0f, FLT_MAX, ImVec2(0, 50));
+    ImGui::PlotLines("##frames", history.data(), static_cast<int>(history.size()), 0, "frame ms",
+                     0.0f, FLT_MAX, ImVec2(0, 50));
   ImGui::Text("%lld edits", static_cast<long long>(world_->edits()));
   if (!status_.empty()) ImGui::TextWrapped("%s", status_.c_str());
 
   if (ImGui::CollapsingHeader("Brush", ImGuiTreeNodeFlags_DefaultOpen)) {
     ImGui::SliderInt("radius", &brush_.radius, 0, 32);
     int material = brush_.material;
-    if (ImGui::SliderInt("material", &material, 1, 255)) brush_.material = static_cast<std::uint8_t>(material);
+    if (ImGui::SliderInt("material", &material, 1, 255))
+      brush_.material = static_cast<std::uint8_t>(material);
     const Rgba c = world_->world().palette[brush_.material];
     ImGui::ColorButton("##swatch", ImVec4(c.r / 255.0f, c.g / 255.0f, c.b / 255.0f, 1.0f));
     ImGui::SameLine();
@@ -43,13 +48,16 @@ void Demo::panel() {
     int v = static_cast<int>(view_);
     if (ImGui::Combo("view", &v, views, 4)) view_ = static_cast<RenderView>(v);
     const std::vector<Algorithm> algorithms = all_algorithms();
-    int a = static_cast<int>(std::find(algorithms.begin(), algorithms.end(), error_algorithm_) - algorithms.begin());
+    int a = static_cast<int>(std::find(algorithms.begin(), algorithms.end(), error_algorithm_) -
+                             algorithms.begin());
     if (ImGui::BeginCombo("algorithm", algorithm_name(error_algorithm_))) {
       for (std::size_t i = 0; i < algorithms.size(); ++i)
-        if (ImGui::Selectable(algorithm_name(algorithms[i]), static_cast<int>(i) == a)) error_algorithm_ = algorithms[i];
+        if (ImGui::Selectable(algorithm_name(algorithms[i]), static_cast<int>(i) == a))
+          error_algorithm_ = algorithms[i];
       ImGui::EndCombo();
     }
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("the approximation the error view measures against the exact field");
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("the approximation the error view measures against the exact field");
     const char* backends[] = {"cpu", "vulkan"};
     if (vk_) {
       if (ImGui::Combo("backend", &ui_backend_, backends, 2)) choose_path(backends[ui_backend_]);
@@ -116,7 +124,8 @@ void Demo::panel() {
 }
 
 void Demo::help() {
-  ImGui::SetNextWindowPos(ImVec2(width() * 0.5f, height() * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowPos(ImVec2(width() * 0.5f, height() * 0.5f), ImGuiCond_Always,
+                          ImVec2(0.5f, 0.5f));
   ImGui::Begin("help (F1)", &show_help_, ImGuiWindowFlags_AlwaysAutoResize);
   ImGui::Text("W A S D       fly; Space / Shift up and down; Ctrl faster");
   ImGui::Text("middle drag   look around; Tab toggles mouse look (edits at the centre)");

@@ -9,17 +9,22 @@ namespace voxfield::demo {
 namespace {
 
 void check(VkResult r, const char* what) {
-  if (r != VK_SUCCESS) throw WindowError(std::string("Vulkan: ") + what + " failed (VkResult " + std::to_string(r) + ")");
+  if (r != VK_SUCCESS)
+    throw WindowError(std::string("Vulkan: ") + what + " failed (VkResult " + std::to_string(r) +
+                      ")");
 }
 
-VKAPI_ATTR VkBool32 VKAPI_CALL on_validation(VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
-                                             const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
+VKAPI_ATTR VkBool32 VKAPI_CALL on_validation(VkDebugUtilsMessageSeverityFlagBitsEXT,
+                                             VkDebugUtilsMessageTypeFlagsEXT,
+                                             const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                             void*) {
   std::cerr << "voxfield-demo: validation: " << data->pMessage << "\n";
   return VK_FALSE;
 }
 
-void image_barrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to, VkPipelineStageFlags src_stage,
-                   VkAccessFlags src_access, VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) {
+void image_barrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to,
+                   VkPipelineStageFlags src_stage, VkAccessFlags src_access,
+                   VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) {
   VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
   b.srcAccessMask = src_access;
   b.dstAccessMask = dst_access;
@@ -70,10 +75,13 @@ void VulkanWindow::open(int width, int height, const std::string& title, bool va
   volkLoadInstance(instance_);
   if (validation) {
     VkDebugUtilsMessengerCreateInfoEXT m{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-    m.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-    m.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    m.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                        VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    m.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                    VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
     m.pfnUserCallback = on_validation;
-    check(vkCreateDebugUtilsMessengerEXT(instance_, &m, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+    check(vkCreateDebugUtilsMessengerEXT(instance_, &m, nullptr, &messenger_),
+          "vkCreateDebugUtilsMessengerEXT");
   }
   check(glfwCreateWindowSurface(instance_, window_, nullptr, &surface_), "glfwCreateWindowSurface");
 
@@ -111,7 +119,8 @@ void VulkanWindow::open(int width, int height, const std::string& title, bool va
       break;
     }
   }
-  if (!physical_) throw WindowError("no Vulkan device can draw, compute and present to this window");
+  if (!physical_)
+    throw WindowError("no Vulkan device can draw, compute and present to this window");
 
   const float priority = 1;
   VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
@@ -144,7 +153,9 @@ void VulkanWindow::open(int width, int height, const std::string& title, bool va
   create_swapchain();
 }
 
-VulkanWindow::~VulkanWindow() { release(); }
+VulkanWindow::~VulkanWindow() {
+  release();
+}
 
 void VulkanWindow::release() {
   if (device_) {
@@ -171,7 +182,8 @@ void VulkanWindow::release() {
 
 void VulkanWindow::create_swapchain() {
   VkSurfaceCapabilitiesKHR caps;
-  check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(physical_, surface_, &caps), "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
+  check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(physical_, surface_, &caps),
+        "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
   if (!(caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_DST_BIT))
     throw WindowError("the swapchain cannot be written by transfers on this device");
   readable_ = (caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_SRC_BIT) != 0;
@@ -188,15 +200,18 @@ void VulkanWindow::create_swapchain() {
       space = f.colorSpace;
       break;
     }
-  if (format_ == VK_FORMAT_UNDEFINED) throw WindowError("the window offers no 8-bit RGBA/BGRA UNORM format");
+  if (format_ == VK_FORMAT_UNDEFINED)
+    throw WindowError("the window offers no 8-bit RGBA/BGRA UNORM format");
 
   int fb_w = 0, fb_h = 0;
   glfwGetFramebufferSize(window_, &fb_w, &fb_h);
   if (caps.currentExtent.width != 0xFFFFFFFFu) {
     extent_ = caps.currentExtent;
   } else {
-    extent_.width = std::clamp(static_cast<std::uint32_t>(std::max(fb_w, 1)), caps.minImageExtent.width, caps.maxImageExtent.width);
-    extent_.height = std::clamp(static_cast<std::uint32_t>(std::max(fb_h, 1)), caps.minImageExtent.height, caps.maxImageExtent.height);
+    extent_.width = std::clamp(static_cast<std::uint32_t>(std::max(fb_w, 1)),
+                               caps.minImageExtent.width, caps.maxImageExtent.width);
+    extent_.height = std::clamp(static_cast<std::uint32_t>(std::max(fb_h, 1)),
+                                caps.minImageExtent.height, caps.maxImageExtent.height);
   }
   min_image_count_ = std::max(2u, caps.minImageCount);
   std::uint32_t images = min_image_count_ + 1;
@@ -239,10 +254,20 @@ void VulkanWindow::create_swapchain() {
     sub.colorAttachmentCount = 1;
     sub.pColorAttachments = &ref;
     VkSubpassDependency deps[2]{};
-    deps[0] = {VK_SUBPASS_EXTERNAL, 0, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-               VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, 0};
-    deps[1] = {0, VK_SUBPASS_EXTERNAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-               VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT, 0};
+    deps[0] = {VK_SUBPASS_EXTERNAL,
+               0,
+               VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+               VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+               VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+               VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+               0};
+    deps[1] = {0,
+               VK_SUBPASS_EXTERNAL,
+               VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+               VK_PIPELINE_STAGE_TRANSFER_BIT,
+               VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+               VK_ACCESS_TRANSFER_READ_BIT,
+               0};
     VkRenderPassCreateInfo rp{VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
     rp.attachmentCount = 1;
     rp.pAttachments = &color;
@@ -305,10 +330,12 @@ void VulkanWindow::recreate_swapchain() {
 }
 
 bool VulkanWindow::draw_frame(const std::function<void(VkCommandBuffer, VkImage)>& fill,
-                              const std::function<void(VkCommandBuffer)>& overlay, Screenshot* screenshot) {
+                              const std::function<void(VkCommandBuffer)>& overlay,
+                              Screenshot* screenshot) {
   check(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
   std::uint32_t index = 0;
-  const VkResult acquired = vkAcquireNextImageKHR(device_, swapchain_, UINT64_MAX, acquired_, VK_NULL_HANDLE, &index);
+  const VkResult acquired =
+      vkAcquireNextImageKHR(device_, swapchain_, UINT64_MAX, acquired_, VK_NULL_HANDLE, &index);
   if (acquired == VK_ERROR_OUT_OF_DATE_KHR) {
     recreate_swapchain();
     return false;
@@ -320,11 +347,13 @@ bool VulkanWindow::draw_frame(const std::function<void(VkCommandBuffer, VkImage)
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   check(vkBeginCommandBuffer(cmd_, &begin), "vkBeginCommandBuffer");
   const VkImage image = images_[index];
-  image_barrier(cmd_, image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
-                VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
+  image_barrier(cmd_, image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                VK_PIPELINE_STAGE_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                VK_ACCESS_TRANSFER_WRITE_BIT);
   fill(cmd_, image);
-  image_barrier(cmd_, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+  image_barrier(cmd_, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
                 VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
   VkRenderPassBeginInfo rp{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
   rp.renderPass = render_pass_;
@@ -340,21 +369,25 @@ bool VulkanWindow::draw_frame(const std::function<void(VkCommandBuffer, VkImage)
       destroy_host_buffer(readback_);
       readback_ = make_host_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     }
-    image_barrier(cmd_, image, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                  0, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+    image_barrier(cmd_, image, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+                  VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                  VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     VkBufferImageCopy copy{};
     copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     copy.imageExtent = {extent_.width, extent_.height, 1};
-    vkCmdCopyImageToBuffer(cmd_, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.buffer, 1, &copy);
-    image_barrier(cmd_, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                  0, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, 0);
+    vkCmdCopyImageToBuffer(cmd_, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.buffer, 1,
+                           &copy);
+    image_barrier(cmd_, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                  VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                  VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, 0);
     VkBufferMemoryBarrier host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
     host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
     host.srcQueueFamilyIndex = host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     host.buffer = readback_.buffer;
     host.size = VK_WHOLE_SIZE;
-    vkCmdPipelineBarrier(cmd_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0, nullptr, 1, &host, 0, nullptr);
+    vkCmdPipelineBarrier(cmd_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0,
+                         nullptr, 1, &host, 0, nullptr);
   }
   check(vkEndCommandBuffer(cmd_), "vkEndCommandBuffer");
 
@@ -393,7 +426,8 @@ bool VulkanWindow::draw_frame(const std::function<void(VkCommandBuffer, VkImage)
       }
     }
   }
-  if (presented == VK_ERROR_OUT_OF_DATE_KHR || presented == VK_SUBOPTIMAL_KHR || acquired == VK_SUBOPTIMAL_KHR) {
+  if (presented == VK_ERROR_OUT_OF_DATE_KHR || presented == VK_SUBOPTIMAL_KHR ||
+      acquired == VK_SUBOPTIMAL_KHR) {
     recreate_swapchain();
   } else {
     check(presented, "vkQueuePresentKHR");
@@ -427,7 +461,9 @@ VkBuffer VulkanWindow::staging(VkDeviceSize bytes, void** mapped) {
   return staging_.buffer;
 }
 
-void VulkanWindow::wait_idle() const { vkDeviceWaitIdle(device_); }
+void VulkanWindow::wait_idle() const {
+  vkDeviceWaitIdle(device_);
+}
 
 std::uint32_t VulkanWindow::memory_type(std::uint32_t bits, VkMemoryPropertyFlags wanted) const {
   VkPhysicalDeviceMemoryProperties props;
@@ -437,7 +473,8 @@ std::uint32_t VulkanWindow::memory_type(std::uint32_t bits, VkMemoryPropertyFlag
   throw WindowError("no host-visible memory for staging");
 }
 
-VulkanWindow::HostBuffer VulkanWindow::make_host_buffer(VkDeviceSize bytes, VkBufferUsageFlags usage) {
+VulkanWindow::HostBuffer VulkanWindow::make_host_buffer(VkDeviceSize bytes,
+                                                        VkBufferUsageFlags usage) {
   HostBuffer b;
   VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   info.size = bytes;
@@ -447,8 +484,8 @@ VulkanWindow::HostBuffer VulkanWindow::make_host_buffer(VkDeviceSize bytes, VkBu
   vkGetBufferMemoryRequirements(device_, b.buffer, &req);
   VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   alloc.allocationSize = req.size;
-  alloc.memoryTypeIndex =
-      memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+  alloc.memoryTypeIndex = memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                                                              VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
   check(vkAllocateMemory(device_, &alloc, nullptr, &b.memory), "vkAllocateMemory");
   check(vkBindBufferMemory(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
   check(vkMapMemory(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");

@@ -38,8 +38,8 @@ struct GlfwSession {
 
 class VulkanWindow {
  public:
-  // Opens a width x height window titled `title` (inside a GlfwSession). Throws WindowError when GLFW or Vulkan is not
-  // usable (no display, no loader, no device that can present to the window).
+  // Opens a width x height window titled `title` (inside a GlfwSession). Throws WindowError when
+  // GLFW or Vulkan is not usable (no display, no loader, no device that can present to the window).
   VulkanWindow(int width, int height, const std::string& title, bool validation);
   ~VulkanWindow();
   VulkanWindow(const VulkanWindow&) = delete;

@@ -49,7 +49,10 @@ struct Vec3d {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
   }
   double length() const { return std::sqrt(x * x + y * y + z * z); }
-  Vec3d normalized() const { const double l = length(); return {x / l, y / l, z / l}; }
+  Vec3d normalized() const {
+    const double l = length();
+    return {x / l, y / l, z / l};
+  }
 };
 
 // The supported coordinate range: -kCoordLimit <= p < kCoordLimit on every axis.
@@ -57,8 +60,12 @@ inline constexpr std::int32_t kCoordLimit = std::int32_t{1} << 29;
 
 // Whether v lies in the supported range (voxel coordinates) / whether a box bound does (a box's
 // end may equal kCoordLimit).
-constexpr bool coord_in_range(std::int64_t v) { return v >= -kCoordLimit && v < kCoordLimit; }
-constexpr bool bound_in_range(std::int64_t v) { return v >= -kCoordLimit && v <= kCoordLimit; }
+constexpr bool coord_in_range(std::int64_t v) {
+  return v >= -kCoordLimit && v < kCoordLimit;
+}
+constexpr bool bound_in_range(std::int64_t v) {
+  return v >= -kCoordLimit && v <= kCoordLimit;
+}
 
 struct Box3i {
   Vec3i begin;  // inclusive
@@ -87,7 +94,8 @@ struct Box3i {
   // Number of voxels; saturates at INT64_MAX (a box of 2^29 on every side holds 2^87).
   constexpr std::int64_t volume() const {
     // Each extent is below 2^32, so the first product fits in 64 unsigned bits.
-    const std::uint64_t xy = static_cast<std::uint64_t>(extent(0)) * static_cast<std::uint64_t>(extent(1));
+    const std::uint64_t xy =
+        static_cast<std::uint64_t>(extent(0)) * static_cast<std::uint64_t>(extent(1));
     const std::uint64_t z = static_cast<std::uint64_t>(extent(2));
     if (z != 0 && xy > static_cast<std::uint64_t>(INT64_MAX) / z) return INT64_MAX;
     return static_cast<std::int64_t>(xy * z);
@@ -105,20 +113,22 @@ struct Box3i {
   }
   // True when every voxel of `other` lies in this box (an empty `other` is contained anywhere).
   constexpr bool contains(const Box3i& other) const {
-    return other.empty() || (other.begin.x >= begin.x && other.end.x <= end.x &&
-                             other.begin.y >= begin.y && other.end.y <= end.y &&
-                             other.begin.z >= begin.z && other.end.z <= end.z);
+    return other.empty() ||
+           (other.begin.x >= begin.x && other.end.x <= end.x && other.begin.y >= begin.y &&
+            other.end.y <= end.y && other.begin.z >= begin.z && other.end.z <= end.z);
   }
   constexpr Box3i intersect(const Box3i& o) const {
-    return {{std::max(begin.x, o.begin.x), std::max(begin.y, o.begin.y), std::max(begin.z, o.begin.z)},
-            {std::min(end.x, o.end.x), std::min(end.y, o.end.y), std::min(end.z, o.end.z)}};
+    return {
+        {std::max(begin.x, o.begin.x), std::max(begin.y, o.begin.y), std::max(begin.z, o.begin.z)},
+        {std::min(end.x, o.end.x), std::min(end.y, o.end.y), std::min(end.z, o.end.z)}};
   }
   // Smallest box holding both; an empty operand is ignored.
   constexpr Box3i unite(const Box3i& o) const {
     if (empty()) return o;
     if (o.empty()) return *this;
-    return {{std::min(begin.x, o.begin.x), std::min(begin.y, o.begin.y), std::min(begin.z, o.begin.z)},
-            {std::max(end.x, o.end.x), std::max(end.y, o.end.y), std::max(end.z, o.end.z)}};
+    return {
+        {std::min(begin.x, o.begin.x), std::min(begin.y, o.begin.y), std::min(begin.z, o.begin.z)},
+        {std::max(end.x, o.end.x), std::max(end.y, o.end.y), std::max(end.z, o.end.z)}};
   }
   // The box grown by `voxels` on every side (shrunk when negative).
   constexpr Box3i grown(std::int32_t voxels) const {
@@ -140,7 +150,14 @@ struct Vec3iHash {
 inline constexpr Box3i kCoordRange{Vec3i::splat(-kCoordLimit), Vec3i::splat(kCoordLimit)};
 
 inline std::string to_string(const Box3i& b) {
-  return "[" + to_string(b.begin) + " .. " + to_string(b.end) + ")";
+  // Appended piece by piece: GCC 12 misreads "[" + std::string&& as a huge copy
+  // (-Wstringop-overflow, a known false positive).
+  std::string s = "[";
+  s += to_string(b.begin);
+  s += " .. ";
+  s += to_string(b.end);
+  s += ")";
+  return s;
 }
 
 }  // namespace voxfield

@@ -93,6 +93,7 @@ struct DistanceField {
 // Multi-threaded on voxfield's pool; the result does not depend on the thread count or chunk edge.
 DistanceField compute_distance_field(const World& world, const DistanceOptions& options);
 // The same for any occupancy grid (non-zero = solid).
-DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy, const DistanceOptions& options);
+DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy,
+                                     const DistanceOptions& options);
 
 }  // namespace voxfield

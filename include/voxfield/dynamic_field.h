@@ -31,8 +31,9 @@ class DynamicDistanceField {
 
   struct UpdateStats {
     std::int64_t voxels_recomputed = 0;  // voxels whose values were recomputed
-    std::int64_t voxels_read = 0;        // voxels the kernel ran over (recomputed boxes and the sites around them)
-    int regions = 0;                     // merged boxes recomputed
+    std::int64_t voxels_read =
+        0;            // voxels the kernel ran over (recomputed boxes and the sites around them)
+    int regions = 0;  // merged boxes recomputed
   };
 
   // Recomputes the whole field.

@@ -19,7 +19,6 @@
 
 namespace voxfield {
 
-
 // Voxels p with |p - center|^2 <= radius^2 (voxel centres at integer coordinates).
 struct SphereBrush {
   Vec3d center{0, 0, 0};
@@ -65,7 +64,8 @@ class DirtyRegions {
     kAnyChange,  // every material change (renderers, meshers)
     kOccupancy,  // only solid <-> air changes: all a distance field depends on
   };
-  explicit DirtyRegions(int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge, Track track = Track::kAnyChange);
+  explicit DirtyRegions(int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge,
+                        Track track = Track::kAnyChange);
   Track track() const { return track_; }
   // Records a change. `removes_solid` / `adds_solid`: whether it may have turned solid voxels into
   // air / air into solid (a distance field updates changes of one kind only more cheaply).
@@ -110,7 +110,7 @@ bool brush_contains(const CapsuleBrush& brush, Vec3i p);
 bool brush_contains(const StampBrush& brush, Vec3i p);
 
 struct EditResult {
-  Box3i changed_box;          // smallest box holding every changed voxel (empty if none)
+  Box3i changed_box;  // smallest box holding every changed voxel (empty if none)
   std::int64_t voxels_changed = 0;
 };
 

@@ -27,7 +27,7 @@
 namespace voxfield {
 
 struct EditScriptOptions {
-  std::filesystem::path base_dir;        // where stamps' relative paths start
+  std::filesystem::path base_dir;                          // where stamps' relative paths start
   int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge;  // of loaded stamp models
   bool load_stamps = true;               // false: stamps keep a null model (syntax checks only)
   std::uint64_t memory_limit_bytes = 0;  // for stamp models; 0: the process default
@@ -44,6 +44,7 @@ Edit parse_edit_line(std::string_view line, const EditScriptOptions& options = {
 std::vector<Edit> parse_edit_script(std::span<const std::uint8_t> text, const std::string& name,
                                     const EditScriptOptions& options = {});
 // Reads the script (a regular file) and parses it; base_dir defaults to the script's directory.
-std::vector<Edit> read_edit_script(const std::filesystem::path& path, EditScriptOptions options = {});
+std::vector<Edit> read_edit_script(const std::filesystem::path& path,
+                                   EditScriptOptions options = {});
 
 }  // namespace voxfield

@@ -22,7 +22,8 @@ class RandomEditStream {
  private:
   int uniform(int lo, int hi);
   Box3i box_;
-  std::mt19937_64 rng_;  // specified bit for bit by the standard (the distributions are not: unused)
+  std::mt19937_64
+      rng_;  // specified bit for bit by the standard (the distributions are not: unused)
   int radius_min_, radius_max_;
 };
 

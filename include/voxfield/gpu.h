@@ -45,8 +45,8 @@ class GpuOutOfMemory : public GpuUnavailable {
 };
 
 enum class Backend { kCpu, kVulkan, kAuto };
-const char* backend_name(Backend b);              // "cpu", "vulkan", "auto"
-Backend parse_backend(const std::string& name);   // throws InvalidArgument
+const char* backend_name(Backend b);             // "cpu", "vulkan", "auto"
+Backend parse_backend(const std::string& name);  // throws InvalidArgument
 
 namespace gpu {
 
@@ -62,9 +62,9 @@ struct ContextOptions {
 };
 
 struct DeviceInfo {
-  std::string name;        // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
-  std::string type;        // "discrete", "integrated", "virtual", "cpu", "other"
-  bool hardware = false;   // a real GPU (not "cpu")
+  std::string name;       // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+  std::string type;       // "discrete", "integrated", "virtual", "cpu", "other"
+  bool hardware = false;  // a real GPU (not "cpu")
   std::uint32_t api_version = 0;
   std::string api_version_string() const;
 };

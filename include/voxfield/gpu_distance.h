@@ -21,7 +21,8 @@ namespace voxfield::gpu {
 // Throws InvalidArgument for what it does not support (anisotropic spacing, a
 // fixed-point scale whose products overflow 32 bits), GpuUnavailable on device errors. One command
 // buffer, one submit, one fence wait.
-DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
+DistanceField compute_distance_field(Context& context, const World& world,
+                                     const DistanceOptions& options,
                                      std::vector<PassTiming>* timings = nullptr);
 
 // One of the dissertation's algorithms on the GPU: kExact (as above); jump flooding — kJfaSeed,
@@ -30,8 +31,10 @@ DistanceField compute_distance_field(Context& context, const World& world, const
 // L-inf bit-identical, Euclidean within 1e-4 voxels of the CPU's), kHybrid and kLod as JFA then
 // FIM (two submits). kBrute and kBruteChunked (CPU references) throw InvalidArgument, as do FIM,
 // hybrid and lod with nearest sites; unit spacing only.
-DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
-                                     const AlgorithmOptions& algorithm, AlgorithmStats* stats = nullptr,
+DistanceField compute_distance_field(Context& context, const World& world,
+                                     const DistanceOptions& options,
+                                     const AlgorithmOptions& algorithm,
+                                     AlgorithmStats* stats = nullptr,
                                      std::vector<PassTiming>* timings = nullptr);
 
 class FieldEngine;

@@ -16,8 +16,9 @@ namespace voxfield::gpu {
 // states. Every view (the error view's counts, rays_through_geometry and max_error, stay zero:
 // the CPU renderer reports them). One submit; stats->ms
 // covers upload, render and read-back. For many frames of a changing scene, use SceneRenderer.
-Image render(Context& context, const RenderScene& scene, const Camera& camera, const RenderOptions& options,
-             RenderStats* stats = nullptr, std::vector<PassTiming>* timings = nullptr);
+Image render(Context& context, const RenderScene& scene, const Camera& camera,
+             const RenderOptions& options, RenderStats* stats = nullptr,
+             std::vector<PassTiming>* timings = nullptr);
 
 // A RenderScene kept on the GPU for many frames — an editor's or a game's view of a changing
 // world. The first sync() copies the whole scene; after RenderScene::update() only the chunks it

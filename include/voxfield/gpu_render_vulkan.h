@@ -1,5 +1,6 @@
 // voxfield — the ray marcher recorded into an application's own command buffer (on a device
-// handed over with gpu::adopt, gpu_vulkan.h). Includes the Vulkan headers for the handle types only.
+// handed over with gpu::adopt, gpu_vulkan.h). Includes the Vulkan headers for the handle types
+// only.
 #pragma once
 
 #include "voxfield/gpu_render.h"

@@ -20,7 +20,7 @@ struct AdoptedDevice {
   VkInstance instance = VK_NULL_HANDLE;  // created with Vulkan 1.1 or later
   VkPhysicalDevice physical = VK_NULL_HANDLE;
   VkDevice device = VK_NULL_HANDLE;
-  VkQueue queue = VK_NULL_HANDLE;        // a queue of `queue_family`, which must support compute
+  VkQueue queue = VK_NULL_HANDLE;  // a queue of `queue_family`, which must support compute
   std::uint32_t queue_family = 0;
 };
 

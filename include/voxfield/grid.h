@@ -54,10 +54,10 @@ struct GridMemory {
 // or it is null and every voxel holds `uniform_value`.
 template <class T>
 struct ChunkView {
-  Vec3i coord;           // chunk coordinate: voxel p lies in chunk floor(p / edge)
-  Box3i box;             // the voxels this chunk covers
-  const T* voxels;       // dense data, or nullptr for a uniform chunk
-  T uniform_value;       // meaningful only when voxels == nullptr
+  Vec3i coord;      // chunk coordinate: voxel p lies in chunk floor(p / edge)
+  Box3i box;        // the voxels this chunk covers
+  const T* voxels;  // dense data, or nullptr for a uniform chunk
+  T uniform_value;  // meaningful only when voxels == nullptr
   bool uniform() const { return voxels == nullptr; }
 };
 
@@ -69,8 +69,8 @@ class Grid {
   static constexpr int kMaxChunkEdge = 128;
   static constexpr int kDefaultChunkEdge = 32;
 
-  // Throws InvalidArgument unless chunk_edge is a power of two in [8, 128] and `bounds`, when given,
-  // is non-empty.
+  // Throws InvalidArgument unless chunk_edge is a power of two in [8, 128] and `bounds`, when
+  // given, is non-empty.
   explicit Grid(int chunk_edge = kDefaultChunkEdge, T background = T{},
                 std::optional<Box3i> bounds = std::nullopt);
   Grid(const Grid& other);
@@ -81,7 +81,9 @@ class Grid {
 
   int chunk_edge() const { return chunk_edge_; }
   int chunk_shift() const { return chunk_shift_; }  // log2(chunk_edge)
-  std::int64_t chunk_volume() const { return std::int64_t{chunk_edge_} * chunk_edge_ * chunk_edge_; }
+  std::int64_t chunk_volume() const {
+    return std::int64_t{chunk_edge_} * chunk_edge_ * chunk_edge_;
+  }
   T background() const { return background_; }
   const std::optional<Box3i>& bounds() const { return bounds_; }
 
@@ -119,8 +121,9 @@ class Grid {
   void fill(const Box3i& box, T value);
 
   // Bulk copies between the grid and a dense array laid out x fastest, then y, then z, holding
-  // box.volume() values. copy_to_dense reads the background where nothing is stored; copy_from_dense
-  // throws InvalidArgument (changing nothing) when a bounded grid does not contain the box.
+  // box.volume() values. copy_to_dense reads the background where nothing is stored;
+  // copy_from_dense throws InvalidArgument (changing nothing) when a bounded grid does not contain
+  // the box.
   void copy_to_dense(const Box3i& box, T* out) const;
   void copy_from_dense(const Box3i& box, const T* in);
 
@@ -155,8 +158,7 @@ class Grid {
   // Chunks that come out uniform are collapsed. Throws InvalidArgument (changing nothing) when a
   // chunk lies outside a bounded grid's bounds; voxels of a chunk beyond the bounds are discarded
   // (reset to the background).
-  void generate_chunks(const std::vector<Vec3i>& chunks,
-                       const std::function<void(Vec3i, T*)>& f);
+  void generate_chunks(const std::vector<Vec3i>& chunks, const std::function<void(Vec3i, T*)>& f);
   // Takes ownership of one dense array of edge^3 values (x fastest) per coordinate, replacing what
   // was stored there; uniform ones are collapsed (scanned in parallel). Same bounds rule as
   // generate_chunks. Throws InvalidArgument (changing nothing) when the sizes disagree.
@@ -183,7 +185,8 @@ class Grid {
 
    private:
     friend class Grid;
-    ChunkEdit(T* voxels, T ref, std::int64_t ref_count) : voxels_(voxels), ref_(ref), ref_count_(ref_count) {}
+    ChunkEdit(T* voxels, T ref, std::int64_t ref_count)
+        : voxels_(voxels), ref_(ref), ref_count_(ref_count) {}
     T* voxels_;
     T ref_;
     std::int64_t ref_count_;

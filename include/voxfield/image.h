@@ -12,10 +12,13 @@ struct Image {
   std::vector<std::uint8_t> rgb;
 
   Image() = default;
-  // A black image. Throws InvalidArgument for a non-positive or absurd size (more than 2^28 pixels).
+  // A black image. Throws InvalidArgument for a non-positive or absurd size (more than 2^28
+  // pixels).
   Image(int width, int height);
 
-  std::uint8_t* pixel(int x, int y) { return rgb.data() + 3 * (static_cast<std::size_t>(y) * width + x); }
+  std::uint8_t* pixel(int x, int y) {
+    return rgb.data() + 3 * (static_cast<std::size_t>(y) * width + x);
+  }
   const std::uint8_t* pixel(int x, int y) const {
     return rgb.data() + 3 * (static_cast<std::size_t>(y) * width + x);
   }

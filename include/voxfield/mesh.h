@@ -9,7 +9,8 @@
 //
 // Conventions, for every mesher:
 //  * triangles wind counter-clockwise seen from outside (the side the field marks as outside), so
-//    their right-hand normals point out; `normals` are the field's normalised gradient, pointing out;
+//    their right-hand normals point out; `normals` are the field's normalised gradient, pointing
+//    out;
 //  * positions are in the volume's frame: sample (x, y, z) sits at origin + (x, y, z) * spacing;
 //  * vertices are shared between the triangles that meet there (indexed mesh, no unreferenced
 //    vertices). A surface inside the volume gives a closed mesh (no boundary edge); marching cubes
@@ -45,16 +46,19 @@ struct ScalarVolume {
   std::int64_t count() const { return Box3i::from_size(size).volume(); }
   float at(int x, int y, int z) const {
     return values[static_cast<std::size_t>(x) +
-                  static_cast<std::size_t>(size.x) * (static_cast<std::size_t>(y) + static_cast<std::size_t>(size.y) * static_cast<std::size_t>(z))];
+                  static_cast<std::size_t>(size.x) *
+                      (static_cast<std::size_t>(y) +
+                       static_cast<std::size_t>(size.y) * static_cast<std::size_t>(z))];
   }
 };
 
 enum class Mesher {
-  kMarchingCubes,  // Lorensen & Cline 1987; faces decided by Nielson & Hamann's asymptotic decider
-  kSurfaceNets,    // Gibson 1998, the naive variant: one vertex per cell the surface crosses
-  kDualContouring, // Ju et al. 2002: surface nets' topology, vertices on the crossings' tangent planes
+  kMarchingCubes,   // Lorensen & Cline 1987; faces decided by Nielson & Hamann's asymptotic decider
+  kSurfaceNets,     // Gibson 1998, the naive variant: one vertex per cell the surface crosses
+  kDualContouring,  // Ju et al. 2002: surface nets' topology, vertices on the crossings' tangent
+                    // planes
 };
-const char* mesher_name(Mesher m);             // "mc", "sn", "dc"
+const char* mesher_name(Mesher m);  // "mc", "sn", "dc"
 // "mc"/"marching-cubes", "sn"/"surface-nets", "dc"/"dual-contouring"; else InvalidArgument.
 Mesher parse_mesher(const std::string& name);
 
@@ -73,7 +77,7 @@ struct Mesh {
   std::vector<std::array<float, 3>> positions;
   std::vector<std::array<float, 3>> normals;        // one per position, unit length, pointing out
   std::vector<std::array<std::uint8_t, 3>> colors;  // one per position, or empty (no colours)
-  std::vector<std::uint32_t> indices;               // three per triangle, counter-clockwise from outside
+  std::vector<std::uint32_t> indices;  // three per triangle, counter-clockwise from outside
 
   std::size_t vertex_count() const { return positions.size(); }
   std::size_t triangle_count() const { return indices.size() / 3; }
@@ -96,13 +100,15 @@ Mesh mesh_world(const World& world, const MeshOptions& options);
 // What a mesh is, topologically and geometrically.
 struct MeshStats {
   std::size_t vertices = 0, triangles = 0;
-  std::size_t edges = 0;             // distinct undirected edges
-  std::size_t boundary_edges = 0;    // in one triangle only
-  std::size_t nonmanifold_edges = 0; // in three or more triangles
-  std::size_t misoriented_edges = 0; // shared by two triangles that traverse it the same way
+  std::size_t edges = 0;                 // distinct undirected edges
+  std::size_t boundary_edges = 0;        // in one triangle only
+  std::size_t nonmanifold_edges = 0;     // in three or more triangles
+  std::size_t misoriented_edges = 0;     // shared by two triangles that traverse it the same way
   std::size_t degenerate_triangles = 0;  // a repeated vertex index
   // Every edge in exactly two triangles, traversed in opposite directions: closed and oriented.
-  bool watertight() const { return triangles > 0 && boundary_edges == 0 && nonmanifold_edges == 0 && misoriented_edges == 0; }
+  bool watertight() const {
+    return triangles > 0 && boundary_edges == 0 && nonmanifold_edges == 0 && misoriented_edges == 0;
+  }
   std::int64_t euler_characteristic = 0;  // V - E + F (2 for a sphere, 0 for a torus)
   double area_units2 = 0;
   double signed_volume_units3 = 0;  // positive when the triangles face out (closed meshes only)

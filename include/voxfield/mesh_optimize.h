@@ -26,7 +26,8 @@ struct SimplifyStats {
 };
 
 // Throws InvalidArgument for a ratio outside (0, 1], a negative error or arrays that disagree.
-Mesh simplify_mesh(const Mesh& mesh, const SimplifyOptions& options, SimplifyStats* stats = nullptr);
+Mesh simplify_mesh(const Mesh& mesh, const SimplifyOptions& options,
+                   SimplifyStats* stats = nullptr);
 void optimize_mesh(Mesh& mesh);
 
 }  // namespace voxfield

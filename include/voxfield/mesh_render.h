@@ -1,7 +1,7 @@
 // voxfield — pictures of triangle meshes on the CPU: a depth-buffered rasteriser with the same
 // cameras as the voxel renderer (render.h), so a mesh and the world it came from line up pixel for
-// pixel. Shading: one directional light (Lambert) plus ambient, from the vertex normals and colours,
-// optionally with the triangle edges drawn (to see how a mesher tessellates).
+// pixel. Shading: one directional light (Lambert) plus ambient, from the vertex normals and
+// colours, optionally with the triangle edges drawn (to see how a mesher tessellates).
 #pragma once
 
 #include <array>

@@ -22,7 +22,19 @@
 
 namespace voxfield {
 
-enum class DType { kBool, kInt8, kUInt8, kInt16, kUInt16, kInt32, kUInt32, kInt64, kUInt64, kFloat32, kFloat64 };
+enum class DType {
+  kBool,
+  kInt8,
+  kUInt8,
+  kInt16,
+  kUInt16,
+  kInt32,
+  kUInt32,
+  kInt64,
+  kUInt64,
+  kFloat32,
+  kFloat64
+};
 
 std::size_t dtype_size(DType t);
 const char* dtype_name(DType t);  // NumPy's name: "bool", "uint8", "float32", ...
@@ -62,16 +74,17 @@ void write_npy(const NpyVolume& volume, const std::filesystem::path& path);
 // Builds a volume from dense values (x fastest). T must match dtype's size.
 template <class T>
 NpyVolume make_npy(DType dtype, Vec3i dims, const T* values) {
-  if (sizeof(T) != dtype_size(dtype)) throw InvalidArgument("make_npy: element size does not match dtype");
+  if (sizeof(T) != dtype_size(dtype))
+    throw InvalidArgument("make_npy: element size does not match dtype");
   NpyVolume v{dtype, dims, {}, 1};
   v.bytes.resize(static_cast<std::size_t>(v.count()) * sizeof(T));
   std::memcpy(v.bytes.data(), values, v.bytes.size());
   return v;
 }
 
-// Volume -> World: every non-zero value is that material, placed with a[x, y, z] at voxel (x, y, z).
-// Throws FormatError naming the element a[x, y, z] and its byte offset in the file when a value is
-// not an integer in 0..255 (bool counts as material 1), ResourceLimitError when the world would
+// Volume -> World: every non-zero value is that material, placed with a[x, y, z] at voxel (x, y,
+// z). Throws FormatError naming the element a[x, y, z] and its byte offset in the file when a value
+// is not an integer in 0..255 (bool counts as material 1), ResourceLimitError when the world would
 // pass the memory limit.
 World world_from_npy(const NpyVolume& volume, const std::string& name,
                      int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge,

@@ -15,7 +15,9 @@
 namespace voxfield::sdf {
 
 // Sphere of `radius` centred at the origin.
-inline double sphere(Vec3d p, double radius) { return p.length() - radius; }
+inline double sphere(Vec3d p, double radius) {
+  return p.length() - radius;
+}
 
 // Axis-aligned box centred at the origin with half extents `half`.
 inline double box(Vec3d p, Vec3d half) {
@@ -38,11 +40,23 @@ inline double capsule(Vec3d p, Vec3d a, Vec3d b, double radius) {
 }
 
 // Closed-form measures, for checking meshes.
-inline double sphere_volume(double r) { return 4.0 / 3.0 * std::numbers::pi * r * r * r; }
-inline double sphere_area(double r) { return 4.0 * std::numbers::pi * r * r; }
-inline double torus_volume(double major, double minor) { return 2.0 * std::numbers::pi * std::numbers::pi * major * minor * minor; }
-inline double torus_area(double major, double minor) { return 4.0 * std::numbers::pi * std::numbers::pi * major * minor; }
-inline double capsule_volume(double length, double r) { return std::numbers::pi * r * r * (length + 4.0 / 3.0 * r); }
-inline double capsule_area(double length, double r) { return 2.0 * std::numbers::pi * r * (length + 2.0 * r); }
+inline double sphere_volume(double r) {
+  return 4.0 / 3.0 * std::numbers::pi * r * r * r;
+}
+inline double sphere_area(double r) {
+  return 4.0 * std::numbers::pi * r * r;
+}
+inline double torus_volume(double major, double minor) {
+  return 2.0 * std::numbers::pi * std::numbers::pi * major * minor * minor;
+}
+inline double torus_area(double major, double minor) {
+  return 4.0 * std::numbers::pi * std::numbers::pi * major * minor;
+}
+inline double capsule_volume(double length, double r) {
+  return std::numbers::pi * r * r * (length + 4.0 / 3.0 * r);
+}
+inline double capsule_area(double length, double r) {
+  return 2.0 * std::numbers::pi * r * (length + 2.0 * r);
+}
 
 }  // namespace voxfield::sdf

@@ -35,7 +35,7 @@ struct Camera {
   enum class Projection { kPerspective, kOrthographic };
   Projection projection = Projection::kPerspective;
   Vec3d eye{0, 0, 0}, target{0, 0, -1}, up{0, 0, 1};  // z is up, as in MagicaVoxel
-  double fov_degrees = 60;  // perspective: vertical field of view
+  double fov_degrees = 60;                            // perspective: vertical field of view
   double ortho_height = 1;  // orthographic: world units spanned by the image height
 
   // Perspective view from above one corner, as close as keeps all eight corners of the box in
@@ -58,11 +58,15 @@ struct Camera {
     // Directions are unit vectors, so t measures voxels.
     Ray ray(double px, double py) const;
     // Size of one pixel, in voxels, at distance t along a ray.
-    double footprint(double t) const { return (projection == Projection::kOrthographic ? 1 : t) * 2 * scale / height; }
+    double footprint(double t) const {
+      return (projection == Projection::kOrthographic ? 1 : t) * 2 * scale / height;
+    }
   };
   Projector projector(int width, int height) const;
   // The ray through the centre of pixel (px, py) of a width x height image (py = 0 at the top).
-  Ray ray(int px, int py, int width, int height) const { return projector(width, height).ray(px + 0.5, py + 0.5); }
+  Ray ray(int px, int py, int width, int height) const {
+    return projector(width, height).ray(px + 0.5, py + 0.5);
+  }
 };
 
 // How far rays may skip. kNone is the plain DDA that visits every voxel (the reference the
@@ -112,7 +116,8 @@ class RenderScene {
   // scene's metric and scales, `light` given exactly when the scene has a lighting field; the
   // world's palette is re-read too. Cost proportional to the chunks touched, not the world. Returns
   // how many of them changed. Throws InvalidArgument for fields that do not fit.
-  std::size_t update(const DistanceField& skip, const DistanceField* light, std::span<const Box3i> boxes);
+  std::size_t update(const DistanceField& skip, const DistanceField* light,
+                     std::span<const Box3i> boxes);
 
   const World& world() const;
   const Box3i& box() const;
@@ -139,8 +144,8 @@ class DynamicRenderScene {
   static RenderSceneOptions default_options();
 
   struct UpdateStats {
-    double field_ms = 0;   // both fields' incremental updates
-    double scene_ms = 0;   // re-reading the chunks they reached
+    double field_ms = 0;  // both fields' incremental updates
+    double scene_ms = 0;  // re-reading the chunks they reached
     std::int64_t voxels_recomputed = 0;
     std::size_t chunks_changed = 0;  // chunks of the scene whose contents changed
   };
@@ -179,8 +184,11 @@ struct TraversalCounters {
   std::int64_t chunk_skips = 0;     // empty chunks crossed in one step
   std::int64_t distance_skips = 0;  // skips of more than one voxel by the distance field
   void add(const TraversalCounters& o) {
-    rays += o.rays; steps += o.steps; voxel_reads += o.voxel_reads;
-    chunk_skips += o.chunk_skips; distance_skips += o.distance_skips;
+    rays += o.rays;
+    steps += o.steps;
+    voxel_reads += o.voxel_reads;
+    chunk_skips += o.chunk_skips;
+    distance_skips += o.distance_skips;
   }
 };
 
@@ -228,7 +236,9 @@ struct RenderStats {
   // largest |approximate - exact| met along any ray.
   std::int64_t rays_through_geometry = 0;
   double max_error = 0;
-  double rays_per_second() const { return ms > 0 ? static_cast<double>(primary.rays) * 1000.0 / ms : 0; }
+  double rays_per_second() const {
+    return ms > 0 ? static_cast<double>(primary.rays) * 1000.0 / ms : 0;
+  }
 };
 
 // Renders one frame. Multi-threaded over tiles; the image does not depend on the thread count or

@@ -49,7 +49,7 @@ struct VoxFileInfo {
   std::vector<VoxModelInfo> models;
   std::vector<VoxInstanceInfo> instances;  // empty for files without a scene graph
   bool has_scene_graph = false;
-  bool has_palette = false;               // an RGBA chunk was present
+  bool has_palette = false;                 // an RGBA chunk was present
   std::map<std::string, int> chunk_counts;  // every chunk id seen, with its count
 };
 

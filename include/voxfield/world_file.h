@@ -29,7 +29,8 @@ struct WorldFileReadOptions {
   std::uint64_t memory_limit_bytes = 0;
 };
 
-std::vector<std::uint8_t> encode_world_file(const World& world, const std::vector<const DistanceField*>& fields = {});
+std::vector<std::uint8_t> encode_world_file(const World& world,
+                                            const std::vector<const DistanceField*>& fields = {});
 // Throws FormatError for a corrupt or malformed file: checksums, a coordinate, bound or domain
 // outside the supported range (box.h), a chunk given twice, field options compute_distance_field
 // would refuse (NaN or negative clamp, spacing <= 0, an inverted domain).
@@ -38,6 +39,7 @@ WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::strin
 
 void write_world_file(const World& world, const std::filesystem::path& path,
                       const std::vector<const DistanceField*>& fields = {});
-WorldFile read_world_file(const std::filesystem::path& path, const WorldFileReadOptions& options = {});
+WorldFile read_world_file(const std::filesystem::path& path,
+                          const WorldFileReadOptions& options = {});
 
 }  // namespace voxfield

@@ -26,7 +26,7 @@ const char* world_format_name(WorldFormat f);  // "vox", "npy", "vfw"
 struct LoadOptions {
   // Of the returned world; 0: a .vfw keeps the edge it was saved with, other files get 32.
   int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge;
-  std::uint64_t memory_limit_bytes = 0;                    // 0: the process default (limits.h)
+  std::uint64_t memory_limit_bytes = 0;  // 0: the process default (limits.h)
 };
 
 // A world read from any supported file, with what the file said about itself.
@@ -36,8 +36,8 @@ struct LoadedWorld {
   // The volume the file declares: the .npy shape, the visible instances' boxes or the model's
   // SIZE for .vox, the bounds (or else the content) for .vfw; always united with the content.
   Box3i extent;
-  std::string description;         // one line: format, version, dtype...
-  std::optional<VoxFileInfo> vox;  // .vox only
+  std::string description;            // one line: format, version, dtype...
+  std::optional<VoxFileInfo> vox;     // .vox only
   std::vector<DistanceField> fields;  // .vfw only: the fields saved with the world
 };
 
@@ -47,8 +47,8 @@ LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& opt
 // The world in chunks of another edge and other bounds (Grid::rechunked), after counting what the
 // copy will allocate against the memory limit (0: the process default): a target chunk is dense
 // unless it lies inside one uniform source chunk. Throws ResourceLimitError naming `who`.
-World rechunk_world(const World& world, int chunk_edge, std::optional<Box3i> bounds, const std::string& who,
-                    std::uint64_t memory_limit_bytes = 0);
+World rechunk_world(const World& world, int chunk_edge, std::optional<Box3i> bounds,
+                    const std::string& who, std::uint64_t memory_limit_bytes = 0);
 
 // The bytes of `world` in a format; for .npy the box `extent` united with the content is written
 // (a 1^3 box when both are empty).

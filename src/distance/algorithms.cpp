@@ -1,6 +1,6 @@
 // voxfield — runs the dissertation's algorithm family and measures it against the exact field.
-#include "voxfield/dissertation_format.h"
 #include "voxfield/algorithms.h"
+#include "voxfield/dissertation_format.h"
 
 #include <chrono>
 
@@ -16,9 +16,15 @@ using detail::DenseProblem;
 using detail::DenseSolution;
 
 constexpr std::pair<Algorithm, const char*> kNames[] = {
-    {Algorithm::kExact, "exact"}, {Algorithm::kBrute, "brute"},      {Algorithm::kBruteChunked, "brute-chunked"},
-    {Algorithm::kFim, "fim"},     {Algorithm::kJfaSeed, "jfa-seed"}, {Algorithm::kJfa, "jfa"},
-    {Algorithm::kJfa1, "jfa+1"},  {Algorithm::kJfa2, "jfa+2"},       {Algorithm::kHybrid, "hybrid"},
+    {Algorithm::kExact, "exact"},
+    {Algorithm::kBrute, "brute"},
+    {Algorithm::kBruteChunked, "brute-chunked"},
+    {Algorithm::kFim, "fim"},
+    {Algorithm::kJfaSeed, "jfa-seed"},
+    {Algorithm::kJfa, "jfa"},
+    {Algorithm::kJfa1, "jfa+1"},
+    {Algorithm::kJfa2, "jfa+2"},
+    {Algorithm::kHybrid, "hybrid"},
     {Algorithm::kLod, "lod"},
 };
 
@@ -74,7 +80,9 @@ DenseSolution solve(const DenseProblem& p, const AlgorithmOptions& a, AlgorithmS
       const Box3i chunks{{down(f.begin.x), down(f.begin.y), down(f.begin.z)},
                          {down(f.end.x - 1) + e, down(f.end.y - 1) + e, down(f.end.z - 1) + e}};
       const Box3i region{chunks.begin - p.box.begin, chunks.end - p.box.begin};
-      detail::fast_iterative(p, s, stats, region.intersect(Box3i::from_size(p.n)).empty() ? Box3i{{0, 0, 0}, {0, 0, 0}} : region);
+      detail::fast_iterative(
+          p, s, stats,
+          region.intersect(Box3i::from_size(p.n)).empty() ? Box3i{{0, 0, 0}, {0, 0, 0}} : region);
       break;
     }
   }
@@ -83,7 +91,8 @@ DenseSolution solve(const DenseProblem& p, const AlgorithmOptions& a, AlgorithmS
 
 template <class T>
 DistanceField assemble(const World& world, const DistanceOptions& o, const detail::FieldPlan& plan,
-                       const DenseSolution& out, const DenseSolution* in, const std::vector<std::uint8_t>& solid) {
+                       const DenseSolution& out, const DenseSolution* in,
+                       const std::vector<std::uint8_t>& solid) {
   DistanceField f;
   f.options = o;
   f.domain = plan.domain;
@@ -122,7 +131,8 @@ DistanceField assemble(const World& world, const DistanceOptions& o, const detai
       }
       dense[i] = detail::encode_distance<T>(d, plan);
       if (want_sites) {
-        sites[i] = (site >= 0 && std::abs(d) <= plan.clamp) ? dense_index_to_offset(i, site) : SiteOffset{};
+        sites[i] = (site >= 0 && std::abs(d) <= plan.clamp) ? dense_index_to_offset(i, site)
+                                                            : SiteOffset{};
       }
     }
   });
@@ -143,7 +153,8 @@ std::vector<double> decoded(const DistanceField& f, const Box3i& box) {
         using T = typename std::decay_t<decltype(g)>::value_type;
         std::vector<T> raw(out.size());
         g.copy_to_dense(box, raw.data());
-        for (std::size_t i = 0; i < raw.size(); ++i) out[i] = f.encoding.decode(static_cast<double>(raw[i]));
+        for (std::size_t i = 0; i < raw.size(); ++i)
+          out[i] = f.encoding.decode(static_cast<double>(raw[i]));
       },
       f.values);
   return out;
@@ -160,8 +171,9 @@ const char* algorithm_name(Algorithm a) {
 Algorithm parse_algorithm(const std::string& name) {
   for (const auto& [alg, n] : kNames)
     if (name == n) return alg;
-  throw InvalidArgument("unknown algorithm \"" + name +
-                        "\" (exact, brute, brute-chunked, fim, jfa-seed, jfa, jfa+1, jfa+2, hybrid, lod)");
+  throw InvalidArgument(
+      "unknown algorithm \"" + name +
+      "\" (exact, brute, brute-chunked, fim, jfa-seed, jfa, jfa+1, jfa+2, hybrid, lod)");
 }
 
 std::vector<Algorithm> all_algorithms() {
@@ -172,16 +184,19 @@ std::vector<Algorithm> all_algorithms() {
 
 namespace detail {
 
-DistanceField compute_with_solver(const World& world, const DistanceOptions& o, const AlgorithmOptions& a,
-                                  AlgorithmStats* stats_out, const DenseSolver& solver) {
+DistanceField compute_with_solver(const World& world, const DistanceOptions& o,
+                                  const AlgorithmOptions& a, AlgorithmStats* stats_out,
+                                  const DenseSolver& solver) {
   AlgorithmStats stats;
   const auto t0 = std::chrono::steady_clock::now();
   auto finish = [&](DistanceField f) {
-    stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    stats.ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (stats_out) *stats_out = stats;
     return f;
   };
-  if (a.algorithm == Algorithm::kLod && !a.focus) throw InvalidArgument("the lod algorithm needs a focus box");
+  if (a.algorithm == Algorithm::kLod && !a.focus)
+    throw InvalidArgument("the lod algorithm needs a focus box");
   const detail::FieldPlan plan = detail::make_field_plan(world.voxels, o);
   std::vector<std::uint8_t> solid(static_cast<std::size_t>(plan.domain.volume()));
   world.voxels.copy_to_dense(plan.domain, solid.data());
@@ -189,30 +204,37 @@ DistanceField compute_with_solver(const World& world, const DistanceOptions& o, 
   DenseSolution in;
   if (plan.is_signed) in = solver(make_problem(world, plan, false), a, stats);
   switch (o.storage) {
-    case Storage::kU8: return finish(assemble<std::uint8_t>(world, o, plan, out, plan.is_signed ? &in : nullptr, solid));
-    case Storage::kU16: return finish(assemble<std::uint16_t>(world, o, plan, out, plan.is_signed ? &in : nullptr, solid));
-    case Storage::kF32: return finish(assemble<float>(world, o, plan, out, plan.is_signed ? &in : nullptr, solid));
+    case Storage::kU8:
+      return finish(
+          assemble<std::uint8_t>(world, o, plan, out, plan.is_signed ? &in : nullptr, solid));
+    case Storage::kU16:
+      return finish(
+          assemble<std::uint16_t>(world, o, plan, out, plan.is_signed ? &in : nullptr, solid));
+    case Storage::kF32:
+      return finish(assemble<float>(world, o, plan, out, plan.is_signed ? &in : nullptr, solid));
   }
   throw InvalidArgument("unknown storage");
 }
 
 }  // namespace detail
 
-DistanceField compute_distance_field(const World& world, const DistanceOptions& o, const AlgorithmOptions& a,
-                                     AlgorithmStats* stats_out) {
+DistanceField compute_distance_field(const World& world, const DistanceOptions& o,
+                                     const AlgorithmOptions& a, AlgorithmStats* stats_out) {
   if (a.algorithm == Algorithm::kExact) {
     const auto t0 = std::chrono::steady_clock::now();
     DistanceField f = compute_distance_field(world, o);
     if (stats_out) {
       *stats_out = AlgorithmStats{};
-      stats_out->ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      stats_out->ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     }
     return f;
   }
   return detail::compute_with_solver(world, o, a, stats_out, solve);
 }
 
-FieldError compare_fields(const DistanceField& approx, const DistanceField& exact, const World& world) {
+FieldError compare_fields(const DistanceField& approx, const DistanceField& exact,
+                          const World& world) {
   const Box3i box = exact.domain;
   FieldError e;
   if (box.empty()) return e;
@@ -241,7 +263,8 @@ FieldError compare_fields(const DistanceField& approx, const DistanceField& exac
   return e;
 }
 
-std::vector<std::uint32_t> pack_dissertation_format(const World& world, const DistanceField& field, const Box3i& box) {
+std::vector<std::uint32_t> pack_dissertation_format(const World& world, const DistanceField& field,
+                                                    const Box3i& box) {
   const std::vector<double> d = decoded(field, box);
   std::vector<std::uint8_t> m(d.size());
   world.voxels.copy_to_dense(box, m.data());

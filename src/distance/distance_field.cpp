@@ -10,18 +10,24 @@ namespace voxfield {
 
 const char* metric_name(Metric m) {
   switch (m) {
-    case Metric::kManhattan: return "manhattan";
-    case Metric::kChebyshev: return "chebyshev";
-    case Metric::kEuclidean: return "euclidean";
+    case Metric::kManhattan:
+      return "manhattan";
+    case Metric::kChebyshev:
+      return "chebyshev";
+    case Metric::kEuclidean:
+      return "euclidean";
   }
   return "?";
 }
 
 const char* storage_name(Storage s) {
   switch (s) {
-    case Storage::kU8: return "u8";
-    case Storage::kU16: return "u16";
-    case Storage::kF32: return "f32";
+    case Storage::kU8:
+      return "u8";
+    case Storage::kU16:
+      return "u16";
+    case Storage::kF32:
+      return "f32";
   }
   return "?";
 }
@@ -39,7 +45,8 @@ Storage parse_storage(const std::string& name) {
 }
 
 double DistanceField::distance(Vec3i p) const {
-  return std::visit([&](const auto& g) { return encoding.decode(static_cast<double>(g.get(p))); }, values);
+  return std::visit([&](const auto& g) { return encoding.decode(static_cast<double>(g.get(p))); },
+                    values);
 }
 
 int DistanceField::chunk_edge() const {

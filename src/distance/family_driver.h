@@ -9,11 +9,13 @@
 
 namespace voxfield::detail {
 
-using DenseSolver = std::function<DenseSolution(const DenseProblem&, const AlgorithmOptions&, AlgorithmStats&)>;
+using DenseSolver =
+    std::function<DenseSolution(const DenseProblem&, const AlgorithmOptions&, AlgorithmStats&)>;
 
 // compute_distance_field(world, options, algorithm, stats) with `solver` doing the dense work
 // (called once per sign: to solids, then to air for signed fields). algorithm must not be kExact.
-DistanceField compute_with_solver(const World& world, const DistanceOptions& options, const AlgorithmOptions& algorithm,
-                                  AlgorithmStats* stats, const DenseSolver& solver);
+DistanceField compute_with_solver(const World& world, const DistanceOptions& options,
+                                  const AlgorithmOptions& algorithm, AlgorithmStats* stats,
+                                  const DenseSolver& solver);
 
 }  // namespace voxfield::detail

@@ -16,7 +16,8 @@ namespace {
 Box3i chunk_aligned(const Box3i& b, int shift) {
   const int e = 1 << shift;
   const Vec3i lo{(b.begin.x >> shift) * e, (b.begin.y >> shift) * e, (b.begin.z >> shift) * e};
-  const Vec3i hi{((b.end.x - 1) >> shift) * e + e, ((b.end.y - 1) >> shift) * e + e, ((b.end.z - 1) >> shift) * e + e};
+  const Vec3i hi{((b.end.x - 1) >> shift) * e + e, ((b.end.y - 1) >> shift) * e + e,
+                 ((b.end.z - 1) >> shift) * e + e};
   return {lo, hi};
 }
 
@@ -27,10 +28,12 @@ FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOpt
     throw InvalidArgument("max distance must be a finite number >= 0 (0 = no clamp)");
   }
   for (double s : o.spacing)
-    if (!(s > 0) || !std::isfinite(s)) throw InvalidArgument("voxel spacing must be positive and finite");
+    if (!(s > 0) || !std::isfinite(s))
+      throw InvalidArgument("voxel spacing must be positive and finite");
   const bool unit_spacing = o.spacing == std::array<double, 3>{1, 1, 1};
   if (!unit_spacing && o.metric != Metric::kEuclidean) {
-    throw InvalidArgument(std::string("voxel spacing applies to the euclidean metric only, not ") + metric_name(o.metric));
+    throw InvalidArgument(std::string("voxel spacing applies to the euclidean metric only, not ") +
+                          metric_name(o.metric));
   }
   if (o.fixed_point_scale < 0 || !std::isfinite(o.fixed_point_scale)) {
     throw InvalidArgument("fixed-point scale must be >= 0");
@@ -56,8 +59,9 @@ FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOpt
     p.clamp = std::min(p.clamp, range);
     // g is held in place in the output type: it must reach past the clamp along z.
     if (type_max * o.spacing[2] < p.clamp) {
-      throw InvalidArgument("voxel spacing " + std::to_string(o.spacing[2]) + " along z is too fine for " +
-                            storage_name(o.storage) + " storage with this clamp; use f32");
+      throw InvalidArgument("voxel spacing " + std::to_string(o.spacing[2]) +
+                            " along z is too fine for " + storage_name(o.storage) +
+                            " storage with this clamp; use f32");
     }
   }
 
@@ -68,23 +72,31 @@ FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOpt
     p.domain = *occupancy.bounds();
   } else {
     const Box3i content = occupancy.content_bounds();
-    const double grow = o.max_distance > 0 ? std::ceil(o.max_distance / std::min({o.spacing[0], o.spacing[1], o.spacing[2]})) : 1.0;
-    p.domain = content.empty() ? content : content.grown(static_cast<std::int32_t>(std::min(grow, 1e6)));
+    const double grow =
+        o.max_distance > 0
+            ? std::ceil(o.max_distance / std::min({o.spacing[0], o.spacing[1], o.spacing[2]}))
+            : 1.0;
+    p.domain =
+        content.empty() ? content : content.grown(static_cast<std::int32_t>(std::min(grow, 1e6)));
   }
   if (!p.domain.empty()) {
     const Vec3i s = p.domain.size();
     const std::int64_t limit = o.nearest_sites ? 32767 : (std::int64_t{1} << 30);
     if (s.x > limit || s.y > limit || s.z > limit) {
-      throw InvalidArgument("domain " + to_string(p.domain) + " is too large" +
-                            (o.nearest_sites ? std::string(" for 16-bit nearest-site offsets") : std::string()));
+      throw InvalidArgument(
+          "domain " + to_string(p.domain) + " is too large" +
+          (o.nearest_sites ? std::string(" for 16-bit nearest-site offsets") : std::string()));
     }
     p.aligned = chunk_aligned(p.domain, occupancy.chunk_shift());
     // The values over the domain (and the sites) are what the field holds at most: refuse a
     // domain they cannot fit in before anything is allocated.
-    const std::uint64_t per_voxel = (o.storage == Storage::kU8 ? 1 : o.storage == Storage::kU16 ? 2 : 4) +
+    const std::uint64_t per_voxel = (o.storage == Storage::kU8    ? 1
+                                     : o.storage == Storage::kU16 ? 2
+                                                                  : 4) +
                                     (o.nearest_sites ? sizeof(SiteOffset) : 0);
     require_memory(dense_bytes(p.domain, per_voxel), 0, "distance field",
-                   "the domain " + to_string(p.domain) + " of " + std::to_string(p.domain.volume()) + " voxels");
+                   "the domain " + to_string(p.domain) + " of " +
+                       std::to_string(p.domain.volume()) + " voxels");
   }
   return p;
 }

@@ -32,8 +32,9 @@ FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOpt
 // nearest-site offsets, x fastest. `sites_within`, when given, limits the sites to that box (solid
 // voxels of `in` outside it count as empty): the distance to a handful of new sites.
 template <class T>
-void compute_region(const Grid<std::uint8_t>& occupancy, const FieldPlan& plan, const Box3i& in, const Box3i& out,
-                    T* values, SiteOffset* sites, const Box3i* sites_within = nullptr);
+void compute_region(const Grid<std::uint8_t>& occupancy, const FieldPlan& plan, const Box3i& in,
+                    const Box3i& out, T* values, SiteOffset* sites,
+                    const Box3i* sites_within = nullptr);
 
 // Stored value for a distance d (negative inside a signed field; +-inf when no site is in reach),
 // clamped and rounded down as documented in distance.h.

@@ -46,7 +46,8 @@ struct EuclideanInt {
   // 1/b of an integer from below stays below it after rounding (1/b >= 2^-16 here, far above the
   // double's relative error), so the floor is exact — and several times faster than idiv.
   static std::int64_t Sep(std::int64_t i, std::int64_t u, Value fi, Value fu) {
-    return floor_quotient(static_cast<double>(u * u - i * i + fu - fi), static_cast<double>(2 * (u - i)));
+    return floor_quotient(static_cast<double>(u * u - i * i + fu - fi),
+                          static_cast<double>(2 * (u - i)));
   }
 };
 

@@ -64,7 +64,10 @@ class TruncatedMinConvolution {
 
   // Where to write row y's nx costs (f, squared voxel units; kInf for no site in the column).
   // Only those nx entries may be written: the padding around them stays "no site".
-  Cost* f_row(int y) { return f_.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(stride_) + static_cast<std::size_t>(reach_); }
+  Cost* f_row(int y) {
+    return f_.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(stride_) +
+           static_cast<std::size_t>(reach_);
+  }
 
   // Both passes. Afterwards out_row(j) holds the squared distances (kInf when beyond the clamp) of
   // the window's row j, columns 0..mx-1.
@@ -73,7 +76,8 @@ class TruncatedMinConvolution {
     // alias anything, so otherwise every member would be reloaded after each of them.
     const int reach = reach_, mw = mw_, ox = ox_, oy = oy_, ny = ny_, my = my_;
     const Cost drop = drop_;
-    const std::size_t row_h = static_cast<std::size_t>(mw), row_f = static_cast<std::size_t>(stride_);
+    const std::size_t row_h = static_cast<std::size_t>(mw),
+                      row_f = static_cast<std::size_t>(stride_);
     const Cost* const f_all = f_.data() + reach;
     Cost* const h_all = h_.data();
     Cost* const out_all = out_.data();
@@ -111,7 +115,9 @@ class TruncatedMinConvolution {
     }
   }
 
-  const Cost* out_row(int j) const { return out_.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(mw_); }
+  const Cost* out_row(int j) const {
+    return out_.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(mw_);
+  }
 
  private:
   int nx_ = 0, ny_ = 0, ox_ = 0, oy_ = 0, mx_ = 0, my_ = 0, reach_ = 0, mw_ = 0, stride_ = 0;

@@ -10,8 +10,12 @@ namespace {
 
 constexpr double kCoordLimit = 1 << 30;  // brushes are clamped to |coordinate| <= 2^30
 
-int floor_coord(double v) { return static_cast<int>(std::floor(std::clamp(v, -kCoordLimit, kCoordLimit))); }
-int ceil_coord(double v) { return static_cast<int>(std::ceil(std::clamp(v, -kCoordLimit, kCoordLimit))); }
+int floor_coord(double v) {
+  return static_cast<int>(std::floor(std::clamp(v, -kCoordLimit, kCoordLimit)));
+}
+int ceil_coord(double v) {
+  return static_cast<int>(std::ceil(std::clamp(v, -kCoordLimit, kCoordLimit)));
+}
 
 Box3i box_around(const Vec3d& lo, const Vec3d& hi) {
   return Box3i::from_inclusive({ceil_coord(lo[0]), ceil_coord(lo[1]), ceil_coord(lo[2])},
@@ -70,7 +74,9 @@ struct Contains {
     const double dx = p.x - s.center[0], dy = p.y - s.center[1], dz = p.z - s.center[2];
     return dx * dx + dy * dy + dz * dz <= s.radius * s.radius;
   }
-  bool operator()(const BoxBrush& b) const { return Box3i::from_inclusive(b.min, b.max).contains(p); }
+  bool operator()(const BoxBrush& b) const {
+    return Box3i::from_inclusive(b.min, b.max).contains(p);
+  }
   bool operator()(const RotatedBoxBrush& b) const {
     // Applying a brush tests thousands of voxels with one rotation: its matrix is kept per thread
     // for the last angles seen, compared bit for bit (the same function of the same bits).
@@ -111,18 +117,34 @@ struct Contains {
     }
     return d2 <= c.radius * c.radius;
   }
-  bool operator()(const StampBrush& s) const { return s.model && s.model->voxels.get(p - s.offset) != 0; }
+  bool operator()(const StampBrush& s) const {
+    return s.model && s.model->voxels.get(p - s.offset) != 0;
+  }
 };
 
 }  // namespace
 
-Box3i brush_bounds(const Brush& brush) { return std::visit(Bounds{}, brush); }
+Box3i brush_bounds(const Brush& brush) {
+  return std::visit(Bounds{}, brush);
+}
 
-bool brush_contains(const Brush& brush, Vec3i p) { return std::visit(Contains{p}, brush); }
-bool brush_contains(const SphereBrush& b, Vec3i p) { return Contains{p}(b); }
-bool brush_contains(const BoxBrush& b, Vec3i p) { return Contains{p}(b); }
-bool brush_contains(const RotatedBoxBrush& b, Vec3i p) { return Contains{p}(b); }
-bool brush_contains(const CapsuleBrush& b, Vec3i p) { return Contains{p}(b); }
-bool brush_contains(const StampBrush& b, Vec3i p) { return Contains{p}(b); }
+bool brush_contains(const Brush& brush, Vec3i p) {
+  return std::visit(Contains{p}, brush);
+}
+bool brush_contains(const SphereBrush& b, Vec3i p) {
+  return Contains{p}(b);
+}
+bool brush_contains(const BoxBrush& b, Vec3i p) {
+  return Contains{p}(b);
+}
+bool brush_contains(const RotatedBoxBrush& b, Vec3i p) {
+  return Contains{p}(b);
+}
+bool brush_contains(const CapsuleBrush& b, Vec3i p) {
+  return Contains{p}(b);
+}
+bool brush_contains(const StampBrush& b, Vec3i p) {
+  return Contains{p}(b);
+}
 
 }  // namespace voxfield

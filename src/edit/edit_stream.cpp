@@ -1,18 +1,19 @@
 // voxfield — the reference dissertation's seeded stream of random sphere edits.
 #include <string>
 
-#include "voxfield/edit_stream.h"
 #include "voxfield/edit.h"
+#include "voxfield/edit_stream.h"
 #include "voxfield/error.h"
 
 namespace voxfield {
 
-RandomEditStream::RandomEditStream(const Box3i& box, std::uint64_t seed, int radius_min, int radius_max)
+RandomEditStream::RandomEditStream(const Box3i& box, std::uint64_t seed, int radius_min,
+                                   int radius_max)
     : box_(box), rng_(seed), radius_min_(radius_min), radius_max_(radius_max) {
   if (box.empty()) throw InvalidArgument("edit stream: empty box " + to_string(box));
   if (radius_min < 0 || radius_max < radius_min)
-    throw InvalidArgument("edit stream: need 0 <= radius_min <= radius_max (got " + std::to_string(radius_min) + ", " +
-                          std::to_string(radius_max) + ")");
+    throw InvalidArgument("edit stream: need 0 <= radius_min <= radius_max (got " +
+                          std::to_string(radius_min) + ", " + std::to_string(radius_max) + ")");
 }
 
 // Uniform in [lo, hi] by a remainder: the modulo bias is below 2^-40 for the ranges used here, and

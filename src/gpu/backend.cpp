@@ -5,9 +5,12 @@ namespace voxfield {
 
 const char* backend_name(Backend b) {
   switch (b) {
-    case Backend::kCpu: return "cpu";
-    case Backend::kVulkan: return "vulkan";
-    case Backend::kAuto: return "auto";
+    case Backend::kCpu:
+      return "cpu";
+    case Backend::kVulkan:
+      return "vulkan";
+    case Backend::kAuto:
+      return "auto";
   }
   return "?";
 }
@@ -20,7 +23,8 @@ Backend parse_backend(const std::string& name) {
 
 namespace gpu {
 
-std::shared_ptr<Context> select_backend(Backend backend, const ContextOptions& options, std::string* why) {
+std::shared_ptr<Context> select_backend(Backend backend, const ContextOptions& options,
+                                        std::string* why) {
   auto say = [&](const std::string& s) {
     if (why) *why = s;
   };

@@ -15,15 +15,24 @@ namespace {
 
 std::string result_name(VkResult r) {
   switch (r) {
-    case VK_ERROR_OUT_OF_HOST_MEMORY: return "VK_ERROR_OUT_OF_HOST_MEMORY";
-    case VK_ERROR_OUT_OF_DEVICE_MEMORY: return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
-    case VK_ERROR_INITIALIZATION_FAILED: return "VK_ERROR_INITIALIZATION_FAILED";
-    case VK_ERROR_DEVICE_LOST: return "VK_ERROR_DEVICE_LOST";
-    case VK_ERROR_LAYER_NOT_PRESENT: return "VK_ERROR_LAYER_NOT_PRESENT";
-    case VK_ERROR_EXTENSION_NOT_PRESENT: return "VK_ERROR_EXTENSION_NOT_PRESENT";
-    case VK_ERROR_FEATURE_NOT_PRESENT: return "VK_ERROR_FEATURE_NOT_PRESENT";
-    case VK_ERROR_INCOMPATIBLE_DRIVER: return "VK_ERROR_INCOMPATIBLE_DRIVER: no Vulkan driver found";
-    default: return "VkResult " + std::to_string(r);
+    case VK_ERROR_OUT_OF_HOST_MEMORY:
+      return "VK_ERROR_OUT_OF_HOST_MEMORY";
+    case VK_ERROR_OUT_OF_DEVICE_MEMORY:
+      return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
+    case VK_ERROR_INITIALIZATION_FAILED:
+      return "VK_ERROR_INITIALIZATION_FAILED";
+    case VK_ERROR_DEVICE_LOST:
+      return "VK_ERROR_DEVICE_LOST";
+    case VK_ERROR_LAYER_NOT_PRESENT:
+      return "VK_ERROR_LAYER_NOT_PRESENT";
+    case VK_ERROR_EXTENSION_NOT_PRESENT:
+      return "VK_ERROR_EXTENSION_NOT_PRESENT";
+    case VK_ERROR_FEATURE_NOT_PRESENT:
+      return "VK_ERROR_FEATURE_NOT_PRESENT";
+    case VK_ERROR_INCOMPATIBLE_DRIVER:
+      return "VK_ERROR_INCOMPATIBLE_DRIVER: no Vulkan driver found";
+    default:
+      return "VkResult " + std::to_string(r);
   }
 }
 
@@ -31,18 +40,24 @@ std::string result_name(VkResult r) {
 
 void check(VkResult result, const char* what) {
   if (result == VK_SUCCESS) return;
-  const std::string message = std::string("Vulkan: ") + what + " failed (" + result_name(result) + ")";
+  const std::string message =
+      std::string("Vulkan: ") + what + " failed (" + result_name(result) + ")";
   switch (result) {
-    case VK_ERROR_DEVICE_LOST: throw GpuDeviceLost(message);
+    case VK_ERROR_DEVICE_LOST:
+      throw GpuDeviceLost(message);
     case VK_ERROR_OUT_OF_DEVICE_MEMORY:
     case VK_ERROR_OUT_OF_HOST_MEMORY:
     case VK_ERROR_OUT_OF_POOL_MEMORY:
-    case VK_ERROR_FRAGMENTED_POOL: throw GpuOutOfMemory(message);
-    default: throw GpuUnavailable(message);
+    case VK_ERROR_FRAGMENTED_POOL:
+      throw GpuOutOfMemory(message);
+    default:
+      throw GpuUnavailable(message);
   }
 }
 
-bool built_with_vulkan() { return true; }
+bool built_with_vulkan() {
+  return true;
+}
 
 // ---- buffers --------------------------------------------------------------------------------
 
@@ -57,25 +72,32 @@ Buffer::Buffer(Context::Impl& ctx, VkDeviceSize bytes, VkBufferUsageFlags usage,
   vkGetBufferMemoryRequirements(device_, buffer_, &req);
   VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   alloc.allocationSize = req.size;
-  alloc.memoryTypeIndex = ctx.memory_type(
-      req.memoryTypeBits, host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
-                                       : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  alloc.memoryTypeIndex =
+      ctx.memory_type(req.memoryTypeBits, host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                                                             VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                                                       : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   const VkResult r = vkAllocateMemory(device_, &alloc, nullptr, &memory_);
   if (r != VK_SUCCESS) {
     vkDestroyBuffer(device_, buffer_, nullptr);
     buffer_ = VK_NULL_HANDLE;
-    const std::string message = "Vulkan: cannot allocate " + std::to_string(req.size) + " bytes of " +
-                                (host_visible ? "host-visible" : "device") + " memory (" + result_name(r) + ")";
+    const std::string message = "Vulkan: cannot allocate " + std::to_string(req.size) +
+                                " bytes of " + (host_visible ? "host-visible" : "device") +
+                                " memory (" + result_name(r) + ")";
     if (r == VK_ERROR_DEVICE_LOST) throw GpuDeviceLost(message);
     throw GpuOutOfMemory(message);
   }
   check(vkBindBufferMemory(device_, buffer_, memory_, 0), "vkBindBufferMemory");
-  if (host_visible) check(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
+  if (host_visible)
+    check(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
 }
 
-Buffer::~Buffer() { release(); }
+Buffer::~Buffer() {
+  release();
+}
 
-Buffer::Buffer(Buffer&& o) noexcept { *this = std::move(o); }
+Buffer::Buffer(Buffer&& o) noexcept {
+  *this = std::move(o);
+}
 
 Buffer& Buffer::operator=(Buffer&& o) noexcept {
   if (this != &o) {
@@ -98,9 +120,11 @@ void Buffer::release() {
   mapped_ = nullptr;
 }
 
-std::uint32_t Context::Impl::memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags wanted) const {
+std::uint32_t Context::Impl::memory_type(std::uint32_t type_bits,
+                                         VkMemoryPropertyFlags wanted) const {
   for (std::uint32_t i = 0; i < memory.memoryTypeCount; ++i)
-    if ((type_bits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & wanted) == wanted) return i;
+    if ((type_bits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & wanted) == wanted)
+      return i;
   // Device-local was only a preference (integrated GPUs and lavapipe may not advertise it).
   if (!(wanted & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT))
     for (std::uint32_t i = 0; i < memory.memoryTypeCount; ++i)
@@ -122,7 +146,8 @@ Buffer& Context::Impl::readback_buffer(VkDeviceSize bytes) {
 
 // ---- pipelines ------------------------------------------------------------------------------
 
-Pipeline Context::Impl::make_pipeline(const char* name, std::span<const std::uint32_t> spirv, VkPipelineLayout layout) {
+Pipeline Context::Impl::make_pipeline(const char* name, std::span<const std::uint32_t> spirv,
+                                      VkPipelineLayout layout) {
   VkShaderModuleCreateInfo sm{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   sm.codeSize = spirv.size_bytes();
   sm.pCode = spirv.data();
@@ -136,7 +161,8 @@ Pipeline Context::Impl::make_pipeline(const char* name, std::span<const std::uin
   info.layout = layout;
   Pipeline p;
   p.name = name;
-  const VkResult r = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &p.pipeline);
+  const VkResult r =
+      vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &p.pipeline);
   vkDestroyShaderModule(device, module, nullptr);
   check(r, "vkCreateComputePipelines");
   return p;
@@ -174,7 +200,8 @@ VkDescriptorPool Context::Impl::make_descriptor_pool(std::uint32_t buffers) {
   return pool;
 }
 
-VkDescriptorSet Context::Impl::bind(const BindingLayout& layout, std::span<const Buffer* const> buffers) {
+VkDescriptorSet Context::Impl::bind(const BindingLayout& layout,
+                                    std::span<const Buffer* const> buffers) {
   return allocate_set(layout.pool, layout, buffers);
 }
 
@@ -198,7 +225,8 @@ VkDescriptorSet Context::Impl::allocate_set(VkDescriptorPool pool, const Binding
     writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     writes[b].pBufferInfo = &infos[b];
   }
-  vkUpdateDescriptorSets(device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  vkUpdateDescriptorSets(device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0,
+                         nullptr);
   return set;
 }
 
@@ -219,7 +247,9 @@ void Context::Impl::create_pipelines() {
 // ---- submission -----------------------------------------------------------------------------
 
 void Context::Impl::require_device() const {
-  if (lost) throw GpuDeviceLost("Vulkan: the device " + info.name + " was lost earlier; make a new context");
+  if (lost)
+    throw GpuDeviceLost("Vulkan: the device " + info.name +
+                        " was lost earlier; make a new context");
 }
 
 void Context::Impl::submit_and_wait(VkCommandBuffer cmd) {
@@ -244,13 +274,15 @@ void dispatch(Context::Impl& ctx, VkCommandBuffer cmd, std::uint64_t invocations
   const std::uint64_t max_x = ctx.limits.maxComputeWorkGroupCount[0];
   const std::uint64_t gx = std::min(groups, max_x), gy = (groups + gx - 1) / gx;
   if (gy > ctx.limits.maxComputeWorkGroupCount[1])
-    throw InvalidArgument("GPU: " + std::to_string(invocations) + " invocations exceed the device's dispatch limits");
-  vkCmdDispatch(cmd, static_cast<std::uint32_t>(gx), static_cast<std::uint32_t>(std::max<std::uint64_t>(gy, 1)), 1);
+    throw InvalidArgument("GPU: " + std::to_string(invocations) +
+                          " invocations exceed the device's dispatch limits");
+  vkCmdDispatch(cmd, static_cast<std::uint32_t>(gx),
+                static_cast<std::uint32_t>(std::max<std::uint64_t>(gy, 1)), 1);
   ++ctx.counters.dispatches;
 }
 
-void barrier(Context::Impl& ctx, VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags src_access,
-             VkPipelineStageFlags dst, VkAccessFlags dst_access) {
+void barrier(Context::Impl& ctx, VkCommandBuffer cmd, VkPipelineStageFlags src,
+             VkAccessFlags src_access, VkPipelineStageFlags dst, VkAccessFlags dst_access) {
   VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   b.srcAccessMask = src_access;
   b.dstAccessMask = dst_access;
@@ -262,13 +294,15 @@ void barrier(Context::Impl& ctx, VkCommandBuffer cmd, VkPipelineStageFlags src, 
 
 namespace {
 
-VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                                     VkDebugUtilsMessageTypeFlagsEXT,
-                                                     const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(
+    VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
+    const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
   auto* impl = static_cast<Context::Impl*>(user);
-  const char* level = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning";
+  const char* level =
+      severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning";
   std::lock_guard lock(impl->messages_mutex);
-  impl->messages.push_back(std::string(level) + ": " + (data && data->pMessage ? data->pMessage : "?"));
+  impl->messages.push_back(std::string(level) + ": " +
+                           (data && data->pMessage ? data->pMessage : "?"));
   return VK_FALSE;
 }
 
@@ -277,26 +311,38 @@ bool has_layer(const char* name) {
   vkEnumerateInstanceLayerProperties(&n, nullptr);
   std::vector<VkLayerProperties> layers(n);
   vkEnumerateInstanceLayerProperties(&n, layers.data());
-  return std::any_of(layers.begin(), layers.end(), [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, name) == 0; });
+  return std::any_of(layers.begin(), layers.end(), [&](const VkLayerProperties& l) {
+    return std::strcmp(l.layerName, name) == 0;
+  });
 }
 
 const char* type_name(VkPhysicalDeviceType t) {
   switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete";
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated";
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual";
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
-    default: return "other";
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return "discrete";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return "integrated";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return "virtual";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return "cpu";
+    default:
+      return "other";
   }
 }
 
 int preference(VkPhysicalDeviceType t) {
   switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 4;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 3;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 1;
-    default: return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return 4;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return 3;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return 1;
+    default:
+      return 0;
   }
 }
 
@@ -362,15 +408,18 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
   Impl& s = *impl;
   struct Guard {  // destroys what was created if anything below throws
     Impl* s;
-    ~Guard() { if (s) s->destroy(); }
+    ~Guard() {
+      if (s) s->destroy();
+    }
   } guard{&s};
 
   constexpr const char* kValidation = "VK_LAYER_KHRONOS_validation";
   std::vector<const char*> layers, extensions;
   if (options.validation) {
     if (!has_layer(kValidation))
-      throw GpuUnavailable("Vulkan: validation requested but VK_LAYER_KHRONOS_validation is not installed "
-                           "(Debian package vulkan-validationlayers)");
+      throw GpuUnavailable(
+          "Vulkan: validation requested but VK_LAYER_KHRONOS_validation is not installed "
+          "(Debian package vulkan-validationlayers)");
     layers.push_back(kValidation);
     extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     extensions.push_back(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
@@ -385,13 +434,16 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
   ici.ppEnabledLayerNames = layers.data();
   ici.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
   ici.ppEnabledExtensionNames = extensions.data();
-  const VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+  const VkValidationFeatureEnableEXT enables[] = {
+      VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
   VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
   features.enabledValidationFeatureCount = 1;
   features.pEnabledValidationFeatures = enables;
   VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-  mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-  mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+  mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                        VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                    VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
   mci.pfnUserCallback = on_validation_message;
   mci.pUserData = &s;
@@ -408,7 +460,8 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
         vkGetInstanceProcAddr(s.instance, "vkDestroyDebugUtilsMessengerEXT"));
     if (!create_messenger || !s.destroy_messenger)
       throw GpuUnavailable("Vulkan: the validation layer is on but VK_EXT_debug_utils is missing");
-    check(create_messenger(s.instance, &mci, nullptr, &s.messenger), "vkCreateDebugUtilsMessengerEXT");
+    check(create_messenger(s.instance, &mci, nullptr, &s.messenger),
+          "vkCreateDebugUtilsMessengerEXT");
   }
 
   std::uint32_t count = 0;
@@ -471,8 +524,10 @@ void Context::Impl::finish_setup() {
   std::vector<VkQueueFamilyProperties> families(nq);
   vkGetPhysicalDeviceQueueFamilyProperties(s.physical, &nq, families.data());
   if (s.queue_family >= nq || !(families[s.queue_family].queueFlags & VK_QUEUE_COMPUTE_BIT))
-    throw GpuUnavailable("Vulkan: queue family " + std::to_string(s.queue_family) + " has no compute queue");
-  s.timestamp_period_ns = families[s.queue_family].timestampValidBits ? props.limits.timestampPeriod : 0;
+    throw GpuUnavailable("Vulkan: queue family " + std::to_string(s.queue_family) +
+                         " has no compute queue");
+  s.timestamp_period_ns =
+      families[s.queue_family].timestampValidBits ? props.limits.timestampPeriod : 0;
 
   VkCommandPoolCreateInfo cp{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   cp.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
@@ -504,7 +559,9 @@ std::shared_ptr<Context> adopt(const AdoptedDevice& app) {
   s.queue_family = app.queue_family;
   struct Guard {
     Context::Impl* s;
-    ~Guard() { if (s) s->destroy(); }
+    ~Guard() {
+      if (s) s->destroy();
+    }
   } guard{&s};
   s.finish_setup();
   guard.s = nullptr;
@@ -512,12 +569,24 @@ std::shared_ptr<Context> adopt(const AdoptedDevice& app) {
 }
 
 Context::Context(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
-Context::~Context() { if (impl_) impl_->destroy(); }
-const DeviceInfo& Context::device() const { return impl_->info; }
-Counters Context::counters() const { return impl_->counters; }
-void Context::reset_counters() { impl_->counters = {}; }
-bool Context::has_timestamps() const { return impl_->timestamps != VK_NULL_HANDLE; }
-bool Context::lost() const { return impl_->lost; }
+Context::~Context() {
+  if (impl_) impl_->destroy();
+}
+const DeviceInfo& Context::device() const {
+  return impl_->info;
+}
+Counters Context::counters() const {
+  return impl_->counters;
+}
+void Context::reset_counters() {
+  impl_->counters = {};
+}
+bool Context::has_timestamps() const {
+  return impl_->timestamps != VK_NULL_HANDLE;
+}
+bool Context::lost() const {
+  return impl_->lost;
+}
 
 std::vector<std::string> Context::validation_messages() const {
   std::lock_guard lock(impl_->messages_mutex);

@@ -97,7 +97,8 @@ struct Context::Impl {
 
   std::uint32_t memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags wanted) const;
   void create_pipelines();
-  Pipeline make_pipeline(const char* name, std::span<const std::uint32_t> spirv, VkPipelineLayout layout);
+  Pipeline make_pipeline(const char* name, std::span<const std::uint32_t> spirv,
+                         VkPipelineLayout layout);
   BindingLayout make_binding_layout(std::uint32_t bindings, std::uint32_t push_bytes);
   // A descriptor set binding `buffers` (one per binding, in order) from the layout's pool, which is
   // reset first: sets live until the next call for the same layout.
@@ -106,7 +107,8 @@ struct Context::Impl {
   // submissions (the resident render scene); the caller destroys it.
   VkDescriptorPool make_descriptor_pool(std::uint32_t buffers);
   // Resets `pool` and allocates from it a set of `layout` binding `buffers` in order.
-  VkDescriptorSet allocate_set(VkDescriptorPool pool, const BindingLayout& layout, std::span<const Buffer* const> buffers);
+  VkDescriptorSet allocate_set(VkDescriptorPool pool, const BindingLayout& layout,
+                               std::span<const Buffer* const> buffers);
   // Allocates a command buffer, lets `record` fill it, submits it and waits (freed after).
   template <class F>
   void run_commands(F&& record);
@@ -145,7 +147,7 @@ void Context::Impl::run_commands(F&& record) {
 // exceed the device limit) and counts it.
 void dispatch(Context::Impl& ctx, VkCommandBuffer cmd, std::uint64_t invocations);
 // A compute-to-compute (and transfer) memory barrier, counted.
-void barrier(Context::Impl& ctx, VkCommandBuffer cmd, VkPipelineStageFlags src, VkAccessFlags src_access,
-             VkPipelineStageFlags dst, VkAccessFlags dst_access);
+void barrier(Context::Impl& ctx, VkCommandBuffer cmd, VkPipelineStageFlags src,
+             VkAccessFlags src_access, VkPipelineStageFlags dst, VkAccessFlags dst_access);
 
 }  // namespace voxfield::gpu

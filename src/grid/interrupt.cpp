@@ -29,7 +29,8 @@ bool Progress::advance(std::int64_t units) {
 bool Progress::keep_going() {
   if (!interrupter_) return true;
   if (cancelled()) return false;
-  const int percent = static_cast<int>(std::min<std::int64_t>(100, done_.load(std::memory_order_relaxed) * 100 / total_));
+  const int percent = static_cast<int>(
+      std::min<std::int64_t>(100, done_.load(std::memory_order_relaxed) * 100 / total_));
   if (interrupter_->was_interrupted(percent)) cancelled_.store(true, std::memory_order_relaxed);
   return !cancelled();
 }

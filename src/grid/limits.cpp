@@ -39,7 +39,9 @@ std::uint64_t default_memory_limit() {
   return set != 0 ? set : environment_or_physical_default();
 }
 
-void set_default_memory_limit(std::uint64_t bytes) { g_limit.store(bytes, std::memory_order_relaxed); }
+void set_default_memory_limit(std::uint64_t bytes) {
+  g_limit.store(bytes, std::memory_order_relaxed);
+}
 
 std::uint64_t parse_byte_size(std::string_view text, std::string_view what) {
   auto bad = [&](const char* why) -> std::uint64_t {
@@ -56,7 +58,8 @@ std::uint64_t parse_byte_size(std::string_view text, std::string_view what) {
   }
   if (i == 0) return bad("is not a size");
   std::string unit;
-  for (; i < text.size(); ++i) unit += static_cast<char>(std::toupper(static_cast<unsigned char>(text[i])));
+  for (; i < text.size(); ++i)
+    unit += static_cast<char>(std::toupper(static_cast<unsigned char>(text[i])));
   int shift = 0;
   if (unit.empty() || unit == "B") {
     shift = 0;
@@ -65,11 +68,20 @@ std::uint64_t parse_byte_size(std::string_view text, std::string_view what) {
     const std::string_view rest = u.substr(1);
     if (!(rest.empty() || rest == "B" || rest == "IB")) return bad("has an unknown unit");
     switch (u[0]) {
-      case 'K': shift = 10; break;
-      case 'M': shift = 20; break;
-      case 'G': shift = 30; break;
-      case 'T': shift = 40; break;
-      default: return bad("has an unknown unit");
+      case 'K':
+        shift = 10;
+        break;
+      case 'M':
+        shift = 20;
+        break;
+      case 'G':
+        shift = 30;
+        break;
+      case 'T':
+        shift = 40;
+        break;
+      default:
+        return bad("has an unknown unit");
     }
   }
   if (v > (UINT64_MAX >> shift)) return bad("is too large");
@@ -96,10 +108,11 @@ void require_memory(std::uint64_t need_bytes, std::uint64_t limit_bytes, const s
                     const std::string& what) {
   const std::uint64_t limit = effective_memory_limit(limit_bytes);
   if (need_bytes <= limit) return;
-  throw ResourceLimitError(who + ": " + what + " needs " +
-                           (need_bytes == UINT64_MAX ? std::string("more than 16 EiB") : format_bytes(need_bytes)) +
-                           ", more than the memory limit of " + format_bytes(limit) +
-                           " (raise it with --memory-limit or VOXFIELD_MEMORY_LIMIT)");
+  throw ResourceLimitError(
+      who + ": " + what + " needs " +
+      (need_bytes == UINT64_MAX ? std::string("more than 16 EiB") : format_bytes(need_bytes)) +
+      ", more than the memory limit of " + format_bytes(limit) +
+      " (raise it with --memory-limit or VOXFIELD_MEMORY_LIMIT)");
 }
 
 }  // namespace voxfield

@@ -22,7 +22,8 @@ void parallel_for(std::size_t n, std::size_t grain,
                   const std::function<void(std::size_t, std::size_t)>& body) {
   if (n == 0) return;
   if (grain == 0) grain = 1;
-  const std::size_t threads = std::min<std::size_t>(static_cast<std::size_t>(max_threads()), (n + grain - 1) / grain);
+  const std::size_t threads =
+      std::min<std::size_t>(static_cast<std::size_t>(max_threads()), (n + grain - 1) / grain);
   if (threads <= 1) {
     body(0, n);
     return;
@@ -68,7 +69,8 @@ struct ThreadLimit::Impl {
 };
 
 ThreadLimit::ThreadLimit(int threads) {
-  if (threads < 1) throw InvalidArgument("thread count must be at least 1, got " + std::to_string(threads));
+  if (threads < 1)
+    throw InvalidArgument("thread count must be at least 1, got " + std::to_string(threads));
   impl_ = std::make_unique<Impl>(static_cast<std::size_t>(threads));
 }
 

@@ -22,7 +22,9 @@ class ByteReader {
   std::size_t remaining() const { return bytes_.size() - pos_; }
   bool at_end() const { return pos_ == bytes_.size(); }
 
-  [[noreturn]] void fail(const std::string& what) const { throw FormatError(*name_, offset(), what); }
+  [[noreturn]] void fail(const std::string& what) const {
+    throw FormatError(*name_, offset(), what);
+  }
   [[noreturn]] void fail_at(std::uint64_t absolute_offset, const std::string& what) const {
     throw FormatError(*name_, absolute_offset, what);
   }

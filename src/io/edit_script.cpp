@@ -14,7 +14,9 @@ namespace {
 
 using nlohmann::json;
 
-[[noreturn]] void bad(const std::string& what) { throw InvalidArgument(what); }
+[[noreturn]] void bad(const std::string& what) {
+  throw InvalidArgument(what);
+}
 
 double number(const json& j, const std::string& key, double lo, double hi) {
   if (!j.is_number()) bad("\"" + key + "\" must be a number");
@@ -44,7 +46,8 @@ Vec3d point(const json& j, const std::string& key, double lo = -kCoord, double h
 Vec3i integer_point(const json& j, const std::string& key) {
   const Vec3d d = point(j, key, -kCoord, kCoord - 1);
   for (int k = 0; k < 3; ++k)
-    if (std::floor(d[k]) != d[k]) bad("\"" + key + "\" must hold integers, got " + required(j, key).dump());
+    if (std::floor(d[k]) != d[k])
+      bad("\"" + key + "\" must hold integers, got " + required(j, key).dump());
   return {static_cast<int>(d.x), static_cast<int>(d.y), static_cast<int>(d.z)};
 }
 
@@ -74,10 +77,14 @@ Edit parse_edit_line(std::string_view line, const EditScriptOptions& options) {
   const json& op = required(j, "op");
   if (!op.is_string()) bad("\"op\" must be a string");
   const std::string op_name = op.get<std::string>();
-  if (op_name == "place") e.op = EditOp::kPlace;
-  else if (op_name == "carve") e.op = EditOp::kCarve;
-  else if (op_name == "paint") e.op = EditOp::kPaint;
-  else bad("unknown op \"" + op_name + "\" (place, carve, paint)");
+  if (op_name == "place")
+    e.op = EditOp::kPlace;
+  else if (op_name == "carve")
+    e.op = EditOp::kCarve;
+  else if (op_name == "paint")
+    e.op = EditOp::kPaint;
+  else
+    bad("unknown op \"" + op_name + "\" (place, carve, paint)");
   int material = 1;
   if (auto it = j.find("material"); it != j.end()) {
     const double m = number(*it, "material", 0, 255);
@@ -87,7 +94,8 @@ Edit parse_edit_line(std::string_view line, const EditScriptOptions& options) {
   if (e.op != EditOp::kCarve && material == 0) {
     bad("\"material\" 0 is air: " + op_name + " needs 1..255 (carve removes voxels)");
   }
-  e.material = static_cast<std::uint8_t>(e.op == EditOp::kCarve ? (material == 0 ? 1 : material) : material);
+  e.material =
+      static_cast<std::uint8_t>(e.op == EditOp::kCarve ? (material == 0 ? 1 : material) : material);
   const json& shape_j = required(j, "shape");
   if (!shape_j.is_string()) bad("\"shape\" must be a string");
   const std::string shape = shape_j.get<std::string>();
@@ -98,16 +106,20 @@ Edit parse_edit_line(std::string_view line, const EditScriptOptions& options) {
     only_keys(j, {"op", "shape", "material", "min", "max"});
     const BoxBrush b{integer_point(j, "min"), integer_point(j, "max")};
     for (int k = 0; k < 3; ++k) {
-      if (b.min[k] > b.max[k]) bad("box \"min\" " + to_string(b.min) + " exceeds \"max\" " + to_string(b.max) + " on axis " + "xyz"[k]);
+      if (b.min[k] > b.max[k])
+        bad("box \"min\" " + to_string(b.min) + " exceeds \"max\" " + to_string(b.max) +
+            " on axis " + "xyz"[k]);
     }
     e.brush = b;
   } else if (shape == "rotated-box") {
     only_keys(j, {"op", "shape", "material", "center", "half_extent", "rotation_deg"});
-    e.brush = RotatedBoxBrush{point(j, "center"), point(j, "half_extent", 0, kCoord),
-                              j.contains("rotation_deg") ? point(j, "rotation_deg", -1e6, 1e6) : Vec3d{0, 0, 0}};
+    e.brush = RotatedBoxBrush{
+        point(j, "center"), point(j, "half_extent", 0, kCoord),
+        j.contains("rotation_deg") ? point(j, "rotation_deg", -1e6, 1e6) : Vec3d{0, 0, 0}};
   } else if (shape == "capsule") {
     only_keys(j, {"op", "shape", "material", "a", "b", "radius"});
-    e.brush = CapsuleBrush{point(j, "a"), point(j, "b"), number(required(j, "radius"), "radius", 0, kCoord)};
+    e.brush = CapsuleBrush{point(j, "a"), point(j, "b"),
+                           number(required(j, "radius"), "radius", 0, kCoord)};
   } else if (shape == "stamp") {
     only_keys(j, {"op", "shape", "material", "file", "offset"});
     const json& f = required(j, "file");

@@ -20,7 +20,8 @@ namespace voxfield {
 
 namespace {
 
-static_assert(std::endian::native == std::endian::little, "the encoders copy native little-endian values");
+static_assert(std::endian::native == std::endian::little,
+              "the encoders copy native little-endian values");
 
 template <class T>
 void put(std::vector<std::uint8_t>& out, const T& value) {
@@ -28,7 +29,9 @@ void put(std::vector<std::uint8_t>& out, const T& value) {
   out.insert(out.end(), p, p + sizeof(T));
 }
 
-void put_text(std::vector<std::uint8_t>& out, const std::string& text) { out.insert(out.end(), text.begin(), text.end()); }
+void put_text(std::vector<std::uint8_t>& out, const std::string& text) {
+  out.insert(out.end(), text.begin(), text.end());
+}
 
 std::vector<std::uint8_t> encode_ply(const Mesh& m) {
   const bool colours = !m.colors.empty();
@@ -38,7 +41,8 @@ std::vector<std::uint8_t> encode_ply(const Mesh& m) {
     << "property float x\nproperty float y\nproperty float z\n"
     << "property float nx\nproperty float ny\nproperty float nz\n";
   if (colours) h << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
-  h << "element face " << m.triangle_count() << "\nproperty list uchar uint vertex_indices\nend_header\n";
+  h << "element face " << m.triangle_count()
+    << "\nproperty list uchar uint vertex_indices\nend_header\n";
   std::vector<std::uint8_t> out;
   put_text(out, h.str());
   out.reserve(out.size() + m.vertex_count() * (colours ? 27 : 24) + m.triangle_count() * 13);
@@ -57,7 +61,8 @@ std::vector<std::uint8_t> encode_ply(const Mesh& m) {
 std::vector<std::uint8_t> encode_obj(const Mesh& m) {
   std::ostringstream os;
   os.precision(std::numeric_limits<float>::max_digits10);  // positions read back bit for bit
-  os << "# written by voxfield: " << m.vertex_count() << " vertices, " << m.triangle_count() << " triangles\n";
+  os << "# written by voxfield: " << m.vertex_count() << " vertices, " << m.triangle_count()
+     << " triangles\n";
   for (const auto& p : m.positions) os << "v " << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
   for (const auto& n : m.normals) os << "vn " << n[0] << ' ' << n[1] << ' ' << n[2] << '\n';
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
@@ -90,7 +95,8 @@ std::vector<std::uint8_t> encode_stl(const Mesh& m) {
     double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
     const double l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     for (double& x : n) x = l > 0 ? x / l : 0;
-    put(out, std::array<float, 3>{static_cast<float>(n[0]), static_cast<float>(n[1]), static_cast<float>(n[2])});
+    put(out, std::array<float, 3>{static_cast<float>(n[0]), static_cast<float>(n[1]),
+                                  static_cast<float>(n[2])});
     put(out, a);
     put(out, b);
     put(out, c);
@@ -111,39 +117,57 @@ std::vector<std::uint8_t> encode_glb(const Mesh& m) {
     while (bin.size() % 4) bin.push_back(0);
     return json{{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}, {"target", target}};
   };
-  constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963, kFloat = 5126, kUnsignedByte = 5121, kUnsignedInt = 5125;
+  constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963, kFloat = 5126,
+                kUnsignedByte = 5121, kUnsignedInt = 5125;
   std::array<float, 3> lo{0, 0, 0}, hi{0, 0, 0};
   if (!m.positions.empty()) {
     lo = hi = m.positions[0];
     for (const auto& p : m.positions)
-      for (std::size_t a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+      for (std::size_t a = 0; a < 3; ++a)
+        lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
   }
   json views = json::array(), accessors = json::array(), attributes = json::object();
   const std::size_t n = m.vertex_count();
   views.push_back(view(m.positions.data(), n * 12, kArrayBuffer));
-  accessors.push_back({{"bufferView", 0}, {"componentType", kFloat}, {"count", n}, {"type", "VEC3"}, {"min", lo}, {"max", hi}});
+  accessors.push_back({{"bufferView", 0},
+                       {"componentType", kFloat},
+                       {"count", n},
+                       {"type", "VEC3"},
+                       {"min", lo},
+                       {"max", hi}});
   attributes["POSITION"] = 0;
   views.push_back(view(m.normals.data(), n * 12, kArrayBuffer));
-  accessors.push_back({{"bufferView", 1}, {"componentType", kFloat}, {"count", n}, {"type", "VEC3"}});
+  accessors.push_back(
+      {{"bufferView", 1}, {"componentType", kFloat}, {"count", n}, {"type", "VEC3"}});
   attributes["NORMAL"] = 1;
   if (!m.colors.empty()) {
     std::vector<std::uint8_t> rgba(4 * n);
     for (std::size_t i = 0; i < n; ++i) {
-      std::copy(m.colors[i].begin(), m.colors[i].end(), rgba.begin() + static_cast<std::ptrdiff_t>(4 * i));
+      std::copy(m.colors[i].begin(), m.colors[i].end(),
+                rgba.begin() + static_cast<std::ptrdiff_t>(4 * i));
       rgba[4 * i + 3] = 255;
     }
     views.push_back(view(rgba.data(), rgba.size(), kArrayBuffer));
-    accessors.push_back({{"bufferView", views.size() - 1}, {"componentType", kUnsignedByte}, {"normalized", true}, {"count", n}, {"type", "VEC4"}});
+    accessors.push_back({{"bufferView", views.size() - 1},
+                         {"componentType", kUnsignedByte},
+                         {"normalized", true},
+                         {"count", n},
+                         {"type", "VEC4"}});
     attributes["COLOR_0"] = accessors.size() - 1;
   }
   views.push_back(view(m.indices.data(), m.indices.size() * 4, kElementArrayBuffer));
-  accessors.push_back({{"bufferView", views.size() - 1}, {"componentType", kUnsignedInt}, {"count", m.indices.size()}, {"type", "SCALAR"}});
+  accessors.push_back({{"bufferView", views.size() - 1},
+                       {"componentType", kUnsignedInt},
+                       {"count", m.indices.size()},
+                       {"type", "SCALAR"}});
   const json doc = {
       {"asset", {{"version", "2.0"}, {"generator", "voxfield"}}},
       {"scene", 0},
       {"scenes", json::array({{{"nodes", json::array({0})}}})},
       {"nodes", json::array({{{"mesh", 0}}})},
-      {"meshes", json::array({{{"primitives", json::array({{{"attributes", attributes}, {"indices", accessors.size() - 1}, {"mode", 4}}})}}})},
+      {"meshes", json::array({{{"primitives", json::array({{{"attributes", attributes},
+                                                            {"indices", accessors.size() - 1},
+                                                            {"mode", 4}}})}}})},
       {"accessors", accessors},
       {"bufferViews", views},
       {"buffers", json::array({{{"byteLength", bin.size()}}})},
@@ -151,7 +175,8 @@ std::vector<std::uint8_t> encode_glb(const Mesh& m) {
   std::string text = doc.dump();
   while (text.size() % 4) text.push_back(' ');
   const std::uint64_t total = 12 + 8 + text.size() + 8 + bin.size();
-  if (total > std::numeric_limits<std::uint32_t>::max()) throw InvalidArgument("glTF: the mesh passes the 4 GiB a .glb can hold");
+  if (total > std::numeric_limits<std::uint32_t>::max())
+    throw InvalidArgument("glTF: the mesh passes the 4 GiB a .glb can hold");
   std::vector<std::uint8_t> out;
   out.reserve(total);
   put(out, std::uint32_t{0x46546C67});  // "glTF"
@@ -170,35 +195,47 @@ std::vector<std::uint8_t> encode_glb(const Mesh& m) {
 
 const char* mesh_format_name(MeshFormat f) {
   switch (f) {
-    case MeshFormat::kPly: return "ply";
-    case MeshFormat::kObj: return "obj";
-    case MeshFormat::kStl: return "stl";
-    case MeshFormat::kGlb: return "glb";
+    case MeshFormat::kPly:
+      return "ply";
+    case MeshFormat::kObj:
+      return "obj";
+    case MeshFormat::kStl:
+      return "stl";
+    case MeshFormat::kGlb:
+      return "glb";
   }
   return "?";
 }
 
 MeshFormat mesh_format_of(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (ext == ".ply") return MeshFormat::kPly;
   if (ext == ".obj") return MeshFormat::kObj;
   if (ext == ".stl") return MeshFormat::kStl;
   if (ext == ".glb") return MeshFormat::kGlb;
-  throw InvalidArgument(path.string() + ": unknown mesh format '" + ext + "' (expected .ply, .obj, .stl or .glb)");
+  throw InvalidArgument(path.string() + ": unknown mesh format '" + ext +
+                        "' (expected .ply, .obj, .stl or .glb)");
 }
 
 std::vector<std::uint8_t> encode_mesh(const Mesh& mesh, MeshFormat format) {
-  if (mesh.normals.size() != mesh.positions.size() || (!mesh.colors.empty() && mesh.colors.size() != mesh.positions.size()) ||
+  if (mesh.normals.size() != mesh.positions.size() ||
+      (!mesh.colors.empty() && mesh.colors.size() != mesh.positions.size()) ||
       mesh.indices.size() % 3 != 0)
     throw InvalidArgument("mesh: normals, colours and indices do not match the positions");
   for (const std::uint32_t i : mesh.indices)
-    if (i >= mesh.positions.size()) throw InvalidArgument("mesh: index " + std::to_string(i) + " is past the last vertex");
+    if (i >= mesh.positions.size())
+      throw InvalidArgument("mesh: index " + std::to_string(i) + " is past the last vertex");
   switch (format) {
-    case MeshFormat::kPly: return encode_ply(mesh);
-    case MeshFormat::kObj: return encode_obj(mesh);
-    case MeshFormat::kStl: return encode_stl(mesh);
-    case MeshFormat::kGlb: return encode_glb(mesh);
+    case MeshFormat::kPly:
+      return encode_ply(mesh);
+    case MeshFormat::kObj:
+      return encode_obj(mesh);
+    case MeshFormat::kStl:
+      return encode_stl(mesh);
+    case MeshFormat::kGlb:
+      return encode_glb(mesh);
   }
   throw InvalidArgument("mesh: unknown format");
 }

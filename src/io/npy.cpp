@@ -26,11 +26,11 @@ struct DTypeInfo {
   const char* name;
 };
 constexpr DTypeInfo kDTypes[] = {
-    {DType::kBool, 'b', 1, "bool"},      {DType::kInt8, 'i', 1, "int8"},
-    {DType::kUInt8, 'u', 1, "uint8"},    {DType::kInt16, 'i', 2, "int16"},
-    {DType::kUInt16, 'u', 2, "uint16"},  {DType::kInt32, 'i', 4, "int32"},
-    {DType::kUInt32, 'u', 4, "uint32"},  {DType::kInt64, 'i', 8, "int64"},
-    {DType::kUInt64, 'u', 8, "uint64"},  {DType::kFloat32, 'f', 4, "float32"},
+    {DType::kBool, 'b', 1, "bool"},       {DType::kInt8, 'i', 1, "int8"},
+    {DType::kUInt8, 'u', 1, "uint8"},     {DType::kInt16, 'i', 2, "int16"},
+    {DType::kUInt16, 'u', 2, "uint16"},   {DType::kInt32, 'i', 4, "int32"},
+    {DType::kUInt32, 'u', 4, "uint32"},   {DType::kInt64, 'i', 8, "int64"},
+    {DType::kUInt64, 'u', 8, "uint64"},   {DType::kFloat32, 'f', 4, "float32"},
     {DType::kFloat64, 'f', 8, "float64"},
 };
 
@@ -140,7 +140,8 @@ class HeaderParser {
         break;
       }
     }
-    if (!have_descr || !have_order || !have_shape) fail("needs 'descr', 'fortran_order' and 'shape'");
+    if (!have_descr || !have_order || !have_shape)
+      fail("needs 'descr', 'fortran_order' and 'shape'");
   }
 
  private:
@@ -171,23 +172,38 @@ double load_as_double(const std::uint8_t* p) {
 
 }  // namespace
 
-std::size_t dtype_size(DType t) { return static_cast<std::size_t>(info(t).size); }
-const char* dtype_name(DType t) { return info(t).name; }
+std::size_t dtype_size(DType t) {
+  return static_cast<std::size_t>(info(t).size);
+}
+const char* dtype_name(DType t) {
+  return info(t).name;
+}
 
 double NpyVolume::value(std::int64_t i) const {
   const std::uint8_t* p = bytes.data() + static_cast<std::size_t>(i) * dtype_size(dtype);
   switch (dtype) {
-    case DType::kBool: return *p ? 1.0 : 0.0;
-    case DType::kInt8: return load_as_double<std::int8_t>(p);
-    case DType::kUInt8: return load_as_double<std::uint8_t>(p);
-    case DType::kInt16: return load_as_double<std::int16_t>(p);
-    case DType::kUInt16: return load_as_double<std::uint16_t>(p);
-    case DType::kInt32: return load_as_double<std::int32_t>(p);
-    case DType::kUInt32: return load_as_double<std::uint32_t>(p);
-    case DType::kInt64: return load_as_double<std::int64_t>(p);
-    case DType::kUInt64: return load_as_double<std::uint64_t>(p);
-    case DType::kFloat32: return load_as_double<float>(p);
-    case DType::kFloat64: return load_as_double<double>(p);
+    case DType::kBool:
+      return *p ? 1.0 : 0.0;
+    case DType::kInt8:
+      return load_as_double<std::int8_t>(p);
+    case DType::kUInt8:
+      return load_as_double<std::uint8_t>(p);
+    case DType::kInt16:
+      return load_as_double<std::int16_t>(p);
+    case DType::kUInt16:
+      return load_as_double<std::uint16_t>(p);
+    case DType::kInt32:
+      return load_as_double<std::int32_t>(p);
+    case DType::kUInt32:
+      return load_as_double<std::uint32_t>(p);
+    case DType::kInt64:
+      return load_as_double<std::int64_t>(p);
+    case DType::kUInt64:
+      return load_as_double<std::uint64_t>(p);
+    case DType::kFloat32:
+      return load_as_double<float>(p);
+    case DType::kFloat64:
+      return load_as_double<double>(p);
   }
   return 0.0;
 }
@@ -199,7 +215,8 @@ std::uint64_t NpyVolume::file_offset_of(std::int64_t i) const {
   return file_data_offset + static_cast<std::uint64_t>(in_file) * dtype_size(dtype);
 }
 
-NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name, const NpyReadOptions& options) {
+NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name,
+                    const NpyReadOptions& options) {
   detail::ByteReader r(bytes, name);
   static constexpr std::uint8_t kMagic[6] = {0x93, 'N', 'U', 'M', 'P', 'Y'};
   auto magic = r.take(6, "magic");
@@ -234,8 +251,9 @@ NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name
   for (const auto& d : kDTypes)
     if (d.kind == kind && d.size == size) found = &d;
   if (!found || (order != '<' && order != '>' && order != '|' && order != '=')) {
-    r.fail_at(header_at, "unsupported dtype '" + h.descr +
-                             "' (voxfield reads bool, int8/16/32/64, uint8/16/32/64, float32, float64)");
+    r.fail_at(header_at,
+              "unsupported dtype '" + h.descr +
+                  "' (voxfield reads bool, int8/16/32/64, uint8/16/32/64, float32, float64)");
   }
   if (h.shape.size() != 3) {
     r.fail_at(header_at, "expected a 3-D array a[x, y, z], got " + std::to_string(h.shape.size()) +
@@ -251,8 +269,9 @@ NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name
     v.dims[k] = static_cast<std::int32_t>(h.shape[k]);
   }
   // Each dimension is below 2^30, but their product may not fit in 64 bits: saturate, then compare.
-  const std::uint64_t n = mul_sat(mul_sat(static_cast<std::uint64_t>(h.shape[0]), static_cast<std::uint64_t>(h.shape[1])),
-                                  static_cast<std::uint64_t>(h.shape[2]));
+  const std::uint64_t n = mul_sat(
+      mul_sat(static_cast<std::uint64_t>(h.shape[0]), static_cast<std::uint64_t>(h.shape[1])),
+      static_cast<std::uint64_t>(h.shape[2]));
   const std::uint64_t data_bytes = mul_sat(n, static_cast<std::uint64_t>(size));
   if (data_bytes > r.remaining()) {
     r.fail("the shape (" + std::to_string(h.shape[0]) + ", " + std::to_string(h.shape[1]) + ", " +
@@ -261,10 +280,12 @@ NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name
            " bytes of data but only " + std::to_string(r.remaining()) + " bytes follow the header");
   }
   if (data_bytes < r.remaining()) {
-    r.fail_at(r.offset() + data_bytes, std::to_string(r.remaining() - data_bytes) +
-                                           " bytes after the array data (a damaged or concatenated file?)");
+    r.fail_at(r.offset() + data_bytes,
+              std::to_string(r.remaining() - data_bytes) +
+                  " bytes after the array data (a damaged or concatenated file?)");
   }
-  require_memory(data_bytes, options.memory_limit_bytes, name, "the array of " + std::to_string(n) + " values");
+  require_memory(data_bytes, options.memory_limit_bytes, name,
+                 "the array of " + std::to_string(n) + " values");
   v.file_data_offset = r.offset();
   v.file_c_order = !h.fortran;
   auto data = r.take(static_cast<std::size_t>(data_bytes), "array data");
@@ -279,7 +300,8 @@ NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name
       for (std::int64_t y = 0; y < Y; ++y)
         for (std::int64_t z = 0; z < Z; ++z) {
           const std::int64_t src = (x * Y + y) * Z + z, dst = (z * Y + y) * X + x;
-          std::memcpy(v.bytes.data() + dst * size, data.data() + src * size, static_cast<std::size_t>(size));
+          std::memcpy(v.bytes.data() + dst * size, data.data() + src * size,
+                      static_cast<std::size_t>(size));
         }
   }
   if (swap) {
@@ -305,16 +327,19 @@ NpyVolume read_npy(const std::filesystem::path& path, const NpyReadOptions& opti
 std::vector<std::uint8_t> encode_npy(const NpyVolume& v) {
   const DTypeInfo& d = info(v.dtype);
   if (v.components < 1) throw InvalidArgument("encode_npy: components must be >= 1");
-  const std::size_t expect = static_cast<std::size_t>(v.count()) * static_cast<std::size_t>(v.components) *
+  const std::size_t expect = static_cast<std::size_t>(v.count()) *
+                             static_cast<std::size_t>(v.components) *
                              static_cast<std::size_t>(d.size);
   if (v.bytes.size() != expect) {
     throw InvalidArgument("encode_npy: volume holds " + std::to_string(v.bytes.size()) +
                           " bytes, expected " + std::to_string(expect));
   }
   const std::string descr = std::string(d.size == 1 ? "|" : "<") + d.kind + std::to_string(d.size);
-  std::string shape = std::to_string(v.dims.x) + ", " + std::to_string(v.dims.y) + ", " + std::to_string(v.dims.z);
+  std::string shape =
+      std::to_string(v.dims.x) + ", " + std::to_string(v.dims.y) + ", " + std::to_string(v.dims.z);
   if (v.components > 1) shape += ", " + std::to_string(v.components);
-  std::string header = "{'descr': '" + descr + "', 'fortran_order': True, 'shape': (" + shape + "), }";
+  std::string header =
+      "{'descr': '" + descr + "', 'fortran_order': True, 'shape': (" + shape + "), }";
   // Pad with spaces so that magic + version + length + header + '\n' is a multiple of 64.
   const bool v2 = header.size() + 11 > 65535;
   const std::size_t prefix = v2 ? 12 : 10;
@@ -323,7 +348,8 @@ std::vector<std::uint8_t> encode_npy(const NpyVolume& v) {
   header.push_back('\n');
   std::vector<std::uint8_t> out;
   out.reserve(total + v.bytes.size());
-  const std::uint8_t magic[8] = {0x93, 'N', 'U', 'M', 'P', 'Y', static_cast<std::uint8_t>(v2 ? 2 : 1), 0};
+  const std::uint8_t magic[8] = {
+      0x93, 'N', 'U', 'M', 'P', 'Y', static_cast<std::uint8_t>(v2 ? 2 : 1), 0};
   out.insert(out.end(), magic, magic + 8);
   const std::uint32_t len = static_cast<std::uint32_t>(header.size());
   out.push_back(static_cast<std::uint8_t>(len & 0xFF));
@@ -341,26 +367,31 @@ void write_npy(const NpyVolume& volume, const std::filesystem::path& path) {
   write_file_atomic(path, encode_npy(volume));
 }
 
-World world_from_npy(const NpyVolume& v, const std::string& name, int chunk_edge, std::uint64_t memory_limit_bytes) {
+World world_from_npy(const NpyVolume& v, const std::string& name, int chunk_edge,
+                     std::uint64_t memory_limit_bytes) {
   World world(chunk_edge);
   // The dense materials, then the grid (at most one byte per voxel of the chunks it covers).
   const Box3i box = Box3i::from_size(v.dims);
   const std::uint64_t chunk_edge_u = static_cast<std::uint64_t>(chunk_edge);
   std::uint64_t chunk_voxels = 1;
   for (int k = 0; k < 3; ++k) {
-    chunk_voxels = mul_sat(chunk_voxels, (static_cast<std::uint64_t>(v.dims[k]) + chunk_edge_u - 1) / chunk_edge_u * chunk_edge_u);
+    chunk_voxels =
+        mul_sat(chunk_voxels, (static_cast<std::uint64_t>(v.dims[k]) + chunk_edge_u - 1) /
+                                  chunk_edge_u * chunk_edge_u);
   }
   require_memory(add_sat(dense_bytes(box, 1), chunk_voxels), memory_limit_bytes, name,
-                 "a world of " + std::to_string(v.dims.x) + " x " + std::to_string(v.dims.y) + " x " +
-                     std::to_string(v.dims.z) + " voxels");
+                 "a world of " + std::to_string(v.dims.x) + " x " + std::to_string(v.dims.y) +
+                     " x " + std::to_string(v.dims.z) + " voxels");
   std::vector<std::uint8_t> materials(static_cast<std::size_t>(v.count()));
   for (std::int64_t i = 0; i < v.count(); ++i) {
     const double m = v.value(i);
     if (!(m >= 0 && m <= 255 && std::floor(m) == m)) {
-      const std::int64_t x = i % v.dims.x, y = (i / v.dims.x) % v.dims.y, z = i / (std::int64_t{v.dims.x} * v.dims.y);
+      const std::int64_t x = i % v.dims.x, y = (i / v.dims.x) % v.dims.y,
+                         z = i / (std::int64_t{v.dims.x} * v.dims.y);
       throw FormatError(name, v.file_offset_of(i),
-                        "element a[" + std::to_string(x) + ", " + std::to_string(y) + ", " + std::to_string(z) +
-                            "] holds " + number_text(m) + ", not a material index (an integer 0..255)");
+                        "element a[" + std::to_string(x) + ", " + std::to_string(y) + ", " +
+                            std::to_string(z) + "] holds " + number_text(m) +
+                            ", not a material index (an integer 0..255)");
     }
     materials[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(m);
   }

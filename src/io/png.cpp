@@ -13,7 +13,8 @@ namespace voxfield {
 
 std::vector<std::uint8_t> encode_png(const Image& image) {
   if (image.width <= 0 || image.height <= 0 ||
-      image.rgb.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3)
+      image.rgb.size() !=
+          static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3)
     throw InvalidArgument("encode_png: image buffer does not match its size");
   png_image png;
   std::memset(&png, 0, sizeof png);

@@ -28,7 +28,7 @@ using detail::vox::lookup;
 using detail::vox::ModelData;
 using detail::vox::Node;
 
-constexpr int kMaxModelEdge = 1024;        // MagicaVoxel writes at most 256; leave room for others
+constexpr int kMaxModelEdge = 1024;  // MagicaVoxel writes at most 256; leave room for others
 constexpr std::int64_t kMaxTranslation = std::int64_t{1} << 30;  // one nTRN's _t component
 constexpr int kMinVersion = 150;                                 // the oldest documented format
 // What the reader itself keeps per stored voxel of an XYZI model, for the memory estimate (the
@@ -110,20 +110,26 @@ class VoxParser {
  public:
   VoxParser(std::span<const std::uint8_t> bytes, const std::string& name,
             const VoxImportOptions& options)
-      : bytes_(bytes), name_(name), options_(options), result_{World(options.chunk_edge), {}}, scene_(bytes, name, options_) {}
+      : bytes_(bytes),
+        name_(name),
+        options_(options),
+        result_{World(options.chunk_edge), {}},
+        scene_(bytes, name, options_) {}
 
   VoxImport run() {
     ByteReader r(bytes_, name_);
-    if (bytes_.size() < 8) r.fail("file too short for a .vox header (" + std::to_string(bytes_.size()) + " bytes)");
+    if (bytes_.size() < 8)
+      r.fail("file too short for a .vox header (" + std::to_string(bytes_.size()) + " bytes)");
     auto magic = r.take(4, "magic");
     if (!std::equal(magic.begin(), magic.end(), "VOX ")) {
-      throw FormatError(name_, 0, "not a MagicaVoxel file: magic is " + printable(magic) +
-                                      ", expected \"VOX \"");
+      throw FormatError(
+          name_, 0, "not a MagicaVoxel file: magic is " + printable(magic) + ", expected \"VOX \"");
     }
     result_.info.version = r.i32("version");
     if (result_.info.version < kMinVersion) {
-      r.fail_at(4, "format version " + std::to_string(result_.info.version) + " is older than the oldest documented (" +
-                       std::to_string(kMinVersion) + ")");
+      r.fail_at(4, "format version " + std::to_string(result_.info.version) +
+                       " is older than the oldest documented (" + std::to_string(kMinVersion) +
+                       ")");
     }
     const std::uint64_t main_at = r.offset();
     const auto [id, content, children] = chunk_header(r);
@@ -131,7 +137,8 @@ class VoxParser {
     r.skip(content, "MAIN content");
     ByteReader body = r.sub(children, "MAIN children");
     if (!r.at_end()) {
-      r.fail(std::to_string(r.remaining()) + " bytes after the MAIN chunk (a damaged or concatenated file?)");
+      r.fail(std::to_string(r.remaining()) +
+             " bytes after the MAIN chunk (a damaged or concatenated file?)");
     }
     while (!body.at_end()) read_chunk(body);
     finish();
@@ -206,7 +213,8 @@ class VoxParser {
     for (int k = 0; k < 3; ++k) {
       s[k] = c.i32("model size");
       if (s[k] < 1 || s[k] > kMaxModelEdge) {
-        c.fail("model size " + std::to_string(s[k]) + " outside 1.." + std::to_string(kMaxModelEdge));
+        c.fail("model size " + std::to_string(s[k]) + " outside 1.." +
+               std::to_string(kMaxModelEdge));
       }
     }
     pending_size_ = s;
@@ -248,7 +256,8 @@ class VoxParser {
     Vec3i s;
     for (int k = 0; k < 3; ++k) s[k] = c.i32("TDCZ size");
     if (!(s == m.info.size)) {
-      c.fail("TDCZ size " + to_string(s) + " differs from the SIZE chunk " + to_string(m.info.size));
+      c.fail("TDCZ size " + to_string(s) + " differs from the SIZE chunk " +
+             to_string(m.info.size));
     }
     const std::int64_t n = Box3i::from_size(s).volume();
     auto packed = c.take(c.remaining(), "TDCZ data");
@@ -273,7 +282,8 @@ class VoxParser {
                         (z.msg ? std::string(z.msg) : std::string("no zlib message")) +
                         "), expected " + std::to_string(n));
     }
-    const std::size_t solid = dense.size() - static_cast<std::size_t>(std::count(dense.begin(), dense.end(), 0));
+    const std::size_t solid =
+        dense.size() - static_cast<std::size_t>(std::count(dense.begin(), dense.end(), 0));
     m.info.voxel_count = static_cast<std::int64_t>(solid);
     if (solid * sizeof(ModelData::Voxel) <= dense.size()) {
       // Mostly air: a voxel list, so that placing the model costs its solid voxels, not its box
@@ -283,10 +293,12 @@ class VoxParser {
         for (int y = 0; y < s.y; ++y)
           for (int x = 0; x < s.x; ++x, ++i)
             if (dense[i] != 0) {
-              m.voxels.push_back({static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), static_cast<std::uint16_t>(zc), dense[i]});
+              m.voxels.push_back({static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
+                                  static_cast<std::uint16_t>(zc), dense[i]});
             }
     } else {
-      m.dense = std::move(dense);  // at least an eighth solid: placing costs at most 8x its solid voxels
+      m.dense =
+          std::move(dense);  // at least an eighth solid: placing costs at most 8x its solid voxels
     }
     scene_.models.push_back(std::move(m));
   }
@@ -387,7 +399,8 @@ VoxImport parse_vox(std::span<const std::uint8_t> bytes, const std::string& name
 }
 
 VoxImport read_vox(const std::filesystem::path& path, const VoxImportOptions& options) {
-  const std::vector<std::uint8_t> bytes = read_file(path, effective_memory_limit(options.memory_limit_bytes));
+  const std::vector<std::uint8_t> bytes =
+      read_file(path, effective_memory_limit(options.memory_limit_bytes));
   VoxImportOptions rest = options;  // what the file's bytes leave for what they decode to
   rest.memory_limit_bytes = remaining_memory(options.memory_limit_bytes, bytes.size());
   return parse_vox(bytes, path.string(), rest);

@@ -13,9 +13,10 @@
 namespace voxfield::detail::vox {
 namespace {
 
-constexpr int kMaxSceneDepth = 64;         // nesting of nTRN/nGRP; real files use < 10
+constexpr int kMaxSceneDepth = 64;  // nesting of nTRN/nGRP; real files use < 10
 constexpr std::int64_t kMaxInstances = 1 << 20;
-constexpr std::int64_t kMaxVisits = 1 << 22;  // node visits: bounds DAGs that instance exponentially
+constexpr std::int64_t kMaxVisits = 1
+                                    << 22;  // node visits: bounds DAGs that instance exponentially
 constexpr std::int64_t kMaxPlacedVoxels = std::int64_t{1} << 32;
 // What the reader itself keeps per item, for the memory estimate (the world's chunks are
 // counted separately): a placed instance (its record and placement), a chunk of the world beyond
@@ -59,7 +60,8 @@ void Scene::place(World& world, VoxFileInfo& info) {
   check_world_memory(world.voxels);
   for (const Placement& pl : placements_) {
     const ModelData& m = models[static_cast<std::size_t>(pl.model)];
-    const std::array<std::int64_t, 3> pivot{m.info.size.x / 2, m.info.size.y / 2, m.info.size.z / 2};
+    const std::array<std::int64_t, 3> pivot{m.info.size.x / 2, m.info.size.y / 2,
+                                            m.info.size.z / 2};
     m.for_each_voxel([&](int x, int y, int z, std::uint8_t c) {
       const auto p = pl.frame.place({x, y, z}, pivot);
       world.voxels.set({static_cast<int>(p[0]), static_cast<int>(p[1]), static_cast<int>(p[2])}, c);
@@ -91,7 +93,8 @@ void Scene::visit(std::int32_t id, const Affine& parent, bool hidden, int depth,
       break;
     }
     case Node::kGroup:
-      for (std::int32_t child : n.children) visit(child, parent, hidden, depth + 1, n.offset, name, info);
+      for (std::int32_t child : n.children)
+        visit(child, parent, hidden, depth + 1, n.offset, name, info);
       break;
     case Node::kShape:
       place_instance(n, parent, hidden, name, info);
@@ -100,7 +103,8 @@ void Scene::visit(std::int32_t id, const Affine& parent, bool hidden, int depth,
 }
 
 // Records an instance; its voxels are placed by place() once the whole scene's cost is known.
-void Scene::place_instance(const Node& n, const Affine& xf, bool hidden, const std::string& name, VoxFileInfo& info) {
+void Scene::place_instance(const Node& n, const Affine& xf, bool hidden, const std::string& name,
+                           VoxFileInfo& info) {
   ByteReader r(bytes_, name_);
   if (n.model < 0 || static_cast<std::size_t>(n.model) >= models.size()) {
     r.fail_at(n.offset, "shape references model " + std::to_string(n.model) + " but the file has " +
@@ -116,8 +120,9 @@ void Scene::place_instance(const Node& n, const Affine& xf, bool hidden, const s
   const auto b = xf.place({m.info.size.x - 1, m.info.size.y - 1, m.info.size.z - 1}, pivot);
   for (int k = 0; k < 3; ++k) {
     if (!coord_in_range(std::min(a[k], b[k])) || !coord_in_range(std::max(a[k], b[k]))) {
-      r.fail_at(n.offset, "instance of model " + std::to_string(n.model) + " spans " + std::to_string(std::min(a[k], b[k])) +
-                              ".." + std::to_string(std::max(a[k], b[k])) + " on axis " + "xyz"[k] +
+      r.fail_at(n.offset, "instance of model " + std::to_string(n.model) + " spans " +
+                              std::to_string(std::min(a[k], b[k])) + ".." +
+                              std::to_string(std::max(a[k], b[k])) + " on axis " + "xyz"[k] +
                               ", outside the supported coordinate range -2^29..2^29-1");
     }
   }
@@ -153,9 +158,9 @@ void Scene::check_world_memory(const Grid<std::uint8_t>& g) const {
   auto add = [&](Vec3i k, std::uint64_t at) {
     if (chunks.insert(k).second && chunks.size() > max_chunks) {
       require_memory(add_sat(reader_bytes_, mul_sat(chunks.size(), per_chunk)), limit, name_,
-                     "placing its voxels (at least " + std::to_string(chunks.size()) + " chunks of " +
-                         std::to_string(g.chunk_edge()) + "^3 touched, from the instance at byte " +
-                         std::to_string(at) + " on)");
+                     "placing its voxels (at least " + std::to_string(chunks.size()) +
+                         " chunks of " + std::to_string(g.chunk_edge()) +
+                         "^3 touched, from the instance at byte " + std::to_string(at) + " on)");
     }
   };
   for (const Placement& pl : placements_) {
@@ -164,10 +169,13 @@ void Scene::check_world_memory(const Grid<std::uint8_t>& g) const {
     const std::int64_t box_chunks =
         std::int64_t{hi.x - lo.x + 1} * (hi.y - lo.y + 1) * (hi.z - lo.z + 1);
     if (m.solid_count() < box_chunks) {
-      const std::array<std::int64_t, 3> pivot{m.info.size.x / 2, m.info.size.y / 2, m.info.size.z / 2};
+      const std::array<std::int64_t, 3> pivot{m.info.size.x / 2, m.info.size.y / 2,
+                                              m.info.size.z / 2};
       m.for_each_voxel([&](int x, int y, int z, std::uint8_t) {
         const auto p = pl.frame.place({x, y, z}, pivot);
-        add({static_cast<int>(p[0] >> shift), static_cast<int>(p[1] >> shift), static_cast<int>(p[2] >> shift)}, pl.offset);
+        add({static_cast<int>(p[0] >> shift), static_cast<int>(p[1] >> shift),
+             static_cast<int>(p[2] >> shift)},
+            pl.offset);
       });
     } else {
       for (int z = lo.z; z <= hi.z; ++z)

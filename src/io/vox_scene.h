@@ -77,7 +77,8 @@ struct Node {
 // the scene into the world.
 class Scene {
  public:
-  Scene(std::span<const std::uint8_t> bytes, const std::string& name, const VoxImportOptions& options)
+  Scene(std::span<const std::uint8_t> bytes, const std::string& name,
+        const VoxImportOptions& options)
       : bytes_(bytes), name_(name), options_(options) {}
 
   std::vector<ModelData> models;
@@ -99,9 +100,10 @@ class Scene {
     Box3i box;             // where the model's SIZE box lands
   };
 
-  void visit(std::int32_t id, const Affine& parent, bool hidden, int depth, std::uint64_t from, const std::string& name,
-             VoxFileInfo& info);
-  void place_instance(const Node& n, const Affine& xf, bool hidden, const std::string& name, VoxFileInfo& info);
+  void visit(std::int32_t id, const Affine& parent, bool hidden, int depth, std::uint64_t from,
+             const std::string& name, VoxFileInfo& info);
+  void place_instance(const Node& n, const Affine& xf, bool hidden, const std::string& name,
+                      VoxFileInfo& info);
   void check_world_memory(const Grid<std::uint8_t>& g) const;
 
   std::span<const std::uint8_t> bytes_;

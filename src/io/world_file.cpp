@@ -78,7 +78,8 @@ void put_grid(Out& o, const Grid<T>& g) {
     }
     o.put<std::uint8_t>(1);
     uLongf size = static_cast<uLongf>(packed.size());
-    if (compress2(packed.data(), &size, reinterpret_cast<const Bytef*>(v.voxels), static_cast<uLong>(raw), 1) != Z_OK) {
+    if (compress2(packed.data(), &size, reinterpret_cast<const Bytef*>(v.voxels),
+                  static_cast<uLong>(raw), 1) != Z_OK) {
       throw Error("world file: zlib could not compress a chunk");
     }
     o.put<std::uint32_t>(static_cast<std::uint32_t>(size));
@@ -96,7 +97,8 @@ T get(detail::ByteReader& r, const char* what) {
 // What a file will cost once decoded, counted before it is allocated.
 class Budget {
  public:
-  Budget(const std::string& name, std::uint64_t limit) : name_(name), limit_(effective_memory_limit(limit)) {}
+  Budget(const std::string& name, std::uint64_t limit)
+      : name_(name), limit_(effective_memory_limit(limit)) {}
   void charge(std::uint64_t bytes, const std::string& what) {
     used_ = add_sat(used_, bytes);
     require_memory(used_, limit_, name_, what);
@@ -113,8 +115,10 @@ constexpr std::uint64_t kBytesPerChunkNode = 96;  // hash node and bookkeeping o
 template <class T>
 Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
   const auto edge = get<std::uint32_t>(r, "chunk edge");
-  if (edge < 8 || edge > 128 || (edge & (edge - 1)) != 0) r.fail("chunk edge " + std::to_string(edge) + " is not a power of two in 8..128");
-  if (get<std::uint32_t>(r, "value size") != sizeof(T)) r.fail("value size does not match the grid's type");
+  if (edge < 8 || edge > 128 || (edge & (edge - 1)) != 0)
+    r.fail("chunk edge " + std::to_string(edge) + " is not a power of two in 8..128");
+  if (get<std::uint32_t>(r, "value size") != sizeof(T))
+    r.fail("value size does not match the grid's type");
   const T background = get<T>(r, "background");
   std::optional<Box3i> bounds;
   if (get<std::uint8_t>(r, "bounds flag")) {
@@ -124,13 +128,15 @@ Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
     for (int k = 0; k < 3; ++k) b.end[k] = get<std::int32_t>(r, "bounds");
     if (b.empty()) r.fail_at(at, "empty grid bounds " + to_string(b));
     if (!kCoordRange.contains(b)) {
-      r.fail_at(at, "grid bounds " + to_string(b) + " reach outside the supported coordinate range " + to_string(kCoordRange));
+      r.fail_at(at, "grid bounds " + to_string(b) +
+                        " reach outside the supported coordinate range " + to_string(kCoordRange));
     }
     bounds = b;
   }
   Grid<T> g(static_cast<int>(edge), background, bounds);
   const auto count = get<std::uint64_t>(r, "chunk count");
-  if (count > r.remaining() / 13) r.fail("chunk count " + std::to_string(count) + " overruns the section");
+  if (count > r.remaining() / 13)
+    r.fail("chunk count " + std::to_string(count) + " overruns the section");
   const std::size_t raw = static_cast<std::size_t>(g.chunk_volume()) * sizeof(T);
 
   // First pass over the chunk records (headers only): coordinates checked, duplicates refused and
@@ -148,9 +154,11 @@ Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
       const auto kind = get<std::uint8_t>(scan, "chunk kind");
       if (!g.chunk_in_range(c)) {
         scan.fail_at(at, "chunk " + to_string(c) + " of edge " + std::to_string(edge) +
-                             " lies outside the supported coordinate range " + to_string(kCoordRange));
+                             " lies outside the supported coordinate range " +
+                             to_string(kCoordRange));
       }
-      if (bounds && g.chunk_box(c).intersect(*bounds).empty()) scan.fail_at(at, "chunk " + to_string(c) + " lies outside the grid bounds");
+      if (bounds && g.chunk_box(c).intersect(*bounds).empty())
+        scan.fail_at(at, "chunk " + to_string(c) + " lies outside the grid bounds");
       if (!seen.insert(c).second) scan.fail_at(at, "chunk " + to_string(c) + " appears twice");
       if (kind == 0) {
         // A uniform chunk the bounds cut through is stored densely (the part outside holds the
@@ -165,8 +173,8 @@ Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
       }
     }
     budget.charge(add_sat(mul_sat(dense, raw), mul_sat(count, kBytesPerChunkNode)),
-                  "a grid of " + std::to_string(count) + " chunks (" + std::to_string(dense) + " dense, " +
-                      std::to_string(raw) + " bytes each)");
+                  "a grid of " + std::to_string(count) + " chunks (" + std::to_string(dense) +
+                      " dense, " + std::to_string(raw) + " bytes each)");
   }
 
   std::vector<Vec3i> coords;
@@ -187,7 +195,8 @@ Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
     const auto size = get<std::uint32_t>(r, "chunk size");
     auto packed = r.take(size, "chunk data");
     uLongf out = static_cast<uLongf>(raw);
-    if (uncompress(reinterpret_cast<Bytef*>(voxels.get()), &out, packed.data(), size) != Z_OK || out != raw) {
+    if (uncompress(reinterpret_cast<Bytef*>(voxels.get()), &out, packed.data(), size) != Z_OK ||
+        out != raw) {
       r.fail("chunk " + to_string(c) + " does not decompress to " + std::to_string(raw) + " bytes");
     }
     coords.push_back(c);
@@ -214,7 +223,9 @@ void put_field(Out& o, const DistanceField& f) {
   if (f.sites) put_grid(o, *f.sites);
 }
 
-bool finite_positive(double v) { return std::isfinite(v) && v > 0; }
+bool finite_positive(double v) {
+  return std::isfinite(v) && v > 0;
+}
 
 DistanceField get_field(detail::ByteReader& r, Budget& budget) {
   const std::uint64_t at = r.offset();
@@ -223,7 +234,8 @@ DistanceField get_field(detail::ByteReader& r, Budget& budget) {
   const auto is_signed = get<std::uint8_t>(r, "signed");
   const auto storage = get<std::uint8_t>(r, "storage");
   const auto has_sites = get<std::uint8_t>(r, "sites flag");
-  if (metric > 2 || storage > 2 || is_signed > 1 || has_sites > 1) r.fail("invalid distance field options");
+  if (metric > 2 || storage > 2 || is_signed > 1 || has_sites > 1)
+    r.fail("invalid distance field options");
   f.options.metric = static_cast<Metric>(metric);
   f.options.signed_distance = is_signed;
   f.options.storage = static_cast<Storage>(storage);
@@ -238,26 +250,36 @@ DistanceField get_field(detail::ByteReader& r, Budget& budget) {
   f.encoding.bias = get<std::int64_t>(r, "bias");
   // The options as compute_distance_field would accept them: a file is not a way around them.
   if (!std::isfinite(f.options.max_distance) || f.options.max_distance < 0) {
-    r.fail_at(at + 4, "invalid clamp " + std::to_string(f.options.max_distance) + " (a finite value >= 0)");
+    r.fail_at(at + 4,
+              "invalid clamp " + std::to_string(f.options.max_distance) + " (a finite value >= 0)");
   }
   for (double sp : f.options.spacing)
-    if (!finite_positive(sp)) r.fail_at(at + 12, "invalid voxel spacing " + std::to_string(sp) + " (finite, > 0)");
+    if (!finite_positive(sp))
+      r.fail_at(at + 12, "invalid voxel spacing " + std::to_string(sp) + " (finite, > 0)");
   if (!std::isfinite(f.options.fixed_point_scale) || f.options.fixed_point_scale < 0) {
     r.fail_at(at + 36, "invalid fixed-point scale " + std::to_string(f.options.fixed_point_scale));
   }
   for (int k = 0; k < 3; ++k) {
-    if (f.domain.end[k] < f.domain.begin[k]) r.fail_at(at + 44, "inverted field domain " + to_string(f.domain));
+    if (f.domain.end[k] < f.domain.begin[k])
+      r.fail_at(at + 44, "inverted field domain " + to_string(f.domain));
   }
   if (!f.domain.in_range()) {
-    r.fail_at(at + 44, "field domain " + to_string(f.domain) + " reaches outside the supported coordinate range");
+    r.fail_at(at + 44, "field domain " + to_string(f.domain) +
+                           " reaches outside the supported coordinate range");
   }
   if (!finite_positive(f.encoding.scale) || f.encoding.bias < 0 || f.encoding.bias > 65535) {
     r.fail_at(at + 68, "invalid field encoding");
   }
   switch (f.options.storage) {
-    case Storage::kU8: f.values = get_grid<std::uint8_t>(r, budget); break;
-    case Storage::kU16: f.values = get_grid<std::uint16_t>(r, budget); break;
-    case Storage::kF32: f.values = get_grid<float>(r, budget); break;
+    case Storage::kU8:
+      f.values = get_grid<std::uint8_t>(r, budget);
+      break;
+    case Storage::kU16:
+      f.values = get_grid<std::uint16_t>(r, budget);
+      break;
+    case Storage::kF32:
+      f.values = get_grid<float>(r, budget);
+      break;
   }
   if (has_sites) f.sites = get_grid<SiteOffset>(r, budget);
   return f;
@@ -272,7 +294,8 @@ void put_section(Out& file, std::uint32_t kind, const Out& payload) {
 
 }  // namespace
 
-std::vector<std::uint8_t> encode_world_file(const World& world, const std::vector<const DistanceField*>& fields) {
+std::vector<std::uint8_t> encode_world_file(const World& world,
+                                            const std::vector<const DistanceField*>& fields) {
   Out file;
   file.bytes(kMagic, 8);
   file.put<std::uint32_t>(kWorldFileVersion);
@@ -294,7 +317,8 @@ WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::strin
                            const WorldFileReadOptions& options) {
   detail::ByteReader r(bytes, name);
   Budget budget(name, options.memory_limit_bytes);
-  if (bytes.size() < 20 || std::memcmp(bytes.data(), kMagic, 8) != 0) r.fail_at(0, "not a voxfield world file (bad magic)");
+  if (bytes.size() < 20 || std::memcmp(bytes.data(), kMagic, 8) != 0)
+    r.fail_at(0, "not a voxfield world file (bad magic)");
   r.skip(8, "magic");
   WorldFile out;
   out.version = get<std::uint32_t>(r, "version");
@@ -306,15 +330,18 @@ WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::strin
                      "); this build reads versions up to " + std::to_string(kWorldFileVersion));
   }
   if (out.version == 0) r.fail_at(8, "invalid format version 0");
-  if (sections == 0 || sections > 1024) r.fail_at(12, "invalid section count " + std::to_string(sections));
+  if (sections == 0 || sections > 1024)
+    r.fail_at(12, "invalid section count " + std::to_string(sections));
   for (std::uint32_t s = 0; s < sections; ++s) {
     const std::uint64_t at = r.offset();
     const auto kind = get<std::uint32_t>(r, "section kind");
     const auto size = get<std::uint64_t>(r, "section size");
-    if (size > r.remaining()) r.fail_at(at, "section of " + std::to_string(size) + " bytes overruns the file");
+    if (size > r.remaining())
+      r.fail_at(at, "section of " + std::to_string(size) + " bytes overruns the file");
     detail::ByteReader payload = r.sub(static_cast<std::size_t>(size), "section");
     const auto stored = get<std::uint32_t>(r, "section checksum");
-    if (stored != crc(bytes.data() + at + 12, static_cast<std::size_t>(size))) r.fail_at(at, "section checksum mismatch (corrupt file)");
+    if (stored != crc(bytes.data() + at + 12, static_cast<std::size_t>(size)))
+      r.fail_at(at, "section checksum mismatch (corrupt file)");
     if (kind == kWorldSection) {
       if (s != 0) r.fail_at(at, "the world section must come first");
       for (Rgba& c : out.world.palette) c = get<Rgba>(payload, "palette");
@@ -325,7 +352,8 @@ WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::strin
       const DistanceField& f = out.fields.back();
       const int edge = out.world.voxels.chunk_edge();
       if (f.chunk_edge() != edge || (f.sites && f.sites->chunk_edge() != edge)) {
-        r.fail_at(at, "a field stored in chunks of another edge than its world's (" + std::to_string(edge) + ")");
+        r.fail_at(at, "a field stored in chunks of another edge than its world's (" +
+                          std::to_string(edge) + ")");
       }
     } else {
       r.fail_at(at, "unknown section kind " + std::to_string(kind));
@@ -336,7 +364,8 @@ WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::strin
   return out;
 }
 
-void write_world_file(const World& world, const std::filesystem::path& path, const std::vector<const DistanceField*>& fields) {
+void write_world_file(const World& world, const std::filesystem::path& path,
+                      const std::vector<const DistanceField*>& fields) {
   write_file_atomic(path, encode_world_file(world, fields));
 }
 

@@ -30,10 +30,12 @@ void check_magic(const std::filesystem::path& path, WorldFormat f) {
       if (head.size() < 4 || std::memcmp(head.data(), "VOX ", 4) != 0) (void)parse_vox(head, name);
       break;
     case WorldFormat::kNpy:
-      if (head.size() < 6 || std::memcmp(head.data(), "\x93NUMPY", 6) != 0) (void)parse_npy(head, name);
+      if (head.size() < 6 || std::memcmp(head.data(), "\x93NUMPY", 6) != 0)
+        (void)parse_npy(head, name);
       break;
     case WorldFormat::kVfw:
-      if (head.size() < 8 || std::memcmp(head.data(), "VXFWORLD", 8) != 0) (void)parse_world_file(head, name);
+      if (head.size() < 8 || std::memcmp(head.data(), "VXFWORLD", 8) != 0)
+        (void)parse_world_file(head, name);
       break;
   }
 }
@@ -45,14 +47,18 @@ WorldFormat world_format_of(const std::filesystem::path& path) {
   if (ext == ".vox") return WorldFormat::kVox;
   if (ext == ".npy") return WorldFormat::kNpy;
   if (ext == ".vfw") return WorldFormat::kVfw;
-  throw InvalidArgument(path.string() + ": unknown file type \"" + ext + "\" (expected .vox, .npy or .vfw)");
+  throw InvalidArgument(path.string() + ": unknown file type \"" + ext +
+                        "\" (expected .vox, .npy or .vfw)");
 }
 
 const char* world_format_name(WorldFormat f) {
   switch (f) {
-    case WorldFormat::kVox: return "vox";
-    case WorldFormat::kNpy: return "npy";
-    case WorldFormat::kVfw: return "vfw";
+    case WorldFormat::kVox:
+      return "vox";
+    case WorldFormat::kNpy:
+      return "npy";
+    case WorldFormat::kVfw:
+      return "vfw";
   }
   return "?";
 }
@@ -61,7 +67,8 @@ LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& opt
   const WorldFormat format = world_format_of(path);
   check_magic(path, format);
   const std::uint64_t limit = effective_memory_limit(options.memory_limit_bytes);
-  const int edge = options.chunk_edge != 0 ? options.chunk_edge : Grid<std::uint8_t>::kDefaultChunkEdge;
+  const int edge =
+      options.chunk_edge != 0 ? options.chunk_edge : Grid<std::uint8_t>::kDefaultChunkEdge;
   LoadedWorld out;
   out.format = format;
   switch (format) {
@@ -115,12 +122,13 @@ LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& opt
   return out;
 }
 
-World rechunk_world(const World& world, int chunk_edge, std::optional<Box3i> bounds, const std::string& who,
-                    std::uint64_t memory_limit_bytes) {
+World rechunk_world(const World& world, int chunk_edge, std::optional<Box3i> bounds,
+                    const std::string& who, std::uint64_t memory_limit_bytes) {
   const Grid<std::uint8_t>& g = world.voxels;
   World out(chunk_edge, bounds);  // checks the edge and the bounds
   const std::uint64_t limit = effective_memory_limit(memory_limit_bytes);
-  const std::uint64_t per_chunk = static_cast<std::uint64_t>(chunk_edge) * chunk_edge * chunk_edge + 96;
+  const std::uint64_t per_chunk =
+      static_cast<std::uint64_t>(chunk_edge) * chunk_edge * chunk_edge + 96;
   const int shift = out.voxels.chunk_shift();
   std::unordered_set<Vec3i, Vec3iHash> dense;
   for (const Vec3i c : g.chunk_coords()) {
@@ -128,7 +136,8 @@ World rechunk_world(const World& world, int chunk_edge, std::optional<Box3i> bou
     Box3i box = g.bounds() ? v.box.intersect(*g.bounds()) : v.box;
     if (bounds) box = box.intersect(*bounds);
     if (box.empty()) continue;
-    const Vec3i lo = out.voxels.chunk_of(box.begin), hi = out.voxels.chunk_of(box.end - Vec3i::splat(1));
+    const Vec3i lo = out.voxels.chunk_of(box.begin),
+                hi = out.voxels.chunk_of(box.end - Vec3i::splat(1));
     for (int z = lo.z; z <= hi.z; ++z)
       for (int y = lo.y; y <= hi.y; ++y)
         for (int x = lo.x; x <= hi.x; ++x) {
@@ -138,8 +147,8 @@ World rechunk_world(const World& world, int chunk_edge, std::optional<Box3i> bou
           if (v.uniform() && box.contains(kept)) continue;  // a uniform fill: no voxel array
           if (dense.insert({x, y, z}).second && dense.size() * per_chunk > limit) {
             require_memory(dense.size() * per_chunk, limit, who,
-                           "its world in chunks of " + std::to_string(chunk_edge) + "^3 (at least " +
-                               std::to_string(dense.size()) + " dense chunks)");
+                           "its world in chunks of " + std::to_string(chunk_edge) +
+                               "^3 (at least " + std::to_string(dense.size()) + " dense chunks)");
           }
         }
   }
@@ -148,16 +157,20 @@ World rechunk_world(const World& world, int chunk_edge, std::optional<Box3i> bou
   return out;
 }
 
-std::vector<std::uint8_t> encode_world(const World& world, const Box3i& extent, WorldFormat format) {
+std::vector<std::uint8_t> encode_world(const World& world, const Box3i& extent,
+                                       WorldFormat format) {
   switch (format) {
-    case WorldFormat::kVox: return encode_vox(world);
+    case WorldFormat::kVox:
+      return encode_vox(world);
     case WorldFormat::kNpy: {
       Box3i box = extent.unite(world.voxels.content_bounds());
       if (box.empty()) box = Box3i::from_size({1, 1, 1});
-      require_memory(dense_bytes(box, 2), 0, "npy output", "a dense volume of " + std::to_string(box.volume()) + " voxels");
+      require_memory(dense_bytes(box, 2), 0, "npy output",
+                     "a dense volume of " + std::to_string(box.volume()) + " voxels");
       return encode_npy(npy_from_world(world, box));
     }
-    case WorldFormat::kVfw: return encode_world_file(world);
+    case WorldFormat::kVfw:
+      return encode_world_file(world);
   }
   throw InvalidArgument("encode_world: unknown format");
 }

@@ -30,7 +30,9 @@ Box3i ChunkGrid::cells_of(Vec3i chunk) const {
   return b;
 }
 
-int ChunkGrid::owner(int axis, int v) const { return std::min(v / edge, count[axis] - 1); }
+int ChunkGrid::owner(int axis, int v) const {
+  return std::min(v / edge, count[axis] - 1);
+}
 
 bool Block::load(const Lattice& lattice, const Box3i& cells) {
   lattice_ = &lattice;
@@ -59,8 +61,8 @@ bool Block::load(const Lattice& lattice, const Box3i& cells) {
       if (nan)
         for (std::size_t i = 0; i < dx; ++i)
           if (std::isnan(row[i]))
-            throw InvalidArgument("mesh: sample (" + std::to_string(lo_.x + static_cast<int>(i)) + ", " + std::to_string(y) +
-                                  ", " + std::to_string(z) + ") is NaN");
+            throw InvalidArgument("mesh: sample (" + std::to_string(lo_.x + static_cast<int>(i)) +
+                                  ", " + std::to_string(y) + ", " + std::to_string(z) + ") is NaN");
       *signs = static_cast<std::uint8_t>(in | out << 1);
       all |= *signs++;
     }
@@ -75,7 +77,8 @@ std::array<double, 3> Block::gradient(int x, int y, int z) const {
     if (p[a] > 0) --lo[a];
     if (p[a] < lattice_->n[a] - 1) ++hi[a];
     const double span = (hi[a] - lo[a]) * lattice_->spacing[static_cast<std::size_t>(a)];
-    g[static_cast<std::size_t>(a)] = (static_cast<double>(s(hi.x, hi.y, hi.z)) - s(lo.x, lo.y, lo.z)) / span;
+    g[static_cast<std::size_t>(a)] =
+        (static_cast<double>(s(hi.x, hi.y, hi.z)) - s(lo.x, lo.y, lo.z)) / span;
   }
   return g;
 }
@@ -100,8 +103,10 @@ std::array<double, 3> Block::one_sided_gradient(int x, int y, int z) const {
       d = s0 - at(-1);
     } else {
       const double left = s0 - at(-1), right = at(1) - s0;
-      const double curve_left = p[a] > 1 ? std::abs(left - (at(-1) - at(-2))) : std::abs(right - left);
-      const double curve_right = p[a] < n - 2 ? std::abs((at(2) - at(1)) - right) : std::abs(right - left);
+      const double curve_left =
+          p[a] > 1 ? std::abs(left - (at(-1) - at(-2))) : std::abs(right - left);
+      const double curve_right =
+          p[a] < n - 2 ? std::abs((at(2) - at(1)) - right) : std::abs(right - left);
       d = curve_left <= curve_right ? left : right;
     }
     g[static_cast<std::size_t>(a)] = d / h;
@@ -119,13 +124,17 @@ void ChunkPart::clear() {
   indices.clear();
 }
 
-std::uint32_t ChunkPart::add(const std::array<double, 3>& position, std::array<double, 3> normal, std::uint64_t key,
-                             std::uint64_t source, bool is_owned, bool is_shared) {
-  const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+std::uint32_t ChunkPart::add(const std::array<double, 3>& position, std::array<double, 3> normal,
+                             std::uint64_t key, std::uint64_t source, bool is_owned,
+                             bool is_shared) {
+  const double length =
+      std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
   if (length > 0)
     for (double& c : normal) c /= length;
-  positions.push_back({static_cast<float>(position[0]), static_cast<float>(position[1]), static_cast<float>(position[2])});
-  normals.push_back({static_cast<float>(normal[0]), static_cast<float>(normal[1]), static_cast<float>(normal[2])});
+  positions.push_back({static_cast<float>(position[0]), static_cast<float>(position[1]),
+                       static_cast<float>(position[2])});
+  normals.push_back({static_cast<float>(normal[0]), static_cast<float>(normal[1]),
+                     static_cast<float>(normal[2])});
   keys.push_back(key);
   sources.push_back(source);
   owned.push_back(is_owned);
@@ -148,7 +157,8 @@ Mesh weld(const std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sourc
     index_base[c + 1] = index_base[c] + parts[c].indices.size();
   }
   if (base.back() > std::numeric_limits<std::uint32_t>::max())
-    throw InvalidArgument("mesh: " + std::to_string(base.back()) + " vertices do not fit 32-bit indices; mesh a smaller volume");
+    throw InvalidArgument("mesh: " + std::to_string(base.back()) +
+                          " vertices do not fit 32-bit indices; mesh a smaller volume");
   std::unordered_map<std::uint64_t, std::uint32_t> by_key;
   by_key.reserve(shared_count);
   for (std::size_t c = 0; c < chunks; ++c) {
@@ -193,10 +203,12 @@ Mesh weld(const std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sourc
     const ChunkPart& p = parts[c];
     for (std::size_t i = 0; i < p.positions.size(); ++i) {
       if (global[c][i] != kUnresolved) continue;
-      const auto [it, orphan] = by_key.emplace(p.keys[i], static_cast<std::uint32_t>(mesh.positions.size()));
+      const auto [it, orphan] =
+          by_key.emplace(p.keys[i], static_cast<std::uint32_t>(mesh.positions.size()));
       if (orphan) {
         if (mesh.positions.size() >= kUnresolved)
-          throw InvalidArgument("mesh: the vertices do not fit 32-bit indices; mesh a smaller volume");
+          throw InvalidArgument(
+              "mesh: the vertices do not fit 32-bit indices; mesh a smaller volume");
         mesh.positions.push_back(p.positions[i]);
         mesh.normals.push_back(p.normals[i]);
         if (sources) sources->push_back(p.sources[i]);

@@ -6,8 +6,9 @@
 // chunk creates the vertices its triangles use; those of elements it does not own are computed the
 // same way as their owner does (same samples, same arithmetic, same rounding) and are replaced by
 // the owner's at the weld (or, where the owner has no triangle using it, by the first user's copy),
-// so chunks meet without cracks and the mesh does not depend on the partition. The weld looks vertices up by element key only for the owned vertices a mesher marks
-// `shared` (those on a chunk border a neighbour can reach), a few per cent of the total.
+// so chunks meet without cracks and the mesh does not depend on the partition. The weld looks
+// vertices up by element key only for the owned vertices a mesher marks `shared` (those on a chunk
+// border a neighbour can reach), a few per cent of the total.
 #pragma once
 
 #include <array>
@@ -33,7 +34,10 @@ struct Lattice {
   // contouring then rebuilds the cubes' edges and corners exactly).
   bool voxel_faces = false;
   std::size_t index(int x, int y, int z) const {
-    return static_cast<std::size_t>(x) + static_cast<std::size_t>(n.x) * (static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * static_cast<std::size_t>(z));
+    return static_cast<std::size_t>(x) +
+           static_cast<std::size_t>(n.x) *
+               (static_cast<std::size_t>(y) +
+                static_cast<std::size_t>(n.y) * static_cast<std::size_t>(z));
   }
 };
 
@@ -63,7 +67,9 @@ class Block {
   bool inside(float value) const { return negate_ ? value > iso_ : value < iso_; }
   float s(int x, int y, int z) const { return s_of(lattice_->values[lattice_->index(x, y, z)]); }
   // The raw samples of row (y, z) from x on (x fastest).
-  const float* row(int x, int y, int z) const { return lattice_->values + lattice_->index(x, y, z); }
+  const float* row(int x, int y, int z) const {
+    return lattice_->values + lattice_->index(x, y, z);
+  }
   // Which signs row (y, z) holds over the block: bit 0 some sample inside, bit 1 some outside.
   std::uint8_t row_signs(int y, int z) const {
     return signs_[static_cast<std::size_t>(y - lo_.y) + dy_ * static_cast<std::size_t>(z - lo_.z)];
@@ -94,8 +100,8 @@ struct ChunkPart {
   std::vector<std::uint8_t> shared;    // owned and possibly used by a neighbour
   std::vector<std::uint32_t> indices;
   void clear();
-  std::uint32_t add(const std::array<double, 3>& position, std::array<double, 3> normal, std::uint64_t key,
-                    std::uint64_t source, bool is_owned, bool is_shared);
+  std::uint32_t add(const std::array<double, 3>& position, std::array<double, 3> normal,
+                    std::uint64_t key, std::uint64_t source, bool is_owned, bool is_shared);
 };
 
 // Joins the chunks' parts (in chunk order) into one mesh; `sources`, when given, receives each
@@ -104,18 +110,22 @@ Mesh weld(const std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sourc
 
 // Position of lattice point p + t along `axis` (t in [0, 1]) in the volume's frame.
 inline std::array<double, 3> lattice_position(const Lattice& l, const std::array<double, 3>& p) {
-  return {l.origin[0] + p[0] * l.spacing[0], l.origin[1] + p[1] * l.spacing[1], l.origin[2] + p[2] * l.spacing[2]};
+  return {l.origin[0] + p[0] * l.spacing[0], l.origin[1] + p[1] * l.spacing[1],
+          l.origin[2] + p[2] * l.spacing[2]};
 }
 
 // The meshers: fill `part` with the triangles of `chunk`'s cells. `block` holds its samples.
-void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,
-                          std::vector<std::int32_t>& scratch, ChunkPart& part);
+void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
+                          const Block& block, std::vector<std::int32_t>& scratch, ChunkPart& part);
 // Where a dual mesher puts the vertex of a cell the surface crosses, in the cell's coordinates
-// ([0, 1]^3 from its lowest corner), from the cell's eight s values (corner c at (c & 1, c >> 1 & 1,
-// c >> 2 & 1)).
-using CellVertex = std::array<double, 3> (*)(const Block& block, const Lattice& lattice, Vec3i cell, const double* v);
-std::array<double, 3> surface_nets_vertex(const Block& block, const Lattice& lattice, Vec3i cell, const double* v);
-std::array<double, 3> dual_contouring_vertex(const Block& block, const Lattice& lattice, Vec3i cell, const double* v);
+// ([0, 1]^3 from its lowest corner), from the cell's eight s values (corner c at (c & 1, c >> 1 &
+// 1, c >> 2 & 1)).
+using CellVertex = std::array<double, 3> (*)(const Block& block, const Lattice& lattice, Vec3i cell,
+                                             const double* v);
+std::array<double, 3> surface_nets_vertex(const Block& block, const Lattice& lattice, Vec3i cell,
+                                          const double* v);
+std::array<double, 3> dual_contouring_vertex(const Block& block, const Lattice& lattice, Vec3i cell,
+                                             const double* v);
 void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,
                      std::vector<std::int32_t>& scratch, ChunkPart& part, CellVertex place);
 

@@ -11,12 +11,16 @@ namespace {
 
 using Vec = std::array<int, 3>;  // in half units: corners at 0 or 2, edge midpoints at 1
 
-Vec corner_position(int c) { return {2 * (c & 1), 2 * (c >> 1 & 1), 2 * (c >> 2 & 1)}; }
+Vec corner_position(int c) {
+  return {2 * (c & 1), 2 * (c >> 1 & 1), 2 * (c >> 2 & 1)};
+}
 
 Vec cross(const Vec& a, const Vec& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
-int dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+int dot(const Vec& a, const Vec& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
 
 std::array<CubeEdge, 12> make_edges() {
   std::array<CubeEdge, 12> edges{};
@@ -46,7 +50,8 @@ bool share_face(int e0, int e1) {
   const auto& edges = cube_edges();
   const CubeEdge &a = edges[static_cast<std::size_t>(e0)], &b = edges[static_cast<std::size_t>(e1)];
   for (int axis = 0; axis < 3; ++axis) {
-    if (axis == a.axis || axis == b.axis) continue;  // a face across `axis` holds edges along the others
+    if (axis == a.axis || axis == b.axis)
+      continue;  // a face across `axis` holds edges along the others
     if ((a.from >> axis & 1) == (b.from >> axis & 1)) return true;
   }
   return false;
@@ -89,7 +94,10 @@ std::pair<int, int> oriented_segment(int face, int e0, int e1, unsigned inside) 
 // vertex inside the cell instead (as Lewiner et al.'s MC33 does for its interior cases).
 void triangulate_loop(const std::vector<int>& loop, CubeCase& out) {
   const int n = static_cast<int>(loop.size());
-  auto allowed = [&](int i, int j) { return j - i == 1 || (i == 0 && j == n - 1) || !share_face(loop[static_cast<std::size_t>(i)], loop[static_cast<std::size_t>(j)]); };
+  auto allowed = [&](int i, int j) {
+    return j - i == 1 || (i == 0 && j == n - 1) ||
+           !share_face(loop[static_cast<std::size_t>(i)], loop[static_cast<std::size_t>(j)]);
+  };
   // split[i][j]: the apex k of the triangle on chord (i, j) triangulating the chain i..j, or -1.
   std::array<std::array<int, 12>, 12> split;
   for (auto& row : split) row.fill(-1);
@@ -97,9 +105,12 @@ void triangulate_loop(const std::vector<int>& loop, CubeCase& out) {
     for (int i = 0; i + len < n; ++i) {
       const int j = i + len;
       if (!allowed(i, j)) continue;
-      for (int k = i + 1; k < j && split[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] < 0; ++k) {
-        const bool left = k - i == 1 || split[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)] >= 0;
-        const bool right = j - k == 1 || split[static_cast<std::size_t>(k)][static_cast<std::size_t>(j)] >= 0;
+      for (int k = i + 1;
+           k < j && split[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] < 0; ++k) {
+        const bool left =
+            k - i == 1 || split[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)] >= 0;
+        const bool right =
+            j - k == 1 || split[static_cast<std::size_t>(k)][static_cast<std::size_t>(j)] >= 0;
         if (left && right) split[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] = k;
       }
     }
@@ -115,18 +126,22 @@ void triangulate_loop(const std::vector<int>& loop, CubeCase& out) {
       const auto [i, j] = chains.back();
       chains.pop_back();
       const int k = n == 3 ? 1 : split[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
-      emit(loop[static_cast<std::size_t>(i)], loop[static_cast<std::size_t>(k)], loop[static_cast<std::size_t>(j)]);
+      emit(loop[static_cast<std::size_t>(i)], loop[static_cast<std::size_t>(k)],
+           loop[static_cast<std::size_t>(j)]);
       if (k - i > 1) chains.push_back({i, k});
       if (j - k > 1) chains.push_back({k, j});
     }
     return;
   }
-  if (out.centre_count == out.centre_sizes.size()) throw std::logic_error("cube_cases: too many centre vertices");
+  if (out.centre_count == out.centre_sizes.size())
+    throw std::logic_error("cube_cases: too many centre vertices");
   const std::size_t c = out.centre_count++;
   out.centre_sizes[c] = static_cast<std::uint8_t>(n);
   for (int i = 0; i < n; ++i) {
-    out.centre_edges[c][static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(loop[static_cast<std::size_t>(i)]);
-    emit(CubeCase::kCentre + static_cast<int>(c), loop[static_cast<std::size_t>(i)], loop[static_cast<std::size_t>((i + 1) % n)]);
+    out.centre_edges[c][static_cast<std::size_t>(i)] =
+        static_cast<std::uint8_t>(loop[static_cast<std::size_t>(i)]);
+    emit(CubeCase::kCentre + static_cast<int>(c), loop[static_cast<std::size_t>(i)],
+         loop[static_cast<std::size_t>((i + 1) % n)]);
   }
 }
 
@@ -139,7 +154,8 @@ CubeCase triangulate(unsigned inside, unsigned outside_joined) {
     const auto corners = CubeCases::face_corners(face);
     auto in = [&](int k) { return (inside >> corners[static_cast<std::size_t>(k & 3)] & 1) != 0; };
     auto side_edge = [&](int k) {  // the face's edge from corner k to corner k + 1 (cyclically)
-      return edge_between(corners[static_cast<std::size_t>(k & 3)], corners[static_cast<std::size_t>((k + 1) & 3)]);
+      return edge_between(corners[static_cast<std::size_t>(k & 3)],
+                          corners[static_cast<std::size_t>((k + 1) & 3)]);
     };
     std::vector<int> crossing;  // face-side positions k whose edge crosses
     for (int k = 0; k < 4; ++k)
@@ -156,21 +172,24 @@ CubeCase triangulate(unsigned inside, unsigned outside_joined) {
     }
     for (const auto& [e0, e1] : segments) {
       const auto [from, to] = oriented_segment(face, e0, e1, inside);
-      if (next[static_cast<std::size_t>(from)] != -1) throw std::logic_error("cube_cases: two segments leave one crossing");
+      if (next[static_cast<std::size_t>(from)] != -1)
+        throw std::logic_error("cube_cases: two segments leave one crossing");
       next[static_cast<std::size_t>(from)] = to;
     }
   }
   CubeCase result;
   std::array<bool, 12> used{};
   for (int start = 0; start < 12; ++start) {
-    if (next[static_cast<std::size_t>(start)] == -1 || used[static_cast<std::size_t>(start)]) continue;
+    if (next[static_cast<std::size_t>(start)] == -1 || used[static_cast<std::size_t>(start)])
+      continue;
     std::vector<int> loop;
     for (int e = start; !used[static_cast<std::size_t>(e)]; e = next[static_cast<std::size_t>(e)]) {
       used[static_cast<std::size_t>(e)] = true;
       loop.push_back(e);
       if (next[static_cast<std::size_t>(e)] == -1) throw std::logic_error("cube_cases: open loop");
     }
-    if (loop.front() != start || next[static_cast<std::size_t>(loop.back())] != start || loop.size() < 3)
+    if (loop.front() != start || next[static_cast<std::size_t>(loop.back())] != start ||
+        loop.size() < 3)
       throw std::logic_error("cube_cases: loop does not close");
     triangulate_loop(loop, result);
   }
@@ -189,7 +208,8 @@ std::array<std::uint8_t, 4> CubeCases::face_corners(int face) {
   const int lo = axis == 0 ? 1 : 0, hi = axis == 2 ? 1 : 2;
   const int base = side << axis;
   return {static_cast<std::uint8_t>(base), static_cast<std::uint8_t>(base | 1 << lo),
-          static_cast<std::uint8_t>(base | 1 << lo | 1 << hi), static_cast<std::uint8_t>(base | 1 << hi)};
+          static_cast<std::uint8_t>(base | 1 << lo | 1 << hi),
+          static_cast<std::uint8_t>(base | 1 << hi)};
 }
 
 CubeCases::CubeCases() {
@@ -198,8 +218,10 @@ CubeCases::CubeCases() {
     std::uint8_t ambiguous = 0;
     for (int face = 0; face < 6; ++face) {
       const auto c = face_corners(face);
-      const unsigned b0 = inside >> c[0] & 1, b1 = inside >> c[1] & 1, b2 = inside >> c[2] & 1, b3 = inside >> c[3] & 1;
-      if (b0 == b2 && b1 == b3 && b0 != b1) ambiguous = static_cast<std::uint8_t>(ambiguous | 1 << face);
+      const unsigned b0 = inside >> c[0] & 1, b1 = inside >> c[1] & 1, b2 = inside >> c[2] & 1,
+                     b3 = inside >> c[3] & 1;
+      if (b0 == b2 && b1 == b3 && b0 != b1)
+        ambiguous = static_cast<std::uint8_t>(ambiguous | 1 << face);
     }
     ambiguous_[inside] = ambiguous;
     offset_[inside] = static_cast<std::uint16_t>(next_offset);

@@ -51,7 +51,9 @@ class CubeCases {
   std::uint8_t ambiguous_faces(unsigned inside) const { return ambiguous_[inside]; }
   // The triangulation for `inside` where `joined` (one bit per ambiguous face, in face order,
   // compacted to the ambiguous faces only) says on which faces the two outside corners connect.
-  const CubeCase& lookup(unsigned inside, unsigned joined) const { return cases_[offset_[inside] + joined]; }
+  const CubeCase& lookup(unsigned inside, unsigned joined) const {
+    return cases_[offset_[inside] + joined];
+  }
 
   // For one ambiguous face: corners in cyclic order around it (so 0/2 and 1/3 are the diagonals),
   // starting at the face's lowest corner and going first along the face's lower axis.

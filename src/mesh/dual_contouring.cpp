@@ -65,7 +65,8 @@ constexpr double kTruncation = 0.01;
 
 }  // namespace
 
-std::array<double, 3> dual_contouring_vertex(const Block& block, const Lattice& lattice, Vec3i cell, const double* v) {
+std::array<double, 3> dual_contouring_vertex(const Block& block, const Lattice& lattice, Vec3i cell,
+                                             const double* v) {
   const auto& h = lattice.spacing;
   std::array<std::array<double, 3>, 12> points, normals;
   int n = 0;
@@ -83,7 +84,8 @@ std::array<double, 3> dual_contouring_vertex(const Block& block, const Lattice& 
     if (lattice.voxel_faces) {
       g[e.axis] = s0 < 0 ? 1 : -1;  // from the solid voxel towards the air
     } else {
-      const auto g0 = block.one_sided_gradient(p0.x, p0.y, p0.z), g1 = block.one_sided_gradient(p1.x, p1.y, p1.z);
+      const auto g0 = block.one_sided_gradient(p0.x, p0.y, p0.z),
+                 g1 = block.one_sided_gradient(p1.x, p1.y, p1.z);
       for (std::size_t a = 0; a < 3; ++a) g[a] = g0[a] + t * (g1[a] - g0[a]);
     }
     double length = 0;
@@ -105,7 +107,8 @@ std::array<double, 3> dual_contouring_vertex(const Block& block, const Lattice& 
   for (int i = 0; i < n; ++i) {
     const auto& ni = normals[static_cast<std::size_t>(i)];
     const auto& pi = points[static_cast<std::size_t>(i)];
-    const double r = ni[0] * (pi[0] - mass[0]) + ni[1] * (pi[1] - mass[1]) + ni[2] * (pi[2] - mass[2]);
+    const double r =
+        ni[0] * (pi[0] - mass[0]) + ni[1] * (pi[1] - mass[1]) + ni[2] * (pi[2] - mass[2]);
     for (std::size_t a = 0; a < 3; ++a) {
       atb[a] += ni[a] * r;
       for (std::size_t b = 0; b < 3; ++b) ata[a][b] += ni[a] * ni[b];

@@ -19,14 +19,18 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
   const Box3i cells = grid.cells_of(chunk);
   Vec3i lo;  // cells with a vertex slot: one before the chunk where the lattice has it
   for (int a = 0; a < 3; ++a) lo[a] = std::max(cells.begin[a] - 1, 0);
-  const std::size_t ex = static_cast<std::size_t>(cells.end.x - lo.x), ey = static_cast<std::size_t>(cells.end.y - lo.y);
+  const std::size_t ex = static_cast<std::size_t>(cells.end.x - lo.x),
+                    ey = static_cast<std::size_t>(cells.end.y - lo.y);
   scratch.assign(ex * ey * static_cast<std::size_t>(cells.end.z - lo.z), -1);
 
   auto vertex = [&](Vec3i q) -> std::uint32_t {
-    std::int32_t& slot = scratch[static_cast<std::size_t>(q.x - lo.x) + ex * (static_cast<std::size_t>(q.y - lo.y) + ey * static_cast<std::size_t>(q.z - lo.z))];
+    std::int32_t& slot = scratch[static_cast<std::size_t>(q.x - lo.x) +
+                                 ex * (static_cast<std::size_t>(q.y - lo.y) +
+                                       ey * static_cast<std::size_t>(q.z - lo.z))];
     if (slot >= 0) return static_cast<std::uint32_t>(slot);
     double v[8];
-    for (int c = 0; c < 8; ++c) v[c] = block.s(q.x + (c & 1), q.y + (c >> 1 & 1), q.z + (c >> 2 & 1));
+    for (int c = 0; c < 8; ++c)
+      v[c] = block.s(q.x + (c & 1), q.y + (c >> 1 & 1), q.z + (c >> 2 & 1));
     const std::array<double, 3> mean = place(block, lattice, q, v);
     const double u = mean[0], w1 = mean[1], w2 = mean[2];
     // Gradient of the trilinear interpolant: along each axis, the corner differences blended by
@@ -52,17 +56,19 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
       owned &= grid.owner(a, q[a]) == chunk[a];
       if (q[a] == cells.end[a] - 1 && cells.end[a] < grid.cells[a]) shared = true;
     }
-    const std::uint64_t source = lattice.index(q.x + (nearest & 1), q.y + (nearest >> 1 & 1), q.z + (nearest >> 2 & 1));
+    const std::uint64_t source =
+        lattice.index(q.x + (nearest & 1), q.y + (nearest >> 1 & 1), q.z + (nearest >> 2 & 1));
     const std::array<double, 3> at{q.x + u, q.y + w1, q.z + w2};
-    const std::uint32_t id = part.add(lattice_position(lattice, at), normal, lattice.index(q.x, q.y, q.z), source, owned,
-                                      owned && shared);
+    const std::uint32_t id = part.add(lattice_position(lattice, at), normal,
+                                      lattice.index(q.x, q.y, q.z), source, owned, owned && shared);
     slot = static_cast<std::int32_t>(id);
     return id;
   };
   auto distance2 = [&](std::uint32_t i, std::uint32_t j) {
     double d = 0;
     for (int a = 0; a < 3; ++a) {
-      const double c = static_cast<double>(part.positions[i][static_cast<std::size_t>(a)]) - part.positions[j][static_cast<std::size_t>(a)];
+      const double c = static_cast<double>(part.positions[i][static_cast<std::size_t>(a)]) -
+                       part.positions[j][static_cast<std::size_t>(a)];
       d += c * c;
     }
     return d;
@@ -85,7 +91,8 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
           --pbc[b];
           --pbc[c];
           // Counter-clockwise seen from +a: (0,0), (1,0), (1,1), (0,1) in (b, c) offsets.
-          const std::uint32_t v00 = vertex(pbc), v10 = vertex(pc), v11 = vertex(p), v01 = vertex(pb);
+          const std::uint32_t v00 = vertex(pbc), v10 = vertex(pc), v11 = vertex(p),
+                              v01 = vertex(pb);
           std::array<std::uint32_t, 6> t;
           if (distance2(v00, v11) <= distance2(v10, v01))
             t = {v00, v10, v11, v00, v11, v01};

@@ -22,7 +22,9 @@ namespace voxfield::detail::mesh {
 
 namespace {
 
-constexpr Vec3i corner_offset(int c) { return {c & 1, c >> 1 & 1, c >> 2 & 1}; }
+constexpr Vec3i corner_offset(int c) {
+  return {c & 1, c >> 1 & 1, c >> 2 & 1};
+}
 
 // On an ambiguous face, whether the two outside corners connect across it: the asymptotic decider
 // puts the bilinear interpolant's saddle outside when the product of the outside diagonal's values
@@ -37,36 +39,44 @@ bool outside_joined(const float* v, const std::array<std::uint8_t, 4>& corners, 
 
 }  // namespace
 
-void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,
-                          std::vector<std::int32_t>& scratch, ChunkPart& part) {
+void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
+                          const Block& block, std::vector<std::int32_t>& scratch, ChunkPart& part) {
   const Box3i cells = grid.cells_of(chunk);
   const Vec3i b = cells.begin;
-  const std::size_t ex = static_cast<std::size_t>(cells.end.x - b.x + 1), ey = static_cast<std::size_t>(cells.end.y - b.y + 1);
+  const std::size_t ex = static_cast<std::size_t>(cells.end.x - b.x + 1),
+                    ey = static_cast<std::size_t>(cells.end.y - b.y + 1);
   scratch.assign(3 * ex * ey * static_cast<std::size_t>(cells.end.z - b.z + 1), -1);
   const CubeCases& table = CubeCases::get();
   const auto& edges = cube_edges();
 
   auto vertex = [&](Vec3i p, int axis) -> std::uint32_t {
-    std::int32_t& slot = scratch[3 * (static_cast<std::size_t>(p.x - b.x) + ex * (static_cast<std::size_t>(p.y - b.y) + ey * static_cast<std::size_t>(p.z - b.z))) +
+    std::int32_t& slot = scratch[3 * (static_cast<std::size_t>(p.x - b.x) +
+                                      ex * (static_cast<std::size_t>(p.y - b.y) +
+                                            ey * static_cast<std::size_t>(p.z - b.z))) +
                                  static_cast<std::size_t>(axis)];
     if (slot >= 0) return static_cast<std::uint32_t>(slot);
     Vec3i q = p;
     ++q[axis];
     const double s0 = block.s(p.x, p.y, p.z), s1 = block.s(q.x, q.y, q.z);
     const double t = s0 / (s0 - s1);  // the signs differ, so s0 != s1
-    std::array<double, 3> at{static_cast<double>(p.x), static_cast<double>(p.y), static_cast<double>(p.z)};
+    std::array<double, 3> at{static_cast<double>(p.x), static_cast<double>(p.y),
+                             static_cast<double>(p.z)};
     at[static_cast<std::size_t>(axis)] += t;
     const auto g0 = block.gradient(p.x, p.y, p.z), g1 = block.gradient(q.x, q.y, q.z);
-    std::array<double, 3> normal{g0[0] + t * (g1[0] - g0[0]), g0[1] + t * (g1[1] - g0[1]), g0[2] + t * (g1[2] - g0[2])};
-    if (normal[0] == 0 && normal[1] == 0 && normal[2] == 0) normal[static_cast<std::size_t>(axis)] = s0 < 0 ? 1 : -1;
+    std::array<double, 3> normal{g0[0] + t * (g1[0] - g0[0]), g0[1] + t * (g1[1] - g0[1]),
+                                 g0[2] + t * (g1[2] - g0[2])};
+    if (normal[0] == 0 && normal[1] == 0 && normal[2] == 0)
+      normal[static_cast<std::size_t>(axis)] = s0 < 0 ? 1 : -1;
     bool owned = true, shared = false;
     for (int a = 0; a < 3; ++a) {
       owned &= grid.owner(a, p[a]) == chunk[a];
       if (a != axis && p[a] == b[a] && b[a] > 0) shared = true;
     }
-    const std::uint64_t source = s0 < 0 ? lattice.index(p.x, p.y, p.z) : lattice.index(q.x, q.y, q.z);
+    const std::uint64_t source =
+        s0 < 0 ? lattice.index(p.x, p.y, p.z) : lattice.index(q.x, q.y, q.z);
     const std::uint32_t id = part.add(lattice_position(lattice, at), normal,
-                                      3 * static_cast<std::uint64_t>(lattice.index(p.x, p.y, p.z)) + static_cast<std::uint64_t>(axis),
+                                      3 * static_cast<std::uint64_t>(lattice.index(p.x, p.y, p.z)) +
+                                          static_cast<std::uint64_t>(axis),
                                       source, owned, owned && shared);
     slot = static_cast<std::int32_t>(id);
     return id;
@@ -76,19 +86,24 @@ void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i c
   // below) is corner 2k at x and corner 2k + 1 at x + 1.
   static constexpr auto spread = [] {
     std::array<std::uint8_t, 16> t{};
-    for (unsigned n = 0; n < 16; ++n) t[n] = static_cast<std::uint8_t>((n & 1) | (n & 2) << 1 | (n & 4) << 2 | (n & 8) << 3);
+    for (unsigned n = 0; n < 16; ++n)
+      t[n] = static_cast<std::uint8_t>((n & 1) | (n & 2) << 1 | (n & 4) << 2 | (n & 8) << 3);
     return t;
   }();
   float v[8];
   for (int z = cells.begin.z; z < cells.end.z; ++z)
     for (int y = cells.begin.y; y < cells.end.y; ++y) {
       // Rows whose four sample rows hold one sign only have no surface: most rows, away from it.
-      if ((block.row_signs(y, z) | block.row_signs(y + 1, z) | block.row_signs(y, z + 1) | block.row_signs(y + 1, z + 1)) != 3)
+      if ((block.row_signs(y, z) | block.row_signs(y + 1, z) | block.row_signs(y, z + 1) |
+           block.row_signs(y + 1, z + 1)) != 3)
         continue;
-      const float* r[4] = {block.row(b.x, y, z), block.row(b.x, y + 1, z), block.row(b.x, y, z + 1), block.row(b.x, y + 1, z + 1)};
+      const float* r[4] = {block.row(b.x, y, z), block.row(b.x, y + 1, z), block.row(b.x, y, z + 1),
+                           block.row(b.x, y + 1, z + 1)};
       auto face = [&](int i) {
-        return static_cast<unsigned>(block.inside(r[0][i])) | static_cast<unsigned>(block.inside(r[1][i])) << 1 |
-               static_cast<unsigned>(block.inside(r[2][i])) << 2 | static_cast<unsigned>(block.inside(r[3][i])) << 3;
+        return static_cast<unsigned>(block.inside(r[0][i])) |
+               static_cast<unsigned>(block.inside(r[1][i])) << 1 |
+               static_cast<unsigned>(block.inside(r[2][i])) << 2 |
+               static_cast<unsigned>(block.inside(r[3][i])) << 3;
       };
       unsigned left = face(0);
       for (int x = cells.begin.x; x < cells.end.x; ++x) {
@@ -125,18 +140,22 @@ void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i c
           const int n = cc.centre_sizes[static_cast<std::size_t>(c)];
           std::uint32_t first = 0;
           for (int i = 0; i < n; ++i) {
-            const std::uint32_t id = edge_vertex(cc.centre_edges[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)]);
+            const std::uint32_t id = edge_vertex(
+                cc.centre_edges[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)]);
             if (i == 0) first = id;
             for (std::size_t a = 0; a < 3; ++a) {
               mean[a] += part.positions[id][a] / static_cast<double>(n);
               normal[a] += part.normals[id][a];
             }
           }
-          centre[static_cast<std::size_t>(c)] = part.add(mean, normal, ~std::uint64_t{0}, part.sources[first], true, false);
+          centre[static_cast<std::size_t>(c)] =
+              part.add(mean, normal, ~std::uint64_t{0}, part.sources[first], true, false);
         }
         for (int k = 0; k < 3 * cc.triangle_count; ++k) {
           const int edge = cc.edges[static_cast<std::size_t>(k)];
-          part.indices.push_back(edge >= CubeCase::kCentre ? centre[static_cast<std::size_t>(edge - CubeCase::kCentre)] : edge_vertex(edge));
+          part.indices.push_back(edge >= CubeCase::kCentre
+                                     ? centre[static_cast<std::size_t>(edge - CubeCase::kCentre)]
+                                     : edge_vertex(edge));
         }
       }
     }

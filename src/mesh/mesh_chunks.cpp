@@ -19,7 +19,8 @@ struct MeshChunks::Impl {
   std::vector<detail::mesh::ChunkPart> parts;
 };
 
-MeshChunks::MeshChunks(const ScalarVolume& volume, const MeshOptions& options) : impl_(std::make_unique<Impl>()) {
+MeshChunks::MeshChunks(const ScalarVolume& volume, const MeshOptions& options)
+    : impl_(std::make_unique<Impl>()) {
   using namespace detail::mesh;
   const Lattice lattice = checked_lattice(volume, options, false);
   impl_->options = options;
@@ -38,14 +39,17 @@ MeshChunks& MeshChunks::operator=(MeshChunks&&) noexcept = default;
 std::vector<Vec3i> MeshChunks::update(const ScalarVolume& volume, const Box3i& changed) {
   using namespace detail::mesh;
   Impl& s = *impl_;
-  if (!(volume.size == s.frame.size) || volume.origin_units != s.frame.origin_units || volume.spacing_units != s.frame.spacing_units)
-    throw InvalidArgument("MeshChunks::update: the volume's size or frame changed; build a new MeshChunks");
+  if (!(volume.size == s.frame.size) || volume.origin_units != s.frame.origin_units ||
+      volume.spacing_units != s.frame.spacing_units)
+    throw InvalidArgument(
+        "MeshChunks::update: the volume's size or frame changed; build a new MeshChunks");
   const Lattice lattice = checked_lattice(volume, s.options, false);
   const Box3i region = changed.intersect(Box3i::from_size(volume.size));
   std::vector<std::int64_t> dirty;
   std::vector<Vec3i> coords;
   if (!region.empty()) {
-    // Chunk k along an axis reads samples [k * edge - 3, end + 2], end its last cell's upper corner.
+    // Chunk k along an axis reads samples [k * edge - 3, end + 2], end its last cell's upper
+    // corner.
     Vec3i lo, hi;
     for (int a = 0; a < 3; ++a) {
       lo[a] = std::max(0, (region.begin[a] - 2) / s.grid.edge - 1);
@@ -61,26 +65,31 @@ std::vector<Vec3i> MeshChunks::update(const ScalarVolume& volume, const Box3i& c
             reads.end[a] = cells.end[a] + 3;  // exclusive: corners up to end, stencils two past
           }
           if (reads.intersect(region).empty()) continue;
-          dirty.push_back(x + static_cast<std::int64_t>(s.grid.count.x) * (y + static_cast<std::int64_t>(s.grid.count.y) * z));
+          dirty.push_back(x + static_cast<std::int64_t>(s.grid.count.x) *
+                                  (y + static_cast<std::int64_t>(s.grid.count.y) * z));
           coords.push_back({x, y, z});
         }
   }
   std::vector<ChunkPart> fresh(dirty.size());
   mesh_chunks(lattice, s.grid, s.options, dirty, fresh);  // built aside: a throw changes nothing
-  for (std::size_t i = 0; i < dirty.size(); ++i) std::swap(s.parts[static_cast<std::size_t>(dirty[i])], fresh[i]);
+  for (std::size_t i = 0; i < dirty.size(); ++i)
+    std::swap(s.parts[static_cast<std::size_t>(dirty[i])], fresh[i]);
   return coords;
 }
 
-Vec3i MeshChunks::chunk_count() const { return impl_->grid.count; }
+Vec3i MeshChunks::chunk_count() const {
+  return impl_->grid.count;
+}
 
 Mesh MeshChunks::chunk_mesh(Vec3i c) const {
   const Impl& s = *impl_;
   for (int a = 0; a < 3; ++a)
     if (c[a] < 0 || c[a] >= s.grid.count[a])
-      throw InvalidArgument("MeshChunks::chunk_mesh: chunk " + to_string(c) + " is outside the " + to_string(s.grid.count) +
-                            " chunks");
-  const auto& p = s.parts[static_cast<std::size_t>(c.x + static_cast<std::int64_t>(s.grid.count.x) *
-                                                         (c.y + static_cast<std::int64_t>(s.grid.count.y) * c.z))];
+      throw InvalidArgument("MeshChunks::chunk_mesh: chunk " + to_string(c) + " is outside the " +
+                            to_string(s.grid.count) + " chunks");
+  const auto& p = s.parts[static_cast<std::size_t>(
+      c.x + static_cast<std::int64_t>(s.grid.count.x) *
+                (c.y + static_cast<std::int64_t>(s.grid.count.y) * c.z))];
   Mesh m;
   m.positions = p.positions;
   m.normals = p.normals;
@@ -88,6 +97,8 @@ Mesh MeshChunks::chunk_mesh(Vec3i c) const {
   return m;
 }
 
-Mesh MeshChunks::merged() const { return detail::mesh::weld(impl_->parts, nullptr); }
+Mesh MeshChunks::merged() const {
+  return detail::mesh::weld(impl_->parts, nullptr);
+}
 
 }  // namespace voxfield

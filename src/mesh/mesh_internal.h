@@ -12,8 +12,8 @@ namespace voxfield::detail::mesh {
 // mesh_volume(), also giving each vertex's source sample (the inside sample it was made from,
 // as an index x fastest) when `sources` is not null.
 // `voxel_faces`: the volume is a voxel world's signed field (see Lattice::voxel_faces).
-Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::vector<std::uint64_t>* sources,
-                  bool voxel_faces = false);
+Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options,
+                  std::vector<std::uint64_t>* sources, bool voxel_faces = false);
 
 // The lattice of a request, after checking it (InvalidArgument for a bad volume or options).
 Lattice checked_lattice(const ScalarVolume& volume, const MeshOptions& options, bool voxel_faces);

@@ -40,15 +40,20 @@ MeshStats mesh_stats(const Mesh& mesh) {
   for (std::size_t i = 0; i < uses.size();) {
     std::size_t j = i;
     int forward = 0;
-    while (j < uses.size() && (uses[j] >> 1) == (uses[i] >> 1)) forward += static_cast<int>(uses[j++] & 1);
+    while (j < uses.size() && (uses[j] >> 1) == (uses[i] >> 1))
+      forward += static_cast<int>(uses[j++] & 1);
     const std::size_t count = j - i;
     ++s.edges;
-    if (count == 1) ++s.boundary_edges;
-    else if (count > 2) ++s.nonmanifold_edges;
-    else if (forward != 1) ++s.misoriented_edges;
+    if (count == 1)
+      ++s.boundary_edges;
+    else if (count > 2)
+      ++s.nonmanifold_edges;
+    else if (forward != 1)
+      ++s.misoriented_edges;
     i = j;
   }
-  s.euler_characteristic = static_cast<std::int64_t>(s.vertices) - static_cast<std::int64_t>(s.edges) +
+  s.euler_characteristic = static_cast<std::int64_t>(s.vertices) -
+                           static_cast<std::int64_t>(s.edges) +
                            static_cast<std::int64_t>(s.triangles);
   return s;
 }

@@ -14,9 +14,12 @@ namespace voxfield {
 
 const char* mesher_name(Mesher m) {
   switch (m) {
-    case Mesher::kMarchingCubes: return "mc";
-    case Mesher::kSurfaceNets: return "sn";
-    case Mesher::kDualContouring: return "dc";
+    case Mesher::kMarchingCubes:
+      return "mc";
+    case Mesher::kSurfaceNets:
+      return "sn";
+    case Mesher::kDualContouring:
+      return "dc";
   }
   return "?";
 }
@@ -35,15 +38,18 @@ Lattice checked_lattice(const ScalarVolume& volume, const MeshOptions& options, 
   for (int a = 0; a < 3; ++a) {
     if (volume.size[a] < 2)
       throw InvalidArgument("mesh: the volume needs at least 2 samples along each axis (it has " +
-                            std::to_string(volume.size.x) + " x " + std::to_string(volume.size.y) + " x " +
-                            std::to_string(volume.size.z) + ")");
+                            std::to_string(volume.size.x) + " x " + std::to_string(volume.size.y) +
+                            " x " + std::to_string(volume.size.z) + ")");
     const double s = volume.spacing_units[static_cast<std::size_t>(a)];
-    if (!(s > 0) || !std::isfinite(s)) throw InvalidArgument("mesh: spacing must be positive and finite");
-    if (!std::isfinite(volume.origin_units[static_cast<std::size_t>(a)])) throw InvalidArgument("mesh: origin must be finite");
+    if (!(s > 0) || !std::isfinite(s))
+      throw InvalidArgument("mesh: spacing must be positive and finite");
+    if (!std::isfinite(volume.origin_units[static_cast<std::size_t>(a)]))
+      throw InvalidArgument("mesh: origin must be finite");
   }
   if (!std::isfinite(options.iso)) throw InvalidArgument("mesh: iso must be finite");
   if (options.chunk_edge < 2 || options.chunk_edge > 1024)
-    throw InvalidArgument("mesh: chunk edge " + std::to_string(options.chunk_edge) + " is outside 2..1024");
+    throw InvalidArgument("mesh: chunk edge " + std::to_string(options.chunk_edge) +
+                          " is outside 2..1024");
   Lattice lattice;
   lattice.n = volume.size;
   lattice.values = volume.values;
@@ -59,7 +65,8 @@ void mesh_chunks(const Lattice& lattice, const ChunkGrid& grid, const MeshOption
                  const std::vector<std::int64_t>& chunks, std::vector<ChunkPart>& parts) {
   Progress progress(options.interrupter,
                     options.algorithm == Mesher::kMarchingCubes ? "marching cubes"
-                    : options.algorithm == Mesher::kSurfaceNets ? "surface nets" : "dual contouring",
+                    : options.algorithm == Mesher::kSurfaceNets ? "surface nets"
+                                                                : "dual contouring",
                     static_cast<std::int64_t>(chunks.size()));
   parallel_for(chunks.size(), 1, [&](std::size_t begin, std::size_t end) {
     Block block;
@@ -74,7 +81,8 @@ void mesh_chunks(const Lattice& lattice, const ChunkGrid& grid, const MeshOption
           marching_cubes_chunk(lattice, grid, chunk, block, scratch, part);
         else
           dual_grid_chunk(lattice, grid, chunk, block, scratch, part,
-                          options.algorithm == Mesher::kSurfaceNets ? surface_nets_vertex : dual_contouring_vertex);
+                          options.algorithm == Mesher::kSurfaceNets ? surface_nets_vertex
+                                                                    : dual_contouring_vertex);
       }
       progress.advance();
     }
@@ -82,8 +90,8 @@ void mesh_chunks(const Lattice& lattice, const ChunkGrid& grid, const MeshOption
   progress.throw_if_cancelled();
 }
 
-Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options, std::vector<std::uint64_t>* sources,
-                  bool voxel_faces) {
+Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options,
+                  std::vector<std::uint64_t>* sources, bool voxel_faces) {
   const Lattice lattice = checked_lattice(volume, options, voxel_faces);
   const ChunkGrid grid(volume.size, options.chunk_edge);
   std::vector<std::int64_t> all(static_cast<std::size_t>(grid.total()));

@@ -29,7 +29,8 @@ Mesh mesh_world(const World& world, const MeshOptions& options) {
   }
   const World& source = clipped ? *unbounded : world;
   // The float samples: 4 bytes per voxel of the domain, on top of the field itself.
-  require_memory(mul_sat(static_cast<std::uint64_t>(domain.volume()), 8), 0, "mesh", "the world's signed distance samples");
+  require_memory(mul_sat(static_cast<std::uint64_t>(domain.volume()), 8), 0, "mesh",
+                 "the world's signed distance samples");
   DistanceOptions field_options;
   field_options.metric = Metric::kEuclidean;
   field_options.signed_distance = true;
@@ -42,17 +43,20 @@ Mesh mesh_world(const World& world, const MeshOptions& options) {
   ScalarVolume volume;
   volume.size = size;
   volume.values = samples.data();
-  for (int a = 0; a < 3; ++a) volume.origin_units[static_cast<std::size_t>(a)] = domain.begin[a] + 0.5;
+  for (int a = 0; a < 3; ++a)
+    volume.origin_units[static_cast<std::size_t>(a)] = domain.begin[a] + 0.5;
   MeshOptions o = options;
   o.iso = 0;
   o.inside_above = false;
   std::vector<std::uint64_t> sources;
   Mesh mesh = detail::mesh::mesh_lattice(volume, o, &sources, /*voxel_faces=*/true);
   mesh.colors.resize(mesh.positions.size());
-  const std::uint64_t nx = static_cast<std::uint64_t>(size.x), nxy = nx * static_cast<std::uint64_t>(size.y);
+  const std::uint64_t nx = static_cast<std::uint64_t>(size.x),
+                      nxy = nx * static_cast<std::uint64_t>(size.y);
   for (std::size_t i = 0; i < sources.size(); ++i) {
     const std::uint64_t s = sources[i];
-    const Vec3i p{domain.begin.x + static_cast<int>(s % nx), domain.begin.y + static_cast<int>(s / nx % static_cast<std::uint64_t>(size.y)),
+    const Vec3i p{domain.begin.x + static_cast<int>(s % nx),
+                  domain.begin.y + static_cast<int>(s / nx % static_cast<std::uint64_t>(size.y)),
                   domain.begin.z + static_cast<int>(s / nxy)};
     const Rgba c = world.palette[world.voxels.get(p)];
     mesh.colors[i] = {c.r, c.g, c.b};

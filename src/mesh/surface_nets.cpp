@@ -16,7 +16,8 @@ std::array<double, 3> surface_nets_vertex(const Block&, const Lattice&, Vec3i, c
     const double s0 = v[e.from], s1 = v[e.to];
     if ((s0 < 0) == (s1 < 0)) continue;
     const double t = s0 / (s0 - s1);
-    for (int a = 0; a < 3; ++a) mean[static_cast<std::size_t>(a)] += a == e.axis ? t : (e.from >> a & 1);
+    for (int a = 0; a < 3; ++a)
+      mean[static_cast<std::size_t>(a)] += a == e.axis ? t : (e.from >> a & 1);
     ++crossings;
   }
   for (double& m : mean) m /= crossings;  // the cell has a crossing: a quad reached it

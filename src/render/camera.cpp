@@ -13,10 +13,13 @@ namespace voxfield {
 namespace {
 
 Vec3d centre_of(const Box3i& box) {
-  return {0.5 * (box.begin.x + box.end.x), 0.5 * (box.begin.y + box.end.y), 0.5 * (box.begin.z + box.end.z)};
+  return {0.5 * (box.begin.x + box.end.x), 0.5 * (box.begin.y + box.end.y),
+          0.5 * (box.begin.z + box.end.z)};
 }
 
-double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
+double radians(double degrees) {
+  return degrees * std::numbers::pi / 180.0;
+}
 
 Vec3d parse_vec(const std::string& key, const std::string& text) {
   std::vector<double> v;
@@ -31,12 +34,14 @@ Vec3d parse_vec(const std::string& key, const std::string& text) {
       throw InvalidArgument("camera: " + key + "=" + text + ": \"" + part + "\" is not a number");
     }
   }
-  if (v.size() != 3) throw InvalidArgument("camera: " + key + "=" + text + ": expected three numbers x,y,z");
+  if (v.size() != 3)
+    throw InvalidArgument("camera: " + key + "=" + text + ": expected three numbers x,y,z");
   // Bounded so that ray positions stay exactly representable next to voxel coordinates (the
   // supported range is 2^29; beyond about 2^40 the traversal's conversions to int lose meaning).
   for (double x : v)
     if (!std::isfinite(x) || std::abs(x) > 1e12) {
-      throw InvalidArgument("camera: " + key + "=" + text + ": each coordinate must be finite and within +-1e12");
+      throw InvalidArgument("camera: " + key + "=" + text +
+                            ": each coordinate must be finite and within +-1e12");
     }
   return {v[0], v[1], v[2]};
 }
@@ -61,8 +66,8 @@ Camera Camera::framing(const Box3i& box, double aspect, double fov_degrees) {
   c.up = {0, 0, 1};
   // From above the (-x, -y) corner, 30 degrees over the horizon: shows two sides and the top.
   const double azimuth = radians(-115), elevation = radians(30);
-  const Vec3d to_eye{std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
-                     std::sin(elevation)};
+  const Vec3d to_eye{std::cos(elevation) * std::cos(azimuth),
+                     std::cos(elevation) * std::sin(azimuth), std::sin(elevation)};
   const Vec3d forward = to_eye * -1;
   const Vec3d right = cross(forward, c.up).normalized();
   const Vec3d up = cross(right, forward);
@@ -81,17 +86,21 @@ Camera Camera::framing(const Box3i& box, double aspect, double fov_degrees) {
     distance = 0;
     for (const Vec3d& corner : corners) {
       const Vec3d q = corner - c.target;
-      distance = std::max(distance, std::max(std::abs(dot(q, right)) / tan_h, std::abs(dot(q, up)) / tan_v) -
-                                        dot(q, forward));
+      distance = std::max(distance,
+                          std::max(std::abs(dot(q, right)) / tan_h, std::abs(dot(q, up)) / tan_v) -
+                              dot(q, forward));
     }
     double lo_x = 1e300, hi_x = -1e300, lo_y = 1e300, hi_y = -1e300;
     for (const Vec3d& corner : corners) {
       const Vec3d q = corner - c.target;
       const double depth = dot(q, forward) + distance;
-      lo_x = std::min(lo_x, dot(q, right) / depth); hi_x = std::max(hi_x, dot(q, right) / depth);
-      lo_y = std::min(lo_y, dot(q, up) / depth); hi_y = std::max(hi_y, dot(q, up) / depth);
+      lo_x = std::min(lo_x, dot(q, right) / depth);
+      hi_x = std::max(hi_x, dot(q, right) / depth);
+      lo_y = std::min(lo_y, dot(q, up) / depth);
+      hi_y = std::max(hi_y, dot(q, up) / depth);
     }
-    c.target = c.target + right * (0.5 * (lo_x + hi_x) * distance) + up * (0.5 * (lo_y + hi_y) * distance);
+    c.target =
+        c.target + right * (0.5 * (lo_x + hi_x) * distance) + up * (0.5 * (lo_y + hi_y) * distance);
   }
   c.eye = c.target + to_eye * (distance * 1.03);
   return c;
@@ -119,7 +128,8 @@ Camera Camera::parse(const std::string& spec, const Box3i& box, double aspect) {
   while (std::getline(ss, part, ':')) {
     const auto eq = part.find('=');
     if (eq == std::string::npos)
-      throw InvalidArgument("camera: \"" + part + "\" is not key=value (keys: eye, target, up, fov, ortho)");
+      throw InvalidArgument("camera: \"" + part +
+                            "\" is not key=value (keys: eye, target, up, fov, ortho)");
     const std::string key = part.substr(0, eq), value = part.substr(eq + 1);
     if (key == "eye") {
       c.eye = parse_vec(key, value);
@@ -131,16 +141,19 @@ Camera Camera::parse(const std::string& spec, const Box3i& box, double aspect) {
       c.up = parse_vec(key, value);
     } else if (key == "fov") {
       c.fov_degrees = parse_number(key, value);
-      if (!(c.fov_degrees > 0 && c.fov_degrees < 180)) throw InvalidArgument("camera: fov must lie in (0, 180) degrees");
+      if (!(c.fov_degrees > 0 && c.fov_degrees < 180))
+        throw InvalidArgument("camera: fov must lie in (0, 180) degrees");
     } else if (key == "ortho") {
       c.projection = Projection::kOrthographic;
       c.ortho_height = parse_number(key, value);
       if (!(c.ortho_height > 0)) throw InvalidArgument("camera: ortho height must be positive");
     } else {
-      throw InvalidArgument("camera: unknown key \"" + key + "\" (keys: eye, target, up, fov, ortho)");
+      throw InvalidArgument("camera: unknown key \"" + key +
+                            "\" (keys: eye, target, up, fov, ortho)");
     }
   }
-  if (!has_eye || !has_target) throw InvalidArgument("camera: give both eye=x,y,z and target=x,y,z");
+  if (!has_eye || !has_target)
+    throw InvalidArgument("camera: give both eye=x,y,z and target=x,y,z");
   const Vec3d forward = c.target - c.eye;
   if (forward.length() == 0) throw InvalidArgument("camera: eye and target coincide");
   if (cross(forward, c.up).length() <= 1e-9 * forward.length() * c.up.length())
@@ -155,7 +168,8 @@ Camera::Projector Camera::projector(int width, int height) const {
   p.forward = (target - eye).normalized();
   p.right = cross(p.forward, up).normalized();
   p.up = cross(p.right, p.forward);
-  p.scale = projection == Projection::kOrthographic ? ortho_height / 2 : std::tan(radians(fov_degrees) / 2);
+  p.scale = projection == Projection::kOrthographic ? ortho_height / 2
+                                                    : std::tan(radians(fov_degrees) / 2);
   p.width = width;
   p.height = height;
   return p;

@@ -28,11 +28,11 @@
 namespace voxfield::render_detail {
 
 struct Dda {
-  Vec3i v{0, 0, 0};          // current voxel
-  int step[3] = {0, 0, 0};   // -1, 0 or +1 per axis
+  Vec3i v{0, 0, 0};             // current voxel
+  int step[3] = {0, 0, 0};      // -1, 0 or +1 per axis
   int boundary[3] = {0, 0, 0};  // the next plane crossed along each axis
   double origin[3] = {0, 0, 0};
-  double inv[3] = {0, 0, 0};    // 1 / direction (unused where step is 0)
+  double inv[3] = {0, 0, 0};  // 1 / direction (unused where step is 0)
   double abs_dir[3] = {0, 0, 0};
   double t_next[3] = {0, 0, 0};  // t_a(0); +inf on axes the ray does not move along
   double t = 0;                  // where the ray entered v
@@ -111,7 +111,8 @@ struct Dda {
         const double tb = t_at(b, j);
         return tb < e.t || (tb == e.t && b < e.axis);
       };
-      int j = static_cast<int>(std::clamp((e.t - t_next[b]) * abs_dir[b], 0.0, static_cast<double>(caps[b])));
+      int j = static_cast<int>(
+          std::clamp((e.t - t_next[b]) * abs_dir[b], 0.0, static_cast<double>(caps[b])));
       while (j > 0 && !before(j - 1)) --j;
       while (j < caps[b] && before(j)) ++j;
       n[b] = j;

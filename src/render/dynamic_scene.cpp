@@ -13,8 +13,10 @@ namespace {
 
 const World& bounded(const World& world) {
   if (!world.voxels.bounds())
-    throw InvalidArgument("DynamicRenderScene: the world must be bounded (its bounds are the render box)");
-  if (world.voxels.bounds()->empty()) throw InvalidArgument("DynamicRenderScene: the world's bounds are empty");
+    throw InvalidArgument(
+        "DynamicRenderScene: the world must be bounded (its bounds are the render box)");
+  if (world.voxels.bounds()->empty())
+    throw InvalidArgument("DynamicRenderScene: the world's bounds are empty");
   return world;
 }
 
@@ -35,7 +37,8 @@ DynamicRenderScene::DynamicRenderScene(const World& world, RenderSceneOptions op
     : world_(&bounded(world)),
       skip_(world, skip_field_options(options, *world.voxels.bounds())),
       light_(options.lighting_field
-                 ? std::optional<DynamicDistanceField>(std::in_place, world, light_field_options(options, *world.voxels.bounds()))
+                 ? std::optional<DynamicDistanceField>(
+                       std::in_place, world, light_field_options(options, *world.voxels.bounds()))
                  : std::nullopt),
       scene_(world, skip_.field(), light_ ? &light_->field() : nullptr) {}
 

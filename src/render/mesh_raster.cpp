@@ -17,13 +17,16 @@
 
 namespace voxfield {
 
-Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOptions& options, MeshRenderStats* stats) {
+Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOptions& options,
+                  MeshRenderStats* stats) {
   const auto start = std::chrono::steady_clock::now();
   Image image(options.width, options.height);
-  if (mesh.normals.size() != mesh.positions.size() || (!mesh.colors.empty() && mesh.colors.size() != mesh.positions.size()))
+  if (mesh.normals.size() != mesh.positions.size() ||
+      (!mesh.colors.empty() && mesh.colors.size() != mesh.positions.size()))
     throw InvalidArgument("render_mesh: normals and colours do not match the positions");
   for (std::size_t i = 0; i < image.rgb.size(); i += 3)
-    std::copy(options.background.begin(), options.background.end(), image.rgb.begin() + static_cast<std::ptrdiff_t>(i));
+    std::copy(options.background.begin(), options.background.end(),
+              image.rgb.begin() + static_cast<std::ptrdiff_t>(i));
   const Camera::Projector pr = camera.projector(options.width, options.height);
   const bool ortho = pr.projection == Camera::Projection::kOrthographic;
   const double w = options.width, h = options.height;
@@ -34,7 +37,8 @@ Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOption
   };
   std::vector<Screen> screen(mesh.positions.size());
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
-    const Vec3d d = Vec3d{mesh.positions[i][0], mesh.positions[i][1], mesh.positions[i][2]} - pr.eye;
+    const Vec3d d =
+        Vec3d{mesh.positions[i][0], mesh.positions[i][1], mesh.positions[i][2]} - pr.eye;
     const double z = dot(d, pr.forward);
     double sx = dot(d, pr.right), sy = dot(d, pr.up);
     const bool visible = ortho || z > 1e-3;
@@ -42,8 +46,9 @@ Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOption
     screen[i] = {(sx / pr.scale * h + w) / 2, (h - sy / pr.scale * h) / 2, z, visible};
   }
   const Vec3d light = options.light_towards.normalized();
-  std::vector<float> depth(static_cast<std::size_t>(options.width) * static_cast<std::size_t>(options.height),
-                           std::numeric_limits<float>::infinity());
+  std::vector<float> depth(
+      static_cast<std::size_t>(options.width) * static_cast<std::size_t>(options.height),
+      std::numeric_limits<float>::infinity());
   MeshRenderStats st;
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
     const std::uint32_t* v = mesh.indices.data() + 3 * t;
@@ -54,9 +59,11 @@ Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOption
     const double area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
     if (area == 0 || !std::isfinite(area)) continue;
     const int x0 = std::max(0, static_cast<int>(std::floor(std::min({a.x, b.x, c.x}))));
-    const int x1 = std::min(options.width - 1, static_cast<int>(std::ceil(std::max({a.x, b.x, c.x}))));
+    const int x1 =
+        std::min(options.width - 1, static_cast<int>(std::ceil(std::max({a.x, b.x, c.x}))));
     const int y0 = std::max(0, static_cast<int>(std::floor(std::min({a.y, b.y, c.y}))));
-    const int y1 = std::min(options.height - 1, static_cast<int>(std::ceil(std::max({a.y, b.y, c.y}))));
+    const int y1 =
+        std::min(options.height - 1, static_cast<int>(std::ceil(std::max({a.y, b.y, c.y}))));
     if (x0 > x1 || y0 > y1) continue;
     ++st.triangles_drawn;
     // Edge lengths in pixels, for the distance of a pixel to each edge.
@@ -79,7 +86,8 @@ Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOption
           z = 1 / inv;
           pa = wa / a.depth * z, pb = wb / b.depth * z, pc = wc / c.depth * z;
         }
-        float& zb = depth[static_cast<std::size_t>(py) * static_cast<std::size_t>(options.width) + static_cast<std::size_t>(px)];
+        float& zb = depth[static_cast<std::size_t>(py) * static_cast<std::size_t>(options.width) +
+                          static_cast<std::size_t>(px)];
         if (!(z < zb)) continue;
         zb = static_cast<float>(z);
         Vec3d n{0, 0, 0};
@@ -98,21 +106,25 @@ Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOption
         for (int ch = 0; ch < 3; ++ch) {
           double base = options.base_color[static_cast<std::size_t>(ch)];
           if (options.use_colors && !mesh.colors.empty())
-            base = pa * mesh.colors[v[0]][static_cast<std::size_t>(ch)] + pb * mesh.colors[v[1]][static_cast<std::size_t>(ch)] +
+            base = pa * mesh.colors[v[0]][static_cast<std::size_t>(ch)] +
+                   pb * mesh.colors[v[1]][static_cast<std::size_t>(ch)] +
                    pc * mesh.colors[v[2]][static_cast<std::size_t>(ch)];
           rgb[ch] = base * shade;
         }
         if (options.edges) {
-          const double d = std::min({wa * std::abs(area) / len_a, wb * std::abs(area) / len_b, wc * std::abs(area) / len_c});
+          const double d = std::min({wa * std::abs(area) / len_a, wb * std::abs(area) / len_b,
+                                     wc * std::abs(area) / len_c});
           if (d < 0.6)
             for (double& ch : rgb) ch *= 0.35;
         }
         std::uint8_t* out = image.pixel(px, py);
-        for (int ch = 0; ch < 3; ++ch) out[ch] = static_cast<std::uint8_t>(std::min(255.0, std::max(0.0, rgb[ch]) + 0.5));
+        for (int ch = 0; ch < 3; ++ch)
+          out[ch] = static_cast<std::uint8_t>(std::min(255.0, std::max(0.0, rgb[ch]) + 0.5));
         ++st.pixels_covered;
       }
   }
-  st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  st.ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   if (stats) *stats = st;
   return image;
 }

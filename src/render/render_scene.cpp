@@ -2,8 +2,8 @@
 // chunk table, empty-chunk flags and the linear-light palette.
 #include <atomic>
 #include <chrono>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 #include <new>
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -27,9 +27,11 @@ std::uint32_t BrickedChunks<T>::take_slot() {
   const std::size_t needed = (std::size_t{slots_used} + 1) * slot_bytes();
   if (needed > arena.size()) {
     // Grow by half again, so a stream of edits that densify chunks costs amortised O(1) copies.
-    const std::size_t slots = std::max<std::size_t>(std::size_t{slots_used} + 1, std::size_t{slots_used} * 3 / 2 + 4);
+    const std::size_t slots =
+        std::max<std::size_t>(std::size_t{slots_used} + 1, std::size_t{slots_used} * 3 / 2 + 4);
     render_detail::LargeBuffer bigger(slots * slot_bytes());
-    if (slots_used > 0) std::memcpy(bigger.data(), arena.data(), std::size_t{slots_used} * slot_bytes());
+    if (slots_used > 0)
+      std::memcpy(bigger.data(), arena.data(), std::size_t{slots_used} * slot_bytes());
     arena = std::move(bigger);
   }
   return slots_used++;
@@ -44,7 +46,8 @@ LargeBuffer::LargeBuffer(std::size_t bytes) : size_(bytes) {
 #if defined(__linux__)
   // Anonymous pages arrive zeroed and only when touched, so a buffer grown for a few more chunks
   // costs nothing until they are written; over-map by 2 MiB to align the start to a huge page.
-  void* p = mmap(nullptr, rounded + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  void* p =
+      mmap(nullptr, rounded + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
   if (p == MAP_FAILED) throw std::bad_alloc();
   map_ = p;
   map_bytes_ = rounded + kHuge;
@@ -92,8 +95,9 @@ DistanceOptions skip_field_options(const RenderSceneOptions& options, const Box3
   o.storage = Storage::kU8;
   const double most = o.metric == Metric::kEuclidean ? 63 : 255;
   if (!(options.skip_clamp >= 0 && options.skip_clamp <= most))
-    throw InvalidArgument("render: the skip clamp must lie in [0, " + std::to_string(static_cast<int>(most)) +
-                          "] voxels for the " + metric_name(o.metric) + " metric (0 = the most)");
+    throw InvalidArgument("render: the skip clamp must lie in [0, " +
+                          std::to_string(static_cast<int>(most)) + "] voxels for the " +
+                          metric_name(o.metric) + " metric (0 = the most)");
   o.max_distance = options.skip_clamp > 0 ? options.skip_clamp : most;
   o.domain = box;
   return o;
@@ -123,7 +127,8 @@ bool place_chunk(BrickedChunks<T>& out, const render_detail::ChunkTable& table, 
                  const Grid<std::uint8_t>& low, const Grid<std::uint8_t>* high) {
   const Vec3i coord = table.chunk_coord(i);
   const ChunkView<std::uint8_t> l = low.chunk_view(coord);
-  const ChunkView<std::uint8_t> h = high ? high->chunk_view(coord) : ChunkView<std::uint8_t>{coord, {}, nullptr, 0};
+  const ChunkView<std::uint8_t> h =
+      high ? high->chunk_view(coord) : ChunkView<std::uint8_t>{coord, {}, nullptr, 0};
   if (l.voxels || h.voxels) {
     if (out.slot[i] != BrickedChunks<T>::kUniform) return false;
     out.slot[i] = out.take_slot();
@@ -146,7 +151,8 @@ bool copy_chunk(BrickedChunks<T>& out, const render_detail::ChunkTable& table, s
                 const Grid<std::uint8_t>& low, const Grid<std::uint8_t>* high) {
   const Vec3i coord = table.chunk_coord(i);
   const ChunkView<std::uint8_t> l = low.chunk_view(coord);
-  const ChunkView<std::uint8_t> h = high ? high->chunk_view(coord) : ChunkView<std::uint8_t>{coord, {}, nullptr, 0};
+  const ChunkView<std::uint8_t> h =
+      high ? high->chunk_view(coord) : ChunkView<std::uint8_t>{coord, {}, nullptr, 0};
   T* dst = out.slot_data(out.slot[i]);
   const int edge = low.chunk_edge();
   const Vec3i origin{coord.x * edge, coord.y * edge, coord.z * edge};
@@ -194,12 +200,14 @@ BrickedChunks<T> empty_bricks(const render_detail::ChunkTable& table, const Grid
 
 void require_field(const DistanceField& f, const Box3i& box, int chunk_edge, const char* what) {
   if (f.options.storage != Storage::kU8 || f.options.signed_distance)
-    throw InvalidArgument(std::string("render: the ") + what + " field must be unsigned with u8 storage");
+    throw InvalidArgument(std::string("render: the ") + what +
+                          " field must be unsigned with u8 storage");
   if (!f.domain.contains(box))
-    throw InvalidArgument(std::string("render: the ") + what + " field's domain " + to_string(f.domain) +
-                          " does not cover the render box " + to_string(box));
+    throw InvalidArgument(std::string("render: the ") + what + " field's domain " +
+                          to_string(f.domain) + " does not cover the render box " + to_string(box));
   if (f.chunk_edge() != chunk_edge)
-    throw InvalidArgument(std::string("render: the ") + what + " field's chunk edge differs from the world's");
+    throw InvalidArgument(std::string("render: the ") + what +
+                          " field's chunk edge differs from the world's");
 }
 
 }  // namespace
@@ -212,7 +220,8 @@ bool RenderScene::Impl::refresh_chunk(std::size_t i, const Grid<std::uint8_t>& s
     changed = copy_chunk(skip.cells, table, i, skip_grid, &world->voxels);
   if (light_grid && light.slot[i] != BrickedChunks<std::uint8_t>::kUniform)
     changed = copy_chunk(light, table, i, *light_grid, nullptr) || changed;
-  const std::uint8_t old_min = skip.chunk_min[i], old_empty = empty_chunk[i], old_dense = dense_material[i];
+  const std::uint8_t old_min = skip.chunk_min[i], old_empty = empty_chunk[i],
+                     old_dense = dense_material[i];
   skip.chunk_min[i] = chunk_min(skip_grid, coord, skip.cells.chunk_volume);
   const ChunkView<std::uint8_t> v = world->voxels.chunk_view(coord);
   bool empty = true;
@@ -223,7 +232,8 @@ bool RenderScene::Impl::refresh_chunk(std::size_t i, const Grid<std::uint8_t>& s
   }
   empty_chunk[i] = empty ? 1 : 0;
   dense_material[i] = v.voxels ? 1 : 0;
-  return changed || old_min != skip.chunk_min[i] || old_empty != empty_chunk[i] || old_dense != dense_material[i];
+  return changed || old_min != skip.chunk_min[i] || old_empty != empty_chunk[i] ||
+         old_dense != dense_material[i];
 }
 
 namespace {
@@ -232,11 +242,13 @@ namespace {
 std::array<std::array<float, 3>, 256> linear_albedo(const World& w) {
   std::array<std::array<float, 3>, 256> out{};
   for (int m = 0; m < 256; ++m)
-    out[m] = {srgb_to_linear(w.palette[m].r), srgb_to_linear(w.palette[m].g), srgb_to_linear(w.palette[m].b)};
+    out[m] = {srgb_to_linear(w.palette[m].r), srgb_to_linear(w.palette[m].g),
+              srgb_to_linear(w.palette[m].b)};
   return out;
 }
 
-void check_fields(const RenderScene::Impl& s, const DistanceField& skip_field, const DistanceField* light_field, int edge) {
+void check_fields(const RenderScene::Impl& s, const DistanceField& skip_field,
+                  const DistanceField* light_field, int edge) {
   require_field(skip_field, s.box, edge, "skip");
   if (light_field) {
     require_field(*light_field, s.box, edge, "lighting");
@@ -250,7 +262,8 @@ void check_fields(const RenderScene::Impl& s, const DistanceField& skip_field, c
 int RenderScene::Impl::slice_z(const RenderOptions& o) const {
   const int z = o.slice_z ? *o.slice_z : (box.begin.z + box.end.z) / 2;
   if (z < box.begin.z || z >= box.end.z)
-    throw InvalidArgument("render: slice z=" + std::to_string(z) + " lies outside the box " + to_string(box));
+    throw InvalidArgument("render: slice z=" + std::to_string(z) + " lies outside the box " +
+                          to_string(box));
   return z;
 }
 
@@ -271,7 +284,8 @@ SkipSource RenderScene::Impl::approximation(Algorithm algorithm) const {
     // FIM in the middle of the box (3/8 to 5/8 of each extent, as `voxfield compare` does).
     const Vec3i sz = box.size();
     const Vec3i lo{sz.x * 3 / 8, sz.y * 3 / 8, sz.z * 3 / 8};
-    const Vec3i hi{std::max(sz.x * 5 / 8, lo.x + 1), std::max(sz.y * 5 / 8, lo.y + 1), std::max(sz.z * 5 / 8, lo.z + 1)};
+    const Vec3i hi{std::max(sz.x * 5 / 8, lo.x + 1), std::max(sz.y * 5 / 8, lo.y + 1),
+                   std::max(sz.z * 5 / 8, lo.z + 1)};
     ao.focus = Box3i{box.begin + lo, box.begin + hi};
   }
   return make_skip_source(compute_distance_field(*world, skip_options, ao));
@@ -288,20 +302,23 @@ SkipSource RenderScene::Impl::make_skip_source(const DistanceField& field) const
   for (std::size_t i = 0; i < n; ++i) place_chunk(src.cells, table, i, grid, &world->voxels);
   parallel_for(n, 4, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
-      if (src.cells.slot[i] != BrickedChunks<std::uint16_t>::kUniform) copy_chunk(src.cells, table, i, grid, &world->voxels);
+      if (src.cells.slot[i] != BrickedChunks<std::uint16_t>::kUniform)
+        copy_chunk(src.cells, table, i, grid, &world->voxels);
       src.chunk_min[i] = chunk_min(grid, table.chunk_coord(i), src.cells.chunk_volume);
     }
   });
   return src;
 }
 
-void RenderScene::Impl::build(const World& w, const DistanceField& skip_field, const DistanceField* light_field) {
+void RenderScene::Impl::build(const World& w, const DistanceField& skip_field,
+                              const DistanceField* light_field) {
   const int edge = w.voxels.chunk_edge();
   check_fields(*this, skip_field, light_field, edge);
   id = next_scene_id.fetch_add(1);
   table = render_detail::ChunkTable(box, edge);
   const auto& skip_grid = std::get<Grid<std::uint8_t>>(skip_field.values);
-  const Grid<std::uint8_t>* light_grid = light_field ? &std::get<Grid<std::uint8_t>>(light_field->values) : nullptr;
+  const Grid<std::uint8_t>* light_grid =
+      light_field ? &std::get<Grid<std::uint8_t>>(light_field->values) : nullptr;
   skip_options = skip_field.options;
   skip.metric = skip_field.options.metric;
   skip.inv_scale = 1.0 / skip_field.encoding.scale;
@@ -331,11 +348,13 @@ std::size_t RenderScene::update(const DistanceField& skip_field, const DistanceF
                                 std::span<const Box3i> boxes) {
   Impl& s = *impl_;
   check_fields(s, skip_field, light_field, s.table.chunk_edge());
-  if (skip_field.options.metric != s.skip.metric || 1.0 / skip_field.encoding.scale != s.skip.inv_scale)
+  if (skip_field.options.metric != s.skip.metric ||
+      1.0 / skip_field.encoding.scale != s.skip.inv_scale)
     throw InvalidArgument("render: update() needs a skip field of the scene's metric and scale");
   if ((light_field != nullptr) != s.has_light ||
       (light_field && 1.0 / light_field->encoding.scale != s.light_inv_scale))
-    throw InvalidArgument("render: update() needs a lighting field exactly when the scene has one, of its scale");
+    throw InvalidArgument(
+        "render: update() needs a lighting field exactly when the scene has one, of its scale");
   if (s.world->voxels.chunk_edge() != s.table.chunk_edge())
     throw InvalidArgument("render: the world's chunk edge changed since the scene was made");
 
@@ -355,13 +374,15 @@ std::size_t RenderScene::update(const DistanceField& skip_field, const DistanceF
   if (chunks.empty()) return 0;
 
   const auto& skip_grid = std::get<Grid<std::uint8_t>>(skip_field.values);
-  const Grid<std::uint8_t>* light_grid = light_field ? &std::get<Grid<std::uint8_t>>(light_field->values) : nullptr;
+  const Grid<std::uint8_t>* light_grid =
+      light_field ? &std::get<Grid<std::uint8_t>>(light_field->values) : nullptr;
   // Slots change hands one chunk at a time; then the voxels are copied in parallel. Only chunks
   // whose contents really changed get a new generation (and are copied to a GPU again).
   std::vector<std::uint8_t> changed(chunks.size(), 0);
   for (std::size_t k = 0; k < chunks.size(); ++k) {
     changed[k] = place_chunk(s.skip.cells, s.table, chunks[k], skip_grid, &s.world->voxels) ? 1 : 0;
-    if (light_grid && place_chunk(s.light, s.table, chunks[k], *light_grid, nullptr)) changed[k] = 1;
+    if (light_grid && place_chunk(s.light, s.table, chunks[k], *light_grid, nullptr))
+      changed[k] = 1;
   }
   parallel_for(chunks.size(), 4, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k)
@@ -385,14 +406,18 @@ std::size_t RenderScene::update(const DistanceField& skip_field, const DistanceF
 namespace {
 
 Box3i default_box(const World& world, std::optional<Box3i> box) {
-  const Box3i b = box ? *box : world.voxels.bounds() ? *world.voxels.bounds() : world.voxels.content_bounds();
-  if (b.empty()) throw InvalidArgument("render: nothing to render (empty box " + to_string(b) + ")");
+  const Box3i b = box                     ? *box
+                  : world.voxels.bounds() ? *world.voxels.bounds()
+                                          : world.voxels.content_bounds();
+  if (b.empty())
+    throw InvalidArgument("render: nothing to render (empty box " + to_string(b) + ")");
   return b;
 }
 
 }  // namespace
 
-RenderScene::RenderScene(const World& world, const RenderSceneOptions& options, std::optional<Box3i> box)
+RenderScene::RenderScene(const World& world, const RenderSceneOptions& options,
+                         std::optional<Box3i> box)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.world = &world;
@@ -405,7 +430,8 @@ RenderScene::RenderScene(const World& world, const RenderSceneOptions& options, 
   const DistanceField skip = compute_distance_field(world, skip_o);
   std::optional<DistanceField> light;
   if (light_o) light = compute_distance_field(world, *light_o);
-  s.field_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  s.field_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   s.build(world, skip, light ? &*light : nullptr);
 }
 
@@ -426,9 +452,17 @@ RenderScene::~RenderScene() = default;
 RenderScene::RenderScene(RenderScene&&) noexcept = default;
 RenderScene& RenderScene::operator=(RenderScene&&) noexcept = default;
 
-const World& RenderScene::world() const { return *impl_->world; }
-const Box3i& RenderScene::box() const { return impl_->box; }
-const RenderSceneOptions& RenderScene::options() const { return impl_->options; }
-double RenderScene::field_ms() const { return impl_->field_ms; }
+const World& RenderScene::world() const {
+  return *impl_->world;
+}
+const Box3i& RenderScene::box() const {
+  return impl_->box;
+}
+const RenderSceneOptions& RenderScene::options() const {
+  return impl_->options;
+}
+double RenderScene::field_ms() const {
+  return impl_->field_ms;
+}
 
 }  // namespace voxfield

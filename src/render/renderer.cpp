@@ -1,9 +1,10 @@
 // voxfield renderer — frames: primary rays per pixel over tiles, shading and the debug views.
 //
 // Shading goes beyond the dissertation's colour x local occlusion: palette albedo in linear light,
-// a sun with soft shadows and a sky dome with ambient occlusion — both read from a clamped Euclidean
-// field (the "distance field soft shadows" of Quilez's SDF rendering notes, made exact in occlusion
-// by tracing the shadow ray with the same DDA) — optional fog, and a sky gradient for misses.
+// a sun with soft shadows and a sky dome with ambient occlusion — both read from a clamped
+// Euclidean field (the "distance field soft shadows" of Quilez's SDF rendering notes, made exact in
+// occlusion by tracing the shadow ray with the same DDA) — optional fog, and a sky gradient for
+// misses.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -17,18 +18,24 @@ namespace voxfield {
 
 const char* render_view_name(RenderView v) {
   switch (v) {
-    case RenderView::kShaded: return "shaded";
-    case RenderView::kDistance: return "distance";
-    case RenderView::kError: return "error";
-    case RenderView::kChunks: return "chunks";
+    case RenderView::kShaded:
+      return "shaded";
+    case RenderView::kDistance:
+      return "distance";
+    case RenderView::kError:
+      return "error";
+    case RenderView::kChunks:
+      return "chunks";
   }
   return "?";
 }
 
 RenderView parse_render_view(const std::string& name) {
-  for (RenderView v : {RenderView::kShaded, RenderView::kDistance, RenderView::kError, RenderView::kChunks})
+  for (RenderView v :
+       {RenderView::kShaded, RenderView::kDistance, RenderView::kError, RenderView::kChunks})
     if (name == render_view_name(v)) return v;
-  throw InvalidArgument("unknown view \"" + name + "\" (expected shaded, distance, error or chunks)");
+  throw InvalidArgument("unknown view \"" + name +
+                        "\" (expected shaded, distance, error or chunks)");
 }
 
 namespace {
@@ -42,7 +49,9 @@ struct Rgb {
   friend Rgb operator*(Rgb a, double s) { return {a.r * s, a.g * s, a.b * s}; }
   friend Rgb operator*(Rgb a, Rgb b) { return {a.r * b.r, a.g * b.g, a.b * b.b}; }
 };
-Rgb mix(Rgb a, Rgb b, double t) { return a * (1 - t) + b * t; }
+Rgb mix(Rgb a, Rgb b, double t) {
+  return a * (1 - t) + b * t;
+}
 
 // Linear light of the sky and the sun (before exposure).
 constexpr Rgb kSunLight{2.4, 2.2, 1.9};
@@ -66,14 +75,19 @@ class ToneMap {
       const double linear = kMaxLinear * i / (kSteps - 1);
       const double v = 1 - std::exp(-1.25 * linear);
       const double s = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
-      table_[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(std::lround(std::clamp(s, 0.0, 1.0) * 255));
+      table_[static_cast<std::size_t>(i)] =
+          static_cast<std::uint8_t>(std::lround(std::clamp(s, 0.0, 1.0) * 255));
     }
   }
   std::uint8_t encode(double linear) const {
     const double x = std::clamp(linear, 0.0, kMaxLinear) * ((kSteps - 1) / kMaxLinear);
     return table_[static_cast<std::size_t>(x + 0.5)];
   }
-  void write(Rgb c, std::uint8_t* px) const { px[0] = encode(c.r); px[1] = encode(c.g); px[2] = encode(c.b); }
+  void write(Rgb c, std::uint8_t* px) const {
+    px[0] = encode(c.r);
+    px[1] = encode(c.g);
+    px[2] = encode(c.b);
+  }
 
  private:
   static constexpr int kSteps = 16384;
@@ -105,9 +119,13 @@ struct Frame {
   int slice_z = 0;
   double heat_max = 1;
 
-  std::uint8_t light_at_voxel(Vec3i v) const { return s.light.read(s.table.chunk_index(v), s.table.brick_index(v)); }
+  std::uint8_t light_at_voxel(Vec3i v) const {
+    return s.light.read(s.table.chunk_index(v), s.table.brick_index(v));
+  }
 
-  std::uint8_t skip_at(Vec3i v) const { return s.skip.distance(s.table.chunk_index(v), s.table.brick_index(v)); }
+  std::uint8_t skip_at(Vec3i v) const {
+    return s.skip.distance(s.table.chunk_index(v), s.table.brick_index(v));
+  }
 
   // The lighting field at a point, interpolated between voxel centres (clamped to the box).
   double light_at(const Vec3d& q) const {
@@ -119,7 +137,8 @@ struct Frame {
     double sum = 0;
     for (int corner = 0; corner < 8; ++corner) {
       const int dx = corner & 1, dy = (corner >> 1) & 1, dz = corner >> 2;
-      const Vec3i v{std::clamp(x0 + dx, box.begin.x, box.end.x - 1), std::clamp(y0 + dy, box.begin.y, box.end.y - 1),
+      const Vec3i v{std::clamp(x0 + dx, box.begin.x, box.end.x - 1),
+                    std::clamp(y0 + dy, box.begin.y, box.end.y - 1),
                     std::clamp(z0 + dz, box.begin.z, box.end.z - 1)};
       const double w = (dx ? tx : 1 - tx) * (dy ? ty : 1 - ty) * (dz ? tz : 1 - tz);
       sum += w * light_at_voxel(v);
@@ -149,12 +168,12 @@ struct Frame {
     constexpr double kSoftness = 5, kNear = 1.5;
     const Ray r{p + n * 1e-4, sun};
     double lit = 1;
-    const RayHit hit = traverse(s, s.box, r, SkipMode::kDistance, s.skip, c,
-                                [&](const Dda& d, std::size_t chunk) {
-                                  if (d.t < kNear) return;
-                                  const double e = s.light.read(chunk, s.table.brick_index(d.v)) * s.light_inv_scale;
-                                  lit = std::min(lit, kSoftness * (e - 0.75) / d.t);
-                                });
+    const RayHit hit =
+        traverse(s, s.box, r, SkipMode::kDistance, s.skip, c, [&](const Dda& d, std::size_t chunk) {
+          if (d.t < kNear) return;
+          const double e = s.light.read(chunk, s.table.brick_index(d.v)) * s.light_inv_scale;
+          lit = std::min(lit, kSoftness * (e - 0.75) / d.t);
+        });
     if (hit.hit) return 0;
     lit = std::clamp(lit, 0.0, 1.0);
     return lit * lit * (3 - 2 * lit);
@@ -164,8 +183,8 @@ struct Frame {
     int axis = h.face_axis, sign = h.face_sign;
     if (axis < 0) {  // the ray started inside: face the viewer along its dominant axis
       axis = std::abs(dir.x) >= std::abs(dir.y) && std::abs(dir.x) >= std::abs(dir.z) ? 0
-             : std::abs(dir.y) >= std::abs(dir.z)                                    ? 1
-                                                                                     : 2;
+             : std::abs(dir.y) >= std::abs(dir.z)                                     ? 1
+                                                                                      : 2;
       sign = dir[axis] > 0 ? -1 : 1;
     }
     Vec3d n;
@@ -173,7 +192,8 @@ struct Frame {
     return n;
   }
 
-  Rgb shade(const RayHit& h, const Ray& ray, bool shadows, TraversalCounters& shadow_counters) const {
+  Rgb shade(const RayHit& h, const Ray& ray, bool shadows,
+            TraversalCounters& shadow_counters) const {
     const Vec3d n = normal_of(h, ray.direction);
     const Vec3d p = ray.origin + ray.direction * h.t;
     const auto& a = s.albedo[h.material];
@@ -219,7 +239,8 @@ struct Frame {
         Box3i cut = s.box;
         cut.end.z = slice_z + 1;
         Dda first;
-        if (render_detail::start_in_box(cut, ray, first) && first.face_axis == 2 && first.step[2] < 0 &&
+        if (render_detail::start_in_box(cut, ray, first) && first.face_axis == 2 &&
+            first.step[2] < 0 &&
             s.skip.material(s.table.chunk_index(first.v), s.table.brick_index(first.v)) == 0) {
           // The ray enters through the cut plane on an air voxel: show the field there, with a
           // darker band every 8 voxels of distance.
@@ -237,13 +258,14 @@ struct Frame {
       case RenderView::kError: {
         // The plain DDA visits every voxel up to the true hit: the largest error on the way...
         double worst = 0;
-        const RayHit exact = traverse(s, s.box, ray, SkipMode::kNone, s.skip, st.primary,
-                                      [&](const Dda& d, std::size_t chunk) {
-                                        const std::uint32_t b = s.table.brick_index(d.v);
-                                        const double e = s.skip.distance(chunk, b) * s.skip.inv_scale;
-                                        const double a = approx->distance(chunk, b) * approx->inv_scale;
-                                        worst = std::max(worst, std::abs(a - e));
-                                      });
+        const RayHit exact =
+            traverse(s, s.box, ray, SkipMode::kNone, s.skip, st.primary,
+                     [&](const Dda& d, std::size_t chunk) {
+                       const std::uint32_t b = s.table.brick_index(d.v);
+                       const double e = s.skip.distance(chunk, b) * s.skip.inv_scale;
+                       const double a = approx->distance(chunk, b) * approx->inv_scale;
+                       worst = std::max(worst, std::abs(a - e));
+                     });
         // ...and whether skipping by the approximate field still stops at that voxel.
         TraversalCounters unused;
         const RayHit skipped = traverse(s, s.box, ray, SkipMode::kDistance, *approx, unused, noop);
@@ -253,12 +275,15 @@ struct Frame {
         tone_map().write({grey, grey, grey}, out);
         if (skipped.hit != exact.hit || skipped.voxel != exact.voxel) {
           ++st.rays_through_geometry;
-          out[0] = 255; out[1] = 0; out[2] = 255;
+          out[0] = 255;
+          out[1] = 0;
+          out[2] = 255;
         } else if (worst > 0) {
           // Logarithmic: errors of one step and of dozens of voxels both stay readable.
           std::uint8_t h[3];
           heat(std::log2(1 + worst) / 6, h);
-          for (int ch = 0; ch < 3; ++ch) out[ch] = static_cast<std::uint8_t>((2 * out[ch] + 3 * h[ch]) / 5);
+          for (int ch = 0; ch < 3; ++ch)
+            out[ch] = static_cast<std::uint8_t>((2 * out[ch] + 3 * h[ch]) / 5);
         }
         return;
       }
@@ -268,18 +293,20 @@ struct Frame {
 
 }  // namespace
 
-Image render(const RenderScene& scene, const Camera& camera, const RenderOptions& o, RenderStats* stats,
-             Interrupter* interrupter) {
+Image render(const RenderScene& scene, const Camera& camera, const RenderOptions& o,
+             RenderStats* stats, Interrupter* interrupter) {
   const RenderScene::Impl& s = scene.impl();
   if (o.width <= 0 || o.height <= 0 || o.width > 16384 || o.height > 16384)
-    throw InvalidArgument("render: image size " + std::to_string(o.width) + "x" + std::to_string(o.height) +
-                          " is out of range (1..16384 per side)");
+    throw InvalidArgument("render: image size " + std::to_string(o.width) + "x" +
+                          std::to_string(o.height) + " is out of range (1..16384 per side)");
   if (o.tile_size <= 0) throw InvalidArgument("render: tile size must be positive");
   if ((o.ambient_occlusion || o.soft_shadows) && !s.has_light)
-    throw InvalidArgument("render: ambient occlusion and soft shadows need the scene's lighting field "
-                          "(RenderSceneOptions::lighting_field)");
+    throw InvalidArgument(
+        "render: ambient occlusion and soft shadows need the scene's lighting field "
+        "(RenderSceneOptions::lighting_field)");
   if (!(o.fog_density >= 0)) throw InvalidArgument("render: fog density must be >= 0");
-  if (!(o.sun_direction.length() > 0)) throw InvalidArgument("render: the sun direction must be non-zero");
+  if (!(o.sun_direction.length() > 0))
+    throw InvalidArgument("render: the sun direction must be non-zero");
 
   Image image(o.width, o.height);
   Frame f{s, o, camera.projector(o.width, o.height), o.sun_direction.normalized()};
@@ -302,7 +329,8 @@ Image render(const RenderScene& scene, const Camera& camera, const RenderOptions
   parallel_for(tile_stats.size(), 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t tile = b; tile < e; ++tile) {
       if (progress.cancelled()) return;
-      const int x0 = static_cast<int>(tile % tiles_x) * ts, y0 = static_cast<int>(tile / tiles_x) * ts;
+      const int x0 = static_cast<int>(tile % tiles_x) * ts,
+                y0 = static_cast<int>(tile / tiles_x) * ts;
       RenderStats& st = tile_stats[tile];
       for (int y = y0; y < std::min(y0 + ts, o.height); ++y)
         for (int x = x0; x < std::min(x0 + ts, o.width); ++x) f.pixel(x, y, image.pixel(x, y), st);
@@ -312,7 +340,8 @@ Image render(const RenderScene& scene, const Camera& camera, const RenderOptions
   progress.throw_if_cancelled();
   if (stats) {
     RenderStats total;
-    total.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    total.ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     total.width = o.width;
     total.height = o.height;
     for (const RenderStats& t : tile_stats) {

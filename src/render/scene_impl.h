@@ -24,18 +24,21 @@ struct BrickedChunks {
   std::vector<T> uniform;           // per chunk: the value of a chunk not stored
   render_detail::LargeBuffer arena;
   std::uint32_t chunk_volume = 0;
-  std::uint32_t slots_used = 0;          // slots ever handed out (the arena's live prefix)
-  std::vector<std::uint32_t> free_slots; // slots below slots_used no chunk holds
+  std::uint32_t slots_used = 0;           // slots ever handed out (the arena's live prefix)
+  std::vector<std::uint32_t> free_slots;  // slots below slots_used no chunk holds
 
   std::size_t slot_bytes() const { return std::size_t{chunk_volume} * sizeof(T); }
-  T* slot_data(std::uint32_t s) { return reinterpret_cast<T*>(arena.data()) + std::size_t{s} * chunk_volume; }
+  T* slot_data(std::uint32_t s) {
+    return reinterpret_cast<T*>(arena.data()) + std::size_t{s} * chunk_volume;
+  }
   // A free slot for a chunk becoming dense (the arena grows when none is left).
   std::uint32_t take_slot();
 
   T read(std::size_t chunk, std::uint32_t brick_index) const {
     const std::uint32_t s = slot[chunk];
     if (s == kUniform) return uniform[chunk];
-    return reinterpret_cast<const T*>(arena.data())[static_cast<std::size_t>(s) * chunk_volume + brick_index];
+    return reinterpret_cast<const T*>(
+        arena.data())[static_cast<std::size_t>(s) * chunk_volume + brick_index];
   }
 };
 
@@ -48,7 +51,9 @@ struct SkipSource {
   BrickedChunks<std::uint16_t> cells;
   std::vector<std::uint8_t> chunk_min;  // per chunk: its smallest distance
 
-  std::uint16_t read(std::size_t chunk, std::uint32_t brick_index) const { return cells.read(chunk, brick_index); }
+  std::uint16_t read(std::size_t chunk, std::uint32_t brick_index) const {
+    return cells.read(chunk, brick_index);
+  }
   std::uint8_t distance(std::size_t chunk, std::uint32_t brick_index) const {
     return static_cast<std::uint8_t>(read(chunk, brick_index) & 0xFF);
   }
@@ -78,7 +83,7 @@ struct RenderScene::Impl {
   double light_inv_scale = 0.25;
   std::vector<std::uint8_t> empty_chunk;     // 1 where a chunk holds no solid voxel
   std::vector<std::uint8_t> dense_material;  // 1 where the world stores a chunk voxel by voxel
-  Palette palette{};                                // the world's palette the albedo was decoded from
+  Palette palette{};                         // the world's palette the albedo was decoded from
   std::array<std::array<float, 3>, 256> albedo{};  // palette in linear RGB
 
   void build(const World& w, const DistanceField& skip_field, const DistanceField* light_field);
@@ -93,7 +98,8 @@ struct RenderScene::Impl {
   SkipSource approximation(Algorithm algorithm) const;
   // Re-reads chunk i from the world and the fields (the fields already checked to fit).
   // Returns whether anything of the chunk changed.
-  bool refresh_chunk(std::size_t i, const Grid<std::uint8_t>& skip_grid, const Grid<std::uint8_t>* light_grid);
+  bool refresh_chunk(std::size_t i, const Grid<std::uint8_t>& skip_grid,
+                     const Grid<std::uint8_t>* light_grid);
 };
 
 // Options of the u8 skip field: Manhattan and Chebyshev distances are integers stored as they are

@@ -3,16 +3,19 @@
 #include <vector>
 
 #include "traverse.h"
-#include "voxfield/parallel.h"
 #include "voxfield/error.h"
+#include "voxfield/parallel.h"
 
 namespace voxfield {
 
 const char* skip_mode_name(SkipMode m) {
   switch (m) {
-    case SkipMode::kNone: return "none";
-    case SkipMode::kChunks: return "chunks";
-    case SkipMode::kDistance: return "distance";
+    case SkipMode::kNone:
+      return "none";
+    case SkipMode::kChunks:
+      return "chunks";
+    case SkipMode::kDistance:
+      return "distance";
   }
   return "?";
 }
@@ -33,7 +36,8 @@ void check_ray(const Ray& ray) {
 
 }  // namespace
 
-RayHit trace_ray(const RenderScene& scene, const Ray& ray, SkipMode mode, TraversalCounters* counters) {
+RayHit trace_ray(const RenderScene& scene, const Ray& ray, SkipMode mode,
+                 TraversalCounters* counters) {
   check_ray(ray);
   const RenderScene::Impl& s = scene.impl();
   TraversalCounters local;
@@ -43,8 +47,8 @@ RayHit trace_ray(const RenderScene& scene, const Ray& ray, SkipMode mode, Traver
   return hit;
 }
 
-void trace_rays(const RenderScene& scene, std::span<const Ray> rays, std::span<RayHit> hits, SkipMode mode,
-                TraversalCounters* counters) {
+void trace_rays(const RenderScene& scene, std::span<const Ray> rays, std::span<RayHit> hits,
+                SkipMode mode, TraversalCounters* counters) {
   if (hits.size() != rays.size()) throw InvalidArgument("trace_rays: as many hits as rays, please");
   for (const Ray& ray : rays) check_ray(ray);
   const RenderScene::Impl& s = scene.impl();

@@ -15,17 +15,26 @@ struct SkipWeights {
   double w[3] = {0, 0, 0};
   SkipWeights() = default;
   SkipWeights(Metric metric, const Ray& ray) {
-    const double ax = std::abs(ray.direction.x), ay = std::abs(ray.direction.y), az = std::abs(ray.direction.z);
+    const double ax = std::abs(ray.direction.x), ay = std::abs(ray.direction.y),
+                 az = std::abs(ray.direction.z);
     double norm = 1;
     switch (metric) {
-      case Metric::kManhattan: norm = ax + ay + az; break;
-      case Metric::kChebyshev: norm = 0; break;
-      case Metric::kEuclidean: norm = std::sqrt(ax * ax + ay * ay + az * az); break;
+      case Metric::kManhattan:
+        norm = ax + ay + az;
+        break;
+      case Metric::kChebyshev:
+        norm = 0;
+        break;
+      case Metric::kEuclidean:
+        norm = std::sqrt(ax * ax + ay * ay + az * az);
+        break;
     }
     if (norm == 0) {
       w[0] = w[1] = w[2] = 1;
     } else {
-      w[0] = ax / norm; w[1] = ay / norm; w[2] = az / norm;
+      w[0] = ax / norm;
+      w[1] = ay / norm;
+      w[2] = az / norm;
     }
   }
 };
@@ -40,7 +49,8 @@ struct SkipWeights {
 //  * Euclidean: stored = floor(4 d) so r = stored / 4 <= d; the box's farthest voxel lies at
 //    sqrt(sum c_a^2) <= r' |w| < d with c_a = floor(r' w_a), |w| = 1, r' just below r.
 // The caps follow the ray's direction so that it leaves the box through its far side.
-inline void skip_caps(const SkipSource& skip, const SkipWeights& sw, std::uint8_t stored, int caps[3]) {
+inline void skip_caps(const SkipSource& skip, const SkipWeights& sw, std::uint8_t stored,
+                      int caps[3]) {
   if (skip.metric == Metric::kEuclidean) {
     const double r = static_cast<double>(stored) * skip.inv_scale * (1 - 1e-9);
     for (int a = 0; a < 3; ++a) caps[a] = static_cast<int>(r * sw.w[a]);
@@ -81,7 +91,10 @@ inline bool start_in_box(const Box3i& box, const Ray& ray, Dda& dda) {
     }
     double ta = (box.begin[a] - o) / d, tb = (box.end[a] - o) / d;
     if (ta > tb) std::swap(ta, tb);
-    if (ta > t0) { t0 = ta; axis0 = a; }
+    if (ta > t0) {
+      t0 = ta;
+      axis0 = a;
+    }
     t1 = std::min(t1, tb);
   }
   const double ts = std::max(t0, 0.0);
@@ -111,11 +124,13 @@ inline RayHit make_hit(const Dda& dda, std::uint8_t material) {
 enum class Step { kContinue, kHit, kMiss };
 
 // One iteration of the traversal at dda.v: a hit, a miss (the ray left `box`), or the DDA moved on
-// (one step, or a skip out of an empty chunk or a box the distance field clears). on_air(dda, chunk)
-// is called at every air voxel the traversal stops at (with kNone: every air voxel on the ray).
+// (one step, or a skip out of an empty chunk or a box the distance field clears). on_air(dda,
+// chunk) is called at every air voxel the traversal stops at (with kNone: every air voxel on the
+// ray).
 template <class OnAir>
-inline Step visit(const RenderScene::Impl& s, const Box3i& box, SkipMode mode, const SkipSource& skip,
-                  const SkipWeights& sw, Dda& dda, TraversalCounters& c, OnAir& on_air, RayHit& hit) {
+inline Step visit(const RenderScene::Impl& s, const Box3i& box, SkipMode mode,
+                  const SkipSource& skip, const SkipWeights& sw, Dda& dda, TraversalCounters& c,
+                  OnAir& on_air, RayHit& hit) {
   if (!box.contains(dda.v)) return Step::kMiss;
   const ChunkTable& table = s.table;
   const std::size_t chunk = table.chunk_index(dda.v);
@@ -124,7 +139,8 @@ inline Step visit(const RenderScene::Impl& s, const Box3i& box, SkipMode mode, c
     // is at least the chunk's smallest value away from geometry, so that bound needs no voxel read.
     const Box3i cb = table.chunk_box_of(dda.v);
     int caps[3];
-    for (int a = 0; a < 3; ++a) caps[a] = dda.step[a] > 0 ? cb.end[a] - 1 - dda.v[a] : dda.v[a] - cb.begin[a];
+    for (int a = 0; a < 3; ++a)
+      caps[a] = dda.step[a] > 0 ? cb.end[a] - 1 - dda.v[a] : dda.v[a] - cb.begin[a];
     const Dda::Exit exit = dda.exit_of(caps);
     on_air(dda, chunk);
     ++c.steps;
@@ -175,9 +191,12 @@ RayHit traverse(const RenderScene::Impl& s, const Box3i& box, const Ray& ray, Sk
   RayHit hit;
   for (;;) {
     switch (visit(s, box, mode, skip, sw, dda, c, on_air, hit)) {
-      case Step::kContinue: break;
-      case Step::kHit: return hit;
-      case Step::kMiss: return {};
+      case Step::kContinue:
+        break;
+      case Step::kHit:
+        return hit;
+      case Step::kMiss:
+        return {};
     }
   }
 }

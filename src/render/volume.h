@@ -20,8 +20,10 @@ class LargeBuffer {
   explicit LargeBuffer(std::size_t bytes);
   ~LargeBuffer();
   LargeBuffer(LargeBuffer&& o) noexcept
-      : data_(std::exchange(o.data_, nullptr)), size_(std::exchange(o.size_, 0)),
-        map_(std::exchange(o.map_, nullptr)), map_bytes_(std::exchange(o.map_bytes_, 0)) {}
+      : data_(std::exchange(o.data_, nullptr)),
+        size_(std::exchange(o.size_, 0)),
+        map_(std::exchange(o.map_, nullptr)),
+        map_bytes_(std::exchange(o.map_bytes_, 0)) {}
   LargeBuffer& operator=(LargeBuffer&& o) noexcept {
     std::swap(data_, o.data_);
     std::swap(size_, o.size_);
@@ -53,7 +55,8 @@ class ChunkTable {
   // Chunk index of voxel v, which must lie in box().
   std::size_t chunk_index(Vec3i v) const {
     return (static_cast<std::size_t>((v.z >> shift_) - first_.z) * dims_.y +
-            static_cast<std::size_t>((v.y >> shift_) - first_.y)) * dims_.x +
+            static_cast<std::size_t>((v.y >> shift_) - first_.y)) *
+               dims_.x +
            static_cast<std::size_t>((v.x >> shift_) - first_.x);
   }
   // Index of v inside its chunk (the Grid's layout: x fastest).
@@ -67,11 +70,12 @@ class ChunkTable {
   // in all three directions, not only along x rows.
   std::uint32_t brick_index(Vec3i v) const {
     const int m = edge_ - 1, bs = shift_ - 2;  // bricks per chunk edge: 2^bs
-    const auto bx = static_cast<std::uint32_t>((v.x & m) >> 2), by = static_cast<std::uint32_t>((v.y & m) >> 2),
+    const auto bx = static_cast<std::uint32_t>((v.x & m) >> 2),
+               by = static_cast<std::uint32_t>((v.y & m) >> 2),
                bz = static_cast<std::uint32_t>((v.z & m) >> 2);
     const std::uint32_t brick = (((bz << bs) | by) << bs) | bx;
-    return (brick << 6) | (static_cast<std::uint32_t>(v.z & 3) << 4) | (static_cast<std::uint32_t>(v.y & 3) << 2) |
-           static_cast<std::uint32_t>(v.x & 3);
+    return (brick << 6) | (static_cast<std::uint32_t>(v.z & 3) << 4) |
+           (static_cast<std::uint32_t>(v.y & 3) << 2) | static_cast<std::uint32_t>(v.x & 3);
   }
   // The voxel box of chunk c (by chunk index), clipped to nothing: whole chunks.
   Box3i chunk_box_of(Vec3i v) const {

@@ -25,9 +25,13 @@ inline std::uint64_t hash3(std::uint64_t seed, std::int64_t x, std::int64_t y, s
 }
 
 // Uniform in [0, 1).
-inline double unit(std::uint64_t h) { return static_cast<double>(h >> 11) * (1.0 / 9007199254740992.0); }
+inline double unit(std::uint64_t h) {
+  return static_cast<double>(h >> 11) * (1.0 / 9007199254740992.0);
+}
 
-inline double smooth(double t) { return t * t * (3.0 - 2.0 * t); }
+inline double smooth(double t) {
+  return t * t * (3.0 - 2.0 * t);
+}
 
 // Value noise in [-1, 1] on a unit lattice.
 inline double value_noise3(std::uint64_t seed, double x, double y, double z) {
@@ -38,14 +42,17 @@ inline double value_noise3(std::uint64_t seed, double x, double y, double z) {
   double c[2][2][2];
   for (int dz = 0; dz < 2; ++dz)
     for (int dy = 0; dy < 2; ++dy)
-      for (int dx = 0; dx < 2; ++dx) c[dz][dy][dx] = unit(hash3(seed, ix + dx, iy + dy, iz + dz)) * 2.0 - 1.0;
+      for (int dx = 0; dx < 2; ++dx)
+        c[dz][dy][dx] = unit(hash3(seed, ix + dx, iy + dy, iz + dz)) * 2.0 - 1.0;
   auto lerp = [](double a, double b, double t) { return a + (b - a) * t; };
   const double y0 = lerp(lerp(c[0][0][0], c[0][0][1], tx), lerp(c[0][1][0], c[0][1][1], tx), ty);
   const double y1 = lerp(lerp(c[1][0][0], c[1][0][1], tx), lerp(c[1][1][0], c[1][1][1], tx), ty);
   return lerp(y0, y1, tz);
 }
 
-inline double value_noise2(std::uint64_t seed, double x, double y) { return value_noise3(seed, x, y, 0.0); }
+inline double value_noise2(std::uint64_t seed, double x, double y) {
+  return value_noise3(seed, x, y, 0.0);
+}
 
 // Fractal sum of `octaves` octaves, each twice the frequency and half the amplitude; about [-1, 1].
 inline double fbm3(std::uint64_t seed, double x, double y, double z, int octaves) {
@@ -61,6 +68,8 @@ inline double fbm3(std::uint64_t seed, double x, double y, double z, int octaves
   return sum / norm;
 }
 
-inline double fbm2(std::uint64_t seed, double x, double y, int octaves) { return fbm3(seed, x, y, 0.5, octaves); }
+inline double fbm2(std::uint64_t seed, double x, double y, int octaves) {
+  return fbm3(seed, x, y, 0.5, octaves);
+}
 
 }  // namespace voxfield::detail

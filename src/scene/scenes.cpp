@@ -18,7 +18,14 @@ using detail::hash3;
 using detail::unit;
 
 enum Material : std::uint8_t {
-  kAir = 0, kGrass = 1, kDirt = 2, kStone = 3, kSand = 4, kBrick = 5, kRoof = 6, kSnow = 7,
+  kAir = 0,
+  kGrass = 1,
+  kDirt = 2,
+  kStone = 3,
+  kSand = 4,
+  kBrick = 5,
+  kRoof = 6,
+  kSnow = 7,
   kMoss = 8,
 };
 
@@ -42,10 +49,12 @@ void require_size(const SceneOptions& o) {
   // Generation fills every chunk before collapsing the uniform ones: refuse sizes that cannot fit
   // in this machine's memory, instead of running into the out-of-memory killer.
   const double bytes = static_cast<double>(Box3i::from_size(o.size).volume());
-  const double physical = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  const double physical =
+      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
   if (physical > 0 && bytes > physical) {
-    throw InvalidArgument("scene size " + to_string(o.size) + " needs " + std::to_string(bytes / 1e9) +
-                          " GB while generating; this machine has " + std::to_string(physical / 1e9) + " GB");
+    throw InvalidArgument("scene size " + to_string(o.size) + " needs " +
+                          std::to_string(bytes / 1e9) + " GB while generating; this machine has " +
+                          std::to_string(physical / 1e9) + " GB");
   }
 }
 
@@ -61,9 +70,9 @@ std::vector<Vec3i> chunks_of(const World& w, Vec3i size) {
 
 struct Tower {
   bool present = false;
-  int cx = 0, cy = 0;      // centre column
-  int half = 0;            // half width: walls at |dx| == half or |dy| == half
-  int base = 0, top = 0;   // wall z range [base, top)
+  int cx = 0, cy = 0;     // centre column
+  int half = 0;           // half width: walls at |dx| == half or |dy| == half
+  int base = 0, top = 0;  // wall z range [base, top)
 };
 
 class Terrain {
@@ -162,7 +171,8 @@ World make_terrain(const SceneOptions& o, Interrupter* interrupter) {
         const int h = terrain.height(wx, wy);
         const Tower t = terrain.tower_of_cell(wx / terrain.cell(), wy / terrain.cell());
         for (int z = 0; z < e; ++z) {
-          out[(static_cast<std::size_t>(z) * e + y) * e + x] = terrain.material(wx, wy, lo.z + z, h, t);
+          out[(static_cast<std::size_t>(z) * e + y) * e + x] =
+              terrain.material(wx, wy, lo.z + z, h, t);
         }
       }
   });
@@ -173,7 +183,8 @@ World make_terrain(const SceneOptions& o, Interrupter* interrupter) {
 World make_spheres(const SceneOptions& o, double solid_fraction, Interrupter* interrupter) {
   require_size(o);
   if (!(solid_fraction > 0 && solid_fraction < 1)) {
-    throw InvalidArgument("solid fraction must be in (0, 1), got " + std::to_string(solid_fraction));
+    throw InvalidArgument("solid fraction must be in (0, 1), got " +
+                          std::to_string(solid_fraction));
   }
   struct Sphere {
     int cx, cy, cz, r;
@@ -205,7 +216,8 @@ World make_spheres(const SceneOptions& o, double solid_fraction, Interrupter* in
     std::fill(out, out + static_cast<std::size_t>(e) * e * e, kAir);
     if (!progress.advance()) return;  // cancelled: the world is discarded
     for (const Sphere& s : spheres) {
-      const Box3i sb = Box3i::from_inclusive({s.cx - s.r, s.cy - s.r, s.cz - s.r}, {s.cx + s.r, s.cy + s.r, s.cz + s.r});
+      const Box3i sb = Box3i::from_inclusive({s.cx - s.r, s.cy - s.r, s.cz - s.r},
+                                             {s.cx + s.r, s.cy + s.r, s.cz + s.r});
       const Box3i part = sb.intersect(box);
       if (part.empty()) continue;
       const std::int64_t r2 = std::int64_t{s.r} * s.r;
@@ -214,7 +226,8 @@ World make_spheres(const SceneOptions& o, double solid_fraction, Interrupter* in
           for (int x = part.begin.x; x < part.end.x; ++x) {
             const std::int64_t dx = x - s.cx, dy = y - s.cy, dz = z - s.cz;
             if (dx * dx + dy * dy + dz * dz <= r2) {
-              out[(static_cast<std::size_t>(z - box.begin.z) * e + (y - box.begin.y)) * e + (x - box.begin.x)] = s.material;
+              out[(static_cast<std::size_t>(z - box.begin.z) * e + (y - box.begin.y)) * e +
+                  (x - box.begin.x)] = s.material;
             }
           }
     }

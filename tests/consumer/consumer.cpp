@@ -25,11 +25,13 @@ int main(int argc, char** argv) {
     const double dx = p.x - 10, dy = p.y - 20, dz = p.z - 5;
     const double expected = std::sqrt(dx * dx + dy * dy + dz * dz);
     if (std::abs(field.distance(p) - expected) > 1e-5) {
-      std::fprintf(stderr, "distance at (%d, %d, %d): %g, expected %g\n", p.x, p.y, p.z, field.distance(p), expected);
+      std::fprintf(stderr, "distance at (%d, %d, %d): %g, expected %g\n", p.x, p.y, p.z,
+                   field.distance(p), expected);
       ++wrong;
     }
   }
-  const std::filesystem::path path = std::filesystem::path(argc > 1 ? argv[1] : ".") / "consumer.npy";
+  const std::filesystem::path path =
+      std::filesystem::path(argc > 1 ? argv[1] : ".") / "consumer.npy";
   save_world(world, domain, path);
   const LoadedWorld back = load_world(path);
   if (back.world.solid_count() != 1 || back.world.voxels.get({10, 20, 5}) == 0) {

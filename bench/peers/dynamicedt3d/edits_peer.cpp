@@ -30,7 +30,8 @@ double ms(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::ti
 double pct(std::vector<double> v, double q) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
+  return v[std::min(v.size() - 1,
+                    static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
 }
 
 double mean(const std::vector<double>& v) {
@@ -43,10 +44,12 @@ double mean(const std::vector<double>& v) {
 
 int main(int argc, char** argv) {
   if (argc != 8) {
-    std::fprintf(stderr, "usage: edits_peer WORLD EDITS RADIUS_MIN RADIUS_MAX CLAMP THREADS OUT.json\n");
+    std::fprintf(stderr,
+                 "usage: edits_peer WORLD EDITS RADIUS_MIN RADIUS_MAX CLAMP THREADS OUT.json\n");
     return 2;
   }
-  const int n = std::atoi(argv[1]), edits = std::atoi(argv[2]), rmin = std::atoi(argv[3]), rmax = std::atoi(argv[4]);
+  const int n = std::atoi(argv[1]), edits = std::atoi(argv[2]), rmin = std::atoi(argv[3]),
+            rmax = std::atoi(argv[4]);
   const int clamp = std::atoi(argv[5]);
   ThreadLimit limit(std::atoi(argv[6]));
   SceneOptions so;
@@ -61,7 +64,8 @@ int main(int argc, char** argv) {
     map[x] = new bool*[n];
     for (int y = 0; y < n; ++y) {
       map[x][y] = new bool[n];
-      for (int z = 0; z < n; ++z) map[x][y][z] = dense[(static_cast<std::size_t>(z) * n + y) * n + x] != 0;
+      for (int z = 0; z < n; ++z)
+        map[x][y][z] = dense[(static_cast<std::size_t>(z) * n + y) * n + x] != 0;
     }
   }
   auto t0 = std::chrono::steady_clock::now();
@@ -82,7 +86,9 @@ int main(int argc, char** argv) {
   // that insertions and deletions are measured in equal numbers (as dynamicEDT3D's own
   // evaluation does).
   std::mt19937_64 rng(6683787);
-  auto uniform_int = [&](int lo, int hi) { return lo + static_cast<int>(rng() % static_cast<std::uint64_t>(hi - lo + 1)); };
+  auto uniform_int = [&](int lo, int hi) {
+    return lo + static_cast<int>(rng() % static_cast<std::uint64_t>(hi - lo + 1));
+  };
   std::vector<double> vf_place, vf_carve, peer_place, peer_carve;
   DirtyRegions dirty(world.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
   for (int i = 0; i < edits; ++i) {
@@ -94,7 +100,9 @@ int main(int argc, char** argv) {
     }
     const int material = i % 2 == 0 ? 1 + uniform_int(0, 254) : 0;
     Edit e;
-    e.brush = SphereBrush{{static_cast<double>(c.x), static_cast<double>(c.y), static_cast<double>(c.z)}, static_cast<double>(radius)};
+    e.brush =
+        SphereBrush{{static_cast<double>(c.x), static_cast<double>(c.y), static_cast<double>(c.z)},
+                    static_cast<double>(radius)};
     e.op = material == 0 ? EditOp::kCarve : EditOp::kPlace;
     e.material = static_cast<std::uint8_t>(std::max(material, 1));
     // dynamicEDT3D: change the cells, then update.
@@ -119,26 +127,35 @@ int main(int argc, char** argv) {
     t1 = std::chrono::steady_clock::now();
     (e.op == EditOp::kCarve ? vf_carve : vf_place).push_back(ms(t0, t1));
   }
-  std::printf("world %d^3 terrain, %d sphere edits r %d..%d, Euclidean clamp %d, %d threads for voxfield\n", n, edits, rmin,
-              rmax, clamp, max_threads());
+  std::printf(
+      "world %d^3 terrain, %d sphere edits r %d..%d, Euclidean clamp %d, %d threads for voxfield\n",
+      n, edits, rmin, rmax, clamp, max_threads());
   std::printf("build: voxfield %.1f ms, dynamicEDT3D %.1f ms\n", vf_build, peer_build);
-  std::printf("%-10s %6s %12s %12s %13s %14s %14s %14s %10s %10s %10s\n", "edits", "count", "voxfield p50", "voxfield p99",
-              "voxfield mean", "dynEDT3D p50", "dynEDT3D p99", "dynEDT3D mean", "p50 ratio", "p99 ratio", "mean ratio");
+  std::printf("%-10s %6s %12s %12s %13s %14s %14s %14s %10s %10s %10s\n", "edits", "count",
+              "voxfield p50", "voxfield p99", "voxfield mean", "dynEDT3D p50", "dynEDT3D p99",
+              "dynEDT3D mean", "p50 ratio", "p99 ratio", "mean ratio");
   auto row = [&](const char* what, const std::vector<double>& v, const std::vector<double>& d) {
-    std::printf("%-10s %6zu %12.3f %12.3f %13.3f %14.3f %14.3f %14.3f %9.2fx %9.2fx %9.2fx\n", what, v.size(), pct(v, 0.5),
-                pct(v, 0.99), mean(v), pct(d, 0.5), pct(d, 0.99), mean(d), pct(d, 0.5) / std::max(1e-9, pct(v, 0.5)),
+    std::printf("%-10s %6zu %12.3f %12.3f %13.3f %14.3f %14.3f %14.3f %9.2fx %9.2fx %9.2fx\n", what,
+                v.size(), pct(v, 0.5), pct(v, 0.99), mean(v), pct(d, 0.5), pct(d, 0.99), mean(d),
+                pct(d, 0.5) / std::max(1e-9, pct(v, 0.5)),
                 pct(d, 0.99) / std::max(1e-9, pct(v, 0.99)), mean(d) / std::max(1e-9, mean(v)));
   };
   row("place", vf_place, peer_place);
   row("carve", vf_carve, peer_carve);
-  std::ofstream(argv[7]) << "{\"world\": " << n << ", \"edits\": " << edits << ", \"radius_min\": " << rmin
-                         << ", \"radius_max\": " << rmax << ", \"clamp\": " << clamp << ", \"threads\": " << max_threads()
-                         << ", \"voxfield_place_p50\": " << pct(vf_place, 0.5) << ", \"voxfield_place_p99\": " << pct(vf_place, 0.99)
-                         << ", \"voxfield_carve_p50\": " << pct(vf_carve, 0.5) << ", \"voxfield_carve_p99\": " << pct(vf_carve, 0.99)
-                         << ", \"voxfield_place_mean\": " << mean(vf_place) << ", \"voxfield_carve_mean\": " << mean(vf_carve)
-                         << ", \"dynamicedt3d_place_mean\": " << mean(peer_place) << ", \"dynamicedt3d_carve_mean\": " << mean(peer_carve)
-                         << ", \"dynamicedt3d_place_p50\": " << pct(peer_place, 0.5) << ", \"dynamicedt3d_place_p99\": " << pct(peer_place, 0.99)
-                         << ", \"dynamicedt3d_carve_p50\": " << pct(peer_carve, 0.5) << ", \"dynamicedt3d_carve_p99\": " << pct(peer_carve, 0.99)
-                         << "}\n";
+  std::ofstream(argv[7]) << "{\"world\": " << n << ", \"edits\": " << edits
+                         << ", \"radius_min\": " << rmin << ", \"radius_max\": " << rmax
+                         << ", \"clamp\": " << clamp << ", \"threads\": " << max_threads()
+                         << ", \"voxfield_place_p50\": " << pct(vf_place, 0.5)
+                         << ", \"voxfield_place_p99\": " << pct(vf_place, 0.99)
+                         << ", \"voxfield_carve_p50\": " << pct(vf_carve, 0.5)
+                         << ", \"voxfield_carve_p99\": " << pct(vf_carve, 0.99)
+                         << ", \"voxfield_place_mean\": " << mean(vf_place)
+                         << ", \"voxfield_carve_mean\": " << mean(vf_carve)
+                         << ", \"dynamicedt3d_place_mean\": " << mean(peer_place)
+                         << ", \"dynamicedt3d_carve_mean\": " << mean(peer_carve)
+                         << ", \"dynamicedt3d_place_p50\": " << pct(peer_place, 0.5)
+                         << ", \"dynamicedt3d_place_p99\": " << pct(peer_place, 0.99)
+                         << ", \"dynamicedt3d_carve_p50\": " << pct(peer_carve, 0.5)
+                         << ", \"dynamicedt3d_carve_p99\": " << pct(peer_carve, 0.99) << "}\n";
   // dynamicEDT3D's destructor frees the map it was given.
 }

@@ -13,14 +13,17 @@
 #include <cstdlib>
 
 namespace voxfield::detail {
-[[noreturn]] inline void assertion_failed(const char* condition, const char* file, int line, const char* function) {
-  std::fprintf(stderr, "voxfield: internal invariant broken: %s (%s:%d, in %s)\n", condition, file, line, function);
+[[noreturn]] inline void assertion_failed(const char* condition, const char* file, int line,
+                                          const char* function) {
+  std::fprintf(stderr, "voxfield: internal invariant broken: %s (%s:%d, in %s)\n", condition, file,
+               line, function);
   std::abort();
 }
 }  // namespace voxfield::detail
 
-#define VOXFIELD_ASSERT(condition) \
-  ((condition) ? static_cast<void>(0) : ::voxfield::detail::assertion_failed(#condition, __FILE__, __LINE__, __func__))
+#define VOXFIELD_ASSERT(condition)    \
+  ((condition) ? static_cast<void>(0) \
+               : ::voxfield::detail::assertion_failed(#condition, __FILE__, __LINE__, __func__))
 #else
 // Not evaluated (the condition may be costly), but still compiled, so it cannot rot.
 #define VOXFIELD_ASSERT(condition) static_cast<void>(sizeof(static_cast<bool>(condition)))

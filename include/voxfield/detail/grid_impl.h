@@ -23,7 +23,8 @@ Grid<T>::Grid(int chunk_edge, T background, std::optional<Box3i> bounds)
     throw InvalidArgument("grid bounds " + to_string(*bounds_) + " are empty");
   }
   if (bounds_ && !kCoordRange.contains(*bounds_)) {
-    throw InvalidArgument("grid bounds " + to_string(*bounds_) + " reach outside the supported coordinate range " +
+    throw InvalidArgument("grid bounds " + to_string(*bounds_) +
+                          " reach outside the supported coordinate range " +
                           to_string(kCoordRange));
   }
   chunk_shift_ = std::countr_zero(static_cast<unsigned>(chunk_edge));
@@ -60,7 +61,8 @@ template <class T>
 void Grid<T>::require_in_bounds(const Box3i& box, const char* what) const {
   if (!bounds_ && !kCoordRange.contains(box)) {
     throw InvalidArgument(std::string(what) + ": box " + to_string(box) +
-                          " reaches outside the supported coordinate range " + to_string(kCoordRange));
+                          " reaches outside the supported coordinate range " +
+                          to_string(kCoordRange));
   }
   if (bounds_ && !bounds_->contains(box)) {
     throw InvalidArgument(std::string(what) + ": box " + to_string(box) +
@@ -93,8 +95,8 @@ void Grid<T>::set(Vec3i p, T value) {
                           to_string(*bounds_));
   }
   if (!kCoordRange.contains(p)) {
-    throw InvalidArgument("set: voxel " + to_string(p) + " is outside the supported coordinate range " +
-                          to_string(kCoordRange));
+    throw InvalidArgument("set: voxel " + to_string(p) +
+                          " is outside the supported coordinate range " + to_string(kCoordRange));
   }
   const Vec3i coord = chunk_of(p);
   auto it = chunks_.find(coord);
@@ -218,7 +220,8 @@ template <class T>
 void Grid<T>::copy_to_dense(const Box3i& box, T* out) const {
   if (box.empty()) return;
   if (!kCoordRange.contains(box)) {
-    throw InvalidArgument("copy_to_dense: box " + to_string(box) + " reaches outside the supported coordinate range " +
+    throw InvalidArgument("copy_to_dense: box " + to_string(box) +
+                          " reaches outside the supported coordinate range " +
                           to_string(kCoordRange));
   }
   const Vec3i size = box.size();
@@ -231,7 +234,8 @@ void Grid<T>::copy_to_dense(const Box3i& box, T* out) const {
     const int run = part.end.x - part.begin.x;
     for (int z = part.begin.z; z < part.end.z; ++z)
       for (int y = part.begin.y; y < part.end.y; ++y) {
-        T* dst = out + (z - box.begin.z) * sxy + (y - box.begin.y) * sx + (part.begin.x - box.begin.x);
+        T* dst =
+            out + (z - box.begin.z) * sxy + (y - box.begin.y) * sx + (part.begin.x - box.begin.x);
         if (c && c->voxels) {
           const T* src = c->voxels.get() + local_index({part.begin.x, y, z});
           std::copy(src, src + run, dst);
@@ -252,7 +256,9 @@ void Grid<T>::copy_from_dense(const Box3i& box, const T* in) {
     const Box3i part = chunk_box(coord).intersect(box);
     auto it = chunks_.find(coord);
     const int run = part.end.x - part.begin.x;
-    auto row = [&](int y, int z) { return in + (z - box.begin.z) * sxy + (y - box.begin.y) * sx + (part.begin.x - box.begin.x); };
+    auto row = [&](int y, int z) {
+      return in + (z - box.begin.z) * sxy + (y - box.begin.y) * sx + (part.begin.x - box.begin.x);
+    };
     if (it == chunks_.end() || !it->second.voxels) {
       // A uniform chunk (or an absent one, which holds the background) written with its own value
       // stays as it is: no expansion, no collapse scan — incremental field updates rewrite large
@@ -366,7 +372,8 @@ void Grid<T>::compact() {
 
 template <class T>
 void Grid<T>::for_each_chunk(const std::function<void(const ChunkView<T>&)>& f) const {
-  for (const auto& [coord, c] : chunks_) f(ChunkView<T>{coord, chunk_box(coord), c.voxels.get(), c.uniform});
+  for (const auto& [coord, c] : chunks_)
+    f(ChunkView<T>{coord, chunk_box(coord), c.voxels.get(), c.uniform});
 }
 
 template <class T>
@@ -408,13 +415,15 @@ void Grid<T>::generate_chunks(const std::vector<Vec3i>& chunks,
 }
 
 template <class T>
-void Grid<T>::adopt_chunks(const std::vector<Vec3i>& chunks, std::vector<std::unique_ptr<T[]>> data) {
+void Grid<T>::adopt_chunks(const std::vector<Vec3i>& chunks,
+                           std::vector<std::unique_ptr<T[]>> data) {
   if (data.size() != chunks.size()) {
     throw InvalidArgument("adopt_chunks: " + std::to_string(data.size()) + " arrays for " +
                           std::to_string(chunks.size()) + " chunks");
   }
   for (std::size_t i = 0; i < chunks.size(); ++i) {
-    if (!data[i]) throw InvalidArgument("adopt_chunks: null array for chunk " + to_string(chunks[i]));
+    if (!data[i])
+      throw InvalidArgument("adopt_chunks: null array for chunk " + to_string(chunks[i]));
     require_chunk_in_range(chunks[i], "adopt_chunks");
     if (bounds_ && chunk_box(chunks[i]).intersect(*bounds_).empty()) {
       throw InvalidArgument("adopt_chunks: chunk " + to_string(chunks[i]) +
@@ -435,12 +444,14 @@ void Grid<T>::adopt_chunks(const std::vector<Vec3i>& chunks, std::vector<std::un
           for (int z = 0; z < chunk_edge_; ++z)
             for (int y = 0; y < chunk_edge_; ++y)
               for (int x = 0; x < chunk_edge_; ++x)
-                if (!bounds_->contains(cb.begin + Vec3i{x, y, z})) v[local_index({x, y, z})] = background_;
+                if (!bounds_->contains(cb.begin + Vec3i{x, y, z}))
+                  v[local_index({x, y, z})] = background_;
         }
       }
       const T first = v[0];
       uniform[i] = std::all_of(v, v + n, [&](const T& x) { return x == first; });
-      background_count[i] = uniform[i] ? (first == background_ ? n : 0) : std::count(v, v + n, background_);
+      background_count[i] =
+          uniform[i] ? (first == background_ ? n : 0) : std::count(v, v + n, background_);
     }
   });
   for (std::size_t i = 0; i < chunks.size(); ++i) {
@@ -467,8 +478,8 @@ template <class F>
 void Grid<T>::edit_chunk(Vec3i coord, F&& f) {
   require_chunk_in_range(coord, "edit_chunk");
   if (bounds_ && chunk_box(coord).intersect(*bounds_).empty()) {
-    throw InvalidArgument("edit_chunk: chunk " + to_string(coord) + " lies outside the grid bounds " +
-                          to_string(*bounds_));
+    throw InvalidArgument("edit_chunk: chunk " + to_string(coord) +
+                          " lies outside the grid bounds " + to_string(*bounds_));
   }
   auto it = chunks_.find(coord);
   if (it == chunks_.end()) {
@@ -493,14 +504,16 @@ void Grid<T>::edit_chunk(Vec3i coord, F&& f) {
     // Only uniform at the value written, if at all: a check that stops at the first other voxel
     // (a count to re-anchor the counter would read the whole chunk on every small edit).
     const T* v = c.voxels.get();
-    if (std::all_of(v, v + chunk_volume(), [&](const T& x) { return x == edit.first_; })) reanchor(it, edit.first_);
+    if (std::all_of(v, v + chunk_volume(), [&](const T& x) { return x == edit.first_; }))
+      reanchor(it, edit.first_);
   }
 }
 
 template <class T>
 void Grid<T>::require_chunk_in_range(Vec3i coord, const char* what) const {
   if (!chunk_in_range(coord)) {
-    throw InvalidArgument(std::string(what) + ": chunk " + to_string(coord) + " of edge " + std::to_string(chunk_edge_) +
+    throw InvalidArgument(std::string(what) + ": chunk " + to_string(coord) + " of edge " +
+                          std::to_string(chunk_edge_) +
                           " lies outside the supported coordinate range " + to_string(kCoordRange));
   }
 }

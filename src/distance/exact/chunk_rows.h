@@ -44,7 +44,8 @@ struct ChunkedVolume {
   // Pointer to the `edge` voxels of the row (chunk column cx, y, z), x fastest.
   T* row(int cx, int y, int z) {
     const int ly = y - box.begin.y, lz = z - box.begin.z;
-    const std::size_t ci = (static_cast<std::size_t>(lz >> shift) * nchunks.y + (ly >> shift)) * nchunks.x + cx;
+    const std::size_t ci =
+        (static_cast<std::size_t>(lz >> shift) * nchunks.y + (ly >> shift)) * nchunks.x + cx;
     const int mask = edge - 1;
     return chunks[ci].get() + (static_cast<std::size_t>(lz & mask) << (2 * shift)) +
            (static_cast<std::size_t>(ly & mask) << shift);
@@ -72,12 +73,14 @@ class SolidRows {
   // Material row (dense chunks) or a row of 0/1 (uniform chunks): non-zero means solid.
   const std::uint8_t* row(int cx, int y, int z) const {
     const int ly = y - box_.begin.y, lz = z - box_.begin.z;
-    const std::size_t ci = (static_cast<std::size_t>(lz >> shift_) * nchunks_.y + (ly >> shift_)) * nchunks_.x + cx;
+    const std::size_t ci =
+        (static_cast<std::size_t>(lz >> shift_) * nchunks_.y + (ly >> shift_)) * nchunks_.x + cx;
     if (!dense_[ci]) return chunks_[ci];
     const int mask = edge_ - 1;
     return chunks_[ci] + (static_cast<std::size_t>(lz & mask) << (2 * shift_)) +
            (static_cast<std::size_t>(ly & mask) << shift_);
   }
+
  private:
   Box3i box_;
   int edge_, shift_;

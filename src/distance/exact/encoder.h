@@ -35,27 +35,32 @@ struct Encoder {
         clamp_f(static_cast<float>(std::min(plan.clamp, 3.0e38))),
         // The stored value is a plain function of the cost for unsigned fields in f32 or with an
         // integer metric (scale 1, bias 0): those rows take encode_row().
-        row_path(!plan.is_signed && (std::is_same_v<T, float> || plan.metric != Metric::kEuclidean)) {}
+        row_path(!plan.is_signed &&
+                 (std::is_same_v<T, float> || plan.metric != Metric::kEuclidean)) {}
 
   const Plan& p;
-  T none;        // stored value for "no site within reach"
+  T none;  // stored value for "no site within reach"
   float clamp_f;
   bool row_path;
 
   // `cost` is what the passes minimised (squared for Euclidean); `inside`: a solid voxel of a
   // signed field (negated).
   T encode(double cost, bool has_site, bool inside) const {
-    if (!has_site) return encode_distance<T>(inside ? -std::numeric_limits<double>::infinity()
-                                                            : std::numeric_limits<double>::infinity(), p);
+    if (!has_site)
+      return encode_distance<T>(inside ? -std::numeric_limits<double>::infinity()
+                                       : std::numeric_limits<double>::infinity(),
+                                p);
     const double d = p.metric == Metric::kEuclidean ? std::sqrt(cost) : cost;
     if constexpr (!std::is_same_v<T, float>) {
       if (p.metric == Metric::kEuclidean && p.unit_spacing && d < p.clamp &&
           p.encoding.scale == std::floor(p.encoding.scale)) {
         // floor(sqrt(cost) * S) computed exactly in integers (cost is an integer here).
         constexpr double kMax = static_cast<double>(std::numeric_limits<T>::max());
-        const std::uint64_t n = static_cast<std::uint64_t>(cost) * static_cast<std::uint64_t>(p.encoding.scale * p.encoding.scale);
+        const std::uint64_t n = static_cast<std::uint64_t>(cost) *
+                                static_cast<std::uint64_t>(p.encoding.scale * p.encoding.scale);
         const std::uint64_t r = isqrt(n);
-        const double scaled = inside ? -static_cast<double>(r + (r * r != n ? 1 : 0)) : static_cast<double>(r);
+        const double scaled =
+            inside ? -static_cast<double>(r + (r * r != n ? 1 : 0)) : static_cast<double>(r);
         return static_cast<T>(std::clamp(scaled + static_cast<double>(p.encoding.bias), 0.0, kMax));
       }
     }
@@ -71,9 +76,11 @@ struct Encoder {
       if (!(c < inf && c <= clamp_v)) {
         out[i] = none;
       } else if constexpr (std::is_same_v<T, float>) {
-        out[i] = std::min(euclid ? std::sqrt(static_cast<float>(c)) : static_cast<float>(c), clamp_f);
+        out[i] =
+            std::min(euclid ? std::sqrt(static_cast<float>(c)) : static_cast<float>(c), clamp_f);
       } else {
-        out[i] = static_cast<T>(std::min<double>(static_cast<double>(c), std::numeric_limits<T>::max()));
+        out[i] =
+            static_cast<T>(std::min<double>(static_cast<double>(c), std::numeric_limits<T>::max()));
       }
     }
   }

@@ -57,23 +57,29 @@ const std::vector<std::uint8_t>& dense_sites(const Grid<std::uint8_t>& occupancy
   const Vec3i n = in.size(), sn = site_box.size();
   for (int z = 0; z < sn.z; ++z)
     for (int y = 0; y < sn.y; ++y)
-      std::copy_n(part.data() + (static_cast<std::size_t>(z) * sn.y + static_cast<std::size_t>(y)) * sn.x, sn.x,
-                  solid.data() + (static_cast<std::size_t>(site_box.begin.z - in.begin.z + z) * n.y +
-                                  static_cast<std::size_t>(site_box.begin.y - in.begin.y + y)) * n.x +
-                      static_cast<std::size_t>(site_box.begin.x - in.begin.x));
+      std::copy_n(
+          part.data() + (static_cast<std::size_t>(z) * sn.y + static_cast<std::size_t>(y)) * sn.x,
+          sn.x,
+          solid.data() +
+              (static_cast<std::size_t>(site_box.begin.z - in.begin.z + z) * n.y +
+               static_cast<std::size_t>(site_box.begin.y - in.begin.y + y)) *
+                  n.x +
+              static_cast<std::size_t>(site_box.begin.x - in.begin.x));
   return solid;
 }
 
 // The slice passes and encoding of compute_region_impl through TruncatedMinConvolution: for
 // unit-spacing Euclidean fields without nearest sites whose clamp D is below kMaxReach + 1.
 template <class T>
-void region_slices_truncated(const Plan& p, const Encoder<T>& encoder, Vec3i n, const Box3i& out, int ox, int oy, int z0,
-                             std::uint8_t cap, const std::uint8_t* solid, const std::uint8_t* g, T* values) {
+void region_slices_truncated(const Plan& p, const Encoder<T>& encoder, Vec3i n, const Box3i& out,
+                             int ox, int oy, int z0, std::uint8_t cap, const std::uint8_t* solid,
+                             const std::uint8_t* g, T* values) {
   using Conv = TruncatedMinConvolution;
   const Vec3i m = out.size();
   const std::size_t plane = static_cast<std::size_t>(n.x) * n.y;
-  const int reach = static_cast<int>(std::floor(p.clamp));               // |k| beyond it costs more than D²
-  const auto drop = static_cast<Conv::Cost>(std::floor(p.clamp * p.clamp));  // integer costs above D² are beyond D
+  const int reach = static_cast<int>(std::floor(p.clamp));  // |k| beyond it costs more than D²
+  const auto drop = static_cast<Conv::Cost>(
+      std::floor(p.clamp * p.clamp));  // integer costs above D² are beyond D
   const std::size_t grain = std::max<std::size_t>(1, kVoxelsPerTask / plane);
   parallel_for(static_cast<std::size_t>(m.z), grain, [&](std::size_t zb, std::size_t ze) {
     thread_local Conv kept[2];
@@ -85,12 +91,16 @@ void region_slices_truncated(const Plan& p, const Encoder<T>& encoder, Vec3i n, 
       const std::uint8_t* ws = solid + (static_cast<std::size_t>(z0) + zi) * plane;
       // `ws` already says which voxels are solid: no copy of it is needed.
       for (int y = 0; y < n.y; ++y)
-        gather_truncated_row(gs + static_cast<std::size_t>(y) * n.x, ws + static_cast<std::size_t>(y) * n.x, n.x, cap,
-                             p.is_signed, conv[0].f_row(y), p.is_signed ? conv[1].f_row(y) : nullptr, nullptr);
+        gather_truncated_row(gs + static_cast<std::size_t>(y) * n.x,
+                             ws + static_cast<std::size_t>(y) * n.x, n.x, cap, p.is_signed,
+                             conv[0].f_row(y), p.is_signed ? conv[1].f_row(y) : nullptr, nullptr);
       for (int k = 0; k < passes; ++k) conv[k].solve();
       for (int y = 0; y < m.y; ++y)
-        encode_truncated_row(encoder, conv, y, 0, m.x, ws + static_cast<std::size_t>(y + oy) * n.x + static_cast<std::size_t>(ox),
-                             values + (zi * static_cast<std::size_t>(m.y) + static_cast<std::size_t>(y)) * m.x, drop);
+        encode_truncated_row(
+            encoder, conv, y, 0, m.x,
+            ws + static_cast<std::size_t>(y + oy) * n.x + static_cast<std::size_t>(ox),
+            values + (zi * static_cast<std::size_t>(m.y) + static_cast<std::size_t>(y)) * m.x,
+            drop);
     }
   });
 }
@@ -99,9 +109,10 @@ void region_slices_truncated(const Plan& p, const Encoder<T>& encoder, Vec3i n, 
 // slice of `out` gathered from `in`'s g (32 bits, `dz` its z offsets when sites are wanted),
 // solved over `in`'s x-y extent and written through the slice I/O the whole field uses.
 template <class T>
-void region_slices_envelope(const Plan& p, const Encoder<T>& encoder, Vec3i n, const Box3i& out, int ox, int oy, int z0,
-                            std::uint32_t cap_vox, const std::uint8_t* solid, const std::uint32_t* g, const std::int16_t* dz,
-                            T* values, SiteOffset* sites) {
+void region_slices_envelope(const Plan& p, const Encoder<T>& encoder, Vec3i n, const Box3i& out,
+                            int ox, int oy, int z0, std::uint32_t cap_vox,
+                            const std::uint8_t* solid, const std::uint32_t* g,
+                            const std::int16_t* dz, T* values, SiteOffset* sites) {
   const Vec3i m = out.size();
   const std::size_t plane = static_cast<std::size_t>(n.x) * n.y;
   exact::dispatch_solver(p, n, [&](auto tag, const auto& solve, auto inf) {
@@ -126,9 +137,10 @@ void region_slices_envelope(const Plan& p, const Encoder<T>& encoder, Vec3i n, c
         }
         for (int k = 0; k < passes; ++k) solve(n.x, n.y, buf[k], ox, ox + m.x);
         for (int y = 0; y < m.y; ++y) {
-          const std::size_t o = (zi * static_cast<std::size_t>(m.y) + static_cast<std::size_t>(y)) * m.x;
-          exact::write_row(encoder, costs, buf, ws, sites ? dz + zi * plane : nullptr, n.x, y + oy, ox, m.x, values + o,
-                           sites ? sites + o : nullptr);
+          const std::size_t o =
+              (zi * static_cast<std::size_t>(m.y) + static_cast<std::size_t>(y)) * m.x;
+          exact::write_row(encoder, costs, buf, ws, sites ? dz + zi * plane : nullptr, n.x, y + oy,
+                           ox, m.x, values + o, sites ? sites + o : nullptr);
         }
       }
     });
@@ -136,8 +148,9 @@ void region_slices_envelope(const Plan& p, const Encoder<T>& encoder, Vec3i n, c
 }
 
 template <class T>
-void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, const Box3i& in, const Box3i& out,
-                         T* values, SiteOffset* sites, const Box3i* sites_within) {
+void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, const Box3i& in,
+                         const Box3i& out, T* values, SiteOffset* sites,
+                         const Box3i* sites_within) {
   const Vec3i n = in.size(), m = out.size();
   const int z0 = out.begin.z - in.begin.z, z1 = out.end.z - in.begin.z;
   const int ox = out.begin.x - in.begin.x, oy = out.begin.y - in.begin.y;
@@ -145,7 +158,9 @@ void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, con
   const std::uint8_t* solid = dense_sites(occupancy, in, sites_within).data();
   // Largest g worth keeping, in voxels: beyond it a column's site is farther than the clamp.
   std::uint64_t cap = std::numeric_limits<std::uint32_t>::max() - 1;
-  if (std::isfinite(p.clamp)) cap = std::min<std::uint64_t>(cap, static_cast<std::uint64_t>(std::floor(p.clamp / p.spacing[2]) + 1));
+  if (std::isfinite(p.clamp))
+    cap = std::min<std::uint64_t>(
+        cap, static_cast<std::uint64_t>(std::floor(p.clamp / p.spacing[2]) + 1));
   const Encoder<T> encoder(p);
   // Scratch kept per thread across calls (see dense_sites).
   thread_local std::vector<std::uint8_t> g8;
@@ -173,20 +188,27 @@ void compute_region_impl(const Grid<std::uint8_t>& occupancy, const Plan& p, con
   } else {
     exact::region_pass_z<false>(solid, n, z0, z1, cap32, g.data(), sites ? dz.data() : nullptr);
   }
-  region_slices_envelope(p, encoder, n, out, ox, oy, z0, cap32, solid, g.data(), sites ? dz.data() : nullptr, values, sites);
+  region_slices_envelope(p, encoder, n, out, ox, oy, z0, cap32, solid, g.data(),
+                         sites ? dz.data() : nullptr, values, sites);
 }
 
 }  // namespace
 
 template <class T>
-void compute_region(const Grid<std::uint8_t>& occupancy, const FieldPlan& p, const Box3i& in, const Box3i& out,
-                    T* values, SiteOffset* sites, const Box3i* sites_within) {
-  if (!in.contains(out)) throw InvalidArgument("compute_region: the input box must contain the output box");
+void compute_region(const Grid<std::uint8_t>& occupancy, const FieldPlan& p, const Box3i& in,
+                    const Box3i& out, T* values, SiteOffset* sites, const Box3i* sites_within) {
+  if (!in.contains(out))
+    throw InvalidArgument("compute_region: the input box must contain the output box");
   if (out.empty()) return;
   compute_region_impl<T>(occupancy, p, in, out, values, sites, sites_within);
 }
-template void compute_region<std::uint8_t>(const Grid<std::uint8_t>&, const FieldPlan&, const Box3i&, const Box3i&, std::uint8_t*, SiteOffset*, const Box3i*);
-template void compute_region<std::uint16_t>(const Grid<std::uint8_t>&, const FieldPlan&, const Box3i&, const Box3i&, std::uint16_t*, SiteOffset*, const Box3i*);
-template void compute_region<float>(const Grid<std::uint8_t>&, const FieldPlan&, const Box3i&, const Box3i&, float*, SiteOffset*, const Box3i*);
+template void compute_region<std::uint8_t>(const Grid<std::uint8_t>&, const FieldPlan&,
+                                           const Box3i&, const Box3i&, std::uint8_t*, SiteOffset*,
+                                           const Box3i*);
+template void compute_region<std::uint16_t>(const Grid<std::uint8_t>&, const FieldPlan&,
+                                            const Box3i&, const Box3i&, std::uint16_t*, SiteOffset*,
+                                            const Box3i*);
+template void compute_region<float>(const Grid<std::uint8_t>&, const FieldPlan&, const Box3i&,
+                                    const Box3i&, float*, SiteOffset*, const Box3i*);
 
 }  // namespace voxfield::detail

@@ -24,7 +24,8 @@ template <class V>
 struct SliceCosts {
   SliceCosts(const Plan& p, V inf_cost)
       : inf(inf_cost),
-        clamp(clamp_cost(p) >= static_cast<double>(inf_cost) ? inf_cost : static_cast<V>(clamp_cost(p))),
+        clamp(clamp_cost(p) >= static_cast<double>(inf_cost) ? inf_cost
+                                                             : static_cast<V>(clamp_cost(p))),
         euclid(p.metric == Metric::kEuclidean),
         unit_spacing(p.unit_spacing),
         spacing_z(p.spacing[2]),
@@ -44,8 +45,8 @@ struct SliceCosts {
 // solid ones). `solid`, when not null, receives which voxels are solid: the write-back needs them
 // for signed fields and nearest sites, and a caller that holds them already passes null.
 template <class V, class G>
-void gather_row(const SliceCosts<V>& costs, const G* g, G cap_vox, const std::uint8_t* world, int count, V* f0, V* f1,
-                std::uint8_t* solid) {
+void gather_row(const SliceCosts<V>& costs, const G* g, G cap_vox, const std::uint8_t* world,
+                int count, V* f0, V* f1, std::uint8_t* solid) {
   // Copied out: V pointers could otherwise alias these fields, and the loops would reload them.
   const V inf = costs.inf, clamp = costs.clamp;
   const bool euclid = costs.euclid, unit_spacing = costs.unit_spacing;
@@ -85,8 +86,8 @@ void gather_row(const SliceCosts<V>& costs, const G* g, G cap_vox, const std::ui
 // which voxels are solid (for signed fields and sites) and `dz` pass A's z offsets (sites only).
 template <class T, class V>
 void write_row(const Encoder<T>& encoder, const SliceCosts<V>& costs, const SliceBuffers<V>* buf,
-               const std::uint8_t* solid, const std::int16_t* dz, int width, int y, int x0, int count, T* out,
-               SiteOffset* sites) {
+               const std::uint8_t* solid, const std::int16_t* dz, int width, int y, int x0,
+               int count, T* out, SiteOffset* sites) {
   const V inf = costs.inf, clamp = costs.clamp;
   const bool is_signed = costs.is_signed;
   const std::size_t o = static_cast<std::size_t>(y) * width + x0;
@@ -126,11 +127,13 @@ void write_row(const Encoder<T>& encoder, const SliceCosts<V>& costs, const Slic
 // none) becomes its square; signed fields split it into the distance to solid (f0, for air
 // voxels) and to air (f1, for solid ones) and note which voxels are solid in `solid`.
 template <class G>
-void gather_truncated_row(const G* g, const std::uint8_t* world, int count, std::uint32_t cap, bool is_signed,
-                          TruncatedMinConvolution::Cost* f0, TruncatedMinConvolution::Cost* f1, std::uint8_t* solid) {
+void gather_truncated_row(const G* g, const std::uint8_t* world, int count, std::uint32_t cap,
+                          bool is_signed, TruncatedMinConvolution::Cost* f0,
+                          TruncatedMinConvolution::Cost* f1, std::uint8_t* solid) {
   using Cost = TruncatedMinConvolution::Cost;
   if (!is_signed) {
-    for (int i = 0; i < count; ++i) f0[i] = g[i] < cap ? static_cast<Cost>(g[i] * g[i]) : TruncatedMinConvolution::kInf;
+    for (int i = 0; i < count; ++i)
+      f0[i] = g[i] < cap ? static_cast<Cost>(g[i] * g[i]) : TruncatedMinConvolution::kInf;
     return;
   }
   for (int i = 0; i < count; ++i) {
@@ -145,8 +148,9 @@ void gather_truncated_row(const G* g, const std::uint8_t* world, int count, std:
 // Encodes `count` solved costs of row y from column x0 of `conv` (conv[1] for the solid voxels
 // of signed fields, `solid` giving them) into `out`.
 template <class T>
-void encode_truncated_row(const Encoder<T>& encoder, const TruncatedMinConvolution* conv, int y, int x0, int count,
-                          const std::uint8_t* solid, T* out, TruncatedMinConvolution::Cost drop) {
+void encode_truncated_row(const Encoder<T>& encoder, const TruncatedMinConvolution* conv, int y,
+                          int x0, int count, const std::uint8_t* solid, T* out,
+                          TruncatedMinConvolution::Cost drop) {
   using Conv = TruncatedMinConvolution;
   if (encoder.row_path) {
     encoder.encode_row(conv[0].out_row(y) + x0, out, count, Conv::kInf, drop);

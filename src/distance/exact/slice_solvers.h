@@ -27,7 +27,9 @@ using Plan = FieldPlan;
 
 // The clamp as a cost of the plan's kernel: squared for Euclidean (whose passes minimise squared
 // distances, so that no square root is taken per voxel), the distance itself otherwise.
-inline double clamp_cost(const Plan& p) { return p.metric == Metric::kEuclidean ? p.clamp * p.clamp : p.clamp; }
+inline double clamp_cost(const Plan& p) {
+  return p.metric == Metric::kEuclidean ? p.clamp * p.clamp : p.clamp;
+}
 
 // Per-thread buffers for one slice. Results (h, arg_x, arg_y) end up row-major: index y*X + x.
 // Arrays are left uninitialised: every element is written before it is read.
@@ -89,7 +91,8 @@ void to_rows(const A* in, A* out, int X, int Y, int x_lo, int x_hi) {
 // worlds and need no envelope: all sites (cost 0 everywhere: inside solid matter) and no site at
 // all (open air far from everything).
 template <class Kernel, class V>
-void solve_line(const Kernel& k, int n, const V* f, V* out, std::int32_t* arg, std::int32_t* s, std::int32_t* t, V inf) {
+void solve_line(const Kernel& k, int n, const V* f, V* out, std::int32_t* arg, std::int32_t* s,
+                std::int32_t* t, V inf) {
   bool all_zero = true, all_inf = true;
   for (int i = 0; i < n; ++i) {
     all_zero &= f[i] == V(0);
@@ -112,36 +115,40 @@ void solve_line(const Kernel& k, int n, const V* f, V* out, std::int32_t* arg, s
 // a pass-B value above it cannot bring any voxel within the clamp (pass C only adds to it), so it
 // is dropped as "none", which leaves pass C fewer functions and more lines it skips outright.
 template <class KernelX, class KernelY, class V>
-void solve_slice_envelope2(const KernelX& kx, const KernelY& ky, int X, int Y, SliceBuffers<V>& b, bool track_sites,
-                           V inf, int x_lo, int x_hi, V drop_above) {
+void solve_slice_envelope2(const KernelX& kx, const KernelY& ky, int X, int Y, SliceBuffers<V>& b,
+                           bool track_sites, V inf, int x_lo, int x_hi, V drop_above) {
   std::int32_t* arg_x = track_sites ? b.arg_x.data() : nullptr;
   std::int32_t* targ = track_sites ? b.targ.data() : nullptr;
   for (int y = 0; y < Y; ++y) {
     const std::size_t o = static_cast<std::size_t>(y) * X;
-    solve_line(kx, X, b.f.data() + o, b.h.data() + o, arg_x ? arg_x + o : nullptr, b.s.data(), b.t.data(), inf);
+    solve_line(kx, X, b.f.data() + o, b.h.data() + o, arg_x ? arg_x + o : nullptr, b.s.data(),
+               b.t.data(), inf);
   }
   if (drop_above < inf) {
     V* h = b.h.data();
-    for (std::size_t i = 0; i < static_cast<std::size_t>(X) * Y; ++i) h[i] = h[i] > drop_above ? inf : h[i];
+    for (std::size_t i = 0; i < static_cast<std::size_t>(X) * Y; ++i)
+      h[i] = h[i] > drop_above ? inf : h[i];
   }
   to_columns(b.h.data(), b.tmp.data(), X, Y, x_lo, x_hi);
   for (int x = x_lo; x < x_hi; ++x) {
     const std::size_t o = static_cast<std::size_t>(x) * Y;
-    solve_line(ky, Y, b.tmp.data() + o, b.f.data() + o, targ ? targ + o : nullptr, b.s.data(), b.t.data(), inf);
+    solve_line(ky, Y, b.tmp.data() + o, b.f.data() + o, targ ? targ + o : nullptr, b.s.data(),
+               b.t.data(), inf);
   }
   to_rows(b.f.data(), b.h.data(), X, Y, x_lo, x_hi);
   if (track_sites) to_rows(b.targ.data(), b.arg_y.data(), X, Y, x_lo, x_hi);
 }
 
 template <class Kernel, class V>
-void solve_slice_envelope(const Kernel& kx, const Kernel& ky, int X, int Y, SliceBuffers<V>& b, bool track_sites, V inf,
-                          int x_lo, int x_hi, V drop_above) {
+void solve_slice_envelope(const Kernel& kx, const Kernel& ky, int X, int Y, SliceBuffers<V>& b,
+                          bool track_sites, V inf, int x_lo, int x_hi, V drop_above) {
   solve_slice_envelope2(kx, ky, X, Y, b, track_sites, inf, x_lo, x_hi, drop_above);
 }
 
 // 2-D solve of one slice for Manhattan: min-plus sweeps along x per row, then along y across whole
 // rows at once (contiguous, vectorisable). Ties keep the smaller index, as the envelope does.
-inline void solve_slice_manhattan(int X, int Y, SliceBuffers<std::int32_t>& b, bool track_sites, int x_lo, int x_hi) {
+inline void solve_slice_manhattan(int X, int Y, SliceBuffers<std::int32_t>& b, bool track_sites,
+                                  int x_lo, int x_hi) {
   constexpr std::int32_t kInf = kManhattanInf;
   std::int32_t* h = b.h.data();
   if (track_sites) {
@@ -164,7 +171,8 @@ inline void solve_slice_manhattan(int X, int Y, SliceBuffers<std::int32_t>& b, b
         best[k] = kInf;
       }
       for (int x = 0; x < X; ++x)
-        for (int k = 0; k < kRows; ++k) r[k][x] = best[k] = std::min(f[k][x], std::min(best[k] + 1, kInf));
+        for (int k = 0; k < kRows; ++k)
+          r[k][x] = best[k] = std::min(f[k][x], std::min(best[k] + 1, kInf));
       for (int x = X - 2; x >= 0; --x)
         for (int k = 0; k < kRows; ++k) r[k][x] = std::min(r[k][x], r[k][x + 1] + 1);
     }
@@ -226,8 +234,8 @@ inline void solve_slice_manhattan(int X, int Y, SliceBuffers<std::int32_t>& b, b
 // clamp: 256³ terrain / spheres on 2 threads, clamp 16: 141 → 58 / 110 → 57 ms, clamp 64:
 // 174 → 124 / 178 → 130 ms.
 inline bool truncated_passes(const Plan& p, bool sites) {
-  return p.metric == Metric::kEuclidean && p.unit_spacing && !sites && std::isfinite(p.clamp) && p.clamp >= 1 &&
-         p.clamp < TruncatedMinConvolution::kMaxReach + 1;
+  return p.metric == Metric::kEuclidean && p.unit_spacing && !sites && std::isfinite(p.clamp) &&
+         p.clamp >= 1 && p.clamp < TruncatedMinConvolution::kMaxReach + 1;
 }
 
 // Calls fn(value_tag, solve, inf) with the 2-D slice solver of the plan's metric: V (the type of
@@ -247,42 +255,45 @@ void dispatch_solver(const Plan& p, Vec3i extent, Fn&& fn) {
     return static_cast<V>(clamp);
   };
   if (p.metric == Metric::kManhattan) {
-    auto solve = [sites](int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) { solve_slice_manhattan(X, Y, b, sites, lo, hi); };
+    auto solve = [sites](int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) {
+      solve_slice_manhattan(X, Y, b, sites, lo, hi);
+    };
     fn(std::int32_t{}, solve, kManhattanInf);
   } else if (p.metric == Metric::kChebyshev) {
-    auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
-      envelope_1d(Chebyshev{}, n, f, o, a, s, t);
-    };
-    auto solve = [k, sites, d = drop(Chebyshev::kInf)](int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) {
+    auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s,
+                std::int32_t* t) { envelope_1d(Chebyshev{}, n, f, o, a, s, t); };
+    auto solve = [k, sites, d = drop(Chebyshev::kInf)](int X, int Y, SliceBuffers<std::int32_t>& b,
+                                                       int lo, int hi) {
       solve_slice_envelope(k, k, X, Y, b, sites, Chebyshev::kInf, lo, hi, d);
     };
     fn(std::int32_t{}, solve, Chebyshev::kInf);
-  } else if (p.unit_spacing && static_cast<double>(extent.x) * extent.x + static_cast<double>(extent.y) * extent.y +
-                                       static_cast<double>(extent.z) * extent.z < (1 << 29)) {
-    auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
-      envelope_1d(EuclideanInt32{}, n, f, o, a, s, t);
-    };
-    auto solve = [k, sites, d = drop(EuclideanInt32::kInf)](int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) {
+  } else if (p.unit_spacing && static_cast<double>(extent.x) * extent.x +
+                                       static_cast<double>(extent.y) * extent.y +
+                                       static_cast<double>(extent.z) * extent.z <
+                                   (1 << 29)) {
+    auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s,
+                std::int32_t* t) { envelope_1d(EuclideanInt32{}, n, f, o, a, s, t); };
+    auto solve = [k, sites, d = drop(EuclideanInt32::kInf)](
+                     int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) {
       solve_slice_envelope(k, k, X, Y, b, sites, EuclideanInt32::kInf, lo, hi, d);
     };
     fn(std::int32_t{}, solve, EuclideanInt32::kInf);
   } else if (p.unit_spacing) {
-    auto k = [](int n, const std::int64_t* f, std::int64_t* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
-      envelope_1d(EuclideanInt{}, n, f, o, a, s, t);
-    };
-    auto solve = [k, sites, d = drop(EuclideanInt::kInf)](int X, int Y, SliceBuffers<std::int64_t>& b, int lo, int hi) {
+    auto k = [](int n, const std::int64_t* f, std::int64_t* o, std::int32_t* a, std::int32_t* s,
+                std::int32_t* t) { envelope_1d(EuclideanInt{}, n, f, o, a, s, t); };
+    auto solve = [k, sites, d = drop(EuclideanInt::kInf)](
+                     int X, int Y, SliceBuffers<std::int64_t>& b, int lo, int hi) {
       solve_slice_envelope(k, k, X, Y, b, sites, EuclideanInt::kInf, lo, hi, d);
     };
     fn(std::int64_t{}, solve, EuclideanInt::kInf);
   } else {
     const EuclideanReal ex{p.spacing[0] * p.spacing[0]}, ey{p.spacing[1] * p.spacing[1]};
-    auto kx = [ex](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
-      envelope_1d(ex, n, f, o, a, s, t);
-    };
-    auto ky = [ey](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s, std::int32_t* t) {
-      envelope_1d(ey, n, f, o, a, s, t);
-    };
-    auto solve = [kx, ky, sites, d = drop(EuclideanReal::kInf)](int X, int Y, SliceBuffers<double>& b, int lo, int hi) {
+    auto kx = [ex](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s,
+                   std::int32_t* t) { envelope_1d(ex, n, f, o, a, s, t); };
+    auto ky = [ey](int n, const double* f, double* o, std::int32_t* a, std::int32_t* s,
+                   std::int32_t* t) { envelope_1d(ey, n, f, o, a, s, t); };
+    auto solve = [kx, ky, sites, d = drop(EuclideanReal::kInf)](
+                     int X, int Y, SliceBuffers<double>& b, int lo, int hi) {
       // The two axes weigh differently; the slice solver takes one kernel per axis.
       solve_slice_envelope2(kx, ky, X, Y, b, sites, EuclideanReal::kInf, lo, hi, d);
     };

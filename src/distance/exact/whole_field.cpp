@@ -36,8 +36,8 @@ namespace {
 using detail::TruncatedMinConvolution;
 using detail::exact::ChunkedVolume;
 using detail::exact::dispatch_solver;
-using detail::exact::Encoder;
 using detail::exact::encode_truncated_row;
+using detail::exact::Encoder;
 using detail::exact::for_each_row_segment;
 using detail::exact::gather_row;
 using detail::exact::gather_truncated_row;
@@ -53,8 +53,9 @@ using detail::exact::write_row;
 // slice_solvers.h: each slice's g is gathered from the chunk rows, solved, and written back into
 // the same rows as final values (T and U have the same size).
 template <class T, class U, class V, class Solve>
-void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, ChunkedVolume<SiteOffset>* sites,
-                 const Solve& solve, const Encoder<T>& encoder, std::uint32_t cap_vox, V inf) {
+void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
+                 ChunkedVolume<SiteOffset>* sites, const Solve& solve, const Encoder<T>& encoder,
+                 std::uint32_t cap_vox, V inf) {
   constexpr U kInfU = std::numeric_limits<U>::max();
   const int X = p.domain.size().x, Y = p.domain.size().y;
   const int by = p.domain.begin.y;
@@ -63,7 +64,8 @@ void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, Chu
   const int passes = p.is_signed ? 2 : 1;
   // Ranges of several slices each, so that the buffers are allocated a few times per thread only.
   const std::size_t Z = static_cast<std::size_t>(p.domain.size().z);
-  const std::size_t grain = std::max<std::size_t>(1, Z / (4 * static_cast<std::size_t>(max_threads())));
+  const std::size_t grain =
+      std::max<std::size_t>(1, Z / (4 * static_cast<std::size_t>(max_threads())));
   parallel_for(Z, grain, [&](std::size_t zb, std::size_t ze) {
     SliceBuffers<V> buf[2];
     std::vector<std::uint8_t> solid(static_cast<std::size_t>(X) * Y);
@@ -74,8 +76,9 @@ void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, Chu
       for (int y = 0; y < Y; ++y) {
         for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
           const std::size_t o = static_cast<std::size_t>(y) * X + xo;
-          gather_row(costs, g.row(cx, by + y, z) + lx, cap_u, world.row(cx, by + y, z) + lx, count, buf[0].f.data() + o,
-                     p.is_signed ? buf[1].f.data() + o : nullptr, p.is_signed || sites ? solid.data() + o : nullptr);
+          gather_row(costs, g.row(cx, by + y, z) + lx, cap_u, world.row(cx, by + y, z) + lx, count,
+                     buf[0].f.data() + o, p.is_signed ? buf[1].f.data() + o : nullptr,
+                     p.is_signed || sites ? solid.data() + o : nullptr);
           if (sites) {
             const SiteOffset* ss = sites->row(cx, by + y, z) + lx;
             for (int i = 0; i < count; ++i) dz[o + i] = ss[i].dz;
@@ -86,19 +89,19 @@ void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, Chu
       for (int y = 0; y < Y; ++y) {
         for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
           write_row(encoder, costs, buf, solid.data(), dz.data(), X, y, xo, count,
-                    reinterpret_cast<T*>(g.row(cx, by + y, z)) + lx, sites ? sites->row(cx, by + y, z) + lx : nullptr);
+                    reinterpret_cast<T*>(g.row(cx, by + y, z)) + lx,
+                    sites ? sites->row(cx, by + y, z) + lx : nullptr);
         });
       }
     }
   });
 }
 
-
 // Passes B and C and encoding of a whole field through TruncatedMinConvolution: pass_slices'
 // work, slice by slice, with the window the whole slice.
 template <class T, class U>
-void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, const Encoder<T>& encoder,
-                           std::uint32_t cap) {
+void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
+                           const Encoder<T>& encoder, std::uint32_t cap) {
   using Conv = TruncatedMinConvolution;
   const int X = p.domain.size().x, Y = p.domain.size().y;
   const int by = p.domain.begin.y;
@@ -106,7 +109,8 @@ void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<
   const auto drop = static_cast<Conv::Cost>(std::floor(p.clamp * p.clamp));
   const int passes = p.is_signed ? 2 : 1;
   const std::size_t Z = static_cast<std::size_t>(p.domain.size().z);
-  const std::size_t grain = std::max<std::size_t>(1, Z / (4 * static_cast<std::size_t>(max_threads())));
+  const std::size_t grain =
+      std::max<std::size_t>(1, Z / (4 * static_cast<std::size_t>(max_threads())));
   parallel_for(Z, grain, [&](std::size_t zb, std::size_t ze) {
     Conv conv[2];
     std::vector<std::uint8_t> solid(p.is_signed ? static_cast<std::size_t>(X) * Y : 0);
@@ -116,8 +120,9 @@ void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<
       for (int y = 0; y < Y; ++y) {
         for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
           const std::size_t o = static_cast<std::size_t>(y) * X + xo;
-          gather_truncated_row(g.row(cx, by + y, z) + lx, world.row(cx, by + y, z) + lx, count, cap, p.is_signed,
-                               conv[0].f_row(y) + xo, p.is_signed ? conv[1].f_row(y) + xo : nullptr,
+          gather_truncated_row(g.row(cx, by + y, z) + lx, world.row(cx, by + y, z) + lx, count, cap,
+                               p.is_signed, conv[0].f_row(y) + xo,
+                               p.is_signed ? conv[1].f_row(y) + xo : nullptr,
                                p.is_signed ? solid.data() + o : nullptr);
         });
       }
@@ -126,8 +131,10 @@ void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<
       for (int y = 0; y < Y; ++y) {
         for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
           T* out = reinterpret_cast<T*>(g.row(cx, by + y, z)) + lx;  // T and U have the same size
-          encode_truncated_row(encoder, conv, y, xo, count, p.is_signed ? solid.data() + static_cast<std::size_t>(y) * X + xo : nullptr,
-                               out, drop);
+          encode_truncated_row(
+              encoder, conv, y, xo, count,
+              p.is_signed ? solid.data() + static_cast<std::size_t>(y) * X + xo : nullptr, out,
+              drop);
         });
       }
     }
@@ -136,7 +143,8 @@ void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<
 
 // The whole field of storage T, g held in place in U (T's size) between the passes.
 template <class T, class U>
-DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy, const DistanceOptions& options, const Plan& p) {
+DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy,
+                                  const DistanceOptions& options, const Plan& p) {
   const T background = detail::field_background<T>(p);
   DistanceField out;
   out.options = options;
@@ -167,7 +175,8 @@ DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy, const Dis
         const Vec3i lo{g.coords[i].x * edge, g.coords[i].y * edge, g.coords[i].z * edge};
         if (!p.domain.contains(Box3i{lo, lo + Vec3i::splat(edge)})) {
           std::fill(g.chunks[i].get(), g.chunks[i].get() + volume, bg);
-          if (sites) std::fill(sites->chunks[i].get(), sites->chunks[i].get() + volume, SiteOffset{});
+          if (sites)
+            std::fill(sites->chunks[i].get(), sites->chunks[i].get() + volume, SiteOffset{});
         }
       }
     });
@@ -212,7 +221,8 @@ DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy, const Dis
 
   // Hand the chunks to the grids (uniform ones collapse).
   std::vector<std::unique_ptr<T[]>> typed(g.chunks.size());
-  for (std::size_t i = 0; i < g.chunks.size(); ++i) typed[i].reset(reinterpret_cast<T*>(g.chunks[i].release()));
+  for (std::size_t i = 0; i < g.chunks.size(); ++i)
+    typed[i].reset(reinterpret_cast<T*>(g.chunks[i].release()));
   values.adopt_chunks(g.coords, std::move(typed));
   if (sites) sites_grid->adopt_chunks(sites->coords, std::move(sites->chunks));
   out.values = std::move(values);
@@ -222,7 +232,8 @@ DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy, const Dis
 
 }  // namespace
 
-DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o) {
+DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy,
+                                     const DistanceOptions& o) {
   const Plan p = detail::make_field_plan(occupancy, o);
   switch (o.storage) {
     case Storage::kU8:

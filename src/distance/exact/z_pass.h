@@ -30,8 +30,8 @@ namespace voxfield::detail::exact {
 // and the local passes.
 // G: the lane type (32 bits in general; 8 bits when cap fits, for four times the lanes per step).
 template <bool kSigned, class G = std::uint32_t>
-inline void z_sweep_step(const std::uint8_t* __restrict w, G* __restrict ds, G* __restrict da, G* __restrict c, std::size_t n,
-                         G cap) {
+inline void z_sweep_step(const std::uint8_t* __restrict w, G* __restrict ds, G* __restrict da,
+                         G* __restrict c, std::size_t n, G cap) {
   for (std::size_t i = 0; i < n; ++i) {
     const bool solid = w[i] != 0;
     ds[i] = solid ? G{0} : std::min(static_cast<G>(ds[i] + 1u), cap);
@@ -49,8 +49,9 @@ inline void z_sweep_step(const std::uint8_t* __restrict w, G* __restrict ds, G* 
 // thread-local buffer small enough for the cache, so each output voxel is written exactly once.
 // U: the unsigned integer the output storage holds g in; g >= cap is stored as kInf ("none").
 template <class U, bool kSigned>
-void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, ChunkedVolume<SiteOffset>* sites,
-            int cx, int cy, std::uint32_t cap, std::vector<std::uint32_t>& col) {
+void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
+            ChunkedVolume<SiteOffset>* sites, int cx, int cy, std::uint32_t cap,
+            std::vector<std::uint32_t>& col) {
   constexpr U kInf = std::numeric_limits<U>::max();
   const int e = g.edge;
   const int y0 = std::max(p.domain.begin.y, g.box.begin.y + cy * e);
@@ -67,7 +68,8 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, ChunkedV
     std::uint32_t* __restrict dsr = ds;
     std::uint32_t* __restrict dar = da;
     for (int z = z0; z < z1; ++z) {
-      z_sweep_step<kSigned>(world.row(cx, y, z), dsr, dar, col.data() + static_cast<std::size_t>(z - z0) * e,
+      z_sweep_step<kSigned>(world.row(cx, y, z), dsr, dar,
+                            col.data() + static_cast<std::size_t>(z - z0) * e,
                             static_cast<std::size_t>(e), cap);
     }
     // Backward (decreasing z): keep the smaller, and store once.
@@ -99,8 +101,12 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, ChunkedV
       SiteOffset* so = sites->row(cx, y, z);
       for (int i = 0; i < e; ++i) {
         const bool solid = w[i] != 0;
-        if (solid) ls[i] = z; else la[i] = z;
-        so[i].dz = static_cast<std::int16_t>(std::clamp((kSigned && solid ? la[i] : ls[i]) - z, -32768, 32767));
+        if (solid)
+          ls[i] = z;
+        else
+          la[i] = z;
+        so[i].dz = static_cast<std::int16_t>(
+            std::clamp((kSigned && solid ? la[i] : ls[i]) - z, -32768, 32767));
       }
     }
     std::fill(ls, ls + e, INT32_MAX / 2);
@@ -110,7 +116,10 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, ChunkedV
       SiteOffset* so = sites->row(cx, y, z);
       for (int i = 0; i < e; ++i) {
         const bool solid = w[i] != 0;
-        if (solid) ls[i] = z; else la[i] = z;
+        if (solid)
+          ls[i] = z;
+        else
+          la[i] = z;
         const std::int32_t above = (kSigned && solid ? la[i] : ls[i]) - z;  // >= 0
         const std::int32_t below = -static_cast<std::int32_t>(so[i].dz);    // >= 0 when found
         if (above < below) so[i].dz = static_cast<std::int16_t>(std::min(above, 32767));
@@ -121,9 +130,11 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g, ChunkedV
 
 // G: the type g is kept in (8 bits when cap < 256, see z_sweep_step); dz only with 32 bits.
 template <bool kSigned, class G>
-void region_pass_z(const std::uint8_t* solid, Vec3i n, int z0, int z1, G cap, G* g, std::int16_t* dz) {
+void region_pass_z(const std::uint8_t* solid, Vec3i n, int z0, int z1, G cap, G* g,
+                   std::int16_t* dz) {
   const std::size_t nx = static_cast<std::size_t>(n.x), plane = nx * static_cast<std::size_t>(n.y);
-  thread_local std::vector<G> col_scratch, ds_scratch, da_scratch;  // kept per thread: see local_region.cpp
+  thread_local std::vector<G> col_scratch, ds_scratch,
+      da_scratch;  // kept per thread: see local_region.cpp
   std::vector<G>& col = col_scratch;
   std::vector<G>& ds = ds_scratch;
   std::vector<G>& da = da_scratch;
@@ -137,13 +148,15 @@ void region_pass_z(const std::uint8_t* solid, Vec3i n, int z0, int z1, G cap, G*
     std::fill(ds.begin(), ds.end(), cap);
     std::fill(da.begin(), da.end(), cap);
     for (int z = 0; z < n.z; ++z) {
-      z_sweep_step<kSigned, G>(solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx, dsr, dar,
-                               col.data() + static_cast<std::size_t>(z) * nx, nx, cap);
+      z_sweep_step<kSigned, G>(
+          solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx, dsr, dar,
+          col.data() + static_cast<std::size_t>(z) * nx, nx, cap);
     }
     std::fill(ds.begin(), ds.end(), cap);
     std::fill(da.begin(), da.end(), cap);
     for (int z = n.z - 1; z >= z0; --z) {
-      const std::uint8_t* __restrict w = solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx;
+      const std::uint8_t* __restrict w =
+          solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx;
       const G* __restrict c = col.data() + static_cast<std::size_t>(z) * nx;
       for (std::size_t i = 0; i < nx; ++i) {
         const bool s = w[i] != 0;
@@ -151,7 +164,8 @@ void region_pass_z(const std::uint8_t* solid, Vec3i n, int z0, int z1, G cap, G*
         if constexpr (kSigned) dar[i] = s ? std::min(static_cast<G>(dar[i] + 1u), cap) : G{0};
       }
       if (z >= z1) continue;
-      G* __restrict out = g + static_cast<std::size_t>(z - z0) * plane + static_cast<std::size_t>(y) * nx;
+      G* __restrict out =
+          g + static_cast<std::size_t>(z - z0) * plane + static_cast<std::size_t>(y) * nx;
       for (std::size_t i = 0; i < nx; ++i) {
         const G back = (kSigned && w[i] != 0) ? dar[i] : dsr[i];
         out[i] = std::min(c[i], back);
@@ -162,24 +176,30 @@ void region_pass_z(const std::uint8_t* solid, Vec3i n, int z0, int z1, G cap, G*
     std::fill(ls.begin(), ls.end(), INT32_MIN / 2);
     std::fill(la.begin(), la.end(), INT32_MIN / 2);
     for (int z = 0; z < z1; ++z) {
-      const std::uint8_t* w = solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx;
+      const std::uint8_t* w =
+          solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx;
       for (std::size_t i = 0; i < nx; ++i) (w[i] != 0 ? ls[i] : la[i]) = z;
       if (z < z0) continue;
-      std::int16_t* d = dz + static_cast<std::size_t>(z - z0) * plane + static_cast<std::size_t>(y) * nx;
+      std::int16_t* d =
+          dz + static_cast<std::size_t>(z - z0) * plane + static_cast<std::size_t>(y) * nx;
       for (std::size_t i = 0; i < nx; ++i) {
-        d[i] = static_cast<std::int16_t>(std::clamp((kSigned && w[i] != 0 ? la[i] : ls[i]) - z, -32768, 32767));
+        d[i] = static_cast<std::int16_t>(
+            std::clamp((kSigned && w[i] != 0 ? la[i] : ls[i]) - z, -32768, 32767));
       }
     }
     std::fill(ls.begin(), ls.end(), INT32_MAX / 2);
     std::fill(la.begin(), la.end(), INT32_MAX / 2);
     for (int z = n.z - 1; z >= z0; --z) {
-      const std::uint8_t* w = solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx;
+      const std::uint8_t* w =
+          solid + static_cast<std::size_t>(z) * plane + static_cast<std::size_t>(y) * nx;
       for (std::size_t i = 0; i < nx; ++i) (w[i] != 0 ? ls[i] : la[i]) = z;
       if (z >= z1) continue;
-      std::int16_t* d = dz + static_cast<std::size_t>(z - z0) * plane + static_cast<std::size_t>(y) * nx;
+      std::int16_t* d =
+          dz + static_cast<std::size_t>(z - z0) * plane + static_cast<std::size_t>(y) * nx;
       for (std::size_t i = 0; i < nx; ++i) {
         const std::int32_t above = (kSigned && w[i] != 0 ? la[i] : ls[i]) - z;
-        if (above < -static_cast<std::int32_t>(d[i])) d[i] = static_cast<std::int16_t>(std::min(above, 32767));
+        if (above < -static_cast<std::int32_t>(d[i]))
+          d[i] = static_cast<std::int16_t>(std::min(above, 32767));
       }
     }
   }

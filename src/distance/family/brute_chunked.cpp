@@ -19,8 +19,10 @@ void brute_chunked(const DenseProblem& p, DenseSolution& out, AlgorithmStats& st
   out.site.assign(p.size(), -1);
   // Chunks are aligned to the world's chunk grid, as the dissertation's were.
   auto floor_div = [](int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); };
-  const Vec3i c0{floor_div(p.box.begin.x, e), floor_div(p.box.begin.y, e), floor_div(p.box.begin.z, e)};
-  const Vec3i c1{floor_div(p.box.end.x - 1, e), floor_div(p.box.end.y - 1, e), floor_div(p.box.end.z - 1, e)};
+  const Vec3i c0{floor_div(p.box.begin.x, e), floor_div(p.box.begin.y, e),
+                 floor_div(p.box.begin.z, e)};
+  const Vec3i c1{floor_div(p.box.end.x - 1, e), floor_div(p.box.end.y - 1, e),
+                 floor_div(p.box.end.z - 1, e)};
   std::vector<Vec3i> chunks;
   for (int z = c0.z; z <= c1.z; ++z)
     for (int y = c0.y; y <= c1.y; ++y)
@@ -30,7 +32,9 @@ void brute_chunked(const DenseProblem& p, DenseSolution& out, AlgorithmStats& st
   parallel_for(chunks.size(), 1, [&](std::size_t b, std::size_t end) {
     for (std::size_t k = b; k < end; ++k) {
       const Vec3i c = chunks[k];
-      const Box3i cb = Box3i{{c.x * e, c.y * e, c.z * e}, {c.x * e + e, c.y * e + e, c.z * e + e}}.intersect(p.box);
+      const Box3i cb =
+          Box3i{{c.x * e, c.y * e, c.z * e}, {c.x * e + e, c.y * e + e, c.z * e + e}}.intersect(
+              p.box);
       const Box3i padded = cb.grown(1);
       World w(inner_edge, padded);
       std::vector<std::uint8_t> dense(static_cast<std::size_t>(padded.volume()));
@@ -40,7 +44,8 @@ void brute_chunked(const DenseProblem& p, DenseSolution& out, AlgorithmStats& st
           for (int x = padded.begin.x; x < padded.end.x; ++x, ++i) {
             const Vec3i q{x, y, z};
             // The padding counts as solid.
-            dense[i] = !cb.contains(q) || p.site[p.index(x - p.box.begin.x, y - p.box.begin.y, z - p.box.begin.z)];
+            dense[i] = !cb.contains(q) ||
+                       p.site[p.index(x - p.box.begin.x, y - p.box.begin.y, z - p.box.begin.z)];
           }
       w.voxels.copy_from_dense(padded, dense.data());
       DistanceOptions o;
@@ -52,7 +57,8 @@ void brute_chunked(const DenseProblem& p, DenseSolution& out, AlgorithmStats& st
       for (int z = cb.begin.z; z < cb.end.z; ++z)
         for (int y = cb.begin.y; y < cb.end.y; ++y)
           for (int x = cb.begin.x; x < cb.end.x; ++x) {
-            out.d[p.index(x - p.box.begin.x, y - p.box.begin.y, z - p.box.begin.z)] = g.get({x, y, z});
+            out.d[p.index(x - p.box.begin.x, y - p.box.begin.y, z - p.box.begin.z)] =
+                g.get({x, y, z});
           }
     }
   });

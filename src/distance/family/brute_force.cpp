@@ -8,19 +8,23 @@
 
 namespace voxfield::detail {
 
-void brute_force(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats, double max_work) {
+void brute_force(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats,
+                 double max_work) {
   std::vector<std::int32_t> sites;
   for (std::size_t i = 0; i < p.size(); ++i)
     if (p.site[i]) sites.push_back(static_cast<std::int32_t>(i));
   const double work = static_cast<double>(p.size()) * static_cast<double>(sites.size());
   if (work > max_work) {
     char text[160];
-    std::snprintf(text, sizeof text, "brute force would need %.3g distance evaluations (limit %.3g); use a smaller input",
-                  work, max_work);
+    std::snprintf(
+        text, sizeof text,
+        "brute force would need %.3g distance evaluations (limit %.3g); use a smaller input", work,
+        max_work);
     throw InvalidArgument(text);
   }
   std::vector<Vec3i> site_xyz(sites.size());
-  for (std::size_t k = 0; k < sites.size(); ++k) site_xyz[k] = p.coord(static_cast<std::size_t>(sites[k]));
+  for (std::size_t k = 0; k < sites.size(); ++k)
+    site_xyz[k] = p.coord(static_cast<std::size_t>(sites[k]));
   out.d.assign(p.size(), kFar);
   out.site.assign(p.size(), -1);
   parallel_for(p.size(), 256, [&](std::size_t b, std::size_t e) {

@@ -19,8 +19,8 @@ namespace voxfield::detail {
 inline constexpr float kFar = std::numeric_limits<float>::infinity();
 
 struct DenseProblem {
-  Box3i box;  // the domain
-  Vec3i n;    // its size
+  Box3i box;                       // the domain
+  Vec3i n;                         // its size
   std::vector<std::uint8_t> site;  // 1 where the voxel is a site
   Metric metric = Metric::kManhattan;
   std::array<double, 3> spacing{1, 1, 1};
@@ -36,11 +36,15 @@ struct DenseProblem {
   }
   // Distance between voxel centres offset by (dx, dy, dz) voxels, in the problem's metric.
   double distance(int dx, int dy, int dz) const {
-    const double ax = std::abs(dx) * spacing[0], ay = std::abs(dy) * spacing[1], az = std::abs(dz) * spacing[2];
+    const double ax = std::abs(dx) * spacing[0], ay = std::abs(dy) * spacing[1],
+                 az = std::abs(dz) * spacing[2];
     switch (metric) {
-      case Metric::kManhattan: return ax + ay + az;
-      case Metric::kChebyshev: return std::max({ax, ay, az});
-      case Metric::kEuclidean: return std::sqrt(ax * ax + ay * ay + az * az);
+      case Metric::kManhattan:
+        return ax + ay + az;
+      case Metric::kChebyshev:
+        return std::max({ax, ay, az});
+      case Metric::kEuclidean:
+        return std::sqrt(ax * ax + ay * ay + az * az);
     }
     return 0;
   }
@@ -51,7 +55,7 @@ struct DenseProblem {
 };
 
 struct DenseSolution {
-  std::vector<float> d;          // distance per voxel
+  std::vector<float> d;            // distance per voxel
   std::vector<std::int32_t> site;  // nearest-site index per voxel, or -1 (empty if not tracked)
 };
 
@@ -60,7 +64,8 @@ void brute_force(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stat
 void brute_chunked(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats);
 void jump_flood_seed(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats);
 // extra_steps: the steps of the correction passes after the standard ones ({}, {1} or {2, 1}).
-void jump_flood(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats, const std::vector<int>& extra_steps);
+void jump_flood(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats,
+                const std::vector<int>& extra_steps);
 
 // Jump flooding's pieces, shared with the GPU backend (which runs the passes itself).
 // A voxel's current nearest site, as coordinates in the domain (x < 0: none).
@@ -76,6 +81,7 @@ std::vector<int> jfa_steps(const DenseProblem& p, const std::vector<int>& extra_
 void jfa_solution(const DenseProblem& p, const std::vector<JfaSite>& sites, DenseSolution& out);
 // Refines `io` (initially +inf except 0 at sites, or an upper bound such as a JFA result) by the
 // Fast Iterative Method. Only voxels inside `region` (all when empty) are updated.
-void fast_iterative(const DenseProblem& p, DenseSolution& io, AlgorithmStats& stats, const Box3i& region);
+void fast_iterative(const DenseProblem& p, DenseSolution& io, AlgorithmStats& stats,
+                    const Box3i& region);
 
 }  // namespace voxfield::detail

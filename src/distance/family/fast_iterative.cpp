@@ -59,7 +59,9 @@ class Updater {
     return best;
   }
 
-  bool inside(Vec3i q) const { return q.x >= 0 && q.y >= 0 && q.z >= 0 && q.x < p_.n.x && q.y < p_.n.y && q.z < p_.n.z; }
+  bool inside(Vec3i q) const {
+    return q.x >= 0 && q.y >= 0 && q.z >= 0 && q.x < p_.n.x && q.y < p_.n.y && q.z < p_.n.z;
+  }
 
  private:
   // Godunov upwind update in 3-D with spacing h: solve sum over the upwind axes of
@@ -102,7 +104,8 @@ class Updater {
 
 }  // namespace
 
-void fast_iterative(const DenseProblem& p, DenseSolution& io, AlgorithmStats& stats, const Box3i& region_in) {
+void fast_iterative(const DenseProblem& p, DenseSolution& io, AlgorithmStats& stats,
+                    const Box3i& region_in) {
   const Box3i all = Box3i::from_size(p.n);
   const Box3i region = region_in.empty() ? all : region_in.intersect(all);
   const bool fresh = io.d.empty();

@@ -26,9 +26,12 @@ struct UnitCost {
   std::int64_t operator()(int dx, int dy, int dz) const {
     dx = std::abs(dx), dy = std::abs(dy), dz = std::abs(dz);
     switch (m) {
-      case Metric::kManhattan: return dx + dy + dz;
-      case Metric::kChebyshev: return std::max({dx, dy, dz});
-      case Metric::kEuclidean: return std::int64_t{dx} * dx + std::int64_t{dy} * dy + std::int64_t{dz} * dz;
+      case Metric::kManhattan:
+        return dx + dy + dz;
+      case Metric::kChebyshev:
+        return std::max({dx, dy, dz});
+      case Metric::kEuclidean:
+        return std::int64_t{dx} * dx + std::int64_t{dy} * dy + std::int64_t{dz} * dz;
     }
     return 0;
   }
@@ -40,7 +43,8 @@ struct SpacedCost {
 };
 
 template <class Cost>
-void flood_pass(const DenseProblem& p, const Cost& cost, const std::vector<Site>& in, std::vector<Site>& out, int step) {
+void flood_pass(const DenseProblem& p, const Cost& cost, const std::vector<Site>& in,
+                std::vector<Site>& out, int step) {
   using C = decltype(cost(0, 0, 0));
   parallel_for(static_cast<std::size_t>(p.n.z) * p.n.y, 8, [&](std::size_t r0, std::size_t r1) {
     for (std::size_t r = r0; r < r1; ++r) {
@@ -48,7 +52,8 @@ void flood_pass(const DenseProblem& p, const Cost& cost, const std::vector<Site>
       for (int x = 0; x < p.n.x; ++x) {
         const std::size_t i = p.index(x, y, z);
         Site best = in[i];
-        C best_c = best.x >= 0 ? cost(best.x - x, best.y - y, best.z - z) : std::numeric_limits<C>::max();
+        C best_c =
+            best.x >= 0 ? cost(best.x - x, best.y - y, best.z - z) : std::numeric_limits<C>::max();
         for (int dz = -1; dz <= 1; ++dz) {
           const int qz = z + dz * step;
           if (qz < 0 || qz >= p.n.z) continue;
@@ -63,7 +68,8 @@ void flood_pass(const DenseProblem& p, const Cost& cost, const std::vector<Site>
               if (s.x < 0) continue;
               const C c = cost(s.x - x, s.y - y, s.z - z);
               // Ties go to the smaller (z, y, x), so the result does not depend on scan order.
-              if (c < best_c || (c == best_c && std::tie(s.z, s.y, s.x) < std::tie(best.z, best.y, best.x))) {
+              if (c < best_c ||
+                  (c == best_c && std::tie(s.z, s.y, s.x) < std::tie(best.z, best.y, best.x))) {
                 best_c = c;
                 best = s;
               }
@@ -83,13 +89,15 @@ std::vector<JfaSite> jfa_seeds(const DenseProblem& p) {
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (!p.site[i]) continue;
     const Vec3i c = p.coord(i);
-    a[i] = {static_cast<std::int16_t>(c.x), static_cast<std::int16_t>(c.y), static_cast<std::int16_t>(c.z)};
+    a[i] = {static_cast<std::int16_t>(c.x), static_cast<std::int16_t>(c.y),
+            static_cast<std::int16_t>(c.z)};
   }
   return a;
 }
 
 std::vector<int> jfa_steps(const DenseProblem& p, const std::vector<int>& extra_steps) {
-  if (std::max({p.n.x, p.n.y, p.n.z}) > 32767) throw InvalidArgument("jump flooding supports domains up to 32767 voxels per axis");
+  if (std::max({p.n.x, p.n.y, p.n.z}) > 32767)
+    throw InvalidArgument("jump flooding supports domains up to 32767 voxels per axis");
   const int largest = std::max({p.n.x, p.n.y, p.n.z});
   std::vector<int> steps;
   int step = 1;
@@ -117,7 +125,8 @@ void jfa_solution(const DenseProblem& p, const std::vector<JfaSite>& sites, Dens
   });
 }
 
-void jump_flood(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats, const std::vector<int>& extra_steps) {
+void jump_flood(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats,
+                const std::vector<int>& extra_steps) {
   const std::vector<int> steps = jfa_steps(p, extra_steps);
   std::vector<Site> a = jfa_seeds(p), b(p.size());
   const bool unit = p.spacing == std::array<double, 3>{1, 1, 1};

@@ -20,9 +20,11 @@ void jump_flood_seed(const DenseProblem& p, DenseSolution& out, AlgorithmStats& 
   const int largest = std::max({p.n.x, p.n.y, p.n.z});
   int step = 1;
   while (step * 2 < largest) step *= 2;
-  const std::size_t sx = 1, sy = static_cast<std::size_t>(p.n.x), sz = sy * static_cast<std::size_t>(p.n.y);
+  const std::size_t sx = 1, sy = static_cast<std::size_t>(p.n.x),
+                    sz = sy * static_cast<std::size_t>(p.n.y);
   for (; step >= 1; step /= 2) {
-    const float fstep[3] = {static_cast<float>(step * p.spacing[0]), static_cast<float>(step * p.spacing[1]),
+    const float fstep[3] = {static_cast<float>(step * p.spacing[0]),
+                            static_cast<float>(step * p.spacing[1]),
                             static_cast<float>(step * p.spacing[2])};
     parallel_for(static_cast<std::size_t>(p.n.z) * p.n.y, 16, [&](std::size_t r0, std::size_t r1) {
       for (std::size_t r = r0; r < r1; ++r) {

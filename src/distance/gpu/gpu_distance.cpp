@@ -28,8 +28,9 @@ namespace {
 namespace L = layout;
 
 constexpr int kMaxExtent = 16384;  // keeps every cost of the passes within 31 bits
-constexpr VkBufferUsageFlags kStorage =
-    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                        VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                        VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
 
 template <class T>
 std::uint32_t bits(T value) {
@@ -50,7 +51,9 @@ void set_encoding(L::Header& h, const detail::FieldPlan& plan) {
 // (d < clamp, d = sqrt(cost) for Euclidean).
 std::uint32_t clamp_cost(const detail::FieldPlan& plan) {
   if (!std::isfinite(plan.clamp)) return L::VF_INF;
-  auto distance = [&](double cost) { return plan.metric == Metric::kEuclidean ? std::sqrt(cost) : cost; };
+  auto distance = [&](double cost) {
+    return plan.metric == Metric::kEuclidean ? std::sqrt(cost) : cost;
+  };
   double c = std::ceil(plan.metric == Metric::kEuclidean ? plan.clamp * plan.clamp : plan.clamp);
   while (c > 0 && distance(c - 1) >= plan.clamp) c -= 1;
   while (distance(c) < plan.clamp) c += 1;
@@ -69,7 +72,9 @@ struct Staging {
 };
 
 // Values of T per word of the resident field (u8: 4, u16: 2, f32: 1).
-std::size_t lanes_of(Storage s) { return s == Storage::kU8 ? 4 : s == Storage::kU16 ? 2 : 1; }
+std::size_t lanes_of(Storage s) {
+  return s == Storage::kU8 ? 4 : s == Storage::kU16 ? 2 : 1;
+}
 
 // Voxels per stored row: x padded to whole words.
 int row_pitch(const detail::FieldPlan& plan, Storage s) {
@@ -79,18 +84,21 @@ int row_pitch(const detail::FieldPlan& plan, Storage s) {
 
 // The field from the resident buffer's bytes: rows of row_pitch() values of T, packed.
 template <class T>
-DistanceField build_field(const World& world, const DistanceOptions& options, const detail::FieldPlan& plan,
-                          const std::uint8_t* stored) {
+DistanceField build_field(const World& world, const DistanceOptions& options,
+                          const detail::FieldPlan& plan, const std::uint8_t* stored) {
   DistanceField out;
   out.options = options;
   out.domain = plan.domain;
   out.encoding = plan.encoding;
-  Grid<T> values(world.voxels.chunk_edge(), detail::field_background<T>(plan), world.voxels.bounds());
+  Grid<T> values(world.voxels.chunk_edge(), detail::field_background<T>(plan),
+                 world.voxels.bounds());
   const Vec3i n = plan.domain.size();
   const std::size_t pitch = static_cast<std::size_t>(row_pitch(plan, options.storage));
   std::vector<T> dense(static_cast<std::size_t>(plan.domain.volume()));
-  for (std::size_t row = 0; row < static_cast<std::size_t>(n.y) * n.z; ++row)  // little-endian lanes: bytes in x order
-    std::memcpy(&dense[row * n.x], stored + row * pitch * sizeof(T), static_cast<std::size_t>(n.x) * sizeof(T));
+  for (std::size_t row = 0; row < static_cast<std::size_t>(n.y) * n.z;
+       ++row)  // little-endian lanes: bytes in x order
+    std::memcpy(&dense[row * n.x], stored + row * pitch * sizeof(T),
+                static_cast<std::size_t>(n.x) * sizeof(T));
   values.copy_from_dense(plan.domain, dense.data());
   values.compact();
   out.values = std::move(values);
@@ -102,35 +110,45 @@ DistanceField build_field(const World& world, const DistanceOptions& options, co
 class FieldEngine {
  public:
   FieldEngine(Context::Impl& ctx, const World& world, const DistanceOptions& options)
-      : ctx_(ctx), world_(world), options_(options), plan_(detail::make_field_plan(world.voxels, options)) {
-    if (options.nearest_sites && (plan_.domain.size().x > 32767 || plan_.domain.size().y > 32767 || plan_.domain.size().z > 32767))
+      : ctx_(ctx),
+        world_(world),
+        options_(options),
+        plan_(detail::make_field_plan(world.voxels, options)) {
+    if (options.nearest_sites && (plan_.domain.size().x > 32767 || plan_.domain.size().y > 32767 ||
+                                  plan_.domain.size().z > 32767))
       throw InvalidArgument("GPU: nearest sites need a domain of at most 32767 voxels per axis");
-    if (!plan_.unit_spacing) throw InvalidArgument("GPU: the Vulkan backend supports unit voxel spacing only");
+    if (!plan_.unit_spacing)
+      throw InvalidArgument("GPU: the Vulkan backend supports unit voxel spacing only");
     if (plan_.domain.empty()) throw InvalidArgument("GPU: the field's domain is empty");
     const Vec3i n = plan_.domain.size();
     if (n.x > kMaxExtent || n.y > kMaxExtent || n.z > kMaxExtent)
-      throw InvalidArgument("GPU: domain " + to_string(plan_.domain) + " exceeds " + std::to_string(kMaxExtent) +
-                            " voxels along an axis");
+      throw InvalidArgument("GPU: domain " + to_string(plan_.domain) + " exceeds " +
+                            std::to_string(kMaxExtent) + " voxels along an axis");
     // Packed as stored on the CPU (1, 2 or 4 bytes per voxel), rows padded to whole words.
-    field_bytes_ = static_cast<VkDeviceSize>(n.y) * n.z * static_cast<VkDeviceSize>(row_pitch(plan_, options.storage)) *
+    field_bytes_ = static_cast<VkDeviceSize>(n.y) * n.z *
+                   static_cast<VkDeviceSize>(row_pitch(plan_, options.storage)) *
                    (4 / lanes_of(options.storage));
     if (field_bytes_ > ctx.limits.maxStorageBufferRange)
-      throw InvalidArgument("GPU: a " + to_string(n) + " domain needs " + std::to_string(field_bytes_) +
+      throw InvalidArgument("GPU: a " + to_string(n) + " domain needs " +
+                            std::to_string(field_bytes_) +
                             " bytes per buffer, more than this device's storage-buffer range (" +
                             std::to_string(ctx.limits.maxStorageBufferRange) + ")");
     make_header();
     const int shift = world.voxels.chunk_shift();
-    chunk_origin_ = {plan_.domain.begin.x >> shift, plan_.domain.begin.y >> shift, plan_.domain.begin.z >> shift};
+    chunk_origin_ = {plan_.domain.begin.x >> shift, plan_.domain.begin.y >> shift,
+                     plan_.domain.begin.z >> shift};
     const Vec3i last{(plan_.domain.end.x - 1) >> shift, (plan_.domain.end.y - 1) >> shift,
                      (plan_.domain.end.z - 1) >> shift};
     chunk_dims_ = last - chunk_origin_ + Vec3i::splat(1);
     header_.chunk_origin = {chunk_origin_.x, chunk_origin_.y, chunk_origin_.z, 0};
-    header_.chunk_dims = {chunk_dims_.x, chunk_dims_.y, chunk_dims_.z, chunk_dims_.x * chunk_dims_.y * chunk_dims_.z};
+    header_.chunk_dims = {chunk_dims_.x, chunk_dims_.y, chunk_dims_.z,
+                          chunk_dims_.x * chunk_dims_.y * chunk_dims_.z};
     chunk_bytes_ = static_cast<std::size_t>(world.voxels.chunk_volume());
     header_.chunk_edge = static_cast<std::uint32_t>(world.voxels.chunk_edge());
     header_.chunk_shift = static_cast<std::uint32_t>(shift);
     header_.chunk_words = static_cast<std::uint32_t>(chunk_bytes_ / 4);
-    pages_.assign(static_cast<std::size_t>(header_.chunk_dims.w), L::VF_UNIFORM);  // all air until uploaded
+    pages_.assign(static_cast<std::size_t>(header_.chunk_dims.w),
+                  L::VF_UNIFORM);  // all air until uploaded
     header_buf_ = Buffer(ctx, sizeof header_, kStorage, false);
     pages_buf_ = Buffer(ctx, pages_.size() * 4, kStorage, false);
     field_buf_ = Buffer(ctx, field_bytes_, kStorage, false);
@@ -154,8 +172,8 @@ class FieldEngine {
 
   // Uploads `chunks` (those inside the page table), recomputes `regions`, optionally reads the
   // whole field back: one command buffer, one submit, one fence wait.
-  void run(const std::vector<Vec3i>& chunks, const std::vector<detail::UpdateRegion>& regions, bool download,
-           std::vector<PassTiming>* timings) {
+  void run(const std::vector<Vec3i>& chunks, const std::vector<detail::UpdateRegion>& regions,
+           bool download, std::vector<PassTiming>* timings) {
     Staging up;
     Uploads uploads;
     stage(chunks, regions, up, uploads);
@@ -168,7 +186,8 @@ class FieldEngine {
     ctx_.run_commands([&](VkCommandBuffer cmd) {
       if (timed) vkCmdResetQueryPool(cmd, ctx_.timestamps, 0, kTimestamps);
       record_transfers(cmd, upload, uploads);
-      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.field_layout.pipeline, 0, 1, &set, 0, nullptr);
+      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.field_layout.pipeline, 0, 1,
+                              &set, 0, nullptr);
       PassRecorder passes(ctx_, cmd, timed);
       for (const detail::UpdateRegion& r : regions) record_region(passes, r);
       if (readback) record_readback(cmd, *readback);
@@ -182,15 +201,22 @@ class FieldEngine {
     const auto* stored = static_cast<const std::uint8_t*>(ctx_.readback.mapped());
     DistanceField f;
     switch (options_.storage) {
-      case Storage::kU8: f = build_field<std::uint8_t>(world_, options_, plan_, stored); break;
-      case Storage::kU16: f = build_field<std::uint16_t>(world_, options_, plan_, stored); break;
-      case Storage::kF32: f = build_field<float>(world_, options_, plan_, stored); break;
+      case Storage::kU8:
+        f = build_field<std::uint8_t>(world_, options_, plan_, stored);
+        break;
+      case Storage::kU16:
+        f = build_field<std::uint16_t>(world_, options_, plan_, stored);
+        break;
+      case Storage::kF32:
+        f = build_field<float>(world_, options_, plan_, stored);
+        break;
     }
     if (options_.nearest_sites) {
       // Three int16 offsets and a pad per voxel, x fastest over the domain: the CPU's SiteOffset.
       std::vector<SiteOffset> dense(static_cast<std::size_t>(plan_.domain.volume()));
       const auto* words = reinterpret_cast<const std::int16_t*>(stored + field_bytes_);
-      for (std::size_t i = 0; i < dense.size(); ++i) dense[i] = {words[4 * i], words[4 * i + 1], words[4 * i + 2]};
+      for (std::size_t i = 0; i < dense.size(); ++i)
+        dense[i] = {words[4 * i], words[4 * i + 1], words[4 * i + 2]};
       Grid<SiteOffset> sites(world_.voxels.chunk_edge(), SiteOffset{}, world_.voxels.bounds());
       sites.copy_from_dense(plan_.domain, dense.data());
       sites.compact();
@@ -200,7 +226,8 @@ class FieldEngine {
   }
 
  private:
-  static constexpr std::uint32_t kTimestamps = 64;  // queries in the context's pool: 32 timed passes
+  static constexpr std::uint32_t kTimestamps =
+      64;  // queries in the context's pool: 32 timed passes
 
   // What a run copies from the upload buffer, and the old pool a grown one copies its bricks from
   // (kept alive until the copy out of it has run).
@@ -215,18 +242,24 @@ class FieldEngine {
   // pool has queries left.
   class PassRecorder {
    public:
-    PassRecorder(Context::Impl& ctx, VkCommandBuffer cmd, bool timed) : ctx_(ctx), cmd_(cmd), timed_(timed) {}
-    void pass(const Pipeline& pipeline, const L::PassParams& pp, std::uint64_t invocations, std::string name) {
+    PassRecorder(Context::Impl& ctx, VkCommandBuffer cmd, bool timed)
+        : ctx_(ctx), cmd_(cmd), timed_(timed) {}
+    void pass(const Pipeline& pipeline, const L::PassParams& pp, std::uint64_t invocations,
+              std::string name) {
       if (!names_.empty())
-        barrier(ctx_, cmd_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+        barrier(ctx_, cmd_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
       const auto q = static_cast<std::uint32_t>(2 * names_.size());
       const bool stamp = timed_ && q + 1 < kTimestamps;
       if (stamp) vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx_.timestamps, q);
       vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
-      vkCmdPushConstants(cmd_, ctx_.field_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pp, &pp);
+      vkCmdPushConstants(cmd_, ctx_.field_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                         sizeof pp, &pp);
       dispatch(ctx_, cmd_, invocations);
-      if (stamp) vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx_.timestamps, q + 1);
+      if (stamp)
+        vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx_.timestamps, q + 1);
       names_.push_back(std::move(name));
     }
     // The passes' names in recording order (pass i has timestamps 2i and 2i + 1).
@@ -241,15 +274,17 @@ class FieldEngine {
 
   // Step 1, stage: the header (first run only), the changed page entries and bricks into `up`,
   // and work buffers large enough for the largest region.
-  void stage(const std::vector<Vec3i>& chunks, const std::vector<detail::UpdateRegion>& regions, Staging& up,
-             Uploads& uploads) {
+  void stage(const std::vector<Vec3i>& chunks, const std::vector<detail::UpdateRegion>& regions,
+             Staging& up, Uploads& uploads) {
     if (first_run_) {
       const VkDeviceSize at = up.add(&header_, sizeof header_);
       header_copy_ = VkBufferCopy{at, 0, sizeof header_};
     }
-    sync_chunks(chunks, up, uploads.page_copies, uploads.brick_copies, uploads.old_pool, uploads.old_pool_bytes);
+    sync_chunks(chunks, up, uploads.page_copies, uploads.brick_copies, uploads.old_pool,
+                uploads.old_pool_bytes);
     VkDeviceSize largest = 4;
-    for (const auto& r : regions) largest = std::max<VkDeviceSize>(largest, static_cast<VkDeviceSize>(r.in.volume()) * 4);
+    for (const auto& r : regions)
+      largest = std::max<VkDeviceSize>(largest, static_cast<VkDeviceSize>(r.in.volume()) * 4);
     if (largest > work_bytes_) grow_work_buffers(largest);
   }
 
@@ -260,8 +295,8 @@ class FieldEngine {
     if (uploads.old_pool) {
       const VkBufferCopy keep{0, 0, uploads.old_pool_bytes};
       vkCmdCopyBuffer(cmd, uploads.old_pool->handle(), bricks_buf_.handle(), 1, &keep);
-      barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-              VK_ACCESS_TRANSFER_WRITE_BIT);
+      barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+              VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
       transferred = true;
     }
     if (first_run_) {
@@ -270,25 +305,30 @@ class FieldEngine {
       transferred = true;
     }
     if (!uploads.page_copies.empty()) {
-      vkCmdCopyBuffer(cmd, upload.handle(), pages_buf_.handle(), static_cast<std::uint32_t>(uploads.page_copies.size()),
+      vkCmdCopyBuffer(cmd, upload.handle(), pages_buf_.handle(),
+                      static_cast<std::uint32_t>(uploads.page_copies.size()),
                       uploads.page_copies.data());
       transferred = true;
     }
     if (!uploads.brick_copies.empty()) {
-      vkCmdCopyBuffer(cmd, upload.handle(), bricks_buf_.handle(), static_cast<std::uint32_t>(uploads.brick_copies.size()),
+      vkCmdCopyBuffer(cmd, upload.handle(), bricks_buf_.handle(),
+                      static_cast<std::uint32_t>(uploads.brick_copies.size()),
                       uploads.brick_copies.data());
       transferred = true;
     }
     if (!first_run_) {
       // The previous submission's shader accesses are complete (its fence was waited on), but
       // this one's transfers and passes overwrite buffers those passes used: order them.
-      barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-              VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-              VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+      barrier(
+          ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     }
     if (transferred)
       barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+              VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     first_run_ = false;
   }
 
@@ -327,35 +367,39 @@ class FieldEngine {
     const std::int64_t lanes = static_cast<std::int64_t>(lanes_of(options_.storage));
     const std::int64_t ox = r.out.begin.x - plan_.domain.begin.x;
     const std::int64_t words = (ox + r.out.size().x - 1) / lanes - ox / lanes + 1;
-    passes.pass(ctx_.edt_encode, enc, static_cast<std::uint64_t>(words * r.out.size().y * r.out.size().z), "encode");
+    passes.pass(ctx_.edt_encode, enc,
+                static_cast<std::uint64_t>(words * r.out.size().y * r.out.size().z), "encode");
   }
 
   // Step 4, read-back (when asked): the field and its sites into `readback`, visible to the host.
   void record_readback(VkCommandBuffer cmd, const Buffer& readback) {
-    barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-            VK_ACCESS_TRANSFER_READ_BIT);
+    barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     const VkBufferCopy down{0, 0, field_bytes_};
     vkCmdCopyBuffer(cmd, field_buf_.handle(), readback.handle(), 1, &down);
     if (site_bytes_ > 0) {
       const VkBufferCopy down_sites{0, field_bytes_, site_bytes_};
       vkCmdCopyBuffer(cmd, field_sites_buf_.handle(), readback.handle(), 1, &down_sites);
     }
-    barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-            VK_ACCESS_HOST_READ_BIT);
+    barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+            VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     ctx_.counters.bytes_downloaded += static_cast<std::int64_t>(field_bytes_ + site_bytes_);
   }
 
   // Step 5, after the fence: each timed pass's duration from its timestamp pair.
-  void read_timings(const std::vector<std::string>& names, bool timed, std::vector<PassTiming>& timings) const {
+  void read_timings(const std::vector<std::string>& names, bool timed,
+                    std::vector<PassTiming>& timings) const {
     timings.clear();
-    const auto count = static_cast<std::uint32_t>(std::min<std::size_t>(2 * names.size(), kTimestamps));
+    const auto count =
+        static_cast<std::uint32_t>(std::min<std::size_t>(2 * names.size(), kTimestamps));
     if (!timed || count < 2) return;
     std::vector<std::uint64_t> ticks(count);
-    check(vkGetQueryPoolResults(ctx_.device, ctx_.timestamps, 0, count, ticks.size() * 8, ticks.data(), 8,
-                                VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+    check(vkGetQueryPoolResults(ctx_.device, ctx_.timestamps, 0, count, ticks.size() * 8,
+                                ticks.data(), 8, VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
           "vkGetQueryPoolResults");
     for (std::size_t i = 0; 2 * i + 1 < count; ++i)
-      timings.push_back({names[i], static_cast<double>(ticks[2 * i + 1] - ticks[2 * i]) * ctx_.timestamp_period_ns * 1e-6});
+      timings.push_back({names[i], static_cast<double>(ticks[2 * i + 1] - ticks[2 * i]) *
+                                       ctx_.timestamp_period_ns * 1e-6});
   }
 
   void make_header() {
@@ -365,27 +409,40 @@ class FieldEngine {
                           row_pitch(plan_, options_.storage)};
     header_.metric = static_cast<std::uint32_t>(plan_.metric);
     header_.is_signed = plan_.is_signed ? 1u : 0u;
-    header_.storage = options_.storage == Storage::kU8 ? L::VF_U8 : options_.storage == Storage::kU16 ? L::VF_U16 : L::VF_F32;
+    header_.storage = options_.storage == Storage::kU8    ? L::VF_U8
+                      : options_.storage == Storage::kU16 ? L::VF_U16
+                                                          : L::VF_F32;
     header_.clamp_cost = clamp_cost(plan_);
     header_.track_sites = options_.nearest_sites ? 1u : 0u;
     // The CPU keeps a site when its cost is at most the clamp's cost, rounded down.
-    const double clamp_c = plan_.metric == Metric::kEuclidean ? plan_.clamp * plan_.clamp : plan_.clamp;
-    header_.site_cost_max = std::isfinite(clamp_c) ? static_cast<std::uint32_t>(std::min<double>(std::floor(clamp_c), L::VF_INF - 1.0))
-                                                   : L::VF_INF - 1;
+    const double clamp_c =
+        plan_.metric == Metric::kEuclidean ? plan_.clamp * plan_.clamp : plan_.clamp;
+    header_.site_cost_max =
+        std::isfinite(clamp_c)
+            ? static_cast<std::uint32_t>(std::min<double>(std::floor(clamp_c), L::VF_INF - 1.0))
+            : L::VF_INF - 1;
     header_.bias = static_cast<std::int32_t>(plan_.encoding.bias);
     switch (options_.storage) {
-      case Storage::kU8: set_encoding<std::uint8_t>(header_, plan_); break;
-      case Storage::kU16: set_encoding<std::uint16_t>(header_, plan_); break;
-      case Storage::kF32: set_encoding<float>(header_, plan_); break;
+      case Storage::kU8:
+        set_encoding<std::uint8_t>(header_, plan_);
+        break;
+      case Storage::kU16:
+        set_encoding<std::uint16_t>(header_, plan_);
+        break;
+      case Storage::kF32:
+        set_encoding<float>(header_, plan_);
+        break;
     }
     if (plan_.metric == Metric::kEuclidean && options_.storage != Storage::kF32) {
       const double s = plan_.encoding.scale;
       if (s != std::floor(s))
-        throw InvalidArgument("GPU: Euclidean fixed point needs an integral scale on the Vulkan backend");
+        throw InvalidArgument(
+            "GPU: Euclidean fixed point needs an integral scale on the Vulkan backend");
       header_.scale_sq = static_cast<std::uint32_t>(s * s);
       const double costs = std::min<double>(header_.clamp_cost, 3.0 * kMaxExtent * kMaxExtent);
       if ((costs - 1) * s * s >= 4294967296.0)
-        throw InvalidArgument("GPU: fixed-point scale " + std::to_string(s) + " with this clamp overflows 32 bits");
+        throw InvalidArgument("GPU: fixed-point scale " + std::to_string(s) +
+                              " with this clamp overflows 32 bits");
     }
   }
 
@@ -395,8 +452,9 @@ class FieldEngine {
   }
 
   // Brings the page table and brick pool in line with the world for `chunks`.
-  void sync_chunks(const std::vector<Vec3i>& chunks, Staging& up, std::vector<VkBufferCopy>& page_copies,
-                   std::vector<VkBufferCopy>& brick_copies, std::optional<Buffer>& old_pool, VkDeviceSize& old_bytes) {
+  void sync_chunks(const std::vector<Vec3i>& chunks, Staging& up,
+                   std::vector<VkBufferCopy>& page_copies, std::vector<VkBufferCopy>& brick_copies,
+                   std::optional<Buffer>& old_pool, VkDeviceSize& old_bytes) {
     struct Change {
       std::size_t page;
       const std::uint8_t* voxels;
@@ -420,7 +478,8 @@ class FieldEngine {
     const std::uint32_t needed = used_slots_ + (new_dense > reusable ? new_dense - reusable : 0);
     if (needed > slot_capacity_) {
       // Grow the pool (amortised doubling); the old bricks are copied over on the GPU.
-      const std::uint32_t capacity = std::max<std::uint32_t>(needed + needed / 4 + 8, slot_capacity_ * 2);
+      const std::uint32_t capacity =
+          std::max<std::uint32_t>(needed + needed / 4 + 8, slot_capacity_ * 2);
       Buffer grown(ctx_, static_cast<VkDeviceSize>(capacity) * chunk_bytes_, kStorage, false);
       if (used_slots_ > 0) {
         old_bytes = static_cast<VkDeviceSize>(used_slots_) * chunk_bytes_;
@@ -447,9 +506,11 @@ class FieldEngine {
           slot = used_slots_++;
         }
         // The pool was sized above; a slot beyond it would be an out-of-range GPU copy.
-        if (slot >= slot_capacity_) throw Error("GPU: internal error: brick pool slot " + std::to_string(slot) +
-                                                " beyond its capacity " + std::to_string(slot_capacity_));
-        brick_copies.push_back({up.add(ch.voxels, chunk_bytes_), static_cast<VkDeviceSize>(slot) * chunk_bytes_, chunk_bytes_});
+        if (slot >= slot_capacity_)
+          throw Error("GPU: internal error: brick pool slot " + std::to_string(slot) +
+                      " beyond its capacity " + std::to_string(slot_capacity_));
+        brick_copies.push_back({up.add(ch.voxels, chunk_bytes_),
+                                static_cast<VkDeviceSize>(slot) * chunk_bytes_, chunk_bytes_});
         ctx_.counters.bytes_uploaded += static_cast<std::int64_t>(chunk_bytes_);
         next = slot;
       }
@@ -471,9 +532,9 @@ class FieldEngine {
   }
 
   VkDescriptorSet descriptor_set() {
-    const Buffer* bound[Context::Impl::kBindings] = {&header_buf_, &pages_buf_,  &bricks_buf_, &cost_[0],
-                                                     &cost_[1],    &cost_[2],    &scratch_s_,  &scratch_t_,
-                                                     &field_buf_,  &work_sites_, &field_sites_buf_};
+    const Buffer* bound[Context::Impl::kBindings] = {
+        &header_buf_, &pages_buf_, &bricks_buf_, &cost_[0],    &cost_[1],        &cost_[2],
+        &scratch_s_,  &scratch_t_, &field_buf_,  &work_sites_, &field_sites_buf_};
     return ctx_.bind(ctx_.field_layout, bound);
   }
 
@@ -494,11 +555,13 @@ class FieldEngine {
   Buffer work_sites_, field_sites_buf_;
 };
 
-DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
+DistanceField compute_distance_field(Context& context, const World& world,
+                                     const DistanceOptions& options,
                                      std::vector<PassTiming>* timings) {
   const detail::FieldPlan plan = detail::make_field_plan(world.voxels, options);
   if (plan.domain.empty()) {
-    if (options.nearest_sites) throw InvalidArgument("GPU: the Vulkan backend does not compute nearest sites yet");
+    if (options.nearest_sites)
+      throw InvalidArgument("GPU: the Vulkan backend does not compute nearest sites yet");
     return voxfield::compute_distance_field(world, options);
   }
   FieldEngine engine(context.impl(), world, options);
@@ -508,12 +571,14 @@ DistanceField compute_distance_field(Context& context, const World& world, const
 
 // ---- DynamicField ----------------------------------------------------------------------------
 
-DynamicField::DynamicField(std::shared_ptr<Context> context, const World& world, DistanceOptions options)
+DynamicField::DynamicField(std::shared_ptr<Context> context, const World& world,
+                           DistanceOptions options)
     : context_(std::move(context)) {
   if (!context_) throw InvalidArgument("gpu::DynamicField needs a context");
   if (!options.domain) {
     if (!world.voxels.bounds())
-      throw InvalidArgument("a dynamic distance field needs a fixed domain: bound the world or set options.domain");
+      throw InvalidArgument(
+          "a dynamic distance field needs a fixed domain: bound the world or set options.domain");
     options.domain = *world.voxels.bounds();
   }
   engine_ = std::make_unique<FieldEngine>(context_->impl(), world, options);
@@ -524,23 +589,29 @@ DynamicField::DynamicField(std::shared_ptr<Context> context, const World& world,
 
 DynamicField::~DynamicField() = default;
 
-const DistanceOptions& DynamicField::options() const { return engine_->options(); }
+const DistanceOptions& DynamicField::options() const {
+  return engine_->options();
+}
 
 void DynamicField::rebuild() {
   const Box3i domain = engine_->plan().domain;
   engine_->run(engine_->all_chunks(), {{domain, domain}}, false, &timings_);
 }
 
-std::size_t DynamicField::field_bytes() const { return engine_->field_bytes(); }
+std::size_t DynamicField::field_bytes() const {
+  return engine_->field_bytes();
+}
 
 DynamicDistanceField::UpdateStats DynamicField::update(const DirtyRegions& dirty) {
   DynamicDistanceField::UpdateStats stats;
   if (dirty.empty()) return stats;
-  const std::vector<detail::UpdateRegion> regions = detail::update_regions(dirty, engine_->plan().domain, reach_);
+  const std::vector<detail::UpdateRegion> regions =
+      detail::update_regions(dirty, engine_->plan().domain, reach_);
   // The chunks whose voxels changed: the dirty boxes are per chunk.
   std::vector<Vec3i> chunks;
   for (const Box3i& b : dirty.boxes())
-    chunks.push_back({b.begin.x >> chunk_shift_, b.begin.y >> chunk_shift_, b.begin.z >> chunk_shift_});
+    chunks.push_back(
+        {b.begin.x >> chunk_shift_, b.begin.y >> chunk_shift_, b.begin.z >> chunk_shift_});
   engine_->run(chunks, regions, false, &timings_);
   for (const auto& r : regions) {
     stats.voxels_recomputed += r.out.volume();

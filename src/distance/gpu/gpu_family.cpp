@@ -8,9 +8,9 @@
 #include <chrono>
 #include <cstring>
 
-#include "shaders/layout.h"
 #include "../family_driver.h"
 #include "gpu/vulkan_context.h"
+#include "shaders/layout.h"
 #include "voxfield/gpu_distance.h"
 
 namespace voxfield::gpu {
@@ -20,32 +20,44 @@ namespace L = layout;
 
 std::vector<int> extra_steps(Algorithm a) {
   switch (a) {
-    case Algorithm::kJfa: return {};
-    case Algorithm::kJfa1: return {1};
-    case Algorithm::kJfa2: return {2, 1};
-    case Algorithm::kJfaSeed: return {};
-    case Algorithm::kFim: return {};
-    case Algorithm::kHybrid: return {};
-    case Algorithm::kLod: return {};
+    case Algorithm::kJfa:
+      return {};
+    case Algorithm::kJfa1:
+      return {1};
+    case Algorithm::kJfa2:
+      return {2, 1};
+    case Algorithm::kJfaSeed:
+      return {};
+    case Algorithm::kFim:
+      return {};
+    case Algorithm::kHybrid:
+      return {};
+    case Algorithm::kLod:
+      return {};
     default:
       throw InvalidArgument(std::string("GPU: the ") + algorithm_name(a) +
-                            " algorithm is not on the Vulkan backend (brute force and brute-chunked are CPU references)");
+                            " algorithm is not on the Vulkan backend (brute force and "
+                            "brute-chunked are CPU references)");
   }
 }
 
 // Runs one pass of `pipeline` per step over a ping-pong buffer of p.size() elements (both halves
 // in one buffer), starting from `initial`, in one command buffer with a barrier between passes;
 // returns the last pass's elements.
-std::vector<std::uint8_t> ping_pong(Context::Impl& ctx, const Pipeline& pipeline, const detail::DenseProblem& p,
-                                    const std::vector<std::uint8_t>& initial, std::size_t element_bytes,
-                                    const std::vector<int>& steps, const std::string& label,
-                                    std::vector<PassTiming>* timings) {
+std::vector<std::uint8_t> ping_pong(Context::Impl& ctx, const Pipeline& pipeline,
+                                    const detail::DenseProblem& p,
+                                    const std::vector<std::uint8_t>& initial,
+                                    std::size_t element_bytes, const std::vector<int>& steps,
+                                    const std::string& label, std::vector<PassTiming>* timings) {
   const std::size_t n = p.size();
   const VkDeviceSize half = static_cast<VkDeviceSize>(n) * element_bytes;
   if (2 * half > ctx.limits.maxStorageBufferRange)
-    throw InvalidArgument("GPU: " + std::to_string(n) + " voxels exceed this device's storage-buffer range for " + label);
+    throw InvalidArgument("GPU: " + std::to_string(n) +
+                          " voxels exceed this device's storage-buffer range for " + label);
   Buffer data(ctx, 2 * half,
-              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false);
+              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                  VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+              false);
   Buffer& upload = ctx.upload_buffer(half);
   std::memcpy(upload.mapped(), initial.data(), half);
   Buffer& readback = ctx.readback_buffer(half);
@@ -58,43 +70,53 @@ std::vector<std::uint8_t> ping_pong(Context::Impl& ctx, const Pipeline& pipeline
     const VkBufferCopy in{0, 0, half};
     vkCmdCopyBuffer(cmd, upload.handle(), data.handle(), 1, &in);
     ctx.counters.bytes_uploaded += static_cast<std::int64_t>(half);
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+            VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
             VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.jfa_layout.pipeline, 0, 1, &set, 0, nullptr);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.jfa_layout.pipeline, 0, 1,
+                            &set, 0, nullptr);
     for (std::size_t k = 0; k < steps.size(); ++k) {
       if (k > 0)
-        barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+        barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
       L::JfaParams jp{};
       jp.size = {p.n.x, p.n.y, p.n.z, 0};
       jp.step = steps[k];
       jp.metric = static_cast<std::uint32_t>(p.metric);
       jp.src = src;
       jp.dst = src == 0 ? static_cast<std::uint32_t>(n) : 0u;
-      vkCmdPushConstants(cmd, ctx.jfa_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof jp, &jp);
-      if (timed) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx.timestamps, static_cast<std::uint32_t>(2 * k));
+      vkCmdPushConstants(cmd, ctx.jfa_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof jp,
+                         &jp);
+      if (timed)
+        vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx.timestamps,
+                            static_cast<std::uint32_t>(2 * k));
       dispatch(ctx, cmd, n);
       if (timed)
-        vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx.timestamps, static_cast<std::uint32_t>(2 * k + 1));
+        vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx.timestamps,
+                            static_cast<std::uint32_t>(2 * k + 1));
       src = jp.dst;
     }
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-            VK_ACCESS_TRANSFER_READ_BIT);
+    barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     const VkBufferCopy out{static_cast<VkDeviceSize>(src) * element_bytes, 0, half};
     vkCmdCopyBuffer(cmd, data.handle(), readback.handle(), 1, &out);
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-            VK_ACCESS_HOST_READ_BIT);
+    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+            VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     ctx.counters.bytes_downloaded += static_cast<std::int64_t>(half);
   });
   if (timed) {
     std::vector<std::uint64_t> ticks(2 * steps.size());
-    check(vkGetQueryPoolResults(ctx.device, ctx.timestamps, 0, static_cast<std::uint32_t>(ticks.size()), ticks.size() * 8,
+    check(vkGetQueryPoolResults(ctx.device, ctx.timestamps, 0,
+                                static_cast<std::uint32_t>(ticks.size()), ticks.size() * 8,
                                 ticks.data(), 8, VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
           "vkGetQueryPoolResults");
     for (std::size_t k = 0; k < steps.size(); ++k)
-      timings->push_back({label + " step " + std::to_string(steps[k]),
-                          static_cast<double>(ticks[2 * k + 1] - ticks[2 * k]) * ctx.timestamp_period_ns * 1e-6});
+      timings->push_back(
+          {label + " step " + std::to_string(steps[k]),
+           static_cast<double>(ticks[2 * k + 1] - ticks[2 * k]) * ctx.timestamp_period_ns * 1e-6});
   }
   std::vector<std::uint8_t> result(half);
   std::memcpy(result.data(), readback.mapped(), half);
@@ -102,8 +124,9 @@ std::vector<std::uint8_t> ping_pong(Context::Impl& ctx, const Pipeline& pipeline
 }
 
 // Jump flooding of sites; they come back for the CPU's assembly.
-detail::DenseSolution flood(Context::Impl& ctx, const detail::DenseProblem& p, const std::vector<int>& extra,
-                            AlgorithmStats& stats, std::vector<PassTiming>* timings) {
+detail::DenseSolution flood(Context::Impl& ctx, const detail::DenseProblem& p,
+                            const std::vector<int>& extra, AlgorithmStats& stats,
+                            std::vector<PassTiming>* timings) {
   const std::vector<int> steps = detail::jfa_steps(p, extra);
   const std::vector<detail::JfaSite> seeds = detail::jfa_seeds(p);
   const std::size_t n = p.size();
@@ -111,15 +134,19 @@ detail::DenseSolution flood(Context::Impl& ctx, const detail::DenseProblem& p, c
   auto* words = reinterpret_cast<std::uint32_t*>(packed.data());
   for (std::size_t i = 0; i < n; ++i) {
     const detail::JfaSite s = seeds[i];
-    words[2 * i] = s.x < 0 ? L::VF_INF : static_cast<std::uint32_t>(s.x) | (static_cast<std::uint32_t>(s.y) << 16);
+    words[2 * i] = s.x < 0
+                       ? L::VF_INF
+                       : static_cast<std::uint32_t>(s.x) | (static_cast<std::uint32_t>(s.y) << 16);
     words[2 * i + 1] = s.x < 0 ? 0u : static_cast<std::uint32_t>(s.z);
   }
-  const std::vector<std::uint8_t> out = ping_pong(ctx, ctx.jfa, p, packed, 8, steps, "jfa", timings);
+  const std::vector<std::uint8_t> out =
+      ping_pong(ctx, ctx.jfa, p, packed, 8, steps, "jfa", timings);
   const auto* got = reinterpret_cast<const std::uint32_t*>(out.data());
   std::vector<detail::JfaSite> final_sites(n);
   for (std::size_t i = 0; i < n; ++i) {
     if (got[2 * i] == L::VF_INF) continue;
-    final_sites[i] = {static_cast<std::int16_t>(got[2 * i] & 0xFFFF), static_cast<std::int16_t>(got[2 * i] >> 16),
+    final_sites[i] = {static_cast<std::int16_t>(got[2 * i] & 0xFFFF),
+                      static_cast<std::int16_t>(got[2 * i] >> 16),
                       static_cast<std::int16_t>(got[2 * i + 1])};
   }
   detail::DenseSolution solution;
@@ -130,14 +157,15 @@ detail::DenseSolution flood(Context::Impl& ctx, const detail::DenseProblem& p, c
 }
 
 // The dissertation's value-propagating flood: 6 neighbours, distances only.
-detail::DenseSolution flood_values(Context::Impl& ctx, const detail::DenseProblem& p, AlgorithmStats& stats,
-                                   std::vector<PassTiming>* timings) {
+detail::DenseSolution flood_values(Context::Impl& ctx, const detail::DenseProblem& p,
+                                   AlgorithmStats& stats, std::vector<PassTiming>* timings) {
   const std::vector<int> steps = detail::jfa_steps(p, {});
   const std::size_t n = p.size();
   std::vector<std::uint8_t> initial(n * 4);
   auto* values = reinterpret_cast<float*>(initial.data());
   for (std::size_t i = 0; i < n; ++i) values[i] = p.site[i] ? 0.0f : detail::kFar;
-  const std::vector<std::uint8_t> out = ping_pong(ctx, ctx.jfa_seed, p, initial, 4, steps, "jfa-seed", timings);
+  const std::vector<std::uint8_t> out =
+      ping_pong(ctx, ctx.jfa_seed, p, initial, 4, steps, "jfa-seed", timings);
   detail::DenseSolution solution;
   solution.d.resize(n);
   std::memcpy(solution.d.data(), out.data(), n * 4);
@@ -160,28 +188,34 @@ std::uint32_t fim_pass_bound(const detail::DenseProblem& p) {
 // The Fast Iterative Method as Jacobi passes over `region` from `initial` values (0 at sites),
 // stopping by itself once a pass moves nothing by more than the CPU's tolerance: one command
 // buffer, no read-back until the end.
-detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p, const std::vector<float>& initial,
-                              const Box3i& region, AlgorithmStats& stats, std::vector<PassTiming>* timings) {
+detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p,
+                              const std::vector<float>& initial, const Box3i& region,
+                              AlgorithmStats& stats, std::vector<PassTiming>* timings) {
   const std::size_t n = p.size();
   const VkDeviceSize half = static_cast<VkDeviceSize>(n) * 4;
   if (2 * half > ctx.limits.maxStorageBufferRange)
-    throw InvalidArgument("GPU: " + std::to_string(n) + " voxels exceed this device's storage-buffer range for fim");
+    throw InvalidArgument("GPU: " + std::to_string(n) +
+                          " voxels exceed this device's storage-buffer range for fim");
   detail::DenseSolution solution;
   solution.d = initial;
   if (region.empty() || n == 0) return solution;
   Buffer data(ctx, 2 * half,
-              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false);
+              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                  VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+              false);
   constexpr VkDeviceSize kControlBytes = 8 * 4;
   Buffer control(ctx, kControlBytes,
-                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-                     VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                     VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                  false);
   // The update pass's workgroups, split over y as dispatch() does.
   const std::uint64_t groups = (n + 63) / 64;
   const std::uint64_t gx = std::min<std::uint64_t>(groups, ctx.limits.maxComputeWorkGroupCount[0]);
   const std::uint64_t gy = (groups + gx - 1) / gx;
-  if (gy > ctx.limits.maxComputeWorkGroupCount[1]) throw InvalidArgument("GPU: the domain exceeds the device's dispatch limits");
-  const std::uint32_t control_init[8] = {0, 0, 0, 0, static_cast<std::uint32_t>(gx), static_cast<std::uint32_t>(gy), 1, 0};
+  if (gy > ctx.limits.maxComputeWorkGroupCount[1])
+    throw InvalidArgument("GPU: the domain exceeds the device's dispatch limits");
+  const std::uint32_t control_init[8] = {
+      0, 0, 0, 0, static_cast<std::uint32_t>(gx), static_cast<std::uint32_t>(gy), 1, 0};
   Buffer& upload = ctx.upload_buffer(half + kControlBytes);
   std::memcpy(upload.mapped(), initial.data(), half);
   std::memcpy(static_cast<std::uint8_t*>(upload.mapped()) + half, control_init, kControlBytes);
@@ -197,7 +231,8 @@ detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p,
   fp.region_end = {region.end.x, region.end.y, region.end.z, 0};
   fp.metric = static_cast<std::uint32_t>(p.metric);
   fp.eps = p.metric == Metric::kEuclidean ? 1e-5f : 0.0f;  // the CPU's tolerance
-  constexpr VkPipelineStageFlags kNext = VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+  constexpr VkPipelineStageFlags kNext =
+      VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
   constexpr VkAccessFlags kNextAccess =
       VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
   ctx.run_commands([&](VkCommandBuffer cmd) {
@@ -210,45 +245,53 @@ detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p,
     const VkBufferCopy in_control{half, 0, kControlBytes};
     vkCmdCopyBuffer(cmd, upload.handle(), control.handle(), 1, &in_control);
     ctx.counters.bytes_uploaded += static_cast<std::int64_t>(half + kControlBytes);
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, kNext, kNextAccess);
+    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, kNext,
+            kNextAccess);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.fim.pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.fim_layout.pipeline, 0, 1, &set, 0, nullptr);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.fim_layout.pipeline, 0, 1,
+                            &set, 0, nullptr);
     std::uint32_t src = 0;
     for (std::uint32_t k = 0; k < passes; ++k) {
       fp.size.w = L::VF_FIM_UPDATE;
       fp.src = src;
       fp.dst = src == 0 ? static_cast<std::uint32_t>(n) : 0u;
-      vkCmdPushConstants(cmd, ctx.fim_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof fp, &fp);
+      vkCmdPushConstants(cmd, ctx.fim_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof fp,
+                         &fp);
       vkCmdDispatchIndirect(cmd, control.handle(), L::VF_FIM_GROUPS * 4);
       ++ctx.counters.dispatches;
-      barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+      barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+              VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+              VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
       fp.size.w = L::VF_FIM_CONTROL;
-      vkCmdPushConstants(cmd, ctx.fim_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof fp, &fp);
+      vkCmdPushConstants(cmd, ctx.fim_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof fp,
+                         &fp);
       vkCmdDispatch(cmd, 1, 1, 1);
       ++ctx.counters.dispatches;
-      barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT, kNext,
-              kNextAccess);
+      barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+              VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT, kNext, kNextAccess);
       src = fp.dst;
     }
     fp.size.w = L::VF_FIM_RESOLVE;
-    vkCmdPushConstants(cmd, ctx.fim_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof fp, &fp);
+    vkCmdPushConstants(cmd, ctx.fim_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof fp,
+                       &fp);
     dispatch(ctx, cmd, n);
     if (timed) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx.timestamps, 1);
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-            VK_ACCESS_TRANSFER_READ_BIT);
+    barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     const VkBufferCopy out{0, 0, half};
     vkCmdCopyBuffer(cmd, data.handle(), readback.handle(), 1, &out);
     const VkBufferCopy out_control{0, half, kControlBytes};
     vkCmdCopyBuffer(cmd, control.handle(), readback.handle(), 1, &out_control);
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-            VK_ACCESS_HOST_READ_BIT);
+    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+            VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     ctx.counters.bytes_downloaded += static_cast<std::int64_t>(half + kControlBytes);
   });
   std::uint32_t words[8];
   std::memcpy(words, static_cast<const std::uint8_t*>(readback.mapped()) + half, sizeof words);
   if (words[L::VF_FIM_CONVERGED] != 1u)
-    throw Error("GPU: fim did not converge within " + std::to_string(passes) + " passes");  // the bound says it must
+    throw Error("GPU: fim did not converge within " + std::to_string(passes) +
+                " passes");  // the bound says it must
   std::memcpy(solution.d.data(), readback.mapped(), half);
   stats.iterations += static_cast<int>(words[L::VF_FIM_PASSES]);
   stats.updates += static_cast<std::int64_t>(region.volume()) * words[L::VF_FIM_PASSES];
@@ -267,15 +310,19 @@ detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p,
 Box3i lod_region(const detail::DenseProblem& p, const Box3i& focus) {
   const int e = p.chunk_edge;
   auto down = [e](int v) { return (v >= 0 ? v / e : -((-v + e - 1) / e)) * e; };
-  const Box3i chunks{{down(focus.begin.x), down(focus.begin.y), down(focus.begin.z)},
-                     {down(focus.end.x - 1) + e, down(focus.end.y - 1) + e, down(focus.end.z - 1) + e}};
-  return Box3i{chunks.begin - p.box.begin, chunks.end - p.box.begin}.intersect(Box3i::from_size(p.n));
+  const Box3i chunks{
+      {down(focus.begin.x), down(focus.begin.y), down(focus.begin.z)},
+      {down(focus.end.x - 1) + e, down(focus.end.y - 1) + e, down(focus.end.z - 1) + e}};
+  return Box3i{chunks.begin - p.box.begin, chunks.end - p.box.begin}.intersect(
+      Box3i::from_size(p.n));
 }
 
-detail::DenseSolution solve(Context::Impl& ctx, const detail::DenseProblem& p, const AlgorithmOptions& a,
-                            const std::vector<int>& extra, AlgorithmStats& st, std::vector<PassTiming>* timings) {
+detail::DenseSolution solve(Context::Impl& ctx, const detail::DenseProblem& p,
+                            const AlgorithmOptions& a, const std::vector<int>& extra,
+                            AlgorithmStats& st, std::vector<PassTiming>* timings) {
   switch (a.algorithm) {
-    case Algorithm::kJfaSeed: return flood_values(ctx, p, st, timings);
+    case Algorithm::kJfaSeed:
+      return flood_values(ctx, p, st, timings);
     case Algorithm::kFim: {
       std::vector<float> initial(p.size());
       for (std::size_t i = 0; i < p.size(); ++i) initial[i] = p.site[i] ? 0.0f : detail::kFar;
@@ -285,16 +332,19 @@ detail::DenseSolution solve(Context::Impl& ctx, const detail::DenseProblem& p, c
     case Algorithm::kLod: {
       // Jump flooding, then FIM from its values (everywhere, or in the focus chunks): two submits.
       const detail::DenseSolution jfa = flood(ctx, p, extra, st, timings);
-      const Box3i region = a.algorithm == Algorithm::kHybrid ? Box3i::from_size(p.n) : lod_region(p, *a.focus);
+      const Box3i region =
+          a.algorithm == Algorithm::kHybrid ? Box3i::from_size(p.n) : lod_region(p, *a.focus);
       return iterate(ctx, p, jfa.d, region, st, timings);
     }
-    default: return flood(ctx, p, extra, st, timings);
+    default:
+      return flood(ctx, p, extra, st, timings);
   }
 }
 
 }  // namespace
 
-DistanceField compute_distance_field(Context& context, const World& world, const DistanceOptions& options,
+DistanceField compute_distance_field(Context& context, const World& world,
+                                     const DistanceOptions& options,
                                      const AlgorithmOptions& algorithm, AlgorithmStats* stats,
                                      std::vector<PassTiming>* timings) {
   if (timings) timings->clear();
@@ -303,22 +353,27 @@ DistanceField compute_distance_field(Context& context, const World& world, const
     DistanceField f = compute_distance_field(context, world, options, timings);
     if (stats) {
       *stats = AlgorithmStats{};
-      stats->ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      stats->ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     }
     return f;
   }
   const std::vector<int> extra = extra_steps(algorithm.algorithm);
   if (options.spacing != std::array<double, 3>{1, 1, 1})
-    throw InvalidArgument("GPU: the algorithm family on the Vulkan backend supports unit voxel spacing only");
+    throw InvalidArgument(
+        "GPU: the algorithm family on the Vulkan backend supports unit voxel spacing only");
   const Algorithm alg = algorithm.algorithm;
-  if (options.nearest_sites && (alg == Algorithm::kFim || alg == Algorithm::kHybrid || alg == Algorithm::kLod))
+  if (options.nearest_sites &&
+      (alg == Algorithm::kFim || alg == Algorithm::kHybrid || alg == Algorithm::kLod))
     throw InvalidArgument(std::string("GPU: ") + algorithm_name(alg) +
-                          " on the Vulkan backend does not track nearest sites (its Jacobi passes carry distances only)");
+                          " on the Vulkan backend does not track nearest sites (its Jacobi passes "
+                          "carry distances only)");
   Context::Impl& ctx = context.impl();
-  return detail::compute_with_solver(world, options, algorithm, stats,
-                                     [&](const detail::DenseProblem& p, const AlgorithmOptions& a, AlgorithmStats& st) {
-                                       return solve(ctx, p, a, extra, st, timings);
-                                     });
+  return detail::compute_with_solver(
+      world, options, algorithm, stats,
+      [&](const detail::DenseProblem& p, const AlgorithmOptions& a, AlgorithmStats& st) {
+        return solve(ctx, p, a, extra, st, timings);
+      });
 }
 
 }  // namespace voxfield::gpu

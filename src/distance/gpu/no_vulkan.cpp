@@ -5,22 +5,36 @@
 
 namespace voxfield::gpu {
 
-DistanceField compute_distance_field(Context&, const World&, const DistanceOptions&, std::vector<PassTiming>*) {
+DistanceField compute_distance_field(Context&, const World&, const DistanceOptions&,
+                                     std::vector<PassTiming>*) {
   built_without_vulkan();
 }
 
-DistanceField compute_distance_field(Context&, const World&, const DistanceOptions&, const AlgorithmOptions&,
-                                     AlgorithmStats*, std::vector<PassTiming>*) {
+DistanceField compute_distance_field(Context&, const World&, const DistanceOptions&,
+                                     const AlgorithmOptions&, AlgorithmStats*,
+                                     std::vector<PassTiming>*) {
   built_without_vulkan();
 }
 
 class FieldEngine {};
-DynamicField::DynamicField(std::shared_ptr<Context>, const World&, DistanceOptions) { built_without_vulkan(); }
+DynamicField::DynamicField(std::shared_ptr<Context>, const World&, DistanceOptions) {
+  built_without_vulkan();
+}
 DynamicField::~DynamicField() = default;
-void DynamicField::rebuild() { built_without_vulkan(); }
-DynamicDistanceField::UpdateStats DynamicField::update(const DirtyRegions&) { built_without_vulkan(); }
-DistanceField DynamicField::download() { built_without_vulkan(); }
-const DistanceOptions& DynamicField::options() const { built_without_vulkan(); }
-std::size_t DynamicField::field_bytes() const { built_without_vulkan(); }
+void DynamicField::rebuild() {
+  built_without_vulkan();
+}
+DynamicDistanceField::UpdateStats DynamicField::update(const DirtyRegions&) {
+  built_without_vulkan();
+}
+DistanceField DynamicField::download() {
+  built_without_vulkan();
+}
+const DistanceOptions& DynamicField::options() const {
+  built_without_vulkan();
+}
+std::size_t DynamicField::field_bytes() const {
+  built_without_vulkan();
+}
 
 }  // namespace voxfield::gpu

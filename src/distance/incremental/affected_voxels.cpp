@@ -40,17 +40,20 @@ struct GapCost {
   Box3i changed;
   std::array<double, 3> spacing;
   float axis(int k, int v) const {  // the gap along axis k, as a cost term
-    const float g = static_cast<float>(std::max({0, changed.begin[k] - v, v - (changed.end[k] - 1)}) * spacing[k]);
+    const float g = static_cast<float>(
+        std::max({0, changed.begin[k] - v, v - (changed.end[k] - 1)}) * spacing[k]);
     return metric == Metric::kEuclidean ? g * g : g;
   }
-  float combine(float a, float b) const { return metric == Metric::kChebyshev ? std::max(a, b) : a + b; }
+  float combine(float a, float b) const {
+    return metric == Metric::kChebyshev ? std::max(a, b) : a + b;
+  }
 };
 
 // The largest gap cost (GapCost's units) from a change at which a voxel holding `stored` can still
-// be moved by it: its distance bound upper_distance() plus `extra`, as (stored + off) * mul + extra,
-// then squared for Euclidean. A few float operations per voxel that vectorise, with margins wider
-// than upper_distance()'s and far wider than float rounding, so the bound is never below the exact
-// one (a voxel is let through whenever in doubt). Values that cannot change get kNever.
+// be moved by it: its distance bound upper_distance() plus `extra`, as (stored + off) * mul +
+// extra, then squared for Euclidean. A few float operations per voxel that vectorise, with margins
+// wider than upper_distance()'s and far wider than float rounding, so the bound is never below the
+// exact one (a voxel is let through whenever in doubt). Values that cannot change get kNever.
 template <class T>
 struct StoredBound {
   static constexpr float kNever = -1.0f;  // below every cost
@@ -62,9 +65,11 @@ struct StoredBound {
 
   // `extra`: a distance added to every bound. `clamp_frozen`: values at the clamp cannot change
   // (the changes only removed sites, so values can only rise).
-  StoredBound(const FieldPlan& plan, double extra_distance, bool clamp_frozen, bool zero_frozen_value)
+  StoredBound(const FieldPlan& plan, double extra_distance, bool clamp_frozen,
+              bool zero_frozen_value)
       : off(std::is_same_v<T, float> ? 1e-5f : 1.0f),
-        mul(static_cast<float>((std::is_same_v<T, float> ? 1.0 : 1.0 / plan.encoding.scale) * (1 + 1e-5))),
+        mul(static_cast<float>((std::is_same_v<T, float> ? 1.0 : 1.0 / plan.encoding.scale) *
+                               (1 + 1e-5))),
         extra(static_cast<float>(extra_distance * (1 + 1e-5))),
         clamp_stored(encode_distance<T>(plan.clamp, plan)),
         at_clamp(clamp_frozen ? kNever : std::numeric_limits<float>::infinity()),
@@ -86,8 +91,8 @@ struct StoredBound {
 // branch-free loop per metric. (Arguments by value and __restrict pointers: nothing the loop reads
 // may be thought to alias its stores, or it stays scalar.)
 template <bool kSquared, bool kChebyshev, class T>
-void test_loop(const StoredBound<T> sb, const T* __restrict v, const float* __restrict gx, int count, float rest,
-               std::uint32_t* __restrict flags) {
+void test_loop(const StoredBound<T> sb, const T* __restrict v, const float* __restrict gx,
+               int count, float rest, std::uint32_t* __restrict flags) {
   for (int i = 0; i < count; ++i) {
     const float cost = kChebyshev ? std::max(gx[i], rest) : gx[i] + rest;
     flags[i] = cost <= sb.template at<kSquared>(v[i]) ? 1u : 0u;
@@ -95,12 +100,18 @@ void test_loop(const StoredBound<T> sb, const T* __restrict v, const float* __re
 }
 
 template <class T>
-void test_segment(Metric metric, const StoredBound<T>& sb, const T* v, const float* gx, int count, float rest,
-                  std::uint32_t* flags) {
+void test_segment(Metric metric, const StoredBound<T>& sb, const T* v, const float* gx, int count,
+                  float rest, std::uint32_t* flags) {
   switch (metric) {
-    case Metric::kEuclidean: test_loop<true, false>(sb, v, gx, count, rest, flags); break;
-    case Metric::kManhattan: test_loop<false, false>(sb, v, gx, count, rest, flags); break;
-    case Metric::kChebyshev: test_loop<false, true>(sb, v, gx, count, rest, flags); break;
+    case Metric::kEuclidean:
+      test_loop<true, false>(sb, v, gx, count, rest, flags);
+      break;
+    case Metric::kManhattan:
+      test_loop<false, false>(sb, v, gx, count, rest, flags);
+      break;
+    case Metric::kChebyshev:
+      test_loop<false, true>(sb, v, gx, count, rest, flags);
+      break;
   }
 }
 
@@ -117,7 +128,8 @@ inline bool flagged_span(const std::uint32_t* flags, int count, int& first, int&
 }  // namespace
 
 template <class T>
-Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& old, const Box3i& changed, Changes kind) {
+Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& old,
+                   const Box3i& changed, Changes kind) {
   // Only a voxel whose old distance reaches the changed voxels can change: a removed site that
   // was its nearest lies at least that far away, and a new site nearer than its old distance lies
   // at least that far away too. Everything else keeps its value — bit for bit — so the
@@ -138,11 +150,14 @@ Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& 
   for (int z = r.begin.z; z < r.end.z; ++z) {
     const float gz = gap.axis(2, z);
     for (int y = r.begin.y; y < r.end.y; ++y, i += static_cast<std::size_t>(nx)) {
-      test_segment(plan.metric, bound, old.data() + i, gx.data(), nx, gap.combine(gap.axis(1, y), gz), pass.data());
+      test_segment(plan.metric, bound, old.data() + i, gx.data(), nx,
+                   gap.combine(gap.axis(1, y), gz), pass.data());
       int first, last;
       if (!flagged_span(pass.data(), nx, first, last)) continue;
-      box = {{std::min(box.begin.x, r.begin.x + first), std::min(box.begin.y, y), std::min(box.begin.z, z)},
-             {std::max(box.end.x, r.begin.x + last + 1), std::max(box.end.y, y + 1), std::max(box.end.z, z + 1)}};
+      box = {{std::min(box.begin.x, r.begin.x + first), std::min(box.begin.y, y),
+              std::min(box.begin.z, z)},
+             {std::max(box.end.x, r.begin.x + last + 1), std::max(box.end.y, y + 1),
+              std::max(box.end.z, z + 1)}};
     }
   }
   return box;
@@ -154,7 +169,8 @@ namespace {
 template <class T>
 class RowReader {
  public:
-  RowReader(const Grid<T>& grid, const Box3i& box) : shift_(grid.chunk_shift()), edge_(grid.chunk_edge()) {
+  RowReader(const Grid<T>& grid, const Box3i& box)
+      : shift_(grid.chunk_shift()), edge_(grid.chunk_edge()) {
     lo_ = grid.chunk_of(box.begin);
     const Vec3i hi = grid.chunk_of(box.end - Vec3i::splat(1));
     n_ = hi - lo_ + Vec3i::splat(1);
@@ -168,14 +184,18 @@ class RowReader {
   // [x0, x1) of the row (y, z).
   template <class Run, class Segment>
   void row(int x0, int x1, int y, int z, Run&& run, Segment&& segment) const {
-    const std::size_t base = (static_cast<std::size_t>((z >> shift_) - lo_.z) * n_.y + static_cast<std::size_t>((y >> shift_) - lo_.y)) * n_.x;
+    const std::size_t base = (static_cast<std::size_t>((z >> shift_) - lo_.z) * n_.y +
+                              static_cast<std::size_t>((y >> shift_) - lo_.y)) *
+                             n_.x;
     for (int x = x0; x < x1;) {
       const ChunkView<T>& v = views_[base + static_cast<std::size_t>((x >> shift_) - lo_.x)];
       const int end = std::min(x1, v.box.end.x);
       if (v.uniform()) {
         run(x, end, v.uniform_value);
       } else {
-        const T* row = v.voxels + (static_cast<std::size_t>(z - v.box.begin.z) * edge_ + static_cast<std::size_t>(y - v.box.begin.y)) * edge_;
+        const T* row = v.voxels + (static_cast<std::size_t>(z - v.box.begin.z) * edge_ +
+                                   static_cast<std::size_t>(y - v.box.begin.y)) *
+                                      edge_;
         segment(x, end, row + (x - v.box.begin.x));
       }
       x = end;
@@ -192,9 +212,12 @@ class RowReader {
 double rounding_slack(const FieldPlan& plan) {
   const double hx = plan.spacing[0] / 2, hy = plan.spacing[1] / 2, hz = plan.spacing[2] / 2;
   switch (plan.metric) {
-    case Metric::kManhattan: return 2 * (hx + hy + hz);
-    case Metric::kChebyshev: return 2 * std::max({hx, hy, hz});
-    case Metric::kEuclidean: break;
+    case Metric::kManhattan:
+      return 2 * (hx + hy + hz);
+    case Metric::kChebyshev:
+      return 2 * std::max({hx, hy, hz});
+    case Metric::kEuclidean:
+      break;
   }
   return 2 * std::sqrt(hx * hx + hy * hy + hz * hz);
 }
@@ -202,7 +225,8 @@ double rounding_slack(const FieldPlan& plan) {
 }  // namespace
 
 template <class T>
-Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r, const Box3i& changed, std::int64_t max_volume) {
+Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
+                    const Box3i& changed, std::int64_t max_volume) {
   // Every voxel p that an edit can change has g(p) <= old(p), g being its distance to the changed
   // box C (see affected_box). Walk from p straight to its nearest point c of C, rounding each point
   // of the segment to its nearest voxel q: g falls exactly as fast as the walk advances, the old
@@ -233,7 +257,9 @@ Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
         auto segment = [&](int x0, int x1, const T* values) {
           // Mostly a voxel or two at the ends of rows already scanned: tested one by one.
           for (int x = x0; x < x1; ++x) {
-            if (gap.combine(gx[static_cast<std::size_t>(x - r.begin.x)], rest) > bound_of(values[x - x0])) continue;
+            if (gap.combine(gx[static_cast<std::size_t>(x - r.begin.x)], rest) >
+                bound_of(values[x - x0]))
+              continue;
             lo = std::min(lo, x);
             hi = std::max(hi, x);
           }
@@ -260,7 +286,8 @@ Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
             hi = std::max(hi, b);
           }
         };
-        const bool inner_row = y >= scanned.begin.y && y < scanned.end.y && z >= scanned.begin.z && z < scanned.end.z;
+        const bool inner_row =
+            y >= scanned.begin.y && y < scanned.end.y && z >= scanned.begin.z && z < scanned.end.z;
         if (inner_row) {  // only the ends of this row are new
           reader.row(outer.begin.x, scanned.begin.x, y, z, run, segment);
           reader.row(scanned.end.x, outer.end.x, y, z, run, segment);
@@ -277,12 +304,16 @@ Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
   return box;
 }
 
-template Box3i grow_affected<std::uint8_t>(const FieldPlan&, const Grid<std::uint8_t>&, const Box3i&, const Box3i&, std::int64_t);
-template Box3i grow_affected<std::uint16_t>(const FieldPlan&, const Grid<std::uint16_t>&, const Box3i&, const Box3i&, std::int64_t);
-template Box3i grow_affected<float>(const FieldPlan&, const Grid<float>&, const Box3i&, const Box3i&, std::int64_t);
+template Box3i grow_affected<std::uint8_t>(const FieldPlan&, const Grid<std::uint8_t>&,
+                                           const Box3i&, const Box3i&, std::int64_t);
+template Box3i grow_affected<std::uint16_t>(const FieldPlan&, const Grid<std::uint16_t>&,
+                                            const Box3i&, const Box3i&, std::int64_t);
+template Box3i grow_affected<float>(const FieldPlan&, const Grid<float>&, const Box3i&,
+                                    const Box3i&, std::int64_t);
 
 template <class T>
-NewValueBounds new_value_bound(const FieldPlan& plan, const Grid<T>& field, const Box3i& r, const Box3i& a) {
+NewValueBounds new_value_bound(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
+                               const Box3i& a) {
   const T clamp_stored = encode_distance<T>(plan.clamp, plan);
   const double inf = std::numeric_limits<double>::infinity();
   const RowReader<T> reader(field, r);
@@ -292,9 +323,13 @@ NewValueBounds new_value_bound(const FieldPlan& plan, const Grid<T>& field, cons
     for (int z = f.begin.z; z < f.end.z && m < inf; ++z)
       for (int y = f.begin.y; y < f.end.y && m < inf; ++y)
         reader.row(
-            f.begin.x, f.end.x, y, z, [&](int, int, T stored) { m = std::max(m, upper_distance<T>(plan, stored, clamp_stored)); },
+            f.begin.x, f.end.x, y, z,
+            [&](int, int, T stored) {
+              m = std::max(m, upper_distance<T>(plan, stored, clamp_stored));
+            },
             [&](int x0, int x1, const T* values) {
-              for (int i = 0; i < x1 - x0; ++i) m = std::max(m, upper_distance<T>(plan, values[i], clamp_stored));
+              for (int i = 0; i < x1 - x0; ++i)
+                m = std::max(m, upper_distance<T>(plan, values[i], clamp_stored));
             });
     return m;
   };
@@ -318,7 +353,8 @@ NewValueBounds new_value_bound(const FieldPlan& plan, const Grid<T>& field, cons
     // The worst voxel along axis k, each bounded through the nearer-valued face.
     double worst = 0;
     for (int v = a.begin[k]; v < a.end[k]; ++v)
-      worst = std::max(worst, std::min(lo_face + (v - a.begin[k] + 1) * plan.spacing[k], hi_face + (a.end[k] - v) * plan.spacing[k]));
+      worst = std::max(worst, std::min(lo_face + (v - a.begin[k] + 1) * plan.spacing[k],
+                                       hi_face + (a.end[k] - v) * plan.spacing[k]));
     // max over p of min over axes = min over axes of each axis's max (the axes vary independently).
     bounds.all = std::min(bounds.all, worst);
   }
@@ -330,7 +366,8 @@ NewValueBounds new_value_bound(const FieldPlan& plan, const Grid<T>& field, cons
 Box3i solid_bounds(const Grid<std::uint8_t>& occupancy, const Box3i& box) {
   Box3i bounds;
   if (box.empty()) return bounds;
-  const Vec3i lo = occupancy.chunk_of(box.begin), hi = occupancy.chunk_of(box.end - Vec3i::splat(1));
+  const Vec3i lo = occupancy.chunk_of(box.begin),
+              hi = occupancy.chunk_of(box.end - Vec3i::splat(1));
   for (int z = lo.z; z <= hi.z; ++z)
     for (int y = lo.y; y <= hi.y; ++y)
       for (int x = lo.x; x <= hi.x; ++x) {
@@ -341,11 +378,18 @@ Box3i solid_bounds(const Grid<std::uint8_t>& occupancy, const Box3i& box) {
   return bounds;
 }
 
-template Box3i affected_box<std::uint8_t>(const FieldPlan&, const Box3i&, const std::vector<std::uint8_t>&, const Box3i&, Changes);
-template Box3i affected_box<std::uint16_t>(const FieldPlan&, const Box3i&, const std::vector<std::uint16_t>&, const Box3i&, Changes);
-template Box3i affected_box<float>(const FieldPlan&, const Box3i&, const std::vector<float>&, const Box3i&, Changes);
-template NewValueBounds new_value_bound<std::uint8_t>(const FieldPlan&, const Grid<std::uint8_t>&, const Box3i&, const Box3i&);
-template NewValueBounds new_value_bound<std::uint16_t>(const FieldPlan&, const Grid<std::uint16_t>&, const Box3i&, const Box3i&);
-template NewValueBounds new_value_bound<float>(const FieldPlan&, const Grid<float>&, const Box3i&, const Box3i&);
+template Box3i affected_box<std::uint8_t>(const FieldPlan&, const Box3i&,
+                                          const std::vector<std::uint8_t>&, const Box3i&, Changes);
+template Box3i affected_box<std::uint16_t>(const FieldPlan&, const Box3i&,
+                                           const std::vector<std::uint16_t>&, const Box3i&,
+                                           Changes);
+template Box3i affected_box<float>(const FieldPlan&, const Box3i&, const std::vector<float>&,
+                                   const Box3i&, Changes);
+template NewValueBounds new_value_bound<std::uint8_t>(const FieldPlan&, const Grid<std::uint8_t>&,
+                                                      const Box3i&, const Box3i&);
+template NewValueBounds new_value_bound<std::uint16_t>(const FieldPlan&, const Grid<std::uint16_t>&,
+                                                       const Box3i&, const Box3i&);
+template NewValueBounds new_value_bound<float>(const FieldPlan&, const Grid<float>&, const Box3i&,
+                                               const Box3i&);
 
 }  // namespace voxfield::detail

@@ -18,7 +18,9 @@ namespace voxfield {
 namespace detail {
 namespace {
 
-Box3i grow(const Box3i& b, Vec3i by) { return {b.begin - by, b.end + by}; }
+Box3i grow(const Box3i& b, Vec3i by) {
+  return {b.begin - by, b.end + by};
+}
 
 // Merges boxes that overlap until none do, so that no voxel is recomputed twice.
 std::vector<Box3i> merge_overlapping(std::vector<Box3i> boxes) {
@@ -43,19 +45,23 @@ Vec3i field_reach(const FieldPlan& plan) {
   const Vec3i size = plan.domain.size();
   Vec3i reach;
   for (int k = 0; k < 3; ++k)
-    reach[k] = std::isfinite(plan.clamp) ? static_cast<int>(std::min<double>(std::ceil(plan.clamp / plan.spacing[k]), size[k]))
-                                         : size[k];
+    reach[k] =
+        std::isfinite(plan.clamp)
+            ? static_cast<int>(std::min<double>(std::ceil(plan.clamp / plan.spacing[k]), size[k]))
+            : size[k];
   return reach;
 }
 
-std::vector<UpdateRegion> update_regions(const DirtyRegions& dirty, const Box3i& domain, Vec3i reach) {
+std::vector<UpdateRegion> update_regions(const DirtyRegions& dirty, const Box3i& domain,
+                                         Vec3i reach) {
   std::vector<Box3i> reach_boxes;
   for (const Box3i& b : dirty.boxes()) {
     const Box3i r = grow(b, reach).intersect(domain);
     if (!r.empty()) reach_boxes.push_back(r);
   }
   std::vector<UpdateRegion> regions;
-  for (const Box3i& r : merge_overlapping(std::move(reach_boxes))) regions.push_back({r, grow(r, reach).intersect(domain)});
+  for (const Box3i& r : merge_overlapping(std::move(reach_boxes)))
+    regions.push_back({r, grow(r, reach).intersect(domain)});
   return regions;
 }
 
@@ -105,10 +111,13 @@ void keep_box(std::vector<T>& old, const Box3i& from, const Box3i& to) {
   std::size_t k = 0;
   for (int z = to.begin.z; z < to.end.z; ++z)
     for (int y = to.begin.y; y < to.end.y; ++y) {
-      const std::size_t at = (static_cast<std::size_t>(z - from.begin.z) * fs.y + static_cast<std::size_t>(y - from.begin.y)) * fs.x +
+      const std::size_t at = (static_cast<std::size_t>(z - from.begin.z) * fs.y +
+                              static_cast<std::size_t>(y - from.begin.y)) *
+                                 fs.x +
                              static_cast<std::size_t>(to.begin.x - from.begin.x);
       if (at != k)  // at > k: rows only move towards the front
-        std::copy(old.begin() + static_cast<std::ptrdiff_t>(at), old.begin() + static_cast<std::ptrdiff_t>(at) + ts.x,
+        std::copy(old.begin() + static_cast<std::ptrdiff_t>(at),
+                  old.begin() + static_cast<std::ptrdiff_t>(at) + ts.x,
                   old.begin() + static_cast<std::ptrdiff_t>(k));
       k += static_cast<std::size_t>(ts.x);
     }
@@ -118,7 +127,8 @@ void keep_box(std::vector<T>& old, const Box3i& from, const Box3i& to) {
 // Step 1, shrink (unsigned fields without nearest sites): the box inside the region `r` holding
 // every voxel the changes `near` can move, empty when none can; `old` receives its old values.
 template <class T>
-Box3i shrink_region(const RegionUpdate& u, const Grid<T>& field, const Box3i& r, const Box3i& near, std::vector<T>& old) {
+Box3i shrink_region(const RegionUpdate& u, const Grid<T>& field, const Box3i& r, const Box3i& near,
+                    std::vector<T>& old) {
   // Open space far from everything needs no search: every voxel of r is in reach of an addition,
   // and no removal can raise a value there.
   const bool all_clamped = all_at_clamp(u.plan, field, r);
@@ -138,14 +148,17 @@ Box3i shrink_region(const RegionUpdate& u, const Grid<T>& field, const Box3i& r,
 // Step 2, site box: the sites the new values of `r` can depend on. `r` is the region `region`
 // itself, or the box shrink_region() found inside it (`shrunk`).
 template <class T>
-Box3i site_box(const RegionUpdate& u, const Grid<T>& field, const Box3i& region, const Box3i& r, bool shrunk) {
+Box3i site_box(const RegionUpdate& u, const Grid<T>& field, const Box3i& region, const Box3i& r,
+               bool shrunk) {
   if (!shrunk) return Box3i{r.begin - u.reach, r.end + u.reach}.intersect(u.domain);
   if (u.additions_only) return r;  // the new sites alone, all inside the changed boxes
   // Sites farther than every new value of r cannot be anyone's nearest, nor sites beyond a face
   // farther than its own bound allows (NewValueBounds).
   Vec3i below = u.reach, above = u.reach;
   const NewValueBounds m = new_value_bound(u.plan, field, region, r);
-  auto voxels = [](double d, double spacing) { return static_cast<int>(std::floor(d / spacing + 1e-9)); };  // d is a bound already
+  auto voxels = [](double d, double spacing) {
+    return static_cast<int>(std::floor(d / spacing + 1e-9));
+  };  // d is a bound already
   for (int k = 0; k < 3; ++k) {
     const double s = u.plan.spacing[static_cast<std::size_t>(k)];
     if (std::isfinite(m.all)) below[k] = above[k] = std::min(u.reach[k], voxels(m.all, s));
@@ -164,8 +177,8 @@ Box3i site_box(const RegionUpdate& u, const Grid<T>& field, const Box3i& region,
 // sites in `in`, densely. Additions take the distance to the new sites in `near`, then the minimum
 // with the old values.
 template <class T>
-void recompute(const RegionUpdate& u, const Box3i& in, const Box3i& r, const Box3i& near, const std::vector<T>& old,
-               std::vector<T>& values, std::vector<SiteOffset>* sites) {
+void recompute(const RegionUpdate& u, const Box3i& in, const Box3i& r, const Box3i& near,
+               const std::vector<T>& old, std::vector<T>& values, std::vector<SiteOffset>* sites) {
   values.resize(static_cast<std::size_t>(r.volume()));
   if (sites) sites->resize(static_cast<std::size_t>(r.volume()));
   compute_region<T>(u.occupancy, u.plan, in, r, values.data(), sites ? sites->data() : nullptr,
@@ -176,8 +189,8 @@ void recompute(const RegionUpdate& u, const Box3i& in, const Box3i& r, const Box
 
 // Step 4, write back: the recomputed box into the field's grids.
 template <class T>
-void write_back(const Box3i& r, const std::vector<T>& values, const std::vector<SiteOffset>& sites, Grid<T>& field,
-                std::optional<Grid<SiteOffset>>& field_sites) {
+void write_back(const Box3i& r, const std::vector<T>& values, const std::vector<SiteOffset>& sites,
+                Grid<T>& field, std::optional<Grid<SiteOffset>>& field_sites) {
   field.copy_from_dense(r, values.data());
   if (field_sites) field_sites->copy_from_dense(r, sites.data());
 }
@@ -190,7 +203,8 @@ DynamicDistanceField::DynamicDistanceField(const World& world, DistanceOptions o
     : world_(&world), options_(std::move(options)) {
   if (!options_.domain) {
     if (!world.voxels.bounds()) {
-      throw InvalidArgument("a dynamic distance field needs a fixed domain: bound the world or set options.domain");
+      throw InvalidArgument(
+          "a dynamic distance field needs a fixed domain: bound the world or set options.domain");
     }
     options_.domain = *world.voxels.bounds();
   }
@@ -198,7 +212,9 @@ DynamicDistanceField::DynamicDistanceField(const World& world, DistanceOptions o
   rebuild();
 }
 
-void DynamicDistanceField::rebuild() { field_ = compute_distance_field(world_->voxels, options_); }
+void DynamicDistanceField::rebuild() {
+  field_ = compute_distance_field(world_->voxels, options_);
+}
 
 DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegions& dirty) {
   UpdateStats stats;
@@ -218,12 +234,14 @@ DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegion
   // box and read the sites up to the reach beyond it.
   const bool shrink = !plan.is_signed && !field_.sites;
   // `kind`: values can only rise after removals and only fall after additions.
-  const detail::Changes kind = !dirty.adds_solid()     ? detail::Changes::kRemovals
+  const detail::Changes kind = !dirty.adds_solid()      ? detail::Changes::kRemovals
                                : !dirty.removes_solid() ? detail::Changes::kAdditions
                                                         : detail::Changes::kBoth;
-  const detail::RegionUpdate u{plan, world_->voxels, *options_.domain, reach_, kind, additions_only};
+  const detail::RegionUpdate u{plan,   world_->voxels, *options_.domain,
+                               reach_, kind,           additions_only};
   const std::vector<Box3i> changed = dirty.boxes();
-  for (const detail::UpdateRegion& region : detail::update_regions(dirty, *options_.domain, reach_)) {
+  for (const detail::UpdateRegion& region :
+       detail::update_regions(dirty, *options_.domain, reach_)) {
     std::visit(
         [&](auto& target) {
           using T = typename std::decay_t<decltype(target)>::value_type;

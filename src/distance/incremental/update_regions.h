@@ -23,14 +23,16 @@ Vec3i field_reach(const FieldPlan& plan);
 
 // The regions to recompute after the changes in `dirty`: their reach boxes, merged until none
 // overlap (so no voxel is computed twice), each with the box of sites it needs.
-std::vector<UpdateRegion> update_regions(const DirtyRegions& dirty, const Box3i& domain, Vec3i reach);
+std::vector<UpdateRegion> update_regions(const DirtyRegions& dirty, const Box3i& domain,
+                                         Vec3i reach);
 
 // A box inside the region `r` holding every voxel of an unsigned field whose value changes in the
 // box `changed` can move (`field` holding the values before them), found by growing `changed` a
 // shell at a time and reading only the voxels around it; `r` itself once the box exceeds
 // `max_volume` voxels.
 template <class T>
-Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r, const Box3i& changed, std::int64_t max_volume);
+Box3i grow_affected(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
+                    const Box3i& changed, std::int64_t max_volume);
 
 // `kind`: what the changes did — only removed solids (values can only rise, so voxels already at
 // the clamp stay there), only added them (values can only fall, so voxels at 0 stay there), or
@@ -40,7 +42,8 @@ enum class Changes { kRemovals, kAdditions, kBoth };
 // The bounding box of the voxels of `r` (`old` holding their values before the changes, x fastest)
 // whose old distance reaches the box `changed`: only they can change; empty when none can.
 template <class T>
-Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& old, const Box3i& changed, Changes kind);
+Box3i affected_box(const FieldPlan& plan, const Box3i& r, const std::vector<T>& old,
+                   const Box3i& changed, Changes kind);
 
 // After removals, the new values inside the affected box `a` are bounded by the unchanged values
 // around it: new(p) <= old(q) + |p - q| for every q outside `a` (distances are 1-Lipschitz, and q
@@ -62,7 +65,8 @@ struct NewValueBounds {
 
 // The bounds above for the box `a` inside the region `r`, from the old values of `field` around it.
 template <class T>
-NewValueBounds new_value_bound(const FieldPlan& plan, const Grid<T>& field, const Box3i& r, const Box3i& a);
+NewValueBounds new_value_bound(const FieldPlan& plan, const Grid<T>& field, const Box3i& r,
+                               const Box3i& a);
 
 // A box holding every solid voxel of `box` (empty if it holds none), from the chunks alone.
 Box3i solid_bounds(const Grid<std::uint8_t>& occupancy, const Box3i& box);

@@ -10,10 +10,10 @@
 #include <chrono>
 #include <cstring>
 
-#include "shaders/layout.h"
 #include "../scene_impl.h"
-#include "voxfield/gpu_render_vulkan.h"
 #include "gpu/vulkan_context.h"
+#include "shaders/layout.h"
+#include "voxfield/gpu_render_vulkan.h"
 
 namespace voxfield::gpu {
 namespace {
@@ -21,18 +21,22 @@ namespace {
 namespace L = layout;
 
 L::vec4f v4(const Vec3d& v, double w = 0) {
-  return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), static_cast<float>(w)};
+  return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z),
+          static_cast<float>(w)};
 }
 
 // The shader's four words per chunk: skip slot, (uniform cell | chunk min << 16 | empty << 24 |
 // dense << 25), light slot, light uniform value.
 std::array<std::uint32_t, 4> chunk_info(const RenderScene::Impl& s, std::size_t i) {
   std::array<std::uint32_t, 4> w{};
-  w[0] = s.skip.cells.slot[i] == BrickedChunks<std::uint16_t>::kUniform ? L::VF_UNIFORM : s.skip.cells.slot[i];
-  w[1] = static_cast<std::uint32_t>(s.skip.cells.uniform[i]) | (std::uint32_t{s.skip.chunk_min[i]} << 16) |
-         (s.empty_chunk[i] ? 1u << 24 : 0u) | (s.dense_material[i] ? 1u << 25 : 0u);
+  w[0] = s.skip.cells.slot[i] == BrickedChunks<std::uint16_t>::kUniform ? L::VF_UNIFORM
+                                                                        : s.skip.cells.slot[i];
+  w[1] = static_cast<std::uint32_t>(s.skip.cells.uniform[i]) |
+         (std::uint32_t{s.skip.chunk_min[i]} << 16) | (s.empty_chunk[i] ? 1u << 24 : 0u) |
+         (s.dense_material[i] ? 1u << 25 : 0u);
   if (s.has_light) {
-    w[2] = s.light.slot[i] == BrickedChunks<std::uint8_t>::kUniform ? L::VF_UNIFORM : s.light.slot[i];
+    w[2] =
+        s.light.slot[i] == BrickedChunks<std::uint8_t>::kUniform ? L::VF_UNIFORM : s.light.slot[i];
     w[3] = s.light.uniform[i];
   } else {
     w[2] = L::VF_UNIFORM;
@@ -42,12 +46,15 @@ std::array<std::uint32_t, 4> chunk_info(const RenderScene::Impl& s, std::size_t 
 
 void check_options(const RenderScene::Impl& s, const RenderOptions& o) {
   if (o.view == RenderView::kDistance) s.slice_z(o);  // throws for a cut outside the box
-  if (o.skip != SkipMode::kDistance) throw InvalidArgument("GPU: the Vulkan ray marcher always skips by distance");
+  if (o.skip != SkipMode::kDistance)
+    throw InvalidArgument("GPU: the Vulkan ray marcher always skips by distance");
   if (o.width <= 0 || o.height <= 0 || o.width > 16384 || o.height > 16384)
     throw InvalidArgument("render: image size out of range (1..16384 per side)");
   if ((o.ambient_occlusion || o.soft_shadows) && !s.has_light)
-    throw InvalidArgument("render: ambient occlusion and soft shadows need the scene's lighting field");
-  if (!(o.sun_direction.length() > 0)) throw InvalidArgument("render: the sun direction must be non-zero");
+    throw InvalidArgument(
+        "render: ambient occlusion and soft shadows need the scene's lighting field");
+  if (!(o.sun_direction.length() > 0))
+    throw InvalidArgument("render: the sun direction must be non-zero");
 }
 
 }  // namespace
@@ -76,7 +83,8 @@ class ResidentScene {
   }
   // Records a frame: parameters, the dispatch, and a barrier making the pixels readable by
   // transfers. Needs a synced scene.
-  void record_render(VkCommandBuffer cmd, const Camera& camera, const RenderOptions& o, bool bgra, bool timed);
+  void record_render(VkCommandBuffer cmd, const Camera& camera, const RenderOptions& o, bool bgra,
+                     bool timed);
 
   const Buffer& pixels() const { return pixels_; }
   const RenderScene::Impl* scene() const { return scene_; }
@@ -99,7 +107,8 @@ class ResidentScene {
   // that read them have completed (one frame in flight).
   std::vector<Buffer> retired_;
   Buffer approx_info_, approx_arena_, approx_staging_;
-  std::uint64_t approx_scene_ = 0, approx_generation_ = 0;  // what the resident approximation was made from
+  std::uint64_t approx_scene_ = 0,
+                approx_generation_ = 0;  // what the resident approximation was made from
   int approx_algorithm_ = -1;
   double approx_inv_scale_ = 1;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
@@ -109,8 +118,9 @@ class ResidentScene {
 
 namespace {
 
-constexpr VkBufferUsageFlags kUsage =
-    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
 
 // Copy regions into one destination buffer, staged contiguously.
 struct Staged {
@@ -124,7 +134,8 @@ bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
   const RenderScene::Impl& s = scene.impl();
   const std::size_t chunks = s.table.chunk_count();
   const std::size_t skip_live = std::size_t{s.skip.cells.slots_used} * s.skip.cells.slot_bytes();
-  const std::size_t light_live = s.has_light ? std::size_t{s.light.slots_used} * s.light.slot_bytes() : 0;
+  const std::size_t light_live =
+      s.has_light ? std::size_t{s.light.slots_used} * s.light.slot_bytes() : 0;
   bool whole = scene_ != &s || scene_id_ != s.id || synced_generation_.size() != chunks;
 
   // Device buffers as large as the host arenas' capacity, so growth is rare. A new scene gets
@@ -140,7 +151,8 @@ bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
       grown.emplace_back(&b, std::move(b));
     } else {
       whole = true;
-      if (b.handle() != VK_NULL_HANDLE) retired_.push_back(std::move(b));  // a frame may still read it
+      if (b.handle() != VK_NULL_HANDLE)
+        retired_.push_back(std::move(b));  // a frame may still read it
     }
     b = std::move(bigger);
     descriptors_stale_ = true;
@@ -158,16 +170,16 @@ bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
           VK_ACCESS_TRANSFER_WRITE_BIT);
   if (!grown.empty())  // earlier submissions' writes of the old arenas come before reading them
-    barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-            VK_ACCESS_TRANSFER_READ_BIT);
+    barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
   for (auto& [now, old] : grown) {
     const VkBufferCopy keep{0, 0, old.size()};
     vkCmdCopyBuffer(cmd, old.handle(), now->handle(), 1, &keep);
     retired_.push_back(std::move(old));
   }
   if (!grown.empty())  // the moved contents come before the changed chunks are written over them
-    barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-            VK_ACCESS_TRANSFER_WRITE_BIT);
+    barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
 
   std::vector<std::size_t> changed;
   const bool palette_changed = whole || synced_palette_ != s.palette_generation;
@@ -180,8 +192,10 @@ bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
   // Stage: palette, then chunk-table entries, then slots of both arenas.
   const std::size_t info_count = whole ? chunks : changed.size();
   std::size_t staged_bytes = (palette_changed ? 256 * 16 : 0) + info_count * 16;
-  staged_bytes += whole ? skip_live + light_live
-                        : changed.size() * (s.skip.cells.slot_bytes() + (s.has_light ? s.light.slot_bytes() : 0));
+  staged_bytes +=
+      whole
+          ? skip_live + light_live
+          : changed.size() * (s.skip.cells.slot_bytes() + (s.has_light ? s.light.slot_bytes() : 0));
   Buffer& upload = ctx_.upload_buffer(staged_bytes);
   auto* base = static_cast<std::uint8_t*>(upload.mapped());
   VkDeviceSize at = 0;
@@ -196,7 +210,9 @@ bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
   if (palette_changed) {
     std::vector<float> palette(256 * 4, 0.0f);
     for (int m = 0; m < 256; ++m)
-      for (int c = 0; c < 3; ++c) palette[static_cast<std::size_t>(4 * m + c)] = s.albedo[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)];
+      for (int c = 0; c < 3; ++c)
+        palette[static_cast<std::size_t>(4 * m + c)] =
+            s.albedo[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)];
     stage(palette_copy, 0, palette.data(), palette.size() * 4);
   }
   if (whole) {
@@ -215,24 +231,28 @@ bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
       const std::uint32_t slot = s.skip.cells.slot[i];
       if (slot != BrickedChunks<std::uint16_t>::kUniform) {
         const std::size_t n = s.skip.cells.slot_bytes();
-        stage(skip_copy, std::size_t{slot} * n, s.skip.cells.arena.data() + std::size_t{slot} * n, n);
+        stage(skip_copy, std::size_t{slot} * n, s.skip.cells.arena.data() + std::size_t{slot} * n,
+              n);
       }
       if (s.has_light && s.light.slot[i] != BrickedChunks<std::uint8_t>::kUniform) {
         const std::size_t n = s.light.slot_bytes();
-        stage(light_copy, std::size_t{s.light.slot[i]} * n, s.light.arena.data() + std::size_t{s.light.slot[i]} * n, n);
+        stage(light_copy, std::size_t{s.light.slot[i]} * n,
+              s.light.arena.data() + std::size_t{s.light.slot[i]} * n, n);
       }
     }
   }
-  const std::pair<Staged*, Buffer*> copies[4] = {{&palette_copy, &palette_}, {&info_copy, &info_},
-                                                 {&skip_copy, &skip_}, {&light_copy, &light_}};
+  const std::pair<Staged*, Buffer*> copies[4] = {{&palette_copy, &palette_},
+                                                 {&info_copy, &info_},
+                                                 {&skip_copy, &skip_},
+                                                 {&light_copy, &light_}};
   for (const auto& [staged, dst] : copies) {
     if (staged->regions.empty()) continue;
-    vkCmdCopyBuffer(cmd, upload.handle(), dst->handle(), static_cast<std::uint32_t>(staged->regions.size()),
-                    staged->regions.data());
+    vkCmdCopyBuffer(cmd, upload.handle(), dst->handle(),
+                    static_cast<std::uint32_t>(staged->regions.size()), staged->regions.data());
     ctx_.counters.bytes_uploaded += staged->bytes;
   }
-  barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-          VK_ACCESS_SHADER_READ_BIT);
+  barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   scene_ = &s;
   scene_id_ = s.id;
   synced_generation_ = s.chunk_generation;
@@ -249,16 +269,18 @@ void ResidentScene::ensure_pixels(VkDeviceSize bytes) {
 void ResidentScene::write_descriptors() {
   if (pool_ == VK_NULL_HANDLE) pool_ = ctx_.make_descriptor_pool(Context::Impl::kRenderBindings);
   for (Buffer* b : {&approx_info_, &approx_arena_})
-    if (b->handle() == VK_NULL_HANDLE) *b = Buffer(ctx_, 16, kUsage, false);  // bound even when unused
-  const Buffer* bound[Context::Impl::kRenderBindings] = {&params_,  &info_,   &skip_,        &light_,
-                                                         &palette_, &pixels_, &approx_info_, &approx_arena_};
+    if (b->handle() == VK_NULL_HANDLE)
+      *b = Buffer(ctx_, 16, kUsage, false);  // bound even when unused
+  const Buffer* bound[Context::Impl::kRenderBindings] = {
+      &params_, &info_, &skip_, &light_, &palette_, &pixels_, &approx_info_, &approx_arena_};
   set_ = ctx_.allocate_set(pool_, ctx_.render_layout, bound);
   descriptors_stale_ = false;
 }
 
 void ResidentScene::record_approximation(VkCommandBuffer cmd, Algorithm algorithm) {
   const RenderScene::Impl& s = *scene_;
-  if (approx_scene_ == s.id && approx_generation_ == s.generation && approx_algorithm_ == static_cast<int>(algorithm))
+  if (approx_scene_ == s.id && approx_generation_ == s.generation &&
+      approx_algorithm_ == static_cast<int>(algorithm))
     return;
   const SkipSource approx = s.approximation(algorithm);
   const std::size_t chunks = s.table.chunk_count();
@@ -266,23 +288,26 @@ void ResidentScene::record_approximation(VkCommandBuffer cmd, Algorithm algorith
   for (std::size_t i = 0; i < chunks; ++i) {
     const std::uint32_t slot = approx.cells.slot[i];
     info[2 * i] = slot == BrickedChunks<std::uint16_t>::kUniform ? L::VF_UNIFORM : slot;
-    info[2 * i + 1] = static_cast<std::uint32_t>(approx.cells.uniform[i]) | (std::uint32_t{approx.chunk_min[i]} << 16);
+    info[2 * i + 1] = static_cast<std::uint32_t>(approx.cells.uniform[i]) |
+                      (std::uint32_t{approx.chunk_min[i]} << 16);
   }
   const std::size_t info_bytes = info.size() * 4;
   const std::size_t arena_bytes = std::size_t{approx.cells.slots_used} * approx.cells.slot_bytes();
-  if (approx_info_.size() < std::max<std::size_t>(info_bytes, 16) || approx_arena_.size() < std::max<std::size_t>(arena_bytes, 16)) {
+  if (approx_info_.size() < std::max<std::size_t>(info_bytes, 16) ||
+      approx_arena_.size() < std::max<std::size_t>(arena_bytes, 16)) {
     approx_info_ = Buffer(ctx_, std::max<std::size_t>(info_bytes, 16), kUsage, false);
     approx_arena_ = Buffer(ctx_, std::max<std::size_t>(arena_bytes, 16), kUsage, false);
     descriptors_stale_ = true;
   }
   if (approx_staging_.size() < info_bytes + arena_bytes)
-    approx_staging_ = Buffer(ctx_, info_bytes + arena_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, /*host_visible=*/true);
+    approx_staging_ = Buffer(ctx_, info_bytes + arena_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                             /*host_visible=*/true);
   auto* base = static_cast<std::uint8_t*>(approx_staging_.mapped());
   std::memcpy(base, info.data(), info_bytes);
   if (arena_bytes > 0) std::memcpy(base + info_bytes, approx.cells.arena.data(), arena_bytes);
   // The previous frame's reads of these buffers come before the copies.
-  barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-          VK_ACCESS_TRANSFER_WRITE_BIT);
+  barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT,
+          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
   const VkBufferCopy to_info{0, 0, info_bytes};
   vkCmdCopyBuffer(cmd, approx_staging_.handle(), approx_info_.handle(), 1, &to_info);
   if (arena_bytes > 0) {
@@ -296,8 +321,8 @@ void ResidentScene::record_approximation(VkCommandBuffer cmd, Algorithm algorith
   approx_inv_scale_ = approx.inv_scale;
 }
 
-void ResidentScene::record_render(VkCommandBuffer cmd, const Camera& camera, const RenderOptions& o, bool bgra,
-                                  bool timed) {
+void ResidentScene::record_render(VkCommandBuffer cmd, const Camera& camera, const RenderOptions& o,
+                                  bool bgra, bool timed) {
   if (!scene_) throw InvalidArgument("GPU render: no scene synced yet");
   const RenderScene::Impl& s = *scene_;
   check_options(s, o);
@@ -328,8 +353,9 @@ void ResidentScene::record_render(VkCommandBuffer cmd, const Camera& camera, con
   // The distance and error views shade without shadows, as the CPU's do.
   rp.flags = (o.ambient_occlusion ? L::VF_RENDER_AO : 0u) |
              (o.soft_shadows && !distance && !error ? L::VF_RENDER_SHADOWS : 0u) |
-             (o.view == RenderView::kChunks ? L::VF_RENDER_CHUNKS : 0u) | (s.has_light ? L::VF_RENDER_HAS_LIGHT : 0u) |
-             (bgra ? L::VF_RENDER_BGRA : 0u) | (distance ? L::VF_RENDER_DISTANCE : 0u) | (error ? L::VF_RENDER_ERROR : 0u);
+             (o.view == RenderView::kChunks ? L::VF_RENDER_CHUNKS : 0u) |
+             (s.has_light ? L::VF_RENDER_HAS_LIGHT : 0u) | (bgra ? L::VF_RENDER_BGRA : 0u) |
+             (distance ? L::VF_RENDER_DISTANCE : 0u) | (error ? L::VF_RENDER_ERROR : 0u);
   rp.approx_inv_scale = static_cast<float>(approx_inv_scale_);
   if (distance) {
     rp.slice_z = s.slice_z(o);
@@ -344,25 +370,27 @@ void ResidentScene::record_render(VkCommandBuffer cmd, const Camera& camera, con
           VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   vkCmdUpdateBuffer(cmd, params_.handle(), 0, sizeof rp, &rp);
   ctx_.counters.bytes_uploaded += static_cast<std::int64_t>(sizeof rp);
-  barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-          VK_ACCESS_SHADER_READ_BIT);
+  barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.render.pipeline);
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.render_layout.pipeline, 0, 1, &set_, 0, nullptr);
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.render_layout.pipeline, 0, 1,
+                          &set_, 0, nullptr);
   if (timed) {
     vkCmdResetQueryPool(cmd, ctx_.timestamps, 0, 2);
     vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx_.timestamps, 0);
   }
   dispatch(ctx_, cmd, static_cast<std::uint64_t>(o.width) * o.height);
   if (timed) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx_.timestamps, 1);
-  barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-          VK_ACCESS_TRANSFER_READ_BIT);
+  barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
 }
 
 namespace {
 
 // Records the frame, reads it back and converts it to an Image: one submit.
-Image render_and_read(Context::Impl& ctx, ResidentScene& resident, const RenderScene* sync, const Camera& camera,
-                      const RenderOptions& o, RenderStats* stats, std::vector<PassTiming>* timings) {
+Image render_and_read(Context::Impl& ctx, ResidentScene& resident, const RenderScene* sync,
+                      const Camera& camera, const RenderOptions& o, RenderStats* stats,
+                      std::vector<PassTiming>* timings) {
   if (!sync && !resident.scene()) throw InvalidArgument("GPU render: no scene synced yet");
   check_options(sync ? sync->impl() : *resident.scene(), o);
   const VkDeviceSize image_bytes = static_cast<VkDeviceSize>(o.width) * o.height * 4;
@@ -374,11 +402,12 @@ Image render_and_read(Context::Impl& ctx, ResidentScene& resident, const RenderS
     resident.record_render(cmd, camera, o, /*bgra=*/false, timed);
     const VkBufferCopy down{0, 0, image_bytes};
     vkCmdCopyBuffer(cmd, resident.pixels().handle(), readback.handle(), 1, &down);
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-            VK_ACCESS_HOST_READ_BIT);
+    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+            VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     ctx.counters.bytes_downloaded += static_cast<std::int64_t>(image_bytes);
   });
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (timings) {
     timings->clear();
     if (timed) {
@@ -386,7 +415,8 @@ Image render_and_read(Context::Impl& ctx, ResidentScene& resident, const RenderS
       check(vkGetQueryPoolResults(ctx.device, ctx.timestamps, 0, 2, sizeof ticks, ticks, 8,
                                   VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
             "vkGetQueryPoolResults");
-      timings->push_back({"render", static_cast<double>(ticks[1] - ticks[0]) * ctx.timestamp_period_ns * 1e-6});
+      timings->push_back(
+          {"render", static_cast<double>(ticks[1] - ticks[0]) * ctx.timestamp_period_ns * 1e-6});
     }
   }
   Image image(o.width, o.height);
@@ -408,14 +438,15 @@ Image render_and_read(Context::Impl& ctx, ResidentScene& resident, const RenderS
 
 }  // namespace
 
-Image render(Context& context, const RenderScene& scene, const Camera& camera, const RenderOptions& o,
-             RenderStats* stats, std::vector<PassTiming>* timings) {
+Image render(Context& context, const RenderScene& scene, const Camera& camera,
+             const RenderOptions& o, RenderStats* stats, std::vector<PassTiming>* timings) {
   check_options(scene.impl(), o);
   ResidentScene resident(context.impl());
   return render_and_read(context.impl(), resident, &scene, camera, o, stats, timings);
 }
 
-// ---- SceneRenderer ----------------------------------------------------------------------------------
+// ---- SceneRenderer
+// ----------------------------------------------------------------------------------
 
 struct SceneRenderer::Impl {
   std::shared_ptr<Context> context;
@@ -432,19 +463,23 @@ SceneRenderer::~SceneRenderer() = default;
 
 bool SceneRenderer::sync(const RenderScene& scene) {
   if (impl_->resident.current(scene)) return false;
-  impl_->context->impl().run_commands([&](VkCommandBuffer cmd) { impl_->resident.record_sync(cmd, scene); });
+  impl_->context->impl().run_commands(
+      [&](VkCommandBuffer cmd) { impl_->resident.record_sync(cmd, scene); });
   return true;
 }
 
 Image SceneRenderer::render(const Camera& camera, const RenderOptions& options, RenderStats* stats,
                             std::vector<PassTiming>* timings) {
-  return render_and_read(impl_->context->impl(), impl_->resident, nullptr, camera, options, stats, timings);
+  return render_and_read(impl_->context->impl(), impl_->resident, nullptr, camera, options, stats,
+                         timings);
 }
 
-Context& SceneRenderer::context() { return *impl_->context; }
+Context& SceneRenderer::context() {
+  return *impl_->context;
+}
 
-VkBuffer record_render(SceneRenderer& renderer, VkCommandBuffer cmd, const Camera& camera, const RenderOptions& options,
-                       PixelOrder order) {
+VkBuffer record_render(SceneRenderer& renderer, VkCommandBuffer cmd, const Camera& camera,
+                       const RenderOptions& options, PixelOrder order) {
   ResidentScene& r = renderer.impl().resident;
   r.record_render(cmd, camera, options, order == PixelOrder::kBgra, /*timed=*/false);
   return r.pixels().handle();

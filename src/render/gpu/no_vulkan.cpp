@@ -5,17 +5,25 @@
 
 namespace voxfield::gpu {
 
-Image render(Context&, const RenderScene&, const Camera&, const RenderOptions&, RenderStats*, std::vector<PassTiming>*) {
+Image render(Context&, const RenderScene&, const Camera&, const RenderOptions&, RenderStats*,
+             std::vector<PassTiming>*) {
   built_without_vulkan();
 }
 
 struct SceneRenderer::Impl {};
-SceneRenderer::SceneRenderer(std::shared_ptr<Context>) { built_without_vulkan(); }
-SceneRenderer::~SceneRenderer() = default;
-bool SceneRenderer::sync(const RenderScene&) { built_without_vulkan(); }
-Image SceneRenderer::render(const Camera&, const RenderOptions&, RenderStats*, std::vector<PassTiming>*) {
+SceneRenderer::SceneRenderer(std::shared_ptr<Context>) {
   built_without_vulkan();
 }
-Context& SceneRenderer::context() { built_without_vulkan(); }
+SceneRenderer::~SceneRenderer() = default;
+bool SceneRenderer::sync(const RenderScene&) {
+  built_without_vulkan();
+}
+Image SceneRenderer::render(const Camera&, const RenderOptions&, RenderStats*,
+                            std::vector<PassTiming>*) {
+  built_without_vulkan();
+}
+Context& SceneRenderer::context() {
+  built_without_vulkan();
+}
 
 }  // namespace voxfield::gpu
