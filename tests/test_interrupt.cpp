@@ -7,7 +7,9 @@
 #include <mutex>
 #include <vector>
 
+#include "voxfield/distance.h"
 #include "voxfield/interrupt.h"
+#include "voxfield/mesh.h"
 #include "voxfield/render.h"
 #include "voxfield/scene.h"
 
@@ -104,4 +106,53 @@ TEST(Interrupt, CancellingARenderThrowsAndAWatchedRenderIsUnchanged) {
   EXPECT_EQ(watch.names, std::vector<std::string>{"render"});
   EXPECT_EQ(watch.percents.size(), 12u * 9u + 1u);  // one question per tile, and one at the start
   EXPECT_EQ(watch.percents.back(), 100);
+}
+
+// The exact transform reports its columns and slices (both its paths: the envelope and the
+// truncated min-convolution) and stops when asked, returning nothing; the result of an
+// uninterrupted run with an interrupter equals one without.
+TEST(Interrupt, ExactFieldsReportProgressAndCancel) {
+  SceneOptions so;
+  so.size = Vec3i::splat(64);
+  const World w = make_terrain(so);
+  for (double clamp : {0.0, 8.0}) {
+    SCOPED_TRACE(clamp);
+    DistanceOptions o;
+    o.metric = Metric::kEuclidean;
+    o.max_distance = clamp;
+    const DistanceField plain = compute_distance_field(w, o);
+    Recorder r;
+    o.interrupter = &r;
+    const DistanceField watched = compute_distance_field(w, o);
+    EXPECT_EQ(r.names, std::vector<std::string>{"exact distance field"});
+    EXPECT_EQ(r.ends, 1);
+    ASSERT_FALSE(r.percents.empty());
+    EXPECT_EQ(r.percents.back(), 100);
+    for (int z = 0; z < 64; z += 7)
+      for (int x = 0; x < 64; x += 5)
+        EXPECT_EQ(watched.distance({x, 11, z}), plain.distance({x, 11, z}));
+    Recorder stop(30);
+    o.interrupter = &stop;
+    EXPECT_THROW(compute_distance_field(w, o), Cancelled);
+    EXPECT_EQ(stop.ends, 1);
+  }
+}
+
+TEST(Interrupt, MeshingReportsChunksAndCancels) {
+  std::vector<float> v(40 * 40 * 40);
+  for (int z = 0; z < 40; ++z)
+    for (int y = 0; y < 40; ++y)
+      for (int x = 0; x < 40; ++x)
+        v[static_cast<std::size_t>(x + 40 * (y + 40 * z))] = static_cast<float>(z - 20 + 0.3 * x);
+  ScalarVolume vol{Vec3i::splat(40), v.data()};
+  MeshOptions o;
+  o.chunk_edge = 8;
+  Recorder r;
+  o.interrupter = &r;
+  EXPECT_GT(mesh_volume(vol, o).triangle_count(), 0u);
+  EXPECT_EQ(r.names, std::vector<std::string>{"marching cubes"});
+  EXPECT_EQ(r.percents.back(), 100);
+  Recorder stop(40);
+  o.interrupter = &stop;
+  EXPECT_THROW(mesh_volume(vol, o), Cancelled);
 }

@@ -5,6 +5,7 @@
 #include "cli.h"
 #include "field_args.h"
 #include "live_field.h"
+#include "progress.h"
 #include "voxfield/dissertation_format.h"
 #include "voxfield/gpu_distance.h"
 #include "voxfield/npy.h"
@@ -30,6 +31,7 @@ int run_field(const FieldSettings& s) {
   outputs.expect(s.packed, "--packed");
   outputs.expect(s.stats, "--stats");
   DistanceOptions o = s.field.options();
+  o.interrupter = progress();  // a progress bar on a terminal for fields that take a while
   o.nearest_sites = !s.sites.empty();
   AlgorithmOptions a;
   a.algorithm = parse_algorithm(s.algorithm);

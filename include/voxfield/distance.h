@@ -23,6 +23,8 @@
 
 namespace voxfield {
 
+class Interrupter;
+
 enum class Metric { kManhattan, kChebyshev, kEuclidean };
 enum class Storage { kU8, kU16, kF32 };
 
@@ -53,6 +55,10 @@ struct DistanceOptions {
   // outside the domain read the field's background (D when clamped, +inf or the type's maximum
   // otherwise). Sites outside the domain are ignored.
   std::optional<Box3i> domain;
+  // Progress and cancellation of the exact transform (interrupt.h): told how far its passes are,
+  // asked between columns and slices; cancelling throws Cancelled and returns nothing. Not stored
+  // with a field (a .vfw never holds it).
+  Interrupter* interrupter = nullptr;
 };
 
 // Offset from a voxel to its nearest site, in voxels. `none()` when no site lies within the clamp

@@ -27,6 +27,7 @@
 #include "slice_io.h"
 #include "slice_solvers.h"
 #include "voxfield/distance.h"
+#include "voxfield/interrupt.h"
 #include "voxfield/parallel.h"
 #include "z_pass.h"
 
@@ -55,7 +56,7 @@ using detail::exact::write_row;
 template <class T, class U, class V, class Solve>
 void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
                  ChunkedVolume<SiteOffset>* sites, const Solve& solve, const Encoder<T>& encoder,
-                 std::uint32_t cap_vox, V inf) {
+                 std::uint32_t cap_vox, V inf, Progress& progress) {
   constexpr U kInfU = std::numeric_limits<U>::max();
   const int X = p.domain.size().x, Y = p.domain.size().y;
   const int by = p.domain.begin.y;
@@ -72,6 +73,7 @@ void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
     std::vector<std::int16_t> dz(sites ? static_cast<std::size_t>(X) * Y : 0);
     for (int k = 0; k < passes; ++k) buf[k].resize(X, Y);
     for (std::size_t zi = zb; zi < ze; ++zi) {
+      if (!progress.advance()) return;  // one unit per slice (counted as it starts)
       const int z = p.domain.begin.z + static_cast<int>(zi);
       for (int y = 0; y < Y; ++y) {
         for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
@@ -101,7 +103,7 @@ void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
 // work, slice by slice, with the window the whole slice.
 template <class T, class U>
 void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
-                           const Encoder<T>& encoder, std::uint32_t cap) {
+                           const Encoder<T>& encoder, std::uint32_t cap, Progress& progress) {
   using Conv = TruncatedMinConvolution;
   const int X = p.domain.size().x, Y = p.domain.size().y;
   const int by = p.domain.begin.y;
@@ -116,6 +118,7 @@ void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<
     std::vector<std::uint8_t> solid(p.is_signed ? static_cast<std::size_t>(X) * Y : 0);
     for (int k = 0; k < passes; ++k) conv[k].prepare(X, Y, 0, 0, X, Y, reach, drop);
     for (std::size_t zi = zb; zi < ze; ++zi) {
+      if (!progress.advance()) return;  // one unit per slice (counted as it starts)
       const int z = p.domain.begin.z + static_cast<int>(zi);
       for (int y = 0; y < Y; ++y) {
         for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
@@ -194,10 +197,13 @@ DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy,
 
   // Pass A.
   const int ncx = g.nchunks.x, ncy = g.nchunks.y;
+  Progress progress(options.interrupter, "exact distance field",
+                    static_cast<std::int64_t>(ncx) * ncy + p.domain.size().z);
   parallel_for(static_cast<std::size_t>(ncx) * ncy, 1, [&](std::size_t b, std::size_t e) {
     std::vector<std::uint32_t> col;
     ChunkedVolume<SiteOffset>* sp = sites ? &*sites : nullptr;
     for (std::size_t i = b; i < e; ++i) {
+      if (!progress.advance()) return;  // one unit per chunk column
       const int cx = static_cast<int>(i % ncx), cy = static_cast<int>(i / ncx);
       if (p.is_signed) {
         pass_z<U, true>(p, world, g, sp, cx, cy, cap32, col);
@@ -211,13 +217,14 @@ DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy,
   const Encoder<T> encoder(p);
   ChunkedVolume<SiteOffset>* sp = sites ? &*sites : nullptr;
   if (truncated_passes(p, p.sites)) {
-    pass_slices_truncated<T, U>(p, world, g, encoder, cap32);
+    pass_slices_truncated<T, U>(p, world, g, encoder, cap32, progress);
   } else {
     dispatch_solver(p, p.domain.size(), [&](auto tag, const auto& solve, auto inf) {
       using V = decltype(tag);
-      pass_slices<T, U, V>(p, world, g, sp, solve, encoder, cap32, inf);
+      pass_slices<T, U, V>(p, world, g, sp, solve, encoder, cap32, inf, progress);
     });
   }
+  progress.throw_if_cancelled();  // before anything is handed out
 
   // Hand the chunks to the grids (uniform ones collapse).
   std::vector<std::unique_ptr<T[]>> typed(g.chunks.size());
