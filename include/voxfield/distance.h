@@ -56,8 +56,8 @@ struct DistanceOptions {
   // otherwise). Sites outside the domain are ignored.
   std::optional<Box3i> domain;
   // Progress and cancellation of the exact transform (interrupt.h): told how far its passes are,
-  // asked between columns and slices; cancelling throws Cancelled and returns nothing. Not stored
-  // with a field (a .vfw never holds it).
+  // asked between columns and slices; cancelling throws Cancelled and returns nothing. Never kept:
+  // a returned field's options and a DynamicDistanceField (after its first build) hold null.
   Interrupter* interrupter = nullptr;
 };
 

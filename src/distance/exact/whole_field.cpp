@@ -151,6 +151,7 @@ DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy,
   const T background = detail::field_background<T>(p);
   DistanceField out;
   out.options = options;
+  out.options.interrupter = nullptr;  // the field never keeps a pointer to the caller's interrupter
   out.domain = p.domain;
   out.encoding = p.encoding;
   const int edge = occupancy.chunk_edge();

@@ -210,6 +210,7 @@ DynamicDistanceField::DynamicDistanceField(const World& world, DistanceOptions o
   }
   reach_ = detail::field_reach(detail::make_field_plan(world.voxels, options_));
   rebuild();
+  options_.interrupter = nullptr;  // it watched the first build; the field outlives it
 }
 
 void DynamicDistanceField::rebuild() {
