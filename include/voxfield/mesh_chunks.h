@@ -17,7 +17,8 @@ namespace voxfield {
 
 class MeshChunks {
  public:
-  // Meshes every chunk of `volume` (options as for mesh_volume; the same errors).
+  // Meshes every chunk of `volume` (options as for mesh_volume; the same errors). The
+  // interrupter, if any, watches this first mesh only.
   MeshChunks(const ScalarVolume& volume, const MeshOptions& options);
   ~MeshChunks();
   MeshChunks(MeshChunks&&) noexcept;

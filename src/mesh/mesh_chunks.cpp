@@ -30,6 +30,7 @@ MeshChunks::MeshChunks(const ScalarVolume& volume, const MeshOptions& options)
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::int64_t>(i);
   impl_->parts.resize(all.size());
   mesh_chunks(lattice, impl_->grid, options, all, impl_->parts);
+  impl_->options.interrupter = nullptr;  // it watched the first mesh; the chunks outlive it
 }
 
 MeshChunks::~MeshChunks() = default;
