@@ -166,6 +166,17 @@ for algo in ["mc", "sn"]:
     check((np.einsum("ij,ij->i", face_n, nrm) >= 0).all(), f"{algo}: an STL facet normal disagrees with its winding")
     check(len(ref) > 1000, f"{algo}: terrain mesh too small ({len(ref)})")
 
+# Simplified and reordered: about the triangles asked for, the file matching the stats.
+simple, sstats = os.path.join(work, "terrain-simple.ply"), os.path.join(work, "terrain-simple.json")
+r = run("mesh", world, "-o", simple, "--simplify", "0.3", "--optimize", "--stats", sstats)
+check(r.returncode == 0, f"--simplify: {r.stderr}")
+if r.returncode == 0:
+    st = json.load(open(sstats))
+    spos, sidx, _ = read_ply(simple)
+    check(st["simplify"]["triangles_after"] == len(sidx) == st["triangles"], f"--simplify: stats {st['simplify']} vs file {len(sidx)}")
+    check(len(sidx) <= 0.31 * st["simplify"]["triangles_before"], f"--simplify 0.3 kept {len(sidx)} of {st['simplify']['triangles_before']}")
+    check(len(np.unique(sidx)) == len(spos), "--simplify left unreferenced vertices")
+
 # A failed command writes nothing.
 bad = os.path.join(work, "nan.npy")
 v = np.zeros((8, 8, 8), np.float32)
