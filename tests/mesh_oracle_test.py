@@ -87,6 +87,13 @@ def read_glb(path):
 
     prim = doc["meshes"][0]["primitives"][0]
     pos = accessor(prim["attributes"]["POSITION"], "<f4", 3)
+    nrm = accessor(prim["attributes"]["NORMAL"], "<f4", 3)
+    assert np.allclose(np.linalg.norm(nrm, axis=1), 1, atol=1e-5), "a glTF normal is not unit length"
+    for view in doc["bufferViews"]:
+        assert view["byteOffset"] % 4 == 0 and view["byteLength"] > 0
+    if "COLOR_0" in prim["attributes"]:
+        a = doc["accessors"][prim["attributes"]["COLOR_0"]]
+        assert a["componentType"] == 5123 and a["normalized"] and a["type"] == "VEC4", a
     a = doc["accessors"][prim["attributes"]["POSITION"]]
     assert np.allclose(a["min"], pos.min(0)) and np.allclose(a["max"], pos.max(0))
     idx = accessor(prim["indices"], "<u4", 1).reshape(-1, 3).astype(np.int64)
@@ -147,7 +154,7 @@ for name, vol, level, spacing in [("noise", noise, 0.3, (1.0, 1.0, 1.0)), ("sphe
 # Every format holds the same triangles.
 world = os.path.join(work, "terrain.npy")
 check(run("generate", "terrain", "--size", "40", "-o", world).returncode == 0, "generate failed")
-for algo in ["mc", "sn"]:
+for algo in ["mc", "sn", "dc"]:
     outs = {ext: os.path.join(work, f"terrain-{algo}.{ext}") for ext in ["ply", "obj", "stl", "glb"]}
     for ext, path in outs.items():
         r = run("mesh", world, "-o", path, "--algorithm", algo)
@@ -176,6 +183,19 @@ if r.returncode == 0:
     check(st["simplify"]["triangles_after"] == len(sidx) == st["triangles"], f"--simplify: stats {st['simplify']} vs file {len(sidx)}")
     check(len(sidx) <= 0.31 * st["simplify"]["triangles_before"], f"--simplify 0.3 kept {len(sidx)} of {st['simplify']['triangles_before']}")
     check(len(np.unique(sidx)) == len(spos), "--simplify left unreferenced vertices")
+
+# An empty mesh is still a valid glTF (no zero-length accessors, views or buffers).
+empty_world = os.path.join(work, "empty.npy")
+np.save(empty_world, np.zeros((4, 4, 4), np.uint8))
+empty_glb = os.path.join(work, "empty.glb")
+r = run("mesh", empty_world, "-o", empty_glb)
+check(r.returncode == 0, f"empty world: {r.stderr}")
+if r.returncode == 0:
+    data = open(empty_glb, "rb").read()
+    jlen = struct.unpack_from("<I", data, 12)[0]
+    doc = json.loads(data[20:20 + jlen])
+    check(len(data) == 20 + jlen and "accessors" not in doc and "buffers" not in doc and doc["nodes"] == [{}],
+          f"empty glTF: {doc}")
 
 # A failed command writes nothing.
 bad = os.path.join(work, "nan.npy")

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "voxfield/error.h"
+#include "voxfield/limits.h"
 #include "voxfield/mesh.h"
 #include "voxfield/parallel.h"
 #include "voxfield/primitives.h"
@@ -181,6 +182,19 @@ TEST(Mesh, SurfaceNetsOfABlockHasOneQuadPerVoxelFace) {
                   p[static_cast<std::size_t>(a)] <= 6.01f);
 }
 
+// Two voxels touching at a corner only: the dual meshers' vertex sits on a saddle of the
+// interpolant (no gradient), and still gets a unit normal.
+TEST(Mesh, NormalsAreUnitLengthEvenOnSaddles) {
+  World w(8);
+  w.voxels.set({0, 0, 0}, 1);
+  w.voxels.set({1, 1, 1}, 1);
+  for (Mesher m : kMeshers) {
+    const Mesh mesh = mesh_world(w, with(m));
+    ASSERT_GT(mesh.vertex_count(), 0u);
+    for (const auto& n : mesh.normals) EXPECT_NEAR(at(n).length(), 1.0, 1e-5) << mesher_name(m);
+  }
+}
+
 // Every one of the 256 corner configurations of a lone cell, with random magnitudes (so ambiguous
 // faces go both ways), inside a lattice of outside samples: a closed, oriented surface each time.
 TEST(Mesh, EveryCellConfigurationGivesAClosedOrientedSurface) {
@@ -222,7 +236,7 @@ TEST(Mesh, RandomFieldsAreWatertightAndIndependentOfChunksAndThreads) {
   ScalarVolume vol{Vec3i::splat(n), v.data()};
   for (Mesher m : kMeshers) {
     SCOPED_TRACE(mesher_name(m));
-    const Mesh reference = mesh_volume(vol, with(m, 1024));
+    const Mesh reference = mesh_volume(vol, with(m, 256));  // one chunk
     const MeshStats s = mesh_stats(reference);
     // Surface nets joins every sheet crossing a cell into its one vertex, so where the surface
     // pinches within a cell an edge gets four triangles (Gibson's nets are closed, not manifold);
@@ -247,6 +261,31 @@ TEST(Mesh, RandomFieldsAreWatertightAndIndependentOfChunksAndThreads) {
         EXPECT_TRUE(closed(mesh_stats(mesh))) << "chunk edge " << edge;
       }
     }
+  }
+}
+
+// The same with the surface running out of the lattice's faces (open borders, the upper face's
+// ownership rule): still the same triangles for every chunk edge and thread count.
+TEST(Mesh, OpenSurfacesAreIndependentOfChunksAndThreads) {
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<float> u(-1, 1);
+  const int n = 23;
+  std::vector<float> v(static_cast<std::size_t>(n) * n * n);
+  for (float& x : v) x = u(rng);
+  ScalarVolume vol{Vec3i::splat(n), v.data()};
+  for (Mesher m : kMeshers) {
+    SCOPED_TRACE(mesher_name(m));
+    const Mesh reference = mesh_volume(vol, with(m, 256));
+    EXPECT_GT(mesh_stats(reference).boundary_edges, 0u);  // the surface does leave the lattice
+    const auto expected = triangle_set(reference);
+    for (int edge : {2, 3, 7, 11, 22})
+      for (int threads : {1, 2}) {
+        ThreadLimit limit(threads);
+        const Mesh mesh = mesh_volume(vol, with(m, edge));
+        EXPECT_EQ(mesh.vertex_count(), reference.vertex_count()) << "chunk edge " << edge;
+        EXPECT_TRUE(triangle_set(mesh) == expected)
+            << "chunk edge " << edge << ", " << threads << " threads";
+      }
   }
 }
 
@@ -312,6 +351,41 @@ TEST(Mesh, BadRequestsAreRefusedClearly) {
   vol.size = {2, 1, 4};
   EXPECT_THROW(mesh_volume(vol, o), InvalidArgument);
   EXPECT_THROW(parse_mesher("dc2"), InvalidArgument);
+  vol.size = Vec3i::splat(2);
+  v[5] = std::numeric_limits<float>::infinity();
+  try {
+    mesh_volume(vol, o);
+    FAIL() << "infinity accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("(1, 0, 1) is infinite"), std::string::npos) << e.what();
+  }
+  v[5] = 1;
+  for (double bad : {-1.0, 0.0, std::numeric_limits<double>::infinity(),
+                     std::numeric_limits<double>::quiet_NaN(), 1e-300, 1e300}) {
+    vol.spacing_units = {1, bad, 1};
+    EXPECT_THROW(mesh_volume(vol, o), InvalidArgument) << "spacing " << bad;
+  }
+  vol.spacing_units = {1, 1, 1};
+  vol.origin_units = {0, std::numeric_limits<double>::quiet_NaN(), 0};
+  EXPECT_THROW(mesh_volume(vol, o), InvalidArgument);
+  vol.origin_units = {0, 0, 0};
+  for (double bad : {std::numeric_limits<double>::infinity(), 1e300}) {
+    o.iso = bad;
+    EXPECT_THROW(mesh_volume(vol, o), InvalidArgument) << "iso " << bad;
+  }
+  o.iso = 0;
+  o.chunk_edge = 257;
+  EXPECT_THROW(mesh_volume(vol, o), InvalidArgument);
+  // Millions of chunks of 2 cells for a volume that size: the bookkeeping alone is refused.
+  std::vector<float> big(1);
+  ScalarVolume huge{Vec3i::splat(1 << 14), big.data()};
+  o.chunk_edge = 2;
+  EXPECT_THROW(mesh_volume(huge, o), ResourceLimitError);
+  Mesh bad_indices;
+  bad_indices.positions.resize(2);
+  bad_indices.normals.resize(2);
+  bad_indices.indices = {0, 1, 2};
+  EXPECT_THROW(mesh_stats(bad_indices), InvalidArgument);
   EXPECT_EQ(parse_mesher("surface-nets"), Mesher::kSurfaceNets);
 }
 

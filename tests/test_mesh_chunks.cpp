@@ -93,6 +93,30 @@ TEST(MeshChunks, EditsReMeshOnlyReachedChunksAndEqualAFullMesh) {
   }
 }
 
+// The reach, pinned: flipping one surface sample at every offset around a chunk border (from
+// four before it to four after) and updating just that sample gives the full mesh each time, for
+// every mesher — a reach one sample short would leave a chunk stale.
+TEST(MeshChunks, OneSampleChangesAtEveryOffsetFromABorder) {
+  for (Mesher m : {Mesher::kMarchingCubes, Mesher::kSurfaceNets, Mesher::kDualContouring}) {
+    SCOPED_TRACE(mesher_name(m));
+    Terrain t;
+    MeshOptions o;
+    o.algorithm = m;
+    o.chunk_edge = 8;
+    MeshChunks chunks(t.volume, o);
+    for (int x = 16 - 4; x <= 16 + 4; ++x) {
+      const int y = 20;
+      int z = 0;
+      while (z + 1 < t.n && t.values[t.index(x, y, z + 1)] < 0) ++z;  // the last inside sample
+      float& v = t.values[t.index(x, y, z)];
+      v = -v + 0.25f;  // now outside: the surface moves
+      chunks.update(t.volume, Box3i{{x, y, z}, {x + 1, y + 1, z + 1}});
+      expect_same(chunks.merged(), mesh_volume(t.volume, o),
+                  "after flipping x = " + std::to_string(x));
+    }
+  }
+}
+
 // Per-chunk meshes drawn on their own: every border vertex of one chunk's mesh is, bit for bit, a
 // vertex of a neighbour's mesh, and together they hold the whole mesh's triangles.
 TEST(MeshChunks, ChunkMeshesMeetWithoutCracks) {

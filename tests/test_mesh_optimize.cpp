@@ -69,6 +69,14 @@ TEST(MeshOptimize, SimplifiedSphereKeepsItsShape) {
   std::vector<bool> used(simple.vertex_count());
   for (std::uint32_t i : simple.indices) used[i] = true;
   EXPECT_EQ(std::count(used.begin(), used.end(), false), 0);  // unreferenced vertices dropped
+  // An error limit alone (ratio 0) simplifies as far as it allows.
+  SimplifyOptions by_error;
+  by_error.triangle_ratio = 0;
+  by_error.max_error_units = 0.05;
+  SimplifyStats est;
+  const Mesh limited = simplify_mesh(full, by_error, &est);
+  EXPECT_LT(limited.triangle_count(), full.triangle_count() / 4);
+  EXPECT_LE(est.error_units, 0.05 + 1e-6);
   // A tight error limit wins over the ratio.
   o.max_error_units = 1e-4;
   EXPECT_GT(simplify_mesh(full, o).triangle_count(), full.triangle_count() / 2);
@@ -107,7 +115,9 @@ TEST(MeshOptimize, OptimizingKeepsTrianglesAndImprovesCacheReuse) {
 TEST(MeshOptimize, BadRequestsAreRefused) {
   Mesh m;
   SimplifyOptions o;
-  o.triangle_ratio = 0;
+  o.triangle_ratio = -0.1;
+  EXPECT_THROW(simplify_mesh(m, o), InvalidArgument);
+  o.triangle_ratio = 1.5;
   EXPECT_THROW(simplify_mesh(m, o), InvalidArgument);
   o.triangle_ratio = 0.5;
   o.max_error_units = -1;

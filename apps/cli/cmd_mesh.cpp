@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <optional>
 
 #include "cli.h"
@@ -57,8 +58,13 @@ int run_mesh(const MeshSettings& s) {
   double mesh_ms = 0;
   if (volume_input) {
     std::vector<float> values(static_cast<std::size_t>(npy->count()));
-    for (std::int64_t i = 0; i < npy->count(); ++i)
-      values[static_cast<std::size_t>(i)] = static_cast<float>(npy->value(i));
+    for (std::int64_t i = 0; i < npy->count(); ++i) {
+      const double v = npy->value(i);
+      if (std::abs(v) > std::numeric_limits<float>::max())  // NaN passes on, refused by name below
+        throw FormatError(s.in, npy->file_offset_of(i),
+                          "value " + std::to_string(v) + " does not fit a float32 sample");
+      values[static_cast<std::size_t>(i)] = static_cast<float>(v);
+    }
     ScalarVolume volume{npy->dims, values.data()};
     if (!s.spacing.empty()) volume.spacing_units = {s.spacing[0], s.spacing[1], s.spacing[2]};
     for (int a = 0; a < 3; ++a)
@@ -85,7 +91,7 @@ int run_mesh(const MeshSettings& s) {
   if (s.simplify || s.simplify_error) {
     set_activity("simplifying the mesh of " + s.in);
     SimplifyOptions so;
-    so.triangle_ratio = s.simplify.value_or(1.0);
+    so.triangle_ratio = s.simplify.value_or(0.0);  // an error limit alone: as far as it allows
     so.max_error_units = s.simplify_error.value_or(0);
     start = std::chrono::steady_clock::now();
     simplified.emplace();

@@ -1,6 +1,8 @@
 // voxfield showcase — the meshing section: the terrain through marching cubes, surface nets and
 // dual contouring, checked closed and seamless, pictured, exported, and set beside scikit-image and
 // VTK on the same signed distance field.
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -27,6 +29,27 @@ double mesh_bytes_per_triangle(const Mesh& m) {
   const double bytes = static_cast<double>(m.positions.size() * 12 + m.normals.size() * 12 +
                                            m.colors.size() * 3 + m.indices.size() * 4);
   return m.triangle_count() ? bytes / static_cast<double>(m.triangle_count()) : 0;
+}
+
+// An order-independent hash of the triangle set: each triangle's three positions (rotated to
+// start at the smallest, so orientation counts) hashed, and the hashes summed.
+std::uint64_t triangle_hash(const Mesh& m) {
+  std::uint64_t sum = 0;
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    std::array<std::array<float, 3>, 3> tri{m.positions[m.indices[3 * t]],
+                                            m.positions[m.indices[3 * t + 1]],
+                                            m.positions[m.indices[3 * t + 2]]};
+    std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end()), tri.end());
+    std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the nine floats' bytes
+    for (const auto& p : tri)
+      for (const float c : p) {
+        std::uint32_t bits;
+        std::memcpy(&bits, &c, 4);
+        for (int k = 0; k < 4; ++k) h = (h ^ ((bits >> (8 * k)) & 0xFF)) * 1099511628211ull;
+      }
+    sum += h;
+  }
+  return sum;
 }
 
 // Runs the peers' script on the field; null when Python, the script or the peers are missing.
@@ -74,7 +97,8 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
     const MeshStats st = mesh_stats(meshes[i]);
     o.chunk_edge = 8;
     const Mesh small_chunks = mesh_world(terrain, o);
-    const bool same = small_chunks.triangle_count() == meshes[i].triangle_count() &&
+    const bool same = triangle_hash(small_chunks) == triangle_hash(meshes[i]) &&
+                      small_chunks.triangle_count() == meshes[i].triangle_count() &&
                       small_chunks.vertex_count() == meshes[i].vertex_count() &&
                       mesh_stats(small_chunks).edges == st.edges;
     timings.push_back(
@@ -97,6 +121,8 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
 
   // The peers, on the very same field (the terrain's signed Euclidean field over its box).
   const NpyVolume sdf = read_npy(sdf_npy);
+  if (sdf.dtype != DType::kFloat32)
+    throw Error("showcase: " + sdf_npy.string() + " is not float32");
   std::vector<float> values(static_cast<std::size_t>(sdf.count()));
   std::memcpy(values.data(), sdf.bytes.data(), values.size() * sizeof(float));
   ScalarVolume volume{sdf.dims, values.data()};

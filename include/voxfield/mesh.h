@@ -68,7 +68,7 @@ struct MeshOptions {
   // Which side of iso is inside: values below it (the default, a signed distance field's
   // convention) or above it (density volumes, the thesis's positive-inside terrain).
   bool inside_above = false;
-  // Cells per chunk edge (each chunk is meshed as one unit of parallel work), 2..1024.
+  // Cells per chunk edge (each chunk is meshed as one unit of parallel work), 2..256.
   int chunk_edge = 32;
   Interrupter* interrupter = nullptr;  // progress per chunk; cancelling throws Cancelled
 };
@@ -84,8 +84,10 @@ struct Mesh {
 };
 
 // Meshes `volume` at options.iso. Throws InvalidArgument for options out of range, a volume
-// smaller than 2 samples along an axis, NaN samples, or more vertices than 32-bit indices hold;
-// Cancelled when the interrupter asks.
+// smaller than 2 samples along an axis, a spacing or origin positions cannot hold as floats, NaN
+// or infinite samples (naming the first), or more vertices than 32-bit indices hold;
+// ResourceLimitError for a partition into so many chunks that its bookkeeping passes the memory
+// limit (limits.h); Cancelled when the interrupter asks.
 Mesh mesh_volume(const ScalarVolume& volume, const MeshOptions& options);
 
 // Meshes a World through its exact signed Euclidean distance field (solid voxels read -(distance
@@ -113,6 +115,7 @@ struct MeshStats {
   double area_units2 = 0;
   double signed_volume_units3 = 0;  // positive when the triangles face out (closed meshes only)
 };
+// Throws InvalidArgument for an index past the last vertex.
 MeshStats mesh_stats(const Mesh& mesh);
 
 }  // namespace voxfield

@@ -13,7 +13,8 @@
 namespace voxfield {
 
 struct SimplifyOptions {
-  // Keep about this fraction of the triangles (0 < ratio <= 1)...
+  // Keep about this fraction of the triangles (0 <= ratio <= 1; 0: as few as the error limit
+  // allows)...
   double triangle_ratio = 0.5;
   // ...unless that moves the surface farther than this, in the mesh's units (0: the default,
   // 1 % of the mesh's largest extent).
@@ -25,7 +26,7 @@ struct SimplifyStats {
   double error_units = 0;  // the largest deviation meshoptimizer estimates, in the mesh's units
 };
 
-// Throws InvalidArgument for a ratio outside (0, 1], a negative error or arrays that disagree.
+// Throws InvalidArgument for a ratio outside [0, 1], a negative error or arrays that disagree.
 Mesh simplify_mesh(const Mesh& mesh, const SimplifyOptions& options,
                    SimplifyStats* stats = nullptr);
 void optimize_mesh(Mesh& mesh);

@@ -35,7 +35,8 @@ inline double torus(Vec3d p, double major, double minor) {
 // Capsule: the segment a-b thickened by `radius`.
 inline double capsule(Vec3d p, Vec3d a, Vec3d b, double radius) {
   const Vec3d pa = p - a, ba = b - a;
-  const double h = std::clamp(dot(pa, ba) / dot(ba, ba), 0.0, 1.0);
+  const double len2 = dot(ba, ba);  // a == b: a sphere
+  const double h = len2 > 0 ? std::clamp(dot(pa, ba) / len2, 0.0, 1.0) : 0.0;
   return (pa - ba * h).length() - radius;
 }
 

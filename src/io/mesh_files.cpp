@@ -105,10 +105,36 @@ std::vector<std::uint8_t> encode_stl(const Mesh& m) {
   return out;
 }
 
+// glTF's COLOR_0 is linear; voxfield's palette colours are sRGB (IEC 61966-2-1's transfer curve).
+std::uint16_t linear_u16(std::uint8_t srgb) {
+  const double c = srgb / 255.0;
+  const double linear = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+  return static_cast<std::uint16_t>(std::lround(linear * 65535));
+}
+
 std::vector<std::uint8_t> encode_glb(const Mesh& m) {
   using nlohmann::json;
-  // One buffer: positions, normals, colours (RGBA, normalised bytes: vertex attributes are
-  // 4-byte aligned), indices; each view starts on a 4-byte boundary.
+  if (m.indices.empty()) {
+    // glTF gives accessors, buffer views and buffers a minimum length of one: an empty mesh is
+    // a scene with one node and nothing in it.
+    const json empty = {{"asset", {{"version", "2.0"}, {"generator", "voxfield"}}},
+                        {"scene", 0},
+                        {"scenes", json::array({{{"nodes", json::array({0})}}})},
+                        {"nodes", json::array({json::object()})}};
+    std::string text = empty.dump();
+    while (text.size() % 4) text.push_back(' ');
+    std::vector<std::uint8_t> out;
+    put(out, std::uint32_t{0x46546C67});
+    put(out, std::uint32_t{2});
+    put(out, static_cast<std::uint32_t>(12 + 8 + text.size()));
+    put(out, static_cast<std::uint32_t>(text.size()));
+    put(out, std::uint32_t{0x4E4F534A});
+    put_text(out, text);
+    return out;
+  }
+  // One buffer: positions, normals, colours (linear RGBA as normalised 16-bit: vertex attributes
+  // are 4-byte aligned, and 8 bits would band dark linear values), indices; each view starts on
+  // a 4-byte boundary.
   std::vector<std::uint8_t> bin;
   auto view = [&](const void* data, std::size_t bytes, json target) {
     const std::size_t offset = bin.size();
@@ -118,7 +144,7 @@ std::vector<std::uint8_t> encode_glb(const Mesh& m) {
     return json{{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}, {"target", target}};
   };
   constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963, kFloat = 5126,
-                kUnsignedByte = 5121, kUnsignedInt = 5125;
+                kUnsignedShort = 5123, kUnsignedInt = 5125;
   std::array<float, 3> lo{0, 0, 0}, hi{0, 0, 0};
   if (!m.positions.empty()) {
     lo = hi = m.positions[0];
@@ -141,15 +167,14 @@ std::vector<std::uint8_t> encode_glb(const Mesh& m) {
       {{"bufferView", 1}, {"componentType", kFloat}, {"count", n}, {"type", "VEC3"}});
   attributes["NORMAL"] = 1;
   if (!m.colors.empty()) {
-    std::vector<std::uint8_t> rgba(4 * n);
+    std::vector<std::uint16_t> rgba(4 * n);
     for (std::size_t i = 0; i < n; ++i) {
-      std::copy(m.colors[i].begin(), m.colors[i].end(),
-                rgba.begin() + static_cast<std::ptrdiff_t>(4 * i));
-      rgba[4 * i + 3] = 255;
+      for (std::size_t c = 0; c < 3; ++c) rgba[4 * i + c] = linear_u16(m.colors[i][c]);
+      rgba[4 * i + 3] = 65535;
     }
-    views.push_back(view(rgba.data(), rgba.size(), kArrayBuffer));
+    views.push_back(view(rgba.data(), rgba.size() * 2, kArrayBuffer));
     accessors.push_back({{"bufferView", views.size() - 1},
-                         {"componentType", kUnsignedByte},
+                         {"componentType", kUnsignedShort},
                          {"normalized", true},
                          {"count", n},
                          {"type", "VEC4"}});

@@ -50,19 +50,20 @@ bool Block::load(const Lattice& lattice, const Box3i& cells) {
   for (int z = lo_.z; z <= hi_.z; ++z)
     for (int y = lo_.y; y <= hi_.y; ++y) {
       const float* row = lattice.values + lattice.index(lo_.x, y, z);
-      bool in = false, out = false, nan = false;
-      for (std::size_t i = 0; i < dx; ++i) {  // no early exit: this loop vectorises
+      bool in = false, out = false, nan = false;  // nan: NaN or infinite
+      for (std::size_t i = 0; i < dx; ++i) {      // no early exit: this loop vectorises
         const float v = row[i];
-        nan |= v != v;
+        nan |= !std::isfinite(v);
         const bool inside_v = negate_ ? v > iso_ : v < iso_;
         in |= inside_v;
         out |= !inside_v;
       }
       if (nan)
         for (std::size_t i = 0; i < dx; ++i)
-          if (std::isnan(row[i]))
+          if (!std::isfinite(row[i]))
             throw InvalidArgument("mesh: sample (" + std::to_string(lo_.x + static_cast<int>(i)) +
-                                  ", " + std::to_string(y) + ", " + std::to_string(z) + ") is NaN");
+                                  ", " + std::to_string(y) + ", " + std::to_string(z) + ") is " +
+                                  (std::isnan(row[i]) ? "NaN" : "infinite"));
       *signs = static_cast<std::uint8_t>(in | out << 1);
       all |= *signs++;
     }
@@ -129,8 +130,11 @@ std::uint32_t ChunkPart::add(const std::array<double, 3>& position, std::array<d
                              bool is_shared) {
   const double length =
       std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-  if (length > 0)
+  if (length > 0 && std::isfinite(length)) {
     for (double& c : normal) c /= length;
+  } else {
+    normal = {0, 0, 1};  // no direction to be had (a perfectly symmetric cell): still unit length
+  }
   positions.push_back({static_cast<float>(position[0]), static_cast<float>(position[1]),
                        static_cast<float>(position[2])});
   normals.push_back({static_cast<float>(normal[0]), static_cast<float>(normal[1]),

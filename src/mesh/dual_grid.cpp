@@ -42,6 +42,20 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
         blend(v[1] - v[0], v[3] - v[2], v[5] - v[4], v[7] - v[6], w1, w2) / lattice.spacing[0],
         blend(v[2] - v[0], v[3] - v[1], v[6] - v[4], v[7] - v[5], u, w2) / lattice.spacing[1],
         blend(v[4] - v[0], v[5] - v[1], v[6] - v[2], v[7] - v[3], u, w1) / lattice.spacing[2]};
+    if (normal[0] == 0 && normal[1] == 0 && normal[2] == 0) {
+      // A saddle of the interpolant (e.g. two inside corners touching diagonally): point away
+      // from the inside corners' mean instead, in world units.
+      std::array<double, 3> inside{0, 0, 0};
+      int count = 0;
+      for (int c = 0; c < 8; ++c)
+        if (v[c] < 0) {
+          inside[0] += c & 1, inside[1] += c >> 1 & 1, inside[2] += c >> 2 & 1;
+          ++count;
+        }
+      const std::array<double, 3> at{u, w1, w2};
+      for (std::size_t a = 0; a < 3; ++a)
+        normal[a] = (at[a] - inside[a] / count) * lattice.spacing[a];
+    }
     // The colour source: the inside corner nearest the vertex (the lowest-numbered on a tie).
     int nearest = -1;
     double best = 1e9;

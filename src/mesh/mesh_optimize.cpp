@@ -48,8 +48,8 @@ void compact(Mesh& m) {
 
 Mesh simplify_mesh(const Mesh& mesh, const SimplifyOptions& options, SimplifyStats* stats) {
   check(mesh, "simplify_mesh");
-  if (!(options.triangle_ratio > 0 && options.triangle_ratio <= 1))
-    throw InvalidArgument("simplify_mesh: the triangle ratio must be in (0, 1]");
+  if (!(options.triangle_ratio >= 0 && options.triangle_ratio <= 1))
+    throw InvalidArgument("simplify_mesh: the triangle ratio must be in [0, 1]");
   if (!(options.max_error_units >= 0) || !std::isfinite(options.max_error_units))
     throw InvalidArgument("simplify_mesh: the error limit must be finite and >= 0");
   Mesh out = mesh;

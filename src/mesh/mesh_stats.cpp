@@ -3,19 +3,31 @@
 // volume by the divergence theorem (the sum of the signed tetrahedra from the origin).
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
+#include "voxfield/error.h"
 #include "voxfield/mesh.h"
 
 namespace voxfield {
 
 MeshStats mesh_stats(const Mesh& mesh) {
+  for (const std::uint32_t i : mesh.indices)
+    if (i >= mesh.positions.size())
+      throw InvalidArgument("mesh_stats: index " + std::to_string(i) + " is past the last vertex");
   MeshStats s;
   s.vertices = mesh.positions.size();
   s.triangles = mesh.triangle_count();
-  // One record per directed triangle edge: the undirected edge in the high bits, the direction in
-  // bit 0, so that sorting groups each edge's uses together.
-  std::vector<std::uint64_t> uses;
+  // One record per directed triangle edge: the undirected edge (both 32-bit ends) and its
+  // direction, so that sorting groups each edge's uses together.
+  struct Use {
+    std::uint64_t edge;
+    bool forward;
+    bool operator<(const Use& o) const {
+      return edge < o.edge || (edge == o.edge && forward < o.forward);
+    }
+  };
+  std::vector<Use> uses;
   uses.reserve(3 * s.triangles);
   for (std::size_t t = 0; t < s.triangles; ++t) {
     const std::uint32_t* v = mesh.indices.data() + 3 * t;
@@ -23,7 +35,7 @@ MeshStats mesh_stats(const Mesh& mesh) {
     for (int k = 0; k < 3; ++k) {
       const std::uint64_t a = v[k], b = v[(k + 1) % 3];
       const std::uint64_t lo = std::min(a, b), hi = std::max(a, b);
-      uses.push_back((lo << 33) | (hi << 1) | (a < b ? 1u : 0u));
+      uses.push_back({lo << 32 | hi, a < b});
     }
     const auto& p0 = mesh.positions[v[0]];
     const auto& p1 = mesh.positions[v[1]];
@@ -40,8 +52,7 @@ MeshStats mesh_stats(const Mesh& mesh) {
   for (std::size_t i = 0; i < uses.size();) {
     std::size_t j = i;
     int forward = 0;
-    while (j < uses.size() && (uses[j] >> 1) == (uses[i] >> 1))
-      forward += static_cast<int>(uses[j++] & 1);
+    while (j < uses.size() && uses[j].edge == uses[i].edge) forward += uses[j++].forward;
     const std::size_t count = j - i;
     ++s.edges;
     if (count == 1)

@@ -1,6 +1,7 @@
 // voxfield — meshing a sampled volume: checks the request, meshes the chunks in parallel on
 // voxfield's pool and welds them (chunked_mesh.h).
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -8,6 +9,7 @@
 #include "mesh_internal.h"
 #include "voxfield/error.h"
 #include "voxfield/interrupt.h"
+#include "voxfield/limits.h"
 #include "voxfield/parallel.h"
 
 namespace voxfield {
@@ -40,16 +42,27 @@ Lattice checked_lattice(const ScalarVolume& volume, const MeshOptions& options, 
       throw InvalidArgument("mesh: the volume needs at least 2 samples along each axis (it has " +
                             std::to_string(volume.size.x) + " x " + std::to_string(volume.size.y) +
                             " x " + std::to_string(volume.size.z) + ")");
+    // Positions are floats: the spacing must be a normal float and the far corner representable.
     const double s = volume.spacing_units[static_cast<std::size_t>(a)];
-    if (!(s > 0) || !std::isfinite(s))
-      throw InvalidArgument("mesh: spacing must be positive and finite");
-    if (!std::isfinite(volume.origin_units[static_cast<std::size_t>(a)]))
-      throw InvalidArgument("mesh: origin must be finite");
+    const double o = volume.origin_units[static_cast<std::size_t>(a)];
+    const double far = o + (volume.size[a] - 1) * s;
+    constexpr double kFloatMax = std::numeric_limits<float>::max();
+    if (!(s >= std::numeric_limits<float>::min()) || !(s <= kFloatMax))
+      throw InvalidArgument("mesh: spacing must be positive and within float range");
+    if (!(std::abs(o) <= kFloatMax) || !(std::abs(far) <= kFloatMax))
+      throw InvalidArgument("mesh: the volume's origin and far corner must be finite floats");
   }
-  if (!std::isfinite(options.iso)) throw InvalidArgument("mesh: iso must be finite");
-  if (options.chunk_edge < 2 || options.chunk_edge > 1024)
+  if (!(std::abs(options.iso) <= std::numeric_limits<float>::max()))
+    throw InvalidArgument("mesh: iso must be a finite float");
+  if (options.chunk_edge < 2 || options.chunk_edge > 256)
     throw InvalidArgument("mesh: chunk edge " + std::to_string(options.chunk_edge) +
-                          " is outside 2..1024");
+                          " is outside 2..256");
+  // One part per chunk (bookkeeping even where there is no surface): refuse partitions whose
+  // bookkeeping alone would pass the memory limit.
+  const ChunkGrid grid(volume.size, options.chunk_edge);
+  require_memory(mul_sat(static_cast<std::uint64_t>(grid.total()), 256), 0, "mesh",
+                 "chunks of " + std::to_string(options.chunk_edge) + " cells (" +
+                     std::to_string(grid.total()) + " of them; choose a larger --chunk)");
   Lattice lattice;
   lattice.n = volume.size;
   lattice.values = volume.values;

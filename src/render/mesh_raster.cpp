@@ -58,12 +58,17 @@ Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOption
     if (!a.visible || !b.visible || !c.visible) continue;  // crosses the eye plane: dropped
     const double area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
     if (area == 0 || !std::isfinite(area)) continue;
-    const int x0 = std::max(0, static_cast<int>(std::floor(std::min({a.x, b.x, c.x}))));
+    // Bounds clamped in double before the casts: a vertex just in front of the eye projects
+    // far off screen, beyond int.
+    auto pixel = [](double v, int size) {
+      return static_cast<int>(std::clamp(v, -1.0, static_cast<double>(size)));
+    };
+    const int x0 = std::max(0, pixel(std::floor(std::min({a.x, b.x, c.x})), options.width));
     const int x1 =
-        std::min(options.width - 1, static_cast<int>(std::ceil(std::max({a.x, b.x, c.x}))));
-    const int y0 = std::max(0, static_cast<int>(std::floor(std::min({a.y, b.y, c.y}))));
+        std::min(options.width - 1, pixel(std::ceil(std::max({a.x, b.x, c.x})), options.width));
+    const int y0 = std::max(0, pixel(std::floor(std::min({a.y, b.y, c.y})), options.height));
     const int y1 =
-        std::min(options.height - 1, static_cast<int>(std::ceil(std::max({a.y, b.y, c.y}))));
+        std::min(options.height - 1, pixel(std::ceil(std::max({a.y, b.y, c.y})), options.height));
     if (x0 > x1 || y0 > y1) continue;
     ++st.triangles_drawn;
     // Edge lengths in pixels, for the distance of a pixel to each edge.
