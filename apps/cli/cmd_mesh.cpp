@@ -161,8 +161,8 @@ void add_mesh(CLI::App& app, Action& action) {
          "sample spacing of a float volume: sx,sy,sz (sample a[x,y,z] at (x,y,z) * spacing)")
       ->delimiter(',')
       ->check(finite_positive());
-  cmd->add_option("--chunk", s->chunk, "cells per chunk edge (2..1024, default 32)")
-      ->check(CLI::Range(2, 1024));
+  cmd->add_option("--chunk", s->chunk, "cells per chunk edge (2..256, default 32)")
+      ->check(CLI::Range(2, 256));
   cmd->add_option("--threads", s->threads, "threads (default: all)")->check(CLI::Range(1, 1024));
   cmd->add_option("--simplify", s->simplify,
                   "keep about this fraction of the triangles (0 < R <= 1; meshoptimizer)")
