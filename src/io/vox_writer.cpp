@@ -62,33 +62,50 @@ struct Region {
 std::vector<std::uint8_t> encode_vox(const World& world) {
   const Grid<std::uint8_t>& g = world.voxels;
   // Tiles of 256^3 aligned to multiples of 256: every chunk edge (8..128) divides 256, so each
-  // stored chunk lies in exactly one tile, and only tiles holding chunks are visited.
-  std::vector<Vec3i> tiles;
+  // stored chunk lies in exactly one tile, and only tiles holding chunks are visited. Within a
+  // tile only the box covering its stored chunks is read: a 20^3 model costs a chunk or two, not
+  // the 16 Mi voxels of its tile.
+  struct TileChunks {
+    Vec3i tile;
+    Box3i chunks;  // the union of the tile's stored chunk boxes
+  };
+  static_assert(kMaxModelEdge == 1 << 8, "tiles are found by shifting coordinates by 8");
+  std::vector<TileChunks> tiles;
   for (const Vec3i c : g.chunk_coords()) {
-    const Vec3i lo = g.chunk_box(c).begin;
-    tiles.push_back({lo.x >> 8, lo.y >> 8, lo.z >> 8});
+    const Box3i box = g.chunk_box(c);
+    tiles.push_back({{box.begin.x >> 8, box.begin.y >> 8, box.begin.z >> 8}, box});
   }
-  std::sort(tiles.begin(), tiles.end(), [](const Vec3i& a, const Vec3i& b) {
-    return std::tie(a.z, a.y, a.x) < std::tie(b.z, b.y, b.x);
+  std::sort(tiles.begin(), tiles.end(), [](const TileChunks& a, const TileChunks& b) {
+    return std::tie(a.tile.z, a.tile.y, a.tile.x) < std::tie(b.tile.z, b.tile.y, b.tile.x);
   });
-  tiles.erase(std::unique(tiles.begin(), tiles.end()), tiles.end());
+  std::vector<TileChunks> merged;
+  for (const TileChunks& t : tiles) {
+    if (merged.empty() || !(merged.back().tile == t.tile)) {
+      merged.push_back(t);
+      continue;
+    }
+    Box3i& u = merged.back().chunks;
+    u = {{std::min(u.begin.x, t.chunks.begin.x), std::min(u.begin.y, t.chunks.begin.y),
+          std::min(u.begin.z, t.chunks.begin.z)},
+         {std::max(u.end.x, t.chunks.end.x), std::max(u.end.y, t.chunks.end.y),
+          std::max(u.end.z, t.chunks.end.z)}};
+  }
 
   // Trim each tile to its content.
   std::vector<Region> regions;
   std::vector<std::uint8_t> dense;
-  for (const Vec3i t : tiles) {
-    const Vec3i origin{t.x * kMaxModelEdge, t.y * kMaxModelEdge, t.z * kMaxModelEdge};
-    const Box3i tile{origin, origin + Vec3i::splat(kMaxModelEdge)};
-    dense.resize(static_cast<std::size_t>(tile.volume()));
-    g.copy_to_dense(tile, dense.data());
-    Vec3i lo = tile.end, hi = tile.begin - Vec3i::splat(1);
-    const Vec3i s = tile.size();
+  for (const TileChunks& t : merged) {
+    const Box3i& box = t.chunks;
+    dense.resize(static_cast<std::size_t>(box.volume()));
+    g.copy_to_dense(box, dense.data());
+    Vec3i lo = box.end, hi = box.begin - Vec3i::splat(1);
+    const Vec3i s = box.size();
     std::size_t i = 0;
     for (int zz = 0; zz < s.z; ++zz)
       for (int yy = 0; yy < s.y; ++yy)
         for (int xx = 0; xx < s.x; ++xx, ++i) {
           if (!dense[i]) continue;
-          const Vec3i p = tile.begin + Vec3i{xx, yy, zz};
+          const Vec3i p = box.begin + Vec3i{xx, yy, zz};
           lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
           hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
         }
