@@ -7,7 +7,9 @@
 # second instead of thousands (the large files are parsed whole by the unit tests). New inputs libFuzzer finds go to a scratch corpus, not into the repository; a
 # crash stops the run with the harness's report and the crashing input under $FUZZ_OUT.
 # Usage: bash fuzz/run.sh [SECONDS] [HARNESS...]   (needs build/fuzz and build/release/bin/voxfield)
-# FUZZ_RUNS=N stops each harness after N executions instead (with SECONDS still the cap).
+# FUZZ_RUNS=N stops each harness after N executions instead (with SECONDS still the cap);
+# FUZZ_TIMEOUT=S sets the per-input time-out (default 20 s; a campaign at nice 19 beside a build
+# needs more: a starved process is not a slow input).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-25}; shift || true
@@ -42,7 +44,7 @@ for h in $harnesses; do
   echo "=== fuzz_$h: ${seconds}s ==="
   runs=${FUZZ_RUNS:+-runs=$FUZZ_RUNS}
   started=$SECONDS
-  "$bin/fuzz_$h" -max_total_time="$seconds" $runs -max_len="$max_len" -timeout=20 -rss_limit_mb=2560 \
+  "$bin/fuzz_$h" -max_total_time="$seconds" $runs -max_len="$max_len" -timeout="${FUZZ_TIMEOUT:-20}" -rss_limit_mb=2560 \
       -artifact_prefix="$out/crash-$h-" -print_final_stats=1 "$work" $dirs 2>"$out/log-$h.txt" || {
     echo "fuzz_$h FAILED; its log:" >&2; tail -60 "$out/log-$h.txt" >&2; exit 1; }
   grep -E "stat::number_of_executed_units|stat::peak_rss_mb|cov: " "$out/log-$h.txt" | tail -3

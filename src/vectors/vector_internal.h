@@ -1,0 +1,85 @@
+// What the vector-field passes share: sources as segments, the distance and score at a voxel
+// centre, and the voxel centres themselves — computed the same way, in the same order, by every
+// algorithm and by the oracle, so that equal winners are bit-for-bit equal values.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "voxfield/vectors.h"
+
+namespace voxfield::detail::vectors {
+
+// A source's segment a + t (b - a), t in [0, 1], and radius.
+struct Segment {
+  Vec3d a, ab;
+  double ab2 = 0;  // |b - a|^2; 0 for a stationary source (its distance is |p - a|: no 0 / 0)
+  double radius = 1;
+};
+
+inline Segment segment_of(const VectorSource& s) {
+  const Vec3d ab = s.position - s.previous;
+  return {s.previous, ab, dot(ab, ab), s.radius};
+}
+
+// Distance from p to the segment; q receives the nearest point.
+inline double distance_to(const Segment& s, Vec3d p, Vec3d& q) {
+  double t = 0;
+  if (s.ab2 > 0) t = std::clamp(dot(p - s.a, s.ab) / s.ab2, 0.0, 1.0);
+  q = s.a + s.ab * t;
+  return (p - q).length();
+}
+
+// Larger is better: the strength 1 - d / r for the paper's figure rule, -d for the nearest rule.
+// Comparisons are strict, so of two equal scores the earlier (lower) index stays.
+inline double score(VectorRule rule, double d, double radius) {
+  return rule == VectorRule::kStrongest ? 1.0 - d / radius : -d;
+}
+
+// Voxel centres as centre + X[i] + Y[j] + Z[k] (in that order), each table the box axis times
+// the voxel's local coordinate: VectorVolume::voxel_centre uses the same expression.
+struct CentreTables {
+  Vec3d centre;
+  std::vector<Vec3d> x, y, z;
+  explicit CentreTables(const VectorVolume& v);
+  Vec3d at(int i, int j, int k) const { return centre + x[i] + y[j] + z[k]; }
+};
+
+// The axis offset of voxel n of `count` along an axis of length `size`, direction `column`.
+inline Vec3d axis_offset(Vec3d column, double size, int n, int count) {
+  const double local = ((n + 0.5) / count - 0.5) * size;
+  return column * local;
+}
+
+// The voxels a source can cover: inclusive index ranges, empty when it misses the box.
+struct IndexBox {
+  int lo[3] = {0, 0, 0}, hi[3] = {-1, -1, -1};
+  bool empty() const { return hi[0] < lo[0] || hi[1] < lo[1] || hi[2] < lo[2]; }
+};
+IndexBox index_box(const VectorVolume& v, const VectorSource& s);
+
+// Runs body(k_begin, k_end) over z slabs of the volume in parallel, reporting each slab to the
+// interrupter; throws Cancelled (naming `what`) when it says stop.
+void for_each_slab(const VectorVolume& v, Interrupter* interrupter, std::string_view what,
+                   const std::function<void(int k_begin, int k_end)>& body);
+
+// Milliseconds since `start` (steady clock).
+double ms_since(std::int64_t start_ns);
+std::int64_t now_ns();
+
+// The algorithms (one per file).
+void brute_winners(const VectorVolume& v, std::span<const Segment> sources, VectorRule rule,
+                   Interrupter* interrupter, std::span<std::int32_t> winners);
+void splat_winners(const VectorVolume& v, std::span<const VectorSource> sources,
+                   std::span<const Segment> segments, VectorRule rule, Interrupter* interrupter,
+                   std::span<std::int32_t> winners);
+void jfa_winners(const VectorVolume& v, std::span<const VectorSource> sources,
+                 std::span<const Segment> segments, VectorRule rule, int extra_passes,
+                 Interrupter* interrupter, std::span<std::int32_t> winners, VectorPassTimes* times);
+
+}  // namespace voxfield::detail::vectors
