@@ -32,6 +32,8 @@ void add_edit(CLI::App& app, Action& action);
 void add_bench(CLI::App& app, Action& action);
 void add_render(CLI::App& app, Action& action);
 void add_mesh(CLI::App& app, Action& action);
+void add_vectors(CLI::App& app, Action& action);
+void add_bench_vectors(CLI::App* bench, Action& action);  // voxfield bench vectors
 
 // A mistake in the command line found after CLI11's checks (options that contradict each other):
 // exits 2 like every other usage error.

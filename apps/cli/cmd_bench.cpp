@@ -234,6 +234,7 @@ void add_bench(CLI::App& app, Action& action) {
   cmd->add_option("--csv", s->csv, "one row per edit");
   cmd->add_option("--json", s->json, "summary as JSON");
   cmd->callback([s, &action] { action = [s] { return run_bench_edits(*s); }; });
+  add_bench_vectors(bench, action);
 }
 
 }  // namespace voxfield::cli

@@ -19,6 +19,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -101,7 +102,9 @@ class VectorTexture {
   VectorStorage storage() const { return storage_; }
   std::int64_t voxel_count() const { return Box3i::from_size(resolution_).volume(); }
   int bytes_per_texel() const;
+  // The raw texels, x fastest, as a GPU upload takes them (layout in docs/vectors.md).
   std::span<const std::uint8_t> bytes() const { return bytes_; }
+  std::uint8_t* data() { return bytes_.data(); }
 
   VectorTexel get(std::int64_t index) const;
   void set(std::int64_t index, const VectorTexel& texel);
@@ -178,7 +181,8 @@ VectorError compare_vector_winners(const VectorVolume& volume,
 // The decay and blend of one step (docs/vectors.md), on decoded texels:
 //   previous strength s_p <- max(0, s_p - decay_per_s * dt);
 //   w = s_c / (s_c + s_p); direction = normalise(w n_c + (1 - w) n_p) (0 if that is 0); strength
-//   = max(s_c, s_p). When both strengths are 0 the result is the zero texel.
+//   = max(s_c, s_p). When both strengths are 0 the result is the zero texel; when one is 0 the
+//   other texel's direction is kept as it is (w = 1 or 0, without renormalising). Float math.
 VectorTexel blend_vector_texels(const VectorTexel& current, const VectorTexel& previous,
                                 double decay_per_s, double dt_s);
 
@@ -189,8 +193,13 @@ class VectorSimulation {
   // Throws InvalidArgument for an invalid volume or a negative or non-finite decay.
   VectorSimulation(const VectorVolume& volume, VectorStorage storage, VectorOptions options,
                    double decay_per_s);
+  ~VectorSimulation();
+  VectorSimulation(VectorSimulation&&) noexcept;
+  VectorSimulation& operator=(VectorSimulation&&) noexcept;
 
-  // One step of dt seconds (> 0). Strong guarantee: if it throws, field() is unchanged.
+  // One step of dt seconds (> 0). Strong guarantee: if it throws, field() is unchanged. The
+  // conversion, decay and blend run fused in one sweep over the texels (last_times().blend_ms);
+  // with splatting the search costs what the sources cover (its scratch is kept between steps).
   void step(std::span<const VectorSource> sources, double dt_s);
 
   const VectorVolume& volume() const { return volume_; }
@@ -206,6 +215,8 @@ class VectorSimulation {
   VectorTexture current_, field_, next_;
   VectorPassTimes times_;
   std::int64_t steps_ = 0;
+  struct Scratch;
+  std::unique_ptr<Scratch> scratch_;
 };
 
 // A fixed time step that catches up: advance(frame_s) adds the frame's time and returns how many

@@ -2,8 +2,10 @@
 // comparison of an approximate generation against it; the algorithms live one per file (brute.cpp,
 // splat.cpp, jfa.cpp) and agree with vector_at() bit for bit where they are exact.
 #include <cmath>
+#include <limits>
 #include <string>
 
+#include "texel_codec.h"
 #include "vector_internal.h"
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
@@ -14,29 +16,9 @@ using detail::vectors::Segment;
 
 namespace {
 
-std::vector<Segment> segments_of(std::span<const VectorSource> sources) {
-  std::vector<Segment> s;
-  s.reserve(sources.size());
-  for (const VectorSource& src : sources) s.push_back(detail::vectors::segment_of(src));
-  return s;
-}
-
-// Direction and strength at p for source `s` (zero when it does not cover p).
-VectorValue value_of(const Segment& s, Vec3d p, int index) {
-  Vec3d q;
-  const double d = detail::vectors::distance_to(s, p, q);
-  VectorValue v;
-  if (!(d < s.radius)) return v;
-  v.source = index;
-  v.strength = 1.0 - d / s.radius;
-  if (d > 0) v.direction = (p - q) * (1.0 / d);
-  return v;
-}
-
-VectorTexel texel_of(const VectorValue& v) {
-  return {static_cast<float>(v.direction.x), static_cast<float>(v.direction.y),
-          static_cast<float>(v.direction.z), static_cast<float>(v.strength)};
-}
+using detail::vectors::segments_of;
+using detail::vectors::texel_of;
+using detail::vectors::value_of;
 
 double angle_deg(Vec3d a, Vec3d b) {
   const double la = a.length(), lb = b.length();
@@ -45,6 +27,15 @@ double angle_deg(Vec3d a, Vec3d b) {
 }
 
 }  // namespace
+
+namespace detail::vectors {
+std::vector<Segment> segments_of(std::span<const VectorSource> sources) {
+  std::vector<Segment> s;
+  s.reserve(sources.size());
+  for (const VectorSource& src : sources) s.push_back(segment_of(src));
+  return s;
+}
+}  // namespace detail::vectors
 
 VectorValue vector_at(Vec3d p, std::span<const VectorSource> sources, VectorRule rule) {
   int best = -1;
@@ -83,11 +74,16 @@ std::vector<std::int32_t> vector_winners(const VectorVolume& volume,
       detail::vectors::brute_winners(volume, segments, options.rule, options.interrupter, winners);
       t.search_ms += detail::vectors::ms_since(start);
       break;
-    case VectorAlgorithm::kSplat:
+    case VectorAlgorithm::kSplat: {
+      detail::vectors::SplatScratch scratch;
+      scratch.winners = std::move(winners);
+      scratch.best.assign(scratch.winners.size(), -std::numeric_limits<double>::infinity());
       detail::vectors::splat_winners(volume, sources, segments, options.rule, options.interrupter,
-                                     winners);
+                                     scratch);
+      winners = std::move(scratch.winners);
       t.search_ms += detail::vectors::ms_since(start);
       break;
+    }
     case VectorAlgorithm::kJfa:
     case VectorAlgorithm::kJfaPlus1:
     case VectorAlgorithm::kJfaPlus2: {
@@ -110,20 +106,24 @@ void write_vector_texels(const VectorVolume& volume, std::span<const VectorSourc
   const std::vector<Segment> segments = segments_of(sources);
   const detail::vectors::CentreTables centres(volume);
   const Vec3i n = volume.resolution;
-  const VectorTexel zero{};
-  detail::vectors::for_each_slab(volume, nullptr, "vector conversion", [&](int k0, int k1) {
-    for (int k = k0; k < k1; ++k)
-      for (int j = 0; j < n.y; ++j) {
-        std::int64_t idx = volume.index(0, j, k);
-        for (int i = 0; i < n.x; ++i, ++idx) {
-          const std::int32_t w = winners[static_cast<std::size_t>(idx)];
-          if (w < 0 || static_cast<std::size_t>(w) >= segments.size()) {
-            out.set(idx, zero);
-            continue;
+  detail::vectors::with_codec(out.storage(), [&](auto codec) {
+    using C = decltype(codec);
+    std::uint8_t* texels = out.data();
+    detail::vectors::for_each_slab(volume, nullptr, "vector conversion", [&](int k0, int k1) {
+      for (int k = k0; k < k1; ++k)
+        for (int j = 0; j < n.y; ++j) {
+          std::int64_t idx = volume.index(0, j, k);
+          for (int i = 0; i < n.x; ++i, ++idx) {
+            const std::int32_t w = winners[static_cast<std::size_t>(idx)];
+            std::uint8_t* p = texels + idx * C::kBytes;
+            if (w < 0 || static_cast<std::size_t>(w) >= segments.size()) {
+              C::store_zero(p);
+              continue;
+            }
+            C::store(p, texel_of(value_of(segments[w], centres.at(i, j, k), w)));
           }
-          out.set(idx, texel_of(value_of(segments[w], centres.at(i, j, k), w)));
         }
-      }
+    });
   });
 }
 

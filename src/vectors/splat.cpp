@@ -12,17 +12,44 @@
 
 namespace voxfield::detail::vectors {
 
+namespace {
+constexpr double kNoScore = -std::numeric_limits<double>::infinity();
+}
+
+void SplatScratch::prepare(const VectorVolume& v) {
+  const std::size_t n = static_cast<std::size_t>(v.voxel_count());
+  if (winners.size() == n) return;
+  winners.assign(n, -1);
+  best.assign(n, kNoScore);
+  boxes.clear();
+}
+
+void SplatScratch::reset(const VectorVolume& v) {
+  for (const IndexBox& b : boxes) {
+    if (b.empty()) continue;
+    for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+      for (int j = b.lo[1]; j <= b.hi[1]; ++j) {
+        const std::size_t at = static_cast<std::size_t>(v.index(b.lo[0], j, k));
+        const std::size_t count = static_cast<std::size_t>(b.hi[0] - b.lo[0] + 1);
+        std::fill_n(winners.begin() + static_cast<std::ptrdiff_t>(at), count, -1);
+        std::fill_n(best.begin() + static_cast<std::ptrdiff_t>(at), count, kNoScore);
+      }
+  }
+  boxes.clear();
+}
+
 void splat_winners(const VectorVolume& v, std::span<const VectorSource> sources,
                    std::span<const Segment> segments, VectorRule rule, Interrupter* interrupter,
-                   std::span<std::int32_t> winners) {
+                   SplatScratch& scratch) {
+  scratch.prepare(v);
+  scratch.reset(v);
   const CentreTables centres(v);
-  std::vector<IndexBox> boxes;
-  boxes.reserve(sources.size());
-  for (const VectorSource& s : sources) boxes.push_back(index_box(v, s));
-  std::vector<double> best(winners.size(), -std::numeric_limits<double>::infinity());
+  for (const VectorSource& s : sources) scratch.boxes.push_back(index_box(v, s));
+  std::int32_t* winners = scratch.winners.data();
+  double* best = scratch.best.data();
   for_each_slab(v, interrupter, "vector field (splat)", [&](int k0, int k1) {
     for (std::size_t s = 0; s < segments.size(); ++s) {
-      const IndexBox& b = boxes[s];
+      const IndexBox& b = scratch.boxes[s];
       if (b.empty() || b.hi[2] < k0 || b.lo[2] >= k1) continue;
       const Segment& seg = segments[s];
       for (int k = std::max(b.lo[2], k0); k <= std::min(b.hi[2], k1 - 1); ++k)
@@ -33,10 +60,9 @@ void splat_winners(const VectorVolume& v, std::span<const VectorSource> sources,
             const double d = distance_to(seg, centres.at(i, j, k), q);
             if (!(d < seg.radius)) continue;
             const double sc = score(rule, d, seg.radius);
-            const std::size_t u = static_cast<std::size_t>(idx);
-            if (sc > best[u]) {
-              best[u] = sc;
-              winners[u] = static_cast<std::int32_t>(s);
+            if (sc > best[idx]) {
+              best[idx] = sc;
+              winners[idx] = static_cast<std::int32_t>(s);
             }
           }
         }

@@ -35,6 +35,25 @@ inline double distance_to(const Segment& s, Vec3d p, Vec3d& q) {
   return (p - q).length();
 }
 
+// Direction and strength at p for a source (zero, source -1, when it does not cover p).
+inline VectorValue value_of(const Segment& s, Vec3d p, int index) {
+  Vec3d q;
+  const double d = distance_to(s, p, q);
+  VectorValue v;
+  if (!(d < s.radius)) return v;
+  v.source = index;
+  v.strength = 1.0 - d / s.radius;
+  if (d > 0) v.direction = (p - q) * (1.0 / d);
+  return v;
+}
+
+inline VectorTexel texel_of(const VectorValue& v) {
+  return {static_cast<float>(v.direction.x), static_cast<float>(v.direction.y),
+          static_cast<float>(v.direction.z), static_cast<float>(v.strength)};
+}
+
+std::vector<Segment> segments_of(std::span<const VectorSource> sources);
+
 // Larger is better: the strength 1 - d / r for the paper's figure rule, -d for the nearest rule.
 // Comparisons are strict, so of two equal scores the earlier (lower) index stays.
 inline double score(VectorRule rule, double d, double radius) {
@@ -75,9 +94,19 @@ std::int64_t now_ns();
 // The algorithms (one per file).
 void brute_winners(const VectorVolume& v, std::span<const Segment> sources, VectorRule rule,
                    Interrupter* interrupter, std::span<std::int32_t> winners);
+// What splatting keeps between generations: winners and best scores, -1 and -inf everywhere
+// except inside the boxes of the last splat's sources, which reset() restores — so a step costs
+// what its sources cover, not the volume.
+struct SplatScratch {
+  std::vector<std::int32_t> winners;
+  std::vector<double> best;
+  std::vector<IndexBox> boxes;
+  void prepare(const VectorVolume& v);  // sized and cleared once per volume
+  void reset(const VectorVolume& v);    // the last splat's boxes cleared
+};
 void splat_winners(const VectorVolume& v, std::span<const VectorSource> sources,
                    std::span<const Segment> segments, VectorRule rule, Interrupter* interrupter,
-                   std::span<std::int32_t> winners);
+                   SplatScratch& scratch);
 void jfa_winners(const VectorVolume& v, std::span<const VectorSource> sources,
                  std::span<const Segment> segments, VectorRule rule, int extra_passes,
                  Interrupter* interrupter, std::span<std::int32_t> winners, VectorPassTimes* times);

@@ -1,0 +1,208 @@
+// voxfield bench vectors --test NAME: the six tests of Hamlin's benchmark program ("Volumetric
+// Interaction", section 4), done with the error columns the paper lacked and whole-step times
+// (generation, conversion, decay and blend — not CPU dispatch time). docs/vectors.md describes the
+// agents' seeded motion and each test's sweep; docs/benchmarks.md holds the figures.
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <random>
+#include <sstream>
+
+#include "cli.h"
+#include "voxfield/parallel.h"
+#include "voxfield/vectors.h"
+
+namespace voxfield::cli {
+namespace {
+
+struct BenchVectorSettings {
+  std::string test = "fidelity", csv, storage = "rgba8";
+  std::vector<std::string> algorithms;  // only these (default: each test's own)
+  int steps = 60, threads = 0;
+  std::uint32_t seed = 1;
+};
+
+// The paper's agents: sources flying through a 10-unit box at 2..5 units/s, bouncing off its
+// walls, radius 0.8 units (5 voxels at 64^3). Seeded: the same motion for every algorithm.
+class Agents {
+ public:
+  Agents(int count, std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> pos(-4.2, 4.2), dir(-1, 1), speed(2, 5);
+    for (int i = 0; i < count; ++i) {
+      Vec3d d{dir(rng), dir(rng), dir(rng)};
+      if (d.length() < 1e-3) d = {1, 0, 0};
+      agents_.push_back({{pos(rng), pos(rng), pos(rng)}, d.normalized() * speed(rng)});
+    }
+  }
+  std::vector<VectorSource> step(double dt) {
+    std::vector<VectorSource> out;
+    for (Agent& a : agents_) {
+      const Vec3d before = a.p;
+      a.p = a.p + a.v * dt;
+      for (int k = 0; k < 3; ++k)
+        if (std::abs(a.p[k]) > 4.2) {
+          a.v[k] = -a.v[k];
+          a.p[k] = std::clamp(a.p[k], -4.2, 4.2);
+        }
+      out.push_back({a.p, before, 0.8});
+    }
+    return out;
+  }
+
+ private:
+  struct Agent {
+    Vec3d p, v;
+  };
+  std::vector<Agent> agents_;
+};
+
+VectorVolume bench_volume(Vec3i resolution) {
+  VectorVolume v;
+  v.size = {10, 10, 10};
+  v.resolution = resolution;
+  return v;
+}
+
+struct Row {
+  std::string test, algorithm;
+  Vec3i resolution;
+  int sources = 0;
+  double dt = 0, decay = 0;
+  double generate_ms = 0, blend_ms = 0, step_ms = 0, p99_step_ms = 0;
+  double percent_differs = 0, max_angle_deg = 0, max_strength_error = 0;
+  double mean_strength = 0;
+};
+
+// Runs `steps` whole steps (generation, conversion, decay and blend) of `count` agents and, for
+// the approximate algorithms, measures each step's winners against splatting's.
+Row run_case(const std::string& test, VectorAlgorithm algorithm, Vec3i resolution, int count,
+             double dt, double decay, VectorStorage storage, int steps, std::uint32_t seed) {
+  const VectorVolume volume = bench_volume(resolution);
+  VectorOptions options;
+  options.algorithm = algorithm;
+  VectorSimulation sim(volume, storage, options, decay);
+  Agents agents(count, seed);
+  Row r{test, vector_algorithm_name(algorithm), resolution, count, dt, decay};
+  std::vector<double> step_ms;
+  const bool approximate = algorithm != VectorAlgorithm::kBrute && algorithm != VectorAlgorithm::kSplat;
+  VectorOptions exact;
+  for (int i = 0; i < steps; ++i) {
+    const std::vector<VectorSource> sources = agents.step(dt);
+    const auto start = std::chrono::steady_clock::now();
+    sim.step(sources, dt);
+    step_ms.push_back(ms_since(start));
+    const VectorPassTimes& t = sim.last_times();
+    r.generate_ms += t.seed_ms + t.flood_ms + t.search_ms + t.convert_ms;
+    r.blend_ms += t.blend_ms;
+    if (approximate && i % 10 == 9) {  // every tenth step: the error against the definition
+      const VectorError e = compare_vector_winners(volume, sources, vector_winners(volume, sources, exact),
+                                                   vector_winners(volume, sources, options));
+      r.percent_differs = std::max(r.percent_differs, e.percent_differs());
+      r.max_angle_deg = std::max(r.max_angle_deg, e.max_angle_deg);
+      r.max_strength_error = std::max(r.max_strength_error, e.max_strength_error);
+    }
+  }
+  double strength = 0;
+  for (std::int64_t i = 0; i < volume.voxel_count(); ++i) strength += sim.field().get(i).strength;
+  r.mean_strength = strength / volume.voxel_count();
+  r.generate_ms /= steps;
+  r.blend_ms /= steps;
+  // The first steps warm the caches and the pool: the mean and p99 of the rest.
+  const std::size_t skip = std::min<std::size_t>(step_ms.size() / 10, 5);
+  std::vector<double> kept(step_ms.begin() + static_cast<std::ptrdiff_t>(skip), step_ms.end());
+  for (double m : kept) r.step_ms += m;
+  r.step_ms /= std::max<std::size_t>(1, kept.size());
+  std::sort(kept.begin(), kept.end());
+  r.p99_step_ms = kept.empty() ? 0 : kept[std::min(kept.size() - 1, kept.size() * 99 / 100)];
+  return r;
+}
+
+int run_bench_vectors(const BenchVectorSettings& s) {
+  const VectorStorage storage = parse_vector_storage(s.storage);
+  Outputs outputs;
+  outputs.expect(s.csv, "--csv");
+  std::optional<ThreadLimit> limit;
+  if (s.threads > 0) limit.emplace(s.threads);
+  using A = VectorAlgorithm;
+  const std::vector<A> all{A::kBrute, A::kSplat, A::kJfa, A::kJfaPlus1, A::kJfaPlus2};
+  const double dt = 1.0 / 60;
+  std::vector<Row> rows;
+  auto add = [&](A a, Vec3i res, int count, double step_dt, double decay) {
+    if (!s.algorithms.empty() && std::find(s.algorithms.begin(), s.algorithms.end(),
+                                           vector_algorithm_name(a)) == s.algorithms.end())
+      return;
+    rows.push_back(run_case(s.test, a, res, count, step_dt, decay, storage, s.steps, s.seed));
+    const Row& r = rows.back();
+    std::cerr << "  " << r.algorithm << " " << to_string(res) << " sources " << count << ": "
+              << r.step_ms << " ms per step\n";
+  };
+  const Vec3i r64{64, 64, 64};
+  if (s.test == "fidelity") {
+    for (A a : all) add(a, r64, 20, dt, 1.0);
+  } else if (s.test == "decay") {
+    for (double decay : {0.0, 0.5, 1.0, 2.0, 4.0}) add(A::kSplat, r64, 20, dt, decay);
+  } else if (s.test == "jfa-sources") {
+    for (int n : {1, 5, 10, 20, 50, 100, 200})
+      for (A a : {A::kBrute, A::kSplat, A::kJfa}) add(a, r64, n, dt, 1.0);
+  } else if (s.test == "jfa-resolution") {
+    for (int n : {16, 32, 64, 128})
+      for (A a : {A::kBrute, A::kSplat, A::kJfa}) add(a, {n, n, n}, 50, dt, 1.0);
+  } else if (s.test == "time-step") {
+    for (double hz : {30.0, 60.0, 120.0, 240.0}) add(A::kSplat, r64, 20, 1.0 / hz, 1.0);
+  } else if (s.test == "quarter-resolution") {
+    for (A a : {A::kSplat, A::kJfa}) {
+      add(a, r64, 20, dt, 1.0);
+      add(a, {64, 16, 64}, 20, dt, 1.0);
+    }
+  } else {
+    throw UsageError("unknown test " + s.test);
+  }
+  std::ostringstream csv;
+  csv << "test,algorithm,nx,ny,nz,sources,dt_s,decay_per_s,storage,steps,generate_ms,decay_blend_ms,"
+         "step_ms,p99_step_ms,percent_source_differs,max_angle_deg,max_strength_error,mean_strength\n";
+  std::cout << "| algorithm | resolution | sources | dt (s) | decay/s | generate ms | decay+blend ms | "
+               "step ms (p99) | % source differs | max angle (deg) | max strength error |\n"
+               "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Row& r : rows) {
+    csv << r.test << "," << r.algorithm << "," << r.resolution.x << "," << r.resolution.y << ","
+        << r.resolution.z << "," << r.sources << "," << r.dt << "," << r.decay << "," << s.storage
+        << "," << s.steps << "," << r.generate_ms << "," << r.blend_ms << "," << r.step_ms << ","
+        << r.p99_step_ms << "," << r.percent_differs << "," << r.max_angle_deg << ","
+        << r.max_strength_error << "," << r.mean_strength << "\n";
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "| %s | %dx%dx%d | %d | %.4f | %.1f | %.3f | %.3f | %.3f (%.3f) | %.3f | %.2f | %.4f |\n",
+                  r.algorithm.c_str(), r.resolution.x, r.resolution.y, r.resolution.z, r.sources,
+                  r.dt, r.decay, r.generate_ms, r.blend_ms, r.step_ms, r.p99_step_ms,
+                  r.percent_differs, r.max_angle_deg, r.max_strength_error);
+    std::cout << line;
+  }
+  if (!s.csv.empty()) outputs.stage(s.csv, std::string_view(csv.str()));
+  outputs.commit();
+  return 0;
+}
+
+}  // namespace
+
+void add_bench_vectors(CLI::App* bench, Action& action) {
+  auto s = std::make_shared<BenchVectorSettings>();
+  CLI::App* cmd = bench->add_subcommand(
+      "vectors", "The vector-field paper's six tests: whole steps, per pass, with JFA's error");
+  cmd->add_option("--test", s->test,
+                  "fidelity, decay, jfa-sources, jfa-resolution, time-step or quarter-resolution")
+      ->check(CLI::IsMember(
+          {"fidelity", "decay", "jfa-sources", "jfa-resolution", "time-step", "quarter-resolution"}));
+  cmd->add_option("--steps", s->steps, "steps per case (default 60)")->check(CLI::Range(1, 100000));
+  cmd->add_option("--storage", s->storage, "rgba8 (default), rgba16f or rgba32f")
+      ->check(CLI::IsMember({"rgba8", "rgba16f", "rgba32f"}));
+  cmd->add_option("--seed", s->seed, "the agents' random seed");
+  cmd->add_option("--algorithms", s->algorithms, "run only these of the test's algorithms (a,b,...)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"splat", "brute", "jfa", "jfa+1", "jfa+2"}));
+  cmd->add_option("--threads", s->threads, "threads (default: all)")->check(CLI::Range(1, 1024));
+  cmd->add_option("--csv", s->csv, "one row per case");
+  cmd->callback([s, &action] { action = [s] { return run_bench_vectors(*s); }; });
+}
+
+}  // namespace voxfield::cli

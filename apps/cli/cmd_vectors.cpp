@@ -1,0 +1,218 @@
+// voxfield vectors SOURCES.json -o OUT: a vector-field volume texture from moving sources
+// (docs/vectors.md), as float32 .npy, Unreal .fga, Unity .vf, or a picture of the visualiser.
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <limits>
+
+#include "cli.h"
+#include "voxfield/png.h"
+#include "voxfield/vector_files.h"
+#include "voxfield/vectors.h"
+
+namespace voxfield::cli {
+namespace {
+
+struct VectorSettings {
+  std::string sources, out, stats, algorithm = "splat", rule = "strongest", storage = "rgba8";
+  std::vector<int> resolution{64, 64, 64};
+  std::vector<double> box, rotation;
+  double dt_s = 1.0 / 60, decay_per_s = 1.0;
+  int width = 640, height = 480;
+};
+
+enum class OutKind { kNpy, kFga, kVf, kPng };
+
+OutKind out_kind(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".npy") return OutKind::kNpy;
+  if (ext == ".fga") return OutKind::kFga;
+  if (ext == ".vf") return OutKind::kVf;
+  if (ext == ".png") return OutKind::kPng;
+  throw UsageError("-o " + path + ": the output must be .npy, .fga, .vf or .png");
+}
+
+// The box of every source's segment grown by its radius (and a tenth on each side), when --box is
+// not given.
+VectorVolume volume_around(const VectorSourceFrames& f, Vec3i resolution) {
+  double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+                  std::numeric_limits<double>::max()};
+  double hi[3] = {-lo[0], -lo[1], -lo[2]};
+  bool any = false;
+  for (const auto& frame : f.frames)
+    for (const VectorSource& s : frame)
+      for (const Vec3d& p : {s.position, s.previous})
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = std::min(lo[a], p[a] - s.radius);
+          hi[a] = std::max(hi[a], p[a] + s.radius);
+          any = true;
+        }
+  if (!any) throw UsageError("the sources file holds no source: give the volume with --box");
+  VectorVolume v;
+  v.resolution = resolution;
+  for (int a = 0; a < 3; ++a) {
+    const double margin = 0.1 * (hi[a] - lo[a]);
+    v.centre[a] = 0.5 * (lo[a] + hi[a]);
+    v.size[a] = hi[a] - lo[a] + 2 * margin;
+  }
+  return v;
+}
+
+int run_vectors(const VectorSettings& s) {
+  const OutKind kind = out_kind(s.out);
+  if (s.resolution.size() != 3) throw UsageError("--resolution takes three values: nx,ny,nz");
+  if (!s.box.empty() && s.box.size() != 6)
+    throw UsageError("--box takes six values: cx,cy,cz,sx,sy,sz");
+  if (!s.rotation.empty() && s.rotation.size() != 4)
+    throw UsageError("--rotation takes four values: degrees,ax,ay,az");
+  VectorOptions options;
+  options.algorithm = parse_vector_algorithm(s.algorithm);
+  options.rule = parse_vector_rule(s.rule);
+  const VectorStorage storage = parse_vector_storage(s.storage);
+  Outputs outputs({s.sources});
+  outputs.expect(s.out, "-o");
+  outputs.expect(s.stats, "--stats");
+
+  set_activity("reading " + s.sources);
+  const VectorSourceFrames frames = read_vector_sources(s.sources);
+  const Vec3i resolution{s.resolution[0], s.resolution[1], s.resolution[2]};
+  VectorVolume volume;
+  if (s.box.empty()) {
+    volume = volume_around(frames, resolution);
+  } else {
+    volume.centre = {s.box[0], s.box[1], s.box[2]};
+    volume.size = {s.box[3], s.box[4], s.box[5]};
+    volume.resolution = resolution;
+  }
+  if (!s.rotation.empty())
+    volume.rotation =
+        VectorVolume::rotation_about(s.rotation[0], {s.rotation[1], s.rotation[2], s.rotation[3]});
+  try {
+    volume.validate();
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  if (kind == OutKind::kFga && (resolution.x > 128 || resolution.y > 128 || resolution.z > 128))
+    throw UsageError("-o " + s.out + ": an .fga vector field holds at most 128 voxels per axis "
+                     "(Unreal's importer refuses more); lower --resolution");
+
+  set_activity("computing the vector field of " + s.sources);
+  const auto start = std::chrono::steady_clock::now();
+  VectorPassTimes totals;
+  VectorTexture texture;
+  if (frames.animated) {
+    VectorSimulation sim(volume, storage, options, s.decay_per_s);
+    for (const auto& frame : frames.frames) {
+      sim.step(frame, s.dt_s);
+      const VectorPassTimes& t = sim.last_times();
+      totals.seed_ms += t.seed_ms;
+      totals.flood_ms += t.flood_ms;
+      totals.search_ms += t.search_ms;
+      totals.convert_ms += t.convert_ms;
+      totals.blend_ms += t.blend_ms;
+      totals.flood_passes += t.flood_passes;
+    }
+    texture = sim.field();
+  } else {
+    texture = generate_vectors(volume, frames.frames.front(), storage, options, &totals);
+  }
+  const double ms = ms_since(start);
+
+  set_activity("writing " + s.out);
+  switch (kind) {
+    case OutKind::kNpy: outputs.stage(s.out, encode_npy(vector_npy(texture))); break;
+    case OutKind::kFga: outputs.stage(s.out, std::string_view(encode_fga(volume, texture))); break;
+    case OutKind::kVf: outputs.stage(s.out, encode_vf(volume, texture)); break;
+    case OutKind::kPng: {
+      VectorViewOptions view;
+      view.width = s.width;
+      view.height = s.height;
+      outputs.stage(s.out, encode_png(render_vectors(volume, texture, view)));
+      break;
+    }
+  }
+  if (!s.stats.empty()) {
+    nlohmann::json j;
+    j["sources_file"] = s.sources;
+    j["output"] = s.out;
+    j["algorithm"] = vector_algorithm_name(options.algorithm);
+    j["rule"] = vector_rule_name(options.rule);
+    j["storage"] = vector_storage_name(storage);
+    j["frames"] = frames.frames.size();
+    j["resolution"] = {resolution.x, resolution.y, resolution.z};
+    j["box"] = {{"centre", {volume.centre.x, volume.centre.y, volume.centre.z}},
+                {"size", {volume.size.x, volume.size.y, volume.size.z}}};
+    j["voxels_written"] = volume.voxel_count() * static_cast<std::int64_t>(frames.frames.size());
+    j["ms"] = ms;
+    j["passes_ms"] = {{"seed", totals.seed_ms},       {"flood", totals.flood_ms},
+                      {"search", totals.search_ms},   {"convert", totals.convert_ms},
+                      {"decay_blend", totals.blend_ms}};
+    if (totals.flood_passes) j["flood_passes"] = totals.flood_passes;
+    if (options.algorithm != VectorAlgorithm::kBrute &&
+        options.algorithm != VectorAlgorithm::kSplat) {
+      // The last frame's winners against the exact ones (splat), as docs/vectors.md defines.
+      const auto& last = frames.frames.back();
+      VectorOptions exact = options;
+      exact.algorithm = VectorAlgorithm::kSplat;
+      const VectorError e = compare_vector_winners(volume, last, vector_winners(volume, last, exact),
+                                                   vector_winners(volume, last, options));
+      j["error"] = {{"percent_source_differs", e.percent_differs()},
+                    {"voxels_source_differs", e.source_differs},
+                    {"max_angle_deg", e.max_angle_deg},
+                    {"max_strength_error", e.max_strength_error}};
+    }
+    outputs.stage_json(s.stats, j);
+  }
+  outputs.commit();
+  std::cerr << "voxfield: wrote " << s.out << " (" << to_string(resolution) << ", "
+            << frames.frames.size() << (frames.frames.size() == 1 ? " frame, " : " frames, ")
+            << vector_algorithm_name(options.algorithm) << ", " << vector_storage_name(storage)
+            << ", " << std::lround(ms) << " ms)\n";
+  return 0;
+}
+
+}  // namespace
+
+void add_vectors(CLI::App& app, Action& action) {
+  auto s = std::make_shared<VectorSettings>();
+  CLI::App* cmd = app.add_subcommand(
+      "vectors",
+      "A vector-field volume texture from moving sources (direction away from the strongest "
+      "source, strength 1 - d/r), one generation or one decayed and blended step per frame");
+  cmd->add_option("SOURCES", s->sources,
+                  "JSON: {\"sources\": [{\"position\": [x,y,z], \"previous\": [x,y,z], "
+                  "\"radius\": r}, ...]} or {\"frames\": [{\"sources\": [...]}, ...]}")
+      ->required();
+  cmd->add_option("-o,--output", s->out,
+                  ".npy (float32 a[i,j,k,4]: direction, strength), .fga (Unreal), .vf (Unity VFX "
+                  "Graph) or .png (the visualiser); written atomically")
+      ->required();
+  cmd->add_option("--resolution", s->resolution, "voxels per axis: nx,ny,nz (default 64,64,64)")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 4096));
+  cmd->add_option("--box", s->box,
+                  "the volume: centre and full size, cx,cy,cz,sx,sy,sz (default: around the "
+                  "sources)")
+      ->delimiter(',')
+      ->check(CLI::Number);
+  cmd->add_option("--rotation", s->rotation, "the volume's rotation: degrees,ax,ay,az")
+      ->delimiter(',')
+      ->check(CLI::Number);
+  cmd->add_option("--algorithm", s->algorithm, "splat (default, exact), brute, jfa, jfa+1, jfa+2")
+      ->check(CLI::IsMember({"splat", "brute", "jfa", "jfa+1", "jfa+2"}));
+  cmd->add_option("--rule", s->rule,
+                  "strongest (default: greatest 1 - d/r) or nearest (the paper's text rule)")
+      ->check(CLI::IsMember({"strongest", "nearest"}));
+  cmd->add_option("--storage", s->storage, "rgba8 (default), rgba16f or rgba32f")
+      ->check(CLI::IsMember({"rgba8", "rgba16f", "rgba32f"}));
+  cmd->add_option("--dt", s->dt_s, "seconds per frame step (default 1/60)")->check(finite_positive());
+  cmd->add_option("--decay-per-s", s->decay_per_s,
+                  "strength lost per second by the previous field (default 1)")
+      ->check(finite_non_negative());
+  cmd->add_option("--width", s->width, "picture width (.png)")->check(CLI::Range(1, 16384));
+  cmd->add_option("--height", s->height, "picture height (.png)")->check(CLI::Range(1, 16384));
+  cmd->add_option("--stats", s->stats, "write pass timings (and jfa's error) as JSON");
+  cmd->callback([s, &action] { action = [s] { return run_vectors(*s); }; });
+}
+
+}  // namespace voxfield::cli
