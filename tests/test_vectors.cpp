@@ -30,18 +30,26 @@ VectorVolume cube_volume(int n) {
 std::vector<VectorSource> random_sources(const VectorVolume& v, int count, std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0, 1);
-  const double voxel = std::min({v.size.x / v.resolution.x, v.size.y / v.resolution.y,
-                                 v.size.z / v.resolution.z});
+  const double voxel =
+      std::min({v.size.x / v.resolution.x, v.size.y / v.resolution.y, v.size.z / v.resolution.z});
   std::vector<VectorSource> out;
   for (int i = 0; i < count; ++i) {
     VectorSource s;
     const Vec3d u{unit(rng) * 1.4 - 0.2, unit(rng) * 1.4 - 0.2, unit(rng) * 1.4 - 0.2};
     s.position = v.to_world(u);
     switch (i % 5) {
-      case 0: s.previous = s.position; break;  // stationary
-      case 1: s.previous = v.to_world({unit(rng), unit(rng), unit(rng)}); break;  // fast mover
-      case 2: s.position = v.to_world({1.0, u.y, u.z}); s.previous = s.position; break;  // + face
-      default: s.previous = s.position + Vec3d{unit(rng) - 0.5, unit(rng) - 0.5, 0} * (3 * voxel);
+      case 0:
+        s.previous = s.position;
+        break;  // stationary
+      case 1:
+        s.previous = v.to_world({unit(rng), unit(rng), unit(rng)});
+        break;  // fast mover
+      case 2:
+        s.position = v.to_world({1.0, u.y, u.z});
+        s.previous = s.position;
+        break;  // + face
+      default:
+        s.previous = s.position + Vec3d{unit(rng) - 0.5, unit(rng) - 0.5, 0} * (3 * voxel);
     }
     s.radius = i % 4 == 3 ? voxel * (0.1 + 0.3 * unit(rng)) : voxel * (1 + 6 * unit(rng));
     out.push_back(s);
@@ -55,7 +63,8 @@ std::vector<std::int32_t> oracle_winners(const VectorVolume& v, std::span<const 
   for (int k = 0; k < v.resolution.z; ++k)
     for (int j = 0; j < v.resolution.y; ++j)
       for (int i = 0; i < v.resolution.x; ++i)
-        w[static_cast<std::size_t>(v.index(i, j, k))] = vector_at(v.voxel_centre(i, j, k), s, rule).source;
+        w[static_cast<std::size_t>(v.index(i, j, k))] =
+            vector_at(v.voxel_centre(i, j, k), s, rule).source;
   return w;
 }
 
@@ -117,11 +126,12 @@ TEST(Vectors, TexelsAreTheDefinitionsValuesInEveryStorage) {
     for (int k = 0; k < v.resolution.z; ++k)
       for (int j = 0; j < v.resolution.y; ++j)
         for (int i = 0; i < v.resolution.x; ++i) {
-          const VectorValue want = vector_at(v.voxel_centre(i, j, k), sources, VectorRule::kStrongest);
+          const VectorValue want =
+              vector_at(v.voxel_centre(i, j, k), sources, VectorRule::kStrongest);
           const VectorTexel got = t.get(v.index(i, j, k));
-          const double e = std::max({std::abs(got.x - want.direction.x), std::abs(got.y - want.direction.y),
-                                     std::abs(got.z - want.direction.z),
-                                     std::abs(got.strength - want.strength)});
+          const double e = std::max(
+              {std::abs(got.x - want.direction.x), std::abs(got.y - want.direction.y),
+               std::abs(got.z - want.direction.z), std::abs(got.strength - want.strength)});
           worst = std::max(worst, e);
         }
     EXPECT_LE(worst, tol) << vector_storage_name(storage);
@@ -144,7 +154,8 @@ TEST(Vectors, SubVoxelSourcesSurviveJumpFlooding) {
   const VectorVolume v = cube_volume(16);
   // Radius 0.3 voxel, off every centre but reaching one (0.2 from voxel (4,4,4)'s centre).
   const VectorSource s{{-3.5 + 0.2, -3.5, -3.5}, {-3.5 + 0.2, -3.5, -3.5}, 0.3};
-  for (VectorAlgorithm a : {VectorAlgorithm::kJfa, VectorAlgorithm::kJfaPlus1, VectorAlgorithm::kJfaPlus2}) {
+  for (VectorAlgorithm a :
+       {VectorAlgorithm::kJfa, VectorAlgorithm::kJfaPlus1, VectorAlgorithm::kJfaPlus2}) {
     VectorOptions o;
     o.algorithm = a;
     const auto w = vector_winners(v, std::span(&s, 1), o);
@@ -165,15 +176,19 @@ TEST(Vectors, JumpFloodingIsExactForOneSourceAndItsErrorIsMeasuredForMany) {
 
   const std::vector<VectorSource> many = random_sources(v, 60, 5);
   const auto want = vector_winners(v, many, exact);
-  for (VectorAlgorithm a : {VectorAlgorithm::kJfa, VectorAlgorithm::kJfaPlus1, VectorAlgorithm::kJfaPlus2}) {
+  for (VectorAlgorithm a :
+       {VectorAlgorithm::kJfa, VectorAlgorithm::kJfaPlus1, VectorAlgorithm::kJfaPlus2}) {
     jfa.algorithm = a;
     VectorPassTimes times;
-    const VectorError e = compare_vector_winners(v, many, want, vector_winners(v, many, jfa, &times));
+    const VectorError e =
+        compare_vector_winners(v, many, want, vector_winners(v, many, jfa, &times));
     EXPECT_EQ(e.voxels, v.voxel_count());
     EXPECT_LT(e.percent_differs(), 50) << vector_algorithm_name(a);  // a flood, not noise
-    EXPECT_EQ(times.flood_passes, 5 + (a == VectorAlgorithm::kJfaPlus1) + 2 * (a == VectorAlgorithm::kJfaPlus2));
-    std::printf("%s: %.3f %% of voxels take another source, max angle %.2f deg, max strength %.4f\n",
-                vector_algorithm_name(a), e.percent_differs(), e.max_angle_deg, e.max_strength_error);
+    EXPECT_EQ(times.flood_passes,
+              5 + (a == VectorAlgorithm::kJfaPlus1) + 2 * (a == VectorAlgorithm::kJfaPlus2));
+    std::printf(
+        "%s: %.3f %% of voxels take another source, max angle %.2f deg, max strength %.4f\n",
+        vector_algorithm_name(a), e.percent_differs(), e.max_angle_deg, e.max_strength_error);
   }
   // The comparison itself is not blind: planted differences are counted.
   auto planted = want;
@@ -217,7 +232,7 @@ TEST(Vectors, DecayAndBlendMatchHandWorkedValues) {
   EXPECT_NEAR(b.x, 0.6 / len, 1e-6);
   EXPECT_NEAR(b.y, 0.4 / len, 1e-6);
   EXPECT_NEAR(b.strength, 0.6, 1e-6);
-  EXPECT_EQ(blend_vector_texels({}, {}, 1.0, 0.1), VectorTexel{});  // 0 / 0 guarded
+  EXPECT_EQ(blend_vector_texels({}, {}, 1.0, 0.1), VectorTexel{});    // 0 / 0 guarded
   const VectorTexel faded = blend_vector_texels({}, prev, 2.0, 0.1);  // no current source
   EXPECT_NEAR(faded.strength, 0.3, 1e-6);
   EXPECT_NEAR(faded.y, 1, 1e-6);
@@ -232,12 +247,14 @@ TEST(Vectors, SimulationStepsGenerateDecayAndBlend) {
   VectorSimulation sim(v, VectorStorage::kRgba32f, {}, 2.0);
   const VectorSource s{{0, 0, 0}, {-4, 0, 0}, 3};
   sim.step(std::span(&s, 1), 0.1);
-  for (std::int64_t i = 0; i < v.voxel_count(); ++i) ASSERT_EQ(sim.field().get(i), sim.current().get(i));
+  for (std::int64_t i = 0; i < v.voxel_count(); ++i)
+    ASSERT_EQ(sim.field().get(i), sim.current().get(i));
   sim.step({}, 0.1);  // the source has gone: its wake fades by 0.2
   for (std::int64_t i = 0; i < v.voxel_count(); ++i) ASSERT_EQ(sim.current().get(i), VectorTexel{});
   const std::int64_t centre = v.index(8, 8, 8);
   const VectorTexture first = generate_vectors(v, std::span(&s, 1), VectorStorage::kRgba32f);
-  EXPECT_NEAR(sim.field().get(centre).strength, std::max(0.0f, first.get(centre).strength - 0.2f), 1e-6);
+  EXPECT_NEAR(sim.field().get(centre).strength, std::max(0.0f, first.get(centre).strength - 0.2f),
+              1e-6);
   EXPECT_EQ(sim.steps(), 2);
   EXPECT_NE(error_of([&] { sim.step({}, 0); }).find("time step"), std::string::npos);
 }
@@ -277,7 +294,8 @@ TEST(Vectors, SamplingIsTrilinearBetweenCentresAndZeroOutside) {
   // Halfway between two centres along x: the mean.
   const Vec3d mid = (v.voxel_centre(10, 4, 6) + v.voxel_centre(11, 4, 6)) * 0.5;
   const VectorSample s = sample_vectors(v, t, mid);
-  EXPECT_NEAR(s.strength, 0.5 * (t.get(v.index(10, 4, 6)).strength + t.get(v.index(11, 4, 6)).strength), 1e-6);
+  EXPECT_NEAR(s.strength,
+              0.5 * (t.get(v.index(10, 4, 6)).strength + t.get(v.index(11, 4, 6)).strength), 1e-6);
   EXPECT_FALSE(sample_vectors(v, t, v.to_world({1.01, 0.5, 0.5})).inside);
   EXPECT_EQ(sample_vectors(v, t, v.to_world({-0.01, 0.5, 0.5})).strength, 0);
 }
@@ -286,24 +304,30 @@ TEST(Vectors, BadVolumesAndSourcesAreRefusedByName) {
   VectorVolume v = cube_volume(8);
   const VectorSource ok{{0, 0, 0}, {0, 0, 0}, 1};
   v.resolution = {0, 8, 8};
-  EXPECT_NE(error_of([&] { generate_vectors(v, std::span(&ok, 1), VectorStorage::kRgba8); }).find("resolution"),
+  EXPECT_NE(error_of([&] {
+              generate_vectors(v, std::span(&ok, 1), VectorStorage::kRgba8);
+            }).find("resolution"),
             std::string::npos);
   v = cube_volume(8);
   v.size.y = std::nan("");
-  EXPECT_NE(error_of([&] { generate_vectors(v, std::span(&ok, 1), VectorStorage::kRgba8); }).find("size"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of([&] { generate_vectors(v, std::span(&ok, 1), VectorStorage::kRgba8); }).find("size"),
+      std::string::npos);
   v = cube_volume(8);
   v.rotation[0] = {2, 0, 0};
   EXPECT_NE(error_of([&] { v.validate(); }).find("orthonormal"), std::string::npos);
   const VectorSource bad{{0, 0, 0}, {0, 0, 0}, -1};
   const VectorSource two[] = {ok, bad};
-  EXPECT_NE(error_of([&] { generate_vectors(cube_volume(8), two, VectorStorage::kRgba8); }).find("source 1"),
+  EXPECT_NE(error_of([&] {
+              generate_vectors(cube_volume(8), two, VectorStorage::kRgba8);
+            }).find("source 1"),
             std::string::npos);
 }
 
 TEST(VectorFiles, SourcesFilesParseAndRefuseWithTheirPlace) {
   auto parse = [](const std::string& text) {
-    return parse_vector_sources({reinterpret_cast<const std::uint8_t*>(text.data()), text.size()}, "s.json");
+    return parse_vector_sources({reinterpret_cast<const std::uint8_t*>(text.data()), text.size()},
+                                "s.json");
   };
   const VectorSourceFrames one = parse(R"({"sources": [{"position": [1, 2, 3], "radius": 2},
       {"position": [0, 0, 0], "previous": [-1, 0, 0], "radius": 0.5}]})");
@@ -311,22 +335,32 @@ TEST(VectorFiles, SourcesFilesParseAndRefuseWithTheirPlace) {
   EXPECT_FALSE(one.animated);
   EXPECT_EQ(one.frames[0][0].previous, (Vec3d{1, 2, 3}));  // stationary by default
   EXPECT_EQ(one.frames[0][1].previous, (Vec3d{-1, 0, 0}));
-  const VectorSourceFrames anim = parse(R"({"frames": [{"sources": []}, {"sources": [{"position": [0,0,0], "radius": 1}]}]})");
+  const VectorSourceFrames anim =
+      parse(R"({"frames": [{"sources": []}, {"sources": [{"position": [0,0,0], "radius": 1}]}]})");
   EXPECT_TRUE(anim.animated);
   EXPECT_EQ(anim.frames.size(), 2u);
   const std::string syntax = error_of([&] { parse("{\"sources\": [\n{\"position\": }]}"); });
   EXPECT_NE(syntax.find("s.json: at byte"), std::string::npos) << syntax;
   EXPECT_NE(syntax.find("line 2"), std::string::npos) << syntax;
   const std::string radius = error_of([&] {
-    parse(R"({"frames": [{"sources": []}, {"sources": [{"position": [0,0,0], "radius": 1}, {"position": [0,0,0], "radius": -2}]}]})");
+    parse(
+        R"({"frames": [{"sources": []}, {"sources": [{"position": [0,0,0], "radius": 1}, {"position": [0,0,0], "radius": -2}]}]})");
   });
-  EXPECT_NE(radius.find("s.json: frame 1, source 1: \"radius\" must be > 0"), std::string::npos) << radius;
-  EXPECT_NE(error_of([&] { parse(R"({"sources": [{"position": [0,0,1e300], "radius": 1}]})"); }).find("1e12"),
+  EXPECT_NE(radius.find("s.json: frame 1, source 1: \"radius\" must be > 0"), std::string::npos)
+      << radius;
+  EXPECT_NE(error_of([&] {
+              parse(R"({"sources": [{"position": [0,0,1e300], "radius": 1}]})");
+            }).find("1e12"),
             std::string::npos);
-  EXPECT_NE(error_of([&] { parse(R"({"sources": [{"position": [0,0], "radius": 1}]})"); }).find("[x, y, z]"),
+  EXPECT_NE(error_of([&] {
+              parse(R"({"sources": [{"position": [0,0], "radius": 1}]})");
+            }).find("[x, y, z]"),
             std::string::npos);
-  EXPECT_NE(error_of([&] { parse(R"({"sources": [], "frames": []})"); }).find("exactly one"), std::string::npos);
-  EXPECT_NE(error_of([&] { parse(R"({"sources": [{"position": [0,0,0], "radius": 1, "speed": 3}]})"); }).find("speed"),
+  EXPECT_NE(error_of([&] { parse(R"({"sources": [], "frames": []})"); }).find("exactly one"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] {
+              parse(R"({"sources": [{"position": [0,0,0], "radius": 1, "speed": 3}]})");
+            }).find("speed"),
             std::string::npos);
 }
 
@@ -363,7 +397,8 @@ TEST(Vectors, TheVisualiserShowsTheFieldAndNothingElse) {
   const Image empty = render_vectors(v, VectorTexture(v.resolution, VectorStorage::kRgba8), view);
   for (std::size_t i = 3; i < empty.rgb.size(); ++i) ASSERT_EQ(empty.rgb[i], empty.rgb[i % 3]);
   const VectorSource s{{0, 0, 0}, {-6, 0, 0}, 6};
-  const Image shown = render_vectors(v, generate_vectors(v, std::span(&s, 1), VectorStorage::kRgba8), view);
+  const Image shown =
+      render_vectors(v, generate_vectors(v, std::span(&s, 1), VectorStorage::kRgba8), view);
   int lit = 0;
   for (int y = 0; y < view.height; ++y)
     for (int x = 0; x < view.width; ++x) lit += shown.pixel(x, y)[0] != empty.pixel(x, y)[0];

@@ -85,7 +85,8 @@ Row run_case(const std::string& test, VectorAlgorithm algorithm, Vec3i resolutio
   Agents agents(count, seed);
   Row r{test, vector_algorithm_name(algorithm), resolution, count, dt, decay};
   std::vector<double> step_ms;
-  const bool approximate = algorithm != VectorAlgorithm::kBrute && algorithm != VectorAlgorithm::kSplat;
+  const bool approximate =
+      algorithm != VectorAlgorithm::kBrute && algorithm != VectorAlgorithm::kSplat;
   VectorOptions exact;
   for (int i = 0; i < steps; ++i) {
     const std::vector<VectorSource> sources = agents.step(dt);
@@ -96,8 +97,9 @@ Row run_case(const std::string& test, VectorAlgorithm algorithm, Vec3i resolutio
     r.generate_ms += t.seed_ms + t.flood_ms + t.search_ms + t.convert_ms;
     r.blend_ms += t.blend_ms;
     if (approximate && i % 10 == 9) {  // every tenth step: the error against the definition
-      const VectorError e = compare_vector_winners(volume, sources, vector_winners(volume, sources, exact),
-                                                   vector_winners(volume, sources, options));
+      const VectorError e =
+          compare_vector_winners(volume, sources, vector_winners(volume, sources, exact),
+                                 vector_winners(volume, sources, options));
       r.percent_differs = std::max(r.percent_differs, e.percent_differs());
       r.max_angle_deg = std::max(r.max_angle_deg, e.max_angle_deg);
       r.max_strength_error = std::max(r.max_strength_error, e.max_strength_error);
@@ -159,11 +161,14 @@ int run_bench_vectors(const BenchVectorSettings& s) {
     throw UsageError("unknown test " + s.test);
   }
   std::ostringstream csv;
-  csv << "test,algorithm,nx,ny,nz,sources,dt_s,decay_per_s,storage,steps,generate_ms,decay_blend_ms,"
-         "step_ms,p99_step_ms,percent_source_differs,max_angle_deg,max_strength_error,mean_strength\n";
-  std::cout << "| algorithm | resolution | sources | dt (s) | decay/s | generate ms | decay+blend ms | "
-               "step ms (p99) | % source differs | max angle (deg) | max strength error |\n"
-               "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  csv << "test,algorithm,nx,ny,nz,sources,dt_s,decay_per_s,storage,steps,generate_ms,decay_blend_"
+         "ms,"
+         "step_ms,p99_step_ms,percent_source_differs,max_angle_deg,max_strength_error,mean_"
+         "strength\n";
+  std::cout
+      << "| algorithm | resolution | sources | dt (s) | decay/s | generate ms | decay+blend ms | "
+         "step ms (p99) | % source differs | max angle (deg) | max strength error |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
     csv << r.test << "," << r.algorithm << "," << r.resolution.x << "," << r.resolution.y << ","
         << r.resolution.z << "," << r.sources << "," << r.dt << "," << r.decay << "," << s.storage
@@ -171,11 +176,12 @@ int run_bench_vectors(const BenchVectorSettings& s) {
         << r.p99_step_ms << "," << r.percent_differs << "," << r.max_angle_deg << ","
         << r.max_strength_error << "," << r.mean_strength << "\n";
     char line[512];
-    std::snprintf(line, sizeof line,
-                  "| %s | %dx%dx%d | %d | %.4f | %.1f | %.3f | %.3f | %.3f (%.3f) | %.3f | %.2f | %.4f |\n",
-                  r.algorithm.c_str(), r.resolution.x, r.resolution.y, r.resolution.z, r.sources,
-                  r.dt, r.decay, r.generate_ms, r.blend_ms, r.step_ms, r.p99_step_ms,
-                  r.percent_differs, r.max_angle_deg, r.max_strength_error);
+    std::snprintf(
+        line, sizeof line,
+        "| %s | %dx%dx%d | %d | %.4f | %.1f | %.3f | %.3f | %.3f (%.3f) | %.3f | %.2f | %.4f |\n",
+        r.algorithm.c_str(), r.resolution.x, r.resolution.y, r.resolution.z, r.sources, r.dt,
+        r.decay, r.generate_ms, r.blend_ms, r.step_ms, r.p99_step_ms, r.percent_differs,
+        r.max_angle_deg, r.max_strength_error);
     std::cout << line;
   }
   if (!s.csv.empty()) outputs.stage(s.csv, std::string_view(csv.str()));
@@ -191,13 +197,14 @@ void add_bench_vectors(CLI::App* bench, Action& action) {
       "vectors", "The vector-field paper's six tests: whole steps, per pass, with JFA's error");
   cmd->add_option("--test", s->test,
                   "fidelity, decay, jfa-sources, jfa-resolution, time-step or quarter-resolution")
-      ->check(CLI::IsMember(
-          {"fidelity", "decay", "jfa-sources", "jfa-resolution", "time-step", "quarter-resolution"}));
+      ->check(CLI::IsMember({"fidelity", "decay", "jfa-sources", "jfa-resolution", "time-step",
+                             "quarter-resolution"}));
   cmd->add_option("--steps", s->steps, "steps per case (default 60)")->check(CLI::Range(1, 100000));
   cmd->add_option("--storage", s->storage, "rgba8 (default), rgba16f or rgba32f")
       ->check(CLI::IsMember({"rgba8", "rgba16f", "rgba32f"}));
   cmd->add_option("--seed", s->seed, "the agents' random seed");
-  cmd->add_option("--algorithms", s->algorithms, "run only these of the test's algorithms (a,b,...)")
+  cmd->add_option("--algorithms", s->algorithms,
+                  "run only these of the test's algorithms (a,b,...)")
       ->delimiter(',')
       ->check(CLI::IsMember({"splat", "brute", "jfa", "jfa+1", "jfa+2"}));
   cmd->add_option("--threads", s->threads, "threads (default: all)")->check(CLI::Range(1, 1024));

@@ -93,7 +93,8 @@ int run_vectors(const VectorSettings& s) {
     throw UsageError(e.what());
   }
   if (kind == OutKind::kFga && (resolution.x > 128 || resolution.y > 128 || resolution.z > 128))
-    throw UsageError("-o " + s.out + ": an .fga vector field holds at most 128 voxels per axis "
+    throw UsageError("-o " + s.out +
+                     ": an .fga vector field holds at most 128 voxels per axis "
                      "(Unreal's importer refuses more); lower --resolution");
 
   set_activity("computing the vector field of " + s.sources);
@@ -120,9 +121,15 @@ int run_vectors(const VectorSettings& s) {
 
   set_activity("writing " + s.out);
   switch (kind) {
-    case OutKind::kNpy: outputs.stage(s.out, encode_npy(vector_npy(texture))); break;
-    case OutKind::kFga: outputs.stage(s.out, std::string_view(encode_fga(volume, texture))); break;
-    case OutKind::kVf: outputs.stage(s.out, encode_vf(volume, texture)); break;
+    case OutKind::kNpy:
+      outputs.stage(s.out, encode_npy(vector_npy(texture)));
+      break;
+    case OutKind::kFga:
+      outputs.stage(s.out, std::string_view(encode_fga(volume, texture)));
+      break;
+    case OutKind::kVf:
+      outputs.stage(s.out, encode_vf(volume, texture));
+      break;
     case OutKind::kPng: {
       VectorViewOptions view;
       view.width = s.width;
@@ -144,8 +151,10 @@ int run_vectors(const VectorSettings& s) {
                 {"size", {volume.size.x, volume.size.y, volume.size.z}}};
     j["voxels_written"] = volume.voxel_count() * static_cast<std::int64_t>(frames.frames.size());
     j["ms"] = ms;
-    j["passes_ms"] = {{"seed", totals.seed_ms},       {"flood", totals.flood_ms},
-                      {"search", totals.search_ms},   {"convert", totals.convert_ms},
+    j["passes_ms"] = {{"seed", totals.seed_ms},
+                      {"flood", totals.flood_ms},
+                      {"search", totals.search_ms},
+                      {"convert", totals.convert_ms},
                       {"decay_blend", totals.blend_ms}};
     if (totals.flood_passes) j["flood_passes"] = totals.flood_passes;
     if (options.algorithm != VectorAlgorithm::kBrute &&
@@ -154,8 +163,8 @@ int run_vectors(const VectorSettings& s) {
       const auto& last = frames.frames.back();
       VectorOptions exact = options;
       exact.algorithm = VectorAlgorithm::kSplat;
-      const VectorError e = compare_vector_winners(volume, last, vector_winners(volume, last, exact),
-                                                   vector_winners(volume, last, options));
+      const VectorError e = compare_vector_winners(
+          volume, last, vector_winners(volume, last, exact), vector_winners(volume, last, options));
       j["error"] = {{"percent_source_differs", e.percent_differs()},
                     {"voxels_source_differs", e.source_differs},
                     {"max_angle_deg", e.max_angle_deg},
@@ -205,7 +214,8 @@ void add_vectors(CLI::App& app, Action& action) {
       ->check(CLI::IsMember({"strongest", "nearest"}));
   cmd->add_option("--storage", s->storage, "rgba8 (default), rgba16f or rgba32f")
       ->check(CLI::IsMember({"rgba8", "rgba16f", "rgba32f"}));
-  cmd->add_option("--dt", s->dt_s, "seconds per frame step (default 1/60)")->check(finite_positive());
+  cmd->add_option("--dt", s->dt_s, "seconds per frame step (default 1/60)")
+      ->check(finite_positive());
   cmd->add_option("--decay-per-s", s->decay_per_s,
                   "strength lost per second by the previous field (default 1)")
       ->check(finite_non_negative());

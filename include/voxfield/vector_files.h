@@ -22,7 +22,8 @@ struct VectorSourceFrames {
   std::vector<std::vector<VectorSource>> frames;
   bool animated = false;  // written as {"frames": ...}
 };
-VectorSourceFrames parse_vector_sources(std::span<const std::uint8_t> bytes, const std::string& name);
+VectorSourceFrames parse_vector_sources(std::span<const std::uint8_t> bytes,
+                                        const std::string& name);
 VectorSourceFrames read_vector_sources(const std::filesystem::path& path);
 
 // float32 a[i, j, k, c]: c = 0..2 the direction in world space, c = 3 the strength, decoded from

@@ -4,7 +4,8 @@
 // (a position, the previous position and a radius each) push the space around them; a volume
 // texture holds, at every voxel, the direction away from the strongest source that reaches it and
 // that strength. Each fixed time step generates a new texture, decays the previous one's strength
-// and blends the two, so moving sources leave fading wakes that grass, water and particles react to.
+// and blends the two, so moving sources leave fading wakes that grass, water and particles react
+// to.
 //
 // One model, used by every algorithm, the sampler and the files:
 //  * a VectorVolume is an oriented box in world space with a resolution; voxel (i, j, k) has its
@@ -44,7 +45,8 @@ struct VectorVolume {
 
   std::int64_t voxel_count() const;
   std::int64_t index(int i, int j, int k) const {
-    return i + static_cast<std::int64_t>(resolution.x) * (j + static_cast<std::int64_t>(resolution.y) * k);
+    return i + static_cast<std::int64_t>(resolution.x) *
+                   (j + static_cast<std::int64_t>(resolution.y) * k);
   }
   // World position of voxel (i, j, k)'s centre.
   Vec3d voxel_centre(int i, int j, int k) const;
@@ -73,9 +75,9 @@ enum class VectorRule { kStrongest, kNearest };
 enum class VectorAlgorithm { kBrute, kSplat, kJfa, kJfaPlus1, kJfaPlus2 };
 enum class VectorStorage { kRgba8, kRgba16f, kRgba32f };
 
-const char* vector_rule_name(VectorRule r);            // "strongest", "nearest"
-const char* vector_algorithm_name(VectorAlgorithm a);  // "brute", "splat", "jfa", "jfa+1", "jfa+2"
-const char* vector_storage_name(VectorStorage s);      // "rgba8", "rgba16f", "rgba32f"
+const char* vector_rule_name(VectorRule r);             // "strongest", "nearest"
+const char* vector_algorithm_name(VectorAlgorithm a);   // "brute", "splat", "jfa", "jfa+1", "jfa+2"
+const char* vector_storage_name(VectorStorage s);       // "rgba8", "rgba16f", "rgba32f"
 VectorRule parse_vector_rule(const std::string& name);  // InvalidArgument for anything else
 VectorAlgorithm parse_vector_algorithm(const std::string& name);
 VectorStorage parse_vector_storage(const std::string& name);
@@ -254,10 +256,10 @@ VectorSample sample_vectors(const VectorVolume& volume, const VectorTexture& tex
 // direction (|component| per channel), over a dark background.
 struct VectorViewOptions {
   int width = 640, height = 480;
-  Vec3d eye{0, 0, 0};          // (0,0,0) with auto_eye: placed from the box (an oblique view)
+  Vec3d eye{0, 0, 0};  // (0,0,0) with auto_eye: placed from the box (an oblique view)
   bool auto_eye = true;
   double fov_deg = 45;
-  double density = 8;          // opacity per world unit at strength 1, scaled by the box size
+  double density = 8;  // opacity per world unit at strength 1, scaled by the box size
 };
 Image render_vectors(const VectorVolume& volume, const VectorTexture& texture,
                      const VectorViewOptions& view = {});

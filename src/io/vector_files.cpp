@@ -30,7 +30,8 @@ void append_number(std::string& s, double v) {
 
 void check_matches(const VectorVolume& v, const VectorTexture& t, const char* who) {
   if (!(t.resolution() == v.resolution))
-    throw InvalidArgument(std::string(who) + ": the texture's resolution differs from the volume's");
+    throw InvalidArgument(std::string(who) +
+                          ": the texture's resolution differs from the volume's");
 }
 
 }  // namespace
@@ -60,10 +61,12 @@ std::string encode_fga(const VectorVolume& volume, const VectorTexture& texture)
   check_matches(volume, texture, "encode_fga");
   const Vec3i n = volume.resolution;
   if (n.x > 128 || n.y > 128 || n.z > 128)
-    throw InvalidArgument("an .fga vector field holds at most 128 voxels per axis (Unreal's "
-                          "importer refuses more); this one is " +
-                          to_string(n));
-  std::string s = std::to_string(n.x) + "," + std::to_string(n.y) + "," + std::to_string(n.z) + ",\n";
+    throw InvalidArgument(
+        "an .fga vector field holds at most 128 voxels per axis (Unreal's "
+        "importer refuses more); this one is " +
+        to_string(n));
+  std::string s =
+      std::to_string(n.x) + "," + std::to_string(n.y) + "," + std::to_string(n.z) + ",\n";
   const Vec3d lo = volume.centre - volume.size * 0.5, hi = volume.centre + volume.size * 0.5;
   for (const Vec3d& corner : {lo, hi}) {
     for (int a = 0; a < 3; ++a) append_number(s, corner[a]);

@@ -24,7 +24,8 @@ struct Reader {
   }
 
   Vec3d point(const json& j, const std::string& where, const char* key) const {
-    if (!j.is_array() || j.size() != 3) bad(where, std::string("\"") + key + "\" must be [x, y, z]");
+    if (!j.is_array() || j.size() != 3)
+      bad(where, std::string("\"") + key + "\" must be [x, y, z]");
     Vec3d p;
     for (int a = 0; a < 3; ++a) {
       if (!j[a].is_number())
@@ -73,8 +74,9 @@ VectorSourceFrames parse_vector_sources(std::span<const std::uint8_t> bytes,
   } catch (const json::parse_error& e) {
     const std::string what = e.what();
     const auto colon = what.find("]: ");
-    throw FormatError(name, e.byte > 0 ? e.byte - 1 : 0,
-                      "not valid JSON: " + (colon == std::string::npos ? what : what.substr(colon + 3)));
+    throw FormatError(
+        name, e.byte > 0 ? e.byte - 1 : 0,
+        "not valid JSON: " + (colon == std::string::npos ? what : what.substr(colon + 3)));
   } catch (const json::exception& e) {  // a number beyond a double's range
     throw InvalidArgument(name + ": not valid JSON: " + e.what());
   }

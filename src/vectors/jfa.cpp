@@ -100,7 +100,8 @@ void flood_pass(const VectorVolume& v, std::span<const Segment> segments, Vector
 
 void jfa_winners(const VectorVolume& v, std::span<const VectorSource> sources,
                  std::span<const Segment> segments, VectorRule rule, int extra_passes,
-                 Interrupter* interrupter, std::span<std::int32_t> winners, VectorPassTimes* times) {
+                 Interrupter* interrupter, std::span<std::int32_t> winners,
+                 VectorPassTimes* times) {
   const CentreTables centres(v);
   std::int64_t start = now_ns();
   seed(v, sources, segments, rule, centres, winners);

@@ -27,7 +27,8 @@ VectorSample sample_vectors(const VectorVolume& volume, const VectorTexture& tex
   double acc[4] = {0, 0, 0, 0};
   for (int c = 0; c < 8; ++c) {
     const int i = c & 1 ? i1[0] : i0[0], j = c & 2 ? i1[1] : i0[1], k = c & 4 ? i1[2] : i0[2];
-    const double w = (c & 1 ? f[0] : 1 - f[0]) * (c & 2 ? f[1] : 1 - f[1]) * (c & 4 ? f[2] : 1 - f[2]);
+    const double w =
+        (c & 1 ? f[0] : 1 - f[0]) * (c & 2 ? f[1] : 1 - f[1]) * (c & 4 ? f[2] : 1 - f[2]);
     const VectorTexel t =
         texture.get(i + static_cast<std::int64_t>(n.x) * (j + static_cast<std::int64_t>(n.y) * k));
     acc[0] += w * t.x;

@@ -59,7 +59,9 @@ struct VectorSimulation::Scratch {
 
 VectorSimulation::VectorSimulation(const VectorVolume& volume, VectorStorage storage,
                                    VectorOptions options, double decay_per_s)
-    : volume_(volume), options_(options), decay_per_s_(decay_per_s),
+    : volume_(volume),
+      options_(options),
+      decay_per_s_(decay_per_s),
       scratch_(std::make_unique<Scratch>()) {
   volume_.validate();
   if (!std::isfinite(decay_per_s) || decay_per_s < 0)
@@ -112,8 +114,9 @@ void fused_step(const VectorVolume& v, std::span<const detail::vectors::Segment>
           const std::int32_t w = winners[static_cast<std::size_t>(first + i)];
           VectorTexel now{};
           if (w >= 0) {
-            C::store(current + at, detail::vectors::texel_of(detail::vectors::value_of(
-                                       segments[static_cast<std::size_t>(w)], centres.at(i, j, k), w)));
+            C::store(current + at,
+                     detail::vectors::texel_of(detail::vectors::value_of(
+                         segments[static_cast<std::size_t>(w)], centres.at(i, j, k), w)));
             now = C::load(current + at);
             any_current = true;
           } else {
@@ -175,10 +178,10 @@ void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) 
       if (winners[i] >= 0) sc.touched_rows[i / static_cast<std::size_t>(n.x)] = 1;
   }
   detail::vectors::with_codec(field_.storage(), [&](auto codec) {
-    fused_step<decltype(codec)>(
-        volume_, segments, winners, static_cast<float>(decay_per_s_ * dt_s), current_.data(),
-        field_.bytes().data(), next_.data(),
-        {sc.current_rows.data(), sc.field_rows.data(), sc.next_rows.data(), sc.touched_rows.data()});
+    fused_step<decltype(codec)>(volume_, segments, winners, static_cast<float>(decay_per_s_ * dt_s),
+                                current_.data(), field_.bytes().data(), next_.data(),
+                                {sc.current_rows.data(), sc.field_rows.data(), sc.next_rows.data(),
+                                 sc.touched_rows.data()});
   });
   t.blend_ms = detail::vectors::ms_since(start);
   std::swap(field_, next_);

@@ -42,8 +42,8 @@ inline std::uint16_t to_half(float f) {
   const std::uint32_t abs = x & 0x7fffffffu;
   if (abs >= 0x7f800000u) return sign | (abs > 0x7f800000u ? 0x7e00u : 0x7c00u);
   if (abs >= 0x477ff000u) return sign | 0x7c00u;  // rounds beyond the largest half: infinity
-  if (abs < 0x38800000u) {                         // below the smallest normal half: subnormal
-    const float scaled = std::bit_cast<float>(abs) * 16777216.0f;  // units of 2^-24, exact
+  if (abs < 0x38800000u) {                        // below the smallest normal half: subnormal
+    const float scaled = std::bit_cast<float>(abs) * 16777216.0f;      // units of 2^-24, exact
     return sign | static_cast<std::uint16_t>(std::nearbyint(scaled));  // nearest even
   }
   const std::uint32_t odd = (abs >> 13) & 1u;
@@ -125,9 +125,12 @@ struct Codec<VectorStorage::kRgba32f> {
 template <class F>
 decltype(auto) with_codec(VectorStorage s, F&& f) {
   switch (s) {
-    case VectorStorage::kRgba8: return f(Codec<VectorStorage::kRgba8>{});
-    case VectorStorage::kRgba16f: return f(Codec<VectorStorage::kRgba16f>{});
-    case VectorStorage::kRgba32f: break;
+    case VectorStorage::kRgba8:
+      return f(Codec<VectorStorage::kRgba8>{});
+    case VectorStorage::kRgba16f:
+      return f(Codec<VectorStorage::kRgba16f>{});
+    case VectorStorage::kRgba32f:
+      break;
   }
   return f(Codec<VectorStorage::kRgba32f>{});
 }

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <cstring>
 
+#include "texel_codec.h"
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
-#include "texel_codec.h"
 #include "voxfield/vectors.h"
 
 namespace voxfield {

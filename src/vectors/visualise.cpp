@@ -25,7 +25,8 @@ Image render_vectors(const VectorVolume& volume, const VectorTexture& texture,
     throw InvalidArgument("render_vectors: the texture's resolution differs from the volume's");
   if (!(view.fov_deg > 1 && view.fov_deg < 179) || !(view.density > 0) ||
       !std::isfinite(view.density))
-    throw InvalidArgument("render_vectors: the field of view must be 1..179 degrees, the density > 0");
+    throw InvalidArgument(
+        "render_vectors: the field of view must be 1..179 degrees, the density > 0");
   Image image(view.width, view.height);
   const double diagonal = volume.size.length();
   const Vec3d eye = view.auto_eye ? volume.to_world({1.6, -0.9, 1.3}) : view.eye;

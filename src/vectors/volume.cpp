@@ -14,15 +14,20 @@ namespace {
 
 constexpr int kMaxResolution = 4096;
 
-bool finite(Vec3d v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(Vec3d v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
-Vec3d column(const std::array<Vec3d, 3>& r, int c) { return {r[0][c], r[1][c], r[2][c]}; }
+Vec3d column(const std::array<Vec3d, 3>& r, int c) {
+  return {r[0][c], r[1][c], r[2][c]};
+}
 
 }  // namespace
 
 std::array<Vec3d, 3> VectorVolume::rotation_about(double degrees, Vec3d axis) {
   if (!finite(axis) || axis.length() == 0 || !std::isfinite(degrees))
-    throw InvalidArgument("rotation: the axis must be a finite non-zero vector and the angle finite");
+    throw InvalidArgument(
+        "rotation: the axis must be a finite non-zero vector and the angle finite");
   const Vec3d u = axis.normalized();
   const double a = degrees * 3.14159265358979323846 / 180.0, c = std::cos(a), s = std::sin(a),
                t = 1 - c;
@@ -32,7 +37,9 @@ std::array<Vec3d, 3> VectorVolume::rotation_about(double degrees, Vec3d axis) {
            {t * u.x * u.z - s * u.y, t * u.y * u.z + s * u.x, t * u.z * u.z + c}}};
 }
 
-std::int64_t VectorVolume::voxel_count() const { return Box3i::from_size(resolution).volume(); }
+std::int64_t VectorVolume::voxel_count() const {
+  return Box3i::from_size(resolution).volume();
+}
 
 Vec3d VectorVolume::voxel_centre(int i, int j, int k) const {
   using detail::vectors::axis_offset;
@@ -95,19 +102,27 @@ const char* vector_rule_name(VectorRule r) {
 }
 const char* vector_algorithm_name(VectorAlgorithm a) {
   switch (a) {
-    case VectorAlgorithm::kBrute: return "brute";
-    case VectorAlgorithm::kSplat: return "splat";
-    case VectorAlgorithm::kJfa: return "jfa";
-    case VectorAlgorithm::kJfaPlus1: return "jfa+1";
-    case VectorAlgorithm::kJfaPlus2: return "jfa+2";
+    case VectorAlgorithm::kBrute:
+      return "brute";
+    case VectorAlgorithm::kSplat:
+      return "splat";
+    case VectorAlgorithm::kJfa:
+      return "jfa";
+    case VectorAlgorithm::kJfaPlus1:
+      return "jfa+1";
+    case VectorAlgorithm::kJfaPlus2:
+      return "jfa+2";
   }
   return "?";
 }
 const char* vector_storage_name(VectorStorage s) {
   switch (s) {
-    case VectorStorage::kRgba8: return "rgba8";
-    case VectorStorage::kRgba16f: return "rgba16f";
-    case VectorStorage::kRgba32f: return "rgba32f";
+    case VectorStorage::kRgba8:
+      return "rgba8";
+    case VectorStorage::kRgba16f:
+      return "rgba16f";
+    case VectorStorage::kRgba32f:
+      return "rgba32f";
   }
   return "?";
 }
@@ -120,7 +135,8 @@ VectorAlgorithm parse_vector_algorithm(const std::string& name) {
   for (VectorAlgorithm a : {VectorAlgorithm::kBrute, VectorAlgorithm::kSplat, VectorAlgorithm::kJfa,
                             VectorAlgorithm::kJfaPlus1, VectorAlgorithm::kJfaPlus2})
     if (name == vector_algorithm_name(a)) return a;
-  throw InvalidArgument("unknown vector algorithm \"" + name + "\" (splat, brute, jfa, jfa+1, jfa+2)");
+  throw InvalidArgument("unknown vector algorithm \"" + name +
+                        "\" (splat, brute, jfa, jfa+1, jfa+2)");
 }
 VectorStorage parse_vector_storage(const std::string& name) {
   for (VectorStorage s : {VectorStorage::kRgba8, VectorStorage::kRgba16f, VectorStorage::kRgba32f})
@@ -181,7 +197,9 @@ std::int64_t now_ns() {
              std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
-double ms_since(std::int64_t start_ns) { return (now_ns() - start_ns) / 1e6; }
+double ms_since(std::int64_t start_ns) {
+  return (now_ns() - start_ns) / 1e6;
+}
 
 }  // namespace detail::vectors
 }  // namespace voxfield
