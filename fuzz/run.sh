@@ -13,7 +13,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-25}; shift || true
-harnesses=${*:-"vox npy vfw edit_script options"}
+harnesses=${*:-"vox npy vfw edit_script options vector_sources"}
 bin=build/fuzz/bin
 cli=build/release/bin/voxfield
 corpus=../shared/data/vox
@@ -38,6 +38,7 @@ for h in $harnesses; do
     vfw) dirs="$seeds/vfw"; max_len=$max_seed ;;
     edit_script) dirs="fuzz/seeds/edit_script"; max_len=4096 ;;
     options) dirs="fuzz/seeds/options"; max_len=256 ;;
+    vector_sources) dirs="fuzz/seeds/vector_sources"; max_len=4096 ;;
     *) echo "unknown harness $h" >&2; exit 2 ;;
   esac
   work="$out/corpus-$h"; mkdir -p "$work"

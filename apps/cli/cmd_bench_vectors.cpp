@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cli.h"
+#include "vector_agents.h"
 #include "voxfield/parallel.h"
 #include "voxfield/vectors.h"
 
@@ -21,48 +22,6 @@ struct BenchVectorSettings {
   int steps = 60, threads = 0;
   std::uint32_t seed = 1;
 };
-
-// The paper's agents: sources flying through a 10-unit box at 2..5 units/s, bouncing off its
-// walls, radius 0.8 units (5 voxels at 64^3). Seeded: the same motion for every algorithm.
-class Agents {
- public:
-  Agents(int count, std::uint32_t seed) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> pos(-4.2, 4.2), dir(-1, 1), speed(2, 5);
-    for (int i = 0; i < count; ++i) {
-      Vec3d d{dir(rng), dir(rng), dir(rng)};
-      if (d.length() < 1e-3) d = {1, 0, 0};
-      agents_.push_back({{pos(rng), pos(rng), pos(rng)}, d.normalized() * speed(rng)});
-    }
-  }
-  std::vector<VectorSource> step(double dt) {
-    std::vector<VectorSource> out;
-    for (Agent& a : agents_) {
-      const Vec3d before = a.p;
-      a.p = a.p + a.v * dt;
-      for (int k = 0; k < 3; ++k)
-        if (std::abs(a.p[k]) > 4.2) {
-          a.v[k] = -a.v[k];
-          a.p[k] = std::clamp(a.p[k], -4.2, 4.2);
-        }
-      out.push_back({a.p, before, 0.8});
-    }
-    return out;
-  }
-
- private:
-  struct Agent {
-    Vec3d p, v;
-  };
-  std::vector<Agent> agents_;
-};
-
-VectorVolume bench_volume(Vec3i resolution) {
-  VectorVolume v;
-  v.size = {10, 10, 10};
-  v.resolution = resolution;
-  return v;
-}
 
 struct Row {
   std::string test, algorithm;
@@ -78,7 +37,7 @@ struct Row {
 // the approximate algorithms, measures each step's winners against splatting's.
 Row run_case(const std::string& test, VectorAlgorithm algorithm, Vec3i resolution, int count,
              double dt, double decay, VectorStorage storage, int steps, std::uint32_t seed) {
-  const VectorVolume volume = bench_volume(resolution);
+  const VectorVolume volume = agents_volume(resolution);
   VectorOptions options;
   options.algorithm = algorithm;
   VectorSimulation sim(volume, storage, options, decay);

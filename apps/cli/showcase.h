@@ -34,4 +34,9 @@ void showcase_meshing(const World& terrain, const std::filesystem::path& out,
                       const std::filesystem::path& peers_script, const Camera& hero,
                       std::ostream& md, std::vector<Timing>& timings);
 
+// Vector fields: agents flying through a volume, fixed steps, the visualiser, every algorithm
+// against the definition, .fga and .vf exports.
+void showcase_vectors(const std::filesystem::path& out, std::ostream& md,
+                      std::vector<Timing>& timings);
+
 }  // namespace voxfield::cli
