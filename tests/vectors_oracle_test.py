@@ -175,6 +175,32 @@ def main():
         values = np.frombuffer(data[10:], "<f4").reshape(-1, 3)
         check(values.shape == flat.shape and np.abs(values - flat).max() < 1e-6, "vf values")
 
+    # A world as input: the flow away from its solids, against SciPy's exact Euclidean transform.
+    from scipy import ndimage
+    world = np.zeros((30, 26, 22), np.uint8)
+    world[rng.random(world.shape) < 0.004] = 3
+    world[10:14, 8:20, 6:9] = 1
+    wpath = os.path.join(work, "world.npy")
+    np.save(wpath, world)
+    out = os.path.join(work, "world-flow.npy")
+    r = run(voxfield, "vectors", wpath, "-o", out, "--reach", "4.5", "--storage", "rgba32f")
+    check(r.returncode == 0, f"vectors world: {r.stderr.strip()}")
+    if r.returncode == 0:
+        got = np.load(out)
+        solid = np.argwhere(world != 0)
+        lo, hi = solid.min(0) - 5, solid.max(0) + 1 + 5  # the content box grown by ceil(4.5)
+        padded = np.zeros(hi - lo, bool)
+        padded[tuple(slice(-l, -l + n) for l, n in zip(lo, world.shape))] = world != 0
+        d, idx = ndimage.distance_transform_edt(~padded, return_indices=True)
+        want = np.where(d < 4.5, 1 - d / 4.5, 0)
+        check(got.shape == padded.shape + (4,), f"world flow shape {got.shape} for {padded.shape}")
+        if got.shape == padded.shape + (4,):
+            check(np.abs(got[..., 3] - want).max() < 1e-6, "world flow strengths against SciPy")
+            # Each direction points away from a solid voxel at exactly that distance.
+            pts = np.argwhere((want > 0) & (d > 0))
+            away_from = np.rint(pts - got[tuple(pts.T)][:, :3] * d[tuple(pts.T)][:, None]).astype(int)
+            check(padded[tuple(away_from.T)].all(), "world flow directions point away from solids")
+
     png = os.path.join(work, "v.png")
     r = run(voxfield, "vectors", src, "-o", png, "--width", "96", "--height", "64", *common)
     check(r.returncode == 0 and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n", "png output")

@@ -8,6 +8,7 @@
 #include "cli.h"
 #include "voxfield/png.h"
 #include "voxfield/vector_files.h"
+#include "voxfield/vector_world.h"
 #include "voxfield/vectors.h"
 
 namespace voxfield::cli {
@@ -18,6 +19,7 @@ struct VectorSettings {
   std::vector<int> resolution{64, 64, 64};
   std::vector<double> box, rotation;
   double dt_s = 1.0 / 60, decay_per_s = 1.0;
+  std::optional<double> reach;  // a world input: the reach of its solids
   int width = 640, height = 480;
 };
 
@@ -58,8 +60,72 @@ VectorVolume volume_around(const VectorSourceFrames& f, Vec3i resolution) {
   return v;
 }
 
+// A world as input: the flow away from its solids, over its content box grown by the reach.
+int run_world_vectors(const VectorSettings& s, OutKind kind, Outputs& outputs) {
+  if (!s.box.empty() || !s.rotation.empty())
+    throw UsageError("--box and --rotation are for sources; a world's field covers its content");
+  const double reach = s.reach.value_or(8.0);
+  const VectorStorage storage = parse_vector_storage(s.storage);
+  set_activity("loading " + s.sources);
+  const LoadedWorld in = load_world(s.sources, LoadOptions{});
+  const Box3i content = in.world.voxels.content_bounds();
+  if (content.empty()) throw InvalidArgument(s.sources + ": the world has no solid voxel");
+  const Box3i box = content.grown(static_cast<std::int32_t>(std::ceil(reach)));
+  const Vec3i n = box.size();
+  if (kind == OutKind::kFga && (n.x > 128 || n.y > 128 || n.z > 128))
+    throw InvalidArgument("-o " + s.out + ": the field of " + s.sources + " is " + to_string(n) +
+                          " voxels; an .fga holds at most 128 per axis");
+  set_activity("computing the vector field of " + s.sources);
+  const auto start = std::chrono::steady_clock::now();
+  const WorldVectorField field(in.world, box, reach, storage);
+  const double ms = ms_since(start);
+  set_activity("writing " + s.out);
+  const VectorVolume& volume = field.volume();
+  switch (kind) {
+    case OutKind::kNpy:
+      outputs.stage(s.out, encode_npy(vector_npy(field.texture())));
+      break;
+    case OutKind::kFga:
+      outputs.stage(s.out, std::string_view(encode_fga(volume, field.texture())));
+      break;
+    case OutKind::kVf:
+      outputs.stage(s.out, encode_vf(volume, field.texture()));
+      break;
+    case OutKind::kPng: {
+      VectorViewOptions view;
+      view.width = s.width;
+      view.height = s.height;
+      outputs.stage(s.out, encode_png(render_vectors(volume, field.texture(), view)));
+      break;
+    }
+  }
+  if (!s.stats.empty()) {
+    nlohmann::json j;
+    j["world"] = s.sources;
+    j["output"] = s.out;
+    j["reach"] = reach;
+    j["storage"] = vector_storage_name(storage);
+    j["box"] = {{"min", {box.begin.x, box.begin.y, box.begin.z}},
+                {"max_exclusive", {box.end.x, box.end.y, box.end.z}}};
+    j["voxels_written"] = box.volume();
+    j["ms"] = ms;
+    outputs.stage_json(s.stats, j);
+  }
+  outputs.commit();
+  std::cerr << "voxfield: wrote " << s.out << " (flow around the solids of " << s.sources << ", "
+            << to_string(n) << ", reach " << reach << ", " << std::lround(ms) << " ms)\n";
+  return 0;
+}
+
 int run_vectors(const VectorSettings& s) {
   const OutKind kind = out_kind(s.out);
+  if (std::filesystem::path(s.sources).extension() != ".json") {
+    Outputs outputs({s.sources});
+    outputs.expect(s.out, "-o");
+    outputs.expect(s.stats, "--stats");
+    return run_world_vectors(s, kind, outputs);
+  }
+  if (s.reach) throw UsageError("--reach is for a world input (.vox, .npy, .vfw), not sources");
   if (s.resolution.size() != 3) throw UsageError("--resolution takes three values: nx,ny,nz");
   if (!s.box.empty() && s.box.size() != 6)
     throw UsageError("--box takes six values: cx,cy,cz,sx,sy,sz");
@@ -190,8 +256,13 @@ void add_vectors(CLI::App& app, Action& action) {
       "source, strength 1 - d/r), one generation or one decayed and blended step per frame");
   cmd->add_option("SOURCES", s->sources,
                   "JSON: {\"sources\": [{\"position\": [x,y,z], \"previous\": [x,y,z], "
-                  "\"radius\": r}, ...]} or {\"frames\": [{\"sources\": [...]}, ...]}")
+                  "\"radius\": r}, ...]} or {\"frames\": [{\"sources\": [...]}, ...]}; or a "
+                  "world (.vox, .npy, .vfw): the flow away from its solid voxels")
       ->required();
+  cmd->add_option("--reach", s->reach,
+                  "a world input: how far its solids push, in voxels (default 8; strength "
+                  "1 - d/reach from the exact distance d)")
+      ->check(CLI::Range(1e-3, 16000.0));
   cmd->add_option("-o,--output", s->out,
                   ".npy (float32 a[i,j,k,4]: direction, strength), .fga (Unreal), .vf (Unity VFX "
                   "Graph) or .png (the visualiser); written atomically")
