@@ -249,6 +249,29 @@ TEST(ExactDistance, RandomWorldsAgainstBruteForce) {
         check_case({Metric::kEuclidean, sgn, clamp, st, aniso, 8, 2}, seed, {21, 13, 17}, 0.05);
         ++seed;
       }
+  // Spacings that are not dyadic fractions (1.2, 0.7): the envelope's separations are rounded
+  // divisions, and at an exact tie one came out a hair low — an empty stretch in the lower
+  // envelope that handed every voxel before it the wrong site (found against SciPy's
+  // distance_transform_edt with sampling (0.5, 1.2, 2.0), a distance off by 1.56 on an 11 x 19 x 2
+  // volume of three sites; planted here as it was found, then at random).
+  {
+    const std::array<double, 3> odd{0.5, 1.2, 1.0};
+    World w(8, Box3i::from_size({11, 19, 2}));
+    for (const Vec3i p : {Vec3i{2, 14, 0}, Vec3i{8, 13, 0}, Vec3i{10, 16, 0}}) w.voxels.set(p, 1);
+    DistanceOptions o;
+    o.metric = Metric::kEuclidean;
+    o.spacing = odd;
+    const DistanceField f = compute_distance_field(w, o);
+    // (6, 0, 0) is nearest to (8, 13, 0): sqrt((2 * 0.5)^2 + (13 * 1.2)^2).
+    EXPECT_NEAR(f.distance({6, 0, 0}), std::sqrt(1.0 + 13 * 13 * 1.44), 1e-5);
+  }
+  const std::array<double, 3> odd{0.7, 1.2, 1.9};
+  for (bool sgn : {false, true})
+    for (double density : {0.01, 0.05, 0.2}) {
+      check_case({Metric::kEuclidean, sgn, 0.0, Storage::kF32, odd, 8, 2}, seed, {29, 23, 11},
+                 density);
+      ++seed;
+    }
 }
 
 TEST(ExactDistance, IdenticalForEveryChunkEdgeAndThreadCount) {

@@ -114,7 +114,11 @@ void envelope_1d(const Traits& tr, int n, const typename Traits::Value* f,
       t[0] = 0;
       fs = fu;
     } else {
-      const std::int64_t w = 1 + tr.Sep(s[q], u, fs, fu);
+      // No pop means s[q] is no worse than u at t[q], so u takes over after t[q]: exactly, Sep
+      // >= t[q]. EuclideanReal's Sep is a rounded division, and at an exact tie it can land one
+      // below (14.999... for 15), which would give s[q] an empty stretch that the write-back
+      // loop below never leaves — the wrong site for every voxel before it.
+      const std::int64_t w = std::max<std::int64_t>(1 + tr.Sep(s[q], u, fs, fu), t[q] + 1);
       if (w < n) {
         ++q;
         s[q] = u;
