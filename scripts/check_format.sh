@@ -9,7 +9,7 @@ format=$(command -v clang-format-14 || command -v clang-format || true)
 if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
   mapfile -t files < <(git ls-files '*.h' '*.cpp')
 else
-  mapfile -t files < <(find apps bench fuzz include src tests shaders \( -name '*.h' -o -name '*.cpp' \) | sort)
+  mapfile -t files < <(find apps bench fuzz include python src tests shaders \( -name '*.h' -o -name '*.cpp' \) | sort)
 fi
 if [ "${1:-}" = "--fix" ]; then
   "$format" -i "${files[@]}"

@@ -1,0 +1,25 @@
+// The voxfield Python extension (voxfield._voxfield): voxfield's errors as Python exceptions and
+// the engines behind the pure-Python modules of python/voxfield/.
+#include <pybind11/pybind11.h>
+
+#include "voxfield/error.h"
+#include "voxfield/interrupt.h"
+
+namespace py = pybind11;
+
+namespace voxfield::python {
+void bind_ndimage(py::module_& m);
+}
+
+PYBIND11_MODULE(_voxfield, m) {
+  m.doc() = "voxfield's C++ engine; use the voxfield package";
+  // Subclasses of ValueError, MemoryError and OSError carrying voxfield's message (which names the
+  // file, and for malformed files the byte offset).
+  py::register_exception<voxfield::InvalidArgument>(m, "InvalidArgument", PyExc_ValueError);
+  py::register_exception<voxfield::FormatError>(m, "FormatError", PyExc_ValueError);
+  py::register_exception<voxfield::ResourceLimitError>(m, "ResourceLimitError", PyExc_MemoryError);
+  py::register_exception<voxfield::IoError>(m, "IoError", PyExc_OSError);
+  py::register_exception<voxfield::Cancelled>(m, "Cancelled", PyExc_KeyboardInterrupt);
+  py::register_exception<voxfield::Error>(m, "Error", PyExc_RuntimeError);
+  voxfield::python::bind_ndimage(m);
+}

@@ -1,0 +1,18 @@
+"""voxfield: exact distance fields of voxel worlds and volumes, from Python.
+
+``voxfield.ndimage`` is a drop-in for ``scipy.ndimage.distance_transform_edt`` and
+``distance_transform_cdt`` (same arguments, results, shapes, dtypes and index layout), computed
+by voxfield's exact separable transforms on every core, with what SciPy lacks: ``signed``,
+``max_distance`` and ``threads``.
+
+voxfield's errors are Python exceptions: ``InvalidArgument`` and ``FormatError`` (ValueError),
+``ResourceLimitError`` (MemoryError), ``IoError`` (OSError), ``Cancelled`` (KeyboardInterrupt);
+their messages name the file and, for malformed files, the byte offset.
+"""
+
+from . import _voxfield
+from ._voxfield import Cancelled, Error, FormatError, InvalidArgument, IoError, ResourceLimitError
+from . import ndimage
+
+__all__ = ["ndimage", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
+           "Cancelled"]
