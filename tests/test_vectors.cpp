@@ -504,3 +504,31 @@ TEST(WorldVectors, EditsKeepTheFieldEqualToARebuild) {
 
 }  // namespace
 }  // namespace voxfield
+
+namespace voxfield {
+namespace {
+
+// Every storage's step (with rgba8's table of decayed strength bytes) against the definition
+// applied texel by texel: generate, then blend_vector_texels with the stored previous field.
+TEST(Vectors, StepsEqualGenerationThenBlendTexelByTexel) {
+  const VectorVolume v = shapes()[2].volume;  // rotated, anisotropic
+  for (VectorStorage storage :
+       {VectorStorage::kRgba8, VectorStorage::kRgba16f, VectorStorage::kRgba32f}) {
+    VectorSimulation sim(v, storage, {}, 3.0);
+    VectorTexture ref(v.resolution, storage);
+    for (int step = 0; step < 8; ++step) {
+      std::vector<VectorSource> sources = random_sources(v, step % 3 == 2 ? 0 : 6, 40 + step);
+      sim.step(sources, 0.05);
+      const VectorTexture cur = generate_vectors(v, sources, storage);
+      for (std::int64_t i = 0; i < v.voxel_count(); ++i)
+        ref.set(i, blend_vector_texels(cur.get(i), ref.get(i), 3.0, 0.05));
+      ASSERT_TRUE(std::equal(ref.bytes().begin(), ref.bytes().end(), sim.field().bytes().begin()))
+          << vector_storage_name(storage) << " step " << step;
+      ASSERT_TRUE(
+          std::equal(cur.bytes().begin(), cur.bytes().end(), sim.current().bytes().begin()));
+    }
+  }
+}
+
+}  // namespace
+}  // namespace voxfield

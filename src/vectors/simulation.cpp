@@ -2,8 +2,11 @@
 // the fixed-step scheduler that drives it. The paper's "fixed time step" was a minimum interval
 // that never caught up after a slow frame; FixedStepScheduler keeps an accumulator and runs whole
 // steps, capped per frame so a stall cannot snowball.
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <string>
+#include <type_traits>
 
 #include "texel_codec.h"
 #include "vector_internal.h"
@@ -83,6 +86,9 @@ struct RowFlags {
   const std::uint8_t* previous;
   std::uint8_t* next;
   const std::uint8_t* touched;
+  // rgba8: the strength byte after decay, as blend() then store() would give it alone (-1: the
+  // decayed strength is exactly 0, which blends to the zero texel).
+  const std::int16_t* decay8;
 };
 
 // Conversion, decay and blend of one step in one sweep: each voxel's current texel from its
@@ -123,6 +129,19 @@ void fused_step(const VectorVolume& v, std::span<const detail::vectors::Segment>
             C::store_zero(current + at);
             if (C::zero_strength(previous + at)) {
               C::store_zero(next + at);
+              continue;
+            }
+            if constexpr (std::is_same_v<C, detail::vectors::Codec<VectorStorage::kRgba8>>) {
+              // The wake alone (most non-zero texels): the blend keeps the stored direction bytes
+              // and decays the strength byte, which the step's table gives directly.
+              const std::int16_t decayed = rows.decay8[previous[at + 3]];
+              if (decayed < 0) {
+                C::store_zero(next + at);
+              } else {
+                std::memcpy(next + at, previous + at, 3);
+                next[at + 3] = static_cast<std::uint8_t>(decayed);
+                any_next = any_next || decayed != 0;
+              }
               continue;
             }
           }
@@ -177,11 +196,19 @@ void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) 
     for (std::size_t i = 0; i < winners.size(); ++i)
       if (winners[i] >= 0) sc.touched_rows[i / static_cast<std::size_t>(n.x)] = 1;
   }
+  std::array<std::int16_t, 256> decay8{};
+  const float decay_s = static_cast<float>(decay_per_s_ * dt_s);
+  for (int b = 0; b < 256; ++b) {
+    const VectorTexel t =
+        blend(VectorTexel{}, {0, 0, 0, detail::vectors::rgba8_tables().strength[b]}, decay_s);
+    decay8[b] =
+        t.strength > 0 ? std::int16_t{detail::vectors::unorm8(t.strength)} : std::int16_t{-1};
+  }
   detail::vectors::with_codec(field_.storage(), [&](auto codec) {
-    fused_step<decltype(codec)>(volume_, segments, winners, static_cast<float>(decay_per_s_ * dt_s),
-                                current_.data(), field_.bytes().data(), next_.data(),
+    fused_step<decltype(codec)>(volume_, segments, winners, decay_s, current_.data(),
+                                field_.bytes().data(), next_.data(),
                                 {sc.current_rows.data(), sc.field_rows.data(), sc.next_rows.data(),
-                                 sc.touched_rows.data()});
+                                 sc.touched_rows.data(), decay8.data()});
   });
   t.blend_ms = detail::vectors::ms_since(start);
   std::swap(field_, next_);

@@ -60,13 +60,15 @@ inline double score(VectorRule rule, double d, double radius) {
   return rule == VectorRule::kStrongest ? 1.0 - d / radius : -d;
 }
 
-// Voxel centres as centre + X[i] + Y[j] + Z[k] (in that order), each table the box axis times
-// the voxel's local coordinate: VectorVolume::voxel_centre uses the same expression.
+// Voxel centres as ((centre + Z[k]) + Y[j]) + X[i] (in that order: a row's base is computed once
+// and each voxel adds its X), each table the box axis times the voxel's local coordinate:
+// VectorVolume::voxel_centre uses the same expression, so every pass sees the same doubles.
 struct CentreTables {
   Vec3d centre;
   std::vector<Vec3d> x, y, z;
   explicit CentreTables(const VectorVolume& v);
-  Vec3d at(int i, int j, int k) const { return centre + x[i] + y[j] + z[k]; }
+  Vec3d row(int j, int k) const { return centre + z[k] + y[j]; }
+  Vec3d at(int i, int j, int k) const { return row(j, k) + x[i]; }
 };
 
 // The axis offset of voxel n of `count` along an axis of length `size`, direction `column`.

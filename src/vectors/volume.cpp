@@ -43,9 +43,9 @@ std::int64_t VectorVolume::voxel_count() const {
 
 Vec3d VectorVolume::voxel_centre(int i, int j, int k) const {
   using detail::vectors::axis_offset;
-  return centre + axis_offset(column(rotation, 0), size.x, i, resolution.x) +
+  return centre + axis_offset(column(rotation, 2), size.z, k, resolution.z) +
          axis_offset(column(rotation, 1), size.y, j, resolution.y) +
-         axis_offset(column(rotation, 2), size.z, k, resolution.z);
+         axis_offset(column(rotation, 0), size.x, i, resolution.x);
 }
 
 Vec3d VectorVolume::to_volume(Vec3d world) const {
