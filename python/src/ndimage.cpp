@@ -13,8 +13,11 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <optional>
 #include <string>
+#include <type_traits>
+#include <variant>
 #include <vector>
 
 #include "voxfield/distance.h"
@@ -83,6 +86,56 @@ bool read_input(const py::array& input, std::array<py::ssize_t, 3> n,
   return false;  // the Python side converts other dtypes with input != 0
 }
 
+// The distances from the field's values (see distance_transform), chunk by chunk.
+template <class T>
+void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, const Box3i& box,
+                       Metric metric, double max_distance, py::array& distances) {
+  Strided dist = strided(distances);
+  dist.data = static_cast<char*>(distances.mutable_data());
+  const int edge = values.chunk_edge();
+  const Vec3i chunks{(box.end.x + edge - 1) / edge, (box.end.y + edge - 1) / edge,
+                     (box.end.z + edge - 1) / edge};
+  const double clamp = max_distance > 0 ? max_distance : INFINITY;
+  const std::size_t chunk_count = static_cast<std::size_t>(chunks.x) * chunks.y * chunks.z;
+  // Integer storage saturates at its range: a stored extreme is "beyond", as +inf in f32.
+  const double saturated =
+      std::is_integral_v<T> ? encoding.decode(std::numeric_limits<T>::max()) : INFINITY;
+  parallel_for(chunk_count, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c) {
+      const Vec3i coord{static_cast<int>(c % chunks.x), static_cast<int>(c / chunks.x % chunks.y),
+                        static_cast<int>(c / chunks.x / chunks.y)};
+      const ChunkView<T> view = values.chunk_view(coord);
+      const Box3i cb = view.box.intersect(box);
+      for (int z = cb.begin.z; z < cb.end.z; ++z)
+        for (int y = cb.begin.y; y < cb.end.y; ++y) {
+          char* row = dist.data + z * dist.strides[0] + y * dist.strides[1];
+          for (int x = cb.begin.x; x < cb.end.x; ++x) {
+            const T stored =
+                view.uniform()
+                    ? view.uniform_value
+                    : view.voxels[(x - view.box.begin.x) +
+                                  edge * ((y - view.box.begin.y) + edge * (z - view.box.begin.z))];
+            const double v = encoding.decode(static_cast<double>(stored));
+            const double sign = v < 0 ? -1.0 : 1.0;
+            double a = std::abs(v);
+            if (a >= saturated) a = INFINITY;
+            char* p = row + x * dist.strides[2];
+            if (metric == Metric::kEuclidean) {
+              double d = clamp;
+              if (a < clamp) d = std::sqrt(std::nearbyint(a * a));
+              d *= sign;
+              std::memcpy(p, &d, 8);
+            } else {
+              std::int32_t d = -1;  // no zero element anywhere (SciPy leaves -1 there too)
+              if (std::isfinite(a)) d = static_cast<std::int32_t>(sign * std::min(a, clamp));
+              std::memcpy(p, &d, 4);
+            }
+          }
+        }
+    }
+  });
+}
+
 // Computes the transform of `input` and writes the distances (float64 for euclidean, int32 for
 // taxicab / chessboard) and the indices (int32, shape (ndim,) + input.shape) into the given arrays.
 void distance_transform(const py::array& input, const std::string& metric_name,
@@ -123,11 +176,32 @@ void distance_transform(const py::array& input, const std::string& metric_name,
   o.metric = metric;
   o.signed_distance = signed_distance;
   o.max_distance = max_distance;
-  o.storage = Storage::kF32;
-  o.nearest_sites = true;
   o.domain = box;
   if (metric == Metric::kEuclidean) o.spacing = spacing;
+  // Without indices the sites are needed only for anisotropic Euclidean distances: an isotropic
+  // field's f32 value v is sqrt(d^2) rounded to float, and round(v^2) recovers the integer d^2
+  // exactly while d^2 < 2^22, so float64 sqrt(d^2) is SciPy's value bit for bit. Integer metrics
+  // are exact in f32. The site transform costs more, and its grid 6 bytes per element.
+  const bool unit = spacing == std::array<double, 3>{1, 1, 1};
+  const double largest_d2 = static_cast<double>(n[0] - 1) * (n[0] - 1) +
+                            static_cast<double>(n[1] - 1) * (n[1] - 1) +
+                            static_cast<double>(n[2] - 1) * (n[2] - 1);
+  const bool from_values =
+      !indices && (metric != Metric::kEuclidean || (unit && largest_d2 < double(1 << 22)));
+  o.nearest_sites = !from_values;
+  // Integer metrics in 16 bits where every distance fits (half the field's memory and traffic).
+  const double largest_l1 = static_cast<double>(n[0] + n[1] + n[2] - 3);
+  o.storage = from_values && metric != Metric::kEuclidean && largest_l1 < 32767 ? Storage::kU16
+                                                                                : Storage::kF32;
   const DistanceField field = compute_distance_field(occupancy, o);
+  if (from_values) {
+    std::visit(
+        [&](const auto& grid) {
+          write_from_values(grid, field.encoding, box, metric, max_distance, *distances);
+        },
+        field.values);
+    return;
+  }
   // The outputs are written chunk by chunk from the field's own site grid (no dense copy of it:
   // at 256^3 that copy was 100 MB of fresh pages).
   const Grid<SiteOffset>& sites = *field.sites;

@@ -1,0 +1,70 @@
+"""voxfield.ndimage against scipy.ndimage in one process, on the same arrays: distance_transform_edt
+(distances only, and with indices) and distance_transform_cdt (taxicab), voxfield on 1 and 2
+threads; medians of RUNS timed calls after a warm-up, min-max in brackets. Checks the results are
+SciPy's before timing. Also times the C++ transform alone (the CLI's `field --stats` is not used:
+this measures the Python call's overhead over voxfield's own work).
+
+Usage: PYTHONPATH=build/release/python /usr/bin/python3 bench/peers/ndimage_bench.py [RUNS]
+"""
+
+import statistics
+import sys
+import time
+
+import numpy as np
+from scipy import ndimage as sn
+
+from voxfield import ndimage as vn
+
+
+def timed(f, runs):
+    f()
+    ts = []
+    for _ in range(runs):
+        t = time.perf_counter()
+        f()
+        ts.append((time.perf_counter() - t) * 1e3)
+    return statistics.median(ts), min(ts), max(ts)
+
+
+def fmt(t):
+    return f"{t[0]:.0f} ({t[1]:.0f}–{t[2]:.0f})"
+
+
+def main():
+    runs = int(sys.argv[1]) if len(sys.argv) > 1 else 3
+    rng = np.random.default_rng(6683787)
+    n = 256
+    z, y, x = np.ogrid[:n, :n, :n]
+    volumes = {
+        "random-256 (0.1 % zeros)": rng.random((n, n, n)) < 0.999,
+        "spheres-256 (zeros outside 40 balls)": np.zeros((n, n, n), bool),
+    }
+    for _ in range(40):
+        c = rng.integers(20, n - 20, 3)
+        r = rng.integers(6, 24)
+        volumes["spheres-256 (zeros outside 40 balls)"] |= (z - c[0]) ** 2 + (y - c[1]) ** 2 + (x - c[2]) ** 2 < r * r
+    print("| volume | call | scipy ms | voxfield 1 thread ms | voxfield 2 threads ms | scipy / voxfield 1 | scipy / voxfield 2 |")
+    print("|---|---|---|---|---|---|---|")
+    for name, a in volumes.items():
+        cases = [
+            ("edt", lambda: sn.distance_transform_edt(a), lambda t: vn.distance_transform_edt(a, threads=t)),
+            ("edt + indices", lambda: sn.distance_transform_edt(a, return_indices=True),
+             lambda t: vn.distance_transform_edt(a, return_indices=True, threads=t)),
+            ("cdt taxicab", lambda: sn.distance_transform_cdt(a, metric="taxicab"),
+             lambda t: vn.distance_transform_cdt(a, metric="taxicab", threads=t)),
+        ]
+        for call, ref, ours in cases:
+            want, got = ref(), ours(None)
+            w0 = want[0] if isinstance(want, tuple) else want
+            g0 = got[0] if isinstance(got, tuple) else got
+            assert np.array_equal(w0, g0), f"{name} {call}: results differ"
+            s = timed(ref, runs)
+            v1 = timed(lambda: ours(1), runs)
+            v2 = timed(lambda: ours(2), runs)
+            print(f"| {name} | {call} | {fmt(s)} | {fmt(v1)} | {fmt(v2)} | {s[0] / v1[0]:.1f}× | {s[0] / v2[0]:.1f}× |",
+                  flush=True)
+
+
+if __name__ == "__main__":
+    main()
