@@ -43,7 +43,7 @@ Row run_case(const std::string& test, VectorAlgorithm algorithm, Vec3i resolutio
   VectorSimulation sim(volume, storage, options, decay);
   Agents agents(count, seed);
   Row r{test, vector_algorithm_name(algorithm), resolution, count, dt, decay};
-  std::vector<double> step_ms;
+  std::vector<double> step_ms, generate_ms, blend_ms;
   const bool approximate =
       algorithm != VectorAlgorithm::kBrute && algorithm != VectorAlgorithm::kSplat;
   VectorOptions exact;
@@ -53,8 +53,8 @@ Row run_case(const std::string& test, VectorAlgorithm algorithm, Vec3i resolutio
     sim.step(sources, dt);
     step_ms.push_back(ms_since(start));
     const VectorPassTimes& t = sim.last_times();
-    r.generate_ms += t.seed_ms + t.flood_ms + t.search_ms + t.convert_ms;
-    r.blend_ms += t.blend_ms;
+    generate_ms.push_back(t.seed_ms + t.flood_ms + t.search_ms + t.convert_ms);
+    blend_ms.push_back(t.blend_ms);
     if (approximate && i % 10 == 9) {  // every tenth step: the error against the definition
       const VectorError e =
           compare_vector_winners(volume, sources, vector_winners(volume, sources, exact),
@@ -67,11 +67,14 @@ Row run_case(const std::string& test, VectorAlgorithm algorithm, Vec3i resolutio
   double strength = 0;
   for (std::int64_t i = 0; i < volume.voxel_count(); ++i) strength += sim.field().get(i).strength;
   r.mean_strength = strength / volume.voxel_count();
-  r.generate_ms /= steps;
-  r.blend_ms /= steps;
   // The first steps warm the caches and the pool: the mean and p99 of the rest.
   const std::size_t skip = std::min<std::size_t>(step_ms.size() / 10, 5);
   std::vector<double> kept(step_ms.begin() + static_cast<std::ptrdiff_t>(skip), step_ms.end());
+  // The same steps for the passes' means.
+  for (std::size_t i = skip; i < step_ms.size(); ++i) {
+    r.generate_ms += generate_ms[i] / static_cast<double>(step_ms.size() - skip);
+    r.blend_ms += blend_ms[i] / static_cast<double>(step_ms.size() - skip);
+  }
   for (double m : kept) r.step_ms += m;
   r.step_ms /= std::max<std::size_t>(1, kept.size());
   std::sort(kept.begin(), kept.end());
