@@ -114,6 +114,33 @@ void fused_step(const VectorVolume& v, std::span<const detail::vectors::Segment>
           rows.current[row] = rows.next[row] = 0;
           continue;
         }
+        if (!rows.touched[row]) {
+          // A wake with no source now: the current row is zero (cleared once), and each texel is
+          // the previous one decayed.
+          if (rows.current[row]) zero_row(current + at0);
+          rows.current[row] = 0;
+          bool any = false;
+          for (int i = 0; i < n.x; ++i) {
+            const std::size_t at = at0 + static_cast<std::size_t>(i) * C::kBytes;
+            if (C::zero_strength(previous + at)) {
+              C::store_zero(next + at);
+            } else if constexpr (std::is_same_v<C, detail::vectors::Codec<VectorStorage::kRgba8>>) {
+              const std::int16_t decayed = rows.decay8[previous[at + 3]];
+              if (decayed < 0) {
+                C::store_zero(next + at);
+              } else {
+                std::memcpy(next + at, previous + at, 3);
+                next[at + 3] = static_cast<std::uint8_t>(decayed);
+                any = any || decayed != 0;
+              }
+            } else {
+              C::store(next + at, blend(VectorTexel{}, C::load(previous + at), decay_s));
+              any = any || !C::zero_strength(next + at);
+            }
+          }
+          rows.next[row] = any;
+          continue;
+        }
         bool any_current = false, any_next = false;
         for (int i = 0; i < n.x; ++i) {
           const std::size_t at = at0 + static_cast<std::size_t>(i) * C::kBytes;
