@@ -355,7 +355,7 @@ int run_showcase(const ShowcaseSettings& s) {
   }
 
   const double total_ms = ms_since(t_start);
-  showcase_vectors(s.out, md, timings);
+  showcase_vectors(s.out, s.seed, md, timings);
 
   md << "\n## Timings\n\n| stage | ms | |\n|---|---|---|\n";
   for (const auto& [stage, ms, note] : timings)

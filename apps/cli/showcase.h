@@ -35,8 +35,8 @@ void showcase_meshing(const World& terrain, const std::filesystem::path& out,
                       std::ostream& md, std::vector<Timing>& timings);
 
 // Vector fields: agents flying through a volume, fixed steps, the visualiser, every algorithm
-// against the definition, .fga and .vf exports.
-void showcase_vectors(const std::filesystem::path& out, std::ostream& md,
+// against the definition, .fga and .vf exports; the flow around a terrain's solids under an edit.
+void showcase_vectors(const std::filesystem::path& out, std::uint64_t seed, std::ostream& md,
                       std::vector<Timing>& timings);
 
 }  // namespace voxfield::cli
