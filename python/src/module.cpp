@@ -15,11 +15,13 @@ PYBIND11_MODULE(_voxfield, m) {
   m.doc() = "voxfield's C++ engine; use the voxfield package";
   // Subclasses of ValueError, MemoryError and OSError carrying voxfield's message (which names the
   // file, and for malformed files the byte offset).
+  // Translators are tried last registered first: the base class goes first, so that it catches
+  // only what no subclass did.
+  py::register_exception<voxfield::Error>(m, "Error", PyExc_RuntimeError);
   py::register_exception<voxfield::InvalidArgument>(m, "InvalidArgument", PyExc_ValueError);
   py::register_exception<voxfield::FormatError>(m, "FormatError", PyExc_ValueError);
   py::register_exception<voxfield::ResourceLimitError>(m, "ResourceLimitError", PyExc_MemoryError);
   py::register_exception<voxfield::IoError>(m, "IoError", PyExc_OSError);
   py::register_exception<voxfield::Cancelled>(m, "Cancelled", PyExc_KeyboardInterrupt);
-  py::register_exception<voxfield::Error>(m, "Error", PyExc_RuntimeError);
   voxfield::python::bind_ndimage(m);
 }

@@ -11,17 +11,20 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <optional>
 #include <string>
+#include <thread>
 #include <type_traits>
 #include <variant>
 #include <vector>
 
 #include "voxfield/distance.h"
 #include "voxfield/error.h"
+#include "voxfield/interrupt.h"
 #include "voxfield/parallel.h"
 
 namespace py = pybind11;
@@ -85,6 +88,27 @@ bool read_input(const py::array& input, std::array<py::ssize_t, 3> n,
   if (kind == 'f' && size == 8) return read_zeros<double>(s, n, out), true;
   return false;  // the Python side converts other dtypes with input != 0
 }
+
+// Ctrl-C during a transform: the thread that called (it works on the transform's tasks too) takes
+// the GIL when the transform asks whether to go on and lets Python run its signal handlers; a
+// KeyboardInterrupt stops the transform (voxfield throws Cancelled, which reaches Python as
+// voxfield.Cancelled, a KeyboardInterrupt). Other worker threads only read the flag.
+class PythonSignals : public Interrupter {
+ public:
+  bool was_interrupted(int) override {
+    if (std::this_thread::get_id() != caller_) return stop_.load(std::memory_order_relaxed);
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) {
+      PyErr_Clear();  // voxfield's Cancelled, translated, takes its place
+      stop_.store(true, std::memory_order_relaxed);
+    }
+    return stop_.load(std::memory_order_relaxed);
+  }
+
+ private:
+  std::thread::id caller_ = std::this_thread::get_id();
+  std::atomic<bool> stop_{false};
+};
 
 // The distances from the field's values (see distance_transform), chunk by chunk.
 template <class T>
@@ -193,6 +217,8 @@ void distance_transform(const py::array& input, const std::string& metric_name,
   const double largest_l1 = static_cast<double>(n[0] + n[1] + n[2] - 3);
   o.storage = from_values && metric != Metric::kEuclidean && largest_l1 < 32767 ? Storage::kU16
                                                                                 : Storage::kF32;
+  PythonSignals signals;
+  o.interrupter = &signals;
   const DistanceField field = compute_distance_field(occupancy, o);
   if (from_values) {
     std::visit(

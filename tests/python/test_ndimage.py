@@ -213,3 +213,25 @@ def test_real_volumes_from_the_corpus(tmp_path):
             np.testing.assert_allclose(got, want, rtol=1e-12, atol=0)
             np.testing.assert_array_equal(vn.distance_transform_cdt(a, metric="taxicab"),
                                           sn.distance_transform_cdt(a, metric="taxicab"))
+
+
+def test_ctrl_c_stops_a_long_transform():
+    import _thread
+    a = random_volume((320, 320, 320), density=0.99999)
+    start = time.perf_counter()
+    vn.distance_transform_edt(a, threads=1)
+    full = time.perf_counter() - start
+    timer = threading.Timer(full / 10, _thread.interrupt_main)
+    timer.start()
+    start = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        vn.distance_transform_edt(a, threads=1)
+    stopped = time.perf_counter() - start
+    timer.join()
+    assert stopped < 0.8 * full, (stopped, full)
+
+
+def test_voxfield_errors_arrive_as_their_python_classes():
+    # A field larger than the 16-bit nearest-site offsets allow: voxfield's InvalidArgument.
+    with pytest.raises(voxfield.InvalidArgument):
+        vn.distance_transform_edt(np.ones((1, 1, 40000)), return_indices=True)
