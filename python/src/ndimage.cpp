@@ -110,52 +110,57 @@ class PythonSignals : public Interrupter {
   std::atomic<bool> stop_{false};
 };
 
-// The distances from the field's values (see distance_transform), chunk by chunk.
+// Calls f(x, y, z, value) for every voxel of `box` (which starts at the origin) in `grid`, chunk
+// by chunk in parallel: the field's own chunks are read in place, never copied densely.
+template <class T, class F>
+void for_each_voxel(const Grid<T>& grid, const Box3i& box, F&& f) {
+  const int edge = grid.chunk_edge();
+  const Vec3i chunks{(box.end.x + edge - 1) / edge, (box.end.y + edge - 1) / edge,
+                     (box.end.z + edge - 1) / edge};
+  const std::size_t chunk_count = static_cast<std::size_t>(chunks.x) * chunks.y * chunks.z;
+  parallel_for(chunk_count, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c) {
+      const Vec3i coord{static_cast<int>(c % chunks.x), static_cast<int>(c / chunks.x % chunks.y),
+                        static_cast<int>(c / chunks.x / chunks.y)};
+      const ChunkView<T> view = grid.chunk_view(coord);
+      const Box3i cb = view.box.intersect(box);
+      for (int z = cb.begin.z; z < cb.end.z; ++z)
+        for (int y = cb.begin.y; y < cb.end.y; ++y)
+          for (int x = cb.begin.x; x < cb.end.x; ++x)
+            f(x, y, z,
+              view.uniform()
+                  ? view.uniform_value
+                  : view.voxels[(x - view.box.begin.x) +
+                                edge * ((y - view.box.begin.y) + edge * (z - view.box.begin.z))]);
+    }
+  });
+}
+
+// The distances from the field's values (see distance_transform).
 template <class T>
 void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, const Box3i& box,
                        Metric metric, double max_distance, py::array& distances) {
   Strided dist = strided(distances);
   dist.data = static_cast<char*>(distances.mutable_data());
-  const int edge = values.chunk_edge();
-  const Vec3i chunks{(box.end.x + edge - 1) / edge, (box.end.y + edge - 1) / edge,
-                     (box.end.z + edge - 1) / edge};
   const double clamp = max_distance > 0 ? max_distance : INFINITY;
-  const std::size_t chunk_count = static_cast<std::size_t>(chunks.x) * chunks.y * chunks.z;
   // Integer storage saturates at its range: a stored extreme is "beyond", as +inf in f32.
   const double saturated =
       std::is_integral_v<T> ? encoding.decode(std::numeric_limits<T>::max()) : INFINITY;
-  parallel_for(chunk_count, 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t c = b; c < e; ++c) {
-      const Vec3i coord{static_cast<int>(c % chunks.x), static_cast<int>(c / chunks.x % chunks.y),
-                        static_cast<int>(c / chunks.x / chunks.y)};
-      const ChunkView<T> view = values.chunk_view(coord);
-      const Box3i cb = view.box.intersect(box);
-      for (int z = cb.begin.z; z < cb.end.z; ++z)
-        for (int y = cb.begin.y; y < cb.end.y; ++y) {
-          char* row = dist.data + z * dist.strides[0] + y * dist.strides[1];
-          for (int x = cb.begin.x; x < cb.end.x; ++x) {
-            const T stored =
-                view.uniform()
-                    ? view.uniform_value
-                    : view.voxels[(x - view.box.begin.x) +
-                                  edge * ((y - view.box.begin.y) + edge * (z - view.box.begin.z))];
-            const double v = encoding.decode(static_cast<double>(stored));
-            const double sign = v < 0 ? -1.0 : 1.0;
-            double a = std::abs(v);
-            if (a >= saturated) a = INFINITY;
-            char* p = row + x * dist.strides[2];
-            if (metric == Metric::kEuclidean) {
-              double d = clamp;
-              if (a < clamp) d = std::sqrt(std::nearbyint(a * a));
-              d *= sign;
-              std::memcpy(p, &d, 8);
-            } else {
-              std::int32_t d = -1;  // no zero element anywhere (SciPy leaves -1 there too)
-              if (std::isfinite(a)) d = static_cast<std::int32_t>(sign * std::min(a, clamp));
-              std::memcpy(p, &d, 4);
-            }
-          }
-        }
+  for_each_voxel(values, box, [&](int x, int y, int z, T stored) {
+    const double v = encoding.decode(static_cast<double>(stored));
+    const double sign = v < 0 ? -1.0 : 1.0;
+    double a = std::abs(v);
+    if (a >= saturated) a = INFINITY;
+    char* p = dist.data + z * dist.strides[0] + y * dist.strides[1] + x * dist.strides[2];
+    if (metric == Metric::kEuclidean) {
+      double d = clamp;
+      if (a < clamp) d = std::sqrt(std::nearbyint(a * a));
+      d *= sign;
+      std::memcpy(p, &d, 8);
+    } else {
+      std::int32_t d = -1;  // no zero element anywhere (SciPy leaves -1 there too)
+      if (std::isfinite(a)) d = static_cast<std::int32_t>(sign * std::min(a, clamp));
+      std::memcpy(p, &d, 4);
     }
   });
 }
@@ -231,10 +236,6 @@ void distance_transform(const py::array& input, const std::string& metric_name,
   // The outputs are written chunk by chunk from the field's own site grid (no dense copy of it:
   // at 256^3 that copy was 100 MB of fresh pages).
   const Grid<SiteOffset>& sites = *field.sites;
-  const int edge = sites.chunk_edge();
-  const Vec3i chunks{(box.end.x + edge - 1) / edge, (box.end.y + edge - 1) / edge,
-                     (box.end.z + edge - 1) / edge};
-
   const std::array<double, 3> s{spacing[2], spacing[1], spacing[0]};  // NumPy axes 0, 1, 2
   Strided dist{nullptr};
   if (distances) {
@@ -250,68 +251,46 @@ void distance_transform(const py::array& input, const std::string& metric_name,
     for (int i = 0; i < nd; ++i) idx.strides[3 - nd + i] = indices->strides(i + 1);
   }
   const double clamp = max_distance > 0 ? max_distance : INFINITY;
-  const std::size_t chunk_count = static_cast<std::size_t>(chunks.x) * chunks.y * chunks.z;
-  parallel_for(chunk_count, 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t c = b; c < e; ++c) {
-      const Vec3i coord{static_cast<int>(c % chunks.x), static_cast<int>(c / chunks.x % chunks.y),
-                        static_cast<int>(c / chunks.x / chunks.y)};
-      const ChunkView<SiteOffset> view = sites.chunk_view(coord);
-      const Box3i cb = view.box.intersect(box);
-      for (int z = cb.begin.z; z < cb.end.z; ++z)
-        for (int y = cb.begin.y; y < cb.end.y; ++y)
-          for (int x = cb.begin.x; x < cb.end.x; ++x) {
-            const SiteOffset o =
-                view.uniform()
-                    ? view.uniform_value
-                    : view.voxels[(x - view.box.begin.x) +
-                                  edge * ((y - view.box.begin.y) + edge * (z - view.box.begin.z))];
-            // NumPy's axes 0, 1, 2 are voxfield's z, y, x.
-            const py::ssize_t a0 = z, a1 = y, a2 = x;
-            const std::size_t i = static_cast<std::size_t>((a0 * n[1] + a1) * n[2] + a2);
-            const bool site = zeros[i] != 0;
-            const double sign = signed_distance && site ? -1.0 : 1.0;
-            const std::array<py::ssize_t, 3> off{o.none() ? 0 : o.dz, o.none() ? 0 : o.dy,
-                                                 o.none() ? 0 : o.dx};
-            if (distances) {
-              char* p =
-                  dist.data + a0 * dist.strides[0] + a1 * dist.strides[1] + a2 * dist.strides[2];
-              if (metric == Metric::kEuclidean) {
-                double d = clamp;
-                if (!o.none()) {
-                  // SciPy's order: each axis' offset times its sampling, squared, summed from axis
-                  // 0.
-                  const double t0 = off[0] * s[0], t1 = off[1] * s[1], t2 = off[2] * s[2];
-                  d = std::min(std::sqrt(t0 * t0 + t1 * t1 + t2 * t2), clamp);
-                }
-                d *= sign;
-                std::memcpy(p, &d, 8);
-              } else {
-                std::int32_t d = -1;  // no zero element anywhere (SciPy leaves -1 there too)
-                if (!o.none()) {
-                  const std::int64_t u = std::abs(off[0]), v = std::abs(off[1]),
-                                     w = std::abs(off[2]);
-                  const std::int64_t m =
-                      metric == Metric::kManhattan ? u + v + w : std::max({u, v, w});
-                  d = static_cast<std::int32_t>(std::min<double>(static_cast<double>(m), clamp));
-                } else if (max_distance > 0) {
-                  d = static_cast<std::int32_t>(max_distance);
-                }
-                d = static_cast<std::int32_t>(sign * d);
-                std::memcpy(p, &d, 4);
-              }
-            }
-            if (indices) {
-              const std::array<py::ssize_t, 3> at{a0, a1, a2};
-              char* base =
-                  idx.data + a0 * idx.strides[0] + a1 * idx.strides[1] + a2 * idx.strides[2];
-              for (int k = 0; k < nd; ++k) {
-                const int axis = 3 - nd + k;
-                const std::int32_t v =
-                    o.none() ? -1 : static_cast<std::int32_t>(at[axis] + off[axis]);
-                std::memcpy(base + k * idx_axis_stride, &v, 4);
-              }
-            }
-          }
+  for_each_voxel(sites, box, [&](int x, int y, int z, const SiteOffset o) {
+    // NumPy's axes 0, 1, 2 are voxfield's z, y, x.
+    const py::ssize_t a0 = z, a1 = y, a2 = x;
+    const std::size_t i = static_cast<std::size_t>((a0 * n[1] + a1) * n[2] + a2);
+    const bool site = zeros[i] != 0;
+    const double sign = signed_distance && site ? -1.0 : 1.0;
+    const std::array<py::ssize_t, 3> off{o.none() ? 0 : o.dz, o.none() ? 0 : o.dy,
+                                         o.none() ? 0 : o.dx};
+    if (distances) {
+      char* p = dist.data + a0 * dist.strides[0] + a1 * dist.strides[1] + a2 * dist.strides[2];
+      if (metric == Metric::kEuclidean) {
+        double d = clamp;
+        if (!o.none()) {
+          // SciPy's order: each axis' offset times its sampling, squared, summed from axis 0.
+          const double t0 = off[0] * s[0], t1 = off[1] * s[1], t2 = off[2] * s[2];
+          d = std::min(std::sqrt(t0 * t0 + t1 * t1 + t2 * t2), clamp);
+        }
+        d *= sign;
+        std::memcpy(p, &d, 8);
+      } else {
+        std::int32_t d = -1;  // no zero element anywhere (SciPy leaves -1 there too)
+        if (!o.none()) {
+          const std::int64_t u = std::abs(off[0]), v = std::abs(off[1]), w = std::abs(off[2]);
+          const std::int64_t m = metric == Metric::kManhattan ? u + v + w : std::max({u, v, w});
+          d = static_cast<std::int32_t>(std::min<double>(static_cast<double>(m), clamp));
+        } else if (max_distance > 0) {
+          d = static_cast<std::int32_t>(max_distance);
+        }
+        d = static_cast<std::int32_t>(sign * d);
+        std::memcpy(p, &d, 4);
+      }
+    }
+    if (indices) {
+      const std::array<py::ssize_t, 3> at{a0, a1, a2};
+      char* base = idx.data + a0 * idx.strides[0] + a1 * idx.strides[1] + a2 * idx.strides[2];
+      for (int k = 0; k < nd; ++k) {
+        const int axis = 3 - nd + k;
+        const std::int32_t v = o.none() ? -1 : static_cast<std::int32_t>(at[axis] + off[axis]);
+        std::memcpy(base + k * idx_axis_stride, &v, 4);
+      }
     }
   });
 }

@@ -91,6 +91,27 @@ struct RowFlags {
   const std::int16_t* decay8;
 };
 
+// A previous texel with no current source: its decayed self (blend with a zero current). In rgba8
+// (most non-zero texels are such wakes) the blend keeps the stored direction bytes and decays the
+// strength byte, which the step's table gives directly. Returns whether the result is non-zero.
+template <class C>
+bool decay_alone(const std::uint8_t* previous, std::uint8_t* next, float decay_s,
+                 const std::int16_t* decay8) {
+  if constexpr (std::is_same_v<C, detail::vectors::Codec<VectorStorage::kRgba8>>) {
+    const std::int16_t decayed = decay8[previous[3]];
+    if (decayed < 0) {
+      C::store_zero(next);
+      return false;
+    }
+    std::memcpy(next, previous, 3);
+    next[3] = static_cast<std::uint8_t>(decayed);
+    return decayed != 0;
+  } else {
+    C::store(next, blend(VectorTexel{}, C::load(previous), decay_s));
+    return !C::zero_strength(next);
+  }
+}
+
 // Conversion, decay and blend of one step in one sweep: each voxel's current texel from its
 // winner (stored, then read back as stored), blended with the decayed previous texel into next.
 template <class C>
@@ -124,18 +145,8 @@ void fused_step(const VectorVolume& v, std::span<const detail::vectors::Segment>
             const std::size_t at = at0 + static_cast<std::size_t>(i) * C::kBytes;
             if (C::zero_strength(previous + at)) {
               C::store_zero(next + at);
-            } else if constexpr (std::is_same_v<C, detail::vectors::Codec<VectorStorage::kRgba8>>) {
-              const std::int16_t decayed = rows.decay8[previous[at + 3]];
-              if (decayed < 0) {
-                C::store_zero(next + at);
-              } else {
-                std::memcpy(next + at, previous + at, 3);
-                next[at + 3] = static_cast<std::uint8_t>(decayed);
-                any = any || decayed != 0;
-              }
             } else {
-              C::store(next + at, blend(VectorTexel{}, C::load(previous + at), decay_s));
-              any = any || !C::zero_strength(next + at);
+              any = decay_alone<C>(previous + at, next + at, decay_s, rows.decay8) || any;
             }
           }
           rows.next[row] = any;
@@ -158,19 +169,8 @@ void fused_step(const VectorVolume& v, std::span<const detail::vectors::Segment>
               C::store_zero(next + at);
               continue;
             }
-            if constexpr (std::is_same_v<C, detail::vectors::Codec<VectorStorage::kRgba8>>) {
-              // The wake alone (most non-zero texels): the blend keeps the stored direction bytes
-              // and decays the strength byte, which the step's table gives directly.
-              const std::int16_t decayed = rows.decay8[previous[at + 3]];
-              if (decayed < 0) {
-                C::store_zero(next + at);
-              } else {
-                std::memcpy(next + at, previous + at, 3);
-                next[at + 3] = static_cast<std::uint8_t>(decayed);
-                any_next = any_next || decayed != 0;
-              }
-              continue;
-            }
+            any_next = decay_alone<C>(previous + at, next + at, decay_s, rows.decay8) || any_next;
+            continue;
           }
           C::store(next + at, blend(now, C::load(previous + at), decay_s));
           any_next = any_next || !C::zero_strength(next + at);
