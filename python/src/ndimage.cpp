@@ -25,6 +25,7 @@
 #include "voxfield/distance.h"
 #include "voxfield/error.h"
 #include "voxfield/interrupt.h"
+#include "voxfield/limits.h"
 #include "voxfield/parallel.h"
 
 namespace py = pybind11;
@@ -143,6 +144,7 @@ void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, 
   Strided dist = strided(distances);
   dist.data = static_cast<char*>(distances.mutable_data());
   const double clamp = max_distance > 0 ? max_distance : INFINITY;
+  const double clamp_f32 = static_cast<double>(static_cast<float>(clamp));
   // Integer storage saturates at its range: a stored extreme is "beyond", as +inf in f32.
   const double saturated =
       std::is_integral_v<T> ? encoding.decode(std::numeric_limits<T>::max()) : INFINITY;
@@ -154,7 +156,9 @@ void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, 
     char* p = dist.data + z * dist.strides[0] + y * dist.strides[1] + x * dist.strides[2];
     if (metric == Metric::kEuclidean) {
       double d = clamp;
-      if (a < clamp) d = std::sqrt(std::nearbyint(a * a));
+      // A clamped element reads float(D), which may round below D: anything at or above
+      // float(D) is the clamp (a true distance that close to D differs from it by < 1 float ulp).
+      if (a < clamp_f32) d = std::min(std::sqrt(std::nearbyint(a * a)), clamp);
       d *= sign;
       std::memcpy(p, &d, 8);
     } else {
@@ -190,6 +194,13 @@ void distance_transform(const py::array& input, const std::string& metric_name,
   if (sampling) {
     for (int i = 0; i < nd; ++i) spacing[nd - 1 - i] = (*sampling)[static_cast<std::size_t>(i)];
   }
+  if (count == 0) return;  // an empty array: empty outputs, as SciPy's
+  if (!distances && !indices)
+    throw InvalidArgument("voxfield.ndimage: neither distances nor indices asked for");
+  // The peak beside the outputs: the input's zeros and their grid (1 byte each), the field
+  // (4 bytes) and its nearest sites when computed (6 bytes).
+  require_memory(mul_sat(count, 1 + 1 + 4 + (indices || metric == Metric::kEuclidean ? 6 : 0)), 0,
+                 "voxfield.ndimage", "a transform of " + std::to_string(count) + " elements");
   std::vector<std::uint8_t> zeros(count);
   if (!read_input(input, n, zeros)) throw InvalidArgument("voxfield.ndimage: unsupported dtype");
 

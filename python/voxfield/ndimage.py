@@ -68,6 +68,18 @@ def _check_common(max_distance, threads):
     return int(threads)
 
 
+def _run(a, metric, sampling, signed, max_distance, threads, dt, ft):
+    # The engine writes native-endian values: byte-swapped outputs get them through a copy.
+    outs = [dt, ft]
+    tmp = [o if o is None or o.dtype.isnative else np.empty(o.shape, o.dtype.newbyteorder("="))
+           for o in outs]
+    _voxfield._distance_transform(a, metric, sampling, bool(signed), float(max_distance), threads,
+                                  tmp[0], tmp[1])
+    for o, t in zip(outs, tmp):
+        if o is not None and t is not o:
+            o[...] = t
+
+
 def _result(return_distances, dt_inplace, dt, return_indices, ft_inplace, ft):
     result = []
     if return_distances and not dt_inplace:
@@ -119,8 +131,7 @@ def distance_transform_edt(input, sampling=None, return_distances=True, return_i
         dt = distances
     else:
         dt = np.empty(a.shape, dtype=np.float64) if return_distances else None
-    _voxfield._distance_transform(a, "euclidean", sampling, bool(signed), float(max_distance),
-                                  n_threads, dt, ft)
+    _run(a, "euclidean", sampling, signed, max_distance, n_threads, dt, ft)
     return _result(return_distances, dt_inplace, dt, return_indices, ft_inplace, ft)
 
 
@@ -162,6 +173,5 @@ def distance_transform_cdt(input, metric="chessboard", return_distances=True,
         ft = indices
     else:
         ft = np.empty((a.ndim,) + a.shape, dtype=np.int32) if return_indices else None
-    _voxfield._distance_transform(a, name, None, bool(signed), float(max_distance), n_threads,
-                                  dt, ft)
+    _run(a, name, None, signed, max_distance, n_threads, dt, ft)
     return _result(return_distances, dt_inplace, dt, return_indices, ft_inplace, ft)

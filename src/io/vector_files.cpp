@@ -67,7 +67,11 @@ std::string encode_fga(const VectorVolume& volume, const VectorTexture& texture)
         to_string(n));
   std::string s =
       std::to_string(n.x) + "," + std::to_string(n.y) + "," + std::to_string(n.z) + ",\n";
-  const Vec3d lo = volume.centre - volume.size * 0.5, hi = volume.centre + volume.size * 0.5;
+  // An axis-aligned volume's corners in world space; a rotated one's in its own frame, centred at
+  // the origin (give the vector-field actor the volume's centre and rotation).
+  const bool rotated = !(volume.rotation == VectorVolume{}.rotation);
+  const Vec3d origin = rotated ? Vec3d{0, 0, 0} : volume.centre;
+  const Vec3d lo = origin - volume.size * 0.5, hi = origin + volume.size * 0.5;
   for (const Vec3d& corner : {lo, hi}) {
     for (int a = 0; a < 3; ++a) append_number(s, corner[a]);
     s += '\n';
@@ -86,6 +90,8 @@ std::vector<std::uint8_t> encode_vf(const VectorVolume& volume, const VectorText
   const Vec3i n = volume.resolution;
   if (n.x > 65535 || n.y > 65535 || n.z > 65535)
     throw InvalidArgument("a .vf vector field holds at most 65535 voxels per axis");
+  require_memory(mul_sat(static_cast<std::uint64_t>(texture.voxel_count()), 12), 0,
+                 "vector texture " + to_string(n), "its .vf file");
   std::vector<std::uint8_t> out{'V', 'F', '_', 'V'};
   for (int a = 0; a < 3; ++a) {
     out.push_back(static_cast<std::uint8_t>(n[a] & 0xff));

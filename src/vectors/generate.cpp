@@ -62,8 +62,14 @@ std::vector<std::int32_t> vector_winners(const VectorVolume& volume,
   validate_sources(sources);
   if (sources.size() > static_cast<std::size_t>(INT32_MAX))
     throw InvalidArgument("vector field: more than 2^31 - 1 sources");
-  require_memory(mul_sat(static_cast<std::uint64_t>(volume.voxel_count()), 8), 0,
-                 "vector field " + to_string(volume.resolution), "its per-voxel source indices");
+  // Per voxel: the winner (4 bytes) and splatting's best score (8) or JFA's second buffer and
+  // seed scores (4 + 8).
+  const std::uint64_t per_voxel = options.algorithm == VectorAlgorithm::kBrute   ? 4
+                                  : options.algorithm == VectorAlgorithm::kSplat ? 12
+                                                                                 : 16;
+  require_memory(mul_sat(static_cast<std::uint64_t>(volume.voxel_count()), per_voxel), 0,
+                 "vector field " + to_string(volume.resolution),
+                 "its per-voxel winners and scratch");
   std::vector<std::int32_t> winners(static_cast<std::size_t>(volume.voxel_count()), -1);
   const std::vector<Segment> segments = segments_of(sources);
   VectorPassTimes local;

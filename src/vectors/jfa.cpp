@@ -42,10 +42,32 @@ void seed(const VectorVolume& v, std::span<const VectorSource> sources,
   std::vector<double> seeded_score(out.size(), 0);
   for (std::size_t s = 0; s < sources.size(); ++s) {
     if (index_box(v, sources[s]).empty()) continue;  // cannot reach any voxel centre
-    const double length = std::sqrt(segments[s].ab2);
-    const int samples = 1 + static_cast<int>(std::min(1e6, std::ceil(length / half_voxel)));
+    // Only the part of the segment within the radius of the box can seed a voxel that matters:
+    // clip it to the box grown by r (slab test in volume coordinates), so a long trail far
+    // outside costs nothing and the samples stay half a voxel apart.
+    const Vec3d ua = v.to_volume(segments[s].a), ub = v.to_volume(segments[s].a + segments[s].ab);
+    double t0 = 0, t1 = 1;
+    for (int a = 0; a < 3; ++a) {
+      const double grow = segments[s].radius / v.size[a], d = ub[a] - ua[a];
+      const double lo = -grow, hi = 1 + grow;
+      if (d == 0) {
+        if (ua[a] < lo || ua[a] > hi) t1 = -1;
+        continue;
+      }
+      double ta = (lo - ua[a]) / d, tb = (hi - ua[a]) / d;
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta);
+      t1 = std::min(t1, tb);
+    }
+    if (t0 > t1) {  // the segment misses the grown box: seed its point nearest to the box
+      t0 = t1 = std::clamp(t0, 0.0, 1.0);
+    }
+    const double length = std::sqrt(segments[s].ab2) * (t1 - t0);
+    // Within the grown box a segment is at most its diagonal long: this many samples is bounded.
+    const int samples = 1 + static_cast<int>(std::ceil(length / half_voxel));
     for (int t = 0; t <= samples; ++t) {
-      const Vec3d point = segments[s].a + segments[s].ab * (static_cast<double>(t) / samples);
+      const double along = t0 + (t1 - t0) * (static_cast<double>(t) / samples);
+      const Vec3d point = segments[s].a + segments[s].ab * along;
       const Vec3d u = v.to_volume(point);
       int idx[3];
       for (int a = 0; a < 3; ++a)

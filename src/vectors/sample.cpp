@@ -4,11 +4,14 @@
 // box. voxfield_vectors.glsl gives shaders the same function.
 #include <cmath>
 
+#include "voxfield/error.h"
 #include "voxfield/vectors.h"
 
 namespace voxfield {
 
 VectorSample sample_vectors(const VectorVolume& volume, const VectorTexture& texture, Vec3d world) {
+  if (!(texture.resolution() == volume.resolution))
+    throw InvalidArgument("sample_vectors: the texture's resolution differs from the volume's");
   VectorSample out;
   const Vec3d u = volume.to_volume(world);
   for (int a = 0; a < 3; ++a)

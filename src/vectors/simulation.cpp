@@ -11,6 +11,7 @@
 #include "texel_codec.h"
 #include "vector_internal.h"
 #include "voxfield/error.h"
+#include "voxfield/limits.h"
 
 namespace voxfield {
 
@@ -70,6 +71,13 @@ VectorSimulation::VectorSimulation(const VectorVolume& volume, VectorStorage sto
   if (!std::isfinite(decay_per_s) || decay_per_s < 0)
     throw InvalidArgument("vector simulation: the decay per second must be finite and >= 0");
   options_.interrupter = nullptr;  // never kept: step() is the long-lived object's only work
+  // Three textures and splatting's scratch (winner and best score, 12 bytes) per voxel.
+  const std::uint64_t texel_bytes = storage == VectorStorage::kRgba8     ? 4
+                                    : storage == VectorStorage::kRgba16f ? 8
+                                                                         : 16;
+  require_memory(mul_sat(static_cast<std::uint64_t>(volume_.voxel_count()), 3 * texel_bytes + 12),
+                 0, "vector simulation " + to_string(volume_.resolution),
+                 "its three textures and scratch");
   current_ = VectorTexture(volume_.resolution, storage);
   field_ = VectorTexture(volume_.resolution, storage);
   next_ = VectorTexture(volume_.resolution, storage);
@@ -204,10 +212,12 @@ void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) 
   start = detail::vectors::now_ns();
   Scratch& sc = *scratch_;
   const std::size_t rows = static_cast<std::size_t>(volume_.resolution.y) * volume_.resolution.z;
-  if (sc.field_rows.size() != rows) {  // the first step: every texture is zero
-    sc.current_rows.assign(rows, 0);
-    sc.field_rows.assign(rows, 0);
-    sc.next_rows.assign(rows, 0);
+  if (sc.field_rows.size() != rows || sc.current_rows.size() != rows ||
+      sc.next_rows.size() != rows) {  // the first step: every texture is zero
+    std::vector<std::uint8_t> c(rows, 0), f(rows, 0), x(rows, 0);  // built aside, then swapped
+    sc.current_rows.swap(c);
+    sc.field_rows.swap(f);
+    sc.next_rows.swap(x);
   }
   // Rows a source may write: its index box's rows (splat), or any winner's (the others).
   sc.touched_rows.assign(rows, 0);

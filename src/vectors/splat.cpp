@@ -18,9 +18,12 @@ constexpr double kNoScore = -std::numeric_limits<double>::infinity();
 
 void SplatScratch::prepare(const VectorVolume& v) {
   const std::size_t n = static_cast<std::size_t>(v.voxel_count());
-  if (winners.size() == n) return;
-  winners.assign(n, -1);
-  best.assign(n, kNoScore);
+  if (winners.size() == n && best.size() == n) return;
+  // Built aside and swapped in: a failed allocation leaves the scratch as it was.
+  std::vector<std::int32_t> w(n, -1);
+  std::vector<double> b(n, kNoScore);
+  winners.swap(w);
+  best.swap(b);
   boxes.clear();
 }
 

@@ -17,7 +17,8 @@ namespace voxfield::detail::vectors {
 // floor(v * 255 + 1/2) for v clamped to [0, 1], in float arithmetic (as a shader computes it;
 // the truncating conversion is the floor of a non-negative value).
 inline std::uint8_t unorm8(float v) {
-  return static_cast<std::uint8_t>(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
+  const float c = v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f;  // NaN reads 0, never reaches the cast
+  return static_cast<std::uint8_t>(c * 255.0f + 0.5f);
 }
 
 // Decoded values of every byte: 2 b / 255 - 1 (directions) and b / 255 (strengths), as floats.

@@ -62,7 +62,13 @@ Image render_vectors(const VectorVolume& volume, const VectorTexture& texture,
       double r = 0.02, g = 0.025, b = 0.035;  // background
       if (t0 < t1) {
         double transmittance = 1, cr = 0, cg = 0, cb = 0;
-        for (double t = t0 + 0.5 * step; t < t1 && transmittance > 0.004; t += step) {
+        // Whole steps counted as integers (t += step stops advancing when t dwarfs step), at most
+        // four per voxel along the longest path through the box.
+        const Vec3i n = volume.resolution;
+        const double span = std::min(t1 - t0, 4.0 * (n.x + n.y + n.z) * step);
+        const std::int64_t steps = static_cast<std::int64_t>(std::ceil(span / step));
+        for (std::int64_t k = 0; k < steps && transmittance > 0.004; ++k) {
+          const double t = t0 + (static_cast<double>(k) + 0.5) * step;
           const VectorSample s = sample_vectors(volume, texture, eye + dir * t);
           if (s.strength <= 0) continue;
           const double alpha = 1 - std::exp(-density * s.strength * step);

@@ -163,10 +163,11 @@ IndexBox index_box(const VectorVolume& v, const VectorSource& s) {
   IndexBox box;
   for (int axis = 0; axis < 3; ++axis) {
     const double n = v.resolution[axis], r = s.radius / v.size[axis];
-    // Widened by 1e-9 voxel: a centre on the bound by rounding is then tested, not skipped (the
-    // test d < r decides, as in the oracle).
-    const double lo = (std::min(a[axis], b[axis]) - r) * n - 0.5 - 1e-9;
-    const double hi = (std::max(a[axis], b[axis]) + r) * n - 0.5 + 1e-9;
+    // Widened by half a voxel: a centre that rounding (large coordinates, a rotation orthonormal
+    // only to 1e-6) puts just outside the bound is then tested, not skipped — the exact test
+    // d < r decides, as in the oracle.
+    const double lo = (std::min(a[axis], b[axis]) - r) * n - 0.5 - 0.5;
+    const double hi = (std::max(a[axis], b[axis]) + r) * n - 0.5 + 0.5;
     if (!(hi >= 0) || !(lo <= n - 1)) return IndexBox{};
     box.lo[axis] = static_cast<int>(std::max(0.0, std::ceil(lo)));
     box.hi[axis] = static_cast<int>(std::min(n - 1, std::floor(hi)));

@@ -235,3 +235,22 @@ def test_voxfield_errors_arrive_as_their_python_classes():
     # A field larger than the 16-bit nearest-site offsets allow: voxfield's InvalidArgument.
     with pytest.raises(voxfield.InvalidArgument):
         vn.distance_transform_edt(np.ones((1, 1, 40000)), return_indices=True)
+
+
+@pytest.mark.parametrize("clamp", [2.3, 4.5, 7.1])
+@pytest.mark.parametrize("with_indices", [False, True])
+def test_max_distance_is_exact_on_every_path(clamp, with_indices):
+    a = random_volume((30, 26, 22), density=0.998)
+    want = np.minimum(sn.distance_transform_edt(a), clamp)
+    got = vn.distance_transform_edt(a, max_distance=clamp, return_indices=with_indices)
+    got = got[0] if with_indices else got
+    np.testing.assert_array_equal(got, want)
+
+
+def test_empty_and_byte_swapped_arrays():
+    e = np.ones((0, 4), bool)
+    assert vn.distance_transform_edt(e).shape == (0, 4)
+    a = random_volume((9, 8, 7))
+    big = np.zeros(a.shape, ">f8")
+    vn.distance_transform_edt(a, distances=big)
+    np.testing.assert_array_equal(big, sn.distance_transform_edt(a))
