@@ -43,6 +43,7 @@ TEST(LiveWorld, ConcurrentEditsUpdatesAndReadersStayConsistent) {
   std::atomic<int> writers_done{0};
   std::atomic<bool> stop_readers{false};
   std::atomic<int> snapshots{0}, inconsistent{0};
+  std::atomic<int> batches{0};
 
   std::vector<std::thread> threads;
   for (int t = 0; t < kWriters; ++t) {
@@ -56,13 +57,17 @@ TEST(LiveWorld, ConcurrentEditsUpdatesAndReadersStayConsistent) {
                                static_cast<double>(rng() % 32)},
                               static_cast<double>(1 + rng() % 4)};
         live.submit(e);
-        // Spread the submissions out so that they interleave with many updates.
+        // Spread the submissions out so that they interleave with many updates; and at two points
+        // wait for the updater to have applied a batch, so that edits arrive during updates
+        // however the threads are scheduled (under ThreadSanitizer a first update could outlast
+        // every writer's sleeps).
         if (i % 5 == 4) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        if (i == 50 || i == 100)
+          while (batches.load() < i / 50) std::this_thread::yield();
       }
       ++writers_done;
     });
   }
-  std::atomic<int> batches{0};
   threads.emplace_back([&] {  // the updater
     while (writers_done.load() < kWriters || live.pending() > 0) batches += live.update().edits > 0;
   });
