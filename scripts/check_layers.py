@@ -2,7 +2,7 @@
 """Checks voxfield's layering: which header each source may include (run as a test).
 
 The rules (docs/architecture.md):
-- the layers, lowest first: core, gpu, distance, vectors, mesh, io, render, live; every public header
+- the layers, lowest first: core, gpu, distance, vectors, csg, mesh, io, render, live; every public header
   (include/voxfield/...) belongs to one, and a public header or a module's source includes public
   headers of its own layer or of one beneath only;
 - a module is a directory of src/ (grid, edit and scene make up core); its private headers are for
@@ -17,9 +17,9 @@ import pathlib
 import re
 import sys
 
-LAYERS = ["core", "gpu", "distance", "vectors", "mesh", "io", "render", "live"]
+LAYERS = ["core", "gpu", "distance", "vectors", "csg", "mesh", "io", "render", "live"]
 MODULE_LAYER = {"grid": "core", "edit": "core", "scene": "core", "gpu": "gpu", "distance": "distance",
-                "vectors": "vectors", "mesh": "mesh", "io": "io", "render": "render", "live": "live"}
+                "vectors": "vectors", "csg": "csg", "mesh": "mesh", "io": "io", "render": "render", "live": "live"}
 PUBLIC_LAYER = {
     "box.h": "core", "error.h": "core", "parallel.h": "core", "limits.h": "core", "grid.h": "core",
     "detail/grid_impl.h": "core", "detail/assert.h": "core", "world.h": "core", "edit.h": "core", "edit_stream.h": "core",
@@ -28,6 +28,7 @@ PUBLIC_LAYER = {
     "distance.h": "distance", "algorithms.h": "distance", "dynamic_field.h": "distance",
     "dissertation_format.h": "distance", "gpu_distance.h": "distance",
     "vectors.h": "vectors", "vector_world.h": "vectors", "vector_files.h": "io",
+    "csg.h": "csg", "csg_compile.h": "csg",
     "mesh.h": "mesh", "mesh_chunks.h": "mesh", "mesh_optimize.h": "mesh", "mesh_files.h": "io",
     "file.h": "io", "npy.h": "io", "vox.h": "io", "world_file.h": "io", "world_io.h": "io",
     "edit_script.h": "io",

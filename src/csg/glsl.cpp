@@ -1,0 +1,141 @@
+// voxfield CSG — GLSL generation (Palecek, "A Better Approach to SDF Decomposition": one small
+// shader per variant, every constant read in order from a parameter buffer so that cells sharing a
+// structure share one compiled shader). The generated functions compute the same operations as the
+// CPU tape, in float.
+#include <sstream>
+
+#include "csg/tape_internal.h"
+#include "voxfield/csg_compile.h"
+
+namespace voxfield::csg {
+
+std::string glsl_prelude() {
+  return R"(// voxfield CSG prelude: the shapes of docs/csg.md in their own frames, and the blends.
+// The including shader defines float vf_param(uint i), reading the parameter buffer.
+float vf_sphere(vec3 p, float r) { return length(p) - r; }
+float vf_box(vec3 p, vec3 h) {
+  vec3 q = abs(p) - h;
+  return length(max(q, 0.0)) + min(max(q.x, max(q.y, q.z)), 0.0);
+}
+float vf_rounded_box(vec3 p, vec3 h, float r) { return vf_box(p, h - vec3(r)) - r; }
+float vf_cylinder(vec3 p, float r, float hh) {
+  vec2 d = vec2(length(p.xy) - r, abs(p.z) - hh);
+  return min(max(d.x, d.y), 0.0) + length(max(d, 0.0));
+}
+float vf_capsule(vec3 p, float r, float hh) {
+  return length(vec3(p.xy, p.z - clamp(p.z, -hh, hh))) - r;
+}
+float vf_torus(vec3 p, float R, float r) { return length(vec2(length(p.xy) - R, p.z)) - r; }
+float vf_segment2(vec2 q, vec2 a, vec2 b) {
+  vec2 pa = q - a, e = b - a;
+  float e2 = dot(e, e);
+  float t = e2 > 0.0 ? clamp(dot(pa, e) / e2, 0.0, 1.0) : 0.0;
+  return length(pa - e * t);
+}
+float vf_cone(vec3 p, float r, float hh) {
+  vec2 q = vec2(length(p.xy), p.z);
+  float d = min(vf_segment2(q, vec2(0.0, hh), vec2(r, -hh)), vf_segment2(q, vec2(r, -hh), vec2(0.0, -hh)));
+  bool inside = q.y >= -hh && q.y <= hh && q.x * 2.0 * hh <= r * (hh - q.y);
+  return inside ? -d : d;
+}
+float vf_plane(vec3 p, vec3 n, float d) { return dot(p, n) - d; }
+float vf_ellipsoid(vec3 p, vec3 r) {
+  float k0 = length(p / r), k1 = length(p / (r * r));
+  return k1 == 0.0 ? -min(r.x, min(r.y, r.z)) : k0 * (k0 - 1.0) / k1;
+}
+float vf_smin(float a, float b, float k) {
+  float h = max(k - abs(a - b), 0.0) / k;
+  return min(a, b) - h * h * k * 0.25;
+}
+float vf_smax(float a, float b, float k) {
+  float h = max(k - abs(a - b), 0.0) / k;
+  return max(a, b) + h * h * k * 0.25;
+}
+)";
+}
+
+namespace {
+
+std::string shape_call(NodeKind kind, const std::string& s0, const std::string& s1,
+                       const std::string& s2, const std::string& s3) {
+  switch (kind) {
+    case NodeKind::kSphere:
+      return "vf_sphere(q, " + s0 + ")";
+    case NodeKind::kBox:
+      return "vf_box(q, vec3(" + s0 + ", " + s1 + ", " + s2 + ") * 0.5)";
+    case NodeKind::kRoundedBox:
+      return "vf_rounded_box(q, vec3(" + s0 + ", " + s1 + ", " + s2 + ") * 0.5, " + s3 + ")";
+    case NodeKind::kCylinder:
+      return "vf_cylinder(q, " + s0 + ", " + s1 + " * 0.5)";
+    case NodeKind::kCapsule:
+      return "vf_capsule(q, " + s0 + ", " + s1 + " * 0.5)";
+    case NodeKind::kTorus:
+      return "vf_torus(q, " + s0 + ", " + s1 + ")";
+    case NodeKind::kCone:
+      return "vf_cone(q, " + s0 + ", " + s1 + " * 0.5)";
+    case NodeKind::kPlane:
+      return "vf_plane(q, vec3(" + s0 + ", " + s1 + ", " + s2 + "), " + s3 + ")";
+    default:
+      return "vf_ellipsoid(q, vec3(" + s0 + ", " + s1 + ", " + s2 + "))";
+  }
+}
+
+}  // namespace
+
+std::string glsl_variant(const Tape& tape, int index) {
+  std::ostringstream g;
+  g << "// voxfield CSG variant " << index << ": " << tape.code.size() << " instructions, "
+    << tape.params.size() << " parameters read in order from base\n";
+  g << "float vf_variant_" << index << "(vec3 p, uint base) {\n";
+  g << "  vec3 q;\n";
+  for (std::uint32_t r = 0; r < tape.registers; ++r) g << "  float r" << r << ";\n";
+  std::uint32_t offset = 0;  // constants are read in instruction order
+  auto param = [&](std::uint32_t i) {
+    return "vf_param(base + " + std::to_string(offset + i) + "u)";
+  };
+  for (std::size_t i = 0; i < tape.code.size(); ++i) {
+    const Instr& in = tape.code[i];
+    const std::string out = "r" + std::to_string(tape.reg[i]);
+    const std::string a = in.op == OpCode::kShape ? "" : "r" + std::to_string(tape.reg[in.a]);
+    const std::string b = detail::is_binary(in.op) ? "r" + std::to_string(tape.reg[in.b]) : "";
+    switch (in.op) {
+      case OpCode::kShape:
+        g << "  q = vec3(";
+        for (std::uint32_t row = 0; row < 3; ++row)
+          g << (row ? ",\n           " : "") << param(row * 3) << " * p.x + " << param(row * 3 + 1)
+            << " * p.y + " << param(row * 3 + 2) << " * p.z + " << param(9 + row);
+        g << ");\n  " << out << " = " << param(12) << " * "
+          << shape_call(in.shape, param(13), param(14), param(15), param(16)) << ";\n";
+        break;
+      case OpCode::kMin:
+        g << "  " << out << " = min(" << a << ", " << b << ");\n";
+        break;
+      case OpCode::kMax:
+        g << "  " << out << " = max(" << a << ", " << b << ");\n";
+        break;
+      case OpCode::kSmoothMin:
+        g << "  " << out << " = vf_smin(" << a << ", " << b << ", " << param(0) << ");\n";
+        break;
+      case OpCode::kSmoothMax:
+        g << "  " << out << " = vf_smax(" << a << ", " << b << ", " << param(0) << ");\n";
+        break;
+      case OpCode::kNeg:
+        g << "  " << out << " = -" << a << ";\n";
+        break;
+      case OpCode::kOffset:
+        g << "  " << out << " = " << a << " - " << param(0) << ";\n";
+        break;
+      case OpCode::kAbsOffset:
+        g << "  " << out << " = abs(" << a << ") - " << param(0) << ";\n";
+        break;
+      case OpCode::kSetMaterial:
+        g << "  " << out << " = " << a << ";\n";
+        break;
+    }
+    offset += static_cast<std::uint32_t>(detail::param_count(in));
+  }
+  g << "  return r" << tape.reg[tape.code.size() - 1] << ";\n}\n";
+  return g.str();
+}
+
+}  // namespace voxfield::csg
