@@ -394,7 +394,7 @@ TEST(CsgOctree, GearHasFewVariantsAndPrunedValuesAgree) {
   std::mt19937 rng(2);
   for (int i = 0; i < 20000; ++i) {
     const Vec3d p = random_point(rng, tree.root);
-    const double want = evaluate(whole, p), got = tree.evaluate(whole, p);
+    const double want = evaluate(whole, p), got = tree.evaluate(p);
     const OctreeLeaf& l = tree.leaves[static_cast<std::size_t>(*tree.leaf_at(p))];
     if (l.state == CellState::kSurface) {
       ASSERT_EQ(got, want);
@@ -478,8 +478,7 @@ TEST(CsgGlsl, EveryVariantOfTheExamplesCompiles) {
         << "float vf_param(uint i) { return vf_params[i]; }\n"
         << glsl_prelude();
     for (std::size_t v = 0; v < tree.variants.size(); ++v)
-      src << glsl_variant(tree.tapes[static_cast<std::size_t>(tree.variants[v].example_tape)],
-                          static_cast<int>(v));
+      src << glsl_variant(tree.variants[v].tape, static_cast<int>(v));
     src << glsl_variant(whole, 999);
     src << "void main() {\n  vec3 p = vec3(gl_GlobalInvocationID);\n  float s = vf_variant_999(p, "
            "0u);\n";

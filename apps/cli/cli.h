@@ -32,6 +32,7 @@ void add_edit(CLI::App& app, Action& action);
 void add_bench(CLI::App& app, Action& action);
 void add_render(CLI::App& app, Action& action);
 void add_mesh(CLI::App& app, Action& action);
+void add_csg(CLI::App& app, Action& action);
 void add_vectors(CLI::App& app, Action& action);
 void add_bench_vectors(CLI::App* bench, Action& action);  // voxfield bench vectors
 

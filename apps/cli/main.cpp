@@ -83,6 +83,7 @@ int main(int argc, char** argv) {
   voxfield::cli::add_bench(app, action);
   voxfield::cli::add_render(app, action);
   voxfield::cli::add_mesh(app, action);
+  voxfield::cli::add_csg(app, action);
   voxfield::cli::add_vectors(app, action);
   voxfield::cli::add_generate(app, action);
   voxfield::cli::add_showcase(app, action);

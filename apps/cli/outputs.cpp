@@ -46,6 +46,7 @@ void Outputs::expect_world(const std::string& path, const std::string& option, b
 }
 
 void Outputs::stage_json(const std::string& path, const nlohmann::json& j) {
+  if (path.empty()) return;  // not asked for
   tx_.stage(path, std::string_view(j.dump(2) + "\n"));
 }
 

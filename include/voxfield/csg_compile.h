@@ -34,6 +34,7 @@ enum class OpCode : std::uint8_t {
   kOffset,       // a - r           (round)
   kAbsOffset,    // |a| - r         (shell, with r = t/2)
   kSetMaterial,  // a, with material m (a pruned max whose dropped first operand gave the material)
+  kCopy,         // a (a pruned tape's result when it is an earlier value)
 };
 
 struct Instr {
@@ -43,6 +44,7 @@ struct Instr {
   std::uint8_t material = 0;           // kShape, kSetMaterial
   std::uint32_t a = 0, b = 0;          // operands: indices of earlier instructions
   std::uint32_t param = 0;             // index of the first constant in Tape::params
+  std::uint32_t source = 0;            // the instruction of the whole tape this one came from
 };
 
 // Constants of a shape instruction: the 3x3 matrix (row major) and translation taking a point into
@@ -70,6 +72,10 @@ Tape compile_tape(const Model& model, std::uint64_t memory_limit_bytes = 0);
 double evaluate(const Tape& tape, Vec3d p);
 void evaluate(const Tape& tape, std::span<const Vec3d> points, std::span<double> values,
               std::span<std::uint8_t> materials = {});
+// The same with the constants taken from `params` instead of tape.params (a variant's structure
+// with one cell's constants).
+void evaluate(const Tape& tape, const double* params, std::span<const Vec3d> points,
+              std::span<double> values, std::span<std::uint8_t> materials = {});
 
 enum class CellState : std::uint8_t { kEmpty, kFull, kSurface };
 const char* cell_state_name(CellState state);
@@ -87,13 +93,21 @@ struct Clipped {
   int material = -1;
 };
 // The tape clipped to a box. Cells whose value is at least `max_distance` from zero everywhere
-// also count as empty or full (callers clamping at that distance need no more).
+// also count as empty or full (callers clamping at that distance need no more). Without
+// `tape_when_settled`, empty and full cells come without a tape (cheaper when none is needed).
 Clipped clip(const Tape& tape, const Bounds& cell,
-             double max_distance = std::numeric_limits<double>::infinity());
+             double max_distance = std::numeric_limits<double>::infinity(),
+             bool tape_when_settled = true);
+// The same into `out`, reusing the memory of its tape (for loops clipping many cells).
+void clip_into(const Tape& tape, const Bounds& cell, double max_distance, bool tape_when_settled,
+               Clipped& out);
 
-// A tape's structure (opcodes, shapes and wiring, without constants): equal keys share one
-// generated evaluator.
+// A tape's structure (opcodes, shapes, materials and wiring, without the numeric constants): equal
+// keys share one generated evaluator. structure_hash is a 64-bit digest of it and same_structure
+// the exact test.
 std::string structure_key(const Tape& tape);
+std::uint64_t structure_hash(const Tape& tape);
+bool same_structure(const Tape& a, const Tape& b);
 
 struct OctreeOptions {
   int depth = 6;              // leaves at most this many halvings below the root (0..8)
@@ -103,19 +117,18 @@ struct OctreeOptions {
 };
 
 struct OctreeLeaf {
-  Bounds box;
-  int level = 0;
+  std::uint16_t x = 0, y = 0, z = 0;  // the cell's index among the 2^level per axis at its level
+  std::uint8_t level = 0;
   CellState state = CellState::kSurface;
-  int variant = -1;  // kSurface
-  int tape = -1;     // kSurface: index into Octree::tapes
+  std::int32_t variant = -1;        // kSurface
+  std::int64_t source_offset = -1;  // kSurface: its instructions' origins in Octree::sources
   double lo = 0, hi = 0;
 };
 
 struct Variant {
   std::string key;
-  int example_tape = -1;  // one of its cells' tapes
+  Tape tape;  // the structure, with the constants of its first cell
   std::int64_t cells = 0;
-  std::int64_t nodes = 0;  // instructions
 };
 
 struct CompileStats {
@@ -131,8 +144,11 @@ struct Octree {
   Bounds root;
   int depth = 0;
   std::vector<OctreeLeaf> leaves;
-  std::vector<Tape> tapes;  // per surface leaf
   std::vector<Variant> variants;
+  Tape whole;  // the tape the octree was built from
+  // For each surface leaf, in leaf order, the whole tape's instruction behind each instruction of
+  // its variant: enough to rebuild its constants (leaf_params) without storing them per cell.
+  std::vector<std::uint32_t> sources;
   CompileStats stats;
   // Child links: node 0 is the root; entries >= 0 are nodes (8 children each, in `children`),
   // entries < 0 are leaves -(leaf + 1).
@@ -140,10 +156,16 @@ struct Octree {
 
   // The leaf containing p (nullopt outside the root).
   std::optional<int> leaf_at(Vec3d p) const;
+  // A leaf's box.
+  Bounds leaf_box(const OctreeLeaf& leaf) const;
+  // A surface leaf's constants, in the order its variant reads them (Palecek's parameter buffer
+  // holds these for every cell), and its pruned tape (the variant with these constants).
+  std::vector<double> leaf_params(const OctreeLeaf& leaf) const;
+  Tape leaf_tape(const OctreeLeaf& leaf) const;
   // The value through p's cell: its pruned tape in surface cells; in empty or full cells the
   // cell's bound nearest zero (right sign, magnitude at most the whole tape's); the whole tape
   // outside the root.
-  double evaluate(const Tape& whole, Vec3d p) const;
+  double evaluate(Vec3d p) const;
 };
 Octree build_octree(const Tape& tape, const Model& model, const OctreeOptions& options);
 

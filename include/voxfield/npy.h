@@ -48,6 +48,9 @@ struct NpyVolume {
   // (Fortran order): bytes hold `components` whole volumes one after another. Written only;
   // parse_npy reads 3-D volumes.
   int components = 1;
+  // Dimensions of the array in the file: 3, or 1 or 2 for arrays a[x] / a[x, y] held with the
+  // missing dimensions 1 (point lists, per-point values). Read when NpyReadOptions::rank asks.
+  int rank = 3;
   // Where the data came from, for error messages: the byte offset of the array data in the file
   // and whether the file stored it in C order (z fastest). Zero / false for volumes built in code.
   std::uint64_t file_data_offset = 0;
@@ -62,6 +65,9 @@ struct NpyVolume {
 
 struct NpyReadOptions {
   std::uint64_t memory_limit_bytes = 0;  // 0: the process default (limits.h)
+  // The number of dimensions the array must have (1..3); fewer than 3 are read with the missing
+  // dimensions 1, so a C-order (N, 3) array of points gives dims (N, 3, 1) and value(n + N c).
+  int rank = 3;
 };
 
 NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name,

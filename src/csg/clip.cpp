@@ -89,16 +89,45 @@ int choose(OpCode op, Interval a, Interval b, double k) {
   }
 }
 
+struct Scratch {
+  std::vector<Interval> iv;
+  std::vector<double> at_centre;
+  std::vector<int> material;
+  std::vector<std::uint8_t> choice, live;
+  std::vector<std::uint32_t> remap;
+  void resize(std::size_t n) {
+    if (iv.size() >= n) return;
+    iv.resize(n);
+    at_centre.resize(n);
+    material.resize(n);
+    choice.resize(n);
+    live.resize(n);
+    remap.resize(n);
+  }
+};
+
 }  // namespace
 
-Clipped clip(const Tape& tape, const Bounds& cell, double max_distance) {
+Clipped clip(const Tape& tape, const Bounds& cell, double max_distance, bool tape_when_settled) {
+  Clipped out;
+  clip_into(tape, cell, max_distance, tape_when_settled, out);
+  return out;
+}
+
+void clip_into(const Tape& tape, const Bounds& cell, double max_distance, bool tape_when_settled,
+               Clipped& out) {
   const std::size_t n = tape.code.size();
   const Vec3d centre = (cell.lo + cell.hi) * 0.5;
   const double half_diagonal = (cell.hi - cell.lo).length() * 0.5;
-  std::vector<Interval> iv(n);
-  std::vector<double> at_centre(n);
-  std::vector<int> material(n);  // constant material over the cell, or -1
-  std::vector<std::uint8_t> choice(n, 0);
+  // Scratch kept per thread: the octree clips millions of small tapes, and allocation would
+  // dominate their cost.
+  thread_local Scratch scratch;
+  scratch.resize(n);
+  Interval* iv = scratch.iv.data();
+  double* at_centre = scratch.at_centre.data();
+  int* material = scratch.material.data();  // constant material over the cell, or -1
+  std::uint8_t* choice = scratch.choice.data();
+  std::fill_n(choice, n, 0);
   for (std::size_t i = 0; i < n; ++i) {
     const Instr& in = tape.code[i];
     const double* c = &tape.params[in.param];
@@ -148,6 +177,7 @@ Clipped clip(const Tape& tape, const Bounds& cell, double max_distance) {
           centre_value = std::abs(ca) - k;
           break;
         case OpCode::kSetMaterial:
+        case OpCode::kCopy:
         case OpCode::kShape:
           v = a;
           centre_value = ca;
@@ -176,7 +206,6 @@ Clipped clip(const Tape& tape, const Bounds& cell, double max_distance) {
     at_centre[i] = centre_value;
   }
 
-  Clipped out;
   const Interval root = iv[n - 1];
   out.lo = root.lo;
   out.hi = root.hi;
@@ -186,7 +215,12 @@ Clipped clip(const Tape& tape, const Bounds& cell, double max_distance) {
                                                           : CellState::kSurface;
 
   // Live instructions, from the result back; a decided min/max passes its kept operand through.
-  std::vector<std::uint8_t> live(n, 0);
+  Tape& t = out.tape;  // its arrays keep their capacity from earlier cells
+  t.code.clear();
+  t.params.clear();
+  if (out.state != CellState::kSurface && !tape_when_settled) return;
+  std::uint8_t* live = scratch.live.data();
+  std::fill_n(live, n, 0);
   live[n - 1] = 1;
   for (std::size_t i = n; i-- > 0;) {
     if (!live[i]) continue;
@@ -195,8 +229,7 @@ Clipped clip(const Tape& tape, const Bounds& cell, double max_distance) {
     if (choice[i] != 2) live[in.a] = 1;
     if (is_binary(in.op) && choice[i] != 1) live[in.b] = 1;
   }
-  std::vector<std::uint32_t> remap(n, 0);
-  Tape& t = out.tape;
+  std::uint32_t* remap = scratch.remap.data();
   for (std::size_t i = 0; i < n; ++i) {
     if (!live[i]) continue;
     const Instr& in = tape.code[i];
@@ -231,15 +264,12 @@ Clipped clip(const Tape& tape, const Bounds& cell, double max_distance) {
   // The result may be an operand passed through (a pruned min at the root): make the last
   // instruction the result.
   if (remap[n - 1] != t.code.size() - 1) {
-    Instr pass{OpCode::kOffset};  // a - 0: the value and material unchanged
+    Instr pass{OpCode::kCopy};
     pass.a = remap[n - 1];
     pass.lipschitz = t.code[pass.a].lipschitz;
-    pass.param = static_cast<std::uint32_t>(t.params.size());
-    t.params.push_back(0);
     t.code.push_back(pass);
   }
   assign_registers(t);
-  return out;
 }
 
 }  // namespace voxfield::csg

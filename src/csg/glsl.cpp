@@ -128,6 +128,7 @@ std::string glsl_variant(const Tape& tape, int index) {
       case OpCode::kAbsOffset:
         g << "  " << out << " = abs(" << a << ") - " << param(0) << ";\n";
         break;
+      case OpCode::kCopy:
       case OpCode::kSetMaterial:
         g << "  " << out << " = " << a << ";\n";
         break;

@@ -1,79 +1,158 @@
 // voxfield CSG — the octree of a model (Palecek, "A Better Approach to SDF Decomposition": clip
 // incrementally down an octree rather than re-clip the whole tree per cell): each child clips its
 // parent's pruned tape, empty and full cells stop early, surface cells split down to the depth,
-// and the pruned tapes of the leaves are grouped into variants by structure.
+// and the pruned tapes of the leaves are grouped into variants by structure. The top two levels
+// are split serially; the 64 subtrees below them are built in parallel and joined in order, so
+// the result does not depend on the thread count.
 #include <chrono>
 #include <cmath>
 #include <unordered_map>
 
+#include "csg/tape_internal.h"
 #include "voxfield/csg_compile.h"
+#include "voxfield/parallel.h"
 
 namespace voxfield::csg {
 namespace {
 
-class OctreeBuilder {
- public:
-  OctreeBuilder(Octree& tree, const OctreeOptions& o)
-      : tree_(tree), o_(o), progress_(o.interrupter, "CSG octree", 8) {}
+constexpr int kParallelLevel = 2;
 
-  void run(const Tape& whole) {
-    tree_.children.push_back(0);  // the root's slot
-    visit(whole, tree_.root, 0, 0, true);
-    progress_.throw_if_cancelled();
+// A subtree as built by one task: child links (entry 0 is the subtree's own root entry), leaves
+// and their constants, with variants still local (found by structure hash, confirmed exactly).
+struct Part {
+  std::vector<std::int32_t> children{0};
+  std::vector<OctreeLeaf> leaves;
+  std::vector<std::uint32_t> sources;
+  std::vector<Tape> variant_tapes;
+  std::unordered_map<std::uint64_t, std::vector<int>> variants_by_hash;
+  std::int64_t visited = 0;
+};
+
+// A cell being visited: its box and index at its level.
+struct Cell {
+  Bounds box;
+  int level = 0;
+  std::uint16_t x = 0, y = 0, z = 0;
+  Cell child(int octant) const {
+    Cell c{box, level + 1, static_cast<std::uint16_t>(x * 2 + (octant & 1)),
+           static_cast<std::uint16_t>(y * 2 + (octant >> 1 & 1)),
+           static_cast<std::uint16_t>(z * 2 + (octant >> 2 & 1))};
+    const Vec3d mid = (box.lo + box.hi) * 0.5;
+    for (int a = 0; a < 3; ++a) (octant >> a & 1 ? c.box.lo[a] : c.box.hi[a]) = mid[a];
+    return c;
+  }
+};
+
+// The variant of a tape among those in `tapes`, adding it when new.
+int variant_of(std::vector<Tape>& tapes,
+               std::unordered_map<std::uint64_t, std::vector<int>>& by_hash, const Tape& t) {
+  std::vector<int>& candidates = by_hash[structure_hash(t)];
+  for (int v : candidates)
+    if (same_structure(tapes[static_cast<std::size_t>(v)], t)) return v;
+  tapes.push_back(t);
+  candidates.push_back(static_cast<int>(tapes.size() - 1));
+  return static_cast<int>(tapes.size() - 1);
+}
+
+class Builder {
+ public:
+  explicit Builder(const OctreeOptions& o) : o_(o) {}
+
+  // Fills slot `slot` of part.children with the cell's node or leaf; `scratch` holds one clip
+  // result per level, whose memory is reused from cell to cell.
+  void visit(Part& part, const Tape& parent, const Cell& cell, std::size_t slot,
+             std::vector<Clipped>& scratch, Progress& progress) const {
+    if (!progress.keep_going()) return;
+    ++part.visited;
+    Clipped& c = scratch[static_cast<std::size_t>(cell.level)];
+    clip_into(parent, cell.box, o_.max_distance, false, c);
+    if (c.state != CellState::kSurface || cell.level == o_.depth) {
+      leaf(part, c, cell, slot);
+      return;
+    }
+    const std::size_t first = part.children.size();
+    part.children[slot] = static_cast<std::int32_t>(first);
+    part.children.resize(first + 8, 0);
+    for (int octant = 0; octant < 8; ++octant)
+      visit(part, c.tape, cell.child(octant), first + static_cast<std::size_t>(octant), scratch,
+            progress);
+  }
+
+  // The top levels, serially: a leaf stops there, a cell at kParallelLevel becomes a task.
+  struct Task {
+    Tape tape;
+    Cell cell;
+    std::size_t slot;  // in the top part's children
+  };
+  void top(Part& part, const Tape& parent, const Cell& cell, std::size_t slot,
+           std::vector<Task>& tasks) const {
+    if (cell.level == kParallelLevel) {
+      tasks.push_back({parent, cell, slot});
+      return;
+    }
+    ++part.visited;
+    Clipped c = clip(parent, cell.box, o_.max_distance, false);
+    if (c.state != CellState::kSurface || cell.level == o_.depth) {
+      leaf(part, c, cell, slot);
+      return;
+    }
+    const std::size_t first = part.children.size();
+    part.children[slot] = static_cast<std::int32_t>(first);
+    part.children.resize(first + 8, 0);
+    for (int octant = 0; octant < 8; ++octant)
+      top(part, c.tape, cell.child(octant), first + static_cast<std::size_t>(octant), tasks);
   }
 
  private:
-  // Fills slot `slot` of tree_.children with the cell's node or leaf.
-  void visit(const Tape& parent, const Bounds& box, int level, std::size_t slot, bool top) {
-    if (!progress_.keep_going()) return;
-    ++tree_.stats.cells_visited;
-    Clipped c = clip(parent, box, o_.max_distance);
-    if (c.state != CellState::kSurface || level == o_.depth) {
-      OctreeLeaf leaf;
-      leaf.box = box;
-      leaf.level = level;
-      leaf.state = c.state;
-      leaf.lo = c.lo;
-      leaf.hi = c.hi;
-      if (c.state == CellState::kSurface) {
-        std::string key = structure_key(c.tape);
-        auto it = variant_of_.find(key);
-        if (it == variant_of_.end()) {
-          it = variant_of_.emplace(key, static_cast<int>(tree_.variants.size())).first;
-          tree_.variants.push_back({std::move(key), static_cast<int>(tree_.tapes.size()), 0,
-                                    static_cast<std::int64_t>(c.tape.code.size())});
-        }
-        leaf.variant = it->second;
-        leaf.tape = static_cast<int>(tree_.tapes.size());
-        ++tree_.variants[static_cast<std::size_t>(it->second)].cells;
-        tree_.tapes.push_back(std::move(c.tape));
-      }
-      tree_.children[slot] = -static_cast<std::int32_t>(tree_.leaves.size()) - 1;
-      tree_.leaves.push_back(leaf);
-      return;
+  static void leaf(Part& part, const Clipped& c, const Cell& cell, std::size_t slot) {
+    OctreeLeaf leaf;
+    leaf.x = cell.x;
+    leaf.y = cell.y;
+    leaf.z = cell.z;
+    leaf.level = static_cast<std::uint8_t>(cell.level);
+    leaf.state = c.state;
+    leaf.lo = c.lo;
+    leaf.hi = c.hi;
+    if (c.state == CellState::kSurface) {
+      leaf.variant = variant_of(part.variant_tapes, part.variants_by_hash, c.tape);
+      leaf.source_offset = static_cast<std::int64_t>(part.sources.size());
+      for (const Instr& in : c.tape.code) part.sources.push_back(in.source);
     }
-    const std::size_t first = tree_.children.size();
-    tree_.children[slot] = static_cast<std::int32_t>(first);
-    tree_.children.resize(first + 8, 0);
-    const Vec3d mid = (box.lo + box.hi) * 0.5;
-    for (int octant = 0; octant < 8; ++octant) {
-      Bounds child = box;
-      for (int a = 0; a < 3; ++a) {
-        if (octant >> a & 1)
-          child.lo[a] = mid[a];
-        else
-          child.hi[a] = mid[a];
-      }
-      visit(c.tape, child, level + 1, first + static_cast<std::size_t>(octant), false);
-      if (top) progress_.advance();
-    }
+    part.children[slot] = -static_cast<std::int32_t>(part.leaves.size()) - 1;
+    part.leaves.push_back(leaf);
   }
 
-  Octree& tree_;
   const OctreeOptions& o_;
-  Progress progress_;
-  std::unordered_map<std::string, int> variant_of_;
 };
+
+// Appends a part to the tree; returns the entry that stands for its root.
+std::int32_t join(Octree& tree, std::vector<Tape>& variant_tapes,
+                  std::unordered_map<std::uint64_t, std::vector<int>>& by_hash, Part& part) {
+  const auto node_offset =
+      static_cast<std::int32_t>(tree.children.size()) - 1;  // local k >= 1 -> k + offset
+  const auto leaf_offset = static_cast<std::int32_t>(tree.leaves.size());
+  const auto source_offset = static_cast<std::int64_t>(tree.sources.size());
+  auto remap = [&](std::int32_t e) { return e >= 0 ? e + node_offset : e - leaf_offset; };
+  std::vector<int> variant(part.variant_tapes.size());
+  for (std::size_t v = 0; v < part.variant_tapes.size(); ++v)
+    variant[v] = variant_of(variant_tapes, by_hash, part.variant_tapes[v]);
+  tree.variants.resize(variant_tapes.size());
+  for (std::size_t k = 1; k < part.children.size(); ++k)
+    tree.children.push_back(remap(part.children[k]));
+  for (OctreeLeaf leaf : part.leaves) {
+    if (leaf.state == CellState::kSurface) {
+      leaf.variant = variant[static_cast<std::size_t>(leaf.variant)];
+      leaf.source_offset += source_offset;
+      ++tree.variants[static_cast<std::size_t>(leaf.variant)].cells;
+    }
+    tree.leaves.push_back(leaf);
+  }
+  tree.sources.insert(tree.sources.end(), part.sources.begin(), part.sources.end());
+  tree.stats.cells_visited += part.visited;
+  const std::int32_t root = remap(part.children[0]);
+  part = Part{};  // its memory is no longer needed
+  return root;
+}
 
 }  // namespace
 
@@ -83,6 +162,7 @@ Octree build_octree(const Tape& tape, const Model& model, const OctreeOptions& o
   const auto start = std::chrono::steady_clock::now();
   Octree tree;
   tree.depth = options.depth;
+  tree.whole = tape;
   if (options.box) {
     if (options.box->empty() ||
         !std::isfinite(options.box->lo.x + options.box->lo.y + options.box->lo.z +
@@ -100,7 +180,32 @@ Octree build_octree(const Tape& tape, const Model& model, const OctreeOptions& o
     const double edge = std::max({size.x, size.y, size.z, 1e-9}) * (1 + 1e-6);
     tree.root = {centre - Vec3d{1, 1, 1} * (edge / 2), centre + Vec3d{1, 1, 1} * (edge / 2)};
   }
-  OctreeBuilder(tree, options).run(tape);
+  const Builder builder(options);
+  Part top;
+  std::vector<Builder::Task> tasks;
+  builder.top(top, tape, Cell{tree.root}, 0, tasks);
+  Progress progress(options.interrupter, "CSG octree", static_cast<std::int64_t>(tasks.size()));
+  std::vector<Part> parts(tasks.size());
+  parallel_for(tasks.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      std::vector<Clipped> scratch(static_cast<std::size_t>(options.depth) + 1);
+      builder.visit(parts[i], tasks[i].tape, tasks[i].cell, 0, scratch, progress);
+      progress.advance();
+    }
+  });
+  progress.throw_if_cancelled();
+  std::vector<Tape> variant_tapes;
+  std::unordered_map<std::uint64_t, std::vector<int>> by_hash;
+  tree.children.push_back(0);  // the root's entry, set below
+  tree.children[0] = join(tree, variant_tapes, by_hash, top);
+  // The top part was joined first, with its slots at the same indices: each task's subtree hangs
+  // from its slot there.
+  for (std::size_t i = 0; i < tasks.size(); ++i)
+    tree.children[tasks[i].slot] = join(tree, variant_tapes, by_hash, parts[i]);
+  for (std::size_t v = 0; v < variant_tapes.size(); ++v) {
+    tree.variants[v].key = structure_key(variant_tapes[v]);
+    tree.variants[v].tape = std::move(variant_tapes[v]);
+  }
   CompileStats& s = tree.stats;
   s.leaves = static_cast<std::int64_t>(tree.leaves.size());
   std::int64_t nodes = 0;
@@ -109,8 +214,8 @@ Octree build_octree(const Tape& tape, const Model& model, const OctreeOptions& o
     s.full += l.state == CellState::kFull;
     if (l.state != CellState::kSurface) continue;
     ++s.surface;
-    const auto n =
-        static_cast<std::int64_t>(tree.tapes[static_cast<std::size_t>(l.tape)].code.size());
+    const auto n = static_cast<std::int64_t>(
+        tree.variants[static_cast<std::size_t>(l.variant)].tape.code.size());
     nodes += n;
     s.max_nodes = std::max(s.max_nodes, n);
   }
@@ -121,7 +226,6 @@ Octree build_octree(const Tape& tape, const Model& model, const OctreeOptions& o
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return tree;
 }
-
 std::optional<int> Octree::leaf_at(Vec3d p) const {
   for (int a = 0; a < 3; ++a)
     if (!(p[a] >= root.lo[a] && p[a] <= root.hi[a])) return std::nullopt;
@@ -143,7 +247,32 @@ std::optional<int> Octree::leaf_at(Vec3d p) const {
   return -entry - 1;
 }
 
-double Octree::evaluate(const Tape& whole, Vec3d p) const {
+Bounds Octree::leaf_box(const OctreeLeaf& leaf) const {
+  const double cells = static_cast<double>(1 << leaf.level);
+  const Vec3d size = (root.hi - root.lo) * (1.0 / cells);
+  const Vec3d lo = root.lo + Vec3d{leaf.x * size.x, leaf.y * size.y, leaf.z * size.z};
+  return {lo, lo + size};
+}
+
+std::vector<double> Octree::leaf_params(const OctreeLeaf& leaf) const {
+  const Tape& v = variants[static_cast<std::size_t>(leaf.variant)].tape;
+  std::vector<double> out;
+  out.reserve(v.params.size());
+  for (std::size_t i = 0; i < v.code.size(); ++i) {
+    const Instr& from = whole.code[sources[static_cast<std::size_t>(leaf.source_offset) + i]];
+    const auto first = whole.params.begin() + from.param;
+    out.insert(out.end(), first, first + detail::param_count(v.code[i]));
+  }
+  return out;
+}
+
+Tape Octree::leaf_tape(const OctreeLeaf& leaf) const {
+  Tape t = variants[static_cast<std::size_t>(leaf.variant)].tape;
+  t.params = leaf_params(leaf);
+  return t;
+}
+
+double Octree::evaluate(Vec3d p) const {
   const auto leaf = leaf_at(p);
   if (!leaf) return csg::evaluate(whole, p);
   const OctreeLeaf& l = leaves[static_cast<std::size_t>(*leaf)];
@@ -153,7 +282,7 @@ double Octree::evaluate(const Tape& whole, Vec3d p) const {
     case CellState::kFull:
       return l.hi;
     default:
-      return csg::evaluate(tapes[static_cast<std::size_t>(l.tape)], p);
+      return csg::evaluate(leaf_tape(l), p);
   }
 }
 

@@ -46,6 +46,7 @@ class Folder {
 
  private:
   std::uint32_t emit(Instr in) {
+    in.source = static_cast<std::uint32_t>(tape_.code.size());
     tape_.code.push_back(in);
     if ((tape_.code.size() & 1023) == 0)
       require_memory(tape_.code.size() * sizeof(Instr) + tape_.params.size() * sizeof(double),
@@ -187,7 +188,9 @@ int param_count(const Instr& in) {
 
 void assign_registers(Tape& tape) {
   const std::size_t n = tape.code.size();
-  std::vector<std::uint32_t> last_use(n, 0);
+  thread_local std::vector<std::uint32_t> last_use, free_regs;  // scratch, reused per thread
+  last_use.assign(n, 0);
+  free_regs.clear();
   for (std::size_t i = 0; i < n; ++i) {
     const Instr& in = tape.code[i];
     last_use[i] = static_cast<std::uint32_t>(i);
@@ -195,7 +198,6 @@ void assign_registers(Tape& tape) {
     if (detail::is_binary(in.op)) last_use[in.b] = static_cast<std::uint32_t>(i);
   }
   tape.reg.assign(n, 0);
-  std::vector<std::uint32_t> free_regs;
   tape.registers = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const Instr& in = tape.code[i];
@@ -227,6 +229,11 @@ double evaluate(const Tape& tape, Vec3d p) {
 
 void evaluate(const Tape& tape, std::span<const Vec3d> points, std::span<double> values,
               std::span<std::uint8_t> materials) {
+  evaluate(tape, tape.params.data(), points, values, materials);
+}
+
+void evaluate(const Tape& tape, const double* params, std::span<const Vec3d> points,
+              std::span<double> values, std::span<std::uint8_t> materials) {
   constexpr std::size_t kBatch = 64;
   const bool want_materials = !materials.empty();
   std::vector<double> regs(std::size_t{tape.registers} * kBatch);
@@ -237,7 +244,7 @@ void evaluate(const Tape& tape, std::span<const Vec3d> points, std::span<double>
       const Instr& in = tape.code[i];
       double* out = &regs[tape.reg[i] * kBatch];
       std::uint8_t* out_m = want_materials ? &mats[tape.reg[i] * kBatch] : nullptr;
-      const double* c = &tape.params[in.param];
+      const double* c = params + in.param;
       if (in.op == OpCode::kShape) {
         detail::shape_values(in, c, &points[start], count, out);
         if (out_m) std::fill(out_m, out_m + count, in.material);
@@ -280,6 +287,10 @@ void evaluate(const Tape& tape, std::span<const Vec3d> points, std::span<double>
           for (std::size_t j = 0; j < count; ++j) out[j] = a[j];
           if (out_m) std::fill(out_m, out_m + count, in.material);
           break;
+        case OpCode::kCopy:
+          for (std::size_t j = 0; j < count; ++j) out[j] = a[j];
+          if (out_m) copy_materials(am, out_m, count);
+          break;
         case OpCode::kShape:
           break;
       }
@@ -296,11 +307,34 @@ std::string structure_key(const Tape& tape) {
   for (const Instr& in : tape.code) {
     key += static_cast<char>(in.op);
     key += static_cast<char>(in.shape);
+    key += static_cast<char>(in.material);
     if (in.op == OpCode::kShape) continue;
     key.append(reinterpret_cast<const char*>(&in.a), sizeof in.a);
     key.append(reinterpret_cast<const char*>(&in.b), sizeof in.b);
   }
   return key;
+}
+
+std::uint64_t structure_hash(const Tape& tape) {
+  std::uint64_t h = 1469598103934665603ull;  // FNV-1a
+  auto mix = [&h](std::uint64_t v) {
+    for (int i = 0; i < 8; ++i, v >>= 8) h = (h ^ (v & 0xff)) * 1099511628211ull;
+  };
+  for (const Instr& in : tape.code)
+    mix(static_cast<std::uint64_t>(in.op) | static_cast<std::uint64_t>(in.shape) << 8 |
+        std::uint64_t{in.material} << 16 |
+        (in.op == OpCode::kShape ? 0 : std::uint64_t{in.a} << 24 | std::uint64_t{in.b} << 44));
+  return h;
+}
+
+bool same_structure(const Tape& a, const Tape& b) {
+  if (a.code.size() != b.code.size()) return false;
+  for (std::size_t i = 0; i < a.code.size(); ++i) {
+    const Instr &x = a.code[i], &y = b.code[i];
+    if (x.op != y.op || x.shape != y.shape || x.material != y.material) return false;
+    if (x.op != OpCode::kShape && (x.a != y.a || x.b != y.b)) return false;
+  }
+  return true;
 }
 
 }  // namespace voxfield::csg

@@ -255,11 +255,16 @@ NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name
               "unsupported dtype '" + h.descr +
                   "' (voxfield reads bool, int8/16/32/64, uint8/16/32/64, float32, float64)");
   }
-  if (h.shape.size() != 3) {
-    r.fail_at(header_at, "expected a 3-D array a[x, y, z], got " + std::to_string(h.shape.size()) +
-                             " dimensions");
+  if (options.rank < 1 || options.rank > 3) throw InvalidArgument("parse_npy: rank must be 1..3");
+  if (h.shape.size() != static_cast<std::size_t>(options.rank)) {
+    r.fail_at(header_at,
+              (options.rank == 3 ? std::string("expected a 3-D array a[x, y, z], got ")
+                                 : "expected a " + std::to_string(options.rank) + "-D array, got ") +
+                  std::to_string(h.shape.size()) + " dimensions");
   }
+  h.shape.resize(3, 1);
   NpyVolume v;
+  v.rank = options.rank;
   v.dtype = found->type;
   for (int k = 0; k < 3; ++k) {
     if (h.shape[k] < 1 || h.shape[k] > kCoordLimit) {
@@ -335,8 +340,11 @@ std::vector<std::uint8_t> encode_npy(const NpyVolume& v) {
                           " bytes, expected " + std::to_string(expect));
   }
   const std::string descr = std::string(d.size == 1 ? "|" : "<") + d.kind + std::to_string(d.size);
-  std::string shape =
-      std::to_string(v.dims.x) + ", " + std::to_string(v.dims.y) + ", " + std::to_string(v.dims.z);
+  if (v.rank < 1 || v.rank > 3 || (v.rank < 3 && (v.dims.z != 1 || (v.rank == 1 && v.dims.y != 1) || v.components > 1)))
+    throw InvalidArgument("encode_npy: an array of rank " + std::to_string(v.rank) + " has its other dimensions 1");
+  std::string shape = std::to_string(v.dims.x) + (v.rank == 1 ? "," : "");  // (N,) is a 1-tuple
+  if (v.rank >= 2) shape += ", " + std::to_string(v.dims.y);
+  if (v.rank == 3) shape += ", " + std::to_string(v.dims.z);
   if (v.components > 1) shape += ", " + std::to_string(v.components);
   std::string header =
       "{'descr': '" + descr + "', 'fortran_order': True, 'shape': (" + shape + "), }";
