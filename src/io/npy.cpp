@@ -257,10 +257,10 @@ NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name
   }
   if (options.rank < 1 || options.rank > 3) throw InvalidArgument("parse_npy: rank must be 1..3");
   if (h.shape.size() != static_cast<std::size_t>(options.rank)) {
-    r.fail_at(header_at,
-              (options.rank == 3 ? std::string("expected a 3-D array a[x, y, z], got ")
-                                 : "expected a " + std::to_string(options.rank) + "-D array, got ") +
-                  std::to_string(h.shape.size()) + " dimensions");
+    r.fail_at(header_at, (options.rank == 3
+                              ? std::string("expected a 3-D array a[x, y, z], got ")
+                              : "expected a " + std::to_string(options.rank) + "-D array, got ") +
+                             std::to_string(h.shape.size()) + " dimensions");
   }
   h.shape.resize(3, 1);
   NpyVolume v;
@@ -340,8 +340,10 @@ std::vector<std::uint8_t> encode_npy(const NpyVolume& v) {
                           " bytes, expected " + std::to_string(expect));
   }
   const std::string descr = std::string(d.size == 1 ? "|" : "<") + d.kind + std::to_string(d.size);
-  if (v.rank < 1 || v.rank > 3 || (v.rank < 3 && (v.dims.z != 1 || (v.rank == 1 && v.dims.y != 1) || v.components > 1)))
-    throw InvalidArgument("encode_npy: an array of rank " + std::to_string(v.rank) + " has its other dimensions 1");
+  if (v.rank < 1 || v.rank > 3 ||
+      (v.rank < 3 && (v.dims.z != 1 || (v.rank == 1 && v.dims.y != 1) || v.components > 1)))
+    throw InvalidArgument("encode_npy: an array of rank " + std::to_string(v.rank) +
+                          " has its other dimensions 1");
   std::string shape = std::to_string(v.dims.x) + (v.rank == 1 ? "," : "");  // (N,) is a 1-tuple
   if (v.rank >= 2) shape += ", " + std::to_string(v.dims.y);
   if (v.rank == 3) shape += ", " + std::to_string(v.dims.z);
