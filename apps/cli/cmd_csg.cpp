@@ -8,9 +8,11 @@
 #include "cli.h"
 #include "voxfield/csg.h"
 #include "voxfield/csg_compile.h"
+#include "voxfield/csg_render.h"
 #include "voxfield/file.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
+#include "voxfield/png.h"
 
 namespace voxfield::cli {
 namespace {
@@ -29,6 +31,10 @@ struct CsgSettings {
   std::string field;
   bool whole = false;
   int threads = 0;
+  // render
+  std::string camera = "auto", view = "shaded";
+  int width = 640, height = 480;
+  bool no_shadows = false;
 };
 
 // Models are small texts: 64 MiB is far beyond any real one.
@@ -288,6 +294,61 @@ int run_compile(const CsgSettings& s) {
   return 0;
 }
 
+int run_render(const CsgSettings& s) {
+  Outputs outputs({s.model});
+  outputs.expect(s.out, "-o");
+  outputs.expect(s.stats, "--stats");
+  if (std::filesystem::path(s.out).extension() != ".png")
+    throw UsageError("-o: render writes a .png, not " + s.out);
+  const csg::Model model = load_model(s.model);
+  CsgRenderOptions o;
+  o.width = s.width;
+  o.height = s.height;
+  o.view =
+      s.view == "variants" ? CsgRenderOptions::View::kVariants : CsgRenderOptions::View::kShaded;
+  o.prune = !s.whole;
+  o.depth = s.depth >= 0 ? s.depth : 6;
+  o.shadows = !s.no_shadows;
+  o.box = parse_box(s.box);
+  if (s.camera != "auto") {
+    const auto b = o.box ? o.box : csg::model_bounds(model);
+    const Box3i around =
+        b ? Box3i{{static_cast<int>(std::floor(b->lo.x)), static_cast<int>(std::floor(b->lo.y)),
+                   static_cast<int>(std::floor(b->lo.z))},
+                  {static_cast<int>(std::ceil(b->hi.x)), static_cast<int>(std::ceil(b->hi.y)),
+                   static_cast<int>(std::ceil(b->hi.z))}}
+          : Box3i::from_size({1, 1, 1});
+    o.camera = Camera::parse(s.camera, around, static_cast<double>(s.width) / s.height);
+  }
+  std::optional<ThreadLimit> limit;
+  if (s.threads > 0) limit.emplace(s.threads);
+  set_activity("rendering " + s.model);
+  CsgRenderStats st;
+  const Image image = render_csg(model, o, &st);
+  outputs.stage(s.out, encode_png(image));
+  outputs.stage_json(s.stats, {{"model", s.model},
+                               {"output", s.out},
+                               {"width", s.width},
+                               {"height", s.height},
+                               {"view", s.view},
+                               {"pruned", o.prune},
+                               {"depth", o.depth},
+                               {"threads", max_threads()},
+                               {"octree_ms", st.octree_ms},
+                               {"render_ms", st.render_ms},
+                               {"rays", st.rays},
+                               {"hits", st.hits},
+                               {"evaluations", st.evaluations},
+                               {"instructions", st.instructions},
+                               {"cells_entered", st.cells_entered},
+                               {"variants", st.variants}});
+  outputs.commit();
+  std::cerr << "voxfield: wrote " << s.out << " (" << s.width << " x " << s.height << ", "
+            << std::lround(st.octree_ms) << " ms octree + " << std::lround(st.render_ms)
+            << " ms tracing, " << st.variants << " variants)\n";
+  return 0;
+}
+
 }  // namespace
 
 void add_csg(CLI::App& app, Action& action) {
@@ -341,6 +402,33 @@ void add_csg(CLI::App& app, Action& action) {
   threads(vox);
   stats(vox);
   vox->callback([s, &action] { action = [s] { return run_voxelize(*s); }; });
+
+  CLI::App* render =
+      cmd->add_subcommand("render", "a picture by sphere tracing through the octree's cells");
+  render->add_option("-o,--output", s->out, "output .png")->required();
+  render
+      ->add_option("--camera", s->camera,
+                   "auto (default), top, or eye=x,y,z:target=x,y,z[:up=...][:fov=deg]")
+      ->check(camera_spec());
+  render
+      ->add_option("--view", s->view,
+                   "shaded (default) or variants (each cell coloured by its variant)")
+      ->check(CLI::IsMember({"shaded", "variants"}));
+  render->add_option("--width", s->width, "image width (default 640)")->check(CLI::Range(1, 16384));
+  render->add_option("--height", s->height, "image height (default 480)")
+      ->check(CLI::Range(1, 16384));
+  render->add_option("--depth", s->depth, "octree depth (0..8, default 6)")
+      ->check(CLI::Range(0, 8));
+  render
+      ->add_option("--box", s->box,
+                   "x0,y0,z0,x1,y1,z1: the box traced (default: the model's bounds)")
+      ->delimiter(',');
+  render->add_flag("--whole", s->whole,
+                   "trace the whole tree instead of each cell's pruned tape (for comparison)");
+  render->add_flag("--no-shadows", s->no_shadows, "no shadow rays");
+  threads(render);
+  stats(render);
+  render->callback([s, &action] { action = [s] { return run_render(*s); }; });
 
   CLI::App* comp =
       cmd->add_subcommand("compile", "each variant's GLSL, the cells' parameters and a manifest");

@@ -12,6 +12,7 @@
 #include <cmath>
 
 #include "scene_impl.h"
+#include "shading.h"
 #include "voxfield/error.h"
 #include "voxfield/parallel.h"
 
@@ -80,14 +81,7 @@ ChunkTable::ChunkTable(const Box3i& box, int chunk_edge) : box_(box), edge_(chun
 
 }  // namespace render_detail
 
-namespace {
-
-float srgb_to_linear(std::uint8_t c) {
-  const double v = c / 255.0;
-  return static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
-}
-
-}  // namespace
+using render_detail::srgb_to_linear;
 
 DistanceOptions skip_field_options(const RenderSceneOptions& options, const Box3i& box) {
   DistanceOptions o;

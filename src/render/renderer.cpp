@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "shading.h"
 #include "traverse.h"
 #include "voxfield/error.h"
 #include "voxfield/parallel.h"
@@ -43,61 +44,13 @@ namespace {
 using render_detail::Dda;
 using render_detail::traverse;
 
-struct Rgb {
-  double r = 0, g = 0, b = 0;
-  friend Rgb operator+(Rgb a, Rgb b) { return {a.r + b.r, a.g + b.g, a.b + b.b}; }
-  friend Rgb operator*(Rgb a, double s) { return {a.r * s, a.g * s, a.b * s}; }
-  friend Rgb operator*(Rgb a, Rgb b) { return {a.r * b.r, a.g * b.g, a.b * b.b}; }
-};
-Rgb mix(Rgb a, Rgb b, double t) {
-  return a * (1 - t) + b * t;
-}
-
-// Linear light of the sky and the sun (before exposure).
-constexpr Rgb kSunLight{2.4, 2.2, 1.9};
-constexpr Rgb kSkyZenith{0.22, 0.38, 0.78};
-constexpr Rgb kSkyHorizon{0.70, 0.80, 0.92};
-constexpr Rgb kGround{0.42, 0.45, 0.50};
-constexpr Rgb kSkyAmbient{0.42, 0.52, 0.70};
-
-Rgb sky(const Vec3d& dir) {
-  const double z = dir.z;
-  if (z < 0) return mix(kSkyHorizon, kGround, std::min(1.0, -z * 3));
-  return mix(kSkyHorizon, kSkyZenith, std::pow(z, 0.6));
-}
-
-// Exposure (1 - exp(-1.25 x)) then sRGB encoding, through one table over linear light in
-// [0, kMaxLinear) — no exp or pow per pixel.
-class ToneMap {
- public:
-  ToneMap() {
-    for (int i = 0; i < kSteps; ++i) {
-      const double linear = kMaxLinear * i / (kSteps - 1);
-      const double v = 1 - std::exp(-1.25 * linear);
-      const double s = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
-      table_[static_cast<std::size_t>(i)] =
-          static_cast<std::uint8_t>(std::lround(std::clamp(s, 0.0, 1.0) * 255));
-    }
-  }
-  std::uint8_t encode(double linear) const {
-    const double x = std::clamp(linear, 0.0, kMaxLinear) * ((kSteps - 1) / kMaxLinear);
-    return table_[static_cast<std::size_t>(x + 0.5)];
-  }
-  void write(Rgb c, std::uint8_t* px) const {
-    px[0] = encode(c.r);
-    px[1] = encode(c.g);
-    px[2] = encode(c.b);
-  }
-
- private:
-  static constexpr int kSteps = 16384;
-  static constexpr double kMaxLinear = 8;  // exposes to 0.99995: white
-  std::array<std::uint8_t, kSteps> table_{};
-};
-const ToneMap& tone_map() {
-  static const ToneMap t;
-  return t;
-}
+using render_detail::kGround;
+using render_detail::kSkyAmbient;
+using render_detail::kSunLight;
+using render_detail::mix;
+using render_detail::Rgb;
+using render_detail::sky;
+using render_detail::tone_map;
 
 // A perceptual heat ramp (dark blue, blue, green, yellow, red) for x in [0, 1], as sRGB bytes.
 void heat(double x, std::uint8_t* px) {
