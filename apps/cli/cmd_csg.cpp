@@ -19,6 +19,7 @@ namespace {
 
 struct CsgSettings {
   std::string model, stats;
+  bool facets = false;  // OpenSCAD spheres and cylinders as its polytopes
   // info / compile
   int depth = -1;
   // eval
@@ -40,13 +41,18 @@ struct CsgSettings {
 // Models are small texts: 64 MiB is far beyond any real one.
 constexpr std::uint64_t kMaxModelFile = std::uint64_t{64} << 20;
 
-csg::Model load_model(const std::string& path) {
+csg::Model load_model(const std::string& path, bool facets) {
   set_activity("reading " + path);
   const auto bytes = read_file(path, kMaxModelFile);
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   const std::string ext = std::filesystem::path(path).extension().string();
   if (ext == ".json") return csg::parse_model_json(text, path);
   if (ext == ".sdf") return csg::parse_model_sexpr(text, path);
+  if (ext == ".csg") {
+    csg::OpenScadOptions o;
+    o.facets = facets;
+    return csg::parse_openscad_csg(text, path, o);
+  }
   return csg::parse_model(text, path);
 }
 
@@ -79,7 +85,7 @@ std::optional<csg::Bounds> parse_box(const std::vector<double>& v) {
 int run_info(const CsgSettings& s) {
   Outputs outputs({s.model});
   outputs.expect(s.stats, "--stats");
-  const csg::Model model = load_model(s.model);
+  const csg::Model model = load_model(s.model, s.facets);
   const csg::ModelInfo info = csg::model_info(model);
   nlohmann::json j{{"model", s.model},
                    {"nodes", info.nodes},
@@ -125,7 +131,7 @@ int run_eval(const CsgSettings& s) {
   Outputs outputs({s.model, s.points});
   outputs.expect(s.out, "-o");
   outputs.expect(s.stats, "--stats");
-  const csg::Model model = load_model(s.model);
+  const csg::Model model = load_model(s.model, s.facets);
   set_activity("reading " + s.points);
   NpyReadOptions ro;
   ro.rank = 2;
@@ -183,7 +189,7 @@ int run_voxelize(const CsgSettings& s) {
   outputs.expect(s.stats, "--stats");
   if (!s.field.empty() && std::filesystem::path(s.field).extension() != ".npy")
     throw UsageError("--field writes a float32 .npy, not " + s.field);
-  const csg::Model model = load_model(s.model);
+  const csg::Model model = load_model(s.model, s.facets);
   csg::VoxelizeOptions o;
   o.voxel_size = s.voxel_size;
   o.box = parse_box(s.box);
@@ -237,7 +243,7 @@ int run_compile(const CsgSettings& s) {
   const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
   if (!fs::is_directory(parent))
     throw IoError("-o " + s.out + ": the directory " + parent.string() + " does not exist");
-  const csg::Model model = load_model(s.model);
+  const csg::Model model = load_model(s.model, s.facets);
   set_activity("compiling " + s.model);
   const csg::Tape tape = csg::compile_tape(model);
   csg::OctreeOptions o;
@@ -300,7 +306,7 @@ int run_render(const CsgSettings& s) {
   outputs.expect(s.stats, "--stats");
   if (std::filesystem::path(s.out).extension() != ".png")
     throw UsageError("-o: render writes a .png, not " + s.out);
-  const csg::Model model = load_model(s.model);
+  const csg::Model model = load_model(s.model, s.facets);
   CsgRenderOptions o;
   o.width = s.width;
   o.height = s.height;
@@ -357,7 +363,12 @@ void add_csg(CLI::App& app, Action& action) {
       "csg",
       "The voxel compiler: CSG models (.sdf S-expressions or .json, docs/csg.md) "
       "pruned per octree cell, voxelised, evaluated and compiled to GLSL");
-  cmd->add_option("MODEL", s->model, "model file (.sdf or .json)")->required();
+  cmd->add_option("MODEL", s->model, "model file: .sdf (S-expressions), .json, or OpenSCAD's .csg")
+      ->required();
+  cmd->add_flag("--facets", s->facets,
+                "OpenSCAD .csg: spheres and cylinders as OpenSCAD's polytopes ($fn/$fa/$fs), not "
+                "ideal shapes");
+  cmd->fallthrough();  // --facets after the subcommand too
   cmd->require_subcommand(1);
   auto stats = [&](CLI::App* sub) {
     sub->add_option("--stats", s->stats, "write the figures as JSON");

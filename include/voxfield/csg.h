@@ -111,6 +111,21 @@ Model parse_model_json(std::string_view text, const std::string& name);
 // JSON when the first non-blank character is '[', the S-expression form otherwise.
 Model parse_model(std::string_view text, const std::string& name);
 
+// OpenSCAD's flattened CSG tree (`openscad -o model.csg`): group, union, difference,
+// intersection, render, multmatrix, color, cube, sphere and cylinder, translated into the model
+// language (docs/csg.md says how). Spheres and cylinders are the ideal shapes unless `facets`,
+// which gives OpenSCAD's own polytopes ($fn, $fa, $fs as OpenSCAD counts fragments). Other nodes
+// (hull, minkowski, polyhedron, extrusions, import, text, 2-D shapes) are refused by name with
+// their line. Throws ModelError.
+struct OpenScadOptions {
+  bool facets = false;
+};
+Model parse_openscad_csg(std::string_view text, const std::string& name,
+                         const OpenScadOptions& options = {});
+// The translation itself (model-language text), for reading or keeping.
+std::string translate_openscad_csg(std::string_view text, const std::string& name,
+                                   const OpenScadOptions& options = {});
+
 // The model's value at p: the definitions of docs/csg.md applied node by node in double
 // precision. This is the reference; compiled evaluators equal it within float rounding.
 double evaluate(const Model& model, Vec3d p);

@@ -180,7 +180,11 @@ Voxelized voxelize(const Model& model, const VoxelizeOptions& options) {
   }
   const Bounds& b = out.box;
   for (int a = 0; a < 3; ++a) {
-    const double cells = std::ceil((b.hi[a] - b.lo[a]) / options.voxel_size);
+    // Whole voxels covering the box; an extent within 1e-6 voxel of a whole number of voxels (a box
+    // written with limited digits) is that number.
+    const double exact = (b.hi[a] - b.lo[a]) / options.voxel_size;
+    double cells = std::ceil(exact);
+    if (cells - exact > 1 - 1e-6) cells -= 1;
     if (!std::isfinite(b.lo[a]) || !std::isfinite(b.hi[a]) || !(b.hi[a] >= b.lo[a]))
       throw InvalidArgument(model.name + ": the box must be finite with lo <= hi on every axis");
     if (!(cells <= kCoordLimit))
