@@ -13,7 +13,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-25}; shift || true
-harnesses=${*:-"vox npy vfw edit_script options vector_sources csg_model"}
+harnesses=${*:-"vox npy vfw edit_script options vector_sources csg_model openscad"}
 bin=build/fuzz/bin
 cli=build/release/bin/voxfield
 corpus=../shared/data/vox
@@ -40,6 +40,7 @@ for h in $harnesses; do
     options) dirs="fuzz/seeds/options"; max_len=256 ;;
     vector_sources) dirs="fuzz/seeds/vector_sources"; max_len=4096 ;;
     csg_model) dirs="fuzz/seeds/csg"; max_len=4096 ;;
+    openscad) dirs="fuzz/seeds/openscad"; max_len=4096 ;;
     *) echo "unknown harness $h" >&2; exit 2 ;;
   esac
   work="$out/corpus-$h"; mkdir -p "$work"
