@@ -25,6 +25,7 @@ struct ShowcaseSettings {
   std::uint64_t seed = 6683787;
   std::string out = "out";
   std::string peers = VOXFIELD_PEERS_DIR "/mesh_peers.py";
+  std::string examples = VOXFIELD_EXAMPLES_DIR;
 };
 
 int run_showcase(const ShowcaseSettings& s) {
@@ -354,8 +355,9 @@ int run_showcase(const ShowcaseSettings& s) {
     if (!exact) throw Error("showcase: the incrementally updated fields differ from full rebuilds");
   }
 
-  const double total_ms = ms_since(t_start);
   showcase_vectors(s.out, s.seed, md, timings);
+  showcase_csg(s.examples, s.out, md, timings);
+  const double total_ms = ms_since(t_start);
 
   md << "\n## Timings\n\n| stage | ms | |\n|---|---|---|\n";
   for (const auto& [stage, ms, note] : timings)
@@ -378,6 +380,8 @@ void add_showcase(CLI::App& app, Action& action) {
   cmd->add_option("--out", s->out, "output directory");
   cmd->add_option("--peers", s->peers,
                   "the peers' meshing script (bench/peers/mesh_peers.py), run when it exists");
+  cmd->add_option("--examples", s->examples,
+                  "the example models' directory (examples/ of the repository)");
   cmd->callback([s, &action] { action = [s] { return run_showcase(*s); }; });
 }
 

@@ -39,4 +39,9 @@ void showcase_meshing(const World& terrain, const std::filesystem::path& out,
 void showcase_vectors(const std::filesystem::path& out, std::uint64_t seed, std::ostream& md,
                       std::vector<Timing>& timings);
 
+// The voxel compiler: the example CSG models (under `examples`/csg) compiled, pictured shaded and
+// by variant, two voxelised into .vox files (pruned and whole-tree voxelisations checked equal).
+void showcase_csg(const std::filesystem::path& examples, const std::filesystem::path& out,
+                  std::ostream& md, std::vector<Timing>& timings);
+
 }  // namespace voxfield::cli
