@@ -8,8 +8,10 @@
 #include "cli.h"
 #include "voxfield/csg.h"
 #include "voxfield/csg_compile.h"
+#include "voxfield/csg_mesh.h"
 #include "voxfield/csg_render.h"
 #include "voxfield/file.h"
+#include "voxfield/mesh_files.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
 #include "voxfield/png.h"
@@ -36,6 +38,10 @@ struct CsgSettings {
   std::string camera = "auto", view = "shaded";
   int width = 640, height = 480;
   bool no_shadows = false;
+  // mesh
+  std::string algorithm = "dc";
+  int chunk = 32;
+  bool sampled = false;
 };
 
 // Models are small texts: 64 MiB is far beyond any real one.
@@ -355,6 +361,47 @@ int run_render(const CsgSettings& s) {
   return 0;
 }
 
+int run_mesh(const CsgSettings& s) {
+  Outputs outputs({s.model});
+  outputs.expect(s.out, "-o");
+  outputs.expect(s.stats, "--stats");
+  const MeshFormat format = mesh_format_of(s.out);
+  const csg::Model model = load_model(s.model, s.facets);
+  CsgMeshOptions o;
+  o.voxel_size = s.voxel_size;
+  o.box = parse_box(s.box);
+  o.mesh.algorithm = parse_mesher(s.algorithm);
+  o.mesh.chunk_edge = s.chunk;
+  o.exact_gradients = !s.sampled;
+  std::optional<ThreadLimit> limit;
+  if (s.threads > 0) limit.emplace(s.threads);
+  set_activity("meshing " + s.model);
+  const auto start = std::chrono::steady_clock::now();
+  const Mesh mesh = mesh_csg(model, o);
+  const double ms = ms_since(start);
+  set_activity("writing " + s.out);
+  outputs.stage(s.out, encode_mesh(mesh, format));
+  const MeshStats st = mesh_stats(mesh);
+  outputs.stage_json(s.stats, {{"model", s.model},
+                               {"output", s.out},
+                               {"algorithm", mesher_name(o.mesh.algorithm)},
+                               {"voxel_size", s.voxel_size},
+                               {"exact_gradients", o.exact_gradients},
+                               {"threads", max_threads()},
+                               {"ms", ms},
+                               {"vertices", st.vertices},
+                               {"triangles", st.triangles},
+                               {"watertight", st.watertight()},
+                               {"euler_characteristic", st.euler_characteristic},
+                               {"area_units2", st.area_units2},
+                               {"volume_units3", st.signed_volume_units3}});
+  outputs.commit();
+  std::cerr << "voxfield: wrote " << s.out << " (" << st.triangles << " triangles, "
+            << mesher_name(o.mesh.algorithm) << ", " << std::lround(ms) << " ms"
+            << (st.watertight() ? ", watertight" : "") << ")\n";
+  return 0;
+}
+
 }  // namespace
 
 void add_csg(CLI::App& app, Action& action) {
@@ -413,6 +460,29 @@ void add_csg(CLI::App& app, Action& action) {
   threads(vox);
   stats(vox);
   vox->callback([s, &action] { action = [s] { return run_voxelize(*s); }; });
+
+  CLI::App* mesh = cmd->add_subcommand("mesh",
+                                       "the surface as triangles: dual contouring (default), "
+                                       "marching cubes or surface nets, with crossings "
+                                       "and normals from the model itself");
+  mesh->add_option("--voxel-size", s->voxel_size, "lattice spacing in model units")
+      ->required()
+      ->check(finite_positive());
+  mesh->add_option("-o,--output", s->out, "output .ply, .obj, .stl or .glb")->required();
+  mesh->add_option("--algorithm", s->algorithm, "dc (default), mc or sn")
+      ->check(
+          CLI::IsMember({"mc", "sn", "dc", "marching-cubes", "surface-nets", "dual-contouring"}));
+  mesh->add_option("--box", s->box,
+                   "x0,y0,z0,x1,y1,z1 in model units (default: the model's bounds)")
+      ->delimiter(',');
+  mesh->add_option("--chunk", s->chunk, "cells per chunk edge (2..256, default 32)")
+      ->check(CLI::Range(2, 256));
+  mesh->add_flag("--sampled", s->sampled,
+                 "interpolate crossings and difference normals from the samples, as for any volume "
+                 "(for comparison)");
+  threads(mesh);
+  stats(mesh);
+  mesh->callback([s, &action] { action = [s] { return run_mesh(*s); }; });
 
   CLI::App* render =
       cmd->add_subcommand("render", "a picture by sphere tracing through the octree's cells");

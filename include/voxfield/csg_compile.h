@@ -150,6 +150,7 @@ struct Octree {
   // its variant: enough to rebuild its constants (leaf_params) without storing them per cell.
   std::vector<std::uint32_t> sources;
   CompileStats stats;
+  std::uint64_t id = 0;  // distinct per build (keys the per-thread caches of leaf tapes)
   // Child links: node 0 is the root; entries >= 0 are nodes (8 children each, in `children`),
   // entries < 0 are leaves -(leaf + 1).
   std::vector<std::int32_t> children;
@@ -164,8 +165,11 @@ struct Octree {
   Tape leaf_tape(const OctreeLeaf& leaf) const;
   // The value through p's cell: its pruned tape in surface cells; in empty or full cells the
   // cell's bound nearest zero (right sign, magnitude at most the whole tape's); the whole tape
-  // outside the root.
+  // outside the root. Leaf tapes are cached per thread, so nearby queries cost one evaluation.
   double evaluate(Vec3d p) const;
+  // The exact value (the whole tape's, bit for bit): through p's cell's pruned tape in surface
+  // cells, the whole tape elsewhere.
+  double exact_value(Vec3d p) const;
 };
 Octree build_octree(const Tape& tape, const Model& model, const OctreeOptions& options);
 

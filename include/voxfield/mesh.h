@@ -23,6 +23,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -71,6 +72,15 @@ struct MeshOptions {
   // Cells per chunk edge (each chunk is meshed as one unit of parallel work), 2..256.
   int chunk_edge = 32;
   Interrupter* interrupter = nullptr;  // progress per chunk; cancelling throws Cancelled
+  // The field's gradient at a position (in the volume's units), when the caller knows it (an
+  // analytic model, csg_mesh.h): dual contouring's Hermite normals and every mesher's vertex
+  // normals come from it instead of differences of the samples. Called from worker threads at
+  // once; it must give the same answer for the same position every time (seamless chunks).
+  std::function<std::array<double, 3>(const std::array<double, 3>& position_units)> gradient;
+  // The field's value at a position, when the caller can evaluate it anywhere: each crossing on a
+  // lattice edge is then found on the function itself (Illinois regula falsi), not by
+  // interpolating the edge's two samples, so vertices lie on the surface. Same rules as gradient.
+  std::function<double(const std::array<double, 3>& position_units)> value;
 };
 
 struct Mesh {

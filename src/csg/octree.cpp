@@ -4,6 +4,7 @@
 // and the pruned tapes of the leaves are grouped into variants by structure. The top two levels
 // are split serially; the 64 subtrees below them are built in parallel and joined in order, so
 // the result does not depend on the thread count.
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <unordered_map>
@@ -160,7 +161,9 @@ Octree build_octree(const Tape& tape, const Model& model, const OctreeOptions& o
   if (options.depth < 0 || options.depth > 8)
     throw InvalidArgument("octree depth must be 0..8, got " + std::to_string(options.depth));
   const auto start = std::chrono::steady_clock::now();
+  static std::atomic<std::uint64_t> next_id{0};
   Octree tree;
+  tree.id = next_id.fetch_add(1) + 1;
   tree.depth = options.depth;
   tree.whole = tape;
   if (options.box) {
@@ -272,6 +275,28 @@ Tape Octree::leaf_tape(const OctreeLeaf& leaf) const {
   return t;
 }
 
+namespace {
+
+// A few leaf tapes per thread, direct-mapped by leaf: queries along a mesher's edges or a ray
+// stay in a handful of cells.
+const Tape& cached_leaf_tape(const Octree& tree, int leaf) {
+  struct Entry {
+    std::uint64_t id = 0;
+    int leaf = -1;
+    Tape tape;
+  };
+  thread_local std::array<Entry, 8> cache;
+  Entry& e = cache[static_cast<std::size_t>(leaf) % cache.size()];
+  if (e.id != tree.id || e.leaf != leaf) {
+    e.tape = tree.leaf_tape(tree.leaves[static_cast<std::size_t>(leaf)]);
+    e.id = tree.id;
+    e.leaf = leaf;
+  }
+  return e.tape;
+}
+
+}  // namespace
+
 double Octree::evaluate(Vec3d p) const {
   const auto leaf = leaf_at(p);
   if (!leaf) return csg::evaluate(whole, p);
@@ -282,8 +307,15 @@ double Octree::evaluate(Vec3d p) const {
     case CellState::kFull:
       return l.hi;
     default:
-      return csg::evaluate(leaf_tape(l), p);
+      return csg::evaluate(cached_leaf_tape(*this, *leaf), p);
   }
+}
+
+double Octree::exact_value(Vec3d p) const {
+  const auto leaf = leaf_at(p);
+  if (!leaf || leaves[static_cast<std::size_t>(*leaf)].state != CellState::kSurface)
+    return csg::evaluate(whole, p);
+  return csg::evaluate(cached_leaf_tape(*this, *leaf), p);
 }
 
 }  // namespace voxfield::csg

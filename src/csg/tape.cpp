@@ -236,8 +236,14 @@ void evaluate(const Tape& tape, const double* params, std::span<const Vec3d> poi
               std::span<double> values, std::span<std::uint8_t> materials) {
   constexpr std::size_t kBatch = 64;
   const bool want_materials = !materials.empty();
-  std::vector<double> regs(std::size_t{tape.registers} * kBatch);
-  std::vector<std::uint8_t> mats(want_materials ? std::size_t{tape.registers} * kBatch : 0);
+  // Registers kept per thread: callers evaluate millions of single points (sphere tracing,
+  // meshing's crossings), where an allocation per call would cost more than the tape.
+  thread_local std::vector<double> regs;
+  thread_local std::vector<std::uint8_t> mats;
+  if (regs.size() < std::size_t{tape.registers} * kBatch)
+    regs.resize(std::size_t{tape.registers} * kBatch);
+  if (want_materials && mats.size() < std::size_t{tape.registers} * kBatch)
+    mats.resize(std::size_t{tape.registers} * kBatch);
   for (std::size_t start = 0; start < points.size(); start += kBatch) {
     const std::size_t count = std::min(kBatch, points.size() - start);
     for (std::size_t i = 0; i < tape.code.size(); ++i) {

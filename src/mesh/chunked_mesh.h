@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "voxfield/box.h"
@@ -33,6 +34,19 @@ struct Lattice {
   // on the face between two voxel centres and its exact normal is its edge's axis (dual
   // contouring then rebuilds the cubes' edges and corners exactly).
   bool voxel_faces = false;
+  // MeshOptions::gradient, when given: the value's gradient at a position in world units.
+  const std::function<std::array<double, 3>(const std::array<double, 3>&)>* gradient = nullptr;
+  // The outward normal there: the gradient of s (the value's, times sign).
+  std::array<double, 3> exact_normal(const std::array<double, 3>& position) const {
+    const auto g = (*gradient)(position);
+    return {g[0] * sign, g[1] * sign, g[2] * sign};
+  }
+  // MeshOptions::value, when given.
+  const std::function<double(const std::array<double, 3>&)>* value = nullptr;
+  // Where along the edge from lattice point p (sample s0) to its neighbour along `axis` (s1) the
+  // surface crosses, as a fraction: on the function itself when it can be evaluated, else by
+  // interpolating the samples. A function of the edge alone, so every chunk finds the same point.
+  double crossing(Vec3i p, int axis, double s0, double s1) const;
   std::size_t index(int x, int y, int z) const {
     return static_cast<std::size_t>(x) +
            static_cast<std::size_t>(n.x) *

@@ -14,7 +14,8 @@
 // Normals at crossings blend one-sided gradients at the edge's two samples (Block::
 // one_sided_gradient: taken from the smoother side, so a crease does not smear the planes of the
 // faces meeting there); positions and normals are in world units, so anisotropic spacing is exact.
-// For voxel worlds the Hermite data is exact: each crossing lies on the face between a solid and
+// With MeshOptions::gradient (an analytic model's) the normals at crossings are that gradient. For
+// voxel worlds the Hermite data is exact too: each crossing lies on the face between a solid and
 // an air voxel, with that face's normal, so the mesh is the voxels' cubes, corners and all.
 #include <cmath>
 
@@ -74,15 +75,20 @@ std::array<double, 3> dual_contouring_vertex(const Block& block, const Lattice& 
   for (const CubeEdge& e : cube_edges()) {
     const double s0 = v[e.from], s1 = v[e.to];
     if ((s0 < 0) == (s1 < 0)) continue;
-    const double t = s0 / (s0 - s1);
     Vec3i p0 = cell, p1 = cell;
     for (int a = 0; a < 3; ++a) {
       p0[a] += e.from >> a & 1;
       p1[a] += e.to >> a & 1;
     }
+    const double t = lattice.crossing(p0, e.axis, s0, s1);
     std::array<double, 3> g{};
     if (lattice.voxel_faces) {
       g[e.axis] = s0 < 0 ? 1 : -1;  // from the solid voxel towards the air
+    } else if (lattice.gradient) {  // exact Hermite data from the caller's gradient
+      std::array<double, 3> at{static_cast<double>(p0.x), static_cast<double>(p0.y),
+                               static_cast<double>(p0.z)};
+      at[static_cast<std::size_t>(e.axis)] += t;
+      g = lattice.exact_normal(lattice_position(lattice, at));
     } else {
       const auto g0 = block.one_sided_gradient(p0.x, p0.y, p0.z),
                  g1 = block.one_sided_gradient(p1.x, p1.y, p1.z);

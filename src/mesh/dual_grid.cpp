@@ -42,6 +42,8 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
         blend(v[1] - v[0], v[3] - v[2], v[5] - v[4], v[7] - v[6], w1, w2) / lattice.spacing[0],
         blend(v[2] - v[0], v[3] - v[1], v[6] - v[4], v[7] - v[5], u, w2) / lattice.spacing[1],
         blend(v[4] - v[0], v[5] - v[1], v[6] - v[2], v[7] - v[3], u, w1) / lattice.spacing[2]};
+    if (lattice.gradient)
+      normal = lattice.exact_normal(lattice_position(lattice, {q.x + u, q.y + w1, q.z + w2}));
     if (normal[0] == 0 && normal[1] == 0 && normal[2] == 0) {
       // A saddle of the interpolant (e.g. two inside corners touching diagonally): point away
       // from the inside corners' mean instead, in world units.

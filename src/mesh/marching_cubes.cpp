@@ -58,13 +58,18 @@ void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i c
     Vec3i q = p;
     ++q[axis];
     const double s0 = block.s(p.x, p.y, p.z), s1 = block.s(q.x, q.y, q.z);
-    const double t = s0 / (s0 - s1);  // the signs differ, so s0 != s1
+    const double t = lattice.crossing(p, axis, s0, s1);
     std::array<double, 3> at{static_cast<double>(p.x), static_cast<double>(p.y),
                              static_cast<double>(p.z)};
     at[static_cast<std::size_t>(axis)] += t;
-    const auto g0 = block.gradient(p.x, p.y, p.z), g1 = block.gradient(q.x, q.y, q.z);
-    std::array<double, 3> normal{g0[0] + t * (g1[0] - g0[0]), g0[1] + t * (g1[1] - g0[1]),
-                                 g0[2] + t * (g1[2] - g0[2])};
+    std::array<double, 3> normal;
+    if (lattice.gradient) {
+      normal = lattice.exact_normal(lattice_position(lattice, at));
+    } else {
+      const auto g0 = block.gradient(p.x, p.y, p.z), g1 = block.gradient(q.x, q.y, q.z);
+      normal = {g0[0] + t * (g1[0] - g0[0]), g0[1] + t * (g1[1] - g0[1]),
+                g0[2] + t * (g1[2] - g0[2])};
+    }
     if (normal[0] == 0 && normal[1] == 0 && normal[2] == 0)
       normal[static_cast<std::size_t>(axis)] = s0 < 0 ? 1 : -1;
     bool owned = true, shared = false;

@@ -71,7 +71,39 @@ Lattice checked_lattice(const ScalarVolume& volume, const MeshOptions& options, 
   lattice.iso = options.iso;
   lattice.sign = options.inside_above ? -1 : 1;
   lattice.voxel_faces = voxel_faces;
+  lattice.gradient = options.gradient ? &options.gradient : nullptr;
+  lattice.value = options.value ? &options.value : nullptr;
   return lattice;
+}
+
+double Lattice::crossing(Vec3i p, int axis, double s0, double s1) const {
+  double t = s0 / (s0 - s1);  // the signs differ, so s0 != s1
+  if (!value) return t;
+  // Illinois regula falsi on s(t) = sign * (value - iso) between the edge's ends, which bracket
+  // the root; stops when the bracket is below 1e-9 of the edge.
+  std::array<double, 3> a{origin[0] + p.x * spacing[0], origin[1] + p.y * spacing[1],
+                          origin[2] + p.z * spacing[2]};
+  const double start = a[static_cast<std::size_t>(axis)],
+               length = spacing[static_cast<std::size_t>(axis)];
+  double lo = 0, hi = 1, f_lo = s0, f_hi = s1;
+  int side = 0;
+  for (int it = 0; it < 60 && hi - lo > 1e-9; ++it) {
+    a[static_cast<std::size_t>(axis)] = start + t * length;
+    const double f = sign * ((*value)(a)-iso);
+    if (f == 0) return t;
+    if ((f < 0) == (f_lo < 0)) {
+      lo = t, f_lo = f;
+      if (side == -1) f_hi /= 2;
+      side = -1;
+    } else {
+      hi = t, f_hi = f;
+      if (side == 1) f_lo /= 2;
+      side = 1;
+    }
+    t = lo + (hi - lo) * (f_lo / (f_lo - f_hi));
+    if (!(t > lo && t < hi)) t = (lo + hi) / 2;
+  }
+  return t;
 }
 
 void mesh_chunks(const Lattice& lattice, const ChunkGrid& grid, const MeshOptions& options,

@@ -9,13 +9,16 @@
 
 namespace voxfield::detail::mesh {
 
-std::array<double, 3> surface_nets_vertex(const Block&, const Lattice&, Vec3i, const double* v) {
+std::array<double, 3> surface_nets_vertex(const Block&, const Lattice& lattice, Vec3i cell,
+                                          const double* v) {
   std::array<double, 3> mean{0, 0, 0};
   int crossings = 0;
   for (const CubeEdge& e : cube_edges()) {
     const double s0 = v[e.from], s1 = v[e.to];
     if ((s0 < 0) == (s1 < 0)) continue;
-    const double t = s0 / (s0 - s1);
+    Vec3i p0 = cell;
+    for (int a = 0; a < 3; ++a) p0[a] += e.from >> a & 1;
+    const double t = lattice.crossing(p0, e.axis, s0, s1);
     for (int a = 0; a < 3; ++a)
       mean[static_cast<std::size_t>(a)] += a == e.axis ? t : (e.from >> a & 1);
     ++crossings;
