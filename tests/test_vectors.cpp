@@ -493,7 +493,16 @@ TEST(WorldVectors, EditsKeepTheFieldEqualToARebuild) {
         SphereBrush{{double(rng() % 40), double(rng() % 32), double(rng() % 24)}, 2.0 + rng() % 4};
     apply_edit(w, edit, &dirty);
     const std::int64_t texels = f.update(dirty);
-    EXPECT_LT(texels, box.volume() * 2);
+    // Exactly the union of the changed boxes grown by the reach (ceil(5) + 1): each texel once.
+    std::vector<char> covered(static_cast<std::size_t>(box.volume()), 0);
+    for (const Box3i& b : dirty.boxes()) {
+      const Box3i r = b.grown(6).intersect(box);
+      for (int z = r.begin.z; z < r.end.z; ++z)
+        for (int y = r.begin.y; y < r.end.y; ++y)
+          for (int x = r.begin.x; x < r.end.x; ++x)
+            covered[static_cast<std::size_t>((z * 32 + y) * 40 + x)] = 1;
+    }
+    EXPECT_EQ(texels, std::count(covered.begin(), covered.end(), 1)) << "after edit " << e;
     const WorldVectorField fresh(w, box, 5, VectorStorage::kRgba8);
     ASSERT_TRUE(std::equal(f.texture().bytes().begin(), f.texture().bytes().end(),
                            fresh.texture().bytes().begin()))

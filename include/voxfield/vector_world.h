@@ -34,7 +34,7 @@ class WorldVectorField {
   WorldVectorField(const World& world, const Box3i& box, double reach, VectorStorage storage);
 
   // After edits of the world recorded in `dirty`: the incremental field's update, then the texels
-  // of every changed box grown by the reach. Returns the texels re-encoded.
+  // of the changed boxes grown by the reach, each texel once. Returns the texels re-encoded.
   std::int64_t update(const DirtyRegions& dirty);
 
   const VectorVolume& volume() const { return volume_; }

@@ -114,13 +114,55 @@ void WorldVectorField::encode(const Box3i& region) {
   encode_region(field_.field(), box_, region, reach_, texture_);
 }
 
+namespace {
+
+// `box` minus the boxes already in `disjoint`, appended to it as disjoint pieces: each overlap
+// splits what remains into at most six slabs (below and above the overlap along x, then y, then z).
+void add_disjoint(std::vector<Box3i>& disjoint, const Box3i& box) {
+  std::vector<Box3i> pieces{box};
+  for (std::size_t k = 0, existing = disjoint.size(); k < existing && !pieces.empty(); ++k) {
+    const Box3i& a = disjoint[k];
+    std::vector<Box3i> next;
+    for (Box3i rest : pieces) {
+      const Box3i overlap = rest.intersect(a);
+      if (overlap.empty()) {
+        next.push_back(rest);
+        continue;
+      }
+      for (int axis = 0; axis < 3; ++axis) {
+        if (rest.begin[axis] < overlap.begin[axis]) {
+          Box3i below = rest;
+          below.end[axis] = overlap.begin[axis];
+          next.push_back(below);
+          rest.begin[axis] = overlap.begin[axis];
+        }
+        if (overlap.end[axis] < rest.end[axis]) {
+          Box3i above = rest;
+          above.begin[axis] = overlap.end[axis];
+          next.push_back(above);
+          rest.end[axis] = overlap.end[axis];
+        }
+      }  // what remains of `rest` is the overlap itself, already covered
+    }
+    pieces = std::move(next);
+  }
+  disjoint.insert(disjoint.end(), pieces.begin(), pieces.end());
+}
+
+}  // namespace
+
 std::int64_t WorldVectorField::update(const DirtyRegions& dirty) {
   field_.update(dirty);
-  // A changed voxel moves the nearest site of voxels within the reach of it only.
+  // A changed voxel moves the nearest site of voxels within the reach of it only. The changed
+  // boxes are per chunk, so grown by the reach they overlap: each texel is encoded once.
   const std::int32_t grow = static_cast<std::int32_t>(std::ceil(reach_)) + 1;
-  std::int64_t texels = 0;
+  std::vector<Box3i> regions;
   for (const Box3i& b : dirty.boxes()) {
     const Box3i r = b.grown(grow).intersect(box_);
+    if (!r.empty()) add_disjoint(regions, r);
+  }
+  std::int64_t texels = 0;
+  for (const Box3i& r : regions) {
     encode(r);
     texels += r.volume();
   }
