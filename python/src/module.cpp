@@ -9,6 +9,7 @@ namespace py = pybind11;
 
 namespace voxfield::python {
 void bind_ndimage(py::module_& m);
+void bind_csg(py::module_& m);
 }
 
 PYBIND11_MODULE(_voxfield, m) {
@@ -24,4 +25,5 @@ PYBIND11_MODULE(_voxfield, m) {
   py::register_exception<voxfield::IoError>(m, "IoError", PyExc_OSError);
   py::register_exception<voxfield::Cancelled>(m, "Cancelled", PyExc_KeyboardInterrupt);
   voxfield::python::bind_ndimage(m);
+  voxfield::python::bind_csg(m);
 }

@@ -1,5 +1,8 @@
 """voxfield: exact distance fields of voxel worlds and volumes, from Python.
 
+``voxfield.csg`` compiles CSG models (docs/csg.md): ``Model(text)`` or ``Model.load(path)``
+(.sdf, .json, OpenSCAD .csg), then ``evaluate(points)``, ``voxelize(voxel_size)``, ``mesh(...)``.
+
 ``voxfield.ndimage`` is a drop-in for ``scipy.ndimage.distance_transform_edt`` and
 ``distance_transform_cdt`` (same arguments, results, shapes, dtypes and index layout), computed
 by voxfield's exact separable transforms on every core, with what SciPy lacks: ``signed``,
@@ -13,6 +16,7 @@ their messages name the file and, for malformed files, the byte offset.
 from . import _voxfield
 from ._voxfield import Cancelled, Error, FormatError, InvalidArgument, IoError, ResourceLimitError
 from . import ndimage
+from . import csg
 
-__all__ = ["ndimage", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
+__all__ = ["ndimage", "csg", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
            "Cancelled"]
