@@ -10,7 +10,7 @@ namespace py = pybind11;
 namespace voxfield::python {
 void bind_ndimage(py::module_& m);
 void bind_csg(py::module_& m);
-}
+}  // namespace voxfield::python
 
 PYBIND11_MODULE(_voxfield, m) {
   m.doc() = "voxfield's C++ engine; use the voxfield package";
