@@ -217,6 +217,17 @@ def definition_part(tmp):
     open(os.path.join(tmp, "bad.npy"), "wb").write(b"not an npy")
     p = run("csg", model, "eval", "--points", os.path.join(tmp, "bad.npy"), "-o", out, expect=1)
     check(p.returncode == 1 and not os.path.exists(out) and "bad.npy" in p.stderr, "a failed eval writes nothing")
+    # compile replaces an earlier compile's directory whole, and refuses any other directory.
+    shaders = os.path.join(tmp, "shaders")
+    for depth in ("5", "3"):
+        run("csg", model, "compile", "--depth", depth, "-o", shaders)
+    manifest = json.load(open(os.path.join(shaders, "manifest.json")))
+    names = sorted(os.listdir(shaders))
+    check(manifest["depth"] == 3 and names == sorted(["manifest.json", "params.f32", "prelude.glsl"] +
+          ["variant_%d.glsl" % v["index"] for v in manifest["variants"]]),
+          "compile replaces an earlier compile's directory whole (%d files)" % len(names))
+    p = run("csg", model, "compile", "-o", tmp, expect=2)
+    check(p.returncode == 2 and "not a compile's output" in p.stderr, "compile refuses a directory of other files")
     p = run("csg", model, "voxelize", "--voxel-size", "1e-7", "-o", out, expect=1)
     check(p.returncode == 1 and not os.path.exists(out) and "memory limit" in p.stderr,
           "an absurd voxelisation is refused by the memory limit: " + p.stderr.strip()[:100])

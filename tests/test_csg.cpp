@@ -375,6 +375,47 @@ TEST(CsgClip, PrunedTapesEqualTheWholeTapeAndSettledCellsHaveNoSurface) {
   EXPECT_GT(settled, 500);
 }
 
+// Large coordinates and radii, small cells: the bounds must cover the rounding of values computed
+// from numbers a million times larger than the cell (the margin scales with them).
+TEST(CsgClip, SoundAtLargeCoordinates) {
+  const Model m = parse(
+      "(union (move 1e6 0 0 (sphere 1e6)) (move -1e6 0.5 0 (sphere 1e6)) (move 0 3e6 0 (box 2e6 "
+      "2e6 2e6)))");
+  const Tape whole = compile_tape(m);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int cell = 0; cell < 3000; ++cell) {
+    // Cells of 1e-3 near the spheres' touching point and the box's face.
+    const Vec3d lo =
+        cell % 2 ? Vec3d{(u(rng) - 0.5) * 0.1, (u(rng) - 0.5) * 2, (u(rng) - 0.5) * 2}
+                 : Vec3d{(u(rng) - 0.5) * 1e3, 2e6 + (u(rng) - 0.5) * 0.01, (u(rng) - 0.5) * 1e3};
+    const Bounds box{lo, lo + Vec3d{1e-3, 1e-3, 1e-3}};
+    const Clipped c = clip(whole, box);
+    for (int i = 0; i < 8; ++i) {
+      const Vec3d p{i & 1 ? box.hi.x : box.lo.x, i & 2 ? box.hi.y : box.lo.y,
+                    i & 4 ? box.hi.z : box.lo.z};
+      const double v = evaluate(whole, p);
+      ASSERT_EQ(evaluate(c.tape, p), v);
+      ASSERT_TRUE(c.lo <= v && v <= c.hi) << cell;
+      if (c.state == CellState::kEmpty) {
+        ASSERT_GT(v, 0);
+      }
+      if (c.state == CellState::kFull) {
+        ASSERT_LT(v, 0);
+      }
+    }
+  }
+}
+
+TEST(CsgTape, ScalesThatUnderflowAreRefused) {
+  std::string deep = "(sphere 1)";
+  for (int i = 0; i < 12; ++i) deep = "(scale 1e-12 " + deep + ")";
+  EXPECT_NE(error_of([&] { (void)compile_tape(parse(deep)); }).find("out of range"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { (void)parse("(sphere 1e-13)"); }).find("at least 1e-12"),
+            std::string::npos);
+}
+
 std::string example(const std::string& name) {
   std::ifstream in(std::string(VOXFIELD_EXAMPLES_DIR) + "/csg/" + name);
   std::stringstream s;

@@ -3,6 +3,7 @@
 // name and line. The bundled examples against OpenSCAD's own meshes are in csg_oracle_test.py.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <random>
 
@@ -96,6 +97,49 @@ TEST(CsgOpenScad, ModifiersAndRefusals) {
   // Colours become paints with palette entries of that colour.
   const Model c = scad("color([1, 0, 0, 1]) { sphere(r = 1); }");
   EXPECT_EQ(c.palette[material_at(c, {0, 0, 0})], (Rgba{255, 0, 0, 255}));
+}
+
+}  // namespace
+}  // namespace voxfield::csg
+
+namespace voxfield::csg {
+namespace {
+
+TEST(CsgOpenScad, HostileCountsAreRefusedAndPolytopesAreBounded) {
+  for (bool facets : {false, true}) {
+    EXPECT_NE(error_of([&] {
+                (void)scad("sphere($fn = 3e9, r = 1);", facets);
+              }).find("more than 1024 fragments"),
+              std::string::npos);
+    EXPECT_NE(
+        error_of([&] { (void)scad("sphere($fa = 0, $fs = 0, r = 1);", facets); }).find("fragments"),
+        std::string::npos);
+  }
+  // Two spheres of 1024 fragments need about 2 x 524 000 planes: past the model's limit.
+  EXPECT_NE(error_of([] {
+              (void)scad(
+                  "sphere($fn = 1024, r = 1); multmatrix([[1, 0, 0, 5], [0, 1, 0, 0], [0, 0, 1, "
+                  "0], [0, 0, 0, 1]]) "
+                  "{ sphere($fn = 1024, r = 1); }",
+                  true);
+            }).find("planes"),
+            std::string::npos);
+  // A polytope is bounded by its vertices' box, so facetted models voxelise without a box.
+  const Model p = scad("sphere($fn = 8, r = 2);", true);
+  const auto b = model_bounds(p);
+  ASSERT_TRUE(b);
+  EXPECT_NEAR(b->hi.x, 2 * std::sin(3.14159265358979 * 1.5 / 4),
+              1e-9);  // ring 1 at 67.5 degrees, vertex at 0
+  EXPECT_LT(evaluate(p, {0, 0, 0}), 0);
+}
+
+TEST(CsgOpenScad, ParsingTimeIsLinear) {
+  // 200 000 statements (2.4 MB): read in one pass, not rescanned per statement.
+  std::string text;
+  for (int i = 0; i < 200000; ++i) text += "cube(1);\n";
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_NO_THROW((void)translate_openscad_csg(text, "many.csg"));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 20.0);
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <iostream>
 
+#include <unistd.h>
+
 #include "cli.h"
 #include "voxfield/csg.h"
 #include "voxfield/csg_compile.h"
@@ -242,8 +244,19 @@ int run_voxelize(const CsgSettings& s) {
 int run_compile(const CsgSettings& s) {
   namespace fs = std::filesystem;
   const fs::path dir = s.out;
-  if (fs::exists(dir) && !fs::is_directory(dir))
-    throw UsageError("-o " + s.out + " exists and is not a directory");
+  // The directory is replaced whole, and only when everything is ready: a new one, an empty one or
+  // an earlier compile's (with its manifest) — never a directory holding other files, or the model.
+  if (fs::exists(dir)) {
+    if (!fs::is_directory(dir)) throw UsageError("-o " + s.out + " exists and is not a directory");
+    if (!fs::is_empty(dir) && !fs::exists(dir / "manifest.json"))
+      throw UsageError(
+          "-o " + s.out +
+          " holds files that are not a compile's output; give a new or empty directory");
+    const fs::path model = fs::weakly_canonical(s.model), target = fs::weakly_canonical(dir);
+    if (std::mismatch(target.begin(), target.end(), model.begin(), model.end()).first ==
+        target.end())
+      throw UsageError("-o " + s.out + " contains the model " + s.model);
+  }
   Outputs outputs({s.model});
   outputs.expect(s.stats, "--stats");
   const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
@@ -289,13 +302,27 @@ int run_compile(const CsgSettings& s) {
       {"model", s.model},          {"depth", o.depth},       {"root", bounds_json(tree.root)},
       {"prelude", "prelude.glsl"}, {"params", "params.f32"}, {"params_count", params.size()},
       {"variants", variants},      {"cells", cells},         {"compile", compile_json(tree.stats)}};
-  fs::create_directories(dir);
-  for (const auto& [name, text] : files)
-    outputs.stage((dir / name).string(), std::string_view(text));
-  outputs.stage((dir / "params.f32").string(),
-                std::span(reinterpret_cast<const std::uint8_t*>(params.data()),
-                          params.size() * sizeof(float)));
-  outputs.stage_json((dir / "manifest.json").string(), manifest);
+  // Written into a fresh directory beside the target, then swapped in.
+  const fs::path fresh = dir.string() + ".tmp." + std::to_string(::getpid());
+  try {
+    fs::remove_all(fresh);
+    fs::create_directory(fresh);
+    for (const auto& [name, text] : files)
+      write_file_atomic(fresh / name,
+                        std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+    write_file_atomic(fresh / "params.f32",
+                      std::span(reinterpret_cast<const std::uint8_t*>(params.data()),
+                                params.size() * sizeof(float)));
+    const std::string m = manifest.dump(2) + "\n";
+    write_file_atomic(fresh / "manifest.json",
+                      std::span(reinterpret_cast<const std::uint8_t*>(m.data()), m.size()));
+    if (fs::exists(dir)) fs::remove_all(dir);
+    fs::rename(fresh, dir);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(fresh, ignored);
+    throw;
+  }
   nlohmann::json stats{
       {"model", s.model}, {"depth", o.depth}, {"compile", compile_json(tree.stats)}};
   stats["compile"]["codegen_ms"] = codegen_ms;
@@ -324,11 +351,14 @@ int run_render(const CsgSettings& s) {
   o.box = parse_box(s.box);
   if (s.camera != "auto") {
     const auto b = o.box ? o.box : csg::model_bounds(model);
+    // A voxel box around the model for "top" framing, clamped to the coordinate range.
+    auto coord = [](double v) {
+      return static_cast<int>(std::clamp(v, -double(kCoordLimit), double(kCoordLimit)));
+    };
     const Box3i around =
-        b ? Box3i{{static_cast<int>(std::floor(b->lo.x)), static_cast<int>(std::floor(b->lo.y)),
-                   static_cast<int>(std::floor(b->lo.z))},
-                  {static_cast<int>(std::ceil(b->hi.x)), static_cast<int>(std::ceil(b->hi.y)),
-                   static_cast<int>(std::ceil(b->hi.z))}}
+        b ? Box3i{{coord(std::floor(b->lo.x)), coord(std::floor(b->lo.y)),
+                   coord(std::floor(b->lo.z))},
+                  {coord(std::ceil(b->hi.x)), coord(std::ceil(b->hi.y)), coord(std::ceil(b->hi.z))}}
           : Box3i::from_size({1, 1, 1});
     o.camera = Camera::parse(s.camera, around, static_cast<double>(s.width) / s.height);
   }

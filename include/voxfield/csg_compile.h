@@ -114,6 +114,7 @@ struct OctreeOptions {
   std::optional<Bounds> box;  // default: the model's bounds made cubic
   double max_distance = std::numeric_limits<double>::infinity();
   Interrupter* interrupter = nullptr;
+  std::uint64_t memory_limit_bytes = 0;  // leaves and their sources (0: the process default)
 };
 
 struct OctreeLeaf {

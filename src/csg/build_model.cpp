@@ -20,6 +20,7 @@ constexpr std::int64_t kMaxExpandedNodes = std::int64_t{1} << 20;
 constexpr int kMaxExpandedDepth = 1024;
 
 enum class Check { kPositive, kNonNegative, kAny };
+constexpr double kMinPositive = 1e-12;
 
 struct Syntax {
   NodeKind kind;
@@ -154,6 +155,10 @@ class Builder {
           (syntax.checks[i] == Check::kNonNegative && !(v >= 0)))
         fail(a, "(" + head.text + signature(syntax) + "): " + syntax.params[i] + " must be " +
                     (syntax.checks[i] == Check::kPositive ? "> 0" : ">= 0") + ", got " + shown(a));
+      // Positive sizes below 1e-12 would fold (with scales) into constants that underflow.
+      if (syntax.checks[i] == Check::kPositive && v < kMinPositive)
+        fail(a, "(" + head.text + signature(syntax) + "): " + syntax.params[i] +
+                    " must be at least 1e-12, got " + shown(a));
       node.params.push_back(v);
     }
     shape_rules(head, d, node);

@@ -7,8 +7,9 @@
 // Soundness: an operand of a min is dropped only when the other operand's upper bound is at most
 // its lower bound over the whole cell, so the min equals the kept operand at every point of the
 // cell, bit for bit (the same instructions compute it); likewise for max, and for the smooth
-// blends once the operands are k apart (their blend term is then exactly zero). Bounds are widened
-// by a relative 1e-12 to cover the rounding of the values they bound.
+// blends once the operands are k apart (their blend term is then exactly zero). Every bound is
+// widened by 1e-12 of the magnitudes that computed it (coordinates, constants, the value) to cover
+// the rounding of the values it bounds.
 #include <algorithm>
 #include <cmath>
 
@@ -95,9 +96,11 @@ struct Scratch {
   std::vector<int> material;
   std::vector<std::uint8_t> choice, live;
   std::vector<std::uint32_t> remap;
+  std::vector<double> magnitude;
   void resize(std::size_t n) {
     if (iv.size() >= n) return;
     iv.resize(n);
+    magnitude.resize(n);
     at_centre.resize(n);
     material.resize(n);
     choice.resize(n);
@@ -127,6 +130,9 @@ void clip_into(const Tape& tape, const Bounds& cell, double max_distance, bool t
   double* at_centre = scratch.at_centre.data();
   int* material = scratch.material.data();  // constant material over the cell, or -1
   std::uint8_t* choice = scratch.choice.data();
+  // How large the numbers computing each value get: rounding errors scale with them, not with
+  // the value (a small value at large coordinates carries their rounding).
+  double* magnitude = scratch.magnitude.data();
   std::fill_n(choice, n, 0);
   for (std::size_t i = 0; i < n; ++i) {
     const Instr& in = tape.code[i];
@@ -135,6 +141,16 @@ void clip_into(const Tape& tape, const Bounds& cell, double max_distance, bool t
     double centre_value = 0;
     if (in.op == OpCode::kShape) {
       material[i] = in.material;
+      double q_max = 0, sizes = 0;
+      for (int row = 0; row < 3; ++row) {
+        double q = std::abs(c[9 + row]);
+        for (int col = 0; col < 3; ++col)
+          q += std::abs(c[row * 3 + col]) * (std::abs(centre[col]) + half_diagonal);
+        q_max = std::max(q_max, q);
+      }
+      for (int k = 0; k < shape_param_count(in.shape); ++k)
+        sizes += std::abs(c[kShapeFrameParams + k]);
+      magnitude[i] = std::abs(c[12]) * (q_max + sizes);
       if (in.lipschitz) {
         detail::shape_values(in, c, &centre, 1, &centre_value);
         v = {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
@@ -183,6 +199,8 @@ void clip_into(const Tape& tape, const Bounds& cell, double max_distance, bool t
           centre_value = ca;
           break;
       }
+      magnitude[i] =
+          std::max(magnitude[in.a], is_binary(in.op) ? magnitude[in.b] : 0.0) + std::abs(k);
       choice[i] = static_cast<std::uint8_t>(is_binary(in.op) ? choose(in.op, a, b, k) : 0);
       const bool min_like = in.op == OpCode::kMin || in.op == OpCode::kSmoothMin;
       if (in.op == OpCode::kSetMaterial) {
@@ -198,10 +216,13 @@ void clip_into(const Tape& tape, const Bounds& cell, double max_distance, bool t
       if (!min_like && choice[i] == 2 && material[in.a] < 0) choice[i] = 0;
     }
     if (in.lipschitz) {
-      const double widen = kWiden * (std::abs(centre_value) + half_diagonal) + 1e-300;
-      v.lo = std::max(v.lo, centre_value - half_diagonal - widen);
-      v.hi = std::min(v.hi, centre_value + half_diagonal + widen);
+      v.lo = std::max(v.lo, centre_value - half_diagonal);
+      v.hi = std::min(v.hi, centre_value + half_diagonal);
     }
+    // Every bound, Lipschitz or interval, widened to cover the rounding of the values it bounds.
+    const double widen = kWiden * (std::abs(centre_value) + half_diagonal + magnitude[i]) + 1e-300;
+    v.lo -= widen;
+    v.hi += widen;
     iv[i] = v;
     at_centre[i] = centre_value;
   }

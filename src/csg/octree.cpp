@@ -11,6 +11,7 @@
 
 #include "csg/tape_internal.h"
 #include "voxfield/csg_compile.h"
+#include "voxfield/limits.h"
 #include "voxfield/parallel.h"
 
 namespace voxfield::csg {
@@ -203,8 +204,14 @@ Octree build_octree(const Tape& tape, const Model& model, const OctreeOptions& o
   tree.children[0] = join(tree, variant_tapes, by_hash, top);
   // The top part was joined first, with its slots at the same indices: each task's subtree hangs
   // from its slot there.
-  for (std::size_t i = 0; i < tasks.size(); ++i)
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
     tree.children[tasks[i].slot] = join(tree, variant_tapes, by_hash, parts[i]);
+    require_memory(tree.leaves.size() * sizeof(OctreeLeaf) +
+                       tree.sources.size() * sizeof(std::uint32_t) +
+                       tree.children.size() * sizeof(std::int32_t),
+                   options.memory_limit_bytes, model.name,
+                   "the octree of depth " + std::to_string(options.depth));
+  }
   for (std::size_t v = 0; v < variant_tapes.size(); ++v) {
     tree.variants[v].key = structure_key(variant_tapes[v]);
     tree.variants[v].tape = std::move(variant_tapes[v]);

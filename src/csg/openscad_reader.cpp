@@ -28,6 +28,10 @@ using detail::Mat3;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kTolerance = 1e-4;  // relative: the six digits of the format, with room
+constexpr int kMaxFragments = 1024;
+// Planes a translation may hold in all (a --facets sphere of n fragments has about n^2/2): the
+// model language's own limit on nodes.
+constexpr std::int64_t kMaxPlanes = 600000;
 
 struct Value {
   enum class Type { kNumber, kBool, kString, kUndef, kVector };
@@ -61,7 +65,21 @@ class Parser {
   }
 
  private:
-  SourcePos here() const { return detail::position_of(text_, i_); }
+  // Statements are read in text order, so their positions advance one cursor (linear in the
+  // text); errors (rare) may look back.
+  SourcePos here() const { return at(i_); }
+  SourcePos at(std::size_t offset) const {
+    if (offset < cursor_) return detail::position_of(text_, offset);
+    for (; cursor_ < offset; ++cursor_) {
+      if (text_[cursor_] == '\n') {
+        ++cursor_pos_.line;
+        cursor_pos_.column = 1;
+      } else {
+        ++cursor_pos_.column;
+      }
+    }
+    return cursor_pos_;
+  }
   [[noreturn]] void fail(const std::string& what) const { fail(here(), what); }
 
   void skip() {
@@ -182,13 +200,15 @@ class Parser {
     const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), v.number);
     if (digits.empty() || ec != std::errc() || end != digits.data() + digits.size() ||
         !std::isfinite(v.number))
-      fail(detail::position_of(text_, start), "expected a number");
+      fail(at(start), "expected a number");
     return v;
   }
 
   std::string_view text_;
   const std::string& name_;
   std::size_t i_ = 0;
+  mutable std::size_t cursor_ = 0;
+  mutable SourcePos cursor_pos_{1, 1};
 };
 
 // An affine map p -> m p + t.
@@ -329,15 +349,18 @@ class Translator {
   }
 
   // OpenSCAD's get_fragments_from_r.
-  static int fragments(double r, double fn, double fs, double fa) {
+  // OpenSCAD's get_fragments_from_r, in doubles (huge or infinite counts are refused before any
+  // cast to int).
+  static double fragments(double r, double fn, double fs, double fa) {
     if (r < 0.00000095367431640625) return 3;
-    if (fn > 0) return fn >= 3 ? static_cast<int>(fn) : 3;
-    return static_cast<int>(std::ceil(std::max(std::min(360.0 / fa, r * 2 * kPi / fs), 5.0)));
+    if (fn > 0) return fn >= 3 ? std::floor(fn) : 3;
+    return std::ceil(std::max(std::min(360.0 / fa, r * 2 * kPi / fs), 5.0));
   }
   int fragments_of(const Statement& s, double r) const {
-    const int f = fragments(r, number(s, "$fn", 0), number(s, "$fs", 2), number(s, "$fa", 12));
-    if (f > 4096) parser_.fail(s.pos, s.name + "(): more than 4096 fragments");
-    return f;
+    const double f = fragments(r, number(s, "$fn", 0), number(s, "$fs", 2), number(s, "$fa", 12));
+    if (!(f <= kMaxFragments))
+      parser_.fail(s.pos, s.name + "(): more than " + std::to_string(kMaxFragments) + " fragments");
+    return static_cast<int>(f);
   }
 
   Shape cube(const Statement& s) const {
@@ -387,7 +410,7 @@ class Translator {
     if (d < 0) m = detail::mul(m, Mat3{-1, 0, 0, 0, 1, 0, 0, 0, 1});
     std::string e;
     if (o_.facets && sh.kind != Shape::Kind::kBox) {
-      e = polytope(sh, m, t);
+      e = polytope(s, sh, m, t);
     } else {
       Mat3 r, st;
       detail::polar(m, r, st);
@@ -398,7 +421,7 @@ class Translator {
         e = diagonal ? placed("(box " + num(sh.size.x * k.x) + " " + num(sh.size.y * k.y) + " " +
                                   num(sh.size.z * k.z) + ")",
                               r, t)
-                     : polytope(sh, m, t);
+                     : polytope(s, sh, m, t);
       } else if (sh.kind == Shape::Kind::kSphere) {
         if (diagonal) {
           const bool uniform =
@@ -460,7 +483,7 @@ class Translator {
 
   // The convex polytope OpenSCAD meshes for the shape, as the intersection of its faces'
   // half-spaces, its vertices mapped by m and t.
-  static std::string polytope(const Shape& sh, const Mat3& m, Vec3d t) {
+  std::string polytope(const Statement& statement, const Shape& sh, const Mat3& m, Vec3d t) {
     std::vector<Vec3d> v;
     std::vector<std::vector<int>> faces;
     const int n = sh.fragments;
@@ -515,7 +538,23 @@ class Translator {
       centroid = centroid + p;
     }
     centroid = centroid * (1.0 / static_cast<double>(v.size()));
-    std::string out = "(inter";
+    planes_ += static_cast<std::int64_t>(faces.size());
+    if (planes_ > kMaxPlanes)
+      parser_.fail(statement.pos, statement.name + "(): the polytopes need more than " +
+                                      std::to_string(kMaxPlanes) +
+                                      " planes in all (fewer fragments, or import without facets)");
+    // The vertices' box first: it leaves the solid as it is (the polytope lies inside it) and gives
+    // the model bounds, which an intersection of planes alone does not have.
+    Vec3d lo = v[0], hi = v[0];
+    for (const Vec3d& p : v)
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], p[a]);
+        hi[a] = std::max(hi[a], p[a]);
+      }
+    const Vec3d mid = (lo + hi) * 0.5, size = hi - lo;
+    std::string out = "(inter (move " + num(mid.x) + " " + num(mid.y) + " " + num(mid.z) +
+                      " (box " + num(std::max(size.x, 1e-9)) + " " + num(std::max(size.y, 1e-9)) +
+                      " " + num(std::max(size.z, 1e-9)) + "))";
     for (const auto& f : faces) {
       const Vec3d a = v[static_cast<std::size_t>(f[0])], b = v[static_cast<std::size_t>(f[1])],
                   c = v[static_cast<std::size_t>(f[2])];
@@ -531,6 +570,7 @@ class Translator {
 
   const Parser& parser_;
   const OpenScadOptions& o_;
+  std::int64_t planes_ = 0;
 };
 
 }  // namespace

@@ -65,6 +65,17 @@ class Folder {
     return emit(in);
   }
 
+  // A constant after folding the scales above it: refused when it under- or overflowed (nested
+  // scales multiply), since the tape would then compute NaN where the model does not.
+  double checked(const Node& n, double v) const {
+    if (!std::isnormal(v) || std::abs(v) > 1e100 || std::abs(v) < 1e-100)
+      throw ModelError(m_.name, n.pos.line, n.pos.column,
+                       std::string("(") + kind_name(n.kind) +
+                           " ...): the scales above it make a constant of " + std::to_string(v) +
+                           " (out of range)");
+    return v;
+  }
+
   std::uint32_t fold(int index, const detail::Affine& frame, double mult, std::uint8_t material) {
     const Node& n = m_.nodes[static_cast<std::size_t>(index)];
     if (is_shape(n.kind)) {
@@ -90,7 +101,7 @@ class Folder {
         in.a = acc;
         in.b = b;
         in.lipschitz = tape_.code[acc].lipschitz && tape_.code[b].lipschitz;
-        if (smooth) in.param = param(n.params[0] * mult);
+        if (smooth) in.param = param(checked(n, n.params[0] * mult));
         acc = emit(in);
       }
       return acc;
@@ -113,13 +124,14 @@ class Folder {
         detail::Affine t;
         const double inv = 1.0 / n.params[0];
         t.m = {inv, 0, 0, 0, inv, 0, 0, 0, inv};
-        return fold(child, t.after(frame), mult * n.params[0], material);
+        return fold(child, t.after(frame), checked(n, mult * n.params[0]), material);
       }
       case NodeKind::kRound:
-        return unary(OpCode::kOffset, fold(child, frame, mult, material), n.params[0] * mult);
+        return unary(OpCode::kOffset, fold(child, frame, mult, material),
+                     n.params[0] == 0 ? 0.0 : checked(n, n.params[0] * mult));
       case NodeKind::kShell:
         return unary(OpCode::kAbsOffset, fold(child, frame, mult, material),
-                     n.params[0] / 2 * mult);
+                     checked(n, n.params[0] / 2 * mult));
       default:  // kPaint
         return fold(child, frame, mult, n.material);
     }

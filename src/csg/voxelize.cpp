@@ -5,6 +5,7 @@
 // wanted there), and leaves evaluate their small tapes in batches.
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <mutex>
 
 #include "voxfield/csg_compile.h"
@@ -19,7 +20,7 @@ constexpr int kJobEdge = 64;
 
 struct Job {
   Box3i box;
-  Tape tape;
+  std::shared_ptr<const Tape> tape;  // the parent cell's, shared by its jobs
 };
 
 class Voxelizer {
@@ -29,19 +30,21 @@ class Voxelizer {
       : out_(out), o_(o), materials_(materials), field_(field) {}
 
   // The top of the octree, serially, down to cells of kJobEdge.
-  void split(const Tape& parent, const Box3i& box, std::vector<Job>& jobs, VoxelizeStats& s) {
+  void split(const std::shared_ptr<const Tape>& parent, const Box3i& box, std::vector<Job>& jobs,
+             VoxelizeStats& s) {
     if (box.empty()) return;
     const Vec3i size = box.size();
     if (std::max({size.x, size.y, size.z}) <= kJobEdge) {
       jobs.push_back({box, parent});
       return;
     }
-    const Clipped c = prune(parent, box, s);
+    Clipped c = prune(*parent, box, s);
     if (settled(c)) {
       fill(c, box, s);
       return;
     }
-    for (const Box3i& child : halves(box)) split(c.tape, child, jobs, s);
+    const auto tape = std::make_shared<const Tape>(std::move(c.tape));
+    for (const Box3i& child : halves(box)) split(tape, child, jobs, s);
   }
 
   // A job's cell and everything below it.
@@ -203,14 +206,14 @@ Voxelized voxelize(const Model& model, const VoxelizeOptions& options) {
   Voxelizer v(out, options, materials, options.field ? out.field.data() : nullptr);
   std::vector<Job> jobs;
   VoxelizeStats total;
-  v.split(whole, grid, jobs, total);
+  v.split(std::make_shared<const Tape>(whole), grid, jobs, total);
   Progress progress(options.interrupter, "voxelising " + model.name,
                     static_cast<std::int64_t>(jobs.size()));
   std::mutex mutex;
   parallel_for(jobs.size(), 1, [&](std::size_t begin, std::size_t end) {
     VoxelizeStats local;
     for (std::size_t j = begin; j < end && progress.keep_going(); ++j) {
-      v.cell(jobs[j].tape, jobs[j].box, local);
+      v.cell(*jobs[j].tape, jobs[j].box, local);
       progress.advance();
     }
     const std::lock_guard lock(mutex);

@@ -163,18 +163,18 @@ Rgb variant_colour(int variant) {
 }  // namespace
 
 Camera csg_camera(const csg::Bounds& box, double aspect) {
-  // Camera::framing works on voxel boxes; framing is scale-invariant, so frame the box scaled to
-  // 4096 units and scale the camera back.
-  const Vec3d size = box.hi - box.lo;
-  const double k = 4096 / std::max({size.x, size.y, size.z, 1e-9});
+  // Camera::framing works on voxel boxes; framing is invariant under scaling and translation, so
+  // frame the box centred at the origin and scaled to 4096 units, then map the camera back.
+  const Vec3d size = box.hi - box.lo, centre = (box.lo + box.hi) * 0.5;
+  const double k = 4096 / std::max({size.x, size.y, size.z, 1e-300});
   const Box3i scaled{
-      {static_cast<int>(std::floor(box.lo.x * k)), static_cast<int>(std::floor(box.lo.y * k)),
-       static_cast<int>(std::floor(box.lo.z * k))},
-      {static_cast<int>(std::ceil(box.hi.x * k)), static_cast<int>(std::ceil(box.hi.y * k)),
-       static_cast<int>(std::ceil(box.hi.z * k))}};
+      {static_cast<int>(std::floor(-size.x / 2 * k)), static_cast<int>(std::floor(-size.y / 2 * k)),
+       static_cast<int>(std::floor(-size.z / 2 * k))},
+      {static_cast<int>(std::ceil(size.x / 2 * k)), static_cast<int>(std::ceil(size.y / 2 * k)),
+       static_cast<int>(std::ceil(size.z / 2 * k))}};
   Camera c = Camera::framing(scaled, aspect);
-  c.eye = c.eye * (1 / k);
-  c.target = c.target * (1 / k);
+  c.eye = c.eye * (1 / k) + centre;
+  c.target = c.target * (1 / k) + centre;
   return c;
 }
 

@@ -157,9 +157,18 @@ std::int64_t WorldVectorField::update(const DirtyRegions& dirty) {
   // boxes are per chunk, so grown by the reach they overlap: each texel is encoded once.
   const std::int32_t grow = static_cast<std::int32_t>(std::ceil(reach_)) + 1;
   std::vector<Box3i> regions;
-  for (const Box3i& b : dirty.boxes()) {
-    const Box3i r = b.grown(grow).intersect(box_);
-    if (!r.empty()) add_disjoint(regions, r);
+  const std::vector<Box3i> boxes = dirty.boxes();
+  if (boxes.size() > 64) {
+    // Cutting n boxes apart costs n^2: past a few dozen (an edit over many chunks) their bounding
+    // box, encoded once, costs less.
+    Box3i all;
+    for (const Box3i& b : boxes) all = all.unite(b.grown(grow).intersect(box_));
+    if (!all.empty()) regions.push_back(all);
+  } else {
+    for (const Box3i& b : boxes) {
+      const Box3i r = b.grown(grow).intersect(box_);
+      if (!r.empty()) add_disjoint(regions, r);
+    }
   }
   std::int64_t texels = 0;
   for (const Box3i& r : regions) {
