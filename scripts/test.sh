@@ -20,7 +20,7 @@ for preset in $presets; do
   ctest --preset "$preset" -j "$(nproc)"
   phase_done "$preset tests"
 done
-fuzz_seconds=${VOXFIELD_FUZZ_SECONDS:-20}
+fuzz_seconds=${VOXFIELD_FUZZ_SECONDS:-15}
 if [ "$fuzz_seconds" -gt 0 ]; then
   echo "=== voxfield fuzz smoke: ${fuzz_seconds}s per harness ==="
   cmake --preset release >/dev/null && cmake --build --preset release --target voxfield_cli  # makes the seeds
