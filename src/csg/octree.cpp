@@ -200,18 +200,28 @@ Octree build_octree(const Tape& tape, const Model& model, const OctreeOptions& o
   progress.throw_if_cancelled();
   std::vector<Tape> variant_tapes;
   std::unordered_map<std::uint64_t, std::vector<int>> by_hash;
+  // The joined arrays' sizes are known: reserve them once (growing them leaf by leaf copied and
+  // page-faulted the whole octree several times over).
+  std::size_t leaves = top.leaves.size(), sources = top.sources.size(),
+              children = top.children.size();
+  for (const Part& p : parts) {
+    leaves += p.leaves.size();
+    sources += p.sources.size();
+    children += p.children.size();
+  }
+  require_memory(leaves * sizeof(OctreeLeaf) + sources * sizeof(std::uint32_t) +
+                     children * sizeof(std::int32_t),
+                 options.memory_limit_bytes, model.name,
+                 "the octree of depth " + std::to_string(options.depth));
+  tree.leaves.reserve(leaves);
+  tree.sources.reserve(sources);
+  tree.children.reserve(children + 1);
   tree.children.push_back(0);  // the root's entry, set below
   tree.children[0] = join(tree, variant_tapes, by_hash, top);
   // The top part was joined first, with its slots at the same indices: each task's subtree hangs
   // from its slot there.
-  for (std::size_t i = 0; i < tasks.size(); ++i) {
+  for (std::size_t i = 0; i < tasks.size(); ++i)
     tree.children[tasks[i].slot] = join(tree, variant_tapes, by_hash, parts[i]);
-    require_memory(tree.leaves.size() * sizeof(OctreeLeaf) +
-                       tree.sources.size() * sizeof(std::uint32_t) +
-                       tree.children.size() * sizeof(std::int32_t),
-                   options.memory_limit_bytes, model.name,
-                   "the octree of depth " + std::to_string(options.depth));
-  }
   for (std::size_t v = 0; v < variant_tapes.size(); ++v) {
     tree.variants[v].key = structure_key(variant_tapes[v]);
     tree.variants[v].tape = std::move(variant_tapes[v]);
