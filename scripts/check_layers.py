@@ -28,7 +28,7 @@ PUBLIC_LAYER = {
     "distance.h": "distance", "algorithms.h": "distance", "dynamic_field.h": "distance",
     "dissertation_format.h": "distance", "gpu_distance.h": "distance",
     "vectors.h": "vectors", "vector_world.h": "vectors", "vector_files.h": "io",
-    "csg.h": "csg", "csg_compile.h": "csg",
+    "csg.h": "csg", "csg_compile.h": "csg", "csg_files.h": "io",
     "mesh.h": "mesh", "mesh_chunks.h": "mesh", "csg_mesh.h": "mesh", "mesh_optimize.h": "mesh", "mesh_files.h": "io",
     "file.h": "io", "npy.h": "io", "vox.h": "io", "world_file.h": "io", "world_io.h": "io",
     "edit_script.h": "io",

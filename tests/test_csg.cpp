@@ -14,6 +14,7 @@
 #include <random>
 #include <sstream>
 
+#include "csg_examples.h"
 #include "error_text.h"
 #include "voxfield/csg.h"
 #include "voxfield/csg_compile.h"
@@ -416,15 +417,8 @@ TEST(CsgTape, ScalesThatUnderflowAreRefused) {
             std::string::npos);
 }
 
-std::string example(const std::string& name) {
-  std::ifstream in(std::string(VOXFIELD_EXAMPLES_DIR) + "/csg/" + name);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(CsgOctree, GearHasFewVariantsAndPrunedValuesAgree) {
-  const Model gear = parse_model(example("gear.sdf"), "gear.sdf");
+  const Model gear = parse_model(test::csg_example_text("gear.sdf"), "gear.sdf");
   const Tape whole = compile_tape(gear);
   OctreeOptions o;
   o.depth = 5;
@@ -448,7 +442,7 @@ TEST(CsgOctree, GearHasFewVariantsAndPrunedValuesAgree) {
 
 TEST(CsgVoxelize, EqualsPointEvaluationAndTheWholeTape) {
   for (const char* name : {"gear.sdf", "blobs.sdf", "building.sdf"}) {
-    const Model m = parse_model(example(name), name);
+    const Model m = parse_model(test::csg_example_text(name), name);
     VoxelizeOptions o;
     o.voxel_size = 0.37;
     o.field = true;
@@ -480,7 +474,7 @@ TEST(CsgVoxelize, EqualsPointEvaluationAndTheWholeTape) {
     EXPECT_GT(solid, 100) << name;
   }
   // A clamped field settles far cells without evaluating them.
-  const Model gear = parse_model(example("gear.sdf"), "gear.sdf");
+  const Model gear = parse_model(test::csg_example_text("gear.sdf"), "gear.sdf");
   VoxelizeOptions o;
   o.voxel_size = 0.1;
   o.field = true;
@@ -507,7 +501,7 @@ TEST(CsgGlsl, EveryVariantOfTheExamplesCompiles) {
       std::filesystem::temp_directory_path() / ("voxfield_csg_glsl_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   for (const char* name : {"gear.sdf", "blobs.sdf", "building.sdf", "menger.sdf"}) {
-    const Model m = parse_model(example(name), name);
+    const Model m = parse_model(test::csg_example_text(name), name);
     const Tape whole = compile_tape(m);
     OctreeOptions o;
     o.depth = 3;

@@ -5,9 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
+#include "csg_examples.h"
 #include "voxfield/csg.h"
 #include "voxfield/csg_compile.h"
 #include "voxfield/csg_mesh.h"
@@ -17,13 +16,6 @@ namespace {
 
 csg::Model parse(const std::string& text) {
   return csg::parse_model(text, "test.sdf");
-}
-
-csg::Model example(const std::string& name) {
-  std::ifstream in(std::string(VOXFIELD_EXAMPLES_DIR) + "/csg/" + name);
-  std::stringstream s;
-  s << in.rdbuf();
-  return csg::parse_model(s.str(), name);
 }
 
 // Triangles as sorted position triples, so meshes compare whatever their vertex order.
@@ -77,7 +69,7 @@ TEST(CsgMesh, DualContouringKeepsABoxsCornersAndEdgesExactly) {
 }
 
 TEST(CsgMesh, GearMeshesCloseLieOnTheSurfaceAndAreSeamless) {
-  const csg::Model gear = example("gear.sdf");
+  const csg::Model gear = test::csg_example("gear.sdf");
   const csg::Tape tape = csg::compile_tape(gear);
   for (Mesher algorithm : {Mesher::kMarchingCubes, Mesher::kSurfaceNets, Mesher::kDualContouring}) {
     CsgMeshOptions o;

@@ -3,26 +3,18 @@
 // else), runs far fewer instructions, and the variant view shows the variants.
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <set>
-#include <sstream>
 
+#include "csg_examples.h"
 #include "voxfield/csg.h"
 #include "voxfield/csg_render.h"
 
 namespace voxfield {
 namespace {
 
-csg::Model example(const std::string& name) {
-  std::ifstream in(std::string(VOXFIELD_EXAMPLES_DIR) + "/csg/" + name);
-  std::stringstream s;
-  s << in.rdbuf();
-  return csg::parse_model(s.str(), name);
-}
-
 TEST(CsgRender, PrunedEqualsWholeAndCostsLess) {
   for (const char* name : {"gear.sdf", "blobs.sdf", "building.sdf"}) {
-    const csg::Model m = example(name);
+    const csg::Model m = test::csg_example(name);
     CsgRenderOptions o;
     o.width = 160;
     o.height = 120;
@@ -46,7 +38,7 @@ TEST(CsgRender, PrunedEqualsWholeAndCostsLess) {
 }
 
 TEST(CsgRender, VariantViewShowsEachVariant) {
-  const csg::Model gear = example("gear.sdf");
+  const csg::Model gear = test::csg_example("gear.sdf");
   CsgRenderOptions o;
   o.width = 200;
   o.height = 150;

@@ -3,9 +3,7 @@
 // and the renderer's rows with per-thread tape caches — the same results as on one thread.
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
-
+#include "csg_examples.h"
 #include "voxfield/csg.h"
 #include "voxfield/csg_compile.h"
 #include "voxfield/csg_render.h"
@@ -13,19 +11,10 @@
 
 using namespace voxfield;
 
-namespace {
-
-csg::Model example(const std::string& name) {
-  std::ifstream in(std::string(VOXFIELD_EXAMPLES_DIR) + "/csg/" + name);
-  std::stringstream s;
-  s << in.rdbuf();
-  return csg::parse_model(s.str(), name);
-}
-
-}  // namespace
+namespace {}  // namespace
 
 TEST(ParallelCsg, ThreadsGiveTheSameOctreeVoxelsAndPicture) {
-  const csg::Model m = example("building.sdf");
+  const csg::Model m = test::csg_example("building.sdf");
   const csg::Tape tape = csg::compile_tape(m);
   csg::OctreeOptions oo;
   oo.depth = 4;

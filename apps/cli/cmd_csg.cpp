@@ -10,6 +10,7 @@
 #include "cli.h"
 #include "voxfield/csg.h"
 #include "voxfield/csg_compile.h"
+#include "voxfield/csg_files.h"
 #include "voxfield/csg_mesh.h"
 #include "voxfield/csg_render.h"
 #include "voxfield/file.h"
@@ -46,22 +47,11 @@ struct CsgSettings {
   bool sampled = false;
 };
 
-// Models are small texts: 64 MiB is far beyond any real one.
-constexpr std::uint64_t kMaxModelFile = std::uint64_t{64} << 20;
-
 csg::Model load_model(const std::string& path, bool facets) {
   set_activity("reading " + path);
-  const auto bytes = read_file(path, kMaxModelFile);
-  const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-  const std::string ext = std::filesystem::path(path).extension().string();
-  if (ext == ".json") return csg::parse_model_json(text, path);
-  if (ext == ".sdf") return csg::parse_model_sexpr(text, path);
-  if (ext == ".csg") {
-    csg::OpenScadOptions o;
-    o.facets = facets;
-    return csg::parse_openscad_csg(text, path, o);
-  }
-  return csg::parse_model(text, path);
+  csg::OpenScadOptions o;
+  o.facets = facets;
+  return csg::load_model(path, o);
 }
 
 nlohmann::json bounds_json(const std::optional<csg::Bounds>& b) {

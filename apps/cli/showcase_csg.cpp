@@ -10,6 +10,7 @@
 #include "showcase.h"
 #include "voxfield/csg.h"
 #include "voxfield/csg_compile.h"
+#include "voxfield/csg_files.h"
 #include "voxfield/csg_mesh.h"
 #include "voxfield/csg_render.h"
 #include "voxfield/file.h"
@@ -43,9 +44,7 @@ void showcase_csg(const std::filesystem::path& examples, const std::filesystem::
   std::string pictures = "| model | shaded | variants |\n|---|---|---|\n";
   for (const char* name : {"gear", "building", "blobs", "menger"}) {
     const fs::path path = examples / "csg" / (std::string(name) + ".sdf");
-    const auto bytes = read_file(path);
-    const csg::Model model =
-        csg::parse_model_sexpr(std::string(bytes.begin(), bytes.end()), path.string());
+    const csg::Model model = csg::load_model(path);
     CsgRenderOptions o;
     o.width = 480;
     o.height = 360;
@@ -86,9 +85,7 @@ void showcase_csg(const std::filesystem::path& examples, const std::filesystem::
         "|\n|---|---|---|---|---|---|\n";
   for (const auto& [name, voxel] : {std::pair{"building", 0.1}, std::pair{"gear", 0.1}}) {
     const fs::path path = examples / "csg" / (std::string(name) + ".sdf");
-    const auto bytes = read_file(path);
-    const csg::Model model =
-        csg::parse_model_sexpr(std::string(bytes.begin(), bytes.end()), path.string());
+    const csg::Model model = csg::load_model(path);
     csg::VoxelizeOptions vo;
     vo.voxel_size = voxel;
     const csg::Voxelized pruned = csg::voxelize(model, vo);
@@ -108,10 +105,7 @@ void showcase_csg(const std::filesystem::path& examples, const std::filesystem::
   // Meshed by dual contouring with crossings and normals from the model itself: the slots' corners
   // stay sharp where sampled normals would round them.
   {
-    const fs::path path = examples / "csg" / "gear.sdf";
-    const auto bytes = read_file(path);
-    const csg::Model gear =
-        csg::parse_model_sexpr(std::string(bytes.begin(), bytes.end()), path.string());
+    const csg::Model gear = csg::load_model(examples / "csg" / "gear.sdf");
     CsgMeshOptions mo;
     mo.voxel_size = 0.1;
     mo.mesh.algorithm = Mesher::kDualContouring;

@@ -155,4 +155,8 @@ struct ModelInfo {
 };
 ModelInfo model_info(const Model& model);
 
+// The box an operation works in: `box` when given (checked finite, lo <= hi), else the model's
+// bounds. Throws InvalidArgument naming the model when it is unbounded and no box is given.
+Bounds box_or_bounds(const Model& model, const std::optional<Bounds>& box);
+
 }  // namespace voxfield::csg

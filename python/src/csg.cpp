@@ -14,6 +14,7 @@
 
 #include "voxfield/csg.h"
 #include "voxfield/csg_compile.h"
+#include "voxfield/csg_files.h"
 #include "voxfield/csg_mesh.h"
 #include "voxfield/file.h"
 #include "voxfield/parallel.h"
@@ -65,16 +66,9 @@ void bind_csg(py::module_& parent) {
       .def_static(
           "load",
           [](const std::string& path, bool facets) {
-            const auto bytes = read_file(path, std::uint64_t{64} << 20);
-            const std::string text(bytes.begin(), bytes.end());
-            const std::string ext = std::filesystem::path(path).extension().string();
-            if (ext == ".csg") {
-              csg::OpenScadOptions o;
-              o.facets = facets;
-              return csg::parse_openscad_csg(text, path, o);
-            }
-            if (ext == ".json") return csg::parse_model_json(text, path);
-            return csg::parse_model_sexpr(text, path);
+            csg::OpenScadOptions o;
+            o.facets = facets;
+            return csg::load_model(path, o);
           },
           py::arg("path"), py::arg("facets") = false,
           "Reads .sdf, .json or OpenSCAD .csg (facets: OpenSCAD's polytopes for spheres and "

@@ -36,6 +36,31 @@ std::vector<Datum> read_json(std::string_view text, const std::string& name);
 // The 1-based line and column of byte `offset` in `text`.
 SourcePos position_of(std::string_view text, std::size_t offset);
 
+// Positions of offsets asked for in increasing order, found by advancing one cursor, so that a
+// reader naming every token's position costs time linear in the text (an offset behind the
+// cursor, as an error may ask, is found from the start).
+class PositionCursor {
+ public:
+  explicit PositionCursor(std::string_view text) : text_(text) {}
+  SourcePos at(std::size_t offset) {
+    if (offset < offset_) return position_of(text_, offset);
+    for (; offset_ < offset && offset_ < text_.size(); ++offset_) {
+      if (text_[offset_] == '\n') {
+        ++pos_.line;
+        pos_.column = 1;
+      } else {
+        ++pos_.column;
+      }
+    }
+    return pos_;
+  }
+
+ private:
+  std::string_view text_;
+  std::size_t offset_ = 0;
+  SourcePos pos_{1, 1};
+};
+
 // The model from its forms: (define NAME EXPR) forms, then exactly one model expression.
 Model build_model(const std::vector<Datum>& forms, const std::string& name);
 

@@ -291,6 +291,21 @@ std::optional<Bounds> model_bounds(const Model& model) {
   return sublevel_box(model, model.root, 0);
 }
 
+Bounds box_or_bounds(const Model& model, const std::optional<Bounds>& box) {
+  if (box) {
+    if (box->empty() ||
+        !std::isfinite(box->lo.x + box->lo.y + box->lo.z + box->hi.x + box->hi.y + box->hi.z))
+      throw InvalidArgument(model.name + ": the box must be finite with lo <= hi on every axis");
+    return *box;
+  }
+  const auto bounds = model_bounds(model);
+  if (!bounds)
+    throw InvalidArgument(
+        model.name +
+        ": the model is unbounded (it has a plane or a difference from one); give a box");
+  return *bounds;
+}
+
 ModelInfo model_info(const Model& model) {
   // Counts over the tree as written out, memoised per stored node (a DAG can expand
   // exponentially: the counts saturate rather than wrap).

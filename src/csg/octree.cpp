@@ -168,19 +168,11 @@ Octree build_octree(const Tape& tape, const Model& model, const OctreeOptions& o
   tree.depth = options.depth;
   tree.whole = tape;
   if (options.box) {
-    if (options.box->empty() ||
-        !std::isfinite(options.box->lo.x + options.box->lo.y + options.box->lo.z +
-                       options.box->hi.x + options.box->hi.y + options.box->hi.z))
-      throw InvalidArgument("the octree's box must be finite with lo <= hi");
-    tree.root = *options.box;
+    tree.root = box_or_bounds(model, options.box);
   } else {
-    const auto bounds = model_bounds(model);
-    if (!bounds)
-      throw InvalidArgument(
-          model.name +
-          ": the model is unbounded (it has a plane or a difference from one); give a box");
+    const Bounds bounds = box_or_bounds(model, std::nullopt);
     // A cube around the bounds, a little larger so that no surface lies on its faces.
-    const Vec3d centre = (bounds->lo + bounds->hi) * 0.5, size = bounds->hi - bounds->lo;
+    const Vec3d centre = (bounds.lo + bounds.hi) * 0.5, size = bounds.hi - bounds.lo;
     const double edge = std::max({size.x, size.y, size.z, 1e-9}) * (1 + 1e-6);
     tree.root = {centre - Vec3d{1, 1, 1} * (edge / 2), centre + Vec3d{1, 1, 1} * (edge / 2)};
   }

@@ -65,21 +65,8 @@ class Parser {
   }
 
  private:
-  // Statements are read in text order, so their positions advance one cursor (linear in the
-  // text); errors (rare) may look back.
   SourcePos here() const { return at(i_); }
-  SourcePos at(std::size_t offset) const {
-    if (offset < cursor_) return detail::position_of(text_, offset);
-    for (; cursor_ < offset; ++cursor_) {
-      if (text_[cursor_] == '\n') {
-        ++cursor_pos_.line;
-        cursor_pos_.column = 1;
-      } else {
-        ++cursor_pos_.column;
-      }
-    }
-    return cursor_pos_;
-  }
+  SourcePos at(std::size_t offset) const { return cursor_.at(offset); }
   [[noreturn]] void fail(const std::string& what) const { fail(here(), what); }
 
   void skip() {
@@ -207,8 +194,7 @@ class Parser {
   std::string_view text_;
   const std::string& name_;
   std::size_t i_ = 0;
-  mutable std::size_t cursor_ = 0;
-  mutable SourcePos cursor_pos_{1, 1};
+  mutable detail::PositionCursor cursor_{text_};
 };
 
 // An affine map p -> m p + t.

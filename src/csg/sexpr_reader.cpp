@@ -53,19 +53,10 @@ class Reader {
     }
   }
 
-  // Tokens are made in text order, so their positions advance one cursor (linear in the text).
   Datum make(Datum::Type type, std::size_t at) {
-    for (; cursor_ < at; ++cursor_) {
-      if (text_[cursor_] == '\n') {
-        ++cursor_pos_.line;
-        cursor_pos_.column = 1;
-      } else {
-        ++cursor_pos_.column;
-      }
-    }
     Datum d;
     d.type = type;
-    d.pos = cursor_pos_;
+    d.pos = cursor_.at(at);  // tokens are made in text order
     return d;
   }
 
@@ -129,8 +120,7 @@ class Reader {
   std::string_view text_;
   const std::string& name_;
   std::size_t i_ = 0;
-  std::size_t cursor_ = 0;
-  SourcePos cursor_pos_{1, 1};
+  PositionCursor cursor_{text_};
 };
 
 }  // namespace

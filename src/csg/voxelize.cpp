@@ -171,16 +171,7 @@ Voxelized voxelize(const Model& model, const VoxelizeOptions& options) {
   if (options.leaf_edge < 1 || options.leaf_edge > 256)
     throw InvalidArgument("leaf edge must be 1..256");
   Voxelized out;
-  if (options.box) {
-    out.box = *options.box;
-  } else {
-    const auto bounds = model_bounds(model);
-    if (!bounds)
-      throw InvalidArgument(
-          model.name +
-          ": the model is unbounded (it has a plane or a difference from one); give a box");
-    out.box = *bounds;
-  }
+  out.box = box_or_bounds(model, options.box);
   const Bounds& b = out.box;
   for (int a = 0; a < 3; ++a) {
     // Whole voxels covering the box; an extent within 1e-6 voxel of a whole number of voxels (a box

@@ -18,16 +18,12 @@ namespace voxfield {
 Mesh mesh_csg(const csg::Model& model, const CsgMeshOptions& options) {
   if (!(options.voxel_size > 0) || !std::isfinite(options.voxel_size))
     throw InvalidArgument("mesh_csg: the voxel size must be a finite number > 0");
-  std::optional<csg::Bounds> box = options.box ? options.box : csg::model_bounds(model);
-  if (!box)
-    throw InvalidArgument(
-        model.name +
-        ": the model is unbounded (it has a plane or a difference from one); give a box");
+  const csg::Bounds box = csg::box_or_bounds(model, options.box);
   const double v = options.voxel_size;
   // Voxel centres of this box are the lattice points: one spacing beyond the box on every side.
   csg::VoxelizeOptions vo;
   vo.voxel_size = v;
-  vo.box = csg::Bounds{box->lo - Vec3d{1.5, 1.5, 1.5} * v, box->hi + Vec3d{1.5, 1.5, 1.5} * v};
+  vo.box = csg::Bounds{box.lo - Vec3d{1.5, 1.5, 1.5} * v, box.hi + Vec3d{1.5, 1.5, 1.5} * v};
   vo.field = true;
   vo.memory_limit_bytes = options.memory_limit_bytes;
   vo.interrupter = options.mesh.interrupter;

@@ -180,11 +180,7 @@ Camera csg_camera(const csg::Bounds& box, double aspect) {
 
 Image render_csg(const csg::Model& model, const CsgRenderOptions& o, CsgRenderStats* stats) {
   Image image(o.width, o.height);
-  std::optional<csg::Bounds> box = o.box ? o.box : csg::model_bounds(model);
-  if (!box)
-    throw InvalidArgument(
-        model.name +
-        ": the model is unbounded (it has a plane or a difference from one); give a box");
+  std::optional<csg::Bounds> box = csg::box_or_bounds(model, o.box);
   {  // a little margin, so that surfaces on the bounds are inside the traced box
     const Vec3d size = box->hi - box->lo;
     const double margin = 1e-3 * std::max({size.x, size.y, size.z, 1e-9});
