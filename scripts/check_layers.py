@@ -36,7 +36,11 @@ PUBLIC_LAYER = {
     "live_world.h": "live",
 }
 # Headers of the GPU compute layer that the modules above it may include (its internal interface).
-INTERNAL_INTERFACE = {"src/gpu/vulkan_context.h", "src/gpu/unavailable.h", "shaders/layout.h"}
+INTERNAL_INTERFACE = {"src/gpu/vulkan_context.h", "src/gpu/kernel.h", "src/gpu/recorder.h",
+                      "src/gpu/shader_source.h", "src/gpu/unavailable.h", "shaders/layout.h"}
+# Headers generated in the build tree: each module's list of embedded shaders
+# (voxfield_embed_shaders in src/CMakeLists.txt), private to that module (and its tests).
+GENERATED = {"distance_shaders.h": "distance", "render_shaders.h": "render"}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 SOURCES = (".h", ".hpp", ".cpp", ".cc")
 
@@ -92,6 +96,10 @@ def check(repo):
                     continue
                 if top == "include":
                     problems.append(f"{where}: a public header includes a private one")
+                    continue
+                if included in GENERATED:
+                    if top == "src" and GENERATED[included] != module:
+                        problems.append(f"{where}: the {GENERATED[included]} module's generated header")
                     continue
                 target = resolve(repo, path, included)
                 if target is None:

@@ -10,6 +10,7 @@ packages=(
   zlib1g-dev                         # TDCZ models in .vox files
   libpng-dev                         # PNG frames from the renderer
   libvulkan-dev libvulkan-volk-dev glslc   # the Vulkan backend: headers, run-time loader, GLSL -> SPIR-V
+  glslang-dev glslang-tools libspirv-cross-c-shared-dev  # run-time GLSL -> SPIR-V (generated CSG shaders; glslang's CMake package needs its tools), SPIR-V reflection
   mesa-vulkan-drivers vulkan-validationlayers  # lavapipe (software Vulkan) and the validation layer, for tests
   libglfw3-dev libimgui-dev          # voxfield-demo: window and input (GLFW), the panel (Dear ImGui)
   xvfb xauth xdotool                 # a virtual display for the demo's tests (xvfb-run), input events

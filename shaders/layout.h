@@ -60,8 +60,6 @@ VF_CONST(uint, VF_U8, 0u);
 VF_CONST(uint, VF_U16, 1u);
 VF_CONST(uint, VF_F32, 2u);
 
-VF_CONST(uint, VF_WORKGROUP, 64u);  // local_size_x of every compute shader
-
 // What stays fixed while a field lives on the GPU: where the world's chunks are, the field's
 // domain, and its encoding. std430, 128 bytes, in a storage buffer. The encoding reproduces the
 // CPU's exactly: the host precomputes every value that involves rounding a real number (the clamp
@@ -117,7 +115,7 @@ struct JfaParams {
   uint dst;     // where this pass writes
 };
 
-// Push constants of a Fast Iterative Method pass (shaders/fim.comp): 64 bytes.
+// Push constants of a Fast Iterative Method pass (src/distance/gpu/shaders/fim.comp): 64 bytes.
 struct FimParams {
   ivec4 size;  // the domain's extent; w = mode: VF_FIM_UPDATE, VF_FIM_CONTROL, VF_FIM_RESOLVE
   ivec4 region_begin;  // the voxels the passes update (the rest only feed them); w unused

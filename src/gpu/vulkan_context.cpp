@@ -1,4 +1,4 @@
-// voxfield GPU backend — instance, device, queue, buffers, pipelines and submission.
+// voxfield GPU compute layer — instance, device, queue, buffers and submission.
 #include "vulkan_context.h"
 
 #include <algorithm>
@@ -6,7 +6,6 @@
 #include <sstream>
 #include <utility>
 
-#include "embedded_shaders.h"
 #include "voxfield/gpu_vulkan.h"
 
 namespace voxfield::gpu {
@@ -107,6 +106,7 @@ Buffer& Buffer::operator=(Buffer&& o) noexcept {
     memory_ = std::exchange(o.memory_, VK_NULL_HANDLE);
     size_ = std::exchange(o.size_, 0);
     mapped_ = std::exchange(o.mapped_, nullptr);
+    sync = std::exchange(o.sync, Sync{});
   }
   return *this;
 }
@@ -144,106 +144,6 @@ Buffer& Context::Impl::readback_buffer(VkDeviceSize bytes) {
   return readback;
 }
 
-// ---- pipelines ------------------------------------------------------------------------------
-
-Pipeline Context::Impl::make_pipeline(const char* name, std::span<const std::uint32_t> spirv,
-                                      VkPipelineLayout layout) {
-  VkShaderModuleCreateInfo sm{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  sm.codeSize = spirv.size_bytes();
-  sm.pCode = spirv.data();
-  VkShaderModule module;
-  check(vkCreateShaderModule(device, &sm, nullptr, &module), "vkCreateShaderModule");
-  VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-  info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  info.stage.module = module;
-  info.stage.pName = "main";
-  info.layout = layout;
-  Pipeline p;
-  p.name = name;
-  const VkResult r =
-      vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &p.pipeline);
-  vkDestroyShaderModule(device, module, nullptr);
-  check(r, "vkCreateComputePipelines");
-  return p;
-}
-
-BindingLayout Context::Impl::make_binding_layout(std::uint32_t n, std::uint32_t push_bytes) {
-  BindingLayout l;
-  l.bindings = n;
-  std::vector<VkDescriptorSetLayoutBinding> bindings(n);
-  for (std::uint32_t b = 0; b < n; ++b)
-    bindings[b] = {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  sl.bindingCount = n;
-  sl.pBindings = bindings.data();
-  check(vkCreateDescriptorSetLayout(device, &sl, nullptr, &l.set), "vkCreateDescriptorSetLayout");
-  VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes};
-  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  pl.setLayoutCount = 1;
-  pl.pSetLayouts = &l.set;
-  pl.pushConstantRangeCount = push_bytes > 0 ? 1 : 0;
-  pl.pPushConstantRanges = push_bytes > 0 ? &push : nullptr;
-  check(vkCreatePipelineLayout(device, &pl, nullptr, &l.pipeline), "vkCreatePipelineLayout");
-  l.pool = make_descriptor_pool(n);
-  return l;
-}
-
-VkDescriptorPool Context::Impl::make_descriptor_pool(std::uint32_t buffers) {
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buffers};
-  VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  dp.maxSets = 1;
-  dp.poolSizeCount = 1;
-  dp.pPoolSizes = &size;
-  VkDescriptorPool pool;
-  check(vkCreateDescriptorPool(device, &dp, nullptr, &pool), "vkCreateDescriptorPool");
-  return pool;
-}
-
-VkDescriptorSet Context::Impl::bind(const BindingLayout& layout,
-                                    std::span<const Buffer* const> buffers) {
-  return allocate_set(layout.pool, layout, buffers);
-}
-
-VkDescriptorSet Context::Impl::allocate_set(VkDescriptorPool pool, const BindingLayout& layout,
-                                            std::span<const Buffer* const> buffers) {
-  check(vkResetDescriptorPool(device, pool, 0), "vkResetDescriptorPool");
-  VkDescriptorSetAllocateInfo dsa{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  dsa.descriptorPool = pool;
-  dsa.descriptorSetCount = 1;
-  dsa.pSetLayouts = &layout.set;
-  VkDescriptorSet set;
-  check(vkAllocateDescriptorSets(device, &dsa, &set), "vkAllocateDescriptorSets");
-  std::vector<VkDescriptorBufferInfo> infos(buffers.size());
-  std::vector<VkWriteDescriptorSet> writes(buffers.size());
-  for (std::size_t b = 0; b < buffers.size(); ++b) {
-    infos[b] = {buffers[b]->handle(), 0, VK_WHOLE_SIZE};
-    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[b].dstSet = set;
-    writes[b].dstBinding = static_cast<std::uint32_t>(b);
-    writes[b].descriptorCount = 1;
-    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[b].pBufferInfo = &infos[b];
-  }
-  vkUpdateDescriptorSets(device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0,
-                         nullptr);
-  return set;
-}
-
-void Context::Impl::create_pipelines() {
-  field_layout = make_binding_layout(kBindings, kPushBytes);
-  render_layout = make_binding_layout(kRenderBindings, 0);
-  edt_sites = make_pipeline("edt_sites", shaders::edt_sites(), field_layout.pipeline);
-  edt_lines = make_pipeline("edt_lines", shaders::edt_lines(), field_layout.pipeline);
-  edt_encode = make_pipeline("edt_encode", shaders::edt_encode(), field_layout.pipeline);
-  render = make_pipeline("render", shaders::render(), render_layout.pipeline);
-  jfa_layout = make_binding_layout(1, 32);
-  jfa = make_pipeline("jfa", shaders::jfa(), jfa_layout.pipeline);
-  jfa_seed = make_pipeline("jfa_seed", shaders::jfa_seed(), jfa_layout.pipeline);
-  fim_layout = make_binding_layout(2, 64);
-  fim = make_pipeline("fim", shaders::fim(), fim_layout.pipeline);
-}
-
 // ---- submission -----------------------------------------------------------------------------
 
 void Context::Impl::require_device() const {
@@ -267,27 +167,6 @@ void Context::Impl::submit_and_wait(VkCommandBuffer cmd) {
     lost = true;  // every later submission refuses at once instead of touching a dead device
     throw;
   }
-}
-
-void dispatch(Context::Impl& ctx, VkCommandBuffer cmd, std::uint64_t invocations) {
-  const std::uint64_t groups = (invocations + 63) / 64;
-  const std::uint64_t max_x = ctx.limits.maxComputeWorkGroupCount[0];
-  const std::uint64_t gx = std::min(groups, max_x), gy = (groups + gx - 1) / gx;
-  if (gy > ctx.limits.maxComputeWorkGroupCount[1])
-    throw InvalidArgument("GPU: " + std::to_string(invocations) +
-                          " invocations exceed the device's dispatch limits");
-  vkCmdDispatch(cmd, static_cast<std::uint32_t>(gx),
-                static_cast<std::uint32_t>(std::max<std::uint64_t>(gy, 1)), 1);
-  ++ctx.counters.dispatches;
-}
-
-void barrier(Context::Impl& ctx, VkCommandBuffer cmd, VkPipelineStageFlags src,
-             VkAccessFlags src_access, VkPipelineStageFlags dst, VkAccessFlags dst_access) {
-  VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  b.srcAccessMask = src_access;
-  b.dstAccessMask = dst_access;
-  vkCmdPipelineBarrier(cmd, src, dst, 0, 1, &b, 0, nullptr, 0, nullptr);
-  ++ctx.counters.pipeline_barriers;
 }
 
 // ---- instance and device --------------------------------------------------------------------
@@ -381,13 +260,7 @@ void Context::Impl::destroy() {
     vkDeviceWaitIdle(device);
     upload = Buffer();
     readback = Buffer();
-    for (Pipeline* p : {&edt_sites, &edt_lines, &edt_encode, &render, &jfa, &jfa_seed, &fim})
-      if (p->pipeline) vkDestroyPipeline(device, p->pipeline, nullptr);
-    for (BindingLayout* l : {&field_layout, &render_layout, &jfa_layout, &fim_layout}) {
-      if (l->pool) vkDestroyDescriptorPool(device, l->pool, nullptr);
-      if (l->pipeline) vkDestroyPipelineLayout(device, l->pipeline, nullptr);
-      if (l->set) vkDestroyDescriptorSetLayout(device, l->set, nullptr);
-    }
+    kernels.destroy(device);
     if (timestamps) vkDestroyQueryPool(device, timestamps, nullptr);
     if (fence) vkDestroyFence(device, fence, nullptr);
     if (command_pool) vkDestroyCommandPool(device, command_pool, nullptr);
@@ -507,8 +380,9 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
 }
 
 // What a created and an adopted device both need: properties, the command pool, the fence, the
-// timestamp pool and the pipelines. Device functions go through the loader's dispatch (volk's
-// instance-level table, never volkLoadDevice), so contexts on different devices can coexist.
+// timestamp pool (kernels are made on first use). Device functions go through the loader's dispatch
+// (volk's instance-level table, never volkLoadDevice), so contexts on different devices can
+// coexist.
 void Context::Impl::finish_setup() {
   Impl& s = *this;
   VkPhysicalDeviceProperties props;
@@ -538,10 +412,9 @@ void Context::Impl::finish_setup() {
   if (s.timestamp_period_ns > 0) {
     VkQueryPoolCreateInfo qp{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
     qp.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    qp.queryCount = 64;
+    qp.queryCount = kQueries;
     check(vkCreateQueryPool(s.device, &qp, nullptr, &s.timestamps), "vkCreateQueryPool");
   }
-  s.create_pipelines();
 }
 
 std::shared_ptr<Context> adopt(const AdoptedDevice& app) {

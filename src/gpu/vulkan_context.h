@@ -1,4 +1,5 @@
-// voxfield GPU backend — the Vulkan objects behind gpu::Context (internal).
+// voxfield GPU compute layer — the Vulkan objects behind gpu::Context (internal): the device,
+// buffers and submission. Kernels are in kernel.h, recording and barriers in recorder.h.
 //
 // Vulkan functions come through volk, which opens the loader at run time: a machine without
 // libvulkan still starts, and gets GpuUnavailable instead of a failed dynamic link.
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "gpu/kernel.h"
 #include "voxfield/gpu.h"
 
 namespace voxfield::gpu {
@@ -35,6 +37,17 @@ class Buffer {
   // Host pointer of a host-visible buffer (persistently mapped, coherent).
   void* mapped() const { return mapped_; }
 
+  // What the recorder knows of the commands recorded so far on this buffer (recorder.h): the
+  // last write, the stages and accesses that have been made to see it, the reads since it.
+  struct Sync {
+    VkPipelineStageFlags write_stages = 0;
+    VkAccessFlags write_access = 0;
+    VkPipelineStageFlags visible_stages = 0;
+    VkAccessFlags visible_access = 0;
+    VkPipelineStageFlags read_stages = 0;
+  };
+  Sync sync;
+
  private:
   void release();
   VkDevice device_ = VK_NULL_HANDLE;
@@ -42,21 +55,6 @@ class Buffer {
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
   VkDeviceSize size_ = 0;
   void* mapped_ = nullptr;
-};
-
-// Storage buffers 0..N-1 (and optionally push constants) for a family of compute pipelines, with
-// a descriptor pool that holds one set at a time (reset for each submission that binds).
-struct BindingLayout {
-  VkDescriptorSetLayout set = VK_NULL_HANDLE;
-  VkPipelineLayout pipeline = VK_NULL_HANDLE;
-  VkDescriptorPool pool = VK_NULL_HANDLE;
-  std::uint32_t bindings = 0;
-};
-
-// A compute pipeline made from embedded SPIR-V.
-struct Pipeline {
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  std::string name;
 };
 
 struct Context::Impl {
@@ -83,12 +81,10 @@ struct Context::Impl {
   mutable std::mutex messages_mutex;
   std::vector<std::string> messages;
 
-  // The distance pipelines (11 storage buffers, push constants) and the ray marcher (8 buffers).
-  static constexpr std::uint32_t kBindings = 11;
-  static constexpr std::uint32_t kPushBytes = 96;
-  static constexpr std::uint32_t kRenderBindings = 8;
-  BindingLayout field_layout, render_layout, jfa_layout, fim_layout;
-  Pipeline edt_sites, edt_lines, edt_encode, render, jfa, jfa_seed, fim;
+  // Every kernel made on this device, by the hash of its SPIR-V (kernel.h).
+  KernelCache kernels;
+  const Kernel& kernel(const ShaderSource& shader) { return kernels.get(device, shader); }
+  static constexpr int kQueries = 64;  // timestamps per submission
 
   // Reusable host-visible buffers for uploads and read-backs (grown when too small).
   Buffer upload, readback;
@@ -96,22 +92,6 @@ struct Context::Impl {
   Buffer& readback_buffer(VkDeviceSize bytes);
 
   std::uint32_t memory_type(std::uint32_t type_bits, VkMemoryPropertyFlags wanted) const;
-  void create_pipelines();
-  Pipeline make_pipeline(const char* name, std::span<const std::uint32_t> spirv,
-                         VkPipelineLayout layout);
-  BindingLayout make_binding_layout(std::uint32_t bindings, std::uint32_t push_bytes);
-  // A descriptor set binding `buffers` (one per binding, in order) from the layout's pool, which is
-  // reset first: sets live until the next call for the same layout.
-  VkDescriptorSet bind(const BindingLayout& layout, std::span<const Buffer* const> buffers);
-  // A pool for one set of `buffers` storage buffers, for objects that keep their set across
-  // submissions (the resident render scene); the caller destroys it.
-  VkDescriptorPool make_descriptor_pool(std::uint32_t buffers);
-  // Resets `pool` and allocates from it a set of `layout` binding `buffers` in order.
-  VkDescriptorSet allocate_set(VkDescriptorPool pool, const BindingLayout& layout,
-                               std::span<const Buffer* const> buffers);
-  // Allocates a command buffer, lets `record` fill it, submits it and waits (freed after).
-  template <class F>
-  void run_commands(F&& record);
   // Submits one command buffer and waits for it (one submit, one fence wait). Throws
   // GpuDeviceLost (and marks the context lost) when the device is lost.
   void submit_and_wait(VkCommandBuffer cmd);
@@ -120,34 +100,5 @@ struct Context::Impl {
   void finish_setup();
   void destroy();
 };
-
-template <class F>
-void Context::Impl::run_commands(F&& record) {
-  require_device();
-  VkCommandBufferAllocateInfo cba{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  cba.commandPool = command_pool;
-  cba.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  cba.commandBufferCount = 1;
-  VkCommandBuffer cmd;
-  check(vkAllocateCommandBuffers(device, &cba, &cmd), "vkAllocateCommandBuffers");
-  struct FreeCmd {
-    Context::Impl& ctx;
-    VkCommandBuffer cmd;
-    ~FreeCmd() { vkFreeCommandBuffers(ctx.device, ctx.command_pool, 1, &cmd); }
-  } free_cmd{*this, cmd};
-  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
-  record(cmd);
-  check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
-  submit_and_wait(cmd);
-}
-
-// Records a dispatch of `invocations` invocations of 64 (split over y when the x count would
-// exceed the device limit) and counts it.
-void dispatch(Context::Impl& ctx, VkCommandBuffer cmd, std::uint64_t invocations);
-// A compute-to-compute (and transfer) memory barrier, counted.
-void barrier(Context::Impl& ctx, VkCommandBuffer cmd, VkPipelineStageFlags src,
-             VkAccessFlags src_access, VkPipelineStageFlags dst, VkAccessFlags dst_access);
 
 }  // namespace voxfield::gpu

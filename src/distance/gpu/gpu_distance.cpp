@@ -18,7 +18,8 @@
 #include <cstring>
 
 #include "../incremental/update_regions.h"
-#include "gpu/vulkan_context.h"
+#include "distance_shaders.h"
+#include "gpu/recorder.h"
 #include "shaders/layout.h"
 #include "voxfield/gpu_distance.h"
 
@@ -180,20 +181,12 @@ class FieldEngine {
     Buffer& upload = ctx_.upload_buffer(std::max<VkDeviceSize>(up.bytes.size(), 16));
     if (!up.bytes.empty()) std::memcpy(upload.mapped(), up.bytes.data(), up.bytes.size());
     Buffer* readback = download ? &ctx_.readback_buffer(field_bytes_ + site_bytes_) : nullptr;
-    const VkDescriptorSet set = descriptor_set();
-    const bool timed = timings && ctx_.timestamps != VK_NULL_HANDLE;
-    std::vector<std::string> names;
-    ctx_.run_commands([&](VkCommandBuffer cmd) {
-      if (timed) vkCmdResetQueryPool(cmd, ctx_.timestamps, 0, kTimestamps);
-      record_transfers(cmd, upload, uploads);
-      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.field_layout.pipeline, 0, 1,
-                              &set, 0, nullptr);
-      PassRecorder passes(ctx_, cmd, timed);
-      for (const detail::UpdateRegion& r : regions) record_region(passes, r);
-      if (readback) record_readback(cmd, *readback);
-      names = passes.take_names();
-    });
-    if (timings) read_timings(names, timed, *timings);
+    Recorder rec(ctx_);
+    record_transfers(rec, upload, uploads);
+    for (const detail::UpdateRegion& r : regions) record_region(rec, r, timings != nullptr);
+    if (readback) record_readback(rec, *readback);
+    rec.submit();
+    if (timings) *timings = rec.timings();
   }
 
   // The field as last read back.
@@ -226,50 +219,12 @@ class FieldEngine {
   }
 
  private:
-  static constexpr std::uint32_t kTimestamps =
-      64;  // queries in the context's pool: 32 timed passes
-
   // What a run copies from the upload buffer, and the old pool a grown one copies its bricks from
   // (kept alive until the copy out of it has run).
   struct Uploads {
     std::vector<VkBufferCopy> page_copies, brick_copies;
     std::optional<Buffer> old_pool;
     VkDeviceSize old_pool_bytes = 0;
-  };
-
-  // Records compute passes into one command buffer, each ordered after the previous one's writes
-  // (barrier() in GLSL only orders one workgroup), with a timestamp pair around each while the
-  // pool has queries left.
-  class PassRecorder {
-   public:
-    PassRecorder(Context::Impl& ctx, VkCommandBuffer cmd, bool timed)
-        : ctx_(ctx), cmd_(cmd), timed_(timed) {}
-    void pass(const Pipeline& pipeline, const L::PassParams& pp, std::uint64_t invocations,
-              std::string name) {
-      if (!names_.empty())
-        barrier(ctx_, cmd_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-      const auto q = static_cast<std::uint32_t>(2 * names_.size());
-      const bool stamp = timed_ && q + 1 < kTimestamps;
-      if (stamp) vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx_.timestamps, q);
-      vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
-      vkCmdPushConstants(cmd_, ctx_.field_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0,
-                         sizeof pp, &pp);
-      dispatch(ctx_, cmd_, invocations);
-      if (stamp)
-        vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx_.timestamps, q + 1);
-      names_.push_back(std::move(name));
-    }
-    // The passes' names in recording order (pass i has timestamps 2i and 2i + 1).
-    std::vector<std::string> take_names() { return std::move(names_); }
-
-   private:
-    Context::Impl& ctx_;
-    VkCommandBuffer cmd_;
-    bool timed_;
-    std::vector<std::string> names_;
   };
 
   // Step 1, stage: the header (first run only), the changed page entries and bricks into `up`,
@@ -289,51 +244,25 @@ class FieldEngine {
   }
 
   // Step 2, transfers, recorded before every pass: a grown pool's old bricks, the header, changed
-  // page entries and bricks.
-  void record_transfers(VkCommandBuffer cmd, const Buffer& upload, const Uploads& uploads) {
-    bool transferred = false;
-    if (uploads.old_pool) {
-      const VkBufferCopy keep{0, 0, uploads.old_pool_bytes};
-      vkCmdCopyBuffer(cmd, uploads.old_pool->handle(), bricks_buf_.handle(), 1, &keep);
-      barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-              VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
-      transferred = true;
-    }
-    if (first_run_) {
-      vkCmdCopyBuffer(cmd, upload.handle(), header_buf_.handle(), 1, &header_copy_);
-      ctx_.counters.bytes_uploaded += sizeof header_;
-      transferred = true;
-    }
-    if (!uploads.page_copies.empty()) {
-      vkCmdCopyBuffer(cmd, upload.handle(), pages_buf_.handle(),
-                      static_cast<std::uint32_t>(uploads.page_copies.size()),
-                      uploads.page_copies.data());
-      transferred = true;
-    }
-    if (!uploads.brick_copies.empty()) {
-      vkCmdCopyBuffer(cmd, upload.handle(), bricks_buf_.handle(),
-                      static_cast<std::uint32_t>(uploads.brick_copies.size()),
-                      uploads.brick_copies.data());
-      transferred = true;
-    }
-    if (!first_run_) {
-      // The previous submission's shader accesses are complete (its fence was waited on), but
-      // this one's transfers and passes overwrite buffers those passes used: order them.
-      barrier(
-          ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-          VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-    }
-    if (transferred)
-      barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-              VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  // page entries and bricks. (The recorder orders them after the previous submission's passes,
+  // which read the buffers they overwrite.)
+  void record_transfers(Recorder& rec, Buffer& upload, Uploads& uploads) {
+    if (uploads.old_pool) rec.copy(*uploads.old_pool, 0, bricks_buf_, 0, uploads.old_pool_bytes);
+    if (first_run_) rec.copy(upload, header_buf_, {&header_copy_, 1});
+    rec.copy(upload, pages_buf_, uploads.page_copies);
+    rec.copy(upload, bricks_buf_, uploads.brick_copies);
     first_run_ = false;
   }
 
   // Step 3, one region's passes: recompute its compute box, encode its out box into the field.
-  void record_region(PassRecorder& passes, const detail::UpdateRegion& r) {
+  void record_region(Recorder& rec, const detail::UpdateRegion& r, bool timed) {
+    const std::array<Buffer*, 11> bound = bindings();
+    const auto pass = [&](const ShaderSource& shader, const L::PassParams& t,
+                          std::uint64_t invocations, std::string name) {
+      const int ticket = timed ? rec.begin_pass() : -1;
+      rec.dispatch(ctx_.kernel(shader), bound, t, invocations);
+      rec.end_pass(ticket, std::move(name));
+    };
     const Vec3i n = r.in.size();
     L::PassParams pp{};
     pp.box_begin = {r.in.begin.x, r.in.begin.y, r.in.begin.z, 0};
@@ -348,15 +277,15 @@ class FieldEngine {
       t.sites_are_air = to_air ? 1u : 0u;
       t.axis = 2;
       t.dst = result;
-      passes.pass(ctx_.edt_sites, t, static_cast<std::uint64_t>(n.x) * n.y, "columns z" + what);
+      pass(shaders::edt_sites(), t, static_cast<std::uint64_t>(n.x) * n.y, "columns z" + what);
       t.axis = 0;
       t.src = result;
       t.dst = other;
-      passes.pass(ctx_.edt_lines, t, static_cast<std::uint64_t>(n.y) * n.z, "lines x" + what);
+      pass(shaders::edt_lines(), t, static_cast<std::uint64_t>(n.y) * n.z, "lines x" + what);
       t.axis = 1;
       t.src = other;
       t.dst = result;
-      passes.pass(ctx_.edt_lines, t, static_cast<std::uint64_t>(n.x) * n.z, "lines y" + what);
+      pass(shaders::edt_lines(), t, static_cast<std::uint64_t>(n.x) * n.z, "lines y" + what);
     };
     transform(0, 1, false);
     if (plan_.is_signed) transform(2, 1, true);
@@ -367,39 +296,14 @@ class FieldEngine {
     const std::int64_t lanes = static_cast<std::int64_t>(lanes_of(options_.storage));
     const std::int64_t ox = r.out.begin.x - plan_.domain.begin.x;
     const std::int64_t words = (ox + r.out.size().x - 1) / lanes - ox / lanes + 1;
-    passes.pass(ctx_.edt_encode, enc,
-                static_cast<std::uint64_t>(words * r.out.size().y * r.out.size().z), "encode");
+    pass(shaders::edt_encode(), enc,
+         static_cast<std::uint64_t>(words * r.out.size().y * r.out.size().z), "encode");
   }
 
-  // Step 4, read-back (when asked): the field and its sites into `readback`, visible to the host.
-  void record_readback(VkCommandBuffer cmd, const Buffer& readback) {
-    barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
-    const VkBufferCopy down{0, 0, field_bytes_};
-    vkCmdCopyBuffer(cmd, field_buf_.handle(), readback.handle(), 1, &down);
-    if (site_bytes_ > 0) {
-      const VkBufferCopy down_sites{0, field_bytes_, site_bytes_};
-      vkCmdCopyBuffer(cmd, field_sites_buf_.handle(), readback.handle(), 1, &down_sites);
-    }
-    barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-            VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
-    ctx_.counters.bytes_downloaded += static_cast<std::int64_t>(field_bytes_ + site_bytes_);
-  }
-
-  // Step 5, after the fence: each timed pass's duration from its timestamp pair.
-  void read_timings(const std::vector<std::string>& names, bool timed,
-                    std::vector<PassTiming>& timings) const {
-    timings.clear();
-    const auto count =
-        static_cast<std::uint32_t>(std::min<std::size_t>(2 * names.size(), kTimestamps));
-    if (!timed || count < 2) return;
-    std::vector<std::uint64_t> ticks(count);
-    check(vkGetQueryPoolResults(ctx_.device, ctx_.timestamps, 0, count, ticks.size() * 8,
-                                ticks.data(), 8, VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-          "vkGetQueryPoolResults");
-    for (std::size_t i = 0; 2 * i + 1 < count; ++i)
-      timings.push_back({names[i], static_cast<double>(ticks[2 * i + 1] - ticks[2 * i]) *
-                                       ctx_.timestamp_period_ns * 1e-6});
+  // Step 4, read-back (when asked): the field and its sites into `readback`.
+  void record_readback(Recorder& rec, Buffer& readback) {
+    rec.copy(field_buf_, 0, readback, 0, field_bytes_);
+    rec.copy(field_sites_buf_, 0, readback, field_bytes_, site_bytes_);
   }
 
   void make_header() {
@@ -511,13 +415,11 @@ class FieldEngine {
                       " beyond its capacity " + std::to_string(slot_capacity_));
         brick_copies.push_back({up.add(ch.voxels, chunk_bytes_),
                                 static_cast<VkDeviceSize>(slot) * chunk_bytes_, chunk_bytes_});
-        ctx_.counters.bytes_uploaded += static_cast<std::int64_t>(chunk_bytes_);
         next = slot;
       }
       if (next != entry || first_run_) {
         entry = next;
         page_copies.push_back({up.add(&entry, 4), ch.page * 4, 4});
-        ctx_.counters.bytes_uploaded += 4;
       }
     }
   }
@@ -531,11 +433,10 @@ class FieldEngine {
     work_bytes_ = bytes;
   }
 
-  VkDescriptorSet descriptor_set() {
-    const Buffer* bound[Context::Impl::kBindings] = {
-        &header_buf_, &pages_buf_, &bricks_buf_, &cost_[0],    &cost_[1],        &cost_[2],
-        &scratch_s_,  &scratch_t_, &field_buf_,  &work_sites_, &field_sites_buf_};
-    return ctx_.bind(ctx_.field_layout, bound);
+  // The exact transform's binding plan (shaders/layout.h), the same for its three kernels.
+  std::array<Buffer*, 11> bindings() {
+    return {&header_buf_, &pages_buf_, &bricks_buf_, &cost_[0],    &cost_[1],        &cost_[2],
+            &scratch_s_,  &scratch_t_, &field_buf_,  &work_sites_, &field_sites_buf_};
   }
 
   Context::Impl& ctx_;

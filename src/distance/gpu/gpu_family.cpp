@@ -2,14 +2,16 @@
 // dissertation's value-propagating jfa-seed, and JFA, JFA+1, JFA+2) as one dispatch per pass with
 // a pipeline barrier between passes, all passes of a field in one command buffer (a fixed number
 // of passes: no read-back to decide when to stop); the Fast Iterative Method as Jacobi passes that
-// stop themselves through indirect dispatch (shaders/fim.comp); hybrid and LOD as JFA then FIM.
-// The problem set-up and the field assembly are the CPU's (src/distance/family_driver.h), and the
-// passes compute exactly what the CPU's do, so the fields are the same bit for bit.
+// stop themselves through indirect dispatch (src/distance/gpu/shaders/fim.comp); hybrid and LOD as
+// JFA then FIM. The problem set-up and the field assembly are the CPU's
+// (src/distance/family_driver.h), and the passes compute exactly what the CPU's do, so the fields
+// are the same bit for bit.
 #include <chrono>
 #include <cstring>
 
 #include "../family_driver.h"
-#include "gpu/vulkan_context.h"
+#include "distance_shaders.h"
+#include "gpu/recorder.h"
 #include "shaders/layout.h"
 #include "voxfield/gpu_distance.h"
 
@@ -41,10 +43,10 @@ std::vector<int> extra_steps(Algorithm a) {
   }
 }
 
-// Runs one pass of `pipeline` per step over a ping-pong buffer of p.size() elements (both halves
-// in one buffer), starting from `initial`, in one command buffer with a barrier between passes;
-// returns the last pass's elements.
-std::vector<std::uint8_t> ping_pong(Context::Impl& ctx, const Pipeline& pipeline,
+// Runs one pass of `kernel` per step over a ping-pong buffer of p.size() elements (both halves
+// in one buffer), starting from `initial`, in one command buffer (the recorder puts a barrier
+// between passes, as each reads what the last wrote); returns the last pass's elements.
+std::vector<std::uint8_t> ping_pong(Context::Impl& ctx, const Kernel& kernel,
                                     const detail::DenseProblem& p,
                                     const std::vector<std::uint8_t>& initial,
                                     std::size_t element_bytes, const std::vector<int>& steps,
@@ -61,63 +63,24 @@ std::vector<std::uint8_t> ping_pong(Context::Impl& ctx, const Pipeline& pipeline
   Buffer& upload = ctx.upload_buffer(half);
   std::memcpy(upload.mapped(), initial.data(), half);
   Buffer& readback = ctx.readback_buffer(half);
-  const Buffer* bound[1] = {&data};
-  const VkDescriptorSet set = ctx.bind(ctx.jfa_layout, bound);
-  const bool timed = timings && ctx.timestamps != VK_NULL_HANDLE && steps.size() <= 31;
+  Recorder rec(ctx);
+  rec.copy(upload, 0, data, 0, half);
   std::uint32_t src = 0;
-  ctx.run_commands([&](VkCommandBuffer cmd) {
-    if (timed) vkCmdResetQueryPool(cmd, ctx.timestamps, 0, 64);
-    const VkBufferCopy in{0, 0, half};
-    vkCmdCopyBuffer(cmd, upload.handle(), data.handle(), 1, &in);
-    ctx.counters.bytes_uploaded += static_cast<std::int64_t>(half);
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-            VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-            VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.jfa_layout.pipeline, 0, 1,
-                            &set, 0, nullptr);
-    for (std::size_t k = 0; k < steps.size(); ++k) {
-      if (k > 0)
-        barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-      L::JfaParams jp{};
-      jp.size = {p.n.x, p.n.y, p.n.z, 0};
-      jp.step = steps[k];
-      jp.metric = static_cast<std::uint32_t>(p.metric);
-      jp.src = src;
-      jp.dst = src == 0 ? static_cast<std::uint32_t>(n) : 0u;
-      vkCmdPushConstants(cmd, ctx.jfa_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof jp,
-                         &jp);
-      if (timed)
-        vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx.timestamps,
-                            static_cast<std::uint32_t>(2 * k));
-      dispatch(ctx, cmd, n);
-      if (timed)
-        vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx.timestamps,
-                            static_cast<std::uint32_t>(2 * k + 1));
-      src = jp.dst;
-    }
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
-    const VkBufferCopy out{static_cast<VkDeviceSize>(src) * element_bytes, 0, half};
-    vkCmdCopyBuffer(cmd, data.handle(), readback.handle(), 1, &out);
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-            VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
-    ctx.counters.bytes_downloaded += static_cast<std::int64_t>(half);
-  });
-  if (timed) {
-    std::vector<std::uint64_t> ticks(2 * steps.size());
-    check(vkGetQueryPoolResults(ctx.device, ctx.timestamps, 0,
-                                static_cast<std::uint32_t>(ticks.size()), ticks.size() * 8,
-                                ticks.data(), 8, VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-          "vkGetQueryPoolResults");
-    for (std::size_t k = 0; k < steps.size(); ++k)
-      timings->push_back(
-          {label + " step " + std::to_string(steps[k]),
-           static_cast<double>(ticks[2 * k + 1] - ticks[2 * k]) * ctx.timestamp_period_ns * 1e-6});
+  for (const int step : steps) {
+    L::JfaParams jp{};
+    jp.size = {p.n.x, p.n.y, p.n.z, 0};
+    jp.step = step;
+    jp.metric = static_cast<std::uint32_t>(p.metric);
+    jp.src = src;
+    jp.dst = src == 0 ? static_cast<std::uint32_t>(n) : 0u;
+    const int pass = timings ? rec.begin_pass() : -1;
+    rec.dispatch(kernel, {&data}, jp, n);
+    rec.end_pass(pass, label + " step " + std::to_string(step));
+    src = jp.dst;
   }
+  rec.copy(data, static_cast<VkDeviceSize>(src) * element_bytes, readback, 0, half);
+  rec.submit();
+  if (timings) timings->insert(timings->end(), rec.timings().begin(), rec.timings().end());
   std::vector<std::uint8_t> result(half);
   std::memcpy(result.data(), readback.mapped(), half);
   return result;
@@ -140,7 +103,7 @@ detail::DenseSolution flood(Context::Impl& ctx, const detail::DenseProblem& p,
     words[2 * i + 1] = s.x < 0 ? 0u : static_cast<std::uint32_t>(s.z);
   }
   const std::vector<std::uint8_t> out =
-      ping_pong(ctx, ctx.jfa, p, packed, 8, steps, "jfa", timings);
+      ping_pong(ctx, ctx.kernel(shaders::jfa()), p, packed, 8, steps, "jfa", timings);
   const auto* got = reinterpret_cast<const std::uint32_t*>(out.data());
   std::vector<detail::JfaSite> final_sites(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -165,7 +128,7 @@ detail::DenseSolution flood_values(Context::Impl& ctx, const detail::DenseProble
   auto* values = reinterpret_cast<float*>(initial.data());
   for (std::size_t i = 0; i < n; ++i) values[i] = p.site[i] ? 0.0f : detail::kFar;
   const std::vector<std::uint8_t> out =
-      ping_pong(ctx, ctx.jfa_seed, p, initial, 4, steps, "jfa-seed", timings);
+      ping_pong(ctx, ctx.kernel(shaders::jfa_seed()), p, initial, 4, steps, "jfa-seed", timings);
   detail::DenseSolution solution;
   solution.d.resize(n);
   std::memcpy(solution.d.data(), out.data(), n * 4);
@@ -208,8 +171,10 @@ detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p,
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
                      VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                  false);
-  // The update pass's workgroups, split over y as dispatch() does.
-  const std::uint64_t groups = (n + 63) / 64;
+  const Kernel& fim = ctx.kernel(shaders::fim());
+  // The update pass's workgroups, split over y as Recorder::dispatch does.
+  const std::uint64_t per_group = fim.interface.invocations_per_group();
+  const std::uint64_t groups = (n + per_group - 1) / per_group;
   const std::uint64_t gx = std::min<std::uint64_t>(groups, ctx.limits.maxComputeWorkGroupCount[0]);
   const std::uint64_t gy = (groups + gx - 1) / gx;
   if (gy > ctx.limits.maxComputeWorkGroupCount[1])
@@ -220,10 +185,7 @@ detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p,
   std::memcpy(upload.mapped(), initial.data(), half);
   std::memcpy(static_cast<std::uint8_t*>(upload.mapped()) + half, control_init, kControlBytes);
   Buffer& readback = ctx.readback_buffer(half + kControlBytes);
-  const Buffer* bound[2] = {&data, &control};
-  const VkDescriptorSet set = ctx.bind(ctx.fim_layout, bound);
   const std::uint32_t passes = fim_pass_bound(p);
-  const bool timed = timings && ctx.timestamps != VK_NULL_HANDLE;
 
   L::FimParams fp{};
   fp.size = {p.n.x, p.n.y, p.n.z, L::VF_FIM_UPDATE};
@@ -231,62 +193,26 @@ detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p,
   fp.region_end = {region.end.x, region.end.y, region.end.z, 0};
   fp.metric = static_cast<std::uint32_t>(p.metric);
   fp.eps = p.metric == Metric::kEuclidean ? 1e-5f : 0.0f;  // the CPU's tolerance
-  constexpr VkPipelineStageFlags kNext =
-      VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
-  constexpr VkAccessFlags kNextAccess =
-      VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  ctx.run_commands([&](VkCommandBuffer cmd) {
-    if (timed) {
-      vkCmdResetQueryPool(cmd, ctx.timestamps, 0, 2);
-      vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx.timestamps, 0);
-    }
-    const VkBufferCopy in{0, 0, half};
-    vkCmdCopyBuffer(cmd, upload.handle(), data.handle(), 1, &in);
-    const VkBufferCopy in_control{half, 0, kControlBytes};
-    vkCmdCopyBuffer(cmd, upload.handle(), control.handle(), 1, &in_control);
-    ctx.counters.bytes_uploaded += static_cast<std::int64_t>(half + kControlBytes);
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, kNext,
-            kNextAccess);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.fim.pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx.fim_layout.pipeline, 0, 1,
-                            &set, 0, nullptr);
-    std::uint32_t src = 0;
-    for (std::uint32_t k = 0; k < passes; ++k) {
-      fp.size.w = L::VF_FIM_UPDATE;
-      fp.src = src;
-      fp.dst = src == 0 ? static_cast<std::uint32_t>(n) : 0u;
-      vkCmdPushConstants(cmd, ctx.fim_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof fp,
-                         &fp);
-      vkCmdDispatchIndirect(cmd, control.handle(), L::VF_FIM_GROUPS * 4);
-      ++ctx.counters.dispatches;
-      barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-              VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-              VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-      fp.size.w = L::VF_FIM_CONTROL;
-      vkCmdPushConstants(cmd, ctx.fim_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof fp,
-                         &fp);
-      vkCmdDispatch(cmd, 1, 1, 1);
-      ++ctx.counters.dispatches;
-      barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-              VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT, kNext, kNextAccess);
-      src = fp.dst;
-    }
-    fp.size.w = L::VF_FIM_RESOLVE;
-    vkCmdPushConstants(cmd, ctx.fim_layout.pipeline, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof fp,
-                       &fp);
-    dispatch(ctx, cmd, n);
-    if (timed) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx.timestamps, 1);
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
-    const VkBufferCopy out{0, 0, half};
-    vkCmdCopyBuffer(cmd, data.handle(), readback.handle(), 1, &out);
-    const VkBufferCopy out_control{0, half, kControlBytes};
-    vkCmdCopyBuffer(cmd, control.handle(), readback.handle(), 1, &out_control);
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-            VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
-    ctx.counters.bytes_downloaded += static_cast<std::int64_t>(half + kControlBytes);
-  });
+  Recorder rec(ctx);
+  const int timed = timings ? rec.begin_pass() : -1;
+  rec.copy(upload, 0, data, 0, half);
+  rec.copy(upload, half, control, 0, kControlBytes);
+  std::uint32_t src = 0;
+  for (std::uint32_t k = 0; k < passes; ++k) {
+    fp.size.w = L::VF_FIM_UPDATE;
+    fp.src = src;
+    fp.dst = src == 0 ? static_cast<std::uint32_t>(n) : 0u;
+    rec.dispatch_indirect(fim, {&data, &control}, &fp, sizeof fp, control, L::VF_FIM_GROUPS * 4);
+    fp.size.w = L::VF_FIM_CONTROL;
+    rec.dispatch_groups(fim, {&data, &control}, &fp, sizeof fp, {1, 1, 1});
+    src = fp.dst;
+  }
+  fp.size.w = L::VF_FIM_RESOLVE;
+  rec.dispatch(fim, {&data, &control}, fp, n);
+  rec.end_pass(timed, "fim");
+  rec.copy(data, 0, readback, 0, half);
+  rec.copy(control, 0, readback, half, kControlBytes);
+  rec.submit();
   std::uint32_t words[8];
   std::memcpy(words, static_cast<const std::uint8_t*>(readback.mapped()) + half, sizeof words);
   if (words[L::VF_FIM_CONVERGED] != 1u)
@@ -295,14 +221,9 @@ detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p,
   std::memcpy(solution.d.data(), readback.mapped(), half);
   stats.iterations += static_cast<int>(words[L::VF_FIM_PASSES]);
   stats.updates += static_cast<std::int64_t>(region.volume()) * words[L::VF_FIM_PASSES];
-  if (timed) {
-    std::uint64_t ticks[2];
-    check(vkGetQueryPoolResults(ctx.device, ctx.timestamps, 0, 2, sizeof ticks, ticks, 8,
-                                VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-          "vkGetQueryPoolResults");
-    timings->push_back({"fim (" + std::to_string(words[L::VF_FIM_PASSES]) + " passes)",
-                        static_cast<double>(ticks[1] - ticks[0]) * ctx.timestamp_period_ns * 1e-6});
-  }
+  if (timings && !rec.timings().empty())
+    timings->push_back(
+        {"fim (" + std::to_string(words[L::VF_FIM_PASSES]) + " passes)", rec.timings().front().ms});
   return solution;
 }
 

@@ -1,5 +1,5 @@
-// voxfield GPU backend — frames from the ray-marching compute shader (shaders/render.comp), over a
-// scene kept resident on the GPU.
+// voxfield GPU backend — frames from the ray-marching compute shader (shaders/render.comp beside
+// this file), over a scene kept resident on the GPU.
 //
 // The scene's bricked arenas (src/render/scene_impl.h: distance + material cells, the lighting
 // field, per-chunk flags) are copied as they are, so the shader walks exactly the data the CPU
@@ -11,7 +11,8 @@
 #include <cstring>
 
 #include "../scene_impl.h"
-#include "gpu/vulkan_context.h"
+#include "gpu/recorder.h"
+#include "render_shaders.h"
 #include "shaders/layout.h"
 #include "voxfield/gpu_render_vulkan.h"
 
@@ -62,17 +63,13 @@ void check_options(const RenderScene::Impl& s, const RenderOptions& o) {
 // The GPU copy of a RenderScene and the buffers a frame writes.
 class ResidentScene {
  public:
-  explicit ResidentScene(Context::Impl& ctx) : ctx_(ctx) {}
-  ~ResidentScene() {
-    if (pool_ != VK_NULL_HANDLE) vkDestroyDescriptorPool(ctx_.device, pool_, nullptr);
-  }
+  explicit ResidentScene(Context::Impl& ctx) : ctx_(ctx), sets_(ctx) {}
   ResidentScene(const ResidentScene&) = delete;
   ResidentScene& operator=(const ResidentScene&) = delete;
 
   // Records the copies that bring the GPU copy up to date with `scene` (staged in the context's
-  // upload buffer) and the barrier before rendering. Returns false, recording nothing, when the
-  // copy is already current.
-  bool record_sync(VkCommandBuffer cmd, const RenderScene& scene);
+  // upload buffer). Returns false, recording nothing, when the copy is already current.
+  bool record_sync(Recorder& rec, const RenderScene& scene);
   // Whether the GPU copy already equals `scene` (record_sync would record nothing).
   bool current(const RenderScene& scene) const {
     const RenderScene::Impl& s = scene.impl();
@@ -81,21 +78,21 @@ class ResidentScene {
            skip_.size() >= std::max<std::size_t>(s.skip.cells.arena.size(), 16) &&
            light_.size() >= std::max<std::size_t>(s.has_light ? s.light.arena.size() : 0, 16);
   }
-  // Records a frame: parameters, the dispatch, and a barrier making the pixels readable by
-  // transfers. Needs a synced scene.
-  void record_render(VkCommandBuffer cmd, const Camera& camera, const RenderOptions& o, bool bgra,
+  // Records a frame: parameters and the dispatch. Needs a synced scene.
+  void record_render(Recorder& rec, const Camera& camera, const RenderOptions& o, bool bgra,
                      bool timed);
 
-  const Buffer& pixels() const { return pixels_; }
+  Buffer& pixels() { return pixels_; }
+  // The frame's descriptor sets: kept across frames, recycled when buffers are replaced.
+  DescriptorArena& sets() { return sets_; }
   const RenderScene::Impl* scene() const { return scene_; }
 
  private:
   void ensure_pixels(VkDeviceSize bytes);
-  void write_descriptors();
   // Records the copy of the error view's approximation when the scene or the algorithm changed
   // since the last one (computed on the CPU as the CPU renderer does, staged in a buffer of its
   // own so a sync in the same command buffer does not overwrite it).
-  void record_approximation(VkCommandBuffer cmd, Algorithm algorithm);
+  void record_approximation(Recorder& rec, Algorithm algorithm);
 
   Context::Impl& ctx_;
   const RenderScene::Impl* scene_ = nullptr;
@@ -111,9 +108,8 @@ class ResidentScene {
                 approx_generation_ = 0;  // what the resident approximation was made from
   int approx_algorithm_ = -1;
   double approx_inv_scale_ = 1;
-  VkDescriptorPool pool_ = VK_NULL_HANDLE;
-  VkDescriptorSet set_ = VK_NULL_HANDLE;
-  bool descriptors_stale_ = true;
+  DescriptorArena sets_;
+  bool descriptors_stale_ = false;
 };
 
 namespace {
@@ -130,7 +126,7 @@ struct Staged {
 
 }  // namespace
 
-bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
+bool ResidentScene::record_sync(Recorder& rec, const RenderScene& scene) {
   const RenderScene::Impl& s = scene.impl();
   const std::size_t chunks = s.table.chunk_count();
   const std::size_t skip_live = std::size_t{s.skip.cells.slots_used} * s.skip.cells.slot_bytes();
@@ -163,23 +159,13 @@ bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
   ensure(skip_, s.skip.cells.arena.size(), true);
   ensure(light_, s.has_light ? s.light.arena.size() : 0, true);
   if (whole) grown.clear();  // everything is copied from the host anyway
-  // A frame submitted earlier may still be reading the buffers these copies write (an application
-  // that records frames into its own command buffers need not wait for one before syncing): the
-  // barrier's first scope covers every command submitted before it on this queue.
-  barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-          VK_ACCESS_TRANSFER_WRITE_BIT);
-  if (!grown.empty())  // earlier submissions' writes of the old arenas come before reading them
-    barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+  // The recorder orders these copies after the frames submitted earlier that read the buffers
+  // they write (an application that records frames into its own command buffers need not wait
+  // for one before syncing), and the moved contents before the changed chunks written over them.
   for (auto& [now, old] : grown) {
-    const VkBufferCopy keep{0, 0, old.size()};
-    vkCmdCopyBuffer(cmd, old.handle(), now->handle(), 1, &keep);
+    rec.copy(old, 0, *now, 0, old.size());
     retired_.push_back(std::move(old));
   }
-  if (!grown.empty())  // the moved contents come before the changed chunks are written over them
-    barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
 
   std::vector<std::size_t> changed;
   const bool palette_changed = whole || synced_palette_ != s.palette_generation;
@@ -245,14 +231,7 @@ bool ResidentScene::record_sync(VkCommandBuffer cmd, const RenderScene& scene) {
                                                  {&info_copy, &info_},
                                                  {&skip_copy, &skip_},
                                                  {&light_copy, &light_}};
-  for (const auto& [staged, dst] : copies) {
-    if (staged->regions.empty()) continue;
-    vkCmdCopyBuffer(cmd, upload.handle(), dst->handle(),
-                    static_cast<std::uint32_t>(staged->regions.size()), staged->regions.data());
-    ctx_.counters.bytes_uploaded += staged->bytes;
-  }
-  barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  for (const auto& [staged, dst] : copies) rec.copy(upload, *dst, staged->regions);
   scene_ = &s;
   scene_id_ = s.id;
   synced_generation_ = s.chunk_generation;
@@ -266,18 +245,7 @@ void ResidentScene::ensure_pixels(VkDeviceSize bytes) {
   descriptors_stale_ = true;
 }
 
-void ResidentScene::write_descriptors() {
-  if (pool_ == VK_NULL_HANDLE) pool_ = ctx_.make_descriptor_pool(Context::Impl::kRenderBindings);
-  for (Buffer* b : {&approx_info_, &approx_arena_})
-    if (b->handle() == VK_NULL_HANDLE)
-      *b = Buffer(ctx_, 16, kUsage, false);  // bound even when unused
-  const Buffer* bound[Context::Impl::kRenderBindings] = {
-      &params_, &info_, &skip_, &light_, &palette_, &pixels_, &approx_info_, &approx_arena_};
-  set_ = ctx_.allocate_set(pool_, ctx_.render_layout, bound);
-  descriptors_stale_ = false;
-}
-
-void ResidentScene::record_approximation(VkCommandBuffer cmd, Algorithm algorithm) {
+void ResidentScene::record_approximation(Recorder& rec, Algorithm algorithm) {
   const RenderScene::Impl& s = *scene_;
   if (approx_scene_ == s.id && approx_generation_ == s.generation &&
       approx_algorithm_ == static_cast<int>(algorithm))
@@ -305,31 +273,29 @@ void ResidentScene::record_approximation(VkCommandBuffer cmd, Algorithm algorith
   auto* base = static_cast<std::uint8_t*>(approx_staging_.mapped());
   std::memcpy(base, info.data(), info_bytes);
   if (arena_bytes > 0) std::memcpy(base + info_bytes, approx.cells.arena.data(), arena_bytes);
-  // The previous frame's reads of these buffers come before the copies.
-  barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT,
-          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
-  const VkBufferCopy to_info{0, 0, info_bytes};
-  vkCmdCopyBuffer(cmd, approx_staging_.handle(), approx_info_.handle(), 1, &to_info);
-  if (arena_bytes > 0) {
-    const VkBufferCopy to_arena{info_bytes, 0, arena_bytes};
-    vkCmdCopyBuffer(cmd, approx_staging_.handle(), approx_arena_.handle(), 1, &to_arena);
-  }
-  ctx_.counters.bytes_uploaded += static_cast<std::int64_t>(info_bytes + arena_bytes);
+  rec.copy(approx_staging_, 0, approx_info_, 0, info_bytes);
+  rec.copy(approx_staging_, info_bytes, approx_arena_, 0, arena_bytes);
   approx_scene_ = s.id;
   approx_generation_ = s.generation;
   approx_algorithm_ = static_cast<int>(algorithm);
   approx_inv_scale_ = approx.inv_scale;
 }
 
-void ResidentScene::record_render(VkCommandBuffer cmd, const Camera& camera, const RenderOptions& o,
+void ResidentScene::record_render(Recorder& rec, const Camera& camera, const RenderOptions& o,
                                   bool bgra, bool timed) {
   if (!scene_) throw InvalidArgument("GPU render: no scene synced yet");
   const RenderScene::Impl& s = *scene_;
   check_options(s, o);
   ensure_pixels(static_cast<VkDeviceSize>(o.width) * o.height * 4);
   const bool error = o.view == RenderView::kError;
-  if (error) record_approximation(cmd, o.error_algorithm);
-  if (descriptors_stale_) write_descriptors();
+  if (error) record_approximation(rec, o.error_algorithm);
+  for (Buffer* b : {&approx_info_, &approx_arena_})
+    if (b->handle() == VK_NULL_HANDLE)
+      *b = Buffer(ctx_, 16, kUsage, false);  // bound even when unused
+  if (descriptors_stale_) {
+    sets_.reset();  // the last frame that used them has completed (gpu_render_vulkan.h)
+    descriptors_stale_ = false;
+  }
 
   const Camera::Projector pj = camera.projector(o.width, o.height);
   L::RenderParams rp{};
@@ -362,27 +328,13 @@ void ResidentScene::record_render(VkCommandBuffer cmd, const Camera& camera, con
     rp.heat_max = static_cast<float>(s.heat_max(rp.slice_z));
   }
 
-  // The approximation's copies, and the previous frame's reads of the parameters and writes of
-  // the pixels, come before these.
-  barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
-          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-          VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-  vkCmdUpdateBuffer(cmd, params_.handle(), 0, sizeof rp, &rp);
-  ctx_.counters.bytes_uploaded += static_cast<std::int64_t>(sizeof rp);
-  barrier(ctx_, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.render.pipeline);
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, ctx_.render_layout.pipeline, 0, 1,
-                          &set_, 0, nullptr);
-  if (timed) {
-    vkCmdResetQueryPool(cmd, ctx_.timestamps, 0, 2);
-    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx_.timestamps, 0);
-  }
-  dispatch(ctx_, cmd, static_cast<std::uint64_t>(o.width) * o.height);
-  if (timed) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx_.timestamps, 1);
-  barrier(ctx_, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+  rec.update(params_, 0, &rp, sizeof rp);
+  Buffer* const bound[] = {&params_,  &info_,   &skip_,        &light_,
+                           &palette_, &pixels_, &approx_info_, &approx_arena_};
+  const int pass = timed ? rec.begin_pass() : -1;
+  rec.dispatch(ctx_.kernel(shaders::render()), bound, nullptr, 0,
+               static_cast<std::uint64_t>(o.width) * o.height);
+  rec.end_pass(pass, "render");
 }
 
 namespace {
@@ -395,30 +347,15 @@ Image render_and_read(Context::Impl& ctx, ResidentScene& resident, const RenderS
   check_options(sync ? sync->impl() : *resident.scene(), o);
   const VkDeviceSize image_bytes = static_cast<VkDeviceSize>(o.width) * o.height * 4;
   Buffer& readback = ctx.readback_buffer(image_bytes);
-  const bool timed = timings && ctx.timestamps != VK_NULL_HANDLE;
   const auto t0 = std::chrono::steady_clock::now();
-  ctx.run_commands([&](VkCommandBuffer cmd) {
-    if (sync) resident.record_sync(cmd, *sync);
-    resident.record_render(cmd, camera, o, /*bgra=*/false, timed);
-    const VkBufferCopy down{0, 0, image_bytes};
-    vkCmdCopyBuffer(cmd, resident.pixels().handle(), readback.handle(), 1, &down);
-    barrier(ctx, cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-            VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
-    ctx.counters.bytes_downloaded += static_cast<std::int64_t>(image_bytes);
-  });
+  Recorder rec(ctx, &resident.sets());
+  if (sync) resident.record_sync(rec, *sync);
+  resident.record_render(rec, camera, o, /*bgra=*/false, timings != nullptr);
+  rec.copy(resident.pixels(), 0, readback, 0, image_bytes);
+  rec.submit();
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  if (timings) {
-    timings->clear();
-    if (timed) {
-      std::uint64_t ticks[2];
-      check(vkGetQueryPoolResults(ctx.device, ctx.timestamps, 0, 2, sizeof ticks, ticks, 8,
-                                  VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-            "vkGetQueryPoolResults");
-      timings->push_back(
-          {"render", static_cast<double>(ticks[1] - ticks[0]) * ctx.timestamp_period_ns * 1e-6});
-    }
-  }
+  if (timings) *timings = rec.timings();
   Image image(o.width, o.height);
   const auto* px = static_cast<const std::uint32_t*>(readback.mapped());
   for (std::size_t i = 0; i < static_cast<std::size_t>(o.width) * o.height; ++i) {
@@ -463,8 +400,9 @@ SceneRenderer::~SceneRenderer() = default;
 
 bool SceneRenderer::sync(const RenderScene& scene) {
   if (impl_->resident.current(scene)) return false;
-  impl_->context->impl().run_commands(
-      [&](VkCommandBuffer cmd) { impl_->resident.record_sync(cmd, scene); });
+  Recorder rec(impl_->context->impl(), &impl_->resident.sets());
+  impl_->resident.record_sync(rec, scene);
+  rec.submit();
   return true;
 }
 
@@ -481,7 +419,10 @@ Context& SceneRenderer::context() {
 VkBuffer record_render(SceneRenderer& renderer, VkCommandBuffer cmd, const Camera& camera,
                        const RenderOptions& options, PixelOrder order) {
   ResidentScene& r = renderer.impl().resident;
-  r.record_render(cmd, camera, options, order == PixelOrder::kBgra, /*timed=*/false);
+  Recorder rec(renderer.context().impl(), cmd, r.sets());
+  r.record_render(rec, camera, options, order == PixelOrder::kBgra, /*timed=*/false);
+  // The application copies the pixels out with a transfer.
+  rec.expose(r.pixels(), VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
   return r.pixels().handle();
 }
 

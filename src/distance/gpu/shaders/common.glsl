@@ -24,8 +24,8 @@ layout(std430, set = 0, binding = 10) buffer FieldSites { uvec2 field_sites[]; }
 
 layout(push_constant) uniform Push { PassParams p; };
 
-// Dispatches wider than the device's x limit spill into y (src/gpu/vulkan_context.cpp: dispatch).
-uint invocation() { return gl_GlobalInvocationID.y * gl_NumWorkGroups.x * VF_WORKGROUP + gl_GlobalInvocationID.x; }
+// Dispatches wider than the device's x limit spill into y (src/gpu/recorder.cpp: Recorder::dispatch).
+uint invocation() { return gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x; }
 
 uint load_cost(uint buffer_index, uint i) {
   if (buffer_index == 0u) return cost0[i];

@@ -87,7 +87,7 @@ void main() {
     }
     return;
   }
-  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * VF_WORKGROUP + gl_GlobalInvocationID.x;
+  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
   const ivec3 n = p.size.xyz;
   if (i >= uint(n.x * n.y * n.z)) return;
   if (mode == VF_FIM_RESOLVE) {

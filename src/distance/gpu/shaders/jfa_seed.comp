@@ -14,7 +14,7 @@ layout(std430, set = 0, binding = 0) buffer Values { float values[]; };
 layout(push_constant) uniform Push { JfaParams p; };
 
 void main() {
-  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * VF_WORKGROUP + gl_GlobalInvocationID.x;
+  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
   const ivec3 n = p.size.xyz;
   if (i >= uint(n.x * n.y * n.z)) return;
   const ivec3 v = ivec3(int(i) % n.x, (int(i) / n.x) % n.y, int(i) / (n.x * n.y));

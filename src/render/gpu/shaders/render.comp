@@ -309,7 +309,7 @@ uvec3 heat(float x) {
 }
 
 void main() {
-  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * VF_WORKGROUP + gl_GlobalInvocationID.x;
+  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
   if (i >= rp.width * rp.height) return;
   const uint px = i % rp.width, py = i / rp.width;
   const float sx = (2.0 * (float(px) + 0.5) - float(rp.width)) / float(rp.height) * rp.scale;

@@ -32,7 +32,7 @@ bool smaller(ivec3 a, ivec3 b) {  // (z, y, x) order
 }
 
 void main() {
-  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * VF_WORKGROUP + gl_GlobalInvocationID.x;
+  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
   const ivec3 n = p.size.xyz;
   if (i >= uint(n.x * n.y * n.z)) return;
   const ivec3 v = ivec3(int(i) % n.x, (int(i) / n.x) % n.y, int(i) / (n.x * n.y));

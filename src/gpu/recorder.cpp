@@ -1,0 +1,334 @@
+// voxfield GPU compute layer — the recorder and its derived barriers (see recorder.h).
+#include "gpu/recorder.h"
+
+#include <algorithm>
+
+#include "voxfield/error.h"
+
+namespace voxfield::gpu {
+namespace {
+
+constexpr VkAccessFlags kWriteAccess =
+    VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_HOST_WRITE_BIT;
+// Sets per descriptor pool, and storage-buffer descriptors per set on average.
+constexpr std::uint32_t kSetsPerPool = 64;
+constexpr std::uint32_t kBuffersPerSet = 16;
+
+VkAccessFlags shader_access(Access a) {
+  VkAccessFlags flags = 0;
+  if (a == Access::kWrite || a == Access::kReadWrite) flags |= VK_ACCESS_SHADER_WRITE_BIT;
+  if (a == Access::kRead || a == Access::kReadWrite) flags |= VK_ACCESS_SHADER_READ_BIT;
+  return flags;
+}
+
+}  // namespace
+
+// ---- descriptor sets --------------------------------------------------------------------------
+
+DescriptorArena::~DescriptorArena() {
+  for (VkDescriptorPool p : pools_) vkDestroyDescriptorPool(ctx_->device, p, nullptr);
+}
+
+void DescriptorArena::reset() {
+  for (VkDescriptorPool p : pools_) vkResetDescriptorPool(ctx_->device, p, 0);
+  // Keep the first pool (recycled), free the rest: a burst does not pin its pools forever.
+  while (pools_.size() > 1) {
+    vkDestroyDescriptorPool(ctx_->device, pools_.back(), nullptr);
+    pools_.pop_back();
+  }
+  left_in_pool_ = pools_.empty() ? 0 : kSetsPerPool;
+  cached_.clear();
+}
+
+VkDescriptorSet DescriptorArena::set(const Kernel& kernel, std::span<Buffer* const> buffers) {
+  Key key{kernel.set_layout, {}};
+  key.buffers.reserve(buffers.size());
+  for (const Buffer* b : buffers) key.buffers.push_back(b->handle());
+  for (const auto& [k, s] : cached_)
+    if (k == key) return s;
+
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  for (int attempt = 0; attempt < 2 && set == VK_NULL_HANDLE; ++attempt) {
+    if (left_in_pool_ == 0 || buffers.size() > kBuffersPerSet || attempt == 1) {
+      const std::uint32_t descriptors =
+          kSetsPerPool *
+          std::max<std::uint32_t>(kBuffersPerSet, static_cast<std::uint32_t>(buffers.size()));
+      const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, descriptors};
+      VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+      dp.maxSets = kSetsPerPool;
+      dp.poolSizeCount = 1;
+      dp.pPoolSizes = &size;
+      VkDescriptorPool pool;
+      check(vkCreateDescriptorPool(ctx_->device, &dp, nullptr, &pool), "vkCreateDescriptorPool");
+      pools_.push_back(pool);
+      left_in_pool_ = kSetsPerPool;
+    }
+    VkDescriptorSetAllocateInfo dsa{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    dsa.descriptorPool = pools_.back();
+    dsa.descriptorSetCount = 1;
+    dsa.pSetLayouts = &kernel.set_layout;
+    const VkResult r = vkAllocateDescriptorSets(ctx_->device, &dsa, &set);
+    if (r == VK_ERROR_OUT_OF_POOL_MEMORY || r == VK_ERROR_FRAGMENTED_POOL) {
+      set = VK_NULL_HANDLE;  // this pool's descriptors ran out before its sets: a fresh pool
+      left_in_pool_ = 0;
+      continue;
+    }
+    check(r, "vkAllocateDescriptorSets");
+    --left_in_pool_;
+  }
+  if (set == VK_NULL_HANDLE) check(VK_ERROR_OUT_OF_POOL_MEMORY, "vkAllocateDescriptorSets");
+
+  std::vector<VkDescriptorBufferInfo> infos(buffers.size());
+  std::vector<VkWriteDescriptorSet> writes(buffers.size());
+  for (std::size_t b = 0; b < buffers.size(); ++b) {
+    infos[b] = {buffers[b]->handle(), 0, VK_WHOLE_SIZE};
+    writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[b].dstSet = set;
+    writes[b].dstBinding = static_cast<std::uint32_t>(b);
+    writes[b].descriptorCount = 1;
+    writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[b].pBufferInfo = &infos[b];
+  }
+  vkUpdateDescriptorSets(ctx_->device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0,
+                         nullptr);
+  cached_.emplace_back(std::move(key), set);
+  return set;
+}
+
+// ---- recording --------------------------------------------------------------------------------
+
+Recorder::Recorder(Context::Impl& ctx, DescriptorArena* sets) : ctx_(ctx), owns_cmd_(true) {
+  ctx.require_device();
+  VkCommandBufferAllocateInfo cba{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  cba.commandPool = ctx.command_pool;
+  cba.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cba.commandBufferCount = 1;
+  check(vkAllocateCommandBuffers(ctx.device, &cba, &cmd_), "vkAllocateCommandBuffers");
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  const VkResult r = vkBeginCommandBuffer(cmd_, &begin);
+  if (r != VK_SUCCESS) {
+    vkFreeCommandBuffers(ctx.device, ctx.command_pool, 1, &cmd_);
+    check(r, "vkBeginCommandBuffer");
+  }
+  if (!sets) own_sets_ = std::make_unique<DescriptorArena>(ctx);
+  sets_ = sets ? sets : own_sets_.get();
+}
+
+Recorder::Recorder(Context::Impl& ctx, VkCommandBuffer external, DescriptorArena& sets)
+    : ctx_(ctx), cmd_(external), sets_(&sets) {
+  ctx.require_device();
+}
+
+Recorder::~Recorder() {
+  if (owns_cmd_) vkFreeCommandBuffers(ctx_.device, ctx_.command_pool, 1, &cmd_);
+}
+
+void Recorder::touch(Buffer& b) {
+  if (b.mapped() && std::find(touched_.begin(), touched_.end(), &b) == touched_.end())
+    touched_.push_back(&b);
+}
+
+void Recorder::prepare(std::span<const Use> uses_in) {
+  // One use per buffer: a buffer bound twice (or copied onto itself) is used by the union.
+  std::vector<Use> uses;
+  for (const Use& u : uses_in) {
+    auto it =
+        std::find_if(uses.begin(), uses.end(), [&](const Use& v) { return v.buffer == u.buffer; });
+    if (it == uses.end()) {
+      uses.push_back(u);
+    } else {
+      it->stage |= u.stage;
+      it->access |= u.access;
+    }
+  }
+  std::vector<VkBufferMemoryBarrier> barriers;
+  VkPipelineStageFlags src = 0, dst = 0;
+  for (const Use& u : uses) {
+    Buffer::Sync& s = u.buffer->sync;
+    const bool writes = (u.access & kWriteAccess) != 0;
+    VkPipelineStageFlags wait = 0;
+    VkAccessFlags made_available = 0;
+    if (s.write_stages != 0 &&
+        (writes || (u.stage & ~s.visible_stages) != 0 || (u.access & ~s.visible_access) != 0)) {
+      wait = s.write_stages | (writes ? s.read_stages : 0);  // after a write (and its readers)
+      made_available = s.write_access;
+    } else if (writes && s.read_stages != 0) {
+      wait = s.read_stages;  // write after read: an execution dependency
+    }
+    if (wait != 0) {
+      VkBufferMemoryBarrier b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+      b.srcAccessMask = made_available;
+      b.dstAccessMask = made_available ? u.access : 0;
+      b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+      b.buffer = u.buffer->handle();
+      b.offset = 0;
+      b.size = VK_WHOLE_SIZE;
+      barriers.push_back(b);
+      src |= wait;
+      dst |= u.stage;
+    }
+    if (writes) {
+      s.write_stages = u.stage;
+      s.write_access = u.access & kWriteAccess;
+      s.visible_stages = 0;
+      s.visible_access = 0;
+      s.read_stages = 0;
+      touch(*u.buffer);
+    } else {
+      if (s.write_stages != 0) {
+        s.visible_stages |= u.stage;
+        s.visible_access |= u.access;
+      }
+      s.read_stages |= u.stage;
+    }
+  }
+  if (barriers.empty()) return;
+  vkCmdPipelineBarrier(cmd_, src, dst, 0, 0, nullptr, static_cast<std::uint32_t>(barriers.size()),
+                       barriers.data(), 0, nullptr);
+  ++ctx_.counters.pipeline_barriers;
+}
+
+void Recorder::bind(const Kernel& kernel, Buffers buffers, const void* push, std::size_t push_bytes,
+                    const Use* also) {
+  // Buffers past the last binding the shader uses are ignored, so passes that share one binding
+  // plan (the exact transform's) can be given the same list.
+  if (buffers.size() < kernel.interface.buffers.size())
+    throw InvalidArgument("GPU kernel " + kernel.name + ": " + std::to_string(buffers.size()) +
+                          " buffers given, the shader uses binding " +
+                          std::to_string(kernel.interface.buffers.size() - 1));
+  if (push_bytes != kernel.interface.push_bytes)
+    throw InvalidArgument("GPU kernel " + kernel.name + ": " + std::to_string(push_bytes) +
+                          " bytes of push constants given, the shader declares " +
+                          std::to_string(kernel.interface.push_bytes));
+  const std::size_t used = kernel.interface.buffers.size();
+  std::vector<Use> uses;
+  for (std::size_t b = 0; b < used; ++b)
+    if (kernel.interface.buffers[b] != Access::kNone)
+      uses.push_back({buffers[b], VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                      shader_access(kernel.interface.buffers[b])});
+  if (also) uses.push_back(*also);  // one barrier for the command's every use
+  prepare(uses);
+  const VkDescriptorSet set = sets_->set(kernel, buffers.first(used));
+  vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, kernel.pipeline);
+  vkCmdBindDescriptorSets(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, kernel.layout, 0, 1, &set, 0,
+                          nullptr);
+  if (push_bytes > 0)
+    vkCmdPushConstants(cmd_, kernel.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                       static_cast<std::uint32_t>(push_bytes), push);
+}
+
+void Recorder::dispatch(const Kernel& kernel, Buffers buffers, const void* push,
+                        std::size_t push_bytes, std::uint64_t invocations) {
+  const std::uint64_t per_group = kernel.interface.invocations_per_group();
+  const std::uint64_t groups = (invocations + per_group - 1) / per_group;
+  const std::uint64_t max_x = ctx_.limits.maxComputeWorkGroupCount[0];
+  const std::uint64_t gx = std::max<std::uint64_t>(std::min(groups, max_x), 1);
+  const std::uint64_t gy = (groups + gx - 1) / gx;
+  if (gy > ctx_.limits.maxComputeWorkGroupCount[1])
+    throw InvalidArgument("GPU kernel " + kernel.name + ": " + std::to_string(invocations) +
+                          " invocations exceed the device's dispatch limits");
+  if (groups == 0) return;
+  dispatch_groups(kernel, buffers, push, push_bytes,
+                  {static_cast<std::uint32_t>(gx), static_cast<std::uint32_t>(gy), 1});
+}
+
+void Recorder::dispatch_groups(const Kernel& kernel, Buffers buffers, const void* push,
+                               std::size_t push_bytes, std::array<std::uint32_t, 3> groups) {
+  bind(kernel, buffers, push, push_bytes, nullptr);
+  vkCmdDispatch(cmd_, groups[0], groups[1], groups[2]);
+  ++ctx_.counters.dispatches;
+}
+
+void Recorder::dispatch_indirect(const Kernel& kernel, Buffers buffers, const void* push,
+                                 std::size_t push_bytes, Buffer& args, VkDeviceSize offset) {
+  const Use use{&args, VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, VK_ACCESS_INDIRECT_COMMAND_READ_BIT};
+  bind(kernel, buffers, push, push_bytes, &use);
+  vkCmdDispatchIndirect(cmd_, args.handle(), offset);
+  ++ctx_.counters.dispatches;
+}
+
+void Recorder::copy(Buffer& src, Buffer& dst, std::span<const VkBufferCopy> regions) {
+  if (regions.empty()) return;
+  const Use uses[2] = {{&src, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT},
+                       {&dst, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT}};
+  prepare(uses);
+  vkCmdCopyBuffer(cmd_, src.handle(), dst.handle(), static_cast<std::uint32_t>(regions.size()),
+                  regions.data());
+  std::int64_t bytes = 0;
+  for (const VkBufferCopy& r : regions) bytes += static_cast<std::int64_t>(r.size);
+  if (src.mapped() && !dst.mapped()) ctx_.counters.bytes_uploaded += bytes;
+  if (dst.mapped() && !src.mapped()) ctx_.counters.bytes_downloaded += bytes;
+}
+
+void Recorder::copy(Buffer& src, VkDeviceSize src_offset, Buffer& dst, VkDeviceSize dst_offset,
+                    VkDeviceSize bytes) {
+  if (bytes == 0) return;
+  const VkBufferCopy region{src_offset, dst_offset, bytes};
+  copy(src, dst, {&region, 1});
+}
+
+void Recorder::update(Buffer& dst, VkDeviceSize offset, const void* data, VkDeviceSize bytes) {
+  const Use use{&dst, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT};
+  prepare({&use, 1});
+  vkCmdUpdateBuffer(cmd_, dst.handle(), offset, bytes, data);
+  ctx_.counters.bytes_uploaded += static_cast<std::int64_t>(bytes);
+}
+
+void Recorder::fill(Buffer& dst, VkDeviceSize offset, VkDeviceSize bytes, std::uint32_t value) {
+  const Use use{&dst, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT};
+  prepare({&use, 1});
+  vkCmdFillBuffer(cmd_, dst.handle(), offset, bytes, value);
+}
+
+void Recorder::expose(Buffer& b, VkPipelineStageFlags stage, VkAccessFlags access) {
+  const Use use{&b, stage, access};
+  prepare({&use, 1});
+}
+
+int Recorder::begin_pass() {
+  if (!owns_cmd_ || ctx_.timestamps == VK_NULL_HANDLE ||
+      queries_used_ + 2 > Context::Impl::kQueries)
+    return -1;
+  if (queries_used_ == 0) vkCmdResetQueryPool(cmd_, ctx_.timestamps, 0, Context::Impl::kQueries);
+  const int ticket = queries_used_;
+  queries_used_ += 2;
+  vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx_.timestamps,
+                      static_cast<std::uint32_t>(ticket));
+  return ticket;
+}
+
+void Recorder::end_pass(int ticket, std::string label) {
+  if (ticket < 0) return;
+  vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx_.timestamps,
+                      static_cast<std::uint32_t>(ticket + 1));
+  passes_.emplace_back(ticket, std::move(label));
+}
+
+void Recorder::submit() {
+  if (!owns_cmd_)
+    throw InvalidArgument(
+        "GPU recorder: an application's command buffer is submitted by the application");
+  if (submitted_) throw InvalidArgument("GPU recorder: submitted twice");
+  submitted_ = true;
+  // The host reads what the GPU wrote into host-visible buffers once the fence has signalled.
+  std::vector<Use> host;
+  for (Buffer* b : touched_)
+    if (b->sync.write_stages != 0 && !(b->sync.visible_stages & VK_PIPELINE_STAGE_HOST_BIT))
+      host.push_back({b, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT});
+  if (!host.empty()) prepare(host);
+  check(vkEndCommandBuffer(cmd_), "vkEndCommandBuffer");
+  ctx_.submit_and_wait(cmd_);
+  if (passes_.empty()) return;
+  std::vector<std::uint64_t> ticks(static_cast<std::size_t>(queries_used_));
+  check(vkGetQueryPoolResults(ctx_.device, ctx_.timestamps, 0,
+                              static_cast<std::uint32_t>(queries_used_), ticks.size() * 8,
+                              ticks.data(), 8, VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+        "vkGetQueryPoolResults");
+  for (const auto& [q, label] : passes_)
+    timings_.push_back({label, static_cast<double>(ticks[static_cast<std::size_t>(q) + 1] -
+                                                   ticks[static_cast<std::size_t>(q)]) *
+                                   ctx_.timestamp_period_ns * 1e-6});
+}
+
+}  // namespace voxfield::gpu

@@ -1,0 +1,143 @@
+// voxfield GPU compute layer — the recorder: records dispatches and copies, and derives every
+// barrier from what each command does to each buffer, so no module places a barrier by hand.
+//
+// Each Buffer remembers its last write (stages and accesses), which stages have been made to see
+// that write, and the reads since it. Before a command, the recorder compares the command's uses
+// with that state and emits one vkCmdPipelineBarrier carrying a buffer memory barrier per buffer
+// that needs one: read after write and write after write get a memory dependency, write after
+// read an execution dependency, read after read nothing. Dispatches take their buffers' accesses
+// from the shader's own `readonly` / `writeonly` qualifiers (kernel.h). The state outlives a
+// submission, so work of a later submission is ordered after the writes of an earlier one by the
+// same rules (a pipeline barrier's first scope covers everything submitted before it on the
+// queue), and host-visible buffers the GPU wrote are made visible to the host at submit().
+//
+// A recorder either owns a command buffer (submit() submits it with the context's fence and waits:
+// one submit, one fence wait) or records into an application's command buffer, which the
+// application submits (gpu_vulkan.h). Descriptor sets come from a DescriptorArena: the recorder's
+// own (freed after its submission), or one the caller keeps alive as long as its commands may run.
+#pragma once
+
+#include <initializer_list>
+#include <string>
+#include <vector>
+
+#include "gpu/kernel.h"
+#include "gpu/vulkan_context.h"
+
+namespace voxfield::gpu {
+
+// Descriptor sets for recorded dispatches, one per distinct (kernel, buffers) pair, from pools
+// grown on demand. reset() recycles them all: only once no recorded command can still run.
+class DescriptorArena {
+ public:
+  explicit DescriptorArena(Context::Impl& ctx) : ctx_(&ctx) {}
+  ~DescriptorArena();
+  DescriptorArena(const DescriptorArena&) = delete;
+  DescriptorArena& operator=(const DescriptorArena&) = delete;
+
+  VkDescriptorSet set(const Kernel& kernel, std::span<Buffer* const> buffers);
+  void reset();
+  std::size_t sets() const { return cached_.size(); }
+
+ private:
+  struct Key {
+    VkDescriptorSetLayout layout;
+    std::vector<VkBuffer> buffers;
+    bool operator==(const Key&) const = default;
+  };
+  Context::Impl* ctx_;
+  std::vector<VkDescriptorPool> pools_;
+  std::uint32_t left_in_pool_ = 0;
+  std::vector<std::pair<Key, VkDescriptorSet>> cached_;
+};
+
+class Recorder {
+ public:
+  // Records into a command buffer of its own; submit() runs it. Descriptor sets come from `sets`
+  // when given (an object that keeps its sets across submissions), else from the recorder's own.
+  explicit Recorder(Context::Impl& ctx, DescriptorArena* sets = nullptr);
+  // Records into `external` (begun by the application, submitted by it), binding sets from `sets`.
+  Recorder(Context::Impl& ctx, VkCommandBuffer external, DescriptorArena& sets);
+  ~Recorder();
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+
+  // The buffers of a dispatch, binding 0 first.
+  using Buffers = std::span<Buffer* const>;
+
+  // `invocations` invocations of `kernel` along x, in workgroups of its local size, split over y
+  // when the count exceeds the device's limit. `push` must be exactly the shader's push-constant
+  // block (checked against its reflected size).
+  void dispatch(const Kernel& kernel, Buffers buffers, const void* push, std::size_t push_bytes,
+                std::uint64_t invocations);
+  void dispatch_groups(const Kernel& kernel, Buffers buffers, const void* push,
+                       std::size_t push_bytes, std::array<std::uint32_t, 3> groups);
+  // Workgroup counts read from `args` at `offset` (three uint32) when the command runs.
+  void dispatch_indirect(const Kernel& kernel, Buffers buffers, const void* push,
+                         std::size_t push_bytes, Buffer& args, VkDeviceSize offset);
+  template <class Push>
+  void dispatch(const Kernel& k, Buffers b, const Push& p, std::uint64_t invocations) {
+    dispatch(k, b, &p, sizeof p, invocations);
+  }
+  template <class Push>
+  void dispatch(const Kernel& k, std::initializer_list<Buffer*> b, const Push& p,
+                std::uint64_t invocations) {
+    dispatch(k, Buffers(b.begin(), b.size()), &p, sizeof p, invocations);
+  }
+  void dispatch_groups(const Kernel& k, std::initializer_list<Buffer*> b, const void* push,
+                       std::size_t push_bytes, std::array<std::uint32_t, 3> groups) {
+    dispatch_groups(k, Buffers(b.begin(), b.size()), push, push_bytes, groups);
+  }
+  void dispatch_indirect(const Kernel& k, std::initializer_list<Buffer*> b, const void* push,
+                         std::size_t push_bytes, Buffer& args, VkDeviceSize offset) {
+    dispatch_indirect(k, Buffers(b.begin(), b.size()), push, push_bytes, args, offset);
+  }
+
+  void copy(Buffer& src, Buffer& dst, std::span<const VkBufferCopy> regions);
+  void copy(Buffer& src, VkDeviceSize src_offset, Buffer& dst, VkDeviceSize dst_offset,
+            VkDeviceSize bytes);
+  // Writes `bytes` (at most 65536, a multiple of 4) into `dst` from the command buffer itself.
+  void update(Buffer& dst, VkDeviceSize offset, const void* data, VkDeviceSize bytes);
+  void fill(Buffer& dst, VkDeviceSize offset, VkDeviceSize bytes, std::uint32_t value);
+
+  // Hands `b` to commands outside the recorder (an application's copy out of a frame): its last
+  // write is made visible to `stage` / `access`, and later writes wait for that use.
+  void expose(Buffer& b, VkPipelineStageFlags stage, VkAccessFlags access);
+
+  // A timed pass: timestamps around the commands recorded between begin_pass() and end_pass(),
+  // read after submit() into timings(). Without timestamps (no support, an external command
+  // buffer, or the query pool used up) both calls do nothing.
+  int begin_pass();
+  void end_pass(int ticket, std::string label);
+  const std::vector<PassTiming>& timings() const { return timings_; }
+
+  // Submits the recorded commands and waits for them (own command buffer only). Afterwards the
+  // host may read every host-visible buffer the commands wrote.
+  void submit();
+
+  VkCommandBuffer command_buffer() const { return cmd_; }
+
+ private:
+  struct Use {
+    Buffer* buffer;
+    VkPipelineStageFlags stage;
+    VkAccessFlags access;
+  };
+  void prepare(std::span<const Use> uses);
+  void bind(const Kernel& kernel, Buffers buffers, const void* push, std::size_t push_bytes,
+            const Use* also);
+  void touch(Buffer& b);
+
+  Context::Impl& ctx_;
+  VkCommandBuffer cmd_ = VK_NULL_HANDLE;
+  bool owns_cmd_ = false;
+  bool submitted_ = false;
+  std::unique_ptr<DescriptorArena> own_sets_;
+  DescriptorArena* sets_;
+  std::vector<Buffer*> touched_;  // host-visible buffers written, made visible at submit()
+  std::vector<std::pair<int, std::string>> passes_;
+  int queries_used_ = 0;
+  std::vector<PassTiming> timings_;
+};
+
+}  // namespace voxfield::gpu

@@ -1,0 +1,202 @@
+// The GPU compute layer on its own (a test of internals: src/gpu/kernel.h, recorder.h). Shaders are
+// reflected from their SPIR-V and checked against the C++ structures they share; generated GLSL is
+// compiled at run time and run; the recorder's derived barriers are counted for chains of known
+// hazards, with the Khronos synchronisation validation watching for any it missed.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <numeric>
+
+#include "distance_shaders.h"
+#include "gpu/recorder.h"
+#include "render_shaders.h"
+#include "shaders/layout.h"
+
+using namespace voxfield;
+using namespace voxfield::gpu;
+
+namespace {
+
+std::shared_ptr<Context> validated() {
+  static std::shared_ptr<Context> ctx = [] {
+    ContextOptions o;
+    o.validation = true;
+    return Context::create(o);
+  }();
+  return ctx;
+}
+
+#define REQUIRE_GPU()                                                            \
+  if (!built_with_vulkan() || std::getenv("VOXFIELD_SKIP_GPU_TESTS") != nullptr) \
+  GTEST_SKIP() << "no Vulkan backend wanted"
+
+// out[i] = a[i] * 2 + k: a read-only, out write-only.
+const char* kScale = R"(#version 450
+layout(local_size_x = 32) in;
+layout(std430, binding = 0) readonly buffer A { float a[]; };
+layout(std430, binding = 1) writeonly buffer Out { float o[]; };
+layout(push_constant) uniform P { float k; uint n; } p;
+void main() {
+  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
+  if (i < p.n) o[i] = a[i] * 2.0 + p.k;
+}
+)";
+
+// b[i] += 1, read-write.
+const char* kIncrement = R"(#version 450
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) buffer B { float b[]; };
+layout(push_constant) uniform P { float k; uint n; } p;
+void main() {
+  const uint i = gl_GlobalInvocationID.x;
+  if (i < p.n) b[i] += 1.0;
+}
+)";
+
+struct ScaleParams {
+  float k;
+  std::uint32_t n;
+};
+
+constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+
+}  // namespace
+
+TEST(GpuCompute, EveryShaderDeclaresWhatItsCppSideSends) {
+  REQUIRE_GPU();
+  for (const ShaderSource& s :
+       {shaders::edt_sites(), shaders::edt_lines(), shaders::edt_encode()}) {
+    const ShaderInterface i = reflect(s.name, s.spirv);
+    EXPECT_EQ(i.push_bytes, sizeof(layout::PassParams)) << s.name;
+    EXPECT_LE(i.buffers.size(), 11u) << s.name;
+    EXPECT_EQ(i.buffers.at(0), Access::kRead) << s.name << ": the header is read-only";
+    EXPECT_GT(i.invocations_per_group(), 0u);
+  }
+  EXPECT_EQ(reflect("jfa", shaders::jfa().spirv).push_bytes, sizeof(layout::JfaParams));
+  EXPECT_EQ(reflect("jfa_seed", shaders::jfa_seed().spirv).push_bytes, sizeof(layout::JfaParams));
+  const ShaderInterface fim = reflect("fim", shaders::fim().spirv);
+  EXPECT_EQ(fim.push_bytes, sizeof(layout::FimParams));
+  EXPECT_EQ(fim.buffers.size(), 2u);
+  const ShaderInterface render = reflect("render", shaders::render().spirv);
+  EXPECT_EQ(render.push_bytes, 0u);
+  EXPECT_EQ(render.buffers.size(), 8u);
+  EXPECT_EQ(render.buffers[5], Access::kWrite) << "the pixels are write-only";
+}
+
+TEST(GpuCompute, GeneratedGlslIsReflectedAndRefusedByName) {
+  REQUIRE_GPU();
+  const std::vector<std::uint32_t> spirv = compile_glsl("scale", kScale);
+  const ShaderInterface i = reflect("scale", spirv);
+  EXPECT_EQ(i.local_size, (std::array<std::uint32_t, 3>{32, 1, 1}));
+  EXPECT_EQ(i.push_bytes, 8u);
+  ASSERT_EQ(i.buffers.size(), 2u);
+  EXPECT_EQ(i.buffers[0], Access::kRead);
+  EXPECT_EQ(i.buffers[1], Access::kWrite);
+
+  try {
+    compile_glsl("broken", "#version 450\nlayout(local_size_x = 1) in;\nvoid main() { x = 1; }\n");
+    FAIL() << "a shader that does not compile was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("broken"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'x'"), std::string::npos) << e.what();
+  }
+  const std::vector<std::uint32_t> ubo = compile_glsl(
+      "ubo",
+      "#version 450\nlayout(local_size_x = 1) in;\nlayout(binding = 0) uniform U { float "
+      "v; };\nlayout(std430, binding = 1) buffer B { float b[]; };\nvoid main() { b[0] = v; }\n");
+  EXPECT_THROW(reflect("ubo", ubo), InvalidArgument);
+  const std::uint32_t garbage[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+  EXPECT_THROW(reflect("garbage", garbage), InvalidArgument);
+}
+
+TEST(GpuCompute, GeneratedKernelsRunAndAreCompiledOnce) {
+  REQUIRE_GPU();
+  auto ctx = validated();
+  Context::Impl& c = ctx->impl();
+  ctx->clear_validation_messages();
+  const std::int64_t compiles = c.kernels.glsl_compiles();
+  const Kernel& k = c.kernels.from_glsl(c.device, "scale", kScale);
+  EXPECT_EQ(&c.kernels.from_glsl(c.device, "scale", kScale), &k) << "the same text is one kernel";
+  EXPECT_EQ(c.kernels.glsl_compiles() - compiles, 1);
+
+  // 1000 values: not a multiple of the local size, so the last group's tail is masked.
+  const std::uint32_t n = 1000;
+  Buffer host_in(c, n * 4, kUsage, true), a(c, n * 4, kUsage, false), out(c, n * 4, kUsage, false);
+  Buffer host_out(c, n * 4, kUsage, true);
+  auto* in = static_cast<float*>(host_in.mapped());
+  std::iota(in, in + n, 0.0f);
+  Recorder rec(c);
+  rec.copy(host_in, 0, a, 0, n * 4);
+  rec.dispatch(k, {&a, &out}, ScaleParams{0.5f, n}, n);
+  rec.copy(out, 0, host_out, 0, n * 4);
+  rec.submit();
+  const auto* got = static_cast<const float*>(host_out.mapped());
+  for (std::uint32_t i = 0; i < n; ++i) ASSERT_EQ(got[i], 2.0f * static_cast<float>(i) + 0.5f) << i;
+  EXPECT_THROW(rec.dispatch(k, {&a, &out}, std::uint32_t{1}, n), InvalidArgument)
+      << "push constants of the wrong size";
+  const auto messages = ctx->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size() << " messages, first: " << messages.front();
+}
+
+TEST(GpuCompute, BarriersFollowTheHazardsAndNothingElse) {
+  REQUIRE_GPU();
+  auto ctx = validated();
+  Context::Impl& c = ctx->impl();
+  ctx->clear_validation_messages();
+  const Kernel& scale = c.kernels.from_glsl(c.device, "scale", kScale);
+  const Kernel& inc = c.kernels.from_glsl(c.device, "increment", kIncrement);
+  const std::uint32_t n = 256;
+  Buffer host(c, n * 4, kUsage, true), x(c, n * 4, kUsage, false), y(c, n * 4, kUsage, false),
+      z(c, n * 4, kUsage, false), back_y(c, n * 4, kUsage, true), back_z(c, n * 4, kUsage, true);
+  auto* h = static_cast<float*>(host.mapped());
+  std::iota(h, h + n, 1.0f);
+
+  const auto barriers = [&] { return ctx->counters().pipeline_barriers; };
+  Recorder rec(c);
+  std::int64_t before = barriers();
+  rec.copy(host, 0, x, 0, n * 4);
+  EXPECT_EQ(barriers() - before, 0) << "nothing came before the upload";
+  before = barriers();
+  rec.dispatch(scale, {&x, &y}, ScaleParams{0, n}, n);  // y = 2x: reads the upload
+  EXPECT_EQ(barriers() - before, 1) << "read after the transfer's write";
+  before = barriers();
+  rec.dispatch(scale, {&x, &z}, ScaleParams{1, n}, n);  // z = 2x + 1: x already visible
+  EXPECT_EQ(barriers() - before, 0) << "a second reader of x, a first writer of z";
+  before = barriers();
+  rec.dispatch(inc, {&y}, ScaleParams{0, n}, n);  // y += 1: after y's write
+  rec.dispatch(inc, {&y}, ScaleParams{0, n}, n);  // y += 1 again
+  EXPECT_EQ(barriers() - before, 2) << "each read-modify-write after the last write";
+  before = barriers();
+  rec.dispatch(scale, {&z, &x}, ScaleParams{0, n}, n);  // x = 2z: after x's readers and z's write
+  EXPECT_EQ(barriers() - before, 1) << "write after read and read after write, one barrier";
+  before = barriers();
+  rec.copy(y, 0, back_y, 0, n * 4);
+  rec.copy(x, 0, back_z, 0, n * 4);
+  EXPECT_EQ(barriers() - before, 2);
+  before = barriers();
+  rec.submit();
+  EXPECT_EQ(barriers() - before, 1) << "one barrier to the host for both read-backs";
+
+  const auto* gy = static_cast<const float*>(back_y.mapped());
+  const auto* gx = static_cast<const float*>(back_z.mapped());
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const float v = static_cast<float>(i + 1);
+    ASSERT_EQ(gy[i], 2 * v + 2) << i;
+    ASSERT_EQ(gx[i], 2 * (2 * v + 1)) << i;
+  }
+
+  // A later submission that reads what an earlier one wrote is ordered after it.
+  Recorder again(c);
+  before = barriers();
+  again.dispatch(inc, {&x}, ScaleParams{0, n}, n);
+  EXPECT_EQ(barriers() - before, 1);
+  again.copy(x, 0, back_z, 0, n * 4);
+  again.submit();
+  for (std::uint32_t i = 0; i < n; ++i)
+    ASSERT_EQ(gx[i], 2 * (2 * static_cast<float>(i + 1) + 1) + 1) << i;
+  const auto messages = ctx->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size() << " messages, first: " << messages.front();
+}
