@@ -249,16 +249,27 @@ void Recorder::dispatch_indirect(const Kernel& kernel, Buffers buffers, const vo
 }
 
 void Recorder::copy(Buffer& src, Buffer& dst, std::span<const VkBufferCopy> regions) {
-  if (regions.empty()) return;
-  const Use uses[2] = {{&src, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT},
-                       {&dst, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT}};
+  copy({Copy{&src, &dst, regions}});
+}
+
+void Recorder::copy(std::initializer_list<Copy> copies) {
+  std::vector<Use> uses;
+  for (const Copy& c : copies)
+    if (!c.regions.empty()) {
+      uses.push_back({c.src, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT});
+      uses.push_back({c.dst, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT});
+    }
+  if (uses.empty()) return;
   prepare(uses);
-  vkCmdCopyBuffer(cmd_, src.handle(), dst.handle(), static_cast<std::uint32_t>(regions.size()),
-                  regions.data());
-  std::int64_t bytes = 0;
-  for (const VkBufferCopy& r : regions) bytes += static_cast<std::int64_t>(r.size);
-  if (src.mapped() && !dst.mapped()) ctx_.counters.bytes_uploaded += bytes;
-  if (dst.mapped() && !src.mapped()) ctx_.counters.bytes_downloaded += bytes;
+  for (const Copy& c : copies) {
+    if (c.regions.empty()) continue;
+    vkCmdCopyBuffer(cmd_, c.src->handle(), c.dst->handle(),
+                    static_cast<std::uint32_t>(c.regions.size()), c.regions.data());
+    std::int64_t bytes = 0;
+    for (const VkBufferCopy& r : c.regions) bytes += static_cast<std::int64_t>(r.size);
+    if (c.src->mapped() && !c.dst->mapped()) ctx_.counters.bytes_uploaded += bytes;
+    if (c.dst->mapped() && !c.src->mapped()) ctx_.counters.bytes_downloaded += bytes;
+  }
 }
 
 void Recorder::copy(Buffer& src, VkDeviceSize src_offset, Buffer& dst, VkDeviceSize dst_offset,

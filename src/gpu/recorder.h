@@ -94,6 +94,15 @@ class Recorder {
   }
 
   void copy(Buffer& src, Buffer& dst, std::span<const VkBufferCopy> regions);
+  // Copies recorded as one step, behind one barrier: the uploads of an update, the read-backs of
+  // a result. The caller guarantees they are independent: no two write overlapping bytes, and no
+  // buffer one of them writes is read by another.
+  struct Copy {
+    Buffer* src;
+    Buffer* dst;
+    std::span<const VkBufferCopy> regions;
+  };
+  void copy(std::initializer_list<Copy> copies);
   void copy(Buffer& src, VkDeviceSize src_offset, Buffer& dst, VkDeviceSize dst_offset,
             VkDeviceSize bytes);
   // Writes `bytes` (at most 65536, a multiple of 4) into `dst` from the command buffer itself.

@@ -247,10 +247,14 @@ class FieldEngine {
   // page entries and bricks. (The recorder orders them after the previous submission's passes,
   // which read the buffers they overwrite.)
   void record_transfers(Recorder& rec, Buffer& upload, Uploads& uploads) {
+    // A grown pool's old bricks first: changed chunks may be written over them.
     if (uploads.old_pool) rec.copy(*uploads.old_pool, 0, bricks_buf_, 0, uploads.old_pool_bytes);
-    if (first_run_) rec.copy(upload, header_buf_, {&header_copy_, 1});
-    rec.copy(upload, pages_buf_, uploads.page_copies);
-    rec.copy(upload, bricks_buf_, uploads.brick_copies);
+    const std::span<const VkBufferCopy> header =
+        first_run_ ? std::span<const VkBufferCopy>(&header_copy_, 1)
+                   : std::span<const VkBufferCopy>();
+    rec.copy({{&upload, &header_buf_, header},
+              {&upload, &pages_buf_, uploads.page_copies},
+              {&upload, &bricks_buf_, uploads.brick_copies}});
     first_run_ = false;
   }
 
@@ -302,8 +306,10 @@ class FieldEngine {
 
   // Step 4, read-back (when asked): the field and its sites into `readback`.
   void record_readback(Recorder& rec, Buffer& readback) {
-    rec.copy(field_buf_, 0, readback, 0, field_bytes_);
-    rec.copy(field_sites_buf_, 0, readback, field_bytes_, site_bytes_);
+    const VkBufferCopy field{0, 0, field_bytes_}, sites{0, field_bytes_, site_bytes_};
+    rec.copy({{&field_buf_, &readback, {&field, 1}},
+              {&field_sites_buf_, &readback,
+               site_bytes_ > 0 ? std::span(&sites, 1) : std::span<const VkBufferCopy>()}});
   }
 
   void make_header() {

@@ -195,8 +195,8 @@ detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p,
   fp.eps = p.metric == Metric::kEuclidean ? 1e-5f : 0.0f;  // the CPU's tolerance
   Recorder rec(ctx);
   const int timed = timings ? rec.begin_pass() : -1;
-  rec.copy(upload, 0, data, 0, half);
-  rec.copy(upload, half, control, 0, kControlBytes);
+  const VkBufferCopy in{0, 0, half}, in_control{half, 0, kControlBytes};
+  rec.copy({{&upload, &data, {&in, 1}}, {&upload, &control, {&in_control, 1}}});
   std::uint32_t src = 0;
   for (std::uint32_t k = 0; k < passes; ++k) {
     fp.size.w = L::VF_FIM_UPDATE;
@@ -210,8 +210,8 @@ detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p,
   fp.size.w = L::VF_FIM_RESOLVE;
   rec.dispatch(fim, {&data, &control}, fp, n);
   rec.end_pass(timed, "fim");
-  rec.copy(data, 0, readback, 0, half);
-  rec.copy(control, 0, readback, half, kControlBytes);
+  const VkBufferCopy out{0, 0, half}, out_control{0, half, kControlBytes};
+  rec.copy({{&data, &readback, {&out, 1}}, {&control, &readback, {&out_control, 1}}});
   rec.submit();
   std::uint32_t words[8];
   std::memcpy(words, static_cast<const std::uint8_t*>(readback.mapped()) + half, sizeof words);

@@ -63,7 +63,10 @@ void check_options(const RenderScene::Impl& s, const RenderOptions& o) {
 // The GPU copy of a RenderScene and the buffers a frame writes.
 class ResidentScene {
  public:
-  explicit ResidentScene(Context::Impl& ctx) : ctx_(ctx), sets_(ctx) {}
+  // The ray marcher's kernel is made with the scene (on first use in the process), not inside
+  // the first frame.
+  explicit ResidentScene(Context::Impl& ctx)
+      : ctx_(ctx), kernel_(ctx.kernel(shaders::render())), sets_(ctx) {}
   ResidentScene(const ResidentScene&) = delete;
   ResidentScene& operator=(const ResidentScene&) = delete;
 
@@ -95,6 +98,7 @@ class ResidentScene {
   void record_approximation(Recorder& rec, Algorithm algorithm);
 
   Context::Impl& ctx_;
+  const Kernel& kernel_;
   const RenderScene::Impl* scene_ = nullptr;
   std::uint64_t scene_id_ = 0;
   std::vector<std::uint64_t> synced_generation_;
@@ -121,7 +125,6 @@ constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
 // Copy regions into one destination buffer, staged contiguously.
 struct Staged {
   std::vector<VkBufferCopy> regions;
-  std::int64_t bytes = 0;
 };
 
 }  // namespace
@@ -189,7 +192,6 @@ bool ResidentScene::record_sync(Recorder& rec, const RenderScene& scene) {
     if (n == 0) return;
     std::memcpy(base + at, data, n);
     into.regions.push_back({at, dst, n});
-    into.bytes += static_cast<std::int64_t>(n);
     at += n;
   };
   Staged palette_copy, info_copy, skip_copy, light_copy;
@@ -227,11 +229,10 @@ bool ResidentScene::record_sync(Recorder& rec, const RenderScene& scene) {
       }
     }
   }
-  const std::pair<Staged*, Buffer*> copies[4] = {{&palette_copy, &palette_},
-                                                 {&info_copy, &info_},
-                                                 {&skip_copy, &skip_},
-                                                 {&light_copy, &light_}};
-  for (const auto& [staged, dst] : copies) rec.copy(upload, *dst, staged->regions);
+  rec.copy({{&upload, &palette_, palette_copy.regions},
+            {&upload, &info_, info_copy.regions},
+            {&upload, &skip_, skip_copy.regions},
+            {&upload, &light_, light_copy.regions}});
   scene_ = &s;
   scene_id_ = s.id;
   synced_generation_ = s.chunk_generation;
@@ -273,8 +274,10 @@ void ResidentScene::record_approximation(Recorder& rec, Algorithm algorithm) {
   auto* base = static_cast<std::uint8_t*>(approx_staging_.mapped());
   std::memcpy(base, info.data(), info_bytes);
   if (arena_bytes > 0) std::memcpy(base + info_bytes, approx.cells.arena.data(), arena_bytes);
-  rec.copy(approx_staging_, 0, approx_info_, 0, info_bytes);
-  rec.copy(approx_staging_, info_bytes, approx_arena_, 0, arena_bytes);
+  const VkBufferCopy to_info{0, 0, info_bytes}, to_arena{info_bytes, 0, arena_bytes};
+  rec.copy({{&approx_staging_, &approx_info_, {&to_info, 1}},
+            {&approx_staging_, &approx_arena_,
+             arena_bytes > 0 ? std::span(&to_arena, 1) : std::span<const VkBufferCopy>()}});
   approx_scene_ = s.id;
   approx_generation_ = s.generation;
   approx_algorithm_ = static_cast<int>(algorithm);
@@ -332,8 +335,7 @@ void ResidentScene::record_render(Recorder& rec, const Camera& camera, const Ren
   Buffer* const bound[] = {&params_,  &info_,   &skip_,        &light_,
                            &palette_, &pixels_, &approx_info_, &approx_arena_};
   const int pass = timed ? rec.begin_pass() : -1;
-  rec.dispatch(ctx_.kernel(shaders::render()), bound, nullptr, 0,
-               static_cast<std::uint64_t>(o.width) * o.height);
+  rec.dispatch(kernel_, bound, nullptr, 0, static_cast<std::uint64_t>(o.width) * o.height);
   rec.end_pass(pass, "render");
 }
 
