@@ -7,6 +7,7 @@
 # second instead of thousands (the large files are parsed whole by the unit tests). New inputs libFuzzer finds go to a scratch corpus, not into the repository; a
 # crash stops the run with the harness's report and the crashing input under $FUZZ_OUT.
 # Usage: bash fuzz/run.sh [SECONDS] [HARNESS...]   (needs build/fuzz and build/release/bin/voxfield)
+# FUZZ_JOBS=N runs N harnesses at once (one per core for CI's smoke);
 # FUZZ_RUNS=N stops each harness after N executions instead (with SECONDS still the cap);
 # FUZZ_TIMEOUT=S sets the per-input time-out (default 20 s; a campaign at nice 19 beside a build
 # needs more: a starved process is not a slow input).
@@ -31,7 +32,9 @@ for m in ephtracy_chr_cat ephtracy_chr_knight mmmm_chr_mayor vengi_robo ephtracy
   done
 done
 
-for h in $harnesses; do
+# One harness: its seeds, its scratch corpus, its log; a finding prints the log's tail and fails.
+run_one() {
+  local h=$1 dirs max_len work runs started
   case $h in
     vox) dirs="$seeds/vox"; max_len=$max_seed ;;
     npy) dirs="$seeds/npy"; max_len=$max_seed ;;
@@ -41,7 +44,7 @@ for h in $harnesses; do
     vector_sources) dirs="fuzz/seeds/vector_sources"; max_len=4096 ;;
     csg_model) dirs="fuzz/seeds/csg"; max_len=4096 ;;
     openscad) dirs="fuzz/seeds/openscad"; max_len=4096 ;;
-    *) echo "unknown harness $h" >&2; exit 2 ;;
+    *) echo "unknown harness $h" >&2; return 2 ;;
   esac
   work="$out/corpus-$h"; mkdir -p "$work"
   echo "=== fuzz_$h: ${seconds}s ==="
@@ -49,7 +52,22 @@ for h in $harnesses; do
   started=$SECONDS
   "$bin/fuzz_$h" -max_total_time="$seconds" $runs -max_len="$max_len" -timeout="${FUZZ_TIMEOUT:-20}" -rss_limit_mb=2560 \
       -artifact_prefix="$out/crash-$h-" -print_final_stats=1 "$work" $dirs 2>"$out/log-$h.txt" || {
-    echo "fuzz_$h FAILED; its log:" >&2; tail -60 "$out/log-$h.txt" >&2; exit 1; }
+    echo "fuzz_$h FAILED; its log:" >&2; tail -60 "$out/log-$h.txt" >&2; return 1; }
   grep -E "stat::number_of_executed_units|stat::peak_rss_mb|cov: " "$out/log-$h.txt" | tail -3
   echo "fuzz_$h: $((SECONDS - started)) s"
+}
+
+# FUZZ_JOBS harnesses at a time (default 1; CI's smoke runs one per core), each report printed
+# whole; each job leaves its exit status in a file, so none is lost however fast it ends.
+jobs_max=${FUZZ_JOBS:-1}
+for h in $harnesses; do
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs_max" ]; do sleep 0.2; done
+  ( set +e; run_one "$h"; echo $? >"$out/status-$h" ) >"$out/report-$h.txt" 2>&1 &
 done
+wait
+failed=0
+for h in $harnesses; do
+  cat "$out/report-$h.txt"
+  [ "$(cat "$out/status-$h" 2>/dev/null)" = 0 ] || failed=1
+done
+exit $failed

@@ -3,7 +3,7 @@
 # layering check and the installed-package consumer), then the build without any GPU dependency
 # (cpu-only), then the same suite under AddressSanitizer + UndefinedBehaviorSanitizer (the parsers
 # face untrusted files), then the concurrency tests under ThreadSanitizer, then every libFuzzer
-# harness for a short smoke on its seeds (a parser regression fails CI).
+# harness for a short smoke on its seeds, one per core (a parser regression fails CI).
 # Set VOXFIELD_TEST_PRESETS to choose, e.g. VOXFIELD_TEST_PRESETS=release; VOXFIELD_FUZZ_SECONDS
 # sets the smoke's length per harness (0 skips it). Each phase prints its wall time.
 set -euo pipefail
@@ -11,7 +11,8 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 phase_start=$SECONDS
 phase_done() { echo "=== $1: $((SECONDS - phase_start)) s ==="; phase_start=$SECONDS; }
-presets=${VOXFIELD_TEST_PRESETS:-"release cpu-only asan-ubsan tsan"}
+# cpu-only-ci is the cpu-only preset at -O1 (what CI checks there does not depend on optimisation).
+presets=${VOXFIELD_TEST_PRESETS:-"release cpu-only-ci asan-ubsan tsan"}
 for preset in $presets; do
   echo "=== voxfield tests: $preset ==="
   cmake --preset "$preset" >/dev/null
@@ -27,6 +28,6 @@ if [ "$fuzz_seconds" -gt 0 ]; then
   cmake --preset fuzz >/dev/null
   cmake --build --preset fuzz
   phase_done "fuzz build"
-  bash fuzz/run.sh "$fuzz_seconds"
+  FUZZ_JOBS=$(nproc) bash fuzz/run.sh "$fuzz_seconds"
   phase_done "fuzz smoke"
 fi
