@@ -8,11 +8,13 @@
 #include <random>
 #include <tuple>
 
+#include "backends.h"
 #include "distance/truncated_min_convolution.h"
 #include "voxfield/distance.h"
 #include "voxfield/parallel.h"
 
 using namespace voxfield;
+using namespace voxfield::testing_backends;
 
 namespace {
 
@@ -144,9 +146,13 @@ std::string describe(const Case& c) {
          std::to_string(c.threads) + (c.sites ? " with sites" : "");
 }
 
-// Builds a random bounded world, runs the field and compares every voxel and site with the oracle.
-void check_case(const Case& c, std::uint32_t seed, Vec3i size, double density) {
-  SCOPED_TRACE(describe(c) + " seed " + std::to_string(seed));
+// Builds a random bounded world, runs the field on `backend` and compares every voxel and site
+// with the oracle. The Vulkan backend takes unit spacing only (other cases are left out there).
+void check_case(Backend backend, const Case& c, std::uint32_t seed, Vec3i size, double density) {
+  const bool unit = c.spacing == std::array<double, 3>{1, 1, 1};
+  if (backend == Backend::kVulkan && !unit) return;
+  SCOPED_TRACE(std::string(backend_name(backend)) + " " + describe(c) + " seed " +
+               std::to_string(seed));
   std::mt19937 rng(seed);
   const Box3i bounds{{-5, 3, -9}, Vec3i{-5, 3, -9} + size};
   World w(c.chunk_edge, bounds);
@@ -167,10 +173,9 @@ void check_case(const Case& c, std::uint32_t seed, Vec3i size, double density) {
   o.nearest_sites = c.sites;
   std::optional<ThreadLimit> limit;
   limit.emplace(c.threads);
-  const DistanceField f = compute_distance_field(w, o);
+  const DistanceField f = exact_field(backend, w, o);
   ASSERT_EQ(f.domain, bounds);
   const auto expect = oracle(solid, bounds, o);
-  const bool unit = c.spacing == std::array<double, 3>{1, 1, 1};
   const double clamp = c.clamp > 0 ? c.clamp : std::numeric_limits<double>::infinity();
   int reported = 0;
   i = 0;
@@ -182,9 +187,13 @@ void check_case(const Case& c, std::uint32_t seed, Vec3i size, double density) {
         const double want = expected_stored(r, solid[i], o, f);
         const double got = stored_at(f, p);
         // Anisotropic Euclidean sums squares in another order than the oracle: allow rounding
-        // (relative 1e-6 on the f32 value; one fixed-point step for integer storage).
+        // (relative 1e-6 on the f32 value; one fixed-point step for integer storage). The GPU's
+        // square root may differ by a few ulps (gpu::kF32Tolerance).
+        const bool gpu_f32 = backend == Backend::kVulkan && c.storage == Storage::kF32;
         const double tol =
-            unit ? 0.0 : (c.storage == Storage::kF32 ? 1e-6 * std::max(1.0, std::abs(want)) : 1.0);
+            gpu_f32 ? gpu::kF32Tolerance * std::max(1.0, std::abs(want))
+            : unit  ? 0.0
+                    : (c.storage == Storage::kF32 ? 1e-6 * std::max(1.0, std::abs(want)) : 1.0);
         if (!(std::abs(got - want) <= tol) &&
             !(std::isinf(got) && std::isinf(want) && got == want)) {
           if (reported++ < 5)
@@ -225,7 +234,16 @@ void check_case(const Case& c, std::uint32_t seed, Vec3i size, double density) {
 
 }  // namespace
 
-TEST(ExactDistance, RandomWorldsAgainstBruteForce) {
+class ExactDistanceOn : public ::testing::TestWithParam<Backend> {};
+INSTANTIATE_TEST_SUITE_P(Backends, ExactDistanceOn,
+                         ::testing::Values(Backend::kCpu, Backend::kVulkan), backend_test_name);
+
+TEST_P(ExactDistanceOn, RandomWorldsAgainstBruteForce) {
+  const Backend b = GetParam();
+  VOXFIELD_SKIP_UNLESS_BACKEND(b);
+  const auto check_case = [b](const Case& c, std::uint32_t seed, Vec3i size, double density) {
+    ::check_case(b, c, seed, size, density);
+  };
   const std::array<double, 3> unit{1, 1, 1}, aniso{0.5, 1.25, 2.0};
   std::uint32_t seed = 1;
   for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
@@ -272,6 +290,7 @@ TEST(ExactDistance, RandomWorldsAgainstBruteForce) {
                  density);
       ++seed;
     }
+  expect_no_validation_messages(b);
 }
 
 TEST(ExactDistance, IdenticalForEveryChunkEdgeAndThreadCount) {

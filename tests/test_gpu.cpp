@@ -1,7 +1,10 @@
-// The Vulkan backend against the CPU: the same test bodies on both backends. Integer fields must
-// be bit-identical, f32 fields within gpu::kF32Tolerance; sizes that are not multiples of the
-// workgroup or the chunk edge; the Khronos validation layer (with synchronisation validation) on,
-// and not a single message from it. In CI this runs on Mesa's lavapipe.
+// The Vulkan backend's own checks: GPU against CPU field for field and frame for frame, the API
+// traffic each operation costs (submits, fence waits, bytes), resident scenes, adopted devices,
+// refusals. The behaviour suites themselves have one body run on both backends (tests/backends.h:
+// the brute-force sweep in test_distance.cpp, the incremental stream in test_edit.cpp). Integer
+// fields must be bit-identical, f32 fields within gpu::kF32Tolerance; sizes that are not multiples
+// of the workgroup or the chunk edge; the Khronos validation layer (with synchronisation
+// validation) on, and not a single message from it. In CI this runs on Mesa's lavapipe.
 #include <gtest/gtest.h>
 
 #include <dlfcn.h>
@@ -11,6 +14,7 @@
 #include <cstdlib>
 #include <random>
 
+#include "backends.h"
 #include "image_compare.h"
 #include "voxfield/edit.h"
 #include "voxfield/gpu_distance.h"
@@ -22,12 +26,7 @@ using namespace voxfield;
 namespace {
 
 std::shared_ptr<gpu::Context> validated_context() {
-  static std::shared_ptr<gpu::Context> ctx = [] {
-    gpu::ContextOptions o;
-    o.validation = true;
-    return gpu::Context::create(o);
-  }();
-  return ctx;
+  return testing_backends::vulkan_context();
 }
 
 bool gpu_tests_wanted() {

@@ -1,0 +1,74 @@
+// One test body per behaviour, run on each backend (the CPU, and Vulkan where this build has it):
+// the parameter of the TEST_P suites that check distance fields, the algorithm family and the
+// incremental field on both. The Vulkan instances run on one shared context with the Khronos
+// validation layer (synchronisation validation included), and fail on any message from it.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include "voxfield/gpu.h"
+#include "voxfield/gpu_distance.h"
+
+namespace voxfield::testing_backends {
+
+inline std::shared_ptr<gpu::Context> vulkan_context() {
+  static std::shared_ptr<gpu::Context> ctx = [] {
+    gpu::ContextOptions o;
+    o.validation = true;
+    return gpu::Context::create(o);
+  }();
+  return ctx;
+}
+
+// Skips a Vulkan instance on a build without the backend or when VOXFIELD_SKIP_GPU_TESTS is set.
+#define VOXFIELD_SKIP_UNLESS_BACKEND(b)                                                     \
+  if ((b) == ::voxfield::Backend::kVulkan &&                                                \
+      (!::voxfield::gpu::built_with_vulkan() || std::getenv("VOXFIELD_SKIP_GPU_TESTS"))) \
+  GTEST_SKIP() << "no Vulkan backend in this build (or VOXFIELD_SKIP_GPU_TESTS)"
+
+inline std::string backend_test_name(const ::testing::TestParamInfo<Backend>& info) {
+  return backend_name(info.param);
+}
+
+// The exact field on `backend`.
+inline DistanceField exact_field(Backend backend, const World& world,
+                                 const DistanceOptions& options) {
+  if (backend == Backend::kVulkan)
+    return gpu::compute_distance_field(*vulkan_context(), world, options);
+  return compute_distance_field(world, options);
+}
+
+// The incremental field on `backend`, behind the one interface both halves share.
+class IncrementalField {
+ public:
+  IncrementalField(Backend backend, const World& world, const DistanceOptions& options) {
+    if (backend == Backend::kVulkan)
+      gpu_ = std::make_unique<gpu::DynamicField>(vulkan_context(), world, options);
+    else
+      cpu_ = std::make_unique<DynamicDistanceField>(world, options);
+  }
+  DynamicDistanceField::UpdateStats update(const DirtyRegions& dirty) {
+    return gpu_ ? gpu_->update(dirty) : cpu_->update(dirty);
+  }
+  DistanceField field() { return gpu_ ? gpu_->download() : cpu_->field(); }
+  const DistanceOptions& options() const { return gpu_ ? gpu_->options() : cpu_->options(); }
+
+ private:
+  std::unique_ptr<DynamicDistanceField> cpu_;
+  std::unique_ptr<gpu::DynamicField> gpu_;
+};
+
+// Fails the current test if the validation layer reported anything since the last call.
+inline void expect_no_validation_messages(Backend backend) {
+  if (backend != Backend::kVulkan) return;
+  const auto messages = vulkan_context()->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: "
+                                << messages.front();
+  vulkan_context()->clear_validation_messages();
+}
+
+}  // namespace voxfield::testing_backends
