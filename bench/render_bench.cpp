@@ -91,6 +91,7 @@ int main(int argc, char** argv) {
       o.soft_shadows = c.shadows;
       RenderStats st;
       bench::Timing t;
+      std::uint64_t frame_hash = 0;  // the frame, pinned beside its time (none when tracing only)
       if (c.trace_only) {
         // The primary rays alone, traced over rows in parallel, no shading and no image.
         const auto proj = cam.projector(w, h);
@@ -107,27 +108,31 @@ int main(int argc, char** argv) {
         });
         for (const auto& r : rows) st.primary.add(r);
       } else {
-        t = bench::time_runs(runs, [&] { render(scene, cam, o, &st); });
+        Image frame;
+        t = bench::time_runs(runs, [&] { frame = render(scene, cam, o, &st); });
+        frame_hash = content_hash(frame);
       }
       const double rays = static_cast<double>(w) * h;
       const double mrays = rays / (t.median_ms * 1e3);
       std::printf("%-10s  %-42s %7.1f %8.2f %10.2f %10.2f\n", res.c_str(), c.name.c_str(),
                   t.median_ms, mrays, st.primary.steps / rays, st.primary.voxel_reads / rays);
       if (!json_path.empty()) {
-        nlohmann::json j{{"size", size},
-                         {"resolution", res},
-                         {"config", c.name},
-                         {"metric", metric_name(c.metric)},
-                         {"skip", skip_mode_name(c.skip)},
-                         {"ms", t.median_ms},
-                         {"min_ms", t.min_ms},
-                         {"max_ms", t.max_ms},
-                         {"mrays_per_s", mrays},
-                         {"threads", max_threads()},
-                         {"steps_per_ray", st.primary.steps / rays},
-                         {"reads_per_ray", st.primary.voxel_reads / rays},
-                         {"shadow_rays", st.shadow.rays},
-                         {"field_ms", field_ms[static_cast<int>(c.metric)]}};
+        nlohmann::json j{
+            {"size", size},
+            {"resolution", res},
+            {"config", c.name},
+            {"metric", metric_name(c.metric)},
+            {"skip", skip_mode_name(c.skip)},
+            {"ms", t.median_ms},
+            {"min_ms", t.min_ms},
+            {"max_ms", t.max_ms},
+            {"mrays_per_s", mrays},
+            {"threads", max_threads()},
+            {"steps_per_ray", st.primary.steps / rays},
+            {"reads_per_ray", st.primary.voxel_reads / rays},
+            {"shadow_rays", st.shadow.rays},
+            {"field_ms", field_ms[static_cast<int>(c.metric)]},
+            {"image_hash", frame_hash ? nlohmann::json(frame_hash) : nlohmann::json()}};
         std::ofstream(json_path, std::ios::app) << j.dump() << "\n";
       }
     }

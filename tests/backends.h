@@ -25,8 +25,8 @@ inline std::shared_ptr<gpu::Context> vulkan_context() {
 }
 
 // Skips a Vulkan instance on a build without the backend or when VOXFIELD_SKIP_GPU_TESTS is set.
-#define VOXFIELD_SKIP_UNLESS_BACKEND(b)                                                     \
-  if ((b) == ::voxfield::Backend::kVulkan &&                                                \
+#define VOXFIELD_SKIP_UNLESS_BACKEND(b)                                                  \
+  if ((b) == ::voxfield::Backend::kVulkan &&                                             \
       (!::voxfield::gpu::built_with_vulkan() || std::getenv("VOXFIELD_SKIP_GPU_TESTS"))) \
   GTEST_SKIP() << "no Vulkan backend in this build (or VOXFIELD_SKIP_GPU_TESTS)"
 
@@ -66,8 +66,8 @@ class IncrementalField {
 inline void expect_no_validation_messages(Backend backend) {
   if (backend != Backend::kVulkan) return;
   const auto messages = vulkan_context()->validation_messages();
-  EXPECT_TRUE(messages.empty()) << messages.size() << " validation messages, first: "
-                                << messages.front();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
   vulkan_context()->clear_validation_messages();
 }
 

@@ -11,6 +11,7 @@
 #include "backends.h"
 #include "distance/truncated_min_convolution.h"
 #include "voxfield/distance.h"
+#include "voxfield/image.h"
 #include "voxfield/parallel.h"
 
 using namespace voxfield;
@@ -497,4 +498,42 @@ TEST(TruncatedMinConvolution, EqualsTheClampedTwoDimensionalTransform) {
       }
   }
   EXPECT_GT(checked, 20000);
+}
+
+TEST(ExactDistance, ContentHashesPinResultsWhateverTheChunkEdge) {
+  // The same field computed on grids of different chunk edges hashes the same; one changed value,
+  // one changed site or another domain does not.
+  const Box3i bounds{{-3, 0, 2}, {30, 21, 17}};
+  std::uint64_t first = 0;
+  for (int edge : {8, 16, 32}) {
+    World w(edge, bounds);
+    std::mt19937 place(5);
+    for (int i = 0; i < 60; ++i)
+      w.voxels.set({bounds.begin.x + static_cast<int>(place() % 33), static_cast<int>(place() % 21),
+                    2 + static_cast<int>(place() % 15)},
+                   1);
+    DistanceOptions o;
+    o.metric = Metric::kEuclidean;
+    o.nearest_sites = true;
+    DistanceField f = compute_distance_field(w, o);
+    const std::uint64_t h = content_hash(f);
+    if (edge == 8) first = h;
+    EXPECT_EQ(h, first) << "edge " << edge;
+    if (edge != 32) continue;
+    const Vec3i p{4, 5, 6};
+    DistanceField changed = f;
+    std::get<Grid<float>>(changed.values).set(p, std::get<Grid<float>>(f.values).get(p) + 1);
+    EXPECT_NE(content_hash(changed), h);
+    DistanceField moved_site = f;
+    moved_site.sites->set(p, SiteOffset{1, 2, 3});
+    EXPECT_NE(content_hash(moved_site), h);
+    DistanceField other_domain = f;
+    other_domain.domain.end.x -= 1;
+    EXPECT_NE(content_hash(other_domain), h);
+  }
+  Image a(4, 3), b(4, 3), c(3, 4);
+  EXPECT_EQ(content_hash(a), content_hash(b));
+  b.pixel(2, 1)[1] = 9;
+  EXPECT_NE(content_hash(a), content_hash(b));
+  EXPECT_NE(content_hash(a), content_hash(c)) << "the same bytes in another shape";
 }

@@ -60,4 +60,7 @@ Vec3i parse_size(const std::vector<int>& values);
 // Milliseconds since `start`, for timing reports.
 double ms_since(std::chrono::steady_clock::time_point start);
 
+// A content hash (hash.h) as 16 hex digits, for stats files: results can be pinned beside times.
+std::string hash_hex(std::uint64_t hash);
+
 }  // namespace voxfield::cli

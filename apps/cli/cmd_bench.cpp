@@ -198,6 +198,7 @@ int run_bench_edits(const BenchEditsSettings& s) {
          {"world_bytes_per_voxel", world_bytes / voxels},
          {"field_bytes_per_voxel", field_bytes / voxels},
          {"within_interval", within},
+         {"field_hash", hash_hex(content_hash(field.field()))},  // after the last edit
          {"backend", field.on_gpu() ? "vulkan" : "cpu"},
          {"gpu", gpu_stats},
          {"verify_mismatches", s.verify ? nlohmann::json(mismatches) : nlohmann::json(nullptr)}});

@@ -76,6 +76,7 @@ int run_field(const FieldSettings& s) {
                           {"mvox_per_s", static_cast<double>(f.domain.volume()) / (stats.ms * 1e3)},
                           {"passes", stats.passes},
                           {"iterations", stats.iterations},
+                          {"field_hash", hash_hex(content_hash(f))},
                           {"peak_rss_mb", static_cast<double>(peak_rss_bytes()) / 1048576.0}});
   j["backend"] = gpu_context ? "vulkan" : "cpu";
   if (gpu_context) {

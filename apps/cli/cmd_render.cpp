@@ -88,6 +88,7 @@ int run_render(const RenderSettings& s) {
     };
     nlohmann::json j{{"input", s.in},
                      {"ms", st.ms},
+                     {"image_hash", hash_hex(content_hash(image))},
                      {"width", st.width},
                      {"height", st.height},
                      {"view", s.view},

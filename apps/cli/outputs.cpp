@@ -1,6 +1,7 @@
 // voxfield CLI — outputs checked first, written all or nothing (outputs.h), and small helpers.
 #include "outputs.h"
 
+#include <cstdio>
 #include <filesystem>
 
 #include "cli.h"
@@ -48,6 +49,12 @@ void Outputs::expect_world(const std::string& path, const std::string& option, b
 void Outputs::stage_json(const std::string& path, const nlohmann::json& j) {
   if (path.empty()) return;  // not asked for
   tx_.stage(path, std::string_view(j.dump(2) + "\n"));
+}
+
+std::string hash_hex(std::uint64_t hash) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+  return text;
 }
 
 double ms_since(std::chrono::steady_clock::time_point start) {

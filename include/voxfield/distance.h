@@ -93,6 +93,11 @@ struct DistanceField {
   int chunk_edge() const;
 };
 
+// FNV-1a (64-bit) of the domain, the encoding, the stored values over the domain (x fastest) and
+// the nearest sites when present: the same field hashes the same on every machine whatever its
+// chunk edge, so benchmarks print it beside their times and results can be pinned.
+std::uint64_t content_hash(const DistanceField& field);
+
 // Computes the exact field of `world` (solid = material != 0). Throws InvalidArgument for options
 // out of range (negative clamp, spacing <= 0, spacing with a non-Euclidean metric, a domain whose
 // nearest-site offsets would not fit 16 bits, a spacing too fine for integer storage).

@@ -24,4 +24,7 @@ struct Image {
   }
 };
 
+// FNV-1a (hash.h) of the size and the pixels: benchmarks print it beside their times.
+std::uint64_t content_hash(const Image& image);
+
 }  // namespace voxfield

@@ -5,6 +5,7 @@
 #include <variant>
 
 #include "voxfield/distance.h"
+#include "voxfield/hash.h"
 
 namespace voxfield {
 
@@ -47,6 +48,42 @@ Storage parse_storage(const std::string& name) {
 double DistanceField::distance(Vec3i p) const {
   return std::visit([&](const auto& g) { return encoding.decode(static_cast<double>(g.get(p))); },
                     values);
+}
+
+std::uint64_t content_hash(const DistanceField& f) {
+  const std::int32_t box[6] = {f.domain.begin.x, f.domain.begin.y, f.domain.begin.z,
+                               f.domain.end.x,   f.domain.end.y,   f.domain.end.z};
+  std::uint64_t h = fnv1a(kFnvOffset, box, sizeof box);
+  const double encoding[2] = {f.encoding.scale, static_cast<double>(f.encoding.bias)};
+  h = fnv1a(h, encoding, sizeof encoding);
+  if (f.domain.empty()) return h;
+  // Slab by slab along z, so a large field is never copied whole.
+  const Vec3i n = f.domain.size();
+  std::visit(
+      [&](const auto& g) {
+        using T = typename std::decay_t<decltype(g)>::value_type;
+        std::vector<T> slab(static_cast<std::size_t>(n.x) * n.y);
+        for (int z = f.domain.begin.z; z < f.domain.end.z; ++z) {
+          g.copy_to_dense(Box3i{{f.domain.begin.x, f.domain.begin.y, z},
+                                {f.domain.end.x, f.domain.end.y, z + 1}},
+                          slab.data());
+          h = fnv1a(h, slab.data(), slab.size() * sizeof(T));
+        }
+      },
+      f.values);
+  if (f.sites) {
+    std::vector<SiteOffset> slab(static_cast<std::size_t>(n.x) * n.y);
+    for (int z = f.domain.begin.z; z < f.domain.end.z; ++z) {
+      f.sites->copy_to_dense(
+          Box3i{{f.domain.begin.x, f.domain.begin.y, z}, {f.domain.end.x, f.domain.end.y, z + 1}},
+          slab.data());
+      for (const SiteOffset& s : slab) {
+        const std::int16_t d[3] = {s.dx, s.dy, s.dz};  // the offsets, never the padding
+        h = fnv1a(h, d, sizeof d);
+      }
+    }
+  }
+  return h;
 }
 
 int DistanceField::chunk_edge() const {
