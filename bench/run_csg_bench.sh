@@ -31,21 +31,25 @@ for m in "${models[@]}"; do
   $B csg "$m" --facets render --threads "$threads" --whole -o "$out/$n-whole.png" --stats "$out/$n-render-whole.json" 2>/dev/null
   $B csg "$m" --facets render --threads "$threads" --view variants -o "$out/$n-variants.png" 2>/dev/null
   rm "$out/$n-whole.png"
+  # Each variant's evaluation kernel to SPIR-V in-process (glslang), on worker threads.
+  $B csg "$m" --facets compile --depth 7 --spirv -o "$out/$n-compiled" --stats "$out/$n-compile.json" 2>/dev/null
+  rm -r "$out/$n-compiled"  # the figures are in the JSON
 done
 rm -f "$out/example024.csg"  # OpenSCAD's own example, exported for the run
 /usr/bin/python3 - "$out" "${models[@]}" <<'PY' | tee "$out/table.md"
 import json, os, sys
 out = sys.argv[1]
 print("| model | nodes | surface cells (depth 7) | variants | nodes per cell: mean / largest / whole | octree ms | GLSL ms "
-      "| voxels | voxelise Mvox/s pruned / whole | speed-up | render ms pruned / whole | instructions whole / pruned |")
-print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+      "| SPIR-V ms: first / mean / all (wall) | voxels | voxelise Mvox/s pruned / whole | speed-up | render ms pruned / whole "
+      "| instructions whole / pruned |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 for m in sys.argv[2:]:
     n = os.path.basename(os.path.splitext(m)[0])
     j = lambda s: json.load(open(os.path.join(out, "%s-%s.json" % (n, s))))
     i, v, vw, r, rw = j("info"), j("vox"), j("vox-whole"), j("render"), j("render-whole")
-    c = i["compile"]
-    print("| %s | %d | %d | %d | %.2f / %d / %d | %.0f | %.2f | %dx%dx%d | %.0f / %.1f | %.0fx | %.0f / %.0f | %.1fx |" % (
+    c, sp = i["compile"], j("compile")["compile"]["spirv"]
+    print("| %s | %d | %d | %d | %.2f / %d / %d | %.0f | %.2f | %.0f / %.1f / %.0f | %dx%dx%d | %.0f / %.1f | %.0fx | %.0f / %.0f | %.1fx |" % (
         n, i["nodes"], c["surface"], c["variants"], c["mean_nodes"], c["max_nodes"], c["whole_nodes"], c["octree_ms"],
-        c["codegen_ms"], *v["dims"], v["mvox_per_s"], vw["mvox_per_s"], vw["ms"] / v["ms"],
+        c["codegen_ms"], sp["first_ms"], sp["mean_ms"], sp["wall_ms"], *v["dims"], v["mvox_per_s"], vw["mvox_per_s"], vw["ms"] / v["ms"],
         r["octree_ms"] + r["render_ms"], rw["render_ms"], rw["instructions"] / max(r["instructions"], 1)))
 PY

@@ -8,10 +8,12 @@
 #include <cstring>
 #include <numeric>
 
+#include "csg_examples.h"
 #include "distance_shaders.h"
 #include "gpu/recorder.h"
 #include "render_shaders.h"
 #include "shaders/layout.h"
+#include "voxfield/csg_compile.h"
 
 using namespace voxfield;
 using namespace voxfield::gpu;
@@ -197,6 +199,75 @@ TEST(GpuCompute, BarriersFollowTheHazardsAndNothingElse) {
   again.submit();
   for (std::uint32_t i = 0; i < n; ++i)
     ASSERT_EQ(gx[i], 2 * (2 * static_cast<float>(i + 1) + 1) + 1) << i;
+  const auto messages = ctx->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size() << " messages, first: " << messages.front();
+}
+
+TEST(GpuCompute, GeneratedCsgKernelsEqualTheCpuTapes) {
+  // The voxel compiler's generated shaders, compiled at run time and run on the device: each
+  // variant's kernel, reading its cells' constants from one parameter buffer, gives at points in
+  // those cells the value of the cell's pruned tape on the CPU (float against double). The Menger
+  // sponge is left to the CPU tests: its 20 variants take lavapipe 17 s to compile under the
+  // validation layer.
+  REQUIRE_GPU();
+  auto ctx = validated();
+  Context::Impl& c = ctx->impl();
+  ctx->clear_validation_messages();
+  for (const char* name : {"gear.sdf", "blobs.sdf", "building.sdf"}) {
+    const csg::Model m = test::csg_example(name);
+    const csg::Tape whole = csg::compile_tape(m);
+    csg::OctreeOptions oo;
+    oo.depth = 3;
+    const csg::Octree tree = csg::build_octree(whole, m, oo);
+    const csg::Bounds root = tree.root;
+    const double scale =
+        std::max({root.hi.x - root.lo.x, root.hi.y - root.lo.y, root.hi.z - root.lo.z, 1.0});
+    std::vector<float> params;
+    std::vector<std::vector<std::array<float, 4>>> points(tree.variants.size());
+    std::vector<std::vector<double>> want(tree.variants.size());
+    for (const csg::OctreeLeaf& l : tree.leaves) {
+      if (l.state != csg::CellState::kSurface || points[l.variant].size() >= 8 * 24) continue;
+      const std::uint32_t base = static_cast<std::uint32_t>(params.size());
+      for (double v : tree.leaf_params(l)) params.push_back(static_cast<float>(v));
+      const csg::Tape t = tree.leaf_tape(l);
+      const csg::Bounds b = tree.leaf_box(l);
+      for (int k = 0; k < 8; ++k) {
+        const Vec3d f{k & 1 ? 0.8 : 0.2, k & 2 ? 0.7 : 0.3, k & 4 ? 0.9 : 0.4};
+        const Vec3d p{b.lo.x + f.x * (b.hi.x - b.lo.x), b.lo.y + f.y * (b.hi.y - b.lo.y),
+                      b.lo.z + f.z * (b.hi.z - b.lo.z)};
+        float w;
+        std::memcpy(&w, &base, 4);
+        points[l.variant].push_back(
+            {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), w});
+        // The CPU at the float point the GPU sees.
+        want[l.variant].push_back(csg::evaluate(
+            t, Vec3d{static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)}));
+      }
+    }
+    Buffer params_host(c, params.size() * 4, kUsage, true),
+        params_dev(c, params.size() * 4, kUsage, false);
+    std::memcpy(params_host.mapped(), params.data(), params.size() * 4);
+    for (std::size_t v = 0; v < tree.variants.size(); ++v) {
+      SCOPED_TRACE(std::string(name) + " variant " + std::to_string(v));
+      const Kernel& k =
+          c.kernels.from_glsl(c.device, "variant",
+                              csg::glsl_variant_kernel(tree.variants[v].tape, static_cast<int>(v)));
+      const auto n = static_cast<std::uint32_t>(points[v].size());
+      ASSERT_GT(n, 0u);
+      Buffer pts_host(c, n * 16, kUsage, true), pts(c, n * 16, kUsage, false),
+          out(c, n * 4, kUsage, false), back(c, n * 4, kUsage, true);
+      std::memcpy(pts_host.mapped(), points[v].data(), n * 16);
+      Recorder rec(c);
+      rec.copy(params_host, 0, params_dev, 0, params.size() * 4);
+      rec.copy(pts_host, 0, pts, 0, n * 16);
+      rec.dispatch(k, {&params_dev, &pts, &out}, n, n);
+      rec.copy(out, 0, back, 0, n * 4);
+      rec.submit();
+      const auto* got = static_cast<const float*>(back.mapped());
+      for (std::uint32_t i = 0; i < n; ++i)
+        ASSERT_NEAR(got[i], want[v][i], 2e-5 * scale) << "point " << i;
+    }
+  }
   const auto messages = ctx->validation_messages();
   EXPECT_TRUE(messages.empty()) << messages.size() << " messages, first: " << messages.front();
 }

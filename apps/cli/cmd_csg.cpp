@@ -1,9 +1,11 @@
 // voxfield csg MODEL SUBCOMMAND: the voxel compiler from the command line — a model's facts, its
 // values at points (whole or through the octree), voxelisation into worlds and fields, and the
 // generated GLSL of its variants.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <numeric>
 
 #include <unistd.h>
 
@@ -14,6 +16,7 @@
 #include "voxfield/csg_mesh.h"
 #include "voxfield/csg_render.h"
 #include "voxfield/file.h"
+#include "voxfield/gpu.h"
 #include "voxfield/mesh_files.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
@@ -27,6 +30,7 @@ struct CsgSettings {
   bool facets = false;  // OpenSCAD spheres and cylinders as its polytopes
   // info / compile
   int depth = -1;
+  bool spirv = false;  // compile: each variant's kernel to SPIR-V too
   // eval
   std::string points, out;
   bool pruned = false;
@@ -274,6 +278,27 @@ int run_compile(const CsgSettings& s) {
                         {"params_per_cell", t.params.size()}});
   }
   const double codegen_ms = ms_since(start);
+  // --spirv: each variant's evaluation kernel compiled in-process on worker threads (glslang),
+  // timed per variant; the binaries join the output files.
+  std::vector<std::vector<std::uint32_t>> spirv(s.spirv ? tree.variants.size() : 0);
+  std::vector<double> spirv_ms(spirv.size());
+  const auto spirv_start = std::chrono::steady_clock::now();
+  parallel_for(spirv.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const std::string name = "variant_" + std::to_string(i);
+      spirv[i] = gpu::compile_compute_shader(
+          name, csg::glsl_variant_kernel(tree.variants[i].tape, static_cast<int>(i)));
+      spirv_ms[i] = ms_since(t0);
+    }
+  });
+  const double spirv_wall_ms = ms_since(spirv_start);
+  for (std::size_t i = 0; i < spirv.size(); ++i) {
+    const std::string name = "variant_" + std::to_string(i) + ".spv";
+    files.push_back(
+        {name, std::string(reinterpret_cast<const char*>(spirv[i].data()), spirv[i].size() * 4)});
+    variants[i]["spirv"] = name;
+  }
   // Every surface cell's constants, float32 in order, and where each cell's start.
   std::vector<float> params;
   nlohmann::json cells = nlohmann::json::array();
@@ -316,6 +341,20 @@ int run_compile(const CsgSettings& s) {
   nlohmann::json stats{
       {"model", s.model}, {"depth", o.depth}, {"compile", compile_json(tree.stats)}};
   stats["compile"]["codegen_ms"] = codegen_ms;
+  if (s.spirv) {
+    std::size_t bytes = 0;
+    for (const auto& w : spirv) bytes += w.size() * 4;
+    stats["compile"]["spirv"] = {
+        {"variants", spirv.size()},
+        {"wall_ms", spirv_wall_ms},
+        {"threads", max_threads()},
+        {"mean_ms", spirv.empty() ? 0.0
+                                  : std::accumulate(spirv_ms.begin(), spirv_ms.end(), 0.0) /
+                                        static_cast<double>(spirv.size())},
+        {"max_ms", spirv.empty() ? 0.0 : *std::max_element(spirv_ms.begin(), spirv_ms.end())},
+        {"first_ms", spirv.empty() ? 0.0 : spirv_ms.front()},
+        {"bytes", bytes}};
+  }
   outputs.stage_json(s.stats, stats);
   outputs.commit();
   std::cerr << "voxfield: wrote " << s.out << "/ (" << tree.variants.size() << " variants over "
@@ -535,6 +574,10 @@ void add_csg(CLI::App& app, Action& action) {
       cmd->add_subcommand("compile", "each variant's GLSL, the cells' parameters and a manifest");
   comp->add_option("--depth", s->depth, "octree depth (0..8, default 6)")->check(CLI::Range(0, 8));
   comp->add_option("-o,--output", s->out, "directory to write (created)")->required();
+  comp->add_flag(
+      "--spirv", s->spirv,
+      "also compile each variant's evaluation kernel to SPIR-V (variant_N.spv), on worker "
+      "threads, timed in --stats");
   stats(comp);
   comp->callback([s, &action] { action = [s] { return run_compile(*s); }; });
 }

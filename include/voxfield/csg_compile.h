@@ -218,5 +218,10 @@ std::string glsl_prelude();
 // One variant as `float vf_variant_N(vec3 p, uint base)`, its constants read in order from
 // vf_param(base + ...).
 std::string glsl_variant(const Tape& tape, int index);
+// A whole compute shader evaluating one variant at points, ready for SPIR-V (gpu::
+// compile_compute_shader): binding 0 the parameter buffer (float), binding 1 the points (vec4:
+// x, y, z in model units and, as uint bits in w, the first parameter of the point's cell),
+// binding 2 the values (float); a push constant with the number of points; 64 invocations a group.
+std::string glsl_variant_kernel(const Tape& tape, int index);
 
 }  // namespace voxfield::csg

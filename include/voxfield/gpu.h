@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "voxfield/error.h"
@@ -113,6 +114,12 @@ class Context {
  private:
   std::unique_ptr<Impl> impl_;
 };
+
+// Compiles a GLSL compute shader (#version 450, Vulkan rules) to SPIR-V in-process with glslang,
+// e.g. the voxel compiler's generated variants. Thread-safe: shaders compile side by side on
+// worker threads; needs no device. Throws InvalidArgument with glslang's log (naming `name` and the
+// line) when the source does not compile, GpuUnavailable in a build without the Vulkan backend.
+std::vector<std::uint32_t> compile_compute_shader(std::string_view name, std::string_view glsl);
 
 // The backend to use: kCpu gives null; kVulkan a context on any Vulkan device, software included
 // (throws GpuUnavailable if there is none); kAuto a context on a hardware GPU if there is one,

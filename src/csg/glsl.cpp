@@ -139,4 +139,26 @@ std::string glsl_variant(const Tape& tape, int index) {
   return g.str();
 }
 
+std::string glsl_variant_kernel(const Tape& tape, int index) {
+  std::ostringstream g;
+  g << "#version 450\n"
+    << "// voxfield CSG: variant " << index << " evaluated at points (one invocation per point)\n"
+    << "layout(local_size_x = 64) in;\n"
+    << "layout(std430, binding = 0) readonly buffer Params { float vf_params[]; };\n"
+    << "// Each point: x, y, z in model units, and the first parameter of its cell (as uint "
+       "bits).\n"
+    << "layout(std430, binding = 1) readonly buffer Points { vec4 vf_points[]; };\n"
+    << "layout(std430, binding = 2) writeonly buffer Values { float vf_values[]; };\n"
+    << "layout(push_constant) uniform Push { uint count; } vf_push;\n"
+    << "float vf_param(uint i) { return vf_params[i]; }\n"
+    << glsl_prelude() << glsl_variant(tape, index) << "void main() {\n"
+    << "  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x +\n"
+    << "                 gl_GlobalInvocationID.x;\n"
+    << "  if (i >= vf_push.count) return;\n"
+    << "  const vec4 pt = vf_points[i];\n"
+    << "  vf_values[i] = vf_variant_" << index << "(pt.xyz, floatBitsToUint(pt.w));\n"
+    << "}\n";
+  return g.str();
+}
+
 }  // namespace voxfield::csg

@@ -57,4 +57,8 @@ std::vector<std::uint32_t> compile_glsl(std::string_view name, std::string_view 
   return spirv;
 }
 
+std::vector<std::uint32_t> compile_compute_shader(std::string_view name, std::string_view glsl) {
+  return compile_glsl(name, glsl);
+}
+
 }  // namespace voxfield::gpu

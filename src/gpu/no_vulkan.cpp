@@ -14,6 +14,9 @@ void built_without_vulkan() {
 bool built_with_vulkan() {
   return false;
 }
+std::vector<std::uint32_t> compile_compute_shader(std::string_view, std::string_view) {
+  built_without_vulkan();
+}
 std::string DeviceInfo::api_version_string() const {
   return "0.0.0";
 }
