@@ -7,7 +7,10 @@
 #include <mutex>
 #include <vector>
 
+#include "voxfield/algorithms.h"
 #include "voxfield/distance.h"
+#include "voxfield/dynamic_field.h"
+#include "voxfield/edit.h"
 #include "voxfield/interrupt.h"
 #include "voxfield/mesh.h"
 #include "voxfield/render.h"
@@ -136,6 +139,65 @@ TEST(Interrupt, ExactFieldsReportProgressAndCancel) {
     EXPECT_THROW(compute_distance_field(w, o), Cancelled);
     EXPECT_EQ(stop.ends, 1);
   }
+}
+
+TEST(Interrupt, TheAlgorithmFamilyReportsAndCancelsBetweenPasses) {
+  SceneOptions so;
+  so.size = Vec3i::splat(40);
+  const World w = make_terrain(so);
+  for (Algorithm alg : {Algorithm::kJfa, Algorithm::kJfa2, Algorithm::kJfaSeed, Algorithm::kFim,
+                        Algorithm::kHybrid, Algorithm::kLod, Algorithm::kBruteChunked}) {
+    SCOPED_TRACE(algorithm_name(alg));
+    DistanceOptions o;
+    o.metric = Metric::kManhattan;
+    o.signed_distance = alg == Algorithm::kJfa;  // two solves, one per sign
+    AlgorithmOptions a;
+    a.algorithm = alg;
+    if (alg == Algorithm::kLod) a.focus = Box3i{{8, 8, 8}, {20, 20, 20}};
+    const DistanceField plain = compute_distance_field(w, o, a);
+    Recorder r;
+    o.interrupter = &r;
+    const DistanceField watched = compute_distance_field(w, o, a);
+    EXPECT_EQ(r.names,
+              std::vector<std::string>{std::string(algorithm_name(alg)) + " distance field"});
+    EXPECT_EQ(r.ends, 1);
+    ASSERT_FALSE(r.percents.empty());
+    EXPECT_EQ(r.percents.back(), 100);
+    EXPECT_EQ(watched.options.interrupter, nullptr) << "the field never keeps the interrupter";
+    for (int z = 0; z < 40; z += 3)
+      for (int x = 0; x < 40; x += 3)
+        ASSERT_EQ(watched.distance({x, 13, z}), plain.distance({x, 13, z}));
+    Recorder stop(0);  // at the first question: within the first pass
+    o.interrupter = &stop;
+    EXPECT_THROW(compute_distance_field(w, o, a), Cancelled);
+    EXPECT_EQ(stop.ends, 1);
+  }
+}
+
+TEST(Interrupt, RebuildsReportAndCancelKeepingTheFieldTheyHad) {
+  SceneOptions so;
+  so.size = Vec3i::splat(48);
+  World w = make_terrain(so);
+  DistanceOptions o;
+  o.metric = Metric::kEuclidean;
+  o.max_distance = 6;
+  DynamicDistanceField live(w, o);
+  const DistanceField before = live.field();
+  apply_edit(w, Edit{EditOp::kCarve, SphereBrush{{24, 24, 10}, 9}, 1});
+  Recorder stop(0);
+  EXPECT_THROW(live.rebuild(&stop), Cancelled);
+  for (int z = 0; z < 48; z += 2)
+    for (int x = 0; x < 48; x += 2)
+      ASSERT_EQ(live.field().distance({x, 24, z}), before.distance({x, 24, z}));
+  Recorder r;
+  live.rebuild(&r);
+  EXPECT_EQ(r.names, std::vector<std::string>{"exact distance field"});
+  EXPECT_EQ(r.percents.back(), 100);
+  EXPECT_EQ(live.field().options.interrupter, nullptr);
+  const DistanceField fresh = compute_distance_field(w, live.options());
+  for (int z = 0; z < 48; z += 2)
+    for (int x = 0; x < 48; x += 2)
+      ASSERT_EQ(live.field().distance({x, 24, z}), fresh.distance({x, 24, z}));
 }
 
 TEST(Interrupt, MeshingReportsChunksAndCancels) {

@@ -36,8 +36,9 @@ class DynamicDistanceField {
     int regions = 0;  // merged boxes recomputed
   };
 
-  // Recomputes the whole field.
-  void rebuild();
+  // Recomputes the whole field, reporting to `interrupter` when given (as compute_distance_field
+  // does). Strong guarantee: if it throws (Cancelled included) the field is the one before.
+  void rebuild(Interrupter* interrupter = nullptr);
   // Recomputes what the recorded changes can affect. The caller clears `dirty` afterwards.
   // Not the strong exception guarantee: the field is written region by region, so if update()
   // throws (out of memory, while recomputing or storing a region) the regions before hold their

@@ -189,20 +189,34 @@ DistanceField compute_with_solver(const World& world, const DistanceOptions& o,
                                   const DenseSolver& solver) {
   AlgorithmStats stats;
   const auto t0 = std::chrono::steady_clock::now();
-  auto finish = [&](DistanceField f) {
-    stats.ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (stats_out) *stats_out = stats;
-    return f;
-  };
   if (a.algorithm == Algorithm::kLod && !a.focus)
     throw InvalidArgument("the lod algorithm needs a focus box");
   const detail::FieldPlan plan = detail::make_field_plan(world.voxels, o);
   std::vector<std::uint8_t> solid(static_cast<std::size_t>(plan.domain.volume()));
   world.voxels.copy_to_dense(plan.domain, solid.data());
-  const DenseSolution out = solver(make_problem(world, plan, true), a, stats);
+  // Progress in solves (one per sign) and the assembly; the solvers ask between their passes
+  // whether to go on, so a cancelled field stops within one pass.
+  Progress progress(o.interrupter, std::string(algorithm_name(a.algorithm)) + " distance field",
+                    plan.is_signed ? 3 : 2);
+  const auto solve = [&](bool to_solid) {
+    DenseProblem problem = make_problem(world, plan, to_solid);
+    problem.progress = &progress;
+    DenseSolution s = solver(problem, a, stats);
+    progress.throw_if_cancelled();
+    progress.advance();
+    return s;
+  };
+  const DenseSolution out = solve(true);
   DenseSolution in;
-  if (plan.is_signed) in = solver(make_problem(world, plan, false), a, stats);
+  if (plan.is_signed) in = solve(false);
+  auto finish = [&](DistanceField f) {
+    progress.advance();
+    stats.ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (stats_out) *stats_out = stats;
+    f.options.interrupter = nullptr;  // the field outlives the caller's interrupter
+    return f;
+  };
   switch (o.storage) {
     case Storage::kU8:
       return finish(

@@ -30,6 +30,7 @@ void brute_chunked(const DenseProblem& p, DenseSolution& out, AlgorithmStats& st
   // The padded chunk (edge + 2) fits a grid chunk of twice the edge (at most 256 > 128: use 128).
   const int inner_edge = std::min(128, 2 * e);
   parallel_for(chunks.size(), 1, [&](std::size_t b, std::size_t end) {
+    if (p.stopped()) return;
     for (std::size_t k = b; k < end; ++k) {
       const Vec3i c = chunks[k];
       const Box3i cb =

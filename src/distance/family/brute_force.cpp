@@ -28,6 +28,7 @@ void brute_force(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stat
   out.d.assign(p.size(), kFar);
   out.site.assign(p.size(), -1);
   parallel_for(p.size(), 256, [&](std::size_t b, std::size_t e) {
+    if (p.stopped()) return;
     for (std::size_t i = b; i < e; ++i) {
       if (p.site[i]) {
         out.d[i] = 0;

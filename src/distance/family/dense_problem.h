@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "voxfield/algorithms.h"
+#include "voxfield/interrupt.h"
 
 namespace voxfield::detail {
 
@@ -25,6 +26,10 @@ struct DenseProblem {
   Metric metric = Metric::kManhattan;
   std::array<double, 3> spacing{1, 1, 1};
   int chunk_edge = 32;  // of the world, for the chunked algorithms
+  // Asked between passes (and blocks of work) whether to go on; null when nobody watches. A
+  // solver that is told to stop returns early, and the caller throws Cancelled.
+  Progress* progress = nullptr;
+  bool stopped() const { return progress && !progress->keep_going(); }
 
   std::size_t size() const { return site.size(); }
   std::size_t index(int x, int y, int z) const {

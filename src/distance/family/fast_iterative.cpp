@@ -136,6 +136,7 @@ void fast_iterative(const DenseProblem& p, DenseSolution& io, AlgorithmStats& st
         }
       }
   while (!list.empty()) {
+    if (p.stopped()) return;
     ++stats.iterations;
     next.clear();
     for (const std::size_t i : list) {

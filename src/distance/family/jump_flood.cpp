@@ -131,6 +131,7 @@ void jump_flood(const DenseProblem& p, DenseSolution& out, AlgorithmStats& stats
   std::vector<Site> a = jfa_seeds(p), b(p.size());
   const bool unit = p.spacing == std::array<double, 3>{1, 1, 1};
   for (int k : steps) {
+    if (p.stopped()) return;
     if (unit) {
       flood_pass(p, UnitCost{p.metric}, a, b, k);
     } else {

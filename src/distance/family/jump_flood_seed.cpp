@@ -23,6 +23,7 @@ void jump_flood_seed(const DenseProblem& p, DenseSolution& out, AlgorithmStats& 
   const std::size_t sx = 1, sy = static_cast<std::size_t>(p.n.x),
                     sz = sy * static_cast<std::size_t>(p.n.y);
   for (; step >= 1; step /= 2) {
+    if (p.stopped()) return;
     const float fstep[3] = {static_cast<float>(step * p.spacing[0]),
                             static_cast<float>(step * p.spacing[1]),
                             static_cast<float>(step * p.spacing[2])};

@@ -213,8 +213,12 @@ DynamicDistanceField::DynamicDistanceField(const World& world, DistanceOptions o
   options_.interrupter = nullptr;  // it watched the first build; the field outlives it
 }
 
-void DynamicDistanceField::rebuild() {
-  field_ = compute_distance_field(world_->voxels, options_);
+void DynamicDistanceField::rebuild(Interrupter* interrupter) {
+  DistanceOptions o = options_;
+  if (interrupter) o.interrupter = interrupter;
+  DistanceField fresh = compute_distance_field(world_->voxels, o);
+  fresh.options.interrupter = nullptr;  // the field outlives the caller's interrupter
+  field_ = std::move(fresh);
 }
 
 DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegions& dirty) {
