@@ -493,6 +493,25 @@ TEST(CsgVoxelize, RefusesUnboundedModelsAndAbsurdSizes) {
             std::string::npos);
 }
 
+TEST(CsgGlsl, InterpreterProgramsEncodeTheTape) {
+  const Tape t = compile_tape(parse("(smooth-union 0.5 (sphere 1) (move 2 0 0 (box 1 2 3)))"));
+  const std::vector<std::uint32_t> program = interpreter_program(t);
+  ASSERT_EQ(program.size(), 1 + 4 * t.code.size());
+  EXPECT_EQ(program[0], t.code.size());
+  std::uint32_t constants = 0;
+  for (std::size_t i = 0; i < t.code.size(); ++i) {
+    const std::uint32_t* w = &program[1 + 4 * i];
+    EXPECT_EQ(w[0] & 0xFFu, static_cast<std::uint32_t>(t.code[i].op));
+    EXPECT_EQ(w[1], t.reg[i]);
+    if (t.code[i].op == OpCode::kShape) {
+      EXPECT_EQ((w[0] >> 8) & 0xFFu, static_cast<std::uint32_t>(t.code[i].shape));
+    }
+    constants += w[0] >> 16;
+  }
+  EXPECT_EQ(constants, t.params.size()) << "the program reads every constant once, in order";
+  EXPECT_EQ(program[1 + 4 * (t.code.size() - 1) + 2], t.reg[t.code.back().a]);
+}
+
 TEST(CsgGlsl, EveryVariantOfTheExamplesCompiles) {
 #ifndef VOXFIELD_GLSLC
   GTEST_SKIP() << "glslc not found at configure time";

@@ -206,13 +206,17 @@ TEST(GpuCompute, BarriersFollowTheHazardsAndNothingElse) {
 TEST(GpuCompute, GeneratedCsgKernelsEqualTheCpuTapes) {
   // The voxel compiler's generated shaders, compiled at run time and run on the device: each
   // variant's kernel, reading its cells' constants from one parameter buffer, gives at points in
-  // those cells the value of the cell's pruned tape on the CPU (float against double). The Menger
+  // those cells the value of the cell's pruned tape on the CPU (float against double), and the
+  // interpreter running the variant's program gives the compiled kernel's values. The Menger
   // sponge is left to the CPU tests: its 20 variants take lavapipe 17 s to compile under the
   // validation layer.
   REQUIRE_GPU();
   auto ctx = validated();
   Context::Impl& c = ctx->impl();
   ctx->clear_validation_messages();
+  const Kernel& interpreter =
+      c.kernels.from_glsl(c.device, "interpreter", csg::glsl_interpreter_kernel());
+  EXPECT_EQ(interpreter.interface.buffers.size(), 4u);
   for (const char* name : {"gear.sdf", "blobs.sdf", "building.sdf"}) {
     const csg::Model m = test::csg_example(name);
     const csg::Tape whole = csg::compile_tape(m);
@@ -257,15 +261,28 @@ TEST(GpuCompute, GeneratedCsgKernelsEqualTheCpuTapes) {
       Buffer pts_host(c, n * 16, kUsage, true), pts(c, n * 16, kUsage, false),
           out(c, n * 4, kUsage, false), back(c, n * 4, kUsage, true);
       std::memcpy(pts_host.mapped(), points[v].data(), n * 16);
+      // The interpreter runs the same variant from its program, at the same points.
+      const std::vector<std::uint32_t> program = csg::interpreter_program(tree.variants[v].tape);
+      Buffer prog_host(c, program.size() * 4, kUsage, true),
+          prog(c, program.size() * 4, kUsage, false), out_i(c, n * 4, kUsage, false),
+          back_i(c, n * 4, kUsage, true);
+      std::memcpy(prog_host.mapped(), program.data(), program.size() * 4);
       Recorder rec(c);
       rec.copy(params_host, 0, params_dev, 0, params.size() * 4);
       rec.copy(pts_host, 0, pts, 0, n * 16);
+      rec.copy(prog_host, 0, prog, 0, program.size() * 4);
       rec.dispatch(k, {&params_dev, &pts, &out}, n, n);
+      rec.dispatch(interpreter, {&params_dev, &pts, &out_i, &prog}, n, n);
       rec.copy(out, 0, back, 0, n * 4);
+      rec.copy(out_i, 0, back_i, 0, n * 4);
       rec.submit();
       const auto* got = static_cast<const float*>(back.mapped());
-      for (std::uint32_t i = 0; i < n; ++i)
+      const auto* interpreted = static_cast<const float*>(back_i.mapped());
+      for (std::uint32_t i = 0; i < n; ++i) {
         ASSERT_NEAR(got[i], want[v][i], 2e-5 * scale) << "point " << i;
+        // The same float operations in the same order (up to the compiler's fused multiply-adds).
+        ASSERT_NEAR(interpreted[i], got[i], 1e-6 * scale) << "point " << i << ", interpreted";
+      }
     }
   }
   const auto messages = ctx->validation_messages();

@@ -223,5 +223,14 @@ std::string glsl_variant(const Tape& tape, int index);
 // x, y, z in model units and, as uint bits in w, the first parameter of the point's cell),
 // binding 2 the values (float); a push constant with the number of points; 64 invocations a group.
 std::string glsl_variant_kernel(const Tape& tape, int index);
+// The interpreter (Palecek's placeholder for cells whose variant's shader is not compiled yet):
+// one fixed compute shader running any tape, given as a program, at points — the bindings of
+// glsl_variant_kernel plus binding 3, the program (uint).
+std::string glsl_interpreter_kernel();
+// A tape as the interpreter's program: its instruction count, then four words per instruction
+// (op | shape << 8 | constants << 16, its register, its operands' registers). Throws
+// InvalidArgument for a tape needing more than kInterpreterRegisters registers.
+inline constexpr std::uint32_t kInterpreterRegisters = 64;
+std::vector<std::uint32_t> interpreter_program(const Tape& tape);
 
 }  // namespace voxfield::csg

@@ -6,6 +6,7 @@
 
 #include "csg/tape_internal.h"
 #include "voxfield/csg_compile.h"
+#include "voxfield/error.h"
 
 namespace voxfield::csg {
 
@@ -157,6 +158,90 @@ std::string glsl_variant_kernel(const Tape& tape, int index) {
     << "  if (i >= vf_push.count) return;\n"
     << "  const vec4 pt = vf_points[i];\n"
     << "  vf_values[i] = vf_variant_" << index << "(pt.xyz, floatBitsToUint(pt.w));\n"
+    << "}\n";
+  return g.str();
+}
+
+std::vector<std::uint32_t> interpreter_program(const Tape& tape) {
+  if (tape.code.empty()) throw InvalidArgument("CSG interpreter: an empty tape");
+  if (tape.registers > kInterpreterRegisters)
+    throw InvalidArgument("CSG interpreter: the tape needs " + std::to_string(tape.registers) +
+                          " registers, the interpreter has " +
+                          std::to_string(kInterpreterRegisters));
+  std::vector<std::uint32_t> program{static_cast<std::uint32_t>(tape.code.size())};
+  for (std::size_t i = 0; i < tape.code.size(); ++i) {
+    const Instr& in = tape.code[i];
+    program.push_back(static_cast<std::uint32_t>(in.op) |
+                      (static_cast<std::uint32_t>(in.shape) << 8) |
+                      (static_cast<std::uint32_t>(detail::param_count(in)) << 16));
+    program.push_back(tape.reg[i]);
+    program.push_back(in.op == OpCode::kShape ? 0u : tape.reg[in.a]);
+    program.push_back(detail::is_binary(in.op) ? tape.reg[in.b] : 0u);
+  }
+  return program;
+}
+
+std::string glsl_interpreter_kernel() {
+  std::ostringstream g;
+  const auto op = [](OpCode o) { return std::to_string(static_cast<int>(o)) + "u"; };
+  g << "#version 450\n"
+    << "// voxfield CSG: the interpreter, running any tape given as a program at points (the\n"
+    << "// placeholder for cells whose variant's shader is not compiled yet).\n"
+    << "layout(local_size_x = 64) in;\n"
+    << "layout(std430, binding = 0) readonly buffer Params { float vf_params[]; };\n"
+    << "layout(std430, binding = 1) readonly buffer Points { vec4 vf_points[]; };\n"
+    << "layout(std430, binding = 2) writeonly buffer Values { float vf_values[]; };\n"
+    << "layout(std430, binding = 3) readonly buffer Program { uint vf_program[]; };\n"
+    << "layout(push_constant) uniform Push { uint count; } vf_push;\n"
+    << "float vf_param(uint i) { return vf_params[i]; }\n"
+    << glsl_prelude()
+    << "// A shape in its own frame, its sizes read from `at` on (only those it has).\n"
+    << "float vf_shape(uint kind, vec3 q, uint at) {\n  switch (kind) {\n";
+  for (NodeKind k : {NodeKind::kSphere, NodeKind::kBox, NodeKind::kRoundedBox, NodeKind::kCylinder,
+                     NodeKind::kCapsule, NodeKind::kTorus, NodeKind::kCone, NodeKind::kPlane,
+                     NodeKind::kEllipsoid})
+    g << "    case " << static_cast<int>(k) << "u: return "
+      << shape_call(k, "vf_param(at)", "vf_param(at + 1u)", "vf_param(at + 2u)",
+                    "vf_param(at + 3u)")
+      << ";\n";
+  g << "  }\n  return 0.0;\n}\n"
+    << "void main() {\n"
+    << "  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x +\n"
+    << "                 gl_GlobalInvocationID.x;\n"
+    << "  if (i >= vf_push.count) return;\n"
+    << "  const vec4 pt = vf_points[i];\n"
+    << "  const vec3 p = pt.xyz;\n"
+    << "  float r[" << kInterpreterRegisters << "];\n"
+    << "  uint at = floatBitsToUint(pt.w);  // the next constant, read in instruction order\n"
+    << "  uint result = 0u;\n"
+    << "  const uint n = vf_program[0];\n"
+    << "  for (uint k = 0u; k < n; ++k) {\n"
+    << "    const uint w = vf_program[1u + 4u * k];\n"
+    << "    const uint op = w & 0xFFu, out_r = vf_program[2u + 4u * k];\n"
+    << "    const float a = r[vf_program[3u + 4u * k]], b = r[vf_program[4u + 4u * k]];\n"
+    << "    float v = a;  // " << op(OpCode::kCopy) << " and " << op(OpCode::kSetMaterial)
+    << " (materials are not evaluated here)\n"
+    << "    if (op == " << op(OpCode::kShape) << ") {\n"
+    << "      const vec3 q = vec3(";
+  // The same expressions, in the same order, as glsl_variant's.
+  for (int row = 0; row < 3; ++row)
+    g << (row ? ",\n                          " : "") << "vf_param(at + " << row * 3
+      << "u) * p.x + vf_param(at + " << row * 3 + 1 << "u) * p.y + vf_param(at + " << row * 3 + 2
+      << "u) * p.z + vf_param(at + " << 9 + row << "u)";
+  g << ");\n"
+    << "      v = vf_param(at + 12u) * vf_shape((w >> 8) & 0xFFu, q, at + 13u);\n"
+    << "    } else if (op == " << op(OpCode::kMin) << ") v = min(a, b);\n"
+    << "    else if (op == " << op(OpCode::kMax) << ") v = max(a, b);\n"
+    << "    else if (op == " << op(OpCode::kSmoothMin) << ") v = vf_smin(a, b, vf_param(at));\n"
+    << "    else if (op == " << op(OpCode::kSmoothMax) << ") v = vf_smax(a, b, vf_param(at));\n"
+    << "    else if (op == " << op(OpCode::kNeg) << ") v = -a;\n"
+    << "    else if (op == " << op(OpCode::kOffset) << ") v = a - vf_param(at);\n"
+    << "    else if (op == " << op(OpCode::kAbsOffset) << ") v = abs(a) - vf_param(at);\n"
+    << "    r[out_r] = v;\n"
+    << "    result = out_r;\n"
+    << "    at += w >> 16;\n"
+    << "  }\n"
+    << "  vf_values[i] = r[result];\n"
     << "}\n";
   return g.str();
 }
