@@ -60,11 +60,23 @@ class Builder {
  public:
   explicit Builder(const OctreeOptions& o) : o_(o) {}
 
+  // A cell at kParallelLevel, left for a worker thread by the serial top levels.
+  struct Task {
+    Tape tape;
+    Cell cell;
+    std::size_t slot;  // in the top part's children
+  };
+
   // Fills slot `slot` of part.children with the cell's node or leaf; `scratch` holds one clip
-  // result per level, whose memory is reused from cell to cell.
+  // result per level, whose memory is reused from cell to cell. With `tasks` (the serial top
+  // levels), a cell at kParallelLevel becomes a task, its parent's tape copied, instead.
   void visit(Part& part, const Tape& parent, const Cell& cell, std::size_t slot,
-             std::vector<Clipped>& scratch, Progress& progress) const {
-    if (!progress.keep_going()) return;
+             std::vector<Clipped>& scratch, Progress* progress, std::vector<Task>* tasks) const {
+    if (tasks && cell.level == kParallelLevel) {
+      tasks->push_back({parent, cell, slot});
+      return;
+    }
+    if (progress && !progress->keep_going()) return;
     ++part.visited;
     Clipped& c = scratch[static_cast<std::size_t>(cell.level)];
     clip_into(parent, cell.box, o_.max_distance, false, c);
@@ -77,32 +89,7 @@ class Builder {
     part.children.resize(first + 8, 0);
     for (int octant = 0; octant < 8; ++octant)
       visit(part, c.tape, cell.child(octant), first + static_cast<std::size_t>(octant), scratch,
-            progress);
-  }
-
-  // The top levels, serially: a leaf stops there, a cell at kParallelLevel becomes a task.
-  struct Task {
-    Tape tape;
-    Cell cell;
-    std::size_t slot;  // in the top part's children
-  };
-  void top(Part& part, const Tape& parent, const Cell& cell, std::size_t slot,
-           std::vector<Task>& tasks) const {
-    if (cell.level == kParallelLevel) {
-      tasks.push_back({parent, cell, slot});
-      return;
-    }
-    ++part.visited;
-    Clipped c = clip(parent, cell.box, o_.max_distance, false);
-    if (c.state != CellState::kSurface || cell.level == o_.depth) {
-      leaf(part, c, cell, slot);
-      return;
-    }
-    const std::size_t first = part.children.size();
-    part.children[slot] = static_cast<std::int32_t>(first);
-    part.children.resize(first + 8, 0);
-    for (int octant = 0; octant < 8; ++octant)
-      top(part, c.tape, cell.child(octant), first + static_cast<std::size_t>(octant), tasks);
+            progress, tasks);
   }
 
  private:
@@ -179,13 +166,14 @@ Octree build_octree(const Tape& tape, const Model& model, const OctreeOptions& o
   const Builder builder(options);
   Part top;
   std::vector<Builder::Task> tasks;
-  builder.top(top, tape, Cell{tree.root}, 0, tasks);
+  std::vector<Clipped> top_scratch(static_cast<std::size_t>(options.depth) + 1);
+  builder.visit(top, tape, Cell{tree.root}, 0, top_scratch, nullptr, &tasks);
   Progress progress(options.interrupter, "CSG octree", static_cast<std::int64_t>(tasks.size()));
   std::vector<Part> parts(tasks.size());
   parallel_for(tasks.size(), 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       std::vector<Clipped> scratch(static_cast<std::size_t>(options.depth) + 1);
-      builder.visit(parts[i], tasks[i].tape, tasks[i].cell, 0, scratch, progress);
+      builder.visit(parts[i], tasks[i].tape, tasks[i].cell, 0, scratch, &progress, nullptr);
       progress.advance();
     }
   });
