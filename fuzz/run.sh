@@ -4,8 +4,10 @@
 # 8 KiB, .npy and .vfw files converted from its small models by the release CLI, and the text seeds
 # in fuzz/seeds/. Binary inputs are capped at 8 KiB: every structure of the three formats fits, and
 # a harness that spends its time on megabyte seeds (the corpus's scenes) runs a few executions a
-# second instead of thousands (the large files are parsed whole by the unit tests). New inputs libFuzzer finds go to a scratch corpus, not into the repository; a
-# crash stops the run with the harness's report and the crashing input under $FUZZ_OUT.
+# second instead of thousands (the large files are parsed whole by the unit tests). New inputs
+# libFuzzer finds go to a scratch corpus, not into the repository; a crash stops that harness, its
+# report (on stdout, with the log's tail) names the crashing input under $FUZZ_OUT, and the run
+# fails once every harness has finished.
 # Usage: bash fuzz/run.sh [SECONDS] [HARNESS...]   (needs build/fuzz and build/release/bin/voxfield)
 # FUZZ_JOBS=N runs N harnesses at once (one per core for CI's smoke);
 # FUZZ_RUNS=N stops each harness after N executions instead (with SECONDS still the cap);
@@ -60,6 +62,8 @@ run_one() {
 # FUZZ_JOBS harnesses at a time (default 1; CI's smoke runs one per core), each report printed
 # whole; each job leaves its exit status in a file, so none is lost however fast it ends.
 jobs_max=${FUZZ_JOBS:-1}
+[ "$jobs_max" -ge 1 ] 2>/dev/null || jobs_max=1
+for h in $harnesses; do rm -f "$out/status-$h"; done  # a reused FUZZ_OUT keeps no old verdict
 for h in $harnesses; do
   while [ "$(jobs -rp | wc -l)" -ge "$jobs_max" ]; do sleep 0.2; done
   ( set +e; run_one "$h"; echo $? >"$out/status-$h" ) >"$out/report-$h.txt" 2>&1 &

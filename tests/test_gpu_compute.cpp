@@ -199,6 +199,23 @@ TEST(GpuCompute, BarriersFollowTheHazardsAndNothingElse) {
   again.submit();
   for (std::uint32_t i = 0; i < n; ++i)
     ASSERT_EQ(gx[i], 2 * (2 * static_cast<float>(i + 1) + 1) + 1) << i;
+
+  // A recording abandoned before its submission (an exception, say) leaves no false promise: its
+  // barrier made x's last write visible only in commands that never ran.
+  {
+    Recorder written(c);
+    written.dispatch(inc, {&x}, ScaleParams{0, n}, n);
+    written.submit();
+  }
+  {
+    Recorder abandoned(c);
+    abandoned.dispatch(scale, {&x, &y}, ScaleParams{0, n}, n);
+  }
+  Recorder after(c);
+  before = barriers();
+  after.dispatch(scale, {&x, &z}, ScaleParams{0, n}, n);
+  EXPECT_EQ(barriers() - before, 1) << "the read of x still waits for its write";
+  after.submit();
   const auto messages = ctx->validation_messages();
   EXPECT_TRUE(messages.empty()) << messages.size() << " messages, first: " << messages.front();
 }

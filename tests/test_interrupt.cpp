@@ -44,6 +44,17 @@ class Recorder : public Interrupter {
   std::mutex mutex_;
 };
 
+// Counts the questions it is asked; cancels at the `cancel_at`-th (never when 0).
+class Questions : public Interrupter {
+ public:
+  explicit Questions(int cancel_at = 0) : cancel_at_(cancel_at) {}
+  bool was_interrupted(int) override { return ++asked == cancel_at_; }
+  std::atomic<int> asked{0};
+
+ private:
+  int cancel_at_;
+};
+
 }  // namespace
 
 TEST(Interrupt, ProgressCountsUnitsAndReachesAHundred) {
@@ -167,10 +178,24 @@ TEST(Interrupt, TheAlgorithmFamilyReportsAndCancelsBetweenPasses) {
     for (int z = 0; z < 40; z += 3)
       for (int x = 0; x < 40; x += 3)
         ASSERT_EQ(watched.distance({x, 13, z}), plain.distance({x, 13, z}));
-    Recorder stop(0);  // at the first question: within the first pass
+    Recorder stop(0);  // at the first question, when it starts
     o.interrupter = &stop;
     EXPECT_THROW(compute_distance_field(w, o, a), Cancelled);
     EXPECT_EQ(stop.ends, 1);
+    // The solvers ask between their passes: more questions than the start and the three units
+    // (the serial ones once per pass, brute-chunked once per block of chunks)...
+    Questions count;
+    o.interrupter = &count;
+    AlgorithmStats st;
+    compute_distance_field(w, o, a, &st);
+    EXPECT_GT(count.asked.load(), 4) << st.passes << " passes, " << st.iterations << " iterations";
+    // ... and one cancelled at the first of those stops there: the serial loops ask no more.
+    Questions cut(2);
+    o.interrupter = &cut;
+    EXPECT_THROW(compute_distance_field(w, o, a), Cancelled);
+    if (alg != Algorithm::kBruteChunked) {
+      EXPECT_EQ(cut.asked.load(), 2);
+    }
   }
 }
 

@@ -457,7 +457,6 @@ TEST(Render, ScenesFollowEditsExactly) {
     o.height = 48;
     const Camera cam = Camera::framing(live.scene().box(), 1.5);
     const std::vector<Ray> rays = test_rays(live.scene().box(), 3, 300);
-    const std::size_t chunks = 9 * 7 * 5;
     for (int e = 1; e <= 60; ++e) {
       const Vec3d c{static_cast<double>(uni(-3, 74)), static_cast<double>(uni(-3, 58)),
                     static_cast<double>(uni(-3, 42))};
@@ -487,7 +486,6 @@ TEST(Render, ScenesFollowEditsExactly) {
       }
       dirty.clear();
       EXPECT_LE(st.chunks_changed, reachable) << "edit " << e;
-      EXPECT_LE(reachable, chunks);
       if (e % 6 != 0) continue;
       const std::string what = std::string(metric_name(m)) + " after edit " + std::to_string(e);
       const RenderScene fresh(w, live.skip_field(), live.light_field());

@@ -17,7 +17,8 @@ enum class PixelOrder { kRgba, kBgra };  // byte order of a packed 32-bit pixel
 // vkCmdCopyBufferToImage into a UNORM swapchain image. The buffer and the frame's parameters are
 // reused by the next frame: wait for `cmd` before recording another frame. SceneRenderer::sync()
 // may run while the frame executes (its copies wait for it on the queue; buffers it replaces live
-// until the sync after).
+// until the sync after), or between recording the frame and submitting it: the frame begins with a
+// barrier on everything submitted before it on the queue.
 // Throws InvalidArgument as SceneRenderer::render does.
 VkBuffer record_render(SceneRenderer& renderer, VkCommandBuffer cmd, const Camera& camera,
                        const RenderOptions& options, PixelOrder order);

@@ -194,8 +194,8 @@ DistanceField compute_with_solver(const World& world, const DistanceOptions& o,
   const detail::FieldPlan plan = detail::make_field_plan(world.voxels, o);
   std::vector<std::uint8_t> solid(static_cast<std::size_t>(plan.domain.volume()));
   world.voxels.copy_to_dense(plan.domain, solid.data());
-  // Progress in solves (one per sign) and the assembly; the solvers ask between their passes
-  // whether to go on, so a cancelled field stops within one pass.
+  // Progress in solves (one per sign) and the assembly; the CPU's solvers ask between their passes
+  // whether to go on, so a cancelled field stops within one pass (the GPU's, between solves).
   Progress progress(o.interrupter, std::string(algorithm_name(a.algorithm)) + " distance field",
                     plan.is_signed ? 3 : 2);
   const auto solve = [&](bool to_solid) {
@@ -211,6 +211,7 @@ DistanceField compute_with_solver(const World& world, const DistanceOptions& o,
   if (plan.is_signed) in = solve(false);
   auto finish = [&](DistanceField f) {
     progress.advance();
+    progress.throw_if_cancelled();  // a cancel answered at the last question is honoured too
     stats.ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (stats_out) *stats_out = stats;

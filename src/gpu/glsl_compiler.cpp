@@ -11,6 +11,7 @@
 
 #include "gpu/kernel.h"
 #include "voxfield/error.h"
+#include "voxfield/gpu.h"
 
 namespace voxfield::gpu {
 

@@ -10,6 +10,7 @@
 
 #include "gpu/vulkan_context.h"
 #include "voxfield/error.h"
+#include "voxfield/hash.h"
 
 namespace voxfield::gpu {
 namespace {
@@ -33,16 +34,6 @@ bool has_decoration(const SpvDecoration* decorations, std::size_t n, SpvDecorati
 
 }  // namespace
 
-std::uint64_t content_hash(const void* data, std::size_t bytes) {
-  std::uint64_t h = 1469598103934665603ull;
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < bytes; ++i) {
-    h ^= p[i];
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
 ShaderInterface reflect(std::string_view name, std::span<const std::uint32_t> spirv) {
   const std::string who = "GPU shader " + std::string(name) + ": ";
   SpvcContext c;
@@ -62,8 +53,12 @@ ShaderInterface reflect(std::string_view name, std::span<const std::uint32_t> sp
     out.local_size[static_cast<std::size_t>(axis)] =
         spvc_compiler_get_execution_mode_argument_by_index(comp, SpvExecutionModeLocalSize,
                                                            static_cast<unsigned>(axis));
-  if (out.invocations_per_group() == 0)
-    throw InvalidArgument(who + "no fixed local size (local_size_x/y/z must be constants)");
+  spvc_specialization_constant sx{}, sy{}, sz{};
+  spvc_compiler_get_work_group_size_specialization_constants(comp, &sx, &sy, &sz);
+  if (out.invocations_per_group() == 0 || sx.id != 0 || sy.id != 0 || sz.id != 0)
+    throw InvalidArgument(who +
+                          "no fixed local size (local_size_x/y/z must be literal constants, "
+                          "not specialisation constants)");
 
   const spvc_reflected_resource* list = nullptr;
   std::size_t count = 0;
@@ -86,6 +81,11 @@ ShaderInterface reflect(std::string_view name, std::span<const std::uint32_t> sp
       throw InvalidArgument(who + "storage buffer " + list[i].name + " is at set " +
                             std::to_string(set) + ", binding " + std::to_string(binding) +
                             "; the compute layer binds set 0, bindings below 64");
+    if (spvc_type_get_num_array_dimensions(spvc_compiler_get_type_handle(comp, list[i].type_id)) >
+        0)
+      throw InvalidArgument(
+          who + "storage buffer " + list[i].name +
+          " is an array of buffers; the compute layer binds one buffer per binding");
     if (binding >= out.buffers.size()) out.buffers.resize(binding + 1, Access::kNone);
     if (out.buffers[binding] != Access::kNone)
       throw InvalidArgument(who + "two storage buffers at binding " + std::to_string(binding));
@@ -112,7 +112,7 @@ ShaderInterface reflect(std::string_view name, std::span<const std::uint32_t> sp
 }
 
 const Kernel& KernelCache::get(VkDevice device, const ShaderSource& shader) {
-  const std::uint64_t key = content_hash(shader.spirv.data(), shader.spirv.size_bytes());
+  const std::uint64_t key = fnv1a(kFnvOffset, shader.spirv.data(), shader.spirv.size_bytes());
   if (auto it = kernels_.find(key); it != kernels_.end()) return *it->second;
 
   auto k = std::make_unique<Kernel>();
@@ -170,7 +170,7 @@ const Kernel& KernelCache::get(VkDevice device, const ShaderSource& shader) {
 
 const Kernel& KernelCache::from_glsl(VkDevice device, std::string_view name,
                                      std::string_view glsl) {
-  const std::uint64_t key = content_hash(glsl.data(), glsl.size());
+  const std::uint64_t key = fnv1a(kFnvOffset, glsl.data(), glsl.size());
   if (auto it = by_glsl_.find(key); it != by_glsl_.end()) return *it->second;
   const std::vector<std::uint32_t> spirv = compile_glsl(name, glsl);
   ++glsl_compiles_;

@@ -46,9 +46,6 @@ ShaderInterface reflect(std::string_view name, std::span<const std::uint32_t> sp
 // (which names `name` and the line) when the source does not compile.
 std::vector<std::uint32_t> compile_glsl(std::string_view name, std::string_view source);
 
-// FNV-1a over bytes: the caches' keys.
-std::uint64_t content_hash(const void* data, std::size_t bytes);
-
 struct Kernel {
   std::string name;
   ShaderInterface interface;

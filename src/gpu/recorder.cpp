@@ -118,10 +118,27 @@ Recorder::Recorder(Context::Impl& ctx, DescriptorArena* sets) : ctx_(ctx), owns_
 Recorder::Recorder(Context::Impl& ctx, VkCommandBuffer external, DescriptorArena& sets)
     : ctx_(ctx), cmd_(external), sets_(&sets) {
   ctx.require_device();
+  // The application submits this command buffer when it likes: voxfield's own submissions made
+  // in between (a SceneRenderer::sync(), say) were not known when these barriers were derived.
+  // One barrier first orders everything submitted before this command buffer on the queue.
+  VkMemoryBarrier all{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  all.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
+  all.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+  vkCmdPipelineBarrier(cmd_, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+                       0, 1, &all, 0, nullptr, 0, nullptr);
+  ++ctx_.counters.pipeline_barriers;
 }
 
 Recorder::~Recorder() {
   if (owns_cmd_) vkFreeCommandBuffers(ctx_.device, ctx_.command_pool, 1, &cmd_);
+  if (owns_cmd_ && !submitted_) {
+    // Abandoned (an exception between recording and submitting): the states recorded for these
+    // buffers describe commands that never ran. Assume anything may have touched them, so the
+    // next use of each waits for everything before it.
+    for (Buffer* b : used_)
+      b->sync = Buffer::Sync{VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, 0, 0,
+                             VK_PIPELINE_STAGE_ALL_COMMANDS_BIT};
+  }
 }
 
 void Recorder::touch(Buffer& b) {
@@ -130,6 +147,7 @@ void Recorder::touch(Buffer& b) {
 }
 
 void Recorder::prepare(std::span<const Use> uses_in) {
+  if (submitted_) throw InvalidArgument("GPU recorder: recording after submit()");
   // One use per buffer: a buffer bound twice (or copied onto itself) is used by the union.
   std::vector<Use> uses;
   for (const Use& u : uses_in) {
@@ -145,6 +163,7 @@ void Recorder::prepare(std::span<const Use> uses_in) {
   std::vector<VkBufferMemoryBarrier> barriers;
   VkPipelineStageFlags src = 0, dst = 0;
   for (const Use& u : uses) {
+    if (std::find(used_.begin(), used_.end(), u.buffer) == used_.end()) used_.push_back(u.buffer);
     Buffer::Sync& s = u.buffer->sync;
     const bool writes = (u.access & kWriteAccess) != 0;
     VkPipelineStageFlags wait = 0;
@@ -183,10 +202,21 @@ void Recorder::prepare(std::span<const Use> uses_in) {
       s.read_stages |= u.stage;
     }
   }
-  if (barriers.empty()) return;
-  vkCmdPipelineBarrier(cmd_, src, dst, 0, 0, nullptr, static_cast<std::uint32_t>(barriers.size()),
-                       barriers.data(), 0, nullptr);
-  ++ctx_.counters.pipeline_barriers;
+  if (!barriers.empty()) {
+    vkCmdPipelineBarrier(cmd_, src, dst, 0, 0, nullptr, static_cast<std::uint32_t>(barriers.size()),
+                         barriers.data(), 0, nullptr);
+    ++ctx_.counters.pipeline_barriers;
+  }
+  start_pending_pass();
+}
+
+void Recorder::start_pending_pass() {
+  // A pass's start is stamped after the barrier of its first command, so that waiting for the
+  // previous pass is not counted in this one.
+  if (pending_start_ < 0) return;
+  vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx_.timestamps,
+                      static_cast<std::uint32_t>(pending_start_));
+  pending_start_ = -1;
 }
 
 void Recorder::bind(const Kernel& kernel, Buffers buffers, const void* push, std::size_t push_bytes,
@@ -302,15 +332,16 @@ int Recorder::begin_pass() {
       queries_used_ + 2 > Context::Impl::kQueries)
     return -1;
   if (queries_used_ == 0) vkCmdResetQueryPool(cmd_, ctx_.timestamps, 0, Context::Impl::kQueries);
+  start_pending_pass();  // a pass begun and never given a command starts here
   const int ticket = queries_used_;
   queries_used_ += 2;
-  vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, ctx_.timestamps,
-                      static_cast<std::uint32_t>(ticket));
+  pending_start_ = ticket;  // stamped after the next command's barrier
   return ticket;
 }
 
 void Recorder::end_pass(int ticket, std::string label) {
   if (ticket < 0) return;
+  if (pending_start_ == ticket) start_pending_pass();  // an empty pass
   vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, ctx_.timestamps,
                       static_cast<std::uint32_t>(ticket + 1));
   passes_.emplace_back(ticket, std::move(label));
@@ -321,7 +352,8 @@ void Recorder::submit() {
     throw InvalidArgument(
         "GPU recorder: an application's command buffer is submitted by the application");
   if (submitted_) throw InvalidArgument("GPU recorder: submitted twice");
-  submitted_ = true;
+  if (pending_start_ >= 0 || passes_.size() * 2 != static_cast<std::size_t>(queries_used_))
+    throw InvalidArgument("GPU recorder: a timed pass was begun and not ended");
   // The host reads what the GPU wrote into host-visible buffers once the fence has signalled.
   std::vector<Use> host;
   for (Buffer* b : touched_)
@@ -330,6 +362,7 @@ void Recorder::submit() {
   if (!host.empty()) prepare(host);
   check(vkEndCommandBuffer(cmd_), "vkEndCommandBuffer");
   ctx_.submit_and_wait(cmd_);
+  submitted_ = true;  // ran: the buffers' states now describe what happened
   if (passes_.empty()) return;
   std::vector<std::uint64_t> ticks(static_cast<std::size_t>(queries_used_));
   check(vkGetQueryPoolResults(ctx_.device, ctx_.timestamps, 0,

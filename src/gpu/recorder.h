@@ -136,6 +136,7 @@ class Recorder {
   void bind(const Kernel& kernel, Buffers buffers, const void* push, std::size_t push_bytes,
             const Use* also);
   void touch(Buffer& b);
+  void start_pending_pass();
 
   Context::Impl& ctx_;
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
@@ -144,6 +145,8 @@ class Recorder {
   std::unique_ptr<DescriptorArena> own_sets_;
   DescriptorArena* sets_;
   std::vector<Buffer*> touched_;  // host-visible buffers written, made visible at submit()
+  std::vector<Buffer*> used_;     // every buffer whose state this recording changed
+  int pending_start_ = -1;        // a begun pass whose start is stamped after the next barrier
   std::vector<std::pair<int, std::string>> passes_;
   int queries_used_ = 0;
   std::vector<PassTiming> timings_;
