@@ -34,6 +34,22 @@ inline std::string backend_test_name(const ::testing::TestParamInfo<Backend>& in
   return backend_name(info.param);
 }
 
+// True under AddressSanitizer or ThreadSanitizer, where the Vulkan instances of the long suites run
+// a sample of their cases: what the sanitizers check there is voxfield's host code, which every
+// case runs alike, while lavapipe's shader emulation under instrumentation costs minutes. The
+// optimised build runs every case.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+inline constexpr bool kSanitizedBuild = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+inline constexpr bool kSanitizedBuild = true;
+#else
+inline constexpr bool kSanitizedBuild = false;
+#endif
+#else
+inline constexpr bool kSanitizedBuild = false;
+#endif
+
 // The exact field on `backend`.
 inline DistanceField exact_field(Backend backend, const World& world,
                                  const DistanceOptions& options) {

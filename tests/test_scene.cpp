@@ -3,32 +3,23 @@
 
 #include "voxfield/parallel.h"
 #include "voxfield/scene.h"
+#include "world_voxels.h"
 
 using namespace voxfield;
-
-namespace {
-
-std::vector<std::uint8_t> dense(const World& w, Vec3i size) {
-  std::vector<std::uint8_t> v(static_cast<std::size_t>(Box3i::from_size(size).volume()));
-  w.voxels.copy_to_dense(Box3i::from_size(size), v.data());
-  return v;
-}
-
-}  // namespace
 
 TEST(Scene, TerrainIsDeterministicAcrossChunkEdgesAndThreads) {
   SceneOptions o;
   o.size = {70, 53, 61};  // odd sizes, not multiples of any chunk edge
-  const auto reference = dense(make_terrain(o), o.size);
+  const auto reference = test::dense_voxels(make_terrain(o), Box3i::from_size(o.size));
   for (int edge : {8, 16, 64, 128}) {
     o.chunk_edge = edge;
-    EXPECT_EQ(dense(make_terrain(o), o.size), reference) << edge;
+    EXPECT_EQ(test::dense_voxels(make_terrain(o), Box3i::from_size(o.size)), reference) << edge;
   }
   ThreadLimit one(1);
   o.chunk_edge = 32;
-  EXPECT_EQ(dense(make_terrain(o), o.size), reference);
+  EXPECT_EQ(test::dense_voxels(make_terrain(o), Box3i::from_size(o.size)), reference);
   o.seed = 1;
-  EXPECT_NE(dense(make_terrain(o), o.size), reference);
+  EXPECT_NE(test::dense_voxels(make_terrain(o), Box3i::from_size(o.size)), reference);
 }
 
 TEST(Scene, SolidFractions) {

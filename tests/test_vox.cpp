@@ -9,6 +9,7 @@
 #include "vox_builder.h"
 #include "voxfield/file.h"
 #include "voxfield/vox.h"
+#include "world_voxels.h"
 
 using namespace voxfield;
 using namespace voxfield::test;
@@ -56,12 +57,6 @@ const CorpusFile kFiles[] = {
     {"mmmm_chr_mayor.vox", 1, 340, {}},
 };
 
-std::vector<std::uint8_t> dense_of(const World& w, const Box3i& box) {
-  std::vector<std::uint8_t> v(static_cast<std::size_t>(box.volume()));
-  w.voxels.copy_to_dense(box, v.data());
-  return v;
-}
-
 class Corpus : public ::testing::TestWithParam<CorpusFile> {};
 
 // Readable test parameter names in failure messages.
@@ -95,7 +90,7 @@ TEST_P(Corpus, MatchesTheCorpusReadme) {
   EXPECT_EQ(back.world.voxels.content_bounds(), content);
   EXPECT_EQ(back.world.solid_count(), in.world.solid_count());
   if (!content.empty()) {
-    EXPECT_TRUE(dense_of(back.world, content) == dense_of(in.world, content));
+    EXPECT_TRUE(test::dense_voxels(back.world, content) == test::dense_voxels(in.world, content));
   }
   for (int m = 1; m < 256; ++m) EXPECT_EQ(back.world.palette[m], in.world.palette[m]) << m;
 }

@@ -12,6 +12,7 @@
 
 #include "voxfield/scene.h"
 #include "voxfield/world_file.h"
+#include "world_voxels.h"
 
 #include <zlib.h>
 
@@ -19,12 +20,6 @@ using namespace voxfield;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::vector<std::uint8_t> dense(const World& w, const Box3i& b) {
-  std::vector<std::uint8_t> v(static_cast<std::size_t>(b.volume()));
-  w.voxels.copy_to_dense(b, v.data());
-  return v;
-}
 
 fs::path temp_dir() {
   const fs::path d = fs::temp_directory_path() / ("voxfield_vfw_" + std::to_string(::getpid()));
@@ -54,7 +49,8 @@ TEST(WorldFile, RoundTripsWorldsAndFieldsExactly) {
   EXPECT_EQ(back.version, kWorldFileVersion);
   EXPECT_EQ(back.world.palette, w.palette);
   EXPECT_EQ(back.world.voxels.bounds(), w.voxels.bounds());
-  EXPECT_EQ(dense(back.world, *w.voxels.bounds()), dense(w, *w.voxels.bounds()));
+  EXPECT_EQ(test::dense_voxels(back.world, *w.voxels.bounds()),
+            test::dense_voxels(w, *w.voxels.bounds()));
   EXPECT_EQ(back.world.voxels.memory().uniform_chunks, w.voxels.memory().uniform_chunks);
   ASSERT_EQ(back.fields.size(), 2u);
   const Box3i box = *w.voxels.bounds();
@@ -115,7 +111,7 @@ TEST(WorldFile, KillingASaveNeverDamagesThePreviousFile) {
   o.seed = 99;
   const World b = make_terrain(o);
   const Box3i box = Box3i::from_size(o.size);
-  const auto da = dense(a, box), db = dense(b, box);
+  const auto da = test::dense_voxels(a, box), db = test::dense_voxels(b, box);
   write_world_file(a, path);
   std::mt19937 rng(8);
   for (int round = 0; round < 6; ++round) {
@@ -130,7 +126,7 @@ TEST(WorldFile, KillingASaveNeverDamagesThePreviousFile) {
     int status = 0;
     waitpid(child, &status, 0);
     const WorldFile back = read_world_file(path);  // must parse: old or new, never a mix
-    const auto d = dense(back.world, box);
+    const auto d = test::dense_voxels(back.world, box);
     EXPECT_TRUE(d == da || d == db) << "round " << round;
   }
   fs::remove_all(dir);

@@ -35,12 +35,12 @@ struct BenchEditsSettings {
   FieldArgs field;
 };
 
-struct Summary {
+struct TimeSummary {
   double mean, median, stddev, ci95, p99, max;
 };
 
-Summary summarise(std::vector<double> v) {
-  Summary s{};
+TimeSummary summarise(std::vector<double> v) {
+  TimeSummary s{};
   if (v.empty()) return s;
   std::sort(v.begin(), v.end());
   const double n = static_cast<double>(v.size());
@@ -128,7 +128,7 @@ int run_bench_edits(const BenchEditsSettings& s) {
     }
   }
   const gpu::Counters gpu_after = field.gpu_counters();
-  const Summary lat = summarise(latency_ms), upd = summarise(update_ms);
+  const TimeSummary lat = summarise(latency_ms), upd = summarise(update_ms);
   const std::size_t field_bytes = field.memory_bytes();
   const std::size_t world_bytes = world.voxels.memory().bytes;
   const double voxels = std::pow(static_cast<double>(s.world), 3);
@@ -171,7 +171,7 @@ int run_bench_edits(const BenchEditsSettings& s) {
               << gpu_stats["per_update"].dump() << "\n";
   }
   if (!s.json.empty()) {
-    auto summary_json = [](const Summary& x) {
+    auto summary_json = [](const TimeSummary& x) {
       return nlohmann::json{{"mean", x.mean}, {"median", x.median}, {"std", x.stddev},
                             {"ci95", x.ci95}, {"p99", x.p99},       {"max", x.max}};
     };

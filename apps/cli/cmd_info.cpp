@@ -40,20 +40,20 @@ std::string bytes_text(std::size_t bytes) {
 }
 
 // What both outputs report, computed once.
-struct Summary {
+struct WorldSummary {
   Box3i content;
   GridMemory memory;
   int materials_used = 0;
   std::int64_t solid = 0;
 
-  explicit Summary(const World& w)
+  explicit WorldSummary(const World& w)
       : content(w.voxels.content_bounds()), memory(w.voxels.memory()), solid(w.solid_count()) {
     const auto histogram = w.material_histogram();
     for (int m = 1; m < 256; ++m) materials_used += histogram[m] > 0;
   }
 };
 
-int print_text(const InfoSettings& s, const LoadedWorld& in, const Summary& sum);
+int print_text(const InfoSettings& s, const LoadedWorld& in, const WorldSummary& sum);
 
 int run_info(const InfoSettings& s) {
   set_activity("loading " + s.path);
@@ -61,7 +61,7 @@ int run_info(const InfoSettings& s) {
   lo.chunk_edge = s.chunk_edge;
   const LoadedWorld in = load_world(s.path, lo);
   set_activity("describing " + s.path);
-  const Summary sum(in.world);
+  const WorldSummary sum(in.world);
   if (!s.json) return print_text(s, in, sum);
   const Grid<std::uint8_t>& g = in.world.voxels;
   const Box3i& content = sum.content;
@@ -118,7 +118,7 @@ int run_info(const InfoSettings& s) {
   return 0;
 }
 
-int print_text(const InfoSettings& s, const LoadedWorld& in, const Summary& sum) {
+int print_text(const InfoSettings& s, const LoadedWorld& in, const WorldSummary& sum) {
   const Grid<std::uint8_t>& g = in.world.voxels;
   const Box3i& content = sum.content;
   const GridMemory& mem = sum.memory;

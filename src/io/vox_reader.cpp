@@ -28,7 +28,7 @@ using detail::vox::lookup;
 using detail::vox::ModelData;
 using detail::vox::Node;
 
-constexpr int kMaxModelEdge = 1024;  // MagicaVoxel writes at most 256; leave room for others
+constexpr int kMaxReadModelEdge = 1024;  // MagicaVoxel writes at most 256; leave room for others
 constexpr std::int64_t kMaxTranslation = std::int64_t{1} << 30;  // one nTRN's _t component
 constexpr int kMinVersion = 150;                                 // the oldest documented format
 // What the reader itself keeps per stored voxel of an XYZI model, for the memory estimate (the
@@ -212,9 +212,9 @@ class VoxParser {
     Vec3i s;
     for (int k = 0; k < 3; ++k) {
       s[k] = c.i32("model size");
-      if (s[k] < 1 || s[k] > kMaxModelEdge) {
+      if (s[k] < 1 || s[k] > kMaxReadModelEdge) {
         c.fail("model size " + std::to_string(s[k]) + " outside 1.." +
-               std::to_string(kMaxModelEdge));
+               std::to_string(kMaxReadModelEdge));
       }
     }
     pending_size_ = s;

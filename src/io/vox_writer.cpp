@@ -15,7 +15,7 @@
 namespace voxfield {
 namespace {
 
-constexpr int kMaxModelEdge = 256;
+constexpr int kMaxWrittenModelEdge = 256;
 
 class Writer {
  public:
@@ -69,7 +69,7 @@ std::vector<std::uint8_t> encode_vox(const World& world) {
     Vec3i tile;
     Box3i chunks;  // the union of the tile's stored chunk boxes
   };
-  static_assert(kMaxModelEdge == 1 << 8, "tiles are found by shifting coordinates by 8");
+  static_assert(kMaxWrittenModelEdge == 1 << 8, "tiles are found by shifting coordinates by 8");
   std::vector<TileChunks> tiles;
   for (const Vec3i c : g.chunk_coords()) {
     const Box3i box = g.chunk_box(c);
