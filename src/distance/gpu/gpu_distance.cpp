@@ -112,6 +112,8 @@ class FieldEngine {
  public:
   FieldEngine(Context::Impl& ctx, const World& world, const DistanceOptions& options)
       : ctx_(ctx),
+        kernels_{ctx.kernel(shaders::edt_sites()), ctx.kernel(shaders::edt_lines()),
+                 ctx.kernel(shaders::edt_encode())},
         world_(world),
         options_(options),
         plan_(detail::make_field_plan(world.voxels, options)) {
@@ -261,10 +263,10 @@ class FieldEngine {
   // Step 3, one region's passes: recompute its compute box, encode its out box into the field.
   void record_region(Recorder& rec, const detail::UpdateRegion& r, bool timed) {
     const std::array<Buffer*, 11> bound = bindings();
-    const auto pass = [&](const ShaderSource& shader, const L::PassParams& t,
-                          std::uint64_t invocations, std::string name) {
+    const auto pass = [&](const Kernel& kernel, const L::PassParams& t, std::uint64_t invocations,
+                          std::string name) {
       const int ticket = timed ? rec.begin_pass() : -1;
-      rec.dispatch(ctx_.kernel(shader), bound, t, invocations);
+      rec.dispatch(kernel, bound, t, invocations);
       rec.end_pass(ticket, std::move(name));
     };
     const Vec3i n = r.in.size();
@@ -281,15 +283,15 @@ class FieldEngine {
       t.sites_are_air = to_air ? 1u : 0u;
       t.axis = 2;
       t.dst = result;
-      pass(shaders::edt_sites(), t, static_cast<std::uint64_t>(n.x) * n.y, "columns z" + what);
+      pass(kernels_.sites, t, static_cast<std::uint64_t>(n.x) * n.y, "columns z" + what);
       t.axis = 0;
       t.src = result;
       t.dst = other;
-      pass(shaders::edt_lines(), t, static_cast<std::uint64_t>(n.y) * n.z, "lines x" + what);
+      pass(kernels_.lines, t, static_cast<std::uint64_t>(n.y) * n.z, "lines x" + what);
       t.axis = 1;
       t.src = other;
       t.dst = result;
-      pass(shaders::edt_lines(), t, static_cast<std::uint64_t>(n.x) * n.z, "lines y" + what);
+      pass(kernels_.lines, t, static_cast<std::uint64_t>(n.x) * n.z, "lines y" + what);
     };
     transform(0, 1, false);
     if (plan_.is_signed) transform(2, 1, true);
@@ -300,7 +302,7 @@ class FieldEngine {
     const std::int64_t lanes = static_cast<std::int64_t>(lanes_of(options_.storage));
     const std::int64_t ox = r.out.begin.x - plan_.domain.begin.x;
     const std::int64_t words = (ox + r.out.size().x - 1) / lanes - ox / lanes + 1;
-    pass(shaders::edt_encode(), enc,
+    pass(kernels_.encode, enc,
          static_cast<std::uint64_t>(words * r.out.size().y * r.out.size().z), "encode");
   }
 
@@ -446,6 +448,13 @@ class FieldEngine {
   }
 
   Context::Impl& ctx_;
+  // The update's three kernels, looked up once: a lookup hashes the shader's SPIR-V, and an update
+  // of many small regions dispatches them hundreds of times.
+  struct Kernels {
+    const Kernel& sites;
+    const Kernel& lines;
+    const Kernel& encode;
+  } kernels_;
   const World& world_;
   DistanceOptions options_;
   detail::FieldPlan plan_;
