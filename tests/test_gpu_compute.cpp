@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <numeric>
+#include <optional>
 
 #include "csg_examples.h"
 #include "distance_shaders.h"
@@ -139,6 +140,62 @@ TEST(GpuCompute, GeneratedKernelsRunAndAreCompiledOnce) {
   for (std::uint32_t i = 0; i < n; ++i) ASSERT_EQ(got[i], 2.0f * static_cast<float>(i) + 0.5f) << i;
   EXPECT_THROW(rec.dispatch(k, {&a, &out}, std::uint32_t{1}, n), InvalidArgument)
       << "push constants of the wrong size";
+  const auto messages = ctx->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size() << " messages, first: " << messages.front();
+}
+
+// Recorders without an arena of their own share the context's, recycled when the last of them is
+// done: a stream of submissions creates no descriptor pools, and a recorder still recording keeps
+// its sets valid while another one submits.
+TEST(GpuCompute, DescriptorSetsAreRecycledNotRecreated) {
+  REQUIRE_GPU();
+  auto ctx = validated();
+  Context::Impl& c = ctx->impl();
+  ctx->clear_validation_messages();
+  const Kernel& k = c.kernels.from_glsl(c.device, "scale", kScale);
+  const std::uint32_t n = 256;
+  Buffer host(c, n * 4, kUsage, true), a(c, n * 4, kUsage, false), b(c, n * 4, kUsage, false);
+  Buffer b2(c, n * 4, kUsage, false), out1(c, n * 4, kUsage, true), out2(c, n * 4, kUsage, true);
+  std::iota(static_cast<float*>(host.mapped()), static_cast<float*>(host.mapped()) + n, 0.0f);
+  const auto run = [&](Recorder& rec, Buffer& out, float k_add, Buffer& mid) {
+    rec.copy(host, 0, a, 0, n * 4);
+    rec.dispatch(k, {&a, &mid}, ScaleParams{k_add, n}, n);
+    rec.copy(mid, 0, out, 0, n * 4);
+  };
+  const auto expect_out = [&](const Buffer& out, float k_add) {
+    const auto* got = static_cast<const float*>(out.mapped());
+    for (std::uint32_t i = 0; i < n; ++i)
+      ASSERT_EQ(got[i], 2.0f * static_cast<float>(i) + k_add) << i;
+  };
+  {
+    Recorder warm(c);
+    run(warm, out1, 0, b);
+    warm.submit();
+  }
+  const std::int64_t pools = ctx->counters().descriptor_pools;
+  for (int i = 0; i < 20; ++i) {
+    Recorder rec(c);
+    run(rec, out1, static_cast<float>(i), b);
+    rec.submit();
+    expect_out(out1, static_cast<float>(i));
+  }
+  EXPECT_EQ(ctx->counters().descriptor_pools, pools) << "sets recycled, no new pools";
+  {
+    // Two recorders alive at once: the first, done and gone, must not recycle the second's sets
+    // (a third recording would then rewrite them to its own buffers).
+    std::optional<Recorder> first(std::in_place, c);
+    Recorder second(c);
+    run(*first, out1, 1, b);
+    run(second, out2, 2, b);
+    first->submit();
+    first.reset();
+    Recorder third(c);
+    run(third, out1, 3, b2);
+    second.submit();
+    expect_out(out2, 2);
+    third.submit();
+    expect_out(out1, 3);
+  }
   const auto messages = ctx->validation_messages();
   EXPECT_TRUE(messages.empty()) << messages.size() << " messages, first: " << messages.front();
 }

@@ -26,7 +26,8 @@ inline nlohmann::json gpu_json(gpu::Context& ctx) {
           {"submits", c.submits},
           {"fence_waits", c.fence_waits},
           {"bytes_uploaded", c.bytes_uploaded},
-          {"bytes_downloaded", c.bytes_downloaded}};
+          {"bytes_downloaded", c.bytes_downloaded},
+          {"descriptor_pools", c.descriptor_pools}};
 }
 
 inline nlohmann::json pass_timings_json(const std::vector<gpu::PassTiming>& timings) {

@@ -78,6 +78,7 @@ struct Counters {
   std::int64_t fence_waits = 0;
   std::int64_t bytes_uploaded = 0;
   std::int64_t bytes_downloaded = 0;
+  std::int64_t descriptor_pools = 0;  // descriptor pools created (sets are recycled, not pools)
 };
 
 // GPU time of one pass from timestamp queries (on lavapipe: CPU emulation, not GPU speed).

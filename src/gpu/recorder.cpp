@@ -61,6 +61,7 @@ VkDescriptorSet DescriptorArena::set(const Kernel& kernel, std::span<Buffer* con
       VkDescriptorPool pool;
       check(vkCreateDescriptorPool(ctx_->device, &dp, nullptr, &pool), "vkCreateDescriptorPool");
       pools_.push_back(pool);
+      ++ctx_->counters.descriptor_pools;
       left_in_pool_ = kSetsPerPool;
     }
     VkDescriptorSetAllocateInfo dsa{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
@@ -111,8 +112,12 @@ Recorder::Recorder(Context::Impl& ctx, DescriptorArena* sets) : ctx_(ctx), owns_
     vkFreeCommandBuffers(ctx.device, ctx.command_pool, 1, &cmd_);
     check(r, "vkBeginCommandBuffer");
   }
-  if (!sets) own_sets_ = std::make_unique<DescriptorArena>(ctx);
-  sets_ = sets ? sets : own_sets_.get();
+  if (!sets) {
+    if (!ctx.transient_sets) ctx.transient_sets = std::make_unique<DescriptorArena>(ctx);
+    ++ctx.transient_set_users;
+    transient_sets_ = true;
+  }
+  sets_ = sets ? sets : ctx.transient_sets.get();
 }
 
 Recorder::Recorder(Context::Impl& ctx, VkCommandBuffer external, DescriptorArena& sets)
@@ -139,6 +144,9 @@ Recorder::~Recorder() {
       b->sync = Buffer::Sync{VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, 0, 0,
                              VK_PIPELINE_STAGE_ALL_COMMANDS_BIT};
   }
+  // This recorder's commands ran (submit() waits) or never will: when no other recorder still
+  // holds sets from the shared arena, its sets are recycled.
+  if (transient_sets_ && --ctx_.transient_set_users == 0) ctx_.transient_sets->reset();
 }
 
 void Recorder::touch(Buffer& b) {

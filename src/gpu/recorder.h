@@ -13,8 +13,9 @@
 //
 // A recorder either owns a command buffer (submit() submits it with the context's fence and waits:
 // one submit, one fence wait) or records into an application's command buffer, which the
-// application submits (gpu_vulkan.h). Descriptor sets come from a DescriptorArena: the recorder's
-// own (freed after its submission), or one the caller keeps alive as long as its commands may run.
+// application submits (gpu_vulkan.h). Descriptor sets come from a DescriptorArena: the context's
+// shared one (recycled once no recorder using it is alive), or one the caller keeps alive as long
+// as its commands may run.
 #pragma once
 
 #include <initializer_list>
@@ -142,8 +143,8 @@ class Recorder {
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   bool owns_cmd_ = false;
   bool submitted_ = false;
-  std::unique_ptr<DescriptorArena> own_sets_;
   DescriptorArena* sets_;
+  bool transient_sets_ = false;   // sets_ is the context's shared arena (vulkan_context.h)
   std::vector<Buffer*> touched_;  // host-visible buffers written, made visible at submit()
   std::vector<Buffer*> used_;     // every buffer whose state this recording changed
   int pending_start_ = -1;        // a begun pass whose start is stamped after the next barrier

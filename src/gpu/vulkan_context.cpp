@@ -6,6 +6,7 @@
 #include <sstream>
 #include <utility>
 
+#include "gpu/recorder.h"
 #include "voxfield/gpu_vulkan.h"
 
 namespace voxfield::gpu {
@@ -260,6 +261,7 @@ void Context::Impl::destroy() {
     vkDeviceWaitIdle(device);
     upload = Buffer();
     readback = Buffer();
+    transient_sets.reset();
     kernels.destroy(device);
     if (timestamps) vkDestroyQueryPool(device, timestamps, nullptr);
     if (fence) vkDestroyFence(device, fence, nullptr);

@@ -8,6 +8,7 @@
 #include <volk.h>
 
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <span>
 #include <string>
@@ -57,6 +58,8 @@ class Buffer {
   void* mapped_ = nullptr;
 };
 
+class DescriptorArena;
+
 struct Context::Impl {
   VkInstance instance = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
@@ -85,6 +88,11 @@ struct Context::Impl {
   KernelCache kernels;
   const Kernel& kernel(const ShaderSource& shader) { return kernels.get(device, shader); }
   static constexpr int kQueries = 64;  // timestamps per submission
+  // Descriptor sets of the recorders that bring no arena of their own: one arena per context,
+  // recycled when the last such recorder is done (recorder.cpp) rather than a pool created and
+  // destroyed with every submission.
+  std::unique_ptr<DescriptorArena> transient_sets;
+  int transient_set_users = 0;
 
   // Reusable host-visible buffers for uploads and read-backs (grown when too small).
   Buffer upload, readback;

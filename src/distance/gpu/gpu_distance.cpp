@@ -302,8 +302,8 @@ class FieldEngine {
     const std::int64_t lanes = static_cast<std::int64_t>(lanes_of(options_.storage));
     const std::int64_t ox = r.out.begin.x - plan_.domain.begin.x;
     const std::int64_t words = (ox + r.out.size().x - 1) / lanes - ox / lanes + 1;
-    pass(kernels_.encode, enc,
-         static_cast<std::uint64_t>(words * r.out.size().y * r.out.size().z), "encode");
+    pass(kernels_.encode, enc, static_cast<std::uint64_t>(words * r.out.size().y * r.out.size().z),
+         "encode");
   }
 
   // Step 4, read-back (when asked): the field and its sites into `readback`.
