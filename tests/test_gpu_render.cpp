@@ -1,0 +1,176 @@
+// The Vulkan ray marcher against the CPU renderer frame for frame, and resident scenes that follow
+// edits copying only their changed chunks (voxfield_gpu_tests; the validation layer on, with
+// synchronisation validation, and not a single message from it).
+#include <gtest/gtest.h>
+
+#include "gpu_suite.h"
+#include "image_compare.h"
+#include "voxfield/edit.h"
+#include "voxfield/gpu_render.h"
+#include "voxfield/gpu_render_vulkan.h"
+
+using namespace voxfield;
+using test::gpu_tests_wanted;
+using test::random_world;
+using test::validated_context;
+
+namespace {
+
+// Same frame on both backends: at most 0.5 % of pixels more than 8 levels apart in a channel
+// (the GPU's float traversal may pick the neighbouring voxel where a ray grazes an edge), mean
+// difference under 0.1 levels (what float vs double and exp vs a table leave: ~0.02).
+void expect_images_close(const Image& gpu_image, const Image& cpu_image, const std::string& what) {
+  ASSERT_EQ(gpu_image.width, cpu_image.width);
+  ASSERT_EQ(gpu_image.height, cpu_image.height);
+  const test::ImageDiff d = test::compare_images(gpu_image, cpu_image, 8);
+  EXPECT_LE(d.off, d.pixels / 200)
+      << what << ": " << d.off << " of " << d.pixels << " pixels differ by more than 8 levels";
+  EXPECT_LT(d.mean, 0.1) << what;
+}
+
+}  // namespace
+
+TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = validated_context();
+  ctx->clear_validation_messages();
+  World w = random_world({70, 50, 40}, 16, 0.004, 31);
+  w.voxels.fill(Box3i{{0, 0, 0}, {70, 50, 3}}, 120);  // a floor to cast shadows on
+  for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean}) {
+    RenderSceneOptions so;
+    so.skip_metric = m;
+    const RenderScene scene(w, so);
+    RenderOptions o;
+    o.width = 160;
+    o.height = 96;
+    for (RenderView view : {RenderView::kShaded, RenderView::kChunks, RenderView::kDistance}) {
+      o.view = view;
+      for (const Camera& cam :
+           {Camera::framing(scene.box(), 160.0 / 96), Camera::top(scene.box(), 160.0 / 96)}) {
+        const std::string what = std::string(metric_name(m)) + " " + render_view_name(view);
+        const gpu::Counters before = ctx->counters();
+        const Image g = gpu::render(*ctx, scene, cam, o);
+        EXPECT_EQ(ctx->counters().submits - before.submits, 1) << what;
+        expect_images_close(g, render(scene, cam, o), what);
+      }
+    }
+  }
+  RenderOptions fog;
+  fog.width = 96;
+  fog.height = 64;
+  fog.fog_density = 0.01;
+  const RenderScene scene(w);
+  const Camera cam = Camera::framing(scene.box(), 1.5);
+  expect_images_close(gpu::render(*ctx, scene, cam, fog), render(scene, cam, fog), "fog");
+  const auto messages = ctx->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
+  RenderOptions cut = fog;
+  cut.view = RenderView::kDistance;
+  for (int z : {3, 7, 39}) {  // just above the floor, a middle cut, the top layer
+    cut.slice_z = z;
+    expect_images_close(gpu::render(*ctx, scene, Camera::top(scene.box(), 1.5), cut),
+                        render(scene, Camera::top(scene.box(), 1.5), cut),
+                        "distance cut z=" + std::to_string(z));
+  }
+  cut.slice_z = 40;  // outside the box
+  EXPECT_THROW(gpu::render(*ctx, scene, cam, cut), InvalidArgument);
+  // The error view: the approximations' errors along each ray and the rays they let through
+  // geometry (magenta), as the CPU draws them.
+  RenderOptions error = fog;
+  error.view = RenderView::kError;
+  for (Algorithm alg : {Algorithm::kJfaSeed, Algorithm::kJfa, Algorithm::kExact}) {
+    error.error_algorithm = alg;
+    RenderStats cpu_stats;
+    const Image cpu_image = render(scene, cam, error, &cpu_stats);
+    expect_images_close(gpu::render(*ctx, scene, cam, error), cpu_image,
+                        std::string("error view ") + algorithm_name(alg));
+    if (alg == Algorithm::kJfaSeed) {
+      EXPECT_GT(cpu_stats.max_error, 0);  // the view has something to show
+    }
+  }
+}
+
+TEST(Gpu, ResidentScenesFollowEditsWithOnlyTheirChunksCopied) {
+  // A SceneRenderer synced after each batch of edits renders what a scene uploaded from scratch
+  // renders (same GPU, same data: bit for bit), copies only the chunks that changed, and submits
+  // nothing when nothing did.
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = validated_context();
+  ctx->clear_validation_messages();
+  World w = random_world({64, 48, 32}, 8, 0.003, 41);
+  w.voxels.fill(Box3i{{0, 0, 0}, {64, 48, 4}}, 120);
+  RenderSceneOptions so = DynamicRenderScene::default_options();
+  so.skip_clamp = 10;
+  so.lighting_clamp = 6;
+  DynamicRenderScene live(w, so);
+  gpu::SceneRenderer renderer(ctx);
+  RenderOptions o;
+  o.width = 96;
+  o.height = 64;
+  const Camera cam = Camera::framing(live.scene().box(), 1.5);
+  EXPECT_TRUE(renderer.sync(live.scene()));
+  gpu::Counters before = ctx->counters();
+  EXPECT_FALSE(renderer.sync(live.scene()));
+  EXPECT_EQ(ctx->counters().submits, before.submits);
+  const std::int64_t chunk_bytes =
+      8 * 8 * 8 * (2 + 1);  // skip cells (u16) + lighting (u8) per chunk
+  std::mt19937 rng(8);
+  auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
+  for (int batch = 0; batch < 6; ++batch) {
+    for (int k = 0; k < 3; ++k) {
+      const EditOp op = uni(0, 2) == 0 ? EditOp::kCarve
+                        : uni(0, 1)    ? EditOp::kPlace
+                                       : EditOp::kPaint;
+      apply_edit(
+          w,
+          {op, SphereBrush{{uni(0, 63) * 1.0, uni(0, 47) * 1.0, uni(0, 20) * 1.0}, uni(1, 5) * 1.0},
+           static_cast<std::uint8_t>(uni(1, 255))},
+          &dirty);
+    }
+    const DynamicRenderScene::UpdateStats st = live.update(dirty);
+    dirty.clear();
+    before = ctx->counters();
+    renderer.sync(live.scene());
+    const gpu::Counters after = ctx->counters();
+    EXPECT_LE(after.submits - before.submits, 1);
+    EXPECT_EQ(after.bytes_downloaded, before.bytes_downloaded);
+    // Each changed chunk: its cells, its chunk-table entry; plus the palette when it changed.
+    EXPECT_LE(after.bytes_uploaded - before.bytes_uploaded,
+              static_cast<std::int64_t>(st.chunks_changed) * (chunk_bytes + 16) + 256 * 16)
+        << "batch " << batch;
+    const Image incremental = renderer.render(cam, o);
+    EXPECT_EQ(incremental.rgb, gpu::render(*ctx, live.scene(), cam, o).rgb) << "batch " << batch;
+    const RenderScene fresh(w, live.skip_field(), live.light_field());
+    EXPECT_EQ(incremental.rgb, gpu::render(*ctx, fresh, cam, o).rgb) << "batch " << batch;
+  }
+  const auto messages = ctx->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
+  gpu::SceneRenderer unsynced(ctx);
+  EXPECT_THROW(unsynced.render(cam, o), InvalidArgument);
+
+  // Arenas outgrowing their device buffers: a nearly empty world where one edit makes dozens of
+  // chunks dense. The buffers move on the GPU; still only the changed chunks travel.
+  World sparse(8, Box3i::from_size({64, 64, 32}));
+  sparse.voxels.set({5, 5, 5}, 3);
+  DynamicRenderScene growing(sparse, so);
+  gpu::SceneRenderer r2(ctx);
+  r2.sync(growing.scene());
+  for (int round = 0; round < 3; ++round) {
+    DirtyRegions d(8, DirtyRegions::Track::kAnyChange);
+    apply_edit(sparse,
+               {EditOp::kPlace, SphereBrush{{12.0 + 20 * round, 30, 12}, 9 + 2.0 * round}, 40}, &d);
+    const DynamicRenderScene::UpdateStats st = growing.update(d);
+    before = ctx->counters();
+    r2.sync(growing.scene());
+    EXPECT_LE(ctx->counters().bytes_uploaded - before.bytes_uploaded,
+              static_cast<std::int64_t>(st.chunks_changed) * (chunk_bytes + 16) + 256 * 16)
+        << "round " << round;
+    const RenderScene fresh(sparse, growing.skip_field(), growing.light_field());
+    EXPECT_EQ(r2.render(cam, o).rgb, gpu::render(*ctx, fresh, cam, o).rgb) << "round " << round;
+  }
+  const auto late = ctx->validation_messages();
+  EXPECT_TRUE(late.empty()) << late.size() << " validation messages, first: " << late.front();
+}
