@@ -506,7 +506,8 @@ TEST(CsgGlsl, InterpreterProgramsEncodeTheTape) {
     if (t.code[i].op == OpCode::kShape) {
       EXPECT_EQ((w[0] >> 8) & 0xFFu, static_cast<std::uint32_t>(t.code[i].shape));
     }
-    constants += w[0] >> 16;
+    EXPECT_EQ(w[0] >> 24, t.code[i].material);
+    constants += (w[0] >> 16) & 0xFFu;
   }
   EXPECT_EQ(constants, t.params.size()) << "the program reads every constant once, in order";
   EXPECT_EQ(program[1 + 4 * (t.code.size() - 1) + 2], t.reg[t.code.back().a]);
@@ -534,11 +535,11 @@ TEST(CsgGlsl, EveryVariantOfTheExamplesCompiles) {
     for (std::size_t v = 0; v < tree.variants.size(); ++v)
       src << glsl_variant(tree.variants[v].tape, static_cast<int>(v));
     src << glsl_variant(whole, 999);
-    src << "void main() {\n  vec3 p = vec3(gl_GlobalInvocationID);\n  float s = vf_variant_999(p, "
-           "0u);\n";
+    src << "void main() {\n  vec3 p = vec3(gl_GlobalInvocationID);\n  uint m, mats = 0u;\n"
+        << "  float s = vf_variant_999(p, 0u, m);\n";
     for (std::size_t v = 0; v < tree.variants.size(); ++v)
-      src << "  s += vf_variant_" << v << "(p, 0u);\n";
-    src << "  vf_out[gl_GlobalInvocationID.x] = s;\n}\n";
+      src << "  s += vf_variant_" << v << "(p, 0u, m);\n  mats += m;\n";
+    src << "  vf_out[gl_GlobalInvocationID.x] = s + float(mats);\n}\n";
     const auto file = dir / (std::string(name) + ".comp");
     std::ofstream(file) << src.str();
     const std::string cmd = std::string(VOXFIELD_GLSLC) + " --target-env=vulkan1.1 -o " +

@@ -215,8 +215,9 @@ Voxelized voxelize(const Model& model, const VoxelizeOptions& options);
 // GLSL shared by every generated evaluator: the shapes and blends (float), and vf_param(i) reading
 // the parameter buffer.
 std::string glsl_prelude();
-// One variant as `float vf_variant_N(vec3 p, uint base)`, its constants read in order from
-// vf_param(base + ...).
+// One variant as `float vf_variant_N(vec3 p, uint base, out uint material)`, its constants read in
+// order from vf_param(base + ...), with the material of the winning branch as the CPU tape gives
+// it.
 std::string glsl_variant(const Tape& tape, int index);
 // A whole compute shader evaluating one variant at points, ready for SPIR-V (gpu::
 // compile_compute_shader): binding 0 the parameter buffer (float), binding 1 the points (vec4:
@@ -227,9 +228,13 @@ std::string glsl_variant_kernel(const Tape& tape, int index);
 // one fixed compute shader running any tape, given as a program, at points — the bindings of
 // glsl_variant_kernel plus binding 3, the program (uint).
 std::string glsl_interpreter_kernel();
+// The interpreter as a function, `float vf_interpret(uint prog, vec3 p, uint at, out uint
+// material)`, running the program at vf_program[prog] (the including shader declares the uint
+// buffer vf_program and vf_param; glsl_prelude() comes first).
+std::string glsl_interpreter();
 // A tape as the interpreter's program: its instruction count, then four words per instruction
-// (op | shape << 8 | constants << 16, its register, its operands' registers). Throws
-// InvalidArgument for a tape needing more than kInterpreterRegisters registers.
+// (op | shape << 8 | constants << 16 | material << 24, its register, its operands' registers).
+// Throws InvalidArgument for a tape needing more than kInterpreterRegisters registers.
 inline constexpr std::uint32_t kInterpreterRegisters = 64;
 std::vector<std::uint32_t> interpreter_program(const Tape& tape);
 

@@ -87,9 +87,12 @@ std::string glsl_variant(const Tape& tape, int index) {
   std::ostringstream g;
   g << "// voxfield CSG variant " << index << ": " << tape.code.size() << " instructions, "
     << tape.params.size() << " parameters read in order from base\n";
-  g << "float vf_variant_" << index << "(vec3 p, uint base) {\n";
+  g << "float vf_variant_" << index << "(vec3 p, uint base, out uint material) {\n";
   g << "  vec3 q;\n";
   for (std::uint32_t r = 0; r < tape.registers; ++r) g << "  float r" << r << ";\n";
+  // Materials in registers of their own, as the CPU tape keeps them (tape.cpp): each
+  // instruction's material is assigned before its value, since its register may be an operand's.
+  for (std::uint32_t r = 0; r < tape.registers; ++r) g << "  uint m" << r << ";\n";
   std::uint32_t offset = 0;  // constants are read in instruction order
   auto param = [&](std::uint32_t i) {
     return "vf_param(base + " + std::to_string(offset + i) + "u)";
@@ -99,6 +102,23 @@ std::string glsl_variant(const Tape& tape, int index) {
     const std::string out = "r" + std::to_string(tape.reg[i]);
     const std::string a = in.op == OpCode::kShape ? "" : "r" + std::to_string(tape.reg[in.a]);
     const std::string b = detail::is_binary(in.op) ? "r" + std::to_string(tape.reg[in.b]) : "";
+    const std::string mo = "m" + std::to_string(tape.reg[i]);
+    const std::string ma = in.op == OpCode::kShape ? "" : "m" + std::to_string(tape.reg[in.a]);
+    const std::string mb = detail::is_binary(in.op) ? "m" + std::to_string(tape.reg[in.b]) : "";
+    const std::string literal = std::to_string(int{in.material}) + "u";
+    switch (in.op) {
+      case OpCode::kShape:
+      case OpCode::kSetMaterial:
+        g << "  " << mo << " = " << literal << ";\n";
+        break;
+      case OpCode::kMin:
+      case OpCode::kSmoothMin:
+        g << "  " << mo << " = " << b << " < " << a << " ? " << mb << " : " << ma << ";\n";
+        break;
+      default:
+        g << "  " << mo << " = " << ma << ";\n";
+        break;
+    }
     switch (in.op) {
       case OpCode::kShape:
         g << "  q = vec3(";
@@ -136,6 +156,7 @@ std::string glsl_variant(const Tape& tape, int index) {
     }
     offset += static_cast<std::uint32_t>(detail::param_count(in));
   }
+  g << "  material = m" << tape.reg[tape.code.size() - 1] << ";\n";
   g << "  return r" << tape.reg[tape.code.size() - 1] << ";\n}\n";
   return g.str();
 }
@@ -157,7 +178,8 @@ std::string glsl_variant_kernel(const Tape& tape, int index) {
     << "                 gl_GlobalInvocationID.x;\n"
     << "  if (i >= vf_push.count) return;\n"
     << "  const vec4 pt = vf_points[i];\n"
-    << "  vf_values[i] = vf_variant_" << index << "(pt.xyz, floatBitsToUint(pt.w));\n"
+    << "  uint material;\n"
+    << "  vf_values[i] = vf_variant_" << index << "(pt.xyz, floatBitsToUint(pt.w), material);\n"
     << "}\n";
   return g.str();
 }
@@ -173,7 +195,8 @@ std::vector<std::uint32_t> interpreter_program(const Tape& tape) {
     const Instr& in = tape.code[i];
     program.push_back(static_cast<std::uint32_t>(in.op) |
                       (static_cast<std::uint32_t>(in.shape) << 8) |
-                      (static_cast<std::uint32_t>(detail::param_count(in)) << 16));
+                      (static_cast<std::uint32_t>(detail::param_count(in)) << 16) |
+                      (static_cast<std::uint32_t>(in.material) << 24));
     program.push_back(tape.reg[i]);
     program.push_back(in.op == OpCode::kShape ? 0u : tape.reg[in.a]);
     program.push_back(detail::is_binary(in.op) ? tape.reg[in.b] : 0u);
@@ -181,20 +204,11 @@ std::vector<std::uint32_t> interpreter_program(const Tape& tape) {
   return program;
 }
 
-std::string glsl_interpreter_kernel() {
+std::string glsl_interpreter() {
   std::ostringstream g;
   const auto op = [](OpCode o) { return std::to_string(static_cast<int>(o)) + "u"; };
-  g << "#version 450\n"
-    << "// voxfield CSG: the interpreter, running any tape given as a program at points (the\n"
-    << "// placeholder for cells whose variant's shader is not compiled yet).\n"
-    << "layout(local_size_x = 64) in;\n"
-    << "layout(std430, binding = 0) readonly buffer Params { float vf_params[]; };\n"
-    << "layout(std430, binding = 1) readonly buffer Points { vec4 vf_points[]; };\n"
-    << "layout(std430, binding = 2) writeonly buffer Values { float vf_values[]; };\n"
-    << "layout(std430, binding = 3) readonly buffer Program { uint vf_program[]; };\n"
-    << "layout(push_constant) uniform Push { uint count; } vf_push;\n"
-    << "float vf_param(uint i) { return vf_params[i]; }\n"
-    << glsl_prelude()
+  g << "// voxfield CSG interpreter: runs the program at vf_program[prog] (interpreter_program's\n"
+    << "// layout) at p, its constants read in instruction order from vf_param(at).\n"
     << "// A shape in its own frame, its sizes read from `at` on (only those it has).\n"
     << "float vf_shape(uint kind, vec3 q, uint at) {\n  switch (kind) {\n";
   for (NodeKind k : {NodeKind::kSphere, NodeKind::kBox, NodeKind::kRoundedBox, NodeKind::kCylinder,
@@ -205,22 +219,23 @@ std::string glsl_interpreter_kernel() {
                     "vf_param(at + 3u)")
       << ";\n";
   g << "  }\n  return 0.0;\n}\n"
-    << "void main() {\n"
-    << "  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x +\n"
-    << "                 gl_GlobalInvocationID.x;\n"
-    << "  if (i >= vf_push.count) return;\n"
-    << "  const vec4 pt = vf_points[i];\n"
-    << "  const vec3 p = pt.xyz;\n"
+    << "float vf_interpret(uint prog, vec3 p, uint at, out uint material) {\n"
     << "  float r[" << kInterpreterRegisters << "];\n"
-    << "  uint at = floatBitsToUint(pt.w);  // the next constant, read in instruction order\n"
+    << "  uint m[" << kInterpreterRegisters << "];\n"
     << "  uint result = 0u;\n"
-    << "  const uint n = vf_program[0];\n"
+    << "  const uint n = vf_program[prog];\n"
     << "  for (uint k = 0u; k < n; ++k) {\n"
-    << "    const uint w = vf_program[1u + 4u * k];\n"
-    << "    const uint op = w & 0xFFu, out_r = vf_program[2u + 4u * k];\n"
-    << "    const float a = r[vf_program[3u + 4u * k]], b = r[vf_program[4u + 4u * k]];\n"
-    << "    float v = a;  // " << op(OpCode::kCopy) << " and " << op(OpCode::kSetMaterial)
-    << " (materials are not evaluated here)\n"
+    << "    const uint w = vf_program[prog + 1u + 4u * k];\n"
+    << "    const uint op = w & 0xFFu, out_r = vf_program[prog + 2u + 4u * k];\n"
+    << "    const uint ra = vf_program[prog + 3u + 4u * k], rb = vf_program[prog + 4u + 4u * k];\n"
+    << "    const float a = r[ra], b = r[rb];\n"
+    << "    // Materials as the CPU tape and the generated variants keep them.\n"
+    << "    uint mat = m[ra];\n"
+    << "    if (op == " << op(OpCode::kShape) << " || op == " << op(OpCode::kSetMaterial)
+    << ") mat = w >> 24;\n"
+    << "    else if (op == " << op(OpCode::kMin) << " || op == " << op(OpCode::kSmoothMin)
+    << ") mat = b < a ? m[rb] : m[ra];\n"
+    << "    float v = a;  // " << op(OpCode::kCopy) << " and " << op(OpCode::kSetMaterial) << "\n"
     << "    if (op == " << op(OpCode::kShape) << ") {\n"
     << "      const vec3 q = vec3(";
   // The same expressions, in the same order, as glsl_variant's.
@@ -238,10 +253,35 @@ std::string glsl_interpreter_kernel() {
     << "    else if (op == " << op(OpCode::kOffset) << ") v = a - vf_param(at);\n"
     << "    else if (op == " << op(OpCode::kAbsOffset) << ") v = abs(a) - vf_param(at);\n"
     << "    r[out_r] = v;\n"
+    << "    m[out_r] = mat;\n"
     << "    result = out_r;\n"
-    << "    at += w >> 16;\n"
+    << "    at += (w >> 16) & 0xFFu;\n"
     << "  }\n"
-    << "  vf_values[i] = r[result];\n"
+    << "  material = m[result];\n"
+    << "  return r[result];\n"
+    << "}\n";
+  return g.str();
+}
+
+std::string glsl_interpreter_kernel() {
+  std::ostringstream g;
+  g << "#version 450\n"
+    << "// voxfield CSG: the interpreter, running any tape given as a program at points (the\n"
+    << "// placeholder for cells whose variant's shader is not compiled yet).\n"
+    << "layout(local_size_x = 64) in;\n"
+    << "layout(std430, binding = 0) readonly buffer Params { float vf_params[]; };\n"
+    << "layout(std430, binding = 1) readonly buffer Points { vec4 vf_points[]; };\n"
+    << "layout(std430, binding = 2) writeonly buffer Values { float vf_values[]; };\n"
+    << "layout(std430, binding = 3) readonly buffer Program { uint vf_program[]; };\n"
+    << "layout(push_constant) uniform Push { uint count; } vf_push;\n"
+    << "float vf_param(uint i) { return vf_params[i]; }\n"
+    << glsl_prelude() << glsl_interpreter() << "void main() {\n"
+    << "  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x +\n"
+    << "                 gl_GlobalInvocationID.x;\n"
+    << "  if (i >= vf_push.count) return;\n"
+    << "  const vec4 pt = vf_points[i];\n"
+    << "  uint material;\n"
+    << "  vf_values[i] = vf_interpret(0u, pt.xyz, floatBitsToUint(pt.w), material);\n"
     << "}\n";
   return g.str();
 }
