@@ -10,6 +10,8 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "live_field.h"
+#include "progress.h"
 #include "voxfield/csg.h"
 #include "voxfield/csg_compile.h"
 #include "voxfield/csg_files.h"
@@ -17,6 +19,7 @@
 #include "voxfield/csg_render.h"
 #include "voxfield/file.h"
 #include "voxfield/gpu.h"
+#include "voxfield/gpu_render.h"
 #include "voxfield/mesh_files.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
@@ -42,7 +45,7 @@ struct CsgSettings {
   bool whole = false;
   int threads = 0;
   // render
-  std::string camera = "auto", view = "shaded";
+  std::string camera = "auto", view = "shaded", backend = "cpu", evaluators = "when-ready";
   int width = 640, height = 480;
   bool no_shadows = false;
   // mesh
@@ -395,9 +398,32 @@ int run_render(const CsgSettings& s) {
   if (s.threads > 0) limit.emplace(s.threads);
   set_activity("rendering " + s.model);
   CsgRenderStats st;
-  const Image image = render_csg(model, o, &st);
+  const auto gpu_context = choose_backend(s.backend);
+  gpu::CsgGpuOptions go;
+  go.evaluators = s.evaluators == "compiled" ? gpu::CsgGpuOptions::Evaluators::kCompiled
+                  : s.evaluators == "interpreter"
+                      ? gpu::CsgGpuOptions::Evaluators::kInterpreter
+                      : gpu::CsgGpuOptions::Evaluators::kCompiledWhenReady;
+  gpu::CsgGpuStats gs;
+  o.interrupter = progress();
+  const Image image = gpu_context ? gpu::render_csg(*gpu_context, model, o, &st, go, &gs)
+                                  : render_csg(model, o, &st);
   outputs.stage(s.out, encode_png(image));
+  nlohmann::json gpu_block = nullptr;
+  if (gpu_context) {
+    gpu_block = gpu_json(*gpu_context);
+    gpu_block.update({{"evaluators", s.evaluators},
+                      {"rounds", gs.rounds},
+                      {"variants_compiled", gs.variants_compiled},
+                      {"compiled_dispatches", gs.compiled_dispatches},
+                      {"interpreted_dispatches", gs.interpreted_dispatches},
+                      {"frame_dispatches", gs.dispatches},
+                      {"frame_submits", gs.submits},
+                      {"compile_ms", gs.compile_ms}});
+  }
   outputs.stage_json(s.stats, {{"model", s.model},
+                               {"backend", gpu_context ? "vulkan" : "cpu"},
+                               {"gpu", gpu_block},
                                {"output", s.out},
                                {"width", s.width},
                                {"height", s.height},
@@ -566,6 +592,16 @@ void add_csg(CLI::App& app, Action& action) {
   render->add_flag("--whole", s->whole,
                    "trace the whole tree instead of each cell's pruned tape (for comparison)");
   render->add_flag("--no-shadows", s->no_shadows, "no shadow rays");
+  render
+      ->add_option("--backend", s->backend,
+                   "cpu (default), vulkan or auto: on Vulkan each variant is its own generated "
+                   "kernel")
+      ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
+  render
+      ->add_option("--evaluators", s->evaluators,
+                   "Vulkan: when-ready (default; the interpreter until a variant's shader is "
+                   "compiled), compiled or interpreter")
+      ->check(CLI::IsMember({"when-ready", "compiled", "interpreter"}));
   threads(render);
   stats(render);
   render->callback([s, &action] { action = [s] { return run_render(*s); }; });

@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "voxfield/csg_render.h"
 #include "voxfield/gpu.h"
 #include "voxfield/render.h"
 
@@ -46,5 +47,35 @@ class SceneRenderer {
  private:
   std::unique_ptr<Impl> impl_;
 };
+
+// ---- CSG models ---------------------------------------------------------------------------------
+
+struct CsgGpuOptions {
+  // Which kernel marches a variant's cells: its own generated shader, compiled before the frame
+  // (kCompiled); the interpreter running its program (kInterpreter); or the interpreter until the
+  // variant's shader, compiled on worker threads meanwhile, is ready (kCompiledWhenReady —
+  // Palecek's placeholder scheme). All three give the same image.
+  enum class Evaluators { kCompiledWhenReady, kCompiled, kInterpreter };
+  Evaluators evaluators = Evaluators::kCompiledWhenReady;
+};
+
+// Hardware-independent figures of one CSG frame.
+struct CsgGpuStats {
+  int rounds = 0;  // advance / bin / scatter / march rounds, primary and shadow rays
+  int variants = 0, variants_compiled = 0;  // compiled: shaders ready by the frame's end
+  std::int64_t compiled_dispatches = 0, interpreted_dispatches = 0;  // variant marches
+  std::int64_t dispatches = 0, submits = 0;
+  double compile_ms = 0;  // kCompiled: compiling the variants before the frame
+};
+
+// render_csg (csg_render.h) on Vulkan: the same octree, camera, epsilon and shading, sphere traced
+// in floats by one generated kernel per variant (or the interpreter); images match the CPU's within
+// the tolerance tests/test_gpu_render.cpp states. stats gets the octree and frame times and the
+// variant count (the per-evaluation counters are the CPU's). Throws InvalidArgument for an octree
+// deeper than 8 or larger than a storage buffer, for kInterpreter with a variant beyond the
+// interpreter's registers, and as render_csg does.
+Image render_csg(Context& context, const csg::Model& model, const CsgRenderOptions& options,
+                 CsgRenderStats* stats = nullptr, const CsgGpuOptions& gpu_options = {},
+                 CsgGpuStats* gpu_stats = nullptr);
 
 }  // namespace voxfield::gpu

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <limits>
 
+#include "csg_frame.h"
 #include "shading.h"
 #include "voxfield/csg_render.h"
 #include "voxfield/parallel.h"
@@ -147,7 +148,10 @@ class Tracer {
   static inline std::atomic<std::uint64_t> next_id_{0};
 };
 
-// A colour per variant, well apart in hue (golden-ratio steps).
+}  // namespace
+
+namespace render_detail {
+
 Rgb variant_colour(int variant) {
   const double h = std::fmod(0.13 + variant * 0.6180339887, 1.0) * 6;
   const double x = 1 - std::abs(std::fmod(h, 2.0) - 1);
@@ -160,7 +164,38 @@ Rgb variant_colour(int variant) {
   return c * 0.55 + Rgb{0.05, 0.05, 0.05};
 }
 
-}  // namespace
+CsgFrame prepare_csg_frame(const csg::Model& model, const CsgRenderOptions& o) {
+  CsgFrame f;
+  std::optional<csg::Bounds> box = csg::box_or_bounds(model, o.box);
+  {  // a little margin, so that surfaces on the bounds are inside the traced box
+    const Vec3d size = box->hi - box->lo;
+    const double margin = 1e-3 * std::max({size.x, size.y, size.z, 1e-9});
+    box = csg::Bounds{box->lo - Vec3d{1, 1, 1} * margin, box->hi + Vec3d{1, 1, 1} * margin};
+  }
+  const auto start = std::chrono::steady_clock::now();
+  f.whole = csg::compile_tape(model);
+  if (o.prune) {
+    csg::OctreeOptions oo;
+    oo.depth = o.depth;
+    oo.box = box;
+    oo.interrupter = o.interrupter;
+    // The octree is cubic: grow the box to a cube around its centre.
+    const Vec3d size = box->hi - box->lo, centre = (box->lo + box->hi) * 0.5;
+    const double edge = std::max({size.x, size.y, size.z});
+    oo.box =
+        csg::Bounds{centre - Vec3d{1, 1, 1} * (edge / 2), centre + Vec3d{1, 1, 1} * (edge / 2)};
+    f.tree = csg::build_octree(f.whole, model, oo);
+  }
+  f.traced_box = f.tree ? f.tree->root : *box;
+  f.octree_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  f.camera = o.camera ? *o.camera : csg_camera(*box, static_cast<double>(o.width) / o.height);
+  const Vec3d size = f.traced_box.hi - f.traced_box.lo;
+  f.epsilon = 1e-4 * std::max({size.x, size.y, size.z});
+  return f;
+}
+
+}  // namespace render_detail
 
 Camera csg_camera(const csg::Bounds& box, double aspect) {
   // Camera::framing works on voxel boxes; framing is invariant under scaling and translation, so
@@ -180,35 +215,14 @@ Camera csg_camera(const csg::Bounds& box, double aspect) {
 
 Image render_csg(const csg::Model& model, const CsgRenderOptions& o, CsgRenderStats* stats) {
   Image image(o.width, o.height);
-  std::optional<csg::Bounds> box = csg::box_or_bounds(model, o.box);
-  {  // a little margin, so that surfaces on the bounds are inside the traced box
-    const Vec3d size = box->hi - box->lo;
-    const double margin = 1e-3 * std::max({size.x, size.y, size.z, 1e-9});
-    box = csg::Bounds{box->lo - Vec3d{1, 1, 1} * margin, box->hi + Vec3d{1, 1, 1} * margin};
-  }
-  const auto start = std::chrono::steady_clock::now();
-  const csg::Tape whole = csg::compile_tape(model);
-  std::optional<csg::Octree> tree;
-  if (o.prune) {
-    csg::OctreeOptions oo;
-    oo.depth = o.depth;
-    oo.box = box;
-    oo.interrupter = o.interrupter;
-    // The octree is cubic: grow the box to a cube around its centre.
-    const Vec3d size = box->hi - box->lo, centre = (box->lo + box->hi) * 0.5;
-    const double edge = std::max({size.x, size.y, size.z});
-    oo.box =
-        csg::Bounds{centre - Vec3d{1, 1, 1} * (edge / 2), centre + Vec3d{1, 1, 1} * (edge / 2)};
-    tree = csg::build_octree(whole, model, oo);
-  }
-  const auto traced_box = tree ? tree->root : *box;
-  const double octree_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  const Camera camera =
-      o.camera ? *o.camera : csg_camera(*box, static_cast<double>(o.width) / o.height);
+  const render_detail::CsgFrame frame = render_detail::prepare_csg_frame(model, o);
+  const csg::Tape& whole = frame.whole;
+  const std::optional<csg::Octree>& tree = frame.tree;
+  const csg::Bounds& traced_box = frame.traced_box;
+  const double octree_ms = frame.octree_ms;
+  const Camera& camera = frame.camera;
   const Camera::Projector proj = camera.projector(o.width, o.height);
-  const Vec3d size = traced_box.hi - traced_box.lo;
-  const double epsilon = 1e-4 * std::max({size.x, size.y, size.z});
+  const double epsilon = frame.epsilon;
   const Tracer tracer(whole, tree ? &*tree : nullptr, traced_box, epsilon);
   const Vec3d sun = RenderOptions{}.sun_direction.normalized();
   std::array<Rgb, 256> albedo;
@@ -251,9 +265,9 @@ Image render_csg(const csg::Model& model, const CsgRenderOptions& o, CsgRenderSt
           if (dot(n, ray.direction) > 0) n = n * -1.0;
           Rgb base = albedo[m[6]];
           if (o.view == CsgRenderOptions::View::kVariants)
-            base = h.leaf >= 0
-                       ? variant_colour(tree->leaves[static_cast<std::size_t>(h.leaf)].variant)
-                       : Rgb{0.3, 0.3, 0.3};
+            base = h.leaf >= 0 ? render_detail::variant_colour(
+                                     tree->leaves[static_cast<std::size_t>(h.leaf)].variant)
+                               : Rgb{0.3, 0.3, 0.3};
           const double ndotl = std::max(0.0, dot(n, sun));
           double shadow = 1;
           if (o.shadows && ndotl > 0) {

@@ -26,4 +26,9 @@ Context& SceneRenderer::context() {
   built_without_vulkan();
 }
 
+Image render_csg(Context&, const csg::Model&, const CsgRenderOptions&, CsgRenderStats*,
+                 const CsgGpuOptions&, CsgGpuStats*) {
+  built_without_vulkan();
+}
+
 }  // namespace voxfield::gpu
