@@ -311,6 +311,21 @@ assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['width'] == 9
   check "gpu edits json" 0 $PY -c "
 import json; j = json.load(open('$tmp/gedits.json'))
 assert j['backend'] == 'vulkan' and j['verify_mismatches'] == 0, j"
+  # CSG models on Vulkan: each variant's own kernel, and the interpreter, give one picture.
+  GEAR="$(dirname "$0")/../examples/csg/gear.sdf"
+  check "csg render --backend vulkan" 0 $GPU "$V" csg "$GEAR" render -o "$tmp/gear-gpu.png" --width 64 --height 48 \
+      --depth 4 --backend vulkan --evaluators compiled --stats "$tmp/gear-gpu.json"
+  check "csg render: the interpreter on vulkan" 0 $GPU "$V" csg "$GEAR" render -o "$tmp/gear-int.png" --width 64 \
+      --height 48 --depth 4 --backend vulkan --evaluators interpreter
+  cmp -s "$tmp/gear-gpu.png" "$tmp/gear-int.png" && passes=$((passes+1)) || { echo "FAIL: compiled and interpreted CSG frames differ"; fails=$((fails+1)); }
+  check "csg render gpu stats" 0 $PY -c "
+import json; j = json.load(open('$tmp/gear-gpu.json'))
+g = j['gpu']
+assert j['backend'] == 'vulkan' and g['variants_compiled'] == j['variants'] and g['interpreted_dispatches'] == 0, j
+assert g['compiled_dispatches'] > 0 and g['rounds'] > 0, j"
+  check "csg render: a bad evaluator name" 2 $GPU "$V" csg "$GEAR" render -o "$tmp/x.png" --backend vulkan --evaluators fast
+  expect_grep "bad evaluator named" "$tmp/err" "fast not in"
+  [ ! -e "$tmp/x.png" ] && passes=$((passes+1)) || { echo "FAIL: csg render wrote a picture after refusing"; fails=$((fails+1)); }
 fi
 
 
