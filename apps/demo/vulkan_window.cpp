@@ -71,6 +71,14 @@ void VulkanWindow::open(int width, int height, const std::string& title, bool va
   ici.ppEnabledExtensionNames = extensions.data();
   ici.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
   ici.ppEnabledLayerNames = layers.data();
+  // With synchronisation validation too: the demo records voxfield's frame into its own command
+  // buffer, then copies it to the swapchain; the layer checks the barriers between the two.
+  const VkValidationFeatureEnableEXT enables[] = {
+      VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+  VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+  features.enabledValidationFeatureCount = 1;
+  features.pEnabledValidationFeatures = enables;
+  if (validation) ici.pNext = &features;
   check(vkCreateInstance(&ici, nullptr, &instance_), "vkCreateInstance");
   volkLoadInstance(instance_);
   if (validation) {
