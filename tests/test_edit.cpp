@@ -351,7 +351,7 @@ TEST(DynamicField, EditsInSolidGroundEqualFullRebuilds) {
   for (const FieldCase& c : cases) {
     SCOPED_TRACE(std::string(metric_name(c.metric)) + " clamp " + std::to_string(c.clamp) + " " +
                  storage_name(c.storage));
-    std::mt19937 rng(seed);
+    std::mt19937 rng(seed++);
     World w(16, bounds);
     // Ground up to a wavy height with a few caves.
     for (int z = 0; z < 66; ++z)

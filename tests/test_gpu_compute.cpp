@@ -174,10 +174,13 @@ TEST(GpuCompute, DescriptorSetsAreRecycledNotRecreated) {
   }
   const std::int64_t pools = ctx->counters().descriptor_pools;
   for (int i = 0; i < 20; ++i) {
-    Recorder rec(c);
-    run(rec, out1, static_cast<float>(i), b);
-    rec.submit();
-    expect_out(out1, static_cast<float>(i));
+    {
+      Recorder rec(c);
+      run(rec, out1, static_cast<float>(i), i % 2 ? b : b2);  // two sets, alternately
+      rec.submit();
+      expect_out(out1, static_cast<float>(i));
+    }
+    ASSERT_EQ(c.transient_sets->sets(), 0u) << "the last recorder's sets were recycled";
   }
   EXPECT_EQ(ctx->counters().descriptor_pools, pools) << "sets recycled, no new pools";
   {

@@ -207,7 +207,12 @@ TEST(Gpu, CsgFramesMatchTheCpuAndEveryEvaluatorAgrees) {
           gpu::render_csg(*ctx, model, o, nullptr, {E::kCompiled}, &compiled_stats);
       const Image interpreted =
           gpu::render_csg(*ctx, model, o, nullptr, {E::kInterpreter}, &interpreted_stats);
-      const Image mixed = gpu::render_csg(*ctx, model, o, nullptr, {E::kCompiledWhenReady});
+      // The compiled run left every variant's kernel in the context: a mixed frame after it
+      // takes them all from there (no compile, no placeholder).
+      gpu::CsgGpuStats mixed_stats;
+      const Image mixed =
+          gpu::render_csg(*ctx, model, o, nullptr, {E::kCompiledWhenReady}, &mixed_stats);
+      EXPECT_EQ(mixed_stats.interpreted_dispatches, 0) << what;
       const test::ImageDiff d = test::compare_images(compiled, cpu, 8);
       EXPECT_LE(d.off, d.pixels / 100)
           << what << ": " << d.off << " of " << d.pixels << " pixels differ by more than 8 levels";

@@ -180,6 +180,21 @@ const Kernel& KernelCache::from_glsl(VkDevice device, std::string_view name,
   return k;
 }
 
+const Kernel* KernelCache::find_glsl(std::string_view glsl) const {
+  const auto it = by_glsl_.find(fnv1a(kFnvOffset, glsl.data(), glsl.size()));
+  return it == by_glsl_.end() ? nullptr : it->second;
+}
+
+const Kernel& KernelCache::adopt_glsl(VkDevice device, std::string_view name, std::string_view glsl,
+                                      std::span<const std::uint32_t> spirv) {
+  const std::uint64_t key = fnv1a(kFnvOffset, glsl.data(), glsl.size());
+  if (auto it = by_glsl_.find(key); it != by_glsl_.end()) return *it->second;
+  const std::string owned(name);
+  const Kernel& k = get(device, ShaderSource{owned.c_str(), spirv});
+  by_glsl_.emplace(key, &k);
+  return k;
+}
+
 void KernelCache::destroy(VkDevice device) {
   for (auto& [key, k] : kernels_) {
     vkDestroyPipeline(device, k->pipeline, nullptr);

@@ -64,6 +64,12 @@ class KernelCache {
   const Kernel& get(VkDevice device, const ShaderSource& shader);
   // The kernel of generated GLSL: compiled once per distinct text.
   const Kernel& from_glsl(VkDevice device, std::string_view name, std::string_view glsl);
+  // The kernel of generated GLSL if it was made already (no compile), else null.
+  const Kernel* find_glsl(std::string_view glsl) const;
+  // The kernel of generated GLSL compiled elsewhere (on a worker thread, by compile_glsl): later
+  // from_glsl and find_glsl calls with the same text find it.
+  const Kernel& adopt_glsl(VkDevice device, std::string_view name, std::string_view glsl,
+                           std::span<const std::uint32_t> spirv);
   std::size_t size() const { return kernels_.size(); }
   std::int64_t glsl_compiles() const { return glsl_compiles_; }
   void destroy(VkDevice device);

@@ -28,7 +28,10 @@
 namespace voxfield::gpu {
 
 // Descriptor sets for recorded dispatches, one per distinct (kernel, buffers) pair, from pools
-// grown on demand. reset() recycles them all: only once no recorded command can still run.
+// grown on demand. reset() recycles them all: only once no recorded command can still run. Sets
+// are found by the buffers' handles: a buffer destroyed while an arena still holds sets naming it
+// must not be replaced by a new one before the arena is reset (a new buffer may reuse the handle).
+// The context's shared arena is reset whenever no recorder is using it.
 class DescriptorArena {
  public:
   explicit DescriptorArena(Context::Impl& ctx) : ctx_(&ctx) {}

@@ -51,7 +51,7 @@ layout(std430, binding = 0) readonly buffer Frame {
   uint width, height, grid_n, variants;
   float scale, epsilon;
   uint whole_program, whole_params;  // the whole tape (0xFFFFFFFF: beyond the interpreter)
-  uint view, shadows, pad0, pad1;    // view 1: colour by variant
+  uint view, shadows, max_groups_x, pad1;  // view 1: colour by variant
   vec4 albedo[256];                  // palette, linear
 } fr;
 layout(std430, binding = 1) readonly buffer Grid { int grid[]; };  // finest cells: leaf or -1
@@ -162,7 +162,9 @@ void main() {
       const Leaf cell = leaves[leaf];
       const vec2 lt = vf_slab(o, inv, cell.lo.xyz, cell.hi.xyz);
       const float t0 = max(lt.x, t), t1 = min(lt.y, t_end);
-      if (t0 <= t1) {
+      // After a march the ray restarts at that cell's exit: a neighbour touched only there (an
+      // edge or a corner, t0 == t1) is passed, or two such cells could hand the ray back and forth.
+      if (t0 < t1 || (t0 == t1 && r.leaf < 0)) {
         if (cell.state == VF_FULL) {  // the surface is at its face
           rays[i].state = VF_HIT;
           if (pc.mode == 0u) {
@@ -208,8 +210,10 @@ void main() {
     const uint count = bins[v];
     bins[v_count + v] = sum;
     bins[2u * v_count + v] = sum;
-    args[3u * v] = (count + 63u) / 64u;
-    args[3u * v + 1u] = 1u;
+    // Workgroups split over y past the device's limit along x (vf_index reads them back).
+    const uint groups = (count + 63u) / 64u, x = min(groups, fr.max_groups_x);
+    args[3u * v] = x;
+    args[3u * v + 1u] = x == 0u ? 1u : (groups + x - 1u) / x;
     args[3u * v + 2u] = 1u;
     sum += count;
   }
@@ -284,6 +288,33 @@ void main() {
 )";
 }
 
+std::string full_hits_main(const std::string& eval) {
+  return eval + R"(layout(local_size_x = 64) in;
+void main() {
+  const uint i = vf_index();
+  if (i >= fr.width * fr.height) return;
+  const Hit h = hits[i];
+  if (h.normal_t.w < 0.0 || leaves[h.leaf].state == VF_SURFACE) return;
+  vec3 o, d;
+  vf_camera_ray(i, o, d);
+  const vec3 p = o + d * h.normal_t.w;
+  const float e = fr.epsilon * 2.0;
+  float samples[7];
+  uint m;
+  for (int k = 0; k < 7; ++k) {  // six around p, then p (one call site, as in the march)
+    vec3 offset = vec3(0.0);
+    if (k < 6) offset[k >> 1] = (k & 1) == 0 ? e : -e;
+    samples[k] = vf_eval(p + offset, fr.whole_params, m);
+  }
+  vec3 nrm = vec3(samples[0] - samples[1], samples[2] - samples[3], samples[4] - samples[5]);
+  nrm = length(nrm) > 0.0 ? normalize(nrm) : -d;
+  if (dot(nrm, d) > 0.0) nrm = -nrm;
+  hits[i].normal_t.xyz = nrm;
+  hits[i].material = m;
+}
+)";
+}
+
 std::string shade_main() {
   return R"(layout(local_size_x = 64) in;
 const vec3 kSunLight = vec3(2.4, 2.2, 1.9);
@@ -314,29 +345,9 @@ void main() {
   const Hit h = hits[i];
   vec3 colour = sky(d);
   if (h.normal_t.w >= 0.0) {
-    vec3 nrm = h.normal_t.xyz;
-    uint material = h.material;
+    const vec3 nrm = h.normal_t.xyz;
+    const uint material = h.material;
     const Leaf cell = leaves[h.leaf];
-    if (cell.state != VF_SURFACE) {
-      // A hit on a full cell's face: normal and material from the whole tape, as on the CPU.
-      nrm = -d;
-      if (fr.whole_program != 0xFFFFFFFFu) {
-        const vec3 p = o + d * h.normal_t.w;
-        const float e = fr.epsilon * 2.0;
-        const uint at = fr.whole_params, prog = fr.whole_program;
-        float samples[7];
-        uint m;
-        for (int k = 0; k < 7; ++k) {  // six around p, then p (one call site, as in the march)
-          vec3 offset = vec3(0.0);
-          if (k < 6) offset[k >> 1] = (k & 1) == 0 ? e : -e;
-          samples[k] = vf_interpret(prog, p + offset, at, m);
-        }
-        material = m;
-        const vec3 g = vec3(samples[0] - samples[1], samples[2] - samples[3], samples[4] - samples[5]);
-        if (length(g) > 0.0) nrm = normalize(g);
-        if (dot(nrm, d) > 0.0) nrm = -nrm;
-      }
-    }
     vec3 base = fr.albedo[material & 255u].rgb;
     if (fr.view == 1u) base = cell.state == VF_SURFACE ? vinfo[cell.variant].colour.rgb : fr.full_colour.rgb;
     const float ndotl = max(0.0, dot(nrm, fr.sun.xyz));

@@ -15,6 +15,8 @@ std::string advance_main();  // each active ray to its next surface cell: queued
 std::string bin_main();      // queue offsets and indirect dispatch sizes per variant
 std::string scatter_main();  // queued rays into their variant's stretch of the queue
 std::string shade_main();    // the pixel colours
+// Normals and materials of the hits on full cells' faces, by `eval` on the whole tape.
+std::string full_hits_main(const std::string& eval);
 // The march through one variant's cells: `eval` is the GLSL of a function
 // `float vf_eval(vec3 p, uint base, out uint material)` (a compiled variant or the interpreter).
 std::string march_main(const std::string& eval);

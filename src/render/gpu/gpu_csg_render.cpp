@@ -11,6 +11,7 @@
 // ray; shadow rays follow the same way from the hits; a last kernel shades. A variant's rays run
 // its compiled kernel when that is ready, else the interpreter: with kCompiledWhenReady the
 // variants compile on worker threads while the interpreter draws, as Palecek recommends.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstring>
@@ -44,7 +45,7 @@ struct FrameBlock {
   std::uint32_t width, height, grid_n, variants;
   float scale, epsilon;
   std::uint32_t whole_program, whole_params;
-  std::uint32_t view, shadows, pad0, pad1;
+  std::uint32_t view, shadows, max_groups_x, pad1;
   F4 albedo[256];
 };
 struct LeafRecord {
@@ -187,7 +188,8 @@ Image render_csg(Context& context, const csg::Model& model, const CsgRenderOptio
   c.require_device();
   using Evaluators = CsgGpuOptions::Evaluators;
   const render_detail::CsgFrame f = render_detail::prepare_csg_frame(model, o);
-  const Scene s = build_scene(model, o, f, gpu_options.evaluators == Evaluators::kInterpreter);
+  Scene s = build_scene(model, o, f, gpu_options.evaluators == Evaluators::kInterpreter);
+  s.frame.max_groups_x = c.limits.maxComputeWorkGroupCount[0];
   const auto render_start = std::chrono::steady_clock::now();
   const Counters before = c.counters;
 
@@ -217,6 +219,7 @@ Image render_csg(Context& context, const csg::Model& model, const CsgRenderOptio
   };
   std::vector<const Kernel*> compiled(n_variants, nullptr);
   std::vector<std::vector<std::uint32_t>> spirv(n_variants);
+  std::vector<std::string> texts(n_variants);
   std::vector<std::atomic<bool>> ready(n_variants);
   std::atomic<bool> stop{false};
   std::future<void> compiling;
@@ -230,16 +233,19 @@ Image render_csg(Context& context, const csg::Model& model, const CsgRenderOptio
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - compile_start)
             .count();
   } else if (gpu_options.evaluators == Evaluators::kCompiledWhenReady) {
-    // A variant beyond the interpreter's registers has no placeholder: it is compiled first.
-    for (std::size_t v = 0; v < n_variants; ++v)
-      if (s.variants[v].program == kNoProgram)
-        compiled[v] =
-            &c.kernels.from_glsl(c.device, "csg-variant-" + std::to_string(v), variant_text(v));
+    // Variants made by an earlier frame are used at once; a variant beyond the interpreter's
+    // registers has no placeholder, so it is compiled first; the rest compile on worker threads.
+    for (std::size_t v = 0; v < n_variants; ++v) {
+      texts[v] = variant_text(v);
+      compiled[v] = c.kernels.find_glsl(texts[v]);
+      if (!compiled[v] && s.variants[v].program == kNoProgram)
+        compiled[v] = &c.kernels.from_glsl(c.device, "csg-variant-" + std::to_string(v), texts[v]);
+    }
     compiling = std::async(std::launch::async, [&] {
       parallel_for(n_variants, 1, [&](std::size_t v0, std::size_t v1) {
         for (std::size_t v = v0; v < v1 && !stop; ++v) {
-          if (s.variants[v].program == kNoProgram) continue;
-          spirv[v] = compile_glsl("csg-variant-" + std::to_string(v), variant_text(v));
+          if (compiled[v]) continue;  // written before this thread started
+          spirv[v] = compile_glsl("csg-variant-" + std::to_string(v), texts[v]);
           ready[v].store(true, std::memory_order_release);
         }
       });
@@ -254,13 +260,11 @@ Image render_csg(Context& context, const csg::Model& model, const CsgRenderOptio
       if (f.valid()) f.wait();
     }
   } stop_compiling{stop, compiling};
-  std::vector<std::string> names(n_variants);
   const auto adopt_ready = [&] {
     for (std::size_t v = 0; v < n_variants; ++v)
-      if (!compiled[v] && ready[v].load(std::memory_order_acquire)) {
-        names[v] = "csg-variant-" + std::to_string(v);
-        compiled[v] = &c.kernels.get(c.device, ShaderSource{names[v].c_str(), spirv[v]});
-      }
+      if (!compiled[v] && ready[v].load(std::memory_order_acquire))
+        compiled[v] =
+            &c.kernels.adopt_glsl(c.device, "csg-variant-" + std::to_string(v), texts[v], spirv[v]);
   };
 
   // Buffers: the scene (uploaded once), the rays and their bookkeeping, the pixels.
@@ -285,6 +289,13 @@ Image render_csg(Context& context, const csg::Model& model, const CsgRenderOptio
     in.emplace_back(c, u.size(), storage, false);
     upload_bytes += (u.size() + 15) / 16 * 16;
   }
+  if (pixels * kRayBytes > c.limits.maxStorageBufferRange)
+    throw InvalidArgument("GPU CSG render: a " + std::to_string(o.width) + " x " +
+                          std::to_string(o.height) + " picture needs " +
+                          std::to_string(pixels * kRayBytes) +
+                          " bytes of rays in one buffer, more than this device's storage-buffer "
+                          "range (" +
+                          std::to_string(c.limits.maxStorageBufferRange) + ")");
   Buffer rays(c, pixels * kRayBytes, storage, false), hits(c, pixels * kHitBytes, storage, false);
   const VkDeviceSize bins_bytes = 16 + 12 * n_variants;
   Buffer bins(c, bins_bytes, storage, false);
@@ -344,6 +355,25 @@ Image render_csg(Context& context, const csg::Model& model, const CsgRenderOptio
     }
   };
   trace(0);
+  // Hits on full cells' faces take their normal and material from the whole tape, as on the CPU,
+  // before the shadow rays leave from them: by the interpreter, or compiled when the whole tape
+  // is beyond the interpreter's registers.
+  const bool full_cells = std::any_of(s.leaves.begin(), s.leaves.end(),
+                                      [](const LeafRecord& l) { return l.state == 1; });
+  if (full_cells) {
+    const std::string eval =
+        s.frame.whole_program != kNoProgram
+            ? "float vf_eval(vec3 p, uint base, out uint m) {\n  return "
+              "vf_interpret(fr.whole_program, p, base, m);\n}\n"
+            : csg::glsl_variant(f.whole, static_cast<int>(n_variants)) +
+                  "float vf_eval(vec3 p, uint base, out uint m) {\n  return vf_variant_" +
+                  std::to_string(n_variants) + "(p, base, m);\n}\n";
+    const Kernel& full = c.kernels.from_glsl(c.device, "csg-full-cell-hits",
+                                             common + csg_trace::full_hits_main(eval));
+    Recorder rec(c);
+    rec.dispatch(full, all, Push{0, 0}, pixels);
+    rec.submit();
+  }
   if (o.shadows) trace(1);
   {
     Recorder rec(c);
@@ -359,7 +389,9 @@ Image render_csg(Context& context, const csg::Model& model, const CsgRenderOptio
     image.rgb[3 * i + 1] = static_cast<std::uint8_t>((px[i] >> 8) & 0xFF);
     image.rgb[3 * i + 2] = static_cast<std::uint8_t>((px[i] >> 16) & 0xFF);
   }
-  adopt_ready();
+  stop = true;
+  if (compiling.valid()) compiling.get();  // a generated shader that failed to compile is an error
+  adopt_ready();                           // kept for the next frame
   for (const Kernel* k : compiled) g.variants_compiled += k != nullptr;
   g.variants = static_cast<int>(n_variants);
   const Counters after = c.counters;
