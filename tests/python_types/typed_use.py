@@ -1,0 +1,47 @@
+"""A typed use of voxfield, checked by mypy --strict against the package's stubs (and run, so the
+stubs describe what the module really returns)."""
+
+import numpy as np
+import numpy.typing as npt
+
+import voxfield
+from voxfield import csg, ndimage
+
+
+def sphere_field(n: int) -> npt.NDArray[np.float64]:
+    grid = np.ones((n, n, n), dtype=np.uint8)
+    grid[n // 2, n // 2, n // 2] = 0
+    d: npt.NDArray[np.float64] = ndimage.distance_transform_edt(grid, sampling=(1.0, 1.0, 2.0), threads=1)
+    return d
+
+
+def model_figures() -> tuple[int, float]:
+    model = csg.Model("(union (sphere 1) (move 1.5 0 0 (box 1 1 1)))", "typed.sdf")
+    values = model.evaluate(np.array([[0.0, 0.0, 0.0], [3.0, 0.0, 0.0]]))
+    bounds = model.bounds
+    assert bounds is not None
+    lo, hi = bounds
+    figures = model.octree(depth=3)
+    vertices, faces, normals, colors = model.mesh(0.25)
+    assert vertices.dtype == np.float32 and faces.dtype == np.uint32 and colors.dtype == np.uint8
+    assert normals.shape == vertices.shape
+    return model.nodes, float(values[0]) + hi[0] - lo[0] + figures["variants"]
+
+
+def refused() -> bool:
+    try:
+        csg.Model("(sphere", "bad.sdf")
+    except csg.ModelError:
+        return True
+    except voxfield.Error:
+        return False
+    return False
+
+
+if __name__ == "__main__":
+    field = sphere_field(9)
+    assert field[4, 4, 4] == 0.0 and field[4, 4, 0] == 8.0, field[4, 4, 0]
+    nodes, _ = model_figures()
+    assert nodes == 4, nodes
+    assert refused()
+    print("typed use: ok")
