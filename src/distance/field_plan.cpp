@@ -23,7 +23,8 @@ Box3i chunk_aligned(const Box3i& b, int shift) {
 
 }  // namespace
 
-FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o) {
+FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o,
+                          const Box3i* part) {
   if (!(o.max_distance >= 0) || std::isinf(o.max_distance)) {
     throw InvalidArgument("max distance must be a finite number >= 0 (0 = no clamp)");
   }
@@ -86,6 +87,12 @@ FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOpt
       throw InvalidArgument(
           "domain " + to_string(p.domain) + " is too large" +
           (o.nearest_sites ? std::string(" for 16-bit nearest-site offsets") : std::string()));
+    }
+    if (part) {
+      if (!p.domain.contains(*part) || part->empty())
+        throw InvalidArgument("the part " + to_string(*part) +
+                              " is not a non-empty box of the domain " + to_string(p.domain));
+      p.domain = *part;
     }
     p.aligned = chunk_aligned(p.domain, occupancy.chunk_shift());
     // The values over the domain (and the sites) are what the field holds at most: refuse a

@@ -23,8 +23,11 @@ struct FieldPlan {
   DistanceEncoding encoding;
 };
 
-// Validates the options (throws InvalidArgument) and resolves the plan.
-FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOptions& options);
+// Validates the options (throws InvalidArgument) and resolves the plan. With `part`, the plan
+// computes only that part of the domain (a slab of a field computed by several processes,
+// distance_slab.h): the options are checked against the whole domain, the memory against the part.
+FieldPlan make_field_plan(const Grid<std::uint8_t>& occupancy, const DistanceOptions& options,
+                          const Box3i* part = nullptr);
 
 // Exact field values of `out` computed from the sites inside `in` (which must contain `out`; for
 // values equal to the whole-domain field's, `in` must hold `out` grown by the clamp's reach,

@@ -29,6 +29,7 @@
 #include "voxfield/distance.h"
 #include "voxfield/interrupt.h"
 #include "voxfield/parallel.h"
+#include "whole_field.h"
 #include "z_pass.h"
 
 namespace voxfield {
@@ -36,6 +37,7 @@ namespace {
 
 using detail::TruncatedMinConvolution;
 using detail::exact::ChunkedVolume;
+using detail::exact::ColumnsBeyond;
 using detail::exact::dispatch_solver;
 using detail::exact::encode_truncated_row;
 using detail::exact::Encoder;
@@ -147,7 +149,8 @@ void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<
 // The whole field of storage T, g held in place in U (T's size) between the passes.
 template <class T, class U>
 DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy,
-                                  const DistanceOptions& options, const Plan& p) {
+                                  const DistanceOptions& options, const Plan& p,
+                                  const ColumnsBeyond* beyond, Vec3i solver_extent) {
   const T background = detail::field_background<T>(p);
   DistanceField out;
   out.options = options;
@@ -207,9 +210,9 @@ DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy,
       if (!progress.advance()) return;  // one unit per chunk column
       const int cx = static_cast<int>(i % ncx), cy = static_cast<int>(i / ncx);
       if (p.is_signed) {
-        pass_z<U, true>(p, world, g, sp, cx, cy, cap32, col);
+        pass_z<U, true>(p, world, g, sp, cx, cy, cap32, col, beyond);
       } else {
-        pass_z<U, false>(p, world, g, sp, cx, cy, cap32, col);
+        pass_z<U, false>(p, world, g, sp, cx, cy, cap32, col, beyond);
       }
     }
   });
@@ -220,7 +223,7 @@ DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy,
   if (truncated_passes(p, p.sites)) {
     pass_slices_truncated<T, U>(p, world, g, encoder, cap32, progress);
   } else {
-    dispatch_solver(p, p.domain.size(), [&](auto tag, const auto& solve, auto inf) {
+    dispatch_solver(p, solver_extent, [&](auto tag, const auto& solve, auto inf) {
       using V = decltype(tag);
       pass_slices<T, U, V>(p, world, g, sp, solve, encoder, cap32, inf, progress);
     });
@@ -240,18 +243,29 @@ DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy,
 
 }  // namespace
 
+namespace detail::exact {
+
+DistanceField compute_exact_field(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o,
+                                  const Plan& p, const ColumnsBeyond* beyond, Vec3i solver_extent) {
+  switch (o.storage) {
+    case Storage::kU8:
+      return compute_whole_field<std::uint8_t, std::uint8_t>(occupancy, o, p, beyond,
+                                                             solver_extent);
+    case Storage::kU16:
+      return compute_whole_field<std::uint16_t, std::uint16_t>(occupancy, o, p, beyond,
+                                                               solver_extent);
+    case Storage::kF32:
+      return compute_whole_field<float, std::uint32_t>(occupancy, o, p, beyond, solver_extent);
+  }
+  throw InvalidArgument("unknown storage");
+}
+
+}  // namespace detail::exact
+
 DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy,
                                      const DistanceOptions& o) {
   const Plan p = detail::make_field_plan(occupancy, o);
-  switch (o.storage) {
-    case Storage::kU8:
-      return compute_whole_field<std::uint8_t, std::uint8_t>(occupancy, o, p);
-    case Storage::kU16:
-      return compute_whole_field<std::uint16_t, std::uint16_t>(occupancy, o, p);
-    case Storage::kF32:
-      return compute_whole_field<float, std::uint32_t>(occupancy, o, p);
-  }
-  throw InvalidArgument("unknown storage");
+  return detail::exact::compute_exact_field(occupancy, o, p, nullptr, p.domain.size());
 }
 
 }  // namespace voxfield

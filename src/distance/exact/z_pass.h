@@ -24,6 +24,16 @@
 
 namespace voxfield::detail::exact {
 
+// For a slab of a larger domain (distance_slab.h): per column of the domain's x-y extent, the z of
+// the nearest solid and air voxel below the slab (INT32_MIN / 2 when none) and above it
+// (INT32_MAX / 2 when none). The sweeps start from them instead of from "nothing seen".
+struct ColumnsBeyond {
+  const std::int32_t* solid_below = nullptr;
+  const std::int32_t* air_below = nullptr;
+  const std::int32_t* solid_above = nullptr;
+  const std::int32_t* air_above = nullptr;
+};
+
 // One step of a z sweep over `n` lanes: ds / da are the running distances (in voxels) to the
 // nearest solid / air voxel seen so far, saturating at cap; returns through `c` the one each voxel
 // stores (for signed fields the distance that is not trivially zero). Shared by the whole-field
@@ -48,10 +58,11 @@ inline void z_sweep_step(const std::uint8_t* __restrict w, G* __restrict ds, G* 
 // over `edge` lanes along x at once. The column of a row (Z x edge values) lives in `col`, a
 // thread-local buffer small enough for the cache, so each output voxel is written exactly once.
 // U: the unsigned integer the output storage holds g in; g >= cap is stored as kInf ("none").
+// `beyond`, when given, holds the sites of the columns outside the domain's z range.
 template <class U, bool kSigned>
 void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
             ChunkedVolume<SiteOffset>* sites, int cx, int cy, std::uint32_t cap,
-            std::vector<std::uint32_t>& col) {
+            std::vector<std::uint32_t>& col, const ColumnsBeyond* beyond = nullptr) {
   constexpr U kInf = std::numeric_limits<U>::max();
   const int e = g.edge;
   const int y0 = std::max(p.domain.begin.y, g.box.begin.y + cy * e);
@@ -60,10 +71,39 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
   col.resize(static_cast<std::size_t>(z1 - z0) * e);
   std::uint32_t ds[128], da[128];
   std::int32_t ls[128], la[128];  // z of the last solid / air site seen (sites only)
+  const int x0 = g.box.begin.x + cx * e;
+  // Lane i's column index into `beyond`, or -1 outside the domain (or without `beyond`).
+  auto column = [&](int y, int i) -> std::int64_t {
+    const int x = x0 + i;
+    if (!beyond || x < p.domain.begin.x || x >= p.domain.end.x) return -1;
+    return static_cast<std::int64_t>(y - p.domain.begin.y) * p.domain.size().x +
+           (x - p.domain.begin.x);
+  };
+  // The running distance (in voxels, capped) just before the sweep enters the domain, from the
+  // nearest site beyond it: `from` sits `dist(from)` voxels before the first voxel minus one.
+  auto start = [&](std::uint32_t* d, const std::int32_t* from, int y, bool upward) {
+    for (int i = 0; i < e; ++i) {
+      const std::int64_t c = column(y, i);
+      // No site beyond (the sentinels of start_sites below): nothing seen yet.
+      if (c < 0 || from[c] == (upward ? INT32_MIN / 2 : INT32_MAX / 2)) {
+        d[i] = cap;
+        continue;
+      }
+      const std::int64_t dist =
+          upward ? std::int64_t{z0} - 1 - from[c] : from[c] - std::int64_t{z1};
+      d[i] = static_cast<std::uint32_t>(std::min<std::int64_t>(dist, cap));
+    }
+  };
+  auto start_sites = [&](std::int32_t* l, const std::int32_t* from, int y, std::int32_t none) {
+    for (int i = 0; i < e; ++i) {
+      const std::int64_t c = column(y, i);
+      l[i] = c < 0 ? none : from[c];
+    }
+  };
   for (int y = y0; y < y1; ++y) {
     // Forward (increasing z): distance to the nearest site at or below.
-    std::fill(ds, ds + e, cap);
-    std::fill(da, da + e, cap);
+    start(ds, beyond ? beyond->solid_below : nullptr, y, true);
+    start(da, beyond ? beyond->air_below : nullptr, y, true);
     // __restrict: the rows never alias, and saying so lets the compiler vectorise the lanes.
     std::uint32_t* __restrict dsr = ds;
     std::uint32_t* __restrict dar = da;
@@ -73,8 +113,8 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
                             static_cast<std::size_t>(e), cap);
     }
     // Backward (decreasing z): keep the smaller, and store once.
-    std::fill(ds, ds + e, cap);
-    std::fill(da, da + e, cap);
+    start(ds, beyond ? beyond->solid_above : nullptr, y, false);
+    start(da, beyond ? beyond->air_above : nullptr, y, false);
     for (int z = z1 - 1; z >= z0; --z) {
       const std::uint8_t* __restrict w = world.row(cx, y, z);
       const std::uint32_t* __restrict c = col.data() + static_cast<std::size_t>(z - z0) * e;
@@ -94,8 +134,8 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
     }
     if (!sites) continue;
     // Nearest site along z: below (found by the upward sweep) wins ties.
-    std::fill(ls, ls + e, INT32_MIN / 2);
-    std::fill(la, la + e, INT32_MIN / 2);
+    start_sites(ls, beyond ? beyond->solid_below : nullptr, y, INT32_MIN / 2);
+    start_sites(la, beyond ? beyond->air_below : nullptr, y, INT32_MIN / 2);
     for (int z = z0; z < z1; ++z) {
       const std::uint8_t* w = world.row(cx, y, z);
       SiteOffset* so = sites->row(cx, y, z);
@@ -109,8 +149,8 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
             std::clamp((kSigned && solid ? la[i] : ls[i]) - z, -32768, 32767));
       }
     }
-    std::fill(ls, ls + e, INT32_MAX / 2);
-    std::fill(la, la + e, INT32_MAX / 2);
+    start_sites(ls, beyond ? beyond->solid_above : nullptr, y, INT32_MAX / 2);
+    start_sites(la, beyond ? beyond->air_above : nullptr, y, INT32_MAX / 2);
     for (int z = z1 - 1; z >= z0; --z) {
       const std::uint8_t* w = world.row(cx, y, z);
       SiteOffset* so = sites->row(cx, y, z);
