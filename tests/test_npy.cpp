@@ -1,7 +1,13 @@
 // .npy against bytes written by NumPy itself (numpy 1.24, np.save) and hand-made headers.
 #include <gtest/gtest.h>
 
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
 #include <string>
+
+#include <unistd.h>
 
 #include "voxfield/npy.h"
 
@@ -167,4 +173,104 @@ TEST(Npy, WorldConversion) {
   }
   NpyVolume big{DType::kInt32, {1, 1, 1}, {0x00, 0x01, 0x00, 0x00}};  // 256
   EXPECT_THROW(world_from_npy(big, "big.npy"), FormatError);
+}
+
+namespace {
+
+// A temporary file holding `bytes`, removed at the end of the test.
+struct TempFile {
+  std::filesystem::path path;
+  TempFile(const std::string& name, const std::vector<std::uint8_t>& bytes)
+      : path(std::filesystem::temp_directory_path() /
+             ("voxfield_npy_part_" + std::to_string(::getpid()) + "_" + name)) {
+    std::ofstream(path, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()),
+               static_cast<std::streamsize>(bytes.size()));
+  }
+  ~TempFile() { std::filesystem::remove(path); }
+};
+
+}  // namespace
+
+// Parts of arrays (what voxfield-mpi's ranks read) against the whole array read at once: every
+// slice range of Fortran- and C-order files, little- and big-endian, several dtypes.
+TEST(Npy, PartsEqualTheWholeArraysSlices) {
+  std::mt19937 rng(11);
+  struct Kind {
+    const char* descr;
+    int size;
+  };
+  for (const Kind k :
+       {Kind{"|u1", 1}, Kind{"<i2", 2}, Kind{">f4", 4}, Kind{"<f8", 8}, Kind{"|b1", 1}}) {
+    for (bool fortran : {true, false}) {
+      const Vec3i d{2 + static_cast<int>(rng() % 6), 1 + static_cast<int>(rng() % 5),
+                    3 + static_cast<int>(rng() % 7)};
+      std::vector<std::uint8_t> data(static_cast<std::size_t>(d.x * d.y * d.z * k.size));
+      for (auto& b : data) b = static_cast<std::uint8_t>(rng() % 3 == 0 ? rng() : 0);
+      const std::string header = std::string("{'descr': '") + k.descr +
+                                 "', 'fortran_order': " + (fortran ? "True" : "False") +
+                                 ", 'shape': (" + std::to_string(d.x) + ", " + std::to_string(d.y) +
+                                 ", " + std::to_string(d.z) + "), }";
+      const auto bytes = npy_bytes(header, data, fortran ? 1 : 2);
+      const TempFile file(std::string(k.descr + 1) + (fortran ? "f" : "c") + ".npy", bytes);
+      const NpyVolume whole = parse_npy(bytes, "whole");
+      const NpyVolume head = read_npy_header(file.path);
+      EXPECT_EQ(head.dims, d);
+      EXPECT_EQ(head.dtype, whole.dtype);
+      EXPECT_TRUE(head.bytes.empty());
+      const std::size_t slice = static_cast<std::size_t>(d.x * d.y * k.size);
+      for (int z0 = 0; z0 < d.z; ++z0)
+        for (int z1 = z0 + 1; z1 <= d.z; ++z1) {
+          const NpyVolume part = read_npy_part(file.path, z0, z1);
+          const std::string what = std::string(k.descr) + (fortran ? " F" : " C") + " z " +
+                                   std::to_string(z0) + ".." + std::to_string(z1);
+          ASSERT_EQ(part.dims, (Vec3i{d.x, d.y, z1 - z0})) << what;
+          EXPECT_EQ(part.file_origin, (Vec3i{0, 0, z0})) << what;
+          const std::vector<std::uint8_t> expect(
+              whole.bytes.begin() + static_cast<std::ptrdiff_t>(z0 * slice),
+              whole.bytes.begin() + static_cast<std::ptrdiff_t>(z1 * slice));
+          EXPECT_EQ(part.bytes, expect) << what;
+          // Every value's file offset is where the whole array has it.
+          for (std::int64_t i = 0; i < part.count(); i += 3) {
+            EXPECT_EQ(part.file_offset_of(i),
+                      whole.file_offset_of(i + static_cast<std::int64_t>(z0) * d.x * d.y))
+                << what;
+          }
+        }
+    }
+  }
+}
+
+TEST(Npy, PartsRefuseBadSlicesAndShortFiles) {
+  const TempFile good("good.npy", npy_bytes(kFortranHeader, kFortranData));
+  EXPECT_THROW(read_npy_part(good.path, 1, 1), InvalidArgument);
+  EXPECT_THROW(read_npy_part(good.path, -1, 1), InvalidArgument);
+  EXPECT_THROW(read_npy_part(good.path, 0, 3), InvalidArgument);
+  auto cut = npy_bytes(kFortranHeader, kFortranData);
+  cut.pop_back();
+  const TempFile short_file("short.npy", cut);
+  EXPECT_THROW(read_npy_header(short_file.path), FormatError);
+  EXPECT_THROW(read_npy_part(short_file.path, 0, 1), FormatError);
+  const TempFile not_npy("not.npy", {'h', 'e', 'l', 'l', 'o'});
+  EXPECT_THROW(read_npy_header(not_npy.path), FormatError);
+  EXPECT_THROW(read_npy_header(std::filesystem::path("/nonexistent/voxfield.npy")), IoError);
+  // A value that is no material names its index in the whole array and its offset in the file.
+  const std::string f32 = "{'descr': '<f4', 'fortran_order': True, 'shape': (3, 2, 2), }";
+  std::vector<std::uint8_t> floats(12 * 4, 0);
+  const float half = 0.5f;
+  std::memcpy(floats.data() + 4 * (2 + 3 * (1 + 2 * 1)), &half, 4);  // a[2, 1, 1]
+  const auto frac_bytes = npy_bytes(f32, floats);
+  const TempFile frac("frac.npy", frac_bytes);
+  try {
+    (void)world_from_npy(read_npy_part(frac.path, 1, 2), frac.path.string());
+    FAIL() << "a fraction was read as a material";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("a[2, 1, 1] holds 0.5"), std::string::npos) << e.what();
+    EXPECT_EQ(e.offset(), frac_bytes.size() - floats.size() + 4 * 11) << e.what();
+  }
+  // The part's world sits at the part's place.
+  const World w = world_from_npy(read_npy_part(good.path, 1, 2), "good");
+  EXPECT_EQ(w.voxels.get({2, 1, 1}), 7);
+  EXPECT_EQ(w.voxels.get({1, 0, 0}), 0);  // slice 0 is not part of it
+  EXPECT_EQ(w.solid_count(), 1);
 }

@@ -29,6 +29,26 @@ std::vector<std::uint8_t> read_file_prefix(const std::filesystem::path& path, st
 // Size in bytes of a regular file (same refusals as read_file).
 std::uint64_t regular_file_size(const std::filesystem::path& path);
 
+// A regular file open for reading pieces of it (same refusals as read_file), so that a large
+// array can be read a part at a time. Not for concurrent use from several threads.
+class FileReader {
+ public:
+  explicit FileReader(const std::filesystem::path& path);
+  ~FileReader();
+  FileReader(const FileReader&) = delete;
+  FileReader& operator=(const FileReader&) = delete;
+
+  std::uint64_t size() const { return size_; }
+  // Exactly `n` bytes at `offset` into `out`. Throws IoError naming the file when the file ends
+  // first (it shrank after opening) or a read fails.
+  void read_at(std::uint64_t offset, std::size_t n, std::uint8_t* out) const;
+
+ private:
+  std::filesystem::path path_;
+  int fd_ = -1;
+  std::uint64_t size_ = 0;
+};
+
 // Checks, without writing or creating anything, that `path` can be written as an output of
 // FileTransaction / write_file_atomic: "-" (standard output) is fine; otherwise (after following
 // symbolic links) the parent directory must exist and be a directory, the path must not be a

@@ -55,12 +55,18 @@ struct NpyVolume {
   // and whether the file stored it in C order (z fastest). Zero / false for volumes built in code.
   std::uint64_t file_data_offset = 0;
   bool file_c_order = false;
+  // A part of a file's array (read_npy_part): the index of this volume's first value in the file's
+  // array, and the whole array's dimensions (zero when the volume is the whole array).
+  Vec3i file_origin{};
+  Vec3i file_dims{};
 
   std::int64_t count() const { return Box3i::from_size(dims).volume(); }
   // Value i (x fastest) converted to double, whatever the dtype.
   double value(std::int64_t i) const;
   // Byte offset in the file of value i (x fastest), following the file's order.
   std::uint64_t file_offset_of(std::int64_t i) const;
+  // The index in the file's array of value i: a[x, y, z].
+  Vec3i file_index_of(std::int64_t i) const;
 };
 
 struct NpyReadOptions {
@@ -73,8 +79,23 @@ struct NpyReadOptions {
 NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name,
                     const NpyReadOptions& options = {});
 NpyVolume read_npy(const std::filesystem::path& path, const NpyReadOptions& options = {});
+// The header of a .npy file, checked against the file's size as read_npy checks it: a volume with
+// its dtype, dims and file layout but no values. With read_npy_part, an array larger than one
+// process may hold is read a part at a time (voxfield-mpi).
+NpyVolume read_npy_header(const std::filesystem::path& path, const NpyReadOptions& options = {});
+// The slices z0..z1 (0 <= z0 < z1 <= dims.z) of the 3-D array of a .npy file: dims (X, Y, z1 - z0),
+// x fastest, the values read_npy gives for those slices, with file_origin (0, 0, z0) and file_dims
+// the whole array's. Only the part is held: a Fortran-order file is read in one piece, a C-order
+// one (z fastest) one x-plane at a time. The memory limit applies to the part. Throws what
+// read_npy throws, and InvalidArgument for slices outside the array.
+NpyVolume read_npy_part(const std::filesystem::path& path, std::int32_t z0, std::int32_t z1,
+                        const NpyReadOptions& options = {});
 // Encodes as format 1.0 (2.0 when the header needs it), Fortran order, little-endian.
 std::vector<std::uint8_t> encode_npy(const NpyVolume& volume);
+// The header encode_npy writes before the values of a 3-D array (dims, then `components` when
+// above 1), for writers that put the values in place themselves: the values follow it, x fastest,
+// component slowest, little-endian.
+std::vector<std::uint8_t> npy_header(DType dtype, Vec3i dims, int components = 1);
 void write_npy(const NpyVolume& volume, const std::filesystem::path& path);
 
 // Builds a volume from dense values (x fastest). T must match dtype's size.
@@ -89,9 +110,10 @@ NpyVolume make_npy(DType dtype, Vec3i dims, const T* values) {
 }
 
 // Volume -> World: every non-zero value is that material, placed with a[x, y, z] at voxel (x, y,
-// z). Throws FormatError naming the element a[x, y, z] and its byte offset in the file when a value
-// is not an integer in 0..255 (bool counts as material 1), ResourceLimitError when the world would
-// pass the memory limit.
+// z) (for a part of a file's array, a[x, y, z] indexes the whole array: file_index_of). Throws
+// FormatError naming the element a[x, y, z] and its byte offset in the file when a value is not an
+// integer in 0..255 (bool counts as material 1), ResourceLimitError when the world would pass the
+// memory limit.
 World world_from_npy(const NpyVolume& volume, const std::string& name,
                      int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge,
                      std::uint64_t memory_limit_bytes = 0);

@@ -19,6 +19,7 @@ class ByteReader {
       : bytes_(bytes), name_(&name), base_(base) {}
 
   std::uint64_t offset() const { return base_ + pos_; }  // absolute offset in the file
+  const std::string& name() const { return *name_; }
   std::size_t remaining() const { return bytes_.size() - pos_; }
   bool at_end() const { return pos_ == bytes_.size(); }
 

@@ -300,6 +300,34 @@ std::uint64_t regular_file_size(const std::filesystem::path& path) {
   return static_cast<std::uint64_t>(st.st_size);
 }
 
+FileReader::FileReader(const std::filesystem::path& path) : path_(path) {
+  struct stat st {};
+  Fd fd = open_regular(path, st);
+  size_ = static_cast<std::uint64_t>(st.st_size);
+  fd_ = fd.release();
+}
+
+FileReader::~FileReader() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void FileReader::read_at(std::uint64_t offset, std::size_t n, std::uint8_t* out) const {
+  std::size_t done = 0;
+  while (done < n) {
+    const ssize_t got = ::pread(fd_, out + done, n - done, static_cast<off_t>(offset + done));
+    if (got < 0) {
+      if (errno == EINTR) continue;
+      throw IoError(path_.string() + ": read of " + std::to_string(n) + " bytes at offset " +
+                    std::to_string(offset) + " failed: " + errno_text());
+    }
+    if (got == 0)
+      throw IoError(path_.string() + ": ends at " + std::to_string(offset + done) +
+                    " bytes, before the " + std::to_string(n) + " bytes read at offset " +
+                    std::to_string(offset) + " (did it shrink while read?)");
+    done += static_cast<std::size_t>(got);
+  }
+}
+
 void check_output_path(const std::filesystem::path& path) {
   (void)inspect_output(path);
 }

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 
 #include "byte_reader.h"
 #include "voxfield/file.h"
@@ -208,16 +209,36 @@ double NpyVolume::value(std::int64_t i) const {
   return 0.0;
 }
 
+Vec3i NpyVolume::file_index_of(std::int64_t i) const {
+  const std::int64_t X = dims.x, Y = dims.y;
+  return file_origin + Vec3i{static_cast<std::int32_t>(i % X),
+                             static_cast<std::int32_t>((i / X) % Y),
+                             static_cast<std::int32_t>(i / (X * Y))};
+}
+
 std::uint64_t NpyVolume::file_offset_of(std::int64_t i) const {
-  const std::int64_t X = dims.x, Y = dims.y, Z = dims.z;
-  const std::int64_t x = i % X, y = (i / X) % Y, z = i / (X * Y);
-  const std::int64_t in_file = file_c_order ? (x * Y + y) * Z + z : i;
+  const Vec3i whole = file_dims.x > 0 ? file_dims : dims;
+  const std::int64_t X = whole.x, Y = whole.y, Z = whole.z;
+  const Vec3i p = file_index_of(i);
+  const std::int64_t in_file = file_c_order ? (p.x * Y + p.y) * Z + p.z : (p.z * Y + p.y) * X + p.x;
   return file_data_offset + static_cast<std::uint64_t>(in_file) * dtype_size(dtype);
 }
 
-NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name,
-                    const NpyReadOptions& options) {
-  detail::ByteReader r(bytes, name);
+namespace {
+
+// A .npy header, validated against the bytes that follow it (`available`): everything the readers
+// need before the data.
+struct Header {
+  const DTypeInfo* type = nullptr;
+  bool swap = false;     // big-endian data of a multi-byte type
+  bool c_order = false;  // z fastest
+  int rank = 3;
+  Vec3i dims;
+  std::uint64_t data_offset = 0, data_bytes = 0, count = 0;
+};
+
+Header read_header(detail::ByteReader& r, const std::function<std::uint64_t()>& available,
+                   const NpyReadOptions& options) {
   static constexpr std::uint8_t kMagic[6] = {0x93, 'N', 'U', 'M', 'P', 'Y'};
   auto magic = r.take(6, "magic");
   if (!std::equal(magic.begin(), magic.end(), kMagic)) r.fail_at(0, "not a .npy file (bad magic)");
@@ -233,6 +254,7 @@ NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name
   const std::uint64_t header_at = r.offset();
   auto header_bytes = r.take(header_len, "header");
   const std::string header(header_bytes.begin(), header_bytes.end());
+  const std::string& name = r.name();
   HeaderParser h(header, name, header_at);
   h.parse();
 
@@ -263,61 +285,98 @@ NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name
                              std::to_string(h.shape.size()) + " dimensions");
   }
   h.shape.resize(3, 1);
-  NpyVolume v;
-  v.rank = options.rank;
-  v.dtype = found->type;
+  Header out;
+  out.rank = options.rank;
+  out.type = found;
   for (int k = 0; k < 3; ++k) {
     if (h.shape[k] < 1 || h.shape[k] > kCoordLimit) {
       r.fail_at(header_at, "dimension " + std::to_string(k) + " is " + std::to_string(h.shape[k]) +
                                ", outside 1..2^29 (the supported coordinate range)");
     }
-    v.dims[k] = static_cast<std::int32_t>(h.shape[k]);
+    out.dims[k] = static_cast<std::int32_t>(h.shape[k]);
   }
   // Each dimension is below 2^30, but their product may not fit in 64 bits: saturate, then compare.
-  const std::uint64_t n = mul_sat(
+  out.count = mul_sat(
       mul_sat(static_cast<std::uint64_t>(h.shape[0]), static_cast<std::uint64_t>(h.shape[1])),
       static_cast<std::uint64_t>(h.shape[2]));
-  const std::uint64_t data_bytes = mul_sat(n, static_cast<std::uint64_t>(size));
-  if (data_bytes > r.remaining()) {
+  out.data_bytes = mul_sat(out.count, static_cast<std::uint64_t>(size));
+  const std::uint64_t follow = available();
+  if (out.data_bytes > follow) {
     r.fail("the shape (" + std::to_string(h.shape[0]) + ", " + std::to_string(h.shape[1]) + ", " +
            std::to_string(h.shape[2]) + ") of " + found->name + " needs " +
-           (data_bytes == UINT64_MAX ? std::string("more than 2^64") : std::to_string(data_bytes)) +
-           " bytes of data but only " + std::to_string(r.remaining()) + " bytes follow the header");
+           (out.data_bytes == UINT64_MAX ? std::string("more than 2^64")
+                                         : std::to_string(out.data_bytes)) +
+           " bytes of data but only " + std::to_string(follow) + " bytes follow the header");
   }
-  if (data_bytes < r.remaining()) {
-    r.fail_at(r.offset() + data_bytes,
-              std::to_string(r.remaining() - data_bytes) +
+  if (out.data_bytes < follow) {
+    r.fail_at(r.offset() + out.data_bytes,
+              std::to_string(follow - out.data_bytes) +
                   " bytes after the array data (a damaged or concatenated file?)");
   }
-  require_memory(data_bytes, options.memory_limit_bytes, name,
-                 "the array of " + std::to_string(n) + " values");
-  v.file_data_offset = r.offset();
-  v.file_c_order = !h.fortran;
-  auto data = r.take(static_cast<std::size_t>(data_bytes), "array data");
-  v.bytes.resize(data.size());
-  const bool swap = size > 1 && order == '>';
-  if (h.fortran) {
-    std::memcpy(v.bytes.data(), data.data(), data.size());
+  out.data_offset = r.offset();
+  out.c_order = !h.fortran;
+  out.swap = size > 1 && order == '>';
+  return out;
+}
+
+// The slices z0..z1 of the array whose file data starts at `data` (the whole array for a C-order
+// file, whose slices are not contiguous; the slices alone for a Fortran-order one), into `out` x
+// fastest in native byte order.
+void decode_part(const Header& h, const std::uint8_t* data, std::int32_t z0, std::int32_t z1,
+                 std::uint8_t* out) {
+  const std::size_t size = static_cast<std::size_t>(h.type->size);
+  const std::int64_t X = h.dims.x, Y = h.dims.y, Z = h.dims.z, nz = z1 - z0;
+  if (!h.c_order) {
+    std::memcpy(out, data, static_cast<std::size_t>(X * Y * nz) * size);
   } else {
     // C order: z fastest. Transpose to x fastest.
-    const std::int64_t X = v.dims.x, Y = v.dims.y, Z = v.dims.z;
     for (std::int64_t x = 0; x < X; ++x)
       for (std::int64_t y = 0; y < Y; ++y)
-        for (std::int64_t z = 0; z < Z; ++z) {
-          const std::int64_t src = (x * Y + y) * Z + z, dst = (z * Y + y) * X + x;
-          std::memcpy(v.bytes.data() + dst * size, data.data() + src * size,
-                      static_cast<std::size_t>(size));
+        for (std::int64_t z = 0; z < nz; ++z) {
+          const std::int64_t src = (x * Y + y) * Z + z0 + z, dst = (z * Y + y) * X + x;
+          std::memcpy(out + dst * size, data + src * size, size);
         }
   }
-  if (swap) {
-    for (std::size_t i = 0; i < v.bytes.size(); i += static_cast<std::size_t>(size)) {
-      std::reverse(v.bytes.begin() + static_cast<std::ptrdiff_t>(i),
-                   v.bytes.begin() + static_cast<std::ptrdiff_t>(i) + size);
+}
+
+void finish_values(const Header& h, std::vector<std::uint8_t>& bytes) {
+  const auto size = static_cast<std::size_t>(h.type->size);
+  if (h.swap) {
+    for (std::size_t i = 0; i < bytes.size(); i += size) {
+      std::reverse(bytes.begin() + static_cast<std::ptrdiff_t>(i),
+                   bytes.begin() + static_cast<std::ptrdiff_t>(i + size));
     }
   }
-  if (v.dtype == DType::kBool) {
-    for (auto& b : v.bytes) b = b ? 1 : 0;
+  if (h.type->type == DType::kBool) {
+    for (auto& b : bytes) b = b ? 1 : 0;
   }
+}
+
+NpyVolume volume_of(const Header& h) {
+  NpyVolume v;
+  v.rank = h.rank;
+  v.dtype = h.type->type;
+  v.dims = h.dims;
+  v.file_dims = h.dims;
+  v.file_data_offset = h.data_offset;
+  v.file_c_order = h.c_order;
+  return v;
+}
+
+}  // namespace
+
+NpyVolume parse_npy(std::span<const std::uint8_t> bytes, const std::string& name,
+                    const NpyReadOptions& options) {
+  detail::ByteReader r(bytes, name);
+  const Header h = read_header(
+      r, [&] { return std::uint64_t{r.remaining()}; }, options);
+  require_memory(h.data_bytes, options.memory_limit_bytes, name,
+                 "the array of " + std::to_string(h.count) + " values");
+  NpyVolume v = volume_of(h);
+  auto data = r.take(static_cast<std::size_t>(h.data_bytes), "array data");
+  v.bytes.resize(data.size());
+  decode_part(h, data.data(), 0, h.dims.z, v.bytes.data());
+  finish_values(h, v.bytes);
   return v;
 }
 
@@ -329,16 +388,85 @@ NpyVolume read_npy(const std::filesystem::path& path, const NpyReadOptions& opti
   return parse_npy(bytes, path.string(), rest);
 }
 
-std::vector<std::uint8_t> encode_npy(const NpyVolume& v) {
+namespace {
+
+// The header of the file behind `reader`, checked against its size.
+Header header_of(const FileReader& reader, const std::string& name, const NpyReadOptions& options) {
+  // The fixed prefix first (magic, version, length), then as much as the header says it takes.
+  std::vector<std::uint8_t> prefix(std::min<std::uint64_t>(reader.size(), 12));
+  reader.read_at(0, prefix.size(), prefix.data());
+  std::uint64_t want = prefix.size();
+  if (prefix.size() >= 10 && prefix[6] == 1) want = 10 + (prefix[8] | (prefix[9] << 8));
+  if (prefix.size() >= 12 && (prefix[6] == 2 || prefix[6] == 3)) {
+    std::uint32_t len;
+    std::memcpy(&len, prefix.data() + 8, 4);
+    want = 12 + std::uint64_t{len};
+  }
+  want = std::min(want, reader.size());
+  require_memory(want, options.memory_limit_bytes, name, "the header");
+  prefix.resize(static_cast<std::size_t>(want));
+  reader.read_at(0, prefix.size(), prefix.data());
+  detail::ByteReader r(prefix, name);
+  return read_header(
+      r, [&] { return reader.size() - r.offset(); }, options);
+}
+
+}  // namespace
+
+NpyVolume read_npy_header(const std::filesystem::path& path, const NpyReadOptions& options) {
+  const FileReader reader(path);
+  return volume_of(header_of(reader, path.string(), options));
+}
+
+NpyVolume read_npy_part(const std::filesystem::path& path, std::int32_t z0, std::int32_t z1,
+                        const NpyReadOptions& options) {
+  const std::string name = path.string();
+  const FileReader reader(path);
+  NpyReadOptions o = options;
+  o.rank = 3;
+  const Header h = header_of(reader, name, o);
+  if (z0 < 0 || z1 > h.dims.z || z0 >= z1)
+    throw InvalidArgument(name + ": slices " + std::to_string(z0) + ".." + std::to_string(z1) +
+                          " are not a part of the array's " + std::to_string(h.dims.z));
+  const std::size_t size = static_cast<std::size_t>(h.type->size);
+  const std::uint64_t X = static_cast<std::uint64_t>(h.dims.x),
+                      Y = static_cast<std::uint64_t>(h.dims.y),
+                      Z = static_cast<std::uint64_t>(h.dims.z),
+                      nz = static_cast<std::uint64_t>(z1 - z0);
+  const std::uint64_t part_bytes = X * Y * nz * size;
+  // A C-order file is read one x-plane at a time, beside the part.
+  const std::uint64_t plane_bytes = h.c_order ? Y * Z * size : 0;
+  require_memory(part_bytes + plane_bytes, options.memory_limit_bytes, name,
+                 "slices " + std::to_string(z0) + ".." + std::to_string(z1) + " of the array");
+  NpyVolume v = volume_of(h);
+  v.dims.z = z1 - z0;
+  v.file_origin = {0, 0, z0};
+  v.bytes.resize(static_cast<std::size_t>(part_bytes));
+  if (!h.c_order) {
+    reader.read_at(h.data_offset + static_cast<std::uint64_t>(z0) * X * Y * size,
+                   static_cast<std::size_t>(part_bytes), v.bytes.data());
+  } else {
+    // The plane a[x, :, :] holds the part's values of that x at y * Z + (z0..z1).
+    std::vector<std::uint8_t> plane(static_cast<std::size_t>((Y - 1) * Z + nz) * size);
+    for (std::uint64_t x = 0; x < X; ++x) {
+      reader.read_at(h.data_offset + (x * Y * Z + static_cast<std::uint64_t>(z0)) * size,
+                     plane.size(), plane.data());
+      for (std::uint64_t y = 0; y < Y; ++y)
+        for (std::uint64_t z = 0; z < nz; ++z)
+          std::memcpy(v.bytes.data() + ((z * Y + y) * X + x) * size,
+                      plane.data() + (y * Z + z) * size, size);
+    }
+  }
+  finish_values(h, v.bytes);
+  return v;
+}
+
+namespace {
+
+// magic, version, length and the dict literal of a volume's shape and dtype, padded to 64 bytes.
+std::vector<std::uint8_t> encode_header(const NpyVolume& v) {
   const DTypeInfo& d = info(v.dtype);
   if (v.components < 1) throw InvalidArgument("encode_npy: components must be >= 1");
-  const std::size_t expect = static_cast<std::size_t>(v.count()) *
-                             static_cast<std::size_t>(v.components) *
-                             static_cast<std::size_t>(d.size);
-  if (v.bytes.size() != expect) {
-    throw InvalidArgument("encode_npy: volume holds " + std::to_string(v.bytes.size()) +
-                          " bytes, expected " + std::to_string(expect));
-  }
   const std::string descr = std::string(d.size == 1 ? "|" : "<") + d.kind + std::to_string(d.size);
   if (v.rank < 1 || v.rank > 3 ||
       (v.rank < 3 && (v.dims.z != 1 || (v.rank == 1 && v.dims.y != 1) || v.components > 1)))
@@ -357,7 +485,7 @@ std::vector<std::uint8_t> encode_npy(const NpyVolume& v) {
   header.append(total - prefix - header.size() - 1, ' ');
   header.push_back('\n');
   std::vector<std::uint8_t> out;
-  out.reserve(total + v.bytes.size());
+  out.reserve(total);
   const std::uint8_t magic[8] = {
       0x93, 'N', 'U', 'M', 'P', 'Y', static_cast<std::uint8_t>(v2 ? 2 : 1), 0};
   out.insert(out.end(), magic, magic + 8);
@@ -369,6 +497,25 @@ std::vector<std::uint8_t> encode_npy(const NpyVolume& v) {
     out.push_back(static_cast<std::uint8_t>(len >> 24));
   }
   out.insert(out.end(), header.begin(), header.end());
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> npy_header(DType dtype, Vec3i dims, int components) {
+  NpyVolume shape_only{dtype, dims, {}, components};
+  return encode_header(shape_only);
+}
+
+std::vector<std::uint8_t> encode_npy(const NpyVolume& v) {
+  const std::size_t expect = static_cast<std::size_t>(v.count()) *
+                             static_cast<std::size_t>(std::max(v.components, 0)) *
+                             dtype_size(v.dtype);
+  std::vector<std::uint8_t> out = encode_header(v);
+  if (v.bytes.size() != expect) {
+    throw InvalidArgument("encode_npy: volume holds " + std::to_string(v.bytes.size()) +
+                          " bytes, expected " + std::to_string(expect));
+  }
   out.insert(out.end(), v.bytes.begin(), v.bytes.end());
   return out;
 }
@@ -396,16 +543,15 @@ World world_from_npy(const NpyVolume& v, const std::string& name, int chunk_edge
   for (std::int64_t i = 0; i < v.count(); ++i) {
     const double m = v.value(i);
     if (!(m >= 0 && m <= 255 && std::floor(m) == m)) {
-      const std::int64_t x = i % v.dims.x, y = (i / v.dims.x) % v.dims.y,
-                         z = i / (std::int64_t{v.dims.x} * v.dims.y);
+      const Vec3i a = v.file_index_of(i);
       throw FormatError(name, v.file_offset_of(i),
-                        "element a[" + std::to_string(x) + ", " + std::to_string(y) + ", " +
-                            std::to_string(z) + "] holds " + number_text(m) +
+                        "element a[" + std::to_string(a.x) + ", " + std::to_string(a.y) + ", " +
+                            std::to_string(a.z) + "] holds " + number_text(m) +
                             ", not a material index (an integer 0..255)");
     }
     materials[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(m);
   }
-  world.voxels.copy_from_dense(Box3i::from_size(v.dims), materials.data());
+  world.voxels.copy_from_dense(Box3i{v.file_origin, v.file_origin + v.dims}, materials.data());
   return world;
 }
 
