@@ -17,9 +17,9 @@ import pathlib
 import re
 import sys
 
-LAYERS = ["core", "gpu", "distance", "vectors", "csg", "mesh", "io", "render", "live"]
+LAYERS = ["core", "gpu", "distance", "vectors", "csg", "mesh", "io", "render", "live", "mpi"]
 MODULE_LAYER = {"grid": "core", "edit": "core", "scene": "core", "gpu": "gpu", "distance": "distance",
-                "vectors": "vectors", "csg": "csg", "mesh": "mesh", "io": "io", "render": "render", "live": "live"}
+                "vectors": "vectors", "csg": "csg", "mesh": "mesh", "io": "io", "render": "render", "live": "live", "mpi": "mpi"}
 PUBLIC_LAYER = {
     "box.h": "core", "error.h": "core", "parallel.h": "core", "limits.h": "core", "grid.h": "core",
     "detail/grid_impl.h": "core", "detail/assert.h": "core", "world.h": "core", "edit.h": "core", "edit_stream.h": "core",
@@ -34,7 +34,7 @@ PUBLIC_LAYER = {
     "file.h": "io", "npy.h": "io", "vox.h": "io", "world_file.h": "io", "world_io.h": "io",
     "edit_script.h": "io",
     "render.h": "render", "mesh_render.h": "render", "csg_render.h": "render", "gpu_render.h": "render", "gpu_render_vulkan.h": "render",
-    "live_world.h": "live",
+    "live_world.h": "live", "mpi.h": "mpi",
 }
 # Headers of the GPU compute layer that the modules above it may include (its internal interface).
 INTERNAL_INTERFACE = {"src/gpu/vulkan_context.h", "src/gpu/kernel.h", "src/gpu/recorder.h",

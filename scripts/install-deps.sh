@@ -24,6 +24,7 @@ packages=(
   python3-skimage                    # test oracle: scikit-image's marching_cubes for the meshers
   openscad                           # test oracle: OpenSCAD's .csg and STL of its bundled examples (CSG import)
   python3-dev pybind11-dev python3-pytest  # the Python package (pybind11 bindings) and its tests
+  libopenmpi-dev openmpi-bin         # voxfield-mpi and the mpi layer: Open MPI, Debian's MPI
   python3-mypy  # checks the package's type stubs against the module (mypy.stubtest) and a typed use of them
 )
 

@@ -103,6 +103,12 @@ class FileTransaction {
 
   void stage(const std::filesystem::path& path, std::span<const std::uint8_t> bytes);
   void stage(const std::filesystem::path& path, std::string_view text);
+  // Stages a target that other writers fill: the temporary is created holding `head` and its path
+  // returned; the caller has it written (e.g. by the processes of an MPI job) before commit(),
+  // which fsyncs it before the rename. Regular-file targets only: standard output, devices and
+  // FIFOs cannot be written by several processes (IoError).
+  std::filesystem::path stage_shared(const std::filesystem::path& path,
+                                     std::span<const std::uint8_t> head);
   void commit();
 
  private:

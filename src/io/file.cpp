@@ -215,6 +215,7 @@ struct Staged {
   fs::path temporary;               // empty when written in place or already renamed/removed
   int slot = -1;                    // in the registry of temporaries
   std::vector<std::uint8_t> bytes;  // kept for an in-place write
+  bool shared = false;              // filled by other writers: fsynced at commit
 };
 
 // Fills a new temporary for `s` and closes it; `s.temporary` is set as soon as the file exists so
@@ -381,6 +382,29 @@ void FileTransaction::stage(const std::filesystem::path& path,
   }
 }
 
+std::filesystem::path FileTransaction::stage_shared(const std::filesystem::path& path,
+                                                    std::span<const std::uint8_t> head) {
+  if (!impl_->failure.empty()) {
+    throw IoError(path.string() +
+                  ": not staged, the transaction failed earlier: " + impl_->failure);
+  }
+  try {
+    impl_->staged.emplace_back();
+    Staged& s = impl_->staged.back();
+    s.path = path;
+    s.out = inspect_output(path);
+    if (s.out.kind == Output::Kind::kStdout || s.out.kind == Output::Kind::kInPlace)
+      throw IoError(path.string() + ": is not a regular file, which several processes could write");
+    s.shared = true;
+    write_temporary(s, head);
+    return s.temporary;
+  } catch (const std::exception& e) {
+    impl_->failure = e.what();
+    impl_->discard();
+    throw;
+  }
+}
+
 void FileTransaction::stage(const std::filesystem::path& path, std::string_view text) {
   stage(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
 }
@@ -396,6 +420,12 @@ void FileTransaction::commit() {
     // leaves every renamed target untouched. The renames that follow do not fail in practice.
     for (Staged& s : impl_->staged) {
       if (s.temporary.empty()) write_in_place(s);
+    }
+    for (Staged& s : impl_->staged) {
+      if (!s.shared) continue;
+      Fd fd(open_retrying(s.temporary.c_str(), O_WRONLY | O_NOFOLLOW | O_CLOEXEC));
+      if (fd.get() < 0 || ::fsync(fd.get()) != 0)
+        throw IoError(s.path.string() + ": fsync of the written file failed: " + errno_text());
     }
     for (Staged& s : impl_->staged) {
       if (s.temporary.empty()) continue;

@@ -1,0 +1,230 @@
+// voxfield-mpi: exact distance fields of volumes split over the processes of an MPI job.
+//
+//   mpirun -np N voxfield-mpi field IN -o OUT.npy [--metric M] [--signed] [--max-distance D]
+//          [--storage S] [--spacing sx,sy,sz] [--sites S.npy] [--stats S.json] [--chunk C]
+//          [--threads T] [--memory-limit B]
+//   mpirun -np N voxfield-mpi bench --size X,Y,Z [--spheres K] [--repeat R] [field options]
+//
+// `field` writes byte for byte what `voxfield field` writes for the same input and options; each
+// rank holds only its slab of a .npy input and of the field. `bench` generates a world of random
+// spheres slab by slab (no file) and prints, per run, the time, the rate and the bytes exchanged.
+// Every rank parses the same command line; rank 0 alone prints. A failure on any rank is reported
+// by rank 0 as "voxfield-mpi: rank R: ..." and every rank exits with 1 (2 for usage errors).
+#include <mpi.h>
+#include <sys/resource.h>
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "bench_world.h"
+#include "voxfield/distance.h"
+#include "voxfield/error.h"
+#include "voxfield/file.h"
+#include "voxfield/limits.h"
+#include "voxfield/mpi.h"
+#include "voxfield/parallel.h"
+
+namespace {
+
+using namespace voxfield;
+
+struct FieldSettings {
+  std::string metric = "manhattan", storage = "f32";
+  bool is_signed = false;
+  double max_distance = 0;
+  std::vector<double> spacing;
+  int chunk = 32, threads = 0;
+
+  void add_to(CLI::App* cmd) {
+    cmd->add_option("--metric", metric, "manhattan, chebyshev or euclidean")
+        ->check(CLI::IsMember({"manhattan", "chebyshev", "euclidean"}))
+        ->capture_default_str();
+    cmd->add_flag("--signed", is_signed, "negative distances inside solids");
+    cmd->add_option("--max-distance", max_distance, "clamp D (0 = no clamp)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--storage", storage, "u8, u16 or f32")
+        ->check(CLI::IsMember({"u8", "u16", "f32"}))
+        ->capture_default_str();
+    cmd->add_option("--spacing", spacing, "voxel size sx,sy,sz (euclidean only)")
+        ->delimiter(',')
+        ->expected(3)
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--chunk", chunk, "chunk edge: 8, 16, 32, 64 or 128; slabs are cut on chunks")
+        ->check(CLI::IsMember({8, 16, 32, 64, 128}));
+    cmd->add_option("--threads", threads, "threads per rank (default: all cores)")
+        ->check(CLI::Range(1, 1024));
+  }
+  DistanceOptions options() const {
+    DistanceOptions o;
+    o.metric = parse_metric(metric);
+    o.signed_distance = is_signed;
+    o.max_distance = max_distance;
+    o.storage = parse_storage(storage);
+    if (!spacing.empty()) o.spacing = {spacing[0], spacing[1], spacing[2]};
+    return o;
+  }
+  nlohmann::json describe(const DistanceOptions& o, Vec3i dims, int ranks) const {
+    return {{"metric", metric_name(o.metric)},
+            {"signed", o.signed_distance},
+            {"max_distance", o.max_distance},
+            {"storage", storage_name(o.storage)},
+            {"dims", {dims.x, dims.y, dims.z}},
+            {"threads", max_threads()},
+            {"chunk", chunk},
+            {"ranks", ranks}};
+  }
+};
+
+// Resident-set high-water mark of this process, in bytes.
+std::size_t peak_rss_bytes() {
+  struct rusage u {};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<std::size_t>(u.ru_maxrss) * 1024;  // Linux reports KiB
+}
+
+// The slowest rank's figure (times) and the sum over ranks (bytes).
+double max_over(MPI_Comm comm, double v) {
+  double out = 0;
+  MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MAX, comm);
+  return out;
+}
+std::uint64_t sum_over(MPI_Comm comm, std::uint64_t v) {
+  std::uint64_t out = 0;
+  MPI_Allreduce(&v, &out, 1, MPI_UINT64_T, MPI_SUM, comm);
+  return out;
+}
+
+nlohmann::json exchange_json(MPI_Comm comm, const mpi::ExchangeStats& s) {
+  return {{"compute_ms_max", max_over(comm, s.compute_ms)},
+          {"exchange_ms_max", max_over(comm, s.exchange_ms)},
+          {"bytes_sent_total", sum_over(comm, s.bytes_sent)},
+          {"bytes_received_total", sum_over(comm, s.bytes_received)},
+          {"collectives_per_rank", s.collectives}};
+}
+
+int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, const std::string& out,
+              const std::string& sites, const std::string& stats) {
+  int rank = 0, size = 0;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  std::optional<ThreadLimit> limit;
+  if (f.threads > 0) limit.emplace(f.threads);
+  DistanceOptions o = f.options();
+  o.nearest_sites = !sites.empty();
+  const double t0 = MPI_Wtime();
+  const mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk);
+  const double load_ms = (MPI_Wtime() - t0) * 1e3;
+  mpi::ExchangeStats ex;
+  MPI_Barrier(comm);  // the field's time starts together on every rank
+  const double t1 = MPI_Wtime();
+  const DistanceField field =
+      mpi::compute_distance_field(comm, slab.partition, slab.world.voxels, o, &ex);
+  const double field_ms = max_over(comm, (MPI_Wtime() - t1) * 1e3);
+  const Box3i& domain = slab.partition.domain;
+  nlohmann::json j = f.describe(o, domain.size(), size);
+  j.update(nlohmann::json{{"algorithm", "exact"},
+                          {"ms", field_ms},
+                          {"mvox_per_s", static_cast<double>(domain.volume()) / (field_ms * 1e3)},
+                          {"load_ms_max", max_over(comm, load_ms)},
+                          {"read_in_parts", slab.read_in_parts},
+                          {"slabs", slab.partition.z}});
+  j["exchange"] = exchange_json(comm, ex);
+  mpi::FieldFiles files{out, sites, stats, j.dump(2) + "\n"};
+  mpi::write_field_npy(comm, slab.partition, field, files);
+  if (rank == 0) {
+    const Vec3i d = domain.size();
+    std::cerr << "voxfield-mpi: exact " << metric_name(o.metric) << " field of " << d.x << "x"
+              << d.y << "x" << d.z << " on " << size << " ranks in " << field_ms << " ms, wrote "
+              << out << "\n";
+  }
+  return 0;
+}
+
+int run_bench(MPI_Comm comm, const FieldSettings& f, const std::vector<int>& dims, int spheres,
+              int repeat) {
+  int rank = 0, size = 0;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  std::optional<ThreadLimit> limit;
+  if (f.threads > 0) limit.emplace(f.threads);
+  const DistanceOptions o = f.options();
+  const Box3i domain = Box3i::from_size({dims[0], dims[1], dims[2]});
+  const mpi::SlabPartition partition = mpi::partition_slabs(domain, size, f.chunk);
+  const World world = mpi_bench::sphere_world_slab(domain, partition.slab(rank), spheres, f.chunk);
+  for (int r = 0; r < repeat; ++r) {
+    mpi::ExchangeStats ex;
+    MPI_Barrier(comm);
+    const double t0 = MPI_Wtime();
+    const DistanceField field = mpi::compute_distance_field(comm, partition, world.voxels, o, &ex);
+    const double ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
+    nlohmann::json j = f.describe(o, domain.size(), size);
+    j.update(nlohmann::json{
+        {"run", r},
+        {"ms", ms},
+        {"mvox_per_s", static_cast<double>(domain.volume()) / (ms * 1e3)},
+        {"column_bytes", 16.0 * domain.size().x * domain.size().y},
+        {"peak_rss_mb_max", max_over(comm, static_cast<double>(peak_rss_bytes()) / 1048576.0)}});
+    j["exchange"] = exchange_json(comm, ex);
+    if (rank == 0) std::cout << j.dump() << std::endl;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int provided = 0;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  MPI_Comm comm = MPI_COMM_WORLD;
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  voxfield::install_signal_cleanup();
+  CLI::App app{"voxfield-mpi: exact distance fields over the processes of an MPI job"};
+  app.require_subcommand(1);
+  std::string memory_limit;
+  app.add_option("--memory-limit", memory_limit,
+                 "memory limit per rank (bytes, or with K/M/G; default: $VOXFIELD_MEMORY_LIMIT, "
+                 "else half of physical memory)");
+  FieldSettings f;
+  std::string in, out, sites, stats;
+  CLI::App* field = app.add_subcommand("field", "a distance field of a world, as `voxfield field`");
+  field->add_option("IN", in, "input .npy (read a slab per rank), .vox or .vfw")->required();
+  field->add_option("-o,--output", out, "output .npy")->required();
+  field->add_option("--sites", sites, "also write nearest-site offsets, int16 a[x, y, z, 3]");
+  field->add_option("--stats", stats, "timing and exchange figures as JSON");
+  f.add_to(field);
+  std::vector<int> dims;
+  int spheres = 200, repeat = 3;
+  FieldSettings fb;
+  CLI::App* bench = app.add_subcommand("bench", "time the field of generated spheres");
+  bench->add_option("--size", dims, "X,Y,Z")
+      ->delimiter(',')
+      ->expected(3)
+      ->required()
+      ->check(CLI::Range(1, 1 << 16));
+  bench->add_option("--spheres", spheres, "random spheres in the world")
+      ->check(CLI::Range(0, 1 << 20));
+  bench->add_option("--repeat", repeat, "runs")->check(CLI::Range(1, 1000));
+  fb.add_to(bench);
+  int code = 0;
+  try {
+    app.parse(argc, argv);
+    if (!memory_limit.empty())
+      voxfield::set_default_memory_limit(voxfield::parse_byte_size(memory_limit, "--memory-limit"));
+    code = field->parsed() ? run_field(comm, f, in, out, sites, stats)
+                           : run_bench(comm, fb, dims, spheres, repeat);
+  } catch (const CLI::ParseError& e) {
+    // Every rank parsed the same line: rank 0 alone speaks.
+    if (rank == 0)
+      code = app.exit(e);
+    else
+      code = e.get_exit_code() == 0 ? 0 : 2;
+    if (code != 0) code = 2;
+  } catch (const std::exception& e) {
+    if (rank == 0) std::cerr << "voxfield-mpi: " << e.what() << "\n";
+    code = 1;
+  }
+  MPI_Finalize();
+  return code;
+}

@@ -1,0 +1,31 @@
+// voxfield — a rank's slab of a world file (mpi.h): .npy arrays read a part per rank, other
+// formats loaded whole by every rank.
+#include "collective.h"
+#include "voxfield/npy.h"
+#include "voxfield/world_io.h"
+
+namespace voxfield::mpi {
+
+WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge) {
+  int rank = 0, size = 0;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  return detail::collectively(comm, nullptr, [&] {
+    const WorldFormat format = world_format_of(path);
+    if (format == WorldFormat::kNpy) {
+      const NpyVolume head = read_npy_header(path);
+      const SlabPartition partition =
+          partition_slabs(Box3i::from_size(head.dims), size, chunk_edge);
+      const Box3i slab = partition.slab(rank);
+      World part =
+          world_from_npy(read_npy_part(path, slab.begin.z, slab.end.z), path.string(), chunk_edge);
+      return WorldSlab{std::move(part), partition, "npy", true};
+    }
+    LoadedWorld whole = load_world(path, {chunk_edge});
+    if (whole.extent.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
+    const SlabPartition partition = partition_slabs(whole.extent, size, chunk_edge);
+    return WorldSlab{std::move(whole.world), partition, world_format_name(format), false};
+  });
+}
+
+}  // namespace voxfield::mpi

@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# voxfield-mpi against voxfield: the same input and options must give byte-identical files on 1, 2,
+# 3 and 4 ranks — Fortran- and C-order .npy (read a slab per rank) and a real .vox (loaded whole by
+# every rank) — and bad input must fail on every rank with one clear message and no output.
+# Usage: cli_test.sh VOXFIELD VOXFIELD_MPI MPIEXEC
+set -euo pipefail
+VF=$1 VFM=$2 MPIEXEC=$3
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+/usr/bin/python3 - <<'PY'
+import numpy as np
+rng = np.random.default_rng(3)
+a = (rng.random((37, 29, 53)) < 0.01).astype(np.uint8) * rng.integers(1, 5, (37, 29, 53)).astype(np.uint8)
+np.save("f.npy", np.asfortranarray(a))
+np.save("c.npy", a)
+np.save("big_endian.npy", a.astype(">i4"))
+np.save("fraction.npy", np.where(a > 0, 0.5, 0.0).astype(np.float32))
+PY
+fail=0
+same() {  # same REF OUT WHAT
+  if ! cmp -s "$1" "$2"; then echo "FAIL: $3: $2 differs from voxfield's $1"; fail=1; fi
+}
+for opts in "--metric euclidean --signed" "--metric manhattan --max-distance 5 --storage u8" \
+            "--metric chebyshev --signed --storage u16" "--metric euclidean --spacing 0.5,1,2" \
+            "--metric euclidean --max-distance 7.5 --storage u16 --signed"; do
+  # shellcheck disable=SC2086
+  "$VF" field f.npy -o ref.npy --sites ref_sites.npy $opts 2>/dev/null
+  # Every rank count and input order for the first options; two rank counts for the others.
+  ranks="2 4" inputs="f.npy"
+  if [ "$opts" = "--metric euclidean --signed" ]; then ranks="1 2 3 4" inputs="f.npy c.npy big_endian.npy"; fi
+  for n in $ranks; do
+    for input in $inputs; do
+      # shellcheck disable=SC2086
+      "$MPIEXEC" -np "$n" "$VFM" field "$input" -o out.npy --sites out_sites.npy --chunk 8 \
+        --stats stats.json $opts 2>/dev/null
+      same ref.npy out.npy "$n ranks, $input, $opts"
+      same ref_sites.npy out_sites.npy "$n ranks, $input, $opts (sites)"
+    done
+  done
+done
+/usr/bin/python3 - <<'PY'
+import json
+s = json.load(open("stats.json"))
+assert s["ranks"] == 4 and s["read_in_parts"] is True and len(s["slabs"]) == 5, s
+assert s["exchange"]["bytes_sent_total"] == 3 * 16 * 37 * 29, s["exchange"]
+PY
+
+vox=$(dirname "$0")/../../../shared/data/vox/dotvox_axes.vox
+if [ -f "$vox" ]; then
+  "$VF" field "$vox" -o ref.npy --metric euclidean --signed 2>/dev/null
+  "$MPIEXEC" -np 3 "$VFM" field "$vox" -o out.npy --metric euclidean --signed 2>/dev/null
+  same ref.npy out.npy "3 ranks, dotvox_axes.vox"
+fi
+
+# Bad input: one message (from rank 0), exit 1 (2 for usage), nothing written.
+expect_failure() {  # expect_failure CODE PATTERN ARGS...
+  local code=$1 pattern=$2
+  shift 2
+  rm -f bad.npy
+  set +e
+  "$MPIEXEC" -np 2 "$VFM" "$@" >out.txt 2>err.txt
+  local got=$?
+  set -e
+  if [ "$got" -ne "$code" ]; then echo "FAIL: $* exited $got, expected $code"; cat err.txt; fail=1; fi
+  if ! grep -q -- "$pattern" err.txt; then echo "FAIL: $*: no '$pattern' in:"; cat err.txt; fail=1; fi
+  if [ "$(grep -c -- "$pattern" err.txt)" -gt 1 ]; then echo "FAIL: $*: said more than once"; fail=1; fi
+  if [ -e bad.npy ]; then echo "FAIL: $* wrote bad.npy"; fail=1; fi
+  if ls -a | grep -q vftmp; then echo "FAIL: $* left a temporary"; fail=1; fi
+}
+expect_failure 1 "missing.npy: cannot open" field missing.npy -o bad.npy
+expect_failure 1 "a\[.*holds 0.5, not a material index" field fraction.npy -o bad.npy
+expect_failure 1 "/no/such/dir/bad.npy: directory /no/such/dir does not exist" field f.npy -o /no/such/dir/bad.npy
+expect_failure 2 "bogus not in" field f.npy -o bad.npy --metric bogus
+expect_failure 1 "spacing applies to the euclidean metric only" field f.npy -o bad.npy --spacing 1,1,2
+printf 'not a numpy file' > junk.npy
+expect_failure 1 "junk.npy: at byte 0: not a .npy file" field junk.npy -o bad.npy
+# More ranks than slices: refused alike by every rank.
+/usr/bin/python3 -c "import numpy as np; np.save('thin.npy', np.ones((4, 4, 1), np.uint8))"
+expect_failure 1 "fewer than the 2" field thin.npy -o bad.npy
+
+# The bench runs and reports the exchange.
+"$MPIEXEC" -np 2 "$VFM" bench --size 40,30,50 --spheres 20 --repeat 1 --chunk 8 > bench.json
+/usr/bin/python3 -c "
+import json; j = json.loads(open('bench.json').read())
+assert j['ranks'] == 2 and j['exchange']['bytes_sent_total'] == 16 * 40 * 30, j"
+
+if [ "$fail" -ne 0 ]; then exit 1; fi
+echo "voxfield-mpi: every file equals voxfield's; bad input refused"

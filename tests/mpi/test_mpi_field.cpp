@@ -1,0 +1,241 @@
+// The MPI layer (mpi.h) against one process: run under mpirun with 1..N ranks, every rank builds
+// the same random world, keeps its slab, and the distributed field's slab must equal the
+// single-process field over the whole domain bit for bit (values and nearest sites), for every
+// metric, sign, clamp, storage and spacing; failures on one rank must reach every rank as the same
+// RankError (no hang), and a failed write must leave the target as it was.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "voxfield/file.h"
+#include "voxfield/limits.h"
+#include "voxfield/mpi.h"
+#include "voxfield/npy.h"
+
+namespace voxfield {
+namespace {
+
+MPI_Comm comm() {
+  return MPI_COMM_WORLD;
+}
+int rank() {
+  int r = 0;
+  MPI_Comm_rank(comm(), &r);
+  return r;
+}
+int ranks() {
+  int n = 0;
+  MPI_Comm_size(comm(), &n);
+  return n;
+}
+
+template <class T>
+std::vector<T> dense(const Grid<T>& g, const Box3i& box) {
+  std::vector<T> v(static_cast<std::size_t>(box.volume()));
+  g.copy_to_dense(box, v.data());
+  return v;
+}
+
+World random_world(std::uint32_t seed, Box3i& domain, int edge) {
+  std::mt19937 rng(seed);
+  const Vec3i origin{static_cast<int>(rng() % 30) - 15, static_cast<int>(rng() % 30) - 15,
+                     static_cast<int>(rng() % 30) - 15};
+  const Vec3i size{4 + static_cast<int>(rng() % 20), 3 + static_cast<int>(rng() % 20),
+                   ranks() + static_cast<int>(rng() % 60)};
+  domain = {origin, origin + size};
+  World w(edge, domain);
+  const double density = std::array<double, 3>{0.003, 0.15, 0.9}[seed % 3];
+  std::bernoulli_distribution solid(density);
+  for (int z = domain.begin.z; z < domain.end.z; ++z)
+    for (int y = domain.begin.y; y < domain.end.y; ++y)
+      for (int x = domain.begin.x; x < domain.end.x; ++x)
+        if (solid(rng)) w.voxels.set({x, y, z}, 1);
+  return w;
+}
+
+// Every rank computes the whole field too: the oracle.
+void check(const DistanceOptions& base, std::uint32_t seed, int align) {
+  Box3i domain;
+  const int edge = seed % 2 ? 8 : 16;
+  const World w = random_world(seed, domain, edge);
+  const mpi::SlabPartition p = mpi::partition_slabs(domain, ranks(), align);
+  const Box3i slab = p.slab(rank());
+  World mine(edge, slab);  // this rank's voxels only
+  mine.voxels.copy_from_dense(slab, dense(w.voxels, slab).data());
+  mpi::ExchangeStats stats;
+  const DistanceField f = mpi::compute_distance_field(comm(), p, mine.voxels, base, &stats);
+  DistanceOptions whole_o = base;
+  whole_o.domain = domain;
+  const DistanceField whole = compute_distance_field(w.voxels, whole_o);
+  const std::string what = std::string(metric_name(base.metric)) +
+                           (base.signed_distance ? " signed" : "") + " clamp " +
+                           std::to_string(base.max_distance) + " " + storage_name(base.storage) +
+                           (base.nearest_sites ? " sites" : "") + " seed " + std::to_string(seed) +
+                           " rank " + std::to_string(rank());
+  ASSERT_EQ(f.domain, slab) << what;
+  std::visit(
+      [&](const auto& g) {
+        using G = std::decay_t<decltype(g)>;
+        EXPECT_EQ(dense(g, slab), dense(std::get<G>(whole.values), slab)) << what;
+      },
+      f.values);
+  if (base.nearest_sites) {
+    ASSERT_TRUE(f.sites) << what;
+    EXPECT_EQ(dense(*f.sites, slab), dense(*whole.sites, slab)) << what;
+  }
+  // 8 bytes per column go up the chain of ranks (the highest solid and air voxel) and 8 down
+  // (the lowest), nothing more: the top rank sends nothing up, the bottom one nothing down.
+  const std::uint64_t columns = static_cast<std::uint64_t>(domain.size().x) * domain.size().y;
+  const std::uint64_t hops = (rank() + 1 < ranks() ? 1 : 0) + (rank() > 0 ? 1 : 0);
+  EXPECT_EQ(stats.bytes_sent, 8 * columns * hops) << what;
+  EXPECT_EQ(stats.bytes_received, 8 * columns * hops) << what;
+}
+
+TEST(MpiField, EqualsOneProcessForEveryOption) {
+  std::uint32_t seed = 1;
+  for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
+    for (bool sgn : {false, true})
+      for (double clamp : {0.0, 4.5})
+        for (Storage st : {Storage::kF32, Storage::kU8, Storage::kU16})
+          for (bool sites : {false, true}) {
+            DistanceOptions o;
+            o.metric = m;
+            o.signed_distance = sgn;
+            o.max_distance = clamp;
+            o.storage = st;
+            o.nearest_sites = sites;
+            check(o, seed, seed % 3 == 0 ? 1 : 8);
+            ++seed;
+          }
+  for (bool sgn : {false, true}) {
+    DistanceOptions o;
+    o.metric = Metric::kEuclidean;
+    o.signed_distance = sgn;
+    o.spacing = {0.5, 1.25, 2.0};
+    o.nearest_sites = true;
+    check(o, seed++, 1);
+  }
+}
+
+TEST(MpiField, PartitionsCoverTheDomainInOrder) {
+  for (int n : {1, 2, 3, 4, 7}) {
+    for (const Box3i d : {Box3i{{0, 0, 0}, {5, 5, 7}}, Box3i{{0, 0, -37}, {3, 2, 100}},
+                          Box3i{{1, 1, 5}, {2, 2, 300}}}) {
+      for (int align : {1, 8, 32}) {
+        const mpi::SlabPartition p = mpi::partition_slabs(d, n, align);
+        ASSERT_EQ(p.ranks(), n);
+        EXPECT_EQ(p.z.front(), d.begin.z);
+        EXPECT_EQ(p.z.back(), d.end.z);
+        std::int64_t total = 0;
+        for (int r = 0; r < n; ++r) {
+          EXPECT_LT(p.z[r], p.z[r + 1]) << "every rank owns a slice";
+          total += p.slab(r).volume();
+        }
+        EXPECT_EQ(total, d.volume());
+      }
+    }
+  }
+  EXPECT_THROW(mpi::partition_slabs(Box3i{{0, 0, 0}, {4, 4, 3}}, 4, 1), InvalidArgument);
+  EXPECT_THROW(mpi::partition_slabs(Box3i{}, 1, 1), InvalidArgument);
+}
+
+TEST(MpiField, AFailureOnOneRankReachesEveryRank) {
+  if (ranks() < 2) GTEST_SKIP() << "needs two ranks";
+  Box3i domain;
+  const World w = random_world(7, domain, 8);
+  const mpi::SlabPartition p = mpi::partition_slabs(domain, ranks(), 1);
+  // The last rank alone may hold almost nothing: its slab's field passes its limit.
+  const bool last = rank() == ranks() - 1;
+  if (last) set_default_memory_limit(64);
+  try {
+    (void)mpi::compute_distance_field(comm(), p, w.voxels, DistanceOptions{});
+    ADD_FAILURE() << "no rank failed";
+  } catch (const mpi::RankError& e) {
+    EXPECT_EQ(e.rank(), ranks() - 1) << e.what();
+    EXPECT_NE(e.message().find("memory"), std::string::npos) << e.what();
+  }
+  set_default_memory_limit(0);
+  // A partition for another number of ranks is refused by every rank alike.
+  const mpi::SlabPartition wrong = mpi::partition_slabs(domain, ranks() + 1, 1);
+  EXPECT_THROW((void)mpi::compute_distance_field(comm(), wrong, w.voxels, DistanceOptions{}),
+               mpi::RankError);
+}
+
+TEST(MpiField, WritesOneFileOrNothing) {
+  Box3i domain;
+  const World w = random_world(11, domain, 8);
+  const mpi::SlabPartition p = mpi::partition_slabs(domain, ranks(), 8);
+  DistanceOptions o;
+  o.metric = Metric::kEuclidean;
+  o.signed_distance = true;
+  o.nearest_sites = true;
+  const DistanceField f = mpi::compute_distance_field(comm(), p, w.voxels, o);
+  // The same directory on every rank: rank 0 makes it.
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("voxfield_mpi_test_" + std::to_string(ranks()));
+  if (rank() == 0) {
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+  }
+  MPI_Barrier(comm());
+  mpi::FieldFiles files{dir / "f.npy", dir / "s.npy", dir / "f.json", "{}\n"};
+  mpi::write_field_npy(comm(), p, f, files);
+  if (rank() == 0) {
+    DistanceOptions whole_o = o;
+    whole_o.domain = domain;
+    const DistanceField whole = compute_distance_field(w.voxels, whole_o);
+    const NpyVolume back = read_npy(dir / "f.npy");
+    EXPECT_EQ(back.dims, domain.size());
+    std::vector<float> expect = dense(std::get<Grid<float>>(whole.values), domain);
+    std::vector<float> got(expect.size());
+    std::memcpy(got.data(), back.bytes.data(), got.size() * sizeof(float));
+    EXPECT_EQ(got, expect);
+    EXPECT_EQ(read_file(dir / "f.json").size(), 3u);
+    EXPECT_EQ(std::filesystem::file_size(dir / "s.npy"),
+              read_file(dir / "s.npy").size());  // present and whole
+  }
+  // A read-only target: refused by rank 0 before anything is written, on every rank alike, and
+  // neither it nor the other outputs change.
+  if (rank() == 0) {
+    std::ofstream(dir / "ro.npy") << "keep";
+    std::filesystem::permissions(dir / "ro.npy", std::filesystem::perms::owner_read);
+  }
+  MPI_Barrier(comm());
+  const auto before = rank() == 0 ? read_file(dir / "f.npy") : std::vector<std::uint8_t>{};
+  mpi::FieldFiles bad{dir / "f.npy", dir / "ro.npy", {}, {}};
+  EXPECT_THROW(mpi::write_field_npy(comm(), p, f, bad), mpi::RankError);
+  if (rank() == 0) {
+    EXPECT_EQ(read_file(dir / "f.npy"), before);
+    EXPECT_EQ(read_file(dir / "ro.npy").size(), 4u);
+    std::size_t entries = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+      (void)e;
+      ++entries;
+    }
+    EXPECT_EQ(entries, 4u) << "a temporary was left behind";
+    std::filesystem::permissions(dir / "ro.npy", std::filesystem::perms::owner_all);
+    std::filesystem::remove_all(dir);
+  }
+}
+
+}  // namespace
+}  // namespace voxfield
+
+// gtest under MPI: every rank runs every test and prints (failures name their rank); the exit
+// status is the worst rank's.
+int main(int argc, char** argv) {
+  int provided = 0;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  ::testing::InitGoogleTest(&argc, argv);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  const int mine = RUN_ALL_TESTS();
+  int worst = 0;
+  MPI_Allreduce(&mine, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Finalize();
+  return worst;
+}
