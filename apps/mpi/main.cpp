@@ -112,6 +112,8 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
   if (f.threads > 0) limit.emplace(f.threads);
   DistanceOptions o = f.options();
   o.nearest_sites = !sites.empty();
+  // Everything that can be wrong with the outputs is found before the world is loaded.
+  mpi::check_outputs(comm, {out, sites, stats, {}});
   const double t0 = MPI_Wtime();
   const mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk);
   const double load_ms = (MPI_Wtime() - t0) * 1e3;

@@ -99,6 +99,10 @@ struct FieldFiles {
   std::string json_text;
 };
 
+// Checks the targets as check_output_path does (on rank 0, whose file system view writes them),
+// before any work: every rank throws RankError when one cannot be written.
+void check_outputs(MPI_Comm comm, const FieldFiles& files);
+
 // Writes every rank's slab of the field into one .npy per output, byte for byte what `voxfield
 // field` writes for the whole domain, all or nothing: rank 0 stages temporaries beside the targets
 // (FileTransaction::stage_shared), every rank writes its slices into them with MPI-IO, and only

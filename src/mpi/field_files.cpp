@@ -89,6 +89,16 @@ std::vector<Piece> sites_pieces(const Grid<SiteOffset>& g, const Box3i& slab, co
 
 }  // namespace
 
+void check_outputs(MPI_Comm comm, const FieldFiles& files) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  detail::collectively(comm, nullptr, [&] {
+    if (rank != 0) return;
+    for (const auto* p : {&files.values, &files.sites, &files.json})
+      if (!p->empty()) check_output_path(*p);
+  });
+}
+
 void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const DistanceField& slab,
                      const FieldFiles& files, ExchangeStats* stats) {
   int rank = 0;

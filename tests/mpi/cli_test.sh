@@ -86,5 +86,37 @@ expect_failure 1 "fewer than the 2" field thin.npy -o bad.npy
 import json; j = json.loads(open('bench.json').read())
 assert j['ranks'] == 2 and j['exchange']['bytes_sent_total'] == 16 * 40 * 30, j"
 
+# A rank killed mid-run takes the job down (mpirun names it) instead of hanging the others, and
+# the target keeps its old content: it is replaced only by rank 0's rename after every rank wrote.
+/usr/bin/python3 -c "
+import numpy as np
+rng = np.random.default_rng(5)
+np.save('large.npy', np.asfortranarray((rng.random((160, 160, 160)) < 0.001).astype(np.uint8)))"
+"$VF" field large.npy -o large_ref.npy --metric euclidean --signed 2>/dev/null
+for delay in 0.1 0.3 0.5 0.7; do
+  printf 'old' > target.npy
+  set +e
+  "$MPIEXEC" -np 2 "$VFM" field large.npy -o target.npy --metric euclidean --signed --chunk 16 \
+    >/dev/null 2>kill_err.txt &
+  job=$!
+  sleep "$delay"
+  victim=$(pgrep -f "voxfield-mpi field large.npy" | tail -n 1)
+  [ -n "$victim" ] && kill -9 "$victim"
+  started=$(date +%s)
+  wait "$job"
+  code=$?
+  set -e
+  if [ $(( $(date +%s) - started )) -gt 20 ]; then echo "FAIL: the job took over 20 s to end after a kill"; fail=1; fi
+  if cmp -s target.npy large_ref.npy; then
+    :  # the kill came after the rename: the new field, whole
+  elif [ "$(cat target.npy)" != "old" ]; then
+    echo "FAIL: a kill after ${delay}s left target.npy neither old nor new"; fail=1
+  elif [ "$code" -eq 0 ]; then
+    echo "FAIL: a killed job exited 0 without writing"; fail=1
+  elif ! grep -q "signal 9\|exited on signal\|killed" kill_err.txt; then
+    echo "FAIL: mpirun did not say which rank died:"; cat kill_err.txt; fail=1
+  fi
+done
+
 if [ "$fail" -ne 0 ]; then exit 1; fi
 echo "voxfield-mpi: every file equals voxfield's; bad input refused"
