@@ -9,6 +9,7 @@
 
 #include "error_text.h"
 #include "voxfield/csg.h"
+#include "voxfield/limits.h"
 
 namespace voxfield::csg {
 namespace {
@@ -124,6 +125,18 @@ TEST(CsgOpenScad, HostileCountsAreRefusedAndPolytopesAreBounded) {
                   true);
             }).find("planes"),
             std::string::npos);
+  // The planes count against the memory limit: a 30-byte file asks for no more than it allows
+  // (found by fuzz_openscad: sphere($fn = 950) took 1.3 GB under the harness's 256 MiB limit).
+  set_default_memory_limit(std::uint64_t{64} << 20);
+  try {
+    (void)scad("sphere($fn = 950, r = 3);", true);
+    ADD_FAILURE() << "450 000 planes fitted in 64 MiB";
+  } catch (const ResourceLimitError& e) {
+    EXPECT_NE(std::string(e.what()).find("planes"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW((void)scad("sphere($fn = 100, r = 3);", true));  // 5 000 planes fit
+  set_default_memory_limit(0);
+  EXPECT_NO_THROW((void)scad("sphere($fn = 950, r = 3);", true));  // and all of them by default
   // A polytope is bounded by its vertices' box, so facetted models voxelise without a box.
   const Model p = scad("sphere($fn = 8, r = 2);", true);
   const auto b = model_bounds(p);

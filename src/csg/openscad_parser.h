@@ -48,6 +48,7 @@ class Parser {
   [[noreturn]] void fail(SourcePos p, const std::string& what) const {
     throw ModelError(name_, p.line, p.column, what);
   }
+  const std::string& name() const { return name_; }
 
  private:
   SourcePos here() const { return at(i_); }
