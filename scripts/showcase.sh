@@ -8,3 +8,11 @@ bash scripts/install-bench-deps.sh  # the peers the report sets voxfield beside
 cmake --preset release >/dev/null
 cmake --build --preset release
 ./build/release/bin/voxfield showcase --out out "$@"
+out=out
+prev=""
+for a in "$@"; do
+  if [ "$prev" = "--out" ]; then out=$a; fi
+  case "$a" in --out=*) out=${a#--out=} ;; esac
+  prev=$a
+done
+bash scripts/showcase_mpi.sh "$out"  # the same terrain's field over MPI ranks, identical to one process

@@ -376,7 +376,7 @@ class Translator {
                                       std::to_string(kMaxPlanes) +
                                       " planes in all (fewer fragments, or import without facets)");
     require_memory(static_cast<std::uint64_t>(planes_) * kBytesPerPlane, 0, parser_.name(),
-                   "the polytopes' " + std::to_string(planes_) + " planes");
+                   "a translation of " + std::to_string(planes_) + " planes");
     // The vertices' box first: it leaves the solid as it is (the polytope lies inside it) and gives
     // the model bounds, which an intersection of planes alone does not have.
     Vec3d lo = v[0], hi = v[0];
