@@ -3,22 +3,28 @@
 //   mpirun -np N voxfield-mpi field IN -o OUT.npy [--metric M] [--signed] [--max-distance D]
 //          [--storage S] [--spacing sx,sy,sz] [--sites S.npy] [--stats S.json] [--chunk C]
 //          [--threads T] [--memory-limit B]
+//   mpirun -np N voxfield-mpi edit IN -e EDITS.jsonl -o OUT.npy [field options] [--stats S.json]
 //   mpirun -np N voxfield-mpi bench --size X,Y,Z [--spheres K] [--repeat R] [field options]
 //
 // `field` writes byte for byte what `voxfield field` writes for the same input and options; each
-// rank holds only its slab of a .npy input and of the field. `bench` generates a world of random
-// spheres slab by slab (no file) and prints, per run, the time, the rate and the bytes exchanged.
-// Every rank parses the same command line; rank 0 alone prints. A failure on any rank is reported
-// by rank 0 as "voxfield-mpi: rank R: ..." and every rank exits with 1 (2 for usage errors).
+// rank holds only its slab of a .npy input and of the field. `edit` writes what `voxfield edit`
+// writes: every rank applies every edit of the script to its slab and the slices a clamped value
+// can reach beyond it, with incremental updates of its own field. `bench` generates a world of
+// random spheres slab by slab (no file) and prints, per run, the time, the rate and the bytes
+// exchanged. Every rank parses the same command line; rank 0 alone prints. A failure on any rank is
+// reported by rank 0 as "voxfield-mpi: rank R: ..." and every rank exits with 1 (2 for usage
+// errors).
 #include <mpi.h>
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <numeric>
 
 #include "bench_world.h"
 #include "voxfield/distance.h"
+#include "voxfield/edit_script.h"
 #include "voxfield/error.h"
 #include "voxfield/file.h"
 #include "voxfield/limits.h"
@@ -143,6 +149,71 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
   return 0;
 }
 
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1,
+                    static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
+}
+
+int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
+             const std::string& edits_path, const std::string& out, const std::string& stats) {
+  int rank = 0, size = 0;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  std::optional<ThreadLimit> limit;
+  if (f.threads > 0) limit.emplace(f.threads);
+  const DistanceOptions o = f.options();
+  mpi::check_outputs(comm, {out, {}, stats, {}});
+  // The script and the ghost slices are checked on every rank before the world is loaded.
+  const auto [edits, ghost] = mpi::collectively(comm, [&] {
+    EditScriptOptions eo;
+    eo.chunk_edge = f.chunk;
+    return std::make_pair(read_edit_script(edits_path, eo), mpi::edit_ghost_slices(o));
+  });
+  const mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk, ghost);
+  const double t0 = MPI_Wtime();
+  mpi::SlabEditor editor(comm, slab.partition, slab.world, o);
+  const double build_ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
+  // Local work only: a failure on one rank is agreed on after the loop.
+  std::vector<double> edit_ms(edits.size(), 0.0);
+  std::uint64_t reached = 0, recomputed = 0;
+  mpi::collectively(comm, [&] {
+    for (std::size_t i = 0; i < edits.size(); ++i) {
+      const double e0 = MPI_Wtime();
+      const mpi::SlabEditor::Result r = editor.apply(edits[i]);
+      edit_ms[i] = (MPI_Wtime() - e0) * 1e3;
+      reached += r.reached ? 1 : 0;
+      recomputed += static_cast<std::uint64_t>(r.voxels_recomputed);
+    }
+  });
+  // An edit is done when the slowest rank is.
+  std::vector<double> slowest(edit_ms.size());
+  MPI_Allreduce(edit_ms.data(), slowest.data(), static_cast<int>(edit_ms.size()), MPI_DOUBLE,
+                MPI_MAX, comm);
+  const double total = std::accumulate(slowest.begin(), slowest.end(), 0.0);
+  nlohmann::json j = f.describe(o, slab.partition.domain.size(), size);
+  j.update(nlohmann::json{
+      {"build_ms", build_ms},
+      {"edits", edits.size()},
+      {"ghost_slices", ghost},
+      {"edit_ms", slowest},
+      {"total_ms", total},
+      {"p50_ms", percentile(slowest, 0.5)},
+      {"p99_ms", percentile(slowest, 0.99)},
+      {"ranks_reached_per_edit", edits.empty() ? 0.0
+                                               : static_cast<double>(sum_over(comm, reached)) /
+                                                     static_cast<double>(edits.size())},
+      {"voxels_recomputed_all_ranks", sum_over(comm, recomputed)},
+      {"slabs", slab.partition.z}});
+  mpi::write_field_npy(comm, slab.partition, editor.field(), {out, {}, stats, j.dump(2) + "\n"});
+  if (rank == 0)
+    std::cerr << "voxfield-mpi: " << edits.size() << " edits on " << size << " ranks, " << total
+              << " ms in all (p50 " << percentile(slowest, 0.5) << " ms, p99 "
+              << percentile(slowest, 0.99) << " ms), wrote " << out << "\n";
+  return 0;
+}
+
 int run_bench(MPI_Comm comm, const FieldSettings& f, const std::vector<int>& dims, int spheres,
               int repeat) {
   int rank = 0, size = 0;
@@ -196,6 +267,17 @@ int main(int argc, char** argv) {
   field->add_option("--sites", sites, "also write nearest-site offsets, int16 a[x, y, z, 3]");
   field->add_option("--stats", stats, "timing and exchange figures as JSON");
   f.add_to(field);
+  FieldSettings fe;
+  std::string edit_in, edit_script, edit_out, edit_stats;
+  CLI::App* edit = app.add_subcommand(
+      "edit", "scripted edits with incremental exact updates, as `voxfield edit`");
+  edit->add_option("IN", edit_in, "input .npy (read a slab per rank), .vox or .vfw")->required();
+  edit->add_option("-e,--edits", edit_script,
+                   "edit script, one JSON object per line (as voxfield edit)")
+      ->required();
+  edit->add_option("-o,--output", edit_out, "output .npy of the final field")->required();
+  edit->add_option("--stats", edit_stats, "per-edit latency of the slowest rank, as JSON");
+  fe.add_to(edit);
   std::vector<int> dims;
   int spheres = 200, repeat = 3;
   FieldSettings fb;
@@ -214,8 +296,13 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
     if (!memory_limit.empty())
       voxfield::set_default_memory_limit(voxfield::parse_byte_size(memory_limit, "--memory-limit"));
-    code = field->parsed() ? run_field(comm, f, in, out, sites, stats)
-                           : run_bench(comm, fb, dims, spheres, repeat);
+    if (field->parsed()) {
+      code = run_field(comm, f, in, out, sites, stats);
+    } else if (edit->parsed()) {
+      code = run_edit(comm, fe, edit_in, edit_script, edit_out, edit_stats);
+    } else {
+      code = run_bench(comm, fb, dims, spheres, repeat);
+    }
   } catch (const CLI::ParseError& e) {
     // Every rank parsed the same line: rank 0 alone speaks.
     if (rank == 0)

@@ -51,4 +51,11 @@ DistanceField compute_slab_distance_field(const Grid<std::uint8_t>& occupancy,
                                           const DistanceOptions& options, std::int32_t z0,
                                           std::int32_t z1, const SlabNeighbours& neighbours);
 
+// The largest distance a field with these options stores — options.max_distance, or what its
+// integer storage can hold (u8 Euclidean: 63.75) when that is less — or +inf for an unclamped f32
+// field. A voxel's value depends only on the sites within it: how far apart the processes of a
+// distributed field must share voxels for edits (mpi.h). Throws InvalidArgument as
+// compute_distance_field does for bad options.
+double effective_clamp(const DistanceOptions& options);
+
 }  // namespace voxfield

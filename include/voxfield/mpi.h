@@ -21,10 +21,15 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "voxfield/distance.h"
+#include "voxfield/dynamic_field.h"
+#include "voxfield/edit.h"
 #include "voxfield/error.h"
 #include "voxfield/world.h"
 
@@ -59,6 +64,42 @@ class RankError : public Error {
   std::string message_;
 };
 
+struct ExchangeStats;
+
+// Collective: returns when no rank failed (`error` empty on every rank); else every rank throws
+// RankError with the lowest failing rank's message.
+void agree(MPI_Comm comm, const std::string& error, ExchangeStats* stats = nullptr);
+
+// Runs fn() on this rank and agrees with every rank on the outcome: fn's result when no rank
+// failed, else the same RankError on every rank (a RankError fn throws — agreed inside it — passes
+// through). For a rank's own work between collective calls: a loop of edits, a file of its own.
+template <class Fn>
+auto collectively(MPI_Comm comm, Fn&& fn, ExchangeStats* stats = nullptr) {
+  using R = std::invoke_result_t<Fn>;
+  std::string error;
+  if constexpr (std::is_void_v<R>) {
+    try {
+      fn();
+    } catch (const RankError&) {
+      throw;
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    agree(comm, error, stats);
+  } else {
+    std::optional<R> result;
+    try {
+      result.emplace(fn());
+    } catch (const RankError&) {
+      throw;
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    agree(comm, error, stats);
+    return std::move(*result);
+  }
+}
+
 // Counters of one rank's part of a collective computation.
 struct ExchangeStats {
   std::uint64_t bytes_sent = 0;      // payload this rank contributed to the exchanges
@@ -77,6 +118,51 @@ DistanceField compute_distance_field(MPI_Comm comm, const SlabPartition& partiti
                                      const DistanceOptions& options,
                                      ExchangeStats* stats = nullptr);
 
+// Edits. Every rank applies every edit (an edit script or a seeded stream is small, and the same on
+// all ranks) to its slab and to `edit_ghost_slices` slices on either side, and updates its own
+// incremental field (dynamic_field.h) over that box: a clamped value depends only on sites within
+// the clamp, so the slab's values stay exact — equal to one process's field after the same edits —
+// with no message per edit. An edit that misses a rank's box costs that rank nothing.
+
+// The slices a rank's box reaches past its slab on either side: the effective clamp over the
+// spacing along z, rounded up (distance_slab.h). Throws InvalidArgument for an unclamped f32 field,
+// whose every value may depend on every voxel (give --max-distance, or integer storage).
+int edit_ghost_slices(const DistanceOptions& options);
+
+// A rank's slab of a world and its exact field, kept under edits. Constructing is collective (it
+// agrees on failures); apply() is local to the rank and may be called any number of times between
+// collective calls.
+class SlabEditor {
+ public:
+  // `world` must hold the partition's slab of this rank grown by edit_ghost_slices along z (clipped
+  // to the domain); what lies beyond is not read. The field is computed over that box.
+  SlabEditor(MPI_Comm comm, const SlabPartition& partition, const World& world,
+             const DistanceOptions& options);
+  SlabEditor(const SlabEditor&) = delete;  // the field is bound to the world it holds
+  SlabEditor& operator=(const SlabEditor&) = delete;
+
+  struct Result {
+    std::int64_t voxels_changed = 0;     // in this rank's box
+    std::int64_t voxels_recomputed = 0;  // by this rank's field update
+    bool reached = false;                // whether the edit touched this rank's box
+  };
+  // Applies the edit clipped to this rank's box and updates the field. Throws what apply_edit
+  // throws (a malformed edit: on every rank alike).
+  Result apply(const Edit& edit);
+
+  // The rank's field over its box; its values over slab() are the whole field's.
+  const DistanceField& field() const { return field_->field(); }
+  const World& world() const { return world_; }
+  Box3i slab() const { return slab_; }
+  Box3i box() const { return box_; }
+
+ private:
+  Box3i slab_, box_;
+  World world_;
+  std::unique_ptr<DynamicDistanceField> field_;
+  DirtyRegions dirty_;
+};
+
 // A rank's slab of a world file.
 struct WorldSlab {
   World world;  // the slab's voxels (at their place in the whole world)
@@ -86,10 +172,12 @@ struct WorldSlab {
 };
 
 // Loads `path` for this rank: a .npy is read a part per rank (read_npy_part), so no rank holds more
-// than its slab; a .vox or .vfw is loaded whole by every rank, which keeps its slab (those formats
-// give no cheap way to read part of them; the memory of one whole world per rank is the cost). The
-// domain is the file's volume (the .npy shape, the .vox/.vfw extent), as `voxfield field` uses.
-WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge);
+// than its slab and `ghost_slices` slices on either side; a .vox or .vfw is loaded whole by every
+// rank, which keeps its slab (those formats give no cheap way to read part of them; the memory of
+// one whole world per rank is the cost). The domain is the file's volume (the .npy shape, the
+// .vox/.vfw extent), as `voxfield field` uses.
+WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
+                          int ghost_slices = 0);
 
 // What write_field_npy writes.
 struct FieldFiles {
@@ -103,7 +191,8 @@ struct FieldFiles {
 // before any work: every rank throws RankError when one cannot be written.
 void check_outputs(MPI_Comm comm, const FieldFiles& files);
 
-// Writes every rank's slab of the field into one .npy per output, byte for byte what `voxfield
+// Writes every rank's slab of the field (a field covering at least the rank's slab: its values over
+// the slab are written) into one .npy per output, byte for byte what `voxfield
 // field` writes for the whole domain, all or nothing: rank 0 stages temporaries beside the targets
 // (FileTransaction::stage_shared), every rank writes its slices into them with MPI-IO, and only
 // when all ranks succeeded does rank 0 rename them onto the targets. On failure no target is

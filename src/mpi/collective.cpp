@@ -1,7 +1,7 @@
 // voxfield — agreement between the ranks of a collective operation (collective.h).
 #include "collective.h"
 
-namespace voxfield::mpi::detail {
+namespace voxfield::mpi {
 
 void agree(MPI_Comm comm, const std::string& error, ExchangeStats* stats) {
   int rank = 0, size = 0;
@@ -11,7 +11,7 @@ void agree(MPI_Comm comm, const std::string& error, ExchangeStats* stats) {
   const int mine = error.empty() ? size : rank;
   int first = size;
   {
-    CollectiveTimer t(stats);
+    detail::CollectiveTimer t(stats);
     MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm);
   }
   if (first == size) return;
@@ -24,6 +24,8 @@ void agree(MPI_Comm comm, const std::string& error, ExchangeStats* stats) {
   throw RankError(first, text);
 }
 
+namespace detail {
+
 std::string mpi_error_text(int code) {
   char text[MPI_MAX_ERROR_STRING];
   int length = 0;
@@ -32,4 +34,5 @@ std::string mpi_error_text(int code) {
   return std::string(text, static_cast<std::size_t>(length));
 }
 
-}  // namespace voxfield::mpi::detail
+}  // namespace detail
+}  // namespace voxfield::mpi

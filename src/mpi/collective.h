@@ -1,14 +1,12 @@
-// voxfield — agreement between the ranks of a collective operation (internal): every rank runs its
-// part, then all learn whether any failed, so that a failure on one rank becomes the same
-// RankError on all of them instead of a hang in the next collective call.
+// voxfield — what the MPI layer's collective operations share (internal): timing of the calls
+// that talk to the other ranks, and MPI's error texts. The agreement on failures (agree,
+// collectively) is public, in mpi.h.
 #pragma once
 
 #include <mpi.h>
 
 #include <chrono>
-#include <optional>
 #include <string>
-#include <type_traits>
 #include <utility>
 
 #include "voxfield/mpi.h"
@@ -38,36 +36,14 @@ class CollectiveTimer {
   std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
 };
 
-// Collective: returns when no rank failed (`error` empty everywhere); else every rank throws
-// RankError with the lowest failing rank's message.
-void agree(MPI_Comm comm, const std::string& error, ExchangeStats* stats);
-
-// Runs fn() on this rank and agrees on the outcome (agree above): fn's result on success.
+// mpi::collectively and mpi::agree with the layer's counters first (the callers' order reads
+// better with the lambda last).
 template <class Fn>
 auto collectively(MPI_Comm comm, ExchangeStats* stats, Fn&& fn) {
-  using R = std::invoke_result_t<Fn>;
-  std::string error;
-  if constexpr (std::is_void_v<R>) {
-    try {
-      fn();
-    } catch (const RankError&) {
-      throw;  // agreed on inside fn, by every rank
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-    agree(comm, error, stats);
-  } else {
-    std::optional<R> result;
-    try {
-      result.emplace(fn());
-    } catch (const RankError&) {
-      throw;  // agreed on inside fn, by every rank
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-    agree(comm, error, stats);
-    return std::move(*result);
-  }
+  return mpi::collectively(comm, std::forward<Fn>(fn), stats);
+}
+inline void agree(MPI_Comm comm, const std::string& error, ExchangeStats* stats) {
+  mpi::agree(comm, error, stats);
 }
 
 // The text of an MPI error code.

@@ -36,17 +36,17 @@ struct Piece {
   std::vector<std::uint8_t> bytes;
 };
 
-// This rank's values, x fastest, at the slab's place in the whole array.
-Piece values_piece(const DistanceField& f, const Box3i& domain) {
+// This rank's values over its slab, x fastest, at the slab's place in the whole array.
+Piece values_piece(const DistanceField& f, const Box3i& slab, const Box3i& domain) {
   return std::visit(
       [&](const auto& g) {
         using T = typename std::decay_t<decltype(g)>::value_type;
         Piece p;
-        p.offset = static_cast<std::uint64_t>(f.domain.begin.z - domain.begin.z) *
+        p.offset = static_cast<std::uint64_t>(slab.begin.z - domain.begin.z) *
                    static_cast<std::uint64_t>(domain.size().x) *
                    static_cast<std::uint64_t>(domain.size().y) * sizeof(T);
-        p.bytes.resize(static_cast<std::size_t>(f.domain.volume()) * sizeof(T));
-        g.copy_to_dense(f.domain, reinterpret_cast<T*>(p.bytes.data()));
+        p.bytes.resize(static_cast<std::size_t>(slab.volume()) * sizeof(T));
+        g.copy_to_dense(slab, reinterpret_cast<T*>(p.bytes.data()));
         return p;
       },
       f.values);
@@ -110,9 +110,9 @@ void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const Distan
   std::vector<std::uint8_t> values_head, sites_head;
   std::string temporaries;  // values '\n' sites
   detail::collectively(comm, stats, [&] {
-    if (slab.domain != partition.slab(rank))
+    if (!slab.domain.contains(partition.slab(rank)))
       throw InvalidArgument("this rank's field covers " + to_string(slab.domain) +
-                            ", not its slab " + to_string(partition.slab(rank)));
+                            ", not all of its slab " + to_string(partition.slab(rank)));
     if (sites && !slab.sites) throw InvalidArgument("the field has no nearest sites to write");
     values_head = npy_header(values_dtype(slab), domain.size());
     if (sites) sites_head = npy_header(DType::kInt16, domain.size(), 3);
@@ -162,8 +162,8 @@ void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const Distan
     std::vector<Piece> values;
     std::vector<Piece> site_planes;
     try {
-      values.push_back(values_piece(slab, domain));
-      if (sites) site_planes = sites_pieces(*slab.sites, slab.domain, domain);
+      values.push_back(values_piece(slab, partition.slab(rank), domain));
+      if (sites) site_planes = sites_pieces(*slab.sites, partition.slab(rank), domain);
     } catch (const std::exception& e) {
       error = e.what();
       values.clear();

@@ -1,12 +1,15 @@
 // voxfield — a rank's slab of a world file (mpi.h): .npy arrays read a part per rank, other
 // formats loaded whole by every rank.
+#include <algorithm>
+
 #include "collective.h"
 #include "voxfield/npy.h"
 #include "voxfield/world_io.h"
 
 namespace voxfield::mpi {
 
-WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge) {
+WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
+                          int ghost_slices) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
@@ -17,8 +20,12 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
       const SlabPartition partition =
           partition_slabs(Box3i::from_size(head.dims), size, chunk_edge);
       const Box3i slab = partition.slab(rank);
-      World part =
-          world_from_npy(read_npy_part(path, slab.begin.z, slab.end.z), path.string(), chunk_edge);
+      const int ghost = std::max(ghost_slices, 0);
+      const std::int32_t z0 =
+          static_cast<std::int32_t>(std::max<std::int64_t>(0, std::int64_t{slab.begin.z} - ghost));
+      const std::int32_t z1 = static_cast<std::int32_t>(
+          std::min<std::int64_t>(head.dims.z, std::int64_t{slab.end.z} + ghost));
+      World part = world_from_npy(read_npy_part(path, z0, z1), path.string(), chunk_edge);
       return WorldSlab{std::move(part), partition, "npy", true};
     }
     LoadedWorld whole = load_world(path, {chunk_edge});

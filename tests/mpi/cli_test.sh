@@ -47,13 +47,6 @@ assert s["ranks"] == 4 and s["read_in_parts"] is True and len(s["slabs"]) == 5, 
 assert s["exchange"]["bytes_sent_total"] == 3 * 16 * 37 * 29, s["exchange"]
 PY
 
-vox=$(dirname "$0")/../../../shared/data/vox/dotvox_axes.vox
-if [ -f "$vox" ]; then
-  "$VF" field "$vox" -o ref.npy --metric euclidean --signed 2>/dev/null
-  "$MPIEXEC" -np 3 "$VFM" field "$vox" -o out.npy --metric euclidean --signed 2>/dev/null
-  same ref.npy out.npy "3 ranks, dotvox_axes.vox"
-fi
-
 # Bad input: one message (from rank 0), exit 1 (2 for usage), nothing written.
 expect_failure() {  # expect_failure CODE PATTERN ARGS...
   local code=$1 pattern=$2
@@ -69,6 +62,47 @@ expect_failure() {  # expect_failure CODE PATTERN ARGS...
   if [ -e bad.npy ]; then echo "FAIL: $* wrote bad.npy"; fail=1; fi
   if ls -a | grep -q vftmp; then echo "FAIL: $* left a temporary"; fail=1; fi
 }
+# Scripted edits: every rank applies every edit to its slab and ghost slices; the final field is
+# voxfield edit's, byte for byte (edits crossing slabs and the volume's faces included).
+/usr/bin/python3 - <<'PY'
+import json, numpy as np
+rng = np.random.default_rng(9)
+X, Y, Z = 37, 29, 53
+with open("edits.jsonl", "w") as f:
+    for i in range(40):
+        op = ("place", "carve", "paint")[i % 3]
+        if i % 2:
+            e = {"shape": "sphere", "center": [int(v) for v in rng.integers(-4, (X + 4, Y + 4, Z + 4))],
+                 "radius": int(rng.integers(1, 8))}
+        else:
+            a = [int(v) for v in rng.integers(-3, (X, Y, Z))]
+            e = {"shape": "box", "min": a, "max": [a[0] + 6, a[1] + 5, a[2] + int(rng.integers(0, 25))]}
+        e["op"] = op
+        if op != "carve":
+            e["material"] = int(rng.integers(1, 6))
+        f.write(json.dumps(e) + "\n")
+PY
+for opts in "--metric euclidean --signed --max-distance 6" "--metric manhattan --storage u8" \
+            "--metric euclidean --max-distance 4.5"; do
+  # shellcheck disable=SC2086
+  "$VF" edit f.npy -e edits.jsonl -o ref.npy $opts 2>/dev/null
+  for n in 1 2 3 4; do
+    # shellcheck disable=SC2086
+    "$MPIEXEC" -np "$n" "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 $opts 2>/dev/null
+    same ref.npy out.npy "edit, $n ranks, $opts"
+  done
+done
+expect_failure 1 "edits over several ranks need a clamped field" edit f.npy -e edits.jsonl -o bad.npy --metric euclidean
+printf '{"op":"place","shape":"sphere","center":[1,2,3],"radius":-1,"material":1}\n' > bad_edit.jsonl
+expect_failure 1 "bad_edit.jsonl" edit f.npy -e bad_edit.jsonl -o bad.npy --max-distance 4
+
+vox=$(dirname "$0")/../../../shared/data/vox/dotvox_axes.vox
+if [ -f "$vox" ]; then
+  "$VF" field "$vox" -o ref.npy --metric euclidean --signed 2>/dev/null
+  "$MPIEXEC" -np 3 "$VFM" field "$vox" -o out.npy --metric euclidean --signed 2>/dev/null
+  same ref.npy out.npy "3 ranks, dotvox_axes.vox"
+fi
+
 expect_failure 1 "missing.npy: cannot open" field missing.npy -o bad.npy
 expect_failure 1 "a\[.*holds 0.5, not a material index" field fraction.npy -o bad.npy
 expect_failure 1 "/no/such/dir/bad.npy: directory /no/such/dir does not exist" field f.npy -o /no/such/dir/bad.npy

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <random>
 
+#include "voxfield/dynamic_field.h"
 #include "voxfield/file.h"
 #include "voxfield/limits.h"
 #include "voxfield/mpi.h"
@@ -40,7 +41,7 @@ std::vector<T> dense(const Grid<T>& g, const Box3i& box) {
   return v;
 }
 
-World random_world(std::uint32_t seed, Box3i& domain, int edge) {
+World random_world(std::uint32_t seed, Box3i& domain, int edge, double density = -1) {
   std::mt19937 rng(seed);
   const Vec3i origin{static_cast<int>(rng() % 30) - 15, static_cast<int>(rng() % 30) - 15,
                      static_cast<int>(rng() % 30) - 15};
@@ -48,7 +49,7 @@ World random_world(std::uint32_t seed, Box3i& domain, int edge) {
                    ranks() + static_cast<int>(rng() % 60)};
   domain = {origin, origin + size};
   World w(edge, domain);
-  const double density = std::array<double, 3>{0.003, 0.15, 0.9}[seed % 3];
+  if (density < 0) density = std::array<double, 3>{0.003, 0.15, 0.9}[seed % 3];
   std::bernoulli_distribution solid(density);
   for (int z = domain.begin.z; z < domain.end.z; ++z)
     for (int y = domain.begin.y; y < domain.end.y; ++y)
@@ -119,6 +120,83 @@ TEST(MpiField, EqualsOneProcessForEveryOption) {
     o.nearest_sites = true;
     check(o, seed++, 1);
   }
+}
+
+// Edits applied by every rank to its slab and ghost slices, against one process's incremental
+// field after the same edits (itself tested against full rebuilds), checked every few edits.
+void check_edits(const DistanceOptions& o, std::uint32_t seed) {
+  Box3i domain;
+  const int edge = seed % 2 ? 8 : 16;
+  // Sparse worlds: a voxel's nearest site is often far along z, where a missing ghost slice shows.
+  World whole = random_world(seed, domain, edge, seed % 2 ? 0.002 : 0.02);
+  const mpi::SlabPartition p = mpi::partition_slabs(domain, ranks(), seed % 3 ? 8 : 1);
+  const int ghost = mpi::edit_ghost_slices(o);
+  const Box3i slab = p.slab(rank());
+  const Box3i box{{domain.begin.x, domain.begin.y, std::max(domain.begin.z, slab.begin.z - ghost)},
+                  {domain.end.x, domain.end.y, std::min(domain.end.z, slab.end.z + ghost)}};
+  World mine(edge, box);  // this rank's box only
+  mine.voxels.copy_from_dense(box, dense(whole.voxels, box).data());
+  mpi::SlabEditor editor(comm(), p, mine, o);
+  DynamicDistanceField oracle(whole, o);
+  DirtyRegions dirty(edge, DirtyRegions::Track::kOccupancy);
+  std::mt19937 rng(seed * 7 + 1);
+  const Vec3i s = domain.size();
+  for (int i = 0; i < 40; ++i) {
+    Edit e;
+    e.op = i % 3 == 0 ? EditOp::kCarve : (i % 3 == 1 ? EditOp::kPlace : EditOp::kPaint);
+    e.material = static_cast<std::uint8_t>(1 + rng() % 4);
+    const Vec3i c = domain.begin + Vec3i{static_cast<int>(rng() % (s.x + 6)) - 3,
+                                         static_cast<int>(rng() % (s.y + 6)) - 3,
+                                         static_cast<int>(rng() % (s.z + 6)) - 3};
+    if (i % 2) {
+      e.brush = SphereBrush{
+          {static_cast<double>(c.x), static_cast<double>(c.y), static_cast<double>(c.z)},
+          static_cast<double>(1 + rng() % 6)};
+    } else {
+      e.brush = BoxBrush{c, c + Vec3i{static_cast<int>(rng() % 8), static_cast<int>(rng() % 8),
+                                      static_cast<int>(rng() % 20)}};
+    }
+    (void)editor.apply(e);
+    (void)apply_edit(whole, e, &dirty);
+    (void)oracle.update(dirty);
+    dirty.clear();
+    if (i % 4 != 3) continue;
+    const std::string what = std::string(metric_name(o.metric)) +
+                             (o.signed_distance ? " signed" : "") + " clamp " +
+                             std::to_string(o.max_distance) + " " + storage_name(o.storage) +
+                             (o.nearest_sites ? " sites" : "") + " seed " + std::to_string(seed) +
+                             " edit " + std::to_string(i) + " rank " + std::to_string(rank());
+    std::visit(
+        [&](const auto& g) {
+          using G = std::decay_t<decltype(g)>;
+          ASSERT_EQ(dense(g, slab), dense(std::get<G>(oracle.field().values), slab)) << what;
+        },
+        editor.field().values);
+    if (o.nearest_sites) {
+      ASSERT_EQ(dense(*editor.field().sites, slab), dense(*oracle.field().sites, slab)) << what;
+    }
+    EXPECT_EQ(dense(editor.world().voxels, slab), dense(whole.voxels, slab)) << what;
+  }
+}
+
+TEST(MpiField, EditsKeepEverySlabEqualToOneProcess) {
+  std::uint32_t seed = 500;
+  for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
+    for (bool sgn : {false, true})
+      for (bool sites : {false, true}) {
+        DistanceOptions o;
+        o.metric = m;
+        o.signed_distance = sgn;
+        o.nearest_sites = sites;
+        o.max_distance = 2.5 + static_cast<double>(seed % 6);
+        check_edits(o, seed++);
+        o.max_distance = 0;
+        o.storage = Storage::kU8;  // the storage's range is the clamp
+        check_edits(o, seed++);
+      }
+  DistanceOptions unclamped;
+  unclamped.metric = Metric::kEuclidean;
+  EXPECT_THROW((void)mpi::edit_ghost_slices(unclamped), InvalidArgument);
 }
 
 TEST(MpiField, PartitionsCoverTheDomainInOrder) {

@@ -117,4 +117,11 @@ DistanceField compute_slab_distance_field(const Grid<std::uint8_t>& occupancy,
   return detail::exact::compute_exact_field(occupancy, options, plan, &beyond, domain.size());
 }
 
+double effective_clamp(const DistanceOptions& options) {
+  DistanceOptions o = options;
+  o.domain = Box3i{{0, 0, 0}, {1, 1, 1}};  // the clamp does not depend on the domain
+  o.nearest_sites = false;
+  return detail::make_field_plan(Grid<std::uint8_t>(), o).clamp;
+}
+
 }  // namespace voxfield

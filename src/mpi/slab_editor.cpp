@@ -1,0 +1,70 @@
+// voxfield — a rank's slab of a world kept with its exact field under edits (mpi.h).
+//
+// With clamp D, a voxel's value depends only on the sites within D (docs/distance.md, "Exactness
+// with a clamp"): the sites within D of a slab lie within ceil(D / spacing_z) slices of it. So each
+// rank keeps its slab and that many ghost slices on either side as a bounded world, applies every
+// edit clipped to that box, and lets its own DynamicDistanceField follow: over the slab its values
+// are the whole field's (the ghost slices' values are not, and are never handed out).
+#include <cmath>
+#include <limits>
+
+#include "collective.h"
+#include "voxfield/distance_slab.h"
+#include "voxfield/mpi.h"
+#include "voxfield/world_io.h"
+
+namespace voxfield::mpi {
+
+int edit_ghost_slices(const DistanceOptions& options) {
+  const double clamp = effective_clamp(options);
+  if (!std::isfinite(clamp))
+    throw InvalidArgument(
+        "edits over several ranks need a clamped field (a max distance, or u8 or u16 storage): "
+        "an unclamped f32 value may depend on every voxel of the domain");
+  const double slices = std::ceil(clamp / options.spacing[2]);
+  return static_cast<int>(std::min<double>(slices, std::numeric_limits<std::int32_t>::max() / 4));
+}
+
+SlabEditor::SlabEditor(MPI_Comm comm, const SlabPartition& partition, const World& world,
+                       const DistanceOptions& options)
+    : dirty_(world.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  detail::collectively(comm, nullptr, [&] {
+    int size = 0;
+    MPI_Comm_size(comm, &size);
+    if (partition.ranks() != size)
+      throw InvalidArgument("a partition into " + std::to_string(partition.ranks()) +
+                            " slabs for a communicator of " + std::to_string(size) + " ranks");
+    slab_ = partition.slab(rank);
+    const int ghost = edit_ghost_slices(options);
+    const Box3i& d = partition.domain;
+    const auto z0 = static_cast<std::int32_t>(
+        std::max<std::int64_t>(d.begin.z, std::int64_t{slab_.begin.z} - ghost));
+    const auto z1 = static_cast<std::int32_t>(
+        std::min<std::int64_t>(d.end.z, std::int64_t{slab_.end.z} + ghost));
+    box_ = Box3i{{d.begin.x, d.begin.y, z0}, {d.end.x, d.end.y, z1}};
+    // A bounded copy of the box: edits are clipped to it, and the field's domain is it.
+    world_ = rechunk_world(world, world.voxels.chunk_edge(), box_, "rank " + std::to_string(rank));
+    world_.palette = world.palette;
+    DistanceOptions o = options;
+    o.domain = box_;
+    field_ = std::make_unique<DynamicDistanceField>(world_, o);
+  });
+}
+
+SlabEditor::Result SlabEditor::apply(const Edit& edit) {
+  validate_edit(edit);  // the same refusal on every rank, whether the edit reaches it or not
+  Result r;
+  const EditResult e = apply_edit(world_, edit, &dirty_);
+  r.voxels_changed = e.voxels_changed;
+  r.reached = !dirty_.empty() || e.voxels_changed > 0;
+  if (!dirty_.empty()) {
+    const DynamicDistanceField::UpdateStats s = field_->update(dirty_);
+    r.voxels_recomputed = s.voxels_recomputed;
+    dirty_.clear();
+  }
+  return r;
+}
+
+}  // namespace voxfield::mpi
