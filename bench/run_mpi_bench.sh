@@ -6,7 +6,8 @@
 # ranks oversubscribe them (Open MPI's --oversubscribe), so past 2 ranks the figures show the
 # overhead of more ranks, not more speed. Each rank is bound to a core (Open MPI's default) and
 # runs one thread; "1 rank x 2 threads" (--bind-to none) is the single-process baseline.
-# JSON lines per run and a markdown table into bench/results/mpi-DATE/.
+# Then scripted edits through voxfield edit and voxfield-mpi edit (identical files, per-edit
+# latency of the slowest rank). JSON lines per run and markdown tables into bench/results/mpi-DATE/.
 # Usage: bash bench/run_mpi_bench.sh [REPEAT] [BIG_EDGE]   (defaults 3 and 1536)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -44,6 +45,48 @@ bytes=$((big * big * big))
 cap=$((bytes / 4 + bytes / 8))
 $M -np 4 $B --memory-limit "$cap" bench --size $big,$big,$big --spheres 2000 --metric euclidean --chunk 32 \
   --storage u8 --threads 1 --repeat 1 | sed "s/^{/{\"label\":\"big $big^3 u8, 4 ranks, memory limit $cap bytes per rank\",/" | tee -a "$out/runs.jsonl"
+# Edits: 400 radius-4 spheres placed and carved on the 256^3 terrain, clamp 16, through voxfield
+# edit (one process, 2 threads) and voxfield-mpi edit (1, 2, 4 ranks of one thread); the files
+# must be identical.
+build/release/bin/voxfield generate terrain --size 256 -o "$out/terrain.npy" 2>/dev/null
+/usr/bin/python3 - "$out/edits.jsonl" <<'PY'
+import json, sys
+import numpy as np
+rng = np.random.default_rng(4)
+with open(sys.argv[1], "w") as f:
+    for i in range(400):
+        e = {"op": "place" if i % 2 else "carve", "shape": "sphere",
+             "center": [int(v) for v in rng.integers(0, 256, 3)], "radius": 4}
+        if i % 2:
+            e["material"] = 2
+        f.write(json.dumps(e) + "\n")
+PY
+edit_opts="--metric euclidean --max-distance 16 --chunk 16"
+# shellcheck disable=SC2086
+build/release/bin/voxfield edit "$out/terrain.npy" -e "$out/edits.jsonl" -o "$out/edit-one.npy" \
+  $edit_opts --threads 2 --stats "$out/edit-one.json" 2>/dev/null
+for n in 1 2 4; do
+  # shellcheck disable=SC2086
+  $M -np "$n" $B edit "$out/terrain.npy" -e "$out/edits.jsonl" -o "$out/edit-$n.npy" $edit_opts \
+    --threads 1 --stats "$out/edit-$n.json" 2>/dev/null
+  cmp "$out/edit-one.npy" "$out/edit-$n.npy"
+  rm -f "$out/edit-$n.npy"
+done
+rm -f "$out/edit-one.npy" "$out/terrain.npy"
+/usr/bin/python3 - "$out" <<'PY' | tee "$out/edits.md"
+import json, sys
+out = sys.argv[1]
+print("| edits, 256^3 terrain, clamp 16 | p50 ms | p99 ms | total ms | build ms | ranks an edit reached (mean) | ghost slices |")
+print("|---|---|---|---|---|---|---|")
+one = json.load(open(out + "/edit-one.json"))
+print("| one process (voxfield edit, 2 threads) | %.3f | %.3f | %.0f | %.0f | — | — |" % (
+    one["p50_ms"], one["p99_ms"], one["total_ms"], one["build_ms"]))
+for n in (1, 2, 4):
+    j = json.load(open("%s/edit-%d.json" % (out, n)))
+    print("| %d rank%s (voxfield-mpi edit, 1 thread each) | %.3f | %.3f | %.0f | %.0f | %.2f | %d |" % (
+        n, "" if n == 1 else "s", j["p50_ms"], j["p99_ms"], j["total_ms"], j["build_ms"],
+        j["ranks_reached_per_edit"], j["ghost_slices"]))
+PY
 /usr/bin/python3 - "$out" <<'PY' | tee "$out/table.md"
 import json, sys
 runs = [json.loads(l) for l in open(sys.argv[1] + "/runs.jsonl")]
