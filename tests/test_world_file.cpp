@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <random>
@@ -130,4 +131,57 @@ TEST(WorldFile, KillingASaveNeverDamagesThePreviousFile) {
     EXPECT_TRUE(d == da || d == db) << "round " << round;
   }
   fs::remove_all(dir);
+}
+
+// A file assembled from parts (voxfield-mpi's ranks each encode the chunks of their slab) is the
+// whole world's file byte for byte, wherever the parts are cut along z, and reads back.
+TEST(WorldFile, PartsAssembleIntoTheWholeFile) {
+  std::mt19937 rng(23);
+  for (int edge : {8, 16}) {
+    for (int trial = 0; trial < 6; ++trial) {
+      const Vec3i origin{static_cast<int>(rng() % 20) - 10, static_cast<int>(rng() % 20) - 10,
+                         static_cast<int>(rng() % 40) - 20};
+      const Box3i bounds{
+          origin, origin + Vec3i{5 + static_cast<int>(rng() % 30), 4 + static_cast<int>(rng() % 30),
+                                 10 + static_cast<int>(rng() % 90)}};
+      World w(edge, bounds);
+      w.palette[3] = {1, 2, 3, 4};
+      for (int k = 0; k < 400; ++k) {
+        const Vec3i s = bounds.size();
+        w.voxels.set(
+            bounds.begin + Vec3i{static_cast<int>(rng() % s.x), static_cast<int>(rng() % s.y),
+                                 static_cast<int>(rng() % s.z)},
+            static_cast<std::uint8_t>(1 + rng() % 5));
+      }
+      // A solid layer: uniform chunks among the dense ones.
+      if (trial % 2)
+        w.voxels.fill(bounds.intersect(
+                          {bounds.begin, {bounds.end.x, bounds.end.y, bounds.begin.z + 3 * edge}}),
+                      7);
+      w.voxels.compact();
+      const std::vector<std::uint8_t> whole = encode_world_file(w);
+      // Cuts at chunk z coordinates, from below the first chunk to past the last.
+      const int c0 = (bounds.begin.z - edge * 64) / edge - 64, c1 = bounds.end.z / edge + 2;
+      std::vector<int> cuts{c0, c1};
+      for (int i = 0; i < static_cast<int>(rng() % 4); ++i)
+        cuts.push_back((bounds.begin.z >> (edge == 8 ? 3 : 4)) + static_cast<int>(rng() % 12) - 2);
+      std::sort(cuts.begin(), cuts.end());
+      std::vector<WorldFilePart> parts;
+      std::vector<WorldFilePartSummary> summaries;
+      for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+        parts.push_back(encode_world_file_part(w.voxels, cuts[i], cuts[i + 1]));
+        summaries.push_back({parts.back().chunks, parts.back().records.size(), parts.back().crc});
+      }
+      const WorldFileFrame frame =
+          encode_world_file_frame(w.palette, edge, w.voxels.bounds(), summaries);
+      std::vector<std::uint8_t> assembled = frame.head;
+      for (const WorldFilePart& p : parts)
+        assembled.insert(assembled.end(), p.records.begin(), p.records.end());
+      assembled.insert(assembled.end(), frame.tail.begin(), frame.tail.end());
+      ASSERT_EQ(assembled, whole) << "edge " << edge << " trial " << trial << ", " << parts.size()
+                                  << " parts";
+      const WorldFile back = parse_world_file(assembled, "assembled.vfw");
+      EXPECT_EQ(test::dense_voxels(back.world, bounds), test::dense_voxels(w, bounds));
+    }
+  }
 }

@@ -119,7 +119,7 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
   DistanceOptions o = f.options();
   o.nearest_sites = !sites.empty();
   // Everything that can be wrong with the outputs is found before the world is loaded.
-  mpi::check_outputs(comm, {out, sites, stats, {}});
+  mpi::check_outputs(comm, {out, sites, stats});
   const double t0 = MPI_Wtime();
   const mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk);
   const double load_ms = (MPI_Wtime() - t0) * 1e3;
@@ -157,14 +157,19 @@ double percentile(std::vector<double> v, double q) {
 }
 
 int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
-             const std::string& edits_path, const std::string& out, const std::string& stats) {
+             const std::string& edits_path, const std::string& out, const std::string& stats,
+             const std::string& save_world) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
   std::optional<ThreadLimit> limit;
   if (f.threads > 0) limit.emplace(f.threads);
   const DistanceOptions o = f.options();
-  mpi::check_outputs(comm, {out, {}, stats, {}});
+  if (!save_world.empty() && std::filesystem::path(save_world).extension() != ".vfw")
+    throw InvalidArgument(
+        "--save-world: voxfield-mpi writes worlds as .vfw (each rank its "
+        "chunks); voxfield convert turns it into .vox or .npy");
+  mpi::check_outputs(comm, {out, stats, save_world});
   // The script and the ghost slices are checked on every rank before the world is loaded.
   const auto [edits, ghost] = mpi::collectively(comm, [&] {
     EditScriptOptions eo;
@@ -206,7 +211,17 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
                                                      static_cast<double>(edits.size())},
       {"voxels_recomputed_all_ranks", sum_over(comm, recomputed)},
       {"slabs", slab.partition.z}});
-  mpi::write_field_npy(comm, slab.partition, editor.field(), {out, {}, stats, j.dump(2) + "\n"});
+  // Both outputs in one transaction of rank 0's: written all or nothing.
+  std::optional<FileTransaction> outputs;
+  if (rank == 0) outputs.emplace();
+  FileTransaction* tx = outputs ? &*outputs : nullptr;
+  mpi::write_field_npy(comm, slab.partition, editor.field(), {out, {}, stats, j.dump(2) + "\n"},
+                       nullptr, tx);
+  if (!save_world.empty())
+    mpi::save_world_vfw(comm, slab.partition, editor.world(), save_world, nullptr, tx);
+  mpi::collectively(comm, [&] {
+    if (tx) tx->commit();
+  });
   if (rank == 0)
     std::cerr << "voxfield-mpi: " << edits.size() << " edits on " << size << " ranks, " << total
               << " ms in all (p50 " << percentile(slowest, 0.5) << " ms, p99 "
@@ -268,7 +283,7 @@ int main(int argc, char** argv) {
   field->add_option("--stats", stats, "timing and exchange figures as JSON");
   f.add_to(field);
   FieldSettings fe;
-  std::string edit_in, edit_script, edit_out, edit_stats;
+  std::string edit_in, edit_script, edit_out, edit_stats, edit_save;
   CLI::App* edit = app.add_subcommand(
       "edit", "scripted edits with incremental exact updates, as `voxfield edit`");
   edit->add_option("IN", edit_in, "input .npy (read a slab per rank), .vox or .vfw")->required();
@@ -277,6 +292,8 @@ int main(int argc, char** argv) {
       ->required();
   edit->add_option("-o,--output", edit_out, "output .npy of the final field")->required();
   edit->add_option("--stats", edit_stats, "per-edit latency of the slowest rank, as JSON");
+  edit->add_option("--save-world", edit_save,
+                   "also write the edited world as one .vfw (every rank its chunks)");
   fe.add_to(edit);
   std::vector<int> dims;
   int spheres = 200, repeat = 3;
@@ -299,7 +316,7 @@ int main(int argc, char** argv) {
     if (field->parsed()) {
       code = run_field(comm, f, in, out, sites, stats);
     } else if (edit->parsed()) {
-      code = run_edit(comm, fe, edit_in, edit_script, edit_out, edit_stats);
+      code = run_edit(comm, fe, edit_in, edit_script, edit_out, edit_stats, edit_save);
     } else {
       code = run_bench(comm, fb, dims, spheres, repeat);
     }

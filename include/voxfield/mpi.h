@@ -31,6 +31,7 @@
 #include "voxfield/dynamic_field.h"
 #include "voxfield/edit.h"
 #include "voxfield/error.h"
+#include "voxfield/file.h"
 #include "voxfield/world.h"
 
 namespace voxfield::mpi {
@@ -44,9 +45,9 @@ struct SlabPartition {
   Box3i slab(int rank) const;
 };
 
-// Slabs of near-equal volume: cuts at multiples of `align` slices from the domain's start (the
-// chunk edge, so that no chunk is split between ranks) where every rank still gets at least one
-// unit of `align`, else at single slices. Throws InvalidArgument when the domain has fewer slices
+// Slabs of near-equal volume: cuts at multiples of `align` slices (the chunk edge, so that no chunk
+// is split between ranks) when every rank can get at least one unit of `align`, else at single
+// slices. Throws InvalidArgument when the domain has fewer slices
 // than ranks (every rank must own one) or is empty.
 SlabPartition partition_slabs(const Box3i& domain, int ranks, int align = 1);
 
@@ -187,9 +188,9 @@ struct FieldFiles {
   std::string json_text;
 };
 
-// Checks the targets as check_output_path does (on rank 0, whose file system view writes them),
-// before any work: every rank throws RankError when one cannot be written.
-void check_outputs(MPI_Comm comm, const FieldFiles& files);
+// Checks the targets (empty paths skipped) as check_output_path does (on rank 0, whose file system
+// view writes them), before any work: every rank throws RankError when one cannot be written.
+void check_outputs(MPI_Comm comm, const std::vector<std::filesystem::path>& targets);
 
 // Writes every rank's slab of the field (a field covering at least the rank's slab: its values over
 // the slab are written) into one .npy per output, byte for byte what `voxfield
@@ -197,7 +198,23 @@ void check_outputs(MPI_Comm comm, const FieldFiles& files);
 // (FileTransaction::stage_shared), every rank writes its slices into them with MPI-IO, and only
 // when all ranks succeeded does rank 0 rename them onto the targets. On failure no target is
 // touched and the temporaries are removed.
+// `into`: rank 0's transaction to stage the outputs in, for the caller to commit with others
+// (collectively); null (and on other ranks): its own, committed before returning.
 void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const DistanceField& slab,
-                     const FieldFiles& files, ExchangeStats* stats = nullptr);
+                     const FieldFiles& files, ExchangeStats* stats = nullptr,
+                     FileTransaction* into = nullptr);
+
+// Writes the world of every rank's slab into one .vfw world file (docs/formats.md), byte for byte
+// what one process writes for the whole world bounded to the partition's domain (`voxfield edit
+// --save-world`, `voxfield convert`), all or nothing as write_field_npy: each rank encodes the
+// chunks of its slab and writes them at its place, rank 0 the header and checksum, and renames the
+// file once every rank has written. `world` must hold this rank's slab (chunks of other slabs it
+// holds are not written); the slabs must be cut on chunk boundaries (InvalidArgument otherwise:
+// partition_slabs with the chunk edge as `align` does so when the domain has a chunk layer for
+// every rank).
+// `into` as for write_field_npy.
+void save_world_vfw(MPI_Comm comm, const SlabPartition& partition, const World& world,
+                    const std::filesystem::path& path, ExchangeStats* stats = nullptr,
+                    FileTransaction* into = nullptr);
 
 }  // namespace voxfield::mpi

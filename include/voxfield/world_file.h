@@ -37,6 +37,31 @@ std::vector<std::uint8_t> encode_world_file(const World& world,
 WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::string& name,
                            const WorldFileReadOptions& options = {});
 
+// A world file written in parts by writers that each hold a slab of the world (voxfield-mpi's
+// ranks): the file is frame.head, every part's records in order, then frame.tail — byte for byte
+// encode_world_file of the whole world (without fields) when the parts are the whole world's chunks
+// cut at chunk z coordinates, in increasing z.
+struct WorldFilePart {
+  std::vector<std::uint8_t> records;  // the chunk records, in file order
+  std::uint64_t chunks = 0;
+  std::uint32_t crc = 0;  // CRC-32 of the records
+};
+struct WorldFilePartSummary {
+  std::uint64_t chunks = 0, bytes = 0;
+  std::uint32_t crc = 0;
+};
+struct WorldFileFrame {
+  std::vector<std::uint8_t> head, tail;
+};
+// The records of the chunks of `voxels` whose chunk coordinate z lies in [chunk_z_begin,
+// chunk_z_end).
+WorldFilePart encode_world_file_part(const Grid<std::uint8_t>& voxels, std::int32_t chunk_z_begin,
+                                     std::int32_t chunk_z_end);
+// What precedes and follows the parts of a world with this palette, chunk edge and bounds.
+WorldFileFrame encode_world_file_frame(const Palette& palette, int chunk_edge,
+                                       const std::optional<Box3i>& bounds,
+                                       std::span<const WorldFilePartSummary> parts);
+
 void write_world_file(const World& world, const std::filesystem::path& path,
                       const std::vector<const DistanceField*>& fields = {});
 WorldFile read_world_file(const std::filesystem::path& path,

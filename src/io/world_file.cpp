@@ -52,18 +52,24 @@ std::uint32_t crc(const std::uint8_t* p, std::size_t n) {
   return static_cast<std::uint32_t>(c);
 }
 
+// A grid's parameters and chunk count: what precedes its chunk records.
 template <class T>
-void put_grid(Out& o, const Grid<T>& g) {
-  o.put<std::uint32_t>(static_cast<std::uint32_t>(g.chunk_edge()));
+void put_grid_head(Out& o, int chunk_edge, T background, const std::optional<Box3i>& bounds,
+                   std::uint64_t chunks) {
+  o.put<std::uint32_t>(static_cast<std::uint32_t>(chunk_edge));
   o.put<std::uint32_t>(sizeof(T));
-  o.put(g.background());
-  o.put<std::uint8_t>(g.bounds() ? 1 : 0);
-  if (g.bounds()) {
-    for (int k = 0; k < 3; ++k) o.put<std::int32_t>(g.bounds()->begin[k]);
-    for (int k = 0; k < 3; ++k) o.put<std::int32_t>(g.bounds()->end[k]);
+  o.put(background);
+  o.put<std::uint8_t>(bounds ? 1 : 0);
+  if (bounds) {
+    for (int k = 0; k < 3; ++k) o.put<std::int32_t>(bounds->begin[k]);
+    for (int k = 0; k < 3; ++k) o.put<std::int32_t>(bounds->end[k]);
   }
-  const std::vector<Vec3i> coords = g.chunk_coords();
-  o.put<std::uint64_t>(coords.size());
+  o.put<std::uint64_t>(chunks);
+}
+
+// The records of the given chunks, in that order.
+template <class T>
+void put_chunk_records(Out& o, const Grid<T>& g, const std::vector<Vec3i>& coords) {
   const std::size_t raw = static_cast<std::size_t>(g.chunk_volume()) * sizeof(T);
   std::vector<std::uint8_t> packed(compressBound(static_cast<uLong>(raw)));
   for (const Vec3i c : coords) {
@@ -85,6 +91,13 @@ void put_grid(Out& o, const Grid<T>& g) {
     o.put<std::uint32_t>(static_cast<std::uint32_t>(size));
     o.bytes(packed.data(), size);
   }
+}
+
+template <class T>
+void put_grid(Out& o, const Grid<T>& g) {
+  const std::vector<Vec3i> coords = g.chunk_coords();
+  put_grid_head(o, g.chunk_edge(), g.background(), g.bounds(), coords.size());
+  put_chunk_records(o, g, coords);
 }
 
 template <class T>
@@ -311,6 +324,54 @@ std::vector<std::uint8_t> encode_world_file(const World& world,
     put_section(file, kFieldSection, p);
   }
   return std::move(file.b);
+}
+
+WorldFilePart encode_world_file_part(const Grid<std::uint8_t>& voxels, std::int32_t chunk_z_begin,
+                                     std::int32_t chunk_z_end) {
+  std::vector<Vec3i> coords = voxels.chunk_coords();
+  std::erase_if(coords, [&](const Vec3i& c) { return c.z < chunk_z_begin || c.z >= chunk_z_end; });
+  Out o;
+  put_chunk_records(o, voxels, coords);
+  WorldFilePart part;
+  part.chunks = coords.size();
+  part.crc = crc(o.b.data(), o.b.size());
+  part.records = std::move(o.b);
+  return part;
+}
+
+WorldFileFrame encode_world_file_frame(const Palette& palette, int chunk_edge,
+                                       const std::optional<Box3i>& bounds,
+                                       std::span<const WorldFilePartSummary> parts) {
+  if (chunk_edge < 8 || chunk_edge > 128 || (chunk_edge & (chunk_edge - 1)) != 0)
+    throw InvalidArgument("world file: chunk edge " + std::to_string(chunk_edge) +
+                          " is not a power of two in 8..128");
+  std::uint64_t chunks = 0, record_bytes = 0;
+  for (const WorldFilePartSummary& p : parts) {
+    chunks += p.chunks;
+    record_bytes += p.bytes;
+  }
+  // The world section's payload starts with the palette and the grid's head; its CRC continues
+  // over every part's records in order (zlib's crc32_combine joins CRCs of adjacent pieces).
+  Out payload;
+  for (const Rgba& c : palette) payload.put(c);
+  put_grid_head<std::uint8_t>(payload, chunk_edge, 0, bounds, chunks);
+  uLong section_crc = crc(payload.b.data(), payload.b.size());
+  for (const WorldFilePartSummary& p : parts)
+    section_crc = crc32_combine(section_crc, p.crc, static_cast<z_off_t>(p.bytes));
+  WorldFileFrame frame;
+  Out head;
+  head.bytes(kMagic, 8);
+  head.put<std::uint32_t>(kWorldFileVersion);
+  head.put<std::uint32_t>(1);
+  head.put<std::uint32_t>(crc(head.b.data(), 16));
+  head.put<std::uint32_t>(kWorldSection);
+  head.put<std::uint64_t>(payload.b.size() + record_bytes);
+  head.bytes(payload.b.data(), payload.b.size());
+  frame.head = std::move(head.b);
+  Out tail;
+  tail.put<std::uint32_t>(static_cast<std::uint32_t>(section_crc));
+  frame.tail = std::move(tail.b);
+  return frame;
 }
 
 WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::string& name,

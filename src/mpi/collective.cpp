@@ -1,6 +1,10 @@
 // voxfield — agreement between the ranks of a collective operation (collective.h).
 #include "collective.h"
 
+#include <algorithm>
+
+#include "voxfield/error.h"
+
 namespace voxfield::mpi {
 
 void agree(MPI_Comm comm, const std::string& error, ExchangeStats* stats) {
@@ -25,6 +29,53 @@ void agree(MPI_Comm comm, const std::string& error, ExchangeStats* stats) {
 }
 
 namespace detail {
+
+std::string broadcast_string(MPI_Comm comm, std::string text, ExchangeStats* stats) {
+  CollectiveTimer t(stats);
+  int length = static_cast<int>(text.size());
+  MPI_Bcast(&length, 1, MPI_INT, 0, comm);
+  text.resize(static_cast<std::size_t>(length));
+  MPI_Bcast(text.data(), length, MPI_CHAR, 0, comm);
+  return text;
+}
+
+namespace {
+
+// Writes `bytes` at `offset` of the open file, in pieces MPI's int counts can take.
+void write_at(MPI_File fh, std::uint64_t offset, const std::uint8_t* bytes, std::uint64_t n,
+              const std::string& name) {
+  constexpr std::uint64_t kPiece = std::uint64_t{1} << 30;
+  for (std::uint64_t at = 0; at < n; at += kPiece) {
+    const int count = static_cast<int>(std::min(kPiece, n - at));
+    MPI_Status status;
+    const int rc = MPI_File_write_at(fh, static_cast<MPI_Offset>(offset + at), bytes + at, count,
+                                     MPI_BYTE, &status);
+    if (rc != MPI_SUCCESS)
+      throw IoError(name + ": write of " + std::to_string(count) + " bytes at offset " +
+                    std::to_string(offset + at) + " failed: " + mpi_error_text(rc));
+  }
+}
+
+}  // namespace
+
+std::string write_pieces(MPI_Comm comm, const std::string& temporary, const std::string& target,
+                         const std::vector<FilePiece>& pieces) {
+  MPI_File fh = MPI_FILE_NULL;
+  std::string mpi_path = temporary;
+  const int rc = MPI_File_open(comm, mpi_path.data(), MPI_MODE_WRONLY, MPI_INFO_NULL, &fh);
+  if (rc != MPI_SUCCESS) return target + ": cannot open " + temporary + ": " + mpi_error_text(rc);
+  std::string error;
+  try {
+    for (const FilePiece& p : pieces)
+      write_at(fh, p.offset, p.bytes.data(), p.bytes.size(), target);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  const int close_rc = MPI_File_close(&fh);
+  if (close_rc != MPI_SUCCESS && error.empty())
+    error = target + ": close failed: " + mpi_error_text(close_rc);
+  return error;
+}
 
 std::string mpi_error_text(int code) {
   char text[MPI_MAX_ERROR_STRING];

@@ -6,8 +6,10 @@
 #include <mpi.h>
 
 #include <chrono>
+#include <cstdint>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "voxfield/mpi.h"
 
@@ -45,6 +47,22 @@ auto collectively(MPI_Comm comm, ExchangeStats* stats, Fn&& fn) {
 inline void agree(MPI_Comm comm, const std::string& error, ExchangeStats* stats) {
   mpi::agree(comm, error, stats);
 }
+
+// Rank 0's `text` on every rank.
+std::string broadcast_string(MPI_Comm comm, std::string text, ExchangeStats* stats);
+
+// Bytes of a shared file at an offset.
+struct FilePiece {
+  std::uint64_t offset = 0;
+  std::vector<std::uint8_t> bytes;
+};
+
+// Collective: every rank opens `temporary` (staged by rank 0), writes its pieces and closes it.
+// Every rank makes the open and close calls whatever happens, so a failure does not leave the
+// others waiting; returns this rank's error (empty on success) for the caller to agree on.
+// `target` names the file in messages.
+std::string write_pieces(MPI_Comm comm, const std::string& temporary, const std::string& target,
+                         const std::vector<FilePiece>& pieces);
 
 // The text of an MPI error code.
 std::string mpi_error_text(int code);

@@ -34,7 +34,9 @@ SlabPartition partition_slabs(const Box3i& domain, int ranks, int align) {
   p.z.resize(static_cast<std::size_t>(ranks) + 1);
   p.z.front() = domain.begin.z;
   p.z.back() = domain.end.z;
-  const bool aligned = units >= 2 * static_cast<std::int64_t>(ranks) || (units >= ranks && a == 1);
+  // Whole units whenever every rank can have one: slabs then never share a chunk (a .vfw written by
+  // every rank needs that), at the price of at most one unit of imbalance.
+  const bool aligned = units >= ranks;
   for (int r = 1; r < ranks; ++r) {
     std::int64_t cut;
     if (aligned) {

@@ -51,15 +51,15 @@ PY
 expect_failure() {  # expect_failure CODE PATTERN ARGS...
   local code=$1 pattern=$2
   shift 2
-  rm -f bad.npy
+  rm -f bad.npy bad.vfw
   set +e
-  "$MPIEXEC" -np 2 "$VFM" "$@" >out.txt 2>err.txt
+  "$MPIEXEC" -np "${EXPECT_RANKS:-2}" "$VFM" "$@" >out.txt 2>err.txt
   local got=$?
   set -e
   if [ "$got" -ne "$code" ]; then echo "FAIL: $* exited $got, expected $code"; cat err.txt; fail=1; fi
   if ! grep -q -- "$pattern" err.txt; then echo "FAIL: $*: no '$pattern' in:"; cat err.txt; fail=1; fi
   if [ "$(grep -c -- "$pattern" err.txt)" -gt 1 ]; then echo "FAIL: $*: said more than once"; fail=1; fi
-  if [ -e bad.npy ]; then echo "FAIL: $* wrote bad.npy"; fail=1; fi
+  if [ -e bad.npy ] || [ -e bad.vfw ]; then echo "FAIL: $* wrote an output"; fail=1; fi
   if ls -a | grep -q vftmp; then echo "FAIL: $* left a temporary"; fail=1; fi
 }
 # Scripted edits: every rank applies every edit to its slab and ghost slices; the final field is
@@ -92,6 +92,20 @@ for opts in "--metric euclidean --signed --max-distance 6" "--metric manhattan -
     same ref.npy out.npy "edit, $n ranks, $opts"
   done
 done
+# The edited world as one .vfw written by every rank: voxfield edit --save-world's file.
+"$VF" edit f.npy -e edits.jsonl -o ref.npy --chunk 8 --max-distance 6 --save-world ref.vfw 2>/dev/null
+for n in 1 2 3 4; do
+  "$MPIEXEC" -np "$n" "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 --max-distance 6 \
+    --save-world out.vfw 2>/dev/null
+  same ref.vfw out.vfw "edit --save-world, $n ranks"
+  same ref.npy out.npy "edit --save-world, $n ranks (field)"
+done
+# Slabs not cut on chunks cannot share a .vfw: refused, and the field is not written either.
+/usr/bin/python3 -c "import numpy as np; np.save('short.npy', np.ones((8, 8, 20), np.uint8))"
+EXPECT_RANKS=4 expect_failure 1 "needs slabs cut on chunk boundaries" edit short.npy -e edits.jsonl -o bad.npy \
+  --chunk 8 --max-distance 3 --save-world bad.vfw
+expect_failure 1 "writes worlds as .vfw" edit f.npy -e edits.jsonl -o bad.npy --max-distance 3 \
+  --save-world bad.vox
 expect_failure 1 "edits over several ranks need a clamped field" edit f.npy -e edits.jsonl -o bad.npy --metric euclidean
 printf '{"op":"place","shape":"sphere","center":[1,2,3],"radius":-1,"material":1}\n' > bad_edit.jsonl
 expect_failure 1 "bad_edit.jsonl" edit f.npy -e bad_edit.jsonl -o bad.npy --max-distance 4
