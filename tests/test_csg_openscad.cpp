@@ -127,6 +127,9 @@ TEST(CsgOpenScad, HostileCountsAreRefusedAndPolytopesAreBounded) {
             std::string::npos);
   // The planes count against the memory limit: a 30-byte file asks for no more than it allows
   // (found by fuzz_openscad: sphere($fn = 950) took 1.3 GB under the harness's 256 MiB limit).
+  struct LimitGuard {  // the process default again however the block ends
+    ~LimitGuard() { set_default_memory_limit(0); }
+  } guard;
   set_default_memory_limit(std::uint64_t{64} << 20);
   try {
     (void)scad("sphere($fn = 950, r = 3);", true);

@@ -119,7 +119,7 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
   DistanceOptions o = f.options();
   o.nearest_sites = !sites.empty();
   // Everything that can be wrong with the outputs is found before the world is loaded.
-  mpi::check_outputs(comm, {out, sites, stats});
+  mpi::check_outputs(comm, {out, sites}, {stats});
   const double t0 = MPI_Wtime();
   const mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk);
   const double load_ms = (MPI_Wtime() - t0) * 1e3;
@@ -169,16 +169,17 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
     throw InvalidArgument(
         "--save-world: voxfield-mpi writes worlds as .vfw (each rank its "
         "chunks); voxfield convert turns it into .vox or .npy");
-  mpi::check_outputs(comm, {out, stats, save_world});
+  mpi::check_outputs(comm, {out, save_world}, {stats});
   // The script and the ghost slices are checked on every rank before the world is loaded.
   const auto [edits, ghost] = mpi::collectively(comm, [&] {
     EditScriptOptions eo;
     eo.chunk_edge = f.chunk;
     return std::make_pair(read_edit_script(edits_path, eo), mpi::edit_ghost_slices(o));
   });
-  const mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk, ghost);
+  mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk, ghost);
   const double t0 = MPI_Wtime();
   mpi::SlabEditor editor(comm, slab.partition, slab.world, o);
+  slab.world = World();  // the editor holds its own copy
   const double build_ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
   // Local work only: a failure on one rank is agreed on after the loop.
   std::vector<double> edit_ms(edits.size(), 0.0);
@@ -267,6 +268,13 @@ int main(int argc, char** argv) {
   MPI_Comm comm = MPI_COMM_WORLD;
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
+  if (provided < MPI_THREAD_FUNNELED) {
+    // voxfield's thread pool works between MPI calls, which only the main thread makes.
+    if (rank == 0)
+      std::cerr << "voxfield-mpi: this MPI library gives no MPI_THREAD_FUNNELED support\n";
+    MPI_Finalize();
+    return 1;
+  }
   voxfield::install_signal_cleanup();
   CLI::App app{"voxfield-mpi: exact distance fields over the processes of an MPI job"};
   app.require_subcommand(1);

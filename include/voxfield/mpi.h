@@ -166,17 +166,17 @@ class SlabEditor {
 
 // A rank's slab of a world file.
 struct WorldSlab {
-  World world;  // the slab's voxels (at their place in the whole world)
+  World world;  // the slab's voxels and its ghost slices, at their place in the whole world
   SlabPartition partition;
   std::string format;          // "npy", "vox" or "vfw"
   bool read_in_parts = false;  // each rank read only its slab (.npy); else each read the whole file
 };
 
-// Loads `path` for this rank: a .npy is read a part per rank (read_npy_part), so no rank holds more
-// than its slab and `ghost_slices` slices on either side; a .vox or .vfw is loaded whole by every
-// rank, which keeps its slab (those formats give no cheap way to read part of them; the memory of
-// one whole world per rank is the cost). The domain is the file's volume (the .npy shape, the
-// .vox/.vfw extent), as `voxfield field` uses.
+// Loads `path` for this rank, keeping its slab and `ghost_slices` slices on either side: a .npy is
+// read a part per rank (read_npy_part), so no rank ever holds more; a .vox or .vfw is read whole by
+// every rank, which then keeps its part (those formats give no cheap partial read: the memory of
+// one whole world per rank, while loading, is the cost). The domain is the file's volume (the .npy
+// shape, the .vox/.vfw extent), as `voxfield field` uses.
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
                           int ghost_slices = 0);
 
@@ -188,9 +188,12 @@ struct FieldFiles {
   std::string json_text;
 };
 
-// Checks the targets (empty paths skipped) as check_output_path does (on rank 0, whose file system
-// view writes them), before any work: every rank throws RankError when one cannot be written.
-void check_outputs(MPI_Comm comm, const std::vector<std::filesystem::path>& targets);
+// Checks the targets (empty paths skipped) as check_output_path does, on rank 0 whose view of the
+// file system writes them, before any work: every rank throws RankError when one cannot be
+// written. `shared` targets, which every rank writes into (the .npy and .vfw outputs), must also be
+// regular files or new ones; `rank0` ones (a JSON file) may be standard output.
+void check_outputs(MPI_Comm comm, const std::vector<std::filesystem::path>& shared,
+                   const std::vector<std::filesystem::path>& rank0 = {});
 
 // Writes every rank's slab of the field (a field covering at least the rank's slab: its values over
 // the slab are written) into one .npy per output, byte for byte what `voxfield

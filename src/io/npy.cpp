@@ -446,15 +446,28 @@ NpyVolume read_npy_part(const std::filesystem::path& path, std::int32_t z0, std:
     reader.read_at(h.data_offset + static_cast<std::uint64_t>(z0) * X * Y * size,
                    static_cast<std::size_t>(part_bytes), v.bytes.data());
   } else {
-    // The plane a[x, :, :] holds the part's values of that x at y * Z + (z0..z1).
-    std::vector<std::uint8_t> plane(static_cast<std::size_t>((Y - 1) * Z + nz) * size);
+    // The plane a[x, :, :] holds the part's values of that x in Y runs, at y * Z + (z0..z1). One
+    // read of the span from the first run to the last is cheapest while the runs fill most of it;
+    // a thin part reads each run by itself, so that P processes read the file once between them
+    // rather than P times.
+    const bool span = (Y - 1) * Z + nz <= 2 * Y * nz;
+    std::vector<std::uint8_t> plane(static_cast<std::size_t>(span ? (Y - 1) * Z + nz : Y * nz) *
+                                    size);
     for (std::uint64_t x = 0; x < X; ++x) {
-      reader.read_at(h.data_offset + (x * Y * Z + static_cast<std::uint64_t>(z0)) * size,
-                     plane.size(), plane.data());
+      const std::uint64_t first =
+          h.data_offset + (x * Y * Z + static_cast<std::uint64_t>(z0)) * size;
+      if (span) {
+        reader.read_at(first, plane.size(), plane.data());
+      } else {
+        for (std::uint64_t y = 0; y < Y; ++y)
+          reader.read_at(first + y * Z * size, static_cast<std::size_t>(nz * size),
+                         plane.data() + y * nz * size);
+      }
+      const std::uint64_t stride = span ? Z : nz;
       for (std::uint64_t y = 0; y < Y; ++y)
         for (std::uint64_t z = 0; z < nz; ++z)
           std::memcpy(v.bytes.data() + ((z * Y + y) * X + x) * size,
-                      plane.data() + (y * Z + z) * size, size);
+                      plane.data() + (y * stride + z) * size, size);
     }
   }
   finish_values(h, v.bytes);
@@ -532,9 +545,13 @@ World world_from_npy(const NpyVolume& v, const std::string& name, int chunk_edge
   const std::uint64_t chunk_edge_u = static_cast<std::uint64_t>(chunk_edge);
   std::uint64_t chunk_voxels = 1;
   for (int k = 0; k < 3; ++k) {
-    chunk_voxels =
-        mul_sat(chunk_voxels, (static_cast<std::uint64_t>(v.dims[k]) + chunk_edge_u - 1) /
-                                  chunk_edge_u * chunk_edge_u);
+    // The chunks the values cover, from a part's place in the whole array (which may start
+    // inside a chunk).
+    const std::uint64_t lo = static_cast<std::uint64_t>(v.file_origin[k]) / chunk_edge_u;
+    const std::uint64_t hi = (static_cast<std::uint64_t>(v.file_origin[k]) +
+                              static_cast<std::uint64_t>(v.dims[k]) + chunk_edge_u - 1) /
+                             chunk_edge_u;
+    chunk_voxels = mul_sat(chunk_voxels, (hi - lo) * chunk_edge_u);
   }
   require_memory(add_sat(dense_bytes(box, 1), chunk_voxels), memory_limit_bytes, name,
                  "a world of " + std::to_string(v.dims.x) + " x " + std::to_string(v.dims.y) +

@@ -30,6 +30,14 @@ void agree(MPI_Comm comm, const std::string& error, ExchangeStats* stats) {
 
 namespace detail {
 
+void require_partition(MPI_Comm comm, const SlabPartition& partition) {
+  int size = 0;
+  MPI_Comm_size(comm, &size);
+  if (partition.ranks() != size)
+    throw InvalidArgument("a partition into " + std::to_string(partition.ranks()) +
+                          " slabs for a communicator of " + std::to_string(size) + " ranks");
+}
+
 std::string broadcast_string(MPI_Comm comm, std::string text, ExchangeStats* stats) {
   CollectiveTimer t(stats);
   int length = static_cast<int>(text.size());
@@ -60,9 +68,13 @@ void write_at(MPI_File fh, std::uint64_t offset, const std::uint8_t* bytes, std:
 
 std::string write_pieces(MPI_Comm comm, const std::string& temporary, const std::string& target,
                          const std::vector<FilePiece>& pieces) {
+  // Each rank opens the file on its own (MPI_COMM_SELF): the writes are independent, and a rank
+  // that cannot open it (a path another node cannot see) must not leave the others in a
+  // collective open or close; its error reaches them through the caller's agreement.
+  (void)comm;
   MPI_File fh = MPI_FILE_NULL;
   std::string mpi_path = temporary;
-  const int rc = MPI_File_open(comm, mpi_path.data(), MPI_MODE_WRONLY, MPI_INFO_NULL, &fh);
+  const int rc = MPI_File_open(MPI_COMM_SELF, mpi_path.data(), MPI_MODE_WRONLY, MPI_INFO_NULL, &fh);
   if (rc != MPI_SUCCESS) return target + ": cannot open " + temporary + ": " + mpi_error_text(rc);
   std::string error;
   try {

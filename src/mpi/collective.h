@@ -38,8 +38,8 @@ class CollectiveTimer {
   std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
 };
 
-// mpi::collectively and mpi::agree with the layer's counters first (the callers' order reads
-// better with the lambda last).
+// mpi::collectively and mpi::agree with the layer's counters before the lambda (the order every
+// caller in the layer reads best in).
 template <class Fn>
 auto collectively(MPI_Comm comm, ExchangeStats* stats, Fn&& fn) {
   return mpi::collectively(comm, std::forward<Fn>(fn), stats);
@@ -47,6 +47,9 @@ auto collectively(MPI_Comm comm, ExchangeStats* stats, Fn&& fn) {
 inline void agree(MPI_Comm comm, const std::string& error, ExchangeStats* stats) {
   mpi::agree(comm, error, stats);
 }
+
+// The partition is one slab per rank of `comm` (InvalidArgument otherwise).
+void require_partition(MPI_Comm comm, const SlabPartition& partition);
 
 // Rank 0's `text` on every rank.
 std::string broadcast_string(MPI_Comm comm, std::string text, ExchangeStats* stats);
@@ -57,10 +60,9 @@ struct FilePiece {
   std::vector<std::uint8_t> bytes;
 };
 
-// Collective: every rank opens `temporary` (staged by rank 0), writes its pieces and closes it.
-// Every rank makes the open and close calls whatever happens, so a failure does not leave the
-// others waiting; returns this rank's error (empty on success) for the caller to agree on.
-// `target` names the file in messages.
+// Every rank opens `temporary` (staged by rank 0) by itself, writes its pieces and closes it — no
+// collective call, so a rank that fails leaves none waiting; returns this rank's error (empty on
+// success) for the caller to agree on. `target` names the file in messages.
 std::string write_pieces(MPI_Comm comm, const std::string& temporary, const std::string& target,
                          const std::vector<FilePiece>& pieces);
 

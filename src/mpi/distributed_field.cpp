@@ -55,35 +55,35 @@ DistanceField compute_distance_field(MPI_Comm comm, const SlabPartition& partiti
   DistanceOptions o = options;
   o.domain = partition.domain;
   const auto t0 = std::chrono::steady_clock::now();
-  // This rank's extremes, packed for the two scans: [highest solid | highest air] and
-  // [lowest solid | lowest air].
-  const ColumnSites own = detail::collectively(comm, stats, [&] {
-    if (partition.ranks() != size)
-      throw InvalidArgument("a partition into " + std::to_string(partition.ranks()) +
-                            " slabs for a communicator of " + std::to_string(size) + " ranks");
-    const Box3i slab = partition.slab(rank);
-    return slab_column_sites(occupancy, partition.domain, slab.begin.z, slab.end.z);
-  });
-  if (stats) stats->compute_ms += detail::ms_since(t0);
-  const std::size_t n = own.lowest_solid.size();
-  std::vector<std::int32_t> below(2 * n), above(2 * n);
-  std::copy(own.highest_solid.begin(), own.highest_solid.end(), below.begin());
-  std::copy(own.highest_air.begin(), own.highest_air.end(),
-            below.begin() + static_cast<std::ptrdiff_t>(n));
-  std::copy(own.lowest_solid.begin(), own.lowest_solid.end(), above.begin());
-  std::copy(own.lowest_air.begin(), own.lowest_air.end(),
-            above.begin() + static_cast<std::ptrdiff_t>(n));
-  exclusive_scan(comm, below, MPI_MAX, ColumnSites::kNoneHigh, stats);
-  // The slabs above: the same scan over the ranks in reverse order.
-  MPI_Comm reversed = MPI_COMM_NULL;
-  MPI_Comm_split(comm, 0, size - 1 - rank, &reversed);
-  exclusive_scan(reversed, above, MPI_MIN, ColumnSites::kNoneLow, stats);
-  MPI_Comm_free(&reversed);
+  // This rank's extremes, packed for the two scans — [highest solid | highest air] and [lowest
+  // solid | lowest air] — then scanned into the neighbours. The packed arrays die before the
+  // transform: at 8192^2 columns each is half a gigabyte.
   SlabNeighbours neighbours;
-  neighbours.solid_below.assign(below.begin(), below.begin() + static_cast<std::ptrdiff_t>(n));
-  neighbours.air_below.assign(below.begin() + static_cast<std::ptrdiff_t>(n), below.end());
-  neighbours.solid_above.assign(above.begin(), above.begin() + static_cast<std::ptrdiff_t>(n));
-  neighbours.air_above.assign(above.begin() + static_cast<std::ptrdiff_t>(n), above.end());
+  {
+    std::vector<std::int32_t> below, above;
+    detail::collectively(comm, stats, [&] {
+      detail::require_partition(comm, partition);
+      const Box3i slab = partition.slab(rank);
+      ColumnSites own = slab_column_sites(occupancy, partition.domain, slab.begin.z, slab.end.z);
+      below = std::move(own.highest_solid);
+      below.insert(below.end(), own.highest_air.begin(), own.highest_air.end());
+      above = std::move(own.lowest_solid);
+      above.insert(above.end(), own.lowest_air.begin(), own.lowest_air.end());
+    });
+    if (stats) stats->compute_ms += detail::ms_since(t0);
+    const std::size_t n = below.size() / 2;
+    exclusive_scan(comm, below, MPI_MAX, ColumnSites::kNoneHigh, stats);
+    // The slabs above: the same scan over the ranks in reverse order.
+    MPI_Comm reversed = MPI_COMM_NULL;
+    MPI_Comm_split(comm, 0, size - 1 - rank, &reversed);
+    exclusive_scan(reversed, above, MPI_MIN, ColumnSites::kNoneLow, stats);
+    MPI_Comm_free(&reversed);
+    const auto half = static_cast<std::ptrdiff_t>(n);
+    neighbours.solid_below.assign(below.begin(), below.begin() + half);
+    neighbours.air_below.assign(below.begin() + half, below.end());
+    neighbours.solid_above.assign(above.begin(), above.begin() + half);
+    neighbours.air_above.assign(above.begin() + half, above.end());
+  }
   const auto t1 = std::chrono::steady_clock::now();
   DistanceField field = detail::collectively(comm, stats, [&] {
     const Box3i slab = partition.slab(rank);

@@ -9,6 +9,7 @@
 
 #include "collective.h"
 #include "voxfield/file.h"
+#include "voxfield/limits.h"
 #include "voxfield/npy.h"
 
 namespace voxfield::mpi {
@@ -19,6 +20,8 @@ detail::FilePiece values_piece(const DistanceField& f, const Box3i& slab, const 
   return std::visit(
       [&](const auto& g) {
         using T = typename std::decay_t<decltype(g)>::value_type;
+        require_memory(dense_bytes(slab, sizeof(T)), 0, "field output",
+                       "a dense copy of this rank's slab " + to_string(slab));
         detail::FilePiece p;
         p.offset = static_cast<std::uint64_t>(slab.begin.z - domain.begin.z) *
                    static_cast<std::uint64_t>(domain.size().x) *
@@ -46,6 +49,9 @@ DType values_dtype(const DistanceField& f) {
 // the whole a[x, y, z, 3] array (component slowest), -32768 where there is none.
 std::vector<detail::FilePiece> sites_pieces(const Grid<SiteOffset>& g, const Box3i& slab,
                                             const Box3i& domain) {
+  // The offsets and their three planes are alive at once.
+  require_memory(dense_bytes(slab, 2 * sizeof(SiteOffset)), 0, "--sites output",
+                 "a dense copy of this rank's slab " + to_string(slab));
   const std::size_t n = static_cast<std::size_t>(slab.volume());
   std::vector<SiteOffset> dense(n);
   g.copy_to_dense(slab, dense.data());
@@ -68,12 +74,22 @@ std::vector<detail::FilePiece> sites_pieces(const Grid<SiteOffset>& g, const Box
 
 }  // namespace
 
-void check_outputs(MPI_Comm comm, const std::vector<std::filesystem::path>& targets) {
+void check_outputs(MPI_Comm comm, const std::vector<std::filesystem::path>& shared,
+                   const std::vector<std::filesystem::path>& rank0) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   detail::collectively(comm, nullptr, [&] {
     if (rank != 0) return;
-    for (const auto& p : targets)
+    for (const auto& p : shared) {
+      if (p.empty()) continue;
+      check_output_path(p);
+      // Every rank writes into these: standard output, a device or a FIFO cannot take that.
+      std::error_code ec;
+      const auto st = std::filesystem::status(p, ec);
+      if (p == "-" || (!ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)))
+        throw IoError(p.string() + ": is not a regular file, which the ranks could write together");
+    }
+    for (const auto& p : rank0)
       if (!p.empty()) check_output_path(p);
   });
 }
@@ -90,6 +106,7 @@ void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const Distan
   std::vector<std::uint8_t> values_head, sites_head;
   std::string temporaries;  // values '\n' sites
   detail::collectively(comm, stats, [&] {
+    detail::require_partition(comm, partition);
     if (!slab.domain.contains(partition.slab(rank)))
       throw InvalidArgument("this rank's field covers " + to_string(slab.domain) +
                             ", not all of its slab " + to_string(partition.slab(rank)));
@@ -99,11 +116,14 @@ void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const Distan
     if (rank != 0) return;
     if (!transaction) transaction = &own.emplace();
     temporaries = transaction->stage_shared(files.values, values_head).string();
-    if (sites) temporaries += "\n" + transaction->stage_shared(files.sites, sites_head).string();
+    // '\0' between the names: the one byte no path holds.
+    if (sites)
+      temporaries +=
+          std::string(1, '\0') + transaction->stage_shared(files.sites, sites_head).string();
     if (!files.json.empty()) transaction->stage(files.json, files.json_text);
   });
   temporaries = detail::broadcast_string(comm, temporaries, stats);
-  const std::size_t cut = temporaries.find('\n');
+  const std::size_t cut = temporaries.find('\0');
   const std::string values_tmp = temporaries.substr(0, cut);
   const std::string sites_tmp = cut == std::string::npos ? "" : temporaries.substr(cut + 1);
 

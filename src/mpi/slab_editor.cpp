@@ -31,11 +31,7 @@ SlabEditor::SlabEditor(MPI_Comm comm, const SlabPartition& partition, const Worl
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   detail::collectively(comm, nullptr, [&] {
-    int size = 0;
-    MPI_Comm_size(comm, &size);
-    if (partition.ranks() != size)
-      throw InvalidArgument("a partition into " + std::to_string(partition.ranks()) +
-                            " slabs for a communicator of " + std::to_string(size) + " ranks");
+    detail::require_partition(comm, partition);
     slab_ = partition.slab(rank);
     const int ghost = edit_ghost_slices(options);
     const Box3i& d = partition.domain;

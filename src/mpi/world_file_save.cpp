@@ -23,19 +23,19 @@ std::int64_t floor_div(std::int64_t a, std::int64_t b) {
 }  // namespace
 
 void save_world_vfw(MPI_Comm comm, const SlabPartition& partition, const World& world,
-                    const std::filesystem::path& path, ExchangeStats* stats, FileTransaction* into) {
+                    const std::filesystem::path& path, ExchangeStats* stats,
+                    FileTransaction* into) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
   const int edge = world.voxels.chunk_edge();
   // This rank's chunk layers and their records.
   const WorldFilePart part = detail::collectively(comm, stats, [&] {
-    if (partition.ranks() != size)
-      throw InvalidArgument("a partition into " + std::to_string(partition.ranks()) +
-                            " slabs for a communicator of " + std::to_string(size) + " ranks");
+    detail::require_partition(comm, partition);
     for (int r = 1; r < size; ++r) {
       if (partition.z[static_cast<std::size_t>(r)] % edge != 0)
-        throw InvalidArgument(path.string() + ": a .vfw written by several ranks needs slabs cut on "
+        throw InvalidArgument(path.string() +
+                              ": a .vfw written by several ranks needs slabs cut on "
                               "chunk boundaries; the cut at z " +
                               std::to_string(partition.z[static_cast<std::size_t>(r)]) +
                               " is not a multiple of the chunk edge " + std::to_string(edge) +
@@ -61,7 +61,7 @@ void save_world_vfw(MPI_Comm comm, const SlabPartition& partition, const World& 
   std::optional<FileTransaction> own;
   FileTransaction* transaction = into;
   std::vector<std::uint8_t> tail;
-  std::string staged;  // temporary '\n' header bytes '\n' record bytes
+  std::string staged;  // temporary '\0' header bytes '\n' record bytes
   detail::collectively(comm, stats, [&] {
     if (rank != 0) return;
     std::vector<WorldFilePartSummary> parts;
@@ -71,14 +71,16 @@ void save_world_vfw(MPI_Comm comm, const SlabPartition& partition, const World& 
       parts.push_back({all[i], all[i + 1], static_cast<std::uint32_t>(all[i + 2])});
       records += all[i + 1];
     }
-    const WorldFileFrame frame = encode_world_file_frame(world.palette, edge, partition.domain, parts);
+    const WorldFileFrame frame =
+        encode_world_file_frame(world.palette, edge, partition.domain, parts);
     if (!transaction) transaction = &own.emplace();
-    staged = transaction->stage_shared(path, frame.head).string() + "\n" +
+    // '\0' after the name: the one byte no path holds.
+    staged = transaction->stage_shared(path, frame.head).string() + std::string(1, '\0') +
              std::to_string(frame.head.size()) + "\n" + std::to_string(records);
     tail = frame.tail;
   });
   staged = detail::broadcast_string(comm, staged, stats);
-  const std::size_t a = staged.find('\n'), b = staged.find('\n', a + 1);
+  const std::size_t a = staged.find('\0'), b = staged.find('\n', a + 1);
   const std::string temporary = staged.substr(0, a);
   const std::uint64_t head_bytes = std::stoull(staged.substr(a + 1, b - a - 1));
   const std::uint64_t record_bytes = std::stoull(staged.substr(b + 1));

@@ -31,7 +31,18 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
     LoadedWorld whole = load_world(path, {chunk_edge});
     if (whole.extent.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
     const SlabPartition partition = partition_slabs(whole.extent, size, chunk_edge);
-    return WorldSlab{std::move(whole.world), partition, world_format_name(format), false};
+    // Only the slab and its ghost slices are kept once the file is read.
+    const Box3i slab = partition.slab(rank);
+    const int ghost = std::max(ghost_slices, 0);
+    const Box3i keep{{whole.extent.begin.x, whole.extent.begin.y,
+                      static_cast<std::int32_t>(std::max<std::int64_t>(
+                          whole.extent.begin.z, std::int64_t{slab.begin.z} - ghost))},
+                     {whole.extent.end.x, whole.extent.end.y,
+                      static_cast<std::int32_t>(std::min<std::int64_t>(
+                          whole.extent.end.z, std::int64_t{slab.end.z} + ghost))}};
+    World part = rechunk_world(whole.world, chunk_edge, keep, path.string());
+    part.palette = whole.world.palette;
+    return WorldSlab{std::move(part), partition, world_format_name(format), false};
   });
 }
 

@@ -209,8 +209,16 @@ TEST(MpiField, PartitionsCoverTheDomainInOrder) {
         EXPECT_EQ(p.z.front(), d.begin.z);
         EXPECT_EQ(p.z.back(), d.end.z);
         std::int64_t total = 0;
+        // Cuts on multiples of align whenever every rank can have a unit of it (what a .vfw
+        // written by every rank needs).
+        const std::int64_t base =
+            (d.begin.z >= 0 ? d.begin.z / align : (d.begin.z - align + 1) / align) * align;
+        const bool units_for_all = (d.end.z - base + align - 1) / align >= n;
         for (int r = 0; r < n; ++r) {
           EXPECT_LT(p.z[r], p.z[r + 1]) << "every rank owns a slice";
+          if (r > 0 && units_for_all) {
+            EXPECT_EQ(p.z[r] % align, 0) << "cut " << r << " of " << n;
+          }
           total += p.slab(r).volume();
         }
         EXPECT_EQ(total, d.volume());
@@ -273,8 +281,17 @@ TEST(MpiField, WritesOneFileOrNothing) {
     std::memcpy(got.data(), back.bytes.data(), got.size() * sizeof(float));
     EXPECT_EQ(got, expect);
     EXPECT_EQ(read_file(dir / "f.json").size(), 3u);
-    EXPECT_EQ(std::filesystem::file_size(dir / "s.npy"),
-              read_file(dir / "s.npy").size());  // present and whole
+    // The sites: int16 a[x, y, z, 3], the three offsets as planes.
+    const std::vector<std::uint8_t> sites_file = read_file(dir / "s.npy");
+    const std::vector<SiteOffset> expect_sites = dense(*whole.sites, domain);
+    const std::size_t n = expect_sites.size();
+    ASSERT_GE(sites_file.size(), 6 * n);
+    const std::uint8_t* planes = sites_file.data() + (sites_file.size() - 6 * n);
+    for (std::size_t i = 0; i < n; i += 7) {
+      std::int16_t d[3];
+      for (int c = 0; c < 3; ++c) std::memcpy(&d[c], planes + 2 * (c * n + i), 2);
+      ASSERT_EQ((SiteOffset{d[0], d[1], d[2]}), expect_sites[i]) << "voxel " << i;
+    }
   }
   // A read-only target: refused by rank 0 before anything is written, on every rank alike, and
   // neither it nor the other outputs change.
