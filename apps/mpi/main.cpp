@@ -240,7 +240,9 @@ int run_bench(MPI_Comm comm, const FieldSettings& f, const std::vector<int>& dim
   const DistanceOptions o = f.options();
   const Box3i domain = Box3i::from_size({dims[0], dims[1], dims[2]});
   const mpi::SlabPartition partition = mpi::partition_slabs(domain, size, f.chunk);
-  const World world = mpi_bench::sphere_world_slab(domain, partition.slab(rank), spheres, f.chunk);
+  const World world = mpi::collectively(comm, [&] {
+    return mpi_bench::sphere_world_slab(domain, partition.slab(rank), spheres, f.chunk);
+  });
   for (int r = 0; r < repeat; ++r) {
     mpi::ExchangeStats ex;
     MPI_Barrier(comm);
