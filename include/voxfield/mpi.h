@@ -6,8 +6,9 @@
 // exclusive scans over the ranks of 16 bytes per column, whatever the clamp or metric, and the
 // result equals compute_distance_field over the whole domain bit for bit.
 //
-// Every function here is collective over its communicator: all ranks call it with the same
-// arguments (their own occupancy aside). A failure on any rank — a bad file, a memory limit, bad
+// Every function here that takes a communicator is collective over it: all ranks call it with the
+// same arguments (their own occupancy and world aside). partition_slabs, edit_ghost_slices and
+// SlabEditor::apply are local. A failure on any rank — a bad file, a memory limit, bad
 // options — is agreed on before anything is written, and every rank then throws RankError naming
 // the first failing rank and its message, so no rank waits forever on a collective the failed one
 // never reaches. A rank that dies outright (a signal) is Open MPI's to report: mpirun ends the job.
