@@ -322,7 +322,8 @@ assert j['backend'] == 'vulkan' and j['verify_mismatches'] == 0, j"
 import json; j = json.load(open('$tmp/gear-gpu.json'))
 g = j['gpu']
 assert j['backend'] == 'vulkan' and g['variants_compiled'] == j['variants'] and g['interpreted_dispatches'] == 0, j
-assert g['compiled_dispatches'] > 0 and g['rounds'] > 0, j"
+assert g['compiled_dispatches'] > 0 and g['rounds'] > 0, j
+assert all(j[k] is None for k in ('hits', 'evaluations', 'instructions', 'cells_entered')), j"
   check "csg render: a bad evaluator name" 2 $GPU "$V" csg "$GEAR" render -o "$tmp/x.png" --backend vulkan --evaluators fast
   expect_grep "bad evaluator named" "$tmp/err" "fast not in"
   [ ! -e "$tmp/x.png" ] && passes=$((passes+1)) || { echo "FAIL: csg render wrote a picture after refusing"; fails=$((fails+1)); }

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "csg_commands.h"
 #include "live_field.h"
 #include "progress.h"
 #include "voxfield/csg.h"
@@ -26,33 +27,6 @@
 #include "voxfield/png.h"
 
 namespace voxfield::cli {
-namespace {
-
-struct CsgSettings {
-  std::string model, stats;
-  bool facets = false;  // OpenSCAD spheres and cylinders as its polytopes
-  // info / compile
-  int depth = -1;
-  bool spirv = false;  // compile: each variant's kernel to SPIR-V too
-  // eval
-  std::string points, out;
-  bool pruned = false;
-  // voxelize
-  double voxel_size = 0;
-  std::vector<double> box;
-  std::optional<double> max_distance;
-  std::string field;
-  bool whole = false;
-  int threads = 0;
-  // render
-  std::string camera = "auto", view = "shaded", backend = "cpu", evaluators = "when-ready";
-  int width = 640, height = 480;
-  bool no_shadows = false;
-  // mesh
-  std::string algorithm = "dc";
-  int chunk = 32;
-  bool sampled = false;
-};
 
 csg::Model load_model(const std::string& path, bool facets) {
   set_activity("reading " + path);
@@ -86,6 +60,8 @@ std::optional<csg::Bounds> parse_box(const std::vector<double>& v) {
   if (b.empty()) throw UsageError("--box: each of x1, y1, z1 must be at least x0, y0, z0");
   return b;
 }
+
+namespace {
 
 int run_info(const CsgSettings& s) {
   Outputs outputs({s.model});
@@ -235,214 +211,6 @@ int run_voxelize(const CsgSettings& s) {
   std::cerr << "voxfield: wrote " << s.out << " (" << v.dims.x << " x " << v.dims.y << " x "
             << v.dims.z << ", " << v.world.solid_count() << " solid, " << std::lround(st.ms)
             << " ms, " << std::lround(mvox_per_s) << " Mvox/s)\n";
-  return 0;
-}
-
-int run_compile(const CsgSettings& s) {
-  namespace fs = std::filesystem;
-  const fs::path dir = s.out;
-  // The directory is replaced whole, and only when everything is ready: a new one, an empty one or
-  // an earlier compile's (with its manifest) — never a directory holding other files, or the model.
-  if (fs::exists(dir)) {
-    if (!fs::is_directory(dir)) throw UsageError("-o " + s.out + " exists and is not a directory");
-    if (!fs::is_empty(dir) && !fs::exists(dir / "manifest.json"))
-      throw UsageError(
-          "-o " + s.out +
-          " holds files that are not a compile's output; give a new or empty directory");
-    const fs::path model = fs::weakly_canonical(s.model), target = fs::weakly_canonical(dir);
-    if (std::mismatch(target.begin(), target.end(), model.begin(), model.end()).first ==
-        target.end())
-      throw UsageError("-o " + s.out + " contains the model " + s.model);
-  }
-  Outputs outputs({s.model});
-  outputs.expect(s.stats, "--stats");
-  const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
-  if (!fs::is_directory(parent))
-    throw IoError("-o " + s.out + ": the directory " + parent.string() + " does not exist");
-  const csg::Model model = load_model(s.model, s.facets);
-  set_activity("compiling " + s.model);
-  const csg::Tape tape = csg::compile_tape(model);
-  csg::OctreeOptions o;
-  o.depth = s.depth >= 0 ? s.depth : 6;
-  const csg::Octree tree = csg::build_octree(tape, model, o);
-  const auto start = std::chrono::steady_clock::now();
-  std::vector<std::pair<std::string, std::string>> files{{"prelude.glsl", csg::glsl_prelude()}};
-  nlohmann::json variants = nlohmann::json::array();
-  for (std::size_t i = 0; i < tree.variants.size(); ++i) {
-    const csg::Variant& v = tree.variants[i];
-    const csg::Tape& t = v.tape;
-    const std::string name = "variant_" + std::to_string(i) + ".glsl";
-    files.push_back({name, csg::glsl_variant(t, static_cast<int>(i))});
-    variants.push_back({{"index", i},
-                        {"file", name},
-                        {"function", "vf_variant_" + std::to_string(i)},
-                        {"cells", v.cells},
-                        {"nodes", t.code.size()},
-                        {"params_per_cell", t.params.size()}});
-  }
-  const double codegen_ms = ms_since(start);
-  // --spirv: each variant's evaluation kernel compiled in-process on worker threads (glslang),
-  // timed per variant; the binaries join the output files.
-  std::vector<std::vector<std::uint32_t>> spirv(s.spirv ? tree.variants.size() : 0);
-  std::vector<double> spirv_ms(spirv.size());
-  const auto spirv_start = std::chrono::steady_clock::now();
-  parallel_for(spirv.size(), 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      const auto t0 = std::chrono::steady_clock::now();
-      const std::string name = "variant_" + std::to_string(i);
-      spirv[i] = gpu::compile_compute_shader(
-          name, csg::glsl_variant_kernel(tree.variants[i].tape, static_cast<int>(i)));
-      spirv_ms[i] = ms_since(t0);
-    }
-  });
-  const double spirv_wall_ms = ms_since(spirv_start);
-  for (std::size_t i = 0; i < spirv.size(); ++i) {
-    const std::string name = "variant_" + std::to_string(i) + ".spv";
-    files.push_back(
-        {name, std::string(reinterpret_cast<const char*>(spirv[i].data()), spirv[i].size() * 4)});
-    variants[i]["spirv"] = name;
-  }
-  // Every surface cell's constants, float32 in order, and where each cell's start.
-  std::vector<float> params;
-  nlohmann::json cells = nlohmann::json::array();
-  for (const csg::OctreeLeaf& l : tree.leaves) {
-    nlohmann::json c{{"box", bounds_json(tree.leaf_box(l))},
-                     {"level", l.level},
-                     {"state", csg::cell_state_name(l.state)}};
-    if (l.state == csg::CellState::kSurface) {
-      c["variant"] = l.variant;
-      c["param_offset"] = params.size();
-      for (double p : tree.leaf_params(l)) params.push_back(static_cast<float>(p));
-    }
-    cells.push_back(std::move(c));
-  }
-  const nlohmann::json manifest{
-      {"model", s.model},          {"depth", o.depth},       {"root", bounds_json(tree.root)},
-      {"prelude", "prelude.glsl"}, {"params", "params.f32"}, {"params_count", params.size()},
-      {"variants", variants},      {"cells", cells},         {"compile", compile_json(tree.stats)}};
-  // Written into a fresh directory beside the target, then swapped in.
-  const fs::path fresh = dir.string() + ".tmp." + std::to_string(::getpid());
-  try {
-    fs::remove_all(fresh);
-    fs::create_directory(fresh);
-    for (const auto& [name, text] : files)
-      write_file_atomic(fresh / name,
-                        std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
-    write_file_atomic(fresh / "params.f32",
-                      std::span(reinterpret_cast<const std::uint8_t*>(params.data()),
-                                params.size() * sizeof(float)));
-    const std::string m = manifest.dump(2) + "\n";
-    write_file_atomic(fresh / "manifest.json",
-                      std::span(reinterpret_cast<const std::uint8_t*>(m.data()), m.size()));
-    if (fs::exists(dir)) fs::remove_all(dir);
-    fs::rename(fresh, dir);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove_all(fresh, ignored);
-    throw;
-  }
-  nlohmann::json stats{
-      {"model", s.model}, {"depth", o.depth}, {"compile", compile_json(tree.stats)}};
-  stats["compile"]["codegen_ms"] = codegen_ms;
-  if (s.spirv) {
-    std::size_t bytes = 0;
-    for (const auto& w : spirv) bytes += w.size() * 4;
-    stats["compile"]["spirv"] = {
-        {"variants", spirv.size()},
-        {"wall_ms", spirv_wall_ms},
-        {"threads", max_threads()},
-        {"mean_ms", spirv.empty() ? 0.0
-                                  : std::accumulate(spirv_ms.begin(), spirv_ms.end(), 0.0) /
-                                        static_cast<double>(spirv.size())},
-        {"max_ms", spirv.empty() ? 0.0 : *std::max_element(spirv_ms.begin(), spirv_ms.end())},
-        {"first_ms", spirv.empty() ? 0.0 : spirv_ms.front()},
-        {"bytes", bytes}};
-  }
-  outputs.stage_json(s.stats, stats);
-  outputs.commit();
-  std::cerr << "voxfield: wrote " << s.out << "/ (" << tree.variants.size() << " variants over "
-            << tree.stats.surface << " surface cells, " << params.size() << " parameters)\n";
-  return 0;
-}
-
-int run_render(const CsgSettings& s) {
-  Outputs outputs({s.model});
-  outputs.expect(s.out, "-o");
-  outputs.expect(s.stats, "--stats");
-  if (std::filesystem::path(s.out).extension() != ".png")
-    throw UsageError("-o: render writes a .png, not " + s.out);
-  const csg::Model model = load_model(s.model, s.facets);
-  CsgRenderOptions o;
-  o.width = s.width;
-  o.height = s.height;
-  o.view =
-      s.view == "variants" ? CsgRenderOptions::View::kVariants : CsgRenderOptions::View::kShaded;
-  o.prune = !s.whole;
-  o.depth = s.depth >= 0 ? s.depth : 6;
-  o.shadows = !s.no_shadows;
-  o.box = parse_box(s.box);
-  if (s.camera != "auto") {
-    const auto b = o.box ? o.box : csg::model_bounds(model);
-    // A voxel box around the model for "top" framing, clamped to the coordinate range.
-    auto coord = [](double v) {
-      return static_cast<int>(std::clamp(v, -double(kCoordLimit), double(kCoordLimit)));
-    };
-    const Box3i around =
-        b ? Box3i{{coord(std::floor(b->lo.x)), coord(std::floor(b->lo.y)),
-                   coord(std::floor(b->lo.z))},
-                  {coord(std::ceil(b->hi.x)), coord(std::ceil(b->hi.y)), coord(std::ceil(b->hi.z))}}
-          : Box3i::from_size({1, 1, 1});
-    o.camera = Camera::parse(s.camera, around, static_cast<double>(s.width) / s.height);
-  }
-  std::optional<ThreadLimit> limit;
-  if (s.threads > 0) limit.emplace(s.threads);
-  set_activity("rendering " + s.model);
-  CsgRenderStats st;
-  const auto gpu_context = choose_backend(s.backend);
-  gpu::CsgGpuOptions go;
-  go.evaluators = s.evaluators == "compiled" ? gpu::CsgGpuOptions::Evaluators::kCompiled
-                  : s.evaluators == "interpreter"
-                      ? gpu::CsgGpuOptions::Evaluators::kInterpreter
-                      : gpu::CsgGpuOptions::Evaluators::kCompiledWhenReady;
-  gpu::CsgGpuStats gs;
-  o.interrupter = progress();
-  const Image image = gpu_context ? gpu::render_csg(*gpu_context, model, o, &st, go, &gs)
-                                  : render_csg(model, o, &st);
-  outputs.stage(s.out, encode_png(image));
-  nlohmann::json gpu_block = nullptr;
-  if (gpu_context) {
-    gpu_block = gpu_json(*gpu_context);
-    gpu_block.update({{"evaluators", s.evaluators},
-                      {"rounds", gs.rounds},
-                      {"variants_compiled", gs.variants_compiled},
-                      {"compiled_dispatches", gs.compiled_dispatches},
-                      {"interpreted_dispatches", gs.interpreted_dispatches},
-                      {"frame_dispatches", gs.dispatches},
-                      {"frame_submits", gs.submits},
-                      {"compile_ms", gs.compile_ms}});
-  }
-  outputs.stage_json(s.stats, {{"model", s.model},
-                               {"backend", gpu_context ? "vulkan" : "cpu"},
-                               {"gpu", gpu_block},
-                               {"output", s.out},
-                               {"width", s.width},
-                               {"height", s.height},
-                               {"view", s.view},
-                               {"pruned", o.prune},
-                               {"depth", o.depth},
-                               {"threads", max_threads()},
-                               {"octree_ms", st.octree_ms},
-                               {"render_ms", st.render_ms},
-                               {"rays", st.rays},
-                               {"hits", st.hits},
-                               {"evaluations", st.evaluations},
-                               {"instructions", st.instructions},
-                               {"cells_entered", st.cells_entered},
-                               {"variants", st.variants}});
-  outputs.commit();
-  std::cerr << "voxfield: wrote " << s.out << " (" << s.width << " x " << s.height << ", "
-            << std::lround(st.octree_ms) << " ms octree + " << std::lround(st.render_ms)
-            << " ms tracing, " << st.variants << " variants)\n";
   return 0;
 }
 
