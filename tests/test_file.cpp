@@ -265,6 +265,34 @@ TEST(File, SweepsStaleTemporariesOfDeadProcessesOnly) {
   for (const auto& name : kept) EXPECT_TRUE(fs::exists(dir / name)) << name;
 }
 
+// Temporaries name their host: on a directory shared between hosts (an MPI job's ranks on a
+// cluster's file system), another host's PID says nothing here, so its temporaries are left alone
+// while this host's stale ones go.
+TEST(File, SweepsOnlyThisHostsStaleTemporaries) {
+  ScratchDir dir;
+  const std::string dead = std::to_string(dead_pid());
+  // The tag this host writes: make a temporary and read it back from the directory.
+  std::string tag;
+  {
+    FileTransaction t;
+    t.stage(dir / "probe.bin", bytes_of("p"));
+    for (const auto& e : fs::directory_iterator(dir.path())) {
+      const std::string n = e.path().filename().string();
+      const std::size_t at = n.find(".vftmp.");
+      if (at != std::string::npos) tag = n.substr(at + 7, 8);
+    }
+  }
+  ASSERT_EQ(tag.size(), 8u);
+  const std::string other = tag == "00000000" ? "00000001" : "00000000";
+  put(dir / (".x.bin.vftmp." + tag + "." + dead + ".0"), "stale, this host");
+  put(dir / (".x.bin.vftmp." + other + "." + dead + ".0"), "another host's");
+  put(dir / (".x.bin.vftmp.ZZZZZZZZ." + dead + ".0"), "not our pattern");
+  write_file_atomic(dir / "y.bin", bytes_of("y"));
+  EXPECT_FALSE(fs::exists(dir / (".x.bin.vftmp." + tag + "." + dead + ".0")));
+  EXPECT_TRUE(fs::exists(dir / (".x.bin.vftmp." + other + "." + dead + ".0")));
+  EXPECT_TRUE(fs::exists(dir / (".x.bin.vftmp.ZZZZZZZZ." + dead + ".0")));
+}
+
 TEST(File, RefusesFifoAsInputWithoutBlocking) {
   ScratchDir dir;
   const fs::path fifo = dir / "in.vox";

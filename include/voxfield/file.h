@@ -64,10 +64,10 @@ bool same_file(const std::filesystem::path& a, const std::filesystem::path& b);
 // A set of output files written all or nothing.
 //
 // stage() checks the target as check_output_path does, then writes the bytes to a temporary file
-// `.NAME.vftmp.PID.N` beside the target (in the directory of the file a symbolic link points to),
-// fsynced and closed. For "-" (standard output), a character or block device, a FIFO, or a file
-// reached through /proc/PID/fd (e.g. /dev/stdout), it instead keeps a copy of the bytes to write
-// in place at commit (appending when that is a regular file). Before creating a temporary it
+// `.NAME.vftmp.HOST.PID.N` beside the target (in the directory of the file a symbolic link points
+// to), fsynced and closed. For "-" (standard output), a character or block device, a FIFO, or a
+// file reached through /proc/PID/fd (e.g. /dev/stdout), it instead keeps a copy of the bytes to
+// write in place at commit (appending when that is a regular file). Before creating a temporary it
 // removes stale temporaries of dead processes from that directory (see below).
 //
 // commit() then, in staging order, renames each temporary onto its target or writes the kept
@@ -91,9 +91,12 @@ bool same_file(const std::filesystem::path& a, const std::filesystem::path& b);
 // install_signal_cleanup() remove; should more than 64 be live at once, the others are not
 // listed (they are still removed on every path out of this class except a signal or kill -9, and
 // swept by the next write into their directory after the process has died). Stale temporaries:
-// entries named exactly `.<anything>.vftmp.<pid>.<n>` that are regular files and whose pid is not
-// a live process (kill(pid, 0) fails with ESRCH) are unlinked; nothing else is touched. A process
-// in another PID namespace sharing the directory would look dead.
+// entries named exactly `.<anything>.vftmp.<host>.<pid>.<n>` (or, from older versions,
+// `.<anything>.vftmp.<pid>.<n>`) that are regular files, written on this host (HOST: 8 hex digits
+// of a hash of the host name; another host's PIDs mean nothing here, so its temporaries in a
+// shared directory are never touched), and whose pid is not a live process (kill(pid, 0) fails with
+// ESRCH) are unlinked; nothing else is touched. A process in another PID namespace sharing the
+// directory would look dead.
 class FileTransaction {
  public:
   FileTransaction();

@@ -11,8 +11,10 @@
 #include <atomic>
 #include <cerrno>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
+#include <string>
 #include <system_error>
 
 #include "voxfield/file.h"
@@ -65,6 +67,32 @@ extern "C" void cleanup_and_reraise(int sig) {
   errno = saved_errno;
 }
 
+// This host, as 8 lowercase hex digits of the FNV-1a hash of its name: a temporary's writer is
+// judged dead by its PID only on its own host (a directory may be shared between hosts, as an MPI
+// job's ranks share one on a cluster's file system).
+const std::string& host_tag() {
+  static const std::string tag = [] {
+    char name[256] = {};
+    if (::gethostname(name, sizeof name - 1) != 0) name[0] = '\0';
+    std::uint32_t h = 2166136261u;
+    for (const char* c = name; *c; ++c) {
+      h ^= static_cast<unsigned char>(*c);
+      h *= 16777619u;
+    }
+    char hex[9];
+    std::snprintf(hex, sizeof hex, "%08x", h);
+    return std::string(hex);
+  }();
+  return tag;
+}
+
+bool is_host_tag(std::string_view s) {
+  if (s.size() != 8) return false;
+  for (const char c : s)
+    if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'))) return false;
+  return true;
+}
+
 bool all_digits_no_leading_zero(std::string_view s) {
   if (s.empty() || (s.size() > 1 && s[0] == '0')) return false;
   for (const char c : s) {
@@ -77,9 +105,10 @@ bool all_digits_no_leading_zero(std::string_view s) {
 
 std::string temporary_name(std::string_view target_name) {
   static std::atomic<std::uint64_t> counter{0};
-  const std::string suffix = std::string(kTag) + std::to_string(::getpid()) + "." +
-                             std::to_string(counter.fetch_add(1, std::memory_order_relaxed));
-  // "." + stem + suffix must fit in NAME_MAX bytes; the suffix is at most 7 + 10 + 1 + 20 bytes.
+  const std::string suffix = std::string(kTag) + host_tag() + "." + std::to_string(::getpid()) +
+                             "." + std::to_string(counter.fetch_add(1, std::memory_order_relaxed));
+  // "." + stem + suffix must fit in NAME_MAX bytes; the suffix is at most 7 + 9 + 10 + 1 + 20
+  // bytes.
   const std::size_t room = NAME_MAX - 1 - suffix.size();
   std::size_t keep = target_name.size();
   if (keep > room) {
@@ -92,15 +121,24 @@ std::string temporary_name(std::string_view target_name) {
   return "." + stem + suffix;
 }
 
-bool parse_temporary_name(std::string_view name, pid_t& pid) {
+bool parse_temporary_name(std::string_view name, pid_t& pid, bool& this_host) {
   if (name.size() < 2 || name[0] != '.') return false;
   const std::size_t n_dot = name.rfind('.');
   if (!all_digits_no_leading_zero(name.substr(n_dot + 1))) return false;
-  std::string_view rest = name.substr(0, n_dot);  // ".<anything>.vftmp.<pid>"
+  std::string_view rest = name.substr(0, n_dot);  // ".<anything>.vftmp.[<host>.]<pid>"
   const std::size_t pid_dot = rest.rfind('.');
   const std::string_view pid_text = rest.substr(pid_dot + 1);
   if (pid_text.size() > 9 || !all_digits_no_leading_zero(pid_text)) return false;
-  rest = rest.substr(0, pid_dot + 1);  // ".<anything>.vftmp."
+  rest = rest.substr(0, pid_dot + 1);  // ".<anything>.vftmp.[<host>.]"
+  this_host = true;  // names without a host are this host's (written before hosts were named)
+  if (!rest.ends_with(kTag)) {
+    const std::size_t host_dot = rest.substr(0, rest.size() - 1).rfind('.');
+    if (host_dot == std::string_view::npos) return false;
+    const std::string_view host = rest.substr(host_dot + 1, rest.size() - host_dot - 2);
+    if (!is_host_tag(host)) return false;
+    this_host = host == host_tag();
+    rest = rest.substr(0, host_dot + 1);
+  }
   if (rest.size() <= 1 + kTag.size() || !rest.ends_with(kTag)) return false;
   pid = static_cast<pid_t>(std::stol(std::string(pid_text)));
   return pid > 0;
@@ -113,7 +151,8 @@ void sweep_stale_temporaries(const std::filesystem::path& dir) {
   const pid_t self = ::getpid();
   while (const dirent* entry = ::readdir(d)) {
     pid_t pid = 0;
-    if (!parse_temporary_name(entry->d_name, pid) || pid == self) continue;
+    bool this_host = true;
+    if (!parse_temporary_name(entry->d_name, pid, this_host) || !this_host || pid == self) continue;
     if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // alive (EPERM: alive, someone else's)
     struct stat st {};
     if (::fstatat(dir_fd, entry->d_name, &st, AT_SYMLINK_NOFOLLOW) != 0 || !S_ISREG(st.st_mode)) {

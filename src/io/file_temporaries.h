@@ -11,16 +11,18 @@
 namespace voxfield::detail {
 
 // Name (not path) of a new temporary for the target file name `target_name`:
-// ".NAME.vftmp.PID.N", NAME shortened (at a UTF-8 character boundary) so that the whole name fits
-// in NAME_MAX bytes.
+// ".NAME.vftmp.HOST.PID.N" (HOST: 8 hex digits naming this host), NAME shortened (at a UTF-8
+// character boundary) so that the whole name fits in NAME_MAX bytes.
 std::string temporary_name(std::string_view target_name);
 
-// Whether `name` is exactly ".<anything>.vftmp.<pid>.<n>" (anything non-empty, pid and n decimal
-// without leading zeros, pid > 0); sets `pid`.
-bool parse_temporary_name(std::string_view name, pid_t& pid);
+// Whether `name` is exactly ".<anything>.vftmp.[<host>.]<pid>.<n>" (anything non-empty, host 8
+// lowercase hex digits, pid and n decimal without leading zeros, pid > 0); sets `pid`, and
+// `this_host` to whether it names this host (true without a host: the names of older versions).
+bool parse_temporary_name(std::string_view name, pid_t& pid, bool& this_host);
 
-// Unlinks, in `dir`, the regular files whose names parse_temporary_name accepts and whose pid is
-// not a live process. Best effort: errors are ignored (an unreadable directory is skipped).
+// Unlinks, in `dir`, the regular files whose names parse_temporary_name accepts, written on this
+// host by a process that is not alive. Best effort: errors are ignored (an unreadable directory
+// is skipped). Another host's temporaries are never touched: its PIDs mean nothing here.
 void sweep_stale_temporaries(const std::filesystem::path& dir);
 
 // Lists `path` (made absolute) in the registry; returns its slot, or -1 when the registry is full
