@@ -343,6 +343,25 @@ struct FileTransaction::Impl {
   std::vector<Staged> staged;
   std::string failure;  // the error that ended this transaction, if one did
 
+  // Adds a target and lets `fill` write it; any failure ends the transaction (every temporary
+  // removed) and is rethrown, and a transaction that failed before refuses new targets.
+  template <class Fill>
+  void stage(const std::filesystem::path& path, Fill&& fill) {
+    if (!failure.empty())
+      throw IoError(path.string() + ": not staged, the transaction failed earlier: " + failure);
+    try {
+      staged.emplace_back();
+      Staged& s = staged.back();
+      s.path = path;
+      s.out = inspect_output(path);
+      fill(s);
+    } catch (const std::exception& e) {
+      failure = e.what();
+      discard();
+      throw;
+    }
+  }
+
   // Removes every temporary; no target is touched. Never throws.
   void discard() noexcept {
     for (Staged& s : staged) {
@@ -361,48 +380,26 @@ FileTransaction::~FileTransaction() {
 
 void FileTransaction::stage(const std::filesystem::path& path,
                             std::span<const std::uint8_t> bytes) {
-  if (!impl_->failure.empty()) {
-    throw IoError(path.string() +
-                  ": not staged, the transaction failed earlier: " + impl_->failure);
-  }
-  try {
-    impl_->staged.emplace_back();
-    Staged& s = impl_->staged.back();
-    s.path = path;
-    s.out = inspect_output(path);
+  impl_->stage(path, [&](Staged& s) {
     if (s.out.kind == Output::Kind::kStdout || s.out.kind == Output::Kind::kInPlace) {
       s.bytes.assign(bytes.begin(), bytes.end());
     } else {
       write_temporary(s, bytes);
     }
-  } catch (const std::exception& e) {
-    impl_->failure = e.what();
-    impl_->discard();
-    throw;
-  }
+  });
 }
 
 std::filesystem::path FileTransaction::stage_shared(const std::filesystem::path& path,
                                                     std::span<const std::uint8_t> head) {
-  if (!impl_->failure.empty()) {
-    throw IoError(path.string() +
-                  ": not staged, the transaction failed earlier: " + impl_->failure);
-  }
-  try {
-    impl_->staged.emplace_back();
-    Staged& s = impl_->staged.back();
-    s.path = path;
-    s.out = inspect_output(path);
+  std::filesystem::path temporary;
+  impl_->stage(path, [&](Staged& s) {
     if (s.out.kind == Output::Kind::kStdout || s.out.kind == Output::Kind::kInPlace)
       throw IoError(path.string() + ": is not a regular file, which several processes could write");
     s.shared = true;
     write_temporary(s, head);
-    return s.temporary;
-  } catch (const std::exception& e) {
-    impl_->failure = e.what();
-    impl_->discard();
-    throw;
-  }
+    temporary = s.temporary;
+  });
+  return temporary;
 }
 
 void FileTransaction::stage(const std::filesystem::path& path, std::string_view text) {
