@@ -82,6 +82,10 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
   // The running distance (in voxels, capped) just before the sweep enters the domain, from the
   // nearest site beyond it: `from` sits `dist(from)` voxels before the first voxel minus one.
   auto start = [&](std::uint32_t* d, const std::int32_t* from, int y, bool upward) {
+    if (!beyond) {  // one process's whole field: nothing beyond the domain
+      std::fill_n(d, e, cap);
+      return;
+    }
     for (int i = 0; i < e; ++i) {
       const std::int64_t c = column(y, i);
       // No site beyond (the sentinels of start_sites below): nothing seen yet.
@@ -95,6 +99,10 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
     }
   };
   auto start_sites = [&](std::int32_t* l, const std::int32_t* from, int y, std::int32_t none) {
+    if (!beyond) {
+      std::fill_n(l, e, none);
+      return;
+    }
     for (int i = 0; i < e; ++i) {
       const std::int64_t c = column(y, i);
       l[i] = c < 0 ? none : from[c];
