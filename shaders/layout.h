@@ -154,12 +154,57 @@ struct RenderParams {
   uint pad1, pad2;
 };
 
+// ---- vector fields (src/vectors/gpu)
+// -------------------------------------------------------------- VectorParams::mode.x: how a voxel
+// finds its source.
+VF_CONST(uint, VF_VECTORS_BRUTE, 0u);    // every source
+VF_CONST(uint, VF_VECTORS_SPLAT, 1u);    // the sources binned to the voxel's tile
+VF_CONST(uint, VF_VECTORS_WINNERS, 2u);  // read from the winners buffer (jump flooding's)
+// VectorParams::mode.w bits.
+VF_CONST(uint, VF_VECTORS_WRITE_WINNERS, 1u);  // brute / splat also store each voxel's winner
+VF_CONST(int, VF_VECTORS_TILE, 8);             // splatting's bins: tiles of 8^3 voxels
+// The voxel-centre table (binding 1, dvec4s): the centre, the box's three axes, its size, then the
+// x, y and z offset tables (VectorParams::tables) as the CPU's CentreTables computes them.
+VF_CONST(int, VF_VECTORS_TABLES, 5);
+
+// Push constants of the vector-field passes: 96 bytes.
+struct VectorParams {
+  ivec4 size;    // nx, ny, nz; w = number of sources
+  ivec4 tables;  // where the x, y, z offset tables start in the centre table; w unused
+  ivec4 tiles;   // splatting's tiles along x, y, z; w unused
+  ivec4 pass;    // x: seeding, the number of samples; flooding, the jump
+  uint search;   // VF_VECTORS_BRUTE, _SPLAT or _WINNERS
+  uint rule;     // 0: strongest source, 1: nearest source
+  uint storage;  // 0: rgba8, 1: rgba16f, 2: rgba32f
+  uint flags;    // VF_VECTORS_WRITE_WINNERS
+  float decay;   // a step: decay_per_s * dt, rounded to float as the CPU's step rounds it
+  uint pad0, pad1, pad2;
+};
+
+// The visualiser's view (a storage buffer): the camera and the volume's box, in floats.
+struct VectorViewParams {
+  vec4f centre;  // the volume's box; w unused
+  vec4f size;
+  vec4f axis_x;  // the box's axes in world space (rotation columns)
+  vec4f axis_y;
+  vec4f axis_z;
+  ivec4 resolution;  // w = storage
+  vec4f eye;
+  vec4f dir00;  // the ray through pixel (0, 0) before normalising; xyz
+  vec4f dx;     // the change per pixel to the right
+  vec4f dy;     // the change per pixel down
+  vec4f march;  // x: step (world units), y: density per world unit, z: max steps, w unused
+  ivec4 image;  // width, height
+};
+
 #ifdef __cplusplus
 static_assert(sizeof(Header) == 128, "std430 size of Header");
 static_assert(sizeof(PassParams) == 96, "push-constant size of PassParams");
 static_assert(sizeof(JfaParams) == 32, "push-constant size of JfaParams");
 static_assert(sizeof(FimParams) == 64, "push-constant size of FimParams");
 static_assert(sizeof(RenderParams) == 192, "std430 size of RenderParams");
+static_assert(sizeof(VectorParams) == 96, "push-constant size of VectorParams");
+static_assert(sizeof(VectorViewParams) == 192, "std430 size of VectorViewParams");
 }  // namespace voxfield::gpu::layout
 #endif
 #undef VF_CONST

@@ -22,6 +22,9 @@ struct AdoptedDevice {
   VkDevice device = VK_NULL_HANDLE;
   VkQueue queue = VK_NULL_HANDLE;  // a queue of `queue_family`, which must support compute
   std::uint32_t queue_family = 0;
+  // Whether the device was created with the shaderFloat64 feature enabled: the vector-field
+  // passes need it (gpu_vectors.h); everything else runs without it.
+  bool shader_float64 = false;
 };
 
 // A context on the application's device and queue: voxfield creates its command pool, pipelines

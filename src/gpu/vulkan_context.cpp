@@ -371,9 +371,16 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
   qci.queueFamilyIndex = s.queue_family;
   qci.queueCount = 1;
   qci.pQueuePriorities = &priority;
+  // Doubles in shaders where the device has them: the vector-field passes compute in double
+  // precision to match the CPU bit for bit (gpu_vectors.h); nothing else needs a feature.
+  VkPhysicalDeviceFeatures supported{}, enabled{};
+  vkGetPhysicalDeviceFeatures(s.physical, &supported);
+  enabled.shaderFloat64 = supported.shaderFloat64;
+  s.float64 = supported.shaderFloat64 == VK_TRUE;
   VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   dci.queueCreateInfoCount = 1;
   dci.pQueueCreateInfos = &qci;
+  dci.pEnabledFeatures = &enabled;
   check(vkCreateDevice(s.physical, &dci, nullptr, &s.device), "vkCreateDevice");
   vkGetDeviceQueue(s.device, s.queue_family, 0, &s.queue);
   s.finish_setup();
@@ -427,6 +434,7 @@ std::shared_ptr<Context> adopt(const AdoptedDevice& app) {
   auto impl = std::make_unique<Context::Impl>();
   Context::Impl& s = *impl;
   s.owns_device = false;
+  s.float64 = app.shader_float64;
   s.instance = app.instance;
   s.physical = app.physical;
   s.device = app.device;

@@ -77,7 +77,8 @@ struct Context::Impl {
   VkPhysicalDeviceMemoryProperties memory{};
   VkPhysicalDeviceLimits limits{};
   bool owns_device = true;
-  bool lost = false;  // the device was lost (GpuDeviceLost): nothing more is submitted
+  bool float64 = false;  // shaderFloat64 is enabled on the device
+  bool lost = false;     // the device was lost (GpuDeviceLost): nothing more is submitted
 
   DeviceInfo info;
   Counters counters;

@@ -37,36 +37,11 @@ void seed(const VectorVolume& v, std::span<const VectorSource> sources,
           std::span<const Segment> segments, VectorRule rule, const CentreTables& centres,
           std::span<std::int32_t> out) {
   const Vec3i n = v.resolution;
-  const Vec3d vs = v.voxel_size();
-  const double half_voxel = 0.5 * std::min({vs.x, vs.y, vs.z});
   std::vector<double> seeded_score(out.size(), 0);
   for (std::size_t s = 0; s < sources.size(); ++s) {
-    if (index_box(v, sources[s]).empty()) continue;  // cannot reach any voxel centre
-    // Only the part of the segment within the radius of the box can seed a voxel that matters:
-    // clip it to the box grown by r (slab test in volume coordinates), so a long trail far
-    // outside costs nothing and the samples stay half a voxel apart.
-    const Vec3d ua = v.to_volume(segments[s].a), ub = v.to_volume(segments[s].a + segments[s].ab);
-    double t0 = 0, t1 = 1;
-    for (int a = 0; a < 3; ++a) {
-      const double grow = segments[s].radius / v.size[a], d = ub[a] - ua[a];
-      const double lo = -grow, hi = 1 + grow;
-      if (d == 0) {
-        if (ua[a] < lo || ua[a] > hi) t1 = -1;
-        continue;
-      }
-      double ta = (lo - ua[a]) / d, tb = (hi - ua[a]) / d;
-      if (ta > tb) std::swap(ta, tb);
-      t0 = std::max(t0, ta);
-      t1 = std::min(t1, tb);
-    }
-    if (t0 > t1) {  // the segment misses the grown box: seed its point nearest to the box
-      t0 = t1 = std::clamp(t0, 0.0, 1.0);
-    }
-    const double length = std::sqrt(segments[s].ab2) * (t1 - t0);
-    // Within the grown box a segment is at most its diagonal long: this many samples is bounded.
-    const int samples = 1 + static_cast<int>(std::ceil(length / half_voxel));
-    for (int t = 0; t <= samples; ++t) {
-      const double along = t0 + (t1 - t0) * (static_cast<double>(t) / samples);
+    const SeedSpan span = seed_span(v, sources[s], segments[s]);
+    for (int t = 0; t <= span.samples; ++t) {
+      const double along = span.t0 + (span.t1 - span.t0) * (static_cast<double>(t) / span.samples);
       const Vec3d point = segments[s].a + segments[s].ab * along;
       const Vec3d u = v.to_volume(point);
       int idx[3];
@@ -120,6 +95,47 @@ void flood_pass(const VectorVolume& v, std::span<const Segment> segments, Vector
 
 }  // namespace
 
+SeedSpan seed_span(const VectorVolume& v, const VectorSource& source, const Segment& segment) {
+  if (index_box(v, source).empty()) return {};  // cannot reach any voxel centre
+  // Only the part of the segment within the radius of the box can seed a voxel that matters:
+  // clip it to the box grown by r (slab test in volume coordinates), so a long trail far
+  // outside costs nothing and the samples stay half a voxel apart.
+  const Vec3d ua = v.to_volume(segment.a), ub = v.to_volume(segment.a + segment.ab);
+  double t0 = 0, t1 = 1;
+  for (int a = 0; a < 3; ++a) {
+    const double grow = segment.radius / v.size[a], d = ub[a] - ua[a];
+    const double lo = -grow, hi = 1 + grow;
+    if (d == 0) {
+      if (ua[a] < lo || ua[a] > hi) t1 = -1;
+      continue;
+    }
+    double ta = (lo - ua[a]) / d, tb = (hi - ua[a]) / d;
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  if (t0 > t1) {  // the segment misses the grown box: seed its point nearest to the box
+    t0 = t1 = std::clamp(t0, 0.0, 1.0);
+  }
+  const Vec3d vs = v.voxel_size();
+  const double half_voxel = 0.5 * std::min({vs.x, vs.y, vs.z});
+  const double length = std::sqrt(segment.ab2) * (t1 - t0);
+  // Within the grown box a segment is at most its diagonal long: this many samples is bounded.
+  return {t0, t1, 1 + static_cast<int>(std::ceil(length / half_voxel))};
+}
+
+std::vector<int> jfa_steps(const VectorVolume& v, int extra_passes) {
+  std::vector<int> steps;
+  const int longest = std::max({v.resolution.x, v.resolution.y, v.resolution.z});
+  if (longest == 1) return steps;  // one voxel across: nothing to flood
+  int first = 1;
+  while (first * 2 < longest) first *= 2;  // N/2 for a power of two N; the same rounding up
+  for (int s = first; s >= 1; s /= 2) steps.push_back(s);
+  if (extra_passes >= 2) steps.push_back(2);
+  if (extra_passes >= 1) steps.push_back(1);
+  return steps;
+}
+
 void jfa_winners(const VectorVolume& v, std::span<const VectorSource> sources,
                  std::span<const Segment> segments, VectorRule rule, int extra_passes,
                  Interrupter* interrupter, std::span<std::int32_t> winners,
@@ -130,14 +146,7 @@ void jfa_winners(const VectorVolume& v, std::span<const VectorSource> sources,
   times->seed_ms += ms_since(start);
 
   start = now_ns();
-  std::vector<int> steps;
-  const int longest = std::max({v.resolution.x, v.resolution.y, v.resolution.z});
-  int first = 1;
-  while (first * 2 < longest) first *= 2;  // N/2 for a power of two N; the same rounding up
-  for (int s = first; s >= 1; s /= 2) steps.push_back(s);
-  if (extra_passes >= 2) steps.push_back(2);
-  if (extra_passes >= 1) steps.push_back(1);
-  if (longest == 1) steps.clear();  // one voxel across: nothing to flood
+  const std::vector<int> steps = jfa_steps(v, extra_passes);
   std::vector<std::int32_t> other(winners.size(), -1);
   std::span<std::int32_t> a = winners, b = other;
   for (int s : steps) {

@@ -109,6 +109,18 @@ struct SplatScratch {
 void splat_winners(const VectorVolume& v, std::span<const VectorSource> sources,
                    std::span<const Segment> segments, VectorRule rule, Interrupter* interrupter,
                    SplatScratch& scratch);
+// Jump flooding's seeding of one source: the part of its segment within its radius of the box,
+// sampled at the samples + 1 points t0 + (t1 - t0) * (t / samples), t = 0..samples, each seeding
+// the voxel it falls in (clamped to the volume). samples = -1: the source seeds nothing (it cannot
+// reach a voxel centre). The GPU's seeding pass samples the same points.
+struct SeedSpan {
+  double t0 = 0, t1 = 0;
+  int samples = -1;
+};
+SeedSpan seed_span(const VectorVolume& v, const VectorSource& source, const Segment& segment);
+// The jumps of the flooding passes: N/2 ... 1 for the longest axis N, then 1 (JFA+1) or 2 and 1
+// (JFA+2); none for a volume one voxel across.
+std::vector<int> jfa_steps(const VectorVolume& v, int extra_passes);
 void jfa_winners(const VectorVolume& v, std::span<const VectorSource> sources,
                  std::span<const Segment> segments, VectorRule rule, int extra_passes,
                  Interrupter* interrupter, std::span<std::int32_t> winners, VectorPassTimes* times);

@@ -1,0 +1,187 @@
+// The vector-field passes on Vulkan (gpu_vectors.h) against the CPU half: every algorithm, rule and
+// storage gives the CPU's texels and winners bit for bit on lavapipe (whose division and square
+// root are correctly rounded — the condition gpu_vectors.h states); a simulation's steps give the
+// CPU simulation's fields; the visualiser matches the CPU's image within a stated tolerance; each
+// step is one submission; oversized textures are refused. Lavapipe under the validation layer.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "gpu_suite.h"
+#include "vector_test_inputs.h"
+#include "voxfield/gpu_vectors.h"
+
+using namespace voxfield;
+
+namespace {
+
+const VectorAlgorithm kAlgorithms[] = {VectorAlgorithm::kBrute, VectorAlgorithm::kSplat,
+                                       VectorAlgorithm::kJfa, VectorAlgorithm::kJfaPlus1,
+                                       VectorAlgorithm::kJfaPlus2};
+const VectorStorage kStorages[] = {VectorStorage::kRgba8, VectorStorage::kRgba16f,
+                                   VectorStorage::kRgba32f};
+
+// The index of the first differing byte, or -1.
+std::ptrdiff_t first_difference(std::span<const std::uint8_t> a, std::span<const std::uint8_t> b) {
+  if (a.size() != b.size()) return 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i] != b[i]) return static_cast<std::ptrdiff_t>(i);
+  return -1;
+}
+
+TEST(GpuVectorPasses, GenerationsEqualTheCpuBitForBit) {
+  if (!test::gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = test::validated_context();
+  for (const test::Shape& shape : test::shapes()) {
+    const std::vector<VectorSource> sources = test::random_sources(shape.volume, 30, 19);
+    for (VectorAlgorithm algorithm : kAlgorithms)
+      for (VectorRule rule : {VectorRule::kStrongest, VectorRule::kNearest})
+        for (VectorStorage storage : kStorages) {
+          SCOPED_TRACE(std::string(shape.name) + " " + vector_algorithm_name(algorithm) + " " +
+                       vector_rule_name(rule) + " " + vector_storage_name(storage));
+          VectorOptions o;
+          o.algorithm = algorithm;
+          o.rule = rule;
+          const std::vector<std::int32_t> cpu_winners = vector_winners(shape.volume, sources, o);
+          const VectorTexture cpu = generate_vectors(shape.volume, sources, storage, o);
+          std::vector<std::int32_t> gpu_winners;
+          gpu::VectorGpuStats stats;
+          const VectorTexture gpu =
+              gpu::generate_vectors(*ctx, shape.volume, sources, storage, o, &gpu_winners, &stats);
+          ASSERT_EQ(gpu_winners, cpu_winners);
+          EXPECT_EQ(first_difference(gpu.bytes(), cpu.bytes()), -1);
+          // brute / splat: one dispatch; jump flooding: seeding, the passes, the conversion.
+          const bool jfa =
+              algorithm != VectorAlgorithm::kBrute && algorithm != VectorAlgorithm::kSplat;
+          EXPECT_EQ(stats.dispatches, jfa ? 2 + stats.flood_passes : 1);
+          if (algorithm == VectorAlgorithm::kSplat) {
+            EXPECT_GT(stats.tile_entries, 0);
+          }
+        }
+  }
+  testing_backends::expect_no_validation_messages(Backend::kVulkan);
+}
+
+TEST(GpuVectorPasses, NoSourcesAndSourcesOutsideGiveTheZeroTexture) {
+  if (!test::gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = test::validated_context();
+  const VectorVolume v = test::cube_volume(12);
+  VectorSource far;
+  far.position = far.previous = {100, 0, 0};
+  far.radius = 2;
+  for (VectorAlgorithm algorithm : kAlgorithms) {
+    VectorOptions o;
+    o.algorithm = algorithm;
+    for (std::span<const VectorSource> s :
+         {std::span<const VectorSource>(), std::span<const VectorSource>(&far, 1)}) {
+      const VectorTexture gpu = gpu::generate_vectors(*ctx, v, s, VectorStorage::kRgba8, o);
+      EXPECT_EQ(
+          first_difference(gpu.bytes(), VectorTexture(v.resolution, VectorStorage::kRgba8).bytes()),
+          -1)
+          << vector_algorithm_name(algorithm);
+    }
+  }
+  testing_backends::expect_no_validation_messages(Backend::kVulkan);
+}
+
+// Frames of moving sources (some frames without any), decayed and blended: the device's field
+// equals the CPU simulation's after every step, in every storage, for splatting and jump flooding.
+TEST(GpuVectorPasses, StepsEqualTheCpuSimulation) {
+  if (!test::gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = test::validated_context();
+  const VectorVolume v = test::shapes()[2].volume;  // rotated, anisotropic
+  for (VectorAlgorithm algorithm : {VectorAlgorithm::kSplat, VectorAlgorithm::kJfa})
+    for (VectorStorage storage : kStorages) {
+      SCOPED_TRACE(std::string(vector_algorithm_name(algorithm)) + " " +
+                   vector_storage_name(storage));
+      VectorOptions o;
+      o.algorithm = algorithm;
+      VectorSimulation cpu(v, storage, o, 2.5);
+      gpu::VectorSimulation gpu(ctx, v, storage, o, 2.5);
+      for (int step = 0; step < 8; ++step) {
+        const std::vector<VectorSource> sources =
+            test::random_sources(v, step % 4 == 3 ? 0 : 8, 60 + step);
+        const double dt = 1.0 / 60 + 0.004 * step;
+        cpu.step(sources, dt);
+        gpu.step(sources, dt);
+        ASSERT_EQ(first_difference(gpu.field().bytes(), cpu.field().bytes()), -1)
+            << "after step " << step;
+        ASSERT_EQ(first_difference(gpu.current().bytes(), cpu.current().bytes()), -1)
+            << "after step " << step;
+        // One submission and one fence wait per step, read-backs aside.
+        EXPECT_EQ(gpu.last_stats().submits, 1);
+        EXPECT_EQ(gpu.last_stats().fence_waits, 1);
+        EXPECT_EQ(gpu.last_stats().bytes_downloaded, 0);
+      }
+      EXPECT_EQ(gpu.steps(), 8);
+    }
+  testing_backends::expect_no_validation_messages(Backend::kVulkan);
+}
+
+// The visualiser works in floats (the CPU's in doubles): nearly every pixel within 2 of 255 per
+// channel, none off by more than 24 (a ray grazing an edge of the box, or a sample straddling a
+// texel boundary, may take one more or one fewer step), and the picture not the background alone.
+TEST(GpuVectorPasses, TheVisualiserMatchesTheCpuImage) {
+  if (!test::gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = test::validated_context();
+  const VectorVolume v = test::shapes()[2].volume;
+  const std::vector<VectorSource> sources = test::random_sources(v, 20, 4);
+  for (VectorStorage storage : kStorages) {
+    const VectorTexture tex = generate_vectors(v, sources, storage);
+    VectorViewOptions view;
+    view.width = 96;
+    view.height = 64;
+    const Image cpu = render_vectors(v, tex, view);
+    gpu::VectorGpuStats stats;
+    const Image gpu = gpu::render_vectors(*ctx, v, tex, view, &stats);
+    const Image empty = render_vectors(v, VectorTexture(v.resolution, storage), view);
+    int close = 0, lit = 0, worst = 0;
+    for (int y = 0; y < view.height; ++y)
+      for (int x = 0; x < view.width; ++x) {
+        int off = 0;
+        for (int c = 0; c < 3; ++c)
+          off = std::max(off, std::abs(int{gpu.pixel(x, y)[c]} - int{cpu.pixel(x, y)[c]}));
+        worst = std::max(worst, off);
+        close += off <= 2;
+        lit += cpu.pixel(x, y)[0] != empty.pixel(x, y)[0];
+      }
+    EXPECT_GT(lit, view.width * view.height / 20) << vector_storage_name(storage);
+    EXPECT_GE(close, view.width * view.height * 99 / 100) << vector_storage_name(storage);
+    EXPECT_LE(worst, 24) << vector_storage_name(storage);
+    EXPECT_EQ(stats.dispatches, 1);
+  }
+  // The simulation draws its resident field the same way.
+  gpu::VectorSimulation sim(ctx, v, VectorStorage::kRgba8, {}, 1.0);
+  sim.step(sources, 0.02);
+  VectorViewOptions view;
+  view.width = 48;
+  view.height = 32;
+  const Image a = sim.render(view), b = gpu::render_vectors(*ctx, v, sim.field(), view);
+  for (int y = 0; y < view.height; ++y)
+    for (int x = 0; x < view.width; ++x) ASSERT_EQ(std::memcmp(a.pixel(x, y), b.pixel(x, y), 3), 0);
+  testing_backends::expect_no_validation_messages(Backend::kVulkan);
+}
+
+TEST(GpuVectorPasses, RefusesWhatTheDeviceCannotHoldAndBadInput) {
+  if (!test::gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = test::validated_context();
+  VectorVolume huge = test::cube_volume(16);
+  huge.resolution = {2048, 2048, 8};  // 32 M texels: 512 MiB of rgba32f, past lavapipe's 128 MiB
+  try {
+    gpu::VectorSimulation sim(ctx, huge, VectorStorage::kRgba32f, {}, 1.0);
+    ADD_FAILURE() << "an oversized texture was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("storage buffer"), std::string::npos) << e.what();
+  }
+  const VectorVolume v = test::cube_volume(8);
+  gpu::VectorSimulation sim(ctx, v, VectorStorage::kRgba8, {}, 1.0);
+  VectorSource bad;
+  bad.position = bad.previous = {0, 0, 0};
+  bad.radius = -1;
+  EXPECT_THROW(sim.step(std::span(&bad, 1), 0.1), InvalidArgument);
+  EXPECT_THROW(sim.step({}, 0), InvalidArgument);
+  EXPECT_EQ(sim.steps(), 0);
+  testing_backends::expect_no_validation_messages(Backend::kVulkan);
+}
+
+}  // namespace
