@@ -327,6 +327,32 @@ assert all(j[k] is None for k in ('hits', 'evaluations', 'instructions', 'cells_
   check "csg render: a bad evaluator name" 2 $GPU "$V" csg "$GEAR" render -o "$tmp/x.png" --backend vulkan --evaluators fast
   expect_grep "bad evaluator named" "$tmp/err" "fast not in"
   [ ! -e "$tmp/x.png" ] && passes=$((passes+1)) || { echo "FAIL: csg render wrote a picture after refusing"; fails=$((fails+1)); }
+  # Vector fields on Vulkan: frames decayed and blended, every output format, byte for byte the CPU's.
+  cat > "$tmp/agents.json" <<'JSON'
+{"frames": [{"sources": [{"position": [1, 2, 3], "previous": [0, 1, 2], "radius": 2.5},
+                         {"position": [4, 4, 4], "radius": 0.2}]},
+            {"sources": [{"position": [2, 3, 3], "previous": [1, 2, 3], "radius": 2.5}]},
+            {"sources": []}]}
+JSON
+  for alg in splat jfa+2; do
+    for ext in npy fga vf; do
+      check "vectors $alg .$ext on vulkan" 0 $GPU "$V" vectors "$tmp/agents.json" -o "$tmp/vg.$ext" --resolution 24,20,16 \
+          --algorithm $alg --storage rgba16f --backend vulkan --stats "$tmp/vg.json"
+      check "vectors $alg .$ext on the cpu" 0 "$V" vectors "$tmp/agents.json" -o "$tmp/vc.$ext" --resolution 24,20,16 \
+          --algorithm $alg --storage rgba16f
+      cmp -s "$tmp/vg.$ext" "$tmp/vc.$ext" && passes=$((passes+1)) || { echo "FAIL: vulkan and cpu vectors ($alg, .$ext) differ"; fails=$((fails+1)); }
+    done
+  done
+  check "vectors gpu stats" 0 $PY -c "
+import json; j = json.load(open('$tmp/vg.json'))
+g = j['gpu']
+assert j['backend'] == 'vulkan' and j['frames'] == 3 and j['flood_passes'] > 0, j
+assert set(j['gpu_passes_ms']) == {'seed', 'flood', 'step'}, j
+assert g['bytes_downloaded'] >= 24 * 20 * 16 * 8 and g['submits'] >= 4, j"
+  check "vectors picture on vulkan" 0 $GPU "$V" vectors "$tmp/agents.json" -o "$tmp/vg.png" --width 64 --height 48 --backend vulkan
+  check "vectors: --backend for a world" 2 $GPU "$V" vectors "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --backend vulkan
+  expect_grep "vectors world backend message" "$tmp/err" "--backend is for sources"
+  [ ! -e "$tmp/x.npy" ] && passes=$((passes+1)) || { echo "FAIL: vectors wrote after refusing"; fails=$((fails+1)); }
 fi
 
 

@@ -1,11 +1,15 @@
 // voxfield vectors SOURCES.json -o OUT: a vector-field volume texture from moving sources
 // (docs/vectors.md), as float32 .npy, Unreal .fga, Unity .vf, or a picture of the visualiser.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iostream>
 #include <limits>
+#include <optional>
 
 #include "cli.h"
+#include "live_field.h"
+#include "voxfield/gpu_vectors.h"
 #include "voxfield/png.h"
 #include "voxfield/vector_files.h"
 #include "voxfield/vector_world.h"
@@ -16,6 +20,7 @@ namespace {
 
 struct VectorSettings {
   std::string sources, out, stats, algorithm = "splat", rule = "strongest", storage = "rgba8";
+  std::string backend = "cpu";
   std::vector<int> resolution{64, 64, 64};
   std::vector<double> box, rotation;
   double dt_s = 1.0 / 60, decay_per_s = 1.0;
@@ -64,6 +69,10 @@ VectorVolume volume_around(const VectorSourceFrames& f, Vec3i resolution) {
 int run_world_vectors(const VectorSettings& s, OutKind kind, Outputs& outputs) {
   if (!s.box.empty() || !s.rotation.empty())
     throw UsageError("--box and --rotation are for sources; a world's field covers its content");
+  if (s.backend != "cpu")
+    throw UsageError("--backend " + s.backend +
+                     ": the flow around a world's solids comes from its nearest-site field on the "
+                     "CPU; --backend is for sources");
   const double reach = s.reach.value_or(8.0);
   const VectorStorage storage = parse_vector_storage(s.storage);
   set_activity("loading " + s.sources);
@@ -164,10 +173,39 @@ int run_vectors(const VectorSettings& s) {
                      "(Unreal's importer refuses more); lower --resolution");
 
   set_activity("computing the vector field of " + s.sources);
+  const auto gpu_context = choose_backend(s.backend);
   const auto start = std::chrono::steady_clock::now();
   VectorPassTimes totals;
   VectorTexture texture;
-  if (frames.animated) {
+  gpu::VectorGpuStats gpu_totals;
+  std::vector<gpu::PassTiming> gpu_passes;
+  auto add_gpu = [&](const gpu::VectorGpuStats& st, const std::vector<gpu::PassTiming>& timings) {
+    gpu_totals.flood_passes += st.flood_passes;
+    for (const gpu::PassTiming& t : timings) {
+      auto same = std::find_if(gpu_passes.begin(), gpu_passes.end(),
+                               [&](const gpu::PassTiming& p) { return p.pass == t.pass; });
+      if (same == gpu_passes.end())
+        gpu_passes.push_back(t);
+      else
+        same->ms += t.ms;
+    }
+  };
+  if (gpu_context) gpu_context->reset_counters();
+  std::optional<gpu::VectorSimulation> gpu_sim;
+  if (gpu_context && frames.animated) {
+    gpu_sim.emplace(gpu_context, volume, storage, options, s.decay_per_s);
+    for (const auto& frame : frames.frames) {
+      gpu_sim->step(frame, s.dt_s);
+      add_gpu(gpu_sim->last_stats(), gpu_sim->last_timings());
+    }
+    texture = gpu_sim->field();
+  } else if (gpu_context) {
+    gpu::VectorGpuStats st;
+    std::vector<gpu::PassTiming> timings;
+    texture = gpu::generate_vectors(*gpu_context, volume, frames.frames.front(), storage, options,
+                                    nullptr, &st, &timings);
+    add_gpu(st, timings);
+  } else if (frames.animated) {
     VectorSimulation sim(volume, storage, options, s.decay_per_s);
     for (const auto& frame : frames.frames) {
       sim.step(frame, s.dt_s);
@@ -200,13 +238,17 @@ int run_vectors(const VectorSettings& s) {
       VectorViewOptions view;
       view.width = s.width;
       view.height = s.height;
-      outputs.stage(s.out, encode_png(render_vectors(volume, texture, view)));
+      outputs.stage(
+          s.out, encode_png(gpu_sim       ? gpu_sim->render(view)
+                            : gpu_context ? gpu::render_vectors(*gpu_context, volume, texture, view)
+                                          : render_vectors(volume, texture, view)));
       break;
     }
   }
   if (!s.stats.empty()) {
     nlohmann::json j;
     j["sources_file"] = s.sources;
+    j["backend"] = gpu_context ? "vulkan" : "cpu";
     j["output"] = s.out;
     j["algorithm"] = vector_algorithm_name(options.algorithm);
     j["rule"] = vector_rule_name(options.rule);
@@ -217,20 +259,40 @@ int run_vectors(const VectorSettings& s) {
                 {"size", {volume.size.x, volume.size.y, volume.size.z}}};
     j["voxels_written"] = volume.voxel_count() * static_cast<std::int64_t>(frames.frames.size());
     j["ms"] = ms;
-    j["passes_ms"] = {{"seed", totals.seed_ms},
-                      {"flood", totals.flood_ms},
-                      {"search", totals.search_ms},
-                      {"convert", totals.convert_ms},
-                      {"decay_blend", totals.blend_ms}};
-    if (totals.flood_passes) j["flood_passes"] = totals.flood_passes;
+    if (gpu_context) {
+      // Timestamps of the device's passes (on a software device such as lavapipe they time its
+      // CPU emulation, not a GPU) and the hardware-independent counters.
+      j["device"] = gpu_context->device().name;
+      nlohmann::json passes = nlohmann::json::object();
+      for (const gpu::PassTiming& t : gpu_passes) passes[t.pass] = t.ms;
+      j["gpu_passes_ms"] = passes;
+      // The whole command's traffic, read-backs and the picture included.
+      const gpu::Counters c = gpu_context->counters();
+      j["gpu"] = {{"dispatches", c.dispatches},         {"submits", c.submits},
+                  {"fence_waits", c.fence_waits},       {"pipeline_barriers", c.pipeline_barriers},
+                  {"bytes_uploaded", c.bytes_uploaded}, {"bytes_downloaded", c.bytes_downloaded}};
+      if (gpu_totals.flood_passes) j["flood_passes"] = gpu_totals.flood_passes;
+    } else {
+      j["passes_ms"] = {{"seed", totals.seed_ms},
+                        {"flood", totals.flood_ms},
+                        {"search", totals.search_ms},
+                        {"convert", totals.convert_ms},
+                        {"decay_blend", totals.blend_ms}};
+      if (totals.flood_passes) j["flood_passes"] = totals.flood_passes;
+    }
     if (options.algorithm != VectorAlgorithm::kBrute &&
         options.algorithm != VectorAlgorithm::kSplat) {
       // The last frame's winners against the exact ones (splat), as docs/vectors.md defines.
       const auto& last = frames.frames.back();
       VectorOptions exact = options;
       exact.algorithm = VectorAlgorithm::kSplat;
-      const VectorError e = compare_vector_winners(
-          volume, last, vector_winners(volume, last, exact), vector_winners(volume, last, options));
+      std::vector<std::int32_t> approximate;
+      if (gpu_context)
+        gpu::generate_vectors(*gpu_context, volume, last, storage, options, &approximate);
+      else
+        approximate = vector_winners(volume, last, options);
+      const VectorError e =
+          compare_vector_winners(volume, last, vector_winners(volume, last, exact), approximate);
       j["error"] = {{"percent_source_differs", e.percent_differs()},
                     {"voxels_source_differs", e.source_differs},
                     {"max_angle_deg", e.max_angle_deg},
@@ -242,7 +304,7 @@ int run_vectors(const VectorSettings& s) {
   std::cerr << "voxfield: wrote " << s.out << " (" << to_string(resolution) << ", "
             << frames.frames.size() << (frames.frames.size() == 1 ? " frame, " : " frames, ")
             << vector_algorithm_name(options.algorithm) << ", " << vector_storage_name(storage)
-            << ", " << std::lround(ms) << " ms)\n";
+            << (gpu_context ? ", vulkan, " : ", ") << std::lround(ms) << " ms)\n";
   return 0;
 }
 
@@ -292,6 +354,11 @@ void add_vectors(CLI::App& app, Action& action) {
       ->check(finite_non_negative());
   cmd->add_option("--width", s->width, "picture width (.png)")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", s->height, "picture height (.png)")->check(CLI::Range(1, 16384));
+  cmd->add_option("--backend", s->backend,
+                  "cpu (default), vulkan (any Vulkan device, software included) or auto (a "
+                  "hardware GPU if there is one, else the CPU): where the passes run; the same "
+                  "texels either way")
+      ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
   cmd->add_option("--stats", s->stats, "write pass timings (and jfa's error) as JSON");
   cmd->callback([s, &action] { action = [s] { return run_vectors(*s); }; });
 }

@@ -23,7 +23,6 @@ void download(Context::Impl& c, DescriptorArena& sets, Buffer& src, std::uint64_
   rec.copy(src, 0, readback, 0, bytes);
   rec.submit();
   std::memcpy(out, readback.mapped(), bytes);
-  c.counters.bytes_downloaded += static_cast<std::int64_t>(bytes);
   if (stats) {
     stats->bytes_downloaded += static_cast<std::int64_t>(bytes);
     ++stats->submits;
@@ -112,7 +111,6 @@ Image render_vectors(Context& context, const VectorVolume& volume, const VectorT
     submitted(rec, st, nullptr);
   }
   st.bytes_uploaded += static_cast<std::int64_t>(texture.bytes().size());
-  c.counters.bytes_uploaded += static_cast<std::int64_t>(texture.bytes().size());
   Image image = download_image(engine, c, *pixels, view, &st);
   st.ms = ms_since(start);
   return image;

@@ -122,11 +122,9 @@ void VectorEngine::stage(Recorder& rec, const Upload& up, VectorGpuStats& stats)
     regions[i] = {at, 0, parts[i].bytes};
     at += align16(parts[i].bytes);
   }
-  // One copy step behind one barrier: the destinations are distinct buffers.
   for (std::size_t i = 0; i < parts.size(); ++i)
     rec.copy(staging_, *parts[i].dst, std::span<const VkBufferCopy>(&regions[i], 1));
-  stats.bytes_uploaded += static_cast<std::int64_t>(total);
-  c_.counters.bytes_uploaded += static_cast<std::int64_t>(total);
+  stats.bytes_uploaded += static_cast<std::int64_t>(total);  // the context's counters: the recorder
 }
 
 void VectorEngine::record(Recorder& rec, std::span<const VectorSource> sources,
