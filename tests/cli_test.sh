@@ -349,6 +349,12 @@ g = j['gpu']
 assert j['backend'] == 'vulkan' and j['frames'] == 3 and j['flood_passes'] > 0, j
 assert set(j['gpu_passes_ms']) == {'seed', 'flood', 'step'}, j
 assert g['bytes_downloaded'] >= 24 * 20 * 16 * 8 and g['submits'] >= 4, j"
+  check "bench vectors --backend vulkan" 0 $GPU "$V" bench vectors --test quarter-resolution --steps 3 --backend vulkan \
+      --csv "$tmp/bv.csv"
+  check "bench vectors gpu csv" 0 $PY -c "
+import csv; rows = list(csv.DictReader(open('$tmp/bv.csv')))
+assert len(rows) == 4 and all(r['backend'] == 'vulkan' and float(r['submits_per_step']) == 1 for r in rows), rows
+assert {r['nx'] + 'x' + r['ny'] for r in rows} == {'64x64', '64x16'}, rows"
   check "vectors picture on vulkan" 0 $GPU "$V" vectors "$tmp/agents.json" -o "$tmp/vg.png" --width 64 --height 48 --backend vulkan
   check "vectors: --backend for a world" 2 $GPU "$V" vectors "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --backend vulkan
   expect_grep "vectors world backend message" "$tmp/err" "--backend is for sources"

@@ -5,11 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <optional>
 #include <random>
 #include <sstream>
 
 #include "cli.h"
+#include "live_field.h"
 #include "vector_agents.h"
+#include "voxfield/gpu_vectors.h"
 #include "voxfield/parallel.h"
 #include "voxfield/vectors.h"
 
@@ -17,7 +20,7 @@ namespace voxfield::cli {
 namespace {
 
 struct BenchVectorSettings {
-  std::string test = "fidelity", csv, storage = "rgba8";
+  std::string test = "fidelity", csv, storage = "rgba8", backend = "cpu";
   std::vector<std::string> algorithms;  // only these (default: each test's own)
   int steps = 60, threads = 0;
   std::uint32_t seed = 1;
@@ -31,41 +34,74 @@ struct Row {
   double generate_ms = 0, blend_ms = 0, step_ms = 0, p99_step_ms = 0;
   double percent_differs = 0, max_angle_deg = 0, max_strength_error = 0;
   double mean_strength = 0;
+  double dispatches_per_step = 0;  // the Vulkan backend's counters (0 on the CPU)
+  double submits_per_step = 0;
 };
 
 // Runs `steps` whole steps (generation, conversion, decay and blend) of `count` agents and, for
 // the approximate algorithms, measures each step's winners against splatting's.
+// On the Vulkan backend a step is one submission: its time is the wall clock from recording to
+// the fence (lavapipe: CPU emulation), the generation's the device's timestamps of its passes (the
+// step's generation, decay and blend are one dispatch there, so decay_blend_ms stays 0).
 Row run_case(const std::string& test, VectorAlgorithm algorithm, Vec3i resolution, int count,
-             double dt, double decay, VectorStorage storage, int steps, std::uint32_t seed) {
+             double dt, double decay, VectorStorage storage, int steps, std::uint32_t seed,
+             const std::shared_ptr<gpu::Context>& gpu_context) {
   const VectorVolume volume = agents_volume(resolution);
   VectorOptions options;
   options.algorithm = algorithm;
-  VectorSimulation sim(volume, storage, options, decay);
+  std::optional<VectorSimulation> cpu;
+  std::optional<gpu::VectorSimulation> gpu;
+  if (gpu_context)
+    gpu.emplace(gpu_context, volume, storage, options, decay);
+  else
+    cpu.emplace(volume, storage, options, decay);
   Agents agents(count, seed);
   Row r{test, vector_algorithm_name(algorithm), resolution, count, dt, decay};
   std::vector<double> step_ms, generate_ms, blend_ms;
   const bool approximate =
       algorithm != VectorAlgorithm::kBrute && algorithm != VectorAlgorithm::kSplat;
   VectorOptions exact;
+  std::int64_t dispatches = 0, submits = 0;
   for (int i = 0; i < steps; ++i) {
     const std::vector<VectorSource> sources = agents.step(dt);
     const auto start = std::chrono::steady_clock::now();
-    sim.step(sources, dt);
+    if (gpu) {
+      gpu->step(sources, dt);
+    } else {
+      cpu->step(sources, dt);
+    }
     step_ms.push_back(ms_since(start));
-    const VectorPassTimes& t = sim.last_times();
-    generate_ms.push_back(t.seed_ms + t.flood_ms + t.search_ms + t.convert_ms);
-    blend_ms.push_back(t.blend_ms);
+    if (gpu) {
+      double device_ms = 0;
+      for (const gpu::PassTiming& t : gpu->last_timings()) device_ms += t.ms;
+      generate_ms.push_back(device_ms);
+      blend_ms.push_back(0);
+      dispatches += gpu->last_stats().dispatches;
+      submits += gpu->last_stats().submits;
+    } else {
+      const VectorPassTimes& t = cpu->last_times();
+      generate_ms.push_back(t.seed_ms + t.flood_ms + t.search_ms + t.convert_ms);
+      blend_ms.push_back(t.blend_ms);
+    }
     if (approximate && i % 10 == 9) {  // every tenth step: the error against the definition
-      const VectorError e =
-          compare_vector_winners(volume, sources, vector_winners(volume, sources, exact),
-                                 vector_winners(volume, sources, options));
+      std::vector<std::int32_t> approximate_winners;
+      if (gpu_context)
+        gpu::generate_vectors(*gpu_context, volume, sources, storage, options,
+                              &approximate_winners);
+      else
+        approximate_winners = vector_winners(volume, sources, options);
+      const VectorError e = compare_vector_winners(
+          volume, sources, vector_winners(volume, sources, exact), approximate_winners);
       r.percent_differs = std::max(r.percent_differs, e.percent_differs());
       r.max_angle_deg = std::max(r.max_angle_deg, e.max_angle_deg);
       r.max_strength_error = std::max(r.max_strength_error, e.max_strength_error);
     }
   }
+  r.dispatches_per_step = static_cast<double>(dispatches) / steps;
+  r.submits_per_step = static_cast<double>(submits) / steps;
+  const VectorTexture field = gpu ? gpu->field() : cpu->field();
   double strength = 0;
-  for (std::int64_t i = 0; i < volume.voxel_count(); ++i) strength += sim.field().get(i).strength;
+  for (std::int64_t i = 0; i < volume.voxel_count(); ++i) strength += field.get(i).strength;
   r.mean_strength = strength / volume.voxel_count();
   // The first steps warm the caches and the pool: the mean and p99 of the rest.
   const std::size_t skip = std::min<std::size_t>(step_ms.size() / 10, 5);
@@ -88,6 +124,8 @@ int run_bench_vectors(const BenchVectorSettings& s) {
   outputs.expect(s.csv, "--csv");
   std::optional<ThreadLimit> limit;
   if (s.threads > 0) limit.emplace(s.threads);
+  const std::shared_ptr<gpu::Context> gpu_context = choose_backend(s.backend);
+  const std::string backend = gpu_context ? "vulkan" : "cpu";
   using A = VectorAlgorithm;
   const std::vector<A> all{A::kBrute, A::kSplat, A::kJfa, A::kJfaPlus1, A::kJfaPlus2};
   const double dt = 1.0 / 60;
@@ -96,7 +134,8 @@ int run_bench_vectors(const BenchVectorSettings& s) {
     if (!s.algorithms.empty() && std::find(s.algorithms.begin(), s.algorithms.end(),
                                            vector_algorithm_name(a)) == s.algorithms.end())
       return;
-    rows.push_back(run_case(s.test, a, res, count, step_dt, decay, storage, s.steps, s.seed));
+    rows.push_back(
+        run_case(s.test, a, res, count, step_dt, decay, storage, s.steps, s.seed, gpu_context));
     const Row& r = rows.back();
     std::cerr << "  " << r.algorithm << " " << to_string(res) << " sources " << count << ": "
               << r.step_ms << " ms per step\n";
@@ -123,20 +162,26 @@ int run_bench_vectors(const BenchVectorSettings& s) {
     throw UsageError("unknown test " + s.test);
   }
   std::ostringstream csv;
-  csv << "test,algorithm,nx,ny,nz,sources,dt_s,decay_per_s,storage,steps,generate_ms,decay_blend_"
-         "ms,"
-         "step_ms,p99_step_ms,percent_source_differs,max_angle_deg,max_strength_error,mean_"
-         "strength\n";
+  csv << "test,backend,algorithm,nx,ny,nz,sources,dt_s,decay_per_s,storage,steps,generate_ms,"
+         "decay_blend_ms,step_ms,p99_step_ms,percent_source_differs,max_angle_deg,max_strength_"
+         "error,mean_strength,dispatches_per_step,submits_per_step\n";
+  if (gpu_context)
+    std::cout << "Vulkan on " << gpu_context->device().name
+              << (gpu_context->device().hardware
+                      ? ""
+                      : " (a CPU implementation: its times are CPU emulation, not GPU speed)")
+              << "\n\n";
   std::cout
       << "| algorithm | resolution | sources | dt (s) | decay/s | generate ms | decay+blend ms | "
          "step ms (p99) | % source differs | max angle (deg) | max strength error |\n"
          "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
-    csv << r.test << "," << r.algorithm << "," << r.resolution.x << "," << r.resolution.y << ","
-        << r.resolution.z << "," << r.sources << "," << r.dt << "," << r.decay << "," << s.storage
-        << "," << s.steps << "," << r.generate_ms << "," << r.blend_ms << "," << r.step_ms << ","
-        << r.p99_step_ms << "," << r.percent_differs << "," << r.max_angle_deg << ","
-        << r.max_strength_error << "," << r.mean_strength << "\n";
+    csv << r.test << "," << backend << "," << r.algorithm << "," << r.resolution.x << ","
+        << r.resolution.y << "," << r.resolution.z << "," << r.sources << "," << r.dt << ","
+        << r.decay << "," << s.storage << "," << s.steps << "," << r.generate_ms << ","
+        << r.blend_ms << "," << r.step_ms << "," << r.p99_step_ms << "," << r.percent_differs << ","
+        << r.max_angle_deg << "," << r.max_strength_error << "," << r.mean_strength << ","
+        << r.dispatches_per_step << "," << r.submits_per_step << "\n";
     char line[512];
     std::snprintf(
         line, sizeof line,
@@ -170,6 +215,10 @@ void add_bench_vectors(CLI::App* bench, Action& action) {
       ->delimiter(',')
       ->check(CLI::IsMember({"splat", "brute", "jfa", "jfa+1", "jfa+2"}));
   cmd->add_option("--threads", s->threads, "threads (default: all)")->check(CLI::Range(1, 1024));
+  cmd->add_option("--backend", s->backend,
+                  "cpu (default), vulkan or auto; on a software Vulkan device (lavapipe) the times "
+                  "are CPU emulation")
+      ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
   cmd->add_option("--csv", s->csv, "one row per case");
   cmd->callback([s, &action] { action = [s] { return run_bench_vectors(*s); }; });
 }
