@@ -485,5 +485,31 @@ TEST(Vectors, StepsEqualGenerationThenBlendTexelByTexel) {
   }
 }
 
+// Wakes fading out with no source: at this decay an rgba8 strength byte of 5 decays to a strength
+// above 0 that stores as byte 0 — a texel with a direction and no strength, which the next step
+// must clear like any other (an early sweep flagged such rows empty and left them stale).
+TEST(Vectors, FadingWakesEqualGenerationThenBlendToTheEnd) {
+  const VectorVolume v = shapes()[1].volume;  // anisotropic
+  const double dt = 1.0 / 60, decay = 4.6 / 255 / dt;
+  for (VectorStorage storage :
+       {VectorStorage::kRgba8, VectorStorage::kRgba16f, VectorStorage::kRgba32f}) {
+    VectorSimulation sim(v, storage, {}, decay);
+    VectorTexture ref(v.resolution, storage);
+    for (int step = 0; step < 70; ++step) {
+      const std::vector<VectorSource> sources =
+          step < 2 ? random_sources(v, 10, 70 + step) : std::vector<VectorSource>{};
+      sim.step(sources, dt);
+      const VectorTexture cur = generate_vectors(v, sources, storage);
+      for (std::int64_t i = 0; i < v.voxel_count(); ++i)
+        ref.set(i, blend_vector_texels(cur.get(i), ref.get(i), decay, dt));
+      ASSERT_TRUE(std::equal(ref.bytes().begin(), ref.bytes().end(), sim.field().bytes().begin()))
+          << vector_storage_name(storage) << " step " << step;
+    }
+    EXPECT_TRUE(std::equal(ref.bytes().begin(), ref.bytes().end(),
+                           VectorTexture(v.resolution, storage).bytes().begin()))
+        << "every wake has faded";
+  }
+}
+
 }  // namespace
 }  // namespace voxfield

@@ -2,7 +2,9 @@
 // the fixed-step scheduler that drives it. The paper's "fixed time step" was a minimum interval
 // that never caught up after a slow frame; FixedStepScheduler keeps an accumulator and runs whole
 // steps, capped per frame so a stall cannot snowball.
+#include <algorithm>
 #include <array>
+#include <climits>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -52,13 +54,18 @@ VectorTexel blend_vector_texels(const VectorTexel& current, const VectorTexel& p
   return blend(current, previous, static_cast<float>(decay_per_s * dt_s));
 }
 
-// Per texture, one flag per row (j, k): whether any texel of the row has a non-zero strength.
-// A row no source touches and whose previous row is all zero stays zero: the sweep writes it only
-// if the texture it writes last held something there, so a step costs what the sources and their
-// wakes cover, not the whole volume.
+// Per texture, one span per row (j, k): the texels of the row that may differ from the zero texel
+// (outside it, the row holds the zero texel). A step sweeps, per row, only the hull of the spans of
+// the sources that touch the row, of the previous field and of the two textures it overwrites, so
+// it costs what the sources and their wakes cover, not the whole volume.
+struct RowSpan {
+  std::uint16_t lo = 0, hi = 0;  // [lo, hi), empty when lo >= hi (rows are at most 4096 texels)
+  bool empty() const { return lo >= hi; }
+};
+
 struct VectorSimulation::Scratch {
   detail::vectors::SplatScratch splat;
-  std::vector<std::uint8_t> current_rows, field_rows, next_rows, touched_rows;
+  std::vector<RowSpan> current_rows, field_rows, next_rows, touched_rows;
 };
 
 VectorSimulation::VectorSimulation(const VectorVolume& volume, VectorStorage storage,
@@ -89,102 +96,168 @@ VectorSimulation& VectorSimulation::operator=(VectorSimulation&&) noexcept = def
 
 namespace {
 
-struct RowFlags {
-  std::uint8_t* current;
-  const std::uint8_t* previous;
-  std::uint8_t* next;
-  const std::uint8_t* touched;
+struct RowSpans {
+  RowSpan* current;
+  const RowSpan* previous;
+  RowSpan* next;
+  const RowSpan* touched;
   // rgba8: the strength byte after decay, as blend() then store() would give it alone (-1: the
   // decayed strength is exactly 0, which blends to the zero texel).
   const std::int16_t* decay8;
 };
 
-// A previous texel with no current source: its decayed self (blend with a zero current). In rgba8
-// (most non-zero texels are such wakes) the blend keeps the stored direction bytes and decays the
-// strength byte, which the step's table gives directly. Returns whether the result is non-zero.
-template <class C>
-bool decay_alone(const std::uint8_t* previous, std::uint8_t* next, float decay_s,
-                 const std::int16_t* decay8) {
-  if constexpr (std::is_same_v<C, detail::vectors::Codec<VectorStorage::kRgba8>>) {
-    const std::int16_t decayed = decay8[previous[3]];
-    if (decayed < 0) {
-      C::store_zero(next);
-      return false;
-    }
-    std::memcpy(next, previous, 3);
-    next[3] = static_cast<std::uint8_t>(decayed);
-    return decayed != 0;
-  } else {
-    C::store(next, blend(VectorTexel{}, C::load(previous), decay_s));
-    return !C::zero_strength(next);
-  }
+RowSpan hull(RowSpan a, RowSpan b) {
+  if (a.empty()) return b;
+  if (b.empty()) return a;
+  return {std::min(a.lo, b.lo), std::max(a.hi, b.hi)};
 }
 
-// Conversion, decay and blend of one step in one sweep: each voxel's current texel from its
-// winner (stored, then read back as stored), blended with the decayed previous texel into next.
+// Grows a span over the texels found to differ from the zero texel.
+struct SpanTracker {
+  int lo = INT32_MAX, hi = -1;
+  void add(int i) {
+    lo = std::min(lo, i);
+    hi = i;  // texels are visited in increasing i
+  }
+  RowSpan span() const {
+    return hi < 0 ? RowSpan{}
+                  : RowSpan{static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(hi + 1)};
+  }
+};
+
+// The rows of one step's sweep. Each row works on restrict-qualified pointers of its own: a store
+// through a byte pointer may alias anything, so without them the compiler reloads every captured
+// variable after each texel it writes.
+template <class C>
+struct StepRows {
+  static constexpr bool kRgba8 = std::is_same_v<C, detail::vectors::Codec<VectorStorage::kRgba8>>;
+  const detail::vectors::Segment* segments;
+  const Vec3d* xs;  // the voxel-centre offsets along x (CentreTables::x)
+  int nx;
+  float decay_s;
+  // rgba8: the strength byte after decay, as blend() then store() would give it alone (-1: the
+  // decayed strength is exactly 0, which blends to the zero texel).
+  const std::int16_t* decay8;
+
+  static constexpr std::uint32_t kZero8 = 0x00808080u;  // rgba8's zero texel, little-endian
+
+  // A previous texel with no current source: its decayed self (blend with a zero current). In
+  // rgba8 (most non-zero texels are such wakes) the blend keeps the stored direction bytes and
+  // decays the strength byte, which the step's table gives directly (decay8[0] = -1: a zero
+  // strength stays the zero texel). Returns whether the result differs from the zero texel — a
+  // direction whose strength stored as 0 does, and is cleared by the next step.
+  bool decay_alone(const std::uint8_t* __restrict previous, std::uint8_t* __restrict next) const {
+    if constexpr (kRgba8) {
+      std::uint32_t word;
+      std::memcpy(&word, previous, 4);
+      const std::int16_t decayed = decay8[word >> 24];
+      const std::uint32_t out =
+          decayed < 0 ? kZero8 : (word & 0x00ffffffu) | (static_cast<std::uint32_t>(decayed) << 24);
+      std::memcpy(next, &out, 4);
+      return out != kZero8;
+    } else {
+      if (C::zero_strength(previous)) {
+        C::store_zero(next);
+        return false;
+      }
+      alignas(16) std::uint8_t out[C::kBytes];
+      C::store(out, blend(VectorTexel{}, C::load(previous), decay_s));
+      std::memcpy(next, out, C::kBytes);
+      return !is_zero_texel(out);
+    }
+  }
+
+  static bool is_zero_texel(const std::uint8_t* p) {
+    static constexpr std::uint8_t kZero[16] = {};
+    if constexpr (kRgba8) {
+      std::uint32_t word;
+      std::memcpy(&word, p, 4);
+      return word == kZero8;
+    } else {
+      return std::memcmp(p, kZero, C::kBytes) == 0;
+    }
+  }
+
+  void zero_span(std::uint8_t* __restrict row, RowSpan span) const {
+    for (int i = span.lo; i < span.hi; ++i)
+      C::store_zero(row + static_cast<std::size_t>(i) * C::kBytes);
+  }
+
+  // A wake with no source now: each texel of `span` is the previous one decayed. Returns the span
+  // of the results that differ from the zero texel.
+  RowSpan decay_row(RowSpan span, const std::uint8_t* __restrict previous,
+                    std::uint8_t* __restrict next) const {
+    SpanTracker out;
+    for (int i = span.lo; i < span.hi; ++i) {
+      const std::size_t at = static_cast<std::size_t>(i) * C::kBytes;
+      if (decay_alone(previous + at, next + at)) out.add(i);
+    }
+    return out.span();
+  }
+
+  // A row the sources touch, over `span`: each voxel's current texel from its winner (stored, then
+  // read back as stored), blended with the decayed previous texel into next. Returns the spans of
+  // the current and next texels that differ from the zero texel.
+  std::pair<RowSpan, RowSpan> source_row(RowSpan span, const std::int32_t* __restrict winners,
+                                         Vec3d row_base, std::uint8_t* __restrict current,
+                                         const std::uint8_t* __restrict previous,
+                                         std::uint8_t* __restrict next) const {
+    SpanTracker now, later;
+    for (int i = span.lo; i < span.hi; ++i) {
+      const std::size_t at = static_cast<std::size_t>(i) * C::kBytes;
+      const std::int32_t w = winners[i];
+      if (w < 0) {
+        C::store_zero(current + at);
+        if (decay_alone(previous + at, next + at)) later.add(i);
+        continue;
+      }
+      // Encoded into locals and copied out whole: reading back a texel just stored byte by byte
+      // would stall on store forwarding.
+      alignas(16) std::uint8_t texel[C::kBytes], blended[C::kBytes];
+      C::store(texel, detail::vectors::texel_of(detail::vectors::value_of(
+                          segments[static_cast<std::size_t>(w)], row_base + xs[i], w)));
+      std::memcpy(current + at, texel, C::kBytes);
+      now.add(i);
+      C::store(blended, blend(C::load(texel), C::load(previous + at), decay_s));
+      std::memcpy(next + at, blended, C::kBytes);
+      if (!is_zero_texel(blended)) later.add(i);
+    }
+    return {now.span(), later.span()};
+  }
+};
+
+// Conversion, decay and blend of one step in one sweep, row by row, over the hull of the row's
+// spans: outside it every texture already holds the zero texel and keeps it.
 template <class C>
 void fused_step(const VectorVolume& v, std::span<const detail::vectors::Segment> segments,
                 std::span<const std::int32_t> winners, float decay_s, std::uint8_t* current,
-                const std::uint8_t* previous, std::uint8_t* next, RowFlags rows) {
+                const std::uint8_t* previous, std::uint8_t* next, RowSpans rows) {
   const detail::vectors::CentreTables centres(v);
   const Vec3i n = v.resolution;
-  auto zero_row = [&](std::uint8_t* p) {
-    for (int i = 0; i < n.x; ++i) C::store_zero(p + static_cast<std::size_t>(i) * C::kBytes);
-  };
+  const StepRows<C> pass{segments.data(), centres.x.data(), n.x, decay_s, rows.decay8};
   detail::vectors::for_each_slab(v, nullptr, "vector step", [&](int k0, int k1) {
     for (int k = k0; k < k1; ++k)
       for (int j = 0; j < n.y; ++j) {
         const std::size_t row = static_cast<std::size_t>(j) + static_cast<std::size_t>(n.y) * k;
         const std::int64_t first = v.index(0, j, k);
         const std::size_t at0 = static_cast<std::size_t>(first) * C::kBytes;
-        if (!rows.touched[row] && !rows.previous[row]) {
-          if (rows.current[row]) zero_row(current + at0);
-          if (rows.next[row]) zero_row(next + at0);
-          rows.current[row] = rows.next[row] = 0;
+        RowSpan& current_span = rows.current[row];
+        RowSpan& next_span = rows.next[row];
+        const RowSpan touched = rows.touched[row], previous_span = rows.previous[row];
+        if (touched.empty()) {
+          // No source now: the current row is zero, and each next texel the previous one decayed
+          // (over the old next span too, which the decay of zero texels clears).
+          pass.zero_span(current + at0, current_span);
+          current_span = {};
+          const RowSpan sweep = hull(previous_span, next_span);
+          next_span = sweep.empty() ? RowSpan{} : pass.decay_row(sweep, previous + at0, next + at0);
           continue;
         }
-        if (!rows.touched[row]) {
-          // A wake with no source now: the current row is zero (cleared once), and each texel is
-          // the previous one decayed.
-          if (rows.current[row]) zero_row(current + at0);
-          rows.current[row] = 0;
-          bool any = false;
-          for (int i = 0; i < n.x; ++i) {
-            const std::size_t at = at0 + static_cast<std::size_t>(i) * C::kBytes;
-            if (C::zero_strength(previous + at)) {
-              C::store_zero(next + at);
-            } else {
-              any = decay_alone<C>(previous + at, next + at, decay_s, rows.decay8) || any;
-            }
-          }
-          rows.next[row] = any;
-          continue;
-        }
-        bool any_current = false, any_next = false;
-        for (int i = 0; i < n.x; ++i) {
-          const std::size_t at = at0 + static_cast<std::size_t>(i) * C::kBytes;
-          const std::int32_t w = winners[static_cast<std::size_t>(first + i)];
-          VectorTexel now{};
-          if (w >= 0) {
-            C::store(current + at,
-                     detail::vectors::texel_of(detail::vectors::value_of(
-                         segments[static_cast<std::size_t>(w)], centres.at(i, j, k), w)));
-            now = C::load(current + at);
-            any_current = true;
-          } else {
-            C::store_zero(current + at);
-            if (C::zero_strength(previous + at)) {
-              C::store_zero(next + at);
-              continue;
-            }
-            any_next = decay_alone<C>(previous + at, next + at, decay_s, rows.decay8) || any_next;
-            continue;
-          }
-          C::store(next + at, blend(now, C::load(previous + at), decay_s));
-          any_next = any_next || !C::zero_strength(next + at);
-        }
-        rows.current[row] = any_current;
-        rows.next[row] = any_next;
+        const RowSpan sweep = hull(hull(touched, previous_span), hull(current_span, next_span));
+        const auto [now, later] = pass.source_row(sweep, winners.data() + first, centres.row(j, k),
+                                                  current + at0, previous + at0, next + at0);
+        current_span = now;
+        next_span = later;
       }
   });
 }
@@ -213,25 +286,33 @@ void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) 
   Scratch& sc = *scratch_;
   const std::size_t rows = static_cast<std::size_t>(volume_.resolution.y) * volume_.resolution.z;
   if (sc.field_rows.size() != rows || sc.current_rows.size() != rows ||
-      sc.next_rows.size() != rows) {  // the first step: every texture is zero
-    std::vector<std::uint8_t> c(rows, 0), f(rows, 0), x(rows, 0);  // built aside, then swapped
+      sc.next_rows.size() != rows) {                 // the first step: every texture is zero
+    std::vector<RowSpan> c(rows), f(rows), x(rows);  // built aside, then swapped
     sc.current_rows.swap(c);
     sc.field_rows.swap(f);
     sc.next_rows.swap(x);
   }
-  // Rows a source may write: its index box's rows (splat), or any winner's (the others).
-  sc.touched_rows.assign(rows, 0);
+  // The texels a source may write: its index box's (splat), or every winner's (the others).
+  sc.touched_rows.assign(rows, RowSpan{});
   const Vec3i n = volume_.resolution;
   if (options_.algorithm == VectorAlgorithm::kSplat) {
     for (const detail::vectors::IndexBox& b : sc.splat.boxes) {
       if (b.empty()) continue;
+      const RowSpan x{static_cast<std::uint16_t>(b.lo[0]), static_cast<std::uint16_t>(b.hi[0] + 1)};
       for (int k = b.lo[2]; k <= b.hi[2]; ++k)
-        std::fill_n(sc.touched_rows.begin() + b.lo[1] + static_cast<std::ptrdiff_t>(n.y) * k,
-                    b.hi[1] - b.lo[1] + 1, std::uint8_t{1});
+        for (int j = b.lo[1]; j <= b.hi[1]; ++j) {
+          RowSpan& r =
+              sc.touched_rows[static_cast<std::size_t>(j) + static_cast<std::size_t>(n.y) * k];
+          r = hull(r, x);
+        }
     }
   } else {
     for (std::size_t i = 0; i < winners.size(); ++i)
-      if (winners[i] >= 0) sc.touched_rows[i / static_cast<std::size_t>(n.x)] = 1;
+      if (winners[i] >= 0) {
+        RowSpan& r = sc.touched_rows[i / static_cast<std::size_t>(n.x)];
+        const auto x = static_cast<std::uint16_t>(i % static_cast<std::size_t>(n.x));
+        r = hull(r, RowSpan{x, static_cast<std::uint16_t>(x + 1)});
+      }
   }
   std::array<std::int16_t, 256> decay8{};
   const float decay_s = static_cast<float>(decay_per_s_ * dt_s);
@@ -242,10 +323,10 @@ void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) 
         t.strength > 0 ? std::int16_t{detail::vectors::unorm8(t.strength)} : std::int16_t{-1};
   }
   detail::vectors::with_codec(field_.storage(), [&](auto codec) {
-    fused_step<decltype(codec)>(volume_, segments, winners, decay_s, current_.data(),
-                                field_.bytes().data(), next_.data(),
-                                {sc.current_rows.data(), sc.field_rows.data(), sc.next_rows.data(),
-                                 sc.touched_rows.data(), decay8.data()});
+    fused_step<decltype(codec)>(
+        volume_, segments, winners, decay_s, current_.data(), field_.bytes().data(), next_.data(),
+        RowSpans{sc.current_rows.data(), sc.field_rows.data(), sc.next_rows.data(),
+                 sc.touched_rows.data(), decay8.data()});
   });
   t.blend_ms = detail::vectors::ms_since(start);
   std::swap(field_, next_);
