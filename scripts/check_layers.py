@@ -28,7 +28,7 @@ PUBLIC_LAYER = {
     "gpu.h": "gpu", "gpu_vulkan.h": "gpu",
     "distance.h": "distance", "algorithms.h": "distance", "dynamic_field.h": "distance",
     "dissertation_format.h": "distance", "gpu_distance.h": "distance", "distance_slab.h": "distance",
-    "vectors.h": "vectors", "vector_world.h": "vectors", "gpu_vectors.h": "vectors", "vector_files.h": "io",
+    "vectors.h": "vectors", "vector_world.h": "vectors", "gpu_vectors.h": "vectors", "vector_agents.h": "vectors", "gpu_vectors_vulkan.h": "vectors", "vector_files.h": "io",
     "csg.h": "csg", "csg_compile.h": "csg", "csg_files.h": "io",
     "mesh.h": "mesh", "mesh_chunks.h": "mesh", "csg_mesh.h": "mesh", "mesh_optimize.h": "mesh", "mesh_files.h": "io",
     "file.h": "io", "npy.h": "io", "vox.h": "io", "world_file.h": "io", "world_io.h": "io",

@@ -194,7 +194,9 @@ struct VectorViewParams {
   vec4f dx;     // the change per pixel to the right
   vec4f dy;     // the change per pixel down
   vec4f march;  // x: step (world units), y: density per world unit, z: max steps, w unused
-  ivec4 image;  // width, height
+  vec4f sheet;  // the reactive sheet: x 1 (drawn) or 0, y its rest height and z its push per
+                // unit of vector (volume units), w unused
+  ivec4 image;  // width, height; z = 1: pack pixels blue first (B8G8R8A8 swapchains)
 };
 
 #ifdef __cplusplus
@@ -204,7 +206,7 @@ static_assert(sizeof(JfaParams) == 32, "push-constant size of JfaParams");
 static_assert(sizeof(FimParams) == 64, "push-constant size of FimParams");
 static_assert(sizeof(RenderParams) == 192, "std430 size of RenderParams");
 static_assert(sizeof(VectorParams) == 96, "push-constant size of VectorParams");
-static_assert(sizeof(VectorViewParams) == 192, "std430 size of VectorViewParams");
+static_assert(sizeof(VectorViewParams) == 208, "std430 size of VectorViewParams");
 }  // namespace voxfield::gpu::layout
 #endif
 #undef VF_CONST

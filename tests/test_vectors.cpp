@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "error_text.h"
@@ -334,6 +335,47 @@ TEST(VectorFiles, UnrealAndUnityLayouts) {
   float s;
   std::memcpy(&s, npy.bytes.data() + 4 * (3 * 2 + 1), 4);  // a[1, 0, 0, 3]
   EXPECT_EQ(s, 0.5f);
+}
+
+// The reactive sheet seen edge-on from its rest height (the fog made invisible): flat, it is a line
+// no ray crosses; a source just above its middle pushes it down there — away from the source —
+// so the dent shows below the horizon, under the source only, and never above it.
+TEST(Vectors, TheSheetIsPushedAwayFromASource) {
+  const VectorVolume v = cube_volume(32);  // 32 units across, centred at the origin
+  const double rest = -16 + 0.3 * 32;
+  VectorSource s;
+  s.position = s.previous = {0, 0, rest + 3};
+  s.radius = 6;
+  VectorViewOptions view;
+  view.width = 160;
+  view.height = 121;  // an odd height: the middle row looks level along the sheet
+  view.auto_eye = false;
+  view.eye = {0, -80, rest};
+  view.look_at = Vec3d{0, 0, rest};
+  view.fov_deg = 30;
+  view.density = 1e-9;
+  view.sheet = true;
+  view.sheet_push = 8;
+  VectorViewOptions no_sheet = view;
+  no_sheet.sheet = false;
+  const VectorTexture zero(v.resolution, VectorStorage::kRgba16f);
+  const Image none = render_vectors(v, zero, no_sheet);
+  const Image flat = render_vectors(v, zero, view);
+  const Image pushed =
+      render_vectors(v, generate_vectors(v, std::span(&s, 1), VectorStorage::kRgba16f), view);
+  auto drawn = [&](const Image& img, int x0, int x1, int y0, int y1) {
+    int n = 0;
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) n += std::memcmp(img.pixel(x, y), none.pixel(x, y), 3) != 0;
+    return n;
+  };
+  const int mid = view.height / 2, w = view.width;
+  EXPECT_EQ(drawn(flat, 0, w, 0, view.height), 0) << "a flat sheet seen edge-on shows nothing";
+  EXPECT_GT(drawn(pushed, w / 2 - 4, w / 2 + 4, mid + 1, view.height), 8) << "the dent, below";
+  EXPECT_EQ(drawn(pushed, 0, w, 0, mid), 0) << "nothing pushed up";
+  EXPECT_EQ(drawn(pushed, 0, 12, 0, view.height), 0) << "nothing far from the source";
+  view.sheet_height = 1.5;
+  EXPECT_THROW(render_vectors(v, zero, view), InvalidArgument);
 }
 
 TEST(Vectors, TheVisualiserShowsTheFieldAndNothingElse) {

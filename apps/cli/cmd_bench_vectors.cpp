@@ -11,9 +11,9 @@
 
 #include "cli.h"
 #include "live_field.h"
-#include "vector_agents.h"
 #include "voxfield/gpu_vectors.h"
 #include "voxfield/parallel.h"
+#include "voxfield/vector_agents.h"
 #include "voxfield/vectors.h"
 
 namespace voxfield::cli {
@@ -46,7 +46,7 @@ struct Row {
 Row run_case(const std::string& test, VectorAlgorithm algorithm, Vec3i resolution, int count,
              double dt, double decay, VectorStorage storage, int steps, std::uint32_t seed,
              const std::shared_ptr<gpu::Context>& gpu_context) {
-  const VectorVolume volume = agents_volume(resolution);
+  const VectorVolume volume = vector_agents_volume(resolution);
   VectorOptions options;
   options.algorithm = algorithm;
   std::optional<VectorSimulation> cpu;
@@ -55,7 +55,7 @@ Row run_case(const std::string& test, VectorAlgorithm algorithm, Vec3i resolutio
     gpu.emplace(gpu_context, volume, storage, options, decay);
   else
     cpu.emplace(volume, storage, options, decay);
-  Agents agents(count, seed);
+  VectorAgents agents(count, seed);
   Row r{test, vector_algorithm_name(algorithm), resolution, count, dt, decay};
   std::vector<double> step_ms, generate_ms, blend_ms;
   const bool approximate =

@@ -6,10 +6,10 @@
 
 #include "cli.h"
 #include "showcase.h"
-#include "vector_agents.h"
 #include "voxfield/file.h"
 #include "voxfield/png.h"
 #include "voxfield/scene.h"
+#include "voxfield/vector_agents.h"
 #include "voxfield/vector_files.h"
 #include "voxfield/vector_world.h"
 
@@ -90,11 +90,11 @@ void showcase_world_flow(const std::filesystem::path& out, std::uint64_t seed, s
 
 void showcase_vectors(const std::filesystem::path& out, std::uint64_t seed, std::ostream& md,
                       std::vector<Timing>& timings) {
-  const VectorVolume volume = agents_volume({64, 64, 64});
+  const VectorVolume volume = vector_agents_volume({64, 64, 64});
   const double dt = 1.0 / 60;
   const int steps = 90;
   VectorSimulation sim(volume, VectorStorage::kRgba8, {}, 1.0);
-  Agents agents(20, 2026);
+  VectorAgents agents(20, 2026);
   std::vector<VectorSource> last;
   double step_ms = 0;
   for (int i = 0; i < steps; ++i) {

@@ -21,6 +21,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -251,15 +252,23 @@ struct VectorSample {
 };
 VectorSample sample_vectors(const VectorVolume& volume, const VectorTexture& texture, Vec3d world);
 
-// The debug visualiser: a camera looking at the volume's centre from `eye` (world space), rays
-// intersected with the box and marched front to back, density from strength and colour from
-// direction (|component| per channel), over a dark background.
+// The debug visualiser: a camera at `eye` (world space) looking at the volume's centre (or at
+// look_at), rays intersected with the box and marched front to back, density from strength and
+// colour from direction (|component| per channel), over a dark background. With `sheet`, a
+// reactive surface as well: a cloth across the box at sheet_height (a fraction of its z extent),
+// each point displaced along the box's z axis by sheet_push world units per unit of the field's
+// vector (direction x strength) at its rest position — what a game's grass or water surface does
+// with the field — drawn opaque, lit, and tinted by the field's direction where it is strong.
 struct VectorViewOptions {
   int width = 640, height = 480;
   Vec3d eye{0, 0, 0};  // (0,0,0) with auto_eye: placed from the box (an oblique view)
   bool auto_eye = true;
+  std::optional<Vec3d> look_at;  // default: the box's centre
   double fov_deg = 45;
   double density = 8;  // opacity per world unit at strength 1, scaled by the box size
+  bool sheet = false;
+  double sheet_height = 0.3;  // 0..1 of the box's z extent
+  double sheet_push = 0.6;    // world units per unit of field vector
 };
 Image render_vectors(const VectorVolume& volume, const VectorTexture& texture,
                      const VectorViewOptions& view = {});

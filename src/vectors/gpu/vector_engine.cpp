@@ -296,7 +296,8 @@ void VectorEngine::record(Recorder& rec, std::span<const VectorSource> sources,
   rec.end_pass(ticket, step ? "step" : "generate");
 }
 
-Buffer& VectorEngine::record_view(Recorder& rec, Buffer& texels, const VectorViewOptions& view) {
+Buffer& VectorEngine::record_view(Recorder& rec, Buffer& texels, const VectorViewOptions& view,
+                                  bool bgra) {
   if (!(view.fov_deg > 1 && view.fov_deg < 179) || !(view.density > 0) ||
       !std::isfinite(view.density))
     throw InvalidArgument(
@@ -307,7 +308,13 @@ Buffer& VectorEngine::record_view(Recorder& rec, Buffer& texels, const VectorVie
   // The camera as visualise.cpp places it, in doubles, handed over as floats.
   const double diagonal = v.size.length();
   const Vec3d eye = view.auto_eye ? v.to_world({1.6, -0.9, 1.3}) : view.eye;
-  const Vec3d forward = (v.centre - eye).normalized();
+  const Vec3d target = view.look_at.value_or(v.centre);
+  if (!((target - eye).length() > 0))
+    throw InvalidArgument("render_vectors: the camera looks at its own position");
+  if (view.sheet &&
+      (!(view.sheet_height >= 0 && view.sheet_height <= 1) || !std::isfinite(view.sheet_push)))
+    throw InvalidArgument("render_vectors: the sheet's height must be 0..1, its push finite");
+  const Vec3d forward = (target - eye).normalized();
   Vec3d up{0, 0, 1};
   if (std::abs(dot(up, forward)) > 0.99) up = {0, 1, 0};
   const Vec3d right = cross(forward, up).normalized();
@@ -336,7 +343,9 @@ Buffer& VectorEngine::record_view(Recorder& rec, Buffer& texels, const VectorVie
   params.dy = f4(true_up * (-2.0 / view.height * tan_half));
   params.march = {static_cast<float>(step), static_cast<float>(view.density / diagonal),
                   static_cast<float>(4.0 * (v.resolution.x + v.resolution.y + v.resolution.z)), 0};
-  params.image = {view.width, view.height, 0, 0};
+  params.sheet = {view.sheet ? 1.0f : 0.0f, static_cast<float>(view.sheet_height),
+                  static_cast<float>(view.sheet_push / v.size.z), 0};
+  params.image = {view.width, view.height, bgra ? 1 : 0, 0};
   grow(view_, sizeof params, false);
   grow(pixels_, static_cast<VkDeviceSize>(view.width) * view.height * 4, false);
   rec.update(view_, 0, &params, sizeof params);

@@ -45,8 +45,10 @@ class VectorEngine {
               const Targets& targets, VectorGpuStats& stats);
   // The buffer holding the winners after a recorded generation with want_winners.
   Buffer& winners() { return *winners_; }
-  // Records the visualiser over `texels` into the engine's pixel buffer; returns it.
-  Buffer& record_view(Recorder& rec, Buffer& texels, const VectorViewOptions& view);
+  // Records the visualiser over `texels` into the engine's pixel buffer (packed 8-bit pixels,
+  // blue first with `bgra`); returns it.
+  Buffer& record_view(Recorder& rec, Buffer& texels, const VectorViewOptions& view,
+                      bool bgra = false);
 
   DescriptorArena& sets() { return sets_; }
   const VectorVolume& volume() const { return volume_; }
