@@ -6,10 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <functional>
 
+#include "gpu/vulkan_context.h"
 #include "gpu_suite.h"
 #include "vector_test_inputs.h"
-#include "voxfield/gpu_vectors.h"
+#include "voxfield/gpu_vectors_vulkan.h"
 
 using namespace voxfield;
 
@@ -174,6 +176,54 @@ TEST(GpuVectorPasses, TheVisualiserMatchesTheCpuImage) {
   const Image a = sim.render(view), b = gpu::render_vectors(*ctx, v, sim.field(), view);
   for (int y = 0; y < view.height; ++y)
     for (int x = 0; x < view.width; ++x) ASSERT_EQ(std::memcmp(a.pixel(x, y), b.pixel(x, y), 3), 0);
+  testing_backends::expect_no_validation_messages(Backend::kVulkan);
+}
+
+// Steps and pictures recorded into a command buffer the application owns and submits: the same
+// fields as the simulation's own steps, and the visualiser's pixels in either byte order.
+TEST(GpuVectorPasses, StepsRecordedIntoTheApplicationsCommandBuffer) {
+  if (!test::gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = test::validated_context();
+  gpu::Context::Impl& c = ctx->impl();
+  const VectorVolume v = test::shapes()[2].volume;
+  gpu::VectorSimulation own(ctx, v, VectorStorage::kRgba8, {}, 2.0);
+  gpu::VectorSimulation app(ctx, v, VectorStorage::kRgba8, {}, 2.0);
+  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  ai.commandPool = c.command_pool;
+  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ai.commandBufferCount = 1;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  ASSERT_EQ(vkAllocateCommandBuffers(c.device, &ai, &cmd), VK_SUCCESS);
+  auto run = [&](const std::function<void()>& record) {
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    vkBeginCommandBuffer(cmd, &bi);
+    record();
+    vkEndCommandBuffer(cmd);
+    c.submit_and_wait(cmd);
+  };
+  VectorViewOptions view;
+  view.width = 40;
+  view.height = 30;
+  view.sheet = true;
+  for (int step = 0; step < 4; ++step) {
+    const std::vector<VectorSource> sources = test::random_sources(v, 6, 90 + step);
+    own.step(sources, 0.05);
+    gpu::VectorFieldBuffer field;
+    VkBuffer pixels = VK_NULL_HANDLE;
+    const gpu::PixelOrder order = step % 2 ? gpu::PixelOrder::kBgra : gpu::PixelOrder::kRgba;
+    view.width = 40 + 16 * step;  // a growing picture replaces the pixel buffer after the step
+    run([&] {
+      field = gpu::record_step(app, cmd, sources, 0.05);
+      pixels = gpu::record_render(app, cmd, view, order);
+    });
+    EXPECT_EQ(field.buffer, gpu::field_buffer(app).buffer);
+    EXPECT_EQ(field.bytes, static_cast<VkDeviceSize>(v.voxel_count()) * 4);
+    ASSERT_EQ(first_difference(app.field().bytes(), own.field().bytes()), -1) << "step " << step;
+    ASSERT_NE(pixels, VkBuffer{VK_NULL_HANDLE});
+  }
+  EXPECT_EQ(app.steps(), 4);
+  vkFreeCommandBuffers(c.device, c.command_pool, 1, &cmd);
   testing_backends::expect_no_validation_messages(Backend::kVulkan);
 }
 

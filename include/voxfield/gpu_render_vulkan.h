@@ -8,8 +8,6 @@
 
 namespace voxfield::gpu {
 
-enum class PixelOrder { kRgba, kBgra };  // byte order of a packed 32-bit pixel
-
 // Records a frame of `renderer`'s synced scene into the application's command buffer `cmd` (on
 // the adopted queue's family): frame parameters, the ray-marching dispatch, and a barrier that
 // makes the pixels readable by transfers. Returns the buffer holding them: width x height packed

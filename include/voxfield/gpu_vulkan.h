@@ -33,4 +33,8 @@ struct AdoptedDevice {
 // Throws InvalidArgument for missing handles, GpuUnavailable when the queue cannot compute.
 std::shared_ptr<Context> adopt(const AdoptedDevice& device);
 
+// Byte order of the packed 32-bit pixels voxfield records into an application's frame (the ray
+// marcher's, gpu_render_vulkan.h; the vector-field visualiser's, gpu_vectors_vulkan.h).
+enum class PixelOrder { kRgba, kBgra };
+
 }  // namespace voxfield::gpu

@@ -6,6 +6,7 @@
 
 #include "vector_engine.h"
 #include "voxfield/error.h"
+#include "voxfield/gpu_vectors_vulkan.h"
 
 namespace voxfield::gpu {
 namespace {
@@ -48,6 +49,20 @@ Image download_image(VectorEngine& e, Context::Impl& c, Buffer& pixels, const Ve
       std::memcpy(image.pixel(x, y), from, 3);
     }
   return image;
+}
+
+// The stages an application may read a recorded field in: compute and transfers, and vertex and
+// fragment shaders where the context's queue family draws.
+VkPipelineStageFlags reader_stages(Context::Impl& c) {
+  std::uint32_t count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(c.physical, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  vkGetPhysicalDeviceQueueFamilyProperties(c.physical, &count, families.data());
+  VkPipelineStageFlags stages =
+      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
+  if (c.queue_family < count && (families[c.queue_family].queueFlags & VK_QUEUE_GRAPHICS_BIT))
+    stages |= VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT;
+  return stages;
 }
 
 void submitted(Recorder& rec, VectorGpuStats& stats, std::vector<PassTiming>* timings) {
@@ -199,6 +214,48 @@ Image VectorSimulation::render(const VectorViewOptions& view) {
     rec.submit();
   }
   return download_image(s.engine, c, *pixels, view, nullptr);
+}
+
+VectorFieldBuffer record_step(VectorSimulation& sim, VkCommandBuffer cmd,
+                              std::span<const VectorSource> sources, double dt_s) {
+  if (!std::isfinite(dt_s) || dt_s <= 0)
+    throw InvalidArgument("vector simulation: the time step must be finite and > 0");
+  validate_sources(sources);
+  VectorSimulation::Impl& s = sim.impl();
+  Context::Impl& c = s.context->impl();
+  c.require_device();
+  {
+    Recorder rec(c, cmd, s.engine.sets());
+    VectorEngine::Targets t;
+    t.current = &s.current;
+    t.previous = &s.field;
+    t.next = &s.next;
+    t.decay = static_cast<float>(s.decay_per_s * dt_s);
+    VectorGpuStats st;
+    s.engine.record(rec, sources, s.options, t, st);
+    // The application's shaders and copies read the new field after this (its vertex and
+    // fragment shaders too where the queue draws).
+    rec.expose(s.next, reader_stages(c), VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+    s.stats = st;
+  }
+  std::swap(s.field, s.next);
+  ++s.steps;
+  return field_buffer(sim);
+}
+
+VectorFieldBuffer field_buffer(VectorSimulation& sim) {
+  return {sim.impl().field.handle(), 0, sim.impl().engine.texture_bytes()};
+}
+
+VkBuffer record_render(VectorSimulation& sim, VkCommandBuffer cmd, const VectorViewOptions& view,
+                       PixelOrder order) {
+  VectorSimulation::Impl& s = sim.impl();
+  Context::Impl& c = s.context->impl();
+  c.require_device();
+  Recorder rec(c, cmd, s.engine.sets());
+  Buffer& pixels = s.engine.record_view(rec, s.field, view, order == PixelOrder::kBgra);
+  rec.expose(pixels, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+  return pixels.handle();
 }
 
 const VectorVolume& VectorSimulation::volume() const {

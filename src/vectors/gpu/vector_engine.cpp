@@ -85,11 +85,20 @@ Buffer VectorEngine::make_texture() const {
 
 Buffer& VectorEngine::grow(Buffer& b, VkDeviceSize bytes, bool host_visible) {
   if (b.handle() != VK_NULL_HANDLE && b.size() >= bytes) return b;
-  // The arena's sets may name the old buffer, whose handle the new one may reuse: recycle them
-  // (every earlier command has finished: the caller waited, vector_engine.h).
-  sets_.reset();
+  // A replaced buffer may still be named by sets bound earlier in the command buffer being
+  // recorded (a step before a picture in one frame): it is retired, alive, until settle().
+  if (b.handle() != VK_NULL_HANDLE) retired_.push_back(std::move(b));
   b = Buffer(c_, std::max<VkDeviceSize>(bytes, 64), kVectorBufferUsage, host_visible);
   return b;
+}
+
+void VectorEngine::settle() {
+  if (retired_.empty()) return;
+  // Every earlier command has finished (record()'s precondition): the sets naming retired buffers
+  // are recycled with all others before the buffers go, so no new buffer can reuse a handle a
+  // cached set still names.
+  sets_.reset();
+  retired_.clear();
 }
 
 void VectorEngine::stage(Recorder& rec, const Upload& up, VectorGpuStats& stats) {
@@ -132,6 +141,7 @@ void VectorEngine::record(Recorder& rec, std::span<const VectorSource> sources,
   validate_sources(sources);
   if (sources.size() > static_cast<std::size_t>(INT32_MAX))
     throw InvalidArgument("vector field: more than 2^31 - 1 sources");
+  settle();
   const Vec3i n = volume_.resolution;
   const int count = static_cast<int>(sources.size());
   Upload up;

@@ -37,9 +37,10 @@ class VectorEngine {
     bool want_winners = false;  // leave each voxel's source in winners()
   };
   // Records the uploads of `sources` and the passes of one generation (a step when targets has
-  // previous and next) into `rec`, a recorder using sets() — one record() or record_view() per
-  // recording, and only once the commands of the previous one have finished (a buffer that grows
-  // is replaced, and the sets naming it recycled). Throws InvalidArgument for invalid sources
+  // previous and next) into `rec`, a recorder using sets(), once every command recorded by an
+  // earlier record() or record_view() has finished (their uploads are reused). record_view() may
+  // follow in the same command buffer: buffers it replaces are retired, not destroyed, until the
+  // next record(). Throws InvalidArgument for invalid sources
   // (nothing recorded).
   void record(Recorder& rec, std::span<const VectorSource> sources, const VectorOptions& options,
               const Targets& targets, VectorGpuStats& stats);
@@ -58,6 +59,7 @@ class VectorEngine {
   struct Upload;
   void stage(Recorder& rec, const Upload& up, VectorGpuStats& stats);
   Buffer& grow(Buffer& b, VkDeviceSize bytes, bool host_visible);
+  void settle();  // recycles the sets and destroys the retired buffers (earlier work finished)
 
   Context::Impl& c_;
   VectorVolume volume_;
@@ -71,6 +73,7 @@ class VectorEngine {
   Buffer* winners_ = nullptr;          // which of them holds the last generation's
   Buffer unused_read_, unused_write_;  // for bindings a pass leaves alone
   Buffer view_, pixels_;               // the visualiser's parameters and image
+  std::vector<Buffer> retired_;        // replaced buffers earlier commands may still name
   bool uploaded_tables_ = false;
 };
 
