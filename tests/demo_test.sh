@@ -46,6 +46,54 @@ grep -q "CPU renderer" "$out/cpu.err" || fail "cpu: the demo did not say it draw
 RUN_ENV="VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json" run opengl --backend vulkan
 grep -q "shown through OpenGL" "$out/opengl.err" || fail "opengl: the demo did not say it fell back to OpenGL"
 
+# The vectors mode: the paper's agents, their field stepped once a frame (benchmark mode: one
+# fixed step per frame) and drawn with the reactive sheet — on the Vulkan passes (the frame's step
+# and picture recorded into the frame) under validation, on the CPU, and through OpenGL. The field
+# is the same bit for bit on both backends, so the pictures right of the panel agree within the
+# visualiser's float tolerance; they show the green sheet and the coloured field.
+vrun() {  # name, demo arguments...
+  local name=$1
+  shift
+  local status=0
+  env ${RUN_ENV:-} xvfb-run -a -s "-screen 0 1024x768x24" "$DEMO" --mode vectors --benchmark --frames 20 --width 640 \
+      --height 360 --csv "$out/$name.csv" --screenshot "$out/$name.png" "$@" >"$out/$name.out" 2>"$out/$name.err" || status=$?
+  if [ "$status" -ne 0 ]; then
+    fail "$name: exit status $status: $(tail -5 "$out/$name.err")"
+    return
+  fi
+  grep -q "validation:" "$out/$name.err" && fail "$name: validation messages: $(grep -m3 validation: "$out/$name.err")"
+  awk -F, 'END { exit !(NR == 21 && $5 == 20) }' "$out/$name.csv" || fail "$name: expected 20 frames of one step each"
+  echo "ok: $name ($(grep -m1 "vectors mode" "$out/$name.err"))"
+}
+vrun vectors-vulkan --backend vulkan --validation
+grep -q "stepped and drawn on the Vulkan device" "$out/vectors-vulkan.err" || fail "vectors-vulkan: not on the device"
+# Every frame of the Vulkan path: voxfield's step and picture go in the frame (no submit of its own).
+awk -F, 'NR > 1 && ($6 != 0 || $7 < 2) { bad = 1 } END { exit bad }' "$out/vectors-vulkan.csv" ||
+  fail "vectors-vulkan: a frame with a submission of voxfield's own, or without its step and picture"
+vrun vectors-cpu --backend cpu
+RUN_ENV="VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json" vrun vectors-opengl --backend vulkan
+/usr/bin/python3 - "$out" <<'PY' || fail "vectors: the pictures differ or lack the sheet and the field"
+import sys
+from PIL import Image
+out = sys.argv[1]
+shots = {n: Image.open(f"{out}/vectors-{n}.png").convert("RGB") for n in ("vulkan", "cpu", "opengl")}
+w, h = shots["cpu"].size
+box = (370, 0, w, h)  # right of the panel
+px = {n: list(s.crop(box).getdata()) for n, s in shots.items()}
+for n in ("vulkan", "opengl"):
+    worst = max(max(abs(a - b) for a, b in zip(p, q)) for p, q in zip(px[n], px["cpu"]))
+    close = sum(max(abs(a - b) for a, b in zip(p, q)) <= 2 for p, q in zip(px[n], px["cpu"]))
+    print(f"vectors {n} vs cpu: {close} of {len(px['cpu'])} pixels within 2, worst {worst}")
+    assert close >= 0.99 * len(px["cpu"]) and worst <= 16, n
+def is_green(p):
+    return p[1] > p[0] + 30 and p[1] > p[2] + 30
+background = max(set(px["cpu"]), key=px["cpu"].count)
+green = sum(map(is_green, px["cpu"]))
+coloured = sum(sum(p) > sum(background) + 60 and not is_green(p) for p in px["cpu"])
+print(f"vectors: {green} sheet pixels, {coloured} field pixels")
+assert green > 2000 and coloured > 300
+PY
+
 # Interactive: real input events through the window system (xdotool). A left click places and a
 # right click carves at the ray hit, each a separate edit; F12 saves a screenshot.
 if command -v xdotool >/dev/null; then

@@ -11,6 +11,7 @@
 #include "demo_world.h"
 #include "fly_camera.h"
 #include "gl_window.h"
+#include "vectors_mode.h"
 #include "voxfield/gpu_render.h"
 #include "vulkan_window.h"
 
@@ -32,6 +33,8 @@ struct Options {
   double interval_ms = 200;
   std::string csv;
   std::string screenshot;
+  std::string mode = "world";  // or "vectors" (vectors_mode.h)
+  VectorsSettings vectors;
 };
 
 // What draws the frames, and why.
@@ -66,6 +69,10 @@ class Demo {
   void panel();
   void help();
   void take_screenshot(const std::string& path);
+  // Switches to the vectors mode (or rebuilds it with new settings), on the render path's device
+  // when there is one, else on the CPU; to the world with `vectors` false.
+  void set_mode(bool vectors);
+  bool draw_vectors(VulkanWindow::Screenshot* shot);
   bool gpu_can_draw() const { return path_.renderer != nullptr; }
   std::string title() const;
   GLFWwindow* glfw() const { return vk_ ? vk_->window() : gl_->window(); }
@@ -80,6 +87,8 @@ class Demo {
   std::unique_ptr<GlWindow> gl_;      // otherwise this one, showing CPU frames
   std::string no_vulkan_;             // why there is no Vulkan window
   std::unique_ptr<DemoWorld> world_;
+  std::unique_ptr<VectorsMode> vectors_;  // the vectors mode, when on
+  VectorsSettings vectors_settings_;
   RenderPath path_;
   FlyCamera camera_;
   Brush brush_;

@@ -48,8 +48,10 @@ Demo::Demo(const Options& o) : options_(o) {
   ui_chunk_ = o.world.chunk_edge;
   ui_clamp_ = static_cast<float>(o.world.clamp);
   ui_metric_ = static_cast<int>(o.world.metric);
+  vectors_settings_ = o.vectors;
   choose_path(o.backend);
   frame_camera();
+  if (o.mode == "vectors") set_mode(true);
 
   // Input callbacks first: the ImGui backend chains to them.
   glfwSetWindowUserPointer(glfw(), this);
@@ -115,12 +117,15 @@ Demo::~Demo() {
   }
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();
+  vectors_.reset();
   path_ = RenderPath{};  // voxfield's objects on the device go before the device
   if (imgui_pool_) vkDestroyDescriptorPool(vk_->device(), imgui_pool_, nullptr);
 }
 
 void Demo::choose_path(const std::string& backend) {
   wait_idle();
+  const bool vectors = vectors_ != nullptr;
+  vectors_.reset();  // its field may live on the device about to go
   path_ = RenderPath{};
   const Backend b = parse_backend(backend);
   if (!vk_) {
@@ -133,8 +138,8 @@ void Demo::choose_path(const std::string& backend) {
                 " is not a hardware GPU; --backend vulkan uses it)";
   } else {
     try {
-      path_.context = gpu::adopt(
-          {vk_->instance(), vk_->physical(), vk_->device(), vk_->queue(), vk_->queue_family()});
+      path_.context = gpu::adopt({vk_->instance(), vk_->physical(), vk_->device(), vk_->queue(),
+                                  vk_->queue_family(), vk_->float64()});
       path_.renderer = std::make_unique<gpu::SceneRenderer>(path_.context);
       path_.why = "Vulkan ray marcher on " + vk_->device_name();
     } catch (const Error& e) {
@@ -144,6 +149,7 @@ void Demo::choose_path(const std::string& backend) {
   }
   ui_backend_ = path_.renderer ? 1 : 0;
   std::cerr << "voxfield-demo: " << path_.why << "\n";
+  if (vectors) set_mode(true);
 }
 
 void Demo::frame_camera() {
@@ -155,6 +161,9 @@ void Demo::frame_camera() {
 }
 
 std::string Demo::title() const {
+  if (vectors_)
+    return std::string("voxfield-demo — vectors — ") +
+           (vectors_->on_gpu() ? "Vulkan passes" : "CPU passes");
   return "voxfield-demo — " + world_->origin() + " — " +
          (gpu_can_draw() ? "Vulkan ray marcher" : "CPU renderer");
 }
@@ -213,7 +222,8 @@ void Demo::handle_input(double dt_s) {
       if (pressed(GLFW_KEY_0 + k)) brush_.material = static_cast<std::uint8_t>(k);
     const double speed =
         (down(GLFW_KEY_LEFT_CONTROL) || down(GLFW_KEY_RIGHT_CONTROL) ? 4.0 : 1.0) *
-        std::max(16.0, world_->scene().box().size().x * 0.35);  // voxels per second
+        (vectors_ ? 4.0  // world units per second across the agents' 10-unit box
+                  : std::max(16.0, world_->scene().box().size().x * 0.35));  // voxels per second
     Vec3d move{0, 0, 0};
     const Vec3d f = camera_.forward(), r = camera_.right();
     if (down(GLFW_KEY_W)) move = move + f;
@@ -233,7 +243,7 @@ void Demo::handle_input(double dt_s) {
   last_x_ = x;
   last_y_ = y;
   const std::vector<int> clicks = std::exchange(clicks_, {});
-  if (!io.WantCaptureMouse) {
+  if (!io.WantCaptureMouse && !vectors_) {  // the vectors mode has nothing to edit
     if (scroll_ != 0)
       brush_.radius = std::clamp(brush_.radius + static_cast<int>(std::lround(scroll_)), 0, 32);
     const EditOp left_op = brush_.paint ? EditOp::kPaint : EditOp::kPlace;
@@ -264,6 +274,7 @@ bool Demo::draw(VulkanWindow::Screenshot* shot) {
   panel();
   if (show_help_) help();
   ImGui::Render();
+  if (vectors_) return draw_vectors(shot);
 
   RenderOptions ro;
   ro.width = width();
@@ -339,6 +350,7 @@ int Demo::run() {
     if (!csv) throw IoError(options_.csv + ": cannot create");
     // The GPU columns are voxfield's own traffic in the frame (scene copies and the ray marcher's
     // work; the demo's swapchain submission is not voxfield's): zero on the CPU renderer.
+    // In the vectors mode the edits column counts the field's steps so far.
     csv << "frame,frame_ms,update_ms,render_ms,edits,gpu_submits,gpu_dispatches,gpu_bytes_up,gpu_"
            "bytes_down\n";
   }
@@ -359,7 +371,21 @@ int Demo::run() {
     const double dt_s = std::min(0.1, ms_between(previous, t0) / 1000.0);
     previous = t0;
     double update_ms = 0;
-    if (stream) {
+    if (vectors_) {
+      if (options_.benchmark) {  // the camera circles the agents' box
+        const double angle = 0.6 + frame * 0.02;
+        // Looking a little to the left of the box, so it shows beside the panel.
+        const Vec3d eye{13 * std::cos(angle), 13 * std::sin(angle), 7};
+        const Vec3d right{-std::sin(angle), std::cos(angle), 0};  // the camera's right
+        camera_.look(eye, Vec3d{0, 0, -1.5} - right * 6.0);
+      } else {
+        handle_input(dt_s);
+      }
+      const auto a = Clock::now();
+      vectors_->advance(options_.benchmark ? 1.0 / 60 : dt_s);
+      update_ms = ms_between(a, Clock::now());
+      last_.update_ms = update_ms;
+    } else if (stream) {
       const Box3i box = world_->scene().box();
       const Vec3i s = box.size();
       const double angle = 0.6 + frame * 0.02;
@@ -393,8 +419,8 @@ int Demo::run() {
     if (csv.is_open()) {
       const gpu::Counters g = path_.context ? path_.context->counters() : gpu::Counters{};
       csv << frame << "," << last_.frame_ms << "," << update_ms << "," << last_.render_ms << ","
-          << world_->edits() << "," << g.submits - gpu_before.submits << ","
-          << g.dispatches - gpu_before.dispatches << ","
+          << (vectors_ ? vectors_->steps() : world_->edits()) << ","
+          << g.submits - gpu_before.submits << "," << g.dispatches - gpu_before.dispatches << ","
           << g.bytes_uploaded - gpu_before.bytes_uploaded << ","
           << g.bytes_downloaded - gpu_before.bytes_downloaded << "\n";
     }
@@ -439,6 +465,17 @@ int main(int argc, char** argv) {
   app.add_option("--csv", o.csv,
                  "one row per frame (frame_ms, update_ms, render_ms, edits, GPU traffic)");
   app.add_option("--screenshot", o.screenshot, "with --frames: save the last frame as PNG");
+  app.add_option("--mode", o.mode,
+                 "world (paint voxels, fields follow) or vectors (the vector-field paper's agents, "
+                 "their field and a reactive sheet)")
+      ->check(CLI::IsMember({"world", "vectors"}));
+  app.add_option("--vector-resolution", o.vectors.resolution, "vectors mode: voxels per axis")
+      ->check(CLI::IsMember({16, 32, 64, 128}));
+  app.add_option("--vector-sources", o.vectors.sources, "vectors mode: agents")
+      ->check(CLI::Range(1, 1000));
+  app.add_option("--vector-algorithm", o.vectors.algorithm,
+                 "vectors mode: 0 brute, 1 splat, 2 jfa, 3 jfa+1, 4 jfa+2")
+      ->check(CLI::Range(0, 4));
   CLI11_PARSE(app, argc, argv);
   if (o.benchmark && o.frames == 0) o.frames = 300;
   glfwSetErrorCallback([](int code, const char* message) {

@@ -17,6 +17,28 @@ void Demo::panel() {
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
   ImGui::Begin("voxfield");
+  int mode = vectors_ ? 1 : 0;
+  const char* modes[] = {"world", "vectors"};
+  if (ImGui::Combo("mode", &mode, modes, 2)) set_mode(mode == 1);
+  if (vectors_) {
+    ImGui::TextWrapped("%s", status_.c_str());
+    ImGui::Text("frame %.1f ms (%.1f FPS), picture %.1f ms", last_.frame_ms,
+                last_.frame_ms > 0 ? 1000.0 / last_.frame_ms : 0.0, last_.render_ms);
+    vectors_->stats_panel();
+    if (ImGui::CollapsingHeader("Field", ImGuiTreeNodeFlags_DefaultOpen) &&
+        VectorsMode::panel(vectors_settings_)) {
+      try {
+        set_mode(true);
+      } catch (const Error& e) {
+        status_ = e.what();
+      }
+    }
+    const char* backends[] = {"cpu", "vulkan"};
+    if (vk_ && ImGui::Combo("backend", &ui_backend_, backends, 2))
+      choose_path(backends[ui_backend_]);
+    ImGui::End();
+    return;
+  }
   ImGui::TextWrapped("%s", gpu_can_draw()
                                ? path_.why.c_str()
                                : (path_.renderer ? "CPU renderer (this view is not on the GPU yet)"

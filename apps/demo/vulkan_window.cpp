@@ -136,9 +136,15 @@ void VulkanWindow::open(int width, int height, const std::string& title, bool va
   qci.queueCount = 1;
   qci.pQueuePriorities = &priority;
   const char* device_extensions[] = {VK_KHR_SWAPCHAIN_EXTENSION_NAME};
+  // Doubles in shaders where the device has them: voxfield's vector-field passes need them.
+  VkPhysicalDeviceFeatures supported{}, enabled{};
+  vkGetPhysicalDeviceFeatures(physical_, &supported);
+  enabled.shaderFloat64 = supported.shaderFloat64;
+  float64_ = supported.shaderFloat64 == VK_TRUE;
   VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   dci.queueCreateInfoCount = 1;
   dci.pQueueCreateInfos = &qci;
+  dci.pEnabledFeatures = &enabled;
   dci.enabledExtensionCount = 1;
   dci.ppEnabledExtensionNames = device_extensions;
   check(vkCreateDevice(physical_, &dci, nullptr, &device_), "vkCreateDevice");

@@ -56,6 +56,7 @@ class VulkanWindow {
   std::uint32_t min_image_count() const { return min_image_count_; }
   std::string device_name() const { return device_name_; }
   bool device_is_hardware() const { return hardware_; }
+  bool float64() const { return float64_; }  // shaderFloat64 is enabled
   bool bgra() const { return format_ == VK_FORMAT_B8G8R8A8_UNORM; }
   int width() const { return static_cast<int>(extent_.width); }
   int height() const { return static_cast<int>(extent_.height); }
@@ -96,6 +97,7 @@ class VulkanWindow {
   std::uint32_t family_ = 0;
   std::string device_name_;
   bool hardware_ = false;
+  bool float64_ = false;
 
   VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
   VkFormat format_ = VK_FORMAT_UNDEFINED;

@@ -19,9 +19,10 @@ struct VectorFieldBuffer {
 
 // Records one step of `sim` (the sources' upload, the passes) into `cmd`, on the adopted queue's
 // family, and a barrier that makes the new field readable by the application's compute shaders and
-// transfers (and its vertex and fragment shaders where that queue family draws). Returns the buffer holding the field after the step. The
-// step's upload and buffers are reused by the next: wait for `cmd` before recording or running
-// another step. Throws InvalidArgument as VectorSimulation::step does (nothing recorded).
+// transfers (and its vertex and fragment shaders where that queue family draws). Returns the buffer
+// holding the field after the step. The step's upload and buffers are reused by the next: wait for
+// `cmd` before recording or running another step. Throws InvalidArgument as VectorSimulation::step
+// does (nothing recorded).
 VectorFieldBuffer record_step(VectorSimulation& sim, VkCommandBuffer cmd,
                               std::span<const VectorSource> sources, double dt_s);
 

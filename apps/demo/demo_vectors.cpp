@@ -1,0 +1,84 @@
+// voxfield-demo — switching to the vectors mode and drawing its frames (vectors_mode.h): on the
+// Vulkan path the frame's step and picture are recorded into the frame's command buffer and the
+// pixels copied to the swapchain image; otherwise the CPU's picture is presented as the world's
+// CPU frames are.
+#include <backends/imgui_impl_opengl2.h>
+#include <backends/imgui_impl_vulkan.h>
+#include <imgui.h>
+
+#include <iostream>
+
+#include "demo.h"
+#include "voxfield/error.h"
+
+namespace voxfield::demo {
+
+void Demo::set_mode(bool vectors) {
+  wait_idle();
+  const bool was_on = vectors_ != nullptr;
+  vectors_.reset();
+  if (!vectors) {
+    frame_camera();
+    status_ = "world mode";
+    return;
+  }
+  try {
+    vectors_ = std::make_unique<VectorsMode>(path_.context, vectors_settings_);
+    status_ = std::string("vectors mode: the field is stepped and drawn on the ") +
+              (vectors_->on_gpu() ? "Vulkan device" : "CPU");
+  } catch (const Error& e) {
+    if (!path_.context) throw;
+    // The device cannot run the vector passes (no shaderFloat64, a texture past its buffers):
+    // the CPU runs the mode, and the panel says why.
+    vectors_ = std::make_unique<VectorsMode>(nullptr, vectors_settings_);
+    status_ = std::string("vectors mode on the CPU: ") + e.what();
+  }
+  std::cerr << "voxfield-demo: " << status_ << "\n";
+  if (!was_on) VectorsMode::frame(camera_);
+}
+
+bool Demo::draw_vectors(VulkanWindow::Screenshot* shot) {
+  const int w = width(), h = height();
+  const auto t0 = Clock::now();
+  if (gl_) {
+    const Image img = vectors_->render(camera_, w, h);
+    gl_->draw_frame(
+        img, [] { ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData()); }, shot);
+    last_.render_ms = ms_between(t0, Clock::now());
+    return true;
+  }
+  VkBufferImageCopy copy{};
+  copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  copy.imageExtent = {static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(h), 1};
+  std::function<void(VkCommandBuffer, VkImage)> fill;
+  if (vectors_->on_gpu()) {
+    fill = [&](VkCommandBuffer cmd, VkImage image) {
+      const VkBuffer pixels = vectors_->record_frame(
+          cmd, camera_, w, h, vk_->bgra() ? gpu::PixelOrder::kBgra : gpu::PixelOrder::kRgba);
+      vkCmdCopyBufferToImage(cmd, pixels, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+    };
+  } else {
+    const Image img = vectors_->render(camera_, w, h);
+    void* mapped = nullptr;
+    const VkBuffer staging = vk_->staging(static_cast<VkDeviceSize>(w) * h * 4, &mapped);
+    auto* dst = static_cast<std::uint8_t*>(mapped);
+    const bool bgra = vk_->bgra();
+    for (std::size_t i = 0; i < static_cast<std::size_t>(w) * h; ++i) {
+      dst[4 * i + 0] = img.rgb[3 * i + (bgra ? 2 : 0)];
+      dst[4 * i + 1] = img.rgb[3 * i + 1];
+      dst[4 * i + 2] = img.rgb[3 * i + (bgra ? 0 : 2)];
+      dst[4 * i + 3] = 255;
+    }
+    fill = [&, staging](VkCommandBuffer cmd, VkImage image) {
+      vkCmdCopyBufferToImage(cmd, staging, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+    };
+  }
+  const bool drawn = vk_->draw_frame(
+      fill, [](VkCommandBuffer cmd) { ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd); },
+      shot);
+  if (vectors_->on_gpu()) wait_idle();  // the frame's time includes its step and picture
+  last_.render_ms = ms_between(t0, Clock::now());
+  return drawn;
+}
+
+}  // namespace voxfield::demo
