@@ -91,7 +91,9 @@ VkBuffer VectorsMode::record_frame(VkCommandBuffer cmd, const FlyCamera& camera,
   return gpu::record_render(*gpu_sim_, cmd, view(camera, width, height), order);
 }
 
-void VectorsMode::frame(FlyCamera& camera) { camera.look({-9.5, -12.5, 7.5}, {0, 0, -1.5}); }
+void VectorsMode::frame(FlyCamera& camera) {
+  camera.look({-9.5, -12.5, 7.5}, {0, 0, -1.5});
+}
 
 bool VectorsMode::panel(VectorsSettings& s) {
   bool changed = false;
@@ -118,12 +120,13 @@ bool VectorsMode::panel(VectorsSettings& s) {
 
 void VectorsMode::stats_panel() const {
   if (on_gpu())
-    ImGui::TextWrapped("%lld steps of %.1f ms on Vulkan; each frame's last step is recorded with its "
-                "picture",
-                static_cast<long long>(steps_), 1000.0 * scheduler_.dt_s());
+    ImGui::TextWrapped(
+        "%lld steps of %.1f ms on Vulkan; each frame's last step is recorded with its "
+        "picture",
+        static_cast<long long>(steps_), 1000.0 * scheduler_.dt_s());
   else
     ImGui::TextWrapped("%lld steps of %.1f ms on the CPU, %.2f ms per step",
-                static_cast<long long>(steps_), 1000.0 * scheduler_.dt_s(), last_step_ms_);
+                       static_cast<long long>(steps_), 1000.0 * scheduler_.dt_s(), last_step_ms_);
   if (scheduler_.dropped_s() > 0)
     ImGui::Text("%.2f s dropped (more than %d steps due in a frame)", scheduler_.dropped_s(),
                 kMaxStepsPerFrame);

@@ -24,7 +24,7 @@ struct VectorsSettings {
   int algorithm = 1;  // index into kVectorAlgorithms: splat
   int storage = 0;    // rgba8, rgba16f, rgba32f
   float decay_per_s = 1.0f;
-  float hz = 60;      // fixed steps per second
+  float hz = 60;  // fixed steps per second
   int sources = 20;
   bool sheet = true;
   float sheet_push = 0.8f;

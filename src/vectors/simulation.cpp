@@ -78,11 +78,11 @@ VectorSimulation::VectorSimulation(const VectorVolume& volume, VectorStorage sto
   if (!std::isfinite(decay_per_s) || decay_per_s < 0)
     throw InvalidArgument("vector simulation: the decay per second must be finite and >= 0");
   options_.interrupter = nullptr;  // never kept: step() is the long-lived object's only work
-  // Three textures and splatting's scratch (winner and best score, 12 bytes) per voxel.
+  // Three textures and splatting's scratch (winner, best score and texel, 28 bytes) per voxel.
   const std::uint64_t texel_bytes = storage == VectorStorage::kRgba8     ? 4
                                     : storage == VectorStorage::kRgba16f ? 8
                                                                          : 16;
-  require_memory(mul_sat(static_cast<std::uint64_t>(volume_.voxel_count()), 3 * texel_bytes + 12),
+  require_memory(mul_sat(static_cast<std::uint64_t>(volume_.voxel_count()), 3 * texel_bytes + 28),
                  0, "vector simulation " + to_string(volume_.resolution),
                  "its three textures and scratch");
   current_ = VectorTexture(volume_.resolution, storage);
@@ -195,11 +195,13 @@ struct StepRows {
     return out.span();
   }
 
-  // A row the sources touch, over `span`: each voxel's current texel from its winner (stored, then
-  // read back as stored), blended with the decayed previous texel into next. Returns the spans of
-  // the current and next texels that differ from the zero texel.
+  // A row the sources touch, over `span`: each voxel's current texel from its winner (`found`:
+  // the search's own values, else computed here; stored, then read back as stored), blended
+  // with the decayed previous texel into next. Returns the spans of the current and next texels
+  // that differ from the zero texel.
   std::pair<RowSpan, RowSpan> source_row(RowSpan span, const std::int32_t* __restrict winners,
-                                         Vec3d row_base, std::uint8_t* __restrict current,
+                                         const VectorTexel* __restrict found, Vec3d row_base,
+                                         std::uint8_t* __restrict current,
                                          const std::uint8_t* __restrict previous,
                                          std::uint8_t* __restrict next) const {
     SpanTracker now, later;
@@ -214,8 +216,9 @@ struct StepRows {
       // Encoded into locals and copied out whole: reading back a texel just stored byte by byte
       // would stall on store forwarding.
       alignas(16) std::uint8_t texel[C::kBytes], blended[C::kBytes];
-      C::store(texel, detail::vectors::texel_of(detail::vectors::value_of(
-                          segments[static_cast<std::size_t>(w)], row_base + xs[i], w)));
+      C::store(texel, found ? found[i]
+                            : detail::vectors::texel_of(detail::vectors::value_of(
+                                  segments[static_cast<std::size_t>(w)], row_base + xs[i], w)));
       std::memcpy(current + at, texel, C::kBytes);
       now.add(i);
       C::store(blended, blend(C::load(texel), C::load(previous + at), decay_s));
@@ -230,8 +233,9 @@ struct StepRows {
 // spans: outside it every texture already holds the zero texel and keeps it.
 template <class C>
 void fused_step(const VectorVolume& v, std::span<const detail::vectors::Segment> segments,
-                std::span<const std::int32_t> winners, float decay_s, std::uint8_t* current,
-                const std::uint8_t* previous, std::uint8_t* next, RowSpans rows) {
+                std::span<const std::int32_t> winners, const VectorTexel* found, float decay_s,
+                std::uint8_t* current, const std::uint8_t* previous, std::uint8_t* next,
+                RowSpans rows) {
   const detail::vectors::CentreTables centres(v);
   const Vec3i n = v.resolution;
   const StepRows<C> pass{segments.data(), centres.x.data(), n.x, decay_s, rows.decay8};
@@ -254,8 +258,9 @@ void fused_step(const VectorVolume& v, std::span<const detail::vectors::Segment>
           continue;
         }
         const RowSpan sweep = hull(hull(touched, previous_span), hull(current_span, next_span));
-        const auto [now, later] = pass.source_row(sweep, winners.data() + first, centres.row(j, k),
-                                                  current + at0, previous + at0, next + at0);
+        const auto [now, later] =
+            pass.source_row(sweep, winners.data() + first, found ? found + first : nullptr,
+                            centres.row(j, k), current + at0, previous + at0, next + at0);
         current_span = now;
         next_span = later;
       }
@@ -273,10 +278,13 @@ void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) 
   std::vector<std::int32_t> full;
   std::span<const std::int32_t> winners;
   std::int64_t start = detail::vectors::now_ns();
+  const VectorTexel* found = nullptr;
   if (options_.algorithm == VectorAlgorithm::kSplat) {
+    scratch_->splat.keep_texels = true;
     detail::vectors::splat_winners(volume_, sources, segments, options_.rule, nullptr,
                                    scratch_->splat);
     winners = scratch_->splat.winners;
+    found = scratch_->splat.texels.data();
     t.search_ms = detail::vectors::ms_since(start);
   } else {
     full = vector_winners(volume_, sources, options_, &t);
@@ -292,20 +300,12 @@ void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) 
     sc.field_rows.swap(f);
     sc.next_rows.swap(x);
   }
-  // The texels a source may write: its index box's (splat), or every winner's (the others).
+  // The texels a source won: as splatting recorded them, or from every winner (the others).
   sc.touched_rows.assign(rows, RowSpan{});
   const Vec3i n = volume_.resolution;
   if (options_.algorithm == VectorAlgorithm::kSplat) {
-    for (const detail::vectors::IndexBox& b : sc.splat.boxes) {
-      if (b.empty()) continue;
-      const RowSpan x{static_cast<std::uint16_t>(b.lo[0]), static_cast<std::uint16_t>(b.hi[0] + 1)};
-      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
-        for (int j = b.lo[1]; j <= b.hi[1]; ++j) {
-          RowSpan& r =
-              sc.touched_rows[static_cast<std::size_t>(j) + static_cast<std::size_t>(n.y) * k];
-          r = hull(r, x);
-        }
-    }
+    for (std::size_t r = 0; r < rows; ++r)
+      sc.touched_rows[r] = {sc.splat.won[r].lo, sc.splat.won[r].hi};
   } else {
     for (std::size_t i = 0; i < winners.size(); ++i)
       if (winners[i] >= 0) {
@@ -324,7 +324,8 @@ void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) 
   }
   detail::vectors::with_codec(field_.storage(), [&](auto codec) {
     fused_step<decltype(codec)>(
-        volume_, segments, winners, decay_s, current_.data(), field_.bytes().data(), next_.data(),
+        volume_, segments, winners, found, decay_s, current_.data(), field_.bytes().data(),
+        next_.data(),
         RowSpans{sc.current_rows.data(), sc.field_rows.data(), sc.next_rows.data(),
                  sc.touched_rows.data(), decay8.data()});
   });

@@ -103,8 +103,21 @@ struct SplatScratch {
   std::vector<std::int32_t> winners;
   std::vector<double> best;
   std::vector<IndexBox> boxes;
+  // With keep_texels, each winner's direction and strength too (value_of's arithmetic on the
+  // distance the search computed anyway), valid where winners >= 0: a step's sweep then encodes
+  // them without computing the distance again. (Encoding here instead, once per improvement
+  // rather than once per texel, measured slower.)
+  bool keep_texels = false;
+  std::vector<VectorTexel> texels;
+  // With keep_texels, per row (j + ny k) the voxels [lo, hi) where some source won (lo >= hi:
+  // none): what a step's sweep must convert.
+  struct Span {
+    std::uint16_t lo = 0, hi = 0;
+  };
+  std::vector<Span> won;
   void prepare(const VectorVolume& v);  // sized and cleared once per volume
-  void reset(const VectorVolume& v);    // the last splat's boxes cleared
+  // Clears `last` (the last splat's boxes) within z layers [k0, k1).
+  void reset(const VectorVolume& v, std::span<const IndexBox> last, int k0, int k1);
 };
 void splat_winners(const VectorVolume& v, std::span<const VectorSource> sources,
                    std::span<const Segment> segments, VectorRule rule, Interrupter* interrupter,
