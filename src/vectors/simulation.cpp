@@ -4,6 +4,7 @@
 // steps, capped per frame so a stall cannot snowball.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <climits>
 #include <cmath>
 #include <cstring>
@@ -14,6 +15,7 @@
 #include "vector_internal.h"
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
+#include "voxfield/parallel.h"
 
 namespace voxfield {
 
@@ -58,10 +60,7 @@ VectorTexel blend_vector_texels(const VectorTexel& current, const VectorTexel& p
 // (outside it, the row holds the zero texel). A step sweeps, per row, only the hull of the spans of
 // the sources that touch the row, of the previous field and of the two textures it overwrites, so
 // it costs what the sources and their wakes cover, not the whole volume.
-struct RowSpan {
-  std::uint16_t lo = 0, hi = 0;  // [lo, hi), empty when lo >= hi (rows are at most 4096 texels)
-  bool empty() const { return lo >= hi; }
-};
+using detail::vectors::RowSpan;
 
 struct VectorSimulation::Scratch {
   detail::vectors::SplatScratch splat;
@@ -100,7 +99,6 @@ struct RowSpans {
   RowSpan* current;
   const RowSpan* previous;
   RowSpan* next;
-  const RowSpan* touched;
   // rgba8: the strength byte after decay, as blend() then store() would give it alone (-1: the
   // decayed strength is exactly 0, which blends to the zero texel).
   const std::int16_t* decay8;
@@ -230,16 +228,33 @@ struct StepRows {
 };
 
 // Conversion, decay and blend of one step in one sweep, row by row, over the hull of the row's
-// spans: outside it every texture already holds the zero texel and keeps it.
+// spans: outside it every texture already holds the zero texel and keeps it. sweep(k0, k1) does
+// the rows of z layers [k0, k1).
 template <class C>
-void fused_step(const VectorVolume& v, std::span<const detail::vectors::Segment> segments,
-                std::span<const std::int32_t> winners, const VectorTexel* found, float decay_s,
-                std::uint8_t* current, const std::uint8_t* previous, std::uint8_t* next,
-                RowSpans rows) {
-  const detail::vectors::CentreTables centres(v);
-  const Vec3i n = v.resolution;
-  const StepRows<C> pass{segments.data(), centres.x.data(), n.x, decay_s, rows.decay8};
-  detail::vectors::for_each_slab(v, nullptr, "vector step", [&](int k0, int k1) {
+struct Sweep {
+  const VectorVolume& v;
+  const detail::vectors::CentreTables centres;
+  const StepRows<C> pass;
+  std::uint8_t* current;
+  const std::uint8_t* previous;
+  std::uint8_t* next;
+  RowSpans rows;
+
+  Sweep(const VectorVolume& volume, std::span<const detail::vectors::Segment> segments,
+        float decay_s, std::uint8_t* current_texels, const std::uint8_t* previous_texels,
+        std::uint8_t* next_texels, RowSpans spans)
+      : v(volume),
+        centres(volume),
+        pass{segments.data(), centres.x.data(), volume.resolution.x, decay_s, spans.decay8},
+        current(current_texels),
+        previous(previous_texels),
+        next(next_texels),
+        rows(spans) {}
+
+  // winners and found (optional) for the whole volume; touched: a span per row.
+  void operator()(int k0, int k1, const std::int32_t* winners, const VectorTexel* found,
+                  const RowSpan* touched_rows) const {
+    const Vec3i n = v.resolution;
     for (int k = k0; k < k1; ++k)
       for (int j = 0; j < n.y; ++j) {
         const std::size_t row = static_cast<std::size_t>(j) + static_cast<std::size_t>(n.y) * k;
@@ -247,7 +262,7 @@ void fused_step(const VectorVolume& v, std::span<const detail::vectors::Segment>
         const std::size_t at0 = static_cast<std::size_t>(first) * C::kBytes;
         RowSpan& current_span = rows.current[row];
         RowSpan& next_span = rows.next[row];
-        const RowSpan touched = rows.touched[row], previous_span = rows.previous[row];
+        const RowSpan touched = touched_rows[row], previous_span = rows.previous[row];
         if (touched.empty()) {
           // No source now: the current row is zero, and each next texel the previous one decayed
           // (over the old next span too, which the decay of zero texels clears).
@@ -259,13 +274,13 @@ void fused_step(const VectorVolume& v, std::span<const detail::vectors::Segment>
         }
         const RowSpan sweep = hull(hull(touched, previous_span), hull(current_span, next_span));
         const auto [now, later] =
-            pass.source_row(sweep, winners.data() + first, found ? found + first : nullptr,
+            pass.source_row(sweep, winners + first, found ? found + first : nullptr,
                             centres.row(j, k), current + at0, previous + at0, next + at0);
         current_span = now;
         next_span = later;
       }
-  });
-}
+  }
+};
 
 }  // namespace
 
@@ -275,22 +290,6 @@ void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) 
   validate_sources(sources);
   VectorPassTimes t;
   const std::vector<detail::vectors::Segment> segments = detail::vectors::segments_of(sources);
-  std::vector<std::int32_t> full;
-  std::span<const std::int32_t> winners;
-  std::int64_t start = detail::vectors::now_ns();
-  const VectorTexel* found = nullptr;
-  if (options_.algorithm == VectorAlgorithm::kSplat) {
-    scratch_->splat.keep_texels = true;
-    detail::vectors::splat_winners(volume_, sources, segments, options_.rule, nullptr,
-                                   scratch_->splat);
-    winners = scratch_->splat.winners;
-    found = scratch_->splat.texels.data();
-    t.search_ms = detail::vectors::ms_since(start);
-  } else {
-    full = vector_winners(volume_, sources, options_, &t);
-    winners = full;
-  }
-  start = detail::vectors::now_ns();
   Scratch& sc = *scratch_;
   const std::size_t rows = static_cast<std::size_t>(volume_.resolution.y) * volume_.resolution.z;
   if (sc.field_rows.size() != rows || sc.current_rows.size() != rows ||
@@ -300,36 +299,59 @@ void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) 
     sc.field_rows.swap(f);
     sc.next_rows.swap(x);
   }
-  // The texels a source won: as splatting recorded them, or from every winner (the others).
-  sc.touched_rows.assign(rows, RowSpan{});
-  const Vec3i n = volume_.resolution;
+  std::array<std::int16_t, 256> decay8{};
+  const float decay_s = static_cast<float>(decay_per_s_ * dt_s);
+  for (int b = 0; b < 256; ++b) {
+    const VectorTexel d =
+        blend(VectorTexel{}, {0, 0, 0, detail::vectors::rgba8_tables().strength[b]}, decay_s);
+    decay8[b] =
+        d.strength > 0 ? std::int16_t{detail::vectors::unorm8(d.strength)} : std::int16_t{-1};
+  }
+  const RowSpans spans{sc.current_rows.data(), sc.field_rows.data(), sc.next_rows.data(),
+                       decay8.data()};
+  const std::int64_t start = detail::vectors::now_ns();
   if (options_.algorithm == VectorAlgorithm::kSplat) {
-    for (std::size_t r = 0; r < rows; ++r)
-      sc.touched_rows[r] = {sc.splat.won[r].lo, sc.splat.won[r].hi};
+    // Each z slab is splatted, then swept at once by the same thread while its rows are in the
+    // cache; the rows splatting wrote are the sweep's sources.
+    sc.splat.keep_texels = true;
+    std::atomic<std::int64_t> splat_ns{0};
+    detail::vectors::with_codec(field_.storage(), [&](auto codec) {
+      const Sweep<decltype(codec)> sweep(volume_, segments, decay_s, current_.data(),
+                                         field_.bytes().data(), next_.data(), spans);
+      detail::vectors::splat_winners(
+          volume_, sources, segments, options_.rule, nullptr, sc.splat,
+          [&](int k0, int k1) {
+            sweep(k0, k1, sc.splat.winners.data(), sc.splat.texels.data(), sc.splat.won.data());
+          },
+          &splat_ns);
+    });
+    // The wall time, apportioned between the two by the threads' time in each.
+    const double total_ms = detail::vectors::ms_since(start);
+    const double thread_ms = total_ms * max_threads();
+    const double splat_share = std::min(1.0, splat_ns.load() * 1e-6 / std::max(thread_ms, 1e-9));
+    t.search_ms = total_ms * splat_share;
+    t.blend_ms = total_ms - t.search_ms;
   } else {
+    const std::vector<std::int32_t> winners = vector_winners(volume_, sources, options_, &t);
+    const std::int64_t sweep_start = detail::vectors::now_ns();
+    // The texels a source won: from every winner.
+    sc.touched_rows.assign(rows, RowSpan{});
+    const Vec3i n = volume_.resolution;
     for (std::size_t i = 0; i < winners.size(); ++i)
       if (winners[i] >= 0) {
         RowSpan& r = sc.touched_rows[i / static_cast<std::size_t>(n.x)];
         const auto x = static_cast<std::uint16_t>(i % static_cast<std::size_t>(n.x));
         r = hull(r, RowSpan{x, static_cast<std::uint16_t>(x + 1)});
       }
+    detail::vectors::with_codec(field_.storage(), [&](auto codec) {
+      const Sweep<decltype(codec)> sweep(volume_, segments, decay_s, current_.data(),
+                                         field_.bytes().data(), next_.data(), spans);
+      detail::vectors::for_each_slab(volume_, nullptr, "vector step", [&](int k0, int k1) {
+        sweep(k0, k1, winners.data(), nullptr, sc.touched_rows.data());
+      });
+    });
+    t.blend_ms = detail::vectors::ms_since(sweep_start);
   }
-  std::array<std::int16_t, 256> decay8{};
-  const float decay_s = static_cast<float>(decay_per_s_ * dt_s);
-  for (int b = 0; b < 256; ++b) {
-    const VectorTexel t =
-        blend(VectorTexel{}, {0, 0, 0, detail::vectors::rgba8_tables().strength[b]}, decay_s);
-    decay8[b] =
-        t.strength > 0 ? std::int16_t{detail::vectors::unorm8(t.strength)} : std::int16_t{-1};
-  }
-  detail::vectors::with_codec(field_.storage(), [&](auto codec) {
-    fused_step<decltype(codec)>(
-        volume_, segments, winners, found, decay_s, current_.data(), field_.bytes().data(),
-        next_.data(),
-        RowSpans{sc.current_rows.data(), sc.field_rows.data(), sc.next_rows.data(),
-                 sc.touched_rows.data(), decay8.data()});
-  });
-  t.blend_ms = detail::vectors::ms_since(start);
   std::swap(field_, next_);
   std::swap(sc.field_rows, sc.next_rows);
   times_ = t;

@@ -27,7 +27,8 @@ void SplatScratch::prepare(const VectorVolume& v) {
   std::vector<std::int32_t> w(n, -1);
   std::vector<double> b(n, kNoScore);
   std::vector<VectorTexel> t(keep_texels ? n : 0);
-  std::vector<Span> r(keep_texels ? static_cast<std::size_t>(v.resolution.y) * v.resolution.z : 0);
+  std::vector<RowSpan> r(keep_texels ? static_cast<std::size_t>(v.resolution.y) * v.resolution.z
+                                     : 0);
   winners.swap(w);
   best.swap(b);
   texels.swap(t);
@@ -50,7 +51,8 @@ void SplatScratch::reset(const VectorVolume& v, std::span<const IndexBox> last, 
 
 void splat_winners(const VectorVolume& v, std::span<const VectorSource> sources,
                    std::span<const Segment> segments, VectorRule rule, Interrupter* interrupter,
-                   SplatScratch& scratch) {
+                   SplatScratch& scratch, const std::function<void(int, int)>& after_slab,
+                   std::atomic<std::int64_t>* splat_ns) {
   scratch.prepare(v);
   const CentreTables centres(v);
   // The last splat's boxes are cleared slab by slab, in parallel, just before each slab splats.
@@ -63,12 +65,13 @@ void splat_winners(const VectorVolume& v, std::span<const VectorSource> sources,
   std::int32_t* winners = scratch.winners.data();
   double* best = scratch.best.data();
   VectorTexel* texels = scratch.keep_texels ? scratch.texels.data() : nullptr;
-  SplatScratch::Span* won = texels ? scratch.won.data() : nullptr;
+  RowSpan* won = texels ? scratch.won.data() : nullptr;
   for_each_slab(v, interrupter, "vector field (splat)", [&](int k0, int k1) {
+    const std::int64_t slab_start = now_ns();
     scratch.reset(v, last, k0, k1);
     if (won)
       std::fill(won + static_cast<std::ptrdiff_t>(k0) * v.resolution.y,
-                won + static_cast<std::ptrdiff_t>(k1) * v.resolution.y, SplatScratch::Span{});
+                won + static_cast<std::ptrdiff_t>(k1) * v.resolution.y, RowSpan{});
     for (std::size_t s = 0; s < segments.size(); ++s) {
       const IndexBox& b = boxes[s];
       if (b.empty() || b.hi[2] < k0 || b.lo[2] >= k1) continue;
@@ -133,15 +136,16 @@ void splat_winners(const VectorVolume& v, std::span<const VectorSource> sources,
             }
           }
           if (won_hi >= 0) {  // rows are split between slabs, never between threads
-            SplatScratch::Span& r =
+            RowSpan& r =
                 won[static_cast<std::size_t>(j) + static_cast<std::size_t>(v.resolution.y) * k];
             const auto lo = static_cast<std::uint16_t>(won_lo);
             const auto hi = static_cast<std::uint16_t>(won_hi + 1);
-            r = r.lo < r.hi ? SplatScratch::Span{std::min(r.lo, lo), std::max(r.hi, hi)}
-                            : SplatScratch::Span{lo, hi};
+            r = r.lo < r.hi ? RowSpan{std::min(r.lo, lo), std::max(r.hi, hi)} : RowSpan{lo, hi};
           }
         }
     }
+    if (splat_ns) *splat_ns += now_ns() - slab_start;
+    if (after_slab) after_slab(k0, k1);
   });
   scratch.boxes.erase(scratch.boxes.begin(),
                       scratch.boxes.begin() + static_cast<std::ptrdiff_t>(last_count));

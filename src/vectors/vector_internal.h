@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -96,6 +97,12 @@ std::int64_t now_ns();
 // The algorithms (one per file).
 void brute_winners(const VectorVolume& v, std::span<const Segment> sources, VectorRule rule,
                    Interrupter* interrupter, std::span<std::int32_t> winners);
+// The texels [lo, hi) of one row of a volume (rows are at most 4096 texels); empty when lo >= hi.
+struct RowSpan {
+  std::uint16_t lo = 0, hi = 0;
+  bool empty() const { return lo >= hi; }
+};
+
 // What splatting keeps between generations: winners and best scores, -1 and -inf everywhere
 // except inside the boxes of the last splat's sources, which reset() restores — so a step costs
 // what its sources cover, not the volume.
@@ -111,17 +118,19 @@ struct SplatScratch {
   std::vector<VectorTexel> texels;
   // With keep_texels, per row (j + ny k) the voxels [lo, hi) where some source won (lo >= hi:
   // none): what a step's sweep must convert.
-  struct Span {
-    std::uint16_t lo = 0, hi = 0;
-  };
-  std::vector<Span> won;
+  std::vector<RowSpan> won;
   void prepare(const VectorVolume& v);  // sized and cleared once per volume
   // Clears `last` (the last splat's boxes) within z layers [k0, k1).
   void reset(const VectorVolume& v, std::span<const IndexBox> last, int k0, int k1);
 };
+// `after_slab`, when given, runs on each z slab [k0, k1) right after the slab is splatted, on the
+// same thread — a step's sweep of those rows, while they are in the cache; the time spent splatting
+// (without it) is added to *splat_ns.
 void splat_winners(const VectorVolume& v, std::span<const VectorSource> sources,
                    std::span<const Segment> segments, VectorRule rule, Interrupter* interrupter,
-                   SplatScratch& scratch);
+                   SplatScratch& scratch,
+                   const std::function<void(int k0, int k1)>& after_slab = nullptr,
+                   std::atomic<std::int64_t>* splat_ns = nullptr);
 // Jump flooding's seeding of one source: the part of its segment within its radius of the box,
 // sampled at the samples + 1 points t0 + (t1 - t0) * (t / samples), t = 0..samples, each seeding
 // the voxel it falls in (clamped to the volume). samples = -1: the source seeds nothing (it cannot

@@ -178,8 +178,9 @@ IndexBox index_box(const VectorVolume& v, const VectorSource& s) {
 void for_each_slab(const VectorVolume& v, Interrupter* interrupter, std::string_view what,
                    const std::function<void(int, int)>& body) {
   const int nz = v.resolution.z;
-  // About four slabs per thread, at least one z layer each.
-  const int slabs = std::min(nz, std::max(1, 4 * max_threads()));
+  // Thin slabs (about 32 per thread, at least one z layer each): a step splats and sweeps a slab
+  // while its rows are in the cache, and small slabs balance uneven work between the threads.
+  const int slabs = std::min(nz, std::max(1, 32 * max_threads()));
   Progress progress(interrupter, what, slabs);
   parallel_for(static_cast<std::size_t>(slabs), 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t s = b; s < e; ++s) {
