@@ -350,7 +350,15 @@ assert j['backend'] == 'vulkan' and j['frames'] == 3 and j['flood_passes'] > 0, 
 assert set(j['gpu_passes_ms']) == {'seed', 'flood', 'step'}, j
 assert g['bytes_downloaded'] >= 24 * 20 * 16 * 8 and g['submits'] >= 4, j"
   check "bench vectors --backend vulkan" 0 $GPU "$V" bench vectors --test quarter-resolution --steps 3 --backend vulkan \
-      --csv "$tmp/bv.csv"
+      --csv "$tmp/bv.csv" --plot "$tmp/bv.svg"
+  check "bench vectors plot" 0 $PY -c "
+import xml.dom.minidom as m; d = m.parse('$tmp/bv.svg')
+bars = [r for r in d.getElementsByTagName('rect') if r.getElementsByTagName('title')]
+assert len(bars) == 4, len(bars)  # splat and jfa at 64x64x64 and 64x16x64
+assert 'vulkan' in d.getElementsByTagName('text')[0].firstChild.data"
+  check "bench vectors: a plot that is not .svg" 2 "$V" bench vectors --test decay --steps 1 --plot "$tmp/bv.png"
+  expect_grep "plot named .svg" "$tmp/err" "name it .svg"
+  [ ! -e "$tmp/bv.png" ] && passes=$((passes+1)) || { echo "FAIL: bench vectors wrote after refusing"; fails=$((fails+1)); }
   check "bench vectors gpu csv" 0 $PY -c "
 import csv; rows = list(csv.DictReader(open('$tmp/bv.csv')))
 assert len(rows) == 4 and all(r['backend'] == 'vulkan' and float(r['submits_per_step']) == 1 for r in rows), rows

@@ -4,6 +4,7 @@
 // agents' seeded motion and each test's sweep; docs/benchmarks.md holds the figures.
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <random>
@@ -11,6 +12,7 @@
 
 #include "cli.h"
 #include "live_field.h"
+#include "svg_chart.h"
 #include "voxfield/gpu_vectors.h"
 #include "voxfield/parallel.h"
 #include "voxfield/vector_agents.h"
@@ -20,7 +22,7 @@ namespace voxfield::cli {
 namespace {
 
 struct BenchVectorSettings {
-  std::string test = "fidelity", csv, storage = "rgba8", backend = "cpu";
+  std::string test = "fidelity", csv, plot, storage = "rgba8", backend = "cpu";
   std::vector<std::string> algorithms;  // only these (default: each test's own)
   int steps = 60, threads = 0;
   std::uint32_t seed = 1;
@@ -122,6 +124,9 @@ int run_bench_vectors(const BenchVectorSettings& s) {
   const VectorStorage storage = parse_vector_storage(s.storage);
   Outputs outputs;
   outputs.expect(s.csv, "--csv");
+  outputs.expect(s.plot, "--plot");
+  if (!s.plot.empty() && std::filesystem::path(s.plot).extension() != ".svg")
+    throw UsageError("--plot " + s.plot + ": the plot is written as SVG (name it .svg)");
   std::optional<ThreadLimit> limit;
   if (s.threads > 0) limit.emplace(s.threads);
   const std::shared_ptr<gpu::Context> gpu_context = choose_backend(s.backend);
@@ -192,6 +197,45 @@ int run_bench_vectors(const BenchVectorSettings& s) {
     std::cout << line;
   }
   if (!s.csv.empty()) outputs.stage(s.csv, std::string_view(csv.str()));
+  if (!s.plot.empty()) {
+    // One group per value of the test's swept parameter, one bar per algorithm: ms per step.
+    BarChart chart;
+    chart.title = "voxfield bench vectors --test " + s.test + " (" + s.storage + ", " + backend +
+                  (gpu_context ? " on " + gpu_context->device().name : "") + ")";
+    chart.value_label = "ms per step";
+    auto group_of = [&](const Row& r) -> std::string {
+      char b[64];
+      if (s.test == "decay")
+        std::snprintf(b, sizeof b, "%.1f", r.decay);
+      else if (s.test == "jfa-sources")
+        std::snprintf(b, sizeof b, "%d", r.sources);
+      else if (s.test == "time-step")
+        std::snprintf(b, sizeof b, "%.0f", 1 / r.dt);
+      else
+        std::snprintf(b, sizeof b, "%dx%dx%d", r.resolution.x, r.resolution.y, r.resolution.z);
+      return b;
+    };
+    chart.group_label = s.test == "decay"         ? "decay per second"
+                        : s.test == "jfa-sources" ? "sources (64^3)"
+                        : s.test == "time-step"   ? "steps per second"
+                                                  : "resolution";
+    for (const Row& r : rows) {
+      const std::string g = group_of(r);
+      if (std::find(chart.groups.begin(), chart.groups.end(), g) == chart.groups.end())
+        chart.groups.push_back(g);
+      if (std::find(chart.series.begin(), chart.series.end(), r.algorithm) == chart.series.end())
+        chart.series.push_back(r.algorithm);
+    }
+    chart.values.assign(chart.series.size(), std::vector<double>(chart.groups.size(), 0));
+    for (const Row& r : rows) {
+      const auto si =
+          std::find(chart.series.begin(), chart.series.end(), r.algorithm) - chart.series.begin();
+      const auto gi =
+          std::find(chart.groups.begin(), chart.groups.end(), group_of(r)) - chart.groups.begin();
+      chart.values[static_cast<std::size_t>(si)][static_cast<std::size_t>(gi)] = r.step_ms;
+    }
+    outputs.stage(s.plot, std::string_view(render_svg(chart)));
+  }
   outputs.commit();
   return 0;
 }
@@ -220,6 +264,7 @@ void add_bench_vectors(CLI::App* bench, Action& action) {
                   "are CPU emulation")
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
   cmd->add_option("--csv", s->csv, "one row per case");
+  cmd->add_option("--plot", s->plot, "ms per step as a grouped bar chart (.svg)");
   cmd->callback([s, &action] { action = [s] { return run_bench_vectors(*s); }; });
 }
 
