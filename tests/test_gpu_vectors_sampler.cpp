@@ -52,8 +52,8 @@ std::string kernel_text(const VectorVolume& v, VectorStorage storage) {
     << "  VfVectorVolume v;\n"
     << "  v.centre = " << vec(v.centre) << ";\n"
     << "  v.size = " << vec(v.size) << ";\n"
-    << "  v.rotation = mat3(" << vec({v.rotation[0][0], v.rotation[1][0], v.rotation[2][0]})
-    << ", " << vec({v.rotation[0][1], v.rotation[1][1], v.rotation[2][1]}) << ", "
+    << "  v.rotation = mat3(" << vec({v.rotation[0][0], v.rotation[1][0], v.rotation[2][0]}) << ", "
+    << vec({v.rotation[0][1], v.rotation[1][1], v.rotation[2][1]}) << ", "
     << vec({v.rotation[0][2], v.rotation[1][2], v.rotation[2][2]}) << ");\n"
     << "  v.resolution = ivec3(" << v.resolution.x << ", " << v.resolution.y << ", "
     << v.resolution.z << ");\n"
@@ -266,9 +266,9 @@ TEST(GpuVectors, TheShaderIncludeSamplesA3dImageAsTheCppSampler) {
     std::memcpy(pts.mapped(), points.data(), points.size() * 4);
     const VkDescriptorImageInfo image_info{image.sampler, image.view,
                                            VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    const VkDescriptorBufferInfo buffer_info[] = {
-        {pts.handle(), 0, VK_WHOLE_SIZE}, {samples.handle(), 0, VK_WHOLE_SIZE},
-        {inside.handle(), 0, VK_WHOLE_SIZE}};
+    const VkDescriptorBufferInfo buffer_info[] = {{pts.handle(), 0, VK_WHOLE_SIZE},
+                                                  {samples.handle(), 0, VK_WHOLE_SIZE},
+                                                  {inside.handle(), 0, VK_WHOLE_SIZE}};
     VkWriteDescriptorSet writes[4]{};
     for (std::uint32_t b = 0; b < 4; ++b) {
       writes[b].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
@@ -310,15 +310,14 @@ TEST(GpuVectors, TheShaderIncludeSamplesA3dImageAsTheCppSampler) {
       const Vec3d u = v.to_volume(world[i]);
       int lo[3], hi[3];
       for (int a = 0; a < 3; ++a) {
-        const double t =
-            std::clamp(u[a] * v.resolution[a] - 0.5, 0.0, v.resolution[a] - 1.0);
+        const double t = std::clamp(u[a] * v.resolution[a] - 0.5, 0.0, v.resolution[a] - 1.0);
         lo[a] = static_cast<int>(std::floor(t));
         hi[a] = std::min(lo[a] + 1, v.resolution[a] - 1);
       }
       double low[4] = {1e9, 1e9, 1e9, 1e9}, high[4] = {-1e9, -1e9, -1e9, -1e9};
       for (int cnr = 0; cnr < 8; ++cnr) {
-        const VectorTexel t = tex.get(v.index(cnr & 1 ? hi[0] : lo[0], cnr & 2 ? hi[1] : lo[1],
-                                              cnr & 4 ? hi[2] : lo[2]));
+        const VectorTexel t = tex.get(
+            v.index(cnr & 1 ? hi[0] : lo[0], cnr & 2 ? hi[1] : lo[1], cnr & 4 ? hi[2] : lo[2]));
         const double ch[4] = {t.x, t.y, t.z, t.strength};
         for (int k = 0; k < 4; ++k) {
           low[k] = std::min(low[k], ch[k]);
@@ -332,8 +331,7 @@ TEST(GpuVectors, TheShaderIncludeSamplesA3dImageAsTheCppSampler) {
         const double spread = high[k] - low[k];
         // rgba8: the filtered value may itself be rounded to 8 bits (lavapipe filters UNORM8 in
         // 8-bit arithmetic): one step of 1/255, twice that for a decoded direction.
-        const double quantum =
-            storage == VectorStorage::kRgba8 ? (k < 3 ? 2.0 : 1.0) / 255 : 0.0;
+        const double quantum = storage == VectorStorage::kRgba8 ? (k < 3 ? 2.0 : 1.0) / 255 : 0.0;
         if (error > spread / 64 + quantum + 1e-5 && off++ < 5)
           ADD_FAILURE() << "point " << i << " channel " << k << ": off by " << error
                         << ", the texels spread " << spread;
