@@ -9,6 +9,7 @@ packages=(
   libtbb-dev                         # thread pool (oneTBB)
   zlib1g-dev                         # TDCZ models in .vox files
   libpng-dev                         # PNG frames from the renderer
+  libcairo2-dev fonts-dejavu-core    # the benchmarks' PNG plots: shapes and text (cairo), a font for it
   libvulkan-dev libvulkan-volk-dev glslc   # the Vulkan backend: headers, run-time loader, GLSL -> SPIR-V
   glslang-dev glslang-tools libspirv-cross-c-shared-dev  # run-time GLSL -> SPIR-V (generated CSG shaders; glslang's CMake package needs its tools), SPIR-V reflection
   mesa-vulkan-drivers vulkan-validationlayers  # lavapipe (software Vulkan) and the validation layer, for tests

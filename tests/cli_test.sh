@@ -356,9 +356,16 @@ import xml.dom.minidom as m; d = m.parse('$tmp/bv.svg')
 bars = [r for r in d.getElementsByTagName('rect') if r.getElementsByTagName('title')]
 assert len(bars) == 4, len(bars)  # splat and jfa at 64x64x64 and 64x16x64
 assert 'vulkan' in d.getElementsByTagName('text')[0].firstChild.data"
-  check "bench vectors: a plot that is not .svg" 2 "$V" bench vectors --test decay --steps 1 --plot "$tmp/bv.png"
-  expect_grep "plot named .svg" "$tmp/err" "name it .svg"
-  [ ! -e "$tmp/bv.png" ] && passes=$((passes+1)) || { echo "FAIL: bench vectors wrote after refusing"; fails=$((fails+1)); }
+  check "bench vectors --plot .png" 0 "$V" bench vectors --test decay --steps 2 --plot "$tmp/bv.png"
+  check "bench vectors png plot" 0 $PY -c "
+import struct, zlib
+b = open('$tmp/bv.png', 'rb').read()
+assert b[:8] == bytes([137, 80, 78, 71, 13, 10, 26, 10]), 'a PNG signature'
+w, h = struct.unpack('>II', b[16:24])
+assert w > 300 and h > 300, (w, h)"
+  check "bench vectors: a plot that is neither" 2 "$V" bench vectors --test decay --steps 1 --plot "$tmp/bv.gif"
+  expect_grep "plot extension named" "$tmp/err" ".svg or .png"
+  [ ! -e "$tmp/bv.gif" ] && passes=$((passes+1)) || { echo "FAIL: bench vectors wrote after refusing"; fails=$((fails+1)); }
   check "bench vectors gpu csv" 0 $PY -c "
 import csv; rows = list(csv.DictReader(open('$tmp/bv.csv')))
 assert len(rows) == 4 and all(r['backend'] == 'vulkan' and float(r['submits_per_step']) == 1 for r in rows), rows

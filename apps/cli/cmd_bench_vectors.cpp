@@ -10,9 +10,9 @@
 #include <random>
 #include <sstream>
 
+#include "chart.h"
 #include "cli.h"
 #include "live_field.h"
-#include "svg_chart.h"
 #include "voxfield/gpu_vectors.h"
 #include "voxfield/parallel.h"
 #include "voxfield/vector_agents.h"
@@ -125,8 +125,9 @@ int run_bench_vectors(const BenchVectorSettings& s) {
   Outputs outputs;
   outputs.expect(s.csv, "--csv");
   outputs.expect(s.plot, "--plot");
-  if (!s.plot.empty() && std::filesystem::path(s.plot).extension() != ".svg")
-    throw UsageError("--plot " + s.plot + ": the plot is written as SVG (name it .svg)");
+  const std::string plot_ext = std::filesystem::path(s.plot).extension().string();
+  if (!s.plot.empty() && plot_ext != ".svg" && plot_ext != ".png")
+    throw UsageError("--plot " + s.plot + ": the plot is written as .svg or .png");
   std::optional<ThreadLimit> limit;
   if (s.threads > 0) limit.emplace(s.threads);
   const std::shared_ptr<gpu::Context> gpu_context = choose_backend(s.backend);
@@ -234,7 +235,10 @@ int run_bench_vectors(const BenchVectorSettings& s) {
           std::find(chart.groups.begin(), chart.groups.end(), group_of(r)) - chart.groups.begin();
       chart.values[static_cast<std::size_t>(si)][static_cast<std::size_t>(gi)] = r.step_ms;
     }
-    outputs.stage(s.plot, std::string_view(render_svg(chart)));
+    if (plot_ext == ".png")
+      outputs.stage(s.plot, render_png(chart));
+    else
+      outputs.stage(s.plot, std::string_view(render_svg(chart)));
   }
   outputs.commit();
   return 0;
@@ -264,7 +268,7 @@ void add_bench_vectors(CLI::App* bench, Action& action) {
                   "are CPU emulation")
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
   cmd->add_option("--csv", s->csv, "one row per case");
-  cmd->add_option("--plot", s->plot, "ms per step as a grouped bar chart (.svg)");
+  cmd->add_option("--plot", s->plot, "ms per step as a grouped bar chart (.png or .svg)");
   cmd->callback([s, &action] { action = [s] { return run_bench_vectors(*s); }; });
 }
 
