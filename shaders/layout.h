@@ -155,12 +155,12 @@ struct RenderParams {
 };
 
 // ---- vector fields (src/vectors/gpu)
-// -------------------------------------------------------------- VectorParams::mode.x: how a voxel
+// -------------------------------------------------------------- VectorParams::search: how a voxel
 // finds its source.
 VF_CONST(uint, VF_VECTORS_BRUTE, 0u);    // every source
 VF_CONST(uint, VF_VECTORS_SPLAT, 1u);    // the sources binned to the voxel's tile
 VF_CONST(uint, VF_VECTORS_WINNERS, 2u);  // read from the winners buffer (jump flooding's)
-// VectorParams::mode.w bits.
+// VectorParams::flags bits.
 VF_CONST(uint, VF_VECTORS_WRITE_WINNERS, 1u);  // brute / splat also store each voxel's winner
 VF_CONST(int, VF_VECTORS_TILE, 8);             // splatting's bins: tiles of 8^3 voxels
 // The voxel-centre table (binding 1, dvec4s): the centre, the box's three axes, its size, then the

@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <fstream>
 #include <memory>
 #include <random>
+#include <sstream>
+#include <string>
 
 #include "backends.h"
 #include "voxfield/world.h"
@@ -14,6 +17,14 @@ namespace voxfield::test {
 
 inline std::shared_ptr<gpu::Context> validated_context() {
   return testing_backends::vulkan_context();
+}
+
+// The text of the installed shader include voxfield_vectors.glsl, for test kernels to prepend.
+inline std::string vectors_glsl_include() {
+  std::ifstream in(std::string(VOXFIELD_INCLUDE_DIR) + "/voxfield/glsl/voxfield_vectors.glsl");
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 
 inline bool gpu_tests_wanted() {

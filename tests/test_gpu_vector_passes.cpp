@@ -15,7 +15,8 @@
 
 using namespace voxfield;
 
-namespace {
+// A named namespace: unity builds put the GPU suites into one translation unit.
+namespace vector_passes_test {
 
 const VectorAlgorithm kAlgorithms[] = {VectorAlgorithm::kBrute, VectorAlgorithm::kSplat,
                                        VectorAlgorithm::kJfa, VectorAlgorithm::kJfaPlus1,
@@ -98,7 +99,7 @@ TEST(GpuVectorPasses, StepsEqualTheCpuSimulation) {
                    vector_storage_name(storage));
       VectorOptions o;
       o.algorithm = algorithm;
-      VectorSimulation cpu(v, storage, o, 2.5);
+      voxfield::VectorSimulation cpu(v, storage, o, 2.5);
       gpu::VectorSimulation gpu(ctx, v, storage, o, 2.5);
       for (int step = 0; step < 8; ++step) {
         const std::vector<VectorSource> sources =
@@ -213,10 +214,32 @@ TEST(GpuVectorPasses, StepsRecordedIntoTheApplicationsCommandBuffer) {
     VkBuffer pixels = VK_NULL_HANDLE;
     const gpu::PixelOrder order = step % 2 ? gpu::PixelOrder::kBgra : gpu::PixelOrder::kRgba;
     view.width = 40 + 16 * step;  // a growing picture replaces the pixel buffer after the step
+    const VkDeviceSize bytes = static_cast<VkDeviceSize>(view.width) * view.height * 4;
+    gpu::Buffer readback(c, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
     run([&] {
       field = gpu::record_step(app, cmd, sources, 0.05);
       pixels = gpu::record_render(app, cmd, view, order);
+      // The application's copy of the picture (record_render made it readable by transfers).
+      const VkBufferCopy region{0, 0, bytes};
+      vkCmdCopyBuffer(cmd, pixels, readback.handle(), 1, &region);
+      VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+      to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+      to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+      vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                           &to_host, 0, nullptr, 0, nullptr);
     });
+    // The same picture as the simulation draws on its own, in the byte order asked for.
+    const Image want = app.render(view);
+    const auto* got = static_cast<const std::uint8_t*>(readback.mapped());
+    int differ = 0;
+    for (int y = 0; y < view.height; ++y)
+      for (int x = 0; x < view.width; ++x) {
+        const std::uint8_t* g = got + 4 * (static_cast<std::size_t>(y) * view.width + x);
+        const std::uint8_t* w = want.pixel(x, y);
+        const bool bgra = order == gpu::PixelOrder::kBgra;
+        differ += g[bgra ? 2 : 0] != w[0] || g[1] != w[1] || g[bgra ? 0 : 2] != w[2] || g[3] != 255;
+      }
+    EXPECT_EQ(differ, 0) << "step " << step;
     EXPECT_EQ(field.buffer, gpu::field_buffer(app).buffer);
     EXPECT_EQ(field.bytes, static_cast<VkDeviceSize>(v.voxel_count()) * 4);
     ASSERT_EQ(first_difference(app.field().bytes(), own.field().bytes()), -1) << "step " << step;
@@ -249,4 +272,4 @@ TEST(GpuVectorPasses, RefusesWhatTheDeviceCannotHoldAndBadInput) {
   testing_backends::expect_no_validation_messages(Backend::kVulkan);
 }
 
-}  // namespace
+}  // namespace vector_passes_test

@@ -18,13 +18,6 @@ using namespace voxfield::gpu;
 
 namespace {
 
-std::string include_text() {
-  std::ifstream in(std::string(VOXFIELD_INCLUDE_DIR) + "/voxfield/glsl/voxfield_vectors.glsl");
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // The test kernel: texels from binding 0 (as stored: rgba8 one word, rgba16f two, rgba32f four),
 // points from binding 1, samples (direction, strength) to binding 2 and inside flags to binding 3.
 std::string kernel_text(const VectorVolume& v, VectorStorage storage) {
@@ -51,7 +44,7 @@ std::string kernel_text(const VectorVolume& v, VectorStorage storage) {
     << "layout(std430, binding = 3) writeonly buffer Inside { uint inside[]; };\n"
     << "layout(push_constant) uniform P { uint count; } p;\n"
     << "#define VF_VECTORS_TEXEL_FETCH\n"
-    << include_text() << "const ivec3 kResolution = ivec3(" << v.resolution.x << ", "
+    << test::vectors_glsl_include() << "const ivec3 kResolution = ivec3(" << v.resolution.x << ", "
     << v.resolution.y << ", " << v.resolution.z << ");\n"
     << "vec4 vf_vectors_texel(ivec3 i) {\n"
     << "  const uint at = " << words

@@ -20,16 +20,12 @@
 #include "voxfield/vectors.h"
 
 using namespace voxfield;
-using namespace voxfield::gpu;
 
-namespace {
+// A named namespace: unity builds put the GPU suites into one translation unit.
+namespace sampler3d_test {
 
-std::string include_text() {
-  std::ifstream in(std::string(VOXFIELD_INCLUDE_DIR) + "/voxfield/glsl/voxfield_vectors.glsl");
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using gpu::Buffer;
+using gpu::Context;
 
 std::string kernel_text(const VectorVolume& v, VectorStorage storage) {
   std::ostringstream g;
@@ -46,7 +42,7 @@ std::string kernel_text(const VectorVolume& v, VectorStorage storage) {
     << "layout(std430, set = 0, binding = 2) writeonly buffer Samples { vec4 samples[]; };\n"
     << "layout(std430, set = 0, binding = 3) writeonly buffer Inside { uint inside[]; };\n"
     << "layout(push_constant) uniform P { uint count; } p;\n"
-    << include_text() << "void main() {\n"
+    << test::vectors_glsl_include() << "void main() {\n"
     << "  const uint i = gl_GlobalInvocationID.x;\n"
     << "  if (i >= p.count) return;\n"
     << "  VfVectorVolume v;\n"
@@ -211,7 +207,7 @@ TEST(GpuVectors, TheShaderIncludeSamplesA3dImageAsTheCppSampler) {
     upload(image, tex);
     // The pipeline: a combined image sampler and three storage buffers, one push constant.
     const std::vector<std::uint32_t> spirv =
-        compile_glsl("vectors-sampler", kernel_text(v, storage));
+        gpu::compile_glsl("vectors-sampler", kernel_text(v, storage));
     VkDescriptorSetLayoutBinding bindings[4]{};
     for (std::uint32_t b = 0; b < 4; ++b) {
       bindings[b].binding = b;
@@ -348,4 +344,4 @@ TEST(GpuVectors, TheShaderIncludeSamplesA3dImageAsTheCppSampler) {
   testing_backends::expect_no_validation_messages(Backend::kVulkan);
 }
 
-}  // namespace
+}  // namespace sampler3d_test

@@ -507,24 +507,34 @@ namespace {
 
 // Every storage's step (with rgba8's table of decayed strength bytes) against the definition
 // applied texel by texel: generate, then blend_vector_texels with the stored previous field.
+// Every algorithm: splatting's step fuses the search with the sweep, the others sweep the winners.
+const VectorAlgorithm kEveryAlgorithm[] = {VectorAlgorithm::kBrute, VectorAlgorithm::kSplat,
+                                           VectorAlgorithm::kJfa, VectorAlgorithm::kJfaPlus1,
+                                           VectorAlgorithm::kJfaPlus2};
+
 TEST(Vectors, StepsEqualGenerationThenBlendTexelByTexel) {
   const VectorVolume v = shapes()[2].volume;  // rotated, anisotropic
-  for (VectorStorage storage :
-       {VectorStorage::kRgba8, VectorStorage::kRgba16f, VectorStorage::kRgba32f}) {
-    VectorSimulation sim(v, storage, {}, 3.0);
-    VectorTexture ref(v.resolution, storage);
-    for (int step = 0; step < 8; ++step) {
-      std::vector<VectorSource> sources = random_sources(v, step % 3 == 2 ? 0 : 6, 40 + step);
-      sim.step(sources, 0.05);
-      const VectorTexture cur = generate_vectors(v, sources, storage);
-      for (std::int64_t i = 0; i < v.voxel_count(); ++i)
-        ref.set(i, blend_vector_texels(cur.get(i), ref.get(i), 3.0, 0.05));
-      ASSERT_TRUE(std::equal(ref.bytes().begin(), ref.bytes().end(), sim.field().bytes().begin()))
-          << vector_storage_name(storage) << " step " << step;
-      ASSERT_TRUE(
-          std::equal(cur.bytes().begin(), cur.bytes().end(), sim.current().bytes().begin()));
+  for (VectorAlgorithm algorithm : kEveryAlgorithm)
+    for (VectorStorage storage :
+         {VectorStorage::kRgba8, VectorStorage::kRgba16f, VectorStorage::kRgba32f}) {
+      SCOPED_TRACE(std::string(vector_algorithm_name(algorithm)) + " " +
+                   vector_storage_name(storage));
+      VectorOptions o;
+      o.algorithm = algorithm;
+      VectorSimulation sim(v, storage, o, 3.0);
+      VectorTexture ref(v.resolution, storage);
+      for (int step = 0; step < 8; ++step) {
+        std::vector<VectorSource> sources = random_sources(v, step % 3 == 2 ? 0 : 6, 40 + step);
+        sim.step(sources, 0.05);
+        const VectorTexture cur = generate_vectors(v, sources, storage, o);
+        for (std::int64_t i = 0; i < v.voxel_count(); ++i)
+          ref.set(i, blend_vector_texels(cur.get(i), ref.get(i), 3.0, 0.05));
+        ASSERT_TRUE(std::equal(ref.bytes().begin(), ref.bytes().end(), sim.field().bytes().begin()))
+            << "step " << step;
+        ASSERT_TRUE(
+            std::equal(cur.bytes().begin(), cur.bytes().end(), sim.current().bytes().begin()));
+      }
     }
-  }
 }
 
 // Wakes fading out with no source: at this decay an rgba8 strength byte of 5 decays to a strength
@@ -533,24 +543,28 @@ TEST(Vectors, StepsEqualGenerationThenBlendTexelByTexel) {
 TEST(Vectors, FadingWakesEqualGenerationThenBlendToTheEnd) {
   const VectorVolume v = shapes()[1].volume;  // anisotropic
   const double dt = 1.0 / 60, decay = 4.6 / 255 / dt;
-  for (VectorStorage storage :
-       {VectorStorage::kRgba8, VectorStorage::kRgba16f, VectorStorage::kRgba32f}) {
-    VectorSimulation sim(v, storage, {}, decay);
-    VectorTexture ref(v.resolution, storage);
-    for (int step = 0; step < 70; ++step) {
-      const std::vector<VectorSource> sources =
-          step < 2 ? random_sources(v, 10, 70 + step) : std::vector<VectorSource>{};
-      sim.step(sources, dt);
-      const VectorTexture cur = generate_vectors(v, sources, storage);
-      for (std::int64_t i = 0; i < v.voxel_count(); ++i)
-        ref.set(i, blend_vector_texels(cur.get(i), ref.get(i), decay, dt));
-      ASSERT_TRUE(std::equal(ref.bytes().begin(), ref.bytes().end(), sim.field().bytes().begin()))
-          << vector_storage_name(storage) << " step " << step;
+  for (VectorAlgorithm algorithm : {VectorAlgorithm::kSplat, VectorAlgorithm::kBrute})
+    for (VectorStorage storage :
+         {VectorStorage::kRgba8, VectorStorage::kRgba16f, VectorStorage::kRgba32f}) {
+      SCOPED_TRACE(vector_algorithm_name(algorithm));
+      VectorOptions o;
+      o.algorithm = algorithm;
+      VectorSimulation sim(v, storage, o, decay);
+      VectorTexture ref(v.resolution, storage);
+      for (int step = 0; step < 70; ++step) {
+        const std::vector<VectorSource> sources =
+            step < 2 ? random_sources(v, 10, 70 + step) : std::vector<VectorSource>{};
+        sim.step(sources, dt);
+        const VectorTexture cur = generate_vectors(v, sources, storage, o);
+        for (std::int64_t i = 0; i < v.voxel_count(); ++i)
+          ref.set(i, blend_vector_texels(cur.get(i), ref.get(i), decay, dt));
+        ASSERT_TRUE(std::equal(ref.bytes().begin(), ref.bytes().end(), sim.field().bytes().begin()))
+            << vector_storage_name(storage) << " step " << step;
+      }
+      EXPECT_TRUE(std::equal(ref.bytes().begin(), ref.bytes().end(),
+                             VectorTexture(v.resolution, storage).bytes().begin()))
+          << "every wake has faded";
     }
-    EXPECT_TRUE(std::equal(ref.bytes().begin(), ref.bytes().end(),
-                           VectorTexture(v.resolution, storage).bytes().begin()))
-        << "every wake has faded";
-  }
 }
 
 }  // namespace

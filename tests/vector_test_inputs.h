@@ -11,7 +11,7 @@
 
 namespace voxfield::test {
 
-VectorVolume cube_volume(int n) {
+inline VectorVolume cube_volume(int n) {
   VectorVolume v;
   v.centre = {0, 0, 0};
   v.size = {static_cast<double>(n), static_cast<double>(n), static_cast<double>(n)};
@@ -21,7 +21,8 @@ VectorVolume cube_volume(int n) {
 
 // Random sources of every kind the definition must handle: sub-voxel radii, stationary ones, fast
 // movers crossing the box, sources on the faces and outside it.
-std::vector<VectorSource> random_sources(const VectorVolume& v, int count, std::uint32_t seed) {
+inline std::vector<VectorSource> random_sources(const VectorVolume& v, int count,
+                                                std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0, 1);
   const double voxel =
@@ -56,7 +57,7 @@ struct Shape {
   VectorVolume volume;
 };
 
-std::vector<Shape> shapes() {
+inline std::vector<Shape> shapes() {
   std::vector<Shape> out;
   out.push_back({"cube 24", cube_volume(24)});
   VectorVolume aniso;  // the paper's quarter-resolution axis and non-cubic voxels
@@ -67,6 +68,15 @@ std::vector<Shape> shapes() {
   VectorVolume rotated = aniso;
   rotated.rotation = VectorVolume::rotation_about(37, {1, 2, 0.5});
   out.push_back({"rotated", rotated});
+  // A rotation orthonormal only to about 5e-7, as VectorVolume::validate() still accepts, with
+  // small voxels far from the origin: the passes must not assume unit axes.
+  VectorVolume loose = rotated;
+  loose.centre = {4000, -2500, 1200};
+  loose.rotation[0].x += 4e-7;
+  loose.rotation[1].y -= 3e-7;
+  loose.rotation[2].z += 2e-7;
+  loose.rotation[0].y += 2e-7;
+  out.push_back({"rotated, orthonormal to 1e-6, far out", loose});
   VectorVolume flat = cube_volume(16);
   flat.resolution = {16, 16, 1};
   out.push_back({"one layer", flat});

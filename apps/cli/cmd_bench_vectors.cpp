@@ -12,7 +12,7 @@
 
 #include "chart.h"
 #include "cli.h"
-#include "live_field.h"
+#include "vector_backend.h"
 #include "voxfield/gpu_vectors.h"
 #include "voxfield/parallel.h"
 #include "voxfield/vector_agents.h"
@@ -130,7 +130,7 @@ int run_bench_vectors(const BenchVectorSettings& s) {
     throw UsageError("--plot " + s.plot + ": the plot is written as .svg or .png");
   std::optional<ThreadLimit> limit;
   if (s.threads > 0) limit.emplace(s.threads);
-  const std::shared_ptr<gpu::Context> gpu_context = choose_backend(s.backend);
+  const std::shared_ptr<gpu::Context> gpu_context = choose_vector_backend(s.backend);
   const std::string backend = gpu_context ? "vulkan" : "cpu";
   using A = VectorAlgorithm;
   const std::vector<A> all{A::kBrute, A::kSplat, A::kJfa, A::kJfaPlus1, A::kJfaPlus2};

@@ -8,7 +8,7 @@
 #include <optional>
 
 #include "cli.h"
-#include "live_field.h"
+#include "vector_backend.h"
 #include "voxfield/gpu_vectors.h"
 #include "voxfield/png.h"
 #include "voxfield/vector_files.h"
@@ -173,7 +173,7 @@ int run_vectors(const VectorSettings& s) {
                      "(Unreal's importer refuses more); lower --resolution");
 
   set_activity("computing the vector field of " + s.sources);
-  const auto gpu_context = choose_backend(s.backend);
+  const auto gpu_context = choose_vector_backend(s.backend);
   const auto start = std::chrono::steady_clock::now();
   VectorPassTimes totals;
   VectorTexture texture;
@@ -266,7 +266,8 @@ int run_vectors(const VectorSettings& s) {
       nlohmann::json passes = nlohmann::json::object();
       for (const gpu::PassTiming& t : gpu_passes) passes[t.pass] = t.ms;
       j["gpu_passes_ms"] = passes;
-      // The whole command's traffic, read-backs and the picture included.
+      // The traffic of the field, its read-back and its picture (the error measurement below,
+      // which generates the last frame again, is not counted).
       const gpu::Counters c = gpu_context->counters();
       j["gpu"] = {{"dispatches", c.dispatches},         {"submits", c.submits},
                   {"fence_waits", c.fence_waits},       {"pipeline_barriers", c.pipeline_barriers},

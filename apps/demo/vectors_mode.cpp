@@ -46,6 +46,10 @@ int VectorsMode::advance(double frame_s) {
   const int due = scheduler_.advance(frame_s);
   const double dt = scheduler_.dt_s();
   const auto start = std::chrono::steady_clock::now();
+  if (has_pending_) {  // the last frame was not drawn (its swapchain was out of date): run it now
+    gpu_sim_->step(pending_, dt);
+    has_pending_ = false;
+  }
   for (int i = 0; i < due; ++i) {
     const std::vector<VectorSource> sources = agents_.step(dt);
     if (cpu_sim_) {

@@ -15,14 +15,16 @@
 // Exactness: distances, winners and directions are computed in doubles and encoded and blended
 // in floats, operation for operation as the CPU does, with no fused multiply-adds. Where the
 // device's division and square root are correctly rounded (lavapipe, and the double units of
-// desktop GPUs) every texel equals the CPU's bit for bit in every storage — tests/test_gpu_vectors
-// checks it on lavapipe. The visualiser works in floats and matches the CPU's image within the
-// tolerance that test states. Needs the device feature shaderFloat64 (GpuUnavailable without it).
+// desktop GPUs) every texel equals the CPU's bit for bit in every storage —
+// tests/test_gpu_vector_passes.cpp checks it on lavapipe. The visualiser works in floats and
+// matches the CPU's image within the tolerance that test states. Needs the device feature
+// shaderFloat64 (GpuUnavailable without it).
 #pragma once
 
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "voxfield/gpu.h"
@@ -30,6 +32,10 @@
 #include "voxfield/vectors.h"
 
 namespace voxfield::gpu {
+
+// Whether `context`'s device can run the vector-field passes (it needs shaderFloat64); `why`, when
+// given, receives the reason when it cannot.
+bool supports_vector_passes(Context& context, std::string* why = nullptr);
 
 // Hardware-independent figures of one call, and its wall-clock time (on lavapipe, CPU emulation).
 struct VectorGpuStats {

@@ -15,7 +15,6 @@
 #include "vector_internal.h"
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
-#include "voxfield/parallel.h"
 
 namespace voxfield {
 
@@ -314,22 +313,23 @@ void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) 
     // Each z slab is splatted, then swept at once by the same thread while its rows are in the
     // cache; the rows splatting wrote are the sweep's sources.
     sc.splat.keep_texels = true;
-    std::atomic<std::int64_t> splat_ns{0};
+    std::atomic<std::int64_t> splat_ns{0}, sweep_ns{0};
     detail::vectors::with_codec(field_.storage(), [&](auto codec) {
       const Sweep<decltype(codec)> sweep(volume_, segments, decay_s, current_.data(),
                                          field_.bytes().data(), next_.data(), spans);
       detail::vectors::splat_winners(
           volume_, sources, segments, options_.rule, nullptr, sc.splat,
           [&](int k0, int k1) {
+            const std::int64_t slab = detail::vectors::now_ns();
             sweep(k0, k1, sc.splat.winners.data(), sc.splat.texels.data(), sc.splat.won.data());
+            sweep_ns += detail::vectors::now_ns() - slab;
           },
           &splat_ns);
     });
     // The wall time, apportioned between the two by the threads' time in each.
     const double total_ms = detail::vectors::ms_since(start);
-    const double thread_ms = total_ms * max_threads();
-    const double splat_share = std::min(1.0, splat_ns.load() * 1e-6 / std::max(thread_ms, 1e-9));
-    t.search_ms = total_ms * splat_share;
+    const double busy = static_cast<double>(splat_ns.load() + sweep_ns.load());
+    t.search_ms = busy > 0 ? total_ms * static_cast<double>(splat_ns.load()) / busy : 0;
     t.blend_ms = total_ms - t.search_ms;
   } else {
     const std::vector<std::int32_t> winners = vector_winners(volume_, sources, options_, &t);

@@ -85,20 +85,26 @@ void splat_winners(const VectorVolume& v, std::span<const VectorSource> sources,
       // each side against rounding) is visited, so a source costs about its sphere, not its box.
       const Vec3d mid = seg.a + seg.ab * 0.5;
       const double bound = seg.radius + 0.5 * std::sqrt(seg.ab2);
-      const double bound2 = bound * bound * (1 + 1e-9);
-      const Vec3d axis{v.rotation[0][0], v.rotation[1][0], v.rotation[2][0]};  // the box's x
-      const double per_unit = v.resolution.x / v.size.x;  // voxels per world unit along x
+      // The box's x column, as the centre tables scale it (a rotation may be orthonormal only to
+      // 1e-6, so its length is not taken to be 1).
+      const Vec3d axis{v.rotation[0][0], v.rotation[1][0], v.rotation[2][0]};
+      const double axis2 = dot(axis, axis);
+      const double per_unit = v.resolution.x / v.size.x;  // voxels per unit of `local`
       for (int k = std::max(b.lo[2], k0); k <= std::min(b.hi[2], k1 - 1); ++k)
         for (int j = b.lo[1]; j <= b.hi[1]; ++j) {
           const Vec3d base = centres.row(j, k);
-          // The row is base + axis * local: the sphere's chord on it, in voxel indices.
+          // The row is base + axis * local: the sphere's chord on it, in voxel indices. The
+          // perpendicular part is computed as a vector (not |to_mid|^2 - along^2, which cancels),
+          // and the bound is loosened by the rounding of these sums, relative to their size.
           const Vec3d to_mid = mid - base;
-          const double along = dot(to_mid, axis);
-          const double off2 = dot(to_mid, to_mid) - along * along;
+          const double closest = dot(to_mid, axis) / axis2;  // `local` nearest to the midpoint
+          const Vec3d perp = to_mid - axis * closest;
+          const double off2 = dot(perp, perp);
+          const double bound2 = bound * bound * (1 + 1e-9) + 1e-12 * dot(to_mid, to_mid);
           if (off2 > bound2) continue;
-          const double half = std::sqrt(std::max(0.0, bound2 - off2));
-          const double first = (along - half) * per_unit + 0.5 * v.resolution.x - 0.5;
-          const double last = (along + half) * per_unit + 0.5 * v.resolution.x - 0.5;
+          const double half = std::sqrt((bound2 - off2) / axis2);
+          const double first = (closest - half) * per_unit + 0.5 * v.resolution.x - 0.5;
+          const double last = (closest + half) * per_unit + 0.5 * v.resolution.x - 0.5;
           const int i0 = std::max(b.lo[0], static_cast<int>(std::max(-1.0, std::floor(first)) - 1));
           const int i1 = std::min(
               b.hi[0],

@@ -131,6 +131,15 @@ void splat_winners(const VectorVolume& v, std::span<const VectorSource> sources,
                    SplatScratch& scratch,
                    const std::function<void(int k0, int k1)>& after_slab = nullptr,
                    std::atomic<std::int64_t>* splat_ns = nullptr);
+// The visualiser's camera, shared by the CPU's render_vectors and the GPU's view pass: the view
+// checked (InvalidArgument naming what is wrong), the eye and its basis, the march step and the
+// density per world unit.
+struct ViewCamera {
+  Vec3d eye, forward, right, up;
+  double tan_half = 0, aspect = 1, step = 0, density = 0;
+};
+ViewCamera view_camera(const VectorVolume& v, const VectorViewOptions& view);
+
 // Jump flooding's seeding of one source: the part of its segment within its radius of the box,
 // sampled at the samples + 1 points t0 + (t1 - t0) * (t / samples), t = 0..samples, each seeding
 // the voxel it falls in (clamped to the volume). samples = -1: the source seeds nothing (it cannot

@@ -10,6 +10,7 @@
 // vectors_view.comp draws the same picture on the GPU, in floats.
 #include <cmath>
 
+#include "vector_internal.h"
 #include "voxfield/error.h"
 #include "voxfield/vectors.h"
 
@@ -62,34 +63,47 @@ struct Sheet {
 
 }  // namespace
 
+namespace detail::vectors {
+
+ViewCamera view_camera(const VectorVolume& v, const VectorViewOptions& view) {
+  if (!(view.fov_deg > 1 && view.fov_deg < 179) || !(view.density > 0) ||
+      !std::isfinite(view.density))
+    throw InvalidArgument(
+        "render_vectors: the field of view must be 1..179 degrees, the density > 0");
+  if (view.width <= 0 || view.height <= 0 || view.width > 16384 || view.height > 16384)
+    throw InvalidArgument("render_vectors: image size out of range (1..16384 per side)");
+  if (view.sheet &&
+      (!(view.sheet_height >= 0 && view.sheet_height <= 1) || !std::isfinite(view.sheet_push)))
+    throw InvalidArgument("render_vectors: the sheet's height must be 0..1, its push finite");
+  ViewCamera c;
+  c.eye = view.auto_eye ? v.to_world({1.6, -0.9, 1.3}) : view.eye;
+  const Vec3d target = view.look_at.value_or(v.centre);
+  if (!((target - c.eye).length() > 0))
+    throw InvalidArgument("render_vectors: the camera looks at its own position");
+  c.forward = (target - c.eye).normalized();
+  Vec3d up{0, 0, 1};
+  if (std::abs(dot(up, c.forward)) > 0.99) up = {0, 1, 0};
+  c.right = cross(c.forward, up).normalized();
+  c.up = cross(c.right, c.forward);
+  c.tan_half = std::tan(view.fov_deg * 3.14159265358979323846 / 360.0);
+  c.aspect = static_cast<double>(view.width) / view.height;
+  const Vec3d vs = v.voxel_size();
+  c.step = 0.5 * std::min({vs.x, vs.y, vs.z});
+  c.density = view.density / v.size.length();  // the box's diagonal at strength 1: opaque
+  return c;
+}
+
+}  // namespace detail::vectors
+
 Image render_vectors(const VectorVolume& volume, const VectorTexture& texture,
                      const VectorViewOptions& view) {
   volume.validate();
   if (!(texture.resolution() == volume.resolution))
     throw InvalidArgument("render_vectors: the texture's resolution differs from the volume's");
-  if (!(view.fov_deg > 1 && view.fov_deg < 179) || !(view.density > 0) ||
-      !std::isfinite(view.density))
-    throw InvalidArgument(
-        "render_vectors: the field of view must be 1..179 degrees, the density > 0");
-  if (view.sheet &&
-      (!(view.sheet_height >= 0 && view.sheet_height <= 1) || !std::isfinite(view.sheet_push)))
-    throw InvalidArgument("render_vectors: the sheet's height must be 0..1, its push finite");
+  const detail::vectors::ViewCamera cam = detail::vectors::view_camera(volume, view);
   Image image(view.width, view.height);
-  const double diagonal = volume.size.length();
-  const Vec3d eye = view.auto_eye ? volume.to_world({1.6, -0.9, 1.3}) : view.eye;
-  const Vec3d target = view.look_at.value_or(volume.centre);
-  if (!((target - eye).length() > 0))
-    throw InvalidArgument("render_vectors: the camera looks at its own position");
-  const Vec3d forward = (target - eye).normalized();
-  Vec3d up{0, 0, 1};
-  if (std::abs(dot(up, forward)) > 0.99) up = {0, 1, 0};
-  const Vec3d right = cross(forward, up).normalized();
-  const Vec3d true_up = cross(right, forward);
-  const double tan_half = std::tan(view.fov_deg * 3.14159265358979323846 / 360.0);
-  const double aspect = static_cast<double>(view.width) / view.height;
-  const Vec3d vs = volume.voxel_size();
-  const double step = 0.5 * std::min({vs.x, vs.y, vs.z});
-  const double density = view.density / diagonal;  // the box's diagonal at strength 1: opaque
+  const Vec3d eye = cam.eye, forward = cam.forward, right = cam.right, true_up = cam.up;
+  const double tan_half = cam.tan_half, aspect = cam.aspect, step = cam.step, density = cam.density;
   const Sheet sheet{volume, texture, view.sheet_height, view.sheet_push / volume.size.z};
 
   for (int y = 0; y < view.height; ++y)

@@ -74,6 +74,15 @@ void submitted(Recorder& rec, VectorGpuStats& stats, std::vector<PassTiming>* ti
 
 }  // namespace
 
+bool supports_vector_passes(Context& context, std::string* why) {
+  const Context::Impl& c = context.impl();
+  if (c.float64) return true;
+  if (why)
+    *why = "the vector-field passes need the device feature shaderFloat64, which " + c.info.name +
+           " does not have (or which was not enabled on it)";
+  return false;
+}
+
 VectorTexture generate_vectors(Context& context, const VectorVolume& volume,
                                std::span<const VectorSource> sources, VectorStorage storage,
                                const VectorOptions& options, std::vector<std::int32_t>* winners,
@@ -166,6 +175,10 @@ VectorSimulation::VectorSimulation(std::shared_ptr<Context> context, const Vecto
                                    VectorStorage storage, VectorOptions options,
                                    double decay_per_s) {
   if (!context) throw InvalidArgument("gpu::VectorSimulation: no context");
+  // Arguments first (InvalidArgument, as the CPU's constructor), then the device.
+  volume.validate();
+  if (!std::isfinite(decay_per_s) || decay_per_s < 0)
+    throw InvalidArgument("vector simulation: the decay per second must be finite and >= 0");
   context->impl().require_device();
   impl_ = std::make_unique<Impl>(std::move(context), volume, storage, options, decay_per_s);
 }
@@ -208,6 +221,7 @@ Image VectorSimulation::render(const VectorViewOptions& view) {
   Impl& s = *impl_;
   Context::Impl& c = s.context->impl();
   Buffer* pixels = nullptr;
+  s.engine.settle();  // an own submission: every earlier command has finished
   {
     Recorder rec(c, &s.engine.sets());
     pixels = &s.engine.record_view(rec, s.field, view);

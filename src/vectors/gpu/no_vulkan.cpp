@@ -5,6 +5,11 @@
 
 namespace voxfield::gpu {
 
+bool supports_vector_passes(Context&, std::string* why) {
+  if (why) *why = "this voxfield was built without the Vulkan backend";
+  return false;
+}
+
 VectorTexture generate_vectors(Context&, const VectorVolume&, std::span<const VectorSource>,
                                VectorStorage, const VectorOptions&, std::vector<std::int32_t>*,
                                VectorGpuStats*, std::vector<PassTiming>*) {

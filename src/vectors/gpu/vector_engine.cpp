@@ -308,31 +308,11 @@ void VectorEngine::record(Recorder& rec, std::span<const VectorSource> sources,
 
 Buffer& VectorEngine::record_view(Recorder& rec, Buffer& texels, const VectorViewOptions& view,
                                   bool bgra) {
-  if (!(view.fov_deg > 1 && view.fov_deg < 179) || !(view.density > 0) ||
-      !std::isfinite(view.density))
-    throw InvalidArgument(
-        "render_vectors: the field of view must be 1..179 degrees, the density > 0");
-  if (view.width <= 0 || view.height <= 0 || view.width > 16384 || view.height > 16384)
-    throw InvalidArgument("render_vectors: image size out of range (1..16384 per side)");
   const VectorVolume& v = volume_;
   // The camera as visualise.cpp places it, in doubles, handed over as floats.
-  const double diagonal = v.size.length();
-  const Vec3d eye = view.auto_eye ? v.to_world({1.6, -0.9, 1.3}) : view.eye;
-  const Vec3d target = view.look_at.value_or(v.centre);
-  if (!((target - eye).length() > 0))
-    throw InvalidArgument("render_vectors: the camera looks at its own position");
-  if (view.sheet &&
-      (!(view.sheet_height >= 0 && view.sheet_height <= 1) || !std::isfinite(view.sheet_push)))
-    throw InvalidArgument("render_vectors: the sheet's height must be 0..1, its push finite");
-  const Vec3d forward = (target - eye).normalized();
-  Vec3d up{0, 0, 1};
-  if (std::abs(dot(up, forward)) > 0.99) up = {0, 1, 0};
-  const Vec3d right = cross(forward, up).normalized();
-  const Vec3d true_up = cross(right, forward);
-  const double tan_half = std::tan(view.fov_deg * 3.14159265358979323846 / 360.0);
-  const double aspect = static_cast<double>(view.width) / view.height;
-  const Vec3d vs = v.voxel_size();
-  const double step = 0.5 * std::min({vs.x, vs.y, vs.z});
+  const vx::ViewCamera cam = vx::view_camera(v, view);
+  const Vec3d eye = cam.eye, forward = cam.forward, right = cam.right, true_up = cam.up;
+  const double tan_half = cam.tan_half, aspect = cam.aspect, step = cam.step;
   // Pixel (x, y)'s ray: forward + right sx + up sy with sx, sy affine in x and y.
   const double sx0 = (1.0 / view.width - 1.0) * tan_half * aspect;
   const double sy0 = (1.0 - 1.0 / view.height) * tan_half;
@@ -351,7 +331,7 @@ Buffer& VectorEngine::record_view(Recorder& rec, Buffer& texels, const VectorVie
   params.dir00 = f4(forward + right * sx0 + true_up * sy0);
   params.dx = f4(right * (2.0 / view.width * tan_half * aspect));
   params.dy = f4(true_up * (-2.0 / view.height * tan_half));
-  params.march = {static_cast<float>(step), static_cast<float>(view.density / diagonal),
+  params.march = {static_cast<float>(step), static_cast<float>(cam.density),
                   static_cast<float>(4.0 * (v.resolution.x + v.resolution.y + v.resolution.z)), 0};
   params.sheet = {view.sheet ? 1.0f : 0.0f, static_cast<float>(view.sheet_height),
                   static_cast<float>(view.sheet_push / v.size.z), 0};

@@ -52,6 +52,9 @@ class VectorEngine {
                       bool bgra = false);
 
   DescriptorArena& sets() { return sets_; }
+  // Recycles the sets and destroys the retired buffers: only once every command recorded so far
+  // has finished (record() does it itself).
+  void settle();
   const VectorVolume& volume() const { return volume_; }
   VectorStorage storage() const { return storage_; }
 
@@ -59,7 +62,6 @@ class VectorEngine {
   struct Upload;
   void stage(Recorder& rec, const Upload& up, VectorGpuStats& stats);
   Buffer& grow(Buffer& b, VkDeviceSize bytes, bool host_visible);
-  void settle();  // recycles the sets and destroys the retired buffers (earlier work finished)
 
   Context::Impl& c_;
   VectorVolume volume_;
