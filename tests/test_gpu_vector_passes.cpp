@@ -189,20 +189,6 @@ TEST(GpuVectorPasses, StepsRecordedIntoTheApplicationsCommandBuffer) {
   const VectorVolume v = test::shapes()[2].volume;
   gpu::VectorSimulation own(ctx, v, VectorStorage::kRgba8, {}, 2.0);
   gpu::VectorSimulation app(ctx, v, VectorStorage::kRgba8, {}, 2.0);
-  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  ai.commandPool = c.command_pool;
-  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  ai.commandBufferCount = 1;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  ASSERT_EQ(vkAllocateCommandBuffers(c.device, &ai, &cmd), VK_SUCCESS);
-  auto run = [&](const std::function<void()>& record) {
-    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    vkBeginCommandBuffer(cmd, &bi);
-    record();
-    vkEndCommandBuffer(cmd);
-    c.submit_and_wait(cmd);
-  };
   VectorViewOptions view;
   view.width = 40;
   view.height = 30;
@@ -216,7 +202,7 @@ TEST(GpuVectorPasses, StepsRecordedIntoTheApplicationsCommandBuffer) {
     view.width = 40 + 16 * step;  // a growing picture replaces the pixel buffer after the step
     const VkDeviceSize bytes = static_cast<VkDeviceSize>(view.width) * view.height * 4;
     gpu::Buffer readback(c, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
-    run([&] {
+    test::run_commands(c, [&](VkCommandBuffer cmd) {
       field = gpu::record_step(app, cmd, sources, 0.05);
       pixels = gpu::record_render(app, cmd, view, order);
       // The application's copy of the picture (record_render made it readable by transfers).
@@ -246,7 +232,6 @@ TEST(GpuVectorPasses, StepsRecordedIntoTheApplicationsCommandBuffer) {
     ASSERT_NE(pixels, VkBuffer{VK_NULL_HANDLE});
   }
   EXPECT_EQ(app.steps(), 4);
-  vkFreeCommandBuffers(c.device, c.command_pool, 1, &cmd);
   testing_backends::expect_no_validation_messages(Backend::kVulkan);
 }
 

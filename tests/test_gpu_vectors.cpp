@@ -90,34 +90,14 @@ TEST(GpuVectors, TheShaderIncludeSamplesAsTheCppSampler) {
   v.rotation = VectorVolume::rotation_about(37, {1, 2, 3});
   v.resolution = {7, 5, 4};
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> unit(-1, 1), u01(0, 1);
-  // World points from volume coordinates in [-0.2, 1.2]^3, none within 1e-3 of a face (where
-  // float and double may disagree on inside).
   const std::uint32_t n = 2000;
-  std::vector<float> points(4 * n);
-  std::vector<Vec3d> world(n);
-  for (std::uint32_t i = 0; i < n; ++i) {
-    Vec3d u;
-    for (int a = 0; a < 3; ++a) {
-      do u[a] = -0.2 + 1.4 * u01(rng);
-      while (std::abs(u[a]) < 1e-3 || std::abs(u[a] - 1) < 1e-3);
-    }
-    world[i] = v.to_world(u);
-    for (int a = 0; a < 3; ++a) points[4 * i + a] = static_cast<float>(world[i][a]);
-    world[i] = {points[4 * i], points[4 * i + 1], points[4 * i + 2]};  // what the GPU sees
-  }
+  const auto [points, world] = test::volume_points(v, n, rng);
   constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
                                         VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   for (VectorStorage storage :
        {VectorStorage::kRgba8, VectorStorage::kRgba16f, VectorStorage::kRgba32f}) {
-    VectorTexture tex(v.resolution, storage);
-    for (std::int64_t i = 0; i < tex.voxel_count(); ++i) {
-      Vec3d d{unit(rng), unit(rng), unit(rng)};
-      d = d.length() > 0 ? d.normalized() : Vec3d{1, 0, 0};
-      tex.set(i, {static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.z),
-                  static_cast<float>(u01(rng))});
-    }
+    const VectorTexture tex = test::random_vector_texture(v.resolution, storage, rng);
     const Kernel& k = c.kernels.from_glsl(c.device, "vectors-include", kernel_text(v, storage));
     Buffer texels(c, tex.bytes().size(), kUsage, true), pts(c, points.size() * 4, kUsage, true);
     Buffer samples(c, 16 * n, kUsage, true), inside(c, 4 * n, kUsage, true);

@@ -83,24 +83,6 @@ struct SampledTexture {
   }
 };
 
-// Records and submits `record` in a command buffer of the context's pool, waiting for it.
-template <class F>
-void run_once(Context::Impl& c, F&& record) {
-  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  ai.commandPool = c.command_pool;
-  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  ai.commandBufferCount = 1;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  ASSERT_EQ(vkAllocateCommandBuffers(c.device, &ai, &cmd), VK_SUCCESS);
-  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  vkBeginCommandBuffer(cmd, &bi);
-  record(cmd);
-  vkEndCommandBuffer(cmd);
-  c.submit_and_wait(cmd);
-  vkFreeCommandBuffers(c.device, c.command_pool, 1, &cmd);
-}
-
 void upload(SampledTexture& t, const VectorTexture& tex) {
   Context::Impl& c = t.c;
   const Vec3i n = tex.resolution();
@@ -125,7 +107,7 @@ void upload(SampledTexture& t, const VectorTexture& tex) {
   ASSERT_EQ(vkBindImageMemory(c.device, t.image, t.memory, 0), VK_SUCCESS);
   Buffer& staging = c.upload_buffer(tex.bytes().size());
   std::memcpy(staging.mapped(), tex.bytes().data(), tex.bytes().size());
-  run_once(c, [&](VkCommandBuffer cmd) {
+  test::run_commands(c, [&](VkCommandBuffer cmd) {
     VkImageMemoryBarrier to_dst{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
     to_dst.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     to_dst.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
@@ -176,33 +158,15 @@ TEST(GpuVectors, TheShaderIncludeSamplesA3dImageAsTheCppSampler) {
   v.rotation = VectorVolume::rotation_about(-52, {2, -1, 1});
   v.resolution = {6, 9, 5};
   std::mt19937 rng(23);
-  std::uniform_real_distribution<double> unit(-1, 1), u01(0, 1);
   const std::uint32_t n = 1500;
-  std::vector<float> points(4 * n);
-  std::vector<Vec3d> world(n);
-  for (std::uint32_t i = 0; i < n; ++i) {
-    Vec3d u;
-    for (int a = 0; a < 3; ++a) {
-      do u[a] = -0.2 + 1.4 * u01(rng);
-      while (std::abs(u[a]) < 1e-3 || std::abs(u[a] - 1) < 1e-3);
-    }
-    const Vec3d w = v.to_world(u);
-    for (int a = 0; a < 3; ++a) points[4 * i + a] = static_cast<float>(w[a]);
-    world[i] = {points[4 * i], points[4 * i + 1], points[4 * i + 2]};  // what the GPU sees
-  }
+  const auto [points, world] = test::volume_points(v, n, rng);
   constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
                                         VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   for (VectorStorage storage :
        {VectorStorage::kRgba8, VectorStorage::kRgba16f, VectorStorage::kRgba32f}) {
     SCOPED_TRACE(vector_storage_name(storage));
-    VectorTexture tex(v.resolution, storage);
-    for (std::int64_t i = 0; i < tex.voxel_count(); ++i) {
-      Vec3d d{unit(rng), unit(rng), unit(rng)};
-      d = d.length() > 0 ? d.normalized() : Vec3d{1, 0, 0};
-      tex.set(i, {static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.z),
-                  static_cast<float>(u01(rng))});
-    }
+    const VectorTexture tex = test::random_vector_texture(v.resolution, storage, rng);
     SampledTexture image(c);
     upload(image, tex);
     // The pipeline: a combined image sampler and three storage buffers, one push constant.
@@ -278,7 +242,7 @@ TEST(GpuVectors, TheShaderIncludeSamplesA3dImageAsTheCppSampler) {
         writes[b].pBufferInfo = &buffer_info[b - 1];
     }
     vkUpdateDescriptorSets(c.device, 4, writes, 0, nullptr);
-    run_once(c, [&](VkCommandBuffer cmd) {
+    test::run_commands(c, [&](VkCommandBuffer cmd) {
       vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
       vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
       const CountPush p{n};

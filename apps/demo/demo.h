@@ -73,6 +73,8 @@ class Demo {
   // when there is one, else on the CPU; to the world with `vectors` false.
   void set_mode(bool vectors);
   bool draw_vectors(VulkanWindow::Screenshot* shot);
+  // A CPU picture copied into the window's staging buffer (in its byte order): the frame's fill.
+  std::function<void(VkCommandBuffer, VkImage)> stage_cpu_frame(const Image& img);
   bool gpu_can_draw() const { return path_.renderer != nullptr; }
   std::string title() const;
   GLFWwindow* glfw() const { return vk_ ? vk_->window() : gl_->window(); }

@@ -58,20 +58,7 @@ bool Demo::draw_vectors(VulkanWindow::Screenshot* shot) {
       vkCmdCopyBufferToImage(cmd, pixels, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
     };
   } else {
-    const Image img = vectors_->render(camera_, w, h);
-    void* mapped = nullptr;
-    const VkBuffer staging = vk_->staging(static_cast<VkDeviceSize>(w) * h * 4, &mapped);
-    auto* dst = static_cast<std::uint8_t*>(mapped);
-    const bool bgra = vk_->bgra();
-    for (std::size_t i = 0; i < static_cast<std::size_t>(w) * h; ++i) {
-      dst[4 * i + 0] = img.rgb[3 * i + (bgra ? 2 : 0)];
-      dst[4 * i + 1] = img.rgb[3 * i + 1];
-      dst[4 * i + 2] = img.rgb[3 * i + (bgra ? 0 : 2)];
-      dst[4 * i + 3] = 255;
-    }
-    fill = [&, staging](VkCommandBuffer cmd, VkImage image) {
-      vkCmdCopyBufferToImage(cmd, staging, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
-    };
+    fill = stage_cpu_frame(vectors_->render(camera_, w, h));
   }
   const bool drawn = vk_->draw_frame(
       fill, [](VkCommandBuffer cmd) { ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd); },

@@ -304,21 +304,7 @@ bool Demo::draw(VulkanWindow::Screenshot* shot) {
       vkCmdCopyBufferToImage(cmd, pixels, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
     };
   } else {
-    const Image img = render(world_->scene(), cam, ro);
-    void* mapped = nullptr;
-    const VkBuffer staging =
-        vk_->staging(static_cast<VkDeviceSize>(ro.width) * ro.height * 4, &mapped);
-    auto* dst = static_cast<std::uint8_t*>(mapped);
-    const bool bgra = vk_->bgra();
-    for (std::size_t i = 0; i < static_cast<std::size_t>(ro.width) * ro.height; ++i) {
-      dst[4 * i + 0] = img.rgb[3 * i + (bgra ? 2 : 0)];
-      dst[4 * i + 1] = img.rgb[3 * i + 1];
-      dst[4 * i + 2] = img.rgb[3 * i + (bgra ? 0 : 2)];
-      dst[4 * i + 3] = 255;
-    }
-    fill = [&, staging](VkCommandBuffer cmd, VkImage image) {
-      vkCmdCopyBufferToImage(cmd, staging, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
-    };
+    fill = stage_cpu_frame(render(world_->scene(), cam, ro));
   }
   const bool drawn = vk_->draw_frame(
       fill, [](VkCommandBuffer cmd) { ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd); },
@@ -326,6 +312,27 @@ bool Demo::draw(VulkanWindow::Screenshot* shot) {
   if (gpu_can_draw()) wait_idle();  // the GPU frame's time includes its execution
   last_.render_ms = ms_between(t0, Clock::now());
   return drawn;
+}
+
+std::function<void(VkCommandBuffer, VkImage)> Demo::stage_cpu_frame(const Image& img) {
+  void* mapped = nullptr;
+  const VkBuffer staging =
+      vk_->staging(static_cast<VkDeviceSize>(img.width) * img.height * 4, &mapped);
+  auto* dst = static_cast<std::uint8_t*>(mapped);
+  const bool bgra = vk_->bgra();
+  for (std::size_t i = 0; i < static_cast<std::size_t>(img.width) * img.height; ++i) {
+    dst[4 * i + 0] = img.rgb[3 * i + (bgra ? 2 : 0)];
+    dst[4 * i + 1] = img.rgb[3 * i + 1];
+    dst[4 * i + 2] = img.rgb[3 * i + (bgra ? 0 : 2)];
+    dst[4 * i + 3] = 255;
+  }
+  VkBufferImageCopy copy{};
+  copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  copy.imageExtent = {static_cast<std::uint32_t>(img.width), static_cast<std::uint32_t>(img.height),
+                      1};
+  return [staging, copy](VkCommandBuffer cmd, VkImage image) {
+    vkCmdCopyBufferToImage(cmd, staging, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+  };
 }
 
 void Demo::take_screenshot(const std::string& path) {
