@@ -149,16 +149,17 @@ struct VectorSimulation::Impl {
   std::int64_t steps = 0;
   VectorGpuStats stats;
   std::vector<PassTiming> timings;
+  VkPipelineStageFlags readers;  // where an application may read a recorded field
 
+  // The arguments are checked by VectorSimulation's constructor.
   Impl(std::shared_ptr<Context> ctx, const VectorVolume& volume, VectorStorage storage,
        VectorOptions o, double decay)
       : context(std::move(ctx)),
         engine(context->impl(), volume, storage),
         options(o),
-        decay_per_s(decay) {
+        decay_per_s(decay),
+        readers(reader_stages(context->impl())) {
     options.interrupter = nullptr;
-    if (!std::isfinite(decay) || decay < 0)
-      throw InvalidArgument("vector simulation: the decay per second must be finite and >= 0");
     current = engine.make_texture();
     field = engine.make_texture();
     next = engine.make_texture();
@@ -168,6 +169,28 @@ struct VectorSimulation::Impl {
     const std::uint32_t zero = storage == VectorStorage::kRgba8 ? 0x00808080u : 0u;
     for (Buffer* b : {&current, &field, &next}) rec.fill(*b, 0, VK_WHOLE_SIZE, zero);
     rec.submit();
+  }
+
+  // One step's uploads and passes into `rec` (own or the application's command buffer); the
+  // textures swap once the caller has recorded what it adds. Throws InvalidArgument for a bad
+  // time step or source before recording anything.
+  void record_step(Recorder& rec, std::span<const VectorSource> sources, double dt_s,
+                   VectorGpuStats& st) {
+    if (!std::isfinite(dt_s) || dt_s <= 0)
+      throw InvalidArgument("vector simulation: the time step must be finite and > 0");
+    validate_sources(sources);
+    context->impl().require_device();
+    VectorEngine::Targets t;
+    t.current = &current;
+    t.previous = &field;
+    t.next = &next;
+    t.decay = static_cast<float>(decay_per_s * dt_s);  // as the CPU's step rounds it
+    engine.record(rec, sources, options, t, st);
+  }
+  void finish_step(const VectorGpuStats& st) {
+    std::swap(field, next);
+    ++steps;
+    stats = st;
   }
 };
 
@@ -186,28 +209,16 @@ VectorSimulation::VectorSimulation(std::shared_ptr<Context> context, const Vecto
 VectorSimulation::~VectorSimulation() = default;
 
 void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) {
-  if (!std::isfinite(dt_s) || dt_s <= 0)
-    throw InvalidArgument("vector simulation: the time step must be finite and > 0");
-  validate_sources(sources);
   const auto start = std::chrono::steady_clock::now();
   Impl& s = *impl_;
-  Context::Impl& c = s.context->impl();
-  c.require_device();
   VectorGpuStats st;
   {
-    Recorder rec(c, &s.engine.sets());
-    VectorEngine::Targets t;
-    t.current = &s.current;
-    t.previous = &s.field;
-    t.next = &s.next;
-    t.decay = static_cast<float>(s.decay_per_s * dt_s);  // as the CPU's step rounds it
-    s.engine.record(rec, sources, s.options, t, st);
+    Recorder rec(s.context->impl(), &s.engine.sets());
+    s.record_step(rec, sources, dt_s, st);
     submitted(rec, st, &s.timings);
   }
-  std::swap(s.field, s.next);
-  ++s.steps;
   st.ms = ms_since(start);
-  s.stats = st;
+  s.finish_step(st);
 }
 
 VectorTexture VectorSimulation::field() {
@@ -232,28 +243,16 @@ Image VectorSimulation::render(const VectorViewOptions& view) {
 
 VectorFieldBuffer record_step(VectorSimulation& sim, VkCommandBuffer cmd,
                               std::span<const VectorSource> sources, double dt_s) {
-  if (!std::isfinite(dt_s) || dt_s <= 0)
-    throw InvalidArgument("vector simulation: the time step must be finite and > 0");
-  validate_sources(sources);
   VectorSimulation::Impl& s = sim.impl();
-  Context::Impl& c = s.context->impl();
-  c.require_device();
+  VectorGpuStats st;
   {
-    Recorder rec(c, cmd, s.engine.sets());
-    VectorEngine::Targets t;
-    t.current = &s.current;
-    t.previous = &s.field;
-    t.next = &s.next;
-    t.decay = static_cast<float>(s.decay_per_s * dt_s);
-    VectorGpuStats st;
-    s.engine.record(rec, sources, s.options, t, st);
+    Recorder rec(s.context->impl(), cmd, s.engine.sets());
+    s.record_step(rec, sources, dt_s, st);
     // The application's shaders and copies read the new field after this (its vertex and
     // fragment shaders too where the queue draws).
-    rec.expose(s.next, reader_stages(c), VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
-    s.stats = st;
+    rec.expose(s.next, s.readers, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
   }
-  std::swap(s.field, s.next);
-  ++s.steps;
+  s.finish_step(st);
   return field_buffer(sim);
 }
 
