@@ -178,8 +178,7 @@ struct VectorSimulation::Impl {
                    VectorGpuStats& st) {
     if (!std::isfinite(dt_s) || dt_s <= 0)
       throw InvalidArgument("vector simulation: the time step must be finite and > 0");
-    validate_sources(sources);
-    context->impl().require_device();
+    context->impl().require_device();  // the sources are checked by engine.record
     VectorEngine::Targets t;
     t.current = &current;
     t.previous = &field;

@@ -48,6 +48,45 @@ std::uint64_t align16(std::uint64_t n) {
   return (n + 15) / 16 * 16;
 }
 
+// Splatting's bins in CSR form: tile_count + 1 offsets, then per tile the sources (ascending, so
+// ties go to the lower index) whose index box meets it — counted, then filled. False, with `out`
+// untouched, when they would take more than `max_bytes`.
+bool bin_sources(const VectorVolume& volume, std::span<const VectorSource> sources, Vec3i tiles,
+                 std::uint64_t max_bytes, std::vector<std::uint32_t>& out) {
+  const int edge = L::VF_VECTORS_TILE;
+  const std::size_t n_tiles = static_cast<std::size_t>(tiles.x) * tiles.y * tiles.z;
+  std::vector<vx::IndexBox> boxes(sources.size());
+  std::uint64_t entries = 0;
+  for (std::size_t s = 0; s < sources.size(); ++s) {
+    boxes[s] = vx::index_box(volume, sources[s]);
+    if (boxes[s].empty()) continue;
+    std::uint64_t covered = 1;
+    for (int a = 0; a < 3; ++a)
+      covered *= static_cast<std::uint64_t>(boxes[s].hi[a] / edge - boxes[s].lo[a] / edge + 1);
+    entries += covered;
+  }
+  if ((n_tiles + 1 + entries) * 4 > max_bytes) return false;
+  auto for_tiles = [&](const vx::IndexBox& b, auto&& f) {
+    for (int z = b.lo[2] / edge; z <= b.hi[2] / edge; ++z)
+      for (int y = b.lo[1] / edge; y <= b.hi[1] / edge; ++y)
+        for (int x = b.lo[0] / edge; x <= b.hi[0] / edge; ++x)
+          f(static_cast<std::size_t>(x) +
+            static_cast<std::size_t>(tiles.x) * (y + static_cast<std::size_t>(tiles.y) * z));
+  };
+  std::vector<std::uint32_t> counts(n_tiles + 1, 0);
+  for (const vx::IndexBox& b : boxes)
+    if (!b.empty()) for_tiles(b, [&](std::size_t tile) { ++counts[tile + 1]; });
+  out.assign(n_tiles + 1 + entries, 0);
+  out[0] = static_cast<std::uint32_t>(n_tiles + 1);
+  for (std::size_t i = 0; i < n_tiles; ++i) out[i + 1] = out[i] + counts[i + 1];
+  std::vector<std::uint32_t> fill(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n_tiles));
+  for (std::size_t s = 0; s < sources.size(); ++s)
+    if (!boxes[s].empty())
+      for_tiles(boxes[s],
+                [&](std::size_t tile) { out[fill[tile]++] = static_cast<std::uint32_t>(s); });
+  return true;
+}
+
 }  // namespace
 
 // The bytes one call uploads, by destination.
@@ -170,45 +209,12 @@ void VectorEngine::record(Recorder& rec, std::span<const VectorSource> sources,
                     (n.y + L::VF_VECTORS_TILE - 1) / L::VF_VECTORS_TILE,
                     (n.z + L::VF_VECTORS_TILE - 1) / L::VF_VECTORS_TILE};
   if (options.algorithm == VectorAlgorithm::kSplat) {
-    // Bins in CSR form, each list ascending (sources visited in index order): counted, then
-    // filled. A source is binned to every tile its index box meets.
-    const std::size_t n_tiles = static_cast<std::size_t>(tiles.x) * tiles.y * tiles.z;
-    std::vector<vx::IndexBox> boxes(sources.size());
-    std::uint64_t entries = 0;
-    for (std::size_t s = 0; s < sources.size(); ++s) {
-      boxes[s] = vx::index_box(volume_, sources[s]);
-      if (boxes[s].empty()) continue;
-      std::uint64_t covered = 1;
-      for (int a = 0; a < 3; ++a)
-        covered *= static_cast<std::uint64_t>(boxes[s].hi[a] / L::VF_VECTORS_TILE -
-                                              boxes[s].lo[a] / L::VF_VECTORS_TILE + 1);
-      entries += covered;
-    }
-    const std::uint64_t bytes = (n_tiles + 1 + entries) * 4;
-    if (bytes <= std::min<std::uint64_t>(kMaxTileBytes, c_.limits.maxStorageBufferRange)) {
+    const std::uint64_t max_bytes =
+        std::min<std::uint64_t>(kMaxTileBytes, c_.limits.maxStorageBufferRange);
+    if (bin_sources(volume_, sources, tiles, max_bytes, up.tiles)) {
       search = L::VF_VECTORS_SPLAT;
-      stats.tile_entries = static_cast<std::int64_t>(entries);
-      std::vector<std::uint32_t> counts(n_tiles + 1, 0);
-      auto for_tiles = [&](const vx::IndexBox& b, auto&& f) {
-        for (int z = b.lo[2] / L::VF_VECTORS_TILE; z <= b.hi[2] / L::VF_VECTORS_TILE; ++z)
-          for (int y = b.lo[1] / L::VF_VECTORS_TILE; y <= b.hi[1] / L::VF_VECTORS_TILE; ++y)
-            for (int x = b.lo[0] / L::VF_VECTORS_TILE; x <= b.hi[0] / L::VF_VECTORS_TILE; ++x)
-              f(static_cast<std::size_t>(x) +
-                static_cast<std::size_t>(tiles.x) * (y + static_cast<std::size_t>(tiles.y) * z));
-      };
-      for (const vx::IndexBox& b : boxes)
-        if (!b.empty()) for_tiles(b, [&](std::size_t tile) { ++counts[tile + 1]; });
-      up.tiles.assign(n_tiles + 1 + entries, 0);
-      const std::uint32_t base = static_cast<std::uint32_t>(n_tiles + 1);
-      up.tiles[0] = base;
-      for (std::size_t i = 0; i < n_tiles; ++i) up.tiles[i + 1] = up.tiles[i] + counts[i + 1];
-      std::vector<std::uint32_t> fill(up.tiles.begin(),
-                                      up.tiles.begin() + static_cast<std::ptrdiff_t>(n_tiles));
-      for (std::size_t s = 0; s < sources.size(); ++s)
-        if (!boxes[s].empty())
-          for_tiles(boxes[s], [&](std::size_t tile) {
-            up.tiles[fill[tile]++] = static_cast<std::uint32_t>(s);
-          });
+      stats.tile_entries =
+          static_cast<std::int64_t>(up.tiles.size() - up.tiles[0]);  // past the offsets
     } else {
       stats.splat_as_brute = true;
     }
