@@ -10,6 +10,7 @@
 
 #include "error_text.h"
 #include "vector_test_inputs.h"
+#include "vectors/blend.h"  // internal: the four-lane rgba8 blend, tested against blend()
 #include "voxfield/error.h"
 #include "voxfield/vector_files.h"
 #include "voxfield/vector_world.h"
@@ -189,6 +190,60 @@ TEST(Vectors, DecayAndBlendMatchHandWorkedValues) {
   const VectorTexel cancel = blend_vector_texels({1, 0, 0, 0.5f}, {-1, 0, 0, 0.5f}, 0, 0.1);
   EXPECT_EQ(cancel, (VectorTexel{0, 0, 0, 0.5f}));
 }
+
+#if VOXFIELD_VECTORS_BLEND4
+// The step's four-lane rgba8 blend against the definition, blend() then store(), on texels read
+// from rgba8 bytes (the only texels it sees): every pair of strength bytes with random directions,
+// random texels, and the cases that stress it — opposite directions cancelling, directions at the
+// clamp (bytes 0 and 255), strengths that decay to a byte of 0 but not to 0.
+TEST(Vectors, FourLaneRgba8BlendEqualsTheDefinitionBitForBit) {
+  using detail::vectors::Codec;
+  using detail::vectors::Rgba8Blend4;
+  std::mt19937 rng(17);
+  std::uniform_int_distribution<std::uint32_t> byte(0, 255), any;
+  const auto decoded = [](std::uint32_t word) {
+    std::uint8_t b[4];
+    std::memcpy(b, &word, 4);
+    return Codec<VectorStorage::kRgba8>::load(b);
+  };
+  std::int64_t checked = 0;
+  for (const float decay_s : {0.0f, 1.0f / 255, 0.0174f, 0.25f, 0.99f}) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    for (std::uint32_t sc = 1; sc < 256; ++sc)
+      for (std::uint32_t sp = 1; sp < 256; ++sp)
+        pairs.emplace_back((any(rng) & 0xffffffu) | sc << 24, (any(rng) & 0xffffffu) | sp << 24);
+    for (int n = 0; n < 20000; ++n) {
+      const std::uint32_t x = byte(rng), y = byte(rng), z = byte(rng);
+      const std::uint32_t sc = 1 + byte(rng) % 255, sp = 1 + byte(rng) % 255;
+      pairs.emplace_back(x | y << 8 | z << 16 | sc << 24,  // and its opposite, of any strength
+                         (255 - x) | (255 - y) << 8 | (255 - z) << 16 | sp << 24);
+      pairs.emplace_back((n % 2 ? 0u : 255u) | 128u << 8 | 128u << 16 | sc << 24,
+                         (n % 3 ? 255u : 0u) | byte(rng) << 8 | 128u << 16 | sp << 24);
+    }
+    for (std::size_t first = 0; first < pairs.size(); first += 4) {
+      const std::size_t count = std::min<std::size_t>(4, pairs.size() - first);
+      std::uint32_t current[4], previous[4], out[4];
+      for (std::size_t n = 0; n < 4; ++n)
+        std::tie(current[n], previous[n]) = pairs[first + std::min(n, count - 1)];
+      Rgba8Blend4::run(current, previous, decay_s, out);
+      for (std::size_t n = 0; n < count; ++n) {
+        const auto [c, p] = pairs[first + n];
+        const VectorTexel previous = decoded(p);
+        if (!(previous.strength - decay_s > 0)) continue;  // one-sided: not the lanes' case
+        std::uint8_t want[4];
+        Codec<VectorStorage::kRgba8>::store(want,
+                                            detail::vectors::blend(decoded(c), previous, decay_s));
+        std::uint32_t want_word;
+        std::memcpy(&want_word, want, 4);
+        ASSERT_EQ(out[n], want_word)
+            << std::hex << "current " << c << " previous " << p << " decay " << decay_s;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 300000);
+}
+#endif
 
 TEST(Vectors, SimulationStepsGenerateDecayAndBlend) {
   const VectorVolume v = cube_volume(16);

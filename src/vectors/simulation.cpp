@@ -11,6 +11,7 @@
 #include <string>
 #include <type_traits>
 
+#include "blend.h"
 #include "texel_codec.h"
 #include "vector_internal.h"
 #include "voxfield/error.h"
@@ -20,33 +21,7 @@ namespace voxfield {
 
 namespace {
 
-// The blend, inlined into the step's sweep; decay_s is decay_per_s * dt_s.
-inline VectorTexel blend(const VectorTexel& current, const VectorTexel& previous, float decay_s) {
-  // In float, as a shader blends (the texels are floats or narrower).
-  const float sc = current.strength;
-  const float sp = std::max(0.0f, previous.strength - decay_s);
-  const float total = sc + sp;
-  // Both gone (or decayed away): the zero texel, as where no source ever was — not the old
-  // direction at strength 0, which would keep a stale direction in the texture.
-  if (!(total > 0)) return {};
-  // One side alone: its direction as stored (renormalising a decoded 8-bit direction every step
-  // would let it drift), with the decayed strength.
-  if (sp == 0) return current;
-  if (sc == 0) return {previous.x, previous.y, previous.z, sp};
-  const float w = sc / total;
-  const float nx = w * current.x + (1 - w) * previous.x, ny = w * current.y + (1 - w) * previous.y,
-              nz = w * current.z + (1 - w) * previous.z;
-  const float length2 = nx * nx + ny * ny + nz * nz;
-  VectorTexel out;
-  if (length2 > 0) {
-    const float inv = 1.0f / std::sqrt(length2);
-    out.x = nx * inv;
-    out.y = ny * inv;
-    out.z = nz * inv;
-  }
-  out.strength = std::max(sc, sp);
-  return out;
-}
+using detail::vectors::blend;
 
 }  // namespace
 
@@ -114,7 +89,7 @@ struct SpanTracker {
   int lo = INT32_MAX, hi = -1;
   void add(int i) {
     lo = std::min(lo, i);
-    hi = i;  // texels are visited in increasing i
+    hi = std::max(hi, i);  // rgba8's four-lane blends report their texels late
   }
   RowSpan span() const {
     return hi < 0 ? RowSpan{}
@@ -201,6 +176,10 @@ struct StepRows {
                                          std::uint8_t* __restrict current,
                                          const std::uint8_t* __restrict previous,
                                          std::uint8_t* __restrict next) const {
+#if VOXFIELD_VECTORS_BLEND4
+    if constexpr (kRgba8)
+      return source_row8(span, winners, found, row_base, current, previous, next);
+#endif
     SpanTracker now, later;
     for (int i = span.lo; i < span.hi; ++i) {
       const std::size_t at = static_cast<std::size_t>(i) * C::kBytes;
@@ -224,6 +203,66 @@ struct StepRows {
     }
     return {now.span(), later.span()};
   }
+
+#if VOXFIELD_VECTORS_BLEND4
+  // source_row for rgba8, with the blends of texels that have both a current and a decayed
+  // previous strength run four at a time (Rgba8Blend4) in a second pass over the row. A blend
+  // with one side alone is that side's bytes — the current texel as stored, or the previous one
+  // with its decayed strength byte (decay_alone) — and both gone is the zero texel, as blend()
+  // then store() gives them.
+  std::pair<RowSpan, RowSpan> source_row8(RowSpan span, const std::int32_t* __restrict winners,
+                                          const VectorTexel* __restrict found, Vec3d row_base,
+                                          std::uint8_t* __restrict current,
+                                          const std::uint8_t* __restrict previous,
+                                          std::uint8_t* __restrict next) const {
+    SpanTracker now, later;
+    std::uint16_t both[4096 + 3];  // the texels blended in the second pass (rows <= 4096)
+    int count = 0;
+    for (int i = span.lo; i < span.hi; ++i) {
+      const std::size_t at = static_cast<std::size_t>(i) * 4;
+      const std::int32_t w = winners[i];
+      if (w < 0) {
+        C::store_zero(current + at);
+        if (decay_alone(previous + at, next + at)) later.add(i);
+        continue;
+      }
+      alignas(4) std::uint8_t texel[4];
+      C::store(texel, found ? found[i]
+                            : detail::vectors::texel_of(detail::vectors::value_of(
+                                  segments[static_cast<std::size_t>(w)], row_base + xs[i], w)));
+      std::uint32_t word, before;
+      std::memcpy(&word, texel, 4);
+      std::memcpy(current + at, &word, 4);
+      now.add(i);
+      std::memcpy(&before, previous + at, 4);
+      if (decay8[before >> 24] < 0) {  // the previous strength decays to 0: the current alone
+        const std::uint32_t out = (word >> 24) == 0 ? kZero8 : word;
+        std::memcpy(next + at, &out, 4);
+        if (out != kZero8) later.add(i);
+      } else if ((word >> 24) == 0) {  // no current strength: the previous one decayed
+        if (decay_alone(previous + at, next + at)) later.add(i);
+      } else {
+        both[count++] = static_cast<std::uint16_t>(i);
+      }
+    }
+    if (count == 0) return {now.span(), later.span()};
+    for (int n = count; n % 4 != 0; ++n) both[n] = both[count - 1];  // pad: repeat the last
+    for (int first = 0; first < count; first += 4) {
+      std::uint32_t c[4], p[4], out[4];
+      for (int n = 0; n < 4; ++n) {
+        const std::size_t at = static_cast<std::size_t>(both[first + n]) * 4;
+        std::memcpy(&c[n], current + at, 4);
+        std::memcpy(&p[n], previous + at, 4);
+      }
+      detail::vectors::Rgba8Blend4::run(c, p, decay_s, out);
+      for (int n = 0; n < std::min(4, count - first); ++n) {
+        std::memcpy(next + static_cast<std::size_t>(both[first + n]) * 4, &out[n], 4);
+        if (out[n] != kZero8) later.add(both[first + n]);
+      }
+    }
+    return {now.span(), later.span()};
+  }
+#endif
 };
 
 // Conversion, decay and blend of one step in one sweep, row by row, over the hull of the row's
