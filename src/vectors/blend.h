@@ -81,12 +81,16 @@ struct Rgba8Blend4 {
     const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
     const __m128 sc = decode(t.strength, current, 24);
     // max(0, s - decay): maxps(x, 0) is x > 0 ? x : 0, as std::max(0.0f, x) for every x.
-    const __m128 sp = _mm_max_ps(_mm_sub_ps(decode(t.strength, previous, 24), _mm_set1_ps(decay_s)), zero);
+    const __m128 sp =
+        _mm_max_ps(_mm_sub_ps(decode(t.strength, previous, 24), _mm_set1_ps(decay_s)), zero);
     const __m128 w = _mm_div_ps(sc, _mm_add_ps(sc, sp));
     const __m128 rest = _mm_sub_ps(one, w);
-    const __m128 nx = _mm_add_ps(_mm_mul_ps(w, decode(t.direction, current, 0)), _mm_mul_ps(rest, decode(t.direction, previous, 0)));
-    const __m128 ny = _mm_add_ps(_mm_mul_ps(w, decode(t.direction, current, 8)), _mm_mul_ps(rest, decode(t.direction, previous, 8)));
-    const __m128 nz = _mm_add_ps(_mm_mul_ps(w, decode(t.direction, current, 16)), _mm_mul_ps(rest, decode(t.direction, previous, 16)));
+    const __m128 nx = _mm_add_ps(_mm_mul_ps(w, decode(t.direction, current, 0)),
+                                 _mm_mul_ps(rest, decode(t.direction, previous, 0)));
+    const __m128 ny = _mm_add_ps(_mm_mul_ps(w, decode(t.direction, current, 8)),
+                                 _mm_mul_ps(rest, decode(t.direction, previous, 8)));
+    const __m128 nz = _mm_add_ps(_mm_mul_ps(w, decode(t.direction, current, 16)),
+                                 _mm_mul_ps(rest, decode(t.direction, previous, 16)));
     const __m128 length2 =
         _mm_add_ps(_mm_add_ps(_mm_mul_ps(nx, nx), _mm_mul_ps(ny, ny)), _mm_mul_ps(nz, nz));
     // Where length2 is 0 (opposite directions cancelling) the direction is zero: the lane's
