@@ -15,6 +15,8 @@
 
 namespace voxfield {
 
+class TerrainField;
+
 class MeshChunks {
  public:
   // Meshes every chunk of `volume` (options as for mesh_volume; the same errors). The
@@ -31,8 +33,15 @@ class MeshChunks {
   // so an exception (NaN sample, cancellation) leaves every chunk as it was.
   std::vector<Vec3i> update(const ScalarVolume& volume, const Box3i& changed);
 
+  // A terrain field's chunks: merged() equals mesh_terrain(terrain, options), colours included.
+  MeshChunks(const TerrainField& terrain, const MeshOptions& options);
+  // After edits of the same terrain (a copy of it will do): `changed` as TerrainField::apply
+  // returns it (or the union of several). InvalidArgument when its size or frame changed.
+  std::vector<Vec3i> update(const TerrainField& terrain, const Box3i& changed);
+
   Vec3i chunk_count() const;
-  // Chunk `c`'s own mesh (no colours). InvalidArgument for a chunk outside chunk_count().
+  // Chunk `c`'s own mesh (colours for a terrain with a palette). InvalidArgument for a chunk
+  // outside chunk_count().
   Mesh chunk_mesh(Vec3i c) const;
   // All chunks welded: equal, array for array, to mesh_volume(volume, options) now.
   Mesh merged() const;

@@ -42,6 +42,24 @@ bool Block::load(const Lattice& lattice, const Box3i& cells) {
     lo_[a] = std::max(cells.begin[a] - 1, 0);
     hi_[a] = std::min(cells.end[a] + 1, lattice.n[a] - 1);
   }
+  if (lattice.values) {
+    data_ = lattice.values;
+    base_ = 0;
+    sy_ = lattice.n.x;
+    sz_ = sy_ * static_cast<std::ptrdiff_t>(lattice.n.y);
+  } else {
+    Box3i reads;
+    for (int a = 0; a < 3; ++a) {
+      reads.begin[a] = std::max(cells.begin[a] - 3, 0);
+      reads.end[a] = std::min(cells.end[a] + 3, lattice.n[a]);
+    }
+    copy_.resize(static_cast<std::size_t>(reads.volume()));
+    (*lattice.fill)(reads, copy_.data());
+    data_ = copy_.data();
+    sy_ = reads.end.x - reads.begin.x;
+    sz_ = sy_ * (reads.end.y - reads.begin.y);
+    base_ = -(reads.begin.x + sy_ * reads.begin.y + sz_ * reads.begin.z);
+  }
   const std::size_t dx = static_cast<std::size_t>(hi_.x - lo_.x + 1);
   dy_ = static_cast<std::size_t>(hi_.y - lo_.y + 1);
   signs_.resize(dy_ * static_cast<std::size_t>(hi_.z - lo_.z + 1));
@@ -49,7 +67,7 @@ bool Block::load(const Lattice& lattice, const Box3i& cells) {
   std::uint8_t* signs = signs_.data();
   for (int z = lo_.z; z <= hi_.z; ++z)
     for (int y = lo_.y; y <= hi_.y; ++y) {
-      const float* row = lattice.values + lattice.index(lo_.x, y, z);
+      const float* row = this->row(lo_.x, y, z);
       bool in = false, out = false, nan = false;  // nan: NaN or infinite
       for (std::size_t i = 0; i < dx; ++i) {      // no early exit: this loop vectorises
         const float v = row[i];
@@ -120,6 +138,7 @@ void ChunkPart::clear() {
   normals.clear();
   keys.clear();
   sources.clear();
+  colors.clear();
   owned.clear();
   shared.clear();
   indices.clear();
@@ -177,6 +196,10 @@ Mesh weld(const std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sourc
   Mesh mesh;
   mesh.positions.resize(base.back());
   mesh.normals.resize(base.back());
+  // Colours when the parts have them (a lattice with colours gives every vertex one).
+  const bool colored =
+      std::any_of(parts.begin(), parts.end(), [](const ChunkPart& p) { return !p.colors.empty(); });
+  if (colored) mesh.colors.resize(base.back());
   if (sources) sources->resize(base.back());
   constexpr std::uint32_t kUnresolved = std::numeric_limits<std::uint32_t>::max();
   // Each chunk's numbering to the global one: owned vertices copied out, borrowed ones found by
@@ -193,6 +216,7 @@ Mesh weld(const std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sourc
           global[c][i] = g;
           mesh.positions[g] = p.positions[i];
           mesh.normals[g] = p.normals[i];
+          if (colored) mesh.colors[g] = p.colors[i];
           if (sources) (*sources)[g] = p.sources[i];
         } else {
           const auto it = by_key.find(p.keys[i]);
@@ -215,6 +239,7 @@ Mesh weld(const std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sourc
               "mesh: the vertices do not fit 32-bit indices; mesh a smaller volume");
         mesh.positions.push_back(p.positions[i]);
         mesh.normals.push_back(p.normals[i]);
+        if (colored) mesh.colors.push_back(p.colors[i]);
         if (sources) sources->push_back(p.sources[i]);
       }
       global[c][i] = it->second;

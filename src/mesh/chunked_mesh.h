@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -27,6 +28,13 @@ namespace voxfield::detail::mesh {
 struct Lattice {
   Vec3i n;  // samples per axis (each >= 2)
   const float* values = nullptr;
+  // Where the samples are not one dense array (values is null: a terrain field's chunks),
+  // fill(region, out) writes the samples of `region`, x fastest; each chunk's block copies what
+  // it reads. Called from worker threads at once.
+  const std::function<void(const Box3i&, float*)>* fill = nullptr;
+  // Vertex colours, when given: the colour of a vertex made from inside sample `index` (x
+  // fastest), looked up as each chunk is meshed.
+  const std::function<std::array<std::uint8_t, 3>(std::uint64_t index)>* color = nullptr;
   std::array<double, 3> origin{}, spacing{};
   double iso = 0;
   double sign = 1;
@@ -70,7 +78,10 @@ struct ChunkGrid {
 
 // A chunk's view of the samples, from one sample before its cells to two past them (clamped to
 // the lattice): the cells' corners plus the neighbours central differences read. Loading scans the
-// rows once for their signs (and NaN); samples are then read in place.
+// rows once for their signs (and NaN); samples are then read in place — from the lattice's array,
+// or, for a lattice that fills regions, from the block's copy of everything the chunk reads (three
+// samples before its cells to two past their last corner: the dual meshers' apron and the
+// one-sided differences).
 class Block {
  public:
   // Loads the block for `cells`; false when no sample changes sign (the chunk has no surface).
@@ -79,10 +90,11 @@ class Block {
   // The value with the inside convention folded in (negative inside).
   float s_of(float value) const { return negate_ ? iso_ - value : value - iso_; }
   bool inside(float value) const { return negate_ ? value > iso_ : value < iso_; }
-  float s(int x, int y, int z) const { return s_of(lattice_->values[lattice_->index(x, y, z)]); }
+  float s(int x, int y, int z) const { return s_of(*row(x, y, z)); }
   // The raw samples of row (y, z) from x on (x fastest).
   const float* row(int x, int y, int z) const {
-    return lattice_->values + lattice_->index(x, y, z);
+    return data_ + (base_ + x + sy_ * static_cast<std::ptrdiff_t>(y) +
+                    sz_ * static_cast<std::ptrdiff_t>(z));
   }
   // Which signs row (y, z) holds over the block: bit 0 some sample inside, bit 1 some outside.
   std::uint8_t row_signs(int y, int z) const {
@@ -103,6 +115,10 @@ class Block {
   Vec3i lo_, hi_;
   std::size_t dy_ = 0;
   std::vector<std::uint8_t> signs_;
+  // Sample (x, y, z) is data_[base_ + x + sy_ y + sz_ z].
+  const float* data_ = nullptr;
+  std::ptrdiff_t base_ = 0, sy_ = 0, sz_ = 0;
+  std::vector<float> copy_;  // a filled lattice's samples
 };
 
 // One chunk's triangles over its own vertex numbering.
@@ -110,8 +126,9 @@ struct ChunkPart {
   std::vector<std::array<float, 3>> positions, normals;
   std::vector<std::uint64_t> keys;     // the vertex's lattice element
   std::vector<std::uint64_t> sources;  // the inside sample the vertex came from (colours)
-  std::vector<std::uint8_t> owned;     // 1: this chunk owns the element; 0: a neighbour does
-  std::vector<std::uint8_t> shared;    // owned and possibly used by a neighbour
+  std::vector<std::array<std::uint8_t, 3>> colors;  // per vertex, when the lattice has colours
+  std::vector<std::uint8_t> owned;   // 1: this chunk owns the element; 0: a neighbour does
+  std::vector<std::uint8_t> shared;  // owned and possibly used by a neighbour
   std::vector<std::uint32_t> indices;
   void clear();
   std::uint32_t add(const std::array<double, 3>& position, std::array<double, 3> normal,

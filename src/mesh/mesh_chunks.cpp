@@ -17,20 +17,54 @@ struct MeshChunks::Impl {
   ScalarVolume frame;  // size, origin and spacing the chunks were meshed with
   detail::mesh::ChunkGrid grid{{2, 2, 2}, 2};
   std::vector<detail::mesh::ChunkPart> parts;
+
+  void mesh_all(const detail::mesh::Lattice& lattice);
+  // Re-meshes the chunks whose reads meet `changed`; returns them.
+  std::vector<Vec3i> update(const detail::mesh::Lattice& lattice, const Box3i& changed);
+  void check_frame(const ScalarVolume& volume) const;
 };
+
+void MeshChunks::Impl::mesh_all(const detail::mesh::Lattice& lattice) {
+  grid = detail::mesh::ChunkGrid(frame.size, options.chunk_edge);
+  std::vector<std::int64_t> all(static_cast<std::size_t>(grid.total()));
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::int64_t>(i);
+  parts.resize(all.size());
+  detail::mesh::mesh_chunks(lattice, grid, options, all, parts);
+  options.interrupter = nullptr;  // it watched the first mesh; the chunks outlive it
+}
+
+void MeshChunks::Impl::check_frame(const ScalarVolume& volume) const {
+  if (!(volume.size == frame.size) || volume.origin_units != frame.origin_units ||
+      volume.spacing_units != frame.spacing_units)
+    throw InvalidArgument(
+        "MeshChunks::update: the volume's size or frame changed; build a new MeshChunks");
+}
 
 MeshChunks::MeshChunks(const ScalarVolume& volume, const MeshOptions& options)
     : impl_(std::make_unique<Impl>()) {
-  using namespace detail::mesh;
-  const Lattice lattice = checked_lattice(volume, options, false);
+  const detail::mesh::Lattice lattice = detail::mesh::checked_lattice(volume, options, false);
   impl_->options = options;
   impl_->frame = volume;
-  impl_->grid = ChunkGrid(volume.size, options.chunk_edge);
-  std::vector<std::int64_t> all(static_cast<std::size_t>(impl_->grid.total()));
-  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::int64_t>(i);
-  impl_->parts.resize(all.size());
-  mesh_chunks(lattice, impl_->grid, options, all, impl_->parts);
-  impl_->options.interrupter = nullptr;  // it watched the first mesh; the chunks outlive it
+  impl_->frame.values = nullptr;
+  impl_->mesh_all(lattice);
+}
+
+MeshChunks::MeshChunks(const TerrainField& terrain, const MeshOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  using namespace detail::mesh;
+  impl_->options = terrain_options(terrain, options);
+  impl_->frame = terrain_frame(terrain);
+  TerrainSamples keep;
+  impl_->mesh_all(terrain_lattice(terrain, impl_->options, keep));
+}
+
+std::vector<Vec3i> MeshChunks::update(const TerrainField& terrain, const Box3i& changed) {
+  using namespace detail::mesh;
+  impl_->check_frame(terrain_frame(terrain));
+  if (terrain_options(terrain, impl_->options).inside_above != impl_->options.inside_above)
+    throw InvalidArgument("MeshChunks::update: the terrain's sign convention changed");
+  TerrainSamples keep;
+  return impl_->update(terrain_lattice(terrain, impl_->options, keep), changed);
 }
 
 MeshChunks::~MeshChunks() = default;
@@ -38,14 +72,15 @@ MeshChunks::MeshChunks(MeshChunks&&) noexcept = default;
 MeshChunks& MeshChunks::operator=(MeshChunks&&) noexcept = default;
 
 std::vector<Vec3i> MeshChunks::update(const ScalarVolume& volume, const Box3i& changed) {
+  impl_->check_frame(volume);
+  return impl_->update(detail::mesh::checked_lattice(volume, impl_->options, false), changed);
+}
+
+std::vector<Vec3i> MeshChunks::Impl::update(const detail::mesh::Lattice& lattice,
+                                            const Box3i& changed) {
   using namespace detail::mesh;
-  Impl& s = *impl_;
-  if (!(volume.size == s.frame.size) || volume.origin_units != s.frame.origin_units ||
-      volume.spacing_units != s.frame.spacing_units)
-    throw InvalidArgument(
-        "MeshChunks::update: the volume's size or frame changed; build a new MeshChunks");
-  const Lattice lattice = checked_lattice(volume, s.options, false);
-  const Box3i region = changed.intersect(Box3i::from_size(volume.size));
+  Impl& s = *this;
+  const Box3i region = changed.intersect(Box3i::from_size(frame.size));
   std::vector<std::int64_t> dirty;
   std::vector<Vec3i> coords;
   if (!region.empty()) {
@@ -94,6 +129,7 @@ Mesh MeshChunks::chunk_mesh(Vec3i c) const {
   Mesh m;
   m.positions = p.positions;
   m.normals = p.normals;
+  m.colors = p.colors;
   m.indices = p.indices;
   return m;
 }

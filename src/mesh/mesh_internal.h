@@ -1,11 +1,14 @@
 // voxfield — the mesh module's entry shared by mesh_volume() and mesh_world() (internal).
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "chunked_mesh.h"
 #include "voxfield/mesh.h"
+#include "voxfield/terrain.h"
 
 namespace voxfield::detail::mesh {
 
@@ -16,7 +19,22 @@ Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options,
                   std::vector<std::uint64_t>* sources, bool voxel_faces = false);
 
 // The lattice of a request, after checking it (InvalidArgument for a bad volume or options).
-Lattice checked_lattice(const ScalarVolume& volume, const MeshOptions& options, bool voxel_faces);
+// A volume without values is read through `fill` (Lattice::fill).
+Lattice checked_lattice(const ScalarVolume& volume, const MeshOptions& options, bool voxel_faces,
+                        const std::function<void(const Box3i&, float*)>* fill = nullptr);
+
+// What a terrain field's lattice reads through (kept by the caller while the lattice is used).
+struct TerrainSamples {
+  std::function<void(const Box3i&, float*)> fill;
+  std::function<std::array<std::uint8_t, 3>(std::uint64_t)> color;
+};
+// The terrain's frame (size, origin and spacing; no values) and the options it is meshed with
+// (iso 0, inside per its sign convention).
+ScalarVolume terrain_frame(const TerrainField& terrain);
+MeshOptions terrain_options(const TerrainField& terrain, const MeshOptions& options);
+// The lattice of a terrain field meshed with terrain_options(); `keep` holds its functions.
+Lattice terrain_lattice(const TerrainField& terrain, const MeshOptions& terrain_options,
+                        TerrainSamples& keep);
 
 // Meshes the chunks numbered `chunks` (ChunkGrid::coord order) into parts[i], in parallel, with
 // progress and cancellation through options.interrupter.

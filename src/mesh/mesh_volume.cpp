@@ -35,8 +35,9 @@ Mesher parse_mesher(const std::string& name) {
 
 namespace detail::mesh {
 
-Lattice checked_lattice(const ScalarVolume& volume, const MeshOptions& options, bool voxel_faces) {
-  if (!volume.values) throw InvalidArgument("mesh: the volume has no samples");
+Lattice checked_lattice(const ScalarVolume& volume, const MeshOptions& options, bool voxel_faces,
+                        const std::function<void(const Box3i&, float*)>* fill) {
+  if (!volume.values && !fill) throw InvalidArgument("mesh: the volume has no samples");
   for (int a = 0; a < 3; ++a) {
     if (volume.size[a] < 2)
       throw InvalidArgument("mesh: the volume needs at least 2 samples along each axis (it has " +
@@ -66,6 +67,7 @@ Lattice checked_lattice(const ScalarVolume& volume, const MeshOptions& options, 
   Lattice lattice;
   lattice.n = volume.size;
   lattice.values = volume.values;
+  lattice.fill = volume.values ? nullptr : fill;
   lattice.origin = volume.origin_units;
   lattice.spacing = volume.spacing_units;
   lattice.iso = options.iso;
@@ -128,6 +130,11 @@ void mesh_chunks(const Lattice& lattice, const ChunkGrid& grid, const MeshOption
           dual_grid_chunk(lattice, grid, chunk, block, scratch, part,
                           options.algorithm == Mesher::kSurfaceNets ? surface_nets_vertex
                                                                     : dual_contouring_vertex);
+        if (lattice.color) {
+          part.colors.resize(part.sources.size());
+          for (std::size_t v = 0; v < part.sources.size(); ++v)
+            part.colors[v] = (*lattice.color)(part.sources[v]);
+        }
       }
       progress.advance();
     }
