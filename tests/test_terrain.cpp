@@ -40,8 +40,10 @@ double smin(double a, double b, double k) {
 }
 
 double brush_sdf(const TerrainBrush& b, Vec3d p) {
-  if (b.shape == TerrainBrush::Shape::kSphere) return sdf::sphere(p - b.centre_units, b.radius_units);
-  if (b.shape == TerrainBrush::Shape::kBox) return sdf::box(p - b.centre_units, b.half_extents_units);
+  if (b.shape == TerrainBrush::Shape::kSphere)
+    return sdf::sphere(p - b.centre_units, b.radius_units);
+  if (b.shape == TerrainBrush::Shape::kBox)
+    return sdf::box(p - b.centre_units, b.half_extents_units);
   return sdf::capsule(p, b.centre_units, b.end_units, b.radius_units);
 }
 
@@ -102,7 +104,9 @@ TEST(Terrain, SamplesAreTheDocumentedQuantisationOfTheClampedValue) {
       const TerrainField::Memory m = t.memory();
       EXPECT_GT(m.uniform_chunks, m.chunks / 3);
       EXPECT_LT(m.bytes, static_cast<std::uint64_t>(Box3i::from_size(n).volume()) *
-                             (s == TerrainStorage::kI8 ? 1 : s == TerrainStorage::kI16 ? 2 : 4));
+                             (s == TerrainStorage::kI8    ? 1
+                              : s == TerrainStorage::kI16 ? 2
+                                                          : 4));
       // A region decoded on its own equals the same samples of the whole.
       const Box3i part{{3, 9, 11}, {30, 10, 33}};
       std::vector<float> piece(static_cast<std::size_t>(part.volume()));
@@ -280,8 +284,8 @@ TEST(Terrain, MeshChunksFollowBrushesExactly) {
         TerrainBrush b;
         b.shape = static_cast<TerrainBrush::Shape>(round % 3);
         b.mode = round % 2 ? TerrainBrush::Mode::kSubtract : TerrainBrush::Mode::kAdd;
-        b.centre_units = position(o, static_cast<int>(5 + u(rng) * 38),
-                                  static_cast<int>(5 + u(rng) * 30), 0);
+        b.centre_units =
+            position(o, static_cast<int>(5 + u(rng) * 38), static_cast<int>(5 + u(rng) * 30), 0);
         b.centre_units.z = b.centre_units.z - ground(b.centre_units);  // on the ground
         b.end_units = b.centre_units + Vec3d{1.5, -1, 0.5};
         b.radius_units = 1 + u(rng) * 1.5;
@@ -331,9 +335,7 @@ TEST(Terrain, QuantisationMovesVerticesByAboutHalfAStep) {
 
 TEST(Terrain, BadRequestsAreRefusedAndChangeNothing) {
   TerrainOptions o = options_of(TerrainStorage::kI16, {20, 20, 20});
-  auto refused = [](TerrainOptions bad) {
-    return error_of([&] { TerrainField t(bad); });
-  };
+  auto refused = [](TerrainOptions bad) { return error_of([&] { TerrainField t(bad); }); };
   TerrainOptions bad = o;
   bad.samples = {1, 20, 20};
   EXPECT_NE(refused(bad).find("2..65536"), std::string::npos);
@@ -363,9 +365,8 @@ TEST(Terrain, BadRequestsAreRefusedAndChangeNothing) {
             return false;
     return true;
   };
-  const std::string nan = error_of([&] {
-    t.assign([](const Vec3d& p) { return p.x > 3 ? std::nan("") : 1.0; });
-  });
+  const std::string nan =
+      error_of([&] { t.assign([](const Vec3d& p) { return p.x > 3 ? std::nan("") : 1.0; }); });
   EXPECT_NE(nan.find("NaN at sample"), std::string::npos) << nan;
   EXPECT_TRUE(same());
   TerrainBrush b;

@@ -61,9 +61,9 @@ struct TerrainBrush {
   enum class Mode : std::uint8_t { kAdd, kSubtract };
   Shape shape = Shape::kSphere;
   Mode mode = Mode::kAdd;
-  Vec3d centre_units;       // sphere and box centre; the capsule's first end
-  Vec3d end_units;          // the capsule's second end
-  double radius_units = 1;  // sphere and capsule
+  Vec3d centre_units;                 // sphere and box centre; the capsule's first end
+  Vec3d end_units;                    // the capsule's second end
+  double radius_units = 1;            // sphere and capsule
   Vec3d half_extents_units{1, 1, 1};  // box (axis-aligned)
   double smooth_units = 0;            // the blend radius k; 0: a sharp seam
   // Adding: the material of the samples where the brush is further inside than the terrain was.

@@ -73,9 +73,11 @@ std::pair<Vec3d, Vec3d> brush_bounds(const TerrainBrush& b) {
       break;
   }
   const Vec3d r{b.radius_units, b.radius_units, b.radius_units};
-  const Vec3d lo{std::min(b.centre_units.x, b.end_units.x), std::min(b.centre_units.y, b.end_units.y),
+  const Vec3d lo{std::min(b.centre_units.x, b.end_units.x),
+                 std::min(b.centre_units.y, b.end_units.y),
                  std::min(b.centre_units.z, b.end_units.z)};
-  const Vec3d hi{std::max(b.centre_units.x, b.end_units.x), std::max(b.centre_units.y, b.end_units.y),
+  const Vec3d hi{std::max(b.centre_units.x, b.end_units.x),
+                 std::max(b.centre_units.y, b.end_units.y),
                  std::max(b.centre_units.z, b.end_units.z)};
   return {lo - r, hi + r};
 }
@@ -134,7 +136,8 @@ Box3i TerrainField::apply(const TerrainBrush& brush) {
             if (code != raw) {
               if (c.samples.empty()) {  // a uniform chunk made dense
                 c.samples.resize(per_chunk * static_cast<std::size_t>(s.codec.bytes));
-                for (std::size_t j = 0; j < per_chunk; ++j) c.set_raw(j, s.codec.bytes, old.uniform);
+                for (std::size_t j = 0; j < per_chunk; ++j)
+                  c.set_raw(j, s.codec.bytes, old.uniform);
               }
               c.set_raw(i, s.codec.bytes, code);
             }

@@ -115,8 +115,7 @@ Vec3i TerrainField::chunk_count() const {
   return impl_->chunks;
 }
 
-void TerrainField::assign(const std::function<double(const Vec3d&)>& value,
-                          std::uint8_t material) {
+void TerrainField::assign(const std::function<double(const Vec3d&)>& value, std::uint8_t material) {
   Impl& s = *impl_;
   const double sign = s.options.positive_inside ? -1 : 1;
   const std::size_t per_chunk = static_cast<std::size_t>(s.edge()) * s.edge() * s.edge();
@@ -215,7 +214,8 @@ void TerrainField::decode(const Box3i& region, float* out) const {
           continue;
         }
         const std::size_t first = s.local(x - cx * e, y % e, z % e);
-        for (std::size_t i = first; x < stop; ++x, ++i) *row++ = sign * s.codec.decode(c.raw(i, s.codec.bytes));
+        for (std::size_t i = first; x < stop; ++x, ++i)
+          *row++ = sign * s.codec.decode(c.raw(i, s.codec.bytes));
       }
     }
 }

@@ -27,7 +27,9 @@ struct Codec {
         step(s == TerrainStorage::kI8    ? clamp_units / 127
              : s == TerrainStorage::kI16 ? clamp_units / 32767
                                          : 0),
-        bytes(s == TerrainStorage::kI8 ? 1 : s == TerrainStorage::kI16 ? 2 : 4) {}
+        bytes(s == TerrainStorage::kI8    ? 1
+              : s == TerrainStorage::kI16 ? 2
+                                          : 4) {}
 
   float decode(std::uint32_t raw) const {
     switch (storage) {
@@ -99,13 +101,15 @@ struct TerrainField::Impl {
                 static_cast<std::size_t>(chunks.y) * static_cast<std::size_t>(c.z));
   }
   Vec3i chunk_coord(std::size_t i) const {
-    const std::size_t nx = static_cast<std::size_t>(chunks.x), ny = static_cast<std::size_t>(chunks.y);
+    const std::size_t nx = static_cast<std::size_t>(chunks.x),
+                      ny = static_cast<std::size_t>(chunks.y);
     return {static_cast<int>(i % nx), static_cast<int>(i / nx % ny), static_cast<int>(i / nx / ny)};
   }
   // Sample (x, y, z) of the chunk at `origin` (its first sample), as an index into the chunk.
   std::size_t local(int x, int y, int z) const {
     const auto e = static_cast<std::size_t>(edge());
-    return static_cast<std::size_t>(x) + e * (static_cast<std::size_t>(y) + e * static_cast<std::size_t>(z));
+    return static_cast<std::size_t>(x) +
+           e * (static_cast<std::size_t>(y) + e * static_cast<std::size_t>(z));
   }
   // The samples of chunk c that lie in the lattice.
   Box3i samples_of(Vec3i c) const {
