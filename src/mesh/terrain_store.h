@@ -42,16 +42,25 @@ struct Codec {
     }
     return std::bit_cast<float>(raw);
   }
+  // std::round (half away from zero) of |x| <= 2^31, inline: truncation, then the fraction (exact:
+  // x and its truncation differ by less than 1) decides. Without SSE4.1 std::round is a call.
+  static std::int32_t round_half_away(double x) {
+    std::int32_t i = static_cast<std::int32_t>(x);
+    const double fraction = x - i;
+    if (fraction >= 0.5) ++i;
+    if (fraction <= -0.5) --i;
+    return i;
+  }
   // v clamped to ±clamp, then rounded to the nearest code (half away from zero). v is finite.
   std::uint32_t encode(double v) const {
     const double c = v < -clamp ? -clamp : v > clamp ? clamp : v;
     switch (storage) {
       case TerrainStorage::kI8:
         return static_cast<std::uint8_t>(
-            static_cast<std::int8_t>(std::clamp(std::round(c / step), -127.0, 127.0)));
+            static_cast<std::int8_t>(std::clamp(round_half_away(c / step), -127, 127)));
       case TerrainStorage::kI16:
         return static_cast<std::uint16_t>(
-            static_cast<std::int16_t>(std::clamp(std::round(c / step), -32767.0, 32767.0)));
+            static_cast<std::int16_t>(std::clamp(round_half_away(c / step), -32767, 32767)));
       case TerrainStorage::kF32:
         break;
     }
