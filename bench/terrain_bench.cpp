@@ -143,8 +143,9 @@ int main(int argc, char** argv) {
     TerrainField terrain(to);
     terrain.assign(volume, 1);
     const TerrainField::Memory memory = terrain.memory();
-    const int sample_bytes =
-        storage == TerrainStorage::kI8 ? 1 : storage == TerrainStorage::kI16 ? 2 : 4;
+    const int sample_bytes = storage == TerrainStorage::kI8    ? 1
+                             : storage == TerrainStorage::kI16 ? 2
+                                                               : 4;
     const std::uint64_t chunk_bytes =
         static_cast<std::uint64_t>(to.chunk_edge) * to.chunk_edge * to.chunk_edge * sample_bytes;
     auto t0 = std::chrono::steady_clock::now();
@@ -213,8 +214,9 @@ int main(int argc, char** argv) {
         static_cast<double>(memory.bytes) / 1e6, static_cast<long long>(memory.uniform_chunks),
         static_cast<long long>(memory.chunks), static_cast<unsigned long long>(chunk_bytes),
         first_ms, first.triangle_count(), bs.p50, bs.p99, ms.p50, ms.p99, ts.mean, ts.p50, ts.p99,
-        bytes_up / edits / 1e3, static_cast<double>(so.size.x) * so.size.y * so.size.z * sample_bytes / 1e6,
-        error, same ? "yes" : "NO");
+        bytes_up / edits / 1e3,
+        static_cast<double>(so.size.x) * so.size.y * so.size.z * sample_bytes / 1e6, error,
+        same ? "yes" : "NO");
     std::fflush(stdout);
   }
   return status;

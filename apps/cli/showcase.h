@@ -34,6 +34,11 @@ void showcase_meshing(const World& terrain, const std::filesystem::path& out,
                       const std::filesystem::path& peers_script, const Camera& hero,
                       std::ostream& md, std::vector<Timing>& timings);
 
+// A deformable terrain field: smooth hills in i8 / i16 / f32, shaped by brushes with incremental
+// re-meshing (checked equal to fresh meshes), pictured before and after, exported as a .glb.
+void showcase_terrain(const std::filesystem::path& out, std::uint64_t seed, std::ostream& md,
+                      std::vector<Timing>& timings);
+
 // Vector fields: agents flying through a volume, fixed steps, the visualiser, every algorithm
 // against the definition, .fga and .vf exports; the flow around a terrain's solids under an edit.
 void showcase_vectors(const std::filesystem::path& out, std::uint64_t seed, std::ostream& md,

@@ -55,7 +55,8 @@ struct TerrainOptions {
 
 // A brush: an analytic shape added to the terrain (union) or subtracted from it, with a sharp or
 // a smooth seam. Smooth seams use the polynomial smooth minimum of radius k (Quilez, "smooth
-// minimum"): smin(a, b) = min(a, b) - h^2 k / 4, h = max(k - |a - b|, 0) / k.
+// minimum"): smin(a, b) = min(a, b) - h^2 k / 4, h = max(k - |a - b|, 0) / k. The blend reads the
+// stored (clamped) values: with k beyond the clamp, the seam's shape depends on the clamp too.
 struct TerrainBrush {
   enum class Shape : std::uint8_t { kSphere, kBox, kCapsule };
   enum class Mode : std::uint8_t { kAdd, kSubtract };
