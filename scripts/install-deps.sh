@@ -27,18 +27,30 @@ packages=(
   python3-dev pybind11-dev python3-pytest  # the Python package (pybind11 bindings) and its tests
   libopenmpi-dev openmpi-bin         # voxfield-mpi and the mpi layer: Open MPI, Debian's MPI
   python3-mypy  # checks the package's type stubs against the module (mypy.stubtest) and a typed use of them
+  chromium                           # the report page's test: headless Chromium opens it and screenshots the mesh viewer
 )
+# Node.js and npm for the report page's JavaScript (below): Debian's, unless the machine has its own.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then packages+=(nodejs npm); fi
 
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-if [ ${#missing[@]} -eq 0 ]; then
-  exit 0
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "voxfield: installing missing packages: ${missing[*]}" >&2
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
-echo "voxfield: installing missing packages: ${missing[*]}" >&2
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+
+# The report page's JavaScript from the npm registry, at the versions web/package-lock.json pins:
+# three.js (the glTF viewer), marked (markdown to HTML), esbuild (bundles the viewer into one
+# classic script, which a page opened from disk may load). Reinstalled only when the lock changed.
+web="$(dirname "$0")/../web"
+if [ ! -f "$web/node_modules/.package-lock.json" ] ||
+  [ "$web/package-lock.json" -nt "$web/node_modules/.package-lock.json" ]; then
+  echo "voxfield: installing the report page's npm packages (web/package-lock.json)" >&2
+  (cd "$web" && npm ci --no-audit --no-fund --loglevel=error >&2)
+fi

@@ -16,3 +16,4 @@ for a in "$@"; do
   prev=$a
 done
 bash scripts/showcase_mpi.sh "$out"  # the same terrain's field over MPI ranks, identical to one process
+node web/build-report.mjs "$out"      # report.html beside report.md, the terrain orbitable in the page

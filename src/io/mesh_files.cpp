@@ -192,7 +192,16 @@ std::vector<std::uint8_t> encode_glb(const Mesh& m) {
       {"nodes", json::array({{{"mesh", 0}}})},
       {"meshes", json::array({{{"primitives", json::array({{{"attributes", attributes},
                                                             {"indices", accessors.size() - 1},
+                                                            {"material", 0},
                                                             {"mode", 4}}})}}})},
+      // A matte material: glTF's default one is fully metallic, which viewers draw nearly black
+      // under plain lights. Double-sided, since a terrain cut by its volume is an open sheet.
+      {"materials", json::array({{{"name", "voxfield"},
+                                  {"pbrMetallicRoughness",
+                                   {{"baseColorFactor", {1.0, 1.0, 1.0, 1.0}},
+                                    {"metallicFactor", 0.0},
+                                    {"roughnessFactor", 0.9}}},
+                                  {"doubleSided", true}}})},
       {"accessors", accessors},
       {"bufferViews", views},
       {"buffers", json::array({{{"byteLength", bin.size()}}})},
