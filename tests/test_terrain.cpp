@@ -16,7 +16,7 @@
 #include "voxfield/terrain.h"
 
 namespace voxfield {
-namespace {
+namespace terrain_test {  // named: unity builds merge the test files
 
 using test::error_of;
 
@@ -399,5 +399,5 @@ TEST(Terrain, BadRequestsAreRefusedAndChangeNothing) {
   EXPECT_TRUE(same());
 }
 
-}  // namespace
+}  // namespace terrain_test
 }  // namespace voxfield

@@ -155,7 +155,8 @@ void showcase_terrain(const fs::path& out, std::uint64_t seed, std::ostream& md,
         "`terrain-field.glb`.\n\n"
      << "| before | after |\n|---|---|\n"
      << "| ![before](terrain-field-before.png) | ![after](terrain-field-after.png) |\n\n"
-     << "| storage | clamp | bytes before → after | uniform chunks after | edit + re-mesh p50 / max "
+     << "| storage | clamp | bytes before → after | uniform chunks after | edit + re-mesh p50 / "
+        "max "
         "| chunks re-meshed per edit | triangles |\n|---|---|---|---|---|---|---|\n";
   for (StorageRun& r : runs) {
     std::sort(r.edit_ms.begin(), r.edit_ms.end());

@@ -100,6 +100,32 @@ struct Mesh {
 // limit (limits.h); Cancelled when the interrupter asks.
 Mesh mesh_volume(const ScalarVolume& volume, const MeshOptions& options);
 
+// Caller-allocated outputs, in meshoptimizer's style: mesh_bound() gives how large the arrays must
+// be for any field on a lattice of `samples` (the worst case: every lattice edge crossed, every
+// cell in its largest case), so an application can allocate them once — or size GPU buffers
+// without reading anything back — and mesh_volume_into() writes the mesh into them.
+struct MeshBound {
+  std::uint64_t vertices = 0, indices = 0;
+};
+// Marching cubes: one vertex per lattice edge plus the case table's centre vertices (at most two
+// per cell), at most 12 triangles per cell; surface nets and dual contouring: one vertex per cell,
+// one quad per lattice edge. InvalidArgument for a lattice under 2 samples along an axis.
+MeshBound mesh_bound(Vec3i samples, Mesher algorithm);
+
+struct MeshBuffers {
+  std::span<std::array<float, 3>> positions, normals;
+  std::span<std::array<std::uint8_t, 3>> colors;  // empty: colours are not written
+  std::span<std::uint32_t> indices;
+};
+struct MeshCounts {
+  std::size_t vertices = 0, indices = 0;  // the first `vertices` and `indices` entries were written
+};
+// mesh_volume() written into `out`: the same arrays, element for element. InvalidArgument naming
+// the counts needed when an array is too small (nothing is written then); other errors as
+// mesh_volume().
+MeshCounts mesh_volume_into(const ScalarVolume& volume, const MeshOptions& options,
+                            const MeshBuffers& out);
+
 // Meshes a World through its exact signed Euclidean distance field (solid voxels read -(distance
 // to air), air +(distance to solid)) at iso 0 (options.iso and inside_above are ignored): the
 // surface runs between solid and air voxel centres. Voxel (x, y, z) spans [x, x+1)^3 in world

@@ -124,5 +124,9 @@ class TerrainField {
 // Meshes the terrain's surface (iso 0; options.iso and inside_above are ignored), in the field's
 // frame, with vertex colours from the palette when the field has one. Errors as mesh_volume.
 Mesh mesh_terrain(const TerrainField& terrain, const MeshOptions& options);
+// mesh_terrain() written into caller-allocated arrays (mesh_bound(terrain.size(), ...) sizes
+// them), as mesh_volume_into.
+MeshCounts mesh_terrain_into(const TerrainField& terrain, const MeshOptions& options,
+                             const MeshBuffers& out);
 
 }  // namespace voxfield

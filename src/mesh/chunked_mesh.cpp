@@ -2,12 +2,9 @@
 #include "chunked_mesh.h"
 
 #include <algorithm>
-#include <limits>
 #include <string>
-#include <unordered_map>
 
 #include "voxfield/error.h"
-#include "voxfield/parallel.h"
 
 namespace voxfield::detail::mesh {
 
@@ -163,96 +160,6 @@ std::uint32_t ChunkPart::add(const std::array<double, 3>& position, std::array<d
   owned.push_back(is_owned);
   shared.push_back(is_shared);
   return static_cast<std::uint32_t>(positions.size() - 1);
-}
-
-Mesh weld(const std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sources) {
-  // Global numbers of owned vertices, chunk by chunk (a prefix sum); the shared ones also by key.
-  const std::size_t chunks = parts.size();
-  std::vector<std::uint64_t> base(chunks + 1, 0), index_base(chunks + 1, 0);
-  std::size_t shared_count = 0;
-  for (std::size_t c = 0; c < chunks; ++c) {
-    std::uint64_t owned = 0;
-    for (std::size_t i = 0; i < parts[c].owned.size(); ++i) {
-      owned += parts[c].owned[i];
-      shared_count += parts[c].shared[i];
-    }
-    base[c + 1] = base[c] + owned;
-    index_base[c + 1] = index_base[c] + parts[c].indices.size();
-  }
-  if (base.back() > std::numeric_limits<std::uint32_t>::max())
-    throw InvalidArgument("mesh: " + std::to_string(base.back()) +
-                          " vertices do not fit 32-bit indices; mesh a smaller volume");
-  std::unordered_map<std::uint64_t, std::uint32_t> by_key;
-  by_key.reserve(shared_count);
-  for (std::size_t c = 0; c < chunks; ++c) {
-    const ChunkPart& p = parts[c];
-    std::uint64_t next = base[c];
-    for (std::size_t i = 0; i < p.positions.size(); ++i) {
-      if (!p.owned[i]) continue;
-      if (p.shared[i]) by_key.emplace(p.keys[i], static_cast<std::uint32_t>(next));
-      ++next;
-    }
-  }
-  Mesh mesh;
-  mesh.positions.resize(base.back());
-  mesh.normals.resize(base.back());
-  // Colours when the parts have them (a lattice with colours gives every vertex one).
-  const bool colored =
-      std::any_of(parts.begin(), parts.end(), [](const ChunkPart& p) { return !p.colors.empty(); });
-  if (colored) mesh.colors.resize(base.back());
-  if (sources) sources->resize(base.back());
-  constexpr std::uint32_t kUnresolved = std::numeric_limits<std::uint32_t>::max();
-  // Each chunk's numbering to the global one: owned vertices copied out, borrowed ones found by
-  // key, chunks in parallel (the map is only read).
-  std::vector<std::vector<std::uint32_t>> global(chunks);
-  parallel_for(chunks, 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t c = begin; c < end; ++c) {
-      const ChunkPart& p = parts[c];
-      global[c].resize(p.positions.size());
-      std::uint64_t next = base[c];
-      for (std::size_t i = 0; i < p.positions.size(); ++i) {
-        if (p.owned[i]) {
-          const auto g = static_cast<std::uint32_t>(next++);
-          global[c][i] = g;
-          mesh.positions[g] = p.positions[i];
-          mesh.normals[g] = p.normals[i];
-          if (colored) mesh.colors[g] = p.colors[i];
-          if (sources) (*sources)[g] = p.sources[i];
-        } else {
-          const auto it = by_key.find(p.keys[i]);
-          global[c][i] = it == by_key.end() ? kUnresolved : it->second;
-        }
-      }
-    }
-  });
-  // A vertex its owner never used (surface nets: a cell only a neighbour's quads reach) is taken
-  // from the first chunk that uses it; every chunk computes it bit for bit the same.
-  for (std::size_t c = 0; c < chunks; ++c) {
-    const ChunkPart& p = parts[c];
-    for (std::size_t i = 0; i < p.positions.size(); ++i) {
-      if (global[c][i] != kUnresolved) continue;
-      const auto [it, orphan] =
-          by_key.emplace(p.keys[i], static_cast<std::uint32_t>(mesh.positions.size()));
-      if (orphan) {
-        if (mesh.positions.size() >= kUnresolved)
-          throw InvalidArgument(
-              "mesh: the vertices do not fit 32-bit indices; mesh a smaller volume");
-        mesh.positions.push_back(p.positions[i]);
-        mesh.normals.push_back(p.normals[i]);
-        if (colored) mesh.colors.push_back(p.colors[i]);
-        if (sources) sources->push_back(p.sources[i]);
-      }
-      global[c][i] = it->second;
-    }
-  }
-  mesh.indices.resize(index_base.back());
-  parallel_for(chunks, 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t c = begin; c < end; ++c) {
-      std::uint32_t* out = mesh.indices.data() + index_base[c];
-      for (const std::uint32_t local : parts[c].indices) *out++ = global[c][local];
-    }
-  });
-  return mesh;
 }
 
 }  // namespace voxfield::detail::mesh

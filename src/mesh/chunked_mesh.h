@@ -139,6 +139,25 @@ struct ChunkPart {
 // vertex's source sample. Throws InvalidArgument when the mesh needs more than 2^32 - 1 vertices.
 Mesh weld(const std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sources);
 
+// The weld in two steps (weld.cpp): the plan — every vertex's global number and the counts — and
+// the writing, into any arrays of at least those counts.
+struct WeldPlan {
+  std::vector<std::vector<std::uint32_t>> global;  // per part: local vertex -> global
+  std::vector<std::uint64_t> base, index_base;     // per part: first owned vertex, first index
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> orphans;  // (part, local), numbered last
+  std::size_t vertices = 0, indices = 0;
+  bool colored = false;  // the parts carry colours
+};
+WeldPlan plan_weld(const std::vector<ChunkPart>& parts);
+struct WeldOutput {
+  std::array<float, 3>* positions;
+  std::array<float, 3>* normals;
+  std::array<std::uint8_t, 3>* colors;  // null: not written
+  std::uint32_t* indices;
+  std::uint64_t* sources;  // null: not written
+};
+void write_weld(const WeldPlan& plan, const std::vector<ChunkPart>& parts, const WeldOutput& out);
+
 // Position of lattice point p + t along `axis` (t in [0, 1]) in the volume's frame.
 inline std::array<double, 3> lattice_position(const Lattice& l, const std::array<double, 3>& p) {
   return {l.origin[0] + p[0] * l.spacing[0], l.origin[1] + p[1] * l.spacing[1],

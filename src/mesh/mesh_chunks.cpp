@@ -26,10 +26,7 @@ struct MeshChunks::Impl {
 
 void MeshChunks::Impl::mesh_all(const detail::mesh::Lattice& lattice) {
   grid = detail::mesh::ChunkGrid(frame.size, options.chunk_edge);
-  std::vector<std::int64_t> all(static_cast<std::size_t>(grid.total()));
-  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::int64_t>(i);
-  parts.resize(all.size());
-  detail::mesh::mesh_chunks(lattice, grid, options, all, parts);
+  parts = detail::mesh::mesh_all_chunks(lattice, options);
   options.interrupter = nullptr;  // it watched the first mesh; the chunks outlive it
 }
 

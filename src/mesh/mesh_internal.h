@@ -40,5 +40,7 @@ Lattice terrain_lattice(const TerrainField& terrain, const MeshOptions& terrain_
 // progress and cancellation through options.interrupter.
 void mesh_chunks(const Lattice& lattice, const ChunkGrid& grid, const MeshOptions& options,
                  const std::vector<std::int64_t>& chunks, std::vector<ChunkPart>& parts);
+// Every chunk of the lattice (options.chunk_edge), in ChunkGrid order.
+std::vector<ChunkPart> mesh_all_chunks(const Lattice& lattice, const MeshOptions& options);
 
 }  // namespace voxfield::detail::mesh

@@ -51,13 +51,7 @@ Mesh mesh_terrain(const TerrainField& terrain, const MeshOptions& options) {
   using namespace detail::mesh;
   const MeshOptions o = terrain_options(terrain, options);
   TerrainSamples keep;
-  const Lattice lattice = terrain_lattice(terrain, o, keep);
-  const ChunkGrid grid(terrain.size(), o.chunk_edge);
-  std::vector<std::int64_t> all(static_cast<std::size_t>(grid.total()));
-  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::int64_t>(i);
-  std::vector<ChunkPart> parts(all.size());
-  mesh_chunks(lattice, grid, o, all, parts);
-  return weld(parts, nullptr);
+  return weld(mesh_all_chunks(terrain_lattice(terrain, o, keep), o), nullptr);
 }
 
 }  // namespace voxfield

@@ -144,13 +144,16 @@ void mesh_chunks(const Lattice& lattice, const ChunkGrid& grid, const MeshOption
 
 Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options,
                   std::vector<std::uint64_t>* sources, bool voxel_faces) {
-  const Lattice lattice = checked_lattice(volume, options, voxel_faces);
-  const ChunkGrid grid(volume.size, options.chunk_edge);
+  return weld(mesh_all_chunks(checked_lattice(volume, options, voxel_faces), options), sources);
+}
+
+std::vector<ChunkPart> mesh_all_chunks(const Lattice& lattice, const MeshOptions& options) {
+  const ChunkGrid grid(lattice.n, options.chunk_edge);
   std::vector<std::int64_t> all(static_cast<std::size_t>(grid.total()));
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::int64_t>(i);
   std::vector<ChunkPart> parts(all.size());
   mesh_chunks(lattice, grid, options, all, parts);
-  return weld(parts, sources);
+  return parts;
 }
 
 }  // namespace detail::mesh

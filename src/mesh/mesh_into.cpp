@@ -1,0 +1,85 @@
+// voxfield — caller-allocated mesh outputs (mesh.h): the worst-case sizes of each mesher's output
+// on a lattice, and meshing straight into arrays the caller owns (the weld is planned first, so a
+// buffer too small is refused before anything is written).
+#include <algorithm>
+#include <bit>
+#include <string>
+
+#include "cube_cases.h"
+#include "mesh_internal.h"
+#include "voxfield/error.h"
+#include "voxfield/terrain.h"
+
+namespace voxfield {
+
+MeshBound mesh_bound(Vec3i samples, Mesher algorithm) {
+  for (int a = 0; a < 3; ++a)
+    if (samples[a] < 2)
+      throw InvalidArgument("mesh_bound: a lattice needs at least 2 samples along each axis (" +
+                            to_string(samples) + ")");
+  const auto nx = static_cast<std::uint64_t>(samples.x), ny = static_cast<std::uint64_t>(samples.y),
+             nz = static_cast<std::uint64_t>(samples.z);
+  const std::uint64_t edges = (nx - 1) * ny * nz + nx * (ny - 1) * nz + nx * ny * (nz - 1);
+  const std::uint64_t cells = (nx - 1) * (ny - 1) * (nz - 1);
+  MeshBound b;
+  if (algorithm == Mesher::kMarchingCubes) {
+    // The table's largest case, in triangles and centre vertices, over every corner mask and
+    // every decision of its ambiguous faces.
+    const auto& cases = detail::mesh::CubeCases::get();
+    std::uint64_t triangles = 0, centres = 0;
+    for (unsigned inside = 0; inside < 256; ++inside) {
+      const unsigned ambiguous = static_cast<unsigned>(std::popcount(cases.ambiguous_faces(inside)));
+      for (unsigned joined = 0; joined < (1u << ambiguous); ++joined) {
+        const auto& c = cases.lookup(inside, joined);
+        triangles = std::max<std::uint64_t>(triangles, c.triangle_count);
+        centres = std::max<std::uint64_t>(centres, c.centre_count);
+      }
+    }
+    b.vertices = edges + centres * cells;
+    b.indices = 3 * triangles * cells;
+  } else {
+    b.vertices = cells;
+    b.indices = 6 * edges;
+  }
+  return b;
+}
+
+namespace detail::mesh {
+namespace {
+
+MeshCounts write_into(const std::vector<ChunkPart>& parts, const MeshBuffers& out) {
+  const WeldPlan plan = plan_weld(parts);
+  const bool colors = plan.colored && !out.colors.empty();
+  if (out.positions.size() < plan.vertices || out.normals.size() < plan.vertices ||
+      (colors && out.colors.size() < plan.vertices) || out.indices.size() < plan.indices)
+    throw InvalidArgument("mesh: the mesh needs " + std::to_string(plan.vertices) +
+                          " positions and normals" + (colors ? " and colours" : "") + " and " +
+                          std::to_string(plan.indices) + " indices; the buffers hold " +
+                          std::to_string(out.positions.size()) + ", " +
+                          std::to_string(out.normals.size()) +
+                          (colors ? ", " + std::to_string(out.colors.size()) : "") + " and " +
+                          std::to_string(out.indices.size()) + " (size them with mesh_bound)");
+  write_weld(plan, parts,
+             {out.positions.data(), out.normals.data(), colors ? out.colors.data() : nullptr,
+              out.indices.data(), nullptr});
+  return {plan.vertices, plan.indices};
+}
+
+}  // namespace
+}  // namespace detail::mesh
+
+MeshCounts mesh_volume_into(const ScalarVolume& volume, const MeshOptions& options,
+                            const MeshBuffers& out) {
+  using namespace detail::mesh;
+  return write_into(mesh_all_chunks(checked_lattice(volume, options, false), options), out);
+}
+
+MeshCounts mesh_terrain_into(const TerrainField& terrain, const MeshOptions& options,
+                             const MeshBuffers& out) {
+  using namespace detail::mesh;
+  const MeshOptions o = terrain_options(terrain, options);
+  TerrainSamples keep;
+  return write_into(mesh_all_chunks(terrain_lattice(terrain, o, keep), o), out);
+}
+
+}  // namespace voxfield
