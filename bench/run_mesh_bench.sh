@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Reproduces the meshing figures in docs/benchmarks.md: marching cubes and surface nets of
-# voxfield on the terrain's signed Euclidean field (256³ and 512³) and on a scan-sized smooth float
+# Reproduces the meshing figures in docs/benchmarks.md: marching cubes, surface nets and dual
+# contouring of voxfield (time, ns per cell, the process's peak memory over its input's, and the
+# mesh's bytes per triangle in memory) on the terrain's signed Euclidean field (256³ and 512³) and on a scan-sized smooth float
 # volume, beside scikit-image's marching_cubes (one thread) and VTK's vtkFlyingEdges3D (all
 # threads) on the same arrays in the same run. Results go to bench/results/mesh-DATE/table.md.
 # Usage: bash bench/run_mesh_bench.sh [RUNS] [SIZES]   (default 3 runs, sizes "256 512")
@@ -31,22 +32,36 @@ PY
 inputs+=("$out/inputs/scan.npy")
 cat "$out/machine.txt"
 {
-  echo "| volume | library | threads | best ms of $runs | triangles | Mcells/s |"
-  echo "|---|---|---|---|---|---|"
+  echo "| volume | library | threads | best ms of $runs | triangles | Mcells/s | ns per cell per thread | peak memory over the input | mesh bytes per triangle |"
+  echo "|---|---|---|---|---|---|---|---|---|"
 } > "$out/table.md"
 for f in "${inputs[@]}"; do
   name=$(basename "$f" .npy)
   cells=$(/usr/bin/python3 -c "import numpy as np,sys; s=np.load(sys.argv[1], mmap_mode='r').shape; print((s[0]-1)*(s[1]-1)*(s[2]-1))" "$f")
-  for algo in mc sn; do
+  input_mb=$(/usr/bin/python3 -c "import os,sys; print(os.path.getsize(sys.argv[1]) / 1e6)" "$f")
+  for algo in mc sn dc; do
     for threads in 1 2; do
       best=""
+      peak_kb=0
       for r in $(seq "$runs"); do
-        "$bin/voxfield" mesh "$f" -o "$out/m.stl" --algorithm "$algo" --threads "$threads" --stats "$out/s.json" 2>/dev/null
+        # The peak resident memory of the whole command (GNU time's %M, kB): the input, the
+        # meshing, the mesh and the file's encoding.
+        /usr/bin/time -f %M -o "$out/rss.txt" "$bin/voxfield" mesh "$f" -o "$out/m.stl" --algorithm "$algo" --threads "$threads" --stats "$out/s.json" 2>/dev/null
+        peak_kb=$(cat "$out/rss.txt")
         ms=$(/usr/bin/python3 -c "import json; print(json.load(open('$out/s.json'))['ms'])")
         best=$(/usr/bin/python3 -c "print(min(float(x) for x in '$best $ms'.split()))")
       done
-      tris=$(/usr/bin/python3 -c "import json; print(json.load(open('$out/s.json'))['triangles'])")
-      echo "| $name | voxfield $algo | $threads | $(printf %.0f "$best") | $tris | $(/usr/bin/python3 -c "print(round($cells/($best*1e3)))") |" >> "$out/table.md"
+      /usr/bin/python3 - "$out/s.json" "$name" "$algo" "$threads" "$best" "$cells" "$peak_kb" "$input_mb" >> "$out/table.md" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+name, algo, threads, best, cells, peak_kb, input_mb = sys.argv[2:9]
+threads, best, cells, peak_kb, input_mb = int(threads), float(best), int(cells), int(peak_kb), float(input_mb)
+tris, verts = s["triangles"], s["vertices"]
+# In memory: positions and normals (3 floats each) and an RGB colour per vertex, 3 indices per triangle.
+mesh_bytes = verts * (12 + 12 + 3) + tris * 12
+print(f"| {name} | voxfield {algo} | {threads} | {best:.0f} | {tris} | {cells / (best * 1e3):.0f} | "
+      f"{best * 1e6 * threads / cells:.1f} | {peak_kb / 1e3 - input_mb:.0f} MB | {mesh_bytes / max(tris, 1):.1f} |")
+PY
     done
   done
   /usr/bin/python3 bench/peers/mesh_peers.py "$f" 0 --runs "$runs" --json "$out/peers.json"
@@ -59,6 +74,6 @@ for peer in ["scikit-image", "vtk-flying-edges"]:
         print(f"| {name} | {peer} {p['version']} | {p['threads']} | {p['ms']:.0f} | {p['triangles']} | {cells / (p['ms'] * 1e3):.0f} |")
 PY
 done
-rm -rf "$out/inputs" "$out/m.stl" "$out/s.json" "$out/peers.json"
+rm -rf "$out/inputs" "$out/m.stl" "$out/s.json" "$out/peers.json" "$out/rss.txt"
 cat "$out/table.md"
 echo "results in $out"

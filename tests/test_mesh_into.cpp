@@ -90,8 +90,9 @@ TEST(MeshInto, BuffersTooSmallAreRefusedUntouched) {
     std::vector<std::array<float, 3>> positions(want.vertex_count() - (short_one == 0), sentinel),
         normals(want.vertex_count() - (short_one == 1), sentinel);
     std::vector<std::uint32_t> indices(want.indices.size() - (short_one == 2), 77);
-    const std::string e =
-        test::error_of([&] { mesh_volume_into(f.volume(), {}, {positions, normals, {}, indices}); });
+    const std::string e = test::error_of([&] {
+      mesh_volume_into(f.volume(), {}, {positions, normals, {}, indices});
+    });
     EXPECT_NE(e.find("needs " + std::to_string(want.vertex_count()) + " positions"),
               std::string::npos)
         << e;

@@ -28,7 +28,8 @@ MeshBound mesh_bound(Vec3i samples, Mesher algorithm) {
     const auto& cases = detail::mesh::CubeCases::get();
     std::uint64_t triangles = 0, centres = 0;
     for (unsigned inside = 0; inside < 256; ++inside) {
-      const unsigned ambiguous = static_cast<unsigned>(std::popcount(cases.ambiguous_faces(inside)));
+      const unsigned ambiguous =
+          static_cast<unsigned>(std::popcount(cases.ambiguous_faces(inside)));
       for (unsigned joined = 0; joined < (1u << ambiguous); ++joined) {
         const auto& c = cases.lookup(inside, joined);
         triangles = std::max<std::uint64_t>(triangles, c.triangle_count);

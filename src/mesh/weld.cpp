@@ -124,9 +124,10 @@ Mesh weld(const std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sourc
   if (plan.colored) mesh.colors.resize(plan.vertices);
   mesh.indices.resize(plan.indices);
   if (sources) sources->resize(plan.vertices);
-  write_weld(plan, parts,
-             {mesh.positions.data(), mesh.normals.data(), plan.colored ? mesh.colors.data() : nullptr,
-              mesh.indices.data(), sources ? sources->data() : nullptr});
+  write_weld(
+      plan, parts,
+      {mesh.positions.data(), mesh.normals.data(), plan.colored ? mesh.colors.data() : nullptr,
+       mesh.indices.data(), sources ? sources->data() : nullptr});
   return mesh;
 }
 

@@ -5,8 +5,12 @@
 // edge functions; barycentric weights come from the same functions. Depth is compared as the
 // view-space depth interpolated perspective-correctly (1/z is linear in screen space); colours and
 // normals are interpolated with the same weights. Both faces are lit (normals turned towards the
-// viewer), so open sheets read correctly from either side.
+// viewer), so open sheets read correctly from either side. Perspective triangles are clipped
+// against the near plane first (Sutherland & Hodgman, "Reentrant Polygon Clipping", 1974, against
+// that one plane): a triangle reaching behind the eye — ground running under the camera — is cut
+// to its part in front, not dropped.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -30,21 +34,32 @@ Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOption
   const Camera::Projector pr = camera.projector(options.width, options.height);
   const bool ortho = pr.projection == Camera::Projection::kOrthographic;
   const double w = options.width, h = options.height;
-  // Screen position (pixels, y down) and view depth of every vertex.
-  struct Screen {
-    double x, y, depth;
-    bool visible;
-  };
-  std::vector<Screen> screen(mesh.positions.size());
+  // Every vertex in view space: along right, up and forward (the depth).
+  std::vector<Vec3d> view(mesh.positions.size());
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
     const Vec3d d =
         Vec3d{mesh.positions[i][0], mesh.positions[i][1], mesh.positions[i][2]} - pr.eye;
-    const double z = dot(d, pr.forward);
-    double sx = dot(d, pr.right), sy = dot(d, pr.up);
-    const bool visible = ortho || z > 1e-3;
-    if (!ortho && visible) sx /= z, sy /= z;
-    screen[i] = {(sx / pr.scale * h + w) / 2, (h - sy / pr.scale * h) / 2, z, visible};
+    view[i] = {dot(d, pr.right), dot(d, pr.up), dot(d, pr.forward)};
   }
+  // A corner of a triangle as drawn: its screen position (pixels, y down), view depth, normal and
+  // colour (a mesh vertex's, or interpolated along an edge the near plane cuts).
+  struct Corner {
+    double x, y, depth;
+    Vec3d normal;
+    std::array<double, 3> color;
+  };
+  const bool colored = options.use_colors && !mesh.colors.empty();
+  const auto corner = [&](const Vec3d& p, const Vec3d& normal, const std::array<double, 3>& color) {
+    const double sx = ortho ? p.x : p.x / p.z, sy = ortho ? p.y : p.y / p.z;
+    return Corner{(sx / pr.scale * h + w) / 2, (h - sy / pr.scale * h) / 2, p.z, normal, color};
+  };
+  const auto vertex_color = [&](std::uint32_t i) {
+    std::array<double, 3> c;
+    for (std::size_t ch = 0; ch < 3; ++ch)
+      c[ch] = colored ? mesh.colors[i][ch] : options.base_color[ch];
+    return c;
+  };
+  constexpr double kNear = 1e-3;  // view depth of the near plane, in world units
   const Vec3d light = options.light_towards.normalized();
   std::vector<float> depth(
       static_cast<std::size_t>(options.width) * static_cast<std::size_t>(options.height),
@@ -52,81 +67,95 @@ Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOption
   MeshRenderStats st;
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
     const std::uint32_t* v = mesh.indices.data() + 3 * t;
-    if (v[0] >= screen.size() || v[1] >= screen.size() || v[2] >= screen.size())
+    if (v[0] >= view.size() || v[1] >= view.size() || v[2] >= view.size())
       throw InvalidArgument("render_mesh: index past the last vertex");
-    const Screen &a = screen[v[0]], &b = screen[v[1]], &c = screen[v[2]];
-    if (!a.visible || !b.visible || !c.visible) continue;  // crosses the eye plane: dropped
-    const double area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    if (area == 0 || !std::isfinite(area)) continue;
-    // Bounds clamped in double before the casts: a vertex just in front of the eye projects
-    // far off screen, beyond int.
-    auto pixel = [](double v, int size) {
-      return static_cast<int>(std::clamp(v, -1.0, static_cast<double>(size)));
-    };
-    const int x0 = std::max(0, pixel(std::floor(std::min({a.x, b.x, c.x})), options.width));
-    const int x1 =
-        std::min(options.width - 1, pixel(std::ceil(std::max({a.x, b.x, c.x})), options.width));
-    const int y0 = std::max(0, pixel(std::floor(std::min({a.y, b.y, c.y})), options.height));
-    const int y1 =
-        std::min(options.height - 1, pixel(std::ceil(std::max({a.y, b.y, c.y})), options.height));
-    if (x0 > x1 || y0 > y1) continue;
-    ++st.triangles_drawn;
-    // Edge lengths in pixels, for the distance of a pixel to each edge.
-    const double len_a = std::hypot(c.x - b.x, c.y - b.y), len_b = std::hypot(a.x - c.x, a.y - c.y),
-                 len_c = std::hypot(b.x - a.x, b.y - a.y);
-    for (int py = y0; py <= y1; ++py)
-      for (int px = x0; px <= x1; ++px) {
-        const double qx = px + 0.5, qy = py + 0.5;
-        // Barycentric weights: each vertex's opposite edge function over the doubled area.
-        const double wa = ((b.x - qx) * (c.y - qy) - (b.y - qy) * (c.x - qx)) / area;
-        const double wb = ((c.x - qx) * (a.y - qy) - (c.y - qy) * (a.x - qx)) / area;
-        const double wc = 1 - wa - wb;
-        if (wa < 0 || wb < 0 || wc < 0) continue;
-        double pa = wa, pb = wb, pc = wc;  // perspective-correct weights
-        double z;
-        if (ortho) {
-          z = wa * a.depth + wb * b.depth + wc * c.depth;
-        } else {
-          const double inv = wa / a.depth + wb / b.depth + wc / c.depth;
-          z = 1 / inv;
-          pa = wa / a.depth * z, pb = wb / b.depth * z, pc = wc / c.depth * z;
-        }
-        float& zb = depth[static_cast<std::size_t>(py) * static_cast<std::size_t>(options.width) +
-                          static_cast<std::size_t>(px)];
-        if (!(z < zb)) continue;
-        zb = static_cast<float>(z);
-        Vec3d n{0, 0, 0};
-        for (int k = 0; k < 3; ++k) {
-          const double wk = k == 0 ? pa : k == 1 ? pb : pc;
-          const auto& nk = mesh.normals[v[k]];
-          n = n + Vec3d{nk[0], nk[1], nk[2]} * wk;
-        }
-        const double nl = n.length();
-        n = nl > 0 ? n * (1 / nl) : Vec3d{0, 0, 1};
-        // Light the face turned towards the viewer.
-        if (dot(n, pr.ray(qx, qy).direction) > 0) n = n * -1;
-        const double lambert = std::max(0.0, dot(n, light));
-        const double shade = 0.28 + 0.72 * lambert;
-        double rgb[3];
-        for (int ch = 0; ch < 3; ++ch) {
-          double base = options.base_color[static_cast<std::size_t>(ch)];
-          if (options.use_colors && !mesh.colors.empty())
-            base = pa * mesh.colors[v[0]][static_cast<std::size_t>(ch)] +
-                   pb * mesh.colors[v[1]][static_cast<std::size_t>(ch)] +
-                   pc * mesh.colors[v[2]][static_cast<std::size_t>(ch)];
-          rgb[ch] = base * shade;
-        }
-        if (options.edges) {
-          const double d = std::min({wa * std::abs(area) / len_a, wb * std::abs(area) / len_b,
-                                     wc * std::abs(area) / len_c});
-          if (d < 0.6)
-            for (double& ch : rgb) ch *= 0.35;
-        }
-        std::uint8_t* out = image.pixel(px, py);
-        for (int ch = 0; ch < 3; ++ch)
-          out[ch] = static_cast<std::uint8_t>(std::min(255.0, std::max(0.0, rgb[ch]) + 0.5));
-        ++st.pixels_covered;
+    // The triangle's part in front of the near plane: a polygon of up to four corners.
+    Corner polygon[4];
+    int corners = 0;
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t i = v[k], j = v[(k + 1) % 3];
+      const Vec3d &p = view[i], &q = view[j];
+      const auto& ni = mesh.normals[i];
+      const bool in_p = ortho || p.z > kNear, in_q = ortho || q.z > kNear;
+      if (in_p) polygon[corners++] = corner(p, {ni[0], ni[1], ni[2]}, vertex_color(i));
+      if (in_p != in_q) {  // the edge crosses the plane: its point there
+        const double f = (kNear - p.z) / (q.z - p.z);
+        const auto& nj = mesh.normals[j];
+        const std::array<double, 3> ci = vertex_color(i), cj = vertex_color(j);
+        polygon[corners++] =
+            corner(p + (q - p) * f,
+                   Vec3d{ni[0], ni[1], ni[2]} +
+                       (Vec3d{nj[0], nj[1], nj[2]} - Vec3d{ni[0], ni[1], ni[2]}) * f,
+                   {ci[0] + (cj[0] - ci[0]) * f, ci[1] + (cj[1] - ci[1]) * f,
+                    ci[2] + (cj[2] - ci[2]) * f});
       }
+    }
+    bool drawn = false;
+    for (int fan = 1; fan + 1 < corners; ++fan) {
+      const Corner &a = polygon[0], &b = polygon[fan], &c = polygon[fan + 1];
+      const double area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+      if (area == 0 || !std::isfinite(area)) continue;
+      // Bounds clamped in double before the casts: a vertex just in front of the eye projects
+      // far off screen, beyond int.
+      auto pixel = [](double v, int size) {
+        return static_cast<int>(std::clamp(v, -1.0, static_cast<double>(size)));
+      };
+      const int x0 = std::max(0, pixel(std::floor(std::min({a.x, b.x, c.x})), options.width));
+      const int x1 =
+          std::min(options.width - 1, pixel(std::ceil(std::max({a.x, b.x, c.x})), options.width));
+      const int y0 = std::max(0, pixel(std::floor(std::min({a.y, b.y, c.y})), options.height));
+      const int y1 =
+          std::min(options.height - 1, pixel(std::ceil(std::max({a.y, b.y, c.y})), options.height));
+      if (x0 > x1 || y0 > y1) continue;
+      drawn = true;
+      // Edge lengths in pixels, for the distance of a pixel to each edge.
+      const double len_a = std::hypot(c.x - b.x, c.y - b.y),
+                   len_b = std::hypot(a.x - c.x, a.y - c.y),
+                   len_c = std::hypot(b.x - a.x, b.y - a.y);
+      for (int py = y0; py <= y1; ++py)
+        for (int px = x0; px <= x1; ++px) {
+          const double qx = px + 0.5, qy = py + 0.5;
+          // Barycentric weights: each vertex's opposite edge function over the doubled area.
+          const double wa = ((b.x - qx) * (c.y - qy) - (b.y - qy) * (c.x - qx)) / area;
+          const double wb = ((c.x - qx) * (a.y - qy) - (c.y - qy) * (a.x - qx)) / area;
+          const double wc = 1 - wa - wb;
+          if (wa < 0 || wb < 0 || wc < 0) continue;
+          double pa = wa, pb = wb, pc = wc;  // perspective-correct weights
+          double z;
+          if (ortho) {
+            z = wa * a.depth + wb * b.depth + wc * c.depth;
+          } else {
+            const double inv = wa / a.depth + wb / b.depth + wc / c.depth;
+            z = 1 / inv;
+            pa = wa / a.depth * z, pb = wb / b.depth * z, pc = wc / c.depth * z;
+          }
+          float& zb = depth[static_cast<std::size_t>(py) * static_cast<std::size_t>(options.width) +
+                            static_cast<std::size_t>(px)];
+          if (!(z < zb)) continue;
+          zb = static_cast<float>(z);
+          Vec3d n = a.normal * pa + b.normal * pb + c.normal * pc;
+          const double nl = n.length();
+          n = nl > 0 ? n * (1 / nl) : Vec3d{0, 0, 1};
+          // Light the face turned towards the viewer.
+          if (dot(n, pr.ray(qx, qy).direction) > 0) n = n * -1;
+          const double lambert = std::max(0.0, dot(n, light));
+          const double shade = 0.28 + 0.72 * lambert;
+          double rgb[3];
+          for (std::size_t ch = 0; ch < 3; ++ch)
+            rgb[ch] = (pa * a.color[ch] + pb * b.color[ch] + pc * c.color[ch]) * shade;
+          if (options.edges) {
+            const double d = std::min({wa * std::abs(area) / len_a, wb * std::abs(area) / len_b,
+                                       wc * std::abs(area) / len_c});
+            if (d < 0.6)
+              for (double& ch : rgb) ch *= 0.35;
+          }
+          std::uint8_t* out = image.pixel(px, py);
+          for (int ch = 0; ch < 3; ++ch)
+            out[ch] = static_cast<std::uint8_t>(std::min(255.0, std::max(0.0, rgb[ch]) + 0.5));
+          ++st.pixels_covered;
+        }
+    }
+    st.triangles_drawn += drawn;
   }
   st.ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
