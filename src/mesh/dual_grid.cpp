@@ -91,7 +91,11 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
   };
 
   for (int z = cells.begin.z; z < cells.end.z; ++z)
-    for (int y = cells.begin.y; y < cells.end.y; ++y)
+    for (int y = cells.begin.y; y < cells.end.y; ++y) {
+      // The edges starting in this row of cells join samples of rows (y, z), (y + 1, z) and
+      // (y, z + 1) only: when those rows hold one sign, no edge of the row is crossed.
+      if ((block.row_signs(y, z) | block.row_signs(y + 1, z) | block.row_signs(y, z + 1)) != 3)
+        continue;
       for (int x = cells.begin.x; x < cells.end.x; ++x) {
         const Vec3i p{x, y, z};
         const bool in0 = block.s(x, y, z) < 0;
@@ -118,6 +122,7 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
           part.indices.insert(part.indices.end(), t.begin(), t.end());
         }
       }
+    }
 }
 
 }  // namespace voxfield::detail::mesh
