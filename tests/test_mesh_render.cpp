@@ -93,13 +93,16 @@ TEST(MeshRender, CoverageEqualsRayCastingOnAClosedMesh) {
     for (std::size_t t = 0; t < m.indices.size(); t += 3) {
       std::uint32_t mid[3];
       for (int e = 0; e < 3; ++e) {
-        const Vec3d p = (at(m.positions[m.indices[t + e]]) + at(m.positions[m.indices[t + (e + 1) % 3]])) * 0.5;
+        const Vec3d p =
+            (at(m.positions[m.indices[t + e]]) + at(m.positions[m.indices[t + (e + 1) % 3]])) * 0.5;
         const Vec3d n = p.normalized();
-        m.positions.push_back({static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z)});
+        m.positions.push_back(
+            {static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z)});
         mid[e] = static_cast<std::uint32_t>(m.positions.size() - 1);
       }
       const std::uint32_t a = m.indices[t], b = m.indices[t + 1], c = m.indices[t + 2];
-      next.insert(next.end(), {a, mid[0], mid[2], mid[0], b, mid[1], mid[2], mid[1], c, mid[0], mid[1], mid[2]});
+      next.insert(next.end(), {a, mid[0], mid[2], mid[0], b, mid[1], mid[2], mid[1], c, mid[0],
+                               mid[1], mid[2]});
     }
     m.indices = next;
   }

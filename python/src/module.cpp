@@ -10,6 +10,7 @@ namespace py = pybind11;
 namespace voxfield::python {
 void bind_ndimage(py::module_& m);
 void bind_csg(py::module_& m);
+void bind_mesh(py::module_& m);
 }  // namespace voxfield::python
 
 PYBIND11_MODULE(_voxfield, m) {
@@ -26,4 +27,5 @@ PYBIND11_MODULE(_voxfield, m) {
   py::register_exception<voxfield::Cancelled>(m, "Cancelled", PyExc_KeyboardInterrupt);
   voxfield::python::bind_ndimage(m);
   voxfield::python::bind_csg(m);
+  voxfield::python::bind_mesh(m);
 }

@@ -22,6 +22,7 @@
 #include <variant>
 #include <vector>
 
+#include "signals.h"
 #include "voxfield/distance.h"
 #include "voxfield/error.h"
 #include "voxfield/interrupt.h"
@@ -89,27 +90,6 @@ bool read_input(const py::array& input, std::array<py::ssize_t, 3> n,
   if (kind == 'f' && size == 8) return read_zeros<double>(s, n, out), true;
   return false;  // the Python side converts other dtypes with input != 0
 }
-
-// Ctrl-C during a transform: the thread that called (it works on the transform's tasks too) takes
-// the GIL when the transform asks whether to go on and lets Python run its signal handlers; a
-// KeyboardInterrupt stops the transform (voxfield throws Cancelled, which reaches Python as
-// voxfield.Cancelled, a KeyboardInterrupt). Other worker threads only read the flag.
-class PythonSignals : public Interrupter {
- public:
-  bool was_interrupted(int) override {
-    if (std::this_thread::get_id() != caller_) return stop_.load(std::memory_order_relaxed);
-    py::gil_scoped_acquire gil;
-    if (PyErr_CheckSignals() != 0) {
-      PyErr_Clear();  // voxfield's Cancelled, translated, takes its place
-      stop_.store(true, std::memory_order_relaxed);
-    }
-    return stop_.load(std::memory_order_relaxed);
-  }
-
- private:
-  std::thread::id caller_ = std::this_thread::get_id();
-  std::atomic<bool> stop_{false};
-};
 
 // Calls f(x, y, z, value) for every voxel of `box` (which starts at the origin) in `grid`, chunk
 // by chunk in parallel: the field's own chunks are read in place, never copied densely.

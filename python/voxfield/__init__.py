@@ -3,6 +3,9 @@
 ``voxfield.csg`` compiles CSG models (docs/csg.md): ``Model(text)`` or ``Model.load(path)``
 (.sdf, .json, OpenSCAD .csg), then ``evaluate(points)``, ``voxelize(voxel_size)``, ``mesh(...)``.
 
+``voxfield.mesh`` meshes NumPy volumes (``mesh_volume``: marching cubes, surface nets, dual
+contouring) and keeps a deformable ``Terrain`` field edited by brushes (docs/meshing.md).
+
 ``voxfield.ndimage`` is a drop-in for ``scipy.ndimage.distance_transform_edt`` and
 ``distance_transform_cdt`` (same arguments, results, shapes, dtypes and index layout), computed
 by voxfield's exact separable transforms on every core, with what SciPy lacks: ``signed``,
@@ -17,6 +20,7 @@ from . import _voxfield
 from ._voxfield import Cancelled, Error, FormatError, InvalidArgument, IoError, ResourceLimitError
 from . import ndimage
 from . import csg
+from . import mesh
 
-__all__ = ["ndimage", "csg", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
+__all__ = ["ndimage", "csg", "mesh", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
            "Cancelled"]

@@ -1,5 +1,6 @@
 # Type stubs of the voxfield package (PEP 561); the implementation is __init__.py and _voxfield.
 from . import csg as csg
+from . import mesh as mesh
 from . import ndimage as ndimage
 
 class Error(RuntimeError): ...
@@ -9,5 +10,5 @@ class ResourceLimitError(MemoryError): ...
 class IoError(OSError): ...
 class Cancelled(KeyboardInterrupt): ...
 
-__all__ = ["ndimage", "csg", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
+__all__ = ["ndimage", "csg", "mesh", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
            "Cancelled"]

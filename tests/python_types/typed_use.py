@@ -5,7 +5,7 @@ import numpy as np
 import numpy.typing as npt
 
 import voxfield
-from voxfield import csg, ndimage
+from voxfield import csg, mesh, ndimage
 
 
 def sphere_field(n: int) -> npt.NDArray[np.float64]:
@@ -28,6 +28,21 @@ def model_figures() -> tuple[int, float]:
     return model.nodes, float(values[0]) + hi[0] - lo[0] + figures["variants"]
 
 
+def terrain_triangles() -> int:
+    n = 24
+    values = np.broadcast_to(np.arange(n, dtype=np.float32) - 8.0, (n, n, n)).copy()
+    vertices, faces, normals = mesh.mesh_volume(values, level=0.0, spacing=(1.0, 1.0, 1.0))
+    assert vertices.dtype == np.float32 and faces.dtype == np.uint32 and normals.shape == vertices.shape
+    terrain = mesh.Terrain((n, n, n), storage="i8")
+    terrain.assign(values, material=1)
+    changed = terrain.apply("sphere", "add", centre=(12.0, 12.0, 8.0), radius=4.0, smooth=1.0)
+    assert changed is not None
+    (x0, _, _), (x1, _, _) = changed
+    v, f, nrm, colors = terrain.mesh("mc", 16)
+    assert colors.dtype == np.uint8 and terrain.values().shape == (n, n, n) and terrain.memory["bytes"] > 0
+    return int(f.shape[0]) + x1 - x0 + terrain.samples[0] + int(terrain.clamp + terrain.step)
+
+
 def refused() -> bool:
     try:
         csg.Model("(sphere", "bad.sdf")
@@ -44,4 +59,5 @@ if __name__ == "__main__":
     nodes, _ = model_figures()
     assert nodes == 4, nodes
     assert refused()
+    assert terrain_triangles() > 0
     print("typed use: ok")

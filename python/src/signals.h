@@ -1,0 +1,34 @@
+// Ctrl-C during voxfield's long calls from Python (shared by the extension's modules).
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+#include <atomic>
+#include <thread>
+
+#include "voxfield/interrupt.h"
+
+namespace voxfield::python {
+
+// Ctrl-C during a long call (a transform, a mesh): the thread that called (it works on the transform's tasks too) takes
+// the GIL when the transform asks whether to go on and lets Python run its signal handlers; a
+// KeyboardInterrupt stops the transform (voxfield throws Cancelled, which reaches Python as
+// voxfield.Cancelled, a KeyboardInterrupt). Other worker threads only read the flag.
+class PythonSignals : public Interrupter {
+ public:
+  bool was_interrupted(int) override {
+    if (std::this_thread::get_id() != caller_) return stop_.load(std::memory_order_relaxed);
+    pybind11::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) {
+      PyErr_Clear();  // voxfield's Cancelled, translated, takes its place
+      stop_.store(true, std::memory_order_relaxed);
+    }
+    return stop_.load(std::memory_order_relaxed);
+  }
+
+ private:
+  std::thread::id caller_ = std::this_thread::get_id();
+  std::atomic<bool> stop_{false};
+};
+
+}  // namespace voxfield::python

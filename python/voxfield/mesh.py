@@ -1,0 +1,27 @@
+"""Meshes of volumes and deformable terrain (docs/meshing.md).
+
+``mesh_volume(volume, level=0.0, spacing=(1, 1, 1), inside="below", algorithm="mc", chunk=32,
+threads=0)`` meshes the iso-surface of a 3-D array a[i, j, k] (i along x, as scikit-image indexes
+it: vertex (x, y, z) = (i, j, k) * spacing) and returns ``(vertices, faces, normals)``: float32
+(V, 3), uint32 (F, 3) counter-clockwise seen from outside, float32 (V, 3) unit normals pointing
+out. ``inside="below"`` suits signed distance fields, ``"above"`` densities (scikit-image's
+default, 'descent'). ``algorithm``: ``"mc"`` (marching cubes: a closed oriented 2-manifold),
+``"sn"`` (surface nets) or ``"dc"`` (dual contouring). The triangles do not depend on ``chunk``
+(only the order vertices are numbered in does) or on ``threads`` (not even the order). A float32 Fortran-ordered array is read in place; others are converted once.
+
+``Terrain(samples, storage="i16", spacing=1.0, origin=(0, 0, 0), clamp=0.0, chunk=16,
+positive_inside=False, palette=None)`` is voxfield's terrain field: signed distances stored per
+chunk in i8, i16 or f32, clamped to ±clamp, uniform chunks stored once. ``assign(values,
+material)`` fills it from an array; ``apply(shape, mode, centre, radius, end, half_extents,
+smooth, material)`` adds or subtracts a sphere, box or capsule (sharp, or blended by a polynomial
+smooth minimum over ``smooth`` units) and returns the box of samples it changed; ``values()`` and
+``materials()`` read it back; ``mesh(algorithm, chunk)`` returns ``(vertices, faces, normals,
+colors)`` with colours from the palette by material.
+
+Errors are voxfield's: a bad argument or a NaN sample raises ``voxfield.InvalidArgument`` (a
+ValueError) naming it; Ctrl-C stops a long mesh with ``voxfield.Cancelled``.
+"""
+
+from ._voxfield.mesh import Terrain, mesh_volume
+
+__all__ = ["Terrain", "mesh_volume"]
