@@ -21,7 +21,7 @@ run() {  # name, demo arguments...
     return
   fi
   grep -q "validation:" "$out/$name.err" && fail "$name: validation messages: $(grep -m3 validation: "$out/$name.err")"
-  [ "$(head -1 "$out/$name.csv")" = "frame,frame_ms,update_ms,render_ms,edits,gpu_submits,gpu_dispatches,gpu_bytes_up,gpu_bytes_down" ] ||
+  [ "$(head -1 "$out/$name.csv")" = "frame,frame_ms,update_ms,render_ms,edits,gpu_submits,gpu_dispatches,gpu_bytes_up,gpu_bytes_down,mesh_ms,triangles,bytes_up" ] ||
     fail "$name: CSV header"
   local rows
   rows=$(tail -n +2 "$out/$name.csv" | wc -l)
@@ -94,6 +94,44 @@ print(f"vectors: {green} sheet pixels, {coloured} field pixels")
 assert green > 2000 and coloured > 300
 PY
 
+# The terrain mode: smooth terrain shaped by seeded brushes (one every 20 ms of wall time, added
+# and carved in turn), each re-meshing only its chunks, drawn by the CPU rasteriser — in the Vulkan
+# window under validation, with the CPU renderer, and through OpenGL. The CSV's terrain columns
+# count the mesh and the bytes an edit would upload; the screenshot shows the grass right of the
+# panel, and the brushes' rock, sand and snow on it.
+trun() {  # name, demo arguments...
+  local name=$1
+  shift
+  local status=0
+  env ${RUN_ENV:-} xvfb-run -a -s "-screen 0 1024x768x24" "$DEMO" --mode terrain --benchmark --frames 40 --interval-ms 20 \
+      --width 640 --height 360 --csv "$out/$name.csv" --screenshot "$out/$name.png" "$@" >"$out/$name.out" 2>"$out/$name.err" || status=$?
+  if [ "$status" -ne 0 ]; then
+    fail "$name: exit status $status: $(tail -5 "$out/$name.err")"
+    return
+  fi
+  grep -q "validation:" "$out/$name.err" && fail "$name: validation messages: $(grep -m3 validation: "$out/$name.err")"
+  grep -q "terrain mode" "$out/$name.err" || fail "$name: the demo did not say it is in the terrain mode"
+  # 40 frames; at least 5 edits by the end; every row has a mesh; the last edit re-meshed and
+  # would upload some chunks, but far less than the whole field (128 x 128 x 64 i8 samples).
+  awk -F, 'NR > 1 && $11 < 1000 { bad = 1 } END { exit bad || !(NR == 41 && $5 >= 5 && $10 > 0 && $12 > 0 && $12 < 1048576 / 4) }' "$out/$name.csv" ||
+    fail "$name: the terrain columns are wrong: $(tail -1 "$out/$name.csv")"
+  /usr/bin/python3 - "$out/$name.png" <<'PY' || fail "$name: the screenshot does not show the edited terrain"
+import sys
+from PIL import Image
+im = Image.open(sys.argv[1]).convert("RGB")
+w, h = im.size
+px = list(im.crop((370, 0, w, h)).getdata())  # right of the panel
+grass = sum(p[1] > p[0] + 15 and p[1] > p[2] + 15 for p in px)
+brushed = sum(abs(p[0] - p[1]) < 40 and p[0] > 60 and not (p[1] > p[0] + 15) for p in px)  # rock, sand, snow
+print(f"terrain: {grass} grass pixels, {brushed} brushed")
+assert grass > 0.1 * len(px) and brushed > 100
+PY
+  echo "ok: $name ($(tail -1 "$out/$name.csv" | cut -d, -f5,10-12))"
+}
+trun terrain-vulkan --backend vulkan --validation
+trun terrain-cpu --backend cpu
+RUN_ENV="VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json" trun terrain-opengl --backend vulkan
+
 # Interactive: real input events through the window system (xdotool). A left click places and a
 # right click carves at the ray hit, each a separate edit; F12 saves a screenshot.
 if command -v xdotool >/dev/null; then
@@ -116,6 +154,26 @@ if command -v xdotool >/dev/null; then
     awk -F, 'END { exit !($5 >= 2) }' "$out/interactive/i.csv" || fail "interactive: the clicks did not edit (edits: $(tail -1 "$out/interactive/i.csv"))"
     "$FRAME_CHECK" "$out/interactive/voxfield-demo-1.png" || fail "interactive: no F12 screenshot of the world"
     echo "ok: interactive (clicks placed and carved; F12 saved a screenshot)"
+  fi
+  # The terrain mode under the mouse: a left click adds a sphere where the cursor's ray meets the
+  # surface, a right click carves one.
+  mkdir -p "$out/terrain-interactive"
+  status=0
+  (cd "$out/terrain-interactive" && DEMO="$DEMO" xvfb-run -a -s "-screen 0 1024x768x24" bash -c '
+    "$DEMO" --mode terrain --width 640 --height 360 --backend cpu --frames 400 --csv i.csv 2>i.err &
+    pid=$!
+    win=$(timeout 60 xdotool search --sync --name voxfield-demo | head -1)
+    sleep 1
+    xdotool mousemove --window "$win" 500 250 click 1
+    sleep 0.5
+    xdotool mousemove --window "$win" 520 200 click 3
+    wait $pid') || status=$?
+  if [ "$status" -ne 0 ]; then
+    fail "terrain-interactive: exit status $status: $(tail -3 "$out/terrain-interactive/i.err" 2>/dev/null)"
+  else
+    awk -F, 'END { exit !($5 >= 2 && $12 > 0) }' "$out/terrain-interactive/i.csv" ||
+      fail "terrain-interactive: the clicks did not edit the terrain ($(tail -1 "$out/terrain-interactive/i.csv"))"
+    echo "ok: terrain-interactive (a click added, a click carved)"
   fi
 else
   fail "xdotool is missing (scripts/install-deps.sh installs it)"

@@ -11,6 +11,7 @@
 #include "demo_world.h"
 #include "fly_camera.h"
 #include "gl_window.h"
+#include "terrain_mode.h"
 #include "vectors_mode.h"
 #include "voxfield/gpu_render.h"
 #include "vulkan_window.h"
@@ -33,8 +34,9 @@ struct Options {
   double interval_ms = 200;
   std::string csv;
   std::string screenshot;
-  std::string mode = "world";  // or "vectors" (vectors_mode.h)
+  std::string mode = "world";  // or "vectors" (vectors_mode.h) or "terrain" (terrain_mode.h)
   VectorsSettings vectors;
+  TerrainSettings terrain;
 };
 
 // What draws the frames, and why.
@@ -49,6 +51,8 @@ struct Brush {
   std::uint8_t material = 1;
   bool paint = false;
 };
+
+enum class Mode { kWorld, kVectors, kTerrain };
 
 struct Timings {
   double frame_ms = 0, update_ms = 0, render_ms = 0;
@@ -69,10 +73,13 @@ class Demo {
   void panel();
   void help();
   void take_screenshot(const std::string& path);
-  // Switches to the vectors mode (or rebuilds it with new settings), on the render path's device
-  // when there is one, else on the CPU; to the world with `vectors` false.
-  void set_mode(bool vectors);
+  // Switches mode (or rebuilds the current one with new settings): the vectors mode on the render
+  // path's device when there is one, else on the CPU; the terrain mode on the CPU.
+  void set_mode(Mode mode);
   bool draw_vectors(VulkanWindow::Screenshot* shot);
+  bool draw_terrain(VulkanWindow::Screenshot* shot);
+  // The ray through the cursor (the window's centre in look mode), in the frame's pixels.
+  Ray cursor_ray();
   // A CPU picture copied into the window's staging buffer (in its byte order): the frame's fill.
   std::function<void(VkCommandBuffer, VkImage)> stage_cpu_frame(const Image& img);
   bool gpu_can_draw() const { return path_.renderer != nullptr; }
@@ -91,6 +98,8 @@ class Demo {
   std::unique_ptr<DemoWorld> world_;
   std::unique_ptr<VectorsMode> vectors_;  // the vectors mode, when on
   VectorsSettings vectors_settings_;
+  std::unique_ptr<TerrainMode> terrain_;  // the terrain mode, when on
+  TerrainSettings terrain_settings_;
   RenderPath path_;
   FlyCamera camera_;
   Brush brush_;

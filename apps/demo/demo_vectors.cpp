@@ -1,7 +1,8 @@
-// voxfield-demo — switching to the vectors mode and drawing its frames (vectors_mode.h): on the
-// Vulkan path the frame's step and picture are recorded into the frame's command buffer and the
-// pixels copied to the swapchain image; otherwise the CPU's picture is presented as the world's
-// CPU frames are.
+// voxfield-demo — switching modes, and drawing the vectors mode's frames (vectors_mode.h) and the
+// terrain mode's (terrain_mode.h). Vectors: on the Vulkan path the frame's step and picture are
+// recorded into the frame's command buffer and the pixels copied to the swapchain image; otherwise
+// the CPU's picture is presented as the world's CPU frames are. Terrain: the CPU rasteriser's
+// picture, presented the same way.
 #include <backends/imgui_impl_opengl2.h>
 #include <backends/imgui_impl_vulkan.h>
 #include <imgui.h>
@@ -13,13 +14,21 @@
 
 namespace voxfield::demo {
 
-void Demo::set_mode(bool vectors) {
+void Demo::set_mode(Mode mode) {
   wait_idle();
-  const bool was_on = vectors_ != nullptr;
+  const bool was_on = vectors_ != nullptr, was_terrain = terrain_ != nullptr;
   vectors_.reset();
-  if (!vectors) {
+  terrain_.reset();
+  if (mode == Mode::kWorld) {
     frame_camera();
     status_ = "world mode";
+    return;
+  }
+  if (mode == Mode::kTerrain) {
+    terrain_ = std::make_unique<TerrainMode>(terrain_settings_);
+    status_ = "terrain mode: the terrain field meshed chunk by chunk, drawn by the CPU rasteriser";
+    std::cerr << "voxfield-demo: " << status_ << "\n";
+    if (!was_terrain) TerrainMode::frame(camera_, terrain_settings_);
     return;
   }
   try {
@@ -64,6 +73,25 @@ bool Demo::draw_vectors(VulkanWindow::Screenshot* shot) {
       fill, [](VkCommandBuffer cmd) { ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd); },
       shot);
   if (vectors_->on_gpu()) wait_idle();  // the frame's time includes its step and picture
+  last_.render_ms = ms_between(t0, Clock::now());
+  return drawn;
+}
+
+// The terrain mode's frames: the CPU rasteriser's picture, presented as the CPU renderer's are.
+bool Demo::draw_terrain(VulkanWindow::Screenshot* shot) {
+  const int w = width(), h = height();
+  const auto t0 = Clock::now();
+  const Image img = terrain_->render(camera_, w, h);
+  if (gl_) {
+    gl_->draw_frame(
+        img, [] { ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData()); }, shot);
+    last_.render_ms = ms_between(t0, Clock::now());
+    return true;
+  }
+  const bool drawn = vk_->draw_frame(
+      stage_cpu_frame(img),
+      [](VkCommandBuffer cmd) { ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd); },
+      shot);
   last_.render_ms = ms_between(t0, Clock::now());
   return drawn;
 }

@@ -20,6 +20,7 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -49,9 +50,11 @@ Demo::Demo(const Options& o) : options_(o) {
   ui_clamp_ = static_cast<float>(o.world.clamp);
   ui_metric_ = static_cast<int>(o.world.metric);
   vectors_settings_ = o.vectors;
+  terrain_settings_ = o.terrain;
   choose_path(o.backend);
   frame_camera();
-  if (o.mode == "vectors") set_mode(true);
+  if (o.mode == "vectors") set_mode(Mode::kVectors);
+  if (o.mode == "terrain") set_mode(Mode::kTerrain);
 
   // Input callbacks first: the ImGui backend chains to them.
   glfwSetWindowUserPointer(glfw(), this);
@@ -149,7 +152,7 @@ void Demo::choose_path(const std::string& backend) {
   }
   ui_backend_ = path_.renderer ? 1 : 0;
   std::cerr << "voxfield-demo: " << path_.why << "\n";
-  if (vectors) set_mode(true);
+  if (vectors) set_mode(Mode::kVectors);
 }
 
 void Demo::frame_camera() {
@@ -161,6 +164,7 @@ void Demo::frame_camera() {
 }
 
 std::string Demo::title() const {
+  if (terrain_) return "voxfield-demo — terrain — CPU meshes and rasteriser";
   if (vectors_)
     return std::string("voxfield-demo — vectors — ") +
            (vectors_->on_gpu() ? "Vulkan passes" : "CPU passes");
@@ -168,7 +172,7 @@ std::string Demo::title() const {
          (gpu_can_draw() ? "Vulkan ray marcher" : "CPU renderer");
 }
 
-void Demo::edit_at_cursor(EditOp op) {
+Ray Demo::cursor_ray() {
   double x = 0, y = 0;
   if (look_mode_) {
     x = width() / 2.0;
@@ -180,7 +184,17 @@ void Demo::edit_at_cursor(EditOp op) {
     x *= static_cast<double>(width()) / std::max(ww, 1);
     y *= static_cast<double>(height()) / std::max(wh, 1);
   }
-  const Ray ray = camera_.camera().projector(width(), height()).ray(x, y);
+  return camera_.camera().projector(width(), height()).ray(x, y);
+}
+
+void Demo::edit_at_cursor(EditOp op) {
+  if (terrain_) {  // left adds, right carves; the material keys choose what is added
+    const auto t0 = Clock::now();
+    if (terrain_->edit_at(cursor_ray(), op != EditOp::kCarve, brush_.material))
+      last_.update_ms = ms_between(t0, Clock::now());
+    return;
+  }
+  const Ray ray = cursor_ray();
   const RayHit hit = trace_ray(world_->scene(), ray);
   if (!hit.hit) return;
   Vec3d centre{static_cast<double>(hit.voxel.x), static_cast<double>(hit.voxel.y),
@@ -222,8 +236,9 @@ void Demo::handle_input(double dt_s) {
       if (pressed(GLFW_KEY_0 + k)) brush_.material = static_cast<std::uint8_t>(k);
     const double speed =
         (down(GLFW_KEY_LEFT_CONTROL) || down(GLFW_KEY_RIGHT_CONTROL) ? 4.0 : 1.0) *
-        (vectors_ ? 4.0  // world units per second across the agents' 10-unit box
-                  : std::max(16.0, world_->scene().box().size().x * 0.35));  // voxels per second
+        (vectors_   ? 4.0  // world units per second across the agents' 10-unit box
+         : terrain_ ? std::max(16.0, terrain_->box().size().x * 0.35)
+                    : std::max(16.0, world_->scene().box().size().x * 0.35));  // voxels per second
     Vec3d move{0, 0, 0};
     const Vec3d f = camera_.forward(), r = camera_.right();
     if (down(GLFW_KEY_W)) move = move + f;
@@ -244,8 +259,12 @@ void Demo::handle_input(double dt_s) {
   last_y_ = y;
   const std::vector<int> clicks = std::exchange(clicks_, {});
   if (!io.WantCaptureMouse && !vectors_) {  // the vectors mode has nothing to edit
-    if (scroll_ != 0)
+    if (scroll_ != 0 && terrain_) {
+      float& r = terrain_->brush_settings().radius;
+      r = std::clamp(r + static_cast<float>(scroll_), 1.0f, 24.0f);
+    } else if (scroll_ != 0) {
       brush_.radius = std::clamp(brush_.radius + static_cast<int>(std::lround(scroll_)), 0, 32);
+    }
     const EditOp left_op = brush_.paint ? EditOp::kPaint : EditOp::kPlace;
     // Every click edits once; held buttons repeat the edit ten times a second.
     for (int button : clicks)
@@ -275,6 +294,7 @@ bool Demo::draw(VulkanWindow::Screenshot* shot) {
   if (show_help_) help();
   ImGui::Render();
   if (vectors_) return draw_vectors(shot);
+  if (terrain_) return draw_terrain(shot);
 
   RenderOptions ro;
   ro.width = width();
@@ -358,13 +378,16 @@ int Demo::run() {
     // The GPU columns are voxfield's own traffic in the frame (scene copies and the ray marcher's
     // work; the demo's swapchain submission is not voxfield's): zero on the CPU renderer.
     // In the vectors mode the edits column counts the field's steps so far.
+    // The terrain mode's columns: its last edit's re-mesh time, the mesh's triangles and the bytes
+    // the edit would upload to a renderer keeping the field on the GPU (zero in the other modes).
     csv << "frame,frame_ms,update_ms,render_ms,edits,gpu_submits,gpu_dispatches,gpu_bytes_up,gpu_"
-           "bytes_down\n";
+           "bytes_down,mesh_ms,triangles,bytes_up\n";
   }
   // Benchmark mode: the dissertation's seeded edits, one every interval of wall time, radii up to
   // the chunk edge - 1, with the camera circling the world.
   std::optional<RandomEditStream> stream;
-  if (options_.benchmark)
+  std::mt19937_64 terrain_edits(options_.world.seed);
+  if (options_.benchmark && !terrain_)
     stream.emplace(world_->scene().box(), options_.world.seed, 1,
                    world_->settings().chunk_edge - 1);
   const auto start = Clock::now();
@@ -378,7 +401,29 @@ int Demo::run() {
     const double dt_s = std::min(0.1, ms_between(previous, t0) / 1000.0);
     previous = t0;
     double update_ms = 0;
-    if (vectors_) {
+    if (terrain_ && options_.benchmark) {
+      // The camera circles the terrain; a seeded brush lands on the surface every interval,
+      // added or carved in turn, with the material of its turn.
+      const Box3i box = terrain_->box();
+      const Vec3i s = box.size();
+      const double angle = 0.6 + frame * 0.02;
+      const Vec3d centre{s.x / 2.0, s.y / 2.0, s.z * 0.3};
+      const double r = 1.05 * std::max(s.x, s.y);
+      // Looking a little to the left of the terrain's centre, so it shows beside the panel.
+      const Vec3d right{-std::sin(angle), std::cos(angle), 0};
+      camera_.look(
+          centre + Vec3d{r * std::cos(angle), r * std::sin(angle), 0.75 * std::max(s.x, s.y)},
+          centre - right * (0.3 * s.x));
+      const auto due = static_cast<std::int64_t>(ms_between(start, t0) / options_.interval_ms) + 1;
+      const auto a = Clock::now();
+      for (; streamed < due; ++streamed) {
+        const double x = static_cast<double>(terrain_edits() % static_cast<unsigned>(s.x));
+        const double y = static_cast<double>(terrain_edits() % static_cast<unsigned>(s.y));
+        terrain_->edit_above(x, y, streamed % 2 == 0, static_cast<std::uint8_t>(2 + streamed % 3));
+      }
+      update_ms = ms_between(a, Clock::now());
+      last_.update_ms = update_ms;
+    } else if (vectors_) {
       if (options_.benchmark) {  // the camera circles the agents' box
         const double angle = 0.6 + frame * 0.02;
         // Looking a little to the left of the box, so it shows beside the panel.
@@ -426,10 +471,15 @@ int Demo::run() {
     if (csv.is_open()) {
       const gpu::Counters g = path_.context ? path_.context->counters() : gpu::Counters{};
       csv << frame << "," << last_.frame_ms << "," << update_ms << "," << last_.render_ms << ","
-          << (vectors_ ? vectors_->steps() : world_->edits()) << ","
-          << g.submits - gpu_before.submits << "," << g.dispatches - gpu_before.dispatches << ","
-          << g.bytes_uploaded - gpu_before.bytes_uploaded << ","
-          << g.bytes_downloaded - gpu_before.bytes_downloaded << "\n";
+          << (vectors_   ? vectors_->steps()
+              : terrain_ ? terrain_->edits()
+                         : world_->edits())
+          << "," << g.submits - gpu_before.submits << "," << g.dispatches - gpu_before.dispatches
+          << "," << g.bytes_uploaded - gpu_before.bytes_uploaded << ","
+          << g.bytes_downloaded - gpu_before.bytes_downloaded << ","
+          << (terrain_ ? terrain_->last_mesh_ms() : 0.0) << ","
+          << (terrain_ ? terrain_->triangles() : 0) << ","
+          << (terrain_ ? terrain_->last_bytes_up() : 0) << "\n";
     }
   }
   if (csv.is_open()) {
@@ -473,9 +523,17 @@ int main(int argc, char** argv) {
                  "one row per frame (frame_ms, update_ms, render_ms, edits, GPU traffic)");
   app.add_option("--screenshot", o.screenshot, "with --frames: save the last frame as PNG");
   app.add_option("--mode", o.mode,
-                 "world (paint voxels, fields follow) or vectors (the vector-field paper's agents, "
-                 "their field and a reactive sheet)")
-      ->check(CLI::IsMember({"world", "vectors"}));
+                 "world (paint voxels, fields follow), vectors (the vector-field paper's agents, "
+                 "their field and a reactive sheet) or terrain (smooth terrain shaped by brushes, "
+                 "re-meshed chunk by chunk)")
+      ->check(CLI::IsMember({"world", "vectors", "terrain"}));
+  app.add_option("--terrain-size", o.terrain.size, "terrain mode: samples along x and y")
+      ->check(CLI::IsMember({64, 128, 192, 256}));
+  app.add_option("--terrain-storage", o.terrain.storage, "terrain mode: 0 i8, 1 i16, 2 f32")
+      ->check(CLI::Range(0, 2));
+  app.add_option("--terrain-mesher", o.terrain.mesher,
+                 "terrain mode: 0 marching cubes, 1 surface nets, 2 dual contouring")
+      ->check(CLI::Range(0, 2));
   app.add_option("--vector-resolution", o.vectors.resolution, "vectors mode: voxels per axis")
       ->check(CLI::IsMember({16, 32, 64, 128}));
   app.add_option("--vector-sources", o.vectors.sources, "vectors mode: agents")

@@ -17,9 +17,31 @@ void Demo::panel() {
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
   ImGui::Begin("voxfield");
-  int mode = vectors_ ? 1 : 0;
-  const char* modes[] = {"world", "vectors"};
-  if (ImGui::Combo("mode", &mode, modes, 2)) set_mode(mode == 1);
+  int mode = vectors_ ? 1 : terrain_ ? 2 : 0;
+  const char* modes[] = {"world", "vectors", "terrain"};
+  if (ImGui::Combo("mode", &mode, modes, 3)) set_mode(static_cast<Mode>(mode));
+  if (terrain_) {
+    ImGui::TextWrapped("%s", status_.c_str());
+    ImGui::Text("frame %.1f ms (%.1f FPS), picture %.1f ms", last_.frame_ms,
+                last_.frame_ms > 0 ? 1000.0 / last_.frame_ms : 0.0, last_.render_ms);
+    terrain_->stats_panel();
+    if (ImGui::CollapsingHeader("Terrain", ImGuiTreeNodeFlags_DefaultOpen)) {
+      terrain_settings_ = terrain_->settings();
+      if (TerrainMode::panel(terrain_settings_)) {
+        try {
+          set_mode(Mode::kTerrain);
+        } catch (const Error& e) {
+          status_ = e.what();
+        }
+      } else {
+        terrain_->brush_settings() = terrain_settings_;
+      }
+    }
+    ImGui::TextWrapped(
+        "left click adds, right click carves; 1 .. 9 the material; wheel the radius");
+    ImGui::End();
+    return;
+  }
   if (vectors_) {
     ImGui::TextWrapped("%s", status_.c_str());
     ImGui::Text("frame %.1f ms (%.1f FPS), picture %.1f ms", last_.frame_ms,
@@ -28,7 +50,7 @@ void Demo::panel() {
     if (ImGui::CollapsingHeader("Field", ImGuiTreeNodeFlags_DefaultOpen) &&
         VectorsMode::panel(vectors_settings_)) {
       try {
-        set_mode(true);
+        set_mode(Mode::kVectors);
       } catch (const Error& e) {
         status_ = e.what();
       }

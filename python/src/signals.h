@@ -10,10 +10,11 @@
 
 namespace voxfield::python {
 
-// Ctrl-C during a long call (a transform, a mesh): the thread that called (it works on the transform's tasks too) takes
-// the GIL when the transform asks whether to go on and lets Python run its signal handlers; a
-// KeyboardInterrupt stops the transform (voxfield throws Cancelled, which reaches Python as
-// voxfield.Cancelled, a KeyboardInterrupt). Other worker threads only read the flag.
+// Ctrl-C during a long call (a transform, a mesh): the thread that called (it works on the
+// transform's tasks too) takes the GIL when the transform asks whether to go on and lets Python run
+// its signal handlers; a KeyboardInterrupt stops the transform (voxfield throws Cancelled, which
+// reaches Python as voxfield.Cancelled, a KeyboardInterrupt). Other worker threads only read the
+// flag.
 class PythonSignals : public Interrupter {
  public:
   bool was_interrupted(int) override {
