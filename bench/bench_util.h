@@ -29,6 +29,25 @@ Timing time_runs(int runs, Fn&& fn) {
   return {ms[ms.size() / 2], ms.front(), ms.back()};
 }
 
+inline double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The mean, median and 99th percentile of per-event times (an edit's, a frame's).
+struct Spread {
+  double mean = 0, p50 = 0, p99 = 0;
+};
+inline Spread spread(std::vector<double> v) {
+  Spread s;
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  for (double x : v) s.mean += x;
+  s.mean /= static_cast<double>(v.size());
+  s.p50 = v[v.size() / 2];
+  s.p99 = v[std::min(v.size() - 1, v.size() * 99 / 100)];
+  return s;
+}
+
 // Reads a "Name:   1234 kB" line of /proc/self/status, in bytes.
 inline std::size_t proc_status_bytes(const char* name) {
   std::ifstream f("/proc/self/status");

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "voxfield/distance.h"
 #include "voxfield/mesh_chunks.h"
 #include "voxfield/scene.h"
@@ -23,23 +24,15 @@ using namespace voxfield;
 
 namespace {
 
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // Inigo Quilez's polynomial smooth minimum with blend radius k.
 float smooth_min(float a, float b, float k) {
   const float h = std::max(k - std::abs(a - b), 0.0f) / k;
   return std::min(a, b) - h * h * k * 0.25f;
 }
 
-void report(const char* what, std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  double sum = 0;
-  for (double x : v) sum += x;
-  std::printf("%-28s mean %8.3f ms   p50 %8.3f ms   p99 %8.3f ms\n", what,
-              sum / static_cast<double>(v.size()), v[v.size() / 2],
-              v[std::min(v.size() - 1, v.size() * 99 / 100)]);
+void report(const char* what, const std::vector<double>& v) {
+  const bench::Spread s = bench::spread(v);
+  std::printf("%-28s mean %8.3f ms   p50 %8.3f ms   p99 %8.3f ms\n", what, s.mean, s.p50, s.p99);
 }
 
 }  // namespace
@@ -76,7 +69,7 @@ int main(int argc, char** argv) {
   std::printf(
       "voxfield-bench-mesh-edits: terrain %d^3, %s, chunks of %d, first mesh %.0f ms, %d smooth "
       "spheres of radius %.1f\n",
-      n, mesher_name(mesher), chunk, ms_since(t0), edits, radius);
+      n, mesher_name(mesher), chunk, bench::ms_since(t0), edits, radius);
   // Surface heights, to put each edit on the terrain.
   auto surface = [&](int x, int y) {
     for (int z = n - 1; z > 0; --z)
@@ -113,10 +106,10 @@ int main(int argc, char** argv) {
           v = add ? smooth_min(v, d, k)
                   : -smooth_min(-v, d, k);  // carve: the smooth maximum of v and -d
         }
-    const double w = ms_since(t0);
+    const double w = bench::ms_since(t0);
     t0 = std::chrono::steady_clock::now();
     remeshed += chunks.update(volume, box).size();
-    const double m = ms_since(t0);
+    const double m = bench::ms_since(t0);
     write_ms.push_back(w);
     mesh_ms.push_back(m);
     total_ms.push_back(w + m);

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "voxfield/distance.h"
 #include "voxfield/mesh_chunks.h"
 #include "voxfield/scene.h"
@@ -32,23 +33,6 @@
 using namespace voxfield;
 
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-struct Summary {
-  double mean = 0, p50 = 0, p99 = 0;
-};
-Summary summarise(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  Summary s;
-  for (double x : v) s.mean += x;
-  s.mean /= static_cast<double>(v.size());
-  s.p50 = v[v.size() / 2];
-  s.p99 = v[std::min(v.size() - 1, v.size() * 99 / 100)];
-  return s;
-}
 
 // The f32 field between samples (trilinear), at a position in sample units.
 double trilinear(const std::vector<float>& f, int n, const std::array<float, 3>& p) {
@@ -150,7 +134,7 @@ int main(int argc, char** argv) {
         static_cast<std::uint64_t>(to.chunk_edge) * to.chunk_edge * to.chunk_edge * sample_bytes;
     auto t0 = std::chrono::steady_clock::now();
     MeshChunks chunks(terrain, mo);
-    const double first_ms = ms_since(t0);
+    const double first_ms = bench::ms_since(t0);
     const Mesh first = chunks.merged();
     double error_sum = 0, error_max = 0;
     if (storage == TerrainStorage::kF32) {
@@ -185,10 +169,10 @@ int main(int argc, char** argv) {
       b.material = 2;
       t0 = std::chrono::steady_clock::now();
       const Box3i changed = terrain.apply(b);
-      const double w = ms_since(t0);
+      const double w = bench::ms_since(t0);
       t0 = std::chrono::steady_clock::now();
       chunks.update(terrain, changed);
-      const double m = ms_since(t0);
+      const double m = bench::ms_since(t0);
       brush_ms.push_back(w);
       mesh_ms.push_back(m);
       total_ms.push_back(w + m);
@@ -202,7 +186,8 @@ int main(int argc, char** argv) {
     const Mesh kept = chunks.merged(), fresh = mesh_terrain(terrain, mo);
     const bool same = kept.positions == fresh.positions && kept.indices == fresh.indices;
     status |= same ? 0 : 1;
-    const Summary bs = summarise(brush_ms), ms = summarise(mesh_ms), ts = summarise(total_ms);
+    const bench::Spread bs = bench::spread(brush_ms), ms = bench::spread(mesh_ms),
+                        ts = bench::spread(total_ms);
     char error[64] = "— (the reference)";
     if (storage != TerrainStorage::kF32)
       std::snprintf(error, sizeof error, "%.4f / %.4f",

@@ -29,7 +29,7 @@ double hills(const Vec3d& p, double n) {
 
 Palette terrain_palette() {
   Palette p{};
-  p[1] = {96, 132, 68, 255};   // grass
+  p[1] = {96, 132, 68, 255};    // grass
   p[2] = {128, 118, 108, 255};  // rock
   p[3] = {214, 192, 128, 255};  // sand
   p[4] = {236, 238, 242, 255};  // snow
@@ -120,7 +120,8 @@ bool TerrainMode::edit_at(const Ray& ray, bool add, std::uint8_t material) {
       b.smooth_units = settings_.smooth;
       b.material = material;
       apply(b);
-      last_edit_ = std::string(add ? "added" : "carved") + (settings_.shape == 0 ? " a sphere" : " a box");
+      last_edit_ =
+          std::string(add ? "added" : "carved") + (settings_.shape == 0 ? " a sphere" : " a box");
       return true;
     }
   }
@@ -196,7 +197,10 @@ void TerrainMode::stats_panel() const {
     ImGui::Text("%.1f kB up per edit (the whole field: %.1f MB)",
                 static_cast<double>(last_bytes_up_) / 1e3,
                 static_cast<double>(box().volume()) *
-                    (settings_.storage == 0 ? 1 : settings_.storage == 1 ? 2 : 4) / 1e6);
+                    (settings_.storage == 0   ? 1
+                     : settings_.storage == 1 ? 2
+                                              : 4) /
+                    1e6);
   }
   ImGui::TextDisabled("drawn by the CPU rasteriser");
 }

@@ -6,14 +6,14 @@ Run by CTest with PYTHONPATH pointing at the build's python/ directory (and VOXF
 
 import os
 import subprocess
-import threading
-import time
 
 import numpy as np
 import pytest
 
 import voxfield
 from voxfield import mesh as vm
+
+from gil import ticks_during
 
 
 def sphere_sdf(shape, centre, radius, dtype=np.float32):
@@ -164,27 +164,6 @@ def test_bad_arguments_raise_value_errors():
 
 
 def test_the_gil_is_released_while_meshing():
-    rng = np.random.default_rng(2)
-    v = rng.standard_normal((150, 150, 150)).astype(np.float32)  # a surface in every cell
-    ticks = 0
-    stop = False
-
-    def count():
-        nonlocal ticks
-        while not stop:
-            ticks += 1
-            time.sleep(0.0005)
-
-    t = threading.Thread(target=count)
-    t.start()
-    try:
-        time.sleep(0.05)
-        before = ticks
-        start = time.perf_counter()
-        vm.mesh_volume(v, threads=1)
-        elapsed = time.perf_counter() - start
-        during = ticks - before
-    finally:
-        stop = True
-        t.join()
+    v = np.random.default_rng(2).standard_normal((150, 150, 150)).astype(np.float32)  # a surface in every cell
+    elapsed, during = ticks_during(lambda: vm.mesh_volume(v, threads=1))
     assert elapsed > 0.02 and during >= 10, (elapsed, during)

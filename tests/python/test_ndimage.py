@@ -17,6 +17,8 @@ from scipy import ndimage as sn
 import voxfield
 from voxfield import ndimage as vn
 
+from gil import ticks_during
+
 RNG = np.random.default_rng(2026)
 
 
@@ -173,27 +175,7 @@ def test_no_zero_element():
 
 def test_the_gil_is_released_during_a_transform():
     a = random_volume((160, 160, 160), density=0.9995)
-    ticks = 0
-    stop = False
-
-    def count():
-        nonlocal ticks
-        while not stop:
-            ticks += 1
-            time.sleep(0.0005)
-
-    t = threading.Thread(target=count)
-    t.start()
-    try:
-        time.sleep(0.05)
-        before = ticks
-        start = time.perf_counter()
-        vn.distance_transform_edt(a, threads=1)
-        elapsed = time.perf_counter() - start
-        during = ticks - before
-    finally:
-        stop = True
-        t.join()
+    elapsed, during = ticks_during(lambda: vn.distance_transform_edt(a, threads=1))
     # While the transform ran (at least tens of milliseconds), the other thread kept counting.
     assert elapsed > 0.02 and during >= 10, (elapsed, during)
 
