@@ -11,6 +11,7 @@ namespace voxfield::python {
 void bind_ndimage(py::module_& m);
 void bind_csg(py::module_& m);
 void bind_mesh(py::module_& m);
+void bind_vectors(py::module_& m);
 }  // namespace voxfield::python
 
 PYBIND11_MODULE(_voxfield, m) {
@@ -28,4 +29,5 @@ PYBIND11_MODULE(_voxfield, m) {
   voxfield::python::bind_ndimage(m);
   voxfield::python::bind_csg(m);
   voxfield::python::bind_mesh(m);
+  voxfield::python::bind_vectors(m);
 }

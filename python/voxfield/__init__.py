@@ -6,6 +6,10 @@
 ``voxfield.mesh`` meshes NumPy volumes (``mesh_volume``: marching cubes, surface nets, dual
 contouring) and keeps a deformable ``Terrain`` field edited by brushes (docs/meshing.md).
 
+``voxfield.vectors`` renders moving sources into vector-field volume textures (docs/vectors.md):
+``Volume``, ``generate``, ``exact`` and ``Simulation`` (steps with decay and blend, sampling, the
+visualiser's picture).
+
 ``voxfield.ndimage`` is a drop-in for ``scipy.ndimage.distance_transform_edt`` and
 ``distance_transform_cdt`` (same arguments, results, shapes, dtypes and index layout), computed
 by voxfield's exact separable transforms on every core, with what SciPy lacks: ``signed``,
@@ -21,6 +25,7 @@ from ._voxfield import Cancelled, Error, FormatError, InvalidArgument, IoError, 
 from . import ndimage
 from . import csg
 from . import mesh
+from . import vectors
 
-__all__ = ["ndimage", "csg", "mesh", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
+__all__ = ["ndimage", "csg", "mesh", "vectors", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
            "Cancelled"]

@@ -5,7 +5,7 @@ import numpy as np
 import numpy.typing as npt
 
 import voxfield
-from voxfield import csg, mesh, ndimage
+from voxfield import csg, mesh, ndimage, vectors
 
 
 def sphere_field(n: int) -> npt.NDArray[np.float64]:
@@ -43,6 +43,19 @@ def terrain_triangles() -> int:
     return int(f.shape[0]) + x1 - x0 + terrain.samples[0] + int(terrain.clamp + terrain.step)
 
 
+def vector_strength() -> float:
+    volume = vectors.Volume(size=(4.0, 4.0, 4.0), resolution=(16, 16, 16))
+    sources = np.array([[0.0, 0.0, 0.0, 1.5]])
+    texture = vectors.generate(volume, sources, algorithm="splat", storage="rgba8")
+    values, winners = vectors.exact(np.array([[0.5, 0.0, 0.0]]), sources)
+    sim = vectors.Simulation(volume, storage="rgba32f", decay_per_s=2.0)
+    sim.step(sources, 1 / 60)
+    sample = sim.sample(np.array([[0.5, 0.0, 0.0]]))
+    picture = sim.render(64, 48)
+    assert picture.dtype == np.uint8 and texture.dtype == np.float32 and int(winners[0]) == 0
+    return float(sample[0, 3]) + float(values[0, 3]) + sim.steps + sim.last_times["total_ms"] * 0
+
+
 def refused() -> bool:
     try:
         csg.Model("(sphere", "bad.sdf")
@@ -60,4 +73,5 @@ if __name__ == "__main__":
     assert nodes == 4, nodes
     assert refused()
     assert terrain_triangles() > 0
+    assert vector_strength() > 1
     print("typed use: ok")
