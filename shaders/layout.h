@@ -199,7 +199,39 @@ struct VectorViewParams {
   ivec4 image;  // width, height; z = 1: pack pixels blue first (B8G8R8A8 swapchains)
 };
 
+// ---- marching cubes on the GPU (src/mesh/gpu) ---------------------------------------------------
+// The case table (binding 1, uints): per corner mask its first case and its ambiguous faces, the
+// faces' corners and the cube's edges, then one record of VF_MC_CASE_WORDS per case.
+VF_CONST(int, VF_MC_OFFSETS, 0);      // 256: the mask's first case
+VF_CONST(int, VF_MC_AMBIGUOUS, 256);  // 256: the mask's ambiguous faces (bit per face)
+VF_CONST(int, VF_MC_FACES, 512);      // 6 x 4: each face's corners in cyclic order
+VF_CONST(int, VF_MC_EDGES, 536);      // 12 x 2: each edge's lower corner and axis
+VF_CONST(int, VF_MC_CASES, 560);
+// A case record: triangle count, 36 edge indices (12 + c: centre vertex c), centre count, two
+// centre sizes, two lists of 12 edges.
+VF_CONST(int, VF_MC_CASE_WORDS, 64);
+VF_CONST(int, VF_MC_CENTRE, 12);
+// How the samples travel (MeshParams::size.w): f32, i16 two per word, i8 four per word.
+VF_CONST(int, VF_MC_F32, 0);
+VF_CONST(int, VF_MC_I16, 1);
+VF_CONST(int, VF_MC_I8, 2);
+// MeshParams::cells.w: the HistoPyramid.
+VF_CONST(int, VF_MC_PYRAMID_4, 0);      // 4-to-1 over the cells' linear order
+VF_CONST(int, VF_MC_PYRAMID_8, 1);      // 8-to-1 over the cells' 3-D grid (Dyken et al. 2007)
+VF_CONST(int, VF_MC_VERTEX_FLOATS, 6);  // position xyz, normal xyz
+
+// Push constants of the marching-cubes passes: 64 bytes.
+struct MeshParams {
+  ivec4 size;   // samples nx, ny, nz; w = VF_MC_F32 / _I16 / _I8
+  ivec4 cells;  // cells along x, y, z; w = VF_MC_PYRAMID_4 / _8
+  ivec4 pass;   // x: the level a reduction builds; y: levels in all; z: triangle capacity
+  float iso;
+  uint negate;  // 1: inside is above iso
+  uint pad0, pad1;
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(MeshParams) == 64, "push-constant size of MeshParams");
 static_assert(sizeof(Header) == 128, "std430 size of Header");
 static_assert(sizeof(PassParams) == 96, "push-constant size of PassParams");
 static_assert(sizeof(JfaParams) == 32, "push-constant size of JfaParams");

@@ -108,8 +108,7 @@ void bind_vectors(py::module_& parent) {
            }),
            py::arg("centre") = std::vector<double>{0, 0, 0},
            py::arg("size") = std::vector<double>{1, 1, 1},
-           py::arg("resolution") = std::vector<int>{64, 64, 64},
-           py::arg("rotation_degrees") = 0.0,
+           py::arg("resolution") = std::vector<int>{64, 64, 64}, py::arg("rotation_degrees") = 0.0,
            py::arg("rotation_axis") = std::vector<double>{0, 0, 1},
            "centre and size (full extents) in world units, resolution (nx, ny, nz), and a rotation "
            "of the box by rotation_degrees about rotation_axis")
@@ -223,7 +222,8 @@ void bind_vectors(py::module_& parent) {
               py::gil_scoped_release release;
               img = render_vectors(sim.volume(), sim.field(), o);
             }
-            py::array_t<std::uint8_t> out({py::ssize_t{height}, py::ssize_t{width}, py::ssize_t{3}});
+            py::array_t<std::uint8_t> out(
+                {py::ssize_t{height}, py::ssize_t{width}, py::ssize_t{3}});
             std::copy(img.rgb.begin(), img.rgb.end(), out.mutable_data());
             return out;
           },

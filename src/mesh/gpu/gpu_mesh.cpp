@@ -1,0 +1,319 @@
+// voxfield GPU backend — marching cubes with a HistoPyramid (gpu_mesh.h): the samples and the case
+// table uploaded through the context's staging buffer, then classify, one reduction per pyramid
+// level, the indirect arguments and the traversal recorded in one command buffer (every barrier
+// derived by the recorder), one submit; the triangles are read back in a second.
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "../cube_cases.h"
+#include "../terrain_store.h"
+#include "gpu/recorder.h"
+#include "mesh_shaders.h"
+#include "shaders/layout.h"
+#include "voxfield/error.h"
+#include "voxfield/gpu_mesh.h"
+#include "voxfield/limits.h"
+
+namespace voxfield::gpu {
+
+namespace L = layout;
+
+namespace {
+
+constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+constexpr std::uint64_t kTriangleBytes = 3 * L::VF_MC_VERTEX_FLOATS * sizeof(float);
+
+// The field as it travels: the samples packed in their width, the frame and the inside rule.
+struct Field {
+  Vec3i n;
+  std::vector<std::uint32_t> words;
+  int width = L::VF_MC_F32;
+  double step = 0;
+  std::array<double, 3> origin{}, spacing{};
+  float iso = 0;
+  bool negate = false;
+};
+
+// The CPU's case table (cube_cases.h), flattened as layout.h's VF_MC_* describe it.
+std::vector<std::uint32_t> case_table() {
+  using detail::mesh::CubeCase;
+  using detail::mesh::CubeCases;
+  const CubeCases& t = CubeCases::get();
+  std::vector<std::uint32_t> out(L::VF_MC_CASES, 0);
+  std::uint32_t next = 0;
+  for (unsigned inside = 0; inside < 256; ++inside) {
+    out[L::VF_MC_OFFSETS + inside] = next;
+    out[L::VF_MC_AMBIGUOUS + inside] = t.ambiguous_faces(inside);
+    const unsigned variants = 1u << std::popcount(t.ambiguous_faces(inside));
+    for (unsigned joined = 0; joined < variants; ++joined) {
+      const CubeCase& c = t.lookup(inside, joined);
+      std::array<std::uint32_t, L::VF_MC_CASE_WORDS> r{};
+      r[0] = c.triangle_count;
+      for (int i = 0; i < 36; ++i) r[1 + static_cast<std::size_t>(i)] = c.edges[static_cast<std::size_t>(i)];
+      r[37] = c.centre_count;
+      r[38] = c.centre_sizes[0];
+      r[39] = c.centre_sizes[1];
+      for (std::size_t k = 0; k < 2; ++k)
+        for (std::size_t i = 0; i < 12; ++i) r[40 + 12 * k + i] = c.centre_edges[k][i];
+      out.insert(out.end(), r.begin(), r.end());
+      ++next;
+    }
+  }
+  for (int face = 0; face < 6; ++face) {
+    const auto corners = CubeCases::face_corners(face);
+    for (std::size_t k = 0; k < 4; ++k)
+      out[static_cast<std::size_t>(L::VF_MC_FACES + 4 * face) + k] = corners[k];
+  }
+  const auto& edges = detail::mesh::cube_edges();
+  for (std::size_t e = 0; e < 12; ++e) {
+    out[L::VF_MC_EDGES + 2 * e] = edges[e].from;
+    out[L::VF_MC_EDGES + 2 * e + 1] = edges[e].axis;
+  }
+  return out;
+}
+
+// The pyramid's levels, base first: (offset, dims x, y, z); the top holds one element.
+std::vector<L::ivec4> pyramid_levels(Vec3i cells, Pyramid kind, std::uint64_t& total) {
+  std::vector<L::ivec4> levels;
+  std::int64_t offset = 0;
+  if (kind == Pyramid::kFourToOne) {
+    std::int64_t count = static_cast<std::int64_t>(cells.x) * cells.y * cells.z;
+    for (;;) {
+      levels.push_back({static_cast<std::int32_t>(offset), static_cast<std::int32_t>(count), 1, 1});
+      offset += count;
+      if (count == 1) break;
+      count = (count + 3) / 4;
+    }
+  } else {
+    Vec3i d = cells;
+    for (;;) {
+      levels.push_back({static_cast<std::int32_t>(offset), d.x, d.y, d.z});
+      offset += static_cast<std::int64_t>(d.x) * d.y * d.z;
+      if (d.x == 1 && d.y == 1 && d.z == 1) break;
+      d = {(d.x + 1) / 2, (d.y + 1) / 2, (d.z + 1) / 2};
+    }
+  }
+  total = static_cast<std::uint64_t>(offset);
+  return levels;
+}
+
+Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats* stats) {
+  const auto start = std::chrono::steady_clock::now();
+  Context::Impl& c = context.impl();
+  c.require_device();
+  if (!c.float64)
+    throw GpuUnavailable(
+        "Vulkan: marching cubes on the GPU needs the device feature shaderFloat64 (double "
+        "precision in shaders, to give the CPU's triangles bit for bit), which " +
+        c.info.name + " does not have");
+  const Counters before = c.counters;
+  const Vec3i cells{f.n.x - 1, f.n.y - 1, f.n.z - 1};
+  const std::uint64_t cell_count = static_cast<std::uint64_t>(cells.x) * cells.y * cells.z;
+  std::uint64_t pyramid_elements = 0;
+  const std::vector<L::ivec4> levels = pyramid_levels(cells, g.pyramid, pyramid_elements);
+  const VkDeviceSize range = c.limits.maxStorageBufferRange;
+  const std::uint64_t sample_bytes = f.words.size() * 4;
+  for (const auto& [what, bytes] :
+       {std::pair<const char*, std::uint64_t>{"samples", sample_bytes},
+        {"HistoPyramid", pyramid_elements * 4},
+        {"cell cases", cell_count * 4}})
+    if (bytes > range)
+      throw ResourceLimitError("marching cubes on the GPU: the " + std::string(what) + " of " +
+                               to_string(f.n) + " samples take " + std::to_string(bytes) +
+                               " bytes, more than one storage buffer of " + c.info.name +
+                               " holds (" + std::to_string(range) + ")");
+  const std::uint64_t capacity =
+      g.max_triangles > 0 ? g.max_triangles : std::max<std::uint64_t>(1, range / kTriangleBytes);
+  if (capacity * kTriangleBytes > range || capacity > static_cast<std::uint64_t>(INT32_MAX))
+    throw InvalidArgument("marching cubes on the GPU: " + std::to_string(capacity) +
+                          " triangles do not fit one storage buffer of " + c.info.name);
+  const std::vector<std::uint32_t> table = case_table();
+  std::array<double, 8> frame{f.origin[0], f.origin[1], f.origin[2], f.step,
+                              f.spacing[0], f.spacing[1], f.spacing[2], 0};
+
+  Buffer samples(c, std::max<std::uint64_t>(sample_bytes, 16), kUsage, false);
+  Buffer tables(c, table.size() * 4, kUsage, false);
+  Buffer frame_buf(c, sizeof frame, kUsage, false);
+  Buffer level_buf(c, levels.size() * sizeof(L::ivec4), kUsage, false);
+  Buffer pyramid(c, pyramid_elements * 4, kUsage, false);
+  Buffer cases(c, cell_count * 4, kUsage, false);
+  Buffer vertices(c, capacity * kTriangleBytes, kUsage, false);
+  Buffer args(c, 16, kUsage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, true);
+  // One upload through the staging buffer: the samples, the table, the frame and the levels.
+  {
+    const std::uint64_t parts[4] = {sample_bytes, table.size() * 4, sizeof frame,
+                                    levels.size() * sizeof(L::ivec4)};
+    const void* data[4] = {f.words.data(), table.data(), frame.data(), levels.data()};
+    Buffer* dst[4] = {&samples, &tables, &frame_buf, &level_buf};
+    std::uint64_t total = 0;
+    for (std::uint64_t b : parts) total += (b + 15) / 16 * 16;
+    Buffer& staging = c.upload_buffer(total);
+    Recorder rec(c);
+    std::uint64_t at = 0;
+    for (int i = 0; i < 4; ++i) {
+      if (parts[i] == 0) continue;
+      std::memcpy(static_cast<std::uint8_t*>(staging.mapped()) + at, data[i], parts[i]);
+      rec.copy(staging, at, *dst[i], 0, parts[i]);
+      at += (parts[i] + 15) / 16 * 16;
+    }
+    L::MeshParams p{};
+    p.size = {f.n.x, f.n.y, f.n.z, f.width};
+    p.cells = {cells.x, cells.y, cells.z,
+               g.pyramid == Pyramid::kFourToOne ? L::VF_MC_PYRAMID_4 : L::VF_MC_PYRAMID_8};
+    p.pass = {0, static_cast<std::int32_t>(levels.size()), static_cast<std::int32_t>(capacity), 0};
+    p.iso = f.iso;
+    p.negate = f.negate ? 1u : 0u;
+    Buffer* all[8] = {&samples, &tables, &frame_buf, &level_buf, &pyramid, &cases, &vertices, &args};
+    const Recorder::Buffers list(all, 8);
+    const int classify = rec.begin_pass();
+    rec.dispatch(c.kernel(shaders::mesh_classify()), list, p, cell_count);
+    rec.end_pass(classify, "classify");
+    const int reduce = rec.begin_pass();
+    for (std::size_t l = 1; l < levels.size(); ++l) {
+      p.pass.x = static_cast<std::int32_t>(l);
+      const L::ivec4& lv = levels[l];
+      rec.dispatch(c.kernel(shaders::mesh_reduce()), list, p,
+                   static_cast<std::uint64_t>(lv.y) * lv.z * lv.w);
+    }
+    rec.end_pass(reduce, "HistoPyramid");
+    rec.dispatch(c.kernel(shaders::mesh_args()), list, p, 1);
+    const int traverse = rec.begin_pass();
+    rec.dispatch_indirect(c.kernel(shaders::mesh_traverse()), list, &p, sizeof p, args, 0);
+    rec.end_pass(traverse, "traverse");
+    rec.submit();
+  }
+  std::uint32_t counts[4];
+  std::memcpy(counts, args.mapped(), sizeof counts);
+  const std::uint64_t triangles = counts[3];
+  if (triangles > capacity)
+    throw ResourceLimitError("marching cubes on the GPU: the surface has " +
+                             std::to_string(triangles) + " triangles; the vertex buffer holds " +
+                             std::to_string(capacity) + " (GpuMeshOptions::max_triangles)");
+  Mesh mesh;
+  if (triangles > 0) {
+    const std::uint64_t bytes = triangles * kTriangleBytes;
+    Buffer& readback = c.readback_buffer(bytes);
+    Recorder rec(c);
+    rec.copy(vertices, 0, readback, 0, bytes);
+    rec.submit();
+    const float* v = static_cast<const float*>(readback.mapped());
+    mesh.positions.resize(3 * triangles);
+    mesh.normals.resize(3 * triangles);
+    mesh.indices.resize(3 * triangles);
+    for (std::size_t i = 0; i < 3 * triangles; ++i, v += L::VF_MC_VERTEX_FLOATS) {
+      mesh.positions[i] = {v[0], v[1], v[2]};
+      mesh.normals[i] = {v[3], v[4], v[5]};
+      mesh.indices[i] = static_cast<std::uint32_t>(i);
+    }
+  }
+  if (stats) {
+    const Counters& now = c.counters;
+    stats->dispatches = now.dispatches - before.dispatches;
+    stats->submits = now.submits - before.submits;
+    stats->fence_waits = now.fence_waits - before.fence_waits;
+    stats->bytes_uploaded = now.bytes_uploaded - before.bytes_uploaded;
+    stats->bytes_downloaded = now.bytes_downloaded - before.bytes_downloaded;
+    stats->samples_bytes = static_cast<std::int64_t>(sample_bytes);
+    stats->pyramid_levels = static_cast<int>(levels.size());
+    stats->triangles = triangles;
+    stats->field_width = f.width == L::VF_MC_F32 ? "f32" : f.width == L::VF_MC_I16 ? "i16" : "i8";
+    stats->ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  }
+  return mesh;
+}
+
+void check_lattice(Vec3i n, const std::array<double, 3>& origin,
+                   const std::array<double, 3>& spacing) {
+  // mesh_volume's checks of the lattice and its frame.
+  for (int a = 0; a < 3; ++a)
+    if (n[a] < 2)
+      throw InvalidArgument("mesh: the volume needs at least 2 samples along each axis (it has " +
+                            to_string(n) + ")");
+  const std::uint64_t cells = static_cast<std::uint64_t>(n.x - 1) * (n.y - 1) * (n.z - 1);
+  if (cells > static_cast<std::uint64_t>(INT32_MAX))
+    throw ResourceLimitError("marching cubes on the GPU: " + to_string(n) +
+                             " samples are more cells than 32-bit indices count");
+  for (int a = 0; a < 3; ++a) {
+    const double s = spacing[static_cast<std::size_t>(a)], o = origin[static_cast<std::size_t>(a)];
+    if (!(s >= std::numeric_limits<float>::min()) || !(s <= std::numeric_limits<float>::max()))
+      throw InvalidArgument("mesh: spacing must be positive and within float range");
+    if (!(std::abs(o) <= std::numeric_limits<float>::max()))
+      throw InvalidArgument("mesh: the volume's origin must be a finite float");
+  }
+}
+
+}  // namespace
+
+Mesh marching_cubes(Context& context, const ScalarVolume& volume, const MeshOptions& options,
+                    const GpuMeshOptions& gpu, GpuMeshStats* stats) {
+  if (options.gradient || options.value)
+    throw InvalidArgument(
+        "marching cubes on the GPU: MeshOptions::gradient and ::value are C++ functions, "
+        "evaluated on the CPU only (use mesh_volume)");
+  if (!volume.values) throw InvalidArgument("mesh: the volume has no samples");
+  if (!(std::abs(options.iso) <= std::numeric_limits<float>::max()))
+    throw InvalidArgument("mesh: iso must be a finite float");
+  check_lattice(volume.size, volume.origin_units, volume.spacing_units);
+  Field f;
+  f.n = volume.size;
+  f.origin = volume.origin_units;
+  f.spacing = volume.spacing_units;
+  f.iso = static_cast<float>(options.iso);
+  f.negate = options.inside_above;
+  const std::uint64_t count = static_cast<std::uint64_t>(volume.count());
+  require_memory(count * 4, 0, "marching cubes on the GPU", "the samples' upload");
+  f.words.resize(count);
+  for (std::uint64_t i = 0; i < count; ++i) {
+    if (!std::isfinite(volume.values[i]))
+      throw InvalidArgument("mesh: sample " + std::to_string(i) + " (x fastest) is " +
+                            (std::isnan(volume.values[i]) ? "NaN" : "infinite"));
+    f.words[i] = std::bit_cast<std::uint32_t>(volume.values[i]);
+  }
+  return run(context, f, gpu, stats);
+}
+
+Mesh marching_cubes(Context& context, const TerrainField& terrain, const GpuMeshOptions& gpu,
+                    GpuMeshStats* stats) {
+  const TerrainOptions& o = terrain.options();
+  check_lattice(o.samples, o.origin_units,
+                {o.spacing_units, o.spacing_units, o.spacing_units});
+  Field f;
+  f.n = o.samples;
+  f.origin = o.origin_units;
+  f.spacing = {o.spacing_units, o.spacing_units, o.spacing_units};
+  // The codes as stored (negative inside): decoded values re-encode to their codes exactly
+  // (terrain.h), so the device decodes what mesh_terrain meshes.
+  const detail::terrain::Codec codec(o.storage, terrain.clamp_units());
+  f.step = codec.step;
+  f.width = o.storage == TerrainStorage::kI8    ? L::VF_MC_I8
+            : o.storage == TerrainStorage::kI16 ? L::VF_MC_I16
+                                                : L::VF_MC_F32;
+  const std::uint64_t count = static_cast<std::uint64_t>(Box3i::from_size(o.samples).volume());
+  const int per_word = f.width == L::VF_MC_I8 ? 4 : f.width == L::VF_MC_I16 ? 2 : 1;
+  require_memory(count * 4 + (count + per_word - 1) / per_word * 4, 0,
+                 "marching cubes on the GPU", "the terrain's decoded samples and their upload");
+  std::vector<float> values(count);
+  terrain.decode(Box3i::from_size(o.samples), values.data());
+  f.words.assign((count + static_cast<std::uint64_t>(per_word) - 1) / per_word, 0);
+  const float sign = o.positive_inside ? -1.0f : 1.0f;
+  for (std::uint64_t i = 0; i < count; ++i) {
+    const std::uint32_t code = codec.encode(sign * values[i]);
+    if (per_word == 1)
+      f.words[i] = code;
+    else
+      f.words[i / per_word] |= (code & (per_word == 4 ? 0xffu : 0xffffu))
+                               << (32 / per_word * (i % per_word));
+  }
+  return run(context, f, gpu, stats);
+}
+
+}  // namespace voxfield::gpu

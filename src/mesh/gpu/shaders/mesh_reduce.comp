@@ -1,0 +1,34 @@
+// voxfield — marching cubes on the GPU, pass 2: one level of the HistoPyramid (Dyken, Ziegler,
+// Theobalt & Seidel 2007), each element the sum of its children in the level below: four
+// consecutive elements (the thesis's 4-to-1 pyramid, over the cells' linear order) or a 2 x 2 x 2
+// block (the 3-D 8-to-1 variant). One dispatch per level, ordered by the recorder's barriers.
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "mesh_common.glsl"
+
+layout(std430, set = 0, binding = 4) buffer Pyramid { uint pyramid[]; };
+
+layout(local_size_x = 64) in;
+
+void main() {
+  const uint i = invocation();
+  const ivec4 below = levels[p.pass.x - 1], here = levels[p.pass.x];
+  if (i >= uint(here.y * here.z * here.w)) return;
+  uint sum = 0u;
+  if (p.cells.w == VF_MC_PYRAMID_4) {
+    for (uint j = 0u; j < 4u; ++j) {
+      const uint child = 4u * i + j;
+      if (child < uint(below.y)) sum += pyramid[uint(below.x) + child];
+    }
+  } else {
+    const ivec3 at = ivec3(int(i % uint(here.y)), int((i / uint(here.y)) % uint(here.z)),
+                           int(i / uint(here.y * here.z)));
+    for (uint k = 0u; k < 8u; ++k) {
+      const ivec3 child = 2 * at + corner_offset(k);
+      if (child.x < below.y && child.y < below.z && child.z < below.w)
+        sum += pyramid[uint(below.x) +
+                       uint(child.x + below.y * (child.y + below.z * child.z))];
+    }
+  }
+  pyramid[uint(here.x) + i] = sum;
+}
