@@ -7,8 +7,8 @@
 //  * the first mesh (CPU, all chunks) and its triangles;
 //  * a stream of seeded smooth-sphere edits on the surface (add or carve, blend radius 2): the
 //    brush's time, the re-mesh of the chunks it reaches, both together (mean / p50 / p99);
-//  * bytes a renderer uploads per edit (the storage chunks an edit changed, whole) against the
-//    thesis's whole field per frame;
+//  * bytes a renderer uploads per edit, at most (the storage chunks the changed box meets, whole),
+//    against the thesis's whole field per frame;
 //  * the quantisation's effect on the mesh: every vertex of the i8 / i16 mesh evaluated in the f32
 //    field (trilinear), which is its distance from the f32 surface to first order, in spacings;
 // and checks that the kept chunk meshes equal a mesh of the edited field made from scratch.

@@ -171,7 +171,7 @@ if command -v xdotool >/dev/null; then
   if [ "$status" -ne 0 ]; then
     fail "terrain-interactive: exit status $status: $(tail -3 "$out/terrain-interactive/i.err" 2>/dev/null)"
   else
-    awk -F, 'END { exit !($5 >= 2 && $12 > 0) }' "$out/terrain-interactive/i.csv" ||
+    awk -F, 'END { exit !($5 >= 2 && $11 > 0) }' "$out/terrain-interactive/i.csv" ||
       fail "terrain-interactive: the clicks did not edit the terrain ($(tail -1 "$out/terrain-interactive/i.csv"))"
     echo "ok: terrain-interactive (a click added, a click carved)"
   fi

@@ -25,8 +25,9 @@ std::vector<std::array<Corner, 3>> triangles(const Mesh& m) {
   for (std::size_t t = 0; t < out.size(); ++t) {
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t v = m.indices[3 * t + static_cast<std::size_t>(k)];
-      out[t][static_cast<std::size_t>(k)] = {m.positions[v][0], m.positions[v][1], m.positions[v][2],
-                                             m.normals[v][0],   m.normals[v][1],   m.normals[v][2]};
+      out[t][static_cast<std::size_t>(k)] = {m.positions[v][0], m.positions[v][1],
+                                             m.positions[v][2], m.normals[v][0],
+                                             m.normals[v][1],   m.normals[v][2]};
     }
     std::rotate(out[t].begin(), std::min_element(out[t].begin(), out[t].end()), out[t].end());
   }
@@ -81,7 +82,8 @@ TEST(GpuMesh, MarchingCubesEqualTheCpusTriangles) {
   for (const auto& [name, volume] : volumes())
     for (gpu::Pyramid pyramid : {gpu::Pyramid::kFourToOne, gpu::Pyramid::kEightToOne})
       for (bool above : {false, true}) {
-        SCOPED_TRACE(std::string(name) + (pyramid == gpu::Pyramid::kFourToOne ? " 4-to-1" : " 8-to-1") +
+        SCOPED_TRACE(std::string(name) +
+                     (pyramid == gpu::Pyramid::kFourToOne ? " 4-to-1" : " 8-to-1") +
                      (above ? " inside above" : ""));
         MeshOptions o;
         o.iso = above ? -0.05 : 0.05;
@@ -108,7 +110,8 @@ TEST(GpuMesh, TerrainFieldsInEveryWidth) {
   auto ctx = test::validated_context();
   for (TerrainStorage storage : {TerrainStorage::kI8, TerrainStorage::kI16, TerrainStorage::kF32})
     for (bool positive_inside : {false, true}) {
-      SCOPED_TRACE(std::string(terrain_storage_name(storage)) + (positive_inside ? " +inside" : ""));
+      SCOPED_TRACE(std::string(terrain_storage_name(storage)) +
+                   (positive_inside ? " +inside" : ""));
       TerrainOptions to;
       to.samples = {37, 29, 23};  // sample counts that do not fill the packed words evenly
       to.storage = storage;
@@ -117,7 +120,9 @@ TEST(GpuMesh, TerrainFieldsInEveryWidth) {
       to.positive_inside = positive_inside;
       TerrainField t(to);
       const double sign = positive_inside ? -1 : 1;
-      t.assign([&](const Vec3d& p) { return sign * (p.z - 5 - 1.5 * std::sin(p.x) * std::cos(p.y / 2)); });
+      t.assign([&](const Vec3d& p) {
+        return sign * (p.z - 5 - 1.5 * std::sin(p.x) * std::cos(p.y / 2));
+      });
       TerrainBrush b;
       b.centre_units = {10, 5, 5};
       b.radius_units = 3;
@@ -131,7 +136,9 @@ TEST(GpuMesh, TerrainFieldsInEveryWidth) {
       expect_same_triangles(got, want);
       // The samples travel in their width: i8 four per word, i16 two.
       const std::int64_t samples = 37 * 29 * 23;
-      const int per_word = storage == TerrainStorage::kI8 ? 4 : storage == TerrainStorage::kI16 ? 2 : 1;
+      const int per_word = storage == TerrainStorage::kI8    ? 4
+                           : storage == TerrainStorage::kI16 ? 2
+                                                             : 1;
       EXPECT_EQ(st.samples_bytes, (samples + per_word - 1) / per_word * 4);
       EXPECT_EQ(st.field_width, terrain_storage_name(storage));
       voxfield::testing_backends::expect_no_validation_messages(Backend::kVulkan);

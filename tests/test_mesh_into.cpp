@@ -102,6 +102,10 @@ TEST(MeshInto, BuffersTooSmallAreRefusedUntouched) {
     for (std::uint32_t i : indices) ASSERT_EQ(i, 77u);
   }
   EXPECT_THROW(mesh_bound({1, 5, 5}, Mesher::kMarchingCubes), InvalidArgument);
+  // Counts past 64 bits saturate: no buffer meets the bound, rather than a small wrapped one.
+  const int huge = 2000000000;
+  EXPECT_EQ(mesh_bound({huge, huge, huge}, Mesher::kMarchingCubes).indices, UINT64_MAX);
+  EXPECT_EQ(mesh_bound({huge, huge, huge}, Mesher::kSurfaceNets).vertices, UINT64_MAX);
 }
 
 TEST(MeshInto, TerrainsWithColours) {
@@ -133,6 +137,15 @@ TEST(MeshInto, TerrainsWithColours) {
     EXPECT_EQ(positions, want.positions) << mesher_name(m);
     EXPECT_EQ(colors, want.colors) << mesher_name(m);
     EXPECT_EQ(indices, want.indices) << mesher_name(m);
+    // A colour array one short is refused before anything is written.
+    std::vector<std::array<float, 3>> p2(want.vertex_count()), n2(want.vertex_count());
+    std::vector<std::array<std::uint8_t, 3>> c2(want.vertex_count() - 1, {7, 7, 7});
+    std::vector<std::uint32_t> i2(want.indices.size());
+    EXPECT_NE(test::error_of([&] {
+                mesh_terrain_into(t, mo, {p2, n2, c2, i2});
+              }).find("colours"),
+              std::string::npos);
+    for (const auto& c : c2) ASSERT_EQ(c, (std::array<std::uint8_t, 3>{7, 7, 7}));
   }
 }
 

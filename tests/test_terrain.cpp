@@ -302,6 +302,20 @@ TEST(Terrain, MeshChunksFollowBrushesExactly) {
       other.spacing_units = 0.25;
       EXPECT_THROW(chunks.update(TerrainField(other), Box3i{{0, 0, 0}, {1, 1, 1}}),
                    InvalidArgument);
+      // So are a terrain without the palette and a volume: every chunk keeps colours or none.
+      TerrainOptions plain = o;
+      plain.palette.reset();
+      EXPECT_THROW(chunks.update(TerrainField(plain), Box3i{{0, 0, 0}, {1, 1, 1}}),
+                   InvalidArgument);
+      std::vector<float> values(static_cast<std::size_t>(Box3i::from_size(o.samples).volume()));
+      t.decode(Box3i::from_size(o.samples), values.data());
+      ScalarVolume v;
+      v.size = o.samples;
+      v.values = values.data();
+      v.origin_units = o.origin_units;
+      v.spacing_units = {o.spacing_units, o.spacing_units, o.spacing_units};
+      EXPECT_THROW(chunks.update(v, Box3i{{0, 0, 0}, {1, 1, 1}}), InvalidArgument);
+      expect_same_mesh(chunks.merged(), mesh_terrain(t, mo));
     }
   }
 }
@@ -348,6 +362,12 @@ TEST(Terrain, BadRequestsAreRefusedAndChangeNothing) {
   bad = o;
   bad.clamp_units = std::nan("");
   EXPECT_NE(refused(bad).find("clamp"), std::string::npos);
+  bad = o;
+  bad.clamp_units = 1e-320;  // its step would underflow to zero
+  EXPECT_NE(refused(bad).find("cannot be stored in i16"), std::string::npos);
+  bad.storage = TerrainStorage::kF32;
+  bad.clamp_units = 1e300;  // no float holds it
+  EXPECT_NE(refused(bad).find("cannot be stored in f32"), std::string::npos);
   bad = o;
   bad.origin_units[1] = INFINITY;
   EXPECT_NE(refused(bad).find("origin"), std::string::npos);

@@ -4,9 +4,11 @@
 // pages need is written beside them: they open from disk with nothing fetched.
 //
 // usage: node web/build-report.mjs OUT [MODEL.glb ...]   (default model: terrain-field.glb)
-// Exit status 1 with a message naming the file when an input is missing or unreadable; the pages
-// are written to temporary names and renamed, so a failed run leaves no partial page.
-import { readFileSync, writeFileSync, renameSync, existsSync } from 'node:fs';
+// Exit status 1 with a message naming the file when an input is missing or unreadable. Every file
+// is written under a temporary name first and the temporaries are renamed only once all are
+// written, report.html last; a failed run removes its temporaries and leaves the pages as they
+// were.
+import { readFileSync, writeFileSync, renameSync, rmSync } from 'node:fs';
 import { join, dirname, basename } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { build } from 'esbuild';
@@ -29,10 +31,17 @@ function read(path) {
   }
 }
 
-function writeAtomically(path, text) {
+const pending = [];  // [temporary, final], in the order they are renamed
+function stage(path, text) {
   const temporary = `${path}.tmp-${process.pid}`;
+  pending.push([temporary, path]);
   writeFileSync(temporary, text);
-  renameSync(temporary, path);
+}
+function commit() {
+  for (const [temporary, path] of pending) renameSync(temporary, path);
+}
+function discard() {
+  for (const [temporary] of pending) rmSync(temporary, { force: true });
 }
 
 const escapeHtml = (s) => s.replace(/[&<>"]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' })[c]);
@@ -90,11 +99,18 @@ ${modelScripts}
 </body></html>
 `;
 
-for (const { name, bytes } of glbs)
-  writeAtomically(join(out, `${name}.js`),
-    `window.voxfieldModels = window.voxfieldModels || {};\nwindow.voxfieldModels[${JSON.stringify(name)}] = "${bytes.toString('base64')}";\n`);
-writeAtomically(join(out, 'viewer.js'), bundle.outputFiles[0].text);
-writeAtomically(join(out, 'viewer.html'),
-  page(`voxfield — ${glbs[0].name}`, `<div class="voxfield-viewer" data-standalone data-model="${escapeHtml(glbs[0].name)}"></div>`, true));
-writeAtomically(join(out, 'report.html'), page('voxfield showcase', body, false));
+try {
+  for (const { name, bytes } of glbs)
+    stage(join(out, `${name}.js`),
+      `window.voxfieldModels = window.voxfieldModels || {};\nwindow.voxfieldModels[${JSON.stringify(name)}] = "${bytes.toString('base64')}";\n`);
+  stage(join(out, 'viewer.js'), bundle.outputFiles[0].text);
+  stage(join(out, 'viewer.html'),
+    page(`voxfield — ${glbs[0].name}`, `<div class="voxfield-viewer" data-standalone data-model="${escapeHtml(glbs[0].name)}"></div>`, true));
+  stage(join(out, 'report.html'), page('voxfield showcase', body, false));
+} catch (e) {
+  discard();
+  console.error(`build-report: cannot write into ${out}: ${e.message}`);
+  process.exit(1);
+}
+commit();
 console.log(`build-report: ${join(out, 'report.html')} and ${join(out, 'viewer.html')} (${glbs.map((g) => g.name).join(', ')})`);

@@ -194,7 +194,7 @@ void TerrainMode::stats_panel() const {
   if (edits_ > 0) {
     ImGui::Text("%s: brush %.2f ms, re-mesh %.2f ms (%zu chunks)", last_edit_.c_str(),
                 last_brush_ms_, last_mesh_ms_, last_chunks_);
-    ImGui::Text("%.1f kB up per edit (the whole field: %.1f MB)",
+    ImGui::Text("at most %.1f kB up per edit (the whole field: %.1f MB)",
                 static_cast<double>(last_bytes_up_) / 1e3,
                 static_cast<double>(box().volume()) *
                     (settings_.storage == 0   ? 1

@@ -48,8 +48,8 @@ class TerrainMode {
   std::int64_t edits() const { return edits_; }
   std::size_t triangles() const { return mesh_.triangle_count(); }
   double last_mesh_ms() const { return last_mesh_ms_; }
-  // Bytes a renderer keeping the field on the GPU would upload for the last edit: the storage
-  // chunks it changed, whole.
+  // Bytes a renderer keeping the field on the GPU would upload for the last edit, at most: the
+  // storage chunks its changed box meets, whole.
   std::uint64_t last_bytes_up() const { return last_bytes_up_; }
   Box3i box() const;
 

@@ -91,8 +91,8 @@ class TerrainField {
 
   // Every sample from a function of its position (units), in the field's sign convention (a
   // height map: z - height(x, y); noise; a scan), and one material for all. Evaluated from worker
-  // threads. InvalidArgument naming the first sample the function gives NaN for; the field is
-  // unchanged then.
+  // threads. InvalidArgument naming a sample the function gives NaN for (the first one a thread
+  // meets); the field is unchanged then.
   void assign(const std::function<double(const Vec3d& position_units)>& value,
               std::uint8_t material = 0);
   // Every sample from a dense volume of this field's size (ScalarVolume's layout; its origin and
@@ -100,8 +100,10 @@ class TerrainField {
   void assign(const ScalarVolume& volume, std::uint8_t material = 0);
 
   // Applies a brush; returns the box of samples whose stored value or material changed (empty
-  // when none): what MeshChunks::update needs. InvalidArgument for a non-finite or negative size,
-  // a non-finite position, or a blend radius < 0.
+  // when none): what MeshChunks::update needs. InvalidArgument for a radius that is not finite
+  // and > 0 (spheres, capsules), half extents not finite and >= 0 (boxes), a non-finite position
+  // or a blend radius that is not finite and >= 0; ResourceLimitError when the chunks it would
+  // make dense pass the memory limit. The field is unchanged when it throws.
   Box3i apply(const TerrainBrush& brush);
 
   float value(Vec3i sample) const;  // decoded; InvalidArgument outside the lattice
@@ -117,6 +119,10 @@ class TerrainField {
   Memory memory() const;
 
  private:
+  // Every sample from value(x, y, z) (sample coordinates), built aside and swapped in.
+  void assign_samples(const std::function<double(int x, int y, int z)>& value,
+                      std::uint8_t material);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -10,7 +10,10 @@
 #include <pybind11/stl.h>
 
 #include <cstring>
+#include <memory>
+#include <mutex>
 #include <optional>
+#include <shared_mutex>
 #include <string>
 
 #include "signals.h"
@@ -53,6 +56,15 @@ Vec3d vec(const std::vector<double>& v, const char* what) {
   if (v.size() != 3) throw InvalidArgument(std::string(what) + " takes three numbers (x, y, z)");
   return {v[0], v[1], v[2]};
 }
+
+// A terrain shared by Python threads: its methods release the GIL while voxfield works, so a
+// brush (a writer) takes the lock alone and readers (values, materials, meshes) share it — each
+// after the GIL is released, so a thread waiting for the lock never holds the GIL.
+struct PyTerrain {
+  TerrainField field;
+  mutable std::shared_mutex lock;
+  explicit PyTerrain(const TerrainOptions& o) : field(o) {}
+};
 
 std::string repr(const TerrainField& t) {
   const TerrainOptions& o = t.options();
@@ -103,7 +115,7 @@ void bind_mesh(py::module_& parent) {
       "field) or 'above' (a density); algorithm 'mc', 'sn' or 'dc'; chunk: cells per chunk edge "
       "(2..256); threads: at most this many (0: every core). The GIL is released meanwhile.");
 
-  py::class_<TerrainField>(m, "Terrain",
+  py::class_<PyTerrain>(m, "Terrain",
                            "A deformable terrain field: a signed lattice in i8, i16 or f32 chunks, "
                            "edited by brushes (docs/meshing.md, 'Terrain fields')")
       .def(py::init([](std::vector<int> samples, const std::string& storage, double spacing,
@@ -128,7 +140,7 @@ void bind_mesh(py::module_& parent) {
                  p[i] = {palette->at(i, 0), palette->at(i, 1), palette->at(i, 2), 255};
                o.palette = p;
              }
-             return TerrainField(o);
+             return std::make_unique<PyTerrain>(o);
            }),
            py::arg("samples"), py::arg("storage") = "i16", py::arg("spacing") = 1.0,
            py::arg("origin") = std::vector<double>{0, 0, 0}, py::arg("clamp") = 0.0,
@@ -136,16 +148,31 @@ void bind_mesh(py::module_& parent) {
            py::arg("palette") = py::none(),
            "samples: (nx, ny, nz); storage 'i8', 'i16' or 'f32'; clamp in world units (0: the "
            "storage's default); palette: uint8 (256, 3) colours by material for meshes")
-      .def("__repr__", &repr)
+      .def("__repr__",
+           [](const PyTerrain& t) {
+             py::gil_scoped_release release;
+             std::shared_lock read(t.lock);
+             return repr(t.field);
+           })
       .def_property_readonly("samples",
-                             [](const TerrainField& t) {
-                               return py::make_tuple(t.size().x, t.size().y, t.size().z);
+                             [](const PyTerrain& t) {  // fixed at construction: no lock
+                               const Vec3i n = t.field.size();
+                               return py::make_tuple(n.x, n.y, n.z);
                              })
-      .def_property_readonly("clamp", &TerrainField::clamp_units, "stored values lie within ±clamp")
-      .def_property_readonly("step", &TerrainField::step_units, "the quantisation step (0 for f32)")
+      .def_property_readonly(
+          "clamp", [](const PyTerrain& t) { return t.field.clamp_units(); },
+          "stored values lie within ±clamp")
+      .def_property_readonly(
+          "step", [](const PyTerrain& t) { return t.field.step_units(); },
+          "the quantisation step (0 for f32)")
       .def_property_readonly("memory",
-                             [](const TerrainField& t) {
-                               const TerrainField::Memory mem = t.memory();
+                             [](const PyTerrain& t) {
+                               TerrainField::Memory mem;
+                               {
+                                 py::gil_scoped_release release;
+                                 std::shared_lock read(t.lock);
+                                 mem = t.field.memory();
+                               }
                                py::dict d;
                                d["chunks"] = mem.chunks, d["uniform_chunks"] = mem.uniform_chunks;
                                d["bytes"] = mem.bytes;
@@ -153,21 +180,22 @@ void bind_mesh(py::module_& parent) {
                              })
       .def(
           "assign",
-          [](TerrainField& t, const Volume& values, std::uint8_t material) {
+          [](PyTerrain& t, const Volume& values, std::uint8_t material) {
             if (values.ndim() != 3) throw InvalidArgument("values must be a 3-D array");
             ScalarVolume v;
             v.size = {static_cast<int>(values.shape(0)), static_cast<int>(values.shape(1)),
                       static_cast<int>(values.shape(2))};
             v.values = values.data();
             py::gil_scoped_release release;
-            t.assign(v, material);
+            std::unique_lock write(t.lock);
+            t.field.assign(v, material);
           },
           py::arg("values"), py::arg("material") = 0,
           "Every sample from an array a[i, j, k] of the terrain's shape (signed distances in world "
           "units, in the terrain's sign convention), and one material for all")
       .def(
           "apply",
-          [](TerrainField& t, const std::string& shape, const std::string& mode,
+          [](PyTerrain& t, const std::string& shape, const std::string& mode,
              std::vector<double> centre, double radius, std::optional<std::vector<double>> end,
              std::optional<std::vector<double>> half_extents, double smooth, std::uint8_t material) {
             TerrainBrush b;
@@ -194,7 +222,8 @@ void bind_mesh(py::module_& parent) {
             Box3i changed;
             {
               py::gil_scoped_release release;
-              changed = t.apply(b);
+              std::unique_lock write(t.lock);
+              changed = t.field.apply(b);
             }
             if (changed.empty()) return py::object(py::none());
             return py::object(py::make_tuple(
@@ -209,12 +238,14 @@ void bind_mesh(py::module_& parent) {
           "or None")
       .def(
           "values",
-          [](const TerrainField& t) {
-            const Vec3i n = t.size();
+          [](const PyTerrain& t) {
+            const Vec3i n = t.field.size();
             py::array_t<float, py::array::f_style> out({n.x, n.y, n.z});
             {
+              float* data = out.mutable_data();
               py::gil_scoped_release release;
-              t.decode(Box3i::from_size(n), out.mutable_data());
+              std::shared_lock read(t.lock);
+              t.field.decode(Box3i::from_size(n), data);
             }
             return out;
           },
@@ -222,26 +253,31 @@ void bind_mesh(py::module_& parent) {
           "convention")
       .def(
           "materials",
-          [](const TerrainField& t) {
-            const Vec3i n = t.size();
+          [](const PyTerrain& t) {
+            const Vec3i n = t.field.size();
             py::array_t<std::uint8_t, py::array::f_style> out({n.x, n.y, n.z});
             std::uint8_t* p = out.mutable_data();
-            for (int z = 0; z < n.z; ++z)
-              for (int y = 0; y < n.y; ++y)
-                for (int x = 0; x < n.x; ++x) *p++ = t.material({x, y, z});
+            {
+              py::gil_scoped_release release;
+              std::shared_lock read(t.lock);
+              for (int z = 0; z < n.z; ++z)
+                for (int y = 0; y < n.y; ++y)
+                  for (int x = 0; x < n.x; ++x) *p++ = t.field.material({x, y, z});
+            }
             return out;
           },
           "The material of every sample, uint8 a[i, j, k]")
       .def(
           "mesh",
-          [](const TerrainField& t, const std::string& algorithm, int chunk) {
+          [](const PyTerrain& t, const std::string& algorithm, int chunk) {
             MeshOptions o = mesh_options(algorithm, chunk);
             PythonSignals signals;
             o.interrupter = &signals;
             Mesh mesh;
             {
               py::gil_scoped_release release;
-              mesh = mesh_terrain(t, o);
+              std::shared_lock read(t.lock);
+              mesh = mesh_terrain(t.field, o);
             }
             return to_arrays(mesh, true);
           },

@@ -11,7 +11,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <memory>
+#include <mutex>
 #include <optional>
+#include <shared_mutex>
 #include <string>
 #include <vector>
 
@@ -77,6 +80,24 @@ py::array_t<double> sample_points(const VectorVolume& volume, const VectorTextur
     out.mutable_at(i, 3) = s.strength;
   }
   return out;
+}
+
+// A simulation shared by Python threads: step() releases the GIL while it writes the textures, so
+// it takes the lock alone and the readers share it — each after releasing the GIL, so a thread
+// waiting for the lock never holds the GIL.
+struct PySimulation {
+  VectorSimulation sim;
+  mutable std::shared_mutex lock;
+  PySimulation(const VectorVolume& v, VectorStorage s, VectorOptions o, double decay)
+      : sim(v, s, o, decay) {}
+};
+
+// A reader's copy of a texture, taken under the lock.
+VectorTexture copy_of(const PySimulation& s,
+                      const VectorTexture& (VectorSimulation::*which)() const) {
+  py::gil_scoped_release release;
+  std::shared_lock read(s.lock);
+  return (s.sim.*which)();
 }
 
 VectorOptions vector_options(const std::string& algorithm, const std::string& rule) {
@@ -172,43 +193,46 @@ void bind_vectors(py::module_& parent) {
       "The definition at world points, in double precision: (float64 (N, 4) direction and "
       "strength, int32 (N,) the winning source or -1)");
 
-  py::class_<VectorSimulation>(m, "Simulation",
-                               "A field that moves with its sources: each step generates, decays "
-                               "and blends")
+  py::class_<PySimulation>(m, "Simulation",
+                           "A field that moves with its sources: each step generates, decays "
+                           "and blends")
       .def(py::init([](const VectorVolume& volume, const std::string& storage,
                        const std::string& algorithm, const std::string& rule, double decay_per_s) {
-             return VectorSimulation(volume, parse_vector_storage(storage),
-                                     vector_options(algorithm, rule), decay_per_s);
+             return std::make_unique<PySimulation>(volume, parse_vector_storage(storage),
+                                                   vector_options(algorithm, rule), decay_per_s);
            }),
            py::arg("volume"), py::arg("storage") = "rgba8", py::arg("algorithm") = "splat",
            py::arg("rule") = "strongest", py::arg("decay_per_s") = 1.0)
       .def(
           "step",
-          [](VectorSimulation& sim, const Rows& sources, double dt_s) {
+          [](PySimulation& sim, const Rows& sources, double dt_s) {
             const std::vector<VectorSource> s = read_sources(sources);
             py::gil_scoped_release release;
-            sim.step(s, dt_s);
+            std::unique_lock write(sim.lock);
+            sim.sim.step(s, dt_s);
           },
           py::arg("sources"), py::arg("dt"),
           "One fixed step of dt seconds; if it raises, the field is unchanged")
       .def(
-          "field", [](const VectorSimulation& sim) { return decoded(sim.field()); },
+          "field",
+          [](const PySimulation& sim) { return decoded(copy_of(sim, &VectorSimulation::field)); },
           "The blended field, float32 a[i, j, k, 4]: what shaders sample")
       .def(
-          "current", [](const VectorSimulation& sim) { return decoded(sim.current()); },
+          "current",
+          [](const PySimulation& sim) { return decoded(copy_of(sim, &VectorSimulation::current)); },
           "The last step's generation, float32 a[i, j, k, 4]")
       .def(
           "sample",
-          [](const VectorSimulation& sim, const Rows& points) {
-            return sample_points(sim.volume(), sim.field(), points);
+          [](const PySimulation& sim, const Rows& points) {
+            return sample_points(sim.sim.volume(), copy_of(sim, &VectorSimulation::field), points);
           },
           py::arg("points"),
           "Trilinear samples of the field at world points (N, 3): float64 (N, 4) rows (vector "
           "x, y, z — direction times strength — and strength); zero outside the box")
       .def(
           "render",
-          [](const VectorSimulation& sim, int width, int height,
-             std::optional<std::vector<double>> eye, bool sheet) {
+          [](const PySimulation& sim, int width, int height, std::optional<std::vector<double>> eye,
+             bool sheet) {
             VectorViewOptions o;
             o.width = width;
             o.height = height;
@@ -220,7 +244,8 @@ void bind_vectors(py::module_& parent) {
             Image img;
             {
               py::gil_scoped_release release;
-              img = render_vectors(sim.volume(), sim.field(), o);
+              std::shared_lock read(sim.lock);
+              img = render_vectors(sim.sim.volume(), sim.sim.field(), o);
             }
             py::array_t<std::uint8_t> out(
                 {py::ssize_t{height}, py::ssize_t{width}, py::ssize_t{3}});
@@ -231,9 +256,19 @@ void bind_vectors(py::module_& parent) {
           py::arg("sheet") = false,
           "The visualiser's picture of the field as uint8 (height, width, 3), with the reactive "
           "sheet when asked")
-      .def_property_readonly("steps", &VectorSimulation::steps)
-      .def_property_readonly("last_times", [](const VectorSimulation& sim) {
-        const VectorPassTimes& t = sim.last_times();
+      .def_property_readonly("steps",
+                             [](const PySimulation& sim) {
+                               py::gil_scoped_release release;
+                               std::shared_lock read(sim.lock);
+                               return sim.sim.steps();
+                             })
+      .def_property_readonly("last_times", [](const PySimulation& sim) {
+        VectorPassTimes t;
+        {
+          py::gil_scoped_release release;
+          std::shared_lock read(sim.lock);
+          t = sim.sim.last_times();
+        }
         py::dict d;
         d["search_ms"] = t.search_ms, d["seed_ms"] = t.seed_ms, d["flood_ms"] = t.flood_ms;
         d["blend_ms"] = t.blend_ms, d["total_ms"] = t.total_ms();

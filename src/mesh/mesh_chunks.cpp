@@ -15,6 +15,10 @@ namespace voxfield {
 struct MeshChunks::Impl {
   MeshOptions options;
   ScalarVolume frame;  // size, origin and spacing the chunks were meshed with
+  // What the chunks were meshed from: a volume, or a terrain (with or without a palette). An
+  // update must come from the same kind of source, so that every part has colours or none does.
+  enum class Source { kVolume, kTerrain, kColouredTerrain } source = Source::kVolume;
+  void check_source(Source given) const;
   detail::mesh::ChunkGrid grid{{2, 2, 2}, 2};
   std::vector<detail::mesh::ChunkPart> parts;
 
@@ -28,6 +32,18 @@ void MeshChunks::Impl::mesh_all(const detail::mesh::Lattice& lattice) {
   grid = detail::mesh::ChunkGrid(frame.size, options.chunk_edge);
   parts = detail::mesh::mesh_all_chunks(lattice, options);
   options.interrupter = nullptr;  // it watched the first mesh; the chunks outlive it
+}
+
+void MeshChunks::Impl::check_source(Source given) const {
+  if (given == source) return;
+  auto name = [](Source s) {
+    return s == Source::kVolume    ? "a volume"
+           : s == Source::kTerrain ? "a terrain without a palette"
+                                   : "a terrain with a palette";
+  };
+  throw InvalidArgument(std::string("MeshChunks::update: the chunks were meshed from ") +
+                        name(source) + ", the update gives " + name(given) +
+                        "; build a new MeshChunks");
 }
 
 void MeshChunks::Impl::check_frame(const ScalarVolume& volume) const {
@@ -51,12 +67,16 @@ MeshChunks::MeshChunks(const TerrainField& terrain, const MeshOptions& options)
   using namespace detail::mesh;
   impl_->options = terrain_options(terrain, options);
   impl_->frame = terrain_frame(terrain);
+  impl_->source =
+      terrain.options().palette ? Impl::Source::kColouredTerrain : Impl::Source::kTerrain;
   TerrainSamples keep;
   impl_->mesh_all(terrain_lattice(terrain, impl_->options, keep));
 }
 
 std::vector<Vec3i> MeshChunks::update(const TerrainField& terrain, const Box3i& changed) {
   using namespace detail::mesh;
+  impl_->check_source(terrain.options().palette ? Impl::Source::kColouredTerrain
+                                                : Impl::Source::kTerrain);
   impl_->check_frame(terrain_frame(terrain));
   if (terrain_options(terrain, impl_->options).inside_above != impl_->options.inside_above)
     throw InvalidArgument("MeshChunks::update: the terrain's sign convention changed");
@@ -69,6 +89,7 @@ MeshChunks::MeshChunks(MeshChunks&&) noexcept = default;
 MeshChunks& MeshChunks::operator=(MeshChunks&&) noexcept = default;
 
 std::vector<Vec3i> MeshChunks::update(const ScalarVolume& volume, const Box3i& changed) {
+  impl_->check_source(Impl::Source::kVolume);
   impl_->check_frame(volume);
   return impl_->update(detail::mesh::checked_lattice(volume, impl_->options, false), changed);
 }

@@ -8,6 +8,7 @@
 #include "cube_cases.h"
 #include "mesh_internal.h"
 #include "voxfield/error.h"
+#include "voxfield/limits.h"
 #include "voxfield/terrain.h"
 
 namespace voxfield {
@@ -19,8 +20,12 @@ MeshBound mesh_bound(Vec3i samples, Mesher algorithm) {
                             to_string(samples) + ")");
   const auto nx = static_cast<std::uint64_t>(samples.x), ny = static_cast<std::uint64_t>(samples.y),
              nz = static_cast<std::uint64_t>(samples.z);
-  const std::uint64_t edges = (nx - 1) * ny * nz + nx * (ny - 1) * nz + nx * ny * (nz - 1);
-  const std::uint64_t cells = (nx - 1) * (ny - 1) * (nz - 1);
+  // Saturating: a lattice whose counts pass 64 bits gets a bound no buffer can meet, never a
+  // small wrapped one.
+  const std::uint64_t edges =
+      add_sat(add_sat(mul_sat(mul_sat(nx - 1, ny), nz), mul_sat(mul_sat(nx, ny - 1), nz)),
+              mul_sat(mul_sat(nx, ny), nz - 1));
+  const std::uint64_t cells = mul_sat(mul_sat(nx - 1, ny - 1), nz - 1);
   MeshBound b;
   if (algorithm == Mesher::kMarchingCubes) {
     // The table's largest case, in triangles and centre vertices, over every corner mask and
@@ -36,11 +41,11 @@ MeshBound mesh_bound(Vec3i samples, Mesher algorithm) {
         centres = std::max<std::uint64_t>(centres, c.centre_count);
       }
     }
-    b.vertices = edges + centres * cells;
-    b.indices = 3 * triangles * cells;
+    b.vertices = add_sat(edges, mul_sat(centres, cells));
+    b.indices = mul_sat(3 * triangles, cells);
   } else {
     b.vertices = cells;
-    b.indices = 6 * edges;
+    b.indices = mul_sat(6, edges);
   }
   return b;
 }

@@ -16,6 +16,7 @@
 
 #include "terrain_store.h"
 #include "voxfield/error.h"
+#include "voxfield/limits.h"
 #include "voxfield/parallel.h"
 #include "voxfield/primitives.h"
 
@@ -108,7 +109,13 @@ Box3i TerrainField::apply(const TerrainBrush& brush) {
       for (int x = region.begin.x / e; x <= (region.end.x - 1) / e; ++x)
         touched.push_back(s.chunk_index({x, y, z}));
   // Each touched chunk is rebuilt aside and swapped in after all are built (an allocation that
-  // fails leaves the field as it was); its changed samples' box is kept per chunk.
+  // fails leaves the field as it was); its changed samples' box is kept per chunk. At most every
+  // touched chunk becomes dense, twice over while the old ones are still held.
+  const std::size_t dense_bytes =
+      static_cast<std::size_t>(e) * e * e * static_cast<std::size_t>(s.codec.bytes + 1);
+  require_memory(mul_sat(2 * touched.size(), dense_bytes), 0,
+                 "terrain brush on " + to_string(o.samples),
+                 std::to_string(touched.size()) + " chunks made dense");
   std::vector<std::optional<Chunk>> fresh(touched.size());
   std::vector<Box3i> changed(touched.size());
   const bool add = brush.mode == TerrainBrush::Mode::kAdd;

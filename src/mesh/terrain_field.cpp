@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <type_traits>
 
@@ -81,6 +82,13 @@ TerrainField::TerrainField(const TerrainOptions& options) : impl_(std::make_uniq
   Impl& s = *impl_;
   s.options = o;
   s.codec = detail::terrain::Codec(o.storage, o.clamp_units);
+  // The step must be a normal double (a clamp so small its step underflows cannot be encoded),
+  // and an f32 clamp a finite float (else every sample would store infinity).
+  if ((o.storage != TerrainStorage::kF32 && !std::isnormal(s.codec.step)) ||
+      (o.storage == TerrainStorage::kF32 && !(o.clamp_units <= std::numeric_limits<float>::max() &&
+                                              o.clamp_units >= std::numeric_limits<float>::min())))
+    throw InvalidArgument("terrain: a clamp of " + std::to_string(o.clamp_units) +
+                          " units cannot be stored in " + terrain_storage_name(o.storage));
   for (int a = 0; a < 3; ++a) s.chunks[a] = (o.samples[a] + o.chunk_edge - 1) / o.chunk_edge;
   const std::uint64_t count = static_cast<std::uint64_t>(s.chunks.x) *
                               static_cast<std::uint64_t>(s.chunks.y) *
@@ -118,6 +126,12 @@ Vec3i TerrainField::chunk_count() const {
 }
 
 void TerrainField::assign(const std::function<double(const Vec3d&)>& value, std::uint8_t material) {
+  const Impl& s = *impl_;
+  assign_samples([&](int x, int y, int z) { return value(s.position(x, y, z)); }, material);
+}
+
+void TerrainField::assign_samples(const std::function<double(int, int, int)>& value,
+                                  std::uint8_t material) {
   Impl& s = *impl_;
   const double sign = s.options.positive_inside ? -1 : 1;
   const std::size_t per_chunk = static_cast<std::size_t>(s.edge()) * s.edge() * s.edge();
@@ -134,7 +148,7 @@ void TerrainField::assign(const std::function<double(const Vec3d&)>& value, std:
       for (int z = b.begin.z; z < b.end.z; ++z)
         for (int y = b.begin.y; y < b.end.y; ++y)
           for (int x = b.begin.x; x < b.end.x; ++x) {
-            const double v = value(s.position(x, y, z));
+            const double v = value(x, y, z);
             if (std::isnan(v))
               throw InvalidArgument("terrain: the function gives NaN at sample " +
                                     to_string(Vec3i{x, y, z}));
@@ -152,18 +166,8 @@ void TerrainField::assign(const ScalarVolume& volume, std::uint8_t material) {
   if (!(volume.size == s.options.samples) || !volume.values)
     throw InvalidArgument("terrain: a volume of " + to_string(volume.size) +
                           " samples cannot fill a terrain of " + to_string(s.options.samples));
-  const Vec3d origin{s.options.origin_units[0], s.options.origin_units[1],
-                     s.options.origin_units[2]};
-  const double h = s.options.spacing_units;
-  // Positions back to sample coordinates: exact, as position() computes origin + x * h.
-  assign(
-      [&](const Vec3d& p) {
-        const int x = static_cast<int>(std::lround((p.x - origin.x) / h));
-        const int y = static_cast<int>(std::lround((p.y - origin.y) / h));
-        const int z = static_cast<int>(std::lround((p.z - origin.z) / h));
-        return static_cast<double>(volume.at(x, y, z));
-      },
-      material);
+  assign_samples([&](int x, int y, int z) { return static_cast<double>(volume.at(x, y, z)); },
+                 material);
 }
 
 namespace {

@@ -98,7 +98,10 @@ void write_weld(const WeldPlan& plan, const std::vector<ChunkPart>& parts, const
         const std::uint32_t g = plan.global[c][i];
         out.positions[g] = p.positions[i];
         out.normals[g] = p.normals[i];
-        if (out.colors) out.colors[g] = p.colors[i];
+        // (Parts meshed from one lattice all have colours or none: MeshChunks refuses updates from
+        // another kind of source. Black, never a read past the array, if that ever broke.)
+        if (out.colors)
+          out.colors[g] = i < p.colors.size() ? p.colors[i] : std::array<std::uint8_t, 3>{};
         if (out.sources) out.sources[g] = p.sources[i];
       }
       std::uint32_t* indices = out.indices + plan.index_base[c];
@@ -110,7 +113,8 @@ void write_weld(const WeldPlan& plan, const std::vector<ChunkPart>& parts, const
     const ChunkPart& p = parts[c];
     out.positions[g] = p.positions[i];
     out.normals[g] = p.normals[i];
-    if (out.colors) out.colors[g] = p.colors[i];
+    if (out.colors)
+      out.colors[g] = i < p.colors.size() ? p.colors[i] : std::array<std::uint8_t, 3>{};
     if (out.sources) out.sources[g] = p.sources[i];
     ++g;
   }

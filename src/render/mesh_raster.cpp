@@ -71,6 +71,7 @@ Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOption
       throw InvalidArgument("render_mesh: index past the last vertex");
     // The triangle's part in front of the near plane: a polygon of up to four corners.
     Corner polygon[4];
+    bool cut[4] = {};  // the corner is where an edge meets the near plane
     int corners = 0;
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t i = v[k], j = v[(k + 1) % 3];
@@ -82,6 +83,7 @@ Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOption
         const double f = (kNear - p.z) / (q.z - p.z);
         const auto& nj = mesh.normals[j];
         const std::array<double, 3> ci = vertex_color(i), cj = vertex_color(j);
+        cut[corners] = true;
         polygon[corners++] =
             corner(p + (q - p) * f,
                    Vec3d{ni[0], ni[1], ni[2]} +
@@ -91,8 +93,14 @@ Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOption
       }
     }
     bool drawn = false;
+    // Polygon edge k (corner k to k + 1) lies on a mesh edge unless it is the cut along the near
+    // plane; the fan's diagonals lie on none. Only mesh edges are drawn as edges.
+    auto mesh_edge = [&](int k) { return !(cut[k] && cut[(k + 1) % corners]); };
     for (int fan = 1; fan + 1 < corners; ++fan) {
       const Corner &a = polygon[0], &b = polygon[fan], &c = polygon[fan + 1];
+      // The edges opposite a, b and c: b-c, c-a and a-b.
+      const bool show[3] = {mesh_edge(fan), fan + 2 == corners && mesh_edge(corners - 1),
+                            fan == 1 && mesh_edge(0)};
       const double area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
       if (area == 0 || !std::isfinite(area)) continue;
       // Bounds clamped in double before the casts: a vertex just in front of the eye projects
@@ -144,8 +152,10 @@ Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOption
           for (std::size_t ch = 0; ch < 3; ++ch)
             rgb[ch] = (pa * a.color[ch] + pb * b.color[ch] + pc * c.color[ch]) * shade;
           if (options.edges) {
-            const double d = std::min({wa * std::abs(area) / len_a, wb * std::abs(area) / len_b,
-                                       wc * std::abs(area) / len_c});
+            constexpr double kFar = std::numeric_limits<double>::infinity();
+            const double d = std::min({show[0] ? wa * std::abs(area) / len_a : kFar,
+                                       show[1] ? wb * std::abs(area) / len_b : kFar,
+                                       show[2] ? wc * std::abs(area) / len_c : kFar});
             if (d < 0.6)
               for (double& ch : rgb) ch *= 0.35;
           }

@@ -167,3 +167,38 @@ def test_the_gil_is_released_while_meshing():
     v = np.random.default_rng(2).standard_normal((150, 150, 150)).astype(np.float32)  # a surface in every cell
     elapsed, during = ticks_during(lambda: vm.mesh_volume(v, threads=1))
     assert elapsed > 0.02 and during >= 10, (elapsed, during)
+
+
+def test_a_terrain_shared_by_threads():
+    # Brushes from one thread while another meshes and reads: each call sees the terrain before or
+    # after a brush, never during one (the binding's lock), and the end state is every brush's.
+    import threading
+    n = (48, 48, 24)
+    t = vm.Terrain(n, storage="i16")
+    z = np.broadcast_to(np.arange(n[2], dtype=np.float32), n)
+    t.assign(z - 8.0, material=1)
+    reference = vm.Terrain(n, storage="i16")
+    reference.assign(z - 8.0, material=1)
+    centres = [(4.0 + 0.8 * i, 24.0 + 10 * np.sin(i / 4), 8.0) for i in range(50)]
+    errors = []
+
+    def brushes():
+        try:
+            for c in centres:
+                t.apply("sphere", "subtract", centre=c, radius=3.0, smooth=1.0)
+        except Exception as e:  # pragma: no cover - reported below
+            errors.append(e)
+
+    worker = threading.Thread(target=brushes)
+    worker.start()
+    meshes = 0
+    while worker.is_alive():
+        verts, faces, _, _ = t.mesh()
+        assert faces.max() < len(verts)
+        assert t.values().shape == n
+        meshes += 1
+    worker.join()
+    assert not errors and meshes > 0
+    for c in centres:
+        reference.apply("sphere", "subtract", centre=c, radius=3.0, smooth=1.0)
+    np.testing.assert_array_equal(t.values(), reference.values())

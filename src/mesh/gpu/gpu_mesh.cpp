@@ -57,7 +57,8 @@ std::vector<std::uint32_t> case_table() {
       const CubeCase& c = t.lookup(inside, joined);
       std::array<std::uint32_t, L::VF_MC_CASE_WORDS> r{};
       r[0] = c.triangle_count;
-      for (int i = 0; i < 36; ++i) r[1 + static_cast<std::size_t>(i)] = c.edges[static_cast<std::size_t>(i)];
+      for (int i = 0; i < 36; ++i)
+        r[1 + static_cast<std::size_t>(i)] = c.edges[static_cast<std::size_t>(i)];
       r[37] = c.centre_count;
       r[38] = c.centre_sizes[0];
       r[39] = c.centre_sizes[1];
@@ -121,10 +122,9 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
   const std::vector<L::ivec4> levels = pyramid_levels(cells, g.pyramid, pyramid_elements);
   const VkDeviceSize range = c.limits.maxStorageBufferRange;
   const std::uint64_t sample_bytes = f.words.size() * 4;
-  for (const auto& [what, bytes] :
-       {std::pair<const char*, std::uint64_t>{"samples", sample_bytes},
-        {"HistoPyramid", pyramid_elements * 4},
-        {"cell cases", cell_count * 4}})
+  for (const auto& [what, bytes] : {std::pair<const char*, std::uint64_t>{"samples", sample_bytes},
+                                    {"HistoPyramid", pyramid_elements * 4},
+                                    {"cell cases", cell_count * 4}})
     if (bytes > range)
       throw ResourceLimitError("marching cubes on the GPU: the " + std::string(what) + " of " +
                                to_string(f.n) + " samples take " + std::to_string(bytes) +
@@ -136,7 +136,7 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
     throw InvalidArgument("marching cubes on the GPU: " + std::to_string(capacity) +
                           " triangles do not fit one storage buffer of " + c.info.name);
   const std::vector<std::uint32_t> table = case_table();
-  std::array<double, 8> frame{f.origin[0], f.origin[1], f.origin[2], f.step,
+  std::array<double, 8> frame{f.origin[0],  f.origin[1],  f.origin[2],  f.step,
                               f.spacing[0], f.spacing[1], f.spacing[2], 0};
 
   Buffer samples(c, std::max<std::uint64_t>(sample_bytes, 16), kUsage, false);
@@ -171,7 +171,8 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
     p.pass = {0, static_cast<std::int32_t>(levels.size()), static_cast<std::int32_t>(capacity), 0};
     p.iso = f.iso;
     p.negate = f.negate ? 1u : 0u;
-    Buffer* all[8] = {&samples, &tables, &frame_buf, &level_buf, &pyramid, &cases, &vertices, &args};
+    Buffer* all[8] = {&samples, &tables, &frame_buf, &level_buf,
+                      &pyramid, &cases,  &vertices,  &args};
     const Recorder::Buffers list(all, 8);
     const int classify = rec.begin_pass();
     rec.dispatch(c.kernel(shaders::mesh_classify()), list, p, cell_count);
@@ -284,8 +285,7 @@ Mesh marching_cubes(Context& context, const ScalarVolume& volume, const MeshOpti
 Mesh marching_cubes(Context& context, const TerrainField& terrain, const GpuMeshOptions& gpu,
                     GpuMeshStats* stats) {
   const TerrainOptions& o = terrain.options();
-  check_lattice(o.samples, o.origin_units,
-                {o.spacing_units, o.spacing_units, o.spacing_units});
+  check_lattice(o.samples, o.origin_units, {o.spacing_units, o.spacing_units, o.spacing_units});
   Field f;
   f.n = o.samples;
   f.origin = o.origin_units;
@@ -299,8 +299,8 @@ Mesh marching_cubes(Context& context, const TerrainField& terrain, const GpuMesh
                                                 : L::VF_MC_F32;
   const std::uint64_t count = static_cast<std::uint64_t>(Box3i::from_size(o.samples).volume());
   const int per_word = f.width == L::VF_MC_I8 ? 4 : f.width == L::VF_MC_I16 ? 2 : 1;
-  require_memory(count * 4 + (count + per_word - 1) / per_word * 4, 0,
-                 "marching cubes on the GPU", "the terrain's decoded samples and their upload");
+  require_memory(count * 4 + (count + per_word - 1) / per_word * 4, 0, "marching cubes on the GPU",
+                 "the terrain's decoded samples and their upload");
   std::vector<float> values(count);
   terrain.decode(Box3i::from_size(o.samples), values.data());
   f.words.assign((count + static_cast<std::uint64_t>(per_word) - 1) / per_word, 0);
