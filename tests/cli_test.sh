@@ -374,6 +374,24 @@ assert {r['nx'] + 'x' + r['ny'] for r in rows} == {'64x64', '64x16'}, rows"
   check "vectors: --backend for a world" 2 $GPU "$V" vectors "$C/ephtracy_chr_knight.vox" -o "$tmp/x.npy" --backend vulkan
   expect_grep "vectors world backend message" "$tmp/err" "--backend is for sources"
   [ ! -e "$tmp/x.npy" ] && passes=$((passes+1)) || { echo "FAIL: vectors wrote after refusing"; fails=$((fails+1)); }
+  # Marching cubes on the GPU (HistoPyramid): the CPU's mesh — the same vertices and triangles,
+  # the same topology — in one computing submit and one read-back.
+  $PY -c "
+import numpy as np
+x, y, z = np.meshgrid(*(np.arange(n, dtype=np.float32) for n in (30, 26, 22)), indexing='ij')
+np.save('$tmp/sphere.npy', np.sqrt((x - 14.6) ** 2 + (y - 12.2) ** 2 + (z - 10.9) ** 2) - 8.3)"
+  check "mesh --backend vulkan" 0 $GPU "$V" mesh "$tmp/sphere.npy" -o "$tmp/sg.ply" --backend vulkan --stats "$tmp/sg.json"
+  check "mesh --backend cpu" 0 "$V" mesh "$tmp/sphere.npy" -o "$tmp/sc.ply" --stats "$tmp/sc.json"
+  check "mesh: gpu and cpu meshes agree" 0 $PY -c "
+import json; g, c = json.load(open('$tmp/sg.json')), json.load(open('$tmp/sc.json'))
+assert g['backend'] == 'vulkan' and c['backend'] == 'cpu', (g['backend'], c['backend'])
+for k in ('vertices', 'triangles', 'watertight', 'euler_characteristic', 'boundary_edges'):
+    assert g[k] == c[k], (k, g[k], c[k])
+assert abs(g['volume_units3'] - c['volume_units3']) < 1e-6 * c['volume_units3'], (g['volume_units3'], c['volume_units3'])
+assert g['gpu']['submits'] == 2 and g['gpu']['dispatches'] == g['gpu']['pyramid_levels'] + 2, g['gpu']"
+  check "mesh: --backend vulkan with surface nets" 2 $GPU "$V" mesh "$tmp/sphere.npy" -o "$tmp/sn.ply" --backend vulkan --algorithm sn
+  expect_grep "mesh backend message" "$tmp/err" "marching cubes only"
+  [ ! -e "$tmp/sn.ply" ] && passes=$((passes+1)) || { echo "FAIL: mesh wrote after refusing"; fails=$((fails+1)); }
 fi
 
 

@@ -257,4 +257,29 @@ TEST(GpuVectorPasses, RefusesWhatTheDeviceCannotHoldAndBadInput) {
   testing_backends::expect_no_validation_messages(Backend::kVulkan);
 }
 
+// Past the device's x limit of workgroups (lavapipe: 65535 x 64 voxels): the passes stride over
+// the rest (dispatches split over y lost their second row on lavapipe).
+TEST(GpuVectorPasses, VolumesPastOneDispatchRow) {
+  if (!test::gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = test::validated_context();
+  VectorVolume vol;
+  vol.size = {10, 10, 10};
+  vol.resolution = {176, 176, 176};
+  std::vector<VectorSource> sources;
+  for (int i = 0; i < 20; ++i) {
+    VectorSource s;
+    s.position = {-4 + 0.4 * i, (i % 5) - 2.0, 4.0 - 0.4 * i};
+    s.previous = s.position;
+    s.radius = 1.5;
+    sources.push_back(s);
+  }
+  for (VectorAlgorithm a : {VectorAlgorithm::kBrute, VectorAlgorithm::kSplat}) {
+    VectorOptions o;
+    o.algorithm = a;
+    const VectorTexture cpu = generate_vectors(vol, sources, VectorStorage::kRgba8, o);
+    const VectorTexture gpu = gpu::generate_vectors(*ctx, vol, sources, VectorStorage::kRgba8, o);
+    EXPECT_EQ(first_difference(cpu.bytes(), gpu.bytes()), -1) << vector_algorithm_name(a);
+  }
+}
+
 }  // namespace vector_passes_test

@@ -7,6 +7,8 @@
 #include <optional>
 
 #include "cli.h"
+#include "live_field.h"
+#include "voxfield/gpu_mesh.h"
 #include "voxfield/mesh.h"
 #include "voxfield/mesh_files.h"
 #include "voxfield/mesh_optimize.h"
@@ -17,7 +19,7 @@ namespace voxfield::cli {
 namespace {
 
 struct MeshSettings {
-  std::string in, out, stats, algorithm = "mc", inside = "below";
+  std::string in, out, stats, algorithm = "mc", inside = "below", backend = "cpu";
   std::optional<double> iso;
   std::vector<double> spacing;
   int chunk = 32, threads = 0;
@@ -45,6 +47,10 @@ int run_mesh(const MeshSettings& s) {
   outputs.expect(s.stats, "--stats");
   std::optional<ThreadLimit> limit;
   if (s.threads > 0) limit.emplace(s.threads);
+  if (s.backend != "cpu" && options.algorithm != Mesher::kMarchingCubes)
+    throw UsageError("--backend " + s.backend +
+                     ": the GPU meshes with marching cubes only (--algorithm mc); surface nets "
+                     "and dual contouring run on the CPU");
 
   auto start = std::chrono::steady_clock::now();
   set_activity("loading " + s.in);
@@ -54,6 +60,7 @@ int run_mesh(const MeshSettings& s) {
   const double load_ms = ms_since(start);
   Mesh mesh;
   std::int64_t chunks = 0;
+  std::optional<gpu::GpuMeshStats> gpu_stats;
   set_activity("meshing " + s.in);
   double mesh_ms = 0;
   if (volume_input) {
@@ -69,10 +76,21 @@ int run_mesh(const MeshSettings& s) {
     if (!s.spacing.empty()) volume.spacing_units = {s.spacing[0], s.spacing[1], s.spacing[2]};
     for (int a = 0; a < 3; ++a)
       chunks = (a ? chunks : 1) * ((npy->dims[a] - 1 + s.chunk - 1) / std::max(1, s.chunk));
+    std::shared_ptr<gpu::Context> gpu_context;
+    if (s.backend != "cpu") gpu_context = choose_backend(s.backend);
     start = std::chrono::steady_clock::now();
-    mesh = mesh_volume(volume, options);
+    if (gpu_context) {
+      gpu_stats.emplace();
+      mesh = gpu::marching_cubes(*gpu_context, volume, options, {}, &*gpu_stats);
+    } else {
+      mesh = mesh_volume(volume, options);
+    }
     mesh_ms = ms_since(start);
   } else {
+    if (s.backend != "cpu")
+      throw UsageError("--backend " + s.backend +
+                       ": worlds are meshed on the CPU (their surface, colours and normals come "
+                       "from the exact field there); the GPU meshes float volumes");
     if (s.iso || s.inside != "below" || !s.spacing.empty())
       throw UsageError(
           "--iso, --inside and --spacing are for float volumes; a world is meshed at its surface "
@@ -117,6 +135,14 @@ int run_mesh(const MeshSettings& s) {
                        {"triangles_after", simplified->triangles_after},
                        {"error_units", simplified->error_units}};
     j["optimized"] = s.optimize;
+    j["backend"] = gpu_stats ? "vulkan" : "cpu";
+    if (gpu_stats)
+      j["gpu"] = {{"dispatches", gpu_stats->dispatches},
+                  {"submits", gpu_stats->submits},
+                  {"fence_waits", gpu_stats->fence_waits},
+                  {"bytes_uploaded", gpu_stats->bytes_uploaded},
+                  {"bytes_downloaded", gpu_stats->bytes_downloaded},
+                  {"pyramid_levels", gpu_stats->pyramid_levels}};
     j["threads"] = max_threads();
     j["chunk_edge"] = s.chunk;
     j["chunks"] = chunks;
@@ -174,6 +200,11 @@ void add_mesh(CLI::App& app, Action& action) {
   cmd->add_flag("--optimize", s->optimize,
                 "reorder triangles and vertices for the GPU's vertex cache (meshoptimizer)");
   cmd->add_option("--stats", s->stats, "write counts, topology and timings as JSON");
+  cmd->add_option("--backend", s->backend,
+                  "cpu (default), vulkan (any Vulkan device, software included) or auto (a "
+                  "hardware GPU if there is one): vulkan runs marching cubes of a float volume "
+                  "with a HistoPyramid, the same triangles as the CPU's")
+      ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
   cmd->callback([s, &action] { action = [s] { return run_mesh(*s); }; });
 }
 

@@ -11,7 +11,8 @@
 //     and writes the triangle's three vertices (position and normal).
 // The triangles are the CPU marching cubes' (mesh.h): the same case table, the same decisions, the
 // same crossing and normal arithmetic in doubles — bit for bit on lavapipe (tests/
-// test_gpu_mesh.cpp) — as a triangle soup in the pyramid's order.
+// test_gpu_mesh.cpp); each vertex carries its lattice element, by which the host shares vertices
+// as the CPU mesher does.
 #pragma once
 
 #include <cstdint>
@@ -43,8 +44,9 @@ struct GpuMeshStats {
 };
 
 // Marching cubes of `volume` at options.iso (options.inside_above honoured; chunk_edge is not
-// used). The mesh is a triangle soup — three vertices per triangle, indices 0, 1, 2, ... — with
-// normals and no colours: the triangles of mesh_volume() with Mesher::kMarchingCubes. Throws
+// used): the triangles of mesh_volume() with Mesher::kMarchingCubes, with normals and no colours,
+// indexed with the same vertices shared (each vertex is its lattice edge's, or its cell's centre;
+// the order of triangles and vertices is the pyramid's, not the CPU's). Throws
 // InvalidArgument as mesh_volume does, and for options.gradient or options.value (evaluated on
 // the CPU only); GpuUnavailable without a device with shaderFloat64; ResourceLimitError for a
 // volume past one storage buffer or more triangles than the vertex buffer holds.

@@ -271,6 +271,15 @@ void Recorder::dispatch(const Kernel& kernel, Buffers buffers, const void* push,
                   {static_cast<std::uint32_t>(gx), static_cast<std::uint32_t>(gy), 1});
 }
 
+void Recorder::dispatch_strided(const Kernel& kernel, Buffers buffers, const void* push,
+                                std::size_t push_bytes, std::uint64_t invocations) {
+  const std::uint64_t per_group = kernel.interface.invocations_per_group();
+  const std::uint64_t groups = std::min<std::uint64_t>((invocations + per_group - 1) / per_group,
+                                                       ctx_.limits.maxComputeWorkGroupCount[0]);
+  if (groups == 0) return;
+  dispatch_groups(kernel, buffers, push, push_bytes, {static_cast<std::uint32_t>(groups), 1, 1});
+}
+
 void Recorder::dispatch_groups(const Kernel& kernel, Buffers buffers, const void* push,
                                std::size_t push_bytes, std::array<std::uint32_t, 3> groups) {
   bind(kernel, buffers, push, push_bytes, nullptr);

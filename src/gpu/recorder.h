@@ -76,6 +76,18 @@ class Recorder {
                 std::uint64_t invocations);
   void dispatch_groups(const Kernel& kernel, Buffers buffers, const void* push,
                        std::size_t push_bytes, std::array<std::uint32_t, 3> groups);
+  // `invocations` invocations of a kernel that strides: workgroups along x only, at most the
+  // device's limit, and the shader loops i = gl_GlobalInvocationID.x; i < n; i +=
+  // gl_NumWorkGroups.x
+  // * gl_WorkGroupSize.x. (On lavapipe, dispatches split over y lost their second row's work in
+  // the vector-field and marching-cubes shaders, while simple kernels ran right; striding needs
+  // no second row.)
+  void dispatch_strided(const Kernel& kernel, Buffers buffers, const void* push,
+                        std::size_t push_bytes, std::uint64_t invocations);
+  template <class Push>
+  void dispatch_strided(const Kernel& k, Buffers b, const Push& p, std::uint64_t invocations) {
+    dispatch_strided(k, b, &p, sizeof p, invocations);
+  }
   // Workgroup counts read from `args` at `offset` (three uint32) when the command runs.
   void dispatch_indirect(const Kernel& kernel, Buffers buffers, const void* push,
                          std::size_t push_bytes, Buffer& args, VkDeviceSize offset);

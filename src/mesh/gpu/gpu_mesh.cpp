@@ -9,6 +9,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "../cube_cases.h"
@@ -132,6 +133,11 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
                                " holds (" + std::to_string(range) + ")");
   const std::uint64_t capacity =
       g.max_triangles > 0 ? g.max_triangles : std::max<std::uint64_t>(1, range / kTriangleBytes);
+  // (Vertex elements are 3 x sample + axis in 32 bits.)
+  if (3 * static_cast<std::uint64_t>(f.n.x) * f.n.y * f.n.z >
+      std::numeric_limits<std::uint32_t>::max())
+    throw ResourceLimitError("marching cubes on the GPU: " + to_string(f.n) +
+                             " samples are more than its 32-bit vertex elements count");
   if (capacity * kTriangleBytes > range || capacity > static_cast<std::uint64_t>(INT32_MAX))
     throw InvalidArgument("marching cubes on the GPU: " + std::to_string(capacity) +
                           " triangles do not fit one storage buffer of " + c.info.name);
@@ -147,6 +153,7 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
   Buffer cases(c, cell_count * 4, kUsage, false);
   Buffer vertices(c, capacity * kTriangleBytes, kUsage, false);
   Buffer args(c, 16, kUsage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, true);
+  Buffer keys(c, capacity * 3 * 8, kUsage, false);
   // One upload through the staging buffer: the samples, the table, the frame and the levels.
   {
     const std::uint64_t parts[4] = {sample_bytes, table.size() * 4, sizeof frame,
@@ -168,21 +175,25 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
     p.size = {f.n.x, f.n.y, f.n.z, f.width};
     p.cells = {cells.x, cells.y, cells.z,
                g.pyramid == Pyramid::kFourToOne ? L::VF_MC_PYRAMID_4 : L::VF_MC_PYRAMID_8};
-    p.pass = {0, static_cast<std::int32_t>(levels.size()), static_cast<std::int32_t>(capacity), 0};
+    // Dispatches stay within the device's x limit of workgroups; the passes stride over the rest.
+    const std::uint32_t max_groups = c.limits.maxComputeWorkGroupCount[0];
+    p.pass = {0, static_cast<std::int32_t>(levels.size()), static_cast<std::int32_t>(capacity),
+              static_cast<std::int32_t>(std::min<std::uint32_t>(max_groups, INT32_MAX))};
+
     p.iso = f.iso;
     p.negate = f.negate ? 1u : 0u;
-    Buffer* all[8] = {&samples, &tables, &frame_buf, &level_buf,
-                      &pyramid, &cases,  &vertices,  &args};
-    const Recorder::Buffers list(all, 8);
+    Buffer* all[9] = {&samples, &tables,   &frame_buf, &level_buf, &pyramid,
+                      &cases,   &vertices, &args,      &keys};
+    const Recorder::Buffers list(all, 9);
     const int classify = rec.begin_pass();
-    rec.dispatch(c.kernel(shaders::mesh_classify()), list, p, cell_count);
+    rec.dispatch_strided(c.kernel(shaders::mesh_classify()), list, p, cell_count);
     rec.end_pass(classify, "classify");
     const int reduce = rec.begin_pass();
     for (std::size_t l = 1; l < levels.size(); ++l) {
       p.pass.x = static_cast<std::int32_t>(l);
       const L::ivec4& lv = levels[l];
-      rec.dispatch(c.kernel(shaders::mesh_reduce()), list, p,
-                   static_cast<std::uint64_t>(lv.y) * lv.z * lv.w);
+      rec.dispatch_strided(c.kernel(shaders::mesh_reduce()), list, p,
+                           static_cast<std::uint64_t>(lv.y) * lv.z * lv.w);
     }
     rec.end_pass(reduce, "HistoPyramid");
     rec.dispatch(c.kernel(shaders::mesh_args()), list, p, 1);
@@ -200,19 +211,29 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
                              std::to_string(capacity) + " (GpuMeshOptions::max_triangles)");
   Mesh mesh;
   if (triangles > 0) {
-    const std::uint64_t bytes = triangles * kTriangleBytes;
-    Buffer& readback = c.readback_buffer(bytes);
+    // The triangles and their vertices' elements in one read-back; vertices of one element are
+    // one vertex (the GPU computed them bit for bit alike, as the CPU's chunks do).
+    const std::uint64_t vertex_bytes = triangles * kTriangleBytes, key_bytes = triangles * 3 * 8;
+    Buffer& readback = c.readback_buffer(vertex_bytes + key_bytes);
     Recorder rec(c);
-    rec.copy(vertices, 0, readback, 0, bytes);
+    rec.copy(vertices, 0, readback, 0, vertex_bytes);
+    rec.copy(keys, 0, readback, vertex_bytes, key_bytes);
     rec.submit();
     const float* v = static_cast<const float*>(readback.mapped());
-    mesh.positions.resize(3 * triangles);
-    mesh.normals.resize(3 * triangles);
+    const auto* k = reinterpret_cast<const std::uint32_t*>(
+        static_cast<const std::uint8_t*>(readback.mapped()) + vertex_bytes);
+    std::unordered_map<std::uint64_t, std::uint32_t> shared;
+    shared.reserve(static_cast<std::size_t>(triangles * 3 / 2));
     mesh.indices.resize(3 * triangles);
     for (std::size_t i = 0; i < 3 * triangles; ++i, v += L::VF_MC_VERTEX_FLOATS) {
-      mesh.positions[i] = {v[0], v[1], v[2]};
-      mesh.normals[i] = {v[3], v[4], v[5]};
-      mesh.indices[i] = static_cast<std::uint32_t>(i);
+      const std::uint64_t element = static_cast<std::uint64_t>(k[2 * i + 1]) << 32 | k[2 * i];
+      const auto [it, fresh] =
+          shared.emplace(element, static_cast<std::uint32_t>(mesh.positions.size()));
+      if (fresh) {
+        mesh.positions.push_back({v[0], v[1], v[2]});
+        mesh.normals.push_back({v[3], v[4], v[5]});
+      }
+      mesh.indices[i] = it->second;
     }
   }
   if (stats) {

@@ -276,7 +276,8 @@ void VectorEngine::record(Recorder& rec, std::span<const VectorSource> sources,
       L::VectorParams seed = p;
       seed.pass = {static_cast<int>(up.samples), 0, 0, 0};
       const auto b = list(&seeds_, &winners_a_, &unused_write_);
-      rec.dispatch(c_.kernel(shaders::vectors_seed()), Recorder::Buffers(b), seed, up.samples);
+      rec.dispatch_strided(c_.kernel(shaders::vectors_seed()), Recorder::Buffers(b), seed,
+                           up.samples);
       ++stats.dispatches;
     }
     rec.end_pass(ticket, "seed");
@@ -289,7 +290,7 @@ void VectorEngine::record(Recorder& rec, std::span<const VectorSource> sources,
       L::VectorParams f = p;
       f.pass = {step, 0, 0, 0};
       const auto bufs = list(&unused_read_, a, b);
-      rec.dispatch(c_.kernel(shaders::vectors_flood()), Recorder::Buffers(bufs), f, voxels);
+      rec.dispatch_strided(c_.kernel(shaders::vectors_flood()), Recorder::Buffers(bufs), f, voxels);
       std::swap(a, b);
       ++stats.dispatches;
       ++stats.flood_passes;
@@ -306,8 +307,8 @@ void VectorEngine::record(Recorder& rec, std::span<const VectorSource> sources,
   const int ticket = rec.begin_pass();
   const auto bufs = list(&unused_read_, in, out);
   const bool step = t.previous != nullptr;
-  rec.dispatch(c_.kernel(step ? shaders::vectors_step() : shaders::vectors_generate()),
-               Recorder::Buffers(bufs), p, voxels);
+  rec.dispatch_strided(c_.kernel(step ? shaders::vectors_step() : shaders::vectors_generate()),
+                       Recorder::Buffers(bufs), p, voxels);
   ++stats.dispatches;
   rec.end_pass(ticket, step ? "step" : "generate");
 }
@@ -349,8 +350,8 @@ Buffer& VectorEngine::record_view(Recorder& rec, Buffer& texels, const VectorVie
                                   &unused_read_, &unused_write_, &unused_read_, &texels,
                                   &unused_read_, &unused_write_, &view_,        &pixels_};
   const int ticket = rec.begin_pass();
-  rec.dispatch(c_.kernel(shaders::vectors_view()), Recorder::Buffers(b), nullptr, 0,
-               static_cast<std::uint64_t>(view.width) * view.height);
+  rec.dispatch_strided(c_.kernel(shaders::vectors_view()), Recorder::Buffers(b), nullptr, 0,
+                       static_cast<std::uint64_t>(view.width) * view.height);
   rec.end_pass(ticket, "view");
   return pixels_;
 }

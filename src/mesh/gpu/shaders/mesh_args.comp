@@ -14,5 +14,6 @@ layout(local_size_x = 1) in;
 void main() {
   const uint total = pyramid[uint(levels[p.pass.y - 1].x)];
   const uint drawn = min(total, uint(p.pass.z));
-  args = uvec4((drawn + 63u) / 64u, 1u, 1u, total);
+  // At most the device's x limit of workgroups (p.pass.w): the traversal strides over the rest.
+  args = uvec4(min((drawn + 63u) / 64u, uint(p.pass.w)), 1u, 1u, total);
 }

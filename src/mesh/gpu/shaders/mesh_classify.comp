@@ -12,10 +12,7 @@ layout(std430, set = 0, binding = 5) writeonly buffer Cases { uint cell_case[]; 
 
 layout(local_size_x = 64) in;
 
-void main() {
-  const uint cell = invocation();
-  const ivec3 c = p.cells.xyz;
-  if (cell >= uint(c.x * c.y * c.z)) return;
+void classify(uint cell) {
   const ivec3 at = cell_of(cell);
   float raw[8];
   uint inside = 0u;
@@ -45,4 +42,12 @@ void main() {
   const uint index = tables[VF_MC_OFFSETS + int(inside)] + joined;
   pyramid[cell] = tables[uint(VF_MC_CASES) + uint(VF_MC_CASE_WORDS) * index];
   cell_case[cell] = index;
+}
+
+void main() {
+  const ivec3 c = p.cells.xyz;
+  const uint cells = uint(c.x * c.y * c.z);
+  // A grid-stride loop: the dispatch is at most the device's x limit of workgroups.
+  for (uint cell = gl_GlobalInvocationID.x; cell < cells; cell += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+    classify(cell);
 }

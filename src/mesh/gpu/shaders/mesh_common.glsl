@@ -18,10 +18,6 @@ layout(std430, set = 0, binding = 3) readonly buffer Levels { ivec4 levels[]; };
 
 layout(push_constant) uniform Push { MeshParams p; };
 
-uint invocation() {
-  return gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
-}
-
 uint sample_index(ivec3 v) {
   return uint(v.x) + uint(p.size.x) * (uint(v.y) + uint(p.size.y) * uint(v.z));
 }

@@ -10,10 +10,7 @@ layout(std430, set = 0, binding = 4) buffer Pyramid { uint pyramid[]; };
 
 layout(local_size_x = 64) in;
 
-void main() {
-  const uint i = invocation();
-  const ivec4 below = levels[p.pass.x - 1], here = levels[p.pass.x];
-  if (i >= uint(here.y * here.z * here.w)) return;
+void reduce(uint i, ivec4 below, ivec4 here) {
   uint sum = 0u;
   if (p.cells.w == VF_MC_PYRAMID_4) {
     for (uint j = 0u; j < 4u; ++j) {
@@ -31,4 +28,12 @@ void main() {
     }
   }
   pyramid[uint(here.x) + i] = sum;
+}
+
+void main() {
+  const ivec4 below = levels[p.pass.x - 1], here = levels[p.pass.x];
+  const uint count = uint(here.y * here.z * here.w);
+  // A grid-stride loop: the dispatch is at most the device's x limit of workgroups.
+  for (uint i = gl_GlobalInvocationID.x; i < count; i += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+    reduce(i, below, here);
 }

@@ -13,6 +13,9 @@ layout(std430, set = 0, binding = 4) readonly buffer Pyramid { uint pyramid[]; }
 layout(std430, set = 0, binding = 5) readonly buffer Cases { uint cell_case[]; };
 layout(std430, set = 0, binding = 6) writeonly buffer Vertices { float vertices[]; };
 layout(std430, set = 0, binding = 7) readonly buffer Args { uvec4 args; };
+// Per vertex its lattice element, for the host to share vertices as the CPU mesher does: (3 x the
+// edge's lower sample + its axis, 0) for a crossing, (2 x the cell + the loop, 1) for a centre.
+layout(std430, set = 0, binding = 8) writeonly buffer Keys { uvec2 keys[]; };
 
 layout(local_size_x = 64) in;
 
@@ -69,9 +72,7 @@ void edge_vertex(ivec3 cell, uint edge, out vec3 pos, out vec3 nrm) {
   emit(position, normal, pos, nrm);
 }
 
-void main() {
-  const uint k = gl_GlobalInvocationID.x;
-  if (k >= min(args.w, uint(p.pass.z))) return;
+void triangle(uint k) {
   // Down the pyramid: at each level, the child whose running count passes k.
   uint key = k, index = 0u;
   const int top = p.pass.y - 1;
@@ -107,10 +108,14 @@ void main() {
   const ivec3 cell = cell_of(index);
   const uint record = uint(VF_MC_CASES) + uint(VF_MC_CASE_WORDS) * cell_case[index];
   vec3 pos[3], nrm[3];
+  uvec2 element[3];
   for (uint v = 0u; v < 3u; ++v) {
     const uint edge = tables[record + 1u + 3u * key + v];
     if (edge < uint(VF_MC_CENTRE)) {
       edge_vertex(cell, edge, pos[v], nrm[v]);
+      const uint from = tables[VF_MC_EDGES + 2 * int(edge)];
+      const uint axis = tables[VF_MC_EDGES + 2 * int(edge) + 1];
+      element[v] = uvec2(3u * sample_index(cell + corner_offset(from)) + axis, 0u);
       continue;
     }
     // A centre vertex: the mean of its loop's crossings (float positions over the loop's length,
@@ -129,6 +134,7 @@ void main() {
       normal = next_normal;
     }
     emit(mean, normal, pos[v], nrm[v]);
+    element[v] = uvec2(2u * index + c, 1u);
   }
   for (uint v = 0u; v < 3u; ++v) {
     const uint base = (3u * k + v) * uint(VF_MC_VERTEX_FLOATS);
@@ -138,5 +144,12 @@ void main() {
     vertices[base + 3u] = nrm[v].x;
     vertices[base + 4u] = nrm[v].y;
     vertices[base + 5u] = nrm[v].z;
+    keys[3u * k + v] = element[v];
   }
+}
+
+void main() {
+  const uint drawn = min(args.w, uint(p.pass.z));
+  for (uint k = gl_GlobalInvocationID.x; k < drawn; k += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+    triangle(k);
 }

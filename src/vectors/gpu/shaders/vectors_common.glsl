@@ -16,10 +16,8 @@ layout(std430, set = 0, binding = 1) readonly buffer Centres { dvec4 centres[]; 
 
 layout(push_constant) uniform Push { VectorParams p; };
 
-// Dispatches wider than the device's x limit spill into y (src/gpu/recorder.cpp).
-uint invocation() {
-  return gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
-}
+// Every pass strides over its voxels (Recorder::dispatch_strided): for (i = gl_GlobalInvocationID.x;
+// i < n; i += gl_NumWorkGroups.x * gl_WorkGroupSize.x).
 
 ivec3 voxel_of(uint i) {
   const ivec3 n = p.size.xyz;

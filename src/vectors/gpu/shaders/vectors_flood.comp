@@ -20,10 +20,8 @@ void consider(int candidate, dvec3 p, inout int current, inout double current_sc
   }
 }
 
-void main() {
-  const uint i = invocation();
+void voxel(uint i) {
   const ivec3 n = p.size.xyz;
-  if (i >= uint(n.x * n.y * n.z)) return;
   const ivec3 v = voxel_of(i);
   const dvec3 centre = voxel_centre(v);
   int best = winners_in[i];
@@ -47,4 +45,10 @@ void main() {
     }
   }
   winners_out[i] = best;
+}
+
+void main() {
+  const uint voxels = uint(p.size.x * p.size.y * p.size.z);
+  for (uint i = gl_GlobalInvocationID.x; i < voxels; i += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+    voxel(i);
 }

@@ -10,13 +10,17 @@ layout(local_size_x = 64) in;
 
 layout(std430, set = 0, binding = 7) writeonly buffer Texels { uint texels[]; };
 
-void main() {
-  const uint i = invocation();
-  if (i >= uint(p.size.x * p.size.y * p.size.z)) return;
+void voxel(uint i) {
   const ivec3 v = voxel_of(i);
   const dvec3 centre = voxel_centre(v);
   const int w = find_winner(i, v, centre);
   const uvec4 texel = w >= 0 && w < p.size.w ? encode_texel(value_of(uint(w), centre)) : zero_texel();
   const uint words = words_per_texel(), at = i * words;
   for (uint k = 0u; k < words; ++k) texels[at + k] = texel[k];
+}
+
+void main() {
+  const uint voxels = uint(p.size.x * p.size.y * p.size.z);
+  for (uint i = gl_GlobalInvocationID.x; i < voxels; i += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+    voxel(i);
 }

@@ -27,9 +27,7 @@ bool beats(uint a, int b, dvec3 p) {
   return sa > sb || (sa == sb && int(a) < b);
 }
 
-void main() {
-  const uint g = invocation();
-  if (g >= uint(p.pass.x)) return;
+void seed(uint g) {
   // The source this sample belongs to: the last whose first sample is at or before g.
   uint lo = 0u, hi = uint(p.size.w) - 1u;
   while (lo < hi) {
@@ -58,4 +56,9 @@ void main() {
     if (was == current) break;
     current = was;
   }
+}
+
+void main() {
+  for (uint g = gl_GlobalInvocationID.x; g < uint(p.pass.x); g += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+    seed(g);
 }

@@ -12,9 +12,7 @@ layout(std430, set = 0, binding = 7) writeonly buffer Current { uint current[]; 
 layout(std430, set = 0, binding = 8) readonly buffer Previous { uint previous[]; };
 layout(std430, set = 0, binding = 9) writeonly buffer Next { uint next[]; };
 
-void main() {
-  const uint i = invocation();
-  if (i >= uint(p.size.x * p.size.y * p.size.z)) return;
+void voxel(uint i) {
   const ivec3 v = voxel_of(i);
   const dvec3 centre = voxel_centre(v);
   const int w = find_winner(i, v, centre);
@@ -35,4 +33,10 @@ void main() {
     current[at + k] = now_texel[k];
     next[at + k] = next_texel[k];
   }
+}
+
+void main() {
+  const uint voxels = uint(p.size.x * p.size.y * p.size.z);
+  for (uint i = gl_GlobalInvocationID.x; i < voxels; i += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+    voxel(i);
 }

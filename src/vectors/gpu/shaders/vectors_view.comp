@@ -63,10 +63,8 @@ vec3 sheet_colour(VfVectorVolume v, float x, float y) {
   return mix(base, 0.15 + 0.85 * abs(tint), clamp(s.strength, 0.0, 1.0)) * (0.25 + 0.75 * diffuse);
 }
 
-void main() {
-  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
+void pixel(uint i) {
   const int width = view.image.x, height = view.image.y;
-  if (i >= uint(width * height)) return;
   const int x = int(i % uint(width)), y = int(i / uint(width));
   VfVectorVolume v;
   v.centre = view.centre.xyz;
@@ -136,4 +134,10 @@ void main() {
   }
   const uvec3 c = uvec3(to_srgb8(colour.r), to_srgb8(colour.g), to_srgb8(colour.b));
   pixels[i] = (view.image.z != 0 ? (c.b | (c.r << 16)) : (c.r | (c.b << 16))) | (c.g << 8) | (255u << 24);
+}
+
+void main() {
+  const uint pixels = uint(view.image.x * view.image.y);
+  for (uint i = gl_GlobalInvocationID.x; i < pixels; i += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+    pixel(i);
 }
