@@ -208,7 +208,10 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
   if (triangles > capacity)
     throw ResourceLimitError("marching cubes on the GPU: the surface has " +
                              std::to_string(triangles) + " triangles; the vertex buffer holds " +
-                             std::to_string(capacity) + " (GpuMeshOptions::max_triangles)");
+                             std::to_string(capacity) + " (72 bytes each; " +
+                             (g.max_triangles > 0 ? std::string("GpuMeshOptions::max_triangles")
+                                                  : "one storage buffer of " + c.info.name) +
+                             ")");
   Mesh mesh;
   if (triangles > 0) {
     // The triangles and their vertices' elements in one read-back; vertices of one element are
