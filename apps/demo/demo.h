@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "clock.h"
 #include "demo_world.h"
 #include "fly_camera.h"
 #include "gl_window.h"
@@ -17,11 +18,6 @@
 #include "vulkan_window.h"
 
 namespace voxfield::demo {
-
-using Clock = std::chrono::steady_clock;
-inline double ms_between(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double, std::milli>(b - a).count();
-}
 
 struct Options {
   WorldSettings world;

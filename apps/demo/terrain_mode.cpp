@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "clock.h"
 #include "voxfield/mesh_render.h"
 
 namespace voxfield::demo {
@@ -15,10 +16,6 @@ namespace {
 const TerrainStorage kStorages[] = {TerrainStorage::kI8, TerrainStorage::kI16,
                                     TerrainStorage::kF32};
 const Mesher kMeshers[] = {Mesher::kMarchingCubes, Mesher::kSurfaceNets, Mesher::kDualContouring};
-
-double ms_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-}
 
 // Rolling hills a third of the way up: a height map's first-order signed distance.
 double hills(const Vec3d& p, double n) {

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include "clock.h"
+
 namespace voxfield::demo {
 namespace {
 
@@ -15,10 +17,6 @@ const VectorAlgorithm kVectorAlgorithms[] = {VectorAlgorithm::kBrute, VectorAlgo
 const VectorStorage kVectorStorages[] = {VectorStorage::kRgba8, VectorStorage::kRgba16f,
                                          VectorStorage::kRgba32f};
 constexpr int kMaxStepsPerFrame = 4;
-
-double ms_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-}
 
 VectorVolume volume_of(const VectorsSettings& s) {
   const int n = s.resolution;
