@@ -224,7 +224,8 @@ VF_CONST(int, VF_MC_VERTEX_FLOATS, 6);  // position xyz, normal xyz
 struct MeshParams {
   ivec4 size;   // samples nx, ny, nz; w = VF_MC_F32 / _I16 / _I8
   ivec4 cells;  // cells along x, y, z; w = VF_MC_PYRAMID_4 / _8
-  ivec4 pass;   // x: the level a reduction builds; y: levels in all; z: triangle capacity
+  ivec4 pass;   // x: the level a reduction builds; y: levels in all; z: triangle capacity;
+                // w: the device's x limit of workgroups (the traversal strides past it)
   float iso;
   uint negate;  // 1: inside is above iso
   uint pad0, pad1;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <random>
 
 #include "gpu_suite.h"
@@ -17,17 +18,19 @@ using namespace voxfield;
 // A named namespace: unity builds put the GPU suites into one translation unit.
 namespace gpu_mesh_test {
 
-// Each triangle as its three (position, normal) corners, rotated to start at the smallest corner
-// (orientation kept), the list sorted: two meshes with the same triangles give equal lists.
-using Corner = std::array<float, 6>;
+// Each triangle as its three (position, normal) corners — the floats' bits, so that -0 and +0
+// differ — rotated to start at the smallest corner (orientation kept), the list sorted: two
+// meshes with the same triangles give equal lists.
+using Corner = std::array<std::uint32_t, 6>;
 std::vector<std::array<Corner, 3>> triangles(const Mesh& m) {
   std::vector<std::array<Corner, 3>> out(m.triangle_count());
   for (std::size_t t = 0; t < out.size(); ++t) {
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t v = m.indices[3 * t + static_cast<std::size_t>(k)];
-      out[t][static_cast<std::size_t>(k)] = {m.positions[v][0], m.positions[v][1],
-                                             m.positions[v][2], m.normals[v][0],
-                                             m.normals[v][1],   m.normals[v][2]};
+      const auto bits = [](float f) { return std::bit_cast<std::uint32_t>(f); };
+      out[t][static_cast<std::size_t>(k)] = {bits(m.positions[v][0]), bits(m.positions[v][1]),
+                                             bits(m.positions[v][2]), bits(m.normals[v][0]),
+                                             bits(m.normals[v][1]),   bits(m.normals[v][2])};
     }
     std::rotate(out[t].begin(), std::min_element(out[t].begin(), out[t].end()), out[t].end());
   }

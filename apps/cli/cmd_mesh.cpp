@@ -80,11 +80,17 @@ int run_mesh(const MeshSettings& s) {
     if (s.backend != "cpu") gpu_context = choose_backend(s.backend);
     start = std::chrono::steady_clock::now();
     if (gpu_context) {
-      gpu_stats.emplace();
-      mesh = gpu::marching_cubes(*gpu_context, volume, options, {}, &*gpu_stats);
-    } else {
-      mesh = mesh_volume(volume, options);
+      try {
+        gpu::GpuMeshStats st;
+        mesh = gpu::marching_cubes(*gpu_context, volume, options, {}, &st);
+        gpu_stats = st;
+      } catch (const GpuUnavailable& e) {
+        // auto promises the CPU where the GPU cannot: a device without shaderFloat64, say.
+        if (s.backend != "auto") throw;
+        std::cerr << "voxfield: " << e.what() << "; using the cpu backend\n";
+      }
     }
+    if (!gpu_stats) mesh = mesh_volume(volume, options);
     mesh_ms = ms_since(start);
   } else {
     if (s.backend != "cpu")
@@ -202,8 +208,9 @@ void add_mesh(CLI::App& app, Action& action) {
   cmd->add_option("--stats", s->stats, "write counts, topology and timings as JSON");
   cmd->add_option("--backend", s->backend,
                   "cpu (default), vulkan (any Vulkan device, software included) or auto (a "
-                  "hardware GPU if there is one): vulkan runs marching cubes of a float volume "
-                  "with a HistoPyramid, the same triangles as the CPU's")
+                  "hardware GPU if there is one, else the CPU): vulkan runs marching cubes of a "
+                  "float volume with a HistoPyramid, the same triangles as the CPU's (--chunk "
+                  "and --threads are the CPU's)")
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
   cmd->callback([s, &action] { action = [s] { return run_mesh(*s); }; });
 }

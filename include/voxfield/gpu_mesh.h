@@ -28,7 +28,8 @@ enum class Pyramid : std::uint8_t { kFourToOne, kEightToOne };
 
 struct GpuMeshOptions {
   Pyramid pyramid = Pyramid::kFourToOne;
-  // Triangles the vertex buffer holds (72 bytes each); 0: as many as one storage buffer of the
+  // The most triangles meshed (72 bytes each of positions and normals, 24 of vertex elements; the
+  // buffers are allocated at the surface's own count); 0: as many as one storage buffer of the
   // device holds. More triangles than this: ResourceLimitError naming both counts.
   std::uint64_t max_triangles = 0;
 };

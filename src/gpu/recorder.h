@@ -77,11 +77,10 @@ class Recorder {
   void dispatch_groups(const Kernel& kernel, Buffers buffers, const void* push,
                        std::size_t push_bytes, std::array<std::uint32_t, 3> groups);
   // `invocations` invocations of a kernel that strides: workgroups along x only, at most the
-  // device's limit, and the shader loops i = gl_GlobalInvocationID.x; i < n; i +=
-  // gl_NumWorkGroups.x
-  // * gl_WorkGroupSize.x. (On lavapipe, dispatches split over y lost their second row's work in
-  // the vector-field and marching-cubes shaders, while simple kernels ran right; striding needs
-  // no second row.)
+  // device's limit, the shader looping over i = gl_GlobalInvocationID.x, then i += stride, with
+  // stride = gl_NumWorkGroups.x * gl_WorkGroupSize.x. On lavapipe, dispatches split over y were
+  // observed to lose their second row's work in the vector-field and marching-cubes shaders
+  // (simple kernels ran right; the cause was not found): striding needs no second row.
   void dispatch_strided(const Kernel& kernel, Buffers buffers, const void* push,
                         std::size_t push_bytes, std::uint64_t invocations);
   template <class Push>

@@ -131,6 +131,8 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
                                to_string(f.n) + " samples take " + std::to_string(bytes) +
                                " bytes, more than one storage buffer of " + c.info.name +
                                " holds (" + std::to_string(range) + ")");
+  // The most triangles one storage buffer holds (or the caller allows): the vertex buffer is
+  // allocated at the surface's own count, once the pyramid has counted it.
   const std::uint64_t capacity =
       g.max_triangles > 0 ? g.max_triangles : std::max<std::uint64_t>(1, range / kTriangleBytes);
   // (Vertex elements are 3 x sample + axis in 32 bits.)
@@ -151,10 +153,13 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
   Buffer level_buf(c, levels.size() * sizeof(L::ivec4), kUsage, false);
   Buffer pyramid(c, pyramid_elements * 4, kUsage, false);
   Buffer cases(c, cell_count * 4, kUsage, false);
-  Buffer vertices(c, capacity * kTriangleBytes, kUsage, false);
   Buffer args(c, 16, kUsage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, true);
-  Buffer keys(c, capacity * 3 * 8, kUsage, false);
-  // One upload through the staging buffer: the samples, the table, the frame and the levels.
+  Buffer vertices, keys;  // sized by the count (submit 2)
+  Buffer unused_vertices(c, 16, kUsage, false), unused_keys(c, 16, kUsage, false);
+  L::MeshParams p{};
+  // Submit 1: one upload through the staging buffer (the samples, the table, the frame and the
+  // levels), classify, the pyramid's levels and the traversal's arguments; the host reads the
+  // count from the arguments (host-visible).
   {
     const std::uint64_t parts[4] = {sample_bytes, table.size() * 4, sizeof frame,
                                     levels.size() * sizeof(L::ivec4)};
@@ -171,7 +176,6 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
       rec.copy(staging, at, *dst[i], 0, parts[i]);
       at += (parts[i] + 15) / 16 * 16;
     }
-    L::MeshParams p{};
     p.size = {f.n.x, f.n.y, f.n.z, f.width};
     p.cells = {cells.x, cells.y, cells.z,
                g.pyramid == Pyramid::kFourToOne ? L::VF_MC_PYRAMID_4 : L::VF_MC_PYRAMID_8};
@@ -182,8 +186,8 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
 
     p.iso = f.iso;
     p.negate = f.negate ? 1u : 0u;
-    Buffer* all[9] = {&samples, &tables,   &frame_buf, &level_buf, &pyramid,
-                      &cases,   &vertices, &args,      &keys};
+    Buffer* all[9] = {&samples, &tables,          &frame_buf, &level_buf,  &pyramid,
+                      &cases,   &unused_vertices, &args,      &unused_keys};
     const Recorder::Buffers list(all, 9);
     const int classify = rec.begin_pass();
     rec.dispatch_strided(c.kernel(shaders::mesh_classify()), list, p, cell_count);
@@ -197,9 +201,6 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
     }
     rec.end_pass(reduce, "HistoPyramid");
     rec.dispatch(c.kernel(shaders::mesh_args()), list, p, 1);
-    const int traverse = rec.begin_pass();
-    rec.dispatch_indirect(c.kernel(shaders::mesh_traverse()), list, &p, sizeof p, args, 0);
-    rec.end_pass(traverse, "traverse");
     rec.submit();
   }
   std::uint32_t counts[4];
@@ -208,17 +209,28 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
   if (triangles > capacity)
     throw ResourceLimitError("marching cubes on the GPU: the surface has " +
                              std::to_string(triangles) + " triangles; the vertex buffer holds " +
-                             std::to_string(capacity) + " (72 bytes each; " +
+                             std::to_string(capacity) + " (72 bytes each, and 24 of keys; " +
                              (g.max_triangles > 0 ? std::string("GpuMeshOptions::max_triangles")
                                                   : "one storage buffer of " + c.info.name) +
                              ")");
   Mesh mesh;
   if (triangles > 0) {
-    // The triangles and their vertices' elements in one read-back; vertices of one element are
-    // one vertex (the GPU computed them bit for bit alike, as the CPU's chunks do).
+    // Submit 2: the traversal into buffers of the surface's size, and the triangles and their
+    // vertices' elements read back; vertices of one element are one vertex (the GPU computed
+    // them bit for bit alike, as the CPU's chunks do).
     const std::uint64_t vertex_bytes = triangles * kTriangleBytes, key_bytes = triangles * 3 * 8;
+    require_memory(mul_sat(triangles, 3 * (24 + 8 + 4) + 96), 0, "marching cubes on the GPU",
+                   std::to_string(triangles) + " triangles read back and shared");
+    vertices = Buffer(c, vertex_bytes, kUsage, false);
+    keys = Buffer(c, key_bytes, kUsage, false);
     Buffer& readback = c.readback_buffer(vertex_bytes + key_bytes);
     Recorder rec(c);
+    Buffer* all[9] = {&samples, &tables,   &frame_buf, &level_buf, &pyramid,
+                      &cases,   &vertices, &args,      &keys};
+    const int traverse = rec.begin_pass();
+    rec.dispatch_indirect(c.kernel(shaders::mesh_traverse()), Recorder::Buffers(all, 9), &p,
+                          sizeof p, args, 0);
+    rec.end_pass(traverse, "traverse");
     rec.copy(vertices, 0, readback, 0, vertex_bytes);
     rec.copy(keys, 0, readback, vertex_bytes, key_bytes);
     rec.submit();
@@ -271,8 +283,10 @@ void check_lattice(Vec3i n, const std::array<double, 3>& origin,
     const double s = spacing[static_cast<std::size_t>(a)], o = origin[static_cast<std::size_t>(a)];
     if (!(s >= std::numeric_limits<float>::min()) || !(s <= std::numeric_limits<float>::max()))
       throw InvalidArgument("mesh: spacing must be positive and within float range");
-    if (!(std::abs(o) <= std::numeric_limits<float>::max()))
-      throw InvalidArgument("mesh: the volume's origin must be a finite float");
+    const double far = o + (n[a] - 1) * s;
+    if (!(std::abs(o) <= std::numeric_limits<float>::max()) ||
+        !(std::abs(far) <= std::numeric_limits<float>::max()))
+      throw InvalidArgument("mesh: the volume's origin and far corner must be finite floats");
   }
 }
 
@@ -314,8 +328,9 @@ Mesh marching_cubes(Context& context, const TerrainField& terrain, const GpuMesh
   f.n = o.samples;
   f.origin = o.origin_units;
   f.spacing = {o.spacing_units, o.spacing_units, o.spacing_units};
-  // The codes as stored (negative inside): decoded values re-encode to their codes exactly
-  // (terrain.h), so the device decodes what mesh_terrain meshes.
+  // The codes of the decoded values (terrain.h: decoded values re-encode to their codes exactly),
+  // in the field's own sign convention, meshed as mesh_terrain meshes them: inside above 0 when
+  // positive inside, so the device computes s = 0 - v as the CPU does (signed zeros included).
   const detail::terrain::Codec codec(o.storage, terrain.clamp_units());
   f.step = codec.step;
   f.width = o.storage == TerrainStorage::kI8    ? L::VF_MC_I8
@@ -328,9 +343,9 @@ Mesh marching_cubes(Context& context, const TerrainField& terrain, const GpuMesh
   std::vector<float> values(count);
   terrain.decode(Box3i::from_size(o.samples), values.data());
   f.words.assign((count + static_cast<std::uint64_t>(per_word) - 1) / per_word, 0);
-  const float sign = o.positive_inside ? -1.0f : 1.0f;
+  f.negate = o.positive_inside;
   for (std::uint64_t i = 0; i < count; ++i) {
-    const std::uint32_t code = codec.encode(sign * values[i]);
+    const std::uint32_t code = codec.encode(values[i]);
     if (per_word == 1)
       f.words[i] = code;
     else

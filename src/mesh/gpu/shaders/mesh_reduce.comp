@@ -10,12 +10,16 @@ layout(std430, set = 0, binding = 4) buffer Pyramid { uint pyramid[]; };
 
 layout(local_size_x = 64) in;
 
+// Counts saturate: a total past 32 bits reads 0xffffffff, more than any vertex buffer holds, and
+// is refused with the counts rather than wrapping to a small wrong one.
+uint add_saturated(uint a, uint b) { return b > 0xffffffffu - a ? 0xffffffffu : a + b; }
+
 void reduce(uint i, ivec4 below, ivec4 here) {
   uint sum = 0u;
   if (p.cells.w == VF_MC_PYRAMID_4) {
     for (uint j = 0u; j < 4u; ++j) {
       const uint child = 4u * i + j;
-      if (child < uint(below.y)) sum += pyramid[uint(below.x) + child];
+      if (child < uint(below.y)) sum = add_saturated(sum, pyramid[uint(below.x) + child]);
     }
   } else {
     const ivec3 at = ivec3(int(i % uint(here.y)), int((i / uint(here.y)) % uint(here.z)),
@@ -23,8 +27,8 @@ void reduce(uint i, ivec4 below, ivec4 here) {
     for (uint k = 0u; k < 8u; ++k) {
       const ivec3 child = 2 * at + corner_offset(k);
       if (child.x < below.y && child.y < below.z && child.z < below.w)
-        sum += pyramid[uint(below.x) +
-                       uint(child.x + below.y * (child.y + below.z * child.z))];
+        sum = add_saturated(sum, pyramid[uint(below.x) +
+                                         uint(child.x + below.y * (child.y + below.z * child.z))]);
     }
   }
   pyramid[uint(here.x) + i] = sum;

@@ -137,7 +137,7 @@ void pixel(uint i) {
 }
 
 void main() {
-  const uint pixels = uint(view.image.x * view.image.y);
-  for (uint i = gl_GlobalInvocationID.x; i < pixels; i += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
+  const uint pixel_count = uint(view.image.x * view.image.y);
+  for (uint i = gl_GlobalInvocationID.x; i < pixel_count; i += gl_NumWorkGroups.x * gl_WorkGroupSize.x)
     pixel(i);
 }
