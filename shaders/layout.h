@@ -231,7 +231,20 @@ struct MeshParams {
   uint pad0, pad1;
 };
 
+// The terrain drawn by the thesis's pipeline (mesh_draw.vert / .frag): the camera as the CPU
+// rasteriser's (src/render/mesh_raster.cpp) and its shading, read by both stages.
+struct MeshDrawView {
+  vec4f eye;      // xyz: the eye (world units); w: 1 perspective, 0 orthographic
+  vec4f right;    // xyz: the camera's right; w: tan(fov / 2), or half the orthographic height
+  vec4f up;       // xyz: the camera's up; w: the image's height / width
+  vec4f forward;  // xyz: the viewing direction; w: the near plane's view depth (perspective)
+  vec4f light;    // xyz: towards the light (unit); w: 1 colour by material, 0 the base colour
+  vec4f base;     // rgb: the base colour (0..255); w unused
+  vec4f depth;    // orthographic: x, y the nearest and farthest view depth of the terrain's box
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(MeshDrawView) == 112, "std430 size of MeshDrawView");
 static_assert(sizeof(MeshParams) == 64, "push-constant size of MeshParams");
 static_assert(sizeof(Header) == 128, "std430 size of Header");
 static_assert(sizeof(PassParams) == 96, "push-constant size of PassParams");

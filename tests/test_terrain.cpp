@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "error_text.h"
@@ -115,6 +116,52 @@ TEST(Terrain, SamplesAreTheDocumentedQuantisationOfTheClampedValue) {
       for (int z = part.begin.z; z < part.end.z; ++z)
         for (int y = part.begin.y; y < part.end.y; ++y)
           for (int x = part.begin.x; x < part.end.x; ++x) ASSERT_EQ(piece[j++], t.value({x, y, z}));
+    }
+}
+
+// read_codes gives the stored codes, which decode (code * step, or the float) to what decode()
+// gives in the negative-inside convention, and the materials material() gives — over a region
+// that crosses uniform and dense chunks.
+TEST(Terrain, RawCodesDecodeToTheSamples) {
+  for (TerrainStorage s : kStorages)
+    for (bool positive_inside : {false, true}) {
+      SCOPED_TRACE(terrain_storage_name(s));
+      TerrainOptions o = options_of(s, {29, 23, 21});
+      o.positive_inside = positive_inside;
+      TerrainField t(o);
+      t.assign([&](const Vec3d& p) { return (positive_inside ? -1 : 1) * ground(p); }, 4);
+      TerrainBrush b;
+      b.centre_units = position(o, 14, 11, 14);
+      b.radius_units = 2;
+      b.material = 9;
+      t.apply(b);
+      const Box3i region{{3, 2, 1}, {27, 20, 19}};
+      const int bytes = s == TerrainStorage::kI8 ? 1 : s == TerrainStorage::kI16 ? 2 : 4;
+      std::vector<std::uint8_t> codes(static_cast<std::size_t>(region.volume() * bytes));
+      std::vector<std::uint8_t> materials(static_cast<std::size_t>(region.volume()));
+      t.read_codes(region, codes.data(), materials.data());
+      std::size_t i = 0, wrong = 0;
+      bool saw_nine = false;
+      for (int z = region.begin.z; z < region.end.z; ++z)
+        for (int y = region.begin.y; y < region.end.y; ++y)
+          for (int x = region.begin.x; x < region.end.x; ++x, ++i) {
+            float v;
+            if (s == TerrainStorage::kI8) {
+              v = static_cast<float>(static_cast<std::int8_t>(codes[i]) * t.step_units());
+            } else if (s == TerrainStorage::kI16) {
+              std::int16_t c;
+              std::memcpy(&c, &codes[2 * i], 2);
+              v = static_cast<float>(c * t.step_units());
+            } else {
+              std::memcpy(&v, &codes[4 * i], 4);
+            }
+            const float want = (positive_inside ? -1 : 1) * t.value({x, y, z});
+            wrong += v != want || materials[i] != t.material({x, y, z});
+            saw_nine |= materials[i] == 9;
+          }
+      EXPECT_EQ(wrong, 0u);
+      EXPECT_TRUE(saw_nine);
+      EXPECT_THROW(t.read_codes(Box3i{{0, 0, 0}, {30, 1, 1}}, codes.data()), InvalidArgument);
     }
 }
 

@@ -73,6 +73,7 @@ struct DeviceInfo {
 // Hardware-independent work counters: what a GPU frame or update costs in API traffic.
 struct Counters {
   std::int64_t dispatches = 0;
+  std::int64_t draws = 0;  // draw calls (the terrain renderer's indirect draws)
   std::int64_t pipeline_barriers = 0;
   std::int64_t submits = 0;
   std::int64_t fence_waits = 0;

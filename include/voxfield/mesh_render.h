@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 
+#include "voxfield/gpu_terrain.h"
 #include "voxfield/image.h"
 #include "voxfield/mesh.h"
 #include "voxfield/render.h"
@@ -27,6 +28,9 @@ struct MeshRenderStats {
   std::int64_t pixels_covered = 0;
   double ms = 0;
 };
+
+// The same picture's camera and shading for the GPU terrain renderer (gpu_terrain.h).
+gpu::TerrainView terrain_view(const Camera& camera, const MeshRenderOptions& options);
 
 // Throws InvalidArgument for a size out of range (Image's limits) or a mesh whose arrays disagree.
 Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOptions& options,

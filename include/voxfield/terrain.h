@@ -111,6 +111,14 @@ class TerrainField {
   // The decoded samples of `region`, x fastest, into out (region.volume() floats);
   // InvalidArgument when the region leaves the lattice.
   void decode(const Box3i& region, float* out) const;
+  // The stored codes of `region` as they are kept — one byte per sample for i8, two for i16 (a
+  // little-endian int16), four for f32 (the float's bits) — x fastest, always in the negative-
+  // inside convention (positive_inside only flips what value() and decode() give); decoding a
+  // code c gives c * step_units() (f32: the float itself). With `materials`, the samples'
+  // materials too. For copies that keep the field's width, such as the GPU renderer's uploads
+  // of the samples an edit changed (gpu_terrain.h). InvalidArgument when the region leaves the
+  // lattice.
+  void read_codes(const Box3i& region, void* codes, std::uint8_t* materials = nullptr) const;
 
   struct Memory {
     std::int64_t chunks = 0, uniform_chunks = 0;  // uniform: one value and one material

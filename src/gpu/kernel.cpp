@@ -34,7 +34,8 @@ bool has_decoration(const SpvDecoration* decorations, std::size_t n, SpvDecorati
 
 }  // namespace
 
-ShaderInterface reflect(std::string_view name, std::span<const std::uint32_t> spirv) {
+ShaderInterface reflect(std::string_view name, std::span<const std::uint32_t> spirv,
+                        VkShaderStageFlagBits stage) {
   const std::string who = "GPU shader " + std::string(name) + ": ";
   SpvcContext c;
   spvc_parsed_ir ir = nullptr;
@@ -45,20 +46,28 @@ ShaderInterface reflect(std::string_view name, std::span<const std::uint32_t> sp
                                    &comp) != SPVC_SUCCESS ||
       spvc_compiler_create_shader_resources(comp, &res) != SPVC_SUCCESS)
     throw InvalidArgument(who + "not a valid SPIR-V module (" + c.last_error + ")");
-  if (spvc_compiler_get_execution_model(comp) != SpvExecutionModelGLCompute)
+  const SpvExecutionModel model = spvc_compiler_get_execution_model(comp);
+  const bool compute = stage == VK_SHADER_STAGE_COMPUTE_BIT;
+  if (compute && model != SpvExecutionModelGLCompute)
     throw InvalidArgument(who + "not a compute shader");
+  if (stage == VK_SHADER_STAGE_VERTEX_BIT && model != SpvExecutionModelVertex)
+    throw InvalidArgument(who + "not a vertex shader");
+  if (stage == VK_SHADER_STAGE_FRAGMENT_BIT && model != SpvExecutionModelFragment)
+    throw InvalidArgument(who + "not a fragment shader");
 
   ShaderInterface out;
-  for (int axis = 0; axis < 3; ++axis)
-    out.local_size[static_cast<std::size_t>(axis)] =
-        spvc_compiler_get_execution_mode_argument_by_index(comp, SpvExecutionModeLocalSize,
-                                                           static_cast<unsigned>(axis));
-  spvc_specialization_constant sx{}, sy{}, sz{};
-  spvc_compiler_get_work_group_size_specialization_constants(comp, &sx, &sy, &sz);
-  if (out.invocations_per_group() == 0 || sx.id != 0 || sy.id != 0 || sz.id != 0)
-    throw InvalidArgument(who +
-                          "no fixed local size (local_size_x/y/z must be literal constants, "
-                          "not specialisation constants)");
+  if (compute) {
+    for (int axis = 0; axis < 3; ++axis)
+      out.local_size[static_cast<std::size_t>(axis)] =
+          spvc_compiler_get_execution_mode_argument_by_index(comp, SpvExecutionModeLocalSize,
+                                                             static_cast<unsigned>(axis));
+    spvc_specialization_constant sx{}, sy{}, sz{};
+    spvc_compiler_get_work_group_size_specialization_constants(comp, &sx, &sy, &sz);
+    if (out.invocations_per_group() == 0 || sx.id != 0 || sy.id != 0 || sz.id != 0)
+      throw InvalidArgument(who +
+                            "no fixed local size (local_size_x/y/z must be literal constants, "
+                            "not specialisation constants)");
+  }
 
   const spvc_reflected_resource* list = nullptr;
   std::size_t count = 0;

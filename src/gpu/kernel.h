@@ -37,9 +37,11 @@ struct ShaderInterface {
   }
 };
 
-// Reads a compute shader's interface from its SPIR-V. Throws InvalidArgument naming the shader
-// when the module is malformed or declares resources outside the supported interface.
-ShaderInterface reflect(std::string_view name, std::span<const std::uint32_t> spirv);
+// Reads a shader's interface from its SPIR-V: a compute shader's by default, or a vertex or
+// fragment shader's (graphics.h; no local size). Throws InvalidArgument naming the shader when the
+// module is malformed, is of another stage, or declares resources outside the supported interface.
+ShaderInterface reflect(std::string_view name, std::span<const std::uint32_t> spirv,
+                        VkShaderStageFlagBits stage = VK_SHADER_STAGE_COMPUTE_BIT);
 
 // Compiles a GLSL compute shader (#version 450, Vulkan rules) to SPIR-V with glslang. Thread-safe:
 // generated shaders may be compiled on worker threads. Throws InvalidArgument with glslang's log

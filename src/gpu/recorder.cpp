@@ -228,7 +228,15 @@ void Recorder::start_pending_pass() {
 }
 
 void Recorder::bind(const Kernel& kernel, Buffers buffers, const void* push, std::size_t push_bytes,
-                    const Use* also) {
+                    const Use* also, VkPipelineBindPoint point) {
+  const bool compute = point == VK_PIPELINE_BIND_POINT_COMPUTE;
+  // A graphics kernel's buffers are read by its vertex and fragment stages (graphics.h).
+  const VkPipelineStageFlags stage =
+      compute ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT
+              : VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT;
+  const VkShaderStageFlags push_stages =
+      compute ? VK_SHADER_STAGE_COMPUTE_BIT
+              : VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
   // Buffers past the last binding the shader uses are ignored, so passes that share one binding
   // plan (the exact transform's) can be given the same list.
   if (buffers.size() < kernel.interface.buffers.size())
@@ -243,17 +251,15 @@ void Recorder::bind(const Kernel& kernel, Buffers buffers, const void* push, std
   std::vector<Use> uses;
   for (std::size_t b = 0; b < used; ++b)
     if (kernel.interface.buffers[b] != Access::kNone)
-      uses.push_back({buffers[b], VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                      shader_access(kernel.interface.buffers[b])});
+      uses.push_back({buffers[b], stage, shader_access(kernel.interface.buffers[b])});
   if (also) uses.push_back(*also);  // one barrier for the command's every use
   prepare(uses);
   const VkDescriptorSet set = sets_->set(kernel, buffers.first(used));
-  vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, kernel.pipeline);
-  vkCmdBindDescriptorSets(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, kernel.layout, 0, 1, &set, 0,
-                          nullptr);
+  vkCmdBindPipeline(cmd_, point, kernel.pipeline);
+  vkCmdBindDescriptorSets(cmd_, point, kernel.layout, 0, 1, &set, 0, nullptr);
   if (push_bytes > 0)
-    vkCmdPushConstants(cmd_, kernel.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
-                       static_cast<std::uint32_t>(push_bytes), push);
+    vkCmdPushConstants(cmd_, kernel.layout, push_stages, 0, static_cast<std::uint32_t>(push_bytes),
+                       push);
 }
 
 void Recorder::dispatch(const Kernel& kernel, Buffers buffers, const void* push,

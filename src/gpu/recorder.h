@@ -27,6 +27,9 @@
 
 namespace voxfield::gpu {
 
+class GraphicsKernel;
+class RenderTarget;
+
 // Descriptor sets for recorded dispatches, one per distinct (kernel, buffers) pair, from pools
 // grown on demand. reset() recycles them all: only once no recorded command can still run. Sets
 // are found by the buffers' handles: a buffer destroyed while an arena still holds sets naming it
@@ -108,6 +111,17 @@ class Recorder {
     dispatch_indirect(k, Buffers(b.begin(), b.size()), push, push_bytes, args, offset);
   }
 
+  // A draw of `graphics` into `target` (graphics.h): the target cleared to `clear` (and the depth
+  // to 0, reversed depth's far), then one vkCmdDrawIndirect whose VkDrawIndirectCommand is read
+  // from `args` at `offset` when the command runs; the shaders pull what they draw from
+  // `buffers`, whose barriers are derived for the vertex and fragment stages.
+  void draw_indirect(const GraphicsKernel& graphics, RenderTarget& target, Buffers buffers,
+                     const void* push, std::size_t push_bytes, Buffer& args, VkDeviceSize offset,
+                     const std::array<float, 4>& clear);
+  // The target's last drawn colour into `dst`: 4 bytes per pixel in the target's format, rows
+  // top first, tightly packed.
+  void copy_colour(RenderTarget& target, Buffer& dst);
+
   void copy(Buffer& src, Buffer& dst, std::span<const VkBufferCopy> regions);
   // Copies recorded as one step, behind one barrier: the uploads of an update, the read-backs of
   // a result. The caller guarantees they are independent: no two write overlapping bytes, and no
@@ -149,7 +163,7 @@ class Recorder {
   };
   void prepare(std::span<const Use> uses);
   void bind(const Kernel& kernel, Buffers buffers, const void* push, std::size_t push_bytes,
-            const Use* also);
+            const Use* also, VkPipelineBindPoint point = VK_PIPELINE_BIND_POINT_COMPUTE);
   void touch(Buffer& b);
   void start_pending_pass();
 

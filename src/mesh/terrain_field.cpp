@@ -257,6 +257,47 @@ void TerrainField::decode(const Box3i& region, float* out) const {
     }
 }
 
+void TerrainField::read_codes(const Box3i& region, void* codes, std::uint8_t* materials) const {
+  const Impl& s = *impl_;
+  if (!Box3i::from_size(s.options.samples).contains(region))
+    throw InvalidArgument("terrain: cannot read the codes of samples outside the " +
+                          to_string(s.options.samples) + " lattice");
+  if (region.empty()) return;
+  const int e = s.edge();
+  const auto bytes = static_cast<std::size_t>(s.codec.bytes);
+  const auto width = static_cast<std::size_t>(region.end.x - region.begin.x);
+  auto* out = static_cast<std::uint8_t*>(codes);
+  for (int z = region.begin.z; z < region.end.z; ++z)
+    for (int y = region.begin.y; y < region.end.y; ++y) {
+      const std::size_t row = width * (static_cast<std::size_t>(y - region.begin.y) +
+                                       static_cast<std::size_t>(region.end.y - region.begin.y) *
+                                           static_cast<std::size_t>(z - region.begin.z));
+      std::uint8_t* code = out + row * bytes;
+      std::uint8_t* material = materials ? materials + row : nullptr;
+      // Chunk by chunk along the row: a uniform chunk repeats its one code; a dense one is copied.
+      for (int x = region.begin.x; x < region.end.x;) {
+        const int cx = x / e, stop = std::min(region.end.x, (cx + 1) * e);
+        const Chunk& c = s.chunk[s.chunk_index({cx, y / e, z / e})];
+        const auto count = static_cast<std::size_t>(stop - x);
+        const std::size_t first = s.local(x - cx * e, y % e, z % e);
+        if (c.samples.empty()) {
+          for (std::size_t i = 0; i < count; ++i) std::memcpy(code + i * bytes, &c.uniform, bytes);
+        } else {
+          std::memcpy(code, c.samples.data() + first * bytes, count * bytes);
+        }
+        code += count * bytes;
+        if (material) {
+          if (c.materials.empty())
+            std::fill(material, material + count, c.uniform_material);
+          else
+            std::memcpy(material, c.materials.data() + first, count);
+          material += count;
+        }
+        x = stop;
+      }
+    }
+}
+
 TerrainField::Memory TerrainField::memory() const {
   const Impl& s = *impl_;
   Memory m;

@@ -21,6 +21,27 @@
 
 namespace voxfield {
 
+gpu::TerrainView terrain_view(const Camera& camera, const MeshRenderOptions& options) {
+  if (options.edges)
+    throw InvalidArgument(
+        "the GPU terrain renderer does not draw triangle edges (use render_mesh)");
+  const Camera::Projector pr = camera.projector(options.width, options.height);
+  gpu::TerrainView v;
+  v.width = options.width;
+  v.height = options.height;
+  v.perspective = pr.projection == Camera::Projection::kPerspective;
+  v.eye = pr.eye;
+  v.forward = pr.forward;
+  v.right = pr.right;
+  v.up = pr.up;
+  v.scale = pr.scale;
+  v.light_towards = options.light_towards;
+  v.background = options.background;
+  v.base_color = options.base_color;
+  v.use_colors = options.use_colors;
+  return v;
+}
+
 Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOptions& options,
                   MeshRenderStats* stats) {
   const auto start = std::chrono::steady_clock::now();

@@ -15,6 +15,7 @@
 #include "../cube_cases.h"
 #include "../terrain_store.h"
 #include "gpu/recorder.h"
+#include "histopyramid.h"
 #include "mesh_shaders.h"
 #include "shaders/layout.h"
 #include "voxfield/error.h"
@@ -43,7 +44,10 @@ struct Field {
   bool negate = false;
 };
 
-// The CPU's case table (cube_cases.h), flattened as layout.h's VF_MC_* describe it.
+}  // namespace
+
+namespace mc {
+
 std::vector<std::uint32_t> case_table() {
   using detail::mesh::CubeCase;
   using detail::mesh::CubeCases;
@@ -82,7 +86,6 @@ std::vector<std::uint32_t> case_table() {
   return out;
 }
 
-// The pyramid's levels, base first: (offset, dims x, y, z); the top holds one element.
 std::vector<L::ivec4> pyramid_levels(Vec3i cells, Pyramid kind, std::uint64_t& total) {
   std::vector<L::ivec4> levels;
   std::int64_t offset = 0;
@@ -106,6 +109,36 @@ std::vector<L::ivec4> pyramid_levels(Vec3i cells, Pyramid kind, std::uint64_t& t
   total = static_cast<std::uint64_t>(offset);
   return levels;
 }
+
+void check_lattice(Vec3i n, const std::array<double, 3>& origin,
+                   const std::array<double, 3>& spacing) {
+  // mesh_volume's checks of the lattice and its frame.
+  for (int a = 0; a < 3; ++a)
+    if (n[a] < 2)
+      throw InvalidArgument("mesh: the volume needs at least 2 samples along each axis (it has " +
+                            to_string(n) + ")");
+  const std::uint64_t cells = static_cast<std::uint64_t>(n.x - 1) * (n.y - 1) * (n.z - 1);
+  if (cells > static_cast<std::uint64_t>(INT32_MAX))
+    throw ResourceLimitError("marching cubes on the GPU: " + to_string(n) +
+                             " samples are more cells than 32-bit indices count");
+  for (int a = 0; a < 3; ++a) {
+    const double s = spacing[static_cast<std::size_t>(a)], o = origin[static_cast<std::size_t>(a)];
+    if (!(s >= std::numeric_limits<float>::min()) || !(s <= std::numeric_limits<float>::max()))
+      throw InvalidArgument("mesh: spacing must be positive and within float range");
+    const double far = o + (n[a] - 1) * s;
+    if (!(std::abs(o) <= std::numeric_limits<float>::max()) ||
+        !(std::abs(far) <= std::numeric_limits<float>::max()))
+      throw InvalidArgument("mesh: the volume's origin and far corner must be finite floats");
+  }
+}
+
+}  // namespace mc
+
+namespace {
+
+using mc::case_table;
+using mc::check_lattice;
+using mc::pyramid_levels;
 
 Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats* stats) {
   const auto start = std::chrono::steady_clock::now();
@@ -266,28 +299,6 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }
   return mesh;
-}
-
-void check_lattice(Vec3i n, const std::array<double, 3>& origin,
-                   const std::array<double, 3>& spacing) {
-  // mesh_volume's checks of the lattice and its frame.
-  for (int a = 0; a < 3; ++a)
-    if (n[a] < 2)
-      throw InvalidArgument("mesh: the volume needs at least 2 samples along each axis (it has " +
-                            to_string(n) + ")");
-  const std::uint64_t cells = static_cast<std::uint64_t>(n.x - 1) * (n.y - 1) * (n.z - 1);
-  if (cells > static_cast<std::uint64_t>(INT32_MAX))
-    throw ResourceLimitError("marching cubes on the GPU: " + to_string(n) +
-                             " samples are more cells than 32-bit indices count");
-  for (int a = 0; a < 3; ++a) {
-    const double s = spacing[static_cast<std::size_t>(a)], o = origin[static_cast<std::size_t>(a)];
-    if (!(s >= std::numeric_limits<float>::min()) || !(s <= std::numeric_limits<float>::max()))
-      throw InvalidArgument("mesh: spacing must be positive and within float range");
-    const double far = o + (n[a] - 1) * s;
-    if (!(std::abs(o) <= std::numeric_limits<float>::max()) ||
-        !(std::abs(far) <= std::numeric_limits<float>::max()))
-      throw InvalidArgument("mesh: the volume's origin and far corner must be finite floats");
-  }
 }
 
 }  // namespace

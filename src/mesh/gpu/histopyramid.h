@@ -1,0 +1,24 @@
+// voxfield — what the mesh module's GPU passes share (internal): the marching-cubes tables as the
+// shaders read them, the HistoPyramid's levels, and the lattice checks of mesh_volume.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "shaders/layout.h"
+#include "voxfield/box.h"
+#include "voxfield/gpu_mesh.h"
+
+namespace voxfield::gpu::mc {
+
+// The CPU's case table (cube_cases.h), flattened as layout.h's VF_MC_* describe it.
+std::vector<std::uint32_t> case_table();
+// The pyramid's levels, base first: (offset, dims x, y, z); the top holds one element. `total`
+// receives the elements of all levels.
+std::vector<layout::ivec4> pyramid_levels(Vec3i cells, Pyramid kind, std::uint64_t& total);
+// mesh_volume's checks of a lattice and its frame, and the GPU's 32-bit cell indices.
+void check_lattice(Vec3i n, const std::array<double, 3>& origin,
+                   const std::array<double, 3>& spacing);
+
+}  // namespace voxfield::gpu::mc
