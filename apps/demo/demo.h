@@ -69,8 +69,8 @@ class Demo {
   void panel();
   void help();
   void take_screenshot(const std::string& path);
-  // Switches mode (or rebuilds the current one with new settings): the vectors mode on the render
-  // path's device when there is one, else on the CPU; the terrain mode on the CPU.
+  // Switches mode (or rebuilds the current one with new settings): the vectors and terrain modes
+  // on the render path's device when there is one (and it can run them), else on the CPU.
   void set_mode(Mode mode);
   bool draw_vectors(VulkanWindow::Screenshot* shot);
   bool draw_terrain(VulkanWindow::Screenshot* shot);

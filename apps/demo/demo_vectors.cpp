@@ -1,8 +1,8 @@
 // voxfield-demo — switching modes, and drawing the vectors mode's frames (vectors_mode.h) and the
 // terrain mode's (terrain_mode.h). Vectors: on the Vulkan path the frame's step and picture are
 // recorded into the frame's command buffer and the pixels copied to the swapchain image; otherwise
-// the CPU's picture is presented as the world's CPU frames are. Terrain: the CPU rasteriser's
-// picture, presented the same way.
+// the CPU's picture is presented as the world's CPU frames are. Terrain: the same, with the GPU
+// terrain renderer's frame or the CPU rasteriser's picture.
 #include <backends/imgui_impl_opengl2.h>
 #include <backends/imgui_impl_vulkan.h>
 #include <imgui.h>
@@ -25,8 +25,12 @@ void Demo::set_mode(Mode mode) {
     return;
   }
   if (mode == Mode::kTerrain) {
-    terrain_ = std::make_unique<TerrainMode>(terrain_settings_);
-    status_ = "terrain mode: the terrain field meshed chunk by chunk, drawn by the CPU rasteriser";
+    terrain_ = std::make_unique<TerrainMode>(terrain_settings_, vk_ ? path_.context : nullptr);
+    status_ = terrain_->on_gpu()
+                  ? "terrain mode: marching cubes, HistoPyramid and an indirect draw on the "
+                    "Vulkan device; edits upload only the samples they change"
+                  : "terrain mode: the terrain field meshed chunk by chunk, drawn by the CPU "
+                    "rasteriser";
     std::cerr << "voxfield-demo: " << status_ << "\n";
     if (!was_terrain) TerrainMode::frame(camera_, terrain_settings_);
     return;
@@ -77,10 +81,28 @@ bool Demo::draw_vectors(VulkanWindow::Screenshot* shot) {
   return drawn;
 }
 
-// The terrain mode's frames: the CPU rasteriser's picture, presented as the CPU renderer's are.
+// The terrain mode's frames: on the GPU, recorded into the frame's command buffer and copied to
+// the swapchain image; otherwise the CPU rasteriser's picture, presented as the CPU renderer's are.
 bool Demo::draw_terrain(VulkanWindow::Screenshot* shot) {
   const int w = width(), h = height();
   const auto t0 = Clock::now();
+  if (vk_ && terrain_->on_gpu()) {
+    VkBufferImageCopy copy{};
+    copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    copy.imageExtent = {static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(h), 1};
+    const bool drawn = vk_->draw_frame(
+        [&](VkCommandBuffer cmd, VkImage image) {
+          const VkBuffer pixels = terrain_->record_frame(
+              cmd, camera_, w, h, vk_->bgra() ? gpu::PixelOrder::kBgra : gpu::PixelOrder::kRgba);
+          vkCmdCopyBufferToImage(cmd, pixels, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                                 &copy);
+        },
+        [](VkCommandBuffer cmd) { ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd); },
+        shot);
+    wait_idle();  // the frame's time includes its meshing and draw; its triangle count is read
+    last_.render_ms = ms_between(t0, Clock::now());
+    return drawn;
+  }
   const Image img = terrain_->render(camera_, w, h);
   if (gl_) {
     gl_->draw_frame(

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "clock.h"
+#include "voxfield/error.h"
 #include "voxfield/mesh_render.h"
 
 namespace voxfield::demo {
@@ -48,13 +49,31 @@ TerrainOptions options_of(const TerrainSettings& s) {
 
 }  // namespace
 
-TerrainMode::TerrainMode(const TerrainSettings& settings)
+TerrainMode::TerrainMode(const TerrainSettings& settings, std::shared_ptr<gpu::Context> context)
     : settings_(settings), terrain_(options_of(settings)) {
   const double n = settings.size;
   terrain_.assign([n](const Vec3d& p) { return hills(p, n); }, 1);
+  if (context && kMeshers[settings.mesher] == Mesher::kMarchingCubes) {
+    try {
+      const auto start = std::chrono::steady_clock::now();
+      gpu_ = std::make_unique<gpu::TerrainRenderer>(std::move(context));
+      gpu_->sync(terrain_);
+      first_mesh_ms_ = last_mesh_ms_ = ms_since(start);
+    } catch (const Error& e) {
+      gpu_.reset();
+      gpu_note_ = e.what();
+    }
+  } else if (context) {
+    gpu_note_ = "the GPU draws marching cubes only";
+  }
+  // The CPU mesh: for the CPU's frames, and for triangle edges (which the GPU does not draw).
+  if (!gpu_) mesh_on_cpu();
+}
+
+void TerrainMode::mesh_on_cpu() {
   MeshOptions mo;
-  mo.algorithm = kMeshers[settings.mesher];
-  mo.chunk_edge = settings.chunk;
+  mo.algorithm = kMeshers[settings_.mesher];
+  mo.chunk_edge = settings_.chunk;
   const auto start = std::chrono::steady_clock::now();
   chunks_.emplace(terrain_, mo);
   mesh_ = chunks_->merged();
@@ -65,22 +84,23 @@ Box3i TerrainMode::box() const {
   return Box3i::from_size(terrain_.size());
 }
 
+std::size_t TerrainMode::triangles() const {
+  return on_gpu() ? gpu_->last_triangles() : mesh_.triangle_count();
+}
+
 void TerrainMode::apply(const TerrainBrush& brush) {
   const auto start = std::chrono::steady_clock::now();
   const Box3i changed = terrain_.apply(brush);
   last_brush_ms_ = ms_since(start);
   const auto meshing = std::chrono::steady_clock::now();
-  last_chunks_ = chunks_->update(terrain_, changed).size();
-  mesh_ = chunks_->merged();
-  last_mesh_ms_ = ms_since(meshing);
-  last_bytes_up_ = 0;
-  if (!changed.empty()) {
-    const int e = terrain_.options().chunk_edge;
-    std::uint64_t touched = 1;
-    for (int a = 0; a < 3; ++a)
-      touched *= static_cast<std::uint64_t>((changed.end[a] - 1) / e - changed.begin[a] / e + 1);
-    const std::uint64_t per_sample = settings_.storage == 0 ? 1 : settings_.storage == 1 ? 2 : 4;
-    last_bytes_up_ = touched * static_cast<std::uint64_t>(e) * e * e * per_sample;
+  const std::uint64_t per_sample = settings_.storage == 0 ? 1 : settings_.storage == 1 ? 2 : 4;
+  last_bytes_up_ = static_cast<std::uint64_t>(changed.volume()) * (per_sample + 1);
+  last_chunks_ = 0;
+  if (gpu_) pending_.push_back(changed);  // uploaded with the frame's other edits (record_frame)
+  if (chunks_) {                          // the CPU mesh, when there is one, follows
+    last_chunks_ = chunks_->update(terrain_, changed).size();
+    mesh_ = chunks_->merged();
+    last_mesh_ms_ = ms_since(meshing);
   }
   ++edits_;
 }
@@ -137,12 +157,27 @@ void TerrainMode::edit_above(double x, double y, bool add, std::uint8_t material
   edit_at(down, add, material);
 }
 
-Image TerrainMode::render(const FlyCamera& camera, int width, int height) const {
+Image TerrainMode::render(const FlyCamera& camera, int width, int height) {
   MeshRenderOptions o;
   o.width = width;
   o.height = height;
   o.edges = settings_.edges;
+  if (!chunks_) mesh_on_cpu();  // triangle edges asked of a mode the GPU draws
   return render_mesh(mesh_, camera.camera(), o);
+}
+
+VkBuffer TerrainMode::record_frame(VkCommandBuffer cmd, const FlyCamera& camera, int width,
+                                   int height, gpu::PixelOrder order) {
+  if (!pending_.empty()) {  // the edits since the last frame: their boxes' samples, one submit
+    const auto start = std::chrono::steady_clock::now();
+    last_bytes_up_ = gpu_->sync(terrain_, pending_);
+    last_mesh_ms_ = ms_since(start);
+    pending_.clear();
+  }
+  MeshRenderOptions o;
+  o.width = width;
+  o.height = height;
+  return gpu::record_render(*gpu_, cmd, terrain_view(camera.camera(), o), order);
 }
 
 void TerrainMode::frame(FlyCamera& camera, const TerrainSettings& s) {
@@ -187,19 +222,28 @@ void TerrainMode::stats_panel() const {
   ImGui::Text("%s field: %.1f MB, %lld of %lld chunks uniform",
               terrain_storage_name(terrain_.options().storage), static_cast<double>(m.bytes) / 1e6,
               static_cast<long long>(m.uniform_chunks), static_cast<long long>(m.chunks));
-  ImGui::Text("%zu triangles; first mesh %.0f ms", mesh_.triangle_count(), first_mesh_ms_);
+  ImGui::Text("%zu triangles; %s %.0f ms", triangles(), on_gpu() ? "first upload" : "first mesh",
+              first_mesh_ms_);
   if (edits_ > 0) {
-    ImGui::Text("%s: brush %.2f ms, re-mesh %.2f ms (%zu chunks)", last_edit_.c_str(),
-                last_brush_ms_, last_mesh_ms_, last_chunks_);
-    ImGui::Text("at most %.1f kB up per edit (the whole field: %.1f MB)",
-                static_cast<double>(last_bytes_up_) / 1e3,
+    if (on_gpu())
+      ImGui::Text("%s: brush %.2f ms; the frame's upload %.2f ms", last_edit_.c_str(),
+                  last_brush_ms_, last_mesh_ms_);
+    else
+      ImGui::Text("%s: brush %.2f ms, re-mesh %.2f ms (%zu chunks)", last_edit_.c_str(),
+                  last_brush_ms_, last_mesh_ms_, last_chunks_);
+    ImGui::Text("%.1f kB up for the %s (the whole field: %.1f MB)",
+                static_cast<double>(last_bytes_up_) / 1e3, on_gpu() ? "last frame's edits" : "edit",
                 static_cast<double>(box().volume()) *
                     (settings_.storage == 0   ? 1
                      : settings_.storage == 1 ? 2
                                               : 4) /
                     1e6);
   }
-  ImGui::TextDisabled("drawn by the CPU rasteriser");
+  if (on_gpu())
+    ImGui::TextDisabled("marching cubes + HistoPyramid + indirect draw on the GPU");
+  else
+    ImGui::TextDisabled("drawn by the CPU rasteriser%s%s", gpu_note_.empty() ? "" : ": ",
+                        gpu_note_.c_str());
 }
 
 }  // namespace voxfield::demo

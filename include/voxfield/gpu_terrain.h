@@ -17,6 +17,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 
 #include "voxfield/box.h"
 #include "voxfield/gpu.h"
@@ -70,6 +71,9 @@ class TerrainRenderer {
   // resident copy is not of this terrain's shape (as sync(terrain)). Empty: nothing. One submit
   // when anything is copied. InvalidArgument for a box outside the lattice.
   std::uint64_t sync(const TerrainField& terrain, const Box3i& changed);
+  // The boxes of several edits (a frame's), in one submit: overlapping boxes are merged first, so
+  // no sample is sent twice.
+  std::uint64_t sync(const TerrainField& terrain, std::span<const Box3i> changed);
 
   // A frame of the synced terrain, read back: classify, the pyramid, the draw's arguments, the
   // draw and the copy of its pixels in one submit. Without use_colors, or for a terrain without a

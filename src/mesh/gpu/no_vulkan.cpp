@@ -27,6 +27,9 @@ std::uint64_t TerrainRenderer::sync(const TerrainField&) {
 std::uint64_t TerrainRenderer::sync(const TerrainField&, const Box3i&) {
   built_without_vulkan();
 }
+std::uint64_t TerrainRenderer::sync(const TerrainField&, std::span<const Box3i>) {
+  built_without_vulkan();
+}
 Image TerrainRenderer::render(const TerrainView&, TerrainDrawStats*) {
   built_without_vulkan();
 }

@@ -91,7 +91,7 @@ struct TerrainRenderer::Impl {
       : context(std::move(ctx)), c(context->impl()), pyramid_kind(kind), sets(c) {}
 
   std::uint64_t upload_whole(const TerrainField& terrain);
-  std::uint64_t upload_rows(const TerrainField& terrain, const Box3i& box);
+  std::uint64_t upload_rows(const TerrainField& terrain, std::span<const Box3i> boxes);
   void ensure_target(int width, int height, VkFormat format);
   L::MeshParams params() const;
   void record_frame(Recorder& rec, const TerrainView& o);
@@ -176,43 +176,53 @@ std::uint64_t TerrainRenderer::Impl::upload_whole(const TerrainField& terrain) {
   return uploaded;
 }
 
-std::uint64_t TerrainRenderer::Impl::upload_rows(const TerrainField& terrain, const Box3i& box) {
+std::uint64_t TerrainRenderer::Impl::upload_rows(const TerrainField& terrain,
+                                                 std::span<const Box3i> boxes) {
   const Vec3i n = shape.n;
-  const auto row_samples = static_cast<std::uint64_t>(box.end.x - box.begin.x);
-  const std::uint64_t rows =
-      static_cast<std::uint64_t>(box.end.y - box.begin.y) * (box.end.z - box.begin.z);
-  const std::uint64_t code_bytes = row_samples * rows * static_cast<std::uint64_t>(bytes);
-  const std::uint64_t material_at = (code_bytes + 15) / 16 * 16;
-  Buffer& staging = c.upload_buffer(material_at + row_samples * rows);
+  const auto w = static_cast<std::uint64_t>(bytes);
+  // Staged box after box: each box's codes, then its materials (16-byte aligned parts).
+  std::uint64_t total = 0;
+  for (const Box3i& b : boxes) {
+    const auto v = static_cast<std::uint64_t>(b.volume());
+    total += (v * w + 15) / 16 * 16 + (v + 15) / 16 * 16;
+  }
+  Buffer& staging = c.upload_buffer(total);
   auto* base = static_cast<std::uint8_t*>(staging.mapped());
-  terrain.read_codes(box, base, base + material_at);
-  // One region per row of the box (rows that continue each other on the device merge: a box
+  // One region per row of a box (rows that continue each other on the device merge: a box
   // spanning whole rows and slices is one region).
   std::vector<VkBufferCopy> codes, mats;
-  std::uint64_t row = 0;
-  for (int z = box.begin.z; z < box.end.z; ++z)
-    for (int y = box.begin.y; y < box.end.y; ++y, ++row) {
-      const std::uint64_t sample =
-          static_cast<std::uint64_t>(box.begin.x) +
-          static_cast<std::uint64_t>(n.x) *
-              (static_cast<std::uint64_t>(y) +
-               static_cast<std::uint64_t>(n.y) * static_cast<std::uint64_t>(z));
-      const auto add = [](std::vector<VkBufferCopy>& list, VkDeviceSize src, VkDeviceSize dst,
-                          VkDeviceSize size) {
-        if (!list.empty() && list.back().srcOffset + list.back().size == src &&
-            list.back().dstOffset + list.back().size == dst)
-          list.back().size += size;
-        else
-          list.push_back({src, dst, size});
-      };
-      const auto w = static_cast<std::uint64_t>(bytes);
-      add(codes, row * row_samples * w, sample * w, row_samples * w);
-      add(mats, material_at + row * row_samples, sample, row_samples);
-    }
+  const auto add = [](std::vector<VkBufferCopy>& list, VkDeviceSize src, VkDeviceSize dst,
+                      VkDeviceSize size) {
+    if (!list.empty() && list.back().srcOffset + list.back().size == src &&
+        list.back().dstOffset + list.back().size == dst)
+      list.back().size += size;
+    else
+      list.push_back({src, dst, size});
+  };
+  std::uint64_t at = 0, sent = 0;
+  for (const Box3i& box : boxes) {
+    const auto v = static_cast<std::uint64_t>(box.volume());
+    const std::uint64_t material_at = at + (v * w + 15) / 16 * 16;
+    terrain.read_codes(box, base + at, base + material_at);
+    const auto row_samples = static_cast<std::uint64_t>(box.end.x - box.begin.x);
+    std::uint64_t row = 0;
+    for (int z = box.begin.z; z < box.end.z; ++z)
+      for (int y = box.begin.y; y < box.end.y; ++y, ++row) {
+        const std::uint64_t sample =
+            static_cast<std::uint64_t>(box.begin.x) +
+            static_cast<std::uint64_t>(n.x) *
+                (static_cast<std::uint64_t>(y) +
+                 static_cast<std::uint64_t>(n.y) * static_cast<std::uint64_t>(z));
+        add(codes, at + row * row_samples * w, sample * w, row_samples * w);
+        add(mats, material_at + row * row_samples, sample, row_samples);
+      }
+    at = material_at + (v + 15) / 16 * 16;
+    sent += v * (w + 1);
+  }
   Recorder rec(c, &sets);
   rec.copy({Recorder::Copy{&staging, &samples, codes}, Recorder::Copy{&staging, &materials, mats}});
   rec.submit();
-  return code_bytes + row_samples * rows;
+  return sent;
 }
 
 void TerrainRenderer::Impl::ensure_target(int width, int height, VkFormat format) {
@@ -336,14 +346,34 @@ std::uint64_t TerrainRenderer::sync(const TerrainField& terrain) {
 }
 
 std::uint64_t TerrainRenderer::sync(const TerrainField& terrain, const Box3i& changed) {
+  return sync(terrain, std::span<const Box3i>(&changed, 1));
+}
+
+std::uint64_t TerrainRenderer::sync(const TerrainField& terrain, std::span<const Box3i> changed) {
   Impl& r = *impl_;
-  if (!Box3i::from_size(terrain.size()).contains(changed))
-    throw InvalidArgument("the GPU terrain renderer: the changed box " + to_string(changed.begin) +
-                          ".." + to_string(changed.end) + " leaves the " +
-                          to_string(terrain.size()) + " lattice");
+  const Box3i lattice = Box3i::from_size(terrain.size());
+  for (const Box3i& b : changed)
+    if (!lattice.contains(b))
+      throw InvalidArgument("the GPU terrain renderer: the changed box " + to_string(b.begin) +
+                            ".." + to_string(b.end) + " leaves the " + to_string(terrain.size()) +
+                            " lattice");
   if (!r.synced || !(shape_of(terrain) == r.shape)) return r.upload_whole(terrain);
-  if (changed.empty()) return 0;
-  return r.upload_rows(terrain, changed);
+  // Disjoint boxes: each overlapping pair becomes its union, until none overlap.
+  std::vector<Box3i> boxes;
+  for (const Box3i& b : changed)
+    if (!b.empty()) boxes.push_back(b);
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (std::size_t i = 0; i < boxes.size() && !merged; ++i)
+      for (std::size_t j = i + 1; j < boxes.size() && !merged; ++j)
+        if (!boxes[i].intersect(boxes[j]).empty()) {
+          boxes[i] = boxes[i].unite(boxes[j]);
+          boxes.erase(boxes.begin() + static_cast<std::ptrdiff_t>(j));
+          merged = true;
+        }
+  }
+  if (boxes.empty()) return 0;
+  return r.upload_rows(terrain, boxes);
 }
 
 std::uint64_t TerrainRenderer::last_triangles() const {
