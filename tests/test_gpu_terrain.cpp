@@ -113,6 +113,10 @@ TEST(GpuTerrain, FramesMatchTheCpuRasteriserOfTheCpuMesh) {
         EXPECT_EQ(st.draws, 1);
         EXPECT_EQ(st.dispatches, 1 + (st.pyramid_levels - 1) + 1);
         EXPECT_EQ(st.bytes_downloaded, 4 * o.width * o.height);
+        if (!st.passes.empty()) {  // the queue has timestamps: classify, HistoPyramid, draw
+          ASSERT_EQ(st.passes.size(), 3u);
+          EXPECT_EQ(st.passes[2].pass, "draw");
+        }
       }
       // Without colours: the base colour, as the CPU draws it.
       MeshRenderOptions plain = o;

@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "voxfield/box.h"
 #include "voxfield/gpu.h"
@@ -48,6 +49,9 @@ struct TerrainDrawStats {
   std::uint64_t triangles = 0;  // drawn (render(): read from the draw's arguments afterwards)
   int pyramid_levels = 0;
   double ms = 0;  // wall time of the call (on lavapipe: CPU emulation)
+  // render(): the passes' GPU times from timestamps — classify, HistoPyramid, draw (on lavapipe:
+  // CPU emulation, not GPU speed); empty where the queue has no timestamps.
+  std::vector<PassTiming> passes;
 };
 
 // Not thread-safe; one frame at a time (a frame's buffers are reused by the next).

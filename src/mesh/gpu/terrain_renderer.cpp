@@ -393,11 +393,13 @@ Image TerrainRenderer::render(const TerrainView& options, TerrainDrawStats* stat
   const std::uint64_t pixel_bytes =
       4ull * static_cast<std::uint64_t>(options.width) * static_cast<std::uint64_t>(options.height);
   Buffer& readback = c.readback_buffer(pixel_bytes);
+  std::vector<PassTiming> passes;
   {
     Recorder rec(c, &r.sets);
     r.record_frame(rec, options);
     rec.copy_colour(*r.target, readback);
     rec.submit();
+    passes = rec.timings();
   }
   Image image(options.width, options.height);
   const auto* rgba = static_cast<const std::uint8_t*>(readback.mapped());
@@ -413,6 +415,7 @@ Image TerrainRenderer::render(const TerrainView& options, TerrainDrawStats* stat
     stats->bytes_downloaded = now.bytes_downloaded - before.bytes_downloaded;
     stats->triangles = last_triangles();
     stats->pyramid_levels = static_cast<int>(r.levels.size());
+    stats->passes = std::move(passes);
     stats->ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }
