@@ -206,8 +206,33 @@ target = os.path.join(work, "nan.ply")
 r = run("mesh", bad, "-o", target)
 check(r.returncode == 1 and "(3, 4, 5) is NaN" in r.stderr and not os.path.exists(target),
       f"NaN volume: rc {r.returncode}, {r.stderr!r}, output exists: {os.path.exists(target)}")
-r = run("mesh", world, "-o", target, "--iso", "0.5")
-check(r.returncode == 2 and not os.path.exists(target), f"--iso on a world: rc {r.returncode}, {r.stderr!r}")
+r = run("mesh", world, "-o", target, "--inside", "above")
+check(r.returncode == 2 and not os.path.exists(target), f"--inside on a world: rc {r.returncode}, {r.stderr!r}")
+r = run("mesh", bad, "-o", target, "--metric", "manhattan")
+check(r.returncode == 2 and not os.path.exists(target), f"--metric on a float volume: rc {r.returncode}, {r.stderr!r}")
+
+# A world's offset surface in each metric: one voxel at (5, 6, 7) (centre (5.5, 6.5, 7.5)) at iso 3
+# is the octahedron |dx| + |dy| + |dz| = 3 (Manhattan), the box max |d| = 3 (Chebyshev: every
+# vertex on it, its edges bevelled between them), and within 1 / 24 of the sphere |d| = 3
+# (Euclidean: linear interpolation of the distance along edges); closed genus-0 surfaces.
+one = os.path.join(work, "one.npy")
+occ = np.zeros((12, 13, 14), np.uint8)
+occ[5, 6, 7] = 3
+np.save(one, occ)
+centre = np.array([5.5, 6.5, 7.5])
+for metric, distance, tol in (("manhattan", lambda d: np.abs(d).sum(1), 1e-4),
+                              ("chebyshev", lambda d: np.abs(d).max(1), 1e-4),
+                              ("euclidean", lambda d: np.sqrt((d * d).sum(1)), 1 / 24 + 1e-4)):
+    path, stats = os.path.join(work, f"offset-{metric}.ply"), os.path.join(work, f"offset-{metric}.json")
+    r = run("mesh", one, "-o", path, "--metric", metric, "--iso", "3", "--stats", stats)
+    check(r.returncode == 0, f"offset {metric}: {r.stderr}")
+    if r.returncode != 0:
+        continue
+    pos, idx, _ = read_ply(path)
+    d = distance(pos - centre)
+    check(np.abs(d - 3).max() <= tol, f"offset {metric}: a vertex at {d.min():.4f}..{d.max():.4f}, not 3")
+    st = json.load(open(stats))
+    check(st["watertight"] and st["euler_characteristic"] == 2, f"offset {metric}: {st}")
 
 print("mesh oracle:", "FAILED" if failures else "ok")
 sys.exit(1 if failures else 0)

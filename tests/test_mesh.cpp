@@ -182,6 +182,76 @@ TEST(Mesh, SurfaceNetsOfABlockHasOneQuadPerVoxelFace) {
                   p[static_cast<std::size_t>(a)] <= 6.01f);
 }
 
+// A world's offset surfaces take the shape of the metric's ball: around one voxel at iso r the
+// Chebyshev surface is the box of half-size r about its centre, the Manhattan one the octahedron
+// |x| + |y| + |z| = r (marching cubes is exact there: the field is linear in every cell), the
+// Euclidean one the sphere of radius r; colours are the nearest voxel's. At iso 0 every metric
+// gives the same mesh, and a negative iso insets a block by the metric's distance.
+TEST(Mesh, WorldOffsetSurfacesAreTheMetricsBalls) {
+  World w(16);
+  w.voxels.set({10, 10, 10}, 9);
+  const Rgba c = w.palette[9];
+  constexpr double kPi = 3.14159265358979323846;
+  for (double r : {2.0, 3.5}) {
+    SCOPED_TRACE(r);
+    MeshOptions o = with(Mesher::kMarchingCubes);
+    o.iso = r;
+    const Mesh box = mesh_world(w, o, Metric::kChebyshev);
+    const Mesh octahedron = mesh_world(w, o, Metric::kManhattan);
+    const Mesh sphere = mesh_world(w, o, Metric::kEuclidean);
+    for (const Mesh* m : {&box, &octahedron, &sphere}) {
+      expect_closed_manifold(*m, 2, "offset surface");
+      for (const auto& col : m->colors)
+        ASSERT_EQ(col, (std::array<std::uint8_t, 3>{c.r, c.g, c.b}));
+    }
+    // The box's faces are exact; marching cubes bevels its edges and corners within the cells
+    // they cross. With f the fraction of a cell the faces lie past the last samples inside (1
+    // when r is a whole number: the faces run through samples), each of the 12 edges (length 2r)
+    // loses a triangle of area f^2 / 2 in section, and the 8 corners give back less than f^3.
+    const double f = r - std::ceil(r) + 1, cube = std::pow(2 * r, 3);
+    const double bevelled = cube - 12 * (2 * r) * f * f / 2;
+    EXPECT_GE(mesh_stats(box).signed_volume_units3, bevelled - 1e-3);
+    EXPECT_LE(mesh_stats(box).signed_volume_units3, bevelled + 8 * f * f * f);
+    EXPECT_NEAR(mesh_stats(octahedron).signed_volume_units3, 4.0 / 3 * r * r * r, 1e-3);
+    for (const auto& p : octahedron.positions) {
+      const Vec3d d = at(p) - Vec3d{10.5, 10.5, 10.5};
+      EXPECT_NEAR(std::abs(d.x) + std::abs(d.y) + std::abs(d.z), r, 1e-4);
+    }
+    // The sphere's crossings interpolate the distance linearly along edges (within 1 / (8r) of
+    // the true sphere); its flat facets cut inside it, more so the smaller it is.
+    for (const auto& p : sphere.positions)
+      EXPECT_NEAR((at(p) - Vec3d{10.5, 10.5, 10.5}).length(), r, 1 / (8 * r) + 1e-4);
+    const double ball = 4.0 / 3 * kPi * r * r * r;
+    EXPECT_GE(mesh_stats(sphere).signed_volume_units3, 0.8 * ball);
+    EXPECT_LE(mesh_stats(sphere).signed_volume_units3, ball);
+  }
+  // At iso 0 the voxels' own surface, whatever the metric.
+  const Mesh e = mesh_world(w, with(Mesher::kMarchingCubes), Metric::kEuclidean);
+  const Mesh m = mesh_world(w, with(Mesher::kMarchingCubes), Metric::kManhattan);
+  EXPECT_EQ(e.positions, m.positions);
+  EXPECT_EQ(e.indices, m.indices);
+  // Inset: a 9^3 block at iso -2 (Chebyshev) is the box of voxel centres two from the air, [1.5,
+  // 7.5]^3 in world units (side 6, faces through samples: f = 1), bevelled as above.
+  World block(16);
+  block.voxels.fill(Box3i::from_size({9, 9, 9}), 4);
+  MeshOptions inset = with(Mesher::kMarchingCubes);
+  inset.iso = -2;
+  const Mesh inner = mesh_world(block, inset, Metric::kChebyshev);
+  expect_closed_manifold(inner, 2, "inset");
+  EXPECT_GE(mesh_stats(inner).signed_volume_units3, 216 - 12 * 6 * 0.5 - 1e-3);
+  EXPECT_LE(mesh_stats(inner).signed_volume_units3, 216 - 12 * 6 * 0.5 + 8);
+  for (const auto& p : inner.positions)
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_GE(p[static_cast<std::size_t>(a)], 1.5f - 1e-4f);
+      EXPECT_LE(p[static_cast<std::size_t>(a)], 7.5f + 1e-4f);
+    }
+  MeshOptions bad = with(Mesher::kMarchingCubes);
+  bad.iso = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(mesh_world(w, bad), InvalidArgument);
+  bad.iso = 1e6;
+  EXPECT_THROW(mesh_world(w, bad), InvalidArgument);
+}
+
 // Two voxels touching at a corner only: the dual meshers' vertex sits on a saddle of the
 // interpolant (no gradient), and still gets a unit normal.
 TEST(Mesh, NormalsAreUnitLengthEvenOnSaddles) {

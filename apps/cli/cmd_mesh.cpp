@@ -1,4 +1,5 @@
-// voxfield mesh IN -o OUT: the iso-surface of a world (through its exact signed Euclidean field)
+// voxfield mesh IN -o OUT: the iso-surface of a world (through its exact signed field, Euclidean
+// unless --metric says otherwise)
 // or of a float volume, as PLY, OBJ, STL or glTF binary.
 #include <chrono>
 #include <cmath>
@@ -21,6 +22,7 @@ namespace {
 struct MeshSettings {
   std::string in, out, stats, algorithm = "mc", inside = "below", backend = "cpu";
   std::optional<double> iso;
+  std::optional<std::string> metric;
   std::vector<double> spacing;
   int chunk = 32, threads = 0;
   std::optional<double> simplify, simplify_error;
@@ -57,6 +59,9 @@ int run_mesh(const MeshSettings& s) {
   std::optional<NpyVolume> npy;
   if (std::filesystem::path(s.in).extension() == ".npy") npy = read_npy(s.in);
   const bool volume_input = npy && is_float(npy->dtype);
+  if (volume_input && s.metric)
+    throw UsageError("--metric is for worlds (meshed through their exact signed field); " + s.in +
+                     " is a float volume, meshed as it is");
   const double load_ms = ms_since(start);
   Mesh mesh;
   std::int64_t chunks = 0;
@@ -97,17 +102,17 @@ int run_mesh(const MeshSettings& s) {
       throw UsageError("--backend " + s.backend +
                        ": worlds are meshed on the CPU (their surface, colours and normals come "
                        "from the exact field there); the GPU meshes float volumes");
-    if (s.iso || s.inside != "below" || !s.spacing.empty())
+    if (s.inside != "below" || !s.spacing.empty())
       throw UsageError(
-          "--iso, --inside and --spacing are for float volumes; a world is meshed at its surface "
-          "(solid voxels inside, one unit per voxel)");
+          "--inside and --spacing are for float volumes; a world's solid voxels are inside, one "
+          "unit per voxel");
     LoadOptions lo;
     const World world = npy ? world_from_npy(*npy, s.in) : load_world(s.in, lo).world;
     const Vec3i size = world.voxels.content_bounds().grown(1).size();
     for (int a = 0; a < 3; ++a)
       chunks = (a ? chunks : 1) * ((size[a] - 1 + s.chunk - 1) / std::max(1, s.chunk));
     start = std::chrono::steady_clock::now();
-    mesh = mesh_world(world, options);
+    mesh = mesh_world(world, options, parse_metric(s.metric.value_or("euclidean")));
     mesh_ms = ms_since(start);
   }
   std::optional<SimplifyStats> simplified;
@@ -184,7 +189,14 @@ void add_mesh(CLI::App& app, Action& action) {
                   "mc (marching cubes), sn (surface nets) or dc (dual contouring)")
       ->check(
           CLI::IsMember({"mc", "sn", "dc", "marching-cubes", "surface-nets", "dual-contouring"}));
-  cmd->add_option("--iso", s->iso, "iso value of a float volume (default 0)")->check(CLI::Number);
+  cmd->add_option("--iso", s->iso,
+                  "iso value (default 0): of a float volume; of a world, the offset surface that "
+                  "many voxels out from its solid voxels (negative: in)")
+      ->check(CLI::Number);
+  cmd->add_option("--metric", s->metric,
+                  "a world's field: euclidean (default), chebyshev or manhattan — the shape of "
+                  "its offset surfaces (at iso 0 all give the voxels' surface)")
+      ->check(CLI::IsMember({"euclidean", "chebyshev", "manhattan"}));
   cmd->add_option("--inside", s->inside,
                   "which values of a float volume are inside: below (default) or above iso")
       ->check(CLI::IsMember({"below", "above"}));

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "voxfield/box.h"
+#include "voxfield/distance.h"
 #include "voxfield/world.h"
 
 namespace voxfield {
@@ -126,14 +127,22 @@ struct MeshCounts {
 MeshCounts mesh_volume_into(const ScalarVolume& volume, const MeshOptions& options,
                             const MeshBuffers& out);
 
-// Meshes a World through its exact signed Euclidean distance field (solid voxels read -(distance
-// to air), air +(distance to solid)) at iso 0 (options.iso and inside_above are ignored): the
-// surface runs between solid and air voxel centres. Voxel (x, y, z) spans [x, x+1)^3 in world
-// units, so its sample sits at its centre (x + 0.5, y + 0.5, z + 0.5). The domain is the world's
-// content grown by one voxel of air (beyond a bounded world's bounds is air, so its surface closes
-// there too). Vertex colours come from the palette: the material of the solid voxel the vertex
-// was made from (an edge's solid end; a cell's solid corner nearest the vertex).
-Mesh mesh_world(const World& world, const MeshOptions& options);
+// Meshes a World through its exact signed distance field in `metric` (solid voxels read
+// -(distance to air), air +(distance to solid), in voxels between centres; options.inside_above is
+// ignored). Voxel (x, y, z) spans [x, x+1)^3 in world units, so its sample sits at its centre
+// (x + 0.5, y + 0.5, z + 0.5).
+//  * At options.iso = 0 (the default): the voxels' own surface, running between solid and air
+//    voxel centres — the same for every metric — with crossings on the faces between centres and
+//    exact axis normals. Vertex colours: the material of the solid voxel a vertex was made from
+//    (an edge's solid end; a cell's solid corner nearest the vertex).
+//  * At iso V != 0: the offset surface V voxels out from the solid voxels' centres (V < 0: in),
+//    shaped by the metric's ball — rounded (Euclidean), a box (Chebyshev), an octahedron
+//    (Manhattan) — with normals from the field's gradient: a safety margin around an obstacle, a
+//    shell. Vertex colours: the material of the nearest solid voxel.
+// The domain is the content grown past the surface by two voxels of air (beyond a bounded world's
+// bounds is air, so the surface closes there too). InvalidArgument for an iso that is not finite or
+// beyond ±1000 voxels.
+Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric = Metric::kEuclidean);
 
 // What a mesh is, topologically and geometrically.
 struct MeshStats {

@@ -1,10 +1,13 @@
-// voxfield — meshing a World through its exact signed Euclidean distance field.
+// voxfield — meshing a World through its exact signed distance field (mesh.h): at iso 0 the
+// voxels' surface, at other iso values the offset surfaces of the metric.
 //
-// The field is computed on the content grown by one voxel (so the surface closes in air, also where
-// the content touches a bounded world's bounds: beyond them is air), clamped
-// at 3 voxels: meshers read only the signs of neighbouring samples, their crossings and central
+// The field is computed on the content grown past the surface (so the surface closes in air, also
+// where the content touches a bounded world's bounds: beyond them is air), clamped at |iso| + 3
+// voxels: meshers read only the signs of neighbouring samples, their crossings and central
 // differences, all within two voxels of the surface, where the clamped field is exact.
+#include <cmath>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "mesh_internal.h"
@@ -14,10 +17,16 @@
 
 namespace voxfield {
 
-Mesh mesh_world(const World& world, const MeshOptions& options) {
+Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
+  const double iso = options.iso;
+  if (!(std::abs(iso) <= 1000))
+    throw InvalidArgument("mesh: the iso value of a world (" + std::to_string(iso) +
+                          " voxels) must be finite and within ±1000");
   const Box3i content = world.voxels.content_bounds();
   if (content.empty()) return Mesh{};
-  const Box3i domain = content.grown(1);
+  // The surface lies up to iso voxels out: the domain reaches two voxels past it.
+  const Box3i domain =
+      content.grown(1 + static_cast<int>(std::ceil(std::max(iso, 0.0))) + (iso > 0 ? 1 : 0));
   const Vec3i size = domain.size();
   // Voxels beyond a bounded world's bounds are air: where the grown content leaves the bounds, the
   // field is computed on an unbounded copy so that the surface closes there with exact distances.
@@ -32,10 +41,12 @@ Mesh mesh_world(const World& world, const MeshOptions& options) {
   require_memory(mul_sat(static_cast<std::uint64_t>(domain.volume()), 8), 0, "mesh",
                  "the world's signed distance samples");
   DistanceOptions field_options;
-  field_options.metric = Metric::kEuclidean;
+  field_options.metric = metric;
   field_options.signed_distance = true;
-  field_options.max_distance = 3;
+  field_options.max_distance = std::abs(iso) + 3;
   field_options.domain = domain;
+  // An offset surface's vertices come from air samples: their colour is their nearest voxel's.
+  field_options.nearest_sites = iso > 0;
   const DistanceField field = compute_distance_field(source, field_options);
   std::vector<float> samples(static_cast<std::size_t>(domain.volume()));
   std::get<Grid<float>>(field.values).copy_to_dense(domain, samples.data());
@@ -46,10 +57,9 @@ Mesh mesh_world(const World& world, const MeshOptions& options) {
   for (int a = 0; a < 3; ++a)
     volume.origin_units[static_cast<std::size_t>(a)] = domain.begin[a] + 0.5;
   MeshOptions o = options;
-  o.iso = 0;
   o.inside_above = false;
   std::vector<std::uint64_t> sources;
-  Mesh mesh = detail::mesh::mesh_lattice(volume, o, &sources, /*voxel_faces=*/true);
+  Mesh mesh = detail::mesh::mesh_lattice(volume, o, &sources, /*voxel_faces=*/iso == 0);
   mesh.colors.resize(mesh.positions.size());
   const std::uint64_t nx = static_cast<std::uint64_t>(size.x),
                       nxy = nx * static_cast<std::uint64_t>(size.y);
@@ -58,7 +68,12 @@ Mesh mesh_world(const World& world, const MeshOptions& options) {
     const Vec3i p{domain.begin.x + static_cast<int>(s % nx),
                   domain.begin.y + static_cast<int>(s / nx % static_cast<std::uint64_t>(size.y)),
                   domain.begin.z + static_cast<int>(s / nxy)};
-    const Rgba c = world.palette[world.voxels.get(p)];
+    std::uint8_t material = world.voxels.get(p);
+    if (material == 0 && field.sites) {  // an air sample of an offset surface: its nearest voxel
+      const SiteOffset off = field.sites->get(p);
+      if (!off.none()) material = world.voxels.get({p.x + off.dx, p.y + off.dy, p.z + off.dz});
+    }
+    const Rgba c = world.palette[material];
     mesh.colors[i] = {c.r, c.g, c.b};
   }
   return mesh;
