@@ -185,8 +185,9 @@ TEST(Mesh, SurfaceNetsOfABlockHasOneQuadPerVoxelFace) {
 // A world's offset surfaces take the shape of the metric's ball: around one voxel at iso r the
 // Chebyshev surface is the box of half-size r about its centre, the Manhattan one the octahedron
 // |x| + |y| + |z| = r (marching cubes is exact there: the field is linear in every cell), the
-// Euclidean one the sphere of radius r; colours are the nearest voxel's. At iso 0 every metric
-// gives the same mesh, and a negative iso insets a block by the metric's distance.
+// Euclidean one the sphere of radius r; colours are the nearest voxel's; normals and dual
+// contouring's Hermite data come from the exact nearest sites. At iso 0 every metric gives the
+// same mesh, and a negative iso insets a block by the metric's distance.
 TEST(Mesh, WorldOffsetSurfacesAreTheMetricsBalls) {
   World w(16);
   w.voxels.set({10, 10, 10}, 9);
@@ -224,6 +225,32 @@ TEST(Mesh, WorldOffsetSurfacesAreTheMetricsBalls) {
     const double ball = 4.0 / 3 * kPi * r * r * r;
     EXPECT_GE(mesh_stats(sphere).signed_volume_units3, 0.8 * ball);
     EXPECT_LE(mesh_stats(sphere).signed_volume_units3, ball);
+  }
+  // Hermite data from the exact nearest sites: dual contouring rebuilds the box's sharp edges and
+  // corners exactly, and every normal of the sphere is radial.
+  for (double r : {2.0, 3.5}) {
+    SCOPED_TRACE(r);
+    MeshOptions o = with(Mesher::kDualContouring);
+    o.iso = r;
+    const Mesh box = mesh_world(w, o, Metric::kChebyshev);
+    expect_closed_manifold(box, 2, "offset box, dual contouring");
+    EXPECT_NEAR(mesh_stats(box).signed_volume_units3, std::pow(2 * r, 3), 1e-3);
+    int corners = 0;
+    for (const auto& p : box.positions) {
+      const Vec3d d = at(p) - Vec3d{10.5, 10.5, 10.5};
+      corners += std::abs(std::abs(d.x) - r) < 1e-4 && std::abs(std::abs(d.y) - r) < 1e-4 &&
+                 std::abs(std::abs(d.z) - r) < 1e-4;
+    }
+    EXPECT_EQ(corners, 8);
+    // (The octahedron's slanted faces are not rebuilt so: its ridges run along cell faces, where
+    // dual contouring's one vertex per cell cannot sit on both sides; it stays closed.)
+    expect_closed_manifold(mesh_world(w, o, Metric::kManhattan), 2, "octahedron, dual contouring");
+    o.algorithm = Mesher::kMarchingCubes;
+    const Mesh sphere = mesh_world(w, o, Metric::kEuclidean);
+    for (std::size_t i = 0; i < sphere.positions.size(); ++i) {
+      const Vec3d radial = (at(sphere.positions[i]) - Vec3d{10.5, 10.5, 10.5}).normalized();
+      EXPECT_GT(dot(at(sphere.normals[i]), radial), 1 - 1e-6);
+    }
   }
   // At iso 0 the voxels' own surface, whatever the metric.
   const Mesh e = mesh_world(w, with(Mesher::kMarchingCubes), Metric::kEuclidean);

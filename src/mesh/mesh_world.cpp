@@ -5,7 +5,10 @@
 // where the content touches a bounded world's bounds: beyond them is air), clamped at |iso| + 3
 // voxels: meshers read only the signs of neighbouring samples, their crossings and central
 // differences, all within two voxels of the surface, where the clamped field is exact.
+#include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +19,71 @@
 #include "voxfield/limits.h"
 
 namespace voxfield {
+
+namespace {
+
+// The exact gradient of a world's signed field at a point of an offset surface, from the field's
+// nearest sites: Hermite data for dual contouring, and every mesher's normals. Outside (iso > 0)
+// the field is the distance to the nearest solid voxel centre c, whose gradient is (p - c) / |p -
+// c| (Euclidean), the unit axis of the largest |p - c| component (Chebyshev), or the signs of p - c
+// (Manhattan); inside it is minus the distance to the nearest air voxel centre. The nearest centre
+// of p is taken among the candidates of the cell around it: each corner sample of the kind the
+// distance is measured to is its own candidate, each of the other kind offers its nearest site.
+std::function<std::array<double, 3>(const std::array<double, 3>&)> offset_gradient(
+    const World& world, const DistanceField& field, Metric metric, bool outside) {
+  return [&world, &field, metric, outside](const std::array<double, 3>& p) {
+    const Box3i& domain = field.domain;
+    Vec3i base;
+    for (int a = 0; a < 3; ++a)
+      base[a] = std::clamp(static_cast<int>(std::floor(p[static_cast<std::size_t>(a)] - 0.5)),
+                           domain.begin[a], domain.end[a] - 2);
+    const Vec3d at{p[0], p[1], p[2]};
+    auto metric_length = [metric](const Vec3d& d) {
+      if (metric == Metric::kManhattan) return std::abs(d.x) + std::abs(d.y) + std::abs(d.z);
+      if (metric == Metric::kChebyshev)
+        return std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+      return d.length();
+    };
+    bool found = false;
+    Vec3d best_centre;
+    double best = std::numeric_limits<double>::infinity();
+    for (int c = 0; c < 8; ++c) {
+      const Vec3i q{base.x + (c & 1), base.y + (c >> 1 & 1), base.z + (c >> 2 & 1)};
+      // A sample of the kind the distance is measured to is its own site; another one's site is
+      // its nearest voxel of that kind.
+      Vec3i site = q;
+      if ((world.voxels.get(q) != 0) == outside) {
+        // q is of the measured kind (solid outside, air inside): itself.
+      } else {
+        const SiteOffset off = field.sites->get(q);
+        if (off.none()) continue;
+        site = {q.x + off.dx, q.y + off.dy, q.z + off.dz};
+      }
+      const Vec3d centre{site.x + 0.5, site.y + 0.5, site.z + 0.5};
+      const double d = metric_length(at - centre);
+      if (d < best) best = d, best_centre = centre, found = true;
+    }
+    std::array<double, 3> g{0, 0, 0};
+    if (!found) return g;  // no site in reach: the mesher's own estimate is used
+    const Vec3d d = at - best_centre;
+    if (metric == Metric::kEuclidean) {
+      const double l = d.length();
+      if (l > 0) g = {d.x / l, d.y / l, d.z / l};
+    } else if (metric == Metric::kChebyshev) {
+      int axis = 0;
+      for (int a = 1; a < 3; ++a)
+        if (std::abs(d[a]) > std::abs(d[axis])) axis = a;
+      g[static_cast<std::size_t>(axis)] = d[axis] > 0 ? 1 : d[axis] < 0 ? -1 : 0;
+    } else {
+      for (int a = 0; a < 3; ++a) g[static_cast<std::size_t>(a)] = d[a] > 0 ? 1 : d[a] < 0 ? -1 : 0;
+    }
+    if (!outside)
+      for (double& v : g) v = -v;
+    return g;
+  };
+}
+
+}  // namespace
 
 Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
   const double iso = options.iso;
@@ -45,8 +113,9 @@ Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
   field_options.signed_distance = true;
   field_options.max_distance = std::abs(iso) + 3;
   field_options.domain = domain;
-  // An offset surface's vertices come from air samples: their colour is their nearest voxel's.
-  field_options.nearest_sites = iso > 0;
+  // An offset surface's normals come from the nearest sites (below), and its vertices from air
+  // samples take their colour from their nearest voxel.
+  field_options.nearest_sites = iso != 0;
   const DistanceField field = compute_distance_field(source, field_options);
   std::vector<float> samples(static_cast<std::size_t>(domain.volume()));
   std::get<Grid<float>>(field.values).copy_to_dense(domain, samples.data());
@@ -58,6 +127,7 @@ Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
     volume.origin_units[static_cast<std::size_t>(a)] = domain.begin[a] + 0.5;
   MeshOptions o = options;
   o.inside_above = false;
+  if (iso != 0) o.gradient = offset_gradient(source, field, metric, iso > 0);
   std::vector<std::uint64_t> sources;
   Mesh mesh = detail::mesh::mesh_lattice(volume, o, &sources, /*voxel_faces=*/iso == 0);
   mesh.colors.resize(mesh.positions.size());
