@@ -155,8 +155,10 @@ int run_mesh(const MeshSettings& s) {
                   {"bytes_downloaded", gpu_stats->bytes_downloaded},
                   {"pyramid_levels", gpu_stats->pyramid_levels}};
     j["threads"] = max_threads();
-    j["chunk_edge"] = s.chunk;
-    j["chunks"] = chunks;
+    if (!gpu_stats) {  // the CPU's partition; the GPU meshes the lattice whole
+      j["chunk_edge"] = s.chunk;
+      j["chunks"] = chunks;
+    }
     j["vertices"] = st.vertices;
     j["triangles"] = st.triangles;
     j["watertight"] = st.watertight();

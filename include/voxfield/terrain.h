@@ -115,9 +115,9 @@ class TerrainField {
   // little-endian int16), four for f32 (the float's bits) — x fastest, always in the negative-
   // inside convention (positive_inside only flips what value() and decode() give); decoding a
   // code c gives c * step_units() (f32: the float itself). With `materials`, the samples'
-  // materials too. For copies that keep the field's width, such as the GPU renderer's uploads
-  // of the samples an edit changed (gpu_terrain.h). InvalidArgument when the region leaves the
-  // lattice.
+  // materials too (x fastest, a byte each); `codes` may be null to read only those. For copies that
+  // keep the field's width, such as the GPU renderer's uploads of the samples an edit changed
+  // (gpu_terrain.h). InvalidArgument when the region leaves the lattice.
   void read_codes(const Box3i& region, void* codes, std::uint8_t* materials = nullptr) const;
 
   struct Memory {

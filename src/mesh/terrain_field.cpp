@@ -272,7 +272,7 @@ void TerrainField::read_codes(const Box3i& region, void* codes, std::uint8_t* ma
       const std::size_t row = width * (static_cast<std::size_t>(y - region.begin.y) +
                                        static_cast<std::size_t>(region.end.y - region.begin.y) *
                                            static_cast<std::size_t>(z - region.begin.z));
-      std::uint8_t* code = out + row * bytes;
+      std::uint8_t* code = out ? out + row * bytes : nullptr;
       std::uint8_t* material = materials ? materials + row : nullptr;
       // Chunk by chunk along the row: a uniform chunk repeats its one code; a dense one is copied.
       for (int x = region.begin.x; x < region.end.x;) {
@@ -280,12 +280,14 @@ void TerrainField::read_codes(const Box3i& region, void* codes, std::uint8_t* ma
         const Chunk& c = s.chunk[s.chunk_index({cx, y / e, z / e})];
         const auto count = static_cast<std::size_t>(stop - x);
         const std::size_t first = s.local(x - cx * e, y % e, z % e);
-        if (c.samples.empty()) {
-          for (std::size_t i = 0; i < count; ++i) std::memcpy(code + i * bytes, &c.uniform, bytes);
-        } else {
-          std::memcpy(code, c.samples.data() + first * bytes, count * bytes);
+        if (code) {
+          if (c.samples.empty())
+            for (std::size_t i = 0; i < count; ++i)
+              std::memcpy(code + i * bytes, &c.uniform, bytes);
+          else
+            std::memcpy(code, c.samples.data() + first * bytes, count * bytes);
+          code += count * bytes;
         }
-        code += count * bytes;
         if (material) {
           if (c.materials.empty())
             std::fill(material, material + count, c.uniform_material);

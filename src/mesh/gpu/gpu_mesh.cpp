@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "../cube_cases.h"
+#include "../mesh_internal.h"
 #include "../terrain_store.h"
 #include "gpu/recorder.h"
 #include "histopyramid.h"
@@ -112,24 +113,18 @@ std::vector<L::ivec4> pyramid_levels(Vec3i cells, Pyramid kind, std::uint64_t& t
 
 void check_lattice(Vec3i n, const std::array<double, 3>& origin,
                    const std::array<double, 3>& spacing) {
-  // mesh_volume's checks of the lattice and its frame.
-  for (int a = 0; a < 3; ++a)
-    if (n[a] < 2)
-      throw InvalidArgument("mesh: the volume needs at least 2 samples along each axis (it has " +
-                            to_string(n) + ")");
+  // mesh_volume's checks of the lattice and its frame (sizes, spacing, origin and far corner),
+  // then the GPU's own 32-bit limit on cells.
+  ScalarVolume frame;
+  frame.size = n;
+  frame.origin_units = origin;
+  frame.spacing_units = spacing;
+  const std::function<void(const Box3i&, float*)> no_samples;  // only the frame is checked
+  detail::mesh::checked_lattice(frame, MeshOptions{}, false, &no_samples);
   const std::uint64_t cells = static_cast<std::uint64_t>(n.x - 1) * (n.y - 1) * (n.z - 1);
   if (cells > static_cast<std::uint64_t>(INT32_MAX))
     throw ResourceLimitError("marching cubes on the GPU: " + to_string(n) +
                              " samples are more cells than 32-bit indices count");
-  for (int a = 0; a < 3; ++a) {
-    const double s = spacing[static_cast<std::size_t>(a)], o = origin[static_cast<std::size_t>(a)];
-    if (!(s >= std::numeric_limits<float>::min()) || !(s <= std::numeric_limits<float>::max()))
-      throw InvalidArgument("mesh: spacing must be positive and within float range");
-    const double far = o + (n[a] - 1) * s;
-    if (!(std::abs(o) <= std::numeric_limits<float>::max()) ||
-        !(std::abs(far) <= std::numeric_limits<float>::max()))
-      throw InvalidArgument("mesh: the volume's origin and far corner must be finite floats");
-  }
 }
 
 }  // namespace mc
@@ -339,29 +334,31 @@ Mesh marching_cubes(Context& context, const TerrainField& terrain, const GpuMesh
   f.n = o.samples;
   f.origin = o.origin_units;
   f.spacing = {o.spacing_units, o.spacing_units, o.spacing_units};
-  // The codes of the decoded values (terrain.h: decoded values re-encode to their codes exactly),
-  // in the field's own sign convention, meshed as mesh_terrain meshes them: inside above 0 when
-  // positive inside, so the device computes s = 0 - v as the CPU does (signed zeros included).
+  // The stored codes in their own width (TerrainField::read_codes: no decode and re-encode),
+  // packed four (i8) or two (i16) per word as the device reads them. They are negative inside
+  // whatever the field's convention; a positive-inside field is meshed from its decoded values
+  // (inside above 0, s = 0 - v), so the device negates codes as it decodes to give the CPU's
+  // signed zeros: the codes are uploaded negated — exactly, as their range is symmetric.
   const detail::terrain::Codec codec(o.storage, terrain.clamp_units());
   f.step = codec.step;
   f.width = o.storage == TerrainStorage::kI8    ? L::VF_MC_I8
             : o.storage == TerrainStorage::kI16 ? L::VF_MC_I16
                                                 : L::VF_MC_F32;
   const std::uint64_t count = static_cast<std::uint64_t>(Box3i::from_size(o.samples).volume());
-  const int per_word = f.width == L::VF_MC_I8 ? 4 : f.width == L::VF_MC_I16 ? 2 : 1;
-  require_memory(count * 4 + (count + per_word - 1) / per_word * 4, 0, "marching cubes on the GPU",
-                 "the terrain's decoded samples and their upload");
-  std::vector<float> values(count);
-  terrain.decode(Box3i::from_size(o.samples), values.data());
-  f.words.assign((count + static_cast<std::uint64_t>(per_word) - 1) / per_word, 0);
+  const int bytes = codec.bytes;
+  require_memory((count * static_cast<std::uint64_t>(bytes) + 3) / 4 * 4, 0,
+                 "marching cubes on the GPU", "the terrain's samples' upload");
+  f.words.assign((count * static_cast<std::uint64_t>(bytes) + 3) / 4, 0);
+  terrain.read_codes(Box3i::from_size(o.samples), f.words.data());
   f.negate = o.positive_inside;
-  for (std::uint64_t i = 0; i < count; ++i) {
-    const std::uint32_t code = codec.encode(values[i]);
-    if (per_word == 1)
-      f.words[i] = code;
-    else
-      f.words[i / per_word] |= (code & (per_word == 4 ? 0xffu : 0xffffu))
-                               << (32 / per_word * (i % per_word));
+  if (o.positive_inside) {
+    auto* raw = reinterpret_cast<std::uint8_t*>(f.words.data());
+    for (std::uint64_t i = 0; i < count; ++i) {
+      std::uint32_t code = 0;
+      std::memcpy(&code, raw + i * bytes, static_cast<std::size_t>(bytes));
+      const std::uint32_t negated = codec.encode(-static_cast<double>(codec.decode(code)));
+      std::memcpy(raw + i * bytes, &negated, static_cast<std::size_t>(bytes));
+    }
   }
   return run(context, f, gpu, stats);
 }
