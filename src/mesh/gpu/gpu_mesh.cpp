@@ -127,6 +127,22 @@ void check_lattice(Vec3i n, const std::array<double, 3>& origin,
                              " samples are more cells than 32-bit indices count");
 }
 
+void record_pyramid(Recorder& rec, Context::Impl& c, Recorder::Buffers buffers, L::MeshParams& p,
+                    const std::vector<L::ivec4>& levels) {
+  const int classify = rec.begin_pass();
+  rec.dispatch_strided(c.kernel(shaders::mesh_classify()), buffers, p,
+                       static_cast<std::uint64_t>(p.cells.x) * p.cells.y * p.cells.z);
+  rec.end_pass(classify, "classify");
+  const int reduce = rec.begin_pass();
+  for (std::size_t l = 1; l < levels.size(); ++l) {
+    p.pass.x = static_cast<std::int32_t>(l);
+    const L::ivec4& lv = levels[l];
+    rec.dispatch_strided(c.kernel(shaders::mesh_reduce()), buffers, p,
+                         static_cast<std::uint64_t>(lv.y) * lv.z * lv.w);
+  }
+  rec.end_pass(reduce, "HistoPyramid");
+}
+
 }  // namespace mc
 
 namespace {
@@ -217,17 +233,7 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
     Buffer* all[9] = {&samples, &tables,          &frame_buf, &level_buf,  &pyramid,
                       &cases,   &unused_vertices, &args,      &unused_keys};
     const Recorder::Buffers list(all, 9);
-    const int classify = rec.begin_pass();
-    rec.dispatch_strided(c.kernel(shaders::mesh_classify()), list, p, cell_count);
-    rec.end_pass(classify, "classify");
-    const int reduce = rec.begin_pass();
-    for (std::size_t l = 1; l < levels.size(); ++l) {
-      p.pass.x = static_cast<std::int32_t>(l);
-      const L::ivec4& lv = levels[l];
-      rec.dispatch_strided(c.kernel(shaders::mesh_reduce()), list, p,
-                           static_cast<std::uint64_t>(lv.y) * lv.z * lv.w);
-    }
-    rec.end_pass(reduce, "HistoPyramid");
+    mc::record_pyramid(rec, c, list, p, levels);
     rec.dispatch(c.kernel(shaders::mesh_args()), list, p, 1);
     rec.submit();
   }

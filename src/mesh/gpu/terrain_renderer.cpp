@@ -282,18 +282,7 @@ void TerrainRenderer::Impl::record_frame(Recorder& rec, const TerrainView& o) {
   Buffer* all[10] = {&samples, &tables, &frame,     &level_buf, &pyramid,
                      &cases,   &view,   &materials, &palette,   &draw};
   const Recorder::Buffers list(all, 10);
-  const int classify = rec.begin_pass();
-  rec.dispatch_strided(c.kernel(shaders::mesh_classify()), list, p,
-                       static_cast<std::uint64_t>(cells.x) * cells.y * cells.z);
-  rec.end_pass(classify, "classify");
-  const int reduce = rec.begin_pass();
-  for (std::size_t l = 1; l < levels.size(); ++l) {
-    p.pass.x = static_cast<std::int32_t>(l);
-    const L::ivec4& lv = levels[l];
-    rec.dispatch_strided(c.kernel(shaders::mesh_reduce()), list, p,
-                         static_cast<std::uint64_t>(lv.y) * lv.z * lv.w);
-  }
-  rec.end_pass(reduce, "HistoPyramid");
+  mc::record_pyramid(rec, c, list, p, levels);
   p.pass.x = 0;
   rec.dispatch(c.kernel(shaders::mesh_draw_args()), list, p, 1);
   const int drawn = rec.begin_pass();
