@@ -2,7 +2,10 @@
 #include "chunked_mesh.h"
 
 #include <algorithm>
+#include <array>
+#include <cstring>
 #include <string>
+#include <type_traits>
 
 #include "voxfield/error.h"
 
@@ -62,17 +65,29 @@ bool Block::load(const Lattice& lattice, const Box3i& cells) {
   signs_.resize(dy_ * static_cast<std::size_t>(hi_.z - lo_.z + 1));
   std::uint8_t all = 0;
   std::uint8_t* signs = signs_.data();
+  // Which signs a row holds, and whether it holds a NaN or an infinity (its exponent bits all
+  // set): 32-bit flags OR-ed without an early exit, so the loop vectorises (bool flags and
+  // std::isfinite kept it scalar, at about 2.5 ns a sample).
+  const auto scan = [this, dx](const float* row, auto inside_above) {
+    std::uint32_t in = 0, out = 0, bad = 0;
+    const float iso = iso_;
+    for (std::size_t i = 0; i < dx; ++i) {
+      const float v = row[i];
+      std::uint32_t bits;
+      std::memcpy(&bits, &v, sizeof bits);
+      bad |= static_cast<std::uint32_t>((bits & 0x7f800000u) == 0x7f800000u);
+      const std::uint32_t inside =
+          static_cast<std::uint32_t>(decltype(inside_above)::value ? v > iso : v < iso);
+      in |= inside;
+      out |= inside ^ 1u;
+    }
+    return std::array<std::uint32_t, 3>{in, out, bad};
+  };
   for (int z = lo_.z; z <= hi_.z; ++z)
     for (int y = lo_.y; y <= hi_.y; ++y) {
       const float* row = this->row(lo_.x, y, z);
-      bool in = false, out = false, nan = false;  // nan: NaN or infinite
-      for (std::size_t i = 0; i < dx; ++i) {      // no early exit: this loop vectorises
-        const float v = row[i];
-        nan |= !std::isfinite(v);
-        const bool inside_v = negate_ ? v > iso_ : v < iso_;
-        in |= inside_v;
-        out |= !inside_v;
-      }
+      const auto [in, out, nan] =
+          negate_ ? scan(row, std::true_type{}) : scan(row, std::false_type{});
       if (nan)
         for (std::size_t i = 0; i < dx; ++i)
           if (!std::isfinite(row[i]))
