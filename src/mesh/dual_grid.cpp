@@ -7,7 +7,10 @@
 // A chunk emits the quads of the edges starting in its own cells; the cells around them reach one
 // cell before the chunk, whose vertices the chunk computes (identically to their owner, for the
 // diagonal test) and the weld replaces with the owner's.
+#include <array>
 #include <cstdint>
+#include <cstring>
+#include <utility>
 #include <vector>
 
 #include "chunked_mesh.h"
@@ -23,11 +26,14 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
                     ey = static_cast<std::size_t>(cells.end.y - lo.y);
   scratch.assign(ex * ey * static_cast<std::size_t>(cells.end.z - lo.z), -1);
 
-  auto vertex = [&](Vec3i q) -> std::uint32_t {
-    std::int32_t& slot = scratch[static_cast<std::size_t>(q.x - lo.x) +
-                                 ex * (static_cast<std::size_t>(q.y - lo.y) +
-                                       ey * static_cast<std::size_t>(q.z - lo.z))];
+  // (The cell comes as three ints: a Vec3i built on the stack and read back as one 64-bit word
+  // stalls store forwarding on every call.)
+  auto vertex = [&](int qx, int qy, int qz) -> std::uint32_t {
+    std::int32_t& slot = scratch[static_cast<std::size_t>(qx - lo.x) +
+                                 ex * (static_cast<std::size_t>(qy - lo.y) +
+                                       ey * static_cast<std::size_t>(qz - lo.z))];
     if (slot >= 0) return static_cast<std::uint32_t>(slot);
+    const Vec3i q{qx, qy, qz};
     double v[8];
     for (int c = 0; c < 8; ++c)
       v[c] = block.s(q.x + (c & 1), q.y + (c >> 1 & 1), q.z + (c >> 2 & 1));
@@ -90,36 +96,67 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
     return d;
   };
 
+  // One quad for the lattice edge from p along `a` when it is crossed: the four cells around the
+  // edge, counter-clockwise seen from +a ((0,0), (1,0), (1,1), (0,1) in (b, c) offsets, with
+  // e_b x e_c = e_a), split along the shorter diagonal, turned over when the outside is towards -a.
+  auto quad = [&](std::uint32_t v00, std::uint32_t v10, std::uint32_t v11, std::uint32_t v01,
+                  bool in0) {
+    std::array<std::uint32_t, 6> t;
+    if (distance2(v00, v11) <= distance2(v10, v01))
+      t = {v00, v10, v11, v00, v11, v01};
+    else
+      t = {v00, v10, v01, v10, v11, v01};
+    if (!in0) std::swap(t[1], t[2]), std::swap(t[4], t[5]);
+    part.indices.insert(part.indices.end(), t.begin(), t.end());
+  };
+  const int row_cells = cells.end.x - cells.begin.x;
+  // Per cell of a row: the inside bits of its sample and of the next along x, y and z (bits 0..3),
+  // computed for the whole row in one loop the compiler vectorises; 8 bytes of slack for the skip.
+  std::vector<std::uint8_t> signs(static_cast<std::size_t>(row_cells) + 8);
   for (int z = cells.begin.z; z < cells.end.z; ++z)
     for (int y = cells.begin.y; y < cells.end.y; ++y) {
       // The edges starting in this row of cells join samples of rows (y, z), (y + 1, z) and
       // (y, z + 1) only: when those rows hold one sign, no edge of the row is crossed.
       if ((block.row_signs(y, z) | block.row_signs(y + 1, z) | block.row_signs(y, z + 1)) != 3)
         continue;
-      for (int x = cells.begin.x; x < cells.end.x; ++x) {
-        const Vec3i p{x, y, z};
-        const bool in0 = block.s(x, y, z) < 0;
-        for (int a = 0; a < 3; ++a) {
-          const int b = (a + 1) % 3, c = (a + 2) % 3;  // e_b x e_c = e_a
-          if (p[b] == 0 || p[c] == 0) continue;        // the quad would leave the lattice
-          Vec3i q = p;
-          ++q[a];
-          if (in0 == (block.s(q.x, q.y, q.z) < 0)) continue;
-          Vec3i pb = p, pc = p, pbc = p;
-          --pb[b];
-          --pc[c];
-          --pbc[b];
-          --pbc[c];
-          // Counter-clockwise seen from +a: (0,0), (1,0), (1,1), (0,1) in (b, c) offsets.
-          const std::uint32_t v00 = vertex(pbc), v10 = vertex(pc), v11 = vertex(p),
-                              v01 = vertex(pb);
-          std::array<std::uint32_t, 6> t;
-          if (distance2(v00, v11) <= distance2(v10, v01))
-            t = {v00, v10, v11, v00, v11, v01};
-          else
-            t = {v00, v10, v01, v10, v11, v01};
-          if (!in0) std::swap(t[1], t[2]), std::swap(t[4], t[5]);  // the outside is towards -a
-          part.indices.insert(part.indices.end(), t.begin(), t.end());
+      const float* r0 = block.row(cells.begin.x, y, z);
+      const float* ry = block.row(cells.begin.x, y + 1, z);
+      const float* rz = block.row(cells.begin.x, y, z + 1);
+      for (int i = 0; i < row_cells; ++i)
+        signs[static_cast<std::size_t>(i)] =
+            static_cast<std::uint8_t>(block.inside(r0[i]) | block.inside(r0[i + 1]) << 1 |
+                                      block.inside(ry[i]) << 2 | block.inside(rz[i]) << 3);
+      for (int i = 0; i < row_cells; ++i) {
+        // Eight cells at once whose edges join samples of one sign: no quad.
+        if (i + 8 <= row_cells) {
+          std::uint64_t w;
+          std::memcpy(&w, &signs[static_cast<std::size_t>(i)], 8);
+          if (w == 0 || w == 0x0f0f0f0f0f0f0f0full) {
+            i += 7;
+            continue;
+          }
+        }
+        const unsigned sg = signs[static_cast<std::size_t>(i)];
+        if (sg == 0 || sg == 15) continue;
+        const int x = cells.begin.x + i;
+        const bool in0 = (sg & 1) != 0;
+        // Along x (b = y, c = z), along y (b = z, c = x), along z (b = x, c = y); a quad needs
+        // the cells before p on its two other axes.
+        // (Vertices are made in the order (0,0), (1,0), (1,1), (0,1): the chunk's numbering.)
+        if (in0 != ((sg >> 1 & 1) != 0) && y > 0 && z > 0) {
+          const std::uint32_t v00 = vertex(x, y - 1, z - 1), v10 = vertex(x, y, z - 1),
+                              v11 = vertex(x, y, z), v01 = vertex(x, y - 1, z);
+          quad(v00, v10, v11, v01, in0);
+        }
+        if (in0 != ((sg >> 2 & 1) != 0) && z > 0 && x > 0) {
+          const std::uint32_t v00 = vertex(x - 1, y, z - 1), v10 = vertex(x - 1, y, z),
+                              v11 = vertex(x, y, z), v01 = vertex(x, y, z - 1);
+          quad(v00, v10, v11, v01, in0);
+        }
+        if (in0 != ((sg >> 3 & 1) != 0) && x > 0 && y > 0) {
+          const std::uint32_t v00 = vertex(x - 1, y - 1, z), v10 = vertex(x, y - 1, z),
+                              v11 = vertex(x, y, z), v01 = vertex(x - 1, y, z);
+          quad(v00, v10, v11, v01, in0);
         }
       }
     }
