@@ -4,6 +4,10 @@
 // Segmented Data", MICCAI 1998, in its naive form (no relaxation): the vertex of a cell the
 // surface crosses is the mean of the crossings on its edges (linear interpolation of the samples).
 // The quads around it come from the dual grid (dual_grid.cpp).
+#include <array>
+#include <bit>
+#include <cstdint>
+
 #include "chunked_mesh.h"
 #include "cube_cases.h"
 
@@ -11,20 +15,43 @@ namespace voxfield::detail::mesh {
 
 std::array<double, 3> surface_nets_vertex(const Block&, const Lattice& lattice, Vec3i cell,
                                           const double* v) {
-  std::array<double, 3> mean{0, 0, 0};
+  // The edges each corner configuration crosses, so the loop visits those alone, in edge order,
+  // without a data-dependent branch per edge.
+  static const std::array<std::uint16_t, 256> crossed = [] {
+    std::array<std::uint16_t, 256> t{};
+    for (unsigned mask = 0; mask < 256; ++mask)
+      for (std::size_t e = 0; e < 12; ++e) {
+        const CubeEdge& edge = cube_edges()[e];
+        if ((mask >> edge.from & 1) != (mask >> edge.to & 1))
+          t[mask] = static_cast<std::uint16_t>(t[mask] | 1u << e);
+      }
+    return t;
+  }();
+  unsigned mask = 0;
+  for (unsigned c = 0; c < 8; ++c) mask |= static_cast<unsigned>(v[c] < 0) << c;
+  // Three scalars, not an array indexed by axis: the array lived in memory and its read-back
+  // stalled store forwarding.
+  double mx = 0, my = 0, mz = 0;
   int crossings = 0;
-  for (const CubeEdge& e : cube_edges()) {
+  for (unsigned bits = crossed[mask]; bits != 0; bits &= bits - 1) {
+    const CubeEdge& e = cube_edges()[static_cast<std::size_t>(std::countr_zero(bits))];
     const double s0 = v[e.from], s1 = v[e.to];
-    if ((s0 < 0) == (s1 < 0)) continue;
-    Vec3i p0 = cell;
-    for (int a = 0; a < 3; ++a) p0[a] += e.from >> a & 1;
-    const double t = lattice.crossing(p0, e.axis, s0, s1);
-    for (int a = 0; a < 3; ++a)
-      mean[static_cast<std::size_t>(a)] += a == e.axis ? t : (e.from >> a & 1);
+    // Lattice::crossing's interpolation, inline unless there is a function to solve on.
+    double t;
+    if (lattice.value) {
+      Vec3i p0 = cell;
+      for (int a = 0; a < 3; ++a) p0[a] += e.from >> a & 1;
+      t = lattice.crossing(p0, e.axis, s0, s1);
+    } else {
+      t = s0 / (s0 - s1);
+    }
+    mx += e.axis == 0 ? t : (e.from & 1);
+    my += e.axis == 1 ? t : (e.from >> 1 & 1);
+    mz += e.axis == 2 ? t : (e.from >> 2 & 1);
     ++crossings;
   }
-  for (double& m : mean) m /= crossings;  // the cell has a crossing: a quad reached it
-  return mean;
+  // (The cell has a crossing: a quad reached it.)
+  return {mx / crossings, my / crossings, mz / crossings};
 }
 
 }  // namespace voxfield::detail::mesh
