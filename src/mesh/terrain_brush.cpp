@@ -126,7 +126,8 @@ Box3i TerrainField::apply(const TerrainBrush& brush) {
       const Chunk& old = s.chunk[touched[t]];
       const Box3i samples = s.samples_of(s.chunk_coord(touched[t]));
       const Box3i visit = samples.intersect(region);
-      Chunk c = old;
+      // Copied on the first change only: most chunks the grown box touches keep every sample.
+      std::optional<Chunk>& c = fresh[t];
       Box3i box;
       for (int z = visit.begin.z; z < visit.end.z; ++z)
         for (int y = visit.begin.y; y < visit.end.y; ++y)
@@ -140,23 +141,23 @@ Box3i TerrainField::apply(const TerrainBrush& brush) {
             const std::uint32_t code = s.codec.encode(next);
             const bool wins = add && b < d && old.material(i) != brush.material;
             if (code == raw && !wins) continue;
+            if (!c) c.emplace(old);
             if (code != raw) {
-              if (c.samples.empty()) {  // a uniform chunk made dense
-                c.samples.resize(per_chunk * static_cast<std::size_t>(s.codec.bytes));
+              if (c->samples.empty()) {  // a uniform chunk made dense
+                c->samples.resize(per_chunk * static_cast<std::size_t>(s.codec.bytes));
                 for (std::size_t j = 0; j < per_chunk; ++j)
-                  c.set_raw(j, s.codec.bytes, old.uniform);
+                  c->set_raw(j, s.codec.bytes, old.uniform);
               }
-              c.set_raw(i, s.codec.bytes, code);
+              c->set_raw(i, s.codec.bytes, code);
             }
             if (wins) {
-              if (c.materials.empty()) c.materials.assign(per_chunk, old.uniform_material);
-              c.materials[i] = brush.material;
+              if (c->materials.empty()) c->materials.assign(per_chunk, old.uniform_material);
+              c->materials[i] = brush.material;
             }
             box = box.unite(Box3i{{x, y, z}, {x + 1, y + 1, z + 1}});
           }
-      if (box.empty()) continue;
-      s.compact(c, samples);
-      fresh[t] = std::move(c);
+      if (!c) continue;
+      s.compact(*c, samples);
       changed[t] = box;
     }
   });
