@@ -19,6 +19,7 @@
 #include "histopyramid.h"
 #include "mesh_shaders.h"
 #include "shaders/layout.h"
+#include "voxfield/detail/assert.h"
 #include "voxfield/error.h"
 #include "voxfield/gpu_mesh.h"
 #include "voxfield/limits.h"
@@ -282,6 +283,9 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
         mesh.positions.push_back({v[0], v[1], v[2]});
         mesh.normals.push_back({v[3], v[4], v[5]});
       }
+      // Every copy of a vertex is computed from the same samples by the same arithmetic: equal.
+      VOXFIELD_ASSERT(std::memcmp(mesh.positions[it->second].data(), v, 12) == 0 &&
+                      std::memcmp(mesh.normals[it->second].data(), v + 3, 12) == 0);
       mesh.indices[i] = it->second;
     }
   }
