@@ -13,6 +13,7 @@
 
 #include "gpu/recorder.h"
 #include "gpu_suite.h"
+#include "voxfield/gpu_mesh.h"
 #include "voxfield/gpu_terrain.h"
 #include "voxfield/gpu_terrain_vulkan.h"
 #include "voxfield/mesh_render.h"
@@ -209,6 +210,48 @@ TEST(GpuTerrain, RecordedIntoAnApplicationsCommandBuffer) {
     }
     EXPECT_EQ(differ, 0u);
     EXPECT_EQ(r.last_triangles(), mesh_terrain(t, MeshOptions{}).triangle_count());
+  }
+  voxfield::testing_backends::expect_no_validation_messages(Backend::kVulkan);
+}
+
+// Every pass strides over its work (dispatch_strided) rather than splitting it over y: with the
+// device's workgroup limit along x cut to 3 for the test — so classify, the pyramid's lower levels
+// and the traversal each run past the limit — marching cubes still gives the CPU's triangles and
+// the terrain renderer the same frame as with the real limit.
+TEST(GpuTerrain, PassesStridePastTheWorkgroupLimit) {
+  if (!test::gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = test::validated_context();
+  const TerrainField t = hills(TerrainStorage::kI16, false, {40, 36, 24});
+  MeshRenderOptions o;
+  o.width = 80;
+  o.height = 60;
+  const gpu::TerrainView view =
+      terrain_view(Camera::framing(Box3i::from_size(t.size()), 4.0 / 3), o);
+  gpu::TerrainRenderer normal(ctx);
+  normal.sync(t);
+  const Image want = normal.render(view);
+  std::uint32_t& limit = ctx->impl().limits.maxComputeWorkGroupCount[0];
+  const std::uint32_t saved = limit;
+  struct Restore {
+    std::uint32_t& limit;
+    std::uint32_t saved;
+    ~Restore() { limit = saved; }
+  } restore{limit, saved};
+  limit = 3;  // 192 invocations a dispatch: the 35 x 39 x 23 cells need 164 strides
+  {
+    gpu::TerrainRenderer strided(ctx);
+    strided.sync(t);
+    EXPECT_EQ(strided.render(view).rgb, want.rgb);
+    EXPECT_EQ(strided.last_triangles(), mesh_terrain(t, MeshOptions{}).triangle_count());
+    gpu::GpuMeshStats st;
+    const Mesh got = gpu::marching_cubes(*ctx, t, {}, &st);
+    const Mesh cpu = mesh_terrain(t, MeshOptions{});
+    EXPECT_EQ(got.triangle_count(), cpu.triangle_count());
+    EXPECT_EQ(got.vertex_count(), cpu.vertex_count());
+    // (Summed in the pyramid's triangle order, not the CPU's: equal to rounding.)
+    EXPECT_NEAR(mesh_stats(got).signed_volume_units3, mesh_stats(cpu).signed_volume_units3,
+                1e-9 * mesh_stats(cpu).signed_volume_units3);
+    ASSERT_GT(st.triangles, 3u * 64);  // the traversal strode too
   }
   voxfield::testing_backends::expect_no_validation_messages(Backend::kVulkan);
 }
