@@ -277,6 +277,8 @@ TEST(Mesh, WorldOffsetSurfacesAreTheMetricsBalls) {
   EXPECT_THROW(mesh_world(w, bad), InvalidArgument);
   bad.iso = 1e6;
   EXPECT_THROW(mesh_world(w, bad), InvalidArgument);
+  bad.iso = 0.5;  // between a solid and an air centre: no offset surface of its own
+  EXPECT_THROW(mesh_world(w, bad), InvalidArgument);
 }
 
 // Two voxels touching at a corner only: the dual meshers' vertex sits on a saddle of the

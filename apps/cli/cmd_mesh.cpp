@@ -108,7 +108,12 @@ int run_mesh(const MeshSettings& s) {
           "unit per voxel");
     LoadOptions lo;
     const World world = npy ? world_from_npy(*npy, s.in) : load_world(s.in, lo).world;
-    const Vec3i size = world.voxels.content_bounds().grown(1).size();
+    // mesh_world's domain: the content grown past the surface (by more for an offset surface).
+    const double world_iso = options.iso;
+    const Vec3i size = world.voxels.content_bounds()
+                           .grown(1 + static_cast<int>(std::ceil(std::max(world_iso, 0.0))) +
+                                  (world_iso > 0 ? 1 : 0))
+                           .size();
     for (int a = 0; a < 3; ++a)
       chunks = (a ? chunks : 1) * ((size[a] - 1 + s.chunk - 1) / std::max(1, s.chunk));
     start = std::chrono::steady_clock::now();
@@ -193,7 +198,7 @@ void add_mesh(CLI::App& app, Action& action) {
           CLI::IsMember({"mc", "sn", "dc", "marching-cubes", "surface-nets", "dual-contouring"}));
   cmd->add_option("--iso", s->iso,
                   "iso value (default 0): of a float volume; of a world, the offset surface that "
-                  "many voxels out from its solid voxels (negative: in)")
+                  "many voxels out from its solid voxels (negative: in; |iso| >= 1)")
       ->check(CLI::Number);
   cmd->add_option("--metric", s->metric,
                   "a world's field: euclidean (default), chebyshev or manhattan — the shape of "

@@ -87,6 +87,7 @@ bool Demo::draw_terrain(VulkanWindow::Screenshot* shot) {
   const int w = width(), h = height();
   const auto t0 = Clock::now();
   if (vk_ && terrain_->on_gpu()) {
+    terrain_->upload_edits();
     VkBufferImageCopy copy{};
     copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     copy.imageExtent = {static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(h), 1};

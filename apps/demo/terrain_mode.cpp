@@ -96,8 +96,16 @@ void TerrainMode::apply(const TerrainBrush& brush) {
   const std::uint64_t per_sample = settings_.storage == 0 ? 1 : settings_.storage == 1 ? 2 : 4;
   last_bytes_up_ = static_cast<std::uint64_t>(changed.volume()) * (per_sample + 1);
   last_chunks_ = 0;
-  if (gpu_) pending_.push_back(changed);  // uploaded with the frame's other edits (record_frame)
-  if (chunks_) {                          // the CPU mesh, when there is one, follows
+  if (gpu_ && !changed.empty()) {  // uploaded with the frame's other edits (upload_edits)
+    pending_.push_back(changed);
+    // Many edits between GPU frames (the CPU drawing meanwhile): one box holding them all.
+    if (pending_.size() > 16) {
+      Box3i all;
+      for (const Box3i& b : pending_) all = all.unite(b);
+      pending_.assign(1, all);
+    }
+  }
+  if (chunks_) {  // the CPU mesh, when there is one, follows
     last_chunks_ = chunks_->update(terrain_, changed).size();
     mesh_ = chunks_->merged();
     last_mesh_ms_ = ms_since(meshing);
@@ -166,14 +174,21 @@ Image TerrainMode::render(const FlyCamera& camera, int width, int height) {
   return render_mesh(mesh_, camera.camera(), o);
 }
 
+void TerrainMode::upload_edits() {
+  // The GPU draws from here on: the CPU mesh (made for triangle edges) is dropped, so edits do not
+  // re-mesh on the CPU too.
+  chunks_.reset();
+  mesh_ = {};
+  if (pending_.empty()) return;
+  // The edits since the last frame: their boxes' samples, one submit.
+  const auto start = std::chrono::steady_clock::now();
+  last_bytes_up_ = gpu_->sync(terrain_, pending_);
+  last_mesh_ms_ = ms_since(start);
+  pending_.clear();
+}
+
 VkBuffer TerrainMode::record_frame(VkCommandBuffer cmd, const FlyCamera& camera, int width,
                                    int height, gpu::PixelOrder order) {
-  if (!pending_.empty()) {  // the edits since the last frame: their boxes' samples, one submit
-    const auto start = std::chrono::steady_clock::now();
-    last_bytes_up_ = gpu_->sync(terrain_, pending_);
-    last_mesh_ms_ = ms_since(start);
-    pending_.clear();
-  }
   MeshRenderOptions o;
   o.width = width;
   o.height = height;

@@ -45,6 +45,9 @@ class TerrainMode {
   void edit_above(double x, double y, bool add, std::uint8_t material);
   // The CPU rasteriser's picture (meshing on the CPU first if only the GPU drew so far).
   Image render(const FlyCamera& camera, int width, int height);
+  // On the GPU (on_gpu() only): the edits since the last frame uploaded, before the frame is
+  // recorded (outside the window's frame, so a failure does not leave it half begun).
+  void upload_edits();
   // The GPU's frame recorded into the window's command buffer (on_gpu() only): the buffer of its
   // pixels in `order`, for the copy into the swapchain image.
   VkBuffer record_frame(VkCommandBuffer cmd, const FlyCamera& camera, int width, int height,

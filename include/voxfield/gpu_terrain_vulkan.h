@@ -12,10 +12,13 @@ namespace voxfield::gpu {
 // classify pass, the HistoPyramid, the draw's arguments, the indirect draw, and the copy of the
 // pixels into a buffer it returns — width x height packed 8-bit pixels in `order` (alpha 255),
 // top row first, readable by transfers: ready for vkCmdCopyBufferToImage into a UNORM swapchain
-// image. The buffer, the images and the frame's parameters are reused by the next frame: wait for
-// `cmd` before recording another. TerrainRenderer::sync may run while the frame executes (its
-// copies are ordered after it on the queue) or between recording and submitting it (the frame
-// begins with a barrier on everything submitted before it). TerrainRenderer::last_triangles()
+// image. Record it outside a render pass instance (it records copies, barriers and its own render
+// pass). The buffer, the images and the frame's parameters are reused by the next frame: wait for
+// `cmd` before recording another. A sync that uploads rows (after edits) may run while the frame
+// executes (its copies are ordered after it on the queue) or between recording and submitting it
+// (the frame begins with a barrier on everything submitted before it); a sync that copies the
+// whole field (the first, or a terrain of another shape) replaces the buffers the frame names, so
+// it must not run between recording a frame and submitting it. TerrainRenderer::last_triangles()
 // reads the count this frame drew once it has completed. Throws as TerrainRenderer::render.
 VkBuffer record_render(TerrainRenderer& renderer, VkCommandBuffer cmd, const TerrainView& view,
                        PixelOrder order);

@@ -135,13 +135,15 @@ MeshCounts mesh_volume_into(const ScalarVolume& volume, const MeshOptions& optio
 //    voxel centres — the same for every metric — with crossings on the faces between centres and
 //    exact axis normals. Vertex colours: the material of the solid voxel a vertex was made from
 //    (an edge's solid end; a cell's solid corner nearest the vertex).
-//  * At iso V != 0: the offset surface V voxels out from the solid voxels' centres (V < 0: in),
-//    shaped by the metric's ball — rounded (Euclidean), a box (Chebyshev), an octahedron
-//    (Manhattan) — with normals from the field's gradient: a safety margin around an obstacle, a
-//    shell. Vertex colours: the material of the nearest solid voxel.
+//  * At iso V with |V| >= 1: the offset surface V voxels out from the solid voxels' centres, or
+//    (V < 0) inside the solid |V| voxels from the air voxels' centres, shaped by the metric's ball
+//    — rounded (Euclidean), a box (Chebyshev), an octahedron (Manhattan) — with normals from the
+//    field's gradient: a safety margin around an obstacle, a shell. Vertex colours: the material of
+//    the nearest solid voxel.
 // The domain is the content grown past the surface by two voxels of air (beyond a bounded world's
-// bounds is air, so the surface closes there too). InvalidArgument for an iso that is not finite or
-// beyond ±1000 voxels.
+// bounds is air, so the surface closes there too). InvalidArgument for an iso that is not finite,
+// beyond ±1000 voxels, or strictly between -1 and 1 other than 0 (the field steps from -1 to +1
+// between a solid and an air centre).
 Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric = Metric::kEuclidean);
 
 // What a mesh is, topologically and geometrically.

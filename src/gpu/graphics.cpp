@@ -14,7 +14,18 @@ namespace {
 
 constexpr VkShaderStageFlags kDrawStages =
     VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+
+// The depth format: 32-bit float where the device can attach it (reversed depth keeps its
+// precision far away), else 24-bit or 16-bit fixed point (Vulkan guarantees 16-bit and one of
+// the other two).
+VkFormat depth_format(const Context::Impl& ctx) {
+  for (VkFormat f : {VK_FORMAT_D32_SFLOAT, VK_FORMAT_X8_D24_UNORM_PACK32, VK_FORMAT_D16_UNORM}) {
+    VkFormatProperties props;
+    vkGetPhysicalDeviceFormatProperties(ctx.physical, f, &props);
+    if (props.optimalTilingFeatures & VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT) return f;
+  }
+  return VK_FORMAT_D16_UNORM;
+}
 
 }  // namespace
 
@@ -32,7 +43,8 @@ RenderTarget::RenderTarget(Context::Impl& ctx, int width, int height, VkFormat c
   // A partly built target is released by the destructor of a fully constructed one only: build
   // into this object, and on a throw undo here.
   try {
-    const VkFormat formats[2] = {colour, kDepthFormat};
+    const VkFormat depth = depth_format(ctx);
+    const VkFormat formats[2] = {colour, depth};
     const VkImageUsageFlags usage[2] = {
         VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
         VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT};
@@ -76,7 +88,7 @@ RenderTarget::RenderTarget(Context::Impl& ctx, int width, int height, VkFormat c
     attachments[0].initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
     attachments[0].finalLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
     attachments[1] = attachments[0];
-    attachments[1].format = kDepthFormat;
+    attachments[1].format = depth;
     attachments[1].storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
     attachments[1].finalLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
     const VkAttachmentReference colour_ref{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};

@@ -22,9 +22,9 @@ namespace voxfield::gpu {
 
 class RenderTarget {
  public:
-  // width x height pixels of `colour` (an 8-bit UNORM RGBA or BGRA format) and a 32-bit float
-  // depth. Throws InvalidArgument for a size past the device's framebuffer limits, and what
-  // check() throws when Vulkan refuses.
+  // width x height pixels of `colour` (an 8-bit UNORM RGBA or BGRA format) and a depth (32-bit
+  // float where the device attaches it, else 24- or 16-bit fixed point). Throws InvalidArgument for
+  // a size past the device's framebuffer limits, and what check() throws when Vulkan refuses.
   RenderTarget(Context::Impl& ctx, int width, int height, VkFormat colour);
   ~RenderTarget();
   RenderTarget(const RenderTarget&) = delete;

@@ -111,8 +111,8 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
   };
   const int row_cells = cells.end.x - cells.begin.x;
   // Per cell of a row: the inside bits of its sample and of the next along x, y and z (bits 0..3),
-  // computed for the whole row in one loop the compiler vectorises; 8 bytes of slack for the skip.
-  std::vector<std::uint8_t> signs(static_cast<std::size_t>(row_cells) + 8);
+  // computed for the whole row in one loop the compiler vectorises.
+  std::vector<std::uint8_t> signs(static_cast<std::size_t>(row_cells));
   for (int z = cells.begin.z; z < cells.end.z; ++z)
     for (int y = cells.begin.y; y < cells.end.y; ++y) {
       // The edges starting in this row of cells join samples of rows (y, z), (y + 1, z) and

@@ -98,8 +98,8 @@ void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i c
   float v[8];
   const int row_cells = cells.end.x - b.x;
   // Per sample of a row of cells: its four sample rows' inside bits (a cell's x faces), computed
-  // for the whole row in one loop the compiler vectorises; 8 bytes of slack for the skip below.
-  std::vector<std::uint8_t> faces(static_cast<std::size_t>(row_cells) + 1 + 8);
+  // for the whole row in one loop the compiler vectorises.
+  std::vector<std::uint8_t> faces(static_cast<std::size_t>(row_cells) + 1);
   for (int z = cells.begin.z; z < cells.end.z; ++z)
     for (int y = cells.begin.y; y < cells.end.y; ++y) {
       // Rows whose four sample rows hold one sign only have no surface: most rows, away from it.

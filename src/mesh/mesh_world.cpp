@@ -64,7 +64,7 @@ std::function<std::array<double, 3>(const std::array<double, 3>&)> offset_gradie
       if (d < best) best = d, best_centre = centre, found = true;
     }
     std::array<double, 3> g{0, 0, 0};
-    if (!found) return g;  // no site in reach: the mesher's own estimate is used
+    if (!found) return g;  // no site in reach: zero, which the meshers' fallbacks handle
     const Vec3d d = at - best_centre;
     if (metric == Metric::kEuclidean) {
       const double l = d.length();
@@ -90,6 +90,11 @@ Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
   if (!(std::abs(iso) <= 1000))
     throw InvalidArgument("mesh: the iso value of a world (" + std::to_string(iso) +
                           " voxels) must be finite and within ±1000");
+  // Between a solid and an air centre the field steps from -1 to +1: a level in (-1, 1) other
+  // than 0 would land between them, not at its distance from either.
+  if (iso != 0 && std::abs(iso) < 1)
+    throw InvalidArgument("mesh: a world's offset surface is at least 1 voxel out (or in); iso " +
+                          std::to_string(iso) + " lies between neighbouring voxel centres");
   const Box3i content = world.voxels.content_bounds();
   if (content.empty()) return Mesh{};
   // The surface lies up to iso voxels out: the domain reaches two voxels past it.

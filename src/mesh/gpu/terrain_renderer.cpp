@@ -126,6 +126,7 @@ std::uint64_t TerrainRenderer::Impl::upload_whole(const TerrainField& terrain) {
                  "the upload of a " + to_string(n) + " terrain");
   // The buffers are replaced: frames recorded earlier must be done with the old ones first.
   if (synced) check(vkQueueWaitIdle(c.queue), "vkQueueWaitIdle");
+  synced = false;  // until every buffer below is made and filled: a failure leaves no frame
   sets.reset();
   const std::vector<std::uint32_t> table = mc::case_table();
   const std::array<double, 8> frame_data{next.origin[0], next.origin[1], next.origin[2], next.step,
@@ -140,7 +141,6 @@ std::uint64_t TerrainRenderer::Impl::upload_whole(const TerrainField& terrain) {
   view = Buffer(c, sizeof(L::MeshDrawView), kUsage, false);
   palette = Buffer(c, 256 * 4, kUsage, false);
   draw = Buffer(c, 16, kUsage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, true);
-  synced = false;  // until the copies below have run
 
   // One staging area: the codes and materials (read in the field's own width), then the tables.
   const std::uint64_t parts[6] = {sample_bytes,
@@ -226,16 +226,17 @@ std::uint64_t TerrainRenderer::Impl::upload_rows(const TerrainField& terrain,
 }
 
 void TerrainRenderer::Impl::ensure_target(int width, int height, VkFormat format) {
-  if (target && target->width() == width && target->height() == height &&
+  if (target && graphics && target->width() == width && target->height() == height &&
       target->format() == format)
     return;
   if (target) check(vkQueueWaitIdle(c.queue), "vkQueueWaitIdle");  // a frame may still use it
   graphics.reset();
   target.reset();
   sets.reset();
-  target = std::make_unique<RenderTarget>(c, width, height, format);
+  auto next = std::make_unique<RenderTarget>(c, width, height, format);
   graphics = std::make_unique<GraphicsKernel>(c, shaders::mesh_draw_vert(),
-                                              shaders::mesh_draw_frag(), *target);
+                                              shaders::mesh_draw_frag(), *next);
+  target = std::move(next);  // both made: a failure above leaves neither
 }
 
 L::MeshParams TerrainRenderer::Impl::params() const {
@@ -301,6 +302,8 @@ void check_frame(const TerrainRenderer::Impl& r, const TerrainView& o) {
       throw InvalidArgument("the GPU terrain renderer: the view has a non-finite vector");
   if (!(o.scale > 0) || !std::isfinite(o.scale))
     throw InvalidArgument("the GPU terrain renderer: the view's scale must be finite and > 0");
+  if (o.light_towards.length() == 0)
+    throw InvalidArgument("the GPU terrain renderer: the light's direction is zero");
   if (o.width < 1 || o.height < 1 ||
       static_cast<std::uint64_t>(o.width) * static_cast<std::uint64_t>(o.height) > (1u << 28))
     throw InvalidArgument("the GPU terrain renderer: a picture of " + std::to_string(o.width) +
@@ -424,6 +427,8 @@ VkBuffer record_render(TerrainRenderer& renderer, VkCommandBuffer cmd, const Ter
   r.record_frame(rec, options);
   rec.copy_colour(*r.target, r.pixels);
   rec.expose(r.pixels, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+  // The draw's count, for last_triangles() once the application's fence has signalled.
+  rec.expose(r.draw, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
   return r.pixels.handle();
 }
 
