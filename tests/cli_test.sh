@@ -452,7 +452,19 @@ expect_grep "save-world help vfw" "$tmp/out" "save-world.*vfw"
 ls -a | grep -q vftmp && { echo "FAIL: temporaries left behind"; fails=$((fails+1)); } || passes=$((passes+1))
 cd - >/dev/null
 
-check "showcase (small)" 0 "$V" showcase --size 48 --out "$tmp/showcase"
+if ldd "$V" | grep -q libasan; then
+  # Under LeakSanitizer: Mesa's lavapipe makes a one-time allocation with its first graphics
+  # pipeline (112 bytes whatever the number of terrain renderers, targets and pipelines made and
+  # destroyed — measured) and the Vulkan loader unloads it before LeakSanitizer runs, so that leak
+  # can neither be told from ours nor suppressed by name. The showcase runs once without a Vulkan
+  # driver, every CPU path leak-checked, and once with Vulkan without leak detection (ASan's and
+  # UBSan's other checks stay; the GPU paths' own tests run under them too).
+  check "showcase (small, no Vulkan driver, leak-checked)" 0 env VK_ICD_FILENAMES=/nonexistent.json \
+    VK_DRIVER_FILES=/nonexistent.json "$V" showcase --size 48 --out "$tmp/showcase-cpu"
+  check "showcase (small)" 0 env ASAN_OPTIONS=detect_leaks=0 "$V" showcase --size 48 --out "$tmp/showcase"
+else
+  check "showcase (small)" 0 "$V" showcase --size 48 --out "$tmp/showcase"
+fi
 expect_grep "showcase report" "$tmp/showcase/report.md" "jfa-seed"
 expect_grep "showcase round trip" "$tmp/showcase/report.md" "identical"
 expect_grep "showcase edits exact" "$tmp/showcase/report.md" "bit-identical to full rebuilds"
