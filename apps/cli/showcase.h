@@ -4,11 +4,14 @@
 
 #include <filesystem>
 #include <iomanip>
+#include <memory>
 #include <ostream>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "voxfield/error.h"
+#include "voxfield/gpu.h"
 #include "voxfield/render.h"
 #include "voxfield/world.h"
 
@@ -19,6 +22,18 @@ struct Timing {
   double ms;
   std::string note;
 };
+
+// The Vulkan device for a section's GPU part (a software one too), or null after the report says
+// why that part is not run here.
+inline std::shared_ptr<gpu::Context> showcase_vulkan(std::ostream& md) {
+  try {
+    std::string why;
+    return gpu::select_backend(Backend::kVulkan, {}, &why);
+  } catch (const GpuUnavailable& e) {
+    md << "\nOn Vulkan: not run here (" << e.what() << ").\n";
+    return nullptr;
+  }
+}
 
 inline std::string fixed(double v, int digits) {
   std::ostringstream os;

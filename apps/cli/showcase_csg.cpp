@@ -28,14 +28,8 @@ namespace {
 // interpreter meanwhile), against the CPU's pictures.
 void showcase_csg_vulkan(const std::filesystem::path& examples, const std::filesystem::path& out,
                          std::ostream& md, std::vector<Timing>& timings) {
-  std::shared_ptr<gpu::Context> ctx;
-  std::string why;
-  try {
-    ctx = gpu::select_backend(Backend::kVulkan, {}, &why);
-  } catch (const GpuUnavailable& e) {
-    md << "\nNo Vulkan device here (" << e.what() << "): the GPU pictures are skipped.\n";
-    return;
-  }
+  const std::shared_ptr<gpu::Context> ctx = showcase_vulkan(md);
+  if (!ctx) return;
   md << "\nThe same models sphere-traced on Vulkan (" << ctx->device().name
      << (ctx->device().hardware ? "" : "; a CPU emulating a GPU, so its times are not GPU speed")
      << "): rays advance cell by cell in rounds, each variant's rays run that variant's own "

@@ -96,14 +96,8 @@ struct StorageRun {
 void showcase_terrain_gpu(const fs::path& out, const Palette& palette,
                           const std::vector<NamedBrush>& brushes, const Camera& camera,
                           const Mesh& cpu_mesh, std::ostream& md, std::vector<Timing>& timings) {
-  std::shared_ptr<gpu::Context> context;
-  std::string why;
-  try {
-    context = gpu::select_backend(Backend::kVulkan, {}, &why);
-  } catch (const GpuUnavailable& e) {
-    md << "\nOn Vulkan: not run here (" << e.what() << ").\n";
-    return;
-  }
+  const std::shared_ptr<gpu::Context> context = showcase_vulkan(md);
+  if (!context) return;
   try {
     TerrainOptions to;
     to.samples = kSize;

@@ -105,14 +105,8 @@ void showcase_sheet_and_gpu(const std::filesystem::path& out, const VectorVolume
   md << "\nThe same field pushing a sheet of cloth (what grass or water does with it through "
         "`voxfield_vectors.glsl`): each point is displaced along z by the field's vector at its "
         "rest position, tinted by its direction.\n\n![the reactive sheet](vectors-sheet.png)\n";
-  std::shared_ptr<gpu::Context> context;
-  std::string why;
-  try {
-    context = gpu::select_backend(Backend::kVulkan, {}, &why);
-  } catch (const GpuUnavailable& e) {
-    md << "\nOn Vulkan: not run here (" << e.what() << ").\n";
-    return;
-  }
+  const std::shared_ptr<gpu::Context> context = showcase_vulkan(md);
+  if (!context) return;
   try {
     gpu::VectorSimulation gpu_sim(context, volume, VectorStorage::kRgba8, {}, 1.0);
     VectorAgents agents(20, 2026);

@@ -183,22 +183,7 @@ GraphicsKernel::GraphicsKernel(Context::Impl& ctx, const ShaderSource& vertex,
   const VkDevice d = ctx.device;
   VkShaderModule modules[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
   try {
-    const auto n = static_cast<std::uint32_t>(in.buffers.size());
-    std::vector<VkDescriptorSetLayoutBinding> bindings(n);
-    for (std::uint32_t b = 0; b < n; ++b)
-      bindings[b] = {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kDrawStages, nullptr};
-    VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    sl.bindingCount = n;
-    sl.pBindings = bindings.data();
-    check(vkCreateDescriptorSetLayout(d, &sl, nullptr, &kernel_.set_layout),
-          "vkCreateDescriptorSetLayout");
-    const VkPushConstantRange push{kDrawStages, 0, in.push_bytes};
-    VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    pl.setLayoutCount = 1;
-    pl.pSetLayouts = &kernel_.set_layout;
-    pl.pushConstantRangeCount = push.size > 0 ? 1 : 0;
-    pl.pPushConstantRanges = push.size > 0 ? &push : nullptr;
-    check(vkCreatePipelineLayout(d, &pl, nullptr, &kernel_.layout), "vkCreatePipelineLayout");
+    make_layouts(d, kernel_, kDrawStages);
 
     const ShaderSource* sources[2] = {&vertex, &fragment};
     VkPipelineShaderStageCreateInfo stages[2]{};

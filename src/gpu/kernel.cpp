@@ -120,6 +120,31 @@ ShaderInterface reflect(std::string_view name, std::span<const std::uint32_t> sp
   return out;
 }
 
+void make_layouts(VkDevice device, Kernel& k, VkShaderStageFlags stages) {
+  const auto n = static_cast<std::uint32_t>(k.interface.buffers.size());
+  std::vector<VkDescriptorSetLayoutBinding> bindings(n);
+  for (std::uint32_t b = 0; b < n; ++b)
+    bindings[b] = {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr};
+  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  sl.bindingCount = n;
+  sl.pBindings = bindings.data();
+  check(vkCreateDescriptorSetLayout(device, &sl, nullptr, &k.set_layout),
+        "vkCreateDescriptorSetLayout");
+  const VkPushConstantRange push{stages, 0, k.interface.push_bytes};
+  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pl.setLayoutCount = 1;
+  pl.pSetLayouts = &k.set_layout;
+  pl.pushConstantRangeCount = push.size > 0 ? 1 : 0;
+  pl.pPushConstantRanges = push.size > 0 ? &push : nullptr;
+  const VkResult r = vkCreatePipelineLayout(device, &pl, nullptr, &k.layout);
+  if (r != VK_SUCCESS) {
+    vkDestroyDescriptorSetLayout(device, k.set_layout, nullptr);
+    k.set_layout = VK_NULL_HANDLE;
+    k.layout = VK_NULL_HANDLE;
+    check(r, "vkCreatePipelineLayout");
+  }
+}
+
 const Kernel& KernelCache::get(VkDevice device, const ShaderSource& shader) {
   const std::uint64_t key = fnv1a(kFnvOffset, shader.spirv.data(), shader.spirv.size_bytes());
   if (auto it = kernels_.find(key); it != kernels_.end()) return *it->second;
@@ -140,23 +165,7 @@ const Kernel& KernelCache::get(VkDevice device, const ShaderSource& shader) {
       if (k->set_layout) vkDestroyDescriptorSetLayout(device, k->set_layout, nullptr);
     }
   } partial{device, k.get()};
-
-  const auto n = static_cast<std::uint32_t>(k->interface.buffers.size());
-  std::vector<VkDescriptorSetLayoutBinding> bindings(n);
-  for (std::uint32_t b = 0; b < n; ++b)
-    bindings[b] = {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  sl.bindingCount = n;
-  sl.pBindings = bindings.data();
-  check(vkCreateDescriptorSetLayout(device, &sl, nullptr, &k->set_layout),
-        "vkCreateDescriptorSetLayout");
-  const VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, k->interface.push_bytes};
-  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  pl.setLayoutCount = 1;
-  pl.pSetLayouts = &k->set_layout;
-  pl.pushConstantRangeCount = push.size > 0 ? 1 : 0;
-  pl.pPushConstantRanges = push.size > 0 ? &push : nullptr;
-  check(vkCreatePipelineLayout(device, &pl, nullptr, &k->layout), "vkCreatePipelineLayout");
+  make_layouts(device, *k, VK_SHADER_STAGE_COMPUTE_BIT);
 
   VkShaderModuleCreateInfo sm{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   sm.codeSize = shader.spirv.size_bytes();

@@ -43,6 +43,12 @@ struct ShaderInterface {
 ShaderInterface reflect(std::string_view name, std::span<const std::uint32_t> spirv,
                         VkShaderStageFlagBits stage = VK_SHADER_STAGE_COMPUTE_BIT);
 
+struct Kernel;
+// Makes `kernel`'s descriptor set layout (one storage buffer per binding of its interface) and its
+// pipeline layout (with its push-constant range), both visible to `stages`. On a throw, what was
+// made is destroyed and the handles left null.
+void make_layouts(VkDevice device, Kernel& kernel, VkShaderStageFlags stages);
+
 // Compiles a GLSL compute shader (#version 450, Vulkan rules) to SPIR-V with glslang. Thread-safe:
 // generated shaders may be compiled on worker threads. Throws InvalidArgument with glslang's log
 // (which names `name` and the line) when the source does not compile.

@@ -30,9 +30,7 @@ namespace L = layout;
 
 namespace {
 
-constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+using mc::kUsage;
 constexpr std::uint64_t kTriangleBytes = 3 * L::VF_MC_VERTEX_FLOATS * sizeof(float);
 
 // The field as it travels: the samples packed in their width, the frame and the inside rule.

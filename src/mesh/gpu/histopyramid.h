@@ -14,6 +14,11 @@
 
 namespace voxfield::gpu::mc {
 
+// The passes' device buffers: bound as storage, filled and read back by copies.
+constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+
 // The CPU's case table (cube_cases.h), flattened as layout.h's VF_MC_* describe it.
 std::vector<std::uint32_t> case_table();
 // The pyramid's levels, base first: (offset, dims x, y, z); the top holds one element. `total`

@@ -27,9 +27,7 @@ namespace L = layout;
 
 namespace {
 
-constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+using mc::kUsage;
 
 // The resident copy's shape: a terrain of another shape is copied whole.
 struct Shape {
