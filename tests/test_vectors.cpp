@@ -10,7 +10,8 @@
 
 #include "error_text.h"
 #include "vector_test_inputs.h"
-#include "vectors/blend.h"  // internal: the four-lane rgba8 blend, tested against blend()
+#include "vectors/blend.h"            // internal: the four-lane rgba8 blend, tested against blend()
+#include "vectors/vector_internal.h"  // internal: segment_t, tested against its definition
 #include "voxfield/error.h"
 #include "voxfield/vector_files.h"
 #include "voxfield/vector_world.h"
@@ -244,6 +245,51 @@ TEST(Vectors, FourLaneRgba8BlendEqualsTheDefinitionBitForBit) {
   EXPECT_GT(checked, 300000);
 }
 #endif
+
+// segment_t divides only where the clamp may not decide; every pass (and the oracle) goes through
+// it, so it is checked here against the clamp of the quotient itself, bit for bit (the sign of a
+// zero included): random points, points whose projection lies exactly on and one ulp either side
+// of -|ab|^2, 0 and |ab|^2, quotients that underflow, and a segment whose |ab|^2 overflows.
+TEST(Vectors, SegmentParameterIsTheClampedQuotientBitForBit) {
+  using detail::vectors::Segment;
+  const auto definition = [](const Segment& s, Vec3d p) {
+    return s.ab2 > 0 ? std::clamp(dot(p - s.a, s.ab) / s.ab2, 0.0, 1.0) : 0.0;
+  };
+  const auto same_bits = [](double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; };
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-2, 2);
+  std::int64_t checked = 0;
+  const auto check = [&](const Segment& s, Vec3d p) {
+    const double got = detail::vectors::segment_t(s, p), want = definition(s, p);
+    ASSERT_TRUE(same_bits(got, want) || (std::isnan(got) && std::isnan(want)))
+        << "got " << got << " want " << want << " along " << dot(p - s.a, s.ab) << " ab2 " << s.ab2;
+    ++checked;
+  };
+  for (int n = 0; n < 20000; ++n) {
+    const Vec3d a{u(rng), u(rng), u(rng)}, b{u(rng) * 0.1, u(rng) * 0.1, u(rng) * 0.1};
+    const Segment s = detail::vectors::segment_of({a + b, a, 0.5});
+    check(s, {u(rng), u(rng), u(rng)});
+    // Along the x axis from a, dot(p - a, ab) = x * ab.x: x chosen to land on the boundaries.
+    if (s.ab.x == 0) continue;
+    for (const double target : {-s.ab2, 0.0, s.ab2})
+      for (const double x0 : {target / s.ab.x, -0.0, 1e-320})
+        for (double x = std::nextafter(x0, -1e9), steps = 0; steps < 3;
+             x = std::nextafter(x, 1e9), ++steps)
+          check(s, {a.x + x, a.y, a.z});
+  }
+  // Quotients below the smallest double: -0 from the division, +0 from the clamp's shortcut
+  // would differ.
+  const Segment wide = detail::vectors::segment_of({{1e150, 0, 0}, {0, 0, 0}, 1});
+  check(wide, {-1e-300, 0, 0});
+  check(wide, {-0.0, 0, 0});
+  check(wide, {2e150, 0, 0});
+  // |ab|^2 overflows to infinity: the quotient is NaN or 0, never the shortcut's 1.
+  const Segment huge = detail::vectors::segment_of({{1e200, 0, 0}, {-1e200, 0, 0}, 1});
+  check(huge, {1e200, 0, 0});
+  check(huge, {-1e200, 0, 0});
+  check(huge, {0, 0, 0});
+  EXPECT_GT(checked, 200000);
+}
 
 TEST(Vectors, SimulationStepsGenerateDecayAndBlend) {
   const VectorVolume v = cube_volume(16);

@@ -81,12 +81,9 @@ std::vector<std::int32_t> vector_winners(const VectorVolume& volume,
       t.search_ms += detail::vectors::ms_since(start);
       break;
     case VectorAlgorithm::kSplat: {
-      detail::vectors::SplatScratch scratch;
-      scratch.winners = std::move(winners);
-      scratch.best.assign(scratch.winners.size(), -std::numeric_limits<double>::infinity());
+      std::vector<double> best(winners.size(), -std::numeric_limits<double>::infinity());
       detail::vectors::splat_winners(volume, sources, segments, options.rule, options.interrupter,
-                                     scratch);
-      winners = std::move(scratch.winners);
+                                     winners, best);
       t.search_ms += detail::vectors::ms_since(start);
       break;
     }

@@ -37,7 +37,7 @@ VectorTexel blend_vector_texels(const VectorTexel& current, const VectorTexel& p
 using detail::vectors::RowSpan;
 
 struct VectorSimulation::Scratch {
-  detail::vectors::SplatScratch splat;
+  detail::vectors::SlabPool splat;
   std::vector<RowSpan> current_rows, field_rows, next_rows, touched_rows;
 };
 
@@ -51,13 +51,12 @@ VectorSimulation::VectorSimulation(const VectorVolume& volume, VectorStorage sto
   if (!std::isfinite(decay_per_s) || decay_per_s < 0)
     throw InvalidArgument("vector simulation: the decay per second must be finite and >= 0");
   options_.interrupter = nullptr;  // never kept: step() is the long-lived object's only work
-  // Three textures and splatting's scratch (winner, best score and texel, 28 bytes) per voxel.
+  // Three textures per voxel (splatting's scratch is a few slabs, per thread).
   const std::uint64_t texel_bytes = storage == VectorStorage::kRgba8     ? 4
                                     : storage == VectorStorage::kRgba16f ? 8
                                                                          : 16;
-  require_memory(mul_sat(static_cast<std::uint64_t>(volume_.voxel_count()), 3 * texel_bytes + 28),
-                 0, "vector simulation " + to_string(volume_.resolution),
-                 "its three textures and scratch");
+  require_memory(mul_sat(static_cast<std::uint64_t>(volume_.voxel_count()), 3 * texel_bytes), 0,
+                 "vector simulation " + to_string(volume_.resolution), "its three textures");
   current_ = VectorTexture(volume_.resolution, storage);
   field_ = VectorTexture(volume_.resolution, storage);
   next_ = VectorTexture(volume_.resolution, storage);
@@ -289,18 +288,22 @@ struct Sweep {
         next(next_texels),
         rows(spans) {}
 
-  // winners and found (optional) for the whole volume; touched: a span per row.
+  // The rows of z layers [k0, k1): winners and found (optional) indexed from voxel (0, 0, k0),
+  // touched (a span per row) from row ny k0.
   void operator()(int k0, int k1, const std::int32_t* winners, const VectorTexel* found,
                   const RowSpan* touched_rows) const {
     const Vec3i n = v.resolution;
+    const std::int64_t slab_first = v.index(0, 0, k0);
     for (int k = k0; k < k1; ++k)
       for (int j = 0; j < n.y; ++j) {
         const std::size_t row = static_cast<std::size_t>(j) + static_cast<std::size_t>(n.y) * k;
         const std::int64_t first = v.index(0, j, k);
         const std::size_t at0 = static_cast<std::size_t>(first) * C::kBytes;
+        const auto local = static_cast<std::size_t>(first - slab_first);
         RowSpan& current_span = rows.current[row];
         RowSpan& next_span = rows.next[row];
-        const RowSpan touched = touched_rows[row], previous_span = rows.previous[row];
+        const RowSpan touched = touched_rows[row - static_cast<std::size_t>(n.y) * k0],
+                      previous_span = rows.previous[row];
         if (touched.empty()) {
           // No source now: the current row is zero, and each next texel the previous one decayed
           // (over the old next span too, which the decay of zero texels clears).
@@ -312,7 +315,7 @@ struct Sweep {
         }
         const RowSpan sweep = hull(hull(touched, previous_span), hull(current_span, next_span));
         const auto [now, later] =
-            pass.source_row(sweep, winners + first, found ? found + first : nullptr,
+            pass.source_row(sweep, winners + local, found ? found + local : nullptr,
                             centres.row(j, k), current + at0, previous + at0, next + at0);
         current_span = now;
         next_span = later;
@@ -351,17 +354,16 @@ void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) 
   if (options_.algorithm == VectorAlgorithm::kSplat) {
     // Each z slab is splatted, then swept at once by the same thread while its rows are in the
     // cache; the rows splatting wrote are the sweep's sources.
-    sc.splat.keep_texels = true;
     std::atomic<std::int64_t> splat_ns{0}, sweep_ns{0};
     detail::vectors::with_codec(field_.storage(), [&](auto codec) {
       const Sweep<decltype(codec)> sweep(volume_, segments, decay_s, current_.data(),
                                          field_.bytes().data(), next_.data(), spans);
-      detail::vectors::splat_winners(
-          volume_, sources, segments, options_.rule, nullptr, sc.splat,
-          [&](int k0, int k1) {
-            const std::int64_t slab = detail::vectors::now_ns();
-            sweep(k0, k1, sc.splat.winners.data(), sc.splat.texels.data(), sc.splat.won.data());
-            sweep_ns += detail::vectors::now_ns() - slab;
+      detail::vectors::splat_slabs(
+          volume_, sources, segments, options_.rule, sc.splat,
+          [&](const detail::vectors::SlabSplat& slab) {
+            const std::int64_t slab_start = detail::vectors::now_ns();
+            sweep(slab.k0, slab.k1, slab.winners, slab.texels, slab.won);
+            sweep_ns += detail::vectors::now_ns() - slab_start;
           },
           &splat_ns);
     });
@@ -386,7 +388,8 @@ void VectorSimulation::step(std::span<const VectorSource> sources, double dt_s) 
       const Sweep<decltype(codec)> sweep(volume_, segments, decay_s, current_.data(),
                                          field_.bytes().data(), next_.data(), spans);
       detail::vectors::for_each_slab(volume_, nullptr, "vector step", [&](int k0, int k1) {
-        sweep(k0, k1, winners.data(), nullptr, sc.touched_rows.data());
+        sweep(k0, k1, winners.data() + volume_.index(0, 0, k0), nullptr,
+              sc.touched_rows.data() + static_cast<std::size_t>(n.y) * k0);
       });
     });
     t.blend_ms = detail::vectors::ms_since(sweep_start);

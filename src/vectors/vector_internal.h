@@ -8,6 +8,9 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
+#include <memory>
+#include <mutex>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -28,10 +31,22 @@ inline Segment segment_of(const VectorSource& s) {
   return {s.previous, ab, dot(ab, ab), s.radius};
 }
 
+// The parameter of the point of the segment nearest p: clamp(dot(p - a, ab) / ab2, 0, 1), 0 for a
+// stationary source. The division is done only where the clamp may not decide: a correctly
+// rounded quotient is monotone, so below -ab2 it is at most -1 (clamped to +0, never -0) and at
+// or above a finite ab2 at least 1 (clamped to 1) — the same doubles as dividing every time, at
+// a tenth of the divisions for the paper's sources (segments a tenth of their radius long).
+inline double segment_t(const Segment& s, Vec3d p) {
+  if (!(s.ab2 > 0)) return 0;
+  const double along = dot(p - s.a, s.ab);
+  if (along < -s.ab2) return 0;
+  if (along >= s.ab2 && s.ab2 < std::numeric_limits<double>::infinity()) return 1;
+  return std::clamp(along / s.ab2, 0.0, 1.0);
+}
+
 // Distance from p to the segment; q receives the nearest point.
 inline double distance_to(const Segment& s, Vec3d p, Vec3d& q) {
-  double t = 0;
-  if (s.ab2 > 0) t = std::clamp(dot(p - s.a, s.ab) / s.ab2, 0.0, 1.0);
+  const double t = segment_t(s, p);
   q = s.a + s.ab * t;
   return (p - q).length();
 }
@@ -103,34 +118,47 @@ struct RowSpan {
   bool empty() const { return lo >= hi; }
 };
 
-// What splatting keeps between generations: winners and best scores, -1 and -inf everywhere
-// except inside the boxes of the last splat's sources, which reset() restores — so a step costs
-// what its sources cover, not the volume.
-struct SplatScratch {
-  std::vector<std::int32_t> winners;
-  std::vector<double> best;
-  std::vector<IndexBox> boxes;
-  // With keep_texels, each winner's direction and strength too (value_of's arithmetic on the
-  // distance the search computed anyway), valid where winners >= 0: a step's sweep then encodes
-  // them without computing the distance again. (Encoding here instead, once per improvement
-  // rather than once per texel, measured slower.)
-  bool keep_texels = false;
-  std::vector<VectorTexel> texels;
-  // With keep_texels, per row (j + ny k) the voxels [lo, hi) where some source won (lo >= hi:
-  // none): what a step's sweep must convert.
-  std::vector<RowSpan> won;
-  void prepare(const VectorVolume& v);  // sized and cleared once per volume
-  // Clears `last` (the last splat's boxes) within z layers [k0, k1).
-  void reset(const VectorVolume& v, std::span<const IndexBox> last, int k0, int k1);
+// One z slab's splat, layers [k0, k1), its arrays indexed from voxel (0, 0, k0): each voxel's
+// winner (-1: none) and best score; for a step, also each winner's direction and strength
+// (value_of's arithmetic on the distance the search computed anyway, valid where winners >= 0,
+// so the sweep encodes them without computing the distance again; encoding here instead, once
+// per improvement rather than once per texel, measured slower) and, per row j + ny (k - k0), the
+// voxels [lo, hi) where some source won: what the sweep must convert.
+struct SlabSplat {
+  int k0 = 0, k1 = 0;
+  std::int32_t* winners = nullptr;
+  double* best = nullptr;
+  VectorTexel* texels = nullptr;
+  RowSpan* won = nullptr;
 };
-// `after_slab`, when given, runs on each z slab [k0, k1) right after the slab is splatted, on the
-// same thread — a step's sweep of those rows, while they are in the cache; the time spent splatting
-// (without it) is added to *splat_ns.
+
+// Splatting into whole-volume arrays (generate_vectors): winners and best, -1 and -inf on entry.
 void splat_winners(const VectorVolume& v, std::span<const VectorSource> sources,
                    std::span<const Segment> segments, VectorRule rule, Interrupter* interrupter,
-                   SplatScratch& scratch,
-                   const std::function<void(int k0, int k1)>& after_slab = nullptr,
-                   std::atomic<std::int64_t>* splat_ns = nullptr);
+                   std::span<std::int32_t> winners, std::span<double> best);
+
+// A step's splatting: each z slab is splatted into a buffer of slab size (winners, scores,
+// texels and row spans: about 1 MB at 128^2 x 2 layers, so it stays in the core's cache, where a
+// volume-sized one went to memory on every write), then after_slab runs on it on the same thread
+// — the step's sweep of those rows — and the buffer is cleared where it was written and reused
+// by the next slab. The pool keeps one buffer per thread between steps.
+class SlabPool {
+ public:
+  struct Buffer;
+  SlabPool();
+  ~SlabPool();
+  std::unique_ptr<Buffer> acquire(const VectorVolume& v, int layers);
+  void release(std::unique_ptr<Buffer> buffer);
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<Buffer>> free_;
+};
+void splat_slabs(const VectorVolume& v, std::span<const VectorSource> sources,
+                 std::span<const Segment> segments, VectorRule rule, SlabPool& pool,
+                 const std::function<void(const SlabSplat&)>& after_slab,
+                 std::atomic<std::int64_t>* splat_ns);
+
 // The visualiser's camera, shared by the CPU's render_vectors and the GPU's view pass: the view
 // checked (InvalidArgument naming what is wrong), the eye and its basis, the march step and the
 // density per world unit.
