@@ -76,16 +76,32 @@ struct Chunk {
   std::vector<std::uint8_t> materials;  // edge³, x fastest
   std::uint8_t uniform_material = 0;
 
+  // Each width is its own fixed-size copy: a copy of `bytes` bytes compiles to a call to memcpy
+  // per sample, which (with the store-forwarding stall of reading its result back) was the
+  // largest cost of a brush.
   std::uint32_t raw(std::size_t i, int bytes) const {
     if (samples.empty()) return uniform;
-    std::uint32_t r = 0;
-    std::memcpy(&r, samples.data() + i * static_cast<std::size_t>(bytes),
-                static_cast<std::size_t>(bytes));
+    const std::uint8_t* p = samples.data() + i * static_cast<std::size_t>(bytes);
+    if (bytes == 1) return *p;
+    if (bytes == 2) {
+      std::uint16_t r;
+      std::memcpy(&r, p, 2);
+      return r;
+    }
+    std::uint32_t r;
+    std::memcpy(&r, p, 4);
     return r;
   }
   void set_raw(std::size_t i, int bytes, std::uint32_t r) {
-    std::memcpy(samples.data() + i * static_cast<std::size_t>(bytes), &r,
-                static_cast<std::size_t>(bytes));
+    std::uint8_t* p = samples.data() + i * static_cast<std::size_t>(bytes);
+    if (bytes == 1) {
+      *p = static_cast<std::uint8_t>(r);
+    } else if (bytes == 2) {
+      const auto r16 = static_cast<std::uint16_t>(r);
+      std::memcpy(p, &r16, 2);
+    } else {
+      std::memcpy(p, &r, 4);
+    }
   }
   std::uint8_t material(std::size_t i) const {
     return materials.empty() ? uniform_material : materials[i];
