@@ -1,4 +1,5 @@
-// voxfield convert IN OUT: between .vox and .npy (in an .npy, non-zero = that material).
+// voxfield convert IN OUT: between .vox, .npy and .vfw (in an .npy, non-zero = that material), and
+// to .vdb (an OpenVDB Int32 grid of materials; vdb.h).
 #include <iostream>
 
 #include "cli.h"
@@ -30,10 +31,10 @@ int run_convert(const ConvertSettings& s) {
 void add_convert(CLI::App& app, Action& action) {
   auto s = std::make_shared<ConvertSettings>();
   CLI::App* cmd = app.add_subcommand("convert",
-                                     "Convert a world between .vox, .npy and .vfw (chosen by "
-                                     "extension); the output is written atomically");
+                                     "Convert a world between .vox, .npy and .vfw, or to .vdb "
+                                     "(chosen by extension); the output is written atomically");
   cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
-  cmd->add_option("OUT", s->out, "output .vox, .npy or .vfw")->required();
+  cmd->add_option("OUT", s->out, "output .vox, .npy, .vfw or .vdb")->required();
   cmd->callback([s, &action] { action = [s] { return run_convert(*s); }; });
 }
 

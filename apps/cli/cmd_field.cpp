@@ -1,4 +1,5 @@
-// voxfield field IN -o OUT.npy [options]: a distance field of a world, written as .npy.
+// voxfield field IN -o OUT.npy|OUT.vdb [options]: a distance field of a world, written as .npy or
+// as an OpenVDB grid (a level set when signed; vdb.h).
 #include <fstream>
 #include <iostream>
 
@@ -10,6 +11,7 @@
 #include "voxfield/gpu_distance.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
+#include "voxfield/vdb.h"
 
 namespace voxfield::cli {
 namespace {
@@ -27,6 +29,7 @@ int run_field(const FieldSettings& s) {
   // Everything that can be wrong with the options is found before the world is loaded.
   Outputs outputs({s.in});
   outputs.expect(s.out, "-o");
+  const bool vdb_output = std::filesystem::path(s.out).extension() == ".vdb";  // else .npy
   outputs.expect(s.sites, "--sites");
   outputs.expect(s.packed, "--packed");
   outputs.expect(s.stats, "--stats");
@@ -58,7 +61,11 @@ int run_field(const FieldSettings& s) {
   const DistanceField& f = *computed;
 
   set_activity("writing " + s.out);
-  outputs.stage(s.out, encode_npy(field_volume(f, f.domain)));
+  if (vdb_output) {
+    outputs.stage(s.out, encode_vdb_field(f));
+  } else {
+    outputs.stage(s.out, encode_npy(field_volume(f, f.domain)));
+  }
   if (!s.sites.empty()) {
     if (!f.sites)
       throw InvalidArgument("--sites: the " + s.algorithm +
@@ -100,9 +107,12 @@ int run_field(const FieldSettings& s) {
 void add_field(CLI::App& app, Action& action) {
   auto s = std::make_shared<FieldSettings>();
   CLI::App* cmd = app.add_subcommand(
-      "field", "Compute a distance field and write it as .npy (a[x, y, z], like the input)");
-  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
-  cmd->add_option("-o,--output", s->out, "output .npy")->required();
+      "field",
+      "Compute a distance field and write it as .npy (a[x, y, z], like the input) or .vdb");
+  cmd->add_option("IN", s->in, "input .vox, .npy, .vfw or .vdb")->required();
+  cmd->add_option("-o,--output", s->out,
+                  "output .npy, or .vdb (an OpenVDB float grid: a level set when signed)")
+      ->required();
   s->field.add_to(cmd);
   cmd->add_option("--backend", s->backend,
                   "cpu (default), vulkan (any Vulkan device, software included) or auto "

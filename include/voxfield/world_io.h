@@ -1,7 +1,8 @@
 // voxfield — loading and saving worlds by file type, shared by every front end (CLI, demo,
 // Python): .vox (MagicaVoxel), .npy (NumPy: non-zero = that material) and .vfw (voxfield's world
-// file). The type comes from the extension; the file's magic is checked against it before the
-// rest of the file is read, so a mislabelled 256 MiB file is refused after 8 bytes.
+// file); .vdb (OpenVDB) is written, not read (vdb.h says why). The type comes from the extension;
+// the file's magic is checked against it before the rest of the file is read, so a mislabelled 256
+// MiB file is refused after 8 bytes.
 #pragma once
 
 #include <cstdint>
@@ -16,12 +17,12 @@
 
 namespace voxfield {
 
-enum class WorldFormat { kVox, kNpy, kVfw };
+enum class WorldFormat { kVox, kNpy, kVfw, kVdb };
 
 // The format named by a path's extension (case-insensitive). Throws InvalidArgument naming the
 // path for anything else.
 WorldFormat world_format_of(const std::filesystem::path& path);
-const char* world_format_name(WorldFormat f);  // "vox", "npy", "vfw"
+const char* world_format_name(WorldFormat f);  // "vox", "npy", "vfw", "vdb"
 
 struct LoadOptions {
   // Of the returned world; 0: a .vfw keeps the edge it was saved with, other files get 32.
@@ -41,7 +42,7 @@ struct LoadedWorld {
   std::vector<DistanceField> fields;  // .vfw only: the fields saved with the world
 };
 
-// Throws FormatError / IoError / ResourceLimitError naming the file.
+// Throws FormatError / IoError / ResourceLimitError naming the file (InvalidArgument for .vdb).
 LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& options = {});
 
 // The world in chunks of another edge and other bounds (Grid::rechunked), after counting what the

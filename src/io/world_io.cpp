@@ -9,6 +9,7 @@
 #include "voxfield/file.h"
 #include "voxfield/limits.h"
 #include "voxfield/npy.h"
+#include "voxfield/vdb.h"
 #include "voxfield/world_file.h"
 
 namespace voxfield {
@@ -37,6 +38,8 @@ void check_magic(const std::filesystem::path& path, WorldFormat f) {
       if (head.size() < 8 || std::memcmp(head.data(), "VXFWORLD", 8) != 0)
         (void)parse_world_file(head, name);
       break;
+    case WorldFormat::kVdb:
+      break;  // refused by load_world before
   }
 }
 
@@ -47,8 +50,9 @@ WorldFormat world_format_of(const std::filesystem::path& path) {
   if (ext == ".vox") return WorldFormat::kVox;
   if (ext == ".npy") return WorldFormat::kNpy;
   if (ext == ".vfw") return WorldFormat::kVfw;
+  if (ext == ".vdb") return WorldFormat::kVdb;
   throw InvalidArgument(path.string() + ": unknown file type \"" + ext +
-                        "\" (expected .vox, .npy or .vfw)");
+                        "\" (expected .vox, .npy, .vfw or .vdb)");
 }
 
 const char* world_format_name(WorldFormat f) {
@@ -59,12 +63,18 @@ const char* world_format_name(WorldFormat f) {
       return "npy";
     case WorldFormat::kVfw:
       return "vfw";
+    case WorldFormat::kVdb:
+      return "vdb";
   }
   return "?";
 }
 
 LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& options) {
   const WorldFormat format = world_format_of(path);
+  if (format == WorldFormat::kVdb)
+    throw InvalidArgument(path.string() +
+                          ": voxfield writes .vdb files but does not read them yet: OpenVDB's "
+                          "reader can abort the process on a damaged file (docs/interop.md)");
   check_magic(path, format);
   const std::uint64_t limit = effective_memory_limit(options.memory_limit_bytes);
   const int edge =
@@ -117,6 +127,8 @@ LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& opt
       }
       break;
     }
+    case WorldFormat::kVdb:
+      break;  // refused above
   }
   out.extent = out.extent.unite(out.world.voxels.content_bounds());
   return out;
@@ -171,6 +183,8 @@ std::vector<std::uint8_t> encode_world(const World& world, const Box3i& extent,
     }
     case WorldFormat::kVfw:
       return encode_world_file(world);
+    case WorldFormat::kVdb:
+      return encode_vdb_world(world, extent);
   }
   throw InvalidArgument("encode_world: unknown format");
 }
