@@ -355,7 +355,24 @@ bool VulkanWindow::draw_frame(const std::function<void(VkCommandBuffer, VkImage)
     return false;
   }
   if (acquired != VK_SUBOPTIMAL_KHR) check(acquired, "vkAcquireNextImageKHR");
-  check(vkResetFences(device_, 1, &fence_), "vkResetFences");
+  // The fence is reset just before the submission that signals it: a frame whose recording
+  // throws (an application's error in `fill`, say) must not leave the next frame waiting on a
+  // fence nothing will signal. Such a frame still consumes the acquire semaphore, with an empty
+  // submission that waits on it and signals the fence, so the next acquire finds it unsignalled.
+  struct Unrecorded {
+    VulkanWindow& w;
+    bool done = false;
+    ~Unrecorded() {
+      if (done) return;
+      const VkPipelineStageFlags stage = VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT;
+      VkSubmitInfo empty{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+      empty.waitSemaphoreCount = 1;
+      empty.pWaitSemaphores = &w.acquired_;
+      empty.pWaitDstStageMask = &stage;
+      if (vkResetFences(w.device_, 1, &w.fence_) == VK_SUCCESS)
+        (void)vkQueueSubmit(w.queue_, 1, &empty, w.fence_);
+    }
+  } unrecorded{*this};
   check(vkResetCommandBuffer(cmd_, 0), "vkResetCommandBuffer");
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -414,6 +431,8 @@ bool VulkanWindow::draw_frame(const std::function<void(VkCommandBuffer, VkImage)
   submit.pCommandBuffers = &cmd_;
   submit.signalSemaphoreCount = 1;
   submit.pSignalSemaphores = &rendered_[index];
+  check(vkResetFences(device_, 1, &fence_), "vkResetFences");
+  unrecorded.done = true;  // from here the frame's own submission owns the semaphore and fence
   check(vkQueueSubmit(queue_, 1, &submit, fence_), "vkQueueSubmit");
   VkPresentInfoKHR present{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
   present.waitSemaphoreCount = 1;
@@ -451,7 +470,6 @@ bool VulkanWindow::draw_frame(const std::function<void(VkCommandBuffer, VkImage)
 
 void VulkanWindow::run_once(const std::function<void(VkCommandBuffer)>& record) {
   check(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-  check(vkResetFences(device_, 1, &fence_), "vkResetFences");
   check(vkResetCommandBuffer(cmd_, 0), "vkResetCommandBuffer");
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -461,6 +479,8 @@ void VulkanWindow::run_once(const std::function<void(VkCommandBuffer)>& record) 
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;
   submit.pCommandBuffers = &cmd_;
+  check(vkResetFences(device_, 1, &fence_),
+        "vkResetFences");  // as draw_frame: never left unsignalled
   check(vkQueueSubmit(queue_, 1, &submit, fence_), "vkQueueSubmit");
   check(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
 }
