@@ -10,6 +10,10 @@ contouring) and keeps a deformable ``Terrain`` field edited by brushes (docs/mes
 ``Volume``, ``generate``, ``exact`` and ``Simulation`` (steps with decay and blend, sampling, the
 visualiser's picture).
 
+``voxfield.world`` holds worlds (``World``: NumPy arrays in and out, .vox/.npy/.vfw read, .vdb
+written too) and computes their exact distance fields (``distance_field``: every metric, sign,
+clamp, storage and spacing, nearest sites).
+
 ``voxfield.ndimage`` is a drop-in for ``scipy.ndimage.distance_transform_edt`` and
 ``distance_transform_cdt`` (same arguments, results, shapes, dtypes and index layout), computed
 by voxfield's exact separable transforms on every core, with what SciPy lacks: ``signed``,
@@ -26,6 +30,7 @@ from . import ndimage
 from . import csg
 from . import mesh
 from . import vectors
+from . import world
 
-__all__ = ["ndimage", "csg", "mesh", "vectors", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
+__all__ = ["ndimage", "csg", "mesh", "vectors", "world", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
            "Cancelled"]

@@ -5,7 +5,7 @@ import numpy as np
 import numpy.typing as npt
 
 import voxfield
-from voxfield import csg, mesh, ndimage, vectors
+from voxfield import csg, mesh, ndimage, vectors, world
 
 
 def sphere_field(n: int) -> npt.NDArray[np.float64]:
@@ -56,6 +56,15 @@ def vector_strength() -> float:
     return float(sample[0, 3]) + float(values[0, 3]) + sim.steps + sim.last_times["total_ms"] * 0
 
 
+def world_field() -> float:
+    a = np.zeros((8, 8, 8), dtype=np.uint8)
+    a[2:5, 2:5, 2:5] = 3
+    w = world.World(a, origin=(1, 0, 0))
+    f: world.Field = world.distance_field(w, metric="euclidean", signed=True, sites=True)
+    assert f.sites is not None and w.extent == ((1, 0, 0), (9, 8, 8))
+    return float(f.decoded()[0, 0, 0]) + float(w.to_numpy().sum()) * 0
+
+
 def refused() -> bool:
     try:
         csg.Model("(sphere", "bad.sdf")
@@ -74,4 +83,5 @@ if __name__ == "__main__":
     assert refused()
     assert terrain_triangles() > 0
     assert vector_strength() > 1
+    assert world_field() > 2
     print("typed use: ok")

@@ -1,0 +1,242 @@
+// voxfield.world's engine: worlds (materials on a sparse chunked grid, a 256-colour palette) to
+// and from NumPy arrays and files (.vox, .npy, .vfw; .vdb written), and their exact distance
+// fields (every metric, storage, clamp, anisotropic spacing, nearest sites). The GIL is released
+// while voxfield works; Ctrl-C stops a long field (voxfield.Cancelled).
+//
+// Arrays are indexed a[x, y, z] as voxfield's .npy files and scipy.ndimage's inputs: element
+// [i, j, k] is voxel origin + (i, j, k). A world's voxels live in chunks, not in one array, so
+// arrays are copies (a view would pin every chunk dense).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <optional>
+#include <string>
+
+#include "signals.h"
+#include "voxfield/distance.h"
+#include "voxfield/error.h"
+#include "voxfield/limits.h"
+#include "voxfield/parallel.h"
+#include "voxfield/world_io.h"
+
+namespace py = pybind11;
+
+namespace voxfield::python {
+namespace {
+
+// A world and the volume its file declared (the extent arrays are taken over by default).
+struct PyWorld {
+  World world;
+  Box3i extent;
+};
+
+using Triple = std::array<int, 3>;
+Vec3i vec3(const Triple& t) { return {t[0], t[1], t[2]}; }
+py::tuple triple(Vec3i v) { return py::make_tuple(v.x, v.y, v.z); }
+
+// The box [begin, end) given as two triples, or the world's extent united with its content.
+Box3i box_of(const PyWorld& w, const std::optional<std::pair<Triple, Triple>>& box) {
+  if (box) return Box3i{vec3(box->first), vec3(box->second)};
+  return w.extent.unite(w.world.voxels.content_bounds());
+}
+
+// C-order arrays a[x, y, z] <-> voxfield's dense x-fastest layout: a transposed copy.
+template <class T>
+py::array_t<T> to_array(const std::vector<T>& dense, Vec3i size) {
+  py::array_t<T, py::array::f_style> out({size.x, size.y, size.z});
+  std::memcpy(out.mutable_data(), dense.data(), dense.size() * sizeof(T));
+  return out;
+}
+
+std::string repr(const PyWorld& w) {
+  const Box3i b = w.extent.unite(w.world.voxels.content_bounds());
+  return "voxfield.world.World(extent=" + (b.empty() ? std::string("empty") : to_string(b)) +
+         ", solid=" + std::to_string(w.world.solid_count()) +
+         ", chunk=" + std::to_string(w.world.voxels.chunk_edge()) + ")";
+}
+
+}  // namespace
+
+void bind_world(py::module_& parent) {
+  py::module_ m = parent.def_submodule("world", "Worlds, their files and their exact fields");
+  py::class_<PyWorld>(m, "World",
+                      "Materials on a sparse chunked grid (0 = air) and a 256-entry RGBA palette")
+      .def(py::init([](std::optional<py::array_t<std::uint8_t, py::array::f_style |
+                                                                   py::array::forcecast>>
+                           materials,
+                       Triple origin, int chunk) {
+             auto w = std::make_unique<PyWorld>(PyWorld{World(chunk), {}});
+             if (materials) {
+               if (materials->ndim() != 3)
+                 throw InvalidArgument("materials must be a 3-D array a[x, y, z]");
+               const Vec3i size{static_cast<int>(materials->shape(0)),
+                                static_cast<int>(materials->shape(1)),
+                                static_cast<int>(materials->shape(2))};
+               w->extent = Box3i{vec3(origin), vec3(origin) + size};
+               const std::uint8_t* data = materials->data();
+               py::gil_scoped_release release;
+               w->world.voxels.copy_from_dense(w->extent, data);
+               w->world.voxels.compact();
+             }
+             return w;
+           }),
+           py::arg("materials") = py::none(), py::arg("origin") = Triple{0, 0, 0},
+           py::arg("chunk") = 32,
+           "A world from a 3-D array of materials a[x, y, z] (any integer dtype, 0..255; element "
+           "[i, j, k] is voxel origin + (i, j, k)), or an empty one; chunk: 8..128, a power of two")
+      .def_static(
+          "load",
+          [](const std::string& path, int chunk) {
+            LoadOptions o;
+            o.chunk_edge = chunk;
+            LoadedWorld in;
+            {
+              py::gil_scoped_release release;
+              in = load_world(path, o);
+            }
+            return std::make_unique<PyWorld>(PyWorld{std::move(in.world), in.extent});
+          },
+          py::arg("path"), py::arg("chunk") = 32,
+          "Reads a .vox, .npy or .vfw file (the type from its extension); errors name the file")
+      .def(
+          "save",
+          [](const PyWorld& w, const std::string& path) {
+            py::gil_scoped_release release;
+            save_world(w.world, w.extent, path);
+          },
+          py::arg("path"),
+          "Writes .vox, .npy, .vfw or .vdb (by extension) atomically: a failed save leaves the "
+          "old file")
+      .def_property_readonly("solid_count", [](const PyWorld& w) { return w.world.solid_count(); })
+      .def_property_readonly(
+          "extent",
+          [](const PyWorld& w) {
+            const Box3i b = w.extent.unite(w.world.voxels.content_bounds());
+            return py::make_tuple(triple(b.begin), triple(b.end));
+          },
+          "(begin, end): the volume the file declared united with the content, half-open")
+      .def_property_readonly(
+          "content_bounds",
+          [](const PyWorld& w) {
+            const Box3i b = w.world.voxels.content_bounds();
+            return py::make_tuple(triple(b.begin), triple(b.end));
+          },
+          "(begin, end) of the solid voxels, half-open; equal points when there are none")
+      .def_property_readonly("chunk", [](const PyWorld& w) { return w.world.voxels.chunk_edge(); })
+      .def_property(
+          "palette",
+          [](const PyWorld& w) {
+            py::array_t<std::uint8_t> p({256, 4});
+            std::memcpy(p.mutable_data(), w.world.palette.data(), 256 * 4);
+            return p;
+          },
+          [](PyWorld& w, const py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>& p) {
+            if (p.ndim() != 2 || p.shape(0) != 256 || p.shape(1) != 4)
+              throw InvalidArgument("palette must be a (256, 4) array of RGBA bytes");
+            std::memcpy(w.world.palette.data(), p.data(), 256 * 4);
+          },
+          "(256, 4) uint8 RGBA; entry m colours material m (entry 0 belongs to air)")
+      .def(
+          "to_numpy",
+          [](const PyWorld& w, std::optional<std::pair<Triple, Triple>> box) {
+            const Box3i b = box_of(w, box);
+            if (b.empty()) throw InvalidArgument("to_numpy: the box is empty");
+            std::vector<std::uint8_t> dense;
+            {
+              py::gil_scoped_release release;
+              require_memory(dense_bytes(b, 1), 0, "World.to_numpy",
+                             "an array of " + to_string(b.size()) + " voxels");
+              dense.resize(static_cast<std::size_t>(b.volume()));
+              w.world.voxels.copy_to_dense(b, dense.data());
+            }
+            return to_array(dense, b.size());
+          },
+          py::arg("box") = py::none(),
+          "The materials of box ((x0, y0, z0), (x1, y1, z1)) (default: the extent) as uint8 "
+          "a[x, y, z]")
+      .def(
+          "fill",
+          [](PyWorld& w, Triple begin, Triple end, int material) {
+            if (material < 0 || material > 255)
+              throw InvalidArgument("material must be 0..255, not " + std::to_string(material));
+            const Box3i b{vec3(begin), vec3(end)};
+            py::gil_scoped_release release;
+            w.world.voxels.fill(b, static_cast<std::uint8_t>(material));
+          },
+          py::arg("begin"), py::arg("end"), py::arg("material"),
+          "Sets every voxel of [begin, end) to material (0: air)")
+      .def("__repr__", &repr);
+
+  m.def(
+      "distance_field",
+      [](const PyWorld& w, const std::string& metric, bool is_signed, double max_distance,
+         const std::string& storage, std::array<double, 3> spacing, bool sites,
+         std::optional<std::pair<Triple, Triple>> box, int threads) {
+        DistanceOptions o;
+        o.metric = parse_metric(metric);
+        o.signed_distance = is_signed;
+        o.max_distance = max_distance;
+        o.storage = parse_storage(storage);
+        o.spacing = spacing;
+        o.nearest_sites = sites;
+        o.domain = box_of(w, box);
+        if (o.domain->empty()) throw InvalidArgument("distance_field: the world holds no volume");
+        PythonSignals signals;
+        o.interrupter = &signals;
+        const Vec3i size = o.domain->size();
+        std::vector<std::uint8_t> values;  // the stored values, x fastest
+        std::vector<std::int16_t> offsets;
+        std::size_t width = 0;
+        DistanceEncoding encoding;
+        {
+          py::gil_scoped_release release;
+          std::optional<ThreadLimit> limit;
+          if (threads > 0) limit.emplace(threads);
+          const DistanceField f = compute_distance_field(w.world, o);
+          encoding = f.encoding;
+          std::visit(
+              [&](const auto& g) {
+                using T = typename std::decay_t<decltype(g)>::value_type;
+                width = sizeof(T);
+                values.resize(static_cast<std::size_t>(f.domain.volume()) * sizeof(T));
+                g.copy_to_dense(f.domain, reinterpret_cast<T*>(values.data()));
+              },
+              f.values);
+          if (sites) {
+            std::vector<SiteOffset> s(static_cast<std::size_t>(f.domain.volume()));
+            f.sites->copy_to_dense(f.domain, s.data());
+            offsets.resize(3 * s.size());
+            std::memcpy(offsets.data(), s.data(), offsets.size() * sizeof(std::int16_t));
+          }
+        }
+        py::array distances;
+        const std::vector<py::ssize_t> shape{size.x, size.y, size.z};
+        const auto strides = [&](std::size_t bytes) {
+          return std::vector<py::ssize_t>{static_cast<py::ssize_t>(bytes),
+                                          static_cast<py::ssize_t>(bytes) * size.x,
+                                          static_cast<py::ssize_t>(bytes) * size.x * size.y};
+        };
+        if (width == 1) distances = py::array_t<std::uint8_t>(shape, strides(1));
+        else if (width == 2) distances = py::array_t<std::uint16_t>(shape, strides(2));
+        else distances = py::array_t<float>(shape, strides(4));
+        std::memcpy(distances.mutable_data(), values.data(), values.size());
+        py::dict info;
+        info["scale"] = encoding.scale;
+        info["bias"] = encoding.bias;
+        if (!sites) return py::make_tuple(distances, info);
+        py::array_t<std::int16_t> s({static_cast<py::ssize_t>(size.x), static_cast<py::ssize_t>(size.y),
+                                     static_cast<py::ssize_t>(size.z), py::ssize_t{3}},
+                                    {py::ssize_t{6}, py::ssize_t{6} * size.x,
+                                     py::ssize_t{6} * size.x * size.y, py::ssize_t{2}});
+        std::memcpy(s.mutable_data(), offsets.data(), offsets.size() * sizeof(std::int16_t));
+        return py::make_tuple(distances, info, s);
+      },
+      py::arg("world"), py::arg("metric") = "euclidean", py::arg("signed") = false,
+      py::arg("max_distance") = 0.0, py::arg("storage") = "f32",
+      py::arg("spacing") = std::array<double, 3>{1, 1, 1}, py::arg("sites") = false,
+      py::arg("box") = py::none(), py::arg("threads") = 0, "See voxfield.world.distance_field");
+}
+
+}  // namespace voxfield::python

@@ -1,0 +1,53 @@
+# Type stubs of voxfield.world (World is implemented by the extension, voxfield._voxfield.world).
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["World", "Field", "distance_field"]
+
+class World:
+    def __init__(
+        self, materials: npt.ArrayLike | None = None, origin: Sequence[int] = ..., chunk: int = 32
+    ) -> None: ...
+    @staticmethod
+    def load(path: str, chunk: int = 32) -> World: ...
+    def save(self, path: str) -> None: ...
+    @property
+    def solid_count(self) -> int: ...
+    @property
+    def extent(self) -> tuple[tuple[int, int, int], tuple[int, int, int]]: ...
+    @property
+    def content_bounds(self) -> tuple[tuple[int, int, int], tuple[int, int, int]]: ...
+    @property
+    def chunk(self) -> int: ...
+    @property
+    def palette(self) -> npt.NDArray[np.uint8]: ...
+    @palette.setter
+    def palette(self, value: npt.ArrayLike) -> None: ...
+    def to_numpy(
+        self, box: tuple[Sequence[int], Sequence[int]] | None = None
+    ) -> npt.NDArray[np.uint8]: ...
+    def fill(self, begin: Sequence[int], end: Sequence[int], material: int) -> None: ...
+
+@dataclass
+class Field:
+    distances: np.ndarray
+    scale: float
+    bias: int
+    origin: tuple[int, int, int]
+    sites: np.ndarray | None = ...
+    def decoded(self) -> np.ndarray: ...
+
+def distance_field(
+    world: World,
+    metric: str = "euclidean",
+    signed: bool = False,
+    max_distance: float = 0.0,
+    storage: str = "f32",
+    spacing: Sequence[float] = ...,
+    sites: bool = False,
+    box: tuple[Sequence[int], Sequence[int]] | None = None,
+    threads: int = 0,
+) -> Field: ...

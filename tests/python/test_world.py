@@ -1,0 +1,120 @@
+"""voxfield.world against NumPy, SciPy and the CLI.
+
+Worlds round-trip through arrays and files (the CLI's .npy of the same .vox is the oracle); exact
+fields equal scipy.ndimage's transforms (Euclidean with anisotropic spacing, taxicab, chessboard)
+and the CLI's signed fields, integer storages and nearest sites byte for byte; errors are
+voxfield's exceptions naming what is wrong.
+
+Run by CTest with PYTHONPATH pointing at the build's python/ directory (and VOXFIELD, VOX_CORPUS).
+"""
+
+import os
+import subprocess
+
+import numpy as np
+import pytest
+import scipy.ndimage as sn
+
+import voxfield
+from voxfield.world import Field, World, distance_field
+
+CORPUS = os.environ.get("VOX_CORPUS")
+CLI = os.environ.get("VOXFIELD")
+needs_cli = pytest.mark.skipif(not CLI or not CORPUS, reason="needs the voxfield CLI and corpus")
+
+
+def random_world(shape=(23, 17, 29), density=0.1, seed=4):
+    rng = np.random.default_rng(seed)
+    a = (rng.random(shape) < density) * rng.integers(1, 256, shape)
+    return a.astype(np.uint8)
+
+
+def test_arrays_round_trip_with_their_origin():
+    a = random_world()
+    w = World(a, origin=(-3, 5, 2), chunk=16)
+    assert w.extent == ((-3, 5, 2), (20, 22, 31))
+    assert w.solid_count == int(np.count_nonzero(a))
+    np.testing.assert_array_equal(w.to_numpy(), a)
+    # A box reaching outside the world reads air there.
+    part = w.to_numpy(((-5, 5, 2), (0, 8, 4)))
+    np.testing.assert_array_equal(part[2:], a[:3, :3, :2])
+    assert not part[:2].any()
+    w.fill((0, 6, 3), (2, 8, 5), 200)
+    assert (w.to_numpy(((0, 6, 3), (2, 8, 5))) == 200).all()
+    p = w.palette
+    p[7] = (1, 2, 3, 4)
+    w.palette = p
+    np.testing.assert_array_equal(w.palette[7], (1, 2, 3, 4))
+    assert "solid=" in repr(w)
+
+
+def test_files_round_trip(tmp_path):
+    a = random_world()
+    w = World(a)
+    for ext in ("vox", "npy", "vfw"):
+        path = str(tmp_path / f"w.{ext}")
+        w.save(path)
+        back = World.load(path)
+        np.testing.assert_array_equal(back.to_numpy(w.extent), a, err_msg=ext)
+    np.testing.assert_array_equal(np.load(tmp_path / "w.npy"), a)
+    w.save(str(tmp_path / "w.vdb"))  # written for OpenVDB tools (tests/test_vdb.cpp reads it)
+    assert (tmp_path / "w.vdb").stat().st_size > 0
+    with pytest.raises(voxfield.InvalidArgument, match="does not read them yet"):
+        World.load(str(tmp_path / "w.vdb"))
+
+
+@needs_cli
+def test_real_files_read_as_the_cli_reads_them(tmp_path):
+    for name in ("ephtracy_T-Rex", "ephtracy_menger"):
+        vox = os.path.join(CORPUS, name + ".vox")
+        out = tmp_path / f"{name}.npy"
+        subprocess.run([CLI, "convert", vox, str(out)], check=True, capture_output=True)
+        np.testing.assert_array_equal(World.load(vox).to_numpy(), np.load(out), err_msg=name)
+
+
+def test_unsigned_fields_equal_scipy():
+    a = random_world(density=0.02)
+    w = World(a)
+    air = a == 0
+    f = distance_field(w, metric="euclidean", spacing=(1.0, 2.0, 0.5))
+    assert isinstance(f, Field) and f.distances.dtype == np.float32 and f.sites is None
+    want = sn.distance_transform_edt(air, sampling=(1.0, 2.0, 0.5)).astype(np.float32)
+    np.testing.assert_array_equal(f.distances, want)
+    for metric, scipy_metric in (("manhattan", "taxicab"), ("chebyshev", "chessboard")):
+        got = distance_field(w, metric=metric).distances
+        np.testing.assert_array_equal(got, sn.distance_transform_cdt(air, metric=scipy_metric),
+                                      err_msg=metric)
+
+
+@needs_cli
+def test_signed_integer_and_site_fields_equal_the_cli(tmp_path):
+    vox = os.path.join(CORPUS, "ephtracy_T-Rex.vox")
+    w = World.load(vox)
+    for metric, storage, clamp in (("euclidean", "f32", 0.0), ("euclidean", "u8", 6.0),
+                                   ("manhattan", "u16", 0.0), ("chebyshev", "f32", 3.0)):
+        d, s = tmp_path / "d.npy", tmp_path / "s.npy"
+        subprocess.run([CLI, "field", vox, "-o", str(d), "--sites", str(s), "--metric", metric,
+                        "--signed", "--storage", storage, "--max-distance", str(clamp)],
+                       check=True, capture_output=True)
+        f = distance_field(w, metric=metric, signed=True, storage=storage, max_distance=clamp,
+                           sites=True)
+        what = f"{metric} {storage} {clamp}"
+        np.testing.assert_array_equal(f.distances, np.load(d), err_msg=what)
+        np.testing.assert_array_equal(f.sites, np.load(s), err_msg=what)
+        if storage != "f32":  # stored = bias + floor(d * scale), signed fields biased
+            assert f.bias == (128 if storage == "u8" else 32768), what
+            solid = w.to_numpy() > 0
+            assert (f.decoded()[solid] < 0).all() and (f.decoded()[~solid] > 0).all(), what
+
+
+def test_errors_are_voxfields():
+    with pytest.raises(voxfield.IoError, match="nowhere.vox"):
+        World.load("/nonexistent/nowhere.vox")
+    with pytest.raises(voxfield.InvalidArgument, match="3-D"):
+        World(np.zeros((4, 4), np.uint8))
+    with pytest.raises(voxfield.InvalidArgument, match="metric"):
+        distance_field(World(random_world()), metric="cosine")
+    with pytest.raises(voxfield.InvalidArgument, match="material"):
+        World().fill((0, 0, 0), (1, 1, 1), 300)
+    with pytest.raises(voxfield.InvalidArgument, match="palette"):
+        World().palette = np.zeros((255, 4), np.uint8)
