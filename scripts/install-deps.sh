@@ -21,7 +21,7 @@ packages=(
   libgtest-dev                       # tests
   clang libclang-rt-14-dev           # the fuzz preset: libFuzzer with ASan + UBSan (CI's fuzz smoke)
   clang-format                       # the format check (scripts/check_format.sh, a test)
-  python3 python3-numpy python3-scipy # test oracles: NumPy reads and writes .npy, SciPy's distance transforms
+  python3 python3-numpy python3-scipy python3-pil # test oracles: NumPy reads and writes .npy, SciPy's distance transforms, Pillow reads PNG frames
   python3-skimage                    # test oracle: scikit-image's marching_cubes for the meshers
   openscad                           # test oracle: OpenSCAD's .csg and STL of its bundled examples (CSG import)
   python3-dev pybind11-dev python3-pytest  # the Python package (pybind11 bindings) and its tests

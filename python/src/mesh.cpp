@@ -16,6 +16,7 @@
 #include <shared_mutex>
 #include <string>
 
+#include "mesh_arrays.h"
 #include "signals.h"
 #include "voxfield/error.h"
 #include "voxfield/mesh.h"
@@ -28,22 +29,6 @@ namespace voxfield::python {
 namespace {
 
 using Volume = py::array_t<float, py::array::f_style | py::array::forcecast>;
-
-// (vertices float32 (V, 3), faces uint32 (F, 3), normals float32 (V, 3)[, colors uint8 (V, 3)]).
-py::tuple to_arrays(const Mesh& mesh, bool with_colors) {
-  const auto nv = static_cast<py::ssize_t>(mesh.positions.size());
-  py::array_t<float> vertices({nv, py::ssize_t{3}}), normals({nv, py::ssize_t{3}});
-  py::array_t<std::uint32_t> faces(
-      {static_cast<py::ssize_t>(mesh.triangle_count()), py::ssize_t{3}});
-  std::memcpy(vertices.mutable_data(), mesh.positions.data(), mesh.positions.size() * 12);
-  std::memcpy(normals.mutable_data(), mesh.normals.data(), mesh.normals.size() * 12);
-  std::memcpy(faces.mutable_data(), mesh.indices.data(), mesh.indices.size() * 4);
-  if (!with_colors) return py::make_tuple(vertices, faces, normals);
-  py::array_t<std::uint8_t> colors({nv, py::ssize_t{3}});
-  if (!mesh.colors.empty())
-    std::memcpy(colors.mutable_data(), mesh.colors.data(), mesh.colors.size() * 3);
-  return py::make_tuple(vertices, faces, normals, colors);
-}
 
 MeshOptions mesh_options(const std::string& algorithm, int chunk) {
   MeshOptions o;

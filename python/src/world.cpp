@@ -1,6 +1,7 @@
 // voxfield.world's engine: worlds (materials on a sparse chunked grid, a 256-colour palette) to
-// and from NumPy arrays and files (.vox, .npy, .vfw; .vdb written), and their exact distance
-// fields (every metric, storage, clamp, anisotropic spacing, nearest sites). The GIL is released
+// and from NumPy arrays and files (.vox, .npy, .vfw; .vdb written), their exact distance fields
+// (every metric, storage, clamp, anisotropic spacing, nearest sites), frames of the DDA ray
+// marcher and meshes of their surfaces. The GIL is released
 // while voxfield works; Ctrl-C stops a long field (voxfield.Cancelled).
 //
 // Arrays are indexed a[x, y, z] as voxfield's .npy files and scipy.ndimage's inputs: element
@@ -14,11 +15,14 @@
 #include <optional>
 #include <string>
 
+#include "mesh_arrays.h"
 #include "signals.h"
 #include "voxfield/distance.h"
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
+#include "voxfield/mesh.h"
 #include "voxfield/parallel.h"
+#include "voxfield/render.h"
 #include "voxfield/world_io.h"
 
 namespace py = pybind11;
@@ -33,8 +37,12 @@ struct PyWorld {
 };
 
 using Triple = std::array<int, 3>;
-Vec3i vec3(const Triple& t) { return {t[0], t[1], t[2]}; }
-py::tuple triple(Vec3i v) { return py::make_tuple(v.x, v.y, v.z); }
+Vec3i vec3(const Triple& t) {
+  return {t[0], t[1], t[2]};
+}
+py::tuple triple(Vec3i v) {
+  return py::make_tuple(v.x, v.y, v.z);
+}
 
 // The box [begin, end) given as two triples, or the world's extent united with its content.
 Box3i box_of(const PyWorld& w, const std::optional<std::pair<Triple, Triple>>& box) {
@@ -218,18 +226,22 @@ void bind_world(py::module_& parent) {
                                           static_cast<py::ssize_t>(bytes) * size.x,
                                           static_cast<py::ssize_t>(bytes) * size.x * size.y};
         };
-        if (width == 1) distances = py::array_t<std::uint8_t>(shape, strides(1));
-        else if (width == 2) distances = py::array_t<std::uint16_t>(shape, strides(2));
-        else distances = py::array_t<float>(shape, strides(4));
+        if (width == 1)
+          distances = py::array_t<std::uint8_t>(shape, strides(1));
+        else if (width == 2)
+          distances = py::array_t<std::uint16_t>(shape, strides(2));
+        else
+          distances = py::array_t<float>(shape, strides(4));
         std::memcpy(distances.mutable_data(), values.data(), values.size());
         py::dict info;
         info["scale"] = encoding.scale;
         info["bias"] = encoding.bias;
         if (!sites) return py::make_tuple(distances, info);
-        py::array_t<std::int16_t> s({static_cast<py::ssize_t>(size.x), static_cast<py::ssize_t>(size.y),
-                                     static_cast<py::ssize_t>(size.z), py::ssize_t{3}},
-                                    {py::ssize_t{6}, py::ssize_t{6} * size.x,
-                                     py::ssize_t{6} * size.x * size.y, py::ssize_t{2}});
+        py::array_t<std::int16_t> s(
+            {static_cast<py::ssize_t>(size.x), static_cast<py::ssize_t>(size.y),
+             static_cast<py::ssize_t>(size.z), py::ssize_t{3}},
+            {py::ssize_t{6}, py::ssize_t{6} * size.x, py::ssize_t{6} * size.x * size.y,
+             py::ssize_t{2}});
         std::memcpy(s.mutable_data(), offsets.data(), offsets.size() * sizeof(std::int16_t));
         return py::make_tuple(distances, info, s);
       },
@@ -237,6 +249,70 @@ void bind_world(py::module_& parent) {
       py::arg("max_distance") = 0.0, py::arg("storage") = "f32",
       py::arg("spacing") = std::array<double, 3>{1, 1, 1}, py::arg("sites") = false,
       py::arg("box") = py::none(), py::arg("threads") = 0, "See voxfield.world.distance_field");
+
+  m.def(
+      "render",
+      [](const PyWorld& w, int width, int height, const std::string& camera,
+         const std::string& view, bool shadows, bool ambient_occlusion, double fog,
+         const std::string& metric, int threads) {
+        const Box3i extent = w.extent.unite(w.world.voxels.content_bounds());
+        if (extent.empty()) throw InvalidArgument("render: the world holds no volume");
+        RenderSceneOptions so;
+        so.skip_metric = parse_metric(metric);
+        so.lighting_field = shadows || ambient_occlusion;
+        RenderOptions o;
+        o.width = width;
+        o.height = height;
+        o.view = parse_render_view(view);
+        o.soft_shadows = shadows;
+        o.ambient_occlusion = ambient_occlusion;
+        o.fog_density = fog;
+        const double aspect = static_cast<double>(width) / std::max(1, height);
+        // As the CLI: automatic cameras frame the content, within the extent.
+        const Box3i content = w.world.voxels.content_bounds().intersect(extent);
+        const Camera cam =
+            Camera::parse(camera, camera == "top" || content.empty() ? extent : content, aspect);
+        PythonSignals signals;
+        Image image;
+        {
+          py::gil_scoped_release release;
+          std::optional<ThreadLimit> limit;
+          if (threads > 0) limit.emplace(threads);
+          const RenderScene scene(w.world, so, extent);
+          image = voxfield::render(scene, cam, o, nullptr, &signals);
+        }
+        py::array_t<std::uint8_t> out({image.height, image.width, 3});
+        std::memcpy(out.mutable_data(), image.rgb.data(), image.rgb.size());
+        return out;
+      },
+      py::arg("world"), py::arg("width") = 640, py::arg("height") = 360, py::arg("camera") = "auto",
+      py::arg("view") = "shaded", py::arg("shadows") = true, py::arg("ambient_occlusion") = true,
+      py::arg("fog") = 0.0, py::arg("metric") = "manhattan", py::arg("threads") = 0,
+      "See voxfield.world.render");
+
+  m.def(
+      "mesh",
+      [](const PyWorld& w, const std::string& algorithm, double iso, const std::string& metric,
+         int chunk, int threads) {
+        MeshOptions o;
+        o.algorithm = parse_mesher(algorithm);
+        o.iso = iso;
+        o.chunk_edge = chunk;
+        const Metric mt = parse_metric(metric);
+        PythonSignals signals;
+        o.interrupter = &signals;
+        Mesh mesh;
+        {
+          py::gil_scoped_release release;
+          std::optional<ThreadLimit> limit;
+          if (threads > 0) limit.emplace(threads);
+          mesh = mesh_world(w.world, o, mt);
+        }
+        return to_arrays(mesh, true);
+      },
+      py::arg("world"), py::arg("algorithm") = "mc", py::arg("iso") = 0.0,
+      py::arg("metric") = "euclidean", py::arg("chunk") = 32, py::arg("threads") = 0,
+      "See voxfield.world.mesh");
 }
 
 }  // namespace voxfield::python

@@ -15,6 +15,16 @@ u8 storage (integer storage holds ``bias + floor(d * scale)``), with the nearest
 (int16 (X, Y, Z, 3)) when ``sites``. It returns a ``Field``: ``distances`` (as stored),
 ``scale``, ``bias``, ``sites`` (or None), ``origin`` and ``decoded()`` (float64 distances). The
 GIL is released meanwhile; Ctrl-C raises ``voxfield.Cancelled``.
+
+``render(world, width=640, height=360, camera="auto", view="shaded", shadows=True,
+ambient_occlusion=True, fog=0.0, metric="manhattan", threads=0)`` is a frame of voxfield's DDA ray
+marcher as uint8 (height, width, 3) RGB, the same pixels as ``voxfield render`` writes: ``camera``
+"auto", "top" or "eye=x,y,z:target=x,y,z[:up=..][:fov=deg][:ortho=h]"; ``view`` "shaded",
+"distance" (a heat map of the field on a cut), "error" or "chunks"; ``metric``: the skip field's.
+
+``mesh(world, algorithm="mc", iso=0.0, metric="euclidean", chunk=32, threads=0)`` meshes the
+surface through the world's exact signed field (``iso`` with |iso| >= 1: an offset surface of the
+metric's balls) and returns ``(vertices, faces, normals, colors)``, colours from the palette.
 """
 
 from dataclasses import dataclass
@@ -23,9 +33,9 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 
 from ._voxfield import world as _world
-from ._voxfield.world import World
+from ._voxfield.world import World, mesh, render
 
-__all__ = ["World", "Field", "distance_field"]
+__all__ = ["World", "Field", "distance_field", "render", "mesh"]
 
 
 @dataclass

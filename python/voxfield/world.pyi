@@ -5,7 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["World", "Field", "distance_field"]
+__all__ = ["World", "Field", "distance_field", "render", "mesh"]
 
 class World:
     def __init__(
@@ -51,3 +51,26 @@ def distance_field(
     box: tuple[Sequence[int], Sequence[int]] | None = None,
     threads: int = 0,
 ) -> Field: ...
+
+def render(
+    world: World,
+    width: int = 640,
+    height: int = 360,
+    camera: str = "auto",
+    view: str = "shaded",
+    shadows: bool = True,
+    ambient_occlusion: bool = True,
+    fog: float = 0.0,
+    metric: str = "manhattan",
+    threads: int = 0,
+) -> npt.NDArray[np.uint8]: ...
+def mesh(
+    world: World,
+    algorithm: str = "mc",
+    iso: float = 0.0,
+    metric: str = "euclidean",
+    chunk: int = 32,
+    threads: int = 0,
+) -> tuple[
+    npt.NDArray[np.float32], npt.NDArray[np.uint32], npt.NDArray[np.float32], npt.NDArray[np.uint8]
+]: ...

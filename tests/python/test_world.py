@@ -118,3 +118,31 @@ def test_errors_are_voxfields():
         World().fill((0, 0, 0), (1, 1, 1), 300)
     with pytest.raises(voxfield.InvalidArgument, match="palette"):
         World().palette = np.zeros((255, 4), np.uint8)
+
+
+@needs_cli
+def test_frames_and_meshes_equal_the_clis(tmp_path):
+    from PIL import Image
+
+    vox = os.path.join(CORPUS, "ephtracy_T-Rex.vox")
+    w = World.load(vox)
+    for view, camera in (("shaded", "auto"), ("distance", "top")):
+        png = tmp_path / f"{view}.png"
+        subprocess.run([CLI, "render", vox, "-o", str(png), "--width", "160", "--height", "90",
+                        "--view", view, "--camera", camera], check=True, capture_output=True)
+        frame = voxfield.world.render(w, 160, 90, camera=camera, view=view)
+        assert frame.shape == (90, 160, 3) and frame.dtype == np.uint8
+        np.testing.assert_array_equal(frame, np.asarray(Image.open(png).convert("RGB")), err_msg=view)
+    stats = tmp_path / "m.json"
+    subprocess.run([CLI, "mesh", vox, "-o", str(tmp_path / "m.ply"), "--stats", str(stats)],
+                   check=True, capture_output=True)
+    import json
+
+    want = json.load(open(stats))
+    v, f, n, c = voxfield.world.mesh(w)
+    assert len(f) == want["triangles"] and len(v) == want["vertices"]
+    # The enclosed volume, by the divergence theorem over the triangles, as the CLI reports it.
+    a, b, cc = (v[f[:, k]].astype(np.float64) for k in range(3))
+    volume = np.einsum("ij,ij->i", a, np.cross(b, cc)).sum() / 6
+    assert abs(volume - want["volume_units3"]) <= 1e-6 * abs(want["volume_units3"])
+    assert c.shape == v.shape and np.allclose(np.linalg.norm(n, axis=1), 1, atol=1e-5)

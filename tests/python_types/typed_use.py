@@ -62,6 +62,9 @@ def world_field() -> float:
     w = world.World(a, origin=(1, 0, 0))
     f: world.Field = world.distance_field(w, metric="euclidean", signed=True, sites=True)
     assert f.sites is not None and w.extent == ((1, 0, 0), (9, 8, 8))
+    frame = world.render(w, 32, 18, shadows=False)
+    vertices, faces, normals, colors = world.mesh(w, algorithm="sn")
+    assert frame.shape == (18, 32, 3) and len(faces) > 0 and colors.dtype == np.uint8
     return float(f.decoded()[0, 0, 0]) + float(w.to_numpy().sum()) * 0
 
 
