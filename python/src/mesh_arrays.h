@@ -13,7 +13,8 @@ namespace voxfield::python {
 // (vertices float32 (V, 3), faces uint32 (F, 3), normals float32 (V, 3)[, colors uint8 (V, 3)]).
 inline pybind11::tuple to_arrays(const Mesh& mesh, bool with_colors) {
   const auto nv = static_cast<pybind11::ssize_t>(mesh.positions.size());
-  pybind11::array_t<float> vertices({nv, pybind11::ssize_t{3}}), normals({nv, pybind11::ssize_t{3}});
+  pybind11::array_t<float> vertices({nv, pybind11::ssize_t{3}}),
+      normals({nv, pybind11::ssize_t{3}});
   pybind11::array_t<std::uint32_t> faces(
       {static_cast<pybind11::ssize_t>(mesh.triangle_count()), pybind11::ssize_t{3}});
   std::memcpy(vertices.mutable_data(), mesh.positions.data(), mesh.positions.size() * 12);

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "mesh_arrays.h"
+#include "py_world.h"
 #include "signals.h"
 #include "voxfield/distance.h"
 #include "voxfield/error.h"
@@ -28,29 +29,63 @@
 namespace py = pybind11;
 
 namespace voxfield::python {
+
+void bind_edit(py::module_& m, py::class_<PyWorld>& world);  // edit.cpp
+
+DenseField dense_field(const DistanceField& f, bool sites) {
+  DenseField d;
+  d.size = f.domain.size();
+  d.encoding = f.encoding;
+  d.with_sites = sites;
+  std::visit(
+      [&](const auto& g) {
+        using T = typename std::decay_t<decltype(g)>::value_type;
+        d.width = sizeof(T);
+        d.values.resize(static_cast<std::size_t>(f.domain.volume()) * sizeof(T));
+        g.copy_to_dense(f.domain, reinterpret_cast<T*>(d.values.data()));
+      },
+      f.values);
+  if (sites) {
+    if (!f.sites) throw InvalidArgument("the field keeps no nearest sites");
+    std::vector<SiteOffset> s(static_cast<std::size_t>(f.domain.volume()));
+    f.sites->copy_to_dense(f.domain, s.data());
+    d.sites.resize(3 * s.size());
+    std::memcpy(d.sites.data(), s.data(), d.sites.size() * sizeof(std::int16_t));
+  }
+  return d;
+}
+
+py::tuple to_python(const DenseField& f) {
+  const Vec3i size = f.size;
+  const std::vector<py::ssize_t> shape{size.x, size.y, size.z};
+  const auto strides = [&](std::size_t bytes) {  // x fastest: Fortran order
+    return std::vector<py::ssize_t>{static_cast<py::ssize_t>(bytes),
+                                    static_cast<py::ssize_t>(bytes) * size.x,
+                                    static_cast<py::ssize_t>(bytes) * size.x * size.y};
+  };
+  py::array distances;
+  if (f.width == 1)
+    distances = py::array_t<std::uint8_t>(shape, strides(1));
+  else if (f.width == 2)
+    distances = py::array_t<std::uint16_t>(shape, strides(2));
+  else
+    distances = py::array_t<float>(shape, strides(4));
+  std::memcpy(distances.mutable_data(), f.values.data(), f.values.size());
+  py::dict info;
+  info["scale"] = f.encoding.scale;
+  info["bias"] = f.encoding.bias;
+  if (!f.with_sites) return py::make_tuple(distances, info);
+  py::array_t<std::int16_t> s(
+      {static_cast<py::ssize_t>(size.x), static_cast<py::ssize_t>(size.y),
+       static_cast<py::ssize_t>(size.z), py::ssize_t{3}},
+      {py::ssize_t{6}, py::ssize_t{6} * size.x, py::ssize_t{6} * size.x * size.y, py::ssize_t{2}});
+  std::memcpy(s.mutable_data(), f.sites.data(), f.sites.size() * sizeof(std::int16_t));
+  return py::make_tuple(distances, info, s);
+}
+
 namespace {
 
-// A world and the volume its file declared (the extent arrays are taken over by default).
-struct PyWorld {
-  World world;
-  Box3i extent;
-};
-
-using Triple = std::array<int, 3>;
-Vec3i vec3(const Triple& t) {
-  return {t[0], t[1], t[2]};
-}
-py::tuple triple(Vec3i v) {
-  return py::make_tuple(v.x, v.y, v.z);
-}
-
-// The box [begin, end) given as two triples, or the world's extent united with its content.
-Box3i box_of(const PyWorld& w, const std::optional<std::pair<Triple, Triple>>& box) {
-  if (box) return Box3i{vec3(box->first), vec3(box->second)};
-  return w.extent.unite(w.world.voxels.content_bounds());
-}
-
-// C-order arrays a[x, y, z] <-> voxfield's dense x-fastest layout: a transposed copy.
+// A dense x-fastest copy as an array a[x, y, z] (Fortran order: the same bytes).
 template <class T>
 py::array_t<T> to_array(const std::vector<T>& dense, Vec3i size) {
   py::array_t<T, py::array::f_style> out({size.x, size.y, size.z});
@@ -69,31 +104,34 @@ std::string repr(const PyWorld& w) {
 
 void bind_world(py::module_& parent) {
   py::module_ m = parent.def_submodule("world", "Worlds, their files and their exact fields");
-  py::class_<PyWorld>(m, "World",
-                      "Materials on a sparse chunked grid (0 = air) and a 256-entry RGBA palette")
-      .def(py::init([](std::optional<py::array_t<std::uint8_t, py::array::f_style |
-                                                                   py::array::forcecast>>
-                           materials,
-                       Triple origin, int chunk) {
-             auto w = std::make_unique<PyWorld>(PyWorld{World(chunk), {}});
-             if (materials) {
-               if (materials->ndim() != 3)
-                 throw InvalidArgument("materials must be a 3-D array a[x, y, z]");
-               const Vec3i size{static_cast<int>(materials->shape(0)),
-                                static_cast<int>(materials->shape(1)),
-                                static_cast<int>(materials->shape(2))};
-               w->extent = Box3i{vec3(origin), vec3(origin) + size};
-               const std::uint8_t* data = materials->data();
-               py::gil_scoped_release release;
-               w->world.voxels.copy_from_dense(w->extent, data);
-               w->world.voxels.compact();
-             }
-             return w;
-           }),
-           py::arg("materials") = py::none(), py::arg("origin") = Triple{0, 0, 0},
-           py::arg("chunk") = 32,
-           "A world from a 3-D array of materials a[x, y, z] (any integer dtype, 0..255; element "
-           "[i, j, k] is voxel origin + (i, j, k)), or an empty one; chunk: 8..128, a power of two")
+  py::class_<PyWorld> world(m, "World",
+                            "Materials on a sparse chunked grid (0 = air) and a 256-entry RGBA "
+                            "palette");
+  world
+      .def(
+          py::init(
+              [](std::optional<py::array_t<std::uint8_t, py::array::f_style | py::array::forcecast>>
+                     materials,
+                 Triple origin, int chunk) {
+                auto w = std::make_unique<PyWorld>(World(chunk), Box3i{});
+                if (materials) {
+                  if (materials->ndim() != 3)
+                    throw InvalidArgument("materials must be a 3-D array a[x, y, z]");
+                  const Vec3i size{static_cast<int>(materials->shape(0)),
+                                   static_cast<int>(materials->shape(1)),
+                                   static_cast<int>(materials->shape(2))};
+                  w->extent = Box3i{vec3(origin), vec3(origin) + size};
+                  const std::uint8_t* data = materials->data();
+                  py::gil_scoped_release release;
+                  w->world.voxels.copy_from_dense(w->extent, data);
+                  w->world.voxels.compact();
+                }
+                return w;
+              }),
+          py::arg("materials") = py::none(), py::arg("origin") = Triple{0, 0, 0},
+          py::arg("chunk") = 32,
+          "A world from a 3-D array of materials a[x, y, z] (any integer dtype, 0..255; element "
+          "[i, j, k] is voxel origin + (i, j, k)), or an empty one; chunk: 8..128, a power of two")
       .def_static(
           "load",
           [](const std::string& path, int chunk) {
@@ -104,7 +142,7 @@ void bind_world(py::module_& parent) {
               py::gil_scoped_release release;
               in = load_world(path, o);
             }
-            return std::make_unique<PyWorld>(PyWorld{std::move(in.world), in.extent});
+            return std::make_unique<PyWorld>(std::move(in.world), in.extent);
           },
           py::arg("path"), py::arg("chunk") = 32,
           "Reads a .vox, .npy or .vfw file (the type from its extension); errors name the file")
@@ -112,6 +150,7 @@ void bind_world(py::module_& parent) {
           "save",
           [](const PyWorld& w, const std::string& path) {
             py::gil_scoped_release release;
+            const std::shared_lock read(w.lock);
             save_world(w.world, w.extent, path);
           },
           py::arg("path"),
@@ -140,10 +179,14 @@ void bind_world(py::module_& parent) {
             std::memcpy(p.mutable_data(), w.world.palette.data(), 256 * 4);
             return p;
           },
-          [](PyWorld& w, const py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>& p) {
+          [](PyWorld& w,
+             const py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>& p) {
             if (p.ndim() != 2 || p.shape(0) != 256 || p.shape(1) != 4)
               throw InvalidArgument("palette must be a (256, 4) array of RGBA bytes");
-            std::memcpy(w.world.palette.data(), p.data(), 256 * 4);
+            const std::uint8_t* data = p.data();
+            py::gil_scoped_release release;
+            const std::unique_lock write(w.lock);
+            std::memcpy(w.world.palette.data(), data, 256 * 4);
           },
           "(256, 4) uint8 RGBA; entry m colours material m (entry 0 belongs to air)")
       .def(
@@ -154,6 +197,7 @@ void bind_world(py::module_& parent) {
             std::vector<std::uint8_t> dense;
             {
               py::gil_scoped_release release;
+              const std::shared_lock read(w.lock);
               require_memory(dense_bytes(b, 1), 0, "World.to_numpy",
                              "an array of " + to_string(b.size()) + " voxels");
               dense.resize(static_cast<std::size_t>(b.volume()));
@@ -171,11 +215,13 @@ void bind_world(py::module_& parent) {
               throw InvalidArgument("material must be 0..255, not " + std::to_string(material));
             const Box3i b{vec3(begin), vec3(end)};
             py::gil_scoped_release release;
+            const std::unique_lock write(w.lock);
             w.world.voxels.fill(b, static_cast<std::uint8_t>(material));
           },
           py::arg("begin"), py::arg("end"), py::arg("material"),
           "Sets every voxel of [begin, end) to material (0: air)")
       .def("__repr__", &repr);
+  bind_edit(m, world);
 
   m.def(
       "distance_field",
@@ -193,57 +239,15 @@ void bind_world(py::module_& parent) {
         if (o.domain->empty()) throw InvalidArgument("distance_field: the world holds no volume");
         PythonSignals signals;
         o.interrupter = &signals;
-        const Vec3i size = o.domain->size();
-        std::vector<std::uint8_t> values;  // the stored values, x fastest
-        std::vector<std::int16_t> offsets;
-        std::size_t width = 0;
-        DistanceEncoding encoding;
+        DenseField dense;
         {
           py::gil_scoped_release release;
+          const std::shared_lock read(w.lock);
           std::optional<ThreadLimit> limit;
           if (threads > 0) limit.emplace(threads);
-          const DistanceField f = compute_distance_field(w.world, o);
-          encoding = f.encoding;
-          std::visit(
-              [&](const auto& g) {
-                using T = typename std::decay_t<decltype(g)>::value_type;
-                width = sizeof(T);
-                values.resize(static_cast<std::size_t>(f.domain.volume()) * sizeof(T));
-                g.copy_to_dense(f.domain, reinterpret_cast<T*>(values.data()));
-              },
-              f.values);
-          if (sites) {
-            std::vector<SiteOffset> s(static_cast<std::size_t>(f.domain.volume()));
-            f.sites->copy_to_dense(f.domain, s.data());
-            offsets.resize(3 * s.size());
-            std::memcpy(offsets.data(), s.data(), offsets.size() * sizeof(std::int16_t));
-          }
+          dense = dense_field(compute_distance_field(w.world, o), sites);
         }
-        py::array distances;
-        const std::vector<py::ssize_t> shape{size.x, size.y, size.z};
-        const auto strides = [&](std::size_t bytes) {
-          return std::vector<py::ssize_t>{static_cast<py::ssize_t>(bytes),
-                                          static_cast<py::ssize_t>(bytes) * size.x,
-                                          static_cast<py::ssize_t>(bytes) * size.x * size.y};
-        };
-        if (width == 1)
-          distances = py::array_t<std::uint8_t>(shape, strides(1));
-        else if (width == 2)
-          distances = py::array_t<std::uint16_t>(shape, strides(2));
-        else
-          distances = py::array_t<float>(shape, strides(4));
-        std::memcpy(distances.mutable_data(), values.data(), values.size());
-        py::dict info;
-        info["scale"] = encoding.scale;
-        info["bias"] = encoding.bias;
-        if (!sites) return py::make_tuple(distances, info);
-        py::array_t<std::int16_t> s(
-            {static_cast<py::ssize_t>(size.x), static_cast<py::ssize_t>(size.y),
-             static_cast<py::ssize_t>(size.z), py::ssize_t{3}},
-            {py::ssize_t{6}, py::ssize_t{6} * size.x, py::ssize_t{6} * size.x * size.y,
-             py::ssize_t{2}});
-        std::memcpy(s.mutable_data(), offsets.data(), offsets.size() * sizeof(std::int16_t));
-        return py::make_tuple(distances, info, s);
+        return to_python(dense);
       },
       py::arg("world"), py::arg("metric") = "euclidean", py::arg("signed") = false,
       py::arg("max_distance") = 0.0, py::arg("storage") = "f32",
@@ -278,6 +282,7 @@ void bind_world(py::module_& parent) {
           py::gil_scoped_release release;
           std::optional<ThreadLimit> limit;
           if (threads > 0) limit.emplace(threads);
+          const std::shared_lock read(w.lock);
           const RenderScene scene(w.world, so, extent);
           image = voxfield::render(scene, cam, o, nullptr, &signals);
         }
@@ -306,6 +311,7 @@ void bind_world(py::module_& parent) {
           py::gil_scoped_release release;
           std::optional<ThreadLimit> limit;
           if (threads > 0) limit.emplace(threads);
+          const std::shared_lock read(w.lock);
           mesh = mesh_world(w.world, o, mt);
         }
         return to_arrays(mesh, true);

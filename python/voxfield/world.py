@@ -22,6 +22,17 @@ marcher as uint8 (height, width, 3) RGB, the same pixels as ``voxfield render`` 
 "auto", "top" or "eye=x,y,z:target=x,y,z[:up=..][:fov=deg][:ortho=h]"; ``view`` "shaded",
 "distance" (a heat map of the field on a cut), "error" or "chunks"; ``metric``: the skip field's.
 
+Editing: ``world.apply(op, shape, *, center=None, radius=1.0, min=None, max=None, a=None, b=None,
+half_extent=None, rotation_deg=None, material=1)`` places, carves or paints (``op``) a "sphere"
+(center, radius), "box" (min, max: inclusive voxel corners), "rotated_box" (center, half_extent,
+rotation_deg about x then y then z) or "capsule" (a, b, radius) and returns ``(changed box or None,
+voxels changed, per-chunk dirty boxes)``. ``LiveField(world, metric="euclidean", signed=False,
+max_distance=0.0, storage="f32", spacing=(1, 1, 1), sites=False, box=None)`` computes the field
+once and keeps it equal to a rebuild through edits made with its own ``apply`` (same keywords; it
+also returns the update's statistics), recomputing only what each edit can change; ``field()``
+returns the ``Field``; ``rebuild()`` catches up with edits made to the world another way. A
+LiveField keeps its world alive.
+
 ``mesh(world, algorithm="mc", iso=0.0, metric="euclidean", chunk=32, threads=0)`` meshes the
 surface through the world's exact signed field (``iso`` with |iso| >= 1: an offset surface of the
 metric's balls) and returns ``(vertices, faces, normals, colors)``, colours from the palette.
@@ -35,7 +46,7 @@ import numpy as np
 from ._voxfield import world as _world
 from ._voxfield.world import World, mesh, render
 
-__all__ = ["World", "Field", "distance_field", "render", "mesh"]
+__all__ = ["World", "Field", "LiveField", "distance_field", "render", "mesh"]
 
 
 @dataclass
@@ -76,6 +87,26 @@ def distance_field(
     origin = tuple(box[0]) if box is not None else tuple(world.extent[0])
     return Field(distances=out[0], scale=out[1]["scale"], bias=out[1]["bias"], origin=origin,
                  sites=out[2] if sites else None)
+
+
+class LiveField(_world.LiveField):
+    """An exact distance field of a World kept equal to a rebuild through its ``apply`` edits."""
+
+    def field(self) -> Field:
+        """The field as it stands: stored distances over the LiveField's box, and sites if kept."""
+        out = self._field()
+        return Field(distances=out[0], scale=out[1]["scale"], bias=out[1]["bias"],
+                     origin=self._origin, sites=out[2] if len(out) > 2 else None)
+
+    def __init__(self, world: World, metric: str = "euclidean", signed: bool = False,
+                 max_distance: float = 0.0, storage: str = "f32",
+                 spacing: Sequence[float] = (1.0, 1.0, 1.0), sites: bool = False,
+                 box: Optional[Tuple[Sequence[int], Sequence[int]]] = None) -> None:
+        spacing = tuple(float(s) for s in spacing)
+        if box is not None:
+            box = (tuple(int(v) for v in box[0]), tuple(int(v) for v in box[1]))
+        super().__init__(world, metric, signed, max_distance, storage, spacing, sites, box)
+        self._origin = tuple(box[0]) if box is not None else tuple(world.extent[0])
 
 
 def _world_error(message: str) -> Exception:

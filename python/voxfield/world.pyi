@@ -5,7 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["World", "Field", "distance_field", "render", "mesh"]
+__all__ = ["World", "Field", "LiveField", "distance_field", "render", "mesh"]
 
 class World:
     def __init__(
@@ -30,6 +30,25 @@ class World:
         self, box: tuple[Sequence[int], Sequence[int]] | None = None
     ) -> npt.NDArray[np.uint8]: ...
     def fill(self, begin: Sequence[int], end: Sequence[int], material: int) -> None: ...
+    def apply(
+        self,
+        op: str,
+        shape: str,
+        *,
+        center: Sequence[float] | None = None,
+        radius: float = 1.0,
+        min: Sequence[int] | None = None,
+        max: Sequence[int] | None = None,
+        a: Sequence[float] | None = None,
+        b: Sequence[float] | None = None,
+        half_extent: Sequence[float] | None = None,
+        rotation_deg: Sequence[float] | None = None,
+        material: int = 1,
+    ) -> tuple[
+        tuple[tuple[int, int, int], tuple[int, int, int]] | None,
+        int,
+        list[tuple[tuple[int, int, int], tuple[int, int, int]]],
+    ]: ...
 
 @dataclass
 class Field:
@@ -74,3 +93,38 @@ def mesh(
 ) -> tuple[
     npt.NDArray[np.float32], npt.NDArray[np.uint32], npt.NDArray[np.float32], npt.NDArray[np.uint8]
 ]: ...
+
+class LiveField:
+    def __init__(
+        self,
+        world: World,
+        metric: str = "euclidean",
+        signed: bool = False,
+        max_distance: float = 0.0,
+        storage: str = "f32",
+        spacing: Sequence[float] = ...,
+        sites: bool = False,
+        box: tuple[Sequence[int], Sequence[int]] | None = None,
+    ) -> None: ...
+    def apply(
+        self,
+        op: str,
+        shape: str,
+        *,
+        center: Sequence[float] | None = None,
+        radius: float = 1.0,
+        min: Sequence[int] | None = None,
+        max: Sequence[int] | None = None,
+        a: Sequence[float] | None = None,
+        b: Sequence[float] | None = None,
+        half_extent: Sequence[float] | None = None,
+        rotation_deg: Sequence[float] | None = None,
+        material: int = 1,
+    ) -> tuple[
+        tuple[tuple[int, int, int], tuple[int, int, int]] | None,
+        int,
+        list[tuple[tuple[int, int, int], tuple[int, int, int]]],
+        dict[str, int],
+    ]: ...
+    def rebuild(self) -> None: ...
+    def field(self) -> Field: ...

@@ -146,3 +146,88 @@ def test_frames_and_meshes_equal_the_clis(tmp_path):
     volume = np.einsum("ij,ij->i", a, np.cross(b, cc)).sum() / 6
     assert abs(volume - want["volume_units3"]) <= 1e-6 * abs(want["volume_units3"])
     assert c.shape == v.shape and np.allclose(np.linalg.norm(n, axis=1), 1, atol=1e-5)
+
+
+def sphere_mask(shape, origin, center, radius):
+    x, y, z = np.meshgrid(*(np.arange(n) + o for n, o in zip(shape, origin)), indexing="ij")
+    return (x - center[0]) ** 2 + (y - center[1]) ** 2 + (z - center[2]) ** 2 <= radius ** 2
+
+
+def test_edits_follow_their_definitions_and_report_what_changed():
+    a = random_world((30, 26, 22), density=0.05)
+    origin = (-4, 2, 0)
+    w = World(a, origin=origin, chunk=8)
+    model = a.copy()
+    rng = np.random.default_rng(9)
+    for n in range(40):
+        op = ("place", "carve", "paint")[n % 3]
+        # Inside the array's box (the world is unbounded: edits beyond it would grow it).
+        radius = float(rng.uniform(0.5, 6))
+        center = [float(v) for v in rng.uniform(np.array(origin) + radius,
+                                                np.array(origin) + a.shape - 1 - radius)]
+        before = model.copy()
+        if n % 2:
+            lo = [int(v) for v in rng.integers(origin, np.array(origin) + a.shape - 7)]
+            hi = [v + int(rng.integers(0, 7)) for v in lo]
+            x, y, z = np.meshgrid(*(np.arange(s) + o for s, o in zip(a.shape, origin)), indexing="ij")
+            inside = (x >= lo[0]) & (x <= hi[0]) & (y >= lo[1]) & (y <= hi[1]) & (z >= lo[2]) & (z <= hi[2])
+            changed, count, dirty = w.apply(op, "box", min=lo, max=hi, material=n + 1)
+        else:
+            inside = sphere_mask(a.shape, origin, center, radius)
+            changed, count, dirty = w.apply(op, "sphere", center=center, radius=radius, material=n + 1)
+        if op == "place":
+            model[inside] = n + 1
+        elif op == "carve":
+            model[inside] = 0
+        else:
+            model[inside & (model > 0)] = n + 1
+        np.testing.assert_array_equal(w.to_numpy(w.extent), model, err_msg=f"edit {n}")
+        diff = np.argwhere(model != before) + origin
+        assert count == len(diff), n
+        if len(diff) == 0:
+            assert changed is None, n
+            continue
+        assert changed == (tuple(diff.min(0)), tuple(diff.max(0) + 1)), n
+        covered = np.zeros(len(diff), bool)
+        for lo, hi in dirty:
+            covered |= ((diff >= lo) & (diff < np.array(hi))).all(1)
+        assert covered.all(), n
+
+
+def test_live_fields_stay_equal_to_a_rebuild():
+    a = random_world((28, 24, 20), density=0.03)
+    for options in (dict(metric="euclidean", signed=True, max_distance=5.0, sites=True),
+                    dict(metric="manhattan", storage="u8"),
+                    dict(metric="chebyshev", signed=True, storage="u16", max_distance=3.0),
+                    dict(metric="euclidean", spacing=(1.0, 1.0, 2.0), max_distance=6.0)):
+        w = World(a, origin=(2, -3, 1))
+        live = voxfield.world.LiveField(w, **options)
+        rng = np.random.default_rng(2)
+        for n in range(24):
+            shape = ("sphere", "capsule", "rotated_box", "box")[n % 4]
+            c = [float(v) for v in rng.uniform((2, -3, 1), (30, 21, 21))]
+            kw = dict(sphere=dict(center=c, radius=3.5),
+                      capsule=dict(a=c, b=[c[0] + 6, c[1] - 2, c[2] + 1], radius=1.5),
+                      rotated_box=dict(center=c, half_extent=[4, 1.5, 2], rotation_deg=[10, 20, 30]),
+                      box=dict(min=[int(v) for v in c], max=[int(v) + 3 for v in c]))[shape]
+            _, _, _, stats = live.apply(("place", "carve")[n % 2], shape, **kw, material=3)
+            assert stats["voxels_recomputed"] >= 0
+            got = live.field()
+            want = distance_field(w, box=((2, -3, 1), (30, 21, 21)), **options)  # the live box
+            np.testing.assert_array_equal(got.distances, want.distances, err_msg=f"{options} {n}")
+            if options.get("sites"):
+                np.testing.assert_array_equal(got.sites, want.sites, err_msg=f"{options} {n}")
+        del w  # the LiveField keeps its world alive
+        assert live.field().distances.shape == (28, 24, 20)
+
+
+def test_edit_errors_name_the_argument():
+    w = World(random_world())
+    with pytest.raises(voxfield.InvalidArgument, match="center"):
+        w.apply("place", "sphere")
+    with pytest.raises(voxfield.InvalidArgument, match="op must be"):
+        w.apply("melt", "sphere", center=(0, 0, 0))
+    with pytest.raises(voxfield.InvalidArgument, match="shape must be"):
+        w.apply("place", "torus", center=(0, 0, 0))
+    with pytest.raises(voxfield.InvalidArgument, match="material"):
+        w.apply("place", "sphere", center=(0, 0, 0), material=0)

@@ -62,6 +62,10 @@ def world_field() -> float:
     w = world.World(a, origin=(1, 0, 0))
     f: world.Field = world.distance_field(w, metric="euclidean", signed=True, sites=True)
     assert f.sites is not None and w.extent == ((1, 0, 0), (9, 8, 8))
+    live = world.LiveField(w, max_distance=4.0)
+    changed, count, dirty, stats = live.apply("carve", "sphere", center=(3.0, 3.0, 3.0), radius=1.0)
+    assert changed is not None and count > 0 and dirty and stats["regions"] >= 0
+    assert live.field().distances.shape == (8, 8, 8)
     frame = world.render(w, 32, 18, shadows=False)
     vertices, faces, normals, colors = world.mesh(w, algorithm="sn")
     assert frame.shape == (18, 32, 3) and len(faces) > 0 and colors.dtype == np.uint8
