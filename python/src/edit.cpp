@@ -23,7 +23,9 @@ namespace {
 using OptionalVec = std::optional<std::array<double, 3>>;
 using OptionalInts = std::optional<Triple>;
 
-Vec3d vec3d(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+Vec3d vec3d(const std::array<double, 3>& a) {
+  return {a[0], a[1], a[2]};
+}
 
 // One edit from Python's keywords; names the missing or stray argument.
 Edit make_edit(const std::string& op, const std::string& shape, const OptionalVec& center,
@@ -31,10 +33,14 @@ Edit make_edit(const std::string& op, const std::string& shape, const OptionalVe
                const OptionalVec& a, const OptionalVec& b, const OptionalVec& half_extent,
                const OptionalVec& rotation_deg, int material) {
   Edit e;
-  if (op == "place") e.op = EditOp::kPlace;
-  else if (op == "carve") e.op = EditOp::kCarve;
-  else if (op == "paint") e.op = EditOp::kPaint;
-  else throw InvalidArgument("op must be 'place', 'carve' or 'paint', not '" + op + "'");
+  if (op == "place")
+    e.op = EditOp::kPlace;
+  else if (op == "carve")
+    e.op = EditOp::kCarve;
+  else if (op == "paint")
+    e.op = EditOp::kPaint;
+  else
+    throw InvalidArgument("op must be 'place', 'carve' or 'paint', not '" + op + "'");
   if (material < 1 || material > 255)
     throw InvalidArgument("material must be 1..255, not " + std::to_string(material));
   e.material = static_cast<std::uint8_t>(material);
@@ -76,11 +82,12 @@ struct PyLiveField {
   bool sites = false;
 };
 
-#define VOXFIELD_EDIT_ARGS                                                                    \
-  py::arg("op"), py::arg("shape"), py::kw_only(), py::arg("center") = py::none(),            \
-      py::arg("radius") = 1.0, py::arg("min") = py::none(), py::arg("max") = py::none(),     \
-      py::arg("a") = py::none(), py::arg("b") = py::none(), py::arg("half_extent") = py::none(), \
-      py::arg("rotation_deg") = py::none(), py::arg("material") = 1
+#define VOXFIELD_EDIT_ARGS                                                                  \
+  py::arg("op"), py::arg("shape"), py::kw_only(),                                           \
+      py::arg("center") = py::none(), py::arg("radius") = 1.0, py::arg("min") = py::none(), \
+      py::arg("max") = py::none(), py::arg("a") = py::none(), py::arg("b") = py::none(),    \
+      py::arg("half_extent") = py::none(), py::arg("rotation_deg") = py::none(),            \
+      py::arg("material") = 1
 
 }  // namespace
 
@@ -90,8 +97,8 @@ void bind_edit(py::module_& m, py::class_<PyWorld>& world) {
       [](PyWorld& w, const std::string& op, const std::string& shape, OptionalVec center,
          double radius, OptionalInts min, OptionalInts max, OptionalVec a, OptionalVec b,
          OptionalVec half_extent, OptionalVec rotation_deg, int material) {
-        const Edit e =
-            make_edit(op, shape, center, radius, min, max, a, b, half_extent, rotation_deg, material);
+        const Edit e = make_edit(op, shape, center, radius, min, max, a, b, half_extent,
+                                 rotation_deg, material);
         DirtyRegions dirty(w.world.voxels.chunk_edge());
         EditResult r;
         {

@@ -6,8 +6,8 @@
 #include <pybind11/pybind11.h>
 
 #include <array>
-#include <optional>
 #include <mutex>
+#include <optional>
 #include <shared_mutex>
 #include <utility>
 #include <vector>
@@ -30,8 +30,12 @@ struct PyWorld {
 
 using Triple = std::array<int, 3>;
 using OptionalBox = std::optional<std::pair<Triple, Triple>>;
-inline Vec3i vec3(const Triple& t) { return {t[0], t[1], t[2]}; }
-inline pybind11::tuple triple(Vec3i v) { return pybind11::make_tuple(v.x, v.y, v.z); }
+inline Vec3i vec3(const Triple& t) {
+  return {t[0], t[1], t[2]};
+}
+inline pybind11::tuple triple(Vec3i v) {
+  return pybind11::make_tuple(v.x, v.y, v.z);
+}
 inline pybind11::object box_tuple(const Box3i& b) {
   if (b.empty()) return pybind11::none();
   return pybind11::make_tuple(triple(b.begin), triple(b.end));

@@ -18,6 +18,7 @@
 #include "mesh_arrays.h"
 #include "py_world.h"
 #include "signals.h"
+#include "voxfield/algorithms.h"
 #include "voxfield/distance.h"
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
@@ -253,6 +254,55 @@ void bind_world(py::module_& parent) {
       py::arg("max_distance") = 0.0, py::arg("storage") = "f32",
       py::arg("spacing") = std::array<double, 3>{1, 1, 1}, py::arg("sites") = false,
       py::arg("box") = py::none(), py::arg("threads") = 0, "See voxfield.world.distance_field");
+
+  m.def(
+      "approximate",
+      [](const PyWorld& w, const std::string& algorithm, const std::string& metric, bool is_signed,
+         double max_distance, const std::string& storage, std::array<double, 3> spacing,
+         OptionalBox box, OptionalBox focus, int threads) {
+        DistanceOptions o;
+        o.metric = parse_metric(metric);
+        o.signed_distance = is_signed;
+        o.max_distance = max_distance;
+        o.storage = parse_storage(storage);
+        o.spacing = spacing;
+        o.domain = box_of(w, box);
+        if (o.domain->empty()) throw InvalidArgument("approximate: the world holds no volume");
+        AlgorithmOptions a;
+        a.algorithm = parse_algorithm(algorithm);
+        if (focus) a.focus = Box3i{vec3(focus->first), vec3(focus->second)};
+        DenseField dense;
+        AlgorithmStats st;
+        FieldError e;
+        {
+          py::gil_scoped_release release;
+          const std::shared_lock read(w.lock);
+          std::optional<ThreadLimit> limit;
+          if (threads > 0) limit.emplace(threads);
+          const DistanceField approx = compute_distance_field(w.world, o, a, &st);
+          e = compare_fields(approx, compute_distance_field(w.world, o), w.world);
+          dense = dense_field(approx, false);
+        }
+        py::dict report;
+        report["ms"] = st.ms;
+        report["passes"] = st.passes;
+        report["iterations"] = st.iterations;
+        report["updates"] = st.updates;
+        report["voxels"] = e.voxels;
+        report["air_voxels"] = e.air_voxels;
+        report["wrong"] = e.wrong;
+        report["too_large"] = e.too_large;
+        report["too_small"] = e.too_small;
+        report["max_over"] = e.max_over;
+        report["max_under"] = e.max_under;
+        report["percent_wrong"] = e.percent_wrong();
+        report["percent_unsafe"] = e.percent_unsafe();
+        return py::make_tuple(to_python(dense), report);
+      },
+      py::arg("world"), py::arg("algorithm") = "jfa", py::arg("metric") = "euclidean",
+      py::arg("signed") = false, py::arg("max_distance") = 0.0, py::arg("storage") = "f32",
+      py::arg("spacing") = std::array<double, 3>{1, 1, 1}, py::arg("box") = py::none(),
+      py::arg("focus") = py::none(), py::arg("threads") = 0, "See voxfield.world.approximate");
 
   m.def(
       "render",

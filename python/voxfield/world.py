@@ -22,6 +22,14 @@ marcher as uint8 (height, width, 3) RGB, the same pixels as ``voxfield render`` 
 "auto", "top" or "eye=x,y,z:target=x,y,z[:up=..][:fov=deg][:ortho=h]"; ``view`` "shaded",
 "distance" (a heat map of the field on a cut), "error" or "chunks"; ``metric``: the skip field's.
 
+``approximate(world, algorithm="jfa", metric="euclidean", signed=False, max_distance=0.0,
+storage="f32", spacing=(1, 1, 1), box=None, focus=None, threads=0)`` runs one of the
+dissertation's algorithm family ("exact", "brute", "brute-chunked", "fim", "jfa-seed", "jfa",
+"jfa+1", "jfa+2", "hybrid", "lod" with a ``focus`` box) and returns ``(Field, report)``: the report
+holds its time, passes, iterations and updates, and its error against the exact field (voxels
+compared, wrong, too large — unsafe for a ray marcher — too small, the largest errors each way and
+the percentages), as ``voxfield compare`` reports them.
+
 Editing: ``world.apply(op, shape, *, center=None, radius=1.0, min=None, max=None, a=None, b=None,
 half_extent=None, rotation_deg=None, material=1)`` places, carves or paints (``op``) a "sphere"
 (center, radius), "box" (min, max: inclusive voxel corners), "rotated_box" (center, half_extent,
@@ -39,14 +47,14 @@ metric's balls) and returns ``(vertices, faces, normals, colors)``, colours from
 """
 
 from dataclasses import dataclass
-from typing import Optional, Sequence, Tuple
+from typing import Dict, Optional, Sequence, Tuple
 
 import numpy as np
 
 from ._voxfield import world as _world
 from ._voxfield.world import World, mesh, render
 
-__all__ = ["World", "Field", "LiveField", "distance_field", "render", "mesh"]
+__all__ = ["World", "Field", "LiveField", "distance_field", "approximate", "render", "mesh"]
 
 
 @dataclass
@@ -87,6 +95,29 @@ def distance_field(
     origin = tuple(box[0]) if box is not None else tuple(world.extent[0])
     return Field(distances=out[0], scale=out[1]["scale"], bias=out[1]["bias"], origin=origin,
                  sites=out[2] if sites else None)
+
+
+def approximate(
+    world: World,
+    algorithm: str = "jfa",
+    metric: str = "euclidean",
+    signed: bool = False,
+    max_distance: float = 0.0,
+    storage: str = "f32",
+    spacing: Sequence[float] = (1.0, 1.0, 1.0),
+    box: Optional[Tuple[Sequence[int], Sequence[int]]] = None,
+    focus: Optional[Tuple[Sequence[int], Sequence[int]]] = None,
+    threads: int = 0,
+) -> Tuple[Field, Dict[str, float]]:
+    """One of the algorithm family's fields and its error against the exact one (see above)."""
+    spacing = tuple(float(s) for s in spacing)
+    box = None if box is None else (tuple(int(v) for v in box[0]), tuple(int(v) for v in box[1]))
+    if focus is not None:
+        focus = (tuple(int(v) for v in focus[0]), tuple(int(v) for v in focus[1]))
+    out, report = _world.approximate(world, algorithm, metric, signed, max_distance, storage,
+                                     spacing, box, focus, threads)
+    origin = tuple(box[0]) if box is not None else tuple(world.extent[0])
+    return Field(distances=out[0], scale=out[1]["scale"], bias=out[1]["bias"], origin=origin), report
 
 
 class LiveField(_world.LiveField):

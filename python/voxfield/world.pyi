@@ -5,7 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["World", "Field", "LiveField", "distance_field", "render", "mesh"]
+__all__ = ["World", "Field", "LiveField", "distance_field", "approximate", "render", "mesh"]
 
 class World:
     def __init__(
@@ -71,6 +71,18 @@ def distance_field(
     threads: int = 0,
 ) -> Field: ...
 
+def approximate(
+    world: World,
+    algorithm: str = "jfa",
+    metric: str = "euclidean",
+    signed: bool = False,
+    max_distance: float = 0.0,
+    storage: str = "f32",
+    spacing: Sequence[float] = ...,
+    box: tuple[Sequence[int], Sequence[int]] | None = None,
+    focus: tuple[Sequence[int], Sequence[int]] | None = None,
+    threads: int = 0,
+) -> tuple[Field, dict[str, float]]: ...
 def render(
     world: World,
     width: int = 640,

@@ -231,3 +231,27 @@ def test_edit_errors_name_the_argument():
         w.apply("place", "torus", center=(0, 0, 0))
     with pytest.raises(voxfield.InvalidArgument, match="material"):
         w.apply("place", "sphere", center=(0, 0, 0), material=0)
+
+
+def test_the_algorithm_family_reports_its_error_against_the_exact_field():
+    a = random_world((26, 22, 18), density=0.01, seed=11)
+    w = World(a)
+    exact = distance_field(w, metric="manhattan").distances.astype(np.float64)
+    air = a == 0
+    for algorithm in ("exact", "brute", "brute-chunked", "fim", "jfa-seed", "jfa", "jfa+2", "hybrid"):
+        field, report = voxfield.world.approximate(w, algorithm=algorithm, metric="manhattan")
+        got = field.decoded()
+        # The report's figures, recomputed here from the two fields (f32: tolerance 1e-4 relative).
+        diff = (got - exact)[air]
+        wrong = np.abs(diff) > 1e-4 * np.maximum(1, np.abs(exact[air]))
+        assert report["air_voxels"] == int(air.sum()), algorithm
+        assert report["wrong"] == int(wrong.sum()), algorithm
+        assert report["too_large"] == int((wrong & (diff > 0)).sum()), algorithm
+        assert report["max_over"] == pytest.approx(max(0.0, diff.max()), abs=1e-9), algorithm
+        if algorithm in ("exact", "brute", "fim", "hybrid"):
+            assert report["wrong"] == 0, (algorithm, report)
+    _, lod = voxfield.world.approximate(w, algorithm="lod", metric="manhattan",
+                                        focus=((0, 0, 0), (8, 8, 8)))
+    assert lod["voxels"] == a.size
+    with pytest.raises(voxfield.InvalidArgument, match="focus"):
+        voxfield.world.approximate(w, algorithm="lod")

@@ -66,6 +66,8 @@ def world_field() -> float:
     changed, count, dirty, stats = live.apply("carve", "sphere", center=(3.0, 3.0, 3.0), radius=1.0)
     assert changed is not None and count > 0 and dirty and stats["regions"] >= 0
     assert live.field().distances.shape == (8, 8, 8)
+    jfa, report = world.approximate(w, algorithm="jfa")
+    assert jfa.distances.shape == (8, 8, 8) and report["voxels"] == 512
     frame = world.render(w, 32, 18, shadows=False)
     vertices, faces, normals, colors = world.mesh(w, algorithm="sn")
     assert frame.shape == (18, 32, 3) and len(faces) > 0 and colors.dtype == np.uint8
