@@ -117,15 +117,9 @@ void bind_edit(py::module_& m, py::class_<PyWorld>& world) {
       .def(py::init([](PyWorld& w, const std::string& metric, bool is_signed, double max_distance,
                        const std::string& storage, std::array<double, 3> spacing, bool sites,
                        OptionalBox box) {
-             DistanceOptions o;
-             o.metric = parse_metric(metric);
-             o.signed_distance = is_signed;
-             o.max_distance = max_distance;
-             o.storage = parse_storage(storage);
-             o.spacing = spacing;
-             o.nearest_sites = sites;
-             o.domain = box_of(w, box);  // fixed: edits never grow it
-             if (o.domain->empty()) throw InvalidArgument("LiveField: the world holds no volume");
+             // The domain is fixed: edits never grow it.
+             const DistanceOptions o = field_options(w, metric, is_signed, max_distance, storage,
+                                                     spacing, sites, box, "LiveField");
              auto f = std::make_unique<PyLiveField>(PyLiveField{w, std::nullopt, sites});
              py::gil_scoped_release release;
              const std::shared_lock read(w.lock);

@@ -9,10 +9,12 @@
 #include <mutex>
 #include <optional>
 #include <shared_mutex>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "voxfield/distance.h"
+#include "voxfield/error.h"
 #include "voxfield/world.h"
 
 namespace voxfield::python {
@@ -45,6 +47,24 @@ inline pybind11::object box_tuple(const Box3i& b) {
 inline Box3i box_of(const PyWorld& w, const OptionalBox& box) {
   if (box) return Box3i{vec3(box->first), vec3(box->second)};
   return w.extent.unite(w.world.voxels.content_bounds());
+}
+
+// The options of a field over `box` (default: the world's extent), checked non-empty; `who` names
+// the caller in the error.
+inline DistanceOptions field_options(const PyWorld& w, const std::string& metric, bool is_signed,
+                                     double max_distance, const std::string& storage,
+                                     std::array<double, 3> spacing, bool sites,
+                                     const OptionalBox& box, const std::string& who) {
+  DistanceOptions o;
+  o.metric = parse_metric(metric);
+  o.signed_distance = is_signed;
+  o.max_distance = max_distance;
+  o.storage = parse_storage(storage);
+  o.spacing = spacing;
+  o.nearest_sites = sites;
+  o.domain = box_of(w, box);
+  if (o.domain->empty()) throw InvalidArgument(who + ": the world holds no volume");
+  return o;
 }
 
 // A field's stored values and sites copied out densely (x fastest), done without the GIL.

@@ -229,15 +229,8 @@ void bind_world(py::module_& parent) {
       [](const PyWorld& w, const std::string& metric, bool is_signed, double max_distance,
          const std::string& storage, std::array<double, 3> spacing, bool sites,
          std::optional<std::pair<Triple, Triple>> box, int threads) {
-        DistanceOptions o;
-        o.metric = parse_metric(metric);
-        o.signed_distance = is_signed;
-        o.max_distance = max_distance;
-        o.storage = parse_storage(storage);
-        o.spacing = spacing;
-        o.nearest_sites = sites;
-        o.domain = box_of(w, box);
-        if (o.domain->empty()) throw InvalidArgument("distance_field: the world holds no volume");
+        DistanceOptions o = field_options(w, metric, is_signed, max_distance, storage, spacing,
+                                          sites, box, "distance_field");
         PythonSignals signals;
         o.interrupter = &signals;
         DenseField dense;
@@ -260,14 +253,8 @@ void bind_world(py::module_& parent) {
       [](const PyWorld& w, const std::string& algorithm, const std::string& metric, bool is_signed,
          double max_distance, const std::string& storage, std::array<double, 3> spacing,
          OptionalBox box, OptionalBox focus, int threads) {
-        DistanceOptions o;
-        o.metric = parse_metric(metric);
-        o.signed_distance = is_signed;
-        o.max_distance = max_distance;
-        o.storage = parse_storage(storage);
-        o.spacing = spacing;
-        o.domain = box_of(w, box);
-        if (o.domain->empty()) throw InvalidArgument("approximate: the world holds no volume");
+        const DistanceOptions o = field_options(w, metric, is_signed, max_distance, storage,
+                                                spacing, false, box, "approximate");
         AlgorithmOptions a;
         a.algorithm = parse_algorithm(algorithm);
         if (focus) a.focus = Box3i{vec3(focus->first), vec3(focus->second)};
