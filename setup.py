@@ -11,6 +11,7 @@ import os
 import shutil
 import subprocess
 import sys
+import sysconfig
 from pathlib import Path
 
 from setuptools import Extension, setup
@@ -29,16 +30,18 @@ class CMakeBuild(build_ext):
             subprocess.run(["cmake", "-S", str(ROOT), "-B", str(build), "-G", "Ninja",
                             "-DCMAKE_BUILD_TYPE=Release", "-DVOXFIELD_BUILD_TESTS=OFF",
                             "-DVOXFIELD_VULKAN=OFF", "-DVOXFIELD_BUILD_MPI=OFF",
+                            "-DVOXFIELD_BUILD_PYTHON=ON",  # a clear error if pybind11 is missing
                             f"-DPython_EXECUTABLE={sys.executable}"], check=True)
         jobs = str(os.cpu_count() or 1)
         subprocess.run(["cmake", "--build", str(build), "--target", "voxfield_python", "-j", jobs],
                        check=True)
-        built = sorted((build / "python" / "voxfield").glob("_voxfield*.so"))
-        if not built:
-            raise RuntimeError(f"voxfield: the build in {build} made no _voxfield module")
+        # The module for this interpreter's ABI (a reused tree may hold others).
+        built = build / "python" / "voxfield" / ("_voxfield" + sysconfig.get_config_var("EXT_SUFFIX"))
+        if not built.exists():
+            raise RuntimeError(f"voxfield: the build in {build} made no {built.name} for this Python")
         target = Path(self.get_ext_fullpath(ext.name))
         target.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copyfile(built[-1], target)
+        shutil.copyfile(built, target)
 
 
 setup(ext_modules=[Extension("voxfield._voxfield", sources=[])], cmdclass={"build_ext": CMakeBuild})

@@ -102,7 +102,7 @@ TEST(Vdb, FieldsAreLevelSetsOrScalarGridsHoldingTheirDistances) {
   int cases = 0;
   for (Metric metric : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
     for (bool is_signed : {false, true})
-      for (double clamp : {0.0, 3.0})
+      for (double clamp : {0.0, 3.0, 3.1, 3.3, 40.0})  // 3.1, 3.3: not stored exactly; 40: past u8
         for (Storage storage : {Storage::kU8, Storage::kF32}) {
           DistanceOptions o;
           o.metric = metric;
@@ -131,10 +131,15 @@ TEST(Vdb, FieldsAreLevelSetsOrScalarGridsHoldingTheirDistances) {
           for (const Vec3i p : {Vec3i{-3, -2, -4}, Vec3i{30, 22, 26}, Vec3i{12, 9, 11}})
             largest = std::max(largest, std::abs(level(f.distance(p))));
           const float bg = grid->background();
+          // Clamped: the clamp as stored (what every voxel beyond it and outside the domain reads).
+          const double stored = level(f.distance({1000, 1000, 1000}));
           if (clamp > 0)
-            EXPECT_EQ(bg, static_cast<float>(clamp - half)) << what;
+            EXPECT_EQ(bg, static_cast<float>(stored)) << what;
           else
             EXPECT_GE(bg, static_cast<float>(largest)) << what;
+          if (clamp == 3) {
+            EXPECT_EQ(bg, static_cast<float>(clamp - half)) << what;
+          }
           EXPECT_EQ(grid->metaValue<double>("voxfield_surface_offset"), half) << what;
           auto access = grid->getConstAccessor();
           for (int z = o.domain->begin.z; z < o.domain->end.z; ++z)
@@ -149,7 +154,7 @@ TEST(Vdb, FieldsAreLevelSetsOrScalarGridsHoldingTheirDistances) {
               }
           ++cases;
         }
-  EXPECT_EQ(cases, 24);
+  EXPECT_EQ(cases, 60);
 }
 
 // A clamped level set keeps only a band active: its inside far from the surface lives in inactive

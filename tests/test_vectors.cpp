@@ -267,15 +267,17 @@ TEST(Vectors, SegmentParameterIsTheClampedQuotientBitForBit) {
   };
   for (int n = 0; n < 20000; ++n) {
     const Vec3d a{u(rng), u(rng), u(rng)}, b{u(rng) * 0.1, u(rng) * 0.1, u(rng) * 0.1};
-    const Segment s = detail::vectors::segment_of({a + b, a, 0.5});
-    check(s, {u(rng), u(rng), u(rng)});
-    // Along the x axis from a, dot(p - a, ab) = x * ab.x: x chosen to land on the boundaries.
+    check(detail::vectors::segment_of({a + b, a, 0.5}), {u(rng), u(rng), u(rng)});
+    // From a segment starting at x = 0, p = (x, a.y, a.z) has p - a = (x, 0, 0) exactly, so
+    // dot(p - a, ab) = x * ab.x, rounded once: x chosen to land on and beside the boundaries.
+    const Vec3d a0{0, a.y, a.z};
+    const Segment s = detail::vectors::segment_of({a0 + b, a0, 0.5});
     if (s.ab.x == 0) continue;
     for (const double target : {-s.ab2, 0.0, s.ab2})
       for (const double x0 : {target / s.ab.x, -0.0, 1e-320})
         for (double x = std::nextafter(x0, -1e9), steps = 0; steps < 3;
              x = std::nextafter(x, 1e9), ++steps)
-          check(s, {a.x + x, a.y, a.z});
+          check(s, {x, a.y, a.z});
   }
   // Quotients below the smallest double: -0 from the division, +0 from the clamp's shortcut
   // would differ.

@@ -97,8 +97,11 @@ out = os.path.join(WORK, "never.npy")
 p = run("convert", world, out, ok=False)
 check(p.returncode == 1 and "does not read them yet" in p.stderr, f"reading .vdb: {p.returncode} {p.stderr}")
 check(not os.path.exists(out), "a failed convert wrote its output")
-p = run("field", os.path.join(WORK, "missing.vox"), "-o", os.path.join(WORK, "never.vdb"), ok=False)
-check(p.returncode == 1 and not os.path.exists(os.path.join(WORK, "never.vdb")), "a failed field wrote .vdb")
+# A clamp within half a voxel of the surface is refused by the writer, after the field is computed.
+p = run("field", VOX, "--signed", "--max-distance", "0.4", "-o", os.path.join(WORK, "never.vdb"),
+        ok=False)
+check(p.returncode == 1 and "leaves no band" in p.stderr, f"clamp 0.4: {p.returncode} {p.stderr}")
+check(not os.path.exists(os.path.join(WORK, "never.vdb")), "a failed field wrote its .vdb")
 
 if failures:
     raise SystemExit(f"{failures} check(s) failed")

@@ -1,5 +1,7 @@
 // voxfield field IN -o OUT.npy|OUT.vdb [options]: a distance field of a world, written as .npy or
 // as an OpenVDB grid (a level set when signed; vdb.h).
+#include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <iostream>
 
@@ -29,7 +31,10 @@ int run_field(const FieldSettings& s) {
   // Everything that can be wrong with the options is found before the world is loaded.
   Outputs outputs({s.in});
   outputs.expect(s.out, "-o");
-  const bool vdb_output = std::filesystem::path(s.out).extension() == ".vdb";  // else .npy
+  std::string out_ext = std::filesystem::path(s.out).extension().string();
+  std::transform(out_ext.begin(), out_ext.end(), out_ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const bool vdb_output = out_ext == ".vdb";  // else .npy
   outputs.expect(s.sites, "--sites");
   outputs.expect(s.packed, "--packed");
   outputs.expect(s.stats, "--stats");
@@ -109,7 +114,7 @@ void add_field(CLI::App& app, Action& action) {
   CLI::App* cmd = app.add_subcommand(
       "field",
       "Compute a distance field and write it as .npy (a[x, y, z], like the input) or .vdb");
-  cmd->add_option("IN", s->in, "input .vox, .npy, .vfw or .vdb")->required();
+  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
   cmd->add_option("-o,--output", s->out,
                   "output .npy, or .vdb (an OpenVDB float grid: a level set when signed)")
       ->required();

@@ -347,6 +347,10 @@ bool VulkanWindow::draw_frame(const std::function<void(VkCommandBuffer, VkImage)
                               const std::function<void(VkCommandBuffer)>& overlay,
                               Screenshot* screenshot) {
   check(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+  if (stale_swapchain_) {
+    recreate_swapchain();
+    stale_swapchain_ = false;
+  }
   std::uint32_t index = 0;
   const VkResult acquired =
       vkAcquireNextImageKHR(device_, swapchain_, UINT64_MAX, acquired_, VK_NULL_HANDLE, &index);
@@ -371,6 +375,7 @@ bool VulkanWindow::draw_frame(const std::function<void(VkCommandBuffer, VkImage)
       empty.pWaitDstStageMask = &stage;
       if (vkResetFences(w.device_, 1, &w.fence_) == VK_SUCCESS)
         (void)vkQueueSubmit(w.queue_, 1, &empty, w.fence_);
+      w.stale_swapchain_ = true;
     }
   } unrecorded{*this};
   check(vkResetCommandBuffer(cmd_, 0), "vkResetCommandBuffer");
@@ -432,8 +437,8 @@ bool VulkanWindow::draw_frame(const std::function<void(VkCommandBuffer, VkImage)
   submit.signalSemaphoreCount = 1;
   submit.pSignalSemaphores = &rendered_[index];
   check(vkResetFences(device_, 1, &fence_), "vkResetFences");
-  unrecorded.done = true;  // from here the frame's own submission owns the semaphore and fence
   check(vkQueueSubmit(queue_, 1, &submit, fence_), "vkQueueSubmit");
+  unrecorded.done = true;  // the frame's own submission owns the semaphore and fence
   VkPresentInfoKHR present{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
   present.waitSemaphoreCount = 1;
   present.pWaitSemaphores = &rendered_[index];

@@ -112,6 +112,9 @@ class VulkanWindow {
   VkCommandPool pool_ = VK_NULL_HANDLE;
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
+  // A frame whose recording failed left its acquired image unpresented: the swapchain is made
+  // again before the next acquire, so failed frames cannot use up its images.
+  bool stale_swapchain_ = false;
   VkSemaphore acquired_ = VK_NULL_HANDLE;
   std::vector<VkSemaphore> rendered_;  // per swapchain image
 

@@ -117,13 +117,13 @@ void bind_edit(py::module_& m, py::class_<PyWorld>& world) {
       .def(py::init([](PyWorld& w, const std::string& metric, bool is_signed, double max_distance,
                        const std::string& storage, std::array<double, 3> spacing, bool sites,
                        OptionalBox box) {
-             // The domain is fixed: edits never grow it.
-             const DistanceOptions o = field_options(w, metric, is_signed, max_distance, storage,
-                                                     spacing, sites, box, "LiveField");
+             const DistanceOptions o =
+                 field_options(metric, is_signed, max_distance, storage, spacing, sites);
              auto f = std::make_unique<PyLiveField>(PyLiveField{w, std::nullopt, sites});
              py::gil_scoped_release release;
              const std::shared_lock read(w.lock);
-             f->field.emplace(w.world, o);
+             // The domain is fixed: edits never grow it.
+             f->field.emplace(w.world, with_domain(o, w, box, "LiveField"));
              return f;
            }),
            py::keep_alive<1, 2>(), py::arg("world"), py::arg("metric") = "euclidean",
@@ -145,7 +145,14 @@ void bind_edit(py::module_& m, py::class_<PyWorld>& world) {
               py::gil_scoped_release release;
               const std::unique_lock write(w.lock);
               r = apply_edit(w.world, e, &dirty);
-              st = f.field->update(dirty);
+              try {
+                st = f.field->update(dirty);
+              } catch (...) {
+                // The world has the edit and a failed update leaves the field inexact
+                // (dynamic_field.h): rebuilt, so the field never silently lags its world.
+                f.field->rebuild();
+                throw;
+              }
             }
             py::tuple out = result(r, dirty);
             py::dict stats;

@@ -43,18 +43,25 @@ inline pybind11::object box_tuple(const Box3i& b) {
   return pybind11::make_tuple(triple(b.begin), triple(b.end));
 }
 
+// f() with the GIL released and the world's lock shared: every read of a world goes through it
+// (or takes the lock itself), since edits on other threads change its chunks meanwhile.
+template <class F>
+auto reading(const PyWorld& w, F&& f) {
+  const pybind11::gil_scoped_release release;
+  const std::shared_lock read(w.lock);
+  return f();
+}
+
 // The box [begin, end) given as two triples, or the world's extent united with its content.
 inline Box3i box_of(const PyWorld& w, const OptionalBox& box) {
   if (box) return Box3i{vec3(box->first), vec3(box->second)};
   return w.extent.unite(w.world.voxels.content_bounds());
 }
 
-// The options of a field over `box` (default: the world's extent), checked non-empty; `who` names
-// the caller in the error.
-inline DistanceOptions field_options(const PyWorld& w, const std::string& metric, bool is_signed,
-                                     double max_distance, const std::string& storage,
-                                     std::array<double, 3> spacing, bool sites,
-                                     const OptionalBox& box, const std::string& who) {
+// The options of a field; its domain is set by with_domain, under the world's lock.
+inline DistanceOptions field_options(const std::string& metric, bool is_signed, double max_distance,
+                                     const std::string& storage, std::array<double, 3> spacing,
+                                     bool sites) {
   DistanceOptions o;
   o.metric = parse_metric(metric);
   o.signed_distance = is_signed;
@@ -62,6 +69,13 @@ inline DistanceOptions field_options(const PyWorld& w, const std::string& metric
   o.storage = parse_storage(storage);
   o.spacing = spacing;
   o.nearest_sites = sites;
+  return o;
+}
+
+// `o` over `box` (default: the world's extent), checked non-empty; `who` names the caller in the
+// error. Call with the world's lock held.
+inline DistanceOptions with_domain(DistanceOptions o, const PyWorld& w, const OptionalBox& box,
+                                   const std::string& who) {
   o.domain = box_of(w, box);
   if (o.domain->empty()) throw InvalidArgument(who + ": the world holds no volume");
   return o;
@@ -74,10 +88,11 @@ struct DenseField {
   std::vector<std::uint8_t> values;
   std::vector<std::int16_t> sites;  // 3 per voxel, when asked for
   DistanceEncoding encoding;
+  Vec3i origin;  // the domain's first voxel
   bool with_sites = false;
 };
 DenseField dense_field(const DistanceField& f, bool sites);
-// (distances a[x, y, z] as stored, {"scale", "bias"}[, sites int16 (X, Y, Z, 3)]).
+// (distances a[x, y, z] as stored, {"scale", "bias", "origin"}[, sites int16 (X, Y, Z, 3)]).
 pybind11::tuple to_python(const DenseField& f);
 
 }  // namespace voxfield::python

@@ -37,6 +37,7 @@ DenseField dense_field(const DistanceField& f, bool sites) {
   DenseField d;
   d.size = f.domain.size();
   d.encoding = f.encoding;
+  d.origin = f.domain.begin;
   d.with_sites = sites;
   std::visit(
       [&](const auto& g) {
@@ -75,6 +76,7 @@ py::tuple to_python(const DenseField& f) {
   py::dict info;
   info["scale"] = f.encoding.scale;
   info["bias"] = f.encoding.bias;
+  info["origin"] = triple(f.origin);
   if (!f.with_sites) return py::make_tuple(distances, info);
   py::array_t<std::int16_t> s(
       {static_cast<py::ssize_t>(size.x), static_cast<py::ssize_t>(size.y),
@@ -95,10 +97,12 @@ py::array_t<T> to_array(const std::vector<T>& dense, Vec3i size) {
 }
 
 std::string repr(const PyWorld& w) {
-  const Box3i b = w.extent.unite(w.world.voxels.content_bounds());
-  return "voxfield.world.World(extent=" + (b.empty() ? std::string("empty") : to_string(b)) +
-         ", solid=" + std::to_string(w.world.solid_count()) +
-         ", chunk=" + std::to_string(w.world.voxels.chunk_edge()) + ")";
+  return reading(w, [&] {
+    const Box3i b = w.extent.unite(w.world.voxels.content_bounds());
+    return "voxfield.world.World(extent=" + (b.empty() ? std::string("empty") : to_string(b)) +
+           ", solid=" + std::to_string(w.world.solid_count()) +
+           ", chunk=" + std::to_string(w.world.voxels.chunk_edge()) + ")";
+  });
 }
 
 }  // namespace
@@ -110,25 +114,48 @@ void bind_world(py::module_& parent) {
                             "palette");
   world
       .def(
-          py::init(
-              [](std::optional<py::array_t<std::uint8_t, py::array::f_style | py::array::forcecast>>
-                     materials,
-                 Triple origin, int chunk) {
-                auto w = std::make_unique<PyWorld>(World(chunk), Box3i{});
-                if (materials) {
-                  if (materials->ndim() != 3)
-                    throw InvalidArgument("materials must be a 3-D array a[x, y, z]");
-                  const Vec3i size{static_cast<int>(materials->shape(0)),
-                                   static_cast<int>(materials->shape(1)),
-                                   static_cast<int>(materials->shape(2))};
-                  w->extent = Box3i{vec3(origin), vec3(origin) + size};
-                  const std::uint8_t* data = materials->data();
-                  py::gil_scoped_release release;
-                  w->world.voxels.copy_from_dense(w->extent, data);
-                  w->world.voxels.compact();
-                }
-                return w;
-              }),
+          py::init([](std::optional<py::array> given, Triple origin, int chunk) {
+            auto w = std::make_unique<PyWorld>(World(chunk), Box3i{});
+            if (given) {
+              if (given->ndim() != 3)
+                throw InvalidArgument("materials must be a 3-D array a[x, y, z]");
+              const char kind = given->dtype().kind();
+              if (kind != 'i' && kind != 'u' && kind != 'b')
+                throw InvalidArgument(std::string("materials must be integers 0..255, not a '") +
+                                      kind +
+                                      "' array (a float volume is meshed by "
+                                      "voxfield.mesh.mesh_volume)");
+              // The box in 64 bits first: origin + shape must lie in voxfield's range.
+              Box3i box;
+              for (int a = 0; a < 3; ++a) {
+                const std::int64_t lo = origin[static_cast<std::size_t>(a)];
+                const std::int64_t hi = lo + given->shape(a);
+                if (lo < kCoordRange.begin[a] || hi > kCoordRange.end[a])
+                  throw InvalidArgument("materials at origin (" + std::to_string(origin[0]) + ", " +
+                                        std::to_string(origin[1]) + ", " +
+                                        std::to_string(origin[2]) + ") reach outside " +
+                                        to_string(kCoordRange));
+                box.begin[a] = static_cast<int>(lo);
+                box.end[a] = static_cast<int>(hi);
+              }
+              w->extent = box;
+              const auto values =
+                  py::array_t<std::int64_t, py::array::f_style | py::array::forcecast>::ensure(
+                      *given);
+              std::vector<std::uint8_t> dense(static_cast<std::size_t>(values.size()));
+              const std::int64_t* v = values.data();
+              for (std::size_t i = 0; i < dense.size(); ++i) {
+                if (v[i] < 0 || v[i] > 255)
+                  throw InvalidArgument("materials must be 0..255; one is " + std::to_string(v[i]));
+                dense[i] = static_cast<std::uint8_t>(v[i]);
+              }
+              const std::uint8_t* data = dense.data();
+              py::gil_scoped_release release;
+              w->world.voxels.copy_from_dense(w->extent, data);
+              w->world.voxels.compact();
+            }
+            return w;
+          }),
           py::arg("materials") = py::none(), py::arg("origin") = Triple{0, 0, 0},
           py::arg("chunk") = 32,
           "A world from a 3-D array of materials a[x, y, z] (any integer dtype, 0..255; element "
@@ -157,18 +184,21 @@ void bind_world(py::module_& parent) {
           py::arg("path"),
           "Writes .vox, .npy, .vfw or .vdb (by extension) atomically: a failed save leaves the "
           "old file")
-      .def_property_readonly("solid_count", [](const PyWorld& w) { return w.world.solid_count(); })
+      .def_property_readonly(
+          "solid_count",
+          [](const PyWorld& w) { return reading(w, [&] { return w.world.solid_count(); }); })
       .def_property_readonly(
           "extent",
           [](const PyWorld& w) {
-            const Box3i b = w.extent.unite(w.world.voxels.content_bounds());
+            const Box3i b =
+                reading(w, [&] { return w.extent.unite(w.world.voxels.content_bounds()); });
             return py::make_tuple(triple(b.begin), triple(b.end));
           },
           "(begin, end): the volume the file declared united with the content, half-open")
       .def_property_readonly(
           "content_bounds",
           [](const PyWorld& w) {
-            const Box3i b = w.world.voxels.content_bounds();
+            const Box3i b = reading(w, [&] { return w.world.voxels.content_bounds(); });
             return py::make_tuple(triple(b.begin), triple(b.end));
           },
           "(begin, end) of the solid voxels, half-open; equal points when there are none")
@@ -176,8 +206,9 @@ void bind_world(py::module_& parent) {
       .def_property(
           "palette",
           [](const PyWorld& w) {
+            const Palette colours = reading(w, [&] { return w.world.palette; });
             py::array_t<std::uint8_t> p({256, 4});
-            std::memcpy(p.mutable_data(), w.world.palette.data(), 256 * 4);
+            std::memcpy(p.mutable_data(), colours.data(), 256 * 4);
             return p;
           },
           [](PyWorld& w,
@@ -193,12 +224,13 @@ void bind_world(py::module_& parent) {
       .def(
           "to_numpy",
           [](const PyWorld& w, std::optional<std::pair<Triple, Triple>> box) {
-            const Box3i b = box_of(w, box);
-            if (b.empty()) throw InvalidArgument("to_numpy: the box is empty");
+            Box3i b;
             std::vector<std::uint8_t> dense;
             {
               py::gil_scoped_release release;
               const std::shared_lock read(w.lock);
+              b = box_of(w, box);
+              if (b.empty()) throw InvalidArgument("to_numpy: the box is empty");
               require_memory(dense_bytes(b, 1), 0, "World.to_numpy",
                              "an array of " + to_string(b.size()) + " voxels");
               dense.resize(static_cast<std::size_t>(b.volume()));
@@ -229,8 +261,7 @@ void bind_world(py::module_& parent) {
       [](const PyWorld& w, const std::string& metric, bool is_signed, double max_distance,
          const std::string& storage, std::array<double, 3> spacing, bool sites,
          std::optional<std::pair<Triple, Triple>> box, int threads) {
-        DistanceOptions o = field_options(w, metric, is_signed, max_distance, storage, spacing,
-                                          sites, box, "distance_field");
+        DistanceOptions o = field_options(metric, is_signed, max_distance, storage, spacing, sites);
         PythonSignals signals;
         o.interrupter = &signals;
         DenseField dense;
@@ -239,7 +270,8 @@ void bind_world(py::module_& parent) {
           const std::shared_lock read(w.lock);
           std::optional<ThreadLimit> limit;
           if (threads > 0) limit.emplace(threads);
-          dense = dense_field(compute_distance_field(w.world, o), sites);
+          dense = dense_field(
+              compute_distance_field(w.world, with_domain(o, w, box, "distance_field")), sites);
         }
         return to_python(dense);
       },
@@ -253,8 +285,8 @@ void bind_world(py::module_& parent) {
       [](const PyWorld& w, const std::string& algorithm, const std::string& metric, bool is_signed,
          double max_distance, const std::string& storage, std::array<double, 3> spacing,
          OptionalBox box, OptionalBox focus, int threads) {
-        const DistanceOptions o = field_options(w, metric, is_signed, max_distance, storage,
-                                                spacing, false, box, "approximate");
+        const DistanceOptions options =
+            field_options(metric, is_signed, max_distance, storage, spacing, false);
         AlgorithmOptions a;
         a.algorithm = parse_algorithm(algorithm);
         if (focus) a.focus = Box3i{vec3(focus->first), vec3(focus->second)};
@@ -266,6 +298,7 @@ void bind_world(py::module_& parent) {
           const std::shared_lock read(w.lock);
           std::optional<ThreadLimit> limit;
           if (threads > 0) limit.emplace(threads);
+          const DistanceOptions o = with_domain(options, w, box, "approximate");
           const DistanceField approx = compute_distance_field(w.world, o, a, &st);
           e = compare_fields(approx, compute_distance_field(w.world, o), w.world);
           dense = dense_field(approx, false);
@@ -296,8 +329,6 @@ void bind_world(py::module_& parent) {
       [](const PyWorld& w, int width, int height, const std::string& camera,
          const std::string& view, bool shadows, bool ambient_occlusion, double fog,
          const std::string& metric, int threads) {
-        const Box3i extent = w.extent.unite(w.world.voxels.content_bounds());
-        if (extent.empty()) throw InvalidArgument("render: the world holds no volume");
         RenderSceneOptions so;
         so.skip_metric = parse_metric(metric);
         so.lighting_field = shadows || ambient_occlusion;
@@ -309,10 +340,6 @@ void bind_world(py::module_& parent) {
         o.ambient_occlusion = ambient_occlusion;
         o.fog_density = fog;
         const double aspect = static_cast<double>(width) / std::max(1, height);
-        // As the CLI: automatic cameras frame the content, within the extent.
-        const Box3i content = w.world.voxels.content_bounds().intersect(extent);
-        const Camera cam =
-            Camera::parse(camera, camera == "top" || content.empty() ? extent : content, aspect);
         PythonSignals signals;
         Image image;
         {
@@ -320,6 +347,12 @@ void bind_world(py::module_& parent) {
           std::optional<ThreadLimit> limit;
           if (threads > 0) limit.emplace(threads);
           const std::shared_lock read(w.lock);
+          const Box3i extent = w.extent.unite(w.world.voxels.content_bounds());
+          if (extent.empty()) throw InvalidArgument("render: the world holds no volume");
+          // As the CLI: automatic cameras frame the content, within the extent.
+          const Box3i content = w.world.voxels.content_bounds().intersect(extent);
+          const Camera cam =
+              Camera::parse(camera, camera == "top" || content.empty() ? extent : content, aspect);
           const RenderScene scene(w.world, so, extent);
           image = voxfield::render(scene, cam, o, nullptr, &signals);
         }

@@ -92,9 +92,8 @@ def distance_field(
         box = (tuple(int(v) for v in box[0]), tuple(int(v) for v in box[1]))
     out = _world.distance_field(world, metric, signed, max_distance, storage, spacing, sites, box,
                                 threads)
-    origin = tuple(box[0]) if box is not None else tuple(world.extent[0])
-    return Field(distances=out[0], scale=out[1]["scale"], bias=out[1]["bias"], origin=origin,
-                 sites=out[2] if sites else None)
+    return Field(distances=out[0], scale=out[1]["scale"], bias=out[1]["bias"],
+                 origin=out[1]["origin"], sites=out[2] if sites else None)
 
 
 def approximate(
@@ -116,8 +115,8 @@ def approximate(
         focus = (tuple(int(v) for v in focus[0]), tuple(int(v) for v in focus[1]))
     out, report = _world.approximate(world, algorithm, metric, signed, max_distance, storage,
                                      spacing, box, focus, threads)
-    origin = tuple(box[0]) if box is not None else tuple(world.extent[0])
-    return Field(distances=out[0], scale=out[1]["scale"], bias=out[1]["bias"], origin=origin), report
+    return Field(distances=out[0], scale=out[1]["scale"], bias=out[1]["bias"],
+                 origin=out[1]["origin"]), report
 
 
 class LiveField(_world.LiveField):
@@ -127,7 +126,7 @@ class LiveField(_world.LiveField):
         """The field as it stands: stored distances over the LiveField's box, and sites if kept."""
         out = self._field()
         return Field(distances=out[0], scale=out[1]["scale"], bias=out[1]["bias"],
-                     origin=self._origin, sites=out[2] if len(out) > 2 else None)
+                     origin=out[1]["origin"], sites=out[2] if len(out) > 2 else None)
 
     def __init__(self, world: World, metric: str = "euclidean", signed: bool = False,
                  max_distance: float = 0.0, storage: str = "f32",
@@ -137,7 +136,6 @@ class LiveField(_world.LiveField):
         if box is not None:
             box = (tuple(int(v) for v in box[0]), tuple(int(v) for v in box[1]))
         super().__init__(world, metric, signed, max_distance, storage, spacing, sites, box)
-        self._origin = tuple(box[0]) if box is not None else tuple(world.extent[0])
 
 
 def _world_error(message: str) -> Exception:

@@ -161,8 +161,13 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
         },
         field.values);
   };
-  // The background: the clamp, or (unclamped) the largest finite |distance| of the field.
-  double background = clamp - offset;
+  // The background: the clamp as the field stores it — what voxels beyond it and outside the
+  // domain read, which integer storage may have lowered to its range and rounded, and f32 rounded
+  // to a float — or, unclamped, the largest finite |distance| of the field.
+  const double stored_clamp = std::visit(
+      [&](const auto& g) { return field.encoding.decode(static_cast<double>(g.background())); },
+      field.values);
+  double background = level(stored_clamp);
   if (clamp > 0 && !(background > 0))
     throw InvalidArgument("vdb: a clamp of " + std::to_string(clamp) +
                           " leaves no band around the surface (the level set needs more than half "

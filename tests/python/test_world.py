@@ -31,6 +31,8 @@ def random_world(shape=(23, 17, 29), density=0.1, seed=4):
 
 def test_arrays_round_trip_with_their_origin():
     a = random_world()
+    np.testing.assert_array_equal(World(a.astype(np.int64)).to_numpy(), a)  # any integer dtype
+    np.testing.assert_array_equal(World(a > 0).to_numpy(), a > 0)
     w = World(a, origin=(-3, 5, 2), chunk=16)
     assert w.extent == ((-3, 5, 2), (20, 22, 31))
     assert w.solid_count == int(np.count_nonzero(a))
@@ -112,6 +114,12 @@ def test_errors_are_voxfields():
         World.load("/nonexistent/nowhere.vox")
     with pytest.raises(voxfield.InvalidArgument, match="3-D"):
         World(np.zeros((4, 4), np.uint8))
+    with pytest.raises(voxfield.InvalidArgument, match="one is 256"):
+        World(np.full((2, 2, 2), 256, np.int32))
+    with pytest.raises(voxfield.InvalidArgument, match="integers"):
+        World(np.zeros((2, 2, 2), np.float32))
+    with pytest.raises(voxfield.InvalidArgument, match="reach outside"):
+        World(np.zeros((2, 2, 2), np.uint8), origin=(2**29 - 1, 0, 0))
     with pytest.raises(voxfield.InvalidArgument, match="metric"):
         distance_field(World(random_world()), metric="cosine")
     with pytest.raises(voxfield.InvalidArgument, match="material"):
