@@ -3,6 +3,7 @@
 // asks.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <mutex>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "voxfield/edit.h"
 #include "voxfield/interrupt.h"
 #include "voxfield/mesh.h"
+#include "voxfield/parallel.h"
 #include "voxfield/render.h"
 #include "voxfield/scene.h"
 
@@ -242,4 +244,21 @@ TEST(Interrupt, MeshingReportsChunksAndCancels) {
   Recorder stop(40);
   o.interrupter = &stop;
   EXPECT_THROW(mesh_volume(vol, o), Cancelled);
+}
+
+// Questions from many threads reach the interrupter one at a time with percentages that never
+// decrease, ending at 100 (a progress bar never steps back).
+TEST(Interrupt, ProgressFromManyThreadsNeverStepsBack) {
+  for (int round = 0; round < 20; ++round) {
+    Recorder r;
+    {
+      Progress p(&r, "many", 4000);
+      parallel_for(4000, 1, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) p.advance();
+      });
+    }
+    ASSERT_FALSE(r.percents.empty());
+    EXPECT_TRUE(std::is_sorted(r.percents.begin(), r.percents.end())) << "round " << round;
+    EXPECT_EQ(r.percents.back(), 100) << "round " << round;
+  }
 }

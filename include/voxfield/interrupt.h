@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <mutex>
 #include <string>
 #include <string_view>
 
@@ -31,7 +32,9 @@ class Interrupter {
   virtual void end() {}
   // Asked between units of work with how far the operation is (0..100). Return true to cancel:
   // the operation stops at its next check and throws Cancelled. Called from any of voxfield's
-  // worker threads, concurrently: an implementation must be thread-safe (an atomic flag is enough).
+  // worker threads; one operation asks one question at a time, with percentages that never
+  // decrease (a progress bar never steps back). Operations on several threads may share an
+  // interrupter, so an implementation must still be thread-safe (an atomic flag is enough).
   virtual bool was_interrupted(int percent) {
     static_cast<void>(percent);
     return false;
@@ -64,6 +67,9 @@ class Progress {
   std::int64_t total_;
   std::atomic<std::int64_t> done_{0};
   std::atomic<bool> cancelled_{false};
+  // Questions are asked one at a time, each with the work done when it is asked: without this,
+  // a thread that computed 52 % could ask after one that computed 100 %.
+  std::mutex ask_;
 };
 
 }  // namespace voxfield

@@ -19,16 +19,16 @@ Progress::~Progress() {
 
 bool Progress::advance(std::int64_t units) {
   if (!interrupter_) return true;
-  const std::int64_t done = done_.fetch_add(units, std::memory_order_relaxed) + units;
-  if (cancelled()) return false;
-  const int percent = static_cast<int>(std::min<std::int64_t>(100, done * 100 / total_));
-  if (interrupter_->was_interrupted(percent)) cancelled_.store(true, std::memory_order_relaxed);
-  return !cancelled();
+  done_.fetch_add(units, std::memory_order_relaxed);
+  return keep_going();
 }
 
 bool Progress::keep_going() {
   if (!interrupter_) return true;
   if (cancelled()) return false;
+  const std::lock_guard lock(ask_);
+  if (cancelled()) return false;
+  // Read under the lock: the work done only grows, so successive questions never step back.
   const int percent = static_cast<int>(
       std::min<std::int64_t>(100, done_.load(std::memory_order_relaxed) * 100 / total_));
   if (interrupter_->was_interrupted(percent)) cancelled_.store(true, std::memory_order_relaxed);
