@@ -182,8 +182,11 @@ def test_a_terrain_shared_by_threads():
     centres = [(4.0 + 0.8 * i, 24.0 + 10 * np.sin(i / 4), 8.0) for i in range(50)]
     errors = []
 
+    meshing = threading.Event()
+
     def brushes():
         try:
+            meshing.wait()  # the brushes start as the first mesh does: the two overlap
             for c in centres:
                 t.apply("sphere", "subtract", centre=c, radius=3.0, smooth=1.0)
         except Exception as e:  # pragma: no cover - reported below
@@ -192,11 +195,14 @@ def test_a_terrain_shared_by_threads():
     worker = threading.Thread(target=brushes)
     worker.start()
     meshes = 0
-    while worker.is_alive():
+    while True:  # at least one mesh, however fast the brushes are (they raced ahead before)
+        meshing.set()
         verts, faces, _, _ = t.mesh()
         assert faces.max() < len(verts)
         assert t.values().shape == n
         meshes += 1
+        if not worker.is_alive():
+            break
     worker.join()
     assert not errors and meshes > 0
     for c in centres:
