@@ -4,7 +4,20 @@
 # every rank) — and bad input must fail on every rank with one clear message and no output.
 # Usage: cli_test.sh VOXFIELD VOXFIELD_MPI MPIEXEC
 set -euo pipefail
-VF=$1 VFM=$2 MPIEXEC=$3
+VF=$1 VFM=$2 MPIEXEC_BIN=$3
+# Every mpirun gets a deadline: a job that hangs (a rank waiting forever on one that failed) fails
+# this test within minutes and names the command, instead of holding CI until its own limit.
+MPI_RUN_SECONDS=${MPI_RUN_SECONDS:-240}
+exec 3>&2  # the test's own stderr, for messages from runs whose stderr is redirected
+MPIEXEC() {
+  local code=0 start=$SECONDS
+  timeout -k 10 "$MPI_RUN_SECONDS" "$MPIEXEC_BIN" "$@" || code=$?
+  if [ $((SECONDS - start)) -ge "$MPI_RUN_SECONDS" ]; then
+    echo "FAIL: hung for ${MPI_RUN_SECONDS} s: mpirun $*" >&3
+    exit 1
+  fi
+  return "$code"
+}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -33,7 +46,7 @@ for opts in "--metric euclidean --signed" "--metric manhattan --max-distance 5 -
   for n in $ranks; do
     for input in $inputs; do
       # shellcheck disable=SC2086
-      "$MPIEXEC" -np "$n" "$VFM" field "$input" -o out.npy --sites out_sites.npy --chunk 8 \
+      MPIEXEC -np "$n" "$VFM" field "$input" -o out.npy --sites out_sites.npy --chunk 8 \
         --stats stats.json $opts 2>/dev/null
       same ref.npy out.npy "$n ranks, $input, $opts"
       same ref_sites.npy out_sites.npy "$n ranks, $input, $opts (sites)"
@@ -53,7 +66,7 @@ expect_failure() {  # expect_failure CODE PATTERN ARGS...
   shift 2
   rm -f bad.npy bad.vfw
   set +e
-  "$MPIEXEC" -np "${EXPECT_RANKS:-2}" "$VFM" "$@" >out.txt 2>err.txt
+  MPIEXEC -np "${EXPECT_RANKS:-2}" "$VFM" "$@" >out.txt 2>err.txt
   local got=$?
   set -e
   if [ "$got" -ne "$code" ]; then echo "FAIL: $* exited $got, expected $code"; cat err.txt; fail=1; fi
@@ -88,14 +101,14 @@ for opts in "--metric euclidean --signed --max-distance 6" "--metric manhattan -
   "$VF" edit f.npy -e edits.jsonl -o ref.npy $opts 2>/dev/null
   for n in 1 2 3 4; do
     # shellcheck disable=SC2086
-    "$MPIEXEC" -np "$n" "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 $opts 2>/dev/null
+    MPIEXEC -np "$n" "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 $opts 2>/dev/null
     same ref.npy out.npy "edit, $n ranks, $opts"
   done
 done
 # The edited world as one .vfw written by every rank: voxfield edit --save-world's file.
 "$VF" edit f.npy -e edits.jsonl -o ref.npy --chunk 8 --max-distance 6 --save-world ref.vfw 2>/dev/null
 for n in 1 2 3 4; do
-  "$MPIEXEC" -np "$n" "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 --max-distance 6 \
+  MPIEXEC -np "$n" "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 --max-distance 6 \
     --save-world out.vfw 2>/dev/null
   same ref.vfw out.vfw "edit --save-world, $n ranks"
   same ref.npy out.npy "edit --save-world, $n ranks (field)"
@@ -114,7 +127,7 @@ vox=$(dirname "$0")/../../../shared/data/vox/dotvox_axes.vox
 # The shared corpus lies beside the repository (README); its absence is a failure, not a skip.
 if [ ! -f "$vox" ]; then echo "FAIL: $vox is missing (../shared beside the repository)"; fail=1; else
   "$VF" field "$vox" -o ref.npy --metric euclidean --signed 2>/dev/null
-  "$MPIEXEC" -np 3 "$VFM" field "$vox" -o out.npy --metric euclidean --signed 2>/dev/null
+  MPIEXEC -np 3 "$VFM" field "$vox" -o out.npy --metric euclidean --signed 2>/dev/null
   same ref.npy out.npy "3 ranks, dotvox_axes.vox"
 fi
 
@@ -130,7 +143,7 @@ expect_failure 1 "junk.npy: at byte 0: not a .npy file" field junk.npy -o bad.np
 expect_failure 1 "fewer than the 2" field thin.npy -o bad.npy
 
 # The bench runs and reports the exchange.
-"$MPIEXEC" -np 2 "$VFM" bench --size 40,30,50 --spheres 20 --repeat 1 --chunk 8 > bench.json
+MPIEXEC -np 2 "$VFM" bench --size 40,30,50 --spheres 20 --repeat 1 --chunk 8 > bench.json
 /usr/bin/python3 -c "
 import json; j = json.loads(open('bench.json').read())
 assert j['ranks'] == 2 and j['exchange']['bytes_sent_total'] == 16 * 40 * 30, j"
@@ -146,19 +159,22 @@ killed=0
 for delay in 0.1 0.3 0.5 0.7; do
   printf 'old' > target.npy
   set +e
-  "$MPIEXEC" -np 2 "$VFM" field large.npy -o target.npy --metric euclidean --signed --chunk 16 \
+  MPIEXEC -np 2 "$VFM" field large.npy -o target.npy --metric euclidean --signed --chunk 16 \
     >/dev/null 2>kill_err.txt &
   job=$!
   sleep "$delay"
   # The newest rank: a process named voxfield-mpi (mpirun is named mpirun; the MPI tests run alone,
   # see tests/CMakeLists.txt). None yet (a slow start under a sanitizer) means no kill this round.
-  victim=$(pgrep -n -x voxfield-mpi)
+  # Zombies are skipped: a rank of the previous round may not be reaped yet.
+  victim=$(pgrep -n -x -r R,S,D voxfield-mpi || true)
   [ -n "$victim" ] && kill -9 "$victim"
   started=$(date +%s)
   wait "$job"
   code=$?
   set -e
-  if [ $(( $(date +%s) - started )) -gt 20 ]; then echo "FAIL: the job took over 20 s to end after a kill"; fail=1; fi
+  if [ $(( $(date +%s) - started )) -gt 20 ]; then
+    echo "FAIL: the job took over 20 s to end after a kill"; cat kill_err.txt; fail=1
+  fi
   if cmp -s target.npy large_ref.npy; then
     :  # the kill came after the rename: the new field, whole
   elif [ "$(cat target.npy)" != "old" ]; then
