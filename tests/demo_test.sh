@@ -13,7 +13,7 @@ fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 run() {  # name, demo arguments...
   local name=$1
   shift
-  local status=0
+  local status=0 t0=$SECONDS
   env ${RUN_ENV:-} xvfb-run -a -s "-screen 0 1024x768x24" "$DEMO" --benchmark --frames 30 --width 480 --height 270 --world 64 \
       --csv "$out/$name.csv" --screenshot "$out/$name.png" "$@" >"$out/$name.out" 2>"$out/$name.err" || status=$?
   if [ "$status" -ne 0 ]; then
@@ -29,7 +29,7 @@ run() {  # name, demo arguments...
   # The benchmark's edits keep coming: the last row counts at least one.
   awk -F, 'END { exit !($5 >= 1) }' "$out/$name.csv" || fail "$name: no edits were made"
   "$FRAME_CHECK" "$out/$name.png" || fail "$name: the screenshot is not a frame of sky and world"
-  echo "ok: $name ($(tail -1 "$out/$name.err"))"
+  echo "ok: $name, $((SECONDS - t0)) s ($(tail -1 "$out/$name.err"))"
 }
 
 run vulkan --backend vulkan --validation
@@ -54,7 +54,7 @@ grep -q "shown through OpenGL" "$out/opengl.err" || fail "opengl: the demo did n
 vrun() {  # name, demo arguments...
   local name=$1
   shift
-  local status=0
+  local status=0 t0=$SECONDS
   env ${RUN_ENV:-} xvfb-run -a -s "-screen 0 1024x768x24" "$DEMO" --mode vectors --benchmark --frames 20 --width 640 \
       --height 360 --csv "$out/$name.csv" --screenshot "$out/$name.png" "$@" >"$out/$name.out" 2>"$out/$name.err" || status=$?
   if [ "$status" -ne 0 ]; then
@@ -63,7 +63,7 @@ vrun() {  # name, demo arguments...
   fi
   grep -q "validation:" "$out/$name.err" && fail "$name: validation messages: $(grep -m3 validation: "$out/$name.err")"
   awk -F, 'END { exit !(NR == 21 && $5 == 20) }' "$out/$name.csv" || fail "$name: expected 20 frames of one step each"
-  echo "ok: $name ($(grep -m1 "vectors mode" "$out/$name.err"))"
+  echo "ok: $name, $((SECONDS - t0)) s ($(grep -m1 "vectors mode" "$out/$name.err"))"
 }
 vrun vectors-vulkan --backend vulkan --validation
 grep -q "stepped and drawn on the Vulkan device" "$out/vectors-vulkan.err" || fail "vectors-vulkan: not on the device"
@@ -104,7 +104,7 @@ PY
 trun() {  # name, demo arguments...
   local name=$1
   shift
-  local status=0
+  local status=0 t0=$SECONDS
   env ${RUN_ENV:-} xvfb-run -a -s "-screen 0 1024x768x24" "$DEMO" --mode terrain --benchmark --frames 40 --interval-ms 20 \
       --width 640 --height 360 --csv "$out/$name.csv" --screenshot "$out/$name.png" "$@" >"$out/$name.out" 2>"$out/$name.err" || status=$?
   if [ "$status" -ne 0 ]; then
@@ -130,7 +130,7 @@ print(f"terrain: {grass} grass pixels, {brushed} brushed")
 # cover much of the grass: the check is that the terrain fills the view and shows both.
 assert grass + brushed > 0.15 * len(px) and grass > 0.02 * len(px) and brushed > 100
 PY
-  echo "ok: $name ($(tail -1 "$out/$name.csv" | cut -d, -f5,10-12))"
+  echo "ok: $name, $((SECONDS - t0)) s ($(tail -1 "$out/$name.csv" | cut -d, -f5,10-12))"
 }
 trun terrain-vulkan --backend vulkan --validation
 grep -q "HistoPyramid and an indirect draw on the Vulkan device" "$out/terrain-vulkan.err" ||
@@ -142,7 +142,7 @@ RUN_ENV="VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json" t
 # right click carves at the ray hit, each a separate edit; F12 saves a screenshot.
 if command -v xdotool >/dev/null; then
   mkdir -p "$out/interactive"
-  status=0
+  status=0 t0=$SECONDS
   (cd "$out/interactive" && DEMO="$DEMO" xvfb-run -a -s "-screen 0 1024x768x24" bash -c '
     "$DEMO" --world 64 --width 640 --height 360 --backend cpu --frames 120 --csv i.csv 2>i.err &
     pid=$!
@@ -159,12 +159,12 @@ if command -v xdotool >/dev/null; then
   else
     awk -F, 'END { exit !($5 >= 2) }' "$out/interactive/i.csv" || fail "interactive: the clicks did not edit (edits: $(tail -1 "$out/interactive/i.csv"))"
     "$FRAME_CHECK" "$out/interactive/voxfield-demo-1.png" || fail "interactive: no F12 screenshot of the world"
-    echo "ok: interactive (clicks placed and carved; F12 saved a screenshot)"
+    echo "ok: interactive, $((SECONDS - t0)) s (clicks placed and carved; F12 saved a screenshot)"
   fi
   # The terrain mode under the mouse: a left click adds a sphere where the cursor's ray meets the
   # surface, a right click carves one.
   mkdir -p "$out/terrain-interactive"
-  status=0
+  status=0 t0=$SECONDS
   (cd "$out/terrain-interactive" && DEMO="$DEMO" xvfb-run -a -s "-screen 0 1024x768x24" bash -c '
     "$DEMO" --mode terrain --width 640 --height 360 --backend cpu --frames 400 --csv i.csv 2>i.err &
     pid=$!
@@ -179,7 +179,7 @@ if command -v xdotool >/dev/null; then
   else
     awk -F, 'END { exit !($5 >= 2 && $11 > 0) }' "$out/terrain-interactive/i.csv" ||
       fail "terrain-interactive: the clicks did not edit the terrain ($(tail -1 "$out/terrain-interactive/i.csv"))"
-    echo "ok: terrain-interactive (a click added, a click carved)"
+    echo "ok: terrain-interactive, $((SECONDS - t0)) s (a click added, a click carved)"
   fi
 else
   fail "xdotool is missing (scripts/install-deps.sh installs it)"

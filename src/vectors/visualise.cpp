@@ -12,6 +12,7 @@
 
 #include "vector_internal.h"
 #include "voxfield/error.h"
+#include "voxfield/parallel.h"
 #include "voxfield/vectors.h"
 
 namespace voxfield {
@@ -106,81 +107,85 @@ Image render_vectors(const VectorVolume& volume, const VectorTexture& texture,
   const double tan_half = cam.tan_half, aspect = cam.aspect, step = cam.step, density = cam.density;
   const Sheet sheet{volume, texture, view.sheet_height, view.sheet_push / volume.size.z};
 
-  for (int y = 0; y < view.height; ++y)
-    for (int x = 0; x < view.width; ++x) {
-      const double sx = (2.0 * (x + 0.5) / view.width - 1.0) * tan_half * aspect;
-      const double sy = (1.0 - 2.0 * (y + 0.5) / view.height) * tan_half;
-      const Vec3d dir = (forward + right * sx + true_up * sy).normalized();
-      // Slab test in volume coordinates: the box is [0, 1]^3 there, the map is affine.
-      const Vec3d o = volume.to_volume(eye), d = volume.to_volume(eye + dir) - o;
-      double t0 = 0, t1 = 1e300;
-      for (int a = 0; a < 3; ++a) {
-        if (d[a] == 0) {
-          if (o[a] < 0 || o[a] > 1) t1 = -1;
-          continue;
-        }
-        double ta = (0 - o[a]) / d[a], tb = (1 - o[a]) / d[a];
-        if (ta > tb) std::swap(ta, tb);
-        t0 = std::max(t0, ta);
-        t1 = std::min(t1, tb);
-      }
-      double r = 0.02, g = 0.025, b = 0.035;  // background
-      if (t0 < t1) {
-        double transmittance = 1, cr = 0, cg = 0, cb = 0;
-        // Above (> 0) or below the sheet at ray parameter t.
-        auto side = [&](double t) {
-          const Vec3d u = o + d * t;
-          return u.z - sheet.height(u.x, u.y);
-        };
-        double last_t = t0, last_side = view.sheet ? side(t0) : 0;
-        // Whole steps counted as integers (t += step stops advancing when t dwarfs step), at most
-        // four per voxel along the longest path through the box.
-        const Vec3i n = volume.resolution;
-        const double span = std::min(t1 - t0, 4.0 * (n.x + n.y + n.z) * step);
-        const std::int64_t steps = static_cast<std::int64_t>(std::ceil(span / step));
-        for (std::int64_t k = 0; k < steps && transmittance > 0.004; ++k) {
-          const double t = t0 + (static_cast<double>(k) + 0.5) * step;
-          if (view.sheet) {
-            const double now = side(t);
-            if ((now > 0) != (last_side > 0)) {
-              double lo = last_t, hi = t;  // the crossing lies between: bisect
-              for (int i = 0; i < 8; ++i) {
-                const double mid = 0.5 * (lo + hi);
-                if ((side(mid) > 0) == (last_side > 0))
-                  lo = mid;
-                else
-                  hi = mid;
-              }
-              const Vec3d u = o + d * (0.5 * (lo + hi));
-              const Vec3d c = sheet.colour(u.x, u.y);
-              cr += transmittance * c.x;
-              cg += transmittance * c.y;
-              cb += transmittance * c.z;
-              transmittance = 0;
-              break;
-            }
-            last_t = t;
-            last_side = now;
+  // Rows are independent: each thread marches whole rows (four at least, so a hand-off costs less
+  // than the rays it carries).
+  parallel_for(static_cast<std::size_t>(view.height), 4, [&](std::size_t row0, std::size_t row1) {
+    for (int y = static_cast<int>(row0); y < static_cast<int>(row1); ++y)
+      for (int x = 0; x < view.width; ++x) {
+        const double sx = (2.0 * (x + 0.5) / view.width - 1.0) * tan_half * aspect;
+        const double sy = (1.0 - 2.0 * (y + 0.5) / view.height) * tan_half;
+        const Vec3d dir = (forward + right * sx + true_up * sy).normalized();
+        // Slab test in volume coordinates: the box is [0, 1]^3 there, the map is affine.
+        const Vec3d o = volume.to_volume(eye), d = volume.to_volume(eye + dir) - o;
+        double t0 = 0, t1 = 1e300;
+        for (int a = 0; a < 3; ++a) {
+          if (d[a] == 0) {
+            if (o[a] < 0 || o[a] > 1) t1 = -1;
+            continue;
           }
-          const VectorSample s = sample_vectors(volume, texture, eye + dir * t);
-          if (s.strength <= 0) continue;
-          const double alpha = 1 - std::exp(-density * s.strength * step);
-          const double len = s.direction.length();
-          const Vec3d c = len > 0 ? s.direction * (1.0 / len) : Vec3d{0.5, 0.5, 0.5};
-          cr += transmittance * alpha * (0.15 + 0.85 * std::abs(c.x));
-          cg += transmittance * alpha * (0.15 + 0.85 * std::abs(c.y));
-          cb += transmittance * alpha * (0.15 + 0.85 * std::abs(c.z));
-          transmittance *= 1 - alpha;
+          double ta = (0 - o[a]) / d[a], tb = (1 - o[a]) / d[a];
+          if (ta > tb) std::swap(ta, tb);
+          t0 = std::max(t0, ta);
+          t1 = std::min(t1, tb);
         }
-        r = cr + transmittance * r;
-        g = cg + transmittance * g;
-        b = cb + transmittance * b;
+        double r = 0.02, g = 0.025, b = 0.035;  // background
+        if (t0 < t1) {
+          double transmittance = 1, cr = 0, cg = 0, cb = 0;
+          // Above (> 0) or below the sheet at ray parameter t.
+          auto side = [&](double t) {
+            const Vec3d u = o + d * t;
+            return u.z - sheet.height(u.x, u.y);
+          };
+          double last_t = t0, last_side = view.sheet ? side(t0) : 0;
+          // Whole steps counted as integers (t += step stops advancing when t dwarfs step), at most
+          // four per voxel along the longest path through the box.
+          const Vec3i n = volume.resolution;
+          const double span = std::min(t1 - t0, 4.0 * (n.x + n.y + n.z) * step);
+          const std::int64_t steps = static_cast<std::int64_t>(std::ceil(span / step));
+          for (std::int64_t k = 0; k < steps && transmittance > 0.004; ++k) {
+            const double t = t0 + (static_cast<double>(k) + 0.5) * step;
+            if (view.sheet) {
+              const double now = side(t);
+              if ((now > 0) != (last_side > 0)) {
+                double lo = last_t, hi = t;  // the crossing lies between: bisect
+                for (int i = 0; i < 8; ++i) {
+                  const double mid = 0.5 * (lo + hi);
+                  if ((side(mid) > 0) == (last_side > 0))
+                    lo = mid;
+                  else
+                    hi = mid;
+                }
+                const Vec3d u = o + d * (0.5 * (lo + hi));
+                const Vec3d c = sheet.colour(u.x, u.y);
+                cr += transmittance * c.x;
+                cg += transmittance * c.y;
+                cb += transmittance * c.z;
+                transmittance = 0;
+                break;
+              }
+              last_t = t;
+              last_side = now;
+            }
+            const VectorSample s = sample_vectors(volume, texture, eye + dir * t);
+            if (s.strength <= 0) continue;
+            const double alpha = 1 - std::exp(-density * s.strength * step);
+            const double len = s.direction.length();
+            const Vec3d c = len > 0 ? s.direction * (1.0 / len) : Vec3d{0.5, 0.5, 0.5};
+            cr += transmittance * alpha * (0.15 + 0.85 * std::abs(c.x));
+            cg += transmittance * alpha * (0.15 + 0.85 * std::abs(c.y));
+            cb += transmittance * alpha * (0.15 + 0.85 * std::abs(c.z));
+            transmittance *= 1 - alpha;
+          }
+          r = cr + transmittance * r;
+          g = cg + transmittance * g;
+          b = cb + transmittance * b;
+        }
+        std::uint8_t* px = image.pixel(x, y);
+        px[0] = to_srgb8(r);
+        px[1] = to_srgb8(g);
+        px[2] = to_srgb8(b);
       }
-      std::uint8_t* px = image.pixel(x, y);
-      px[0] = to_srgb8(r);
-      px[1] = to_srgb8(g);
-      px[2] = to_srgb8(b);
-    }
+  });
   return image;
 }
 
