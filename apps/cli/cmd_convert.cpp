@@ -1,20 +1,44 @@
 // voxfield convert IN OUT: between .vox, .npy and .vfw (in an .npy, non-zero = that material), and
-// to .vdb (an OpenVDB Int32 grid of materials; vdb.h).
+// to .vdb (an OpenVDB Int32 grid of materials; vdb.h); a triangle mesh (.obj, .ply, .stl, .off)
+// is voxelised by its generalized winding number (mesh_voxelize.h) at --voxel-size.
 #include <iostream>
 
 #include "cli.h"
+#include "progress.h"
+#include "voxfield/mesh_read.h"
 
 namespace voxfield::cli {
 namespace {
 
 struct ConvertSettings {
   std::string in, out;
+  double voxel_size = 0;
 };
 
 int run_convert(const ConvertSettings& s) {
   // Converting a file onto itself is safe: the input is read whole before the output is written.
   Outputs outputs({s.in});
   outputs.expect_world(s.out, "OUT", /*may_be_input=*/true);
+  if (mesh_input_format_of(s.in)) {
+    if (!(s.voxel_size > 0)) throw UsageError(s.in + ": a mesh needs --voxel-size (in its units)");
+    set_activity("reading " + s.in);
+    const TriangleMesh mesh = read_mesh(s.in);
+    MeshVoxelOptions o;
+    o.voxel_size = s.voxel_size;
+    o.padding_voxels = 0;
+    o.interrupter = progress();
+    set_activity("voxelising " + s.in);
+    const World world = voxelize_mesh(mesh, o);
+    set_activity("writing " + s.out);
+    outputs.stage(s.out, encode_world(world, *world.voxels.bounds(), world_format_of(s.out)));
+    outputs.commit();
+    std::cerr << "voxfield: wrote " << s.out << " (" << mesh.triangles.size() << " triangles, "
+              << world.solid_count() << " solid voxels in "
+              << to_string(world.voxels.bounds()->size()) << ")\n";
+    return 0;
+  }
+  if (s.voxel_size != 0)
+    throw UsageError("--voxel-size applies to mesh inputs (.obj, .ply, .stl, .off)");
   set_activity("loading " + s.in);
   LoadOptions lo;
   lo.chunk_edge = 0;  // a .vfw keeps the chunk edge it was saved with
@@ -31,9 +55,14 @@ int run_convert(const ConvertSettings& s) {
 void add_convert(CLI::App& app, Action& action) {
   auto s = std::make_shared<ConvertSettings>();
   CLI::App* cmd = app.add_subcommand("convert",
-                                     "Convert a world between .vox, .npy and .vfw, or to .vdb "
-                                     "(chosen by extension); the output is written atomically");
-  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
+                                     "Convert a world between .vox, .npy and .vfw, or to .vdb, or "
+                                     "voxelise a mesh (chosen by extension); the output is written "
+                                     "atomically");
+  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw, or a mesh: .obj, .ply, .stl, .off")
+      ->required();
+  cmd->add_option("--voxel-size", s->voxel_size,
+                  "for a mesh: the voxels' edge in the mesh's units (solid where the generalized "
+                  "winding number at a voxel's centre is >= 1/2)");
   cmd->add_option("OUT", s->out, "output .vox, .npy, .vfw or .vdb")->required();
   cmd->callback([s, &action] { action = [s] { return run_convert(*s); }; });
 }

@@ -1,7 +1,9 @@
 // voxfield field IN -o OUT.npy|OUT.vdb [options]: a distance field of a world, written as .npy or
-// as an OpenVDB grid (a level set when signed; vdb.h).
+// as an OpenVDB grid (a level set when signed; vdb.h); or the signed distance field of a triangle
+// mesh (.obj, .ply, .stl, .off) at --voxel-size, in the mesh's units (mesh_voxelize.h).
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <fstream>
 #include <iostream>
 
@@ -11,6 +13,7 @@
 #include "progress.h"
 #include "voxfield/dissertation_format.h"
 #include "voxfield/gpu_distance.h"
+#include "voxfield/mesh_read.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
 #include "voxfield/vdb.h"
@@ -23,7 +26,68 @@ struct FieldSettings {
   std::string algorithm = "exact";
   std::string backend = "cpu";
   FieldArgs field;
+  double voxel_size = 0;
+  bool metric_given = false;
 };
+
+// A mesh's field: always signed (by the winding number) and Euclidean, in the mesh's units, f32.
+int run_mesh_field(const FieldSettings& s, Outputs& outputs) {
+  const auto refuse = [&](bool bad, const std::string& what) {
+    if (bad) throw UsageError(s.in + ": " + what);
+  };
+  refuse(!(s.voxel_size > 0), "a mesh needs --voxel-size (the voxels' edge in its units)");
+  refuse(s.metric_given && s.field.metric != "euclidean",
+         "a mesh's field is Euclidean (--metric " + s.field.metric + ")");
+  refuse(s.field.storage != "f32", "a mesh's field is stored as f32, in the mesh's units");
+  refuse(!s.field.spacing.empty(), "--spacing: a mesh's voxels are cubes of --voxel-size");
+  refuse(s.algorithm != "exact" || s.backend != "cpu" || !s.field.focus.empty(),
+         "a mesh's field has one algorithm, on the CPU (no --algorithm, --backend or --focus)");
+  refuse(!s.sites.empty() || !s.packed.empty(), "--sites and --packed apply to worlds");
+  std::string out_ext = std::filesystem::path(s.out).extension().string();
+  std::transform(out_ext.begin(), out_ext.end(), out_ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  refuse(out_ext != ".npy", "a mesh's field is written as .npy");
+  set_activity("reading " + s.in);
+  const TriangleMesh mesh = read_mesh(s.in);
+  MeshDistanceOptions o;
+  o.voxel_size = s.voxel_size;
+  o.interrupter = progress();
+  set_activity("computing the field of " + s.in);
+  const auto start = std::chrono::steady_clock::now();
+  MeshDistanceField f = mesh_distance_field(mesh, o);
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  if (s.field.max_distance > 0) {
+    const float d = static_cast<float>(s.field.max_distance);
+    for (float& v : f.values) v = std::clamp(v, -d, d);
+  }
+  set_activity("writing " + s.out);
+  const Vec3i dims = f.box.size();
+  outputs.stage(s.out, encode_npy(make_npy(DType::kFloat32, dims, f.values.data())));
+  const std::array<double, 3> first{(f.box.begin.x + 0.5) * f.voxel_size,
+                                    (f.box.begin.y + 0.5) * f.voxel_size,
+                                    (f.box.begin.z + 0.5) * f.voxel_size};
+  if (!s.stats.empty()) {
+    outputs.stage_json(
+        s.stats,
+        nlohmann::json{{"input", "mesh"},
+                       {"triangles", mesh.triangles.size()},
+                       {"vertices", mesh.positions.size()},
+                       {"voxel_size", f.voxel_size},
+                       {"dims", {dims.x, dims.y, dims.z}},
+                       {"first_sample", first},
+                       {"band_voxels", f.band_voxels},
+                       {"max_distance", s.field.max_distance},
+                       {"ms", ms},
+                       {"peak_rss_mb", static_cast<double>(peak_rss_bytes()) / 1048576.0}});
+  }
+  outputs.commit();
+  std::cerr << "voxfield: signed distance field of " << mesh.triangles.size() << " triangles, "
+            << dims.x << "x" << dims.y << "x" << dims.z << " samples of " << f.voxel_size
+            << " from (" << first[0] << ", " << first[1] << ", " << first[2] << "), in " << ms
+            << " ms, wrote " << s.out << "\n";
+  return 0;
+}
 
 int run_field(const FieldSettings& s) {
   std::optional<ThreadLimit> limit;
@@ -31,13 +95,16 @@ int run_field(const FieldSettings& s) {
   // Everything that can be wrong with the options is found before the world is loaded.
   Outputs outputs({s.in});
   outputs.expect(s.out, "-o");
+  outputs.expect(s.stats, "--stats");
+  if (mesh_input_format_of(s.in)) return run_mesh_field(s, outputs);
+  if (s.voxel_size != 0)
+    throw UsageError("--voxel-size applies to mesh inputs (.obj, .ply, .stl, .off)");
   std::string out_ext = std::filesystem::path(s.out).extension().string();
   std::transform(out_ext.begin(), out_ext.end(), out_ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   const bool vdb_output = out_ext == ".vdb";  // else .npy
   outputs.expect(s.sites, "--sites");
   outputs.expect(s.packed, "--packed");
-  outputs.expect(s.stats, "--stats");
   DistanceOptions o = s.field.options();
   o.interrupter = progress();  // a progress bar on a terminal for fields that take a while
   o.nearest_sites = !s.sites.empty();
@@ -114,7 +181,8 @@ void add_field(CLI::App& app, Action& action) {
   CLI::App* cmd = app.add_subcommand(
       "field",
       "Compute a distance field and write it as .npy (a[x, y, z], like the input) or .vdb");
-  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
+  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw, or a mesh: .obj, .ply, .stl, .off")
+      ->required();
   cmd->add_option("-o,--output", s->out,
                   "output .npy, or .vdb (an OpenVDB float grid: a level set when signed)")
       ->required();
@@ -132,7 +200,13 @@ void add_field(CLI::App& app, Action& action) {
   cmd->add_option("--packed", s->packed,
                   "also write the dissertation's packed uint32 voxels to this .npy");
   cmd->add_option("--stats", s->stats, "write timing (ms: compute only) and error figures as JSON");
-  cmd->callback([s, &action] { action = [s] { return run_field(*s); }; });
+  cmd->add_option("--voxel-size", s->voxel_size,
+                  "for a mesh: the samples' spacing in its units (the field is signed by the "
+                  "winding number, Euclidean, f32, in the mesh's units)");
+  cmd->callback([s, cmd, &action] {
+    s->metric_given = cmd->get_option("--metric")->count() > 0;
+    action = [s] { return run_field(*s); };
+  });
 }
 
 }  // namespace voxfield::cli

@@ -1,0 +1,70 @@
+// voxfield — small geometry shared by the mesh voxeliser and the mesh distance field (internal).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "voxfield/box.h"
+#include "voxfield/mesh_voxelize.h"
+
+namespace voxfield::detail {
+namespace triangles {
+
+using V3 = std::array<double, 3>;
+inline V3 sub(const V3& a, const V3& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+inline double dot(const V3& a, const V3& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+inline V3 cross(const V3& a, const V3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+// Distance from p to the segment ab (a point when a == b).
+inline double segment_distance(const V3& p, const V3& a, const V3& b) {
+  const V3 ab = sub(b, a), ap = sub(p, a);
+  const double len2 = dot(ab, ab);
+  const double t = len2 > 0 ? std::clamp(dot(ap, ab) / len2, 0.0, 1.0) : 0.0;
+  const V3 d{ap[0] - t * ab[0], ap[1] - t * ab[1], ap[2] - t * ab[2]};
+  return std::sqrt(dot(d, d));
+}
+
+}  // namespace triangles
+
+// The centres of a box of voxels in the mesh's units, and which of them lie inside the mesh's
+// bounding box (the only ones whose winding number can reach 1/2). Local indices: 0 at box.begin.
+struct VoxelCentres {
+  Box3i box;
+  double voxel_size;
+  std::array<double, 3> lo, hi;  // the mesh's bounds
+  int x_begin = 0, x_end = 0;    // local x whose centres lie within [lo.x, hi.x]
+
+  VoxelCentres(const TriangleMesh& mesh, const Box3i& b, double v) : box(b), voxel_size(v) {
+    const auto bounds = mesh.bounds();
+    lo = bounds[0];
+    hi = bounds[1];
+    const Vec3i size = box.size();
+    x_begin = size.x;
+    for (int x = 0; x < size.x; ++x)
+      if (inside(0, x)) {
+        x_begin = std::min(x_begin, x);
+        x_end = x + 1;
+      }
+    if (x_end == 0) x_begin = 0;
+  }
+  double coordinate(int axis, int local) const {
+    return (static_cast<double>(box.begin[axis]) + local + 0.5) * voxel_size;
+  }
+  bool inside(int axis, int local) const {
+    const double c = coordinate(axis, local);
+    return c >= lo[axis] && c <= hi[axis];
+  }
+  bool may_be_inside_y(int y) const { return inside(1, y); }
+  bool may_be_inside_z(int z) const { return inside(2, z); }
+  std::array<double, 3> at(int x, int y, int z) const {
+    return {coordinate(0, x), coordinate(1, y), coordinate(2, z)};
+  }
+};
+
+}  // namespace voxfield::detail
