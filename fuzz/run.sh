@@ -16,7 +16,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-25}; shift || true
-harnesses=${*:-"vox npy vfw edit_script options vector_sources csg_model openscad"}
+harnesses=${*:-"vox npy vfw edit_script options vector_sources csg_model openscad mesh"}
 bin=build/fuzz/bin
 cli=build/release/bin/voxfield
 corpus=../shared/data/vox
@@ -46,6 +46,7 @@ run_one() {
     vector_sources) dirs="fuzz/seeds/vector_sources"; max_len=4096 ;;
     csg_model) dirs="fuzz/seeds/csg"; max_len=4096 ;;
     openscad) dirs="fuzz/seeds/openscad"; max_len=4096 ;;
+    mesh) dirs="fuzz/seeds/mesh"; max_len=4096 ;;
     *) echo "unknown harness $h" >&2; return 2 ;;
   esac
   work="$out/corpus-$h"; mkdir -p "$work"

@@ -56,3 +56,6 @@ if [ ! -f "$web/node_modules/.package-lock.json" ] ||
   echo "voxfield: installing the report page's npm packages (web/package-lock.json)" >&2
   (cd "$web" && npm ci --no-audit --no-fund --loglevel=error >&2)
 fi
+
+# The classic meshes the mesh-input oracle reads (Debian's packages, downloaded, never in the repo).
+bash "$(dirname "$0")/fetch-test-meshes.sh"
