@@ -20,7 +20,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       voxfield::MeshInputFormat::kStl, voxfield::MeshInputFormat::kOff};
   const voxfield::MeshInputFormat format = kFormats[data[0] % 4];
   try {
-    const voxfield::TriangleMesh m = voxfield::parse_mesh({data + 1, size - 1}, format, "fuzz.mesh");
+    const voxfield::TriangleMesh m =
+        voxfield::parse_mesh({data + 1, size - 1}, format, "fuzz.mesh");
     m.validate();  // a reader that lets a bad index or a NaN through fails here, loudly
     if (!m.triangles.empty() && m.triangles.size() < 4096) {
       const voxfield::WindingNumber w(m);

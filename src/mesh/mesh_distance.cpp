@@ -29,6 +29,17 @@ namespace {
 constexpr int kBandSlabDepth = 4;      // z layers per unit of parallel work in the band
 constexpr int kMaxPasses = 64;         // beyond the band; in the tests they settle within a handful
 constexpr double kImprovement = 1e-4;  // voxels: a nearer triangle must win by more than this
+// The 26 neighbours. Only the 6 face neighbours halves the time but leaves errors of 0.13 voxels
+// where the 26 leave under 0.05 (the brute-force test's bound).
+constexpr auto kNeighbours = [] {
+  std::array<std::array<int, 3>, 26> n{};
+  int k = 0;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (dx != 0 || dy != 0 || dz != 0) n[k++] = {dx, dy, dz};
+  return n;
+}();
 
 struct Band {
   std::vector<float> distance;        // +inf outside the band
@@ -166,19 +177,16 @@ void beyond_band(const TriangleMesh& mesh, const Box3i& box, double v, const Ban
       for (const std::uint32_t c : changed) {
         const int x = static_cast<int>(c % size.x), y = static_cast<int>(c / size.x % size.y),
                   z = static_cast<int>(c / plane);
-        for (int dz = -1; dz <= 1; ++dz)
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              const int nx = x + dx, ny = y + dy, nz = z + dz;
-              if (nx < 0 || ny < 0 || nz < 0 || nx >= size.x || ny >= size.y || nz >= size.z)
-                continue;
-              const std::size_t j = index(nx, ny, nz);
-              if (band.nearest[j] >= 0 || nearest[j] < 0 ||
-                  stamp[j] == static_cast<std::uint32_t>(pass))
-                continue;
-              stamp[j] = static_cast<std::uint32_t>(pass);
-              asked.push_back(static_cast<std::uint32_t>(j));
-            }
+        for (const auto& s : kNeighbours) {
+          const int nx = x + s[0], ny = y + s[1], nz = z + s[2];
+          if (nx < 0 || ny < 0 || nz < 0 || nx >= size.x || ny >= size.y || nz >= size.z) continue;
+          const std::size_t j = index(nx, ny, nz);
+          if (band.nearest[j] >= 0 || nearest[j] < 0 ||
+              stamp[j] == static_cast<std::uint32_t>(pass))
+            continue;
+          stamp[j] = static_cast<std::uint32_t>(pass);
+          asked.push_back(static_cast<std::uint32_t>(j));
+        }
       }
     }
     answer.assign(asked.size(), -1);
@@ -193,21 +201,18 @@ void beyond_band(const TriangleMesh& mesh, const Box3i& box, double v, const Ban
         float best_d = values[i];
         int n_tried = 0;
         tried[n_tried++] = best;
-        for (int dz = -1; dz <= 1; ++dz)
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              const int nx = x + dx, ny = y + dy, nz = z + dz;
-              if (nx < 0 || ny < 0 || nz < 0 || nx >= size.x || ny >= size.y || nz >= size.z)
-                continue;
-              const std::int32_t t = nearest[index(nx, ny, nz)];
-              if (t < 0 || std::find(tried, tried + n_tried, t) != tried + n_tried) continue;
-              tried[n_tried++] = t;
-              const float d = distance_to(x, y, z, t);
-              if (d < best_d - improvement) {
-                best_d = d;
-                best = t;
-              }
-            }
+        for (const auto& s : kNeighbours) {
+          const int nx = x + s[0], ny = y + s[1], nz = z + s[2];
+          if (nx < 0 || ny < 0 || nz < 0 || nx >= size.x || ny >= size.y || nz >= size.z) continue;
+          const std::int32_t t = nearest[index(nx, ny, nz)];
+          if (t < 0 || std::find(tried, tried + n_tried, t) != tried + n_tried) continue;
+          tried[n_tried++] = t;
+          const float d = distance_to(x, y, z, t);
+          if (d < best_d - improvement) {
+            best_d = d;
+            best = t;
+          }
+        }
         if (best != nearest[i]) {
           answer[a] = best;
           answer_distance[a] = best_d;
@@ -241,8 +246,9 @@ MeshDistanceField mesh_distance_field(const TriangleMesh& mesh,
     throw InvalidArgument("mesh distance field: the band must be 1..64 voxels");
   const Box3i box = mesh_voxel_box(mesh, options);
   // Per voxel: the band's distance and triangle (8 bytes), the sites (1) and the transform's
-  // field and nearest-site offsets (4 + 6), the output (4).
-  require_memory(mul_sat(static_cast<std::uint64_t>(box.volume()), 23), options.memory_limit_bytes,
+  // field and nearest-site offsets (4 + 6), the output (4); then the sign's regions and queue (8)
+  // and masks (2).
+  require_memory(mul_sat(static_cast<std::uint64_t>(box.volume()), 33), options.memory_limit_bytes,
                  "mesh distance field", "a box of " + to_string(box.size()) + " voxels");
   const double v = options.voxel_size;
   const Vec3i size = box.size();
@@ -262,24 +268,17 @@ MeshDistanceField mesh_distance_field(const TriangleMesh& mesh,
   if (out.band_voxels < static_cast<std::int64_t>(count))
     beyond_band(mesh, box, v, band, out.values);
 
-  // Step 3: the sign.
+  // Step 3: the sign. The surface enters only cells within half a voxel diagonal of it, all in
+  // the band.
   if (options.signed_distance) {
     const WindingNumber winding(mesh, options.accuracy);
-    const detail::VoxelCentres centres(mesh, box, v);
-    parallel_for(static_cast<std::size_t>(size.z), 1, [&](std::size_t z0, std::size_t z1) {
-      for (int z = static_cast<int>(z0); z < static_cast<int>(z1); ++z) {
-        if (!progress.keep_going()) return;
-        if (centres.may_be_inside_z(z))
-          for (int y = 0; y < size.y; ++y) {
-            if (!centres.may_be_inside_y(y)) continue;
-            const std::size_t row = (static_cast<std::size_t>(z) * size.y + y) * size.x;
-            for (int x = centres.x_begin; x < centres.x_end; ++x)
-              if (winding.inside(centres.at(x, y, z))) out.values[row + x] = -out.values[row + x];
-          }
-        progress.advance();
-      }
-    });
+    std::vector<std::uint8_t> near_surface(count);
+    for (std::size_t i = 0; i < count; ++i) near_surface[i] = band.nearest[i] >= 0 ? 1 : 0;
+    const std::vector<std::uint8_t> inside =
+        detail::inside_voxels(mesh, winding, box, v, near_surface, progress);
     progress.throw_if_cancelled();
+    for (std::size_t i = 0; i < count; ++i)
+      if (inside[i]) out.values[i] = -out.values[i];
   }
   return out;
 }

@@ -4,8 +4,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "voxfield/box.h"
+#include "voxfield/interrupt.h"
 #include "voxfield/mesh_voxelize.h"
 
 namespace voxfield::detail {
@@ -66,5 +69,13 @@ struct VoxelCentres {
     return {coordinate(0, x), coordinate(1, y), coordinate(2, z)};
   }
 };
+
+// Which voxels of `box` have a winding number >= 1/2 (1 per voxel, x fastest). `near_surface`
+// marks voxels whose cells the surface may enter (at least every one it does); the rest are
+// decided by regions (mesh_sign.cpp). Advances `progress` once per z slice.
+std::vector<std::uint8_t> inside_voxels(const TriangleMesh& mesh, const WindingNumber& winding,
+                                        const Box3i& box, double voxel_size,
+                                        const std::vector<std::uint8_t>& near_surface,
+                                        Progress& progress);
 
 }  // namespace voxfield::detail

@@ -4,7 +4,8 @@
 //
 // Only centres inside the mesh's bounding box are evaluated: seen from a point outside the box,
 // every triangle lies in one half-space, so together they subtend at most a hemisphere — a winding
-// number of at most 1/2, reached only in the limit of a surface flat against the box's face.
+// number of at most 1/2, reached only in the limit of a surface flat against the box's face. And
+// away from the surface whole regions are decided from their boundaries (mesh_sign.cpp).
 #include <cmath>
 
 #include "mesh_triangles.h"
@@ -70,28 +71,36 @@ Box3i mesh_voxel_box(const TriangleMesh& mesh, const MeshVoxelOptions& options) 
 
 World voxelize_mesh(const TriangleMesh& mesh, const MeshVoxelOptions& options) {
   const Box3i box = mesh_voxel_box(mesh, options);
-  require_memory(mul_sat(static_cast<std::uint64_t>(box.volume()), 2), options.memory_limit_bytes,
+  // The mask, the regions and their queue (10 bytes a voxel), the result and the world's copy.
+  require_memory(mul_sat(static_cast<std::uint64_t>(box.volume()), 12), options.memory_limit_bytes,
                  "voxelize_mesh", "a box of " + to_string(box.size()) + " voxels");
   const WindingNumber winding(mesh, options.accuracy);
-  const detail::VoxelCentres centres(mesh, box, options.voxel_size);
   const Vec3i size = box.size();
-  std::vector<std::uint8_t> dense(static_cast<std::size_t>(box.volume()), 0);
-  Progress progress(options.interrupter, "voxelising a mesh", size.z);
-  parallel_for(static_cast<std::size_t>(size.z), 1, [&](std::size_t z0, std::size_t z1) {
-    for (std::size_t z = z0; z < z1; ++z) {
-      if (!progress.keep_going()) return;
-      const int k = static_cast<int>(z);
-      if (centres.may_be_inside_z(k))
-        for (int y = 0; y < size.y; ++y) {
-          if (!centres.may_be_inside_y(y)) continue;
-          std::uint8_t* row = dense.data() + (static_cast<std::size_t>(k) * size.y + y) * size.x;
-          for (int x = centres.x_begin; x < centres.x_end; ++x)
-            if (winding.inside(centres.at(x, y, k))) row[x] = options.material;
-        }
-      progress.advance();
+  // The cells the surface may enter: those whose centres lie within each triangle's bounding box
+  // grown by a voxel (a superset: mesh_sign.cpp needs every such cell, not only these).
+  std::vector<std::uint8_t> near_surface(static_cast<std::size_t>(box.volume()), 0);
+  const double v = options.voxel_size;
+  for (const auto& tri : mesh.triangles) {
+    int lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+      double a = HUGE_VAL, b = -HUGE_VAL;
+      for (std::uint32_t p : tri) {
+        a = std::min(a, mesh.positions[p][k]);
+        b = std::max(b, mesh.positions[p][k]);
+      }
+      lo[k] = std::max(0, static_cast<int>(std::ceil((a - v) / v - 0.5)) - box.begin[k]);
+      hi[k] = std::min(size[k] - 1, static_cast<int>(std::floor((b + v) / v - 0.5)) - box.begin[k]);
     }
-  });
+    for (int z = lo[2]; z <= hi[2]; ++z)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int x = lo[0]; x <= hi[0]; ++x)
+          near_surface[(static_cast<std::size_t>(z) * size.y + y) * size.x + x] = 1;
+  }
+  Progress progress(options.interrupter, "voxelising a mesh", size.z);
+  std::vector<std::uint8_t> dense =
+      detail::inside_voxels(mesh, winding, box, v, near_surface, progress);
   progress.throw_if_cancelled();
+  for (std::uint8_t& m : dense) m = m ? options.material : 0;
   World world(Grid<std::uint8_t>::kDefaultChunkEdge, box);
   world.voxels.copy_from_dense(box, dense.data());
   world.voxels.compact();
