@@ -231,6 +231,23 @@ TEST(MeshInput, CubeFieldIsTheAnalyticBoxField) {
   EXPECT_LT(worst, 2e-6);  // float rounding only
 }
 
+TEST(MeshInput, ClampedFieldsAreTheFullFieldClamped) {
+  const TriangleMesh sphere = icosphere(2, 2.0, {0.3, 0.1, -0.2});
+  MeshDistanceOptions o;
+  o.voxel_size = 0.25;
+  o.padding_voxels = 6;
+  const MeshDistanceField full = mesh_distance_field(sphere, o);
+  for (const double clamp : {0.1, 0.5, 0.75, 1.2}) {  // within the band (0.75) and beyond it
+    o.max_distance = clamp;
+    const MeshDistanceField f = mesh_distance_field(sphere, o);
+    ASSERT_EQ(f.values.size(), full.values.size());
+    for (std::size_t i = 0; i < f.values.size(); ++i)
+      ASSERT_EQ(f.values[i],
+                std::clamp(full.values[i], -static_cast<float>(clamp), static_cast<float>(clamp)))
+          << clamp << " at " << i;
+  }
+}
+
 TEST(MeshInput, FieldsMatchBruteForceAndDoNotDependOnThreads) {
   // A sphere, a holed sphere and two overlapping spheres (a soup, not a manifold).
   TriangleMesh two = icosphere(2, 2.0, {0, 0, 0});

@@ -51,16 +51,13 @@ int run_mesh_field(const FieldSettings& s, Outputs& outputs) {
   const TriangleMesh mesh = read_mesh(s.in);
   MeshDistanceOptions o;
   o.voxel_size = s.voxel_size;
+  o.max_distance = s.field.max_distance;
   o.interrupter = progress();
   set_activity("computing the field of " + s.in);
   const auto start = std::chrono::steady_clock::now();
   MeshDistanceField f = mesh_distance_field(mesh, o);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  if (s.field.max_distance > 0) {
-    const float d = static_cast<float>(s.field.max_distance);
-    for (float& v : f.values) v = std::clamp(v, -d, d);
-  }
   set_activity("writing " + s.out);
   const Vec3i dims = f.box.size();
   outputs.stage(s.out, encode_npy(make_npy(DType::kFloat32, dims, f.values.data())));

@@ -97,6 +97,10 @@ struct MeshDistanceOptions : MeshVoxelOptions {
   // and, as measured in docs/mesh_input.md, within a few hundredths of a voxel of it.
   double band_voxels = 3;
   bool signed_distance = true;  // negative where the winding number is >= 1/2
+  // Clamp, in the mesh's units (0: none): distances beyond it read it (-it inside). A clamp within
+  // the band is a narrow band, as OpenVDB's level sets are: nothing beyond it is computed but the
+  // sign.
+  double max_distance = 0;
 };
 
 // A signed distance field sampled at voxel centres, in the mesh's units.

@@ -244,6 +244,8 @@ MeshDistanceField mesh_distance_field(const TriangleMesh& mesh,
                                       const MeshDistanceOptions& options) {
   if (!(options.band_voxels >= 1) || !(options.band_voxels <= 64))
     throw InvalidArgument("mesh distance field: the band must be 1..64 voxels");
+  if (!(options.max_distance >= 0) || !std::isfinite(options.max_distance))
+    throw InvalidArgument("mesh distance field: the clamp must be >= 0 and finite");
   const Box3i box = mesh_voxel_box(mesh, options);
   // Per voxel: the band's distance and triangle (8 bytes), the sites (1) and the transform's
   // field and nearest-site offsets (4 + 6), the output (4); then the sign's regions and queue (8)
@@ -256,7 +258,12 @@ MeshDistanceField mesh_distance_field(const TriangleMesh& mesh,
   const int slabs = (size.z + kBandSlabDepth - 1) / kBandSlabDepth;
   Progress progress(options.interrupter, "mesh distance field",
                     slabs + (options.signed_distance ? size.z : 0));
-  const Band band = narrow_band(mesh, box, v, options.band_voxels * v, progress);
+  // A clamp within the band needs no more than the clamp (and a voxel at least: the sign's regions
+  // need every cell the surface enters marked); nothing beyond it then needs step 2.
+  const double clamp = options.max_distance;
+  const bool band_only = clamp > 0 && clamp <= options.band_voxels * v;
+  const double band_width = band_only ? std::max(clamp, v) : options.band_voxels * v;
+  const Band band = narrow_band(mesh, box, v, band_width, progress);
   progress.throw_if_cancelled();
 
   MeshDistanceField out;
@@ -265,8 +272,13 @@ MeshDistanceField mesh_distance_field(const TriangleMesh& mesh,
   out.values.assign(band.distance.begin(), band.distance.end());
   for (float d : band.distance) out.band_voxels += std::isfinite(d) ? 1 : 0;
 
-  if (out.band_voxels < static_cast<std::int64_t>(count))
+  if (band_only) {
+    for (float& d : out.values) d = std::min(d, static_cast<float>(clamp));
+  } else if (out.band_voxels < static_cast<std::int64_t>(count)) {
     beyond_band(mesh, box, v, band, out.values);
+    if (clamp > 0)
+      for (float& d : out.values) d = std::min(d, static_cast<float>(clamp));
+  }
 
   // Step 3: the sign. The surface enters only cells within half a voxel diagonal of it, all in
   // the band.

@@ -93,8 +93,10 @@ std::vector<std::uint8_t> inside_voxels(const TriangleMesh& mesh, const WindingN
   // 0: outside, 1: inside, 2: ask every voxel.
   std::vector<std::uint8_t> verdict(regions, 2);
   for (std::uint32_t r = 0; r < regions; ++r) {
-    if (hi[r] <= 0.5 - kRegionMargin) verdict[r] = 0;
-    else if (lo[r] >= 0.5 + kRegionMargin) verdict[r] = 1;
+    if (hi[r] <= 0.5 - kRegionMargin)
+      verdict[r] = 0;
+    else if (lo[r] >= 0.5 + kRegionMargin)
+      verdict[r] = 1;
   }
 
   parallel_for(static_cast<std::size_t>(size.z), 1, [&](std::size_t z0, std::size_t z1) {
