@@ -452,6 +452,32 @@ expect_grep "save-world help vfw" "$tmp/out" "save-world.*vfw"
 ls -a | grep -q vftmp && { echo "FAIL: temporaries left behind"; fails=$((fails+1)); } || passes=$((passes+1))
 cd - >/dev/null
 
+# Meshes in: a cube as OBJ (quads) — its field is the box's, its voxels the cube's; mistakes are
+# refused with the file and the byte, and write nothing.
+printf 'v 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\nv 0 0 2\nv 2 0 2\nv 2 2 2\nv 0 2 2\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 3 4 8 7\nf 1 5 8 4\nf 2 3 7 6\n' >"$tmp/cube.obj"
+check "mesh field needs --voxel-size" 2 "$V" field "$tmp/cube.obj" -o "$tmp/m.npy"
+expect_grep "mesh field names the missing option" "$tmp/err" "cube.obj: a mesh needs --voxel-size"
+check "mesh field" 0 "$V" field "$tmp/cube.obj" -o "$tmp/m.npy" --voxel-size 0.5 --stats "$tmp/m.json"
+check "mesh field values" 0 /usr/bin/python3 -c "
+import json, numpy as np
+a, s = np.load('$tmp/m.npy'), json.load(open('$tmp/m.json'))
+first = np.array(s['first_sample'])
+idx = np.indices(a.shape).reshape(3, -1).T
+p = first + 0.5 * idx
+d = np.maximum(-p, p - 2)  # outside distance per axis of the box [0, 2]^3
+want = np.where((d > 0).any(1), np.linalg.norm(np.maximum(d, 0), axis=1), d.max(1))
+assert a.dtype == np.float32 and a.shape == (8, 8, 8), (a.dtype, a.shape)
+assert np.abs(a.reshape(-1) - want).max() < 1e-6, np.abs(a.reshape(-1) - want).max()"
+check "mesh voxelised" 0 "$V" convert "$tmp/cube.obj" "$tmp/cube.npy" --voxel-size 0.5
+check "mesh voxels" 0 /usr/bin/python3 -c "
+import numpy as np; a = np.load('$tmp/cube.npy'); assert a.shape == (4, 4, 4) and (a == 1).all(), a"
+printf 'v 0 0 0\nv 1 0 0\nf 1 2 3\n' >"$tmp/bad.obj"
+check "bad mesh refused" 1 "$V" field "$tmp/bad.obj" -o "$tmp/bad.npy" --voxel-size 0.5
+expect_grep "bad mesh names file and byte" "$tmp/err" "bad.obj: at byte 22: the face names vertex 3"
+[ ! -e "$tmp/bad.npy" ] && passes=$((passes+1)) || { echo "FAIL: a refused mesh wrote its output"; fails=$((fails+1)); }
+check "--voxel-size is for meshes" 2 "$V" convert "$tmp/cube.npy" "$tmp/again.npy" --voxel-size 1
+check "a mesh field is Euclidean" 2 "$V" field "$tmp/cube.obj" -o "$tmp/m2.npy" --voxel-size 0.5 --metric manhattan
+
 if ldd "$V" | grep -q libasan; then
   # Under LeakSanitizer: Mesa's lavapipe makes a one-time allocation with its first graphics
   # pipeline (112 bytes whatever the number of terrain renderers, targets and pipelines made and
@@ -471,7 +497,8 @@ expect_grep "showcase edits exact" "$tmp/showcase/report.md" "bit-identical to f
 expect_grep "showcase meshes" "$tmp/showcase/report.md" "| marching cubes | [0-9]* | [0-9]* | [0-9]* | yes |"
 expect_grep "showcase vector fields" "$tmp/showcase/report.md" "| splat | [0-9.]* | 0.000 | 0.00 | 0.0000 |"
 expect_grep "showcase world flow exact under edits" "$tmp/showcase/report.md" "byte-identical\*\* to a rebuild"
-for png in terrain-before terrain-after terrain-top-before terrain-top-after terrain-chunks terrain-distance error-jfa-seed vectors flow-before flow-after; do
+expect_grep "showcase mesh voxelised back exactly" "$tmp/showcase/report.md" "solid voxels; 0 differ from the block's"
+for png in terrain-before terrain-after terrain-top-before terrain-top-after terrain-chunks terrain-distance error-jfa-seed vectors flow-before flow-after bunny; do
   [ -s "$tmp/showcase/$png.png" ] && grep -q "($png.png)" "$tmp/showcase/report.md" && passes=$((passes+1)) \
     || { echo "FAIL: showcase frame $png missing or not in the report"; fails=$((fails+1)); }
 done

@@ -44,6 +44,11 @@ inline std::string fixed(double v, int digits) {
 // Meshes of the terrain: both meshers, their topology and cost, the peers on the same field (when
 // `peers_script` exists and Debian's Python runs it), pictures, a .glb and a .ply. `sdf_npy` is
 // the terrain's signed Euclidean field over its box, already written.
+// Meshes in: a block of `terrain` meshed, written as `out`/terrain-block.obj, read back, voxelised
+// and set against the block; its signed distance field; the Stanford bunny when
+// scripts/fetch-test-meshes.sh has fetched it.
+void showcase_mesh_input(const World& terrain, const std::filesystem::path& out, std::ostream& md,
+                         std::vector<Timing>& timings);
 void showcase_meshing(const World& terrain, const std::filesystem::path& out,
                       const std::filesystem::path& sdf_npy,
                       const std::filesystem::path& peers_script, const Camera& hero,
