@@ -208,13 +208,16 @@ def main():
                 inside, volume = float((ours < 0).sum()) * voxel ** 3, abs(signed_volume(pts, tris))
                 if abs(inside - volume) > 0.05 * volume:
                     failures.append(f"{name}: {inside:.4g} inside, the mesh encloses {volume:.4g}")
-            # voxfield convert: the same voxels as the field's negative samples.
+            # voxfield convert: the same voxels as the field's negative samples (its box is the
+            # field's less the field's 2 voxels of padding on every side).
             world = os.path.join(work, "w.npy")
             subprocess.run([vf, "convert", path, world, "--voxel-size", str(voxel)], check=True,
                            stderr=subprocess.DEVNULL)
-            solid = int(np.count_nonzero(np.load(world)))
-            if solid != int((ours < 0).sum()):
-                failures.append(f"{name}: convert made {solid} solid voxels, the field has {(ours < 0).sum()} inside")
+            solid = np.load(world) != 0
+            inner = ours[2:-2, 2:-2, 2:-2] < 0
+            if solid.shape != inner.shape or (solid != inner).any():
+                failures.append(f"{name}: convert's {solid.shape} voxels differ from the field's inside "
+                                f"{inner.shape} at {int((solid != inner).sum()) if solid.shape == inner.shape else 'every'} places")
     for f in failures:
         print("FAIL:", f)
     return 1 if failures else 0

@@ -213,6 +213,45 @@ TEST(MeshInput, AHoledMeshVoxelisesLikeItsClosedSelf) {
   EXPECT_LT(differ, closed.solid_count() / 100) << "only voxels at the holes' rims may differ";
 }
 
+TEST(MeshInput, SoupsAreJudgedByTheirWindingNumberEverywhere) {
+  // An open square sheet laid twice (a soup: the doubled sheet winds a full turn just behind it,
+  // outside the mesh's flat bounding box), and a closed cube beside it.
+  TriangleMesh soup;
+  soup.positions = {{0, 0, 1}, {3, 0, 1}, {3, 3, 1}, {0, 3, 1}};
+  soup.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 1, 2}, {0, 2, 3}};
+  const TriangleMesh cube = box_mesh({4.2, 0.3, 0.1}, {6.1, 2.2, 1.9});
+  for (const auto& t : cube.triangles) soup.triangles.push_back({t[0] + 4, t[1] + 4, t[2] + 4});
+  soup.positions.insert(soup.positions.end(), cube.positions.begin(), cube.positions.end());
+  MeshVoxelOptions o;
+  o.voxel_size = 0.25;
+  const World world = voxelize_mesh(soup, o);
+  MeshDistanceOptions d;
+  d.voxel_size = 0.25;
+  const MeshDistanceField field = mesh_distance_field(soup, d);
+  const WindingNumber w(soup);
+  const Box3i box = *world.voxels.bounds();
+  ASSERT_EQ(box, field.box);
+  std::int64_t wound = 0;
+  for (int z = box.begin.z; z < box.end.z; ++z)
+    for (int y = box.begin.y; y < box.end.y; ++y)
+      for (int x = box.begin.x; x < box.end.x; ++x) {
+        const double exact = w.exact(centre_of({x, y, z}, 0.25));
+        if (std::abs(exact - 0.5) < 0.05) continue;
+        wound += exact >= 0.5;
+        ASSERT_EQ(world.voxels.get({x, y, z}) != 0, exact >= 0.5)
+            << x << "," << y << "," << z << ": " << exact;
+        ASSERT_EQ(field.at({x, y, z}) < 0, exact >= 0.5)
+            << x << "," << y << "," << z << ": " << exact;
+      }
+  EXPECT_GT(wound, 100);
+  // A flat mesh with no padding still gets a box, one voxel thick.
+  TriangleMesh flat = soup;
+  flat.triangles.resize(2);
+  o.padding_voxels = 0;
+  EXPECT_EQ(mesh_voxel_box(flat, o).size().z, 1);
+  EXPECT_EQ(voxelize_mesh(flat, o).solid_count(), 0);
+}
+
 TEST(MeshInput, CubeFieldIsTheAnalyticBoxField) {
   const P lo{-1.3, 0.45, 2.1}, hi{2.2, 3.05, 3.9};
   const TriangleMesh cube = box_mesh(lo, hi);
@@ -426,7 +465,9 @@ TEST(MeshInput, BadRequestsAreRefused) {
   EXPECT_THROW(voxelize_mesh(sphere, o), InvalidArgument);
   o.voxel_size = 1e-9;  // 2e9 voxels along each axis
   EXPECT_THROW(voxelize_mesh(sphere, o), InvalidArgument);
-  o.voxel_size = 1e-3;  // 2000^3 voxels: past a 1 GiB limit
+  o.voxel_size = 1e-3;  // 2004^3 voxels: more than 32-bit voxel indices hold
+  EXPECT_THROW(voxelize_mesh(sphere, o), InvalidArgument);
+  o.voxel_size = 2.5e-3;  // 804^3 voxels: past a 1 GiB limit
   o.memory_limit_bytes = std::uint64_t{1} << 30;
   EXPECT_THROW(voxelize_mesh(sphere, o), ResourceLimitError);
   EXPECT_THROW(voxelize_mesh(TriangleMesh{}, MeshVoxelOptions{}), InvalidArgument);

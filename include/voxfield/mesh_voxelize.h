@@ -64,9 +64,7 @@ class WindingNumber {
  private:
   struct Tree;
   double evaluate(const std::array<double, 3>& point, double accuracy) const;
-  std::vector<std::array<double, 3>> positions_;
-  std::vector<std::array<std::uint32_t, 3>> triangles_;
-  Tree* tree_ = nullptr;
+  Tree* tree_ = nullptr;  // the triangles' corners in tree order, and the clusters
 };
 
 struct MeshVoxelOptions {
@@ -81,8 +79,9 @@ struct MeshVoxelOptions {
 };
 
 // The voxels whose centres lie within the mesh's bounds grown by options.padding_voxels: the box
-// every function below works on. Throws InvalidArgument for an empty mesh, a voxel size <= 0 or
-// not finite, or a box beyond 2^20 voxels along an axis.
+// every function below works on (one voxel thick at least along each axis). Throws
+// InvalidArgument for an empty mesh, a voxel size <= 0 or not finite, a box beyond 2^20 voxels
+// along an axis or of 2^32 voxels or more.
 Box3i mesh_voxel_box(const TriangleMesh& mesh, const MeshVoxelOptions& options);
 
 // A world with `material` where the winding number at the voxel's centre is >= 1/2, bounded by

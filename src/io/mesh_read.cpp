@@ -176,8 +176,10 @@ TriangleMesh parse_stl_binary(std::span<const std::uint8_t> bytes, const std::st
                               std::uint64_t limit, std::uint32_t count) {
   MeshBuilder out(name, limit);
   // The welder's table holds up to 3 corners a facet (about 48 bytes each): counted with the mesh.
+  // The mesh (24 bytes a corner, 12 a facet) and the welder's table (about 48 bytes a corner).
+  require_memory(add_sat(mul_sat(std::uint64_t{3} * count, 24 + 48), mul_sat(count, 12)), limit,
+                 name, "the mesh and its corners' table (" + std::to_string(count) + " facets)");
   out.reserve(std::uint64_t{3} * count, count);
-  require_memory(mul_sat(std::uint64_t{3} * count, 48), limit, name, "the corners' table");
   CornerWelder weld(out);
   for (std::uint32_t f = 0; f < count; ++f) {
     const std::uint8_t* facet = bytes.data() + 84 + std::size_t{50} * f;
@@ -200,6 +202,9 @@ TriangleMesh parse_stl_ascii(std::span<const std::uint8_t> bytes, const std::str
                              std::uint64_t limit) {
   TextCursor in(bytes, name);
   MeshBuilder out(name, limit);
+  // A corner takes at least "vertex 0 0 0\n" (13 bytes) and up to about 48 in the welder's table:
+  // the table can cost up to 4 bytes per byte of text, charged before it grows.
+  require_memory(mul_sat(bytes.size(), 4), limit, name, "the corners' table");
   CornerWelder weld(out);
   const auto expect = [&](std::string_view what) {
     const std::size_t at = (in.skip_space(), in.offset());

@@ -50,7 +50,7 @@ struct Band {
 // by one thread: no two threads write a voxel, and ties go to the lower triangle index, so the
 // result does not depend on the thread count.
 Band narrow_band(const TriangleMesh& mesh, const Box3i& box, double v, double band,
-                 Progress& progress) {
+                 std::uint64_t memory_limit, Progress& progress) {
   const Vec3i size = box.size();
   const std::size_t count = static_cast<std::size_t>(box.volume());
   Band out{std::vector<float>(count, std::numeric_limits<float>::infinity()),
@@ -76,7 +76,19 @@ Band narrow_band(const TriangleMesh& mesh, const Box3i& box, double v, double ba
           std::min(size[k] - 1, static_cast<int>(std::floor((hi + band) / v - 0.5)) - box.begin[k]);
       empty |= r.lo[k] > r.hi[k];
     }
-    if (empty) continue;
+    if (empty) r.lo[2] = r.hi[2] + 1;  // no slab
+  }
+  // The buckets, counted before they are filled: long slivers reach many slabs each.
+  std::uint64_t entries = 0;
+  for (const Range& r : ranges)
+    if (r.lo[2] <= r.hi[2])
+      entries +=
+          static_cast<std::uint64_t>(r.hi[2] / kBandSlabDepth - r.lo[2] / kBandSlabDepth + 1);
+  require_memory(mul_sat(entries, 4), memory_limit, "mesh distance field",
+                 "the triangles' slab lists (" + std::to_string(entries) + " entries)");
+  for (std::size_t t = 0; t < ranges.size(); ++t) {
+    const Range& r = ranges[t];
+    if (r.lo[2] > r.hi[2]) continue;
     for (int s = r.lo[2] / kBandSlabDepth; s <= r.hi[2] / kBandSlabDepth; ++s)
       bucket[static_cast<std::size_t>(s)].push_back(static_cast<std::uint32_t>(t));
   }
@@ -94,7 +106,12 @@ Band narrow_band(const TriangleMesh& mesh, const Box3i& box, double v, double ba
         for (int z = std::max(z_begin, r.lo[2]); z < std::min(z_end, r.hi[2] + 1); ++z)
           for (int y = r.lo[1]; y <= r.hi[1]; ++y) {
             const std::size_t row = (static_cast<std::size_t>(z) * size.y + y) * size.x;
-            for (int x = r.lo[0]; x <= r.hi[0]; ++x) {
+            int x0, x1;
+            if (!detail::triangles::row_near_plane(a, b, c, centres.coordinate(1, y),
+                                                   centres.coordinate(2, z), band, v, box.begin.x,
+                                                   r.lo[0], r.hi[0], &x0, &x1))
+              continue;
+            for (int x = x0; x <= x1; ++x) {
               const double d = point_triangle_distance(centres.at(x, y, z), a, b, c);
               if (d > band) continue;
               const float df = static_cast<float>(d);
@@ -121,7 +138,7 @@ Band narrow_band(const TriangleMesh& mesh, const Box3i& box, double v, double ba
 // a pass changes nothing. Passes read the last pass and write a new one: the result does not
 // depend on the threads.
 void beyond_band(const TriangleMesh& mesh, const Box3i& box, double v, const Band& band,
-                 std::vector<float>& values) {
+                 std::vector<float>& values, Progress& progress) {
   const Vec3i size = box.size();
   const std::size_t count = band.distance.size();
   const float site_reach = static_cast<float>(0.5 * std::sqrt(3.0) * v);
@@ -170,6 +187,7 @@ void beyond_band(const TriangleMesh& mesh, const Box3i& box, double v, const Ban
   std::vector<std::int32_t> answer;
   const std::size_t plane = static_cast<std::size_t>(size.x) * size.y;
   for (int pass = 0; pass < kMaxPasses && !changed.empty(); ++pass) {
+    if (!progress.keep_going()) return;
     asked.clear();
     if (pass == 0) {
       asked = changed;
@@ -247,23 +265,28 @@ MeshDistanceField mesh_distance_field(const TriangleMesh& mesh,
   if (!(options.max_distance >= 0) || !std::isfinite(options.max_distance))
     throw InvalidArgument("mesh distance field: the clamp must be >= 0 and finite");
   const Box3i box = mesh_voxel_box(mesh, options);
-  // Per voxel: the band's distance and triangle (8 bytes), the sites (1) and the transform's
-  // field and nearest-site offsets (4 + 6), the output (4); then the sign's regions and queue (8)
-  // and masks (2).
-  require_memory(mul_sat(static_cast<std::uint64_t>(box.volume()), 33), options.memory_limit_bytes,
-                 "mesh distance field", "a box of " + to_string(box.size()) + " voxels");
+  // Per voxel: the band's distance and triangle (8 bytes), the sites and their grid (2), the
+  // transform's field and nearest-site offsets (4 + 6), the far field's triangles and stamps (8),
+  // its lists (up to 12), the output (4); the sign's regions and queue (8), masks (2) and boundary
+  // lists (up to 16) come after the transform is gone. 56 covers them all at once. And the
+  // winding number's tree: about 120 bytes a triangle.
+  require_memory(add_sat(mul_sat(static_cast<std::uint64_t>(box.volume()), 56),
+                         mul_sat(mesh.triangles.size(), 120)),
+                 options.memory_limit_bytes, "mesh distance field",
+                 "a box of " + to_string(box.size()) + " voxels");
   const double v = options.voxel_size;
   const Vec3i size = box.size();
   const std::size_t count = static_cast<std::size_t>(box.volume());
   const int slabs = (size.z + kBandSlabDepth - 1) / kBandSlabDepth;
   Progress progress(options.interrupter, "mesh distance field",
                     slabs + (options.signed_distance ? size.z : 0));
-  // A clamp within the band needs no more than the clamp (and a voxel at least: the sign's regions
-  // need every cell the surface enters marked); nothing beyond it then needs step 2.
+  // A clamp within the band needs no more than the clamp, and two voxels at least: the sign's
+  // regions must keep their distance from the surface (mesh_sign.cpp). Nothing beyond the clamp
+  // then needs step 2.
   const double clamp = options.max_distance;
   const bool band_only = clamp > 0 && clamp <= options.band_voxels * v;
-  const double band_width = band_only ? std::max(clamp, v) : options.band_voxels * v;
-  const Band band = narrow_band(mesh, box, v, band_width, progress);
+  const double band_width = band_only ? std::max(clamp, 2 * v) : options.band_voxels * v;
+  const Band band = narrow_band(mesh, box, v, band_width, options.memory_limit_bytes, progress);
   progress.throw_if_cancelled();
 
   MeshDistanceField out;
@@ -275,7 +298,8 @@ MeshDistanceField mesh_distance_field(const TriangleMesh& mesh,
   if (band_only) {
     for (float& d : out.values) d = std::min(d, static_cast<float>(clamp));
   } else if (out.band_voxels < static_cast<std::int64_t>(count)) {
-    beyond_band(mesh, box, v, band, out.values);
+    beyond_band(mesh, box, v, band, out.values, progress);
+    progress.throw_if_cancelled();
     if (clamp > 0)
       for (float& d : out.values) d = std::min(d, static_cast<float>(clamp));
   }

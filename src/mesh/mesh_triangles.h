@@ -33,6 +33,27 @@ inline double segment_distance(const V3& p, const V3& a, const V3& b) {
   return std::sqrt(dot(d, d));
 }
 
+// The local x range [*x0, *x1] (clipped to [lo, hi]) of the row of voxel centres at (y, z) — in
+// the mesh's units — whose distance to the plane of triangle abc is at most `reach`: a large
+// triangle's voxels are then those near it, not its whole bounding box. A degenerate triangle
+// (no plane) or one edge-on to x keeps [lo, hi]. Returns false when the range is empty.
+inline bool row_near_plane(const V3& a, const V3& b, const V3& c, double y, double z, double reach,
+                           double voxel, int box_begin_x, int lo, int hi, int* x0, int* x1) {
+  const V3 n = cross(sub(b, a), sub(c, a));
+  const double len = std::sqrt(dot(n, n));
+  *x0 = lo;
+  *x1 = hi;
+  if (!(len > 0) || !(std::abs(n[0]) > 1e-9 * len)) return lo <= hi;
+  // n . (p - a) = 0 at the plane: solve for p.x along the row, then widen by reach.
+  const double at = (dot(n, a) - n[1] * y - n[2] * z) / n[0];
+  const double half = reach * len / std::abs(n[0]);
+  const double first = std::ceil((at - half) / voxel - 0.5) - box_begin_x;
+  const double last = std::floor((at + half) / voxel - 0.5) - box_begin_x;
+  if (first > *x0) *x0 = first > hi ? hi + 1 : static_cast<int>(first);
+  if (last < *x1) *x1 = last < lo ? lo - 1 : static_cast<int>(last);
+  return *x0 <= *x1;
+}
+
 }  // namespace triangles
 
 // The centres of a box of voxels in the mesh's units, and which of them lie inside the mesh's

@@ -2,10 +2,8 @@
 // at least 1/2 (Jacobson et al. 2013; winding_number.cpp) is solid — the definition that fills a
 // mesh with holes the way its closed version would be filled.
 //
-// Only centres inside the mesh's bounding box are evaluated: seen from a point outside the box,
-// every triangle lies in one half-space, so together they subtend at most a hemisphere — a winding
-// number of at most 1/2, reached only in the limit of a surface flat against the box's face. And
-// away from the surface whole regions are decided from their boundaries (mesh_sign.cpp).
+// Away from the surface whole regions are decided from their boundaries (mesh_sign.cpp); the
+// voxels near it are asked one by one.
 #include <cmath>
 
 #include "mesh_triangles.h"
@@ -64,23 +62,38 @@ Box3i mesh_voxel_box(const TriangleMesh& mesh, const MeshVoxelOptions& options) 
                             " makes the mesh over 2^20 voxels along an axis or beyond voxfield's "
                             "coordinates; choose a larger voxel size");
     box.begin[k] = static_cast<std::int32_t>(first);
-    box.end[k] = static_cast<std::int32_t>(std::max(last, first - 1)) + 1;
+    // A mesh flat along an axis (and no padding) still gets one layer of voxels.
+    box.end[k] = static_cast<std::int32_t>(std::max(last, first)) + 1;
   }
+  // Voxels are indexed in 32 bits by the sign's regions and the far field's lists.
+  if (box.volume() >= (std::int64_t{1} << 32))
+    throw InvalidArgument("mesh voxels: a voxel size of " + std::to_string(v) + " makes " +
+                          to_string(box.size()) +
+                          " voxels, 2^32 or more; choose a larger voxel size");
   return box;
 }
 
 World voxelize_mesh(const TriangleMesh& mesh, const MeshVoxelOptions& options) {
   const Box3i box = mesh_voxel_box(mesh, options);
-  // The mask, the regions and their queue (10 bytes a voxel), the result and the world's copy.
-  require_memory(mul_sat(static_cast<std::uint64_t>(box.volume()), 12), options.memory_limit_bytes,
-                 "voxelize_mesh", "a box of " + to_string(box.size()) + " voxels");
+  // The mask, the regions and their queue (9 bytes a voxel), the boundary lists (up to 16), the
+  // result and the world's copy (2); the winding number's tree, about 120 bytes a triangle.
+  require_memory(add_sat(mul_sat(static_cast<std::uint64_t>(box.volume()), 27),
+                         mul_sat(mesh.triangles.size(), 120)),
+                 options.memory_limit_bytes, "voxelize_mesh",
+                 "a box of " + to_string(box.size()) + " voxels");
   const WindingNumber winding(mesh, options.accuracy);
   const Vec3i size = box.size();
-  // The cells the surface may enter: those whose centres lie within each triangle's bounding box
-  // grown by a voxel (a superset: mesh_sign.cpp needs every such cell, not only these).
+  // The cells the surface may enter, and their neighbours: centres within two voxels of each
+  // triangle's plane and bounding box (a superset; mesh_sign.cpp wants its regions' cells more than
+  // a voxel from the surface). Rows are clipped to the plane, so a large triangle costs its area.
+  Progress progress(options.interrupter, "voxelising a mesh", size.z);
   std::vector<std::uint8_t> near_surface(static_cast<std::size_t>(box.volume()), 0);
   const double v = options.voxel_size;
-  for (const auto& tri : mesh.triangles) {
+  const double reach = 2 * v;
+  const detail::VoxelCentres centres(mesh, box, v);
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    if (t % 4096 == 0 && !progress.keep_going()) progress.throw_if_cancelled();
     int lo[3], hi[3];
     for (int k = 0; k < 3; ++k) {
       double a = HUGE_VAL, b = -HUGE_VAL;
@@ -88,15 +101,23 @@ World voxelize_mesh(const TriangleMesh& mesh, const MeshVoxelOptions& options) {
         a = std::min(a, mesh.positions[p][k]);
         b = std::max(b, mesh.positions[p][k]);
       }
-      lo[k] = std::max(0, static_cast<int>(std::ceil((a - v) / v - 0.5)) - box.begin[k]);
-      hi[k] = std::min(size[k] - 1, static_cast<int>(std::floor((b + v) / v - 0.5)) - box.begin[k]);
+      lo[k] = std::max(0, static_cast<int>(std::ceil((a - reach) / v - 0.5)) - box.begin[k]);
+      hi[k] =
+          std::min(size[k] - 1, static_cast<int>(std::floor((b + reach) / v - 0.5)) - box.begin[k]);
     }
+    const auto &pa = mesh.positions[tri[0]], &pb = mesh.positions[tri[1]],
+               &pc = mesh.positions[tri[2]];
     for (int z = lo[2]; z <= hi[2]; ++z)
-      for (int y = lo[1]; y <= hi[1]; ++y)
-        for (int x = lo[0]; x <= hi[0]; ++x)
-          near_surface[(static_cast<std::size_t>(z) * size.y + y) * size.x + x] = 1;
+      for (int y = lo[1]; y <= hi[1]; ++y) {
+        int x0, x1;
+        if (!detail::triangles::row_near_plane(pa, pb, pc, centres.coordinate(1, y),
+                                               centres.coordinate(2, z), reach, v, box.begin.x,
+                                               lo[0], hi[0], &x0, &x1))
+          continue;
+        std::fill_n(near_surface.data() + (static_cast<std::size_t>(z) * size.y + y) * size.x + x0,
+                    x1 - x0 + 1, std::uint8_t{1});
+      }
   }
-  Progress progress(options.interrupter, "voxelising a mesh", size.z);
   std::vector<std::uint8_t> dense =
       detail::inside_voxels(mesh, winding, box, v, near_surface, progress);
   progress.throw_if_cancelled();

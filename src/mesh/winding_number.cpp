@@ -70,21 +70,22 @@ struct WindingNumber::Tree {
   }
 };
 
-WindingNumber::WindingNumber(const TriangleMesh& mesh, double accuracy)
-    : positions_(mesh.positions), triangles_(mesh.triangles) {
+WindingNumber::WindingNumber(const TriangleMesh& mesh, double accuracy) {
   if (!(accuracy >= 1) || !std::isfinite(accuracy))
     throw InvalidArgument("WindingNumber: the accuracy must be >= 1 (Barill et al. use 2)");
   mesh.validate();
   auto tree = std::make_unique<Tree>();
   tree->accuracy = accuracy;
-  const std::size_t n = triangles_.size();
+  const auto& positions = mesh.positions;
+  const auto& triangles = mesh.triangles;
+  const std::size_t n = triangles.size();
   std::vector<std::uint32_t> order(n);
   std::iota(order.begin(), order.end(), 0u);
   std::vector<V3> centroid(n);
   for (std::size_t t = 0; t < n; ++t) {
-    const auto& tri = triangles_[t];
+    const auto& tri = triangles[t];
     for (int k = 0; k < 3; ++k)
-      centroid[t][k] = (positions_[tri[0]][k] + positions_[tri[1]][k] + positions_[tri[2]][k]) / 3;
+      centroid[t][k] = (positions[tri[0]][k] + positions[tri[1]][k] + positions[tri[2]][k]) / 3;
   }
   // Top-down median splits on the centroids' longest axis; an explicit stack (a degenerate soup of
   // a million coincident triangles must not recurse a million deep: median splits keep the depth
@@ -125,8 +126,8 @@ WindingNumber::WindingNumber(const TriangleMesh& mesh, double accuracy)
   }
   tree->corners.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const auto& tri = triangles_[order[i]];
-    tree->corners[i] = {positions_[tri[0]], positions_[tri[1]], positions_[tri[2]]};
+    const auto& tri = triangles[order[i]];
+    tree->corners[i] = {positions[tri[0]], positions[tri[1]], positions[tri[2]]};
   }
   // Moments bottom-up: children are always stored after their parent, so a reverse sweep sees
   // both children of a node before the node itself.
@@ -175,15 +176,12 @@ WindingNumber::WindingNumber(const TriangleMesh& mesh, double accuracy)
 WindingNumber::~WindingNumber() {
   delete tree_;
 }
-WindingNumber::WindingNumber(WindingNumber&& o) noexcept
-    : positions_(std::move(o.positions_)), triangles_(std::move(o.triangles_)), tree_(o.tree_) {
+WindingNumber::WindingNumber(WindingNumber&& o) noexcept : tree_(o.tree_) {
   o.tree_ = nullptr;
 }
 WindingNumber& WindingNumber::operator=(WindingNumber&& o) noexcept {
   if (this != &o) {
     delete tree_;
-    positions_ = std::move(o.positions_);
-    triangles_ = std::move(o.triangles_);
     tree_ = o.tree_;
     o.tree_ = nullptr;
   }
