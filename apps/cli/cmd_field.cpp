@@ -31,6 +31,14 @@ struct FieldSettings {
 };
 
 // A mesh's field: always signed (by the winding number) and Euclidean, in the mesh's units, f32.
+// The output's extension, lower case (".npy", ".vdb", ...).
+std::string output_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
 int run_mesh_field(const FieldSettings& s, Outputs& outputs) {
   const auto refuse = [&](bool bad, const std::string& what) {
     if (bad) throw UsageError(s.in + ": " + what);
@@ -43,10 +51,7 @@ int run_mesh_field(const FieldSettings& s, Outputs& outputs) {
   refuse(s.algorithm != "exact" || s.backend != "cpu" || !s.field.focus.empty(),
          "a mesh's field has one algorithm, on the CPU (no --algorithm, --backend or --focus)");
   refuse(!s.sites.empty() || !s.packed.empty(), "--sites and --packed apply to worlds");
-  std::string out_ext = std::filesystem::path(s.out).extension().string();
-  std::transform(out_ext.begin(), out_ext.end(), out_ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  refuse(out_ext != ".npy", "a mesh's field is written as .npy");
+  refuse(output_extension(s.out) != ".npy", "a mesh's field is written as .npy");
   set_activity("reading " + s.in);
   const TriangleMesh mesh = read_mesh(s.in);
   MeshDistanceOptions o;
@@ -96,10 +101,7 @@ int run_field(const FieldSettings& s) {
   if (mesh_input_format_of(s.in)) return run_mesh_field(s, outputs);
   if (s.voxel_size != 0)
     throw UsageError("--voxel-size applies to mesh inputs (.obj, .ply, .stl, .off)");
-  std::string out_ext = std::filesystem::path(s.out).extension().string();
-  std::transform(out_ext.begin(), out_ext.end(), out_ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  const bool vdb_output = out_ext == ".vdb";  // else .npy
+  const bool vdb_output = output_extension(s.out) == ".vdb";  // else .npy
   outputs.expect(s.sites, "--sites");
   outputs.expect(s.packed, "--packed");
   DistanceOptions o = s.field.options();

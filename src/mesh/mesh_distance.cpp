@@ -92,7 +92,7 @@ Band narrow_band(const TriangleMesh& mesh, const Box3i& box, double v, double ba
     for (int s = r.lo[2] / kBandSlabDepth; s <= r.hi[2] / kBandSlabDepth; ++s)
       bucket[static_cast<std::size_t>(s)].push_back(static_cast<std::uint32_t>(t));
   }
-  const detail::VoxelCentres centres(mesh, box, v);
+  const detail::VoxelCentres centres{box, v};
   parallel_for(static_cast<std::size_t>(slabs), 1, [&](std::size_t s0, std::size_t s1) {
     for (std::size_t s = s0; s < s1; ++s) {
       if (!progress.keep_going()) return;
@@ -151,7 +151,7 @@ void beyond_band(const TriangleMesh& mesh, const Box3i& box, double v, const Ban
   o.nearest_sites = true;
   o.domain = box;
   const DistanceField transform = compute_distance_field(occupancy, o);
-  const detail::VoxelCentres centres(mesh, box, v);
+  const detail::VoxelCentres centres{box, v};
   const auto distance_to = [&](int x, int y, int z, std::int32_t t) {
     const auto& tri = mesh.triangles[static_cast<std::size_t>(t)];
     return static_cast<float>(point_triangle_distance(centres.at(x, y, z), mesh.positions[tri[0]],
@@ -311,7 +311,7 @@ MeshDistanceField mesh_distance_field(const TriangleMesh& mesh,
     std::vector<std::uint8_t> near_surface(count);
     for (std::size_t i = 0; i < count; ++i) near_surface[i] = band.nearest[i] >= 0 ? 1 : 0;
     const std::vector<std::uint8_t> inside =
-        detail::inside_voxels(mesh, winding, box, v, near_surface, progress);
+        detail::inside_voxels(winding, box, v, near_surface, progress);
     progress.throw_if_cancelled();
     for (std::size_t i = 0; i < count; ++i)
       if (inside[i]) out.values[i] = -out.values[i];

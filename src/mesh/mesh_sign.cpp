@@ -27,14 +27,14 @@ constexpr std::uint32_t kNoRegion = 0xFFFFFFFFu;
 
 }  // namespace
 
-std::vector<std::uint8_t> inside_voxels(const TriangleMesh& mesh, const WindingNumber& winding,
-                                        const Box3i& box, double voxel_size,
+std::vector<std::uint8_t> inside_voxels(const WindingNumber& winding, const Box3i& box,
+                                        double voxel_size,
                                         const std::vector<std::uint8_t>& near_surface,
                                         Progress& progress) {
   const Vec3i size = box.size();
   const std::size_t count = near_surface.size();
   const std::size_t plane = static_cast<std::size_t>(size.x) * size.y;
-  const VoxelCentres centres(mesh, box, voxel_size);
+  const VoxelCentres centres{box, voxel_size};
   const auto coords = [&](std::size_t i) {
     return Vec3i{static_cast<int>(i % size.x), static_cast<int>(i / size.x % size.y),
                  static_cast<int>(i / plane)};

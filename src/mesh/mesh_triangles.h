@@ -56,36 +56,14 @@ inline bool row_near_plane(const V3& a, const V3& b, const V3& c, double y, doub
 
 }  // namespace triangles
 
-// The centres of a box of voxels in the mesh's units, and which of them lie inside the mesh's
-// bounding box (the only ones whose winding number can reach 1/2). Local indices: 0 at box.begin.
+// The centres of a box of voxels in the mesh's units. Local indices: 0 at box.begin.
 struct VoxelCentres {
   Box3i box;
   double voxel_size;
-  std::array<double, 3> lo, hi;  // the mesh's bounds
-  int x_begin = 0, x_end = 0;    // local x whose centres lie within [lo.x, hi.x]
 
-  VoxelCentres(const TriangleMesh& mesh, const Box3i& b, double v) : box(b), voxel_size(v) {
-    const auto bounds = mesh.bounds();
-    lo = bounds[0];
-    hi = bounds[1];
-    const Vec3i size = box.size();
-    x_begin = size.x;
-    for (int x = 0; x < size.x; ++x)
-      if (inside(0, x)) {
-        x_begin = std::min(x_begin, x);
-        x_end = x + 1;
-      }
-    if (x_end == 0) x_begin = 0;
-  }
   double coordinate(int axis, int local) const {
     return (static_cast<double>(box.begin[axis]) + local + 0.5) * voxel_size;
   }
-  bool inside(int axis, int local) const {
-    const double c = coordinate(axis, local);
-    return c >= lo[axis] && c <= hi[axis];
-  }
-  bool may_be_inside_y(int y) const { return inside(1, y); }
-  bool may_be_inside_z(int z) const { return inside(2, z); }
   std::array<double, 3> at(int x, int y, int z) const {
     return {coordinate(0, x), coordinate(1, y), coordinate(2, z)};
   }
@@ -94,8 +72,8 @@ struct VoxelCentres {
 // Which voxels of `box` have a winding number >= 1/2 (1 per voxel, x fastest). `near_surface`
 // marks voxels whose cells the surface may enter (at least every one it does); the rest are
 // decided by regions (mesh_sign.cpp). Advances `progress` once per z slice.
-std::vector<std::uint8_t> inside_voxels(const TriangleMesh& mesh, const WindingNumber& winding,
-                                        const Box3i& box, double voxel_size,
+std::vector<std::uint8_t> inside_voxels(const WindingNumber& winding, const Box3i& box,
+                                        double voxel_size,
                                         const std::vector<std::uint8_t>& near_surface,
                                         Progress& progress);
 

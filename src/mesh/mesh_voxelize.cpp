@@ -90,7 +90,7 @@ World voxelize_mesh(const TriangleMesh& mesh, const MeshVoxelOptions& options) {
   std::vector<std::uint8_t> near_surface(static_cast<std::size_t>(box.volume()), 0);
   const double v = options.voxel_size;
   const double reach = 2 * v;
-  const detail::VoxelCentres centres(mesh, box, v);
+  const detail::VoxelCentres centres{box, v};
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& tri = mesh.triangles[t];
     if (t % 4096 == 0 && !progress.keep_going()) progress.throw_if_cancelled();
@@ -118,8 +118,7 @@ World voxelize_mesh(const TriangleMesh& mesh, const MeshVoxelOptions& options) {
                     x1 - x0 + 1, std::uint8_t{1});
       }
   }
-  std::vector<std::uint8_t> dense =
-      detail::inside_voxels(mesh, winding, box, v, near_surface, progress);
+  std::vector<std::uint8_t> dense = detail::inside_voxels(winding, box, v, near_surface, progress);
   progress.throw_if_cancelled();
   for (std::uint8_t& m : dense) m = m ? options.material : 0;
   World world(Grid<std::uint8_t>::kDefaultChunkEdge, box);
