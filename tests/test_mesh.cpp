@@ -15,6 +15,7 @@
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
 #include "voxfield/mesh.h"
+#include "voxfield/mesh_chunks.h"
 #include "voxfield/parallel.h"
 #include "voxfield/primitives.h"
 
@@ -358,6 +359,12 @@ TEST(Mesh, RandomFieldsAreWatertightAndIndependentOfChunksAndThreads) {
         EXPECT_TRUE(triangle_set(mesh) == expected)
             << "chunk edge " << edge << ", " << threads << " threads";
         EXPECT_TRUE(closed(mesh_stats(mesh))) << "chunk edge " << edge;
+        // Marching cubes of a whole volume runs in Flying Edges' passes (flying_edges.h); the
+        // chunked driver MeshChunks keeps must give the same triangles.
+        const Mesh chunked = MeshChunks(vol, with(m, edge)).merged();
+        EXPECT_EQ(chunked.vertex_count(), reference.vertex_count()) << "chunk edge " << edge;
+        EXPECT_TRUE(triangle_set(chunked) == expected)
+            << "chunked driver, chunk edge " << edge << ", " << threads << " threads";
       }
     }
   }
@@ -384,6 +391,10 @@ TEST(Mesh, OpenSurfacesAreIndependentOfChunksAndThreads) {
         EXPECT_EQ(mesh.vertex_count(), reference.vertex_count()) << "chunk edge " << edge;
         EXPECT_TRUE(triangle_set(mesh) == expected)
             << "chunk edge " << edge << ", " << threads << " threads";
+        const Mesh chunked = MeshChunks(vol, with(m, edge)).merged();
+        EXPECT_EQ(chunked.vertex_count(), reference.vertex_count()) << "chunk edge " << edge;
+        EXPECT_TRUE(triangle_set(chunked) == expected)
+            << "chunked driver, chunk edge " << edge << ", " << threads << " threads";
       }
   }
 }

@@ -78,9 +78,10 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
         "(surface nets' "
         "topology, each vertex where the crossings' tangent planes meet: the voxels' edges and "
         "corners stay "
-        "sharp). Meshed in chunks of 32 cells on all threads; the same triangles come out for "
-        "every chunk "
-        "edge.\n\n"
+        "sharp). Surface nets and dual contouring are meshed in chunks of 32 cells on all threads, "
+        "and the same triangles come out for every chunk edge; marching cubes of a whole volume "
+        "runs in Flying Edges' passes (rows counted, then every vertex and triangle written once "
+        "in place), whose mesh does not depend on chunks at all.\n\n"
      << "| mesher | triangles | vertices | ms | watertight | Euler characteristic | area (voxel "
         "faces) | bytes/triangle | "
         "chunk edge 8: same triangles |\n|---|---|---|---|---|---|---|---|---|\n";

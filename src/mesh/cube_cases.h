@@ -55,6 +55,26 @@ class CubeCases {
     return cases_[offset_[inside] + joined];
   }
 
+  // The `joined` bits of `lookup` for corner mask `inside`, decided on each ambiguous face by the
+  // asymptotic decider from the cell's eight values v (negative inside, corner c at v[c]): the
+  // bilinear interpolant's saddle lies outside when the product of the outside diagonal's values
+  // is at least that of the inside diagonal's. Products of the same four samples are computed
+  // whichever cell asks, so both cells sharing the face decide alike (ties join the outside).
+  unsigned joined_faces(const float* v, unsigned inside) const {
+    unsigned joined = 0;
+    const unsigned ambiguous = ambiguous_[inside];
+    for (int face = 0, bit = 0; face < 6; ++face)
+      if (ambiguous >> face & 1) {
+        const std::array<std::uint8_t, 4> c = face_corners(face);
+        const double d02 = static_cast<double>(v[c[0]]) * v[c[2]];
+        const double d13 = static_cast<double>(v[c[1]]) * v[c[3]];
+        const bool diagonal02_inside = (inside >> c[0] & 1) != 0;
+        if (diagonal02_inside ? d13 >= d02 : d02 >= d13) joined |= 1u << bit;
+        ++bit;
+      }
+    return joined;
+  }
+
   // For one ambiguous face: corners in cyclic order around it (so 0/2 and 1/3 are the diagonals),
   // starting at the face's lowest corner and going first along the face's lower axis.
   static std::array<std::uint8_t, 4> face_corners(int face);

@@ -21,21 +21,6 @@
 
 namespace voxfield::detail::mesh {
 
-namespace {
-
-// On an ambiguous face, whether the two outside corners connect across it: the asymptotic decider
-// puts the bilinear interpolant's saddle outside when the product of the outside diagonal's values
-// is at least that of the inside diagonal's. Products of the same four samples are computed
-// whichever cell asks, so both cells sharing the face decide alike (ties join the outside).
-bool outside_joined(const float* v, const std::array<std::uint8_t, 4>& corners, unsigned inside) {
-  const double d02 = static_cast<double>(v[corners[0]]) * v[corners[2]];
-  const double d13 = static_cast<double>(v[corners[1]]) * v[corners[3]];
-  const bool diagonal02_inside = (inside >> corners[0] & 1) != 0;
-  return diagonal02_inside ? d13 >= d02 : d02 >= d13;
-}
-
-}  // namespace
-
 void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
                           const Block& block, std::vector<std::int32_t>& scratch, ChunkPart& part) {
   const Box3i cells = grid.cells_of(chunk);
@@ -129,14 +114,7 @@ void marching_cubes_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i c
             static_cast<unsigned>(spread[faces[static_cast<std::size_t>(i) + 1]]) << 1;
         if (inside == 0 || inside == 255) continue;
         for (int c = 0; c < 8; ++c) v[c] = block.s_of(r[c >> 1][i + (c & 1)]);
-        unsigned joined = 0;
-        const unsigned ambiguous = table.ambiguous_faces(inside);
-        for (int face = 0, bit = 0; face < 6; ++face)
-          if (ambiguous >> face & 1) {
-            if (outside_joined(v, CubeCases::face_corners(face), inside)) joined |= 1u << bit;
-            ++bit;
-          }
-        const CubeCase& cc = table.lookup(inside, joined);
+        const CubeCase& cc = table.lookup(inside, table.joined_faces(v, inside));
         // The cell's crossing edges, each looked up (or made) once however many triangles use it.
         std::array<std::uint32_t, 12> ids;
         std::uint32_t known = 0;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cube_cases.h"
+#include "flying_edges.h"
 #include "mesh_internal.h"
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
@@ -53,18 +54,23 @@ MeshBound mesh_bound(Vec3i samples, Mesher algorithm) {
 namespace detail::mesh {
 namespace {
 
-MeshCounts write_into(const std::vector<ChunkPart>& parts, const MeshBuffers& out) {
-  const WeldPlan plan = plan_weld(parts);
-  const bool colors = plan.colored && !out.colors.empty();
-  if (out.positions.size() < plan.vertices || out.normals.size() < plan.vertices ||
-      (colors && out.colors.size() < plan.vertices) || out.indices.size() < plan.indices)
-    throw InvalidArgument("mesh: the mesh needs " + std::to_string(plan.vertices) +
+// Refuses buffers smaller than the mesh, before anything is written.
+void check_room(std::size_t vertices, std::size_t indices, bool colors, const MeshBuffers& out) {
+  if (out.positions.size() < vertices || out.normals.size() < vertices ||
+      (colors && out.colors.size() < vertices) || out.indices.size() < indices)
+    throw InvalidArgument("mesh: the mesh needs " + std::to_string(vertices) +
                           " positions and normals" + (colors ? " and colours" : "") + " and " +
-                          std::to_string(plan.indices) + " indices; the buffers hold " +
+                          std::to_string(indices) + " indices; the buffers hold " +
                           std::to_string(out.positions.size()) + ", " +
                           std::to_string(out.normals.size()) +
                           (colors ? ", " + std::to_string(out.colors.size()) : "") + " and " +
                           std::to_string(out.indices.size()) + " (size them with mesh_bound)");
+}
+
+MeshCounts write_into(const std::vector<ChunkPart>& parts, const MeshBuffers& out) {
+  const WeldPlan plan = plan_weld(parts);
+  const bool colors = plan.colored && !out.colors.empty();
+  check_room(plan.vertices, plan.indices, colors, out);
   write_weld(plan, parts,
              {out.positions.data(), out.normals.data(), colors ? out.colors.data() : nullptr,
               out.indices.data(), nullptr});
@@ -77,7 +83,13 @@ MeshCounts write_into(const std::vector<ChunkPart>& parts, const MeshBuffers& ou
 MeshCounts mesh_volume_into(const ScalarVolume& volume, const MeshOptions& options,
                             const MeshBuffers& out) {
   using namespace detail::mesh;
-  return write_into(mesh_all_chunks(checked_lattice(volume, options, false), options), out);
+  const Lattice lattice = checked_lattice(volume, options, false);
+  if (!flying_edges_applies(lattice, options))
+    return write_into(mesh_all_chunks(lattice, options), out);
+  const FlyingEdges plan(lattice, options.interrupter);
+  check_room(plan.vertices(), plan.indices(), false, out);
+  plan.write({out.positions.data(), out.normals.data(), nullptr, out.indices.data(), nullptr});
+  return {plan.vertices(), plan.indices()};
 }
 
 MeshCounts mesh_terrain_into(const TerrainField& terrain, const MeshOptions& options,

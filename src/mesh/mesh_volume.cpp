@@ -6,7 +6,9 @@
 #include <vector>
 
 #include "chunked_mesh.h"
+#include "flying_edges.h"
 #include "mesh_internal.h"
+#include "mesh_memory.h"
 #include "voxfield/error.h"
 #include "voxfield/interrupt.h"
 #include "voxfield/limits.h"
@@ -144,7 +146,18 @@ void mesh_chunks(const Lattice& lattice, const ChunkGrid& grid, const MeshOption
 
 Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options,
                   std::vector<std::uint64_t>* sources, bool voxel_faces) {
-  return weld(mesh_all_chunks(checked_lattice(volume, options, voxel_faces), options), sources);
+  const Lattice lattice = checked_lattice(volume, options, voxel_faces);
+  if (!flying_edges_applies(lattice, options))
+    return weld(mesh_all_chunks(lattice, options), sources);
+  const FlyingEdges plan(lattice, options.interrupter);
+  Mesh mesh;
+  resize_on_huge_pages(mesh.positions, plan.vertices());
+  resize_on_huge_pages(mesh.normals, plan.vertices());
+  resize_on_huge_pages(mesh.indices, plan.indices());
+  if (sources) resize_on_huge_pages(*sources, plan.vertices());
+  plan.write({mesh.positions.data(), mesh.normals.data(), nullptr, mesh.indices.data(),
+              sources ? sources->data() : nullptr});
+  return mesh;
 }
 
 std::vector<ChunkPart> mesh_all_chunks(const Lattice& lattice, const MeshOptions& options) {

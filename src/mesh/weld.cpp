@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "chunked_mesh.h"
+#include "mesh_memory.h"
 #include "voxfield/error.h"
 #include "voxfield/parallel.h"
 
@@ -123,11 +124,11 @@ void write_weld(const WeldPlan& plan, const std::vector<ChunkPart>& parts, const
 Mesh weld(const std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sources) {
   const WeldPlan plan = plan_weld(parts);
   Mesh mesh;
-  mesh.positions.resize(plan.vertices);
-  mesh.normals.resize(plan.vertices);
-  if (plan.colored) mesh.colors.resize(plan.vertices);
-  mesh.indices.resize(plan.indices);
-  if (sources) sources->resize(plan.vertices);
+  resize_on_huge_pages(mesh.positions, plan.vertices);
+  resize_on_huge_pages(mesh.normals, plan.vertices);
+  if (plan.colored) resize_on_huge_pages(mesh.colors, plan.vertices);
+  resize_on_huge_pages(mesh.indices, plan.indices);
+  if (sources) resize_on_huge_pages(*sources, plan.vertices);
   write_weld(
       plan, parts,
       {mesh.positions.data(), mesh.normals.data(), plan.colored ? mesh.colors.data() : nullptr,

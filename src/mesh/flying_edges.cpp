@@ -1,0 +1,509 @@
+// voxfield — marching cubes of a whole dense lattice in Flying Edges' passes.
+//
+// W. Schroeder, R. Maynard & B. Geveci, "Flying Edges: A High-Performance Scalable Isocontouring
+// Algorithm", IEEE LDAV 2015: instead of visiting cells and looking their vertices up, classify
+// every lattice edge first, count each row's crossings and triangles, turn the counts into
+// offsets by a prefix sum, then write every vertex and every triangle exactly once at its final
+// place — rows in parallel, no locks, no hash, no copy. Vertex numbers follow from the counts: a
+// crossing's number is its row's first vertex plus the crossings before it on that row, which a
+// population count of the row's crossing bits gives directly.
+//
+// Rows here are bit rows: pass 1 turns each sample row into bits (inside or not, 64 samples a
+// word, checking for NaN on the way); an edge crosses where the bits of its two ends differ, so a
+// row's x-, y- and z-edge crossings are XORs of whole words and a cell is active unless its eight
+// corner bits agree. Pass 2 counts per row and per cell row (triangles by the case table of
+// cube_cases.h, ambiguous faces by the asymptotic decider); pass 3 writes. The triangles, their
+// positions, normals and sources are those of marching_cubes.cpp (same table, same arithmetic),
+// only numbered by row instead of by chunk.
+#include "flying_edges.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include "cube_cases.h"
+#include "voxfield/error.h"
+#include "voxfield/limits.h"
+#include "voxfield/parallel.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace voxfield::detail::mesh {
+
+bool flying_edges_applies(const Lattice& lattice, const MeshOptions& options) {
+  return options.algorithm == Mesher::kMarchingCubes && lattice.values && !lattice.value &&
+         !lattice.gradient && !lattice.color;
+}
+
+namespace {
+
+// Where each of the cube's 12 edges (cube_cases.h numbering) finds its crossing among a cell
+// row's eight crossing masks — the x-edges of the four sample rows (y, z), (y + 1, z),
+// (y, z + 1), (y + 1, z + 1); the y-edges of rows (y, z) and (y, z + 1); the z-edges of rows
+// (y, z) and (y + 1, z) — and at which x past the cell's own.
+struct EdgeSlot {
+  std::uint8_t mask, dx;
+};
+constexpr std::array<EdgeSlot, 12> kEdgeSlots = [] {
+  std::array<EdgeSlot, 12> s{};
+  for (std::uint8_t j = 0; j < 4; ++j) {
+    s[j] = {j, 0};  // x: row y + (j & 1), z + (j >> 1)
+    s[4 + j] = {static_cast<std::uint8_t>(4 + (j >> 1)), static_cast<std::uint8_t>(j & 1)};  // y
+    s[8 + j] = {static_cast<std::uint8_t>(6 + (j >> 1)), static_cast<std::uint8_t>(j & 1)};  // z
+  }
+  return s;
+}();
+
+// Set bits of a word. (std::popcount compiles to a library call on the x86-64 baseline, which
+// has no POPCNT instruction; these dozen operations inline.)
+unsigned bit_count(std::uint64_t v) {
+  v = v - (v >> 1 & 0x5555555555555555ull);
+  v = (v & 0x3333333333333333ull) + (v >> 2 & 0x3333333333333333ull);
+  v = (v + (v >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return static_cast<unsigned>((v * 0x0101010101010101ull) >> 56);
+}
+
+std::uint64_t low_bits(unsigned n) {  // n < 64
+  return (std::uint64_t{1} << n) - 1;
+}
+
+// Bits x and x + 1 of a bit row (bit 0: x).
+unsigned two_bits(const std::uint64_t* row, int x) {
+  const std::size_t w = static_cast<std::size_t>(x) >> 6;
+  const unsigned s = static_cast<unsigned>(x) & 63;
+  std::uint64_t v = row[w] >> s;
+  if (s == 63) v |= row[w + 1] << 1;
+  return static_cast<unsigned>(v & 3);
+}
+
+// The samples with the inside convention folded in, as Block reads them (chunked_mesh.h): the
+// same float arithmetic, so vertices come out bit for bit as the chunked driver's.
+struct RowSamples {
+  const Lattice& lattice;
+  float iso;
+  bool negate;
+  std::ptrdiff_t sy, sz;
+  explicit RowSamples(const Lattice& l)
+      : lattice(l),
+        iso(static_cast<float>(l.iso)),
+        negate(l.sign < 0),
+        sy(l.n.x),
+        sz(static_cast<std::ptrdiff_t>(l.n.x) * l.n.y) {}
+  float s_of(float v) const { return negate ? iso - v : v - iso; }
+  float s(std::ptrdiff_t i) const { return s_of(lattice.values[i]); }
+  std::ptrdiff_t index(int x, int y, int z) const { return x + sy * y + sz * z; }
+  // Central differences, one-sided on the lattice's faces (Block::gradient).
+  std::array<double, 3> gradient(int x, int y, int z) const {
+    const std::ptrdiff_t i = index(x, y, z);
+    const int p[3] = {x, y, z};
+    const std::ptrdiff_t step[3] = {1, sy, sz};
+    std::array<double, 3> g;
+    for (int a = 0; a < 3; ++a) {
+      const bool down = p[a] > 0, up = p[a] < lattice.n[a] - 1;
+      const std::ptrdiff_t lo = down ? i - step[a] : i, hi = up ? i + step[a] : i;
+      const double span = (static_cast<int>(up) + static_cast<int>(down)) *
+                          lattice.spacing[static_cast<std::size_t>(a)];
+      g[static_cast<std::size_t>(a)] = (static_cast<double>(s(hi)) - s(lo)) / span;
+    }
+    return g;
+  }
+};
+
+struct Vertex {
+  std::array<float, 3> position, normal;
+  std::uint64_t source;
+};
+
+// ChunkPart::add's normalisation: unit length, or +z where there is no direction.
+std::array<float, 3> unit(std::array<double, 3> n) {
+  const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (length > 0 && std::isfinite(length)) {
+    for (double& c : n) c /= length;
+  } else {
+    n = {0, 0, 1};
+  }
+  return {static_cast<float>(n[0]), static_cast<float>(n[1]), static_cast<float>(n[2])};
+}
+
+// The crossing on the edge from lattice point (x, y, z) along `axis` (marching_cubes.cpp's
+// vertex(), without an analytic value or gradient).
+Vertex edge_vertex(const RowSamples& in, int x, int y, int z, int axis) {
+  const std::ptrdiff_t i0 = in.index(x, y, z);
+  const std::ptrdiff_t i1 = i0 + (axis == 0 ? 1 : axis == 1 ? in.sy : in.sz);
+  const double s0 = in.s(i0), s1 = in.s(i1);
+  const double t = s0 / (s0 - s1);  // the signs differ, so s0 != s1
+  std::array<double, 3> at{static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)};
+  at[static_cast<std::size_t>(axis)] += t;
+  const auto position = lattice_position(in.lattice, at);
+  const int qx = x + (axis == 0), qy = y + (axis == 1), qz = z + (axis == 2);
+  const auto g0 = in.gradient(x, y, z), g1 = in.gradient(qx, qy, qz);
+  std::array<double, 3> normal{g0[0] + t * (g1[0] - g0[0]), g0[1] + t * (g1[1] - g0[1]),
+                               g0[2] + t * (g1[2] - g0[2])};
+  if (normal[0] == 0 && normal[1] == 0 && normal[2] == 0)
+    normal[static_cast<std::size_t>(axis)] = s0 < 0 ? 1 : -1;
+  return {{static_cast<float>(position[0]), static_cast<float>(position[1]),
+           static_cast<float>(position[2])},
+          unit(normal),
+          static_cast<std::uint64_t>(s0 < 0 ? i0 : i1)};
+}
+
+// edge_vertex() called out of line: its floats are then rounded as stored. (Inlined into
+// centre_vertex(), GCC 12 let some means see a crossing's double position before its rounding to
+// float, one unit in the last place away from the chunked driver's mean of the stored floats.)
+[[gnu::noinline]] Vertex stored_edge_vertex(const RowSamples& in, int x, int y, int z, int axis) {
+  return edge_vertex(in, x, y, z, axis);
+}
+
+// Centre vertex c of a cell's case (a loop fanned from its mean): the mean of the loop's
+// crossings, recomputed here bit for bit as the rows owning them write them.
+Vertex centre_vertex(const RowSamples& in, const CubeCase& cc, int c, int x, int y, int z) {
+  const auto& edges = cube_edges();
+  const int count = cc.centre_sizes[static_cast<std::size_t>(c)];
+  std::array<double, 3> mean{0, 0, 0}, normal{0, 0, 0};
+  std::uint64_t source = 0;
+  for (int i = 0; i < count; ++i) {
+    const CubeEdge& e =
+        edges[cc.centre_edges[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)]];
+    const Vertex on = stored_edge_vertex(in, x + (e.from & 1), y + (e.from >> 1 & 1),
+                                         z + (e.from >> 2 & 1), e.axis);
+    if (i == 0) source = on.source;
+    for (std::size_t a = 0; a < 3; ++a) {
+      mean[a] += on.position[a] / static_cast<double>(count);
+      normal[a] += on.normal[a];
+    }
+  }
+  return {{static_cast<float>(mean[0]), static_cast<float>(mean[1]), static_cast<float>(mean[2])},
+          unit(normal),
+          source};
+}
+
+// Inside bits of `count` samples into words (bit k of word w: sample 64 w + k); returns whether
+// one is NaN or infinite (its exponent bits all set).
+bool inside_bits(const float* v, int count, float iso, bool inside_above, std::uint64_t* out) {
+  std::uint32_t bad = 0;
+  int x = 0;
+  std::uint64_t word = 0;
+#if defined(__SSE2__)
+  const __m128 iso4 = _mm_set1_ps(iso);
+  const __m128i exponent = _mm_set1_epi32(0x7f800000);
+  __m128i bad4 = _mm_setzero_si128();
+  for (; x + 4 <= count; x += 4) {
+    const __m128 s = _mm_loadu_ps(v + x);
+    const __m128 in = inside_above ? _mm_cmpgt_ps(s, iso4) : _mm_cmplt_ps(s, iso4);
+    word |= static_cast<std::uint64_t>(_mm_movemask_ps(in)) << (x & 63);
+    bad4 =
+        _mm_or_si128(bad4, _mm_cmpeq_epi32(_mm_and_si128(_mm_castps_si128(s), exponent), exponent));
+    if ((x & 63) == 60) {
+      out[x >> 6] = word;
+      word = 0;
+    }
+  }
+  bad = static_cast<std::uint32_t>(_mm_movemask_epi8(bad4));
+#endif
+  for (; x < count; ++x) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &v[x], sizeof bits);
+    bad |= static_cast<std::uint32_t>((bits & 0x7f800000u) == 0x7f800000u);
+    const bool in = inside_above ? v[x] > iso : v[x] < iso;
+    word |= static_cast<std::uint64_t>(in) << (x & 63);
+    if ((x & 63) == 63) {
+      out[x >> 6] = word;
+      word = 0;
+    }
+  }
+  if (count & 63) out[count >> 6] = word;
+  return bad != 0;
+}
+
+}  // namespace
+
+// The eight crossing masks of one cell row with their running population counts, and the first
+// vertex number of each (the row's first vertex plus the crossings of earlier axes).
+struct FlyingEdges::RowCounts {
+  std::size_t words;
+  std::vector<std::uint64_t> masks, before;  // 8 x words; before[k][w]: crossings in words < w
+  std::array<std::uint64_t, 8> base{};
+  explicit RowCounts(std::size_t w) : words(w), masks(8 * w), before(8 * w) {}
+  std::uint64_t* mask(int k) { return masks.data() + static_cast<std::size_t>(k) * words; }
+  // The number of crossing `k` at x: base + crossings of that mask before x.
+  std::uint64_t id(int k, int x) const {
+    const std::size_t w = static_cast<std::size_t>(x) >> 6;
+    const std::size_t at = static_cast<std::size_t>(k) * words + w;
+    return base[static_cast<std::size_t>(k)] + before[at] +
+           static_cast<std::uint64_t>(
+               bit_count(masks[at] & low_bits(static_cast<unsigned>(x) & 63)));
+  }
+};
+
+const std::uint64_t* FlyingEdges::inside_row(int y, int z) const {
+  return inside_.data() +
+         words_ * (static_cast<std::size_t>(y) +
+                   static_cast<std::size_t>(lattice_.n.y) * static_cast<std::size_t>(z));
+}
+
+namespace {
+
+// Crossing masks from bit rows (words past the row's last sample are zero).
+void x_crossings(const std::uint64_t* b, std::size_t words, int nx, std::uint64_t* out) {
+  for (std::size_t w = 0; w < words; ++w) {
+    const std::uint64_t next = w + 1 < words ? b[w + 1] : 0;
+    out[w] = b[w] ^ (b[w] >> 1 | next << 63);
+  }
+  // The last sample has no x-edge (its "neighbour" bit is the zero padding).
+  out[static_cast<std::size_t>(nx - 1) >> 6] &= ~(std::uint64_t{1} << ((nx - 1) & 63));
+}
+void differences(const std::uint64_t* a, const std::uint64_t* b, std::size_t words,
+                 std::uint64_t* out) {
+  for (std::size_t w = 0; w < words; ++w) out[w] = a[w] ^ b[w];
+}
+std::uint64_t population(const std::uint64_t* m, std::size_t words) {
+  std::uint64_t n = 0;
+  for (std::size_t w = 0; w < words; ++w) n += static_cast<std::uint64_t>(bit_count(m[w]));
+  return n;
+}
+
+// Calls f(x, inside) for every cell of cell row (rows b[0..3], see kEdgeSlots) whose corners are
+// not all on one side, x increasing; inside is its corner mask (bit c: corner c inside).
+template <class F>
+void for_each_active_cell(const std::uint64_t* const b[4], std::size_t words, int nx, F&& f) {
+  const std::size_t last = static_cast<std::size_t>(nx - 2) >> 6;  // the word of the last cell
+  for (std::size_t w = 0; w <= last; ++w) {
+    const auto any = [&](std::size_t i) {
+      return i < words ? b[0][i] | b[1][i] | b[2][i] | b[3][i] : 0;
+    };
+    const auto all = [&](std::size_t i) {
+      return i < words ? b[0][i] & b[1][i] & b[2][i] & b[3][i] : 0;
+    };
+    const std::uint64_t a = any(w), a_next = a >> 1 | any(w + 1) << 63;
+    const std::uint64_t e = all(w), e_next = e >> 1 | all(w + 1) << 63;
+    std::uint64_t active = ~((e & e_next) | (~a & ~a_next));
+    if (w == last) active &= low_bits(static_cast<unsigned>(nx - 2) & 63) << 1 | 1;
+    while (active) {
+      const int x = static_cast<int>(64 * w) + std::countr_zero(active);
+      active &= active - 1;
+      f(x, two_bits(b[0], x) | two_bits(b[1], x) << 2 | two_bits(b[2], x) << 4 |
+               two_bits(b[3], x) << 6);
+    }
+  }
+}
+
+}  // namespace
+
+FlyingEdges::FlyingEdges(const Lattice& lattice, Interrupter* interrupter)
+    : lattice_(lattice),
+      progress_(std::make_unique<Progress>(interrupter, "marching cubes",
+                                           3 * static_cast<std::int64_t>(lattice.n.z))) {
+  const Vec3i n = lattice.n;
+  const std::size_t rows = static_cast<std::size_t>(n.y) * static_cast<std::size_t>(n.z);
+  words_ = static_cast<std::size_t>(n.x) / 64 + 1;
+  require_memory(mul_sat(rows, add_sat(mul_sat(words_, 8), 4 * 8 + 3 * 4)), 0, "mesh",
+                 "marching cubes' row bookkeeping");
+  inside_.assign(rows * words_, 0);
+  Progress& progress = *progress_;
+  // Pass 1: bit rows, and the first plane holding a NaN or infinite sample.
+  std::vector<std::int64_t> first_bad(static_cast<std::size_t>(n.z), -1);
+  parallel_for(static_cast<std::size_t>(n.z), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t z = begin; z < end; ++z) {
+      if (!progress.keep_going()) return;
+      classify_plane(static_cast<int>(z), first_bad[z]);
+      progress.advance();
+    }
+  });
+  progress.throw_if_cancelled();
+  for (const std::int64_t bad : first_bad)
+    if (bad >= 0) {
+      const int x = static_cast<int>(bad % n.x), y = static_cast<int>(bad / n.x % n.y),
+                z = static_cast<int>(bad / n.x / n.y);
+      const float v = lattice.values[bad];
+      throw InvalidArgument("mesh: sample (" + std::to_string(x) + ", " + std::to_string(y) + ", " +
+                            std::to_string(z) + ") is " + (std::isnan(v) ? "NaN" : "infinite"));
+    }
+  // Pass 2: each row's counts, then their prefix sums.
+  x_count_.assign(rows, 0);
+  y_count_.assign(rows, 0);
+  z_count_.assign(rows, 0);
+  std::vector<std::uint64_t> vertex_count(rows), index_count(rows);
+  parallel_for(static_cast<std::size_t>(n.z), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t z = begin; z < end; ++z) {
+      if (!progress.keep_going()) return;
+      count_plane(static_cast<int>(z), vertex_count, index_count);
+      progress.advance();
+    }
+  });
+  progress.throw_if_cancelled();
+  first_vertex_.resize(rows + 1);
+  first_index_.resize(rows + 1);
+  first_vertex_[0] = first_index_[0] = 0;
+  for (std::size_t r = 0; r < rows; ++r) {
+    first_vertex_[r + 1] = first_vertex_[r] + vertex_count[r];
+    first_index_[r + 1] = first_index_[r] + index_count[r];
+  }
+  if (first_vertex_[rows] > std::numeric_limits<std::uint32_t>::max() - 1)
+    throw InvalidArgument("mesh: " + std::to_string(first_vertex_[rows]) +
+                          " vertices do not fit 32-bit indices; mesh a smaller volume");
+  vertices_ = first_vertex_[rows];
+  indices_ = first_index_[rows];
+}
+
+void FlyingEdges::classify_plane(int z, std::int64_t& first_bad) {
+  const Vec3i n = lattice_.n;
+  const RowSamples in(lattice_);
+  std::uint64_t* bits =
+      inside_.data() + words_ * static_cast<std::size_t>(n.y) * static_cast<std::size_t>(z);
+  for (int y = 0; y < n.y; ++y, bits += words_) {
+    const float* row = lattice_.values + in.index(0, y, z);
+    if (inside_bits(row, n.x, in.iso, in.negate, bits) && first_bad < 0)
+      for (int x = 0; x < n.x; ++x)
+        if (!std::isfinite(row[x])) {
+          first_bad = in.index(x, y, z);
+          break;
+        }
+  }
+}
+
+void FlyingEdges::count_plane(int z, std::vector<std::uint64_t>& vertex_count,
+                              std::vector<std::uint64_t>& index_count) {
+  const Vec3i n = lattice_.n;
+  const RowSamples in(lattice_);
+  const CubeCases& table = CubeCases::get();
+  std::vector<std::uint64_t> scratch(words_);
+  for (int y = 0; y < n.y; ++y) {
+    const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
+    const std::uint64_t* b = inside_row(y, z);
+    x_crossings(b, words_, n.x, scratch.data());
+    x_count_[r] = static_cast<std::uint32_t>(population(scratch.data(), words_));
+    if (y + 1 < n.y) {
+      differences(b, inside_row(y + 1, z), words_, scratch.data());
+      y_count_[r] = static_cast<std::uint32_t>(population(scratch.data(), words_));
+    }
+    if (z + 1 < n.z) {
+      differences(b, inside_row(y, z + 1), words_, scratch.data());
+      z_count_[r] = static_cast<std::uint32_t>(population(scratch.data(), words_));
+    }
+    std::uint64_t triangles = 0, centres = 0;
+    if (y + 1 < n.y && z + 1 < n.z) {
+      const std::uint64_t* rows[4] = {b, inside_row(y + 1, z), inside_row(y, z + 1),
+                                      inside_row(y + 1, z + 1)};
+      const float* v0 = lattice_.values + in.index(0, y, z);
+      for_each_active_cell(rows, words_, n.x, [&](int x, unsigned inside) {
+        unsigned joined = 0;
+        if (table.ambiguous_faces(inside)) {
+          float v[8];
+          for (int c = 0; c < 8; ++c)
+            v[c] = in.s_of(v0[x + (c & 1) + in.sy * (c >> 1 & 1) + in.sz * (c >> 2 & 1)]);
+          joined = table.joined_faces(v, inside);
+        }
+        const CubeCase& cc = table.lookup(inside, joined);
+        triangles += cc.triangle_count;
+        centres += cc.centre_count;
+      });
+    }
+    vertex_count[r] = std::uint64_t{x_count_[r]} + y_count_[r] + z_count_[r] + centres;
+    index_count[r] = 3 * triangles;
+  }
+}
+
+void FlyingEdges::write(const WeldOutput& out) const {
+  Progress& progress = *progress_;
+  parallel_for(static_cast<std::size_t>(lattice_.n.z), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t z = begin; z < end; ++z) {
+      if (!progress.keep_going()) return;
+      write_plane(static_cast<int>(z), out);
+      progress.advance();
+    }
+  });
+  progress.throw_if_cancelled();
+}
+
+void FlyingEdges::write_plane(int z, const WeldOutput& out) const {
+  const Vec3i n = lattice_.n;
+  const RowSamples in(lattice_);
+  const CubeCases& table = CubeCases::get();
+  const auto put = [&](std::uint64_t g, const Vertex& v) {
+    out.positions[g] = v.position;
+    out.normals[g] = v.normal;
+    if (out.sources) out.sources[g] = v.source;
+  };
+  RowCounts counts(words_);
+  for (int y = 0; y < n.y; ++y) {
+    const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
+    const std::uint64_t* b = inside_row(y, z);
+    // This row's edge vertices: its x-edge crossings, then its y-edge and z-edge ones.
+    std::uint64_t g = first_vertex_[r];
+    const auto emit = [&](const std::uint64_t* mask, int axis) {
+      for (std::size_t w = 0; w < words_; ++w)
+        for (std::uint64_t m = mask[w]; m; m &= m - 1)
+          put(g++, edge_vertex(in, static_cast<int>(64 * w) + std::countr_zero(m), y, z, axis));
+    };
+    const bool up_y = y + 1 < n.y, up_z = z + 1 < n.z;
+    // Masks 0 (x), 4 (y) and 6 (z) of the cell row starting here are this row's own.
+    x_crossings(b, words_, n.x, counts.mask(0));
+    emit(counts.mask(0), 0);
+    if (up_y) {
+      differences(b, inside_row(y + 1, z), words_, counts.mask(4));
+      emit(counts.mask(4), 1);
+    }
+    if (up_z) {
+      differences(b, inside_row(y, z + 1), words_, counts.mask(6));
+      emit(counts.mask(6), 2);
+    }
+    if (!up_y || !up_z) continue;
+    // The cell row (y, z): every crossing's number from the masks' running counts.
+    const std::uint64_t* rows[4] = {b, inside_row(y + 1, z), inside_row(y, z + 1),
+                                    inside_row(y + 1, z + 1)};
+    const std::size_t up = static_cast<std::size_t>(n.y);
+    const std::size_t row_of[4] = {r, r + 1, r + up, r + up + 1};
+    for (int j = 1; j < 4; ++j) x_crossings(rows[j], words_, n.x, counts.mask(j));
+    differences(rows[2], rows[3], words_, counts.mask(5));
+    differences(rows[1], rows[3], words_, counts.mask(7));
+    for (int j = 0; j < 4; ++j) counts.base[static_cast<std::size_t>(j)] = first_vertex_[row_of[j]];
+    counts.base[4] = first_vertex_[r] + x_count_[r];
+    counts.base[5] = first_vertex_[row_of[2]] + x_count_[row_of[2]];
+    counts.base[6] = counts.base[4] + y_count_[r];
+    counts.base[7] = first_vertex_[row_of[1]] + x_count_[row_of[1]] + y_count_[row_of[1]];
+    for (int k = 0; k < 8; ++k) {
+      const std::uint64_t* m = counts.mask(k);
+      std::uint64_t* before = counts.before.data() + static_cast<std::size_t>(k) * words_;
+      std::uint64_t sum = 0;
+      for (std::size_t w = 0; w < words_; ++w) {
+        before[w] = sum;
+        sum += static_cast<std::uint64_t>(bit_count(m[w]));
+      }
+    }
+    std::uint64_t centre_next = counts.base[6] + z_count_[r];
+    std::uint32_t* index = out.indices + first_index_[r];
+    const float* v0 = lattice_.values + in.index(0, y, z);
+    for_each_active_cell(rows, words_, n.x, [&](int x, unsigned inside) {
+      float v[8];
+      for (int c = 0; c < 8; ++c)
+        v[c] = in.s_of(v0[x + (c & 1) + in.sy * (c >> 1 & 1) + in.sz * (c >> 2 & 1)]);
+      const CubeCase& cc = table.lookup(inside, table.joined_faces(v, inside));
+      const auto id = [&](int edge) {
+        const EdgeSlot s = kEdgeSlots[static_cast<std::size_t>(edge)];
+        return static_cast<std::uint32_t>(counts.id(s.mask, x + s.dx));
+      };
+      // Centre vertices (a loop fanned from its mean) belong to this cell alone; their crossings
+      // are recomputed here, bit for bit those another row writes.
+      std::array<std::uint32_t, 2> centre{};
+      for (int c = 0; c < cc.centre_count; ++c) {
+        centre[static_cast<std::size_t>(c)] = static_cast<std::uint32_t>(centre_next);
+        put(centre_next++, centre_vertex(in, cc, c, x, y, z));
+      }
+      for (int k = 0; k < 3 * cc.triangle_count; ++k) {
+        const int edge = cc.edges[static_cast<std::size_t>(k)];
+        *index++ = edge >= CubeCase::kCentre
+                       ? centre[static_cast<std::size_t>(edge - CubeCase::kCentre)]
+                       : id(edge);
+      }
+    });
+  }
+}
+
+}  // namespace voxfield::detail::mesh

@@ -1,0 +1,60 @@
+// voxfield — marching cubes of a whole dense lattice in Flying Edges' passes (internal to the mesh
+// module; flying_edges.cpp explains the algorithm).
+//
+// The chunked driver (chunked_mesh.h) meshes chunks into parts and welds them, which is what
+// MeshChunks keeps between edits and what a terrain's chunk-by-chunk samples need. A whole dense
+// volume meshed once needs neither: this path counts every row's vertices and triangles first,
+// then writes each vertex and triangle once, straight into the output — no part, no weld, no hash.
+// Its vertices are numbered by lattice row (every chunk edge and thread count gives the same
+// arrays); the triangles, positions and normals are the chunked driver's, bit for bit.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "chunked_mesh.h"
+#include "voxfield/interrupt.h"
+
+namespace voxfield::detail::mesh {
+
+// Whether a lattice can take this path: marching cubes over samples in one array, with crossings
+// and normals from the samples (no analytic value or gradient, no per-vertex colour function).
+bool flying_edges_applies(const Lattice& lattice, const MeshOptions& options);
+
+class FlyingEdges {
+ public:
+  // Classifies and counts (the first two passes). Throws InvalidArgument for a NaN or infinite
+  // sample (naming the first) or more vertices than 32-bit indices hold, ResourceLimitError when
+  // the bookkeeping passes the memory limit, Cancelled when the interrupter asks.
+  FlyingEdges(const Lattice& lattice, Interrupter* interrupter);
+  std::size_t vertices() const { return vertices_; }
+  std::size_t indices() const { return indices_; }
+  // Writes the mesh into arrays of at least vertices() / indices() elements (out.colors is
+  // ignored: this path has no colours; out.sources, when not null, gets each vertex's inside
+  // sample). Throws Cancelled when the interrupter asks (the arrays then hold part of the mesh).
+  void write(const WeldOutput& out) const;
+
+ private:
+  struct RowCounts;
+  const Lattice& lattice_;
+  // One operation for the interrupter from counting to writing: units are planes, 3 per plane.
+  std::unique_ptr<Progress> progress_;
+  std::size_t words_ = 0;  // 64-bit words per row of inside bits (one spare past the last sample)
+  std::vector<std::uint64_t> inside_;  // per sample row (y + ny z): bit x set = sample inside
+  // Per sample row: its first vertex (the row's x-edge crossings, then its y-edge and z-edge
+  // ones, then the centre vertices of the cell row it starts) and the three edge counts; per cell
+  // row, its first index. One entry past the last row holds the totals.
+  std::vector<std::uint64_t> first_vertex_, first_index_;
+  std::vector<std::uint32_t> x_count_, y_count_, z_count_;
+  std::size_t vertices_ = 0, indices_ = 0;
+
+  const std::uint64_t* inside_row(int y, int z) const;
+  void classify_plane(int z, std::int64_t& first_bad);
+  void count_plane(int z, std::vector<std::uint64_t>& vertex_count,
+                   std::vector<std::uint64_t>& index_count);
+  void write_plane(int z, const WeldOutput& out) const;
+};
+
+}  // namespace voxfield::detail::mesh
