@@ -63,6 +63,17 @@ struct Lattice {
   }
 };
 
+// The reciprocals of central differences' spans per axis: [a][k] = 1 / (k * spacing[a]) for a
+// span of k samples (1 one-sided on the lattice's faces, 2 central inside), so that a gradient
+// costs multiplications, not divisions. Shared by every marching-cubes path, which must round
+// alike (Block::gradient, flying_edges.cpp).
+inline std::array<std::array<double, 3>, 3> inverse_spans(const std::array<double, 3>& spacing) {
+  std::array<std::array<double, 3>, 3> r{};
+  for (std::size_t a = 0; a < 3; ++a)
+    for (int k = 1; k <= 2; ++k) r[a][static_cast<std::size_t>(k)] = 1.0 / (k * spacing[a]);
+  return r;
+}
+
 struct ChunkGrid {
   Vec3i cells;  // n - 1 per axis
   int edge = 32;
@@ -110,6 +121,7 @@ class Block {
 
  private:
   const Lattice* lattice_ = nullptr;
+  std::array<std::array<double, 3>, 3> inverse_span_{};  // inverse_spans(lattice spacing)
   float iso_ = 0;
   bool negate_ = false;
   Vec3i lo_, hi_;

@@ -19,7 +19,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -27,6 +26,7 @@
 #include <string>
 
 #include "cube_cases.h"
+#include "mesh_memory.h"
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
 #include "voxfield/parallel.h"
@@ -43,6 +43,32 @@ bool flying_edges_applies(const Lattice& lattice, const MeshOptions& options) {
 }
 
 namespace {
+
+// Per corner mask (bit c: corner c inside), the cube edges whose two corners differ.
+constexpr std::array<std::uint16_t, 256> kCrossedEdges = [] {
+  std::array<std::uint16_t, 256> t{};
+  for (unsigned inside = 0; inside < 256; ++inside)
+    for (unsigned e = 0; e < 12; ++e) {
+      const unsigned axis = e / 4, j = e % 4;
+      const unsigned lo = axis == 0 ? 1 : 0, hi = axis == 2 ? 1 : 2;  // cube_cases.h numbering
+      const unsigned from = (j & 1) << lo | (j >> 1 & 1) << hi, to = from | 1u << axis;
+      if ((inside >> from & 1) != (inside >> to & 1))
+        t[inside] |= static_cast<std::uint16_t>(1u << e);
+    }
+  return t;
+}();
+
+// Triangles and centre vertices of each corner mask without an ambiguous face.
+struct CaseCounts {
+  std::array<std::uint8_t, 256> triangles{}, centres{};
+  explicit CaseCounts(const CubeCases& table) {
+    for (unsigned inside = 0; inside < 256; ++inside)
+      if (!table.ambiguous_faces(inside)) {
+        triangles[inside] = table.lookup(inside, 0).triangle_count;
+        centres[inside] = table.lookup(inside, 0).centre_count;
+      }
+  }
+};
 
 // Where each of the cube's 12 edges (cube_cases.h numbering) finds its crossing among a cell
 // row's eight crossing masks — the x-edges of the four sample rows (y, z), (y + 1, z),
@@ -90,16 +116,18 @@ struct RowSamples {
   float iso;
   bool negate;
   std::ptrdiff_t sy, sz;
+  std::array<std::array<double, 3>, 3> inverse_span;
   explicit RowSamples(const Lattice& l)
       : lattice(l),
         iso(static_cast<float>(l.iso)),
         negate(l.sign < 0),
         sy(l.n.x),
-        sz(static_cast<std::ptrdiff_t>(l.n.x) * l.n.y) {}
+        sz(static_cast<std::ptrdiff_t>(l.n.x) * l.n.y),
+        inverse_span(inverse_spans(l.spacing)) {}
   float s_of(float v) const { return negate ? iso - v : v - iso; }
   float s(std::ptrdiff_t i) const { return s_of(lattice.values[i]); }
   std::ptrdiff_t index(int x, int y, int z) const { return x + sy * y + sz * z; }
-  // Central differences, one-sided on the lattice's faces (Block::gradient).
+  // Central differences, one-sided on the lattice's faces (Block::gradient, the same rounding).
   std::array<double, 3> gradient(int x, int y, int z) const {
     const std::ptrdiff_t i = index(x, y, z);
     const int p[3] = {x, y, z};
@@ -108,9 +136,9 @@ struct RowSamples {
     for (int a = 0; a < 3; ++a) {
       const bool down = p[a] > 0, up = p[a] < lattice.n[a] - 1;
       const std::ptrdiff_t lo = down ? i - step[a] : i, hi = up ? i + step[a] : i;
-      const double span = (static_cast<int>(up) + static_cast<int>(down)) *
-                          lattice.spacing[static_cast<std::size_t>(a)];
-      g[static_cast<std::size_t>(a)] = (static_cast<double>(s(hi)) - s(lo)) / span;
+      g[static_cast<std::size_t>(a)] =
+          (static_cast<double>(s(hi)) - s(lo)) *
+          inverse_span[static_cast<std::size_t>(a)][static_cast<std::size_t>(up) + down];
     }
     return g;
   }
@@ -125,7 +153,8 @@ struct Vertex {
 std::array<float, 3> unit(std::array<double, 3> n) {
   const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   if (length > 0 && std::isfinite(length)) {
-    for (double& c : n) c /= length;
+    const double inverse = 1 / length;
+    for (double& c : n) c *= inverse;
   } else {
     n = {0, 0, 1};
   }
@@ -305,7 +334,9 @@ FlyingEdges::FlyingEdges(const Lattice& lattice, Interrupter* interrupter)
   words_ = static_cast<std::size_t>(n.x) / 64 + 1;
   require_memory(mul_sat(rows, add_sat(mul_sat(words_, 8), 4 * 8 + 3 * 4)), 0, "mesh",
                  "marching cubes' row bookkeeping");
-  inside_.assign(rows * words_, 0);
+  // Every bookkeeping array on huge pages too: their small pages' faults cost more than the
+  // passes that fill them.
+  resize_on_huge_pages(inside_, rows * words_);  // zeroed: the padding past each row stays 0
   Progress& progress = *progress_;
   // Pass 1: bit rows, and the first plane holding a NaN or infinite sample.
   std::vector<std::int64_t> first_bad(static_cast<std::size_t>(n.z), -1);
@@ -326,24 +357,23 @@ FlyingEdges::FlyingEdges(const Lattice& lattice, Interrupter* interrupter)
                             std::to_string(z) + ") is " + (std::isnan(v) ? "NaN" : "infinite"));
     }
   // Pass 2: each row's counts, then their prefix sums.
-  x_count_.assign(rows, 0);
-  y_count_.assign(rows, 0);
-  z_count_.assign(rows, 0);
-  std::vector<std::uint64_t> vertex_count(rows), index_count(rows);
+  // Row r's counts go to entry r + 1 of first_vertex_ and first_index_, summed in place after.
+  resize_on_huge_pages(x_count_, rows);
+  resize_on_huge_pages(y_count_, rows);
+  resize_on_huge_pages(z_count_, rows);
+  resize_on_huge_pages(first_vertex_, rows + 1);
+  resize_on_huge_pages(first_index_, rows + 1);
   parallel_for(static_cast<std::size_t>(n.z), 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t z = begin; z < end; ++z) {
       if (!progress.keep_going()) return;
-      count_plane(static_cast<int>(z), vertex_count, index_count);
+      count_plane(static_cast<int>(z));
       progress.advance();
     }
   });
   progress.throw_if_cancelled();
-  first_vertex_.resize(rows + 1);
-  first_index_.resize(rows + 1);
-  first_vertex_[0] = first_index_[0] = 0;
   for (std::size_t r = 0; r < rows; ++r) {
-    first_vertex_[r + 1] = first_vertex_[r] + vertex_count[r];
-    first_index_[r + 1] = first_index_[r] + index_count[r];
+    first_vertex_[r + 1] += first_vertex_[r];
+    first_index_[r + 1] += first_index_[r];
   }
   if (first_vertex_[rows] > std::numeric_limits<std::uint32_t>::max() - 1)
     throw InvalidArgument("mesh: " + std::to_string(first_vertex_[rows]) +
@@ -368,11 +398,11 @@ void FlyingEdges::classify_plane(int z, std::int64_t& first_bad) {
   }
 }
 
-void FlyingEdges::count_plane(int z, std::vector<std::uint64_t>& vertex_count,
-                              std::vector<std::uint64_t>& index_count) {
+void FlyingEdges::count_plane(int z) {
   const Vec3i n = lattice_.n;
   const RowSamples in(lattice_);
   const CubeCases& table = CubeCases::get();
+  static const CaseCounts counts(table);
   std::vector<std::uint64_t> scratch(words_);
   for (int y = 0; y < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
@@ -393,20 +423,21 @@ void FlyingEdges::count_plane(int z, std::vector<std::uint64_t>& vertex_count,
                                       inside_row(y + 1, z + 1)};
       const float* v0 = lattice_.values + in.index(0, y, z);
       for_each_active_cell(rows, words_, n.x, [&](int x, unsigned inside) {
-        unsigned joined = 0;
-        if (table.ambiguous_faces(inside)) {
-          float v[8];
-          for (int c = 0; c < 8; ++c)
-            v[c] = in.s_of(v0[x + (c & 1) + in.sy * (c >> 1 & 1) + in.sz * (c >> 2 & 1)]);
-          joined = table.joined_faces(v, inside);
+        if (!table.ambiguous_faces(inside)) {  // most cells: a 512-byte table, not the cases
+          triangles += counts.triangles[inside];
+          centres += counts.centres[inside];
+          return;
         }
-        const CubeCase& cc = table.lookup(inside, joined);
+        float v[8];
+        for (int c = 0; c < 8; ++c)
+          v[c] = in.s_of(v0[x + (c & 1) + in.sy * (c >> 1 & 1) + in.sz * (c >> 2 & 1)]);
+        const CubeCase& cc = table.lookup(inside, table.joined_faces(v, inside));
         triangles += cc.triangle_count;
         centres += cc.centre_count;
       });
     }
-    vertex_count[r] = std::uint64_t{x_count_[r]} + y_count_[r] + z_count_[r] + centres;
-    index_count[r] = 3 * triangles;
+    first_vertex_[r + 1] = std::uint64_t{x_count_[r]} + y_count_[r] + z_count_[r] + centres;
+    first_index_[r + 1] = 3 * triangles;
   }
 }
 
@@ -481,27 +512,31 @@ void FlyingEdges::write_plane(int z, const WeldOutput& out) const {
     std::uint32_t* index = out.indices + first_index_[r];
     const float* v0 = lattice_.values + in.index(0, y, z);
     for_each_active_cell(rows, words_, n.x, [&](int x, unsigned inside) {
-      float v[8];
-      for (int c = 0; c < 8; ++c)
-        v[c] = in.s_of(v0[x + (c & 1) + in.sy * (c >> 1 & 1) + in.sz * (c >> 2 & 1)]);
-      const CubeCase& cc = table.lookup(inside, table.joined_faces(v, inside));
-      const auto id = [&](int edge) {
+      unsigned joined = 0;
+      if (table.ambiguous_faces(inside)) {
+        float v[8];
+        for (int c = 0; c < 8; ++c)
+          v[c] = in.s_of(v0[x + (c & 1) + in.sy * (c >> 1 & 1) + in.sz * (c >> 2 & 1)]);
+        joined = table.joined_faces(v, inside);
+      }
+      const CubeCase& cc = table.lookup(inside, joined);
+      // Every crossing's number once, however many triangles use it; ids[kCentre + c] is
+      // centre vertex c, which belongs to this cell alone (its crossings are recomputed here,
+      // bit for bit those another row writes).
+      std::array<std::uint32_t, CubeCase::kCentre + 2> ids;
+      for (unsigned m = kCrossedEdges[inside]; m; m &= m - 1) {
+        const int edge = std::countr_zero(m);
         const EdgeSlot s = kEdgeSlots[static_cast<std::size_t>(edge)];
-        return static_cast<std::uint32_t>(counts.id(s.mask, x + s.dx));
-      };
-      // Centre vertices (a loop fanned from its mean) belong to this cell alone; their crossings
-      // are recomputed here, bit for bit those another row writes.
-      std::array<std::uint32_t, 2> centre{};
+        ids[static_cast<std::size_t>(edge)] =
+            static_cast<std::uint32_t>(counts.id(s.mask, x + s.dx));
+      }
       for (int c = 0; c < cc.centre_count; ++c) {
-        centre[static_cast<std::size_t>(c)] = static_cast<std::uint32_t>(centre_next);
+        ids[static_cast<std::size_t>(CubeCase::kCentre + c)] =
+            static_cast<std::uint32_t>(centre_next);
         put(centre_next++, centre_vertex(in, cc, c, x, y, z));
       }
-      for (int k = 0; k < 3 * cc.triangle_count; ++k) {
-        const int edge = cc.edges[static_cast<std::size_t>(k)];
-        *index++ = edge >= CubeCase::kCentre
-                       ? centre[static_cast<std::size_t>(edge - CubeCase::kCentre)]
-                       : id(edge);
-      }
+      for (int k = 0; k < 3 * cc.triangle_count; ++k)
+        *index++ = ids[cc.edges[static_cast<std::size_t>(k)]];
     });
   }
 }

@@ -52,8 +52,7 @@ class FlyingEdges {
 
   const std::uint64_t* inside_row(int y, int z) const;
   void classify_plane(int z, std::int64_t& first_bad);
-  void count_plane(int z, std::vector<std::uint64_t>& vertex_count,
-                   std::vector<std::uint64_t>& index_count);
+  void count_plane(int z);
   void write_plane(int z, const WeldOutput& out) const;
 };
 

@@ -4,12 +4,16 @@
 // of it costs a fault on first touch, and on a virtual machine a fault costs microseconds: for the
 // 256³ terrain's 2.3 M triangles (56 MB) the faults took longer than meshing itself. So the
 // arrays are reserved first (nothing touched yet), advised onto transparent huge pages (2 MiB, one
-// fault for 512 small pages), and only then sized.
+// fault for 512 small pages), touched once per page by all threads (the kernel zeroes each page
+// on the thread that faults it), and only then sized — the vector's own zero-fill then runs over
+// resident memory.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <vector>
+
+#include "voxfield/parallel.h"
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -28,6 +32,15 @@ void resize_on_huge_pages(std::vector<T>& v, std::size_t n) {
   if (last > first)  // advice only: where it is refused the pages stay small
     madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
 #endif
+  // The storage is allocated but holds no objects yet: writing its bytes is allowed.
+  auto* bytes = reinterpret_cast<unsigned char*>(v.data());
+  const std::size_t size = n * sizeof(T);
+  constexpr std::size_t kPage = 4096, kPagesPerTask = 512;
+  if (size >= 4 * kPagesPerTask * kPage)
+    parallel_for((size + kPage - 1) / kPage, kPagesPerTask,
+                 [&](std::size_t begin, std::size_t end) {
+                   for (std::size_t page = begin; page < end; ++page) bytes[page * kPage] = 0;
+                 });
   v.resize(n);
 }
 
