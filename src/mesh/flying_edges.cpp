@@ -25,15 +25,12 @@
 #include <limits>
 #include <string>
 
+#include "bit_rows.h"
 #include "cube_cases.h"
 #include "mesh_memory.h"
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
 #include "voxfield/parallel.h"
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 namespace voxfield::detail::mesh {
 
@@ -86,28 +83,6 @@ constexpr std::array<EdgeSlot, 12> kEdgeSlots = [] {
   }
   return s;
 }();
-
-// Set bits of a word. (std::popcount compiles to a library call on the x86-64 baseline, which
-// has no POPCNT instruction; these dozen operations inline.)
-unsigned bit_count(std::uint64_t v) {
-  v = v - (v >> 1 & 0x5555555555555555ull);
-  v = (v & 0x3333333333333333ull) + (v >> 2 & 0x3333333333333333ull);
-  v = (v + (v >> 4)) & 0x0f0f0f0f0f0f0f0full;
-  return static_cast<unsigned>((v * 0x0101010101010101ull) >> 56);
-}
-
-std::uint64_t low_bits(unsigned n) {  // n < 64
-  return (std::uint64_t{1} << n) - 1;
-}
-
-// Bits x and x + 1 of a bit row (bit 0: x).
-unsigned two_bits(const std::uint64_t* row, int x) {
-  const std::size_t w = static_cast<std::size_t>(x) >> 6;
-  const unsigned s = static_cast<unsigned>(x) & 63;
-  std::uint64_t v = row[w] >> s;
-  if (s == 63) v |= row[w + 1] << 1;
-  return static_cast<unsigned>(v & 3);
-}
 
 // The samples with the inside convention folded in, as Block reads them (chunked_mesh.h): the
 // same float arithmetic, so vertices come out bit for bit as the chunked driver's.
@@ -213,90 +188,9 @@ Vertex centre_vertex(const RowSamples& in, const CubeCase& cc, int c, int x, int
           source};
 }
 
-// Inside bits of `count` samples into words (bit k of word w: sample 64 w + k); returns whether
-// one is NaN or infinite (its exponent bits all set).
-bool inside_bits(const float* v, int count, float iso, bool inside_above, std::uint64_t* out) {
-  std::uint32_t bad = 0;
-  int x = 0;
-  std::uint64_t word = 0;
-#if defined(__SSE2__)
-  const __m128 iso4 = _mm_set1_ps(iso);
-  const __m128i exponent = _mm_set1_epi32(0x7f800000);
-  __m128i bad4 = _mm_setzero_si128();
-  for (; x + 4 <= count; x += 4) {
-    const __m128 s = _mm_loadu_ps(v + x);
-    const __m128 in = inside_above ? _mm_cmpgt_ps(s, iso4) : _mm_cmplt_ps(s, iso4);
-    word |= static_cast<std::uint64_t>(_mm_movemask_ps(in)) << (x & 63);
-    bad4 =
-        _mm_or_si128(bad4, _mm_cmpeq_epi32(_mm_and_si128(_mm_castps_si128(s), exponent), exponent));
-    if ((x & 63) == 60) {
-      out[x >> 6] = word;
-      word = 0;
-    }
-  }
-  bad = static_cast<std::uint32_t>(_mm_movemask_epi8(bad4));
-#endif
-  for (; x < count; ++x) {
-    std::uint32_t bits;
-    std::memcpy(&bits, &v[x], sizeof bits);
-    bad |= static_cast<std::uint32_t>((bits & 0x7f800000u) == 0x7f800000u);
-    const bool in = inside_above ? v[x] > iso : v[x] < iso;
-    word |= static_cast<std::uint64_t>(in) << (x & 63);
-    if ((x & 63) == 63) {
-      out[x >> 6] = word;
-      word = 0;
-    }
-  }
-  if (count & 63) out[count >> 6] = word;
-  return bad != 0;
-}
-
 }  // namespace
 
-// The eight crossing masks of one cell row with their running population counts, and the first
-// vertex number of each (the row's first vertex plus the crossings of earlier axes).
-struct FlyingEdges::RowCounts {
-  std::size_t words;
-  std::vector<std::uint64_t> masks, before;  // 8 x words; before[k][w]: crossings in words < w
-  std::array<std::uint64_t, 8> base{};
-  explicit RowCounts(std::size_t w) : words(w), masks(8 * w), before(8 * w) {}
-  std::uint64_t* mask(int k) { return masks.data() + static_cast<std::size_t>(k) * words; }
-  // The number of crossing `k` at x: base + crossings of that mask before x.
-  std::uint64_t id(int k, int x) const {
-    const std::size_t w = static_cast<std::size_t>(x) >> 6;
-    const std::size_t at = static_cast<std::size_t>(k) * words + w;
-    return base[static_cast<std::size_t>(k)] + before[at] +
-           static_cast<std::uint64_t>(
-               bit_count(masks[at] & low_bits(static_cast<unsigned>(x) & 63)));
-  }
-};
-
-const std::uint64_t* FlyingEdges::inside_row(int y, int z) const {
-  return inside_.data() +
-         words_ * (static_cast<std::size_t>(y) +
-                   static_cast<std::size_t>(lattice_.n.y) * static_cast<std::size_t>(z));
-}
-
 namespace {
-
-// Crossing masks from bit rows (words past the row's last sample are zero).
-void x_crossings(const std::uint64_t* b, std::size_t words, int nx, std::uint64_t* out) {
-  for (std::size_t w = 0; w < words; ++w) {
-    const std::uint64_t next = w + 1 < words ? b[w + 1] : 0;
-    out[w] = b[w] ^ (b[w] >> 1 | next << 63);
-  }
-  // The last sample has no x-edge (its "neighbour" bit is the zero padding).
-  out[static_cast<std::size_t>(nx - 1) >> 6] &= ~(std::uint64_t{1} << ((nx - 1) & 63));
-}
-void differences(const std::uint64_t* a, const std::uint64_t* b, std::size_t words,
-                 std::uint64_t* out) {
-  for (std::size_t w = 0; w < words; ++w) out[w] = a[w] ^ b[w];
-}
-std::uint64_t population(const std::uint64_t* m, std::size_t words) {
-  std::uint64_t n = 0;
-  for (std::size_t w = 0; w < words; ++w) n += static_cast<std::uint64_t>(bit_count(m[w]));
-  return n;
-}
 
 // Calls f(x, inside) for every cell of cell row (rows b[0..3], see kEdgeSlots) whose corners are
 // not all on one side, x increasing; inside is its corner mask (bit c: corner c inside).
@@ -331,31 +225,11 @@ FlyingEdges::FlyingEdges(const Lattice& lattice, Interrupter* interrupter)
                                            3 * static_cast<std::int64_t>(lattice.n.z))) {
   const Vec3i n = lattice.n;
   const std::size_t rows = static_cast<std::size_t>(n.y) * static_cast<std::size_t>(n.z);
-  words_ = static_cast<std::size_t>(n.x) / 64 + 1;
-  require_memory(mul_sat(rows, add_sat(mul_sat(words_, 8), 4 * 8 + 3 * 4)), 0, "mesh",
-                 "marching cubes' row bookkeeping");
-  // Every bookkeeping array on huge pages too: their small pages' faults cost more than the
-  // passes that fill them.
-  resize_on_huge_pages(inside_, rows * words_);  // zeroed: the padding past each row stays 0
+  require_memory(mul_sat(rows, 2 * 8 + 3 * 4), 0, "mesh", "marching cubes' row bookkeeping");
+  // Pass 1: bit rows (and the refusal of a NaN or infinite sample).
+  inside_ = std::make_unique<InsideBits>(lattice, *progress_);
+  words_ = inside_->words();
   Progress& progress = *progress_;
-  // Pass 1: bit rows, and the first plane holding a NaN or infinite sample.
-  std::vector<std::int64_t> first_bad(static_cast<std::size_t>(n.z), -1);
-  parallel_for(static_cast<std::size_t>(n.z), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t z = begin; z < end; ++z) {
-      if (!progress.keep_going()) return;
-      classify_plane(static_cast<int>(z), first_bad[z]);
-      progress.advance();
-    }
-  });
-  progress.throw_if_cancelled();
-  for (const std::int64_t bad : first_bad)
-    if (bad >= 0) {
-      const int x = static_cast<int>(bad % n.x), y = static_cast<int>(bad / n.x % n.y),
-                z = static_cast<int>(bad / n.x / n.y);
-      const float v = lattice.values[bad];
-      throw InvalidArgument("mesh: sample (" + std::to_string(x) + ", " + std::to_string(y) + ", " +
-                            std::to_string(z) + ") is " + (std::isnan(v) ? "NaN" : "infinite"));
-    }
   // Pass 2: each row's counts, then their prefix sums.
   // Row r's counts go to entry r + 1 of first_vertex_ and first_index_, summed in place after.
   resize_on_huge_pages(x_count_, rows);
@@ -382,22 +256,6 @@ FlyingEdges::FlyingEdges(const Lattice& lattice, Interrupter* interrupter)
   indices_ = first_index_[rows];
 }
 
-void FlyingEdges::classify_plane(int z, std::int64_t& first_bad) {
-  const Vec3i n = lattice_.n;
-  const RowSamples in(lattice_);
-  std::uint64_t* bits =
-      inside_.data() + words_ * static_cast<std::size_t>(n.y) * static_cast<std::size_t>(z);
-  for (int y = 0; y < n.y; ++y, bits += words_) {
-    const float* row = lattice_.values + in.index(0, y, z);
-    if (inside_bits(row, n.x, in.iso, in.negate, bits) && first_bad < 0)
-      for (int x = 0; x < n.x; ++x)
-        if (!std::isfinite(row[x])) {
-          first_bad = in.index(x, y, z);
-          break;
-        }
-  }
-}
-
 void FlyingEdges::count_plane(int z) {
   const Vec3i n = lattice_.n;
   const RowSamples in(lattice_);
@@ -406,21 +264,21 @@ void FlyingEdges::count_plane(int z) {
   std::vector<std::uint64_t> scratch(words_);
   for (int y = 0; y < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
-    const std::uint64_t* b = inside_row(y, z);
+    const std::uint64_t* b = inside_->row(y, z);
     x_crossings(b, words_, n.x, scratch.data());
     x_count_[r] = static_cast<std::uint32_t>(population(scratch.data(), words_));
     if (y + 1 < n.y) {
-      differences(b, inside_row(y + 1, z), words_, scratch.data());
+      differences(b, inside_->row(y + 1, z), words_, scratch.data());
       y_count_[r] = static_cast<std::uint32_t>(population(scratch.data(), words_));
     }
     if (z + 1 < n.z) {
-      differences(b, inside_row(y, z + 1), words_, scratch.data());
+      differences(b, inside_->row(y, z + 1), words_, scratch.data());
       z_count_[r] = static_cast<std::uint32_t>(population(scratch.data(), words_));
     }
     std::uint64_t triangles = 0, centres = 0;
     if (y + 1 < n.y && z + 1 < n.z) {
-      const std::uint64_t* rows[4] = {b, inside_row(y + 1, z), inside_row(y, z + 1),
-                                      inside_row(y + 1, z + 1)};
+      const std::uint64_t* rows[4] = {b, inside_->row(y + 1, z), inside_->row(y, z + 1),
+                                      inside_->row(y + 1, z + 1)};
       const float* v0 = lattice_.values + in.index(0, y, z);
       for_each_active_cell(rows, words_, n.x, [&](int x, unsigned inside) {
         if (!table.ambiguous_faces(inside)) {  // most cells: a 512-byte table, not the cases
@@ -462,10 +320,10 @@ void FlyingEdges::write_plane(int z, const WeldOutput& out) const {
     out.normals[g] = v.normal;
     if (out.sources) out.sources[g] = v.source;
   };
-  RowCounts counts(words_);
+  RowRanks counts(8, words_);
   for (int y = 0; y < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
-    const std::uint64_t* b = inside_row(y, z);
+    const std::uint64_t* b = inside_->row(y, z);
     // This row's edge vertices: its x-edge crossings, then its y-edge and z-edge ones.
     std::uint64_t g = first_vertex_[r];
     const auto emit = [&](const std::uint64_t* mask, int axis) {
@@ -478,37 +336,29 @@ void FlyingEdges::write_plane(int z, const WeldOutput& out) const {
     x_crossings(b, words_, n.x, counts.mask(0));
     emit(counts.mask(0), 0);
     if (up_y) {
-      differences(b, inside_row(y + 1, z), words_, counts.mask(4));
+      differences(b, inside_->row(y + 1, z), words_, counts.mask(4));
       emit(counts.mask(4), 1);
     }
     if (up_z) {
-      differences(b, inside_row(y, z + 1), words_, counts.mask(6));
+      differences(b, inside_->row(y, z + 1), words_, counts.mask(6));
       emit(counts.mask(6), 2);
     }
     if (!up_y || !up_z) continue;
     // The cell row (y, z): every crossing's number from the masks' running counts.
-    const std::uint64_t* rows[4] = {b, inside_row(y + 1, z), inside_row(y, z + 1),
-                                    inside_row(y + 1, z + 1)};
+    const std::uint64_t* rows[4] = {b, inside_->row(y + 1, z), inside_->row(y, z + 1),
+                                    inside_->row(y + 1, z + 1)};
     const std::size_t up = static_cast<std::size_t>(n.y);
     const std::size_t row_of[4] = {r, r + 1, r + up, r + up + 1};
     for (int j = 1; j < 4; ++j) x_crossings(rows[j], words_, n.x, counts.mask(j));
     differences(rows[2], rows[3], words_, counts.mask(5));
     differences(rows[1], rows[3], words_, counts.mask(7));
-    for (int j = 0; j < 4; ++j) counts.base[static_cast<std::size_t>(j)] = first_vertex_[row_of[j]];
-    counts.base[4] = first_vertex_[r] + x_count_[r];
-    counts.base[5] = first_vertex_[row_of[2]] + x_count_[row_of[2]];
-    counts.base[6] = counts.base[4] + y_count_[r];
-    counts.base[7] = first_vertex_[row_of[1]] + x_count_[row_of[1]] + y_count_[row_of[1]];
-    for (int k = 0; k < 8; ++k) {
-      const std::uint64_t* m = counts.mask(k);
-      std::uint64_t* before = counts.before.data() + static_cast<std::size_t>(k) * words_;
-      std::uint64_t sum = 0;
-      for (std::size_t w = 0; w < words_; ++w) {
-        before[w] = sum;
-        sum += static_cast<std::uint64_t>(bit_count(m[w]));
-      }
-    }
-    std::uint64_t centre_next = counts.base[6] + z_count_[r];
+    for (int j = 0; j < 4; ++j) counts.set_base(j, first_vertex_[row_of[j]]);
+    counts.set_base(4, first_vertex_[r] + x_count_[r]);
+    counts.set_base(5, first_vertex_[row_of[2]] + x_count_[row_of[2]]);
+    counts.set_base(6, counts.base(4) + y_count_[r]);
+    counts.set_base(7, first_vertex_[row_of[1]] + x_count_[row_of[1]] + y_count_[row_of[1]]);
+    counts.count();
+    std::uint64_t centre_next = counts.base(6) + z_count_[r];
     std::uint32_t* index = out.indices + first_index_[r];
     const float* v0 = lattice_.values + in.index(0, y, z);
     for_each_active_cell(rows, words_, n.x, [&](int x, unsigned inside) {

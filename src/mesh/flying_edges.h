@@ -14,6 +14,7 @@
 #include <memory>
 #include <vector>
 
+#include "bit_rows.h"
 #include "chunked_mesh.h"
 #include "voxfield/interrupt.h"
 
@@ -37,12 +38,11 @@ class FlyingEdges {
   void write(const WeldOutput& out) const;
 
  private:
-  struct RowCounts;
   const Lattice& lattice_;
   // One operation for the interrupter from counting to writing: units are planes, 3 per plane.
   std::unique_ptr<Progress> progress_;
-  std::size_t words_ = 0;  // 64-bit words per row of inside bits (one spare past the last sample)
-  std::vector<std::uint64_t> inside_;  // per sample row (y + ny z): bit x set = sample inside
+  std::unique_ptr<InsideBits> inside_;
+  std::size_t words_ = 0;  // per bit row
   // Per sample row: its first vertex (the row's x-edge crossings, then its y-edge and z-edge
   // ones, then the centre vertices of the cell row it starts) and the three edge counts; per cell
   // row, its first index. One entry past the last row holds the totals.
@@ -50,8 +50,6 @@ class FlyingEdges {
   std::vector<std::uint32_t> x_count_, y_count_, z_count_;
   std::size_t vertices_ = 0, indices_ = 0;
 
-  const std::uint64_t* inside_row(int y, int z) const;
-  void classify_plane(int z, std::int64_t& first_bad);
   void count_plane(int z);
   void write_plane(int z, const WeldOutput& out) const;
 };

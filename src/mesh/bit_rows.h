@@ -1,0 +1,114 @@
+// voxfield — a lattice's samples as rows of inside bits, for the meshers that run in Flying Edges'
+// passes (internal to the mesh module; flying_edges.cpp, flying_dual.cpp).
+//
+// One bit per sample, 64 samples a word, a row (y, z) of `words()` words with at least one zero
+// word's worth of padding past its last sample. An edge crosses the surface where the bits of its
+// two ends differ, so a row's x-, y- and z-edge crossings are XORs of whole words, and a crossing's
+// place among its row's crossings — its number — is a population count.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "chunked_mesh.h"
+#include "voxfield/interrupt.h"
+
+namespace voxfield::detail::mesh {
+
+// Set bits of a word. (std::popcount compiles to a library call on the x86-64 baseline, which
+// has no POPCNT instruction; these dozen operations inline.)
+inline unsigned bit_count(std::uint64_t v) {
+  v = v - (v >> 1 & 0x5555555555555555ull);
+  v = (v & 0x3333333333333333ull) + (v >> 2 & 0x3333333333333333ull);
+  v = (v + (v >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return static_cast<unsigned>((v * 0x0101010101010101ull) >> 56);
+}
+
+inline std::uint64_t low_bits(unsigned n) {  // n < 64
+  return (std::uint64_t{1} << n) - 1;
+}
+
+// Bits x and x + 1 of a bit row (bit 0: x).
+inline unsigned two_bits(const std::uint64_t* row, int x) {
+  const std::size_t w = static_cast<std::size_t>(x) >> 6;
+  const unsigned s = static_cast<unsigned>(x) & 63;
+  std::uint64_t v = row[w] >> s;
+  if (s == 63) v |= row[w + 1] << 1;
+  return static_cast<unsigned>(v & 3);
+}
+
+// The crossings of a row's x-edges (bit x: the edge from x to x + 1).
+inline void x_crossings(const std::uint64_t* b, std::size_t words, int nx, std::uint64_t* out) {
+  for (std::size_t w = 0; w < words; ++w) {
+    const std::uint64_t next = w + 1 < words ? b[w + 1] : 0;
+    out[w] = b[w] ^ (b[w] >> 1 | next << 63);
+  }
+  // The last sample has no x-edge (its "neighbour" bit is the zero padding).
+  out[static_cast<std::size_t>(nx - 1) >> 6] &= ~(std::uint64_t{1} << ((nx - 1) & 63));
+}
+// The crossings of the edges between two rows (bit x: the edge at x).
+inline void differences(const std::uint64_t* a, const std::uint64_t* b, std::size_t words,
+                        std::uint64_t* out) {
+  for (std::size_t w = 0; w < words; ++w) out[w] = a[w] ^ b[w];
+}
+inline std::uint64_t population(const std::uint64_t* m, std::size_t words) {
+  std::uint64_t n = 0;
+  for (std::size_t w = 0; w < words; ++w) n += static_cast<std::uint64_t>(bit_count(m[w]));
+  return n;
+}
+
+// K bit masks over one row with their running population counts: the number of bit x of mask k
+// is base[k] plus the set bits before x.
+class RowRanks {
+ public:
+  RowRanks(int masks, std::size_t words)
+      : words_(words), bits_(static_cast<std::size_t>(masks) * words),
+        before_(bits_.size()), base_(static_cast<std::size_t>(masks)) {}
+  std::uint64_t* mask(int k) { return bits_.data() + static_cast<std::size_t>(k) * words_; }
+  const std::uint64_t* mask(int k) const {
+    return bits_.data() + static_cast<std::size_t>(k) * words_;
+  }
+  void set_base(int k, std::uint64_t base) { base_[static_cast<std::size_t>(k)] = base; }
+  std::uint64_t base(int k) const { return base_[static_cast<std::size_t>(k)]; }
+  // After the masks are filled: the running counts of each.
+  void count() {
+    for (std::size_t k = 0; k < base_.size(); ++k) {
+      std::uint64_t sum = 0;
+      for (std::size_t w = 0; w < words_; ++w) {
+        before_[k * words_ + w] = sum;
+        sum += bit_count(bits_[k * words_ + w]);
+      }
+    }
+  }
+  std::uint64_t id(int k, int x) const {
+    const std::size_t at =
+        static_cast<std::size_t>(k) * words_ + (static_cast<std::size_t>(x) >> 6);
+    return base_[static_cast<std::size_t>(k)] + before_[at] +
+           bit_count(bits_[at] & low_bits(static_cast<unsigned>(x) & 63));
+  }
+
+ private:
+  std::size_t words_;
+  std::vector<std::uint64_t> bits_, before_, base_;
+};
+
+// Every sample of a dense lattice as an inside bit (pass 1 of both Flying Edges meshers).
+class InsideBits {
+ public:
+  // Throws InvalidArgument naming the first NaN or infinite sample, ResourceLimitError past the
+  // memory limit, Cancelled when `progress` is cancelled (one unit per plane).
+  InsideBits(const Lattice& lattice, Progress& progress);
+  std::size_t words() const { return words_; }
+  const std::uint64_t* row(int y, int z) const {
+    return bits_.data() + words_ * (static_cast<std::size_t>(y) +
+                                    static_cast<std::size_t>(ny_) * static_cast<std::size_t>(z));
+  }
+
+ private:
+  std::size_t words_ = 0;
+  int ny_ = 0;
+  std::vector<std::uint64_t> bits_;
+};
+
+}  // namespace voxfield::detail::mesh
