@@ -359,8 +359,8 @@ TEST(Mesh, RandomFieldsAreWatertightAndIndependentOfChunksAndThreads) {
         EXPECT_TRUE(triangle_set(mesh) == expected)
             << "chunk edge " << edge << ", " << threads << " threads";
         EXPECT_TRUE(closed(mesh_stats(mesh))) << "chunk edge " << edge;
-        // Marching cubes of a whole volume runs in Flying Edges' passes (flying_edges.h); the
-        // chunked driver MeshChunks keeps must give the same triangles.
+        // A whole volume is meshed in Flying Edges' passes (flying_edges.h); the chunked driver
+        // MeshChunks keeps must give the same triangles.
         const Mesh chunked = MeshChunks(vol, with(m, edge)).merged();
         EXPECT_EQ(chunked.vertex_count(), reference.vertex_count()) << "chunk edge " << edge;
         EXPECT_TRUE(triangle_set(chunked) == expected)

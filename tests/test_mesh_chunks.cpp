@@ -30,7 +30,7 @@ void expect_same(const Mesh& a, const Mesh& b, const std::string& what) {
 
 // The kept chunks after edits against meshing the edited volume from scratch: array for array
 // against a new MeshChunks (the same chunked driver), and triangle for triangle against
-// mesh_volume(), whose marching cubes numbers its vertices by lattice row (flying_edges.h).
+// mesh_volume(), which numbers its vertices by lattice row (flying_edges.h).
 void expect_full_mesh(const MeshChunks& chunks, const ScalarVolume& volume,
                       const MeshOptions& options, const std::string& what) {
   const Mesh kept = chunks.merged();

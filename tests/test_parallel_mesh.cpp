@@ -1,6 +1,6 @@
 // The meshers' parallel paths under ThreadSanitizer (the tsan preset runs this executable): chunks
 // meshed concurrently, the weld writing disjoint ranges of the output from several threads,
-// marching cubes' rows counted and written concurrently (Flying Edges' passes), and MeshChunks
+// a whole volume's rows counted and written concurrently (Flying Edges' passes), and MeshChunks
 // re-meshing dirty chunks in parallel — the same mesh as on one thread.
 #include <gtest/gtest.h>
 
@@ -35,8 +35,8 @@ TEST(ParallelMesh, ThreadsGiveTheSameMesh) {
     MeshChunks chunks(vol, o);
     for (int i = 0; i < 8; ++i) v[static_cast<std::size_t>(i * 977 % v.size())] *= -1;
     chunks.update(vol, Box3i::from_size(vol.size));
-    // A full re-mesh by the same chunked driver, array for array; mesh_volume()'s marching cubes
-    // (Flying Edges' passes, numbered by row) triangle for triangle.
+    // A full re-mesh by the same chunked driver, array for array; mesh_volume() (Flying Edges'
+    // passes, numbered by row) triangle for triangle.
     const Mesh kept = chunks.merged();
     EXPECT_TRUE(kept.indices == MeshChunks(vol, o).merged().indices) << mesher_name(m);
     EXPECT_TRUE(test::corner_triangles(kept) == test::corner_triangles(mesh_volume(vol, o)))

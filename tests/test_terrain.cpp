@@ -256,7 +256,7 @@ TEST(Terrain, MeshesEqualMeshesOfTheDecodedVolume) {
         const Mesh got = mesh_terrain(t, mo);
         mo.iso = 0;
         // The same chunked driver on the decoded volume, array for array; mesh_volume()'s
-        // marching cubes (numbered by row, flying_edges.h) triangle for triangle.
+        // whole-volume passes (numbered by row, flying_edges.h) triangle for triangle.
         const Mesh want = MeshChunks(v, mo).merged();
         ASSERT_GT(want.triangle_count(), 1000u);
         expect_same_mesh(got, want);

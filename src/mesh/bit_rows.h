@@ -63,8 +63,10 @@ inline std::uint64_t population(const std::uint64_t* m, std::size_t words) {
 class RowRanks {
  public:
   RowRanks(int masks, std::size_t words)
-      : words_(words), bits_(static_cast<std::size_t>(masks) * words),
-        before_(bits_.size()), base_(static_cast<std::size_t>(masks)) {}
+      : words_(words),
+        bits_(static_cast<std::size_t>(masks) * words),
+        before_(bits_.size()),
+        base_(static_cast<std::size_t>(masks)) {}
   std::uint64_t* mask(int k) { return bits_.data() + static_cast<std::size_t>(k) * words_; }
   const std::uint64_t* mask(int k) const {
     return bits_.data() + static_cast<std::size_t>(k) * words_;

@@ -34,6 +34,21 @@ int ChunkGrid::owner(int axis, int v) const {
   return std::min(v / edge, count[axis] - 1);
 }
 
+void Block::view(const Lattice& lattice) {
+  lattice_ = &lattice;
+  inverse_span_ = inverse_spans(lattice.spacing);
+  iso_ = static_cast<float>(lattice.iso);
+  negate_ = lattice.sign < 0;
+  lo_ = {0, 0, 0};
+  hi_ = {lattice.n.x - 1, lattice.n.y - 1, lattice.n.z - 1};
+  data_ = lattice.values;
+  base_ = 0;
+  sy_ = lattice.n.x;
+  sz_ = sy_ * static_cast<std::ptrdiff_t>(lattice.n.y);
+  signs_.clear();
+  dy_ = 0;
+}
+
 bool Block::load(const Lattice& lattice, const Box3i& cells) {
   lattice_ = &lattice;
   inverse_span_ = inverse_spans(lattice.spacing);
@@ -157,21 +172,25 @@ void ChunkPart::clear() {
   indices.clear();
 }
 
-std::uint32_t ChunkPart::add(const std::array<double, 3>& position, std::array<double, 3> normal,
-                             std::uint64_t key, std::uint64_t source, bool is_owned,
-                             bool is_shared) {
+std::array<float, 3> unit_normal(std::array<double, 3> normal) {
   const double length =
       std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
   if (length > 0 && std::isfinite(length)) {
-    const double inverse = 1 / length;  // one division, not three (flying_edges.cpp rounds alike)
+    const double inverse = 1 / length;  // one division, not three
     for (double& c : normal) c *= inverse;
   } else {
     normal = {0, 0, 1};  // no direction to be had (a perfectly symmetric cell): still unit length
   }
+  return {static_cast<float>(normal[0]), static_cast<float>(normal[1]),
+          static_cast<float>(normal[2])};
+}
+
+std::uint32_t ChunkPart::add(const std::array<double, 3>& position, std::array<double, 3> normal,
+                             std::uint64_t key, std::uint64_t source, bool is_owned,
+                             bool is_shared) {
   positions.push_back({static_cast<float>(position[0]), static_cast<float>(position[1]),
                        static_cast<float>(position[2])});
-  normals.push_back({static_cast<float>(normal[0]), static_cast<float>(normal[1]),
-                     static_cast<float>(normal[2])});
+  normals.push_back(unit_normal(normal));
   keys.push_back(key);
   sources.push_back(source);
   owned.push_back(is_owned);

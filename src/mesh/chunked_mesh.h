@@ -98,6 +98,9 @@ class Block {
   // Loads the block for `cells`; false when no sample changes sign (the chunk has no surface).
   // Throws InvalidArgument for a NaN sample.
   bool load(const Lattice& lattice, const Box3i& cells);
+  // Views a dense lattice's whole array (lattice.values): no copy and no scan, so row_signs() is
+  // not available — for the whole-volume passes, which classify the samples themselves.
+  void view(const Lattice& lattice);
   // The value with the inside convention folded in (negative inside).
   float s_of(float value) const { return negate_ ? iso_ - value : value - iso_; }
   bool inside(float value) const { return negate_ ? value > iso_ : value < iso_; }
@@ -190,5 +193,17 @@ std::array<double, 3> dual_contouring_vertex(const Block& block, const Lattice& 
                                              const double* v);
 void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,
                      std::vector<std::int32_t>& scratch, ChunkPart& part, CellVertex place);
+// A dual mesher's vertex of cell q: its position in the volume's frame, its normal (not yet unit
+// length) and its colour source (the inside corner nearest it). Every dual path computes it here,
+// so that chunks and whole-volume passes agree bit for bit.
+struct DualVertex {
+  std::array<double, 3> position, normal;
+  std::uint64_t source;
+};
+DualVertex dual_cell_vertex(const Block& block, const Lattice& lattice, int qx, int qy, int qz,
+                            CellVertex place);
+// A normal scaled to unit length in floats (+z where it has no direction): ChunkPart::add's rule,
+// shared by the whole-volume passes.
+std::array<float, 3> unit_normal(std::array<double, 3> normal);
 
 }  // namespace voxfield::detail::mesh

@@ -124,18 +124,6 @@ struct Vertex {
   std::uint64_t source;
 };
 
-// ChunkPart::add's normalisation: unit length, or +z where there is no direction.
-std::array<float, 3> unit(std::array<double, 3> n) {
-  const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-  if (length > 0 && std::isfinite(length)) {
-    const double inverse = 1 / length;
-    for (double& c : n) c *= inverse;
-  } else {
-    n = {0, 0, 1};
-  }
-  return {static_cast<float>(n[0]), static_cast<float>(n[1]), static_cast<float>(n[2])};
-}
-
 // The crossing on the edge from lattice point (x, y, z) along `axis` (marching_cubes.cpp's
 // vertex(), without an analytic value or gradient).
 Vertex edge_vertex(const RowSamples& in, int x, int y, int z, int axis) {
@@ -154,7 +142,7 @@ Vertex edge_vertex(const RowSamples& in, int x, int y, int z, int axis) {
     normal[static_cast<std::size_t>(axis)] = s0 < 0 ? 1 : -1;
   return {{static_cast<float>(position[0]), static_cast<float>(position[1]),
            static_cast<float>(position[2])},
-          unit(normal),
+          unit_normal(normal),
           static_cast<std::uint64_t>(s0 < 0 ? i0 : i1)};
 }
 
@@ -184,7 +172,7 @@ Vertex centre_vertex(const RowSamples& in, const CubeCase& cc, int c, int x, int
     }
   }
   return {{static_cast<float>(mean[0]), static_cast<float>(mean[1]), static_cast<float>(mean[2])},
-          unit(normal),
+          unit_normal(normal),
           source};
 }
 

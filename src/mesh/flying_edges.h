@@ -1,5 +1,6 @@
-// voxfield — marching cubes of a whole dense lattice in Flying Edges' passes (internal to the mesh
-// module; flying_edges.cpp explains the algorithm).
+// voxfield — the meshers of a whole dense lattice in Flying Edges' passes (internal to the mesh
+// module): marching cubes (flying_edges.cpp, which explains the passes) and the dual meshers
+// (flying_dual.cpp).
 //
 // The chunked driver (chunked_mesh.h) meshes chunks into parts and welds them, which is what
 // MeshChunks keeps between edits and what a terrain's chunk-by-chunk samples need. A whole dense
@@ -52,6 +53,42 @@ class FlyingEdges {
 
   void count_plane(int z);
   void write_plane(int z, const WeldOutput& out) const;
+};
+
+// Whether a lattice can take the dual path: surface nets or dual contouring over samples in one
+// array, crossings and normals from the samples.
+bool flying_dual_applies(const Lattice& lattice, const MeshOptions& options);
+
+// Surface nets and dual contouring of a whole dense lattice in the same passes (flying_dual.cpp):
+// counted per row, then each cell's vertex and each crossed edge's quad written once, in place.
+class FlyingDual {
+ public:
+  // Classifies and counts; throws as FlyingEdges does.
+  FlyingDual(const Lattice& lattice, const MeshOptions& options);
+  std::size_t vertices() const { return vertices_; }
+  std::size_t indices() const { return indices_; }
+  // As FlyingEdges::write.
+  void write(const WeldOutput& out) const;
+
+ private:
+  const Lattice& lattice_;
+  CellVertex place_;
+  std::unique_ptr<Progress> progress_;  // units are planes, 4 per plane
+  std::unique_ptr<InsideBits> inside_;
+  std::size_t words_ = 0;
+  Block block_;  // a view of the lattice, for the vertex placement
+  // Per cell row (y + ny z): its first vertex (one per cell a quad reaches); per sample row: its
+  // first index (two triangles per crossed edge starting on it). One entry past the last row
+  // holds the totals.
+  std::vector<std::uint64_t> first_vertex_, first_index_;
+  std::size_t vertices_ = 0, indices_ = 0;
+
+  struct Masks;
+  void quads(int y, int z, Masks& m) const;
+  void cells(int y, int z, Masks& scratch, std::uint64_t* used) const;
+  void count_plane(int z);
+  void write_vertices(int z, const WeldOutput& out) const;
+  void write_quads(int z, const WeldOutput& out) const;
 };
 
 }  // namespace voxfield::detail::mesh

@@ -84,12 +84,15 @@ MeshCounts mesh_volume_into(const ScalarVolume& volume, const MeshOptions& optio
                             const MeshBuffers& out) {
   using namespace detail::mesh;
   const Lattice lattice = checked_lattice(volume, options, false);
-  if (!flying_edges_applies(lattice, options))
-    return write_into(mesh_all_chunks(lattice, options), out);
-  const FlyingEdges plan(lattice, options.interrupter);
-  check_room(plan.vertices(), plan.indices(), false, out);
-  plan.write({out.positions.data(), out.normals.data(), nullptr, out.indices.data(), nullptr});
-  return {plan.vertices(), plan.indices()};
+  const auto into = [&](const auto& plan) -> MeshCounts {
+    check_room(plan.vertices(), plan.indices(), false, out);
+    plan.write({out.positions.data(), out.normals.data(), nullptr, out.indices.data(), nullptr});
+    return {plan.vertices(), plan.indices()};
+  };
+  if (flying_edges_applies(lattice, options))
+    return into(FlyingEdges(lattice, options.interrupter));
+  if (flying_dual_applies(lattice, options)) return into(FlyingDual(lattice, options));
+  return write_into(mesh_all_chunks(lattice, options), out);
 }
 
 MeshCounts mesh_terrain_into(const TerrainField& terrain, const MeshOptions& options,

@@ -144,12 +144,11 @@ void mesh_chunks(const Lattice& lattice, const ChunkGrid& grid, const MeshOption
   progress.throw_if_cancelled();
 }
 
-Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options,
-                  std::vector<std::uint64_t>* sources, bool voxel_faces) {
-  const Lattice lattice = checked_lattice(volume, options, voxel_faces);
-  if (!flying_edges_applies(lattice, options))
-    return weld(mesh_all_chunks(lattice, options), sources);
-  const FlyingEdges plan(lattice, options.interrupter);
+namespace {
+
+// A whole-volume plan's mesh in fresh arrays (on huge pages: mesh_memory.h).
+template <class Plan>
+Mesh mesh_of(const Plan& plan, std::vector<std::uint64_t>* sources) {
   Mesh mesh;
   resize_on_huge_pages(mesh.positions, plan.vertices());
   resize_on_huge_pages(mesh.normals, plan.vertices());
@@ -158,6 +157,17 @@ Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options,
   plan.write({mesh.positions.data(), mesh.normals.data(), nullptr, mesh.indices.data(),
               sources ? sources->data() : nullptr});
   return mesh;
+}
+
+}  // namespace
+
+Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options,
+                  std::vector<std::uint64_t>* sources, bool voxel_faces) {
+  const Lattice lattice = checked_lattice(volume, options, voxel_faces);
+  if (flying_edges_applies(lattice, options))
+    return mesh_of(FlyingEdges(lattice, options.interrupter), sources);
+  if (flying_dual_applies(lattice, options)) return mesh_of(FlyingDual(lattice, options), sources);
+  return weld(mesh_all_chunks(lattice, options), sources);
 }
 
 std::vector<ChunkPart> mesh_all_chunks(const Lattice& lattice, const MeshOptions& options) {

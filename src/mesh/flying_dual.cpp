@@ -1,0 +1,256 @@
+// voxfield — surface nets and dual contouring of a whole dense lattice in Flying Edges' passes.
+//
+// The dual grid of S. F. F. Gibson, "Constrained Elastic Surface Nets" (MICCAI 1998) and of Ju,
+// Losasso, Schaefer & Warren, "Dual Contouring of Hermite Data" (SIGGRAPH 2002) — one vertex per
+// cell the surface crosses, one quad per crossed lattice edge joining the four cells around it —
+// run in the pass structure of W. Schroeder, R. Maynard & B. Geveci, "Flying Edges: A
+// High-Performance Scalable Isocontouring Algorithm" (IEEE LDAV 2015): the samples become rows of
+// inside bits (bit_rows.h); each sample row's crossed edges that have four cells around them make
+// its quads, and each cell row's cells those quads reach make its vertices, both counted per row
+// with whole-word bit operations; prefix sums give every row's first vertex and index; then the
+// vertices are written, rows in parallel, and after them the quads (split along the shorter
+// diagonal, which reads the vertices' positions). A cell's vertex number is its row's first
+// vertex plus the reached cells before it on the row — a population count. Vertices, normals and
+// sources come from dual_cell_vertex (dual_grid.cpp), as in the chunked driver: the triangles are
+// the same, bit for bit, only numbered by row.
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "bit_rows.h"
+#include "flying_edges.h"
+#include "mesh_memory.h"
+#include "voxfield/error.h"
+#include "voxfield/limits.h"
+#include "voxfield/parallel.h"
+
+namespace voxfield::detail::mesh {
+
+bool flying_dual_applies(const Lattice& lattice, const MeshOptions& options) {
+  return options.algorithm != Mesher::kMarchingCubes && lattice.values && !lattice.value &&
+         !lattice.gradient && !lattice.color;
+}
+
+// One sample row's quads: its crossed x-, y- and z-edges that have four cells around them.
+struct FlyingDual::Masks {
+  std::vector<std::uint64_t> x, y, z;
+  explicit Masks(std::size_t words) : x(words), y(words), z(words) {}
+};
+
+namespace {
+
+// Bit x of the result is bit x + 1 of m: the cells whose upper corner on x is a mask's bit.
+std::uint64_t next_bits(const std::uint64_t* m, std::size_t words, std::size_t w) {
+  return m[w] >> 1 | (w + 1 < words ? m[w + 1] << 63 : 0);
+}
+
+}  // namespace
+
+void FlyingDual::quads(int y, int z, Masks& m) const {
+  const Vec3i n = lattice_.n;
+  const std::size_t words = words_;
+  std::fill(m.x.begin(), m.x.end(), 0);
+  std::fill(m.y.begin(), m.y.end(), 0);
+  std::fill(m.z.begin(), m.z.end(), 0);
+  // A quad needs the cells on both sides along its two other axes: the edge's other coordinates
+  // lie strictly inside the lattice (dual_grid.cpp's rule: cells before and after it).
+  const bool inner_y = y >= 1 && y <= n.y - 2, inner_z = z >= 1 && z <= n.z - 2;
+  const bool below_y = y <= n.y - 2, below_z = z <= n.z - 2;
+  const std::uint64_t* b = inside_->row(y, z);
+  if (inner_y && inner_z) x_crossings(b, words, n.x, m.x.data());
+  const auto inner_x = [&](std::uint64_t* mask) {
+    mask[0] &= ~std::uint64_t{1};
+    mask[static_cast<std::size_t>(n.x - 1) >> 6] &= ~(std::uint64_t{1} << ((n.x - 1) & 63));
+  };
+  if (below_y && inner_z) {
+    differences(b, inside_->row(y + 1, z), words, m.y.data());
+    inner_x(m.y.data());
+  }
+  if (below_z && inner_y) {
+    differences(b, inside_->row(y, z + 1), words, m.z.data());
+    inner_x(m.z.data());
+  }
+}
+
+void FlyingDual::cells(int y, int z, Masks& scratch, std::uint64_t* used) const {
+  const Vec3i n = lattice_.n;
+  const std::size_t words = words_;
+  std::fill(used, used + words, 0);
+  // Cell (x, y, z) is reached by the x-edge quads of sample rows (y..y+1, z..z+1) at x, the
+  // y-edge quads of rows (y, z..z+1) and the z-edge quads of rows (y..y+1, z) at x or x + 1.
+  for (int dz = 0; dz < 2; ++dz)
+    for (int dy = 0; dy < 2; ++dy) {
+      quads(y + dy, z + dz, scratch);
+      for (std::size_t w = 0; w < words; ++w) {
+        used[w] |= scratch.x[w];
+        if (dy == 0) used[w] |= scratch.y[w] | next_bits(scratch.y.data(), words, w);
+        if (dz == 0) used[w] |= scratch.z[w] | next_bits(scratch.z.data(), words, w);
+      }
+    }
+  // Only cells that exist (x <= nx - 2).
+  const std::size_t last = static_cast<std::size_t>(n.x - 2) >> 6;
+  used[last] &= low_bits(static_cast<unsigned>(n.x - 2) & 63) << 1 | 1;
+  for (std::size_t w = last + 1; w < words; ++w) used[w] = 0;
+}
+
+FlyingDual::FlyingDual(const Lattice& lattice, const MeshOptions& options)
+    : lattice_(lattice),
+      place_(options.algorithm == Mesher::kSurfaceNets ? surface_nets_vertex
+                                                       : dual_contouring_vertex),
+      progress_(std::make_unique<Progress>(
+          options.interrupter,
+          options.algorithm == Mesher::kSurfaceNets ? "surface nets" : "dual contouring",
+          4 * static_cast<std::int64_t>(lattice.n.z))) {
+  const Vec3i n = lattice.n;
+  const std::size_t rows = static_cast<std::size_t>(n.y) * static_cast<std::size_t>(n.z);
+  require_memory(mul_sat(rows, 2 * 8), 0, "mesh", "the dual mesher's row bookkeeping");
+  inside_ = std::make_unique<InsideBits>(lattice, *progress_);
+  words_ = inside_->words();
+  block_.view(lattice);
+  Progress& progress = *progress_;
+  resize_on_huge_pages(first_vertex_, rows + 1);
+  resize_on_huge_pages(first_index_, rows + 1);
+  parallel_for(static_cast<std::size_t>(n.z), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t z = begin; z < end; ++z) {
+      if (!progress.keep_going()) return;
+      count_plane(static_cast<int>(z));
+      progress.advance();
+    }
+  });
+  progress.throw_if_cancelled();
+  for (std::size_t r = 0; r < rows; ++r) {
+    first_vertex_[r + 1] += first_vertex_[r];
+    first_index_[r + 1] += first_index_[r];
+  }
+  if (first_vertex_[rows] > std::numeric_limits<std::uint32_t>::max() - 1)
+    throw InvalidArgument("mesh: " + std::to_string(first_vertex_[rows]) +
+                          " vertices do not fit 32-bit indices; mesh a smaller volume");
+  vertices_ = first_vertex_[rows];
+  indices_ = first_index_[rows];
+}
+
+void FlyingDual::count_plane(int z) {
+  const Vec3i n = lattice_.n;
+  Masks m(words_), scratch(words_);
+  std::vector<std::uint64_t> used(words_);
+  for (int y = 0; y < n.y; ++y) {
+    const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
+    quads(y, z, m);
+    first_index_[r + 1] = 6 * (population(m.x.data(), words_) + population(m.y.data(), words_) +
+                               population(m.z.data(), words_));
+    if (y + 1 < n.y && z + 1 < n.z) {
+      cells(y, z, scratch, used.data());
+      first_vertex_[r + 1] = population(used.data(), words_);
+    }
+  }
+}
+
+void FlyingDual::write(const WeldOutput& out) const {
+  Progress& progress = *progress_;
+  const std::size_t planes = static_cast<std::size_t>(lattice_.n.z);
+  // The vertices first: a quad's diagonal is chosen from its four vertices' positions.
+  parallel_for(planes, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t z = begin; z < end; ++z) {
+      if (!progress.keep_going()) return;
+      write_vertices(static_cast<int>(z), out);
+      progress.advance();
+    }
+  });
+  progress.throw_if_cancelled();
+  parallel_for(planes, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t z = begin; z < end; ++z) {
+      if (!progress.keep_going()) return;
+      write_quads(static_cast<int>(z), out);
+      progress.advance();
+    }
+  });
+  progress.throw_if_cancelled();
+}
+
+void FlyingDual::write_vertices(int z, const WeldOutput& out) const {
+  const Vec3i n = lattice_.n;
+  if (z + 1 >= n.z) return;
+  Masks scratch(words_);
+  std::vector<std::uint64_t> used(words_);
+  for (int y = 0; y + 1 < n.y; ++y) {
+    const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
+    cells(y, z, scratch, used.data());
+    std::uint64_t g = first_vertex_[r];
+    for (std::size_t w = 0; w < words_; ++w)
+      for (std::uint64_t m = used[w]; m; m &= m - 1) {
+        const int x = static_cast<int>(64 * w) + std::countr_zero(m);
+        const DualVertex v = dual_cell_vertex(block_, lattice_, x, y, z, place_);
+        out.positions[g] = {static_cast<float>(v.position[0]), static_cast<float>(v.position[1]),
+                            static_cast<float>(v.position[2])};
+        out.normals[g] = unit_normal(v.normal);
+        if (out.sources) out.sources[g] = v.source;
+        ++g;
+      }
+  }
+}
+
+void FlyingDual::write_quads(int z, const WeldOutput& out) const {
+  const Vec3i n = lattice_.n;
+  Masks m(words_), scratch(words_);
+  // The reached cells of the cell rows around a sample row's edges: 0 (y - 1, z - 1),
+  // 1 (y, z - 1), 2 (y, z), 3 (y - 1, z), each with its running counts.
+  RowRanks ranks(4, words_);
+  const auto distance2 = [&](std::uint32_t i, std::uint32_t j) {
+    double d = 0;
+    for (std::size_t a = 0; a < 3; ++a) {
+      const double c = static_cast<double>(out.positions[i][a]) - out.positions[j][a];
+      d += c * c;
+    }
+    return d;
+  };
+  for (int y = 0; y < n.y; ++y) {
+    const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
+    quads(y, z, m);
+    std::uint32_t* index = out.indices + first_index_[r];
+    std::uint32_t* const end = out.indices + first_index_[r + 1];
+    if (index == end) continue;
+    const int cy[4] = {y - 1, y, y, y - 1}, cz[4] = {z - 1, z - 1, z, z};
+    for (int k = 0; k < 4; ++k) {
+      std::uint64_t* used = ranks.mask(k);
+      if (cy[k] < 0 || cz[k] < 0 || cy[k] > n.y - 2 || cz[k] > n.z - 2) {
+        std::fill(used, used + words_, 0);
+        ranks.set_base(k, 0);
+        continue;
+      }
+      cells(cy[k], cz[k], scratch, used);
+      ranks.set_base(k, first_vertex_[static_cast<std::size_t>(cy[k]) +
+                                      static_cast<std::size_t>(n.y) * cz[k]]);
+    }
+    ranks.count();
+    const std::uint64_t* b = inside_->row(y, z);
+    // One quad: the four cells around the edge counter-clockwise seen from +axis, split along
+    // the shorter diagonal, turned over when the outside is towards -axis (dual_grid.cpp).
+    const auto quad = [&](std::uint32_t v00, std::uint32_t v10, std::uint32_t v11,
+                          std::uint32_t v01, bool in0) {
+      std::array<std::uint32_t, 6> t;
+      if (distance2(v00, v11) <= distance2(v10, v01))
+        t = {v00, v10, v11, v00, v11, v01};
+      else
+        t = {v00, v10, v01, v10, v11, v01};
+      if (!in0) std::swap(t[1], t[2]), std::swap(t[4], t[5]);
+      index = std::copy(t.begin(), t.end(), index);
+    };
+    const auto id = [&](int k, int x) { return static_cast<std::uint32_t>(ranks.id(k, x)); };
+    for (std::size_t w = 0; w < words_; ++w)
+      for (std::uint64_t any = m.x[w] | m.y[w] | m.z[w]; any; any &= any - 1) {
+        const int bit = std::countr_zero(any), x = static_cast<int>(64 * w) + bit;
+        const bool in0 = (b[w] >> bit & 1) != 0;
+        if (m.x[w] >> bit & 1)  // cells (x, y-1, z-1), (x, y, z-1), (x, y, z), (x, y-1, z)
+          quad(id(0, x), id(1, x), id(2, x), id(3, x), in0);
+        if (m.y[w] >> bit & 1)  // cells (x-1, y, z-1), (x-1, y, z), (x, y, z), (x, y, z-1)
+          quad(id(1, x - 1), id(2, x - 1), id(2, x), id(1, x), in0);
+        if (m.z[w] >> bit & 1)  // cells (x-1, y-1, z), (x, y-1, z), (x, y, z), (x-1, y, z)
+          quad(id(3, x - 1), id(3, x), id(2, x), id(2, x - 1), in0);
+      }
+  }
+}
+
+}  // namespace voxfield::detail::mesh
