@@ -3,9 +3,11 @@
 //
 // A mesher reads a scalar field sampled on a lattice (a ScalarVolume: a float volume, or the exact
 // signed distance field of a World) and returns one indexed triangle mesh of the surface where the
-// field crosses `iso`. The work is split into chunks of cells meshed in parallel; vertices on chunk
-// borders are computed the same way on both sides and welded, so the mesh has no cracks and no
-// duplicate triangles, and its triangle set does not depend on the chunk edge or the thread count.
+// field crosses `iso`. A volume in one array is meshed in Flying Edges' passes (rows counted, then
+// every vertex and triangle written once, in place, rows in parallel; vertices numbered by row);
+// terrains and MeshChunks split the cells into chunks meshed in parallel, whose border vertices are
+// computed the same way on both sides and welded. Either way the mesh has no cracks and no
+// duplicate triangles, and its arrays do not depend on the chunk edge or the thread count.
 //
 // Conventions, for every mesher:
 //  * triangles wind counter-clockwise seen from outside (the side the field marks as outside), so
@@ -70,7 +72,9 @@ struct MeshOptions {
   // Which side of iso is inside: values below it (the default, a signed distance field's
   // convention) or above it (density volumes, the thesis's positive-inside terrain).
   bool inside_above = false;
-  // Cells per chunk edge (each chunk is meshed as one unit of parallel work), 2..256.
+  // Cells per chunk edge (each chunk is meshed as one unit of parallel work), 2..256: for
+  // terrains, MeshChunks, and volumes meshed through an analytic value or gradient. A volume in
+  // one array is meshed in Flying Edges' passes, which do not use chunks.
   int chunk_edge = 32;
   Interrupter* interrupter = nullptr;  // progress per chunk; cancelling throws Cancelled
   // The field's gradient at a position (in the volume's units), when the caller knows it (an

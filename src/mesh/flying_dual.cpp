@@ -221,8 +221,9 @@ void FlyingDual::write_quads(int z, const WeldOutput& out) const {
         continue;
       }
       cells(cy[k], cz[k], scratch, used);
-      ranks.set_base(k, first_vertex_[static_cast<std::size_t>(cy[k]) +
-                                      static_cast<std::size_t>(n.y) * cz[k]]);
+      ranks.set_base(
+          k,
+          first_vertex_[static_cast<std::size_t>(cy[k]) + static_cast<std::size_t>(n.y) * cz[k]]);
     }
     ranks.count();
     const std::uint64_t* b = inside_->row(y, z);
