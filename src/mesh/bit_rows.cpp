@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 
 #include "mesh_memory.h"
@@ -69,23 +70,19 @@ InsideBits::InsideBits(const Lattice& lattice, Progress& progress) : ny_(lattice
   const bool above = lattice.sign < 0;
   // The first sample of each plane that is NaN or infinite, if any.
   std::vector<std::int64_t> first_bad(static_cast<std::size_t>(n.z), -1);
-  parallel_for(static_cast<std::size_t>(n.z), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t z = begin; z < end; ++z) {
-      if (!progress.keep_going()) return;
-      for (int y = 0; y < n.y; ++y) {
-        const std::size_t at = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
-        const float* values = lattice.values + at * static_cast<std::size_t>(n.x);
-        if (inside_bits(values, n.x, iso, above, bits_.data() + at * words_) && first_bad[z] < 0)
-          for (int x = 0; x < n.x; ++x)
-            if (!std::isfinite(values[x])) {
-              first_bad[z] = static_cast<std::int64_t>(at) * n.x + x;
-              break;
-            }
-      }
-      progress.advance();
+  for_each_plane(n.z, progress, [&](int z) {
+    for (int y = 0; y < n.y; ++y) {
+      const std::size_t at = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
+      const float* values = lattice.values + at * static_cast<std::size_t>(n.x);
+      std::int64_t& bad = first_bad[static_cast<std::size_t>(z)];
+      if (inside_bits(values, n.x, iso, above, bits_.data() + at * words_) && bad < 0)
+        for (int x = 0; x < n.x; ++x)
+          if (!std::isfinite(values[x])) {
+            bad = static_cast<std::int64_t>(at) * n.x + x;
+            break;
+          }
     }
   });
-  progress.throw_if_cancelled();
   for (const std::int64_t bad : first_bad)
     if (bad >= 0) {
       const int x = static_cast<int>(bad % n.x), y = static_cast<int>(bad / n.x % n.y),
@@ -94,6 +91,32 @@ InsideBits::InsideBits(const Lattice& lattice, Progress& progress) : ny_(lattice
                             std::to_string(z) + ") is " +
                             (std::isnan(lattice.values[bad]) ? "NaN" : "infinite"));
     }
+}
+
+void for_each_plane(int planes, Progress& progress, const std::function<void(int z)>& f) {
+  parallel_for(static_cast<std::size_t>(planes), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t z = begin; z < end; ++z) {
+      if (!progress.keep_going()) return;
+      f(static_cast<int>(z));
+      progress.advance();
+    }
+  });
+  progress.throw_if_cancelled();
+}
+
+void count_rows(int planes, std::size_t rows, Progress& progress,
+                const std::function<void(int z)>& count, std::vector<std::uint64_t>& first_vertex,
+                std::vector<std::uint64_t>& first_index) {
+  resize_on_huge_pages(first_vertex, rows + 1);
+  resize_on_huge_pages(first_index, rows + 1);
+  for_each_plane(planes, progress, count);
+  for (std::size_t r = 0; r < rows; ++r) {
+    first_vertex[r + 1] += first_vertex[r];
+    first_index[r + 1] += first_index[r];
+  }
+  if (first_vertex[rows] > std::numeric_limits<std::uint32_t>::max() - 1)
+    throw InvalidArgument("mesh: " + std::to_string(first_vertex[rows]) +
+                          " vertices do not fit 32-bit indices; mesh a smaller volume");
 }
 
 }  // namespace voxfield::detail::mesh

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "chunked_mesh.h"
@@ -94,6 +95,19 @@ class RowRanks {
   std::size_t words_;
   std::vector<std::uint64_t> bits_, before_, base_;
 };
+
+// f(z) for every plane of the lattice, planes in parallel, one progress unit each; stops early
+// and throws Cancelled when the operation is cancelled.
+void for_each_plane(int planes, Progress& progress, const std::function<void(int z)>& f);
+
+// Pass 2 of both Flying Edges meshers: sizes first_vertex and first_index to rows + 1 zeros, runs
+// count(z) for every plane in parallel (one progress unit each), which puts each row r's vertex
+// and index counts in first_vertex[r + 1] and first_index[r + 1], then turns them into prefix
+// sums in place. Throws InvalidArgument when the vertices pass 32-bit indices, Cancelled when
+// cancelled.
+void count_rows(int planes, std::size_t rows, Progress& progress,
+                const std::function<void(int z)>& count, std::vector<std::uint64_t>& first_vertex,
+                std::vector<std::uint64_t>& first_index);
 
 // Every sample of a dense lattice as an inside bit (pass 1 of both Flying Edges meshers).
 class InsideBits {

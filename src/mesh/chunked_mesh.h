@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "voxfield/box.h"
@@ -193,6 +194,22 @@ std::array<double, 3> dual_contouring_vertex(const Block& block, const Lattice& 
                                              const double* v);
 void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,
                      std::vector<std::int32_t>& scratch, ChunkPart& part, CellVertex place);
+// A dual quad — the four cells around a crossed edge, counter-clockwise seen from the edge's +axis
+// ((0,0), (1,0), (1,1), (0,1) in its two other axes' offsets) — as two triangles split along the
+// shorter diagonal (distance2 between two vertices), turned over when the outside is towards
+// -axis (in0: the edge's lower sample is inside).
+template <class Distance2>
+std::array<std::uint32_t, 6> quad_triangles(std::uint32_t v00, std::uint32_t v10, std::uint32_t v11,
+                                            std::uint32_t v01, bool in0, Distance2&& distance2) {
+  std::array<std::uint32_t, 6> t;
+  if (distance2(v00, v11) <= distance2(v10, v01))
+    t = {v00, v10, v11, v00, v11, v01};
+  else
+    t = {v00, v10, v01, v10, v11, v01};
+  if (!in0) std::swap(t[1], t[2]), std::swap(t[4], t[5]);
+  return t;
+}
+
 // A dual mesher's vertex of cell q: its position in the volume's frame, its normal (not yet unit
 // length) and its colour source (the inside corner nearest it). Every dual path computes it here,
 // so that chunks and whole-volume passes agree bit for bit.

@@ -10,7 +10,6 @@
 #include <array>
 #include <cstdint>
 #include <cstring>
-#include <utility>
 #include <vector>
 
 #include "chunked_mesh.h"
@@ -105,12 +104,7 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
   // e_b x e_c = e_a), split along the shorter diagonal, turned over when the outside is towards -a.
   auto quad = [&](std::uint32_t v00, std::uint32_t v10, std::uint32_t v11, std::uint32_t v01,
                   bool in0) {
-    std::array<std::uint32_t, 6> t;
-    if (distance2(v00, v11) <= distance2(v10, v01))
-      t = {v00, v10, v11, v00, v11, v01};
-    else
-      t = {v00, v10, v01, v10, v11, v01};
-    if (!in0) std::swap(t[1], t[2]), std::swap(t[4], t[5]);
+    const auto t = quad_triangles(v00, v10, v11, v01, in0, distance2);
     part.indices.insert(part.indices.end(), t.begin(), t.end());
   };
   const int row_cells = cells.end.x - cells.begin.x;

@@ -16,9 +16,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <limits>
 #include <string>
-#include <utility>
 
 #include "bit_rows.h"
 #include "flying_edges.h"
@@ -111,23 +109,8 @@ FlyingDual::FlyingDual(const Lattice& lattice, const MeshOptions& options)
   words_ = inside_->words();
   block_.view(lattice);
   Progress& progress = *progress_;
-  resize_on_huge_pages(first_vertex_, rows + 1);
-  resize_on_huge_pages(first_index_, rows + 1);
-  parallel_for(static_cast<std::size_t>(n.z), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t z = begin; z < end; ++z) {
-      if (!progress.keep_going()) return;
-      count_plane(static_cast<int>(z));
-      progress.advance();
-    }
-  });
-  progress.throw_if_cancelled();
-  for (std::size_t r = 0; r < rows; ++r) {
-    first_vertex_[r + 1] += first_vertex_[r];
-    first_index_[r + 1] += first_index_[r];
-  }
-  if (first_vertex_[rows] > std::numeric_limits<std::uint32_t>::max() - 1)
-    throw InvalidArgument("mesh: " + std::to_string(first_vertex_[rows]) +
-                          " vertices do not fit 32-bit indices; mesh a smaller volume");
+  count_rows(
+      n.z, rows, progress, [this](int z) { count_plane(z); }, first_vertex_, first_index_);
   vertices_ = first_vertex_[rows];
   indices_ = first_index_[rows];
 }
@@ -150,24 +133,10 @@ void FlyingDual::count_plane(int z) {
 
 void FlyingDual::write(const WeldOutput& out) const {
   Progress& progress = *progress_;
-  const std::size_t planes = static_cast<std::size_t>(lattice_.n.z);
+  const int planes = lattice_.n.z;
   // The vertices first: a quad's diagonal is chosen from its four vertices' positions.
-  parallel_for(planes, 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t z = begin; z < end; ++z) {
-      if (!progress.keep_going()) return;
-      write_vertices(static_cast<int>(z), out);
-      progress.advance();
-    }
-  });
-  progress.throw_if_cancelled();
-  parallel_for(planes, 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t z = begin; z < end; ++z) {
-      if (!progress.keep_going()) return;
-      write_quads(static_cast<int>(z), out);
-      progress.advance();
-    }
-  });
-  progress.throw_if_cancelled();
+  for_each_plane(planes, progress, [&](int z) { write_vertices(z, out); });
+  for_each_plane(planes, progress, [&](int z) { write_quads(z, out); });
 }
 
 void FlyingDual::write_vertices(int z, const WeldOutput& out) const {
@@ -227,16 +196,9 @@ void FlyingDual::write_quads(int z, const WeldOutput& out) const {
     }
     ranks.count();
     const std::uint64_t* b = inside_->row(y, z);
-    // One quad: the four cells around the edge counter-clockwise seen from +axis, split along
-    // the shorter diagonal, turned over when the outside is towards -axis (dual_grid.cpp).
     const auto quad = [&](std::uint32_t v00, std::uint32_t v10, std::uint32_t v11,
                           std::uint32_t v01, bool in0) {
-      std::array<std::uint32_t, 6> t;
-      if (distance2(v00, v11) <= distance2(v10, v01))
-        t = {v00, v10, v11, v00, v11, v01};
-      else
-        t = {v00, v10, v01, v10, v11, v01};
-      if (!in0) std::swap(t[1], t[2]), std::swap(t[4], t[5]);
+      const auto t = quad_triangles(v00, v10, v11, v01, in0, distance2);
       index = std::copy(t.begin(), t.end(), index);
     };
     const auto id = [&](int k, int x) { return static_cast<std::uint32_t>(ranks.id(k, x)); };

@@ -22,7 +22,6 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <string>
 
 #include "bit_rows.h"
@@ -223,23 +222,8 @@ FlyingEdges::FlyingEdges(const Lattice& lattice, Interrupter* interrupter)
   resize_on_huge_pages(x_count_, rows);
   resize_on_huge_pages(y_count_, rows);
   resize_on_huge_pages(z_count_, rows);
-  resize_on_huge_pages(first_vertex_, rows + 1);
-  resize_on_huge_pages(first_index_, rows + 1);
-  parallel_for(static_cast<std::size_t>(n.z), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t z = begin; z < end; ++z) {
-      if (!progress.keep_going()) return;
-      count_plane(static_cast<int>(z));
-      progress.advance();
-    }
-  });
-  progress.throw_if_cancelled();
-  for (std::size_t r = 0; r < rows; ++r) {
-    first_vertex_[r + 1] += first_vertex_[r];
-    first_index_[r + 1] += first_index_[r];
-  }
-  if (first_vertex_[rows] > std::numeric_limits<std::uint32_t>::max() - 1)
-    throw InvalidArgument("mesh: " + std::to_string(first_vertex_[rows]) +
-                          " vertices do not fit 32-bit indices; mesh a smaller volume");
+  count_rows(
+      n.z, rows, progress, [this](int z) { count_plane(z); }, first_vertex_, first_index_);
   vertices_ = first_vertex_[rows];
   indices_ = first_index_[rows];
 }
@@ -288,15 +272,7 @@ void FlyingEdges::count_plane(int z) {
 }
 
 void FlyingEdges::write(const WeldOutput& out) const {
-  Progress& progress = *progress_;
-  parallel_for(static_cast<std::size_t>(lattice_.n.z), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t z = begin; z < end; ++z) {
-      if (!progress.keep_going()) return;
-      write_plane(static_cast<int>(z), out);
-      progress.advance();
-    }
-  });
-  progress.throw_if_cancelled();
+  for_each_plane(lattice_.n.z, *progress_, [&](int z) { write_plane(z, out); });
 }
 
 void FlyingEdges::write_plane(int z, const WeldOutput& out) const {
