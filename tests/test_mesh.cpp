@@ -10,8 +10,10 @@
 #include <limits>
 #include <random>
 #include <set>
+#include <string>
 #include <vector>
 
+#include "mesh_compare.h"
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
 #include "voxfield/mesh.h"
@@ -395,6 +397,39 @@ TEST(Mesh, OpenSurfacesAreIndependentOfChunksAndThreads) {
         EXPECT_EQ(chunked.vertex_count(), reference.vertex_count()) << "chunk edge " << edge;
         EXPECT_TRUE(triangle_set(chunked) == expected)
             << "chunked driver, chunk edge " << edge << ", " << threads << " threads";
+      }
+  }
+}
+
+// The whole-volume passes work on rows of 64-sample words: lattices of 2 samples on an axis, rows
+// just short of, at and past a word (63, 64, 65, 129 samples), inside-above densities and surfaces
+// leaving the lattice give the chunked driver's triangles, for every mesher.
+TEST(Mesh, WholeVolumePassesMatchTheChunkedDriverAtWordAndLatticeEdges) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> u(-1, 1);
+  const Vec3i sizes[] = {{2, 2, 2},  {2, 5, 3},   {5, 2, 2},  {63, 3, 4}, {64, 4, 3},
+                         {65, 3, 3}, {129, 3, 2}, {3, 66, 2}, {2, 3, 70}};
+  for (const Vec3i n : sizes) {
+    std::vector<float> v(static_cast<std::size_t>(n.x) * n.y * n.z);
+    for (float& x : v) x = u(rng);
+    const ScalarVolume vol{n, v.data()};
+    for (Mesher m : kMeshers)
+      for (bool above : {false, true}) {
+        SCOPED_TRACE(std::string(mesher_name(m)) + " " + std::to_string(n.x) + "x" +
+                     std::to_string(n.y) + "x" + std::to_string(n.z) + (above ? " above" : ""));
+        MeshOptions o = with(m, 3);
+        o.inside_above = above;
+        const Mesh whole = mesh_volume(vol, o);
+        const Mesh chunked = MeshChunks(vol, o).merged();
+        EXPECT_EQ(whole.vertex_count(), chunked.vertex_count());
+        // Positions and normals, bit for bit.
+        EXPECT_TRUE(test::corner_triangles(whole) == test::corner_triangles(chunked));
+        std::vector<bool> used(whole.vertex_count());
+        for (std::uint32_t i : whole.indices) {
+          ASSERT_LT(i, whole.vertex_count());
+          used[i] = true;
+        }
+        EXPECT_EQ(std::count(used.begin(), used.end(), false), 0) << "unreferenced vertices";
       }
   }
 }
