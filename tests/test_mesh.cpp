@@ -409,28 +409,45 @@ TEST(Mesh, WholeVolumePassesMatchTheChunkedDriverAtWordAndLatticeEdges) {
   std::uniform_real_distribution<float> u(-1, 1);
   const Vec3i sizes[] = {{2, 2, 2},  {2, 5, 3},   {5, 2, 2},  {63, 3, 4}, {64, 4, 3},
                          {65, 3, 3}, {129, 3, 2}, {3, 66, 2}, {2, 3, 70}};
-  for (const Vec3i n : sizes) {
-    std::vector<float> v(static_cast<std::size_t>(n.x) * n.y * n.z);
-    for (float& x : v) x = u(rng);
-    const ScalarVolume vol{n, v.data()};
-    for (Mesher m : kMeshers)
-      for (bool above : {false, true}) {
-        SCOPED_TRACE(std::string(mesher_name(m)) + " " + std::to_string(n.x) + "x" +
-                     std::to_string(n.y) + "x" + std::to_string(n.z) + (above ? " above" : ""));
-        MeshOptions o = with(m, 3);
-        o.inside_above = above;
-        const Mesh whole = mesh_volume(vol, o);
-        const Mesh chunked = MeshChunks(vol, o).merged();
-        EXPECT_EQ(whole.vertex_count(), chunked.vertex_count());
-        // Positions and normals, bit for bit.
-        EXPECT_TRUE(test::corner_triangles(whole) == test::corner_triangles(chunked));
-        std::vector<bool> used(whole.vertex_count());
-        for (std::uint32_t i : whole.indices) {
-          ASSERT_LT(i, whole.vertex_count());
-          used[i] = true;
+  for (const Vec3i n : sizes)
+    for (bool steps : {false, true}) {
+      // Smooth noise, or values of -1, 0 and 1: samples exactly at iso (crossings at an edge's end,
+      // ties in the asymptotic decider, normals of no direction).
+      std::vector<float> v(static_cast<std::size_t>(n.x) * n.y * n.z);
+      for (float& x : v) x = steps ? std::round(u(rng) * 1.4f) : u(rng);
+      // An anisotropic spacing and an origin away from zero, where the arithmetic is not exact.
+      ScalarVolume vol{n, v.data()};
+      vol.spacing_units = {0.5, 0.75, 1.3};
+      vol.origin_units = {-3.1, 2.0, 0.7};
+      for (Mesher m : kMeshers)
+        for (bool above : {false, true}) {
+          SCOPED_TRACE(std::string(mesher_name(m)) + " " + std::to_string(n.x) + "x" +
+                       std::to_string(n.y) + "x" + std::to_string(n.z) + (above ? " above" : "") +
+                       (steps ? " steps" : ""));
+          MeshOptions o = with(m, 3);
+          o.inside_above = above;
+          const Mesh whole = mesh_volume(vol, o);
+          const Mesh chunked = MeshChunks(vol, o).merged();
+          EXPECT_EQ(whole.vertex_count(), chunked.vertex_count());
+          // Positions and normals, bit for bit.
+          EXPECT_TRUE(test::corner_triangles(whole) == test::corner_triangles(chunked));
+          std::vector<bool> used(whole.vertex_count());
+          for (std::uint32_t i : whole.indices) {
+            ASSERT_LT(i, whole.vertex_count());
+            used[i] = true;
+          }
+          EXPECT_EQ(std::count(used.begin(), used.end(), false), 0) << "unreferenced vertices";
         }
-        EXPECT_EQ(std::count(used.begin(), used.end(), false), 0) << "unreferenced vertices";
-      }
+    }
+  // A NaN in a row's second word is found by the vectorised scan and named.
+  std::vector<float> v(70 * 3 * 3, 1.0f);
+  v[66 + 70 * (1 + 3 * 2)] = std::numeric_limits<float>::quiet_NaN();
+  try {
+    mesh_volume({{70, 3, 3}, v.data()}, {});
+    ADD_FAILURE() << "a NaN sample was meshed";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("sample (66, 1, 2) is NaN"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -521,10 +538,13 @@ TEST(Mesh, BadRequestsAreRefusedClearly) {
   o.iso = 0;
   o.chunk_edge = 257;
   EXPECT_THROW(mesh_volume(vol, o), InvalidArgument);
-  // Millions of chunks of 2 cells for a volume that size: the bookkeeping alone is refused.
+  // Millions of chunks of 2 cells for a volume that size: the chunked driver's bookkeeping alone
+  // is refused; so is the whole-volume passes' (half a terabyte of inside bits), before a sample
+  // is read.
   std::vector<float> big(1);
   ScalarVolume huge{Vec3i::splat(1 << 14), big.data()};
   o.chunk_edge = 2;
+  EXPECT_THROW(MeshChunks(huge, o), ResourceLimitError);
   EXPECT_THROW(mesh_volume(huge, o), ResourceLimitError);
   Mesh bad_indices;
   bad_indices.positions.resize(2);

@@ -76,7 +76,7 @@ struct MeshOptions {
   // terrains, MeshChunks, and volumes meshed through an analytic value or gradient. A volume in
   // one array is meshed in Flying Edges' passes, which do not use chunks.
   int chunk_edge = 32;
-  Interrupter* interrupter = nullptr;  // progress per chunk; cancelling throws Cancelled
+  Interrupter* interrupter = nullptr;  // progress per chunk or plane; cancelling throws Cancelled
   // The field's gradient at a position (in the volume's units), when the caller knows it (an
   // analytic model, csg_mesh.h): dual contouring's Hermite normals and every mesher's vertex
   // normals come from it instead of differences of the samples. Called from worker threads at

@@ -5,7 +5,9 @@
 // Each chunk's mesh is a unit a renderer uploads and swaps on its own: its triangles over its own
 // vertices, the vertices on its borders repeated in its neighbours' meshes with bit-identical
 // positions (no cracks between separately drawn chunks). merged() welds them into exactly the
-// mesh mesh_volume() gives for the same samples: updating is never an approximation.
+// mesh a new MeshChunks gives for the same samples, and the same triangles (positions and normals
+// bit for bit) as mesh_volume(), which numbers its vertices by row: updating is never an
+// approximation.
 #pragma once
 
 #include <memory>
@@ -43,7 +45,8 @@ class MeshChunks {
   // Chunk `c`'s own mesh (colours for a terrain with a palette). InvalidArgument for a chunk
   // outside chunk_count().
   Mesh chunk_mesh(Vec3i c) const;
-  // All chunks welded: equal, array for array, to mesh_volume(volume, options) now.
+  // All chunks welded: equal, array for array, to MeshChunks(volume, options).merged() now, and
+  // triangle for triangle to mesh_volume(volume, options).
   Mesh merged() const;
 
  private:

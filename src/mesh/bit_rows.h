@@ -1,8 +1,8 @@
 // voxfield — a lattice's samples as rows of inside bits, for the meshers that run in Flying Edges'
 // passes (internal to the mesh module; flying_edges.cpp, flying_dual.cpp).
 //
-// One bit per sample, 64 samples a word, a row (y, z) of `words()` words with at least one zero
-// word's worth of padding past its last sample. An edge crosses the surface where the bits of its
+// One bit per sample, 64 samples a word, a row (y, z) of `words()` words (nx / 64 + 1) whose bits
+// past its last sample are zero. An edge crosses the surface where the bits of its
 // two ends differ, so a row's x-, y- and z-edge crossings are XORs of whole words, and a crossing's
 // place among its row's crossings — its number — is a population count.
 #pragma once

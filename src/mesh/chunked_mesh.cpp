@@ -36,7 +36,6 @@ int ChunkGrid::owner(int axis, int v) const {
 
 void Block::view(const Lattice& lattice) {
   lattice_ = &lattice;
-  inverse_span_ = inverse_spans(lattice.spacing);
   iso_ = static_cast<float>(lattice.iso);
   negate_ = lattice.sign < 0;
   lo_ = {0, 0, 0};
@@ -51,7 +50,6 @@ void Block::view(const Lattice& lattice) {
 
 bool Block::load(const Lattice& lattice, const Box3i& cells) {
   lattice_ = &lattice;
-  inverse_span_ = inverse_spans(lattice.spacing);
   iso_ = static_cast<float>(lattice.iso);
   negate_ = lattice.sign < 0;
   for (int a = 0; a < 3; ++a) {
@@ -123,9 +121,9 @@ std::array<double, 3> Block::gradient(int x, int y, int z) const {
     Vec3i lo = p, hi = p;
     if (p[a] > 0) --lo[a];
     if (p[a] < lattice_->n[a] - 1) ++hi[a];
+    const double span = (hi[a] - lo[a]) * lattice_->spacing[static_cast<std::size_t>(a)];
     g[static_cast<std::size_t>(a)] =
-        (static_cast<double>(s(hi.x, hi.y, hi.z)) - s(lo.x, lo.y, lo.z)) *
-        inverse_span_[static_cast<std::size_t>(a)][static_cast<std::size_t>(hi[a] - lo[a])];
+        (static_cast<double>(s(hi.x, hi.y, hi.z)) - s(lo.x, lo.y, lo.z)) / span;
   }
   return g;
 }
@@ -176,8 +174,7 @@ std::array<float, 3> unit_normal(std::array<double, 3> normal) {
   const double length =
       std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
   if (length > 0 && std::isfinite(length)) {
-    const double inverse = 1 / length;  // one division, not three
-    for (double& c : normal) c *= inverse;
+    for (double& c : normal) c /= length;
   } else {
     normal = {0, 0, 1};  // no direction to be had (a perfectly symmetric cell): still unit length
   }

@@ -64,17 +64,6 @@ struct Lattice {
   }
 };
 
-// The reciprocals of central differences' spans per axis: [a][k] = 1 / (k * spacing[a]) for a
-// span of k samples (1 one-sided on the lattice's faces, 2 central inside), so that a gradient
-// costs multiplications, not divisions. Shared by every marching-cubes path, which must round
-// alike (Block::gradient, flying_edges.cpp).
-inline std::array<std::array<double, 3>, 3> inverse_spans(const std::array<double, 3>& spacing) {
-  std::array<std::array<double, 3>, 3> r{};
-  for (std::size_t a = 0; a < 3; ++a)
-    for (int k = 1; k <= 2; ++k) r[a][static_cast<std::size_t>(k)] = 1.0 / (k * spacing[a]);
-  return r;
-}
-
 struct ChunkGrid {
   Vec3i cells;  // n - 1 per axis
   int edge = 32;
@@ -125,7 +114,6 @@ class Block {
 
  private:
   const Lattice* lattice_ = nullptr;
-  std::array<std::array<double, 3>, 3> inverse_span_{};  // inverse_spans(lattice spacing)
   float iso_ = 0;
   bool negate_ = false;
   Vec3i lo_, hi_;
@@ -220,7 +208,7 @@ struct DualVertex {
 DualVertex dual_cell_vertex(const Block& block, const Lattice& lattice, int qx, int qy, int qz,
                             CellVertex place);
 // A normal scaled to unit length in floats (+z where it has no direction): ChunkPart::add's rule,
-// shared by the whole-volume passes.
+// shared by the whole-volume passes. (Three divisions, as the GPU mesher's shader does them.)
 std::array<float, 3> unit_normal(std::array<double, 3> normal);
 
 }  // namespace voxfield::detail::mesh

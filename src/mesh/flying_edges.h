@@ -78,8 +78,8 @@ class FlyingDual {
   std::size_t words_ = 0;
   Block block_;  // a view of the lattice, for the vertex placement
   // Per cell row (y + ny z): its first vertex (one per cell a quad reaches); per sample row: its
-  // first index (two triangles per crossed edge starting on it). One entry past the last row
-  // holds the totals.
+  // first index (two triangles per crossed edge starting on it that has four cells around it). One
+  // entry past the last row holds the totals.
   std::vector<std::uint64_t> first_vertex_, first_index_;
   std::size_t vertices_ = 0, indices_ = 0;
 

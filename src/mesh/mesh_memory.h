@@ -21,8 +21,10 @@
 
 namespace voxfield::detail::mesh {
 
+// v becomes n value-initialised (zero) elements.
 template <class T>
 void resize_on_huge_pages(std::vector<T>& v, std::size_t n) {
+  v.clear();
   v.reserve(n);
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
   constexpr std::uintptr_t kHuge = std::uintptr_t{2} << 20;
@@ -32,7 +34,7 @@ void resize_on_huge_pages(std::vector<T>& v, std::size_t n) {
   if (last > first)  // advice only: where it is refused the pages stay small
     madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
 #endif
-  // The storage is allocated but holds no objects yet: writing its bytes is allowed.
+  // The storage is allocated but holds no objects yet (v is empty): writing its bytes is allowed.
   auto* bytes = reinterpret_cast<unsigned char*>(v.data());
   const std::size_t size = n * sizeof(T);
   constexpr std::size_t kPage = 4096, kPagesPerTask = 512;

@@ -60,12 +60,6 @@ Lattice checked_lattice(const ScalarVolume& volume, const MeshOptions& options, 
   if (options.chunk_edge < 2 || options.chunk_edge > 256)
     throw InvalidArgument("mesh: chunk edge " + std::to_string(options.chunk_edge) +
                           " is outside 2..256");
-  // One part per chunk (bookkeeping even where there is no surface): refuse partitions whose
-  // bookkeeping alone would pass the memory limit.
-  const ChunkGrid grid(volume.size, options.chunk_edge);
-  require_memory(mul_sat(static_cast<std::uint64_t>(grid.total()), 256), 0, "mesh",
-                 "chunks of " + std::to_string(options.chunk_edge) + " cells (" +
-                     std::to_string(grid.total()) + " of them; choose a larger --chunk)");
   Lattice lattice;
   lattice.n = volume.size;
   lattice.values = volume.values;
@@ -172,6 +166,11 @@ Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options,
 
 std::vector<ChunkPart> mesh_all_chunks(const Lattice& lattice, const MeshOptions& options) {
   const ChunkGrid grid(lattice.n, options.chunk_edge);
+  // One part per chunk (bookkeeping even where there is no surface): refuse partitions whose
+  // bookkeeping alone would pass the memory limit.
+  require_memory(mul_sat(static_cast<std::uint64_t>(grid.total()), 256), 0, "mesh",
+                 "chunks of " + std::to_string(options.chunk_edge) + " cells (" +
+                     std::to_string(grid.total()) + " of them; choose a larger --chunk)");
   std::vector<std::int64_t> all(static_cast<std::size_t>(grid.total()));
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::int64_t>(i);
   std::vector<ChunkPart> parts(all.size());
