@@ -1,12 +1,13 @@
 // voxfield — sizing a mesh's output arrays (internal to the mesh module).
 //
-// A mesh of millions of triangles is tens of megabytes written once. On 4 KiB pages every page
-// of it costs a fault on first touch, and on a virtual machine a fault costs microseconds: for the
-// 256³ terrain's 2.3 M triangles (56 MB) the faults took longer than meshing itself. So the
-// arrays are reserved first (nothing touched yet), advised onto transparent huge pages (2 MiB, one
-// fault for 512 small pages), touched once per page by all threads (the kernel zeroes each page
-// on the thread that faults it), and only then sized — the vector's own zero-fill then runs over
-// resident memory.
+// A mesh of millions of triangles is tens of megabytes written once: 14 000 faults on 4 KiB pages
+// for the 256³ terrain's 2.3 M triangles (56 MB). On this project's virtual machine, perf of
+// `voxfield mesh` put about a fifth of the command's samples in the kernel's page-fault path, and
+// sizing the output (faults and zero-fill) still takes 16-18 ms beside 34-36 ms of writing on two
+// threads with what follows (docs/benchmarks.md). So the arrays are reserved first (nothing touched
+// yet), advised onto transparent huge pages (2 MiB, one fault for 512 small pages), touched once
+// per page by all threads (the kernel zeroes each page on the thread that faults it), and only then
+// sized — the vector's own zero-fill then runs over resident memory.
 #pragma once
 
 #include <cstddef>
