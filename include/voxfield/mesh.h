@@ -101,8 +101,9 @@ struct Mesh {
 // Meshes `volume` at options.iso. Throws InvalidArgument for options out of range, a volume
 // smaller than 2 samples along an axis, a spacing or origin positions cannot hold as floats, NaN
 // or infinite samples (naming the first), or more vertices than 32-bit indices hold;
-// ResourceLimitError for a partition into so many chunks that its bookkeeping passes the memory
-// limit (limits.h); Cancelled when the interrupter asks.
+// ResourceLimitError for a mesh whose arrays, or a partition into so many chunks that its
+// bookkeeping, would pass the memory limit (limits.h), before allocating them; Cancelled when the
+// interrupter asks.
 Mesh mesh_volume(const ScalarVolume& volume, const MeshOptions& options);
 
 // Caller-allocated outputs, in meshoptimizer's style: mesh_bound() gives how large the arrays must

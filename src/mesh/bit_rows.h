@@ -60,18 +60,21 @@ inline std::uint64_t population(const std::uint64_t* m, std::size_t words) {
 }
 
 // K bit masks over one row with their running population counts: the number of bit x of mask k
-// is base[k] plus the set bits before x.
+// is base[k] plus the set bits before x. Mask k is the ranks' own (filled through mask(k)) unless
+// borrow(k, row) points it at a row kept elsewhere.
 class RowRanks {
  public:
   RowRanks(int masks, std::size_t words)
       : words_(words),
         bits_(static_cast<std::size_t>(masks) * words),
         before_(bits_.size()),
-        base_(static_cast<std::size_t>(masks)) {}
-  std::uint64_t* mask(int k) { return bits_.data() + static_cast<std::size_t>(k) * words_; }
-  const std::uint64_t* mask(int k) const {
-    return bits_.data() + static_cast<std::size_t>(k) * words_;
+        base_(static_cast<std::size_t>(masks)),
+        rows_(static_cast<std::size_t>(masks)) {
+    for (int k = 0; k < masks; ++k) rows_[static_cast<std::size_t>(k)] = mask(k);
   }
+  std::uint64_t* mask(int k) { return bits_.data() + static_cast<std::size_t>(k) * words_; }
+  // Mask k reads `row` (of the same words) until the next borrow.
+  void borrow(int k, const std::uint64_t* row) { rows_[static_cast<std::size_t>(k)] = row; }
   void set_base(int k, std::uint64_t base) { base_[static_cast<std::size_t>(k)] = base; }
   std::uint64_t base(int k) const { return base_[static_cast<std::size_t>(k)]; }
   // After the masks are filled: the running counts of each.
@@ -80,20 +83,20 @@ class RowRanks {
       std::uint64_t sum = 0;
       for (std::size_t w = 0; w < words_; ++w) {
         before_[k * words_ + w] = sum;
-        sum += bit_count(bits_[k * words_ + w]);
+        sum += bit_count(rows_[k][w]);
       }
     }
   }
   std::uint64_t id(int k, int x) const {
-    const std::size_t at =
-        static_cast<std::size_t>(k) * words_ + (static_cast<std::size_t>(x) >> 6);
-    return base_[static_cast<std::size_t>(k)] + before_[at] +
-           bit_count(bits_[at] & low_bits(static_cast<unsigned>(x) & 63));
+    const std::size_t kk = static_cast<std::size_t>(k), w = static_cast<std::size_t>(x) >> 6;
+    return base_[kk] + before_[kk * words_ + w] +
+           bit_count(rows_[kk][w] & low_bits(static_cast<unsigned>(x) & 63));
   }
 
  private:
   std::size_t words_;
   std::vector<std::uint64_t> bits_, before_, base_;
+  std::vector<const std::uint64_t*> rows_;
 };
 
 // f(z) for every plane of the lattice, planes in parallel, one progress unit each; stops early

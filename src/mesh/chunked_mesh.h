@@ -162,6 +162,12 @@ struct WeldOutput {
 };
 void write_weld(const WeldPlan& plan, const std::vector<ChunkPart>& parts, const WeldOutput& out);
 
+// A mesh's arrays sized for `vertices` and `indices` (colours when `colored`, and `sources` when
+// given), on huge pages, with the WeldOutput that writes into them. Throws ResourceLimitError when
+// the arrays would pass the memory limit (voxfield/limits.h), before allocating any.
+WeldOutput size_mesh(Mesh& mesh, std::uint64_t vertices, std::uint64_t indices, bool colored,
+                     std::vector<std::uint64_t>* sources);
+
 // Position of lattice point p + t along `axis` (t in [0, 1]) in the volume's frame.
 inline std::array<double, 3> lattice_position(const Lattice& l, const std::array<double, 3>& p) {
   return {l.origin[0] + p[0] * l.spacing[0], l.origin[1] + p[1] * l.spacing[1],

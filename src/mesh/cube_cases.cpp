@@ -224,6 +224,11 @@ CubeCases::CubeCases() {
         ambiguous = static_cast<std::uint8_t>(ambiguous | 1 << face);
     }
     ambiguous_[inside] = ambiguous;
+    for (std::size_t e = 0; e < 12; ++e) {
+      const CubeEdge& edge = cube_edges()[e];
+      if ((inside >> edge.from & 1) != (inside >> edge.to & 1))
+        crossed_[inside] = static_cast<std::uint16_t>(crossed_[inside] | 1u << e);
+    }
     offset_[inside] = static_cast<std::uint16_t>(next_offset);
     std::vector<int> faces;
     for (int face = 0; face < 6; ++face)

@@ -47,6 +47,9 @@ class CubeCases {
  public:
   static const CubeCases& get();  // built once, on first use (thread-safe)
 
+  // Edges (bit e: cube edge e) whose two corners differ for corner mask `inside`: the edges a
+  // cell crosses, so the meshers visit those alone without a branch per edge.
+  std::uint16_t crossed_edges(unsigned inside) const { return crossed_[inside]; }
   // Faces (bit 2a + s) with four crossings for corner mask `inside` (bit c: corner c inside).
   std::uint8_t ambiguous_faces(unsigned inside) const { return ambiguous_[inside]; }
   // The triangulation for `inside` where `joined` (one bit per ambiguous face, in face order,
@@ -82,6 +85,7 @@ class CubeCases {
  private:
   CubeCases();
   std::array<std::uint8_t, 256> ambiguous_{};
+  std::array<std::uint16_t, 256> crossed_{};
   std::array<std::uint16_t, 257> offset_{};
   std::array<CubeCase, 1024> cases_{};
 };

@@ -107,6 +107,8 @@ FlyingDual::FlyingDual(const Lattice& lattice, const MeshOptions& options)
   require_memory(mul_sat(rows, 2 * 8), 0, "mesh", "the dual mesher's row bookkeeping");
   inside_ = std::make_unique<InsideBits>(lattice, *progress_);
   words_ = inside_->words();
+  require_memory(mul_sat(mul_sat(rows, words_), 8), 0, "mesh", "the dual mesher's reached cells");
+  resize_on_huge_pages(reached_, rows * words_);
   block_.view(lattice);
   Progress& progress = *progress_;
   count_rows(
@@ -115,18 +117,23 @@ FlyingDual::FlyingDual(const Lattice& lattice, const MeshOptions& options)
   indices_ = first_index_[rows];
 }
 
+const std::uint64_t* FlyingDual::reached(int y, int z) const {
+  return reached_.data() +
+         words_ * (static_cast<std::size_t>(y) + static_cast<std::size_t>(lattice_.n.y) * z);
+}
+
 void FlyingDual::count_plane(int z) {
   const Vec3i n = lattice_.n;
   Masks m(words_), scratch(words_);
-  std::vector<std::uint64_t> used(words_);
   for (int y = 0; y < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
     quads(y, z, m);
     first_index_[r + 1] = 6 * (population(m.x.data(), words_) + population(m.y.data(), words_) +
                                population(m.z.data(), words_));
     if (y + 1 < n.y && z + 1 < n.z) {
-      cells(y, z, scratch, used.data());
-      first_vertex_[r + 1] = population(used.data(), words_);
+      std::uint64_t* used = reached_.data() + words_ * r;  // this plane's own rows
+      cells(y, z, scratch, used);
+      first_vertex_[r + 1] = population(used, words_);
     }
   }
 }
@@ -142,11 +149,9 @@ void FlyingDual::write(const WeldOutput& out) const {
 void FlyingDual::write_vertices(int z, const WeldOutput& out) const {
   const Vec3i n = lattice_.n;
   if (z + 1 >= n.z) return;
-  Masks scratch(words_);
-  std::vector<std::uint64_t> used(words_);
   for (int y = 0; y + 1 < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
-    cells(y, z, scratch, used.data());
+    const std::uint64_t* used = reached(y, z);
     std::uint64_t g = first_vertex_[r];
     for (std::size_t w = 0; w < words_; ++w)
       for (std::uint64_t m = used[w]; m; m &= m - 1) {
@@ -163,10 +168,12 @@ void FlyingDual::write_vertices(int z, const WeldOutput& out) const {
 
 void FlyingDual::write_quads(int z, const WeldOutput& out) const {
   const Vec3i n = lattice_.n;
-  Masks m(words_), scratch(words_);
+  Masks m(words_);
   // The reached cells of the cell rows around a sample row's edges: 0 (y - 1, z - 1),
-  // 1 (y, z - 1), 2 (y, z), 3 (y - 1, z), each with its running counts.
+  // 1 (y, z - 1), 2 (y, z), 3 (y - 1, z), each with its running counts; a row past the lattice's
+  // cells has none.
   RowRanks ranks(4, words_);
+  const std::vector<std::uint64_t> none(words_, 0);
   const auto distance2 = [&](std::uint32_t i, std::uint32_t j) {
     double d = 0;
     for (std::size_t a = 0; a < 3; ++a) {
@@ -183,13 +190,12 @@ void FlyingDual::write_quads(int z, const WeldOutput& out) const {
     if (index == end) continue;
     const int cy[4] = {y - 1, y, y, y - 1}, cz[4] = {z - 1, z - 1, z, z};
     for (int k = 0; k < 4; ++k) {
-      std::uint64_t* used = ranks.mask(k);
       if (cy[k] < 0 || cz[k] < 0 || cy[k] > n.y - 2 || cz[k] > n.z - 2) {
-        std::fill(used, used + words_, 0);
+        ranks.borrow(k, none.data());
         ranks.set_base(k, 0);
         continue;
       }
-      cells(cy[k], cz[k], scratch, used);
+      ranks.borrow(k, reached(cy[k], cz[k]));
       ranks.set_base(
           k,
           first_vertex_[static_cast<std::size_t>(cy[k]) + static_cast<std::size_t>(n.y) * cz[k]]);

@@ -21,7 +21,6 @@
 #include <array>
 #include <bit>
 #include <cmath>
-#include <cstring>
 #include <string>
 
 #include "bit_rows.h"
@@ -39,20 +38,6 @@ bool flying_edges_applies(const Lattice& lattice, const MeshOptions& options) {
 }
 
 namespace {
-
-// Per corner mask (bit c: corner c inside), the cube edges whose two corners differ.
-constexpr std::array<std::uint16_t, 256> kCrossedEdges = [] {
-  std::array<std::uint16_t, 256> t{};
-  for (unsigned inside = 0; inside < 256; ++inside)
-    for (unsigned e = 0; e < 12; ++e) {
-      const unsigned axis = e / 4, j = e % 4;
-      const unsigned lo = axis == 0 ? 1 : 0, hi = axis == 2 ? 1 : 2;  // cube_cases.h numbering
-      const unsigned from = (j & 1) << lo | (j >> 1 & 1) << hi, to = from | 1u << axis;
-      if ((inside >> from & 1) != (inside >> to & 1))
-        t[inside] |= static_cast<std::uint16_t>(1u << e);
-    }
-  return t;
-}();
 
 // Triangles and centre vertices of each corner mask without an ambiguous face.
 struct CaseCounts {
@@ -337,7 +322,7 @@ void FlyingEdges::write_plane(int z, const WeldOutput& out) const {
       // centre vertex c, which belongs to this cell alone (its crossings are recomputed here,
       // bit for bit those another row writes).
       std::array<std::uint32_t, CubeCase::kCentre + 2> ids;
-      for (unsigned m = kCrossedEdges[inside]; m; m &= m - 1) {
+      for (unsigned m = table.crossed_edges(inside); m; m &= m - 1) {
         const int edge = std::countr_zero(m);
         const EdgeSlot s = kEdgeSlots[static_cast<std::size_t>(edge)];
         ids[static_cast<std::size_t>(edge)] =

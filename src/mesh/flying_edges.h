@@ -81,8 +81,12 @@ class FlyingDual {
   // first index (two triangles per crossed edge starting on it that has four cells around it). One
   // entry past the last row holds the totals.
   std::vector<std::uint64_t> first_vertex_, first_index_;
+  // Per cell row, as many words as a bit row: the cells quads reach (bit x: cell x has a vertex),
+  // found while counting and read by both writing passes.
+  std::vector<std::uint64_t> reached_;
   std::size_t vertices_ = 0, indices_ = 0;
 
+  const std::uint64_t* reached(int y, int z) const;
   struct Masks;
   void quads(int y, int z, Masks& m) const;
   void cells(int y, int z, Masks& scratch, std::uint64_t* used) const;
@@ -90,5 +94,17 @@ class FlyingDual {
   void write_vertices(int z, const WeldOutput& out) const;
   void write_quads(int z, const WeldOutput& out) const;
 };
+
+// The one place the path is chosen: whole(plan) with the whole-volume plan for a lattice one of
+// them applies to (FlyingEdges or FlyingDual, counted already), chunked() otherwise (terrains'
+// chunk-by-chunk samples, analytic values and gradients, colours).
+template <class Whole, class Chunked>
+auto mesh_by_plan(const Lattice& lattice, const MeshOptions& options, Whole&& whole,
+                  Chunked&& chunked) {
+  if (flying_edges_applies(lattice, options))
+    return whole(FlyingEdges(lattice, options.interrupter));
+  if (flying_dual_applies(lattice, options)) return whole(FlyingDual(lattice, options));
+  return chunked();
+}
 
 }  // namespace voxfield::detail::mesh

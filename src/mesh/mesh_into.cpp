@@ -89,10 +89,8 @@ MeshCounts mesh_volume_into(const ScalarVolume& volume, const MeshOptions& optio
     plan.write({out.positions.data(), out.normals.data(), nullptr, out.indices.data(), nullptr});
     return {plan.vertices(), plan.indices()};
   };
-  if (flying_edges_applies(lattice, options))
-    return into(FlyingEdges(lattice, options.interrupter));
-  if (flying_dual_applies(lattice, options)) return into(FlyingDual(lattice, options));
-  return write_into(mesh_all_chunks(lattice, options), out);
+  return mesh_by_plan(lattice, options, into,
+                      [&] { return write_into(mesh_all_chunks(lattice, options), out); });
 }
 
 MeshCounts mesh_terrain_into(const TerrainField& terrain, const MeshOptions& options,

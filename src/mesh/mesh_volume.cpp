@@ -8,7 +8,6 @@
 #include "chunked_mesh.h"
 #include "flying_edges.h"
 #include "mesh_internal.h"
-#include "mesh_memory.h"
 #include "voxfield/error.h"
 #include "voxfield/interrupt.h"
 #include "voxfield/limits.h"
@@ -140,16 +139,11 @@ void mesh_chunks(const Lattice& lattice, const ChunkGrid& grid, const MeshOption
 
 namespace {
 
-// A whole-volume plan's mesh in fresh arrays (on huge pages: mesh_memory.h).
+// A whole-volume plan's mesh in fresh arrays.
 template <class Plan>
 Mesh mesh_of(const Plan& plan, std::vector<std::uint64_t>* sources) {
   Mesh mesh;
-  resize_on_huge_pages(mesh.positions, plan.vertices());
-  resize_on_huge_pages(mesh.normals, plan.vertices());
-  resize_on_huge_pages(mesh.indices, plan.indices());
-  if (sources) resize_on_huge_pages(*sources, plan.vertices());
-  plan.write({mesh.positions.data(), mesh.normals.data(), nullptr, mesh.indices.data(),
-              sources ? sources->data() : nullptr});
+  plan.write(size_mesh(mesh, plan.vertices(), plan.indices(), false, sources));
   return mesh;
 }
 
@@ -158,10 +152,9 @@ Mesh mesh_of(const Plan& plan, std::vector<std::uint64_t>* sources) {
 Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options,
                   std::vector<std::uint64_t>* sources, bool voxel_faces) {
   const Lattice lattice = checked_lattice(volume, options, voxel_faces);
-  if (flying_edges_applies(lattice, options))
-    return mesh_of(FlyingEdges(lattice, options.interrupter), sources);
-  if (flying_dual_applies(lattice, options)) return mesh_of(FlyingDual(lattice, options), sources);
-  return weld(mesh_all_chunks(lattice, options), sources);
+  return mesh_by_plan(
+      lattice, options, [&](const auto& plan) { return mesh_of(plan, sources); },
+      [&] { return weld(mesh_all_chunks(lattice, options), sources); });
 }
 
 std::vector<ChunkPart> mesh_all_chunks(const Lattice& lattice, const MeshOptions& options) {

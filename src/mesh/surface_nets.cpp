@@ -15,25 +15,13 @@ namespace voxfield::detail::mesh {
 
 std::array<double, 3> surface_nets_vertex(const Block&, const Lattice& lattice, Vec3i cell,
                                           const double* v) {
-  // The edges each corner configuration crosses, so the loop visits those alone, in edge order,
-  // without a data-dependent branch per edge.
-  static const std::array<std::uint16_t, 256> crossed = [] {
-    std::array<std::uint16_t, 256> t{};
-    for (unsigned mask = 0; mask < 256; ++mask)
-      for (std::size_t e = 0; e < 12; ++e) {
-        const CubeEdge& edge = cube_edges()[e];
-        if ((mask >> edge.from & 1) != (mask >> edge.to & 1))
-          t[mask] = static_cast<std::uint16_t>(t[mask] | 1u << e);
-      }
-    return t;
-  }();
   unsigned mask = 0;
   for (unsigned c = 0; c < 8; ++c) mask |= static_cast<unsigned>(v[c] < 0) << c;
   // Three scalars, not an array indexed by axis: the array lived in memory and its read-back
   // stalled store forwarding.
   double mx = 0, my = 0, mz = 0;
   int crossings = 0;
-  for (unsigned bits = crossed[mask]; bits != 0; bits &= bits - 1) {
+  for (unsigned bits = CubeCases::get().crossed_edges(mask); bits != 0; bits &= bits - 1) {
     const CubeEdge& e = cube_edges()[static_cast<std::size_t>(std::countr_zero(bits))];
     const double s0 = v[e.from], s1 = v[e.to];
     // Lattice::crossing's interpolation, inline unless there is a function to solve on.

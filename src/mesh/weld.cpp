@@ -11,6 +11,7 @@
 #include "chunked_mesh.h"
 #include "mesh_memory.h"
 #include "voxfield/error.h"
+#include "voxfield/limits.h"
 #include "voxfield/parallel.h"
 
 namespace voxfield::detail::mesh {
@@ -121,18 +122,27 @@ void write_weld(const WeldPlan& plan, const std::vector<ChunkPart>& parts, const
   }
 }
 
+WeldOutput size_mesh(Mesh& mesh, std::uint64_t vertices, std::uint64_t indices, bool colored,
+                     std::vector<std::uint64_t>* sources) {
+  const std::uint64_t per_vertex = 2 * sizeof(std::array<float, 3>) +
+                                   (colored ? sizeof(std::array<std::uint8_t, 3>) : 0) +
+                                   (sources ? sizeof(std::uint64_t) : 0);
+  require_memory(add_sat(mul_sat(vertices, per_vertex), mul_sat(indices, 4)), 0, "mesh",
+                 "a mesh of " + std::to_string(vertices) + " vertices and " +
+                     std::to_string(indices / 3) + " triangles");
+  resize_on_huge_pages(mesh.positions, vertices);
+  resize_on_huge_pages(mesh.normals, vertices);
+  if (colored) resize_on_huge_pages(mesh.colors, vertices);
+  resize_on_huge_pages(mesh.indices, indices);
+  if (sources) resize_on_huge_pages(*sources, vertices);
+  return {mesh.positions.data(), mesh.normals.data(), colored ? mesh.colors.data() : nullptr,
+          mesh.indices.data(), sources ? sources->data() : nullptr};
+}
+
 Mesh weld(const std::vector<ChunkPart>& parts, std::vector<std::uint64_t>* sources) {
   const WeldPlan plan = plan_weld(parts);
   Mesh mesh;
-  resize_on_huge_pages(mesh.positions, plan.vertices);
-  resize_on_huge_pages(mesh.normals, plan.vertices);
-  if (plan.colored) resize_on_huge_pages(mesh.colors, plan.vertices);
-  resize_on_huge_pages(mesh.indices, plan.indices);
-  if (sources) resize_on_huge_pages(*sources, plan.vertices);
-  write_weld(
-      plan, parts,
-      {mesh.positions.data(), mesh.normals.data(), plan.colored ? mesh.colors.data() : nullptr,
-       mesh.indices.data(), sources ? sources->data() : nullptr});
+  write_weld(plan, parts, size_mesh(mesh, plan.vertices, plan.indices, plan.colored, sources));
   return mesh;
 }
 
