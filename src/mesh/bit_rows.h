@@ -99,6 +99,20 @@ class RowRanks {
   std::vector<const std::uint64_t*> rows_;
 };
 
+// Asks the cache for the sample row a writing pass over plane z reaches first when it comes to
+// row y + 1: row (y + 3, z + 2), the gradients' farthest reach (a cell row's corners go to z + 1,
+// their central differences one further). Its nearer rows were read for the previous plane, but
+// that plane is new, and its reads are sparse (only around crossings) and so not prefetched by
+// the hardware: without this, one thread's marching cubes of a 256³ terrain spent a tenth of its
+// time waiting for those loads.
+inline void prefetch_ahead(const Lattice& lattice, int y, int z) {
+  if (z + 2 >= lattice.n.z || y + 3 >= lattice.n.y) return;
+  const float* row =
+      lattice.values + static_cast<std::ptrdiff_t>(lattice.n.x) *
+                           (y + 3 + static_cast<std::ptrdiff_t>(lattice.n.y) * (z + 2));
+  for (int x = 0; x < lattice.n.x; x += 16) __builtin_prefetch(row + x);  // 64-byte lines
+}
+
 // f(z) for every plane of the lattice, planes in parallel, one progress unit each; stops early
 // and throws Cancelled when the operation is cancelled.
 void for_each_plane(int planes, Progress& progress, const std::function<void(int z)>& f);

@@ -151,6 +151,7 @@ void FlyingDual::write_vertices(int z, const WeldOutput& out) const {
   if (z + 1 >= n.z) return;
   for (int y = 0; y + 1 < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
+    prefetch_ahead(lattice_, y, z);
     const std::uint64_t* used = reached(y, z);
     std::uint64_t g = first_vertex_[r];
     for (std::size_t w = 0; w < words_; ++w)

@@ -271,6 +271,7 @@ void FlyingEdges::write_plane(int z, const WeldOutput& out) const {
   RowRanks counts(8, words_);
   for (int y = 0; y < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
+    prefetch_ahead(lattice_, y, z);
     const std::uint64_t* b = inside_->row(y, z);
     // This row's edge vertices: its x-edge crossings, then its y-edge and z-edge ones.
     std::uint64_t g = first_vertex_[r];
