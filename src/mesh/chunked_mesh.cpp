@@ -170,18 +170,6 @@ void ChunkPart::clear() {
   indices.clear();
 }
 
-std::array<float, 3> unit_normal(std::array<double, 3> normal) {
-  const double length =
-      std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-  if (length > 0 && std::isfinite(length)) {
-    for (double& c : normal) c /= length;
-  } else {
-    normal = {0, 0, 1};  // no direction to be had (a perfectly symmetric cell): still unit length
-  }
-  return {static_cast<float>(normal[0]), static_cast<float>(normal[1]),
-          static_cast<float>(normal[2])};
-}
-
 std::uint32_t ChunkPart::add(const std::array<double, 3>& position, std::array<double, 3> normal,
                              std::uint64_t key, std::uint64_t source, bool is_owned,
                              bool is_shared) {

@@ -215,6 +215,16 @@ DualVertex dual_cell_vertex(const Block& block, const Lattice& lattice, int qx, 
                             CellVertex place);
 // A normal scaled to unit length in floats (+z where it has no direction): ChunkPart::add's rule,
 // shared by the whole-volume passes. (Three divisions, as the GPU mesher's shader does them.)
-std::array<float, 3> unit_normal(std::array<double, 3> normal);
+inline std::array<float, 3> unit_normal(std::array<double, 3> normal) {
+  const double length =
+      std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+  if (length > 0 && std::isfinite(length)) {
+    for (double& c : normal) c /= length;
+  } else {
+    normal = {0, 0, 1};  // no direction to be had (a perfectly symmetric cell): still unit length
+  }
+  return {static_cast<float>(normal[0]), static_cast<float>(normal[1]),
+          static_cast<float>(normal[2])};
+}
 
 }  // namespace voxfield::detail::mesh
