@@ -15,10 +15,15 @@ if [ "${1:-}" = "--fix" ]; then
   "$format" -i "${files[@]}"
   exit 0
 fi
-bad=()
-for f in "${files[@]}"; do
-  "$format" --dry-run -Werror "$f" >/dev/null 2>&1 || bad+=("$f")
-done
+# One clang-format for every file (a process per file took 42 s of the test run, this about 3):
+# each difference is reported as "<file>:<line>:<column>: error: code should be clang-formatted".
+status=0
+report=$("$format" --dry-run -Werror "${files[@]}" 2>&1 >/dev/null) || status=$?
+mapfile -t bad < <(printf '%s\n' "$report" | sed -n 's/^\(.*\):[0-9]*:[0-9]*: error: .*/\1/p' | sort -u)
+if [ "$status" -ne 0 ] && [ ${#bad[@]} -eq 0 ]; then
+  printf 'check_format: %s failed:\n%s\n' "$format" "$report" >&2
+  exit 1
+fi
 if [ ${#bad[@]} -gt 0 ]; then
   printf 'not formatted (clang-format -i, or bash scripts/check_format.sh --fix):\n'; printf '  %s\n' "${bad[@]}"
   exit 1
