@@ -82,11 +82,24 @@ shots = {n: Image.open(f"{out}/vectors-{n}.png").convert("RGB") for n in ("vulka
 w, h = shots["cpu"].size
 box = (370, 0, w, h)  # right of the panel
 px = {n: list(s.crop(box).getdata()) for n, s in shots.items()}
+def near(p, q, tolerance=2):
+    return max(abs(a - b) for a, b in zip(p, q)) <= tolerance
 for n in ("vulkan", "opengl"):
-    worst = max(max(abs(a - b) for a, b in zip(p, q)) for p, q in zip(px[n], px["cpu"]))
-    close = sum(max(abs(a - b) for a, b in zip(p, q)) <= 2 for p, q in zip(px[n], px["cpu"]))
-    print(f"vectors {n} vs cpu: {close} of {len(px['cpu'])} pixels within 2, worst {worst}")
-    assert close >= 0.99 * len(px["cpu"]) and worst <= 16, n
+    # The backends step the same field bit for bit but march and shade in their own floats, so
+    # colours agree within 2 — except where a hard edge (the sheet's silhouette, the box's) passes
+    # within rounding of a pixel's ray: one backend's ray grazes the sheet, the other's misses it,
+    # and the pixel takes the colour of its neighbour across the edge (seen: one pixel of 97 200 in
+    # a 6-frame run, sheet green against background). Such a pixel must show a colour the CPU's
+    # picture has beside it; anything else is a real divergence.
+    img, ref = shots[n].load(), shots["cpu"].load()
+    off = [(x, y) for x in range(box[0], w) for y in range(h) if not near(img[x, y], ref[x, y])]
+    stray = [(x, y) for x, y in off
+             if not any(near(img[x, y], ref[u, v]) for u in range(max(x - 1, box[0]), min(x + 2, w))
+                        for v in range(max(y - 1, 0), min(y + 2, h)))]
+    total = len(px["cpu"])
+    print(f"vectors {n} vs cpu: {total - len(off)} of {total} pixels within 2; "
+          f"{len(off)} more than 2 off, {len(stray)} of them without that colour beside them")
+    assert len(off) <= 0.001 * total and not stray, (n, len(off), stray[:5])
 def is_green(p):
     return p[1] > p[0] + 30 and p[1] > p[2] + 30
 background = max(set(px["cpu"]), key=px["cpu"].count)
