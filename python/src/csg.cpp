@@ -12,6 +12,7 @@
 #include <optional>
 #include <span>
 
+#include "mesh_arrays.h"
 #include "voxfield/csg.h"
 #include "voxfield/csg_compile.h"
 #include "voxfield/csg_files.h"
@@ -40,14 +41,6 @@ std::vector<Vec3d> read_points(const Points& points) {
   std::vector<Vec3d> out(static_cast<std::size_t>(points.shape(0)));
   const double* p = points.data();
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = {p[3 * i], p[3 * i + 1], p[3 * i + 2]};
-  return out;
-}
-
-// A Fortran-ordered array of `dims` over a copy of `values` (x fastest).
-template <class T>
-py::array_t<T> fortran(const std::vector<T>& values, Vec3i dims) {
-  py::array_t<T, py::array::f_style> out({dims.x, dims.y, dims.z});
-  std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
   return out;
 }
 

@@ -26,6 +26,9 @@
 namespace py = pybind11;
 
 namespace voxfield::python {
+
+void bind_mesh_input(py::module_& m);  // mesh_input.cpp
+
 namespace {
 
 using Volume = py::array_t<float, py::array::f_style | py::array::forcecast>;
@@ -267,6 +270,7 @@ void bind_mesh(py::module_& parent) {
           py::arg("algorithm") = "mc", py::arg("chunk") = 32,
           "The surface as (vertices, faces, normals, colors uint8 (V, 3)); colours by material "
           "from the palette (zeros without one)");
+  bind_mesh_input(m);
 }
 
 }  // namespace voxfield::python

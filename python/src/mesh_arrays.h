@@ -1,11 +1,14 @@
-// A voxfield Mesh as NumPy arrays (shared by the extension's modules that return meshes).
+// NumPy arrays of voxfield's results, shared by the extension's modules: meshes, and volumes in
+// Fortran order.
 #pragma once
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include <cstring>
+#include <vector>
 
+#include "voxfield/box.h"
 #include "voxfield/mesh.h"
 
 namespace voxfield::python {
@@ -25,6 +28,15 @@ inline pybind11::tuple to_arrays(const Mesh& mesh, bool with_colors) {
   if (!mesh.colors.empty())
     std::memcpy(colors.mutable_data(), mesh.colors.data(), mesh.colors.size() * 3);
   return pybind11::make_tuple(vertices, faces, normals, colors);
+}
+
+// A Fortran-ordered array of `dims` over a copy of `values` (x fastest): a[i, j, k] is element
+// i + dims.x * (j + dims.y * k).
+template <class T>
+pybind11::array_t<T> fortran(const std::vector<T>& values, Vec3i dims) {
+  pybind11::array_t<T, pybind11::array::f_style> out({dims.x, dims.y, dims.z});
+  if (!values.empty()) std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
+  return out;
 }
 
 }  // namespace voxfield::python

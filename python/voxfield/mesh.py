@@ -18,10 +18,23 @@ smooth minimum over ``smooth`` units) and returns the box of samples it changed;
 ``materials()`` read it back; ``mesh(algorithm, chunk)`` returns ``(vertices, faces, normals,
 colors)`` with colours from the palette by material.
 
+Meshes in (docs/mesh_input.md): ``read_mesh(path)`` reads an OBJ, PLY, STL or OFF file as
+``(vertices float64 (V, 3), faces uint32 (F, 3))``. ``WindingNumber(vertices, faces,
+accuracy=2.0)`` is the mesh's generalized winding number (1 inside, 0 outside, in between near a
+hole): call it on points (N, 3), or ``exact(points)``, or ``inside(points)`` (>= 1/2).
+``voxelize_mesh(vertices, faces, voxel_size, padding=2, material=1)`` returns ``(materials,
+first)``: uint8 a[i, j, k] solid where the winding number at the voxel's centre is >= 1/2, over
+the mesh's bounds grown by ``padding`` voxels, a[i, j, k] being voxel ``first + (i, j, k)``
+centred at ``(first + (i, j, k) + 1/2) * voxel_size``. ``mesh_distance_field(vertices, faces,
+voxel_size, padding=2, band=3.0, signed=True, max_distance=0.0)`` returns ``(values, first)``:
+float32 distances to the mesh at the same voxel centres, in the mesh's units, exact within
+``band`` voxels of the surface, negative inside.
+
 Errors are voxfield's: a bad argument or a NaN sample raises ``voxfield.InvalidArgument`` (a
-ValueError) naming it; Ctrl-C stops a long mesh with ``voxfield.Cancelled``.
+ValueError) naming it, a malformed mesh file ``voxfield.FormatError`` naming the file and the byte
+offset; Ctrl-C stops a long mesh, voxelisation or field with ``voxfield.Cancelled``.
 """
 
-from ._voxfield.mesh import Terrain, mesh_volume
+from ._voxfield.mesh import Terrain, WindingNumber, mesh_distance_field, mesh_volume, read_mesh, voxelize_mesh
 
-__all__ = ["Terrain", "mesh_volume"]
+__all__ = ["Terrain", "WindingNumber", "mesh_distance_field", "mesh_volume", "read_mesh", "voxelize_mesh"]

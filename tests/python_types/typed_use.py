@@ -43,6 +43,20 @@ def terrain_triangles() -> int:
     return int(f.shape[0]) + x1 - x0 + terrain.samples[0] + int(terrain.clamp + terrain.step)
 
 
+def mesh_input_figures() -> float:
+    corners = np.array([[x, y, z] for z in (0.0, 1.0) for y in (0.0, 1.0) for x in (0.0, 1.0)])
+    faces = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
+                      [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])
+    winding = mesh.WindingNumber(corners, faces)
+    at: npt.NDArray[np.float64] = winding(np.array([[0.5, 0.5, 0.5]]))
+    inside: npt.NDArray[np.bool_] = winding.inside(np.array([[2.0, 0.5, 0.5]]))
+    materials, first = mesh.voxelize_mesh(corners, faces, 0.25, material=3)
+    values, same = mesh.mesh_distance_field(corners, faces, 0.25, band=2.0)
+    assert materials.dtype == np.uint8 and values.dtype == np.float32 and first == same
+    assert not inside[0] and int(materials.sum()) == 3 * 64
+    return float(at[0]) + float(values.min()) + float(winding.exact(corners[:1] + 0.5)[0])
+
+
 def vector_strength() -> float:
     volume = vectors.Volume(size=(4.0, 4.0, 4.0), resolution=(16, 16, 16))
     sources = np.array([[0.0, 0.0, 0.0, 1.5]])
@@ -91,6 +105,7 @@ if __name__ == "__main__":
     assert nodes == 4, nodes
     assert refused()
     assert terrain_triangles() > 0
+    assert mesh_input_figures() > 1.5
     assert vector_strength() > 1
     assert world_field() > 2
     print("typed use: ok")
