@@ -478,6 +478,18 @@ expect_grep "bad mesh names file and byte" "$tmp/err" "bad.obj: at byte 22: the 
 check "--voxel-size is for meshes" 2 "$V" convert "$tmp/cube.npy" "$tmp/again.npy" --voxel-size 1
 check "a mesh field is Euclidean" 2 "$V" field "$tmp/cube.obj" -o "$tmp/m2.npy" --voxel-size 0.5 --metric manhattan
 
+# A world's flow (vectors away from its solid voxels) as OpenVDB grids: the .npy's strengths, and
+# its directions times them, read back by OpenVDB's own Python module.
+check "vectors: a world's flow as .vdb" 0 "$V" vectors "$C/ephtracy_chr_knight.vox" -o "$tmp/flow.vdb" --reach 3
+check "vectors: a world's flow as .npy" 0 "$V" vectors "$C/ephtracy_chr_knight.vox" -o "$tmp/flow.npy" --reach 3
+check "vectors: the flow's .vdb is its .npy" 0 $PY -c "
+import numpy as np, pyopenvdb as vdb
+t = np.load('$tmp/flow.npy'); g = {x.name: x for x in vdb.readAll('$tmp/flow.vdb')[0]}
+s = np.zeros(t.shape[:3], np.float32); g['strength'].copyToArray(s, ijk=(0, 0, 0))
+v = np.zeros(t.shape[:3] + (3,), np.float32); g['vectors'].copyToArray(v, ijk=(0, 0, 0))
+assert (t[..., 3] > 0).sum() > 100 and np.array_equal(s, t[..., 3]), (t[..., 3] > 0).sum()
+assert np.array_equal(v, t[..., :3] * t[..., 3:4])"
+
 if ldd "$V" | grep -q libasan; then
   # Under the sanitizers the showcase runs once, without a Vulkan driver: every CPU path it takes
   # is leak-checked. (With Vulkan it cannot be: Mesa's lavapipe makes a one-time allocation with its

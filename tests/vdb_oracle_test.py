@@ -86,6 +86,49 @@ for metric, signed, clamp, storage, spacing in cases:
         check(bg >= np.abs(level).max() - 1e-6, f"{name}: background {bg} below the largest value")
     check(g.activeVoxelCount() == int((np.abs(level) < bg).sum()), f"{name}: active voxels")
 
+# A vector field: grids "vectors" (direction x strength) and "strength", against the .npy of the
+# same command (float32 a[i, j, k, 4]), with the transform mapping index (i, j, k) to the volume's
+# voxel centre: centre + R ((i, j, k) + 1/2) * size / resolution - size / 2), R from the
+# --rotation by Rodrigues' formula. rgba32f, so the .npy holds the texels exactly.
+agents = os.path.join(WORK, "agents.json")
+with open(agents, "w") as f:
+    f.write('{"frames": [{"sources": [{"position": [1, 2, 3], "previous": [-1, 1, 2], "radius": 2.5},'
+            ' {"position": [4, 4, 4], "radius": 1.2}]}]}')
+res, centre, size = (14, 11, 9), np.array([1.5, 2.0, 3.0]), np.array([9.0, 7.0, 6.0])
+angle, axis = 35.0, np.array([1.0, 2.0, 3.0])
+common = ["--resolution", ",".join(map(str, res)), "--box", ",".join(map(str, [*centre, *size])),
+          "--rotation", ",".join(map(str, [angle, *axis])), "--storage", "rgba32f"]
+run("vectors", agents, "-o", os.path.join(WORK, "v.vdb"), *common)
+run("vectors", agents, "-o", os.path.join(WORK, "v.npy"), *common)
+texels = np.load(os.path.join(WORK, "v.npy"))
+check(texels.shape == (*res, 4), f"vectors: .npy shape {texels.shape}")
+grids = {g.name: g for g in vdb.readAll(os.path.join(WORK, "v.vdb"))[0]}
+check(set(grids) == {"vectors", "strength"}, f"vectors: grids {sorted(grids)}")
+vec, strength = grids["vectors"], grids["strength"]
+check(vec.valueTypeName == "vec3s" and strength.valueTypeName == "float",
+      f"vectors: types {vec.valueTypeName}, {strength.valueTypeName}")
+check(vec.metadata.get("vector_type") == "invariant", f"vectors: {vec.metadata.get('vector_type')}")
+check(vec.metadata.get("voxfield_kind") == "vector field", "vectors: voxfield_kind")
+got_v = np.zeros((*res, 3), np.float32)
+got_s = np.zeros(res, np.float32)
+vec.copyToArray(got_v, ijk=(0, 0, 0))
+strength.copyToArray(got_s, ijk=(0, 0, 0))
+want_s = texels[..., 3]
+want_v = texels[..., :3] * want_s[..., None]
+check((want_s > 0).sum() > 50 and (want_s == 0).sum() > 50, "vectors: the field has both")
+check(np.array_equal(got_s, want_s), f"vectors: strengths differ at {np.argwhere(got_s != want_s)[:3]}")
+check(np.array_equal(got_v, want_v), f"vectors: vectors differ at {np.argwhere(got_v != want_v)[:3]}")
+check(vec.activeVoxelCount() == int((want_s > 0).sum()), "vectors: active voxels")
+k = axis / np.linalg.norm(axis)
+K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+t = np.radians(angle)
+R = np.eye(3) + np.sin(t) * K + (1 - np.cos(t)) * K @ K
+worst = 0.0
+for ijk in [(0, 0, 0), (13, 0, 0), (0, 10, 0), (0, 0, 8), (13, 10, 8), (5, 7, 2)]:
+    want = centre + R @ ((np.array(ijk) + 0.5) * size / np.array(res) - size / 2)
+    worst = max(worst, float(np.abs(np.array(vec.transform.indexToWorld(ijk)) - want).max()))
+check(worst < 1e-9, f"vectors: the transform is {worst} away from the voxel centres")
+
 # A world is an Int32 grid, which pyopenvdb cannot open (tests/test_vdb.cpp checks it with
 # OpenVDB's C++ reader); here it is only written, then refused as an input.
 world = os.path.join(WORK, "world.vdb")
@@ -105,4 +148,4 @@ check(not os.path.exists(os.path.join(WORK, "never.vdb")), "a failed field wrote
 
 if failures:
     raise SystemExit(f"{failures} check(s) failed")
-print(f"vdb oracle: {len(cases)} fields checked against pyopenvdb")
+print(f"vdb oracle: {len(cases)} fields and a vector field checked against pyopenvdb")

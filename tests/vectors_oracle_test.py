@@ -214,7 +214,7 @@ def main():
             ([os.path.join(work, "missing.json"), "-o", os.path.join(work, "no2.npy")], 1, ["missing.json"]),
             ([src, "-o", os.path.join(work, "no3.fga"), "--resolution", "129,8,8"], 2, ["at most 128"]),
             ([src, "-o", os.path.join(work, "no4.npy"), "--box", "0,0,0,1,0,1"], 2, ["size"]),
-            ([src, "-o", os.path.join(work, "no5.txt")], 2, [".npy, .fga, .vf or .png"]),
+            ([src, "-o", os.path.join(work, "no5.txt")], 2, [".npy, .fga, .vf, .vdb or .png"]),
             ([src, "-o", os.path.join(work, "no6.npy"), "--stats", os.path.join(work, "nodir", "s.json")], 1,
              ["nodir"])):
         r = run(voxfield, "vectors", *args)

@@ -1,5 +1,5 @@
 // voxfield vectors SOURCES.json -o OUT: a vector-field volume texture from moving sources
-// (docs/vectors.md), as float32 .npy, Unreal .fga, Unity .vf, or a picture of the visualiser.
+// (docs/vectors.md), as float32 .npy, Unreal .fga, Unity .vf, OpenVDB .vdb or a visualiser picture.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,6 +11,7 @@
 #include "vector_backend.h"
 #include "voxfield/gpu_vectors.h"
 #include "voxfield/png.h"
+#include "voxfield/vdb.h"
 #include "voxfield/vector_files.h"
 #include "voxfield/vector_world.h"
 #include "voxfield/vectors.h"
@@ -28,15 +29,16 @@ struct VectorSettings {
   int width = 640, height = 480;
 };
 
-enum class OutKind { kNpy, kFga, kVf, kPng };
+enum class OutKind { kNpy, kFga, kVf, kVdb, kPng };
 
 OutKind out_kind(const std::string& path) {
   const std::string ext = std::filesystem::path(path).extension().string();
   if (ext == ".npy") return OutKind::kNpy;
   if (ext == ".fga") return OutKind::kFga;
   if (ext == ".vf") return OutKind::kVf;
+  if (ext == ".vdb") return OutKind::kVdb;
   if (ext == ".png") return OutKind::kPng;
-  throw UsageError("-o " + path + ": the output must be .npy, .fga, .vf or .png");
+  throw UsageError("-o " + path + ": the output must be .npy, .fga, .vf, .vdb or .png");
 }
 
 // The box of every source's segment grown by its radius (and a tenth on each side), when --box is
@@ -99,6 +101,9 @@ int run_world_vectors(const VectorSettings& s, OutKind kind, Outputs& outputs) {
       break;
     case OutKind::kVf:
       outputs.stage(s.out, encode_vf(volume, field.texture()));
+      break;
+    case OutKind::kVdb:
+      outputs.stage(s.out, encode_vdb_vectors(volume, field.texture()));
       break;
     case OutKind::kPng: {
       VectorViewOptions view;
@@ -234,6 +239,9 @@ int run_vectors(const VectorSettings& s) {
     case OutKind::kVf:
       outputs.stage(s.out, encode_vf(volume, texture));
       break;
+    case OutKind::kVdb:
+      outputs.stage(s.out, encode_vdb_vectors(volume, texture));
+      break;
     case OutKind::kPng: {
       VectorViewOptions view;
       view.width = s.width;
@@ -328,7 +336,8 @@ void add_vectors(CLI::App& app, Action& action) {
       ->check(CLI::Range(1e-3, 16000.0));
   cmd->add_option("-o,--output", s->out,
                   ".npy (float32 a[i,j,k,4]: direction, strength), .fga (Unreal), .vf (Unity VFX "
-                  "Graph) or .png (the visualiser); written atomically")
+                  "Graph), .vdb (OpenVDB grids 'vectors' and 'strength') or .png (the "
+                  "visualiser); written atomically")
       ->required();
   cmd->add_option("--resolution", s->resolution, "voxels per axis: nx,ny,nz (default 64,64,64)")
       ->delimiter(',')

@@ -11,6 +11,10 @@
 //    the smallest edge on anisotropic voxels): negative inside, |gradient| 1 as OpenVDB's tools
 //    assume. Background: the clamp less that half voxel (or, unclamped, the largest value);
 //    active where |value| < background, the inactive inside at -background (a closed level set).
+//  * A vector field (vectors.h): a Vec3f grid "vectors" holding direction x strength (world-space
+//    vectors, vector type invariant) and a Float grid "strength", both zero in the background and
+//    active where the strength is above 0; their transform maps index (i, j, k) to the volume's
+//    voxel centre, rotation included.
 //  * An unsigned distance field: a Float grid of class "unknown" (not "fog volume": to every tool a
 //    fog volume is a density, and a distance is not one), background as above.
 // Fields carry voxfield's metric, clamp, storage and domain in their metadata.
@@ -26,6 +30,7 @@
 
 #include "voxfield/box.h"
 #include "voxfield/distance.h"
+#include "voxfield/vectors.h"
 #include "voxfield/world.h"
 
 namespace voxfield {
@@ -40,5 +45,11 @@ std::vector<std::uint8_t> encode_vdb_world(const World& world, const Box3i& exte
 // bound its background (an unclamped field of an empty world).
 std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
                                            const std::string& grid_name = "distance");
+
+// The bytes of a .vdb file holding a vector field's texture over `volume` as the grids "vectors"
+// and "strength" (above; an rgba8 or rgba16f texture as it decodes). Throws InvalidArgument for
+// an invalid volume or a texture of another resolution.
+std::vector<std::uint8_t> encode_vdb_vectors(const VectorVolume& volume,
+                                             const VectorTexture& texture);
 
 }  // namespace voxfield

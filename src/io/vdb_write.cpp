@@ -222,4 +222,58 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
   return write_grids({grid});
 }
 
+std::vector<std::uint8_t> encode_vdb_vectors(const VectorVolume& volume,
+                                             const VectorTexture& texture) {
+  volume.validate();
+  if (texture.resolution() != volume.resolution)
+    throw InvalidArgument("vdb: the texture's resolution " + to_string(texture.resolution()) +
+                          " is not the volume's " + to_string(volume.resolution));
+  ensure_initialized();
+  // Index (i, j, k) to world: centre + R * ((i, j, k) + 1/2) * voxel - size / 2), as
+  // VectorVolume::voxel_centre. OpenVDB's matrices act on row vectors: row a is the image of
+  // index axis a (column a of R times that axis' voxel edge), row 3 the translation.
+  const Vec3d edge = volume.voxel_size();
+  openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
+  for (int c = 0; c < 3; ++c) {
+    const Vec3d& row = volume.rotation[static_cast<std::size_t>(c)];  // row c of R
+    double t = volume.centre[c];
+    for (int a = 0; a < 3; ++a) {
+      m[a][c] = row[a] * edge[a];
+      t += row[a] * (0.5 * edge[a] - 0.5 * volume.size[a]);
+    }
+    m[3][c] = t;
+  }
+  const openvdb::math::Transform::Ptr transform =
+      openvdb::math::Transform::createLinearTransform(m);
+  // The field's vector (direction times strength: what a tool samples as a force or a velocity)
+  // and the strength alone, both zero in the background; voxels with a strength are active.
+  openvdb::Vec3fGrid::Ptr vectors = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.f));
+  openvdb::FloatGrid::Ptr strength = openvdb::FloatGrid::create(0.f);
+  vectors->setName("vectors");
+  strength->setName("strength");
+  // The directions are world-space already: they do not transform with the grid.
+  vectors->setVectorType(openvdb::VEC_INVARIANT);
+  auto put_vector = vectors->getAccessor();
+  auto put_strength = strength->getAccessor();
+  const Vec3i n = volume.resolution;
+  for (int k = 0; k < n.z; ++k)
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i) {
+        const VectorTexel t = texture.get(volume.index(i, j, k));
+        if (!(t.strength > 0)) continue;
+        put_vector.setValueOn(openvdb::Coord(i, j, k),
+                              openvdb::Vec3f(t.x * t.strength, t.y * t.strength, t.z * t.strength));
+        put_strength.setValueOn(openvdb::Coord(i, j, k), t.strength);
+      }
+  for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(vectors.get()),
+                               static_cast<openvdb::GridBase*>(strength.get())}) {
+    g->setTransform(transform);
+    g->insertMeta(kKind, openvdb::StringMetadata("vector field"));
+    g->insertMeta(kStorage, openvdb::StringMetadata(vector_storage_name(texture.storage())));
+  }
+  vectors->tree().prune();
+  strength->tree().prune();
+  return write_grids({vectors, strength});
+}
+
 }  // namespace voxfield
