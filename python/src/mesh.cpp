@@ -85,13 +85,7 @@ void bind_mesh(py::module_& parent) {
         o.inside_above = inside == "above";
         PythonSignals signals;
         o.interrupter = &signals;
-        Mesh mesh;
-        {
-          py::gil_scoped_release release;
-          std::optional<ThreadLimit> limit;
-          if (threads > 0) limit.emplace(threads);
-          mesh = mesh_volume(v, o);
-        }
+        const Mesh mesh = without_gil(threads, [&] { return mesh_volume(v, o); });
         return to_arrays(mesh, false);
       },
       py::arg("volume"), py::arg("level") = 0.0, py::arg("spacing") = std::vector<double>{1, 1, 1},

@@ -187,16 +187,13 @@ void bind_mesh_input(py::module_& m) {
         PythonSignals signals;
         o.interrupter = &signals;
         std::vector<std::uint8_t> materials;
-        Box3i box;
-        {
-          py::gil_scoped_release release;
-          std::optional<ThreadLimit> limit;
-          if (threads > 0) limit.emplace(threads);
-          box = mesh_voxel_box(mesh, o);
+        const Box3i box = without_gil(threads, [&] {
+          const Box3i b = mesh_voxel_box(mesh, o);
           const World world = voxelize_mesh(mesh, o);
-          materials.resize(static_cast<std::size_t>(box.volume()));
-          world.voxels.copy_to_dense(box, materials.data());
-        }
+          materials.resize(static_cast<std::size_t>(b.volume()));
+          world.voxels.copy_to_dense(b, materials.data());
+          return b;
+        });
         return py::make_tuple(fortran(materials, box.size()), triple(box.begin));
       },
       py::arg("vertices"), py::arg("faces"), py::arg("voxel_size"), py::arg("padding") = 2,
@@ -218,13 +215,8 @@ void bind_mesh_input(py::module_& m) {
         o.max_distance = max_distance;
         PythonSignals signals;
         o.interrupter = &signals;
-        MeshDistanceField field;
-        {
-          py::gil_scoped_release release;
-          std::optional<ThreadLimit> limit;
-          if (threads > 0) limit.emplace(threads);
-          field = mesh_distance_field(mesh, o);
-        }
+        const MeshDistanceField field =
+            without_gil(threads, [&] { return mesh_distance_field(mesh, o); });
         return py::make_tuple(fortran(field.values, field.box.size()), triple(field.box.begin));
       },
       py::arg("vertices"), py::arg("faces"), py::arg("voxel_size"), py::arg("padding") = 2,

@@ -4,9 +4,12 @@
 #include <pybind11/pybind11.h>
 
 #include <atomic>
+#include <optional>
 #include <thread>
+#include <utility>
 
 #include "voxfield/interrupt.h"
+#include "voxfield/parallel.h"
 
 namespace voxfield::python {
 
@@ -31,5 +34,15 @@ class PythonSignals : public Interrupter {
   std::thread::id caller_ = std::this_thread::get_id();
   std::atomic<bool> stop_{false};
 };
+
+// f() with the GIL released (other Python threads run meanwhile) and voxfield's parallel work
+// limited to `threads` threads (0: every core).
+template <class F>
+auto without_gil(int threads, F&& f) {
+  const pybind11::gil_scoped_release release;
+  std::optional<ThreadLimit> limit;
+  if (threads > 0) limit.emplace(threads);
+  return std::forward<F>(f)();
+}
 
 }  // namespace voxfield::python

@@ -376,14 +376,10 @@ void bind_world(py::module_& parent) {
         const Metric mt = parse_metric(metric);
         PythonSignals signals;
         o.interrupter = &signals;
-        Mesh mesh;
-        {
-          py::gil_scoped_release release;
-          std::optional<ThreadLimit> limit;
-          if (threads > 0) limit.emplace(threads);
+        const Mesh mesh = without_gil(threads, [&] {
           const std::shared_lock read(w.lock);
-          mesh = mesh_world(w.world, o, mt);
-        }
+          return mesh_world(w.world, o, mt);
+        });
         return to_arrays(mesh, true);
       },
       py::arg("world"), py::arg("algorithm") = "mc", py::arg("iso") = 0.0,
