@@ -554,45 +554,6 @@ TEST(Mesh, BadRequestsAreRefusedClearly) {
   EXPECT_EQ(parse_mesher("surface-nets"), Mesher::kSurfaceNets);
 }
 
-// A mesh whose arrays would pass the memory limit is refused by name before they are allocated,
-// by every mesher and both paths (the whole-volume passes and, through an analytic gradient, the
-// chunked driver); under the limit the same requests mesh.
-TEST(Mesh, MeshesPastTheMemoryLimitAreRefusedBeforeTheirArrays) {
-  // Signs alternating like a 3-D checkerboard: every lattice edge crosses, every cell is active.
-  const Vec3i n{48, 48, 48};
-  std::vector<float> values(static_cast<std::size_t>(n.x) * n.y * n.z);
-  for (int z = 0; z < n.z; ++z)
-    for (int y = 0; y < n.y; ++y)
-      for (int x = 0; x < n.x; ++x)
-        values[static_cast<std::size_t>(x + n.x * (y + n.y * z))] = (x + y + z) % 2 ? 1.f : -1.f;
-  const ScalarVolume vol{n, values.data()};
-  struct LimitGuard {
-    ~LimitGuard() { set_default_memory_limit(0); }
-  } guard;
-  for (const Mesher m : {Mesher::kMarchingCubes, Mesher::kSurfaceNets, Mesher::kDualContouring})
-    for (const bool chunked : {false, true}) {
-      MeshOptions o;
-      o.algorithm = m;
-      if (chunked)
-        o.gradient = [](const std::array<double, 3>&) { return std::array<double, 3>{0, 0, 1}; };
-      set_default_memory_limit(0);
-      const Mesh mesh = mesh_volume(vol, o);
-      const std::uint64_t bytes = mesh.vertex_count() * 24 + mesh.indices.size() * 4;
-      ASSERT_GT(mesh.vertex_count(), 40u * 40 * 40) << mesher_name(m);
-      // Room for everything the passes keep beside the mesh (a few hundred kB), not the mesh.
-      set_default_memory_limit(bytes / 2);
-      try {
-        (void)mesh_volume(vol, o);
-        ADD_FAILURE() << mesher_name(m) << (chunked ? " chunked" : "") << " was not refused";
-      } catch (const ResourceLimitError& e) {
-        EXPECT_NE(std::string(e.what()).find("a mesh of " + std::to_string(mesh.vertex_count()) +
-                                             " vertices"),
-                  std::string::npos)
-            << e.what();
-      }
-    }
-}
-
 // Dual contouring keeps a box's corners and edges where marching cubes bevels them: on a box not
 // aligned with the lattice (spacing 0.5), its vertices sit on the box and nearer its corners. From
 // samples alone a crease cannot be exact: crossings near it are interpolated across the kink of

@@ -102,7 +102,8 @@ struct Mesh {
 // smaller than 2 samples along an axis, a spacing or origin positions cannot hold as floats, NaN
 // or infinite samples (naming the first), or more vertices than 32-bit indices hold;
 // ResourceLimitError for a mesh whose arrays, or a partition into so many chunks that its
-// bookkeeping, would pass the memory limit (limits.h), before allocating them; Cancelled when the
+// bookkeeping, would pass the memory limit (limits.h), before allocating them (a volume meshed
+// through chunks has built its chunks' parts by then; docs/limits.md); Cancelled when the
 // interrupter asks.
 Mesh mesh_volume(const ScalarVolume& volume, const MeshOptions& options);
 

@@ -13,8 +13,10 @@
 //    active where |value| < background, the inactive inside at -background (a closed level set).
 //  * A vector field (vectors.h): a Vec3f grid "vectors" holding direction x strength (world-space
 //    vectors, vector type invariant) and a Float grid "strength", both zero in the background and
-//    active where the strength is above 0; their transform maps index (i, j, k) to the volume's
-//    voxel centre, rotation included.
+//    active where the strength is above 0. A volume's field: texel (i, j, k) at VDB index (i, j,
+//    k), the transform mapping it to the volume's voxel centre, rotation included. A world's flow
+//    (vector_world.h): on the world's own lattice, texel (i, j, k) of the box at VDB voxel
+//    box.begin + (i, j, k), the transform a world's (unit scale), so it lies on the world's grid.
 //  * An unsigned distance field: a Float grid of class "unknown" (not "fog volume": to every tool a
 //    fog volume is a density, and a distance is not one), background as above.
 // Fields carry voxfield's metric, clamp, storage and domain in their metadata.
@@ -51,5 +53,9 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
 // an invalid volume or a texture of another resolution.
 std::vector<std::uint8_t> encode_vdb_vectors(const VectorVolume& volume,
                                              const VectorTexture& texture);
+// The bytes of a .vdb file holding a world's flow over `box` (WorldVectorField: the texture's
+// resolution is the box's size) on the world's lattice, as encode_vdb_world places voxels.
+// Throws InvalidArgument for a texture of another size.
+std::vector<std::uint8_t> encode_vdb_world_vectors(const Box3i& box, const VectorTexture& texture);
 
 }  // namespace voxfield

@@ -49,6 +49,7 @@ constexpr const char* kStorage = "voxfield_storage";       // "u8", "u16", "f32"
 constexpr const char* kSurfaceOffset = "voxfield_surface_offset";
 constexpr const char* kDomainMin = "voxfield_domain_min";  // Vec3i, inclusive
 constexpr const char* kDomainMax = "voxfield_domain_max";  // Vec3i, inclusive
+constexpr const char* kFirst = "voxfield_first";  // Vec3i: the VDB index of a texture's texel 0
 
 openvdb::Coord coord(Vec3i p) {
   return openvdb::Coord(p.x, p.y, p.z);
@@ -222,6 +223,46 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
   return write_grids({grid});
 }
 
+namespace {
+
+// A vector texture as the grids "vectors" (direction x strength) and "strength", both zero in the
+// background, active where the strength is above 0; texel (i, j, k) at VDB index first + (i, j, k).
+std::vector<std::uint8_t> write_vectors(const VectorTexture& texture, Vec3i first,
+                                        const openvdb::math::Transform::Ptr& transform) {
+  openvdb::Vec3fGrid::Ptr vectors = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.f));
+  openvdb::FloatGrid::Ptr strength = openvdb::FloatGrid::create(0.f);
+  vectors->setName("vectors");
+  strength->setName("strength");
+  // The directions are world-space already: they do not transform with the grid.
+  vectors->setVectorType(openvdb::VEC_INVARIANT);
+  auto put_vector = vectors->getAccessor();
+  auto put_strength = strength->getAccessor();
+  const Vec3i n = texture.resolution();
+  std::int64_t index = 0;
+  for (int k = 0; k < n.z; ++k)
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i, ++index) {
+        const VectorTexel t = texture.get(index);
+        if (!(t.strength > 0)) continue;
+        const openvdb::Coord at(first.x + i, first.y + j, first.z + k);
+        put_vector.setValueOn(at,
+                              openvdb::Vec3f(t.x * t.strength, t.y * t.strength, t.z * t.strength));
+        put_strength.setValueOn(at, t.strength);
+      }
+  for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(vectors.get()),
+                               static_cast<openvdb::GridBase*>(strength.get())}) {
+    g->setTransform(transform);
+    g->insertMeta(kKind, openvdb::StringMetadata("vector field"));
+    g->insertMeta(kStorage, openvdb::StringMetadata(vector_storage_name(texture.storage())));
+    g->insertMeta(kFirst, openvdb::Vec3IMetadata(openvdb::Vec3i(first.x, first.y, first.z)));
+  }
+  vectors->tree().prune();
+  strength->tree().prune();
+  return write_grids({vectors, strength});
+}
+
+}  // namespace
+
 std::vector<std::uint8_t> encode_vdb_vectors(const VectorVolume& volume,
                                              const VectorTexture& texture) {
   volume.validate();
@@ -229,7 +270,7 @@ std::vector<std::uint8_t> encode_vdb_vectors(const VectorVolume& volume,
     throw InvalidArgument("vdb: the texture's resolution " + to_string(texture.resolution()) +
                           " is not the volume's " + to_string(volume.resolution));
   ensure_initialized();
-  // Index (i, j, k) to world: centre + R * ((i, j, k) + 1/2) * voxel - size / 2), as
+  // Index (i, j, k) to world: centre + R * (((i, j, k) + 1/2) * voxel - size / 2), as
   // VectorVolume::voxel_centre. OpenVDB's matrices act on row vectors: row a is the image of
   // index axis a (column a of R times that axis' voxel edge), row 3 the translation.
   const Vec3d edge = volume.voxel_size();
@@ -243,37 +284,16 @@ std::vector<std::uint8_t> encode_vdb_vectors(const VectorVolume& volume,
     }
     m[3][c] = t;
   }
-  const openvdb::math::Transform::Ptr transform =
-      openvdb::math::Transform::createLinearTransform(m);
-  // The field's vector (direction times strength: what a tool samples as a force or a velocity)
-  // and the strength alone, both zero in the background; voxels with a strength are active.
-  openvdb::Vec3fGrid::Ptr vectors = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.f));
-  openvdb::FloatGrid::Ptr strength = openvdb::FloatGrid::create(0.f);
-  vectors->setName("vectors");
-  strength->setName("strength");
-  // The directions are world-space already: they do not transform with the grid.
-  vectors->setVectorType(openvdb::VEC_INVARIANT);
-  auto put_vector = vectors->getAccessor();
-  auto put_strength = strength->getAccessor();
-  const Vec3i n = volume.resolution;
-  for (int k = 0; k < n.z; ++k)
-    for (int j = 0; j < n.y; ++j)
-      for (int i = 0; i < n.x; ++i) {
-        const VectorTexel t = texture.get(volume.index(i, j, k));
-        if (!(t.strength > 0)) continue;
-        put_vector.setValueOn(openvdb::Coord(i, j, k),
-                              openvdb::Vec3f(t.x * t.strength, t.y * t.strength, t.z * t.strength));
-        put_strength.setValueOn(openvdb::Coord(i, j, k), t.strength);
-      }
-  for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(vectors.get()),
-                               static_cast<openvdb::GridBase*>(strength.get())}) {
-    g->setTransform(transform);
-    g->insertMeta(kKind, openvdb::StringMetadata("vector field"));
-    g->insertMeta(kStorage, openvdb::StringMetadata(vector_storage_name(texture.storage())));
-  }
-  vectors->tree().prune();
-  strength->tree().prune();
-  return write_grids({vectors, strength});
+  return write_vectors(texture, Vec3i::splat(0),
+                       openvdb::math::Transform::createLinearTransform(m));
+}
+
+std::vector<std::uint8_t> encode_vdb_world_vectors(const Box3i& box, const VectorTexture& texture) {
+  if (texture.resolution() != box.size())
+    throw InvalidArgument("vdb: the texture's resolution " + to_string(texture.resolution()) +
+                          " is not the box's " + to_string(box.size()));
+  ensure_initialized();
+  return write_vectors(texture, box.begin, scale_transform({1, 1, 1}));
 }
 
 }  // namespace voxfield

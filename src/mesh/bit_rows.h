@@ -72,6 +72,9 @@ class RowRanks {
         rows_(static_cast<std::size_t>(masks)) {
     for (int k = 0; k < masks; ++k) rows_[static_cast<std::size_t>(k)] = mask(k);
   }
+  // rows_ may point into bits_: a copy would read the original's masks.
+  RowRanks(const RowRanks&) = delete;
+  RowRanks& operator=(const RowRanks&) = delete;
   std::uint64_t* mask(int k) { return bits_.data() + static_cast<std::size_t>(k) * words_; }
   // Mask k reads `row` (of the same words) until the next borrow.
   void borrow(int k, const std::uint64_t* row) { rows_[static_cast<std::size_t>(k)] = row; }
