@@ -19,6 +19,7 @@
 #include <string>
 
 #include "mesh_arrays.h"
+#include "py_world.h"  // triple()
 #include "signals.h"
 #include "voxfield/error.h"
 #include "voxfield/mesh_read.h"
@@ -89,10 +90,6 @@ py::array_t<T> per_point(const Points& points, F&& f) {
                  });
   }
   return out;
-}
-
-py::tuple triple(Vec3i v) {
-  return py::make_tuple(v.x, v.y, v.z);
 }
 
 // The winding number with what its repr shows.

@@ -46,7 +46,7 @@ std::vector<VectorSource> read_sources(const Rows& rows) {
   return out;
 }
 
-Vec3d vec3(const std::vector<double>& v, const char* what) {
+Vec3d vec3_arg(const std::vector<double>& v, const char* what) {
   if (v.size() != 3) throw InvalidArgument(std::string(what) + " takes three numbers");
   return {v[0], v[1], v[2]};
 }
@@ -117,13 +117,13 @@ void bind_vectors(py::module_& parent) {
                        std::vector<int> resolution, double rotation_degrees,
                        std::vector<double> rotation_axis) {
              VectorVolume v;
-             v.centre = vec3(centre, "centre");
-             v.size = vec3(size, "size");
+             v.centre = vec3_arg(centre, "centre");
+             v.size = vec3_arg(size, "size");
              if (resolution.size() != 3) throw InvalidArgument("resolution takes three integers");
              v.resolution = {resolution[0], resolution[1], resolution[2]};
              if (rotation_degrees != 0)
                v.rotation =
-                   VectorVolume::rotation_about(rotation_degrees, vec3(rotation_axis, "axis"));
+                   VectorVolume::rotation_about(rotation_degrees, vec3_arg(rotation_axis, "axis"));
              v.validate();
              return v;
            }),
@@ -238,7 +238,7 @@ void bind_vectors(py::module_& parent) {
             o.height = height;
             if (eye) {
               o.auto_eye = false;
-              o.eye = vec3(*eye, "eye");
+              o.eye = vec3_arg(*eye, "eye");
             }
             o.sheet = sheet;
             Image img;

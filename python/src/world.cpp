@@ -96,7 +96,7 @@ py::array_t<T> to_array(const std::vector<T>& dense, Vec3i size) {
   return out;
 }
 
-std::string repr(const PyWorld& w) {
+std::string world_repr(const PyWorld& w) {
   return reading(w, [&] {
     const Box3i b = w.extent.unite(w.world.voxels.content_bounds());
     return "voxfield.world.World(extent=" + (b.empty() ? std::string("empty") : to_string(b)) +
@@ -253,7 +253,7 @@ void bind_world(py::module_& parent) {
           },
           py::arg("begin"), py::arg("end"), py::arg("material"),
           "Sets every voxel of [begin, end) to material (0: air)")
-      .def("__repr__", &repr);
+      .def("__repr__", &world_repr);
   bind_edit(m, world);
 
   m.def(
