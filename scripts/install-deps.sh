@@ -18,6 +18,7 @@ packages=(
   nlohmann-json3-dev                 # JSON output of the CLI
   libcli11-dev                       # CLI parsing
   libmeshoptimizer-dev               # mesh simplification and vertex-cache ordering (voxfield mesh --simplify)
+  libjemalloc-dev                    # the programs' allocator: jemalloc on transparent huge pages (apps/common/huge_page_allocator.cpp)
   libgtest-dev                       # tests
   clang libclang-rt-14-dev           # the fuzz preset: libFuzzer with ASan + UBSan (CI's fuzz smoke)
   clang-format                       # the format check (scripts/check_format.sh, a test)
