@@ -1,6 +1,7 @@
 // voxfield — topology and measures of a triangle mesh: the edge census (each undirected edge with
-// the triangles using it and their directions), the Euler characteristic, area and the enclosed
-// volume by the divergence theorem (the sum of the signed tetrahedra from the origin).
+// the triangles using it and their directions, gathered by a counting sort on the lower vertex),
+// the Euler characteristic, area and the enclosed volume by the divergence theorem (the sum of the
+// signed tetrahedra from the origin).
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -18,24 +19,26 @@ MeshStats mesh_stats(const Mesh& mesh) {
   MeshStats s;
   s.vertices = mesh.positions.size();
   s.triangles = mesh.triangle_count();
-  // One record per directed triangle edge: the undirected edge (both 32-bit ends) and its
-  // direction, so that sorting groups each edge's uses together.
-  struct Use {
-    std::uint64_t edge;
-    bool forward;
-    bool operator<(const Use& o) const {
-      return edge < o.edge || (edge == o.edge && forward < o.forward);
-    }
-  };
-  std::vector<Use> uses;
-  uses.reserve(3 * s.triangles);
+  // The edge census files each triangle edge's use under its lower vertex, with the upper vertex
+  // and the direction packed as (upper << 1 | forward): a counting sort, linear in the uses. Each
+  // vertex then holds a handful of uses, sorted in place, so equal edges sit together. (Sorting
+  // all 3T uses at once took about half of `voxfield mesh` on a 2.3 M-triangle terrain.)
+  const std::size_t uses_count = 3 * s.triangles;
+  std::vector<std::size_t> first(s.vertices + 1, 0);
+  for (std::size_t t = 0; t < s.triangles; ++t) {
+    const std::uint32_t* v = mesh.indices.data() + 3 * t;
+    for (int k = 0; k < 3; ++k) ++first[std::min(v[k], v[(k + 1) % 3]) + std::size_t{1}];
+  }
+  for (std::size_t i = 1; i <= s.vertices; ++i) first[i] += first[i - 1];
+  std::vector<std::size_t> next(first.begin(), first.end() - 1);
+  std::vector<std::uint64_t> uses(uses_count);
   for (std::size_t t = 0; t < s.triangles; ++t) {
     const std::uint32_t* v = mesh.indices.data() + 3 * t;
     if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) ++s.degenerate_triangles;
     for (int k = 0; k < 3; ++k) {
-      const std::uint64_t a = v[k], b = v[(k + 1) % 3];
-      const std::uint64_t lo = std::min(a, b), hi = std::max(a, b);
-      uses.push_back({lo << 32 | hi, a < b});
+      const std::uint32_t a = v[k], b = v[(k + 1) % 3];
+      const std::uint32_t lo = std::min(a, b), hi = std::max(a, b);
+      uses[next[lo]++] = std::uint64_t{hi} << 1 | (a < b ? 1u : 0u);
     }
     const auto& p0 = mesh.positions[v[0]];
     const auto& p1 = mesh.positions[v[1]];
@@ -48,20 +51,24 @@ MeshStats mesh_stats(const Mesh& mesh) {
     // p0 . (a x b) / 6 with a, b the edges from p0.
     s.signed_volume_units3 += (double{p0[0]} * cx + double{p0[1]} * cy + double{p0[2]} * cz) / 6;
   }
-  std::sort(uses.begin(), uses.end());
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t j = i;
-    int forward = 0;
-    while (j < uses.size() && uses[j].edge == uses[i].edge) forward += uses[j++].forward;
-    const std::size_t count = j - i;
-    ++s.edges;
-    if (count == 1)
-      ++s.boundary_edges;
-    else if (count > 2)
-      ++s.nonmanifold_edges;
-    else if (forward != 1)
-      ++s.misoriented_edges;
-    i = j;
+  for (std::size_t lo = 0; lo < s.vertices; ++lo) {
+    std::uint64_t* const begin = uses.data() + first[lo];
+    std::uint64_t* const end = uses.data() + first[lo + 1];
+    std::sort(begin, end);
+    for (const std::uint64_t* i = begin; i < end;) {
+      const std::uint64_t* j = i;
+      int forward = 0;
+      while (j < end && (*j >> 1) == (*i >> 1)) forward += static_cast<int>(*j++ & 1);
+      const std::ptrdiff_t count = j - i;
+      ++s.edges;
+      if (count == 1)
+        ++s.boundary_edges;
+      else if (count > 2)
+        ++s.nonmanifold_edges;
+      else if (forward != 1)
+        ++s.misoriented_edges;
+      i = j;
+    }
   }
   s.euler_characteristic = static_cast<std::int64_t>(s.vertices) -
                            static_cast<std::int64_t>(s.edges) +
