@@ -50,6 +50,7 @@ Census brute_force_census(const Mesh& m) {
 
 TEST(MeshStats, TheEdgeCensusEqualsABruteForceCensusOnRandomSoups) {
   std::mt19937 rng(20261204);
+  Census seen;  // over all trials: every kind of edge must have been exercised
   for (int trial = 0; trial < 200; ++trial) {
     // Few vertices for many triangles, so that edges are shared once, twice and more often.
     const int vertices = 3 + static_cast<int>(rng() % 40);
@@ -75,10 +76,20 @@ TEST(MeshStats, TheEdgeCensusEqualsABruteForceCensusOnRandomSoups) {
     EXPECT_EQ(s.nonmanifold_edges, c.nonmanifold) << "trial " << trial;
     EXPECT_EQ(s.misoriented_edges, c.misoriented) << "trial " << trial;
     EXPECT_EQ(s.degenerate_triangles, c.degenerate) << "trial " << trial;
+    seen.boundary += c.boundary;
+    seen.nonmanifold += c.nonmanifold;
+    seen.misoriented += c.misoriented;
+    seen.degenerate += c.degenerate;
+    seen.edges += c.edges - c.boundary - c.nonmanifold - c.misoriented;  // manifold, oriented
     EXPECT_EQ(s.euler_characteristic, static_cast<std::int64_t>(s.vertices) -
                                           static_cast<std::int64_t>(c.edges) +
                                           static_cast<std::int64_t>(s.triangles));
   }
+  EXPECT_GT(seen.boundary, 0u);
+  EXPECT_GT(seen.nonmanifold, 0u);
+  EXPECT_GT(seen.misoriented, 0u);
+  EXPECT_GT(seen.degenerate, 0u);
+  EXPECT_GT(seen.edges, 0u);
 }
 
 TEST(MeshStats, AClosedBoxIsWatertightWithItsAreaVolumeAndEulerCharacteristic) {
@@ -86,8 +97,8 @@ TEST(MeshStats, AClosedBoxIsWatertightWithItsAreaVolumeAndEulerCharacteristic) {
   // (vertices count every position, used or not).
   Mesh m;
   for (int i = 0; i < 8; ++i)
-    m.positions.push_back({1.0f + 2.0f * (i & 1), 1.0f + 3.0f * ((i >> 1) & 1),
-                           1.0f + 4.0f * ((i >> 2) & 1)});
+    m.positions.push_back(
+        {1.0f + 2.0f * (i & 1), 1.0f + 3.0f * ((i >> 1) & 1), 1.0f + 4.0f * ((i >> 2) & 1)});
   m.positions.push_back({9, 9, 9});
   const std::uint32_t faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6},
                                       {0, 1, 4}, {1, 5, 4}, {2, 6, 3}, {3, 6, 7},
