@@ -3,7 +3,8 @@
 // buffers, by one of three solvers chosen from the plan:
 //  - the lower envelope (Meijster, Roerdink & Hesselink, "A general algorithm for computing
 //    distance transforms in linear time", 2000) for Chebyshev and Euclidean: along x on rows,
-//    transposed, along y on rows, transposed back (line kernels in ../line_transforms.h);
+//    transposed, along y on rows, transposed back (line kernels in ../line_transforms.h; for
+//    unit-spacing Euclidean costs in 32 bits, its division-free form);
 //  - two min-plus sweeps per axis for Manhattan (Rosenfeld & Pfaltz 1966), the pass along y on
 //    whole rows at once;
 //  - truncated min-convolutions (Felzenszwalb & Huttenlocher 2012, ../truncated_min_convolution.h)
@@ -272,7 +273,7 @@ void dispatch_solver(const Plan& p, Vec3i extent, Fn&& fn) {
                                        static_cast<double>(extent.z) * extent.z <
                                    (1 << 29)) {
     auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s,
-                std::int32_t* t) { envelope_1d(EuclideanInt32{}, n, f, o, a, s, t); };
+                std::int32_t* t) { envelope_euclidean_int32(n, f, o, a, s, t); };
     auto solve = [k, sites, d = drop(EuclideanInt32::kInf)](
                      int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) {
       solve_slice_envelope(k, k, X, Y, b, sites, EuclideanInt32::kInf, lo, hi, d);

@@ -1,0 +1,117 @@
+// The one-dimensional Euclidean kernels of the exact transform (src/distance/line_transforms.h)
+// against brute force: every voxel's minimum of (x - i)^2 + f[i] and its smallest minimising index,
+// on random lines built to hold ties (small costs over few distinct values), lines without sites,
+// single sites, and lines at the 32-bit kernel's bounds (n^2 and the costs near 2^29). The
+// division-free kernel must also agree with Meijster's scan, value for value and site for site.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "distance/line_transforms.h"
+
+using namespace voxfield::detail;
+
+namespace {
+
+constexpr std::int32_t kInf = EuclideanInt32::kInf;
+
+// Brute force at x: the minimum and the smallest i reaching it (-1 and kInf without a site).
+std::pair<std::int32_t, std::int32_t> brute_force_at(const std::vector<std::int32_t>& f, int x) {
+  std::int64_t best = kInf;
+  std::int32_t site = -1;
+  for (int i = 0; i < static_cast<int>(f.size()); ++i) {
+    if (!(f[i] < kInf)) continue;
+    const std::int64_t c = std::int64_t{x - i} * (x - i) + f[i];
+    if (c < best) {
+      best = c;
+      site = i;
+    }
+  }
+  return {static_cast<std::int32_t>(best), site};
+}
+
+struct LineResult {
+  std::vector<std::int32_t> out, arg;
+};
+
+LineResult division_free(const std::vector<std::int32_t>& f) {
+  const int n = static_cast<int>(f.size());
+  LineResult r{std::vector<std::int32_t>(n), std::vector<std::int32_t>(n)};
+  std::vector<std::int32_t> s(n), h(n);
+  envelope_euclidean_int32(n, f.data(), r.out.data(), r.arg.data(), s.data(), h.data());
+  return r;
+}
+
+LineResult meijster(const std::vector<std::int32_t>& f) {
+  const int n = static_cast<int>(f.size());
+  LineResult r{std::vector<std::int32_t>(n), std::vector<std::int32_t>(n)};
+  std::vector<std::int32_t> s(n), t(n);
+  envelope_1d(EuclideanInt32{}, n, f.data(), r.out.data(), r.arg.data(), s.data(), t.data());
+  return r;
+}
+
+}  // namespace
+
+TEST(LineTransforms, TheDivisionFreeEnvelopeEqualsBruteForceOnRandomLinesWithTies) {
+  std::mt19937 rng(29);
+  for (int trial = 0; trial < 3000; ++trial) {
+    const int n = 1 + static_cast<int>(rng() % 90);
+    // Costs from a few small values (squares and non-squares), so that parabolas tie often; a
+    // share of voxels without a site, and some lines with none at all.
+    const int air_percent = trial % 10 == 0 ? 100 : static_cast<int>(rng() % 90);
+    const int spread = 1 + static_cast<int>(rng() % 40);
+    std::vector<std::int32_t> f(n);
+    for (auto& v : f)
+      v = static_cast<int>(rng() % 100) < air_percent ? kInf : static_cast<std::int32_t>(rng() % spread);
+    const LineResult got = division_free(f);
+    const LineResult ref = meijster(f);
+    for (int x = 0; x < n; ++x) {
+      const auto [value, site] = brute_force_at(f, x);
+      ASSERT_EQ(got.out[x], value) << "trial " << trial << ", x " << x;
+      ASSERT_EQ(got.arg[x], site) << "trial " << trial << ", x " << x;
+      ASSERT_EQ(ref.out[x], value) << "trial " << trial << ", x " << x;
+      ASSERT_EQ(ref.arg[x], site) << "trial " << trial << ", x " << x;
+    }
+  }
+}
+
+TEST(LineTransforms, TheDivisionFreeEnvelopeHoldsAtTheThirtyTwoBitBounds) {
+  // The kernel's domain: n^2 + the largest finite cost below 2^30, products in 64 bits.
+  std::mt19937 rng(7);
+  const int n = 23170;  // n^2 < 2^29
+  std::vector<std::int32_t> f(n);
+  for (auto& v : f) {
+    const std::uint32_t r = rng();
+    v = r % 3 == 0 ? kInf : static_cast<std::int32_t>(r % static_cast<std::uint32_t>(kInf));
+  }
+  f[n - 1] = kInf - 1;  // the largest finite cost, at the far end
+  const LineResult got = division_free(f);
+  const LineResult ref = meijster(f);
+  EXPECT_EQ(got.out, ref.out);
+  EXPECT_EQ(got.arg, ref.arg);
+  for (int x = 0; x < n; x += 97) {
+    const auto [value, site] = brute_force_at(f, x);
+    ASSERT_EQ(got.out[x], value) << "x " << x;
+    ASSERT_EQ(got.arg[x], site) << "x " << x;
+  }
+}
+
+TEST(LineTransforms, LinesWithOneSiteOrNoneGiveItsParabolaOrNothing) {
+  for (int n : {1, 2, 7, 64}) {
+    std::vector<std::int32_t> none(n, kInf);
+    const LineResult empty = division_free(none);
+    for (int x = 0; x < n; ++x) {
+      EXPECT_EQ(empty.out[x], kInf);
+      EXPECT_EQ(empty.arg[x], -1);
+    }
+    std::vector<std::int32_t> one(n, kInf);
+    one[n / 2] = 5;
+    const LineResult r = division_free(one);
+    for (int x = 0; x < n; ++x) {
+      EXPECT_EQ(r.out[x], (x - n / 2) * (x - n / 2) + 5);
+      EXPECT_EQ(r.arg[x], n / 2);
+    }
+  }
+}
