@@ -64,7 +64,8 @@ TEST(LineTransforms, TheDivisionFreeEnvelopeEqualsBruteForceOnRandomLinesWithTie
     const int spread = 1 + static_cast<int>(rng() % 40);
     std::vector<std::int32_t> f(n);
     for (auto& v : f)
-      v = static_cast<int>(rng() % 100) < air_percent ? kInf : static_cast<std::int32_t>(rng() % spread);
+      v = static_cast<int>(rng() % 100) < air_percent ? kInf
+                                                      : static_cast<std::int32_t>(rng() % spread);
     const LineResult got = division_free(f);
     const LineResult ref = meijster(f);
     for (int x = 0; x < n; ++x) {
