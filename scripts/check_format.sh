@@ -8,8 +8,10 @@ format=$(command -v clang-format-14 || command -v clang-format || true)
 [ -n "$format" ] || { echo "check_format: clang-format is not installed (scripts/install-deps.sh)" >&2; exit 1; }
 if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
   # Tracked files and new ones not yet added (not ignored): a file written but not yet staged is
-  # checked before it is committed, not first by CI.
-  mapfile -t files < <(git ls-files --cached --others --exclude-standard '*.h' '*.cpp')
+  # checked before it is committed, not first by CI. Only the source folders (the same as below):
+  # a build directory outside build/ holds CMake's own generated sources.
+  mapfile -t files < <(git ls-files --cached --others --exclude-standard '*.h' '*.cpp' |
+    grep -E '^(apps|bench|fuzz|include|python|src|tests|shaders)/')
 else
   mapfile -t files < <(find apps bench fuzz include python src tests shaders \( -name '*.h' -o -name '*.cpp' \) | sort)
 fi

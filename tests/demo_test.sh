@@ -110,7 +110,7 @@ assert green > 2000 and coloured > 300
 PY
 
 # The terrain mode: smooth terrain shaped by seeded brushes (one every 20 ms of wall time, at most
-# four a frame, added and carved in turn) — on the Vulkan device under validation the thesis's
+# four a frame, added and carved in turn) — on the Vulkan device (under validation in the optimised build) the thesis's
 # pipeline (the field resident, each frame's edits uploading their samples, classify, HistoPyramid
 # and an indirect draw); with the CPU renderer and through OpenGL each edit re-meshes its chunks
 # for the CPU rasteriser. The CSV's terrain columns count the mesh and the bytes the edits upload

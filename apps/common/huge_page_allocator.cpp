@@ -3,8 +3,8 @@
 // page fault. On the machines we measure on (Debian 12 guests, THP in "madvise" mode) a first touch
 // costs about 11 µs per 4 KiB page against about 0.3 ms per 2 MiB page, so `voxfield field` on a
 // 256³ volume spent a sixth to a fifth of its transform and two fifths of its run faulting pages
-// in: 77 800 faults with glibc's malloc, 3 300 with this (docs/benchmarks.md, "Allocation and page
-// faults"). glibc's malloc can do the same only through GLIBC_TUNABLES=glibc.malloc.hugetlb=1, read
+// in: 77 800 faults with glibc's malloc, 3 300 with this (docs/benchmarks.md, "As a user runs
+// them"). glibc's malloc can do the same only through GLIBC_TUNABLES=glibc.malloc.hugetlb=1, read
 // from the environment at start-up; jemalloc reads the configuration below from the program itself.
 //
 // The library never chooses a process's allocator: applications linking libvoxfield keep theirs
