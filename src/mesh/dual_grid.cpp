@@ -21,7 +21,12 @@ DualVertex dual_cell_vertex(const Block& block, const Lattice& lattice, int qx, 
   const Vec3i q{qx, qy, qz};
   double v[8];
   for (int c = 0; c < 8; ++c) v[c] = block.s(q.x + (c & 1), q.y + (c >> 1 & 1), q.z + (c >> 2 & 1));
-  const std::array<double, 3> mean = place(block, lattice, q, v);
+  return dual_vertex_at(lattice, qx, qy, qz, v, place(block, lattice, q, v), true);
+}
+
+DualVertex dual_vertex_at(const Lattice& lattice, int qx, int qy, int qz, const double* v,
+                          const std::array<double, 3>& mean, bool with_source) {
+  const Vec3i q{qx, qy, qz};
   const double u = mean[0], w1 = mean[1], w2 = mean[2];
   // Gradient of the trilinear interpolant: along each axis, the corner differences blended by
   // the other two local coordinates.
@@ -48,17 +53,20 @@ DualVertex dual_cell_vertex(const Block& block, const Lattice& lattice, int qx, 
     for (std::size_t a = 0; a < 3; ++a)
       normal[a] = (at[a] - inside[a] / count) * lattice.spacing[a];
   }
-  // The colour source: the inside corner nearest the vertex (the lowest-numbered on a tie).
-  int nearest = -1;
-  double best = 1e9;
-  for (int c = 0; c < 8; ++c) {
-    if (!(v[c] < 0)) continue;
-    const double dx = (c & 1) - u, dy = (c >> 1 & 1) - w1, dz = (c >> 2 & 1) - w2;
-    const double d = dx * dx + dy * dy + dz * dz;
-    if (d < best) best = d, nearest = c;
+  std::uint64_t source = 0;
+  if (with_source) {
+    // The colour source: the inside corner nearest the vertex (the lowest-numbered on a tie).
+    int nearest = -1;
+    double best = 1e9;
+    for (int c = 0; c < 8; ++c) {
+      if (!(v[c] < 0)) continue;
+      const double dx = (c & 1) - u, dy = (c >> 1 & 1) - w1, dz = (c >> 2 & 1) - w2;
+      const double d = dx * dx + dy * dy + dz * dz;
+      if (d < best) best = d, nearest = c;
+    }
+    source = lattice.index(q.x + (nearest & 1), q.y + (nearest >> 1 & 1), q.z + (nearest >> 2 & 1));
   }
-  return {lattice_position(lattice, {q.x + u, q.y + w1, q.z + w2}), normal,
-          lattice.index(q.x + (nearest & 1), q.y + (nearest >> 1 & 1), q.z + (nearest >> 2 & 1))};
+  return {lattice_position(lattice, {q.x + u, q.y + w1, q.z + w2}), normal, source};
 }
 
 void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,

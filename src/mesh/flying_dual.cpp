@@ -19,6 +19,7 @@
 #include <string>
 
 #include "bit_rows.h"
+#include "cube_cases.h"
 #include "flying_edges.h"
 #include "mesh_memory.h"
 #include "voxfield/error.h"
@@ -142,7 +143,12 @@ void FlyingDual::write(const WeldOutput& out) const {
   Progress& progress = *progress_;
   const int planes = lattice_.n.z;
   // The vertices first: a quad's diagonal is chosen from its four vertices' positions.
-  for_each_plane(planes, progress, [&](int z) { write_vertices(z, out); });
+  for_each_plane(planes, progress, [&](int z) {
+    if (place_ == surface_nets_vertex)
+      write_surface_nets_vertices(z, out);
+    else
+      write_vertices(z, out);
+  });
   for_each_plane(planes, progress, [&](int z) { write_quads(z, out); });
 }
 
@@ -157,11 +163,109 @@ void FlyingDual::write_vertices(int z, const WeldOutput& out) const {
     for (std::size_t w = 0; w < words_; ++w)
       for (std::uint64_t m = used[w]; m; m &= m - 1) {
         const int x = static_cast<int>(64 * w) + std::countr_zero(m);
-        const DualVertex v = dual_cell_vertex(block_, lattice_, x, y, z, place_);
+        double s[8];
+        for (int c = 0; c < 8; ++c)
+          s[c] = block_.s(x + (c & 1), y + (c >> 1 & 1), z + (c >> 2 & 1));
+        const DualVertex v = dual_vertex_at(lattice_, x, y, z, s,
+                                            place_(block_, lattice_, {x, y, z}, s), out.sources);
         out.positions[g] = {static_cast<float>(v.position[0]), static_cast<float>(v.position[1]),
                             static_cast<float>(v.position[2])};
         out.normals[g] = unit_normal(v.normal);
         if (out.sources) out.sources[g] = v.source;
+        ++g;
+      }
+  }
+}
+
+// Surface nets' vertices of plane z with each crossed edge interpolated once: a cell's vertex is
+// the mean of its edges' crossings, and every edge is shared by four cells, so the crossings are
+// found per sample row first (t = s0 / (s0 - s1), surface_nets_vertex's arithmetic on the same
+// values) and each cell then sums its edges' in surface_nets_vertex's order: the same vertices,
+// bit for bit, at a quarter of the divisions.
+void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const {
+  const Vec3i n = lattice_.n;
+  if (z + 1 >= n.z) return;
+  const std::size_t words = words_, nx = static_cast<std::size_t>(n.x);
+  // Crossings of x-edges on sample rows (y', z + dz), kept for two y' (by parity) per layer dz;
+  // of z-edges from rows (y', z) to (y', z + 1), two y'; of y-edges from (y, z + dz) to
+  // (y + 1, z + dz), the current y only. Entries of edges not crossed are never read.
+  std::vector<double> store(8 * nx);
+  double* tx[2][2] = {{&store[0], &store[nx]}, {&store[2 * nx], &store[3 * nx]}};
+  double* tz[2] = {&store[4 * nx], &store[5 * nx]};
+  double* ty[2] = {&store[6 * nx], &store[7 * nx]};
+  std::vector<std::uint64_t> mask(words);
+  // t along each crossed edge from r0[x] to r1[x], for x below `end`.
+  const auto crossings = [&](const float* r0, const float* r1, int end, double* t) {
+    for (std::size_t w = 0; w < words; ++w)
+      for (std::uint64_t m = mask[w]; m; m &= m - 1) {
+        const int x = static_cast<int>(64 * w) + std::countr_zero(m);
+        if (x >= end) return;
+        const double s0 = block_.s_of(r0[x]), s1 = block_.s_of(r1[x]);
+        t[x] = s0 / (s0 - s1);
+      }
+  };
+  const auto along_x = [&](int y, int zz, double* t) {
+    x_crossings(inside_->row(y, zz), words, n.x, mask.data());
+    const float* r = block_.row(0, y, zz);
+    crossings(r, r + 1, n.x - 1, t);
+  };
+  const auto between = [&](int y0, int z0, int y1, int z1, double* t) {
+    differences(inside_->row(y0, z0), inside_->row(y1, z1), words, mask.data());
+    crossings(block_.row(0, y0, z0), block_.row(0, y1, z1), n.x, t);
+  };
+  along_x(0, z, tx[0][0]);
+  along_x(0, z + 1, tx[1][0]);
+  between(0, z, 0, z + 1, tz[0]);
+  const CubeCases& table = CubeCases::get();
+  const auto& edges = cube_edges();
+  for (int y = 0; y + 1 < n.y; ++y) {
+    const int p = y & 1, q = p ^ 1;
+    along_x(y + 1, z, tx[0][q]);
+    along_x(y + 1, z + 1, tx[1][q]);
+    between(y + 1, z, y + 1, z + 1, tz[q]);
+    const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
+    const std::uint64_t* used = reached(y, z);
+    if (population(used, words) == 0) continue;
+    between(y, z, y + 1, z, ty[0]);
+    between(y, z + 1, y + 1, z + 1, ty[1]);
+    // Edge e of a cell at x reads its crossing at tp[e][x].
+    const double* tp[12];
+    for (std::size_t e = 0; e < 12; ++e) {
+      const int from = edges[e].from, dx = from & 1, dy = from >> 1 & 1, dz = from >> 2 & 1;
+      const int yp = dy ? q : p;
+      tp[e] = edges[e].axis == 0 ? tx[dz][yp] : edges[e].axis == 1 ? ty[dz] + dx : tz[yp] + dx;
+    }
+    const float* row[4] = {block_.row(0, y, z), block_.row(0, y + 1, z), block_.row(0, y, z + 1),
+                           block_.row(0, y + 1, z + 1)};
+    prefetch_ahead(lattice_, y, z);
+    std::uint64_t g = first_vertex_[r];
+    for (std::size_t w = 0; w < words; ++w)
+      for (std::uint64_t m = used[w]; m; m &= m - 1) {
+        const int x = static_cast<int>(64 * w) + std::countr_zero(m);
+        double v[8];
+        unsigned inside = 0;
+        for (unsigned c = 0; c < 8; ++c) {
+          v[c] = block_.s_of(row[c >> 1][x + (c & 1)]);
+          inside |= static_cast<unsigned>(v[c] < 0) << c;
+        }
+        double mx = 0, my = 0, mz = 0;
+        int count = 0;
+        for (unsigned bits = table.crossed_edges(inside); bits != 0; bits &= bits - 1) {
+          const std::size_t e = static_cast<std::size_t>(std::countr_zero(bits));
+          const CubeEdge& edge = edges[e];
+          const double t = tp[e][x];
+          mx += edge.axis == 0 ? t : (edge.from & 1);
+          my += edge.axis == 1 ? t : (edge.from >> 1 & 1);
+          mz += edge.axis == 2 ? t : (edge.from >> 2 & 1);
+          ++count;
+        }
+        const DualVertex vertex =
+            dual_vertex_at(lattice_, x, y, z, v, {mx / count, my / count, mz / count}, out.sources);
+        out.positions[g] = {static_cast<float>(vertex.position[0]),
+                            static_cast<float>(vertex.position[1]),
+                            static_cast<float>(vertex.position[2])};
+        out.normals[g] = unit_normal(vertex.normal);
+        if (out.sources) out.sources[g] = vertex.source;
         ++g;
       }
   }

@@ -92,6 +92,7 @@ class FlyingDual {
   void cells(int y, int z, Masks& scratch, std::uint64_t* used) const;
   void count_plane(int z);
   void write_vertices(int z, const WeldOutput& out) const;
+  void write_surface_nets_vertices(int z, const WeldOutput& out) const;
   void write_quads(int z, const WeldOutput& out) const;
 };
 
