@@ -185,8 +185,8 @@ void bind_mesh_input(py::module_& m) {
         o.interrupter = &signals;
         std::vector<std::uint8_t> materials;
         const Box3i box = without_gil(threads, [&] {
-          const Box3i b = mesh_voxel_box(mesh, o);
           const World world = voxelize_mesh(mesh, o);
+          const Box3i b = *world.voxels.bounds();  // mesh_voxel_box, which the world is bounded by
           materials.resize(static_cast<std::size_t>(b.volume()));
           world.voxels.copy_to_dense(b, materials.data());
           return b;
