@@ -3,7 +3,8 @@
 # contouring of voxfield (time, ns per cell, the process's peak memory over its input's, and the
 # mesh's bytes per triangle in memory) on the terrain's signed Euclidean field (256³ and 512³) and on a scan-sized smooth float
 # volume, beside scikit-image's marching_cubes (one thread) and VTK's vtkFlyingEdges3D (all
-# threads) on the same arrays in the same run. Results go to bench/results/mesh-DATE/table.md.
+# threads) on the same arrays in the same run, then voxfield-bench-mesh's fresh and reused-output
+# library paths (library.md). Results go to bench/results/mesh-DATE/table.md and library.md.
 # Usage: bash bench/run_mesh_bench.sh [RUNS] [SIZES]   (default 3 runs, sizes "256 512")
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -64,6 +65,11 @@ print(f"| {name} | voxfield {algo} | {threads} | {best:.0f} | {tris} | {cells / 
 PY
     done
   done
+  # The library's own paths in one process: a fresh Mesh per call (mesh_volume, what the CLI
+  # times above) and arrays reused across calls (mesh_volume_into, a game re-meshing per frame).
+  for threads in 1 2; do
+    "$bin/voxfield-bench-mesh" "$f" --runs "$runs" --threads "$threads" --algorithms mc,sn >> "$out/library.md"
+  done
   /usr/bin/python3 bench/peers/mesh_peers.py "$f" 0 --runs "$runs" --json "$out/peers.json"
   /usr/bin/python3 - "$out/peers.json" "$name" "$cells" >> "$out/table.md" <<'PY'
 import json, sys
@@ -76,4 +82,7 @@ PY
 done
 rm -rf "$out/inputs" "$out/m.stl" "$out/s.json" "$out/peers.json" "$out/rss.txt"
 cat "$out/table.md"
+# One header for the library table (each run of voxfield-bench-mesh printed its own).
+awk 'NR <= 2 || !/^\|( volume |---)/' "$out/library.md" > "$out/library.tmp" && mv "$out/library.tmp" "$out/library.md"
+cat "$out/library.md"
 echo "results in $out"

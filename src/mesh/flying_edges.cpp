@@ -75,12 +75,27 @@ struct RowSamples {
   float iso;
   bool negate;
   std::ptrdiff_t sy, sz;
+  // Per axis, the differences' spans (one and two spacings) and, where a span is a power of two
+  // (unit spacings), its exact inverse: x * (1 / span) then rounds the same real number as
+  // x / span, so the gradient is the same bit for bit for a multiplication's cost.
+  std::array<std::array<double, 2>, 3> span{}, inverse{};
+  std::array<bool, 3> exact_inverse{};
   explicit RowSamples(const Lattice& l)
       : lattice(l),
         iso(static_cast<float>(l.iso)),
         negate(l.sign < 0),
         sy(l.n.x),
-        sz(static_cast<std::ptrdiff_t>(l.n.x) * l.n.y) {}
+        sz(static_cast<std::ptrdiff_t>(l.n.x) * l.n.y) {
+    for (std::size_t a = 0; a < 3; ++a) {
+      int exponent = 0;
+      const double mantissa = std::frexp(l.spacing[a], &exponent);
+      exact_inverse[a] = mantissa == 0.5 && exponent > -1000 && exponent < 1000;
+      for (std::size_t k = 0; k < 2; ++k) {
+        span[a][k] = static_cast<double>(k + 1) * l.spacing[a];
+        inverse[a][k] = 1 / span[a][k];
+      }
+    }
+  }
   float s_of(float v) const { return negate ? iso - v : v - iso; }
   float s(std::ptrdiff_t i) const { return s_of(lattice.values[i]); }
   std::ptrdiff_t index(int x, int y, int z) const { return x + sy * y + sz * z; }
@@ -90,12 +105,12 @@ struct RowSamples {
     const int p[3] = {x, y, z};
     const std::ptrdiff_t step[3] = {1, sy, sz};
     std::array<double, 3> g;
-    for (int a = 0; a < 3; ++a) {
-      const bool down = p[a] > 0, up = p[a] < lattice.n[a] - 1;
+    for (std::size_t a = 0; a < 3; ++a) {
+      const bool down = p[a] > 0, up = p[a] < lattice.n[static_cast<int>(a)] - 1;
       const std::ptrdiff_t lo = down ? i - step[a] : i, hi = up ? i + step[a] : i;
-      const double span = (static_cast<int>(up) + static_cast<int>(down)) *
-                          lattice.spacing[static_cast<std::size_t>(a)];
-      g[static_cast<std::size_t>(a)] = (static_cast<double>(s(hi)) - s(lo)) / span;
+      const std::size_t k = static_cast<std::size_t>(up) + static_cast<std::size_t>(down) - 1;
+      const double difference = static_cast<double>(s(hi)) - s(lo);
+      g[a] = exact_inverse[a] ? difference * inverse[a][k] : difference / span[a][k];
     }
     return g;
   }
