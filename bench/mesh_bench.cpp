@@ -3,7 +3,8 @@
 // the kernel must zero, as in a one-shot program such as `voxfield mesh`) and `mesh_volume_into`
 // into arrays allocated once and reused (as a game re-meshing every frame, or
 // fast-surface-nets-rs's reused buffer, calls it). The difference between the two is the output's
-// first-touch cost.
+// cost: allocating, zero-filling and freeing its arrays, of which the kernel's zeroing of their
+// new pages is most.
 //
 // usage: voxfield-bench-mesh VOLUME.npy [--runs N] [--threads T] [--algorithms mc,sn,dc]
 // Prints one Markdown row per mesher and path: median / min of N runs, triangles, vertices,
@@ -11,6 +12,7 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <optional>
 #include <sstream>
 #include <string>

@@ -15,7 +15,15 @@ void bind_vectors(py::module_& m);
 void bind_world(py::module_& m);
 }  // namespace voxfield::python
 
+#if defined(VOXFIELD_HAS_CPU_CHECK)
+extern "C" const char* voxfield_cpu_lacks_build_level();  // apps/common/cpu_check.cpp
+#endif
+
 PYBIND11_MODULE(_voxfield, m) {
+#if defined(VOXFIELD_HAS_CPU_CHECK)
+  // Before any of the engine runs: an ImportError that says why, not SIGILL.
+  if (const char* why = voxfield_cpu_lacks_build_level()) throw py::import_error(why);
+#endif
   m.doc() = "voxfield's C++ engine; use the voxfield package";
   // Subclasses of ValueError, MemoryError and OSError carrying voxfield's message (which names the
   // file, and for malformed files the byte offset).

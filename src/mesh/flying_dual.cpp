@@ -11,8 +11,9 @@
 // vertices are written, rows in parallel, and after them the quads (split along the shorter
 // diagonal, which reads the vertices' positions). A cell's vertex number is its row's first
 // vertex plus the reached cells before it on the row — a population count. Vertices, normals and
-// sources come from dual_cell_vertex (dual_grid.cpp), as in the chunked driver: the triangles are
-// the same, bit for bit, only numbered by row.
+// sources are the chunked driver's (dual_grid.cpp's dual_cell_vertex; surface nets find each
+// edge's crossing once per sample row and place the vertex with the same arithmetic, dual
+// contouring calls it): the triangles are the same, bit for bit, only numbered by row.
 #include <algorithm>
 #include <array>
 #include <bit>
