@@ -211,11 +211,12 @@ struct DualVertex {
   std::array<double, 3> position, normal;
   std::uint64_t source;
 };
+// Without `with_source` the source is left 0 (the nearest-corner search skipped: no colours, no
+// sources asked for).
 DualVertex dual_cell_vertex(const Block& block, const Lattice& lattice, int qx, int qy, int qz,
-                            CellVertex place);
+                            CellVertex place, bool with_source);
 // The same once the cell's s values `v` and the vertex's place in the cell (`mean`, what a
-// CellVertex returns) are known, for a pass that places vertices itself; without `with_source`
-// the source is left 0 (the nearest-corner search skipped: no colours, no sources asked for).
+// CellVertex returns) are known, for a pass that places vertices itself.
 DualVertex dual_vertex_at(const Lattice& lattice, int qx, int qy, int qz, const double* v,
                           const std::array<double, 3>& mean, bool with_source);
 // A normal scaled to unit length in floats (+z where it has no direction): ChunkPart::add's rule,

@@ -21,6 +21,7 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstdint>
 
 namespace voxfield::detail::mesh {
@@ -89,5 +90,30 @@ class CubeCases {
   std::array<std::uint16_t, 257> offset_{};
   std::array<CubeCase, 1024> cases_{};
 };
+
+// Surface nets' vertex in the cell's coordinates: the mean of the crossings of the edges a corner
+// mask crosses, each edge contributing t_of(edge) (where along it the surface crosses, 0..1) on
+// its axis and its corner's fixed coordinates on the other two. One summation, in edge order, for
+// every path that places these vertices, so that they agree bit for bit however t is found.
+// (The tables come in as arguments: a hot caller looks them up once, not once per cell.)
+template <class CrossingOf>
+std::array<double, 3> crossing_mean(const CubeCases& table, const std::array<CubeEdge, 12>& edges,
+                                    unsigned inside, CrossingOf&& t_of) {
+  // Three scalars, not an array indexed by axis: the array lived in memory and its read-back
+  // stalled store forwarding.
+  double mx = 0, my = 0, mz = 0;
+  int count = 0;
+  for (unsigned bits = table.crossed_edges(inside); bits != 0; bits &= bits - 1) {
+    const unsigned e = static_cast<unsigned>(std::countr_zero(bits));
+    const CubeEdge& edge = edges[e];
+    const double t = t_of(e);
+    mx += edge.axis == 0 ? t : (edge.from & 1);
+    my += edge.axis == 1 ? t : (edge.from >> 1 & 1);
+    mz += edge.axis == 2 ? t : (edge.from >> 2 & 1);
+    ++count;
+  }
+  // (The cell has a crossing: a quad reached it.)
+  return {mx / count, my / count, mz / count};
+}
 
 }  // namespace voxfield::detail::mesh

@@ -17,11 +17,11 @@
 namespace voxfield::detail::mesh {
 
 DualVertex dual_cell_vertex(const Block& block, const Lattice& lattice, int qx, int qy, int qz,
-                            CellVertex place) {
+                            CellVertex place, bool with_source) {
   const Vec3i q{qx, qy, qz};
   double v[8];
   for (int c = 0; c < 8; ++c) v[c] = block.s(q.x + (c & 1), q.y + (c >> 1 & 1), q.z + (c >> 2 & 1));
-  return dual_vertex_at(lattice, qx, qy, qz, v, place(block, lattice, q, v), true);
+  return dual_vertex_at(lattice, qx, qy, qz, v, place(block, lattice, q, v), with_source);
 }
 
 DualVertex dual_vertex_at(const Lattice& lattice, int qx, int qy, int qz, const double* v,
@@ -85,7 +85,7 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
                                  ex * (static_cast<std::size_t>(qy - lo.y) +
                                        ey * static_cast<std::size_t>(qz - lo.z))];
     if (slot >= 0) return static_cast<std::uint32_t>(slot);
-    const DualVertex v = dual_cell_vertex(block, lattice, qx, qy, qz, place);
+    const DualVertex v = dual_cell_vertex(block, lattice, qx, qy, qz, place, true);
     const Vec3i q{qx, qy, qz};
     bool owned = true, shared = false;
     for (int a = 0; a < 3; ++a) {

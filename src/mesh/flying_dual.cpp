@@ -164,11 +164,7 @@ void FlyingDual::write_vertices(int z, const WeldOutput& out) const {
     for (std::size_t w = 0; w < words_; ++w)
       for (std::uint64_t m = used[w]; m; m &= m - 1) {
         const int x = static_cast<int>(64 * w) + std::countr_zero(m);
-        double s[8];
-        for (int c = 0; c < 8; ++c)
-          s[c] = block_.s(x + (c & 1), y + (c >> 1 & 1), z + (c >> 2 & 1));
-        const DualVertex v = dual_vertex_at(lattice_, x, y, z, s,
-                                            place_(block_, lattice_, {x, y, z}, s), out.sources);
+        const DualVertex v = dual_cell_vertex(block_, lattice_, x, y, z, place_, out.sources);
         out.positions[g] = {static_cast<float>(v.position[0]), static_cast<float>(v.position[1]),
                             static_cast<float>(v.position[2])};
         out.normals[g] = unit_normal(v.normal);
@@ -249,19 +245,9 @@ void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const
           v[c] = block_.s_of(row[c >> 1][x + (c & 1)]);
           inside |= static_cast<unsigned>(v[c] < 0) << c;
         }
-        double mx = 0, my = 0, mz = 0;
-        int count = 0;
-        for (unsigned bits = table.crossed_edges(inside); bits != 0; bits &= bits - 1) {
-          const std::size_t e = static_cast<std::size_t>(std::countr_zero(bits));
-          const CubeEdge& edge = edges[e];
-          const double t = tp[e][x];
-          mx += edge.axis == 0 ? t : (edge.from & 1);
-          my += edge.axis == 1 ? t : (edge.from >> 1 & 1);
-          mz += edge.axis == 2 ? t : (edge.from >> 2 & 1);
-          ++count;
-        }
-        const DualVertex vertex =
-            dual_vertex_at(lattice_, x, y, z, v, {mx / count, my / count, mz / count}, out.sources);
+        const DualVertex vertex = dual_vertex_at(
+            lattice_, x, y, z, v,
+            crossing_mean(table, edges, inside, [&](unsigned e) { return tp[e][x]; }), out.sources);
         out.positions[g] = {static_cast<float>(vertex.position[0]),
                             static_cast<float>(vertex.position[1]),
                             static_cast<float>(vertex.position[2])};

@@ -17,29 +17,16 @@ std::array<double, 3> surface_nets_vertex(const Block&, const Lattice& lattice, 
                                           const double* v) {
   unsigned mask = 0;
   for (unsigned c = 0; c < 8; ++c) mask |= static_cast<unsigned>(v[c] < 0) << c;
-  // Three scalars, not an array indexed by axis: the array lived in memory and its read-back
-  // stalled store forwarding.
-  double mx = 0, my = 0, mz = 0;
-  int crossings = 0;
-  for (unsigned bits = CubeCases::get().crossed_edges(mask); bits != 0; bits &= bits - 1) {
-    const CubeEdge& e = cube_edges()[static_cast<std::size_t>(std::countr_zero(bits))];
-    const double s0 = v[e.from], s1 = v[e.to];
+  const auto& edges = cube_edges();
+  return crossing_mean(CubeCases::get(), edges, mask, [&](unsigned e) {
+    const CubeEdge& edge = edges[e];
+    const double s0 = v[edge.from], s1 = v[edge.to];
     // Lattice::crossing's interpolation, inline unless there is a function to solve on.
-    double t;
-    if (lattice.value) {
-      Vec3i p0 = cell;
-      for (int a = 0; a < 3; ++a) p0[a] += e.from >> a & 1;
-      t = lattice.crossing(p0, e.axis, s0, s1);
-    } else {
-      t = s0 / (s0 - s1);
-    }
-    mx += e.axis == 0 ? t : (e.from & 1);
-    my += e.axis == 1 ? t : (e.from >> 1 & 1);
-    mz += e.axis == 2 ? t : (e.from >> 2 & 1);
-    ++crossings;
-  }
-  // (The cell has a crossing: a quad reached it.)
-  return {mx / crossings, my / crossings, mz / crossings};
+    if (!lattice.value) return s0 / (s0 - s1);
+    Vec3i p0 = cell;
+    for (int a = 0; a < 3; ++a) p0[a] += edge.from >> a & 1;
+    return lattice.crossing(p0, edge.axis, s0, s1);
+  });
 }
 
 }  // namespace voxfield::detail::mesh
