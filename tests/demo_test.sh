@@ -157,12 +157,13 @@ trun terrain-cpu --backend cpu
 RUN_ENV="VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json" trun terrain-opengl --backend vulkan
 
 # Interactive: real input events through the window system (xdotool). A left click places and a
-# right click carves at the ray hit, each a separate edit; F12 saves a screenshot.
+# right click carves at the ray hit, each a separate edit; F12 saves a screenshot; Ctrl+Q quits
+# (well before the runs' cap of 3000 frames).
 if command -v xdotool >/dev/null; then
   mkdir -p "$out/interactive"
   status=0 t0=$SECONDS
   (cd "$out/interactive" && DEMO="$DEMO" xvfb-run -a -s "-screen 0 1024x768x24" bash -c '
-    "$DEMO" --world 64 --width 640 --height 360 --backend cpu --frames 120 --csv i.csv 2>i.err &
+    "$DEMO" --world 64 --width 640 --height 360 --backend cpu --frames 3000 --csv i.csv 2>i.err &
     pid=$!
     win=$(timeout 60 xdotool search --sync --name voxfield-demo | head -1)
     sleep 1
@@ -171,12 +172,15 @@ if command -v xdotool >/dev/null; then
     xdotool mousemove --window "$win" 480 220 click 3
     sleep 0.3
     xdotool key --window "$win" F12
+    sleep 0.3
+    xdotool key --window "$win" ctrl+q  # quits (--frames is the cap if it did not)
     wait $pid') || status=$?
   if [ "$status" -ne 0 ]; then
     fail "interactive: exit status $status: $(tail -3 "$out/interactive/i.err" 2>/dev/null)"
   else
     awk -F, 'END { exit !($5 >= 2) }' "$out/interactive/i.csv" || fail "interactive: the clicks did not edit (edits: $(tail -1 "$out/interactive/i.csv"))"
     "$FRAME_CHECK" "$out/interactive/voxfield-demo-1.png" || fail "interactive: no F12 screenshot of the world"
+    awk 'END { exit !(NR - 1 < 3000) }' "$out/interactive/i.csv" || fail "interactive: Ctrl+Q did not quit"
     echo "ok: interactive, $((SECONDS - t0)) s (clicks placed and carved; F12 saved a screenshot)"
   fi
   # The terrain mode under the mouse: a left click adds a sphere where the cursor's ray meets the
@@ -184,19 +188,22 @@ if command -v xdotool >/dev/null; then
   mkdir -p "$out/terrain-interactive"
   status=0 t0=$SECONDS
   (cd "$out/terrain-interactive" && DEMO="$DEMO" xvfb-run -a -s "-screen 0 1024x768x24" bash -c '
-    "$DEMO" --mode terrain --width 640 --height 360 --backend cpu --frames 400 --csv i.csv 2>i.err &
+    "$DEMO" --mode terrain --width 640 --height 360 --backend cpu --frames 3000 --csv i.csv 2>i.err &
     pid=$!
     win=$(timeout 60 xdotool search --sync --name voxfield-demo | head -1)
     sleep 1
     xdotool mousemove --window "$win" 500 250 click 1
     sleep 0.5
     xdotool mousemove --window "$win" 520 200 click 3
+    sleep 0.5
+    xdotool key --window "$win" ctrl+q
     wait $pid') || status=$?
   if [ "$status" -ne 0 ]; then
     fail "terrain-interactive: exit status $status: $(tail -3 "$out/terrain-interactive/i.err" 2>/dev/null)"
   else
     awk -F, 'END { exit !($5 >= 2 && $11 > 0) }' "$out/terrain-interactive/i.csv" ||
       fail "terrain-interactive: the clicks did not edit the terrain ($(tail -1 "$out/terrain-interactive/i.csv"))"
+    awk 'END { exit !(NR - 1 < 3000) }' "$out/terrain-interactive/i.csv" || fail "terrain-interactive: Ctrl+Q did not quit"
     echo "ok: terrain-interactive, $((SECONDS - t0)) s (a click added, a click carved)"
   fi
 else

@@ -207,7 +207,9 @@ TEST(CsgLanguage, ErrorsNameLineAndColumn) {
       {"[\"sphere\", {\"r\": 1}]", "test.sdf:1:12: a object has no meaning"},
       {"", "test.sdf:1:1: no model expression"},
   };
-  for (const auto& [text, want] : cases) {
+  for (const auto& c : cases) {  // (not a structured binding: clang 14 cannot capture one)
+    const std::string& text = c.first;
+    const std::string& want = c.second;
     const std::string got = error_of([&] { (void)parse(text); });
     EXPECT_EQ(got.substr(0, want.size()), want) << "text: " << text << "\ngot: " << got;
   }

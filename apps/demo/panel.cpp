@@ -179,6 +179,7 @@ void Demo::help() {
   ImGui::Text("1 .. 9        material; P toggles paint mode");
   ImGui::Text("F12           screenshot (voxfield-demo-N.png)");
   ImGui::Text("F1            this help");
+  ImGui::Text("Ctrl+Q        quit");
   ImGui::End();
 }
 

@@ -171,11 +171,15 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
         "chunks); voxfield convert turns it into .vox or .npy");
   mpi::check_outputs(comm, {out, save_world}, {stats});
   // The script and the ghost slices are checked on every rank before the world is loaded.
-  const auto [edits, ghost] = mpi::collectively(comm, [&] {
+  // (Two named values, not a structured binding: the loop's lambda below captures the script,
+  // and clang 14, which CI's sanitizer builds use, cannot capture a binding.)
+  const auto script_and_ghost = mpi::collectively(comm, [&] {
     EditScriptOptions eo;
     eo.chunk_edge = f.chunk;
     return std::make_pair(read_edit_script(edits_path, eo), mpi::edit_ghost_slices(o));
   });
+  const std::vector<Edit>& edits = script_and_ghost.first;
+  const int ghost = script_and_ghost.second;
   mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk, ghost);
   const double t0 = MPI_Wtime();
   mpi::SlabEditor editor(comm, slab.partition, slab.world, o);
