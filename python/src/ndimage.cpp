@@ -53,68 +53,116 @@ Strided strided(const py::array& a) {
   return s;
 }
 
-// The occupancy voxfield sees: 1 where the input element is zero (a site), x fastest.
-template <class T>
-void read_zeros(const Strided& in, std::array<py::ssize_t, 3> n, std::vector<std::uint8_t>& out) {
-  std::size_t i = 0;
-  for (py::ssize_t a0 = 0; a0 < n[0]; ++a0)
-    for (py::ssize_t a1 = 0; a1 < n[1]; ++a1) {
-      const char* row = in.data + a0 * in.strides[0] + a1 * in.strides[1];
-      for (py::ssize_t a2 = 0; a2 < n[2]; ++a2, ++i) {
-        T v;
-        std::memcpy(&v, row + a2 * in.strides[2], sizeof v);
-        out[i] = v == T(0);
-      }
-    }
+// The chunks of a grid (of edge `edge`) that cover `box`, which starts at the origin.
+std::vector<Vec3i> chunks_covering(const Box3i& box, int edge) {
+  std::vector<Vec3i> coords;
+  for (int z = 0; z * edge < box.end.z; ++z)
+    for (int y = 0; y * edge < box.end.y; ++y)
+      for (int x = 0; x * edge < box.end.x; ++x) coords.push_back({x, y, z});
+  return coords;
 }
 
-bool read_input(const py::array& input, std::array<py::ssize_t, 3> n,
-                std::vector<std::uint8_t>& out) {
-  const Strided s = strided(input);
+// One row of the input to occupancy: 1 where the element is zero (a site). Called with a constant
+// `stride` for contiguous rows, so the loop vectorises there.
+template <class T>
+inline void mark_zeros(const char* src, py::ssize_t stride, int run, std::uint8_t* dst) {
+  for (int x = 0; x < run; ++x) {
+    T v;
+    std::memcpy(&v, src + x * stride, sizeof v);
+    dst[x] = v == T(0);
+  }
+}
+
+// Reads the input into `occupancy` (bounded by `box`) chunk by chunk in parallel, straight from
+// NumPy's memory in any order and strides: no dense copy of it (at 256^3 the serial copy and its
+// conversion into chunks took longer than the Manhattan transform itself).
+template <class T>
+void read_sites(const Strided& in, const Box3i& box, Grid<std::uint8_t>& occupancy) {
+  const int edge = occupancy.chunk_edge();
+  const std::int64_t volume = occupancy.chunk_volume();
+  occupancy.generate_chunks(chunks_covering(box, edge), [&](Vec3i coord, std::uint8_t* voxels) {
+    const Box3i cb = occupancy.chunk_box(coord);
+    const Box3i part = cb.intersect(box);
+    if (part != cb) std::fill(voxels, voxels + volume, std::uint8_t{0});
+    const int run = part.end.x - part.begin.x;
+    for (int z = part.begin.z; z < part.end.z; ++z)
+      for (int y = part.begin.y; y < part.end.y; ++y) {
+        // NumPy's axes 0, 1, 2 are voxfield's z, y, x.
+        const char* src =
+            in.data + z * in.strides[0] + y * in.strides[1] + part.begin.x * in.strides[2];
+        std::uint8_t* dst = voxels + ((z - cb.begin.z) * edge + (y - cb.begin.y)) * edge +
+                            (part.begin.x - cb.begin.x);
+        if (in.strides[2] == static_cast<py::ssize_t>(sizeof(T)))
+          mark_zeros<T>(src, sizeof(T), run, dst);
+        else
+          mark_zeros<T>(src, in.strides[2], run, dst);
+      }
+  });
+}
+
+// The reader of the input's dtype (chosen while the GIL is held), or null for dtypes the Python
+// side converts first with input != 0.
+using SiteReader = void (*)(const Strided&, const Box3i&, Grid<std::uint8_t>&);
+SiteReader reader_for(const py::array& input) {
   const char kind = input.dtype().kind();
   const py::ssize_t size = input.dtype().itemsize();
-  if (kind == 'b') return read_zeros<std::uint8_t>(s, n, out), true;
+  if (kind == 'b') return &read_sites<std::uint8_t>;
   if (kind == 'i' || kind == 'u') {
     switch (size) {
       case 1:
-        return read_zeros<std::uint8_t>(s, n, out), true;
+        return &read_sites<std::uint8_t>;
       case 2:
-        return read_zeros<std::uint16_t>(s, n, out), true;
+        return &read_sites<std::uint16_t>;
       case 4:
-        return read_zeros<std::uint32_t>(s, n, out), true;
+        return &read_sites<std::uint32_t>;
       case 8:
-        return read_zeros<std::uint64_t>(s, n, out), true;
+        return &read_sites<std::uint64_t>;
     }
   }
-  if (kind == 'f' && size == 4) return read_zeros<float>(s, n, out), true;
-  if (kind == 'f' && size == 8) return read_zeros<double>(s, n, out), true;
-  return false;  // the Python side converts other dtypes with input != 0
+  if (kind == 'f' && size == 4) return &read_sites<float>;
+  if (kind == 'f' && size == 8) return &read_sites<double>;
+  return nullptr;
 }
 
-// Calls f(x, y, z, value) for every voxel of `box` (which starts at the origin) in `grid`, chunk
-// by chunk in parallel: the field's own chunks are read in place, never copied densely.
+// Calls row(y, z, x_begin, x_end, values) for every row of `box` (which starts at the origin) in
+// `grid`, chunk by chunk in parallel; `values` points at the row's stored values from x_begin on,
+// or is null when the chunk is uniform (its value is then grid.chunk_view(...).uniform_value,
+// passed as `uniform`). The field's own chunks are read in place, never copied densely.
 template <class T, class F>
-void for_each_voxel(const Grid<T>& grid, const Box3i& box, F&& f) {
+void for_each_row(const Grid<T>& grid, const Box3i& box, F&& row) {
   const int edge = grid.chunk_edge();
-  const Vec3i chunks{(box.end.x + edge - 1) / edge, (box.end.y + edge - 1) / edge,
-                     (box.end.z + edge - 1) / edge};
-  const std::size_t chunk_count = static_cast<std::size_t>(chunks.x) * chunks.y * chunks.z;
-  parallel_for(chunk_count, 1, [&](std::size_t b, std::size_t e) {
+  const std::vector<Vec3i> coords = chunks_covering(box, edge);
+  parallel_for(coords.size(), 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t c = b; c < e; ++c) {
-      const Vec3i coord{static_cast<int>(c % chunks.x), static_cast<int>(c / chunks.x % chunks.y),
-                        static_cast<int>(c / chunks.x / chunks.y)};
-      const ChunkView<T> view = grid.chunk_view(coord);
+      const ChunkView<T> view = grid.chunk_view(coords[c]);
       const Box3i cb = view.box.intersect(box);
       for (int z = cb.begin.z; z < cb.end.z; ++z)
-        for (int y = cb.begin.y; y < cb.end.y; ++y)
-          for (int x = cb.begin.x; x < cb.end.x; ++x)
-            f(x, y, z,
-              view.uniform()
-                  ? view.uniform_value
-                  : view.voxels[(x - view.box.begin.x) +
-                                edge * ((y - view.box.begin.y) + edge * (z - view.box.begin.z))]);
+        for (int y = cb.begin.y; y < cb.end.y; ++y) {
+          const T* values =
+              view.uniform() ? nullptr
+                             : view.voxels + (cb.begin.x - view.box.begin.x) +
+                                   edge * ((y - view.box.begin.y) + edge * (z - view.box.begin.z));
+          row(y, z, cb.begin.x, cb.end.x, values, view.uniform_value);
+        }
     }
   });
+}
+
+// Writes out[x] = value(x) for x in [x0, x1) of one output row (`stride` bytes apart; constant
+// for contiguous outputs, so the loop vectorises there).
+template <class Out, class F>
+inline void write_row(char* row, py::ssize_t stride, int x0, int x1, F&& value) {
+  if (stride == static_cast<py::ssize_t>(sizeof(Out))) {
+    for (int x = x0; x < x1; ++x) {
+      const Out v = value(x);
+      std::memcpy(row + x * static_cast<py::ssize_t>(sizeof(Out)), &v, sizeof v);
+    }
+  } else {
+    for (int x = x0; x < x1; ++x) {
+      const Out v = value(x);
+      std::memcpy(row + x * stride, &v, sizeof v);
+    }
+  }
 }
 
 // The distances from the field's values (see distance_transform).
@@ -128,23 +176,60 @@ void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, 
   // Integer storage saturates at its range: a stored extreme is "beyond", as +inf in f32.
   const double saturated =
       std::is_integral_v<T> ? encoding.decode(std::numeric_limits<T>::max()) : INFINITY;
-  for_each_voxel(values, box, [&](int x, int y, int z, T stored) {
-    const double v = encoding.decode(static_cast<double>(stored));
-    const double sign = v < 0 ? -1.0 : 1.0;
-    double a = std::abs(v);
-    if (a >= saturated) a = INFINITY;
-    char* p = dist.data + z * dist.strides[0] + y * dist.strides[1] + x * dist.strides[2];
-    if (metric == Metric::kEuclidean) {
-      double d = clamp;
-      // A clamped element reads float(D), which may round below D: anything at or above
-      // float(D) is the clamp (a true distance that close to D differs from it by < 1 float ulp).
-      if (a < clamp_f32) d = std::min(std::sqrt(std::nearbyint(a * a)), clamp);
-      d *= sign;
-      std::memcpy(p, &d, 8);
+  // f32 storage holds the distance itself (scale 1, bias 0): no per-element division.
+  const bool identity = encoding.scale == 1 && encoding.bias == 0;
+  const auto magnitude = [&](T stored, double& sign) {
+    const double v = std::is_floating_point_v<T> && identity
+                         ? static_cast<double>(stored)
+                         : encoding.decode(static_cast<double>(stored));
+    sign = v < 0 ? -1.0 : 1.0;
+    const double a = std::abs(v);
+    return a >= saturated ? INFINITY : a;
+  };
+  const auto euclidean = [&](T stored) {
+    double sign;
+    const double a = magnitude(stored, sign);
+    double d = clamp;
+    // A clamped element reads float(D), which may round below D: anything at or above float(D)
+    // is the clamp (a true distance that close to D differs from it by < 1 float ulp).
+    if (a < clamp_f32) d = std::min(std::sqrt(std::nearbyint(a * a)), clamp);
+    return d * sign;
+  };
+  const auto integer = [&](T stored) {
+    double sign;
+    const double a = magnitude(stored, sign);
+    // No zero element anywhere: -1 (SciPy leaves -1 there too).
+    return std::isfinite(a) ? static_cast<std::int32_t>(sign * std::min(a, clamp))
+                            : std::int32_t{-1};
+  };
+  // Integer metrics in integer storage: every stored value's output, decoded once (at most 2^16
+  // of them) and looked up per element.
+  std::vector<std::int32_t> table;
+  if constexpr (std::is_integral_v<T>) {
+    if (metric != Metric::kEuclidean) {
+      table.resize(std::size_t{std::numeric_limits<T>::max()} + 1);
+      for (std::size_t v = 0; v < table.size(); ++v) table[v] = integer(static_cast<T>(v));
+    }
+  }
+  for_each_row(values, box, [&](int y, int z, int x0, int x1, const T* row, T uniform) {
+    char* out = dist.data + z * dist.strides[0] + y * dist.strides[1];
+    if (!table.empty() && row) {
+      write_row<std::int32_t>(out, dist.strides[2], x0, x1,
+                              [&](int x) { return table[row[x - x0]]; });
+    } else if (metric == Metric::kEuclidean) {
+      if (!row) {
+        const double d = euclidean(uniform);
+        write_row<double>(out, dist.strides[2], x0, x1, [&](int) { return d; });
+      } else {
+        write_row<double>(out, dist.strides[2], x0, x1,
+                          [&](int x) { return euclidean(row[x - x0]); });
+      }
+    } else if (!row) {
+      const std::int32_t d = integer(uniform);
+      write_row<std::int32_t>(out, dist.strides[2], x0, x1, [&](int) { return d; });
     } else {
-      std::int32_t d = -1;  // no zero element anywhere (SciPy leaves -1 there too)
-      if (std::isfinite(a)) d = static_cast<std::int32_t>(sign * std::min(a, clamp));
-      std::memcpy(p, &d, 4);
+      write_row<std::int32_t>(out, dist.strides[2], x0, x1,
+                              [&](int x) { return integer(row[x - x0]); });
     }
   });
 }
@@ -177,12 +262,13 @@ void distance_transform(const py::array& input, const std::string& metric_name,
   if (count == 0) return;  // an empty array: empty outputs, as SciPy's
   if (!distances && !indices)
     throw InvalidArgument("voxfield.ndimage: neither distances nor indices asked for");
-  // The peak beside the outputs: the input's zeros and their grid (1 byte each), the field
-  // (4 bytes) and its nearest sites when computed (6 bytes).
-  require_memory(mul_sat(count, 1 + 1 + 4 + (indices || metric == Metric::kEuclidean ? 6 : 0)), 0,
+  // The peak beside the outputs: the input's zeros as a grid (1 byte each), the field (4 bytes)
+  // and its nearest sites when computed (6 bytes).
+  require_memory(mul_sat(count, 1 + 4 + (indices || metric == Metric::kEuclidean ? 6 : 0)), 0,
                  "voxfield.ndimage", "a transform of " + std::to_string(count) + " elements");
-  std::vector<std::uint8_t> zeros(count);
-  if (!read_input(input, n, zeros)) throw InvalidArgument("voxfield.ndimage: unsupported dtype");
+  const SiteReader read = reader_for(input);
+  if (!read) throw InvalidArgument("voxfield.ndimage: unsupported dtype");
+  const Strided in = strided(input);  // the caller holds the array: its memory outlives the call
 
   py::gil_scoped_release release;
   std::optional<ThreadLimit> limit;
@@ -190,7 +276,7 @@ void distance_transform(const py::array& input, const std::string& metric_name,
   const Box3i box =
       Box3i::from_size({static_cast<int>(n[2]), static_cast<int>(n[1]), static_cast<int>(n[0])});
   Grid<std::uint8_t> occupancy(32, 0, box);
-  occupancy.copy_from_dense(box, zeros.data());
+  read(in, box, occupancy);
 
   DistanceOptions o;
   o.metric = metric;
@@ -242,48 +328,64 @@ void distance_transform(const py::array& input, const std::string& metric_name,
     for (int i = 0; i < nd; ++i) idx.strides[3 - nd + i] = indices->strides(i + 1);
   }
   const double clamp = max_distance > 0 ? max_distance : INFINITY;
-  for_each_voxel(sites, box, [&](int x, int y, int z, const SiteOffset o) {
-    // NumPy's axes 0, 1, 2 are voxfield's z, y, x.
-    const py::ssize_t a0 = z, a1 = y, a2 = x;
-    const std::size_t i = static_cast<std::size_t>((a0 * n[1] + a1) * n[2] + a2);
-    const bool site = zeros[i] != 0;
-    const double sign = signed_distance && site ? -1.0 : 1.0;
-    const std::array<py::ssize_t, 3> off{o.none() ? 0 : o.dz, o.none() ? 0 : o.dy,
-                                         o.none() ? 0 : o.dx};
-    if (distances) {
-      char* p = dist.data + a0 * dist.strides[0] + a1 * dist.strides[1] + a2 * dist.strides[2];
-      if (metric == Metric::kEuclidean) {
-        double d = clamp;
-        if (!o.none()) {
-          // SciPy's order: each axis' offset times its sampling, squared, summed from axis 0.
-          const double t0 = off[0] * s[0], t1 = off[1] * s[1], t2 = off[2] * s[2];
-          d = std::min(std::sqrt(t0 * t0 + t1 * t1 + t2 * t2), clamp);
+  const int edge = occupancy.chunk_edge();  // the field's grids share the world's chunks
+  for_each_row(
+      sites, box, [&](int y, int z, int x0, int x1, const SiteOffset* row, SiteOffset uniform) {
+        const auto offset_at = [&](int x) { return row ? row[x - x0] : uniform; };
+        // The element's own occupancy (a zero element is a site: negative when signed).
+        const ChunkView<std::uint8_t> occ = occupancy.chunk_view(occupancy.chunk_of({x0, y, z}));
+        const std::uint8_t* occ_row =
+            occ.uniform() ? nullptr
+                          : occ.voxels + (x0 - occ.box.begin.x) +
+                                edge * ((y - occ.box.begin.y) + edge * (z - occ.box.begin.z));
+        const auto sign_at = [&](int x) {
+          const bool site = occ_row ? occ_row[x - x0] != 0 : occ.uniform_value != 0;
+          return signed_distance && site ? -1.0 : 1.0;
+        };
+        // NumPy's axes 0, 1, 2 are voxfield's z, y, x.
+        if (distances) {
+          char* out = dist.data + z * dist.strides[0] + y * dist.strides[1];
+          if (metric == Metric::kEuclidean) {
+            write_row<double>(out, dist.strides[2], x0, x1, [&](int x) {
+              const SiteOffset o = offset_at(x);
+              double d = clamp;
+              if (!o.none()) {
+                // SciPy's order: each axis' offset times its sampling, squared, summed from axis 0.
+                const double t0 = o.dz * s[0], t1 = o.dy * s[1], t2 = o.dx * s[2];
+                d = std::min(std::sqrt(t0 * t0 + t1 * t1 + t2 * t2), clamp);
+              }
+              return d * sign_at(x);
+            });
+          } else {
+            write_row<std::int32_t>(out, dist.strides[2], x0, x1, [&](int x) {
+              const SiteOffset o = offset_at(x);
+              std::int32_t d = -1;  // no zero element anywhere (SciPy leaves -1 there too)
+              if (!o.none()) {
+                const int u = std::abs(o.dz), v = std::abs(o.dy), w = std::abs(o.dx);
+                const int m = metric == Metric::kManhattan ? u + v + w : std::max({u, v, w});
+                d = static_cast<std::int32_t>(std::min<double>(m, clamp));
+              } else if (max_distance > 0) {
+                d = static_cast<std::int32_t>(max_distance);
+              }
+              return static_cast<std::int32_t>(sign_at(x) * d);
+            });
+          }
         }
-        d *= sign;
-        std::memcpy(p, &d, 8);
-      } else {
-        std::int32_t d = -1;  // no zero element anywhere (SciPy leaves -1 there too)
-        if (!o.none()) {
-          const std::int64_t u = std::abs(off[0]), v = std::abs(off[1]), w = std::abs(off[2]);
-          const std::int64_t m = metric == Metric::kManhattan ? u + v + w : std::max({u, v, w});
-          d = static_cast<std::int32_t>(std::min<double>(static_cast<double>(m), clamp));
-        } else if (max_distance > 0) {
-          d = static_cast<std::int32_t>(max_distance);
+        if (indices) {
+          // indices[k] holds the coordinate along the input's axis k (padded axis 3 - nd + k).
+          for (int k = 0; k < nd; ++k) {
+            const int axis = 3 - nd + k;
+            char* out = idx.data + k * idx_axis_stride + z * idx.strides[0] + y * idx.strides[1];
+            write_row<std::int32_t>(out, idx.strides[2], x0, x1, [&](int x) {
+              const SiteOffset o = offset_at(x);
+              if (o.none()) return std::int32_t{-1};
+              return static_cast<std::int32_t>(axis == 0   ? z + o.dz
+                                               : axis == 1 ? y + o.dy
+                                                           : x + o.dx);
+            });
+          }
         }
-        d = static_cast<std::int32_t>(sign * d);
-        std::memcpy(p, &d, 4);
-      }
-    }
-    if (indices) {
-      const std::array<py::ssize_t, 3> at{a0, a1, a2};
-      char* base = idx.data + a0 * idx.strides[0] + a1 * idx.strides[1] + a2 * idx.strides[2];
-      for (int k = 0; k < nd; ++k) {
-        const int axis = 3 - nd + k;
-        const std::int32_t v = o.none() ? -1 : static_cast<std::int32_t>(at[axis] + off[axis]);
-        std::memcpy(base + k * idx_axis_stride, &v, 4);
-      }
-    }
-  });
+      });
 }
 
 }  // namespace

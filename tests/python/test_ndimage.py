@@ -158,6 +158,20 @@ def test_max_distance_clamps():
     assert zero[tuple(i[near] for i in idx)].all()
 
 
+@pytest.mark.parametrize("metric", ["taxicab", "chessboard"])
+@pytest.mark.parametrize("order", ["C", "view"])
+def test_cdt_distances_clamped_across_chunks(metric, order):
+    # Distances only (written from the field's stored values, not its sites), over a volume of
+    # several 32^3 chunks, most of them entirely at the clamp (stored as one value), from a
+    # reversed, strided view of the input.
+    base = random_volume((140, 75, 70), density=0.9995)
+    a = {"C": base[:70], "view": base[::2, ::-1, 3:]}[order]
+    got = vn.distance_transform_cdt(a, metric=metric, max_distance=6)
+    np.testing.assert_array_equal(got, np.minimum(sn.distance_transform_cdt(a, metric=metric), 6))
+    signed = vn.distance_transform_cdt(a, metric=metric, max_distance=6, signed=True)
+    np.testing.assert_array_equal(signed, np.where(a != 0, got, -1))
+
+
 def test_threads_do_not_change_results():
     a = random_volume((64, 48, 40), density=0.995)
     one = vn.distance_transform_edt(a, threads=1, return_indices=True)
