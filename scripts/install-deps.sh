@@ -20,7 +20,7 @@ packages=(
   libmeshoptimizer-dev               # mesh simplification and vertex-cache ordering (voxfield mesh --simplify)
   libjemalloc-dev                    # the programs' allocator: jemalloc on transparent huge pages (apps/common/huge_page_allocator.cpp)
   libgtest-dev                       # tests
-  clang libclang-rt-14-dev           # the sanitizer presets (ASan + UBSan, TSan) and the fuzz preset (libFuzzer)
+  clang libclang-rt-14-dev           # the asan-ubsan preset and the fuzz preset (libFuzzer)
   clang-format                       # the format check (scripts/check_format.sh, a test)
   python3 python3-numpy python3-scipy python3-pil # test oracles: NumPy reads and writes .npy, SciPy's distance transforms, Pillow reads PNG frames
   python3-skimage                    # test oracle: scikit-image's marching_cubes for the meshers
