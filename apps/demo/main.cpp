@@ -64,10 +64,13 @@ Demo::Demo(const Options& o) : options_(o) {
   // Presses are queued from the callbacks, so a click or a key tap shorter than a frame (frames
   // are slow on software Vulkan) is never lost between two polls of the button state.
   // Ctrl+Q quits as the window's close button does (the frame loop ends, --csv is complete); the
-  // press's own modifiers are checked, since Ctrl may be up again by the next frame.
-  glfwSetKeyCallback(glfw(), [](GLFWwindow* w, int key, int, int action, int mods) {
+  // press's own modifiers are checked, since Ctrl may be up again by the next frame. Q is the key
+  // the keyboard layout calls "q" (Ctrl+A's place on AZERTY), the US position where it has no name.
+  glfwSetKeyCallback(glfw(), [](GLFWwindow* w, int key, int scancode, int action, int mods) {
     if (action != GLFW_PRESS) return;
-    if (key == GLFW_KEY_Q && (mods & GLFW_MOD_CONTROL) != 0) glfwSetWindowShouldClose(w, GLFW_TRUE);
+    const char* name = glfwGetKeyName(key, scancode);
+    const bool q = name ? std::strcmp(name, "q") == 0 : key == GLFW_KEY_Q;
+    if (q && (mods & GLFW_MOD_CONTROL) != 0) glfwSetWindowShouldClose(w, GLFW_TRUE);
     static_cast<Demo*>(glfwGetWindowUserPointer(w))->keys_pressed_.push_back(key);
   });
   glfwSetMouseButtonCallback(glfw(), [](GLFWwindow* w, int button, int action, int) {

@@ -83,7 +83,7 @@ void read_sites(const Strided& in, const Box3i& box, Grid<std::uint8_t>& occupan
   occupancy.generate_chunks(chunks_covering(box, edge), [&](Vec3i coord, std::uint8_t* voxels) {
     const Box3i cb = occupancy.chunk_box(coord);
     const Box3i part = cb.intersect(box);
-    if (part != cb) std::fill(voxels, voxels + volume, std::uint8_t{0});
+    if (part != cb) std::fill(voxels, voxels + volume, std::uint8_t{0});  // beyond: no site
     const int run = part.end.x - part.begin.x;
     for (int z = part.begin.z; z < part.end.z; ++z)
       for (int y = part.begin.y; y < part.end.y; ++y) {
@@ -168,9 +168,7 @@ inline void write_row(char* row, py::ssize_t stride, int x0, int x1, F&& value) 
 // The distances from the field's values (see distance_transform).
 template <class T>
 void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, const Box3i& box,
-                       Metric metric, double max_distance, py::array& distances) {
-  Strided dist = strided(distances);
-  dist.data = static_cast<char*>(distances.mutable_data());
+                       Metric metric, double max_distance, const Strided& dist) {
   const double clamp = max_distance > 0 ? max_distance : INFINITY;
   const double clamp_f32 = static_cast<double>(static_cast<float>(clamp));
   // Integer storage saturates at its range: a stored extreme is "beyond", as +inf in f32.
@@ -203,10 +201,11 @@ void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, 
                             : std::int32_t{-1};
   };
   // Integer metrics in integer storage: every stored value's output, decoded once (at most 2^16
-  // of them) and looked up per element.
+  // of them) and looked up per element, where the volume has more elements than the table.
   std::vector<std::int32_t> table;
   if constexpr (std::is_integral_v<T>) {
-    if (metric != Metric::kEuclidean) {
+    if (metric != Metric::kEuclidean &&
+        box.volume() > std::int64_t{std::numeric_limits<T>::max()} + 1) {
       table.resize(std::size_t{std::numeric_limits<T>::max()} + 1);
       for (std::size_t v = 0; v < table.size(); ++v) table[v] = integer(static_cast<T>(v));
     }
@@ -262,19 +261,36 @@ void distance_transform(const py::array& input, const std::string& metric_name,
   if (count == 0) return;  // an empty array: empty outputs, as SciPy's
   if (!distances && !indices)
     throw InvalidArgument("voxfield.ndimage: neither distances nor indices asked for");
-  // The peak beside the outputs: the input's zeros as a grid (1 byte each), the field (4 bytes)
-  // and its nearest sites when computed (6 bytes).
-  require_memory(mul_sat(count, 1 + 4 + (indices || metric == Metric::kEuclidean ? 6 : 0)), 0,
+  const Box3i box =
+      Box3i::from_size({static_cast<int>(n[2]), static_cast<int>(n[1]), static_cast<int>(n[0])});
+  // The peak beside the outputs, per element of the chunks covering the volume (whole 32^3 chunks:
+  // a thin volume is stored in far more elements than it has): the input's zeros as a grid (1
+  // byte), the field (4 bytes) and its nearest sites when computed (6 bytes).
+  const std::size_t stored = chunks_covering(box, 32).size() * std::size_t{32 * 32 * 32};
+  require_memory(mul_sat(stored, 1 + 4 + (indices || metric == Metric::kEuclidean ? 6 : 0)), 0,
                  "voxfield.ndimage", "a transform of " + std::to_string(count) + " elements");
   const SiteReader read = reader_for(input);
   if (!read) throw InvalidArgument("voxfield.ndimage: unsupported dtype");
-  const Strided in = strided(input);  // the caller holds the array: its memory outlives the call
+  // Every array's address and strides are read while the GIL is held; the caller holds the arrays,
+  // so their memory outlives the call.
+  const Strided in = strided(input);
+  Strided dist{nullptr};
+  if (distances) {
+    dist = strided(*distances);
+    dist.data = static_cast<char*>(distances->mutable_data());
+  }
+  Strided idx{nullptr};
+  py::ssize_t idx_axis_stride = 0;
+  if (indices) {
+    // indices has shape (ndim,) + shape: its first axis selects the coordinate.
+    idx.data = static_cast<char*>(indices->mutable_data());
+    idx_axis_stride = indices->strides(0);
+    for (int i = 0; i < nd; ++i) idx.strides[3 - nd + i] = indices->strides(i + 1);
+  }
 
   py::gil_scoped_release release;
   std::optional<ThreadLimit> limit;
   if (threads > 0) limit.emplace(threads);
-  const Box3i box =
-      Box3i::from_size({static_cast<int>(n[2]), static_cast<int>(n[1]), static_cast<int>(n[0])});
   Grid<std::uint8_t> occupancy(32, 0, box);
   read(in, box, occupancy);
 
@@ -305,7 +321,7 @@ void distance_transform(const py::array& input, const std::string& metric_name,
   if (from_values) {
     std::visit(
         [&](const auto& grid) {
-          write_from_values(grid, field.encoding, box, metric, max_distance, *distances);
+          write_from_values(grid, field.encoding, box, metric, max_distance, dist);
         },
         field.values);
     return;
@@ -314,19 +330,6 @@ void distance_transform(const py::array& input, const std::string& metric_name,
   // at 256^3 that copy was 100 MB of fresh pages).
   const Grid<SiteOffset>& sites = *field.sites;
   const std::array<double, 3> s{spacing[2], spacing[1], spacing[0]};  // NumPy axes 0, 1, 2
-  Strided dist{nullptr};
-  if (distances) {
-    dist = strided(*distances);
-    dist.data = static_cast<char*>(distances->mutable_data());
-  }
-  Strided idx{nullptr};
-  py::ssize_t idx_axis_stride = 0;
-  if (indices) {
-    // indices has shape (ndim,) + shape: its first axis selects the coordinate.
-    idx.data = static_cast<char*>(indices->mutable_data());
-    idx_axis_stride = indices->strides(0);
-    for (int i = 0; i < nd; ++i) idx.strides[3 - nd + i] = indices->strides(i + 1);
-  }
   const double clamp = max_distance > 0 ? max_distance : INFINITY;
   const int edge = occupancy.chunk_edge();  // the field's grids share the world's chunks
   for_each_row(
