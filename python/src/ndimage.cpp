@@ -266,7 +266,9 @@ void distance_transform(const py::array& input, const std::string& metric_name,
   // The peak beside the outputs, per element of the chunks covering the volume (whole 32^3 chunks:
   // a thin volume is stored in far more elements than it has): the input's zeros as a grid (1
   // byte), the field (4 bytes) and its nearest sites when computed (6 bytes).
-  const std::size_t stored = chunks_covering(box, 32).size() * std::size_t{32 * 32 * 32};
+  const auto chunks_along = [](py::ssize_t e) { return static_cast<std::size_t>((e + 31) / 32); };
+  const std::size_t stored =
+      mul_sat(mul_sat(chunks_along(n[0]) * chunks_along(n[1]), chunks_along(n[2])), 32 * 32 * 32);
   require_memory(mul_sat(stored, 1 + 4 + (indices || metric == Metric::kEuclidean ? 6 : 0)), 0,
                  "voxfield.ndimage", "a transform of " + std::to_string(count) + " elements");
   const SiteReader read = reader_for(input);
