@@ -4,7 +4,10 @@ threads; medians of RUNS timed calls after a warm-up, min-max in brackets. Check
 SciPy's before timing. Also times the C++ transform alone (the CLI's `field --stats` is not used:
 this measures the Python call's overhead over voxfield's own work).
 
-Usage: PYTHONPATH=build/release/python /usr/bin/python3 bench/peers/ndimage_bench.py [RUNS]
+Usage: PYTHONPATH=build/release/python /usr/bin/python3 bench/peers/ndimage_bench.py [RUNS] [--voxfield-only]
+
+--voxfield-only times voxfield alone (the results are still checked against SciPy's first): run it
+with two builds' PYTHONPATH in turn, alternated, to compare one binding against another.
 """
 
 import statistics
@@ -32,7 +35,9 @@ def fmt(t):
 
 
 def main():
-    runs = int(sys.argv[1]) if len(sys.argv) > 1 else 3
+    args = [a for a in sys.argv[1:] if a != "--voxfield-only"]
+    voxfield_only = len(args) != len(sys.argv) - 1
+    runs = int(args[0]) if args else 3
     rng = np.random.default_rng(6683787)
     n = 256
     z, y, x = np.ogrid[:n, :n, :n]
@@ -44,8 +49,12 @@ def main():
         c = rng.integers(20, n - 20, 3)
         r = rng.integers(6, 24)
         volumes["spheres-256 (zeros outside 40 balls)"] |= (z - c[0]) ** 2 + (y - c[1]) ** 2 + (x - c[2]) ** 2 < r * r
-    print("| volume | call | scipy ms | voxfield 1 thread ms | voxfield 2 threads ms | scipy / voxfield 1 | scipy / voxfield 2 |")
-    print("|---|---|---|---|---|---|---|")
+    if voxfield_only:
+        print("| volume | call | voxfield 1 thread ms | voxfield 2 threads ms |")
+        print("|---|---|---|---|")
+    else:
+        print("| volume | call | scipy ms | voxfield 1 thread ms | voxfield 2 threads ms | scipy / voxfield 1 | scipy / voxfield 2 |")
+        print("|---|---|---|---|---|---|---|")
     for name, a in volumes.items():
         cases = [
             ("edt", lambda: sn.distance_transform_edt(a), lambda t: vn.distance_transform_edt(a, threads=t)),
@@ -59,9 +68,12 @@ def main():
             w0 = want[0] if isinstance(want, tuple) else want
             g0 = got[0] if isinstance(got, tuple) else got
             assert np.array_equal(w0, g0), f"{name} {call}: results differ"
-            s = timed(ref, runs)
+            s = None if voxfield_only else timed(ref, runs)
             v1 = timed(lambda: ours(1), runs)
             v2 = timed(lambda: ours(2), runs)
+            if voxfield_only:
+                print(f"| {name} | {call} | {fmt(v1)} | {fmt(v2)} |", flush=True)
+                continue
             print(f"| {name} | {call} | {fmt(s)} | {fmt(v1)} | {fmt(v2)} | {s[0] / v1[0]:.1f}× | {s[0] / v2[0]:.1f}× |",
                   flush=True)
 
