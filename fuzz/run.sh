@@ -16,7 +16,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-25}; shift || true
-harnesses=${*:-"vox npy vfw edit_script options vector_sources csg_model openscad mesh"}
+harnesses=${*:-"vox npy vfw vdb edit_script options vector_sources csg_model openscad mesh"}
 bin=build/fuzz/bin
 cli=build/release/bin/voxfield
 corpus=../shared/data/vox
@@ -25,14 +25,21 @@ mkdir -p "$out"
 
 seeds="$out/seeds"
 max_seed=8192
-mkdir -p "$seeds/vox" "$seeds/npy" "$seeds/vfw"
+mkdir -p "$seeds/vox" "$seeds/npy" "$seeds/vfw" "$seeds/vdb"
 find "$corpus" -name '*.vox' -size -$((max_seed + 1))c -exec cp {} "$seeds/vox/" \;
 for m in ephtracy_chr_cat ephtracy_chr_knight mmmm_chr_mayor vengi_robo ephtracy_snow; do
   for ext in npy vfw; do
     [ -s "$seeds/$ext/$m.$ext" ] || "$cli" convert "$corpus/$m.vox" "$seeds/$ext/$m.$ext" >/dev/null 2>&1
     [ "$(stat -c %s "$seeds/$ext/$m.$ext")" -le $max_seed ] || rm "$seeds/$ext/$m.$ext"
   done
+  # .vdb seeds: a world's Int32 grid and a signed field's level set, as voxfield writes them
+  # (OpenVDB's writer: Blosc, active-mask compression); a top node alone is kilobytes, so their
+  # cap is higher.
+  [ -s "$seeds/vdb/$m.vdb" ] || "$cli" convert "$corpus/$m.vox" "$seeds/vdb/$m.vdb" >/dev/null 2>&1
+  [ -s "$seeds/vdb/$m-sdf.vdb" ] ||
+    "$cli" field "$corpus/$m.vox" -o "$seeds/vdb/$m-sdf.vdb" --signed --max-distance 3 >/dev/null 2>&1
 done
+find "$seeds/vdb" -size +$((4 * max_seed))c -delete
 
 # One harness: its seeds, its scratch corpus, its log; a finding prints the log's tail and fails.
 run_one() {
@@ -41,6 +48,7 @@ run_one() {
     vox) dirs="$seeds/vox"; max_len=$max_seed ;;
     npy) dirs="$seeds/npy"; max_len=$max_seed ;;
     vfw) dirs="$seeds/vfw"; max_len=$max_seed ;;
+    vdb) dirs="$seeds/vdb"; max_len=$((4 * max_seed)) ;;
     edit_script) dirs="fuzz/seeds/edit_script"; max_len=4096 ;;
     options) dirs="fuzz/seeds/options"; max_len=256 ;;
     vector_sources) dirs="fuzz/seeds/vector_sources"; max_len=4096 ;;

@@ -28,6 +28,7 @@ packages=(
   python3-dev pybind11-dev python3-pytest  # the Python package (pybind11 bindings) and its tests
   python3-venv python3-setuptools python3-wheel  # pip install --no-build-isolation . (and its test)
   libopenmpi-dev openmpi-bin         # voxfield-mpi and the mpi layer: Open MPI, Debian's MPI
+  libblosc-dev                       # Blosc, which .vdb files are compressed with (voxfield's own .vdb reader)
   libopenvdb-dev libboost-dev python3-openvdb  # .vdb files (OpenVDB; its headers need Boost's), and the tests' oracle (pyopenvdb)
   python3-mypy  # checks the package's type stubs against the module (mypy.stubtest) and a typed use of them
   chromium                           # the report page's test: headless Chromium opens it and screenshots the mesh viewer

@@ -4,7 +4,9 @@ A real MagicaVoxel file's distance fields are written by the CLI as .vdb and as 
 run; pyopenvdb must see a level set (signed) or a scalar grid (unsigned) with the documented
 background, voxel size and metadata, holding at every voxel of the domain the .npy's distance
 (for a level set, less half a voxel: the distance to the surface midway between voxel centres).
-Reading .vdb is refused with the reason, and a failed command writes nothing.
+voxfield reads .vdb back with its own parser: the world file as the world it came from, and a
+level set pyopenvdb writes as its inside; a truncated file is refused naming the file, and a failed
+command writes nothing.
 
 Usage: vdb_oracle_test.py VOXFIELD_BINARY VOX_FILE WORK_DIR
 """
@@ -130,15 +132,39 @@ for ijk in [(0, 0, 0), (13, 0, 0), (0, 10, 0), (0, 0, 8), (13, 10, 8), (5, 7, 2)
 check(worst < 1e-9, f"vectors: the transform is {worst} away from the voxel centres")
 
 # A world is an Int32 grid, which pyopenvdb cannot open (tests/test_vdb.cpp checks it with
-# OpenVDB's C++ reader); here it is only written, then refused as an input.
+# OpenVDB's C++ reader); voxfield reads it back as the world it came from.
 world = os.path.join(WORK, "world.vdb")
 run("convert", VOX, world)
-check(os.path.getsize(world) > 0, "world: written")
+run("convert", world, os.path.join(WORK, "world-back.npy"))
+run("convert", VOX, os.path.join(WORK, "world-direct.npy"))
+back, direct = np.load(os.path.join(WORK, "world-back.npy")), np.load(os.path.join(WORK, "world-direct.npy"))
+check(back.shape == direct.shape and np.array_equal(back, direct), "world: .vdb read back differs")
 
-# Reading .vdb: refused with the reason; a failed command writes nothing.
+# A level set pyopenvdb writes (Blosc, active-mask compression, a 0.5 voxel size): voxfield's world
+# from it is its inside, value < 0, as pyopenvdb's own dense copy says.
+sphere = vdb.createLevelSetSphere(radius=6.0, center=(1.0, -2.0, 0.5), voxelSize=0.5, halfWidth=3.0)
+sphere.name = "sphere"
+sphere_path = os.path.join(WORK, "sphere.vdb")
+vdb.write(sphere_path, grids=[sphere])
+run("convert", sphere_path, os.path.join(WORK, "sphere.npy"))
+lo, hi = sphere.evalActiveVoxelBoundingBox()
+dense = np.zeros([hi[i] - lo[i] + 1 for i in range(3)], dtype=np.float32)
+sphere.copyToArray(dense, ijk=lo)  # dense[i, j, k] is voxel lo + (i, j, k)
+inside = (dense < 0).astype(np.uint8)
+nz = np.nonzero(inside)  # voxfield's .npy of a world without a recorded extent covers its content
+inside = inside[nz[0].min():nz[0].max() + 1, nz[1].min():nz[1].max() + 1, nz[2].min():nz[2].max() + 1]
+got = np.load(os.path.join(WORK, "sphere.npy"))  # voxfield's .npy: [z, y, x] over the content
+check(got.shape == inside.T.shape and np.array_equal(got != 0, inside.T != 0),
+      f"sphere: voxfield's inside {got.shape} {int((got != 0).sum())} voxels, pyopenvdb's "
+      f"{inside.T.shape} {int(inside.sum())}")
+
+# A truncated .vdb: refused naming the file; a failed command writes nothing.
+cut = os.path.join(WORK, "cut.vdb")
+with open(world, "rb") as f, open(cut, "wb") as g:
+    g.write(f.read()[: os.path.getsize(world) // 2])
 out = os.path.join(WORK, "never.npy")
-p = run("convert", world, out, ok=False)
-check(p.returncode == 1 and "does not read them yet" in p.stderr, f"reading .vdb: {p.returncode} {p.stderr}")
+p = run("convert", cut, out, ok=False)
+check(p.returncode == 1 and cut in p.stderr and "at byte" in p.stderr, f"cut .vdb: {p.returncode} {p.stderr}")
 check(not os.path.exists(out), "a failed convert wrote its output")
 # A clamp within half a voxel of the surface is refused by the writer, after the field is computed.
 p = run("field", VOX, "--signed", "--max-distance", "0.4", "-o", os.path.join(WORK, "never.vdb"),

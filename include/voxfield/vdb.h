@@ -21,12 +21,19 @@
 //    fog volume is a density, and a distance is not one), background as above.
 // Fields carry voxfield's metric, clamp, storage and domain in their metadata.
 //
-// Reading .vdb files is not offered: OpenVDB 10's reader aborts the process (std::terminate) or
-// corrupts its heap on truncated files, so it cannot be handed untrusted bytes; docs/interop.md.
+// Reading: voxfield's own parser (vdb_read*.cpp), not OpenVDB's, whose reader aborts the process
+// (std::terminate) or corrupts its heap on truncated files and so cannot be handed untrusted
+// bytes (docs/interop.md). It reads OpenVDB file formats 222 to 225 (OpenVDB 3 to 12): Float,
+// Double, Bool, Int32 and Vec3f grids of any node configuration, uncompressed, zip or Blosc,
+// with active-mask compression and half floats, shared (instanced) trees, and the affine family
+// of transforms; every count, size and offset is checked against the bytes and the memory limit.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <filesystem>
+#include <map>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -57,5 +64,102 @@ std::vector<std::uint8_t> encode_vdb_vectors(const VectorVolume& volume,
 // resolution is the box's size) on the world's lattice, as encode_vdb_world places voxels.
 // Throws InvalidArgument for a texture of another size.
 std::vector<std::uint8_t> encode_vdb_world_vectors(const Box3i& box, const VectorTexture& texture);
+
+// ---------------------------------------------------------------------------------------------
+// Reading
+
+enum class VdbValueType { kFloat, kDouble, kBool, kInt32, kVec3f };
+const char* vdb_value_type_name(VdbValueType t);  // "float", "double", "bool", "int32", "vec3s"
+
+// A metadata item: its OpenVDB type name ("string", "int32", "vec3i", "double"...), the text of
+// a string, the numbers of a number or vector (bools as 0 / 1); unknown types keep neither.
+struct VdbMetadata {
+  std::string type;
+  std::string text;
+  std::vector<double> numbers;
+};
+
+// A constant region of the tree: a root tile or an internal node's value slot, an axis-aligned
+// cube of `edge` voxels from `origin`. Slots holding the background inactive are not listed.
+struct VdbTile {
+  Vec3i origin;
+  std::int32_t edge = 0;
+  bool active = false;
+  std::array<double, 3> value{};  // components beyond the grid's are 0
+};
+
+// A leaf: leaf_edge^3 voxels from `origin`, their values in `VdbGrid::leaf_values` from
+// `first_value` (components interleaved, x slowest then y then z, OpenVDB's order), their active
+// flags as a bit mask in the same order.
+struct VdbLeaf {
+  Vec3i origin;
+  std::size_t first_value = 0;
+  std::vector<std::uint64_t> active_bits;
+};
+
+struct VdbGrid {
+  std::string name;       // without OpenVDB's "\x1e" duplicate-name suffix
+  std::string type_name;  // "Tree_float_5_4_3"...
+  VdbValueType value_type = VdbValueType::kFloat;
+  int components = 1;       // 3 for Vec3f
+  bool half_float = false;  // stored as 16-bit halves (read back as floats)
+  std::string grid_class;   // "level set", "fog volume", "staggered", "unknown"
+  std::string instance_of;  // the grid whose tree this one shares, if any
+  // Index space to world space: world = m * (i, j, k, 1), row-major 3 x 4.
+  std::array<double, 12> index_to_world{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+  std::array<double, 3> voxel_size{1, 1, 1};  // world units per index step along each axis
+  std::map<std::string, VdbMetadata> metadata;
+  std::array<double, 3> background{};
+  std::vector<int> log2_dims;  // per level, root's children first; the last is the leaves'
+  int leaf_edge = 8;
+  std::vector<VdbTile> tiles;
+  std::vector<VdbLeaf> leaves;
+  std::vector<double> leaf_values;
+
+  bool leaf_active(const VdbLeaf& leaf, int i) const {
+    return (leaf.active_bits[static_cast<std::size_t>(i) >> 6] >> (i & 63)) & 1u;
+  }
+  // The voxels the tree stores anything but the inactive background for (tiles and leaves), and
+  // the active ones; empty boxes for an empty tree.
+  Box3i stored_bounds() const;
+  Box3i active_bounds() const;
+  // Every value over `box`, x fastest (voxfield's order), `components` per voxel; the
+  // background where the tree stores nothing. Throws ResourceLimitError past the memory limit.
+  std::vector<double> dense(const Box3i& box, std::uint64_t memory_limit_bytes = 0) const;
+};
+
+struct VdbFile {
+  std::uint32_t format_version = 0;
+  std::uint32_t library_major = 0, library_minor = 0;
+  std::map<std::string, VdbMetadata> metadata;  // the file's own
+  std::vector<VdbGrid> grids;
+};
+
+struct VdbReadOptions {
+  std::uint64_t memory_limit_bytes = 0;  // 0: the process default (limits.h)
+};
+
+// Parses a .vdb file's bytes; `name` names it in errors. Throws FormatError (file, offset and
+// cause) for anything malformed or unsupported, ResourceLimitError when the decoded trees would
+// pass the memory limit.
+VdbFile decode_vdb(std::span<const std::uint8_t> bytes, const std::string& name,
+                   const VdbReadOptions& options = {});
+// decode_vdb on a file's contents; IoError naming the path when it cannot be read.
+VdbFile read_vdb(const std::filesystem::path& path, const VdbReadOptions& options = {});
+
+// The world a .vdb file holds, from its first grid of voxfield's kind "world", else its first
+// Int32 grid, else its first grid: Int32 grids give each active voxel its value as the material
+// (values outside 0..255 are refused), Bool grids material 1 where active and true, level sets
+// material 1 inside (value < 0, active or not), other Float / Double grids material 1 where
+// active and > 0 (a fog volume's density), Vec3f grids material 1 where active and non-zero.
+// A palette and extent written by voxfield come back from the metadata. Throws FormatError naming
+// `name`, ResourceLimitError past the memory limit.
+struct VdbWorld {
+  World world;
+  Box3i extent;             // voxfield's recorded extent united with the content
+  std::string description;  // one line: format, grid, type, class, voxel size
+};
+VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_edge,
+                        std::uint64_t memory_limit_bytes = 0);
 
 }  // namespace voxfield

@@ -1,8 +1,8 @@
 // voxfield — loading and saving worlds by file type, shared by every front end (CLI, demo,
 // Python): .vox (MagicaVoxel), .npy (NumPy: non-zero = that material) and .vfw (voxfield's world
-// file); .vdb (OpenVDB) is written, not read (vdb.h says why). The type comes from the extension;
-// the file's magic is checked against it before the rest of the file is read, so a mislabelled 256
-// MiB file is refused after 8 bytes.
+// file) and .vdb (OpenVDB; vdb.h says which grid and voxels make the world). The type comes from
+// the extension; the file's magic is checked against it before the rest of the file is read, so a
+// mislabelled 256 MiB file is refused after 8 bytes.
 #pragma once
 
 #include <cstdint>
@@ -42,7 +42,7 @@ struct LoadedWorld {
   std::vector<DistanceField> fields;  // .vfw only: the fields saved with the world
 };
 
-// Throws FormatError / IoError / ResourceLimitError naming the file (InvalidArgument for .vdb).
+// Throws FormatError / IoError / ResourceLimitError naming the file.
 LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& options = {});
 
 // The world in chunks of another edge and other bounds (Grid::rechunked), after counting what the

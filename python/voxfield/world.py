@@ -3,7 +3,7 @@
 ``World(materials=None, origin=(0, 0, 0), chunk=32)`` holds materials (0 = air, 1..255) on a
 sparse chunked grid and a 256-colour RGBA ``palette``. Arrays are indexed a[x, y, z], element
 [i, j, k] being voxel origin + (i, j, k), as voxfield's .npy files and scipy.ndimage index them.
-``World.load(path)`` reads .vox, .npy or .vfw; ``save(path)`` writes .vox, .npy, .vfw or .vdb
+``World.load(path)`` reads .vox, .npy, .vfw or .vdb; ``save(path)`` writes .vox, .npy, .vfw or .vdb
 atomically. ``extent`` is the volume the file declared united with the content; ``to_numpy(box)``
 copies a box out (default: the extent); ``fill(begin, end, material)`` edits a box.
 

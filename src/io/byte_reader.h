@@ -48,6 +48,20 @@ class ByteReader {
     return v;
   }
   std::int32_t i32(const char* what = "integer") { return static_cast<std::int32_t>(u32(what)); }
+  std::uint64_t u64(const char* what = "integer") {
+    need(8, what);
+    std::uint64_t v;
+    std::memcpy(&v, bytes_.data() + pos_, 8);
+    pos_ += 8;
+    return v;
+  }
+  std::int64_t i64(const char* what = "integer") { return static_cast<std::int64_t>(u64(what)); }
+  double f64(const char* what = "number") {
+    const std::uint64_t bits = u64(what);
+    double v;
+    std::memcpy(&v, &bits, 8);
+    return v;
+  }
   std::uint16_t u16(const char* what = "integer") {
     need(2, what);
     std::uint16_t v;
@@ -68,6 +82,14 @@ class ByteReader {
     return ByteReader(s, *name_, at);
   }
   void skip(std::size_t n, const char* what) { take(n, what); }
+  // Moves to an absolute offset in this reader's span (as offset() reports it); throws when the
+  // offset lies outside it.
+  void seek(std::uint64_t absolute_offset, const char* what) {
+    if (absolute_offset < base_ || absolute_offset - base_ > bytes_.size())
+      fail(std::string(what) + " at offset " + std::to_string(absolute_offset) +
+           " lies outside the " + std::to_string(bytes_.size()) + "-byte input");
+    pos_ = static_cast<std::size_t>(absolute_offset - base_);
+  }
 
  private:
   std::span<const std::uint8_t> bytes_;

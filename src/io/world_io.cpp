@@ -39,7 +39,9 @@ void check_magic(const std::filesystem::path& path, WorldFormat f) {
         (void)parse_world_file(head, name);
       break;
     case WorldFormat::kVdb:
-      break;  // refused by load_world before
+      if (head.size() < 8 || std::memcmp(head.data(), "\x20\x42\x44\x56\0\0\0\0", 8) != 0)
+        (void)decode_vdb(head, name);
+      break;
   }
 }
 
@@ -71,10 +73,6 @@ const char* world_format_name(WorldFormat f) {
 
 LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& options) {
   const WorldFormat format = world_format_of(path);
-  if (format == WorldFormat::kVdb)
-    throw InvalidArgument(path.string() +
-                          ": voxfield writes .vdb files but does not read them yet: OpenVDB's "
-                          "reader can abort the process on a damaged file (docs/interop.md)");
   check_magic(path, format);
   const std::uint64_t limit = effective_memory_limit(options.memory_limit_bytes);
   const int edge =
@@ -127,8 +125,16 @@ LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& opt
       }
       break;
     }
-    case WorldFormat::kVdb:
-      break;  // refused above
+    case WorldFormat::kVdb: {
+      VdbReadOptions vo;
+      vo.memory_limit_bytes = limit;
+      const VdbFile file = read_vdb(path, vo);
+      VdbWorld w = world_from_vdb(file, path.string(), edge, limit);
+      out.world = std::move(w.world);
+      out.extent = w.extent;
+      out.description = std::move(w.description);
+      break;
+    }
   }
   out.extent = out.extent.unite(out.world.voxels.content_bounds());
   return out;

@@ -1,0 +1,259 @@
+// voxfield — what a .vdb file's grids mean to voxfield: their bounds, their values over a box,
+// and the world a file holds (vdb.h says which grid and which voxels become solid). The
+// memory a world or a dense box will take is counted before anything is allocated.
+#include <algorithm>
+#include <cstdio>
+#include <string>
+#include <unordered_set>
+
+#include "voxfield/error.h"
+#include "voxfield/limits.h"
+#include "voxfield/vdb.h"
+
+namespace voxfield {
+namespace {
+
+Box3i leaf_box(const VdbGrid& g, const VdbLeaf& leaf) {
+  return {leaf.origin, leaf.origin + Vec3i::splat(g.leaf_edge)};
+}
+Box3i tile_box(const VdbTile& t) {
+  return {t.origin, t.origin + Vec3i::splat(t.edge)};
+}
+
+// f(voxel, index of its first component in leaf_values) for every voxel of a leaf.
+template <typename F>
+void for_each_leaf_voxel(const VdbGrid& g, const VdbLeaf& leaf, F&& f) {
+  const int e = g.leaf_edge;
+  std::size_t i = 0;
+  for (int x = 0; x < e; ++x)
+    for (int y = 0; y < e; ++y)
+      for (int z = 0; z < e; ++z, ++i)
+        f(leaf.origin + Vec3i{x, y, z}, static_cast<int>(i),
+          leaf.first_value + i * static_cast<std::size_t>(g.components));
+}
+
+const VdbMetadata* find_meta(const VdbGrid& g, const char* key) {
+  const auto it = g.metadata.find(key);
+  return it == g.metadata.end() ? nullptr : &it->second;
+}
+
+// Which voxels of a grid are solid in the world it makes (vdb.h).
+enum class SolidRule { kMaterial, kTrue, kInside, kPositive, kZero, kNonZeroVector };
+
+SolidRule rule_for(const VdbGrid& g) {
+  const VdbMetadata* kind = find_meta(g, "voxfield_kind");
+  switch (g.value_type) {
+    case VdbValueType::kInt32:
+      return SolidRule::kMaterial;
+    case VdbValueType::kBool:
+      return SolidRule::kTrue;
+    case VdbValueType::kVec3f:
+      return SolidRule::kNonZeroVector;
+    case VdbValueType::kFloat:
+    case VdbValueType::kDouble:
+      break;
+  }
+  if (g.grid_class == "level set") return SolidRule::kInside;
+  if (kind && kind->text == "unsigned distance") return SolidRule::kZero;  // distance to solid
+  return SolidRule::kPositive;
+}
+
+// The material a value makes under a rule, or -1 for a material outside 0..255.
+int material_of(SolidRule rule, const double* v, bool active) {
+  switch (rule) {
+    case SolidRule::kMaterial:
+      if (!active) return 0;
+      return v[0] >= 0 && v[0] <= 255 ? static_cast<int>(v[0]) : -1;
+    case SolidRule::kTrue:
+      return active && v[0] != 0 ? 1 : 0;
+    case SolidRule::kInside:
+      return v[0] < 0 ? 1 : 0;
+    case SolidRule::kPositive:
+      return active && v[0] > 0 ? 1 : 0;
+    case SolidRule::kZero:
+      return v[0] <= 0 ? 1 : 0;
+    case SolidRule::kNonZeroVector:
+      return active && (v[0] != 0 || v[1] != 0 || v[2] != 0) ? 1 : 0;
+  }
+  return 0;
+}
+
+std::string format_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+}  // namespace
+
+Box3i VdbGrid::stored_bounds() const {
+  Box3i b;
+  for (const VdbTile& t : tiles) b = b.unite(tile_box(t));
+  for (const VdbLeaf& l : leaves) b = b.unite(leaf_box(*this, l));
+  return b;
+}
+
+Box3i VdbGrid::active_bounds() const {
+  Box3i b;
+  for (const VdbTile& t : tiles)
+    if (t.active) b = b.unite(tile_box(t));
+  for (const VdbLeaf& l : leaves) {
+    if (std::all_of(l.active_bits.begin(), l.active_bits.end(),
+                    [](std::uint64_t w) { return w == 0; }))
+      continue;
+    for_each_leaf_voxel(*this, l, [&](Vec3i p, int i, std::size_t) {
+      if (leaf_active(l, i)) b = b.unite(Box3i{p, p + Vec3i::splat(1)});
+    });
+  }
+  return b;
+}
+
+std::vector<double> VdbGrid::dense(const Box3i& box, std::uint64_t memory_limit_bytes) const {
+  const std::uint64_t comps = static_cast<std::uint64_t>(components);
+  require_memory(dense_bytes(box, 8 * comps), memory_limit_bytes, "vdb grid \"" + name + "\"",
+                 "a dense box of " + std::to_string(box.volume()) + " voxels");
+  std::vector<double> out(static_cast<std::size_t>(box.volume() * components));
+  if (box.empty()) return out;
+  const Vec3i size = box.size();
+  auto index = [&](Vec3i p) {
+    const Vec3i d = p - box.begin;
+    return ((static_cast<std::size_t>(d.z) * static_cast<std::size_t>(size.y) +
+             static_cast<std::size_t>(d.y)) *
+                static_cast<std::size_t>(size.x) +
+            static_cast<std::size_t>(d.x)) *
+           comps;
+  };
+  for (std::size_t i = 0; i < out.size(); i += comps)
+    for (std::size_t c = 0; c < comps; ++c) out[i + c] = background[c];
+  for (const VdbTile& t : tiles) {
+    const Box3i b = tile_box(t).intersect(box);
+    for (int z = b.begin.z; z < b.end.z; ++z)
+      for (int y = b.begin.y; y < b.end.y; ++y)
+        for (int x = b.begin.x; x < b.end.x; ++x)
+          for (std::size_t c = 0; c < comps; ++c) out[index({x, y, z}) + c] = t.value[c];
+  }
+  for (const VdbLeaf& l : leaves) {
+    if (leaf_box(*this, l).intersect(box).empty()) continue;
+    for_each_leaf_voxel(*this, l, [&](Vec3i p, int, std::size_t first) {
+      if (!box.contains(p)) return;
+      for (std::size_t c = 0; c < comps; ++c) out[index(p) + c] = leaf_values[first + c];
+    });
+  }
+  return out;
+}
+
+VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_edge,
+                        std::uint64_t memory_limit_bytes) {
+  if (file.grids.empty())
+    throw FormatError(name, 0, "holds no float, double, bool, int32 or vec3s grid");
+  const VdbGrid* grid = nullptr;
+  for (const VdbGrid& g : file.grids) {
+    const VdbMetadata* kind = find_meta(g, "voxfield_kind");
+    if (kind && kind->text == "world" && g.value_type == VdbValueType::kInt32) grid = &g;
+    if (grid) break;
+  }
+  for (const VdbGrid& g : file.grids)
+    if (!grid && g.value_type == VdbValueType::kInt32) grid = &g;
+  if (!grid) grid = &file.grids.front();
+  const VdbGrid& g = *grid;
+  const SolidRule rule = rule_for(g);
+
+  VdbWorld out;
+  out.world = World(chunk_edge);
+  Grid<std::uint8_t>& voxels = out.world.voxels;
+  const int shift = voxels.chunk_shift();
+  const std::uint64_t limit = effective_memory_limit(memory_limit_bytes);
+  const std::uint64_t dense_chunk = (std::uint64_t{1} << (3 * shift)) + 96, uniform_chunk = 96;
+
+  // Count what the world will hold before building it: the chunks solid tiles cover, and the
+  // chunks solid leaf voxels make dense.
+  std::uint64_t need = 0;
+  std::unordered_set<Vec3i, Vec3iHash> dense;
+  auto count_dense = [&](Vec3i origin, int edge) {
+    const Vec3i lo = voxels.chunk_of(origin), hi = voxels.chunk_of(origin + Vec3i::splat(edge - 1));
+    for (int z = lo.z; z <= hi.z && need <= limit; ++z)
+      for (int y = lo.y; y <= hi.y; ++y)
+        for (int x = lo.x; x <= hi.x; ++x)
+          if (dense.insert({x, y, z}).second) need = add_sat(need, dense_chunk);
+  };
+  for (const VdbTile& t : g.tiles) {
+    if (need > limit) break;
+    if (material_of(rule, t.value.data(), t.active) == 0) continue;
+    if (t.edge < (1 << shift)) {
+      count_dense(t.origin, t.edge);
+      continue;
+    }
+    const std::uint64_t per_edge = std::uint64_t(t.edge) >> shift;  // OpenVDB's nodes and
+    need = add_sat(need, mul_sat(per_edge * per_edge * per_edge, uniform_chunk));  // chunks: 2^n
+  }
+  for (const VdbLeaf& l : g.leaves) {
+    if (need > limit) break;
+    bool solid = false;
+    for_each_leaf_voxel(g, l, [&](Vec3i, int i, std::size_t first) {
+      solid = solid || material_of(rule, &g.leaf_values[first], g.leaf_active(l, i)) != 0;
+    });
+    if (solid) count_dense(l.origin, g.leaf_edge);
+  }
+  require_memory(need, limit, name, "its world (grid \"" + g.name + "\")");
+
+  for (const VdbTile& t : g.tiles) {
+    const int m = material_of(rule, t.value.data(), t.active);
+    if (m < 0)
+      throw FormatError(name, 0,
+                        "grid \"" + g.name + "\" has material " + format_number(t.value[0]) +
+                            " (outside 0..255)");
+    if (m != 0) voxels.fill(tile_box(t), static_cast<std::uint8_t>(m));
+  }
+  for (const VdbLeaf& l : g.leaves) {
+    for_each_leaf_voxel(g, l, [&](Vec3i p, int i, std::size_t first) {
+      const int m = material_of(rule, &g.leaf_values[first], g.leaf_active(l, i));
+      if (m < 0)
+        throw FormatError(name, 0,
+                          "grid \"" + g.name + "\" has material " +
+                              format_number(g.leaf_values[first]) + " at (" + std::to_string(p.x) +
+                              ", " + std::to_string(p.y) + ", " + std::to_string(p.z) +
+                              ") (outside 0..255)");
+      if (m != 0) voxels.set(p, static_cast<std::uint8_t>(m));
+    });
+  }
+  voxels.compact();
+
+  if (const VdbMetadata* p = find_meta(g, "voxfield_palette"); p && p->text.size() == 256 * 8) {
+    Palette pal{};
+    bool ok = true;
+    for (int i = 0; i < 256 && ok; ++i) {
+      std::uint8_t c[4];
+      for (int k = 0; k < 4 && ok; ++k) {
+        unsigned v = 0;
+        ok = std::sscanf(p->text.c_str() + i * 8 + k * 2, "%2x", &v) == 1;
+        c[k] = static_cast<std::uint8_t>(v);
+      }
+      pal[static_cast<std::size_t>(i)] = {c[0], c[1], c[2], c[3]};
+    }
+    if (ok) out.world.palette = pal;
+  }
+  const VdbMetadata* lo = find_meta(g, "voxfield_extent_min");
+  const VdbMetadata* hi = find_meta(g, "voxfield_extent_max");
+  if (lo && hi && lo->numbers.size() == 3 && hi->numbers.size() == 3) {
+    bool ok = true;
+    for (int c = 0; c < 3; ++c)
+      ok = ok && coord_in_range(static_cast<std::int64_t>(lo->numbers[c])) &&
+           coord_in_range(static_cast<std::int64_t>(hi->numbers[c]));
+    auto vec = [](const std::vector<double>& n, int add) {
+      return Vec3i{static_cast<int>(n[0]) + add, static_cast<int>(n[1]) + add,
+                   static_cast<int>(n[2]) + add};
+    };
+    const Vec3i a = ok ? vec(lo->numbers, 0) : Vec3i{}, b = ok ? vec(hi->numbers, 1) : Vec3i{};
+    if (ok && a.x < b.x && a.y < b.y && a.z < b.z) out.extent = Box3i{a, b};
+  }
+  out.extent = out.extent.unite(voxels.content_bounds());
+  out.description = "OpenVDB .vdb, format " + std::to_string(file.format_version) + " (OpenVDB " +
+                    std::to_string(file.library_major) + "." + std::to_string(file.library_minor) +
+                    "), grid \"" + g.name + "\" " + vdb_value_type_name(g.value_type) +
+                    (g.half_float ? " (half)" : "") + ", class " + g.grid_class + ", voxel size " +
+                    format_number(g.voxel_size[0]) + " x " + format_number(g.voxel_size[1]) +
+                    " x " + format_number(g.voxel_size[2]);
+  return out;
+}
+
+}  // namespace voxfield

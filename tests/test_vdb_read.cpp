@@ -1,0 +1,383 @@
+// Reading .vdb files (voxfield/vdb.h) against OpenVDB itself: grids of every type voxfield reads,
+// written by OpenVDB with every compression it offers (none, zip, Blosc, with and without its
+// active-mask compression), as files (with grid offsets) and as streams, in full and half
+// precision, are read by voxfield's parser and by OpenVDB's, and compared voxel by voxel; then
+// damaged files, which must each give an Error naming the file and never crash.
+#include <gtest/gtest.h>
+#include <openvdb/io/File.h>
+#include <openvdb/io/Stream.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/LevelSetSphere.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <random>
+#include <sstream>
+
+#include "error_text.h"
+#include "voxfield/error.h"
+#include "voxfield/file.h"
+#include "voxfield/vdb.h"
+#include "voxfield/world_io.h"
+
+namespace voxfield {
+namespace vdb_read_test {
+
+using test::error_of;
+
+constexpr std::uint32_t kCompressions[] = {
+    openvdb::io::COMPRESS_NONE,
+    openvdb::io::COMPRESS_ZIP,
+    openvdb::io::COMPRESS_ACTIVE_MASK,
+    openvdb::io::COMPRESS_ZIP | openvdb::io::COMPRESS_ACTIVE_MASK,
+    openvdb::io::COMPRESS_BLOSC,
+    openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK,
+};
+
+std::vector<std::uint8_t> stream_bytes(const openvdb::GridPtrVec& grids, std::uint32_t c) {
+  std::ostringstream out(std::ios_base::binary);
+  openvdb::io::Stream s(out);
+  s.setCompression(c);
+  s.write(grids);
+  const std::string text = out.str();
+  return {text.begin(), text.end()};
+}
+
+// As io::File writes them: with grid offsets (so a reader can seek to one grid).
+std::vector<std::uint8_t> file_bytes(const openvdb::GridPtrVec& grids, std::uint32_t c) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("voxfield-vdb-read-" + std::to_string(::getpid()) + ".vdb");
+  {
+    openvdb::io::File f(path.string());
+    f.setCompression(c);
+    f.write(grids);
+    f.close();
+  }
+  std::vector<std::uint8_t> bytes = read_file(path);
+  std::filesystem::remove(path);
+  return bytes;
+}
+
+// OpenVDB's reading of the bytes, through io::File as a user's tool would read them.
+openvdb::GridPtrVecPtr openvdb_read(const std::vector<std::uint8_t>& bytes) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("voxfield-vdb-oracle-" + std::to_string(::getpid()) + ".vdb");
+  write_file_atomic(path, bytes);
+  openvdb::io::File f(path.string());
+  f.open(/*delayLoad=*/false);
+  openvdb::GridPtrVecPtr grids = f.getGrids();
+  f.close();
+  std::filesystem::remove(path);
+  return grids;
+}
+
+template <typename T>
+std::array<double, 3> components(const T& v) {
+  if constexpr (std::is_same_v<T, openvdb::Vec3f>)
+    return {v[0], v[1], v[2]};
+  else
+    return {static_cast<double>(v), 0, 0};
+}
+
+// voxfield's reading of `got` against OpenVDB's of the same bytes: every value over the stored
+// region and a margin, the active voxel count and bounds, the background and the transform.
+template <typename GridT>
+void expect_same(const openvdb::GridBase::Ptr& base, const VdbGrid& got, const std::string& what) {
+  const auto ref = openvdb::gridPtrCast<GridT>(base);
+  ASSERT_TRUE(ref) << what;
+  EXPECT_EQ(got.name, ref->getName()) << what;
+  EXPECT_EQ(got.grid_class, openvdb::GridBase::gridClassToString(ref->getGridClass())) << what;
+  EXPECT_EQ(got.background, components(ref->background())) << what;
+  for (const openvdb::Vec3d ijk : {openvdb::Vec3d(0, 0, 0), openvdb::Vec3d(3, -7, 11)}) {
+    const openvdb::Vec3d w = ref->transform().indexToWorld(ijk);
+    for (int a = 0; a < 3; ++a) {
+      const double mine = got.index_to_world[4 * a] * ijk[0] +
+                          got.index_to_world[4 * a + 1] * ijk[1] +
+                          got.index_to_world[4 * a + 2] * ijk[2] + got.index_to_world[4 * a + 3];
+      EXPECT_NEAR(mine, w[a], 1e-12) << what;
+    }
+  }
+  std::int64_t active = 0;
+  for (const VdbTile& t : got.tiles)
+    if (t.active) active += std::int64_t{t.edge} * t.edge * t.edge;
+  for (const VdbLeaf& l : got.leaves)
+    for (int i = 0; i < got.leaf_edge * got.leaf_edge * got.leaf_edge; ++i)
+      active += got.leaf_active(l, i);
+  EXPECT_EQ(static_cast<openvdb::Index64>(active), ref->activeVoxelCount()) << what;
+  const openvdb::CoordBBox bb = ref->evalActiveVoxelBoundingBox();
+  const Box3i ab = got.active_bounds();
+  if (!bb.empty()) {
+    EXPECT_EQ(ab.begin, (Vec3i{bb.min().x(), bb.min().y(), bb.min().z()})) << what;
+    EXPECT_EQ(ab.end, (Vec3i{bb.max().x() + 1, bb.max().y() + 1, bb.max().z() + 1})) << what;
+  }
+  auto acc = ref->getConstAccessor();
+  // Tiles larger than a leaf (a root tile spans 4096^3 voxels) are checked at their corners; the
+  // leaves and leaf-sized tiles voxel by voxel, with a margin.
+  Box3i box;
+  for (const VdbTile& t : got.tiles) {
+    if (t.edge <= 8) {
+      box = box.unite(Box3i{t.origin, t.origin + Vec3i::splat(t.edge)});
+      continue;
+    }
+    for (const Vec3i p : {t.origin, t.origin + Vec3i::splat(t.edge - 1)}) {
+      EXPECT_EQ(t.value, components(acc.getValue(openvdb::Coord(p.x, p.y, p.z)))) << what;
+      EXPECT_EQ(t.active, acc.isValueOn(openvdb::Coord(p.x, p.y, p.z))) << what;
+    }
+  }
+  for (const VdbLeaf& l : got.leaves)
+    box = box.unite(Box3i{l.origin, l.origin + Vec3i::splat(got.leaf_edge)});
+  box = Box3i{box.begin - Vec3i::splat(2), box.end + Vec3i::splat(2)};
+  ASSERT_LE(box.volume(), std::int64_t{1} << 23) << what;
+  const std::vector<double> dense = got.dense(box);
+  std::int64_t mismatches = 0;
+  std::size_t i = 0;
+  for (int z = box.begin.z; z < box.end.z; ++z)
+    for (int y = box.begin.y; y < box.end.y; ++y)
+      for (int x = box.begin.x; x < box.end.x; ++x, i += static_cast<std::size_t>(got.components)) {
+        const auto want = components(acc.getValue(openvdb::Coord(x, y, z)));
+        for (int c = 0; c < got.components; ++c)
+          if (dense[i + static_cast<std::size_t>(c)] != want[static_cast<std::size_t>(c)]) {
+            if (++mismatches <= 3)
+              ADD_FAILURE() << what << ": (" << x << ", " << y << ", " << z << ") component " << c
+                            << " reads " << dense[i + static_cast<std::size_t>(c)] << ", OpenVDB "
+                            << want[static_cast<std::size_t>(c)];
+          }
+      }
+  EXPECT_EQ(mismatches, 0) << what;
+}
+
+// Grids of every type voxfield reads, with leaves, tiles at two levels, inactive values other
+// than the background, negative coordinates and a non-trivial transform.
+openvdb::GridPtrVec sample_grids(bool half) {
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> at(-24, 24);
+  std::uniform_real_distribution<float> value(-4, 4);
+  openvdb::GridPtrVec grids;
+
+  auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+      /*radius=*/9.0f, openvdb::Vec3f(1.5f, -2.0f, 0.25f), /*voxelSize=*/0.25f);
+  sphere->setName("sphere");
+  sphere->setSaveFloatAsHalf(half);
+  grids.push_back(sphere);
+
+  auto ints = openvdb::Int32Grid::create(-3);
+  ints->setName("ints");
+  ints->fill(openvdb::CoordBBox({-4096, 0, 0}, {-1, 4095, 4095}), 42, /*active=*/true);
+  ints->fill(openvdb::CoordBBox({128, 0, 0}, {255, 127, 127}), 9, /*active=*/false);
+  ints->fill(openvdb::CoordBBox({64, 8, 8}, {71, 15, 15}), 6,
+             /*active=*/true);  // a leaf-sized tile
+  auto ia = ints->getAccessor();
+  for (int n = 0; n < 3000; ++n) {
+    const openvdb::Coord c(at(rng) + 80, at(rng), at(rng));
+    if (n % 3 == 0)
+      ia.setValueOff(c, n % 2 ? 5 : 3);  // a second and a third inactive value
+    else
+      ia.setValue(c, n);
+  }
+  ints->setTransform(openvdb::math::Transform::createLinearTransform(0.5));
+  ints->insertMeta("note", openvdb::StringMetadata("an int grid"));
+  ints->insertMeta("corner", openvdb::Vec3IMetadata(openvdb::Vec3i(-1, 2, 3)));
+  grids.push_back(ints);
+
+  auto doubles = openvdb::DoubleGrid::create(0.5);
+  doubles->setName("doubles");
+  doubles->setGridClass(openvdb::GRID_FOG_VOLUME);
+  auto da = doubles->getAccessor();
+  for (int n = 0; n < 2000; ++n) da.setValue(openvdb::Coord(at(rng), at(rng), at(rng)), value(rng));
+  doubles->setSaveFloatAsHalf(half);
+  openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
+  m.preRotate(openvdb::math::Y_AXIS, 0.3);
+  m.preScale(openvdb::Vec3d(0.5, 1, 2));
+  m.postTranslate(openvdb::Vec3d(1, 2, 3));
+  doubles->setTransform(openvdb::math::Transform::createLinearTransform(m));
+  grids.push_back(doubles);
+
+  auto bools = openvdb::BoolGrid::create(false);
+  bools->setName("bools");
+  auto ba = bools->getAccessor();
+  for (int n = 0; n < 2000; ++n) ba.setValue(openvdb::Coord(at(rng), at(rng), at(rng)), n % 4 != 0);
+  bools->fill(openvdb::CoordBBox({0, 0, 0}, {127, 127, 127}), true, true);
+  bools->fill(openvdb::CoordBBox({-16, -16, -16}, {-9, -9, -9}), true, false);
+  grids.push_back(bools);
+
+  auto vectors = openvdb::Vec3SGrid::create(openvdb::Vec3f(0, 0, 1));
+  vectors->setName("vectors");
+  auto va = vectors->getAccessor();
+  for (int n = 0; n < 2000; ++n)
+    va.setValue(openvdb::Coord(at(rng), at(rng), at(rng)),
+                openvdb::Vec3f(value(rng), value(rng), value(rng)));
+  vectors->setSaveFloatAsHalf(half);
+  grids.push_back(vectors);
+  return grids;
+}
+
+TEST(VdbRead, EveryTypeAndCompressionReadsAsOpenVdbReadsIt) {
+  openvdb::initialize();
+  for (bool half : {false, true}) {
+    const openvdb::GridPtrVec grids = sample_grids(half);
+    for (std::uint32_t c : kCompressions)
+      for (bool as_file : {false, true}) {
+        const std::vector<std::uint8_t> bytes =
+            as_file ? file_bytes(grids, c) : stream_bytes(grids, c);
+        const std::string what = std::string(as_file ? "file" : "stream") + ", compression " +
+                                 openvdb::io::compressionToString(c) + (half ? ", half" : "");
+        const VdbFile got = decode_vdb(bytes, "sample.vdb");
+        const openvdb::GridPtrVecPtr ref = openvdb_read(bytes);
+        ASSERT_EQ(got.grids.size(), ref->size()) << what;
+        EXPECT_EQ(got.format_version, openvdb::OPENVDB_FILE_VERSION) << what;
+        // io::File lists grids by name; voxfield in the file's order, as they were written.
+        auto named = [&](const char* name) {
+          for (const auto& g : *ref)
+            if (g->getName() == name) return g;
+          return openvdb::GridBase::Ptr();
+        };
+        expect_same<openvdb::FloatGrid>(named("sphere"), got.grids[0], what + ", sphere");
+        expect_same<openvdb::Int32Grid>(named("ints"), got.grids[1], what + ", ints");
+        expect_same<openvdb::DoubleGrid>(named("doubles"), got.grids[2], what + ", doubles");
+        expect_same<openvdb::BoolGrid>(named("bools"), got.grids[3], what + ", bools");
+        expect_same<openvdb::Vec3SGrid>(named("vectors"), got.grids[4], what + ", vectors");
+        EXPECT_EQ(got.grids[0].half_float, half) << what;
+        const VdbGrid& ints = got.grids[1];
+        EXPECT_EQ(ints.metadata.at("note").text, "an int grid") << what;
+        EXPECT_EQ(ints.metadata.at("corner").numbers, (std::vector<double>{-1, 2, 3})) << what;
+        EXPECT_EQ(ints.voxel_size, (std::array<double, 3>{0.5, 0.5, 0.5})) << what;
+      }
+  }
+}
+
+// Grids sharing one tree are written once; the instance reads as a copy with its own transform.
+// A grid of a type voxfield does not read is skipped in a file and refused in a stream (where
+// nothing says where it ends).
+TEST(VdbRead, InstancesShareTreesAndOtherTypesAreSkippedWhereTheFileAllows) {
+  openvdb::initialize();
+  auto a =
+      openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(5.0f, openvdb::Vec3f(0.0f), 1.0f);
+  a->setName("a");
+  openvdb::GridBase::Ptr b = a->copyGrid();  // shares a's tree
+  b->setTransform(openvdb::math::Transform::createLinearTransform(2.0));
+  b->setName("b");
+  auto other = openvdb::Vec3DGrid::create();
+  other->setName("doubles3");
+  other->tree().setValue(openvdb::Coord(1, 2, 3), openvdb::Vec3d(1, 2, 3));
+  const openvdb::GridPtrVec grids{openvdb::GridBase::Ptr(a), openvdb::GridBase::Ptr(other),
+                                  openvdb::GridBase::Ptr(b)};
+  const std::vector<std::uint8_t> bytes = file_bytes(grids, openvdb::io::COMPRESS_BLOSC);
+  const VdbFile got = decode_vdb(bytes, "instances.vdb");
+  ASSERT_EQ(got.grids.size(), 2u);
+  EXPECT_EQ(got.grids[1].name, "b");
+  EXPECT_EQ(got.grids[1].instance_of, "a");
+  EXPECT_EQ(got.grids[1].voxel_size, (std::array<double, 3>{2, 2, 2}));
+  EXPECT_EQ(got.grids[1].leaf_values, got.grids[0].leaf_values);
+  EXPECT_FALSE(got.grids[0].leaves.empty());
+  EXPECT_NE(error_of([&] {
+              (void)decode_vdb(stream_bytes(grids, openvdb::io::COMPRESS_BLOSC), "s.vdb");
+            }).find("s.vdb: at byte "),
+            std::string::npos);
+  EXPECT_NE(error_of([&] {
+              (void)decode_vdb(stream_bytes(grids, openvdb::io::COMPRESS_BLOSC), "s.vdb");
+            }).find("Tree_vec3d_5_4_3"),
+            std::string::npos);
+}
+
+World solid_world() {
+  World w(16);
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> at(-30, 30), m(1, 255);
+  for (int n = 0; n < 2000; ++n)
+    w.voxels.set({at(rng), at(rng), at(rng)}, static_cast<std::uint8_t>(m(rng)));
+  w.voxels.fill(Box3i{{-64, -32, 0}, {-32, 0, 32}}, 7);
+  w.palette[9] = {1, 2, 3, 4};
+  return w;
+}
+
+// voxfield's own .vdb files load back as the worlds they came from: materials, palette and
+// extent from a world's file; the solid voxels from a signed field's level set.
+TEST(VdbRead, VoxfieldsFilesLoadBackAsTheirWorlds) {
+  const World w = solid_world();
+  const Box3i extent{{-70, -40, -35}, {40, 50, 41}};
+  const auto path = std::filesystem::temp_directory_path() / "voxfield-vdb-read-world.vdb";
+  write_file_atomic(path, encode_vdb_world(w, extent, {0.5, 0.5, 2}));
+  const LoadedWorld back = load_world(path);
+  std::filesystem::remove(path);
+  EXPECT_EQ(back.format, WorldFormat::kVdb);
+  EXPECT_EQ(back.extent, extent);
+  EXPECT_EQ(back.world.palette, w.palette);
+  EXPECT_NE(back.description.find("voxel size 0.5 x 0.5 x 2"), std::string::npos)
+      << back.description;
+  const Box3i c = w.voxels.content_bounds();
+  ASSERT_EQ(back.world.voxels.content_bounds(), c);
+  for (int z = c.begin.z; z < c.end.z; ++z)
+    for (int y = c.begin.y; y < c.end.y; ++y)
+      for (int x = c.begin.x; x < c.end.x; ++x)
+        ASSERT_EQ(back.world.voxels.get({x, y, z}), w.voxels.get({x, y, z})) << x << " " << y;
+
+  DistanceOptions o;
+  o.signed_distance = true;
+  o.max_distance = 4;
+  o.domain = Box3i{{-80, -50, -40}, {40, 40, 40}};
+  const VdbFile field = decode_vdb(encode_vdb_field(compute_distance_field(w, o)), "f.vdb");
+  const VdbWorld solid = world_from_vdb(field, "f.vdb", 32);
+  EXPECT_EQ(solid.world.solid_count(), w.solid_count());
+  for (int z = c.begin.z; z < c.end.z; ++z)
+    for (int y = c.begin.y; y < c.end.y; ++y)
+      for (int x = c.begin.x; x < c.end.x; ++x)
+        ASSERT_EQ(solid.world.voxels.get({x, y, z}) != 0, w.voxels.get({x, y, z}) != 0);
+}
+
+// Every prefix of a file and thousands of corrupted copies: an Error naming the file, or a
+// successful read, never a crash (the ASan build runs this too).
+TEST(VdbRead, DamagedFilesAreRefusedWithTheFileAndCause) {
+  openvdb::initialize();
+  auto g =
+      openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(3.0f, openvdb::Vec3f(0.0f), 1.0f);
+  auto ints = openvdb::Int32Grid::create(0);
+  ints->tree().setValue(openvdb::Coord(-5, 6, 700), 3);
+  for (std::uint32_t c : kCompressions) {
+    const std::vector<std::uint8_t> bytes =
+        file_bytes({openvdb::GridBase::Ptr(g), openvdb::GridBase::Ptr(ints)}, c);
+    // About 1000 prefixes of each (an uncompressed top node alone is 140 kB), every one of the
+    // first 1000 bytes (the header, metadata, descriptors, transforms and masks).
+    const std::size_t stride = std::max<std::size_t>(1, bytes.size() / 1000);
+    for (std::size_t n = 0; n < bytes.size(); n += n < 1000 ? 1 : stride) {
+      const std::string e =
+          error_of([&] { (void)decode_vdb(std::span(bytes.data(), n), "cut.vdb"); });
+      ASSERT_EQ(e.rfind("cut.vdb: at byte ", 0), 0u) << n << ": " << e;
+    }
+    std::mt19937 rng(c);
+    std::uniform_int_distribution<std::size_t> pos(0, bytes.size() - 1);
+    std::uniform_int_distribution<int> byte(0, 255);
+    for (int n = 0; n < 250; ++n) {
+      std::vector<std::uint8_t> bad = bytes;
+      for (int k = 0; k < 1 + n % 4; ++k) bad[pos(rng)] = static_cast<std::uint8_t>(byte(rng));
+      VdbReadOptions o;
+      o.memory_limit_bytes = std::uint64_t{8} << 20;
+      try {
+        (void)world_from_vdb(decode_vdb(bad, "bad.vdb", o), "bad.vdb", 32, o.memory_limit_bytes);
+      } catch (const Error& e) {
+        ASSERT_NE(std::string(e.what()).find("bad.vdb"), std::string::npos) << e.what();
+      }
+    }
+  }
+  EXPECT_NE(error_of([] {
+              (void)decode_vdb(std::vector<std::uint8_t>(64, 7), "x.vdb");
+            }).find("x.vdb: at byte 0: not an OpenVDB file"),
+            std::string::npos);
+}
+
+// A tree that would decode past the memory limit is refused before it is held.
+TEST(VdbRead, TreesPastTheMemoryLimitAreRefused) {
+  openvdb::initialize();
+  auto g =
+      openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(60.0f, openvdb::Vec3f(0.0f), 1.0f);
+  const std::vector<std::uint8_t> bytes =
+      file_bytes({openvdb::GridBase::Ptr(g)}, openvdb::io::COMPRESS_BLOSC);
+  VdbReadOptions o;
+  o.memory_limit_bytes = std::uint64_t{1} << 20;
+  const std::string e = error_of([&] { (void)decode_vdb(bytes, "big.vdb", o); });
+  EXPECT_NE(e.find("big.vdb"), std::string::npos) << e;
+  EXPECT_NE(e.find("memory limit"), std::string::npos) << e;
+}
+
+}  // namespace vdb_read_test
+}  // namespace voxfield
