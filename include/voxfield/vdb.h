@@ -126,6 +126,9 @@ struct VdbGrid {
   // Every value over `box`, x fastest (voxfield's order), `components` per voxel; the
   // background where the tree stores nothing. Throws ResourceLimitError past the memory limit.
   std::vector<double> dense(const Box3i& box, std::uint64_t memory_limit_bytes = 0) const;
+  // Whether each voxel over `box` is active (1) or not (0), x fastest.
+  std::vector<std::uint8_t> dense_active(const Box3i& box,
+                                         std::uint64_t memory_limit_bytes = 0) const;
 };
 
 struct VdbFile {
@@ -133,6 +136,8 @@ struct VdbFile {
   std::uint32_t library_major = 0, library_minor = 0;
   std::map<std::string, VdbMetadata> metadata;  // the file's own
   std::vector<VdbGrid> grids;
+  // What the decoded file holds in memory (trees and metadata), as the memory limit counts it.
+  std::uint64_t memory_bytes() const;
 };
 
 struct VdbReadOptions {

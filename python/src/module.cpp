@@ -12,6 +12,7 @@ void bind_ndimage(py::module_& m);
 void bind_csg(py::module_& m);
 void bind_mesh(py::module_& m);
 void bind_vectors(py::module_& m);
+void bind_vdb(py::module_& m);
 void bind_world(py::module_& m);
 }  // namespace voxfield::python
 
@@ -39,5 +40,6 @@ PYBIND11_MODULE(_voxfield, m) {
   voxfield::python::bind_csg(m);
   voxfield::python::bind_mesh(m);
   voxfield::python::bind_vectors(m);
+  voxfield::python::bind_vdb(m);
   voxfield::python::bind_world(m);
 }

@@ -10,8 +10,11 @@ contouring) and keeps a deformable ``Terrain`` field edited by brushes (docs/mes
 ``Volume``, ``generate``, ``exact`` and ``Simulation`` (steps with decay and blend, sampling, the
 visualiser's picture).
 
-``voxfield.world`` holds worlds (``World``: NumPy arrays in and out, .vox/.npy/.vfw read, .vdb
-written too) and computes their exact distance fields (``distance_field``: every metric, sign,
+``voxfield.vdb`` reads OpenVDB files with voxfield's own parser, safe on damaged files: each
+grid's values and activity over a box as NumPy arrays, its transform and metadata.
+
+``voxfield.world`` holds worlds (``World``: NumPy arrays in and out, .vox/.npy/.vfw/.vdb read and
+written) and computes their exact distance fields (``distance_field``: every metric, sign,
 clamp, storage and spacing, nearest sites).
 
 ``voxfield.ndimage`` is a drop-in for ``scipy.ndimage.distance_transform_edt`` and
@@ -30,7 +33,8 @@ from . import ndimage
 from . import csg
 from . import mesh
 from . import vectors
+from . import vdb
 from . import world
 
-__all__ = ["ndimage", "csg", "mesh", "vectors", "world", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
+__all__ = ["ndimage", "csg", "mesh", "vectors", "vdb", "world", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
            "Cancelled"]

@@ -2,6 +2,7 @@
 from . import csg as csg
 from . import mesh as mesh
 from . import ndimage as ndimage
+from . import vdb as vdb
 from . import vectors as vectors
 from . import world as world
 
@@ -12,5 +13,5 @@ class ResourceLimitError(MemoryError): ...
 class IoError(OSError): ...
 class Cancelled(KeyboardInterrupt): ...
 
-__all__ = ["ndimage", "csg", "mesh", "vectors", "world", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
+__all__ = ["ndimage", "csg", "mesh", "vectors", "vdb", "world", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
            "Cancelled"]

@@ -8,7 +8,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "byte_reader.h"
@@ -194,6 +196,19 @@ void read_transform(ByteReader& r, VdbGrid& g) {
     r.fail_at(at, "a transform with a zero voxel size");
 }
 
+// What a grid's tree and a metadata map hold in memory, as the memory limit counts them.
+std::uint64_t tree_bytes(const VdbGrid& g) {
+  std::uint64_t n = g.leaf_values.size() * sizeof(double) + g.tiles.size() * sizeof(VdbTile);
+  for (const VdbLeaf& l : g.leaves) n += sizeof(VdbLeaf) + l.active_bits.size() * 8;
+  return n;
+}
+std::uint64_t metadata_bytes(const std::map<std::string, VdbMetadata>& m) {
+  std::uint64_t n = 0;
+  for (const auto& [key, value] : m)
+    n += 64 + key.size() + value.type.size() + value.text.size() + value.numbers.size() * 8;
+  return n;
+}
+
 struct Descriptor {
   std::string unique_name, type, parent;
   bool half = false;
@@ -237,8 +252,8 @@ VdbFile decode_vdb(std::span<const std::uint8_t> bytes, const std::string& name,
   const std::int32_t count = r.i32("grid count");
   if (count < 0 || static_cast<std::uint64_t>(count) > r.remaining() / 12)
     r.fail_at(count_at, "grid count " + std::to_string(count) + " does not fit the file");
-  std::uint64_t used = 0;
-  std::vector<std::string> unique_names;
+  std::uint64_t used = metadata_bytes(file.metadata);
+  std::unordered_map<std::string, std::size_t> read_grids;  // unique name -> index in file.grids
   for (std::int32_t i = 0; i < count; ++i) {
     const std::uint64_t desc_at = r.offset();
     Descriptor d = read_descriptor(r);
@@ -246,14 +261,18 @@ VdbFile decode_vdb(std::span<const std::uint8_t> bytes, const std::string& name,
     d.grid_pos = r.i64("grid offset");
     d.block_pos = r.i64("grid block offset");
     d.end_pos = r.i64("grid end offset");
+    // In a file, a grid is read within [grid offset, end offset) and the next descriptor from
+    // the end offset: a grid follows its descriptor (Archive::write), so every byte is read once.
+    std::optional<ByteReader> body;
     if (has_offsets) {
-      // A grid follows its descriptor (Archive::write), so offsets only move forward.
-      if (static_cast<std::uint64_t>(d.grid_pos) < r.offset() || d.end_pos < d.grid_pos ||
-          static_cast<std::uint64_t>(d.end_pos) > bytes.size())
+      if (d.grid_pos < 0 || static_cast<std::uint64_t>(d.grid_pos) < r.offset() ||
+          d.end_pos < d.grid_pos || static_cast<std::uint64_t>(d.end_pos) > bytes.size())
         r.fail_at(desc_at,
                   "grid \"" + strip_suffix(d.unique_name) + "\" has offsets outside the file");
       r.seek(static_cast<std::uint64_t>(d.grid_pos), "grid");
+      body.emplace(r.sub(static_cast<std::size_t>(d.end_pos - d.grid_pos), "grid"));
     }
+    ByteReader& in = body ? *body : r;
     VdbGrid g;
     g.name = strip_suffix(d.unique_name);
     g.type_name = d.type;
@@ -264,32 +283,31 @@ VdbFile decode_vdb(std::span<const std::uint8_t> bytes, const std::string& name,
         r.fail_at(desc_at, "grid \"" + g.name + "\" of type " + d.type +
                                ": voxfield reads float, double, bool, int32 and vec3s trees "
                                "(and cannot skip a grid in a file without grid offsets)");
-      r.seek(static_cast<std::uint64_t>(d.end_pos), "grid end");
       continue;  // another kind of grid (points, masks...): skipped, as its offsets allow
     }
     detail::VdbTreeReading how;
     how.format_version = file.format_version;
-    how.compression = r.u32("grid compression flags");
+    how.compression = in.u32("grid compression flags");
     how.memory_limit_bytes = options.memory_limit_bytes;
     how.used_bytes = &used;
-    g.metadata = read_metadata(r);
+    g.metadata = read_metadata(in);
+    used = add_sat(used, metadata_bytes(g.metadata));
     if (auto it = g.metadata.find("class"); it != g.metadata.end()) g.grid_class = it->second.text;
     if (g.grid_class.empty()) g.grid_class = "unknown";
-    read_transform(r, g);
+    read_transform(in, g);
     if (d.parent.empty()) {
-      detail::read_vdb_tree(r, g, how);
+      detail::read_vdb_tree(in, g, how);
     } else {
       // An instance shares the tree of a grid read before it (Archive::connectInstance).
-      const auto parent = std::find(unique_names.begin(), unique_names.end(), d.parent);
-      if (parent == unique_names.end())
+      const auto parent = read_grids.find(d.parent);
+      if (parent == read_grids.end())
         r.fail_at(desc_at, "grid \"" + g.name + "\" instances \"" + g.instance_of +
                                "\", which is not a float, double, bool, int32 or vec3s grid "
                                "before it");
-      const VdbGrid& p = file.grids[static_cast<std::size_t>(parent - unique_names.begin())];
+      const VdbGrid& p = file.grids[parent->second];
       if (p.type_name != g.type_name)
         r.fail_at(desc_at, "grid \"" + g.name + "\" instances a grid of another type");
-      used =
-          add_sat(used, p.leaf_values.size() * sizeof(double) + p.tiles.size() * sizeof(VdbTile));
+      used = add_sat(used, tree_bytes(p));
       if (used > effective_memory_limit(options.memory_limit_bytes))
         require_memory(used, options.memory_limit_bytes, name, "its instanced grids");
       g.background = p.background;
@@ -297,17 +315,24 @@ VdbFile decode_vdb(std::span<const std::uint8_t> bytes, const std::string& name,
       g.leaves = p.leaves;
       g.leaf_values = p.leaf_values;
     }
-    if (has_offsets) r.seek(static_cast<std::uint64_t>(d.end_pos), "grid end");
-    unique_names.push_back(d.unique_name);
+    read_grids[d.unique_name] = file.grids.size();
     file.grids.push_back(std::move(g));
   }
   return file;
 }
 
+std::uint64_t VdbFile::memory_bytes() const {
+  std::uint64_t n = metadata_bytes(metadata);
+  for (const VdbGrid& g : grids) n = add_sat(n, add_sat(tree_bytes(g), metadata_bytes(g.metadata)));
+  return n;
+}
+
 VdbFile read_vdb(const std::filesystem::path& path, const VdbReadOptions& options) {
-  const std::vector<std::uint8_t> bytes =
-      read_file(path, effective_memory_limit(options.memory_limit_bytes));
-  return decode_vdb(bytes, path.string(), options);
+  const std::uint64_t limit = effective_memory_limit(options.memory_limit_bytes);
+  const std::vector<std::uint8_t> bytes = read_file(path, limit);
+  VdbReadOptions rest = options;  // the file's bytes are held while its trees are decoded
+  rest.memory_limit_bytes = remaining_memory(limit, bytes.size());
+  return decode_vdb(bytes, path.string(), rest);
 }
 
 const char* vdb_value_type_name(VdbValueType t) {

@@ -70,8 +70,10 @@ class TreeReader {
     const std::int64_t edge = std::int64_t{1} << shift;
     // A root tile is 12 bytes of origin, a value and an active flag; a child at least its masks.
     if (tiles > r_.remaining() / (13 + full_bytes_)) r_.fail("more root tiles than bytes left");
+    std::vector<std::array<std::int32_t, 3>> origins;  // the root's table: one entry per origin
     for (std::uint32_t t = 0; t < tiles; ++t) {
       const Vec3i origin = read_origin(edge, "root tile");
+      origins.push_back({origin.x, origin.y, origin.z});
       const Value v = read_full_value("root tile value");
       const std::uint8_t active = r_.u8("root tile active flag");
       if (active > 1) r_.fail("a root tile's active flag is neither 0 nor 1");
@@ -85,6 +87,7 @@ class TreeReader {
     std::vector<Child> root_children;
     for (std::uint32_t c = 0; c < children; ++c) {
       Child child{read_origin(edge, "root child"), {}};
+      origins.push_back({child.origin.x, child.origin.y, child.origin.z});
       read_internal_topology(child.origin, 0, child.leaves);
       root_children.push_back(std::move(child));
     }
@@ -94,9 +97,18 @@ class TreeReader {
       return std::tie(a.origin.x, a.origin.y, a.origin.z) <
              std::tie(b.origin.x, b.origin.y, b.origin.z);
     });
-    for (std::size_t i = 1; i < root_children.size(); ++i)
-      if (root_children[i].origin == root_children[i - 1].origin)
-        r_.fail("two root children at the same origin");
+    // OpenVDB's table keeps one entry per origin (and then never reads a shadowed child's
+    // buffers): refused rather than guessed.
+    std::sort(origins.begin(), origins.end());
+    if (std::adjacent_find(origins.begin(), origins.end()) != origins.end())
+      r_.fail("two root tiles or children at the same origin");
+    std::size_t leaf_count = 0;
+    for (const Child& child : root_children) leaf_count += child.leaves.size();
+    // Every leaf's values were counted with its topology: held once, without regrowth.
+    grid_.leaves.reserve(grid_.leaves.size() + leaf_count);
+    grid_.leaf_values.reserve(grid_.leaf_values.size() +
+                              leaf_count * (std::size_t{1} << (3 * grid_.log2_dims.back())) *
+                                  static_cast<std::size_t>(grid_.components));
     for (Child& child : root_children)
       for (PendingLeaf& leaf : child.leaves) read_leaf_buffers(leaf);
   }
@@ -226,7 +238,8 @@ class TreeReader {
     const std::int64_t size = r_.i64("compressed block size");
     if (size <= 0) {
       if (static_cast<std::uint64_t>(-(size + 1)) + 1 != need)
-        r_.fail_at(at, "an uncompressed block of " + std::to_string(-(size + 1) + 1) +
+        r_.fail_at(at, "an uncompressed block of " +
+                           std::to_string(static_cast<std::uint64_t>(-(size + 1)) + 1) +
                            " bytes where the node holds " + std::to_string(need));
       const auto raw = r_.take(need, "node values");
       out.assign(raw.begin(), raw.end());
@@ -278,8 +291,10 @@ class TreeReader {
         (how_.compression & kVdbCompressActiveMask) && flag != kNoMaskAndAllVals;
     const std::size_t stored = mask_compressed ? count_on(active) : count;
     // Half floats with nothing to store store nothing, not even a block size (HalfReader).
+    const bool real =
+        grid_.value_type != VdbValueType::kBool && grid_.value_type != VdbValueType::kInt32;
     const std::vector<std::uint8_t> bytes =
-        grid_.half_float && stored == 0 ? std::vector<std::uint8_t>{} : read_data(stored);
+        grid_.half_float && real && stored == 0 ? std::vector<std::uint8_t>{} : read_data(stored);
     std::vector<Value> values(count);
     if (stored == count) {
       for (std::size_t i = 0; i < count; ++i)
@@ -308,9 +323,8 @@ class TreeReader {
     const int child_shift = subtree_shift(level + 1);
     const auto child_mask = read_mask(dim, "child mask");
     const auto value_mask = read_mask(dim, "value mask");
-    charge(count * sizeof(Value), "a node's values");
+    charge(count * sizeof(Value), "a node's values");  // held while its children are read
     const std::vector<Value> values = read_values(count, value_mask, dim);
-    *how_.used_bytes -= count * sizeof(Value);  // a temporary
     const bool children_are_leaves = level + 2 == grid_.log2_dims.size();
     for (std::size_t i = 0; i < count; ++i) {
       if (!bit(child_mask, i) && !bit(value_mask, i) && values[i] == grid_.background) continue;
@@ -329,6 +343,7 @@ class TreeReader {
         read_internal_topology(at, level + 1, leaves);
       }
     }
+    *how_.used_bytes -= count * sizeof(Value);
   }
 
   void read_leaf_buffers(PendingLeaf& leaf) {
@@ -337,14 +352,16 @@ class TreeReader {
     const std::size_t first = grid_.leaf_values.size();
     grid_.leaf_values.resize(first + count * static_cast<std::size_t>(grid_.components));
     double* out = grid_.leaf_values.data() + first;
-    // A file's reader uses the topology's mask and skips this copy (io::File seeks over it).
-    r_.skip(count / 8, "leaf value mask");
     if (grid_.value_type == VdbValueType::kBool) {
-      // Bool leaves: the origin, then one bit per voxel, never compressed.
+      // Bool leaves: their value mask again (OpenVDB keeps this copy), the origin, then one bit
+      // per voxel, never compressed.
+      leaf.mask = read_mask(dim, "leaf value mask");
       r_.skip(12, "bool leaf origin");
       const auto bits = read_mask(dim, "bool leaf values");
       for (std::size_t i = 0; i < count; ++i) out[i] = bit(bits, i) ? 1 : 0;
     } else {
+      // A file's reader uses the topology's mask and seeks over this copy (io::File).
+      r_.skip(count / 8, "leaf value mask");
       const std::vector<Value> values = read_values(count, leaf.mask, dim);
       for (std::size_t i = 0; i < count; ++i)
         for (int c = 0; c < grid_.components; ++c)

@@ -2,6 +2,7 @@
 // and the world a file holds (vdb.h says which grid and which voxels become solid). The
 // memory a world or a dense box will take is counted before anything is allocated.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <unordered_set>
@@ -19,6 +20,18 @@ Box3i leaf_box(const VdbGrid& g, const VdbLeaf& leaf) {
 Box3i tile_box(const VdbTile& t) {
   return {t.origin, t.origin + Vec3i::splat(t.edge)};
 }
+
+// The position of a voxel of `box` in an x-fastest array over it.
+struct DenseIndex {
+  Box3i box;
+  std::size_t operator()(Vec3i p) const {
+    const Vec3i d = p - box.begin, size = box.size();
+    return (static_cast<std::size_t>(d.z) * static_cast<std::size_t>(size.y) +
+            static_cast<std::size_t>(d.y)) *
+               static_cast<std::size_t>(size.x) +
+           static_cast<std::size_t>(d.x);
+  }
+};
 
 // f(voxel, index of its first component in leaf_values) for every voxel of a leaf.
 template <typename F>
@@ -110,19 +123,14 @@ Box3i VdbGrid::active_bounds() const {
 
 std::vector<double> VdbGrid::dense(const Box3i& box, std::uint64_t memory_limit_bytes) const {
   const std::uint64_t comps = static_cast<std::uint64_t>(components);
+  if (!box.in_range())
+    throw InvalidArgument("vdb grid \"" + name + "\": a box outside voxfield's range");
   require_memory(dense_bytes(box, 8 * comps), memory_limit_bytes, "vdb grid \"" + name + "\"",
                  "a dense box of " + std::to_string(box.volume()) + " voxels");
   std::vector<double> out(static_cast<std::size_t>(box.volume() * components));
   if (box.empty()) return out;
-  const Vec3i size = box.size();
-  auto index = [&](Vec3i p) {
-    const Vec3i d = p - box.begin;
-    return ((static_cast<std::size_t>(d.z) * static_cast<std::size_t>(size.y) +
-             static_cast<std::size_t>(d.y)) *
-                static_cast<std::size_t>(size.x) +
-            static_cast<std::size_t>(d.x)) *
-           comps;
-  };
+  const DenseIndex at{box};
+  auto index = [&](Vec3i p) { return at(p) * comps; };
   for (std::size_t i = 0; i < out.size(); i += comps)
     for (std::size_t c = 0; c < comps; ++c) out[i + c] = background[c];
   for (const VdbTile& t : tiles) {
@@ -137,6 +145,31 @@ std::vector<double> VdbGrid::dense(const Box3i& box, std::uint64_t memory_limit_
     for_each_leaf_voxel(*this, l, [&](Vec3i p, int, std::size_t first) {
       if (!box.contains(p)) return;
       for (std::size_t c = 0; c < comps; ++c) out[index(p) + c] = leaf_values[first + c];
+    });
+  }
+  return out;
+}
+
+std::vector<std::uint8_t> VdbGrid::dense_active(const Box3i& box,
+                                                std::uint64_t memory_limit_bytes) const {
+  if (!box.in_range())
+    throw InvalidArgument("vdb grid \"" + name + "\": a box outside voxfield's range");
+  require_memory(dense_bytes(box, 1), memory_limit_bytes, "vdb grid \"" + name + "\"",
+                 "an activity mask of " + std::to_string(box.volume()) + " voxels");
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(box.volume()), 0);
+  if (box.empty()) return out;
+  const DenseIndex index{box};
+  for (const VdbTile& t : tiles) {
+    if (!t.active) continue;
+    const Box3i b = tile_box(t).intersect(box);
+    for (int z = b.begin.z; z < b.end.z; ++z)
+      for (int y = b.begin.y; y < b.end.y; ++y)
+        for (int x = b.begin.x; x < b.end.x; ++x) out[index({x, y, z})] = 1;
+  }
+  for (const VdbLeaf& l : leaves) {
+    if (leaf_box(*this, l).intersect(box).empty()) continue;
+    for_each_leaf_voxel(*this, l, [&](Vec3i p, int i, std::size_t) {
+      if (box.contains(p)) out[index(p)] = leaf_active(l, i) ? 1 : 0;
     });
   }
   return out;
@@ -235,10 +268,12 @@ VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_
   const VdbMetadata* lo = find_meta(g, "voxfield_extent_min");
   const VdbMetadata* hi = find_meta(g, "voxfield_extent_max");
   if (lo && hi && lo->numbers.size() == 3 && hi->numbers.size() == 3) {
-    bool ok = true;
-    for (int c = 0; c < 3; ++c)
-      ok = ok && coord_in_range(static_cast<std::int64_t>(lo->numbers[c])) &&
-           coord_in_range(static_cast<std::int64_t>(hi->numbers[c]));
+    // Numbers a file controls: checked finite and in range before any conversion.
+    auto in_range = [](double v) {
+      return std::isfinite(v) && v >= -kCoordLimit && v < kCoordLimit;
+    };
+    bool ok = lo->type == "vec3i" && hi->type == "vec3i";
+    for (int c = 0; c < 3; ++c) ok = ok && in_range(lo->numbers[c]) && in_range(hi->numbers[c]);
     auto vec = [](const std::vector<double>& n, int add) {
       return Vec3i{static_cast<int>(n[0]) + add, static_cast<int>(n[1]) + add,
                    static_cast<int>(n[2]) + add};

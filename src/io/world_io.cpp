@@ -129,7 +129,9 @@ LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& opt
       VdbReadOptions vo;
       vo.memory_limit_bytes = limit;
       const VdbFile file = read_vdb(path, vo);
-      VdbWorld w = world_from_vdb(file, path.string(), edge, limit);
+      // The decoded file is held while the world is built from it.
+      VdbWorld w =
+          world_from_vdb(file, path.string(), edge, remaining_memory(limit, file.memory_bytes()));
       out.world = std::move(w.world);
       out.extent = w.extent;
       out.description = std::move(w.description);

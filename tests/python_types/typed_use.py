@@ -1,11 +1,14 @@
 """A typed use of voxfield, checked by mypy --strict against the package's stubs (and run, so the
 stubs describe what the module really returns)."""
 
+import os
+import tempfile
+
 import numpy as np
 import numpy.typing as npt
 
 import voxfield
-from voxfield import csg, mesh, ndimage, vectors, world
+from voxfield import csg, mesh, ndimage, vdb, vectors, world
 
 
 def sphere_field(n: int) -> npt.NDArray[np.float64]:
@@ -88,6 +91,21 @@ def world_field() -> float:
     return float(f.decoded()[0, 0, 0]) + float(w.to_numpy().sum()) * 0
 
 
+def vdb_grid_values() -> int:
+    a = np.zeros((8, 8, 8), dtype=np.uint8)
+    a[1:4, 2:6, 3:5] = 7
+    with tempfile.TemporaryDirectory() as d:
+        path = os.path.join(d, "w.vdb")
+        world.World(a).save(path)
+        grids: list[vdb.Grid] = vdb.read(path)
+    g = grids[0]
+    bounds = g.active_bounds
+    assert bounds is not None and g.value_type == "int32" and g.index_to_world.shape == (3, 4)
+    values = g.to_numpy()
+    assert bool(g.active_mask().all()) and g.metadata["voxfield_kind"] == "world"
+    return int(values.sum())
+
+
 def refused() -> bool:
     try:
         csg.Model("(sphere", "bad.sdf")
@@ -108,4 +126,5 @@ if __name__ == "__main__":
     assert mesh_input_figures() > 1.5
     assert vector_strength() > 1
     assert world_field() > 2
+    assert vdb_grid_values() == 7 * 3 * 4 * 2
     print("typed use: ok")
