@@ -341,7 +341,7 @@ TEST(VdbRead, VoxfieldsFilesLoadBackAsTheirWorlds) {
         ASSERT_EQ(solid.world.voxels.get({x, y, z}) != 0, w.voxels.get({x, y, z}) != 0);
 }
 
-// Every prefix of a file and thousands of corrupted copies: an Error naming the file, or a
+// Prefixes of files and hundreds of corrupted copies: an Error naming the file, or a
 // successful read, never a crash (the ASan build runs this too).
 TEST(VdbRead, DamagedFilesAreRefusedWithTheFileAndCause) {
   openvdb::initialize();
@@ -352,10 +352,13 @@ TEST(VdbRead, DamagedFilesAreRefusedWithTheFileAndCause) {
   for (std::uint32_t c : kCompressions) {
     const std::vector<std::uint8_t> bytes =
         file_bytes({openvdb::GridBase::Ptr(g), openvdb::GridBase::Ptr(ints)}, c);
-    // About 1000 prefixes of each (an uncompressed top node alone is 140 kB), every one of the
-    // first 1000 bytes (the header, metadata, descriptors, transforms and masks).
-    const std::size_t stride = std::max<std::size_t>(1, bytes.size() / 1000);
-    for (std::size_t n = 0; n < bytes.size(); n += n < 1000 ? 1 : stride) {
+    // Every one of the first 1000 bytes (the header, metadata, descriptors, transforms and masks)
+    // of OpenVDB's default (Blosc, active mask), every 11th of the others, whose first kilobyte
+    // differs only in the compression flags; then about 200 prefixes through the rest (an
+    // uncompressed top node alone is 140 kB).
+    const std::size_t near = c == kCompressions[5] ? 1 : 11;
+    const std::size_t stride = std::max<std::size_t>(1, bytes.size() / 200);
+    for (std::size_t n = 0; n < bytes.size(); n += n < 1000 ? near : stride) {
       const std::string e =
           error_of([&] { (void)decode_vdb(std::span(bytes.data(), n), "cut.vdb"); });
       ASSERT_EQ(e.rfind("cut.vdb: at byte ", 0), 0u) << n << ": " << e;
@@ -370,7 +373,7 @@ TEST(VdbRead, DamagedFilesAreRefusedWithTheFileAndCause) {
     std::uniform_int_distribution<std::size_t> structure(0, std::min<std::size_t>(size, 2000) - 1);
     std::uniform_int_distribution<int> byte(0, 255);
     int refused = 0;
-    for (int n = 0; n < 250; ++n) {
+    for (int n = 0; n < 120; ++n) {
       std::vector<std::uint8_t> bad = n % 2 ? bytes : stream;
       for (int k = 0; k < 1 + n % 4; ++k)
         bad[(n / 2) % 2 ? structure(rng) : anywhere(rng)] = static_cast<std::uint8_t>(byte(rng));
@@ -383,7 +386,7 @@ TEST(VdbRead, DamagedFilesAreRefusedWithTheFileAndCause) {
         ++refused;
       }
     }
-    EXPECT_GT(refused, 10) << "the reader noticed almost none of the damage";
+    EXPECT_GT(refused, 6) << "the reader noticed almost none of the damage";
   }
   EXPECT_NE(error_of([] {
               (void)decode_vdb(std::vector<std::uint8_t>(64, 7), "x.vdb");

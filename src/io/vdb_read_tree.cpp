@@ -267,9 +267,10 @@ class TreeReader {
     return out;
   }
 
-  // OpenVDB's readCompressedValues: `count` values of a node whose value mask is `active`.
-  std::vector<Value> read_values(std::size_t count, const std::vector<std::uint64_t>& active,
-                                 int log2_dim) {
+  // OpenVDB's readCompressedValues: `count` values of a node whose value mask is `active`, into
+  // `values` (one buffer per tree level, reused from node to node: a top node holds 32768).
+  void read_values(std::size_t count, const std::vector<std::uint64_t>& active, int log2_dim,
+                   std::vector<Value>& values) {
     std::uint8_t flag = kNoMaskAndAllVals;
     const std::uint64_t at = r_.offset();
     if (how_.format_version >= 222) flag = r_.u8("node compression flag");
@@ -295,11 +296,11 @@ class TreeReader {
         grid_.value_type != VdbValueType::kBool && grid_.value_type != VdbValueType::kInt32;
     const std::vector<std::uint8_t> bytes =
         grid_.half_float && real && stored == 0 ? std::vector<std::uint8_t>{} : read_data(stored);
-    std::vector<Value> values(count);
+    values.resize(count);
     if (stored == count) {
       for (std::size_t i = 0; i < count; ++i)
         values[i] = decode(bytes.data() + i * stored_bytes_, grid_.half_float);
-      return values;
+      return;
     }
     for (std::size_t i = 0, j = 0; i < count; ++i) {
       if (bit(active, i))
@@ -307,7 +308,6 @@ class TreeReader {
       else
         values[i] = bit(selection, i) ? inactive1 : inactive0;
     }
-    return values;
   }
 
   void add_tile(Vec3i origin, int shift, const Value& v, bool active) {
@@ -324,7 +324,8 @@ class TreeReader {
     const auto child_mask = read_mask(dim, "child mask");
     const auto value_mask = read_mask(dim, "value mask");
     charge(count * sizeof(Value), "a node's values");  // held while its children are read
-    const std::vector<Value> values = read_values(count, value_mask, dim);
+    std::vector<Value>& values = level_values_[level];
+    read_values(count, value_mask, dim, values);
     const bool children_are_leaves = level + 2 == grid_.log2_dims.size();
     for (std::size_t i = 0; i < count; ++i) {
       if (!bit(child_mask, i) && !bit(value_mask, i) && values[i] == grid_.background) continue;
@@ -362,7 +363,8 @@ class TreeReader {
     } else {
       // A file's reader uses the topology's mask and seeks over this copy (io::File).
       r_.skip(count / 8, "leaf value mask");
-      const std::vector<Value> values = read_values(count, leaf.mask, dim);
+      std::vector<Value>& values = level_values_.back();
+      read_values(count, leaf.mask, dim, values);
       for (std::size_t i = 0; i < count; ++i)
         for (int c = 0; c < grid_.components; ++c)
           out[i * static_cast<std::size_t>(grid_.components) + c] = values[i][c];
@@ -375,6 +377,7 @@ class TreeReader {
   const VdbTreeReading& how_;
   std::size_t full_bytes_ = 4, stored_bytes_ = 4;
   Decoder full_decode_ = nullptr, stored_decode_ = nullptr;
+  std::array<std::vector<Value>, 5> level_values_;  // internal levels from 0; leaves last
 };
 
 }  // namespace
