@@ -134,7 +134,7 @@ class TreeReader {
     return 4;
   }
 
-  // log2 of the edge of a node at `level`'s children... of the node at `level` itself, in voxels.
+  // log2 of the edge, in voxels, of a node at `level` (0: a child of the root).
   int subtree_shift(std::size_t level) const {
     int s = 0;
     for (std::size_t l = level; l < grid_.log2_dims.size(); ++l) s += grid_.log2_dims[l];
