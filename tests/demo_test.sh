@@ -51,7 +51,7 @@ grep -q "shown through OpenGL" "$out/opengl.err" || fail "opengl: the demo did n
 # and picture recorded into the frame) under validation, on the CPU, and through OpenGL. The field
 # is the same bit for bit on both backends, so the pictures right of the panel agree within the
 # visualiser's float tolerance; they show the green sheet and the coloured field.
-vector_frames=${VECTOR_FRAMES:-20}  # fewer under a sanitizer (tests/CMakeLists.txt)
+vector_frames=${VECTOR_FRAMES:-10}  # fewer under a sanitizer (tests/CMakeLists.txt)
 vrun() {  # name, demo arguments...
   local name=$1
   shift

@@ -242,7 +242,11 @@ INSTANTIATE_TEST_SUITE_P(Backends, ExactDistanceOn,
 TEST_P(ExactDistanceOn, RandomWorldsAgainstBruteForce) {
   const Backend b = GetParam();
   VOXFIELD_SKIP_UNLESS_BACKEND(b);
+  // Under a sanitizer the Vulkan backend checks every third case (its host code takes the same
+  // path for each, and the shaders run in lavapipe, which is not instrumented); the optimised
+  // build checks them all on both backends.
   const auto check_case = [b](const Case& c, std::uint32_t seed, Vec3i size, double density) {
+    if (b == Backend::kVulkan && kSanitizedBuild && seed % 3 != 0) return;
     ::check_case(b, c, seed, size, density);
   };
   const std::array<double, 3> unit{1, 1, 1}, aniso{0.5, 1.25, 2.0};
