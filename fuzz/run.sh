@@ -16,7 +16,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-25}; shift || true
-harnesses=${*:-"vox npy vfw vdb edit_script options vector_sources csg_model openscad mesh"}
+harnesses=${*:-"vox npy vfw vdb edit_script options vector_sources csg_model openscad mesh mesh_pieces"}
 bin=build/fuzz/bin
 cli=build/release/bin/voxfield
 corpus=../shared/data/vox
@@ -55,6 +55,7 @@ run_one() {
     csg_model) dirs="fuzz/seeds/csg"; max_len=4096 ;;
     openscad) dirs="fuzz/seeds/openscad"; max_len=4096 ;;
     mesh) dirs="fuzz/seeds/mesh"; max_len=4096 ;;
+    mesh_pieces) dirs=""; max_len=600 ;;  # edits to real pieces the harness makes itself
     *) echo "unknown harness $h" >&2; return 2 ;;
   esac
   work="$out/corpus-$h"; mkdir -p "$work"

@@ -5,17 +5,19 @@
 //          [--threads T] [--memory-limit B]
 //   mpirun -np N voxfield-mpi edit IN -e EDITS.jsonl -o OUT.npy [field options] [--stats S.json]
 //   mpirun -np N voxfield-mpi bench --size X,Y,Z [--spheres K] [--repeat R] [field options]
+//   mpirun -np N voxfield-mpi mesh IN.npy -o OUT.{ply,obj,stl,glb} [--algorithm mc|sn|dc]
+//          [--iso V] [--inside below|above] [--spacing sx,sy,sz] [--chunk C] [--stats S.json]
 //
 // `field` writes byte for byte what `voxfield field` writes for the same input and options; each
 // rank holds only its slab of a .npy input and of the field. `edit` writes what `voxfield edit`
 // writes: every rank applies every edit of the script to its slab and the slices a clamped value
 // can reach beyond it, with incremental updates of its own field. `bench` generates a world of
 // random spheres slab by slab (no file) and prints, per run, the time, the rate and the bytes
-// exchanged. Every rank parses the same command line; rank 0 alone prints. A failure on any rank is
-// reported by rank 0 as "voxfield-mpi: rank R: ..." and every rank exits with 1 (2 for usage
-// errors).
+// exchanged. `mesh` meshes a float volume, each rank the chunk layers of its planes (mpi.h), and
+// writes the mesh `voxfield mesh` writes, triangle for triangle. Every rank parses the same command
+// line; rank 0 alone prints. A failure on any rank is reported by rank 0 as "voxfield-mpi: rank R:
+// ..." and every rank exits with 1 (2 for usage errors).
 #include <mpi.h>
-#include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
 #include <iostream>
@@ -23,6 +25,8 @@
 #include <numeric>
 
 #include "bench_world.h"
+#include "mesh_command.h"
+#include "rank_stats.h"
 #include "voxfield/distance.h"
 #include "voxfield/edit_script.h"
 #include "voxfield/error.h"
@@ -82,32 +86,10 @@ struct FieldSettings {
   }
 };
 
-// Resident-set high-water mark of this process, in bytes.
-std::size_t peak_rss_bytes() {
-  struct rusage u {};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<std::size_t>(u.ru_maxrss) * 1024;  // Linux reports KiB
-}
-
-// The slowest rank's figure (times) and the sum over ranks (bytes).
-double max_over(MPI_Comm comm, double v) {
-  double out = 0;
-  MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MAX, comm);
-  return out;
-}
-std::uint64_t sum_over(MPI_Comm comm, std::uint64_t v) {
-  std::uint64_t out = 0;
-  MPI_Allreduce(&v, &out, 1, MPI_UINT64_T, MPI_SUM, comm);
-  return out;
-}
-
-nlohmann::json exchange_json(MPI_Comm comm, const mpi::ExchangeStats& s) {
-  return {{"compute_ms_max", max_over(comm, s.compute_ms)},
-          {"exchange_ms_max", max_over(comm, s.exchange_ms)},
-          {"bytes_sent_total", sum_over(comm, s.bytes_sent)},
-          {"bytes_received_total", sum_over(comm, s.bytes_received)},
-          {"collectives_per_rank", s.collectives}};
-}
+using mpi_cli::exchange_json;
+using mpi_cli::max_over;
+using mpi_cli::peak_rss_bytes;
+using mpi_cli::sum_over;
 
 int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, const std::string& out,
               const std::string& sites, const std::string& stats) {
@@ -282,7 +264,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   voxfield::install_signal_cleanup();
-  CLI::App app{"voxfield-mpi: exact distance fields over the processes of an MPI job"};
+  CLI::App app{"voxfield-mpi: exact distance fields and meshes over the processes of an MPI job"};
   app.require_subcommand(1);
   std::string memory_limit;
   app.add_option("--memory-limit", memory_limit,
@@ -322,6 +304,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 1 << 20));
   bench->add_option("--repeat", repeat, "runs")->check(CLI::Range(1, 1000));
   fb.add_to(bench);
+  mpi_cli::MeshSettings mesh_settings;
+  CLI::App* mesh = mpi_cli::add_mesh_command(app, mesh_settings);
   int code = 0;
   try {
     app.parse(argc, argv);
@@ -331,6 +315,8 @@ int main(int argc, char** argv) {
       code = run_field(comm, f, in, out, sites, stats);
     } else if (edit->parsed()) {
       code = run_edit(comm, fe, edit_in, edit_script, edit_out, edit_stats, edit_save);
+    } else if (mesh->parsed()) {
+      code = mpi_cli::run_mesh(comm, mesh_settings);
     } else {
       code = run_bench(comm, fb, dims, spheres, repeat);
     }

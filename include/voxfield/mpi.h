@@ -33,6 +33,7 @@
 #include "voxfield/edit.h"
 #include "voxfield/error.h"
 #include "voxfield/file.h"
+#include "voxfield/mesh.h"
 #include "voxfield/world.h"
 
 namespace voxfield::mpi {
@@ -220,5 +221,52 @@ void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const Distan
 void save_world_vfw(MPI_Comm comm, const SlabPartition& partition, const World& world,
                     const std::filesystem::path& path, ExchangeStats* stats = nullptr,
                     FileTransaction* into = nullptr);
+
+// Meshes of a lattice no rank holds whole (a scan or a simulation's float volume, a distributed
+// field). The lattice's chunk layers (mesh_pieces.h: the chunked mesher's chunks grouped along z)
+// are dealt to the ranks in runs of near-equal length; each rank meshes its run from the sample
+// planes that run reads — its own planes and three on either side — and rank 0 joins the pieces
+// with the chunked mesher's weld. The mesh equals MeshChunks(volume, options).merged() of the whole
+// lattice array for array (and mesh_volume's triangle for triangle), for any number of ranks.
+
+// Rank r meshes chunk layers [layers[r], layers[r + 1]).
+struct MeshLayers {
+  Vec3i samples;  // the whole lattice's
+  int chunk_edge = 32;
+  std::vector<std::int32_t> layers;  // ranks + 1 cut points
+
+  int ranks() const { return static_cast<int>(layers.size()) - 1; }
+  bool empty(int rank) const;  // a rank past the layers' count has none
+  // The sample planes [first, second) rank `rank` must hold: what its layers read ([0, 0) when it
+  // has none).
+  std::pair<int, int> planes(int rank) const;
+};
+
+// Runs of ceil or floor(layers / ranks) layers, in rank order. InvalidArgument for a lattice under
+// 2 samples along an axis or a chunk edge outside 2..256.
+MeshLayers partition_mesh_layers(Vec3i samples, int chunk_edge, int ranks);
+// Runs of near-equal total weight (layer_weights[k] >= 0: layer k's work), in rank order: a
+// terrain's surface lies in a few layers, which equal counts would hand to one or two ranks.
+// InvalidArgument also for weights not one per layer, negative or not finite.
+MeshLayers partition_mesh_layers(Vec3i samples, int chunk_edge, int ranks,
+                                 const std::vector<double>& layer_weights);
+
+// Collective: each chunk layer's meshing work, for partition_mesh_layers: the lattice edges within
+// its sample planes that the iso-surface crosses (what its triangles follow) plus a 64th of its
+// samples (every sample is classified, surface or not). Rank r passes the samples of planes
+// [z0, z1) of the lattice (x fastest) — any split of the planes among the ranks, each plane passed
+// by exactly one (InvalidArgument on every rank otherwise). Options as for mesh_volume.
+std::vector<double> mesh_layer_weights(MPI_Comm comm, Vec3i samples, int z0, int z1,
+                                       const float* planes, const MeshOptions& options,
+                                       ExchangeStats* stats = nullptr);
+
+// Collective: meshes the lattice `frame` describes (its size, origin and spacing; frame.values is
+// not read) with `options` (options.chunk_edge must be layers.chunk_edge). Each rank passes
+// `planes`: the samples of layers.planes(rank), x fastest (null on a rank without layers). Returns
+// the whole mesh on rank 0 and an empty one on the others. Rank 0 must hold the mesh and every
+// piece; pieces travel in messages of at most 256 MiB. Throws RankError on every rank when any
+// fails (a NaN sample, the memory limit, mismatched options).
+Mesh mesh_volume(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& frame,
+                 const float* planes, const MeshOptions& options, ExchangeStats* stats = nullptr);
 
 }  // namespace voxfield::mpi

@@ -64,7 +64,7 @@ PY
 expect_failure() {  # expect_failure CODE PATTERN ARGS...
   local code=$1 pattern=$2
   shift 2
-  rm -f bad.npy bad.vfw
+  rm -f bad.npy bad.vfw bad.ply
   set +e
   MPIEXEC -np "${EXPECT_RANKS:-2}" "$VFM" "$@" >out.txt 2>err.txt
   local got=$?
@@ -72,7 +72,7 @@ expect_failure() {  # expect_failure CODE PATTERN ARGS...
   if [ "$got" -ne "$code" ]; then echo "FAIL: $* exited $got, expected $code"; cat err.txt; fail=1; fi
   if ! grep -q -- "$pattern" err.txt; then echo "FAIL: $*: no '$pattern' in:"; cat err.txt; fail=1; fi
   if [ "$(grep -c -- "$pattern" err.txt)" -gt 1 ]; then echo "FAIL: $*: said more than once"; fail=1; fi
-  if [ -e bad.npy ] || [ -e bad.vfw ]; then echo "FAIL: $* wrote an output"; fail=1; fi
+  if [ -e bad.npy ] || [ -e bad.vfw ] || [ -e bad.ply ]; then echo "FAIL: $* wrote an output"; fail=1; fi
   if ls -a | grep -q vftmp; then echo "FAIL: $* left a temporary"; fail=1; fi
 }
 # Scripted edits: every rank applies every edit to its slab and ghost slices; the final field is
@@ -141,6 +141,58 @@ expect_failure 1 "junk.npy: at byte 0: not a .npy file" field junk.npy -o bad.np
 # More ranks than slices: refused alike by every rank.
 /usr/bin/python3 -c "import numpy as np; np.save('thin.npy', np.ones((4, 4, 1), np.uint8))"
 expect_failure 1 "fewer than the 2" field thin.npy -o bad.npy
+
+# Meshes: a float volume meshed over 1..4 ranks (each reading only its chunk layers' planes) gives
+# voxfield mesh's triangles bit for bit — its whole-volume pass numbers the same vertices by row,
+# so the triangles are compared as sets of corner positions — for every mesher, in every format.
+/usr/bin/python3 - <<'PY'
+import numpy as np
+z, y, x = np.meshgrid(np.arange(45), np.arange(31), np.arange(26), indexing="ij")
+v = np.sin(0.31 * x + 0.2 * y) + np.cos(0.23 * z - 0.11 * x) + 0.4 * np.sin(0.5 * y * 0.7 + z * 0.13)
+np.save("wave.npy", np.ascontiguousarray(v.transpose(2, 1, 0)).astype(np.float32))  # a[x, y, z]
+np.save("wave64.npy", np.asfortranarray(v.transpose(2, 1, 0)))
+PY
+same_triangles() {  # same_triangles REF.ply OUT.ply WHAT
+  /usr/bin/python3 "$(dirname "$0")/../../scripts/same_triangles.py" "$1" "$2" >/dev/null ||
+    { echo "FAIL: $3: the triangles differ from voxfield mesh's"; fail=1; }
+}
+for alg in mc sn dc; do
+  "$VF" mesh wave.npy -o ref.ply --algorithm "$alg" --iso 0.2 --spacing 0.5,1,1.5 2>/dev/null
+  # Every rank count for marching cubes; one each for the dual meshers (each mpirun costs a second).
+  ranks="1 2 3 4"
+  [ "$alg" = sn ] && ranks=3
+  [ "$alg" = dc ] && ranks=2
+  for n in $ranks; do
+    MPIEXEC -np "$n" "$VFM" mesh wave.npy -o out.ply --algorithm "$alg" --iso 0.2 --spacing 0.5,1,1.5 \
+      --chunk 8 --stats mesh.json 2>/dev/null
+    same_triangles ref.ply out.ply "$alg, $n ranks"
+  done
+done
+"$VF" mesh wave64.npy -o ref.ply --inside above 2>/dev/null
+MPIEXEC -np 3 "$VFM" mesh wave64.npy -o out.ply --inside above --chunk 5 2>/dev/null
+same_triangles ref.ply out.ply "float64, inside above, 3 ranks"
+/usr/bin/python3 -c "
+import json; s = json.load(open('mesh.json'))
+assert s['ranks'] == 2 and s['watertight'] is False and len(s['chunk_layers']) == 3, s
+assert s['exchange']['bytes_received_total'] > 0, s"
+# The other formats: binary STL and glTF sizes follow the counts alone; OBJ's text, the vertices'
+# numbers, so there the lines of each kind are counted.
+for fmt in obj stl glb; do
+  "$VF" mesh wave.npy -o "ref.$fmt" 2>/dev/null
+  MPIEXEC -np 2 "$VFM" mesh wave.npy -o "out.$fmt" --chunk 16 2>/dev/null
+  if [ "$fmt" = obj ]; then
+    for kind in v vn f; do
+      [ "$(grep -c "^$kind " ref.obj)" = "$(grep -c "^$kind " out.obj)" ] ||
+        { echo "FAIL: mesh .obj: the '$kind' lines differ in number"; fail=1; }
+    done
+  else
+    [ "$(stat -c %s "ref.$fmt")" = "$(stat -c %s "out.$fmt")" ] || { echo "FAIL: mesh .$fmt sizes differ"; fail=1; }
+  fi
+done
+expect_failure 1 "f.npy: voxfield-mpi mesh meshes float32/float64 volumes" mesh f.npy -o bad.ply
+expect_failure 1 "unknown mesh format" mesh wave.npy -o bad.xyz
+/usr/bin/python3 -c "import numpy as np; a = np.zeros((6, 6, 20), np.float32); a[2, 3, 17] = np.nan; np.save('nan.npy', a)"
+expect_failure 1 "sample (2, 3, 17) is NaN" mesh nan.npy -o bad.ply --chunk 4
 
 # The bench runs and reports the exchange.
 MPIEXEC -np 2 "$VFM" bench --size 40,30,50 --spheres 20 --repeat 1 --chunk 8 > bench.json

@@ -1,0 +1,160 @@
+// voxfield-mpi mesh (mesh_command.h).
+#include "mesh_command.h"
+
+#include <cmath>
+#include <iostream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "rank_stats.h"
+#include "voxfield/error.h"
+#include "voxfield/file.h"
+#include "voxfield/mesh.h"
+#include "voxfield/mesh_files.h"
+#include "voxfield/mpi.h"
+#include "voxfield/npy.h"
+#include "voxfield/parallel.h"
+
+namespace voxfield::mpi_cli {
+
+CLI::App* add_mesh_command(CLI::App& app, MeshSettings& s) {
+  CLI::App* cmd = app.add_subcommand(
+      "mesh",
+      "the iso-surface of a float .npy volume, as `voxfield mesh` (each rank reads its planes)");
+  cmd->add_option("IN", s.in, "input float32/float64 .npy volume")->required();
+  cmd->add_option("-o,--output", s.out, "output .ply, .obj, .stl or .glb (written by rank 0)")
+      ->required();
+  cmd->add_option("--algorithm", s.algorithm,
+                  "mc (marching cubes), sn (surface nets) or dc (dual contouring)")
+      ->check(
+          CLI::IsMember({"mc", "sn", "dc", "marching-cubes", "surface-nets", "dual-contouring"}));
+  cmd->add_option("--iso", s.iso, "iso value (default 0)");
+  cmd->add_option("--inside", s.inside, "which values are inside: below (default) or above iso")
+      ->check(CLI::IsMember({"below", "above"}));
+  cmd->add_option("--spacing", s.spacing, "sample spacing sx,sy,sz (a[x,y,z] at (x,y,z) * spacing)")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--chunk", s.chunk,
+                  "cells per chunk edge (2..256, default 32); ranks mesh whole layers of chunks")
+      ->check(CLI::Range(2, 256));
+  cmd->add_option("--threads", s.threads, "threads per rank (default: all cores)")
+      ->check(CLI::Range(1, 1024));
+  cmd->add_option("--balance", s.balance,
+                  "deal the chunk layers to the ranks by content (default: each rank about as many "
+                  "crossed edges, read in a first pass) or by count")
+      ->check(CLI::IsMember({"content", "count"}));
+  cmd->add_option("--stats", s.stats, "counts, timings and exchange figures as JSON");
+  return cmd;
+}
+
+int run_mesh(MPI_Comm comm, const MeshSettings& s) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  std::optional<ThreadLimit> limit;
+  if (s.threads > 0) limit.emplace(s.threads);
+  MeshOptions options;
+  options.algorithm = parse_mesher(s.algorithm);
+  options.iso = s.iso;
+  options.inside_above = s.inside == "above";
+  options.chunk_edge = s.chunk;
+  const MeshFormat format = mesh_format_of(s.out);
+  mpi::check_outputs(comm, {}, {s.out, s.stats});
+  // Every rank reads the header; a world (integer or bool .npy) is not a float volume.
+  const NpyVolume header = mpi::collectively(comm, [&] {
+    NpyVolume h = read_npy_header(s.in);
+    if (h.dtype != DType::kFloat32 && h.dtype != DType::kFloat64)
+      throw InvalidArgument(s.in +
+                            ": voxfield-mpi mesh meshes float32/float64 volumes; for a world, "
+                            "write its signed field first (voxfield-mpi field IN -o F.npy "
+                            "--metric euclidean --signed) and mesh that, or use voxfield mesh");
+    return h;
+  });
+  ScalarVolume frame{header.dims, nullptr};
+  if (!s.spacing.empty()) frame.spacing_units = {s.spacing[0], s.spacing[1], s.spacing[2]};
+  const double t0 = MPI_Wtime();
+  // Planes [z0, z1) of the file as floats (a value past float's range is refused, naming its place
+  // in the file, as voxfield mesh does).
+  const auto read_planes = [&](int z0, int z1) {
+    return mpi::collectively(comm, [&] {
+      std::vector<float> values;
+      if (z1 <= z0) return values;
+      const NpyVolume part = read_npy_part(s.in, z0, z1);
+      values.resize(static_cast<std::size_t>(part.count()));
+      for (std::int64_t i = 0; i < part.count(); ++i) {
+        const double v = part.value(i);
+        if (std::abs(v) > std::numeric_limits<float>::max())  // NaN passes on, refused by name
+          throw FormatError(s.in, part.file_offset_of(i),
+                            "value " + std::to_string(v) + " does not fit a float32 sample");
+        values[static_cast<std::size_t>(i)] = static_cast<float>(v);
+      }
+      return values;
+    });
+  };
+  mpi::ExchangeStats ex;
+  const mpi::MeshLayers layers = [&] {
+    if (s.balance == "count")
+      return mpi::collectively(
+          comm, [&] { return mpi::partition_mesh_layers(header.dims, s.chunk, size); });
+    // By content: a first pass over equal shares of the planes counts each layer's crossings.
+    const int z0 = static_cast<int>(static_cast<std::int64_t>(header.dims.z) * rank / size);
+    const int z1 = static_cast<int>(static_cast<std::int64_t>(header.dims.z) * (rank + 1) / size);
+    const std::vector<double> weights = [&] {
+      const std::vector<float> share = read_planes(z0, z1);
+      return mpi::mesh_layer_weights(comm, header.dims, z0, z1, share.data(), options, &ex);
+    }();
+    return mpi::collectively(
+        comm, [&] { return mpi::partition_mesh_layers(header.dims, s.chunk, size, weights); });
+  }();
+  const auto [z0, z1] = layers.planes(rank);
+  const std::vector<float> planes = read_planes(z0, z1);
+  const double load_ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
+  MPI_Barrier(comm);  // the mesh's time starts together on every rank
+  const double t1 = MPI_Wtime();
+  const Mesh mesh =
+      mpi::mesh_volume(comm, layers, frame, planes.empty() ? nullptr : planes.data(), options, &ex);
+  const double mesh_ms = max_over(comm, (MPI_Wtime() - t1) * 1e3);
+  nlohmann::json exchange = exchange_json(comm, ex);
+  const double peak_mb = max_over(comm, static_cast<double>(peak_rss_bytes()) / 1048576.0);
+  // Rank 0 encodes and writes; the others wait for its outcome.
+  std::optional<FileTransaction> outputs;
+  std::size_t triangles = 0, vertices = 0;
+  mpi::collectively(comm, [&] {
+    if (rank != 0) return;
+    outputs.emplace();
+    outputs->stage(s.out, encode_mesh(mesh, format));
+    const MeshStats st = mesh_stats(mesh);
+    triangles = st.triangles;
+    vertices = st.vertices;
+    if (!s.stats.empty()) {
+      nlohmann::json j{{"input", s.in},
+                       {"output", s.out},
+                       {"algorithm", mesher_name(options.algorithm)},
+                       {"ms", mesh_ms},
+                       {"load_ms_max", load_ms},
+                       {"ranks", size},
+                       {"threads", max_threads()},
+                       {"chunk_edge", s.chunk},
+                       {"chunk_layers", layers.layers},
+                       {"balance", s.balance},
+                       {"vertices", st.vertices},
+                       {"triangles", st.triangles},
+                       {"watertight", st.watertight()},
+                       {"boundary_edges", st.boundary_edges},
+                       {"euler_characteristic", st.euler_characteristic},
+                       {"peak_rss_mb_max", peak_mb}};
+      j["exchange"] = exchange;
+      outputs->stage(s.stats, j.dump(2) + "\n");
+    }
+    outputs->commit();
+  });
+  if (rank == 0)
+    std::cerr << "voxfield-mpi: wrote " << s.out << " (" << triangles << " triangles, " << vertices
+              << " vertices, " << mesher_name(options.algorithm) << ", " << size << " ranks, "
+              << std::lround(mesh_ms) << " ms)\n";
+  return 0;
+}
+
+}  // namespace voxfield::mpi_cli

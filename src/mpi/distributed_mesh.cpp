@@ -1,0 +1,211 @@
+// voxfield — meshes of a lattice split over the ranks of an MPI job (mpi.h).
+//
+// The chunked mesher's chunks grouped into layers along z (mesh_pieces.h) are dealt to the ranks
+// in runs; a run reads its own sample planes and three on either side, so a rank needs nothing
+// from the others while meshing. Each rank's piece — its chunks' parts with their vertices' lattice
+// element keys — goes to rank 0, which joins them with the chunked mesher's weld: border vertices
+// are computed the same way on both sides of a cut and welded by key, so the cut leaves no crack
+// and no duplicate, and the mesh is the same array for array for any number of ranks.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <span>
+#include <string>
+
+#include "collective.h"
+#include "voxfield/mesh_pieces.h"
+#include "voxfield/mpi.h"
+
+namespace voxfield::mpi {
+
+bool MeshLayers::empty(int rank) const {
+  return layers[static_cast<std::size_t>(rank)] == layers[static_cast<std::size_t>(rank) + 1];
+}
+
+std::pair<int, int> MeshLayers::planes(int rank) const {
+  if (empty(rank)) return {0, 0};
+  return mesh_layer_planes(samples, chunk_edge, layers[static_cast<std::size_t>(rank)],
+                           layers[static_cast<std::size_t>(rank) + 1]);
+}
+
+MeshLayers partition_mesh_layers(Vec3i samples, int chunk_edge, int ranks) {
+  if (ranks < 1) throw InvalidArgument("partition_mesh_layers: ranks must be at least 1");
+  const int count = mesh_chunk_layers(samples, chunk_edge);
+  MeshLayers p;
+  p.samples = samples;
+  p.chunk_edge = chunk_edge;
+  p.layers.resize(static_cast<std::size_t>(ranks) + 1);
+  for (int r = 0; r <= ranks; ++r)
+    p.layers[static_cast<std::size_t>(r)] =
+        static_cast<std::int32_t>(static_cast<std::int64_t>(count) * r / ranks);
+  return p;
+}
+
+MeshLayers partition_mesh_layers(Vec3i samples, int chunk_edge, int ranks,
+                                 const std::vector<double>& layer_weights) {
+  MeshLayers p = partition_mesh_layers(samples, chunk_edge, ranks);
+  const std::size_t count = static_cast<std::size_t>(p.layers.back());
+  if (layer_weights.size() != count)
+    throw InvalidArgument("partition_mesh_layers: " + std::to_string(layer_weights.size()) +
+                          " weights for " + std::to_string(count) + " chunk layers");
+  // prefix[k]: the weight of the layers before k.
+  std::vector<double> prefix(count + 1, 0.0);
+  for (std::size_t k = 0; k < count; ++k) {
+    if (!(layer_weights[k] >= 0) || !std::isfinite(layer_weights[k]))
+      throw InvalidArgument("partition_mesh_layers: layer " + std::to_string(k) + "'s weight " +
+                            std::to_string(layer_weights[k]) + " is not a finite weight >= 0");
+    prefix[k + 1] = prefix[k] + layer_weights[k];
+  }
+  // Each cut where the running weight comes nearest to its share (never before the previous cut).
+  std::size_t k = 0;
+  for (int r = 1; r < ranks; ++r) {
+    const double target = prefix[count] * r / ranks;
+    while (k < count && prefix[k + 1] <= target) ++k;
+    if (k < count && target - prefix[k] > prefix[k + 1] - target) ++k;
+    p.layers[static_cast<std::size_t>(r)] = static_cast<std::int32_t>(k);
+  }
+  return p;
+}
+
+std::vector<double> mesh_layer_weights(MPI_Comm comm, Vec3i samples, int z0, int z1,
+                                       const float* planes, const MeshOptions& options,
+                                       ExchangeStats* stats) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t nz = static_cast<std::size_t>(std::max(samples.z, 0));
+  // Per plane: the crossed edges counted by the rank holding it, and how many ranks hold it.
+  std::vector<std::uint64_t> own(2 * nz, 0);
+  detail::collectively(comm, stats, [&] {
+    const int layers = mesh_chunk_layers(samples, options.chunk_edge);  // checks samples, edge
+    (void)layers;
+    if (!(z0 >= 0 && z0 <= z1 && z1 <= samples.z) || (z1 > z0 && !planes))
+      throw InvalidArgument("mesh_layer_weights: planes [" + std::to_string(z0) + ", " +
+                            std::to_string(z1) + ") are not within the lattice's " +
+                            std::to_string(samples.z));
+    const float iso = static_cast<float>(options.iso);
+    const bool above = options.inside_above;
+    const std::size_t nx = static_cast<std::size_t>(samples.x),
+                      ny = static_cast<std::size_t>(samples.y);
+    std::vector<std::uint8_t> in(nx * ny);
+    for (int z = z0; z < z1; ++z) {
+      const float* p = planes + nx * ny * static_cast<std::size_t>(z - z0);
+      for (std::size_t i = 0; i < in.size(); ++i) in[i] = above ? p[i] > iso : p[i] < iso;
+      std::uint64_t crossed = 0;
+      for (std::size_t y = 0; y < ny; ++y)
+        for (std::size_t x = 0; x < nx; ++x) {
+          const std::size_t i = x + nx * y;
+          crossed += (x + 1 < nx && in[i] != in[i + 1]) + (y + 1 < ny && in[i] != in[i + nx]);
+        }
+      own[static_cast<std::size_t>(z)] = crossed;
+      own[nz + static_cast<std::size_t>(z)] = 1;
+    }
+  });
+  if (stats) stats->compute_ms += detail::ms_since(t0);
+  std::vector<std::uint64_t> all(own.size());
+  {
+    detail::CollectiveTimer t(stats);
+    MPI_Allreduce(own.data(), all.data(), static_cast<int>(all.size()), MPI_UINT64_T, MPI_SUM,
+                  comm);
+  }
+  if (stats) {
+    stats->bytes_sent += own.size() * sizeof(std::uint64_t);
+    stats->bytes_received += all.size() * sizeof(std::uint64_t);
+  }
+  return detail::collectively(comm, stats, [&] {
+    for (std::size_t z = 0; z < nz; ++z)
+      if (all[nz + z] != 1)
+        throw InvalidArgument("mesh_layer_weights: sample plane " + std::to_string(z) +
+                              " was passed by " + std::to_string(all[nz + z]) +
+                              " ranks; each plane by exactly one");
+    const int edge = options.chunk_edge;
+    const int layers = mesh_chunk_layers(samples, edge);
+    const double per_plane = static_cast<double>(samples.x) * samples.y / 64.0;
+    std::vector<double> weights(static_cast<std::size_t>(layers), 0.0);
+    for (int k = 0; k < layers; ++k)
+      // The planes of layer k's cells: k * edge .. (k + 1) * edge, within the lattice.
+      for (int z = k * edge; z <= std::min((k + 1) * edge, samples.z - 1); ++z)
+        weights[static_cast<std::size_t>(k)] +=
+            static_cast<double>(all[static_cast<std::size_t>(z)]) + per_plane;
+    return weights;
+  });
+}
+
+namespace {
+
+constexpr int kPieceTag = 7401;
+constexpr std::size_t kMessageBytes = std::size_t{256} << 20;
+
+// Every rank's piece on rank 0 (in rank order; empty on the others). Sizes first, then each
+// piece in messages of at most kMessageBytes.
+std::vector<std::vector<std::uint8_t>> gather_pieces(MPI_Comm comm, std::vector<std::uint8_t> own,
+                                                     ExchangeStats* stats) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  std::vector<std::uint64_t> sizes(static_cast<std::size_t>(size));
+  const std::uint64_t own_size = own.size();
+  {
+    detail::CollectiveTimer t(stats);
+    MPI_Gather(&own_size, 1, MPI_UINT64_T, sizes.data(), 1, MPI_UINT64_T, 0, comm);
+  }
+  std::vector<std::vector<std::uint8_t>> pieces;
+  detail::CollectiveTimer t(stats);
+  if (rank != 0) {
+    for (std::size_t at = 0; at < own.size(); at += kMessageBytes) {
+      const int n = static_cast<int>(std::min(kMessageBytes, own.size() - at));
+      MPI_Send(own.data() + at, n, MPI_BYTE, 0, kPieceTag, comm);
+    }
+    if (stats) stats->bytes_sent += own_size;
+    return pieces;
+  }
+  pieces.resize(static_cast<std::size_t>(size));
+  pieces[0] = std::move(own);
+  for (int r = 1; r < size; ++r) {
+    std::vector<std::uint8_t>& piece = pieces[static_cast<std::size_t>(r)];
+    piece.resize(static_cast<std::size_t>(sizes[static_cast<std::size_t>(r)]));
+    for (std::size_t at = 0; at < piece.size(); at += kMessageBytes) {
+      const int n = static_cast<int>(std::min(kMessageBytes, piece.size() - at));
+      MPI_Recv(piece.data() + at, n, MPI_BYTE, r, kPieceTag, comm, MPI_STATUS_IGNORE);
+    }
+    if (stats) stats->bytes_received += piece.size();
+  }
+  return pieces;
+}
+
+}  // namespace
+
+Mesh mesh_volume(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& frame,
+                 const float* planes, const MeshOptions& options, ExchangeStats* stats) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<std::uint8_t> piece = detail::collectively(comm, stats, [&] {
+    if (layers.ranks() != size)
+      throw InvalidArgument("mpi::mesh_volume: the layers are dealt to " +
+                            std::to_string(layers.ranks()) + " ranks, the communicator has " +
+                            std::to_string(size));
+    if (!(layers.samples == frame.size) || layers.chunk_edge != options.chunk_edge)
+      throw InvalidArgument(
+          "mpi::mesh_volume: the layers were cut for another lattice size or chunk edge");
+    if (layers.empty(rank)) return std::vector<std::uint8_t>{};
+    const auto [z0, z1] = layers.planes(rank);
+    return mesh_piece(frame, z0, z1 - z0, planes, options,
+                      layers.layers[static_cast<std::size_t>(rank)],
+                      layers.layers[static_cast<std::size_t>(rank) + 1]);
+  });
+  if (stats) stats->compute_ms += detail::ms_since(t0);
+  const std::vector<std::vector<std::uint8_t>> pieces =
+      gather_pieces(comm, std::move(piece), stats);
+  const auto t1 = std::chrono::steady_clock::now();
+  Mesh mesh = detail::collectively(comm, stats, [&] {
+    if (rank != 0) return Mesh{};
+    std::vector<std::span<const std::uint8_t>> spans;
+    for (int r = 0; r < size; ++r)
+      if (!layers.empty(r)) spans.emplace_back(pieces[static_cast<std::size_t>(r)]);
+    return join_mesh_pieces(spans);
+  });
+  if (stats) stats->compute_ms += detail::ms_since(t1);
+  return mesh;
+}
+
+}  // namespace voxfield::mpi
