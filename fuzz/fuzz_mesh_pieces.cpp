@@ -1,9 +1,9 @@
 // libFuzzer harness for join_mesh_pieces (mesh_pieces.h): the bytes a rank of voxfield-mpi mesh
 // sends rank 0. Random bytes would never get past a piece's header, so the harness starts from the
 // real pieces of a small lattice — layers [0, 1) and [1, 3), every mesher by turns — and reads the
-// input as damage to the second: its first byte picks the mesher, the next two cut the piece to a
-// length, then each three bytes set one byte at an offset. Any input must join or throw
-// voxfield::Error; a mesh that joins must index only its own vertices.
+// input as damage to them: its first byte picks the mesher, the next two cut the second piece to a
+// length, then each three bytes set one byte of either piece at an offset. Any input must join or
+// throw voxfield::Error; a mesh that joins must index only its own vertices.
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -51,18 +51,21 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 3) return 0;
   const auto& real = pieces[data[0] % 3];
-  std::vector<std::uint8_t> second = real[1];
-  const std::size_t keep = (static_cast<std::size_t>(data[1]) << 8 | data[2]) % (second.size() + 1);
-  second.resize(keep == 0 ? second.size() : keep);  // 0 keeps it whole
+  std::array<std::vector<std::uint8_t>, 2> piece = real;
+  const std::size_t keep =
+      (static_cast<std::size_t>(data[1]) << 8 | data[2]) % (piece[1].size() + 1);
+  piece[1].resize(keep == 0 ? piece[1].size() : keep);  // 0 keeps it whole
+  // Each edit: the top bit picks the piece (both can be forged, headers that agree included).
   for (std::size_t at = 3; at + 3 <= size; at += 3) {
-    if (second.empty()) break;
+    std::vector<std::uint8_t>& p = piece[data[at] >> 7];
+    if (p.empty()) continue;
     const std::size_t offset =
-        (static_cast<std::size_t>(data[at]) << 8 | data[at + 1]) % second.size();
-    second[offset] = data[at + 2];
+        (static_cast<std::size_t>(data[at] & 0x7f) << 8 | data[at + 1]) % p.size();
+    p[offset] = data[at + 2];
   }
   try {
     const voxfield::Mesh mesh = voxfield::join_mesh_pieces(
-        {std::span<const std::uint8_t>(real[0]), std::span<const std::uint8_t>(second)});
+        {std::span<const std::uint8_t>(piece[0]), std::span<const std::uint8_t>(piece[1])});
     for (const std::uint32_t index : mesh.indices)
       if (index >= mesh.vertex_count()) std::abort();
   } catch (const voxfield::Error&) {

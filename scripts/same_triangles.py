@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Whether two binary PLY meshes that voxfield wrote hold the same triangles, bit for bit, however
-their vertices are numbered: each triangle as its three corners' positions (float bits), rotated to
-start at its smallest corner (so the winding counts), the lists sorted and compared. Prints the
-triangle counts; exit status 0 when equal, 1 when not.
+their vertices are numbered: each triangle as its three corners' positions and normals (float
+bits), rotated to start at its smallest corner (so the winding counts), the lists sorted and
+compared. Prints the triangle counts; exit status 0 when equal, 1 when not.
 
 Usage: /usr/bin/python3 scripts/same_triangles.py A.ply B.ply
 """
@@ -28,7 +28,8 @@ def triangles(path):
     faces = np.frombuffer(data, np.dtype([("k", "u1"), ("i", "<u4", 3)]), nf, end + nv * vert.itemsize)
     if not (faces["k"] == 3).all():
         raise SystemExit(f"{path}: a face that is not a triangle")
-    return np.ascontiguousarray(verts["p"][faces["i"]]).view(np.uint32).reshape(nf, 3, 3)
+    corners = np.concatenate([verts["p"][faces["i"]], verts["n"][faces["i"]]], axis=2)
+    return np.ascontiguousarray(corners).view(np.uint32).reshape(nf, 3, 6)
 
 
 def canonical(corners, ids):
@@ -41,9 +42,10 @@ def canonical(corners, ids):
 
 
 a, b = triangles(sys.argv[1]), triangles(sys.argv[2])
-# One id per distinct corner position over both meshes, in lexicographic order of its float bits.
-corners = np.concatenate([a.reshape(-1, 3), b.reshape(-1, 3)])
-order = np.lexsort((corners[:, 2], corners[:, 1], corners[:, 0]))
+# One id per distinct corner (position and normal) over both meshes, in lexicographic order of its
+# float bits.
+corners = np.concatenate([a.reshape(-1, 6), b.reshape(-1, 6)])
+order = np.lexsort(corners.T[::-1])
 ordered = corners[order]
 first = np.ones(len(ordered), bool)
 first[1:] = (ordered[1:] != ordered[:-1]).any(axis=1)

@@ -3,6 +3,7 @@
 // pieces refused by name.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <random>
 #include <span>
 
@@ -12,6 +13,7 @@
 #include "voxfield/mesh_chunks.h"
 #include "voxfield/mesh_pieces.h"
 #include "voxfield/parallel.h"
+#include "wave_volume.h"
 
 using namespace voxfield;
 
@@ -19,26 +21,6 @@ namespace {
 
 constexpr Mesher kPieceMeshers[] = {Mesher::kMarchingCubes, Mesher::kSurfaceNets,
                                     Mesher::kDualContouring};
-
-// Smooth noise (a sum of a few random waves) with a sheet of isolated spikes, so that the surface
-// crosses every chunk layer and its cuts in many places.
-std::vector<float> pieces_test_volume(Vec3i n, std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1, 1);
-  double k[4][4];
-  for (auto& w : k)
-    for (double& c : w) c = u(rng);
-  std::vector<float> v(static_cast<std::size_t>(n.x) * n.y * n.z);
-  std::size_t i = 0;
-  for (int z = 0; z < n.z; ++z)
-    for (int y = 0; y < n.y; ++y)
-      for (int x = 0; x < n.x; ++x, ++i) {
-        double s = 0;
-        for (const auto& w : k) s += std::sin(0.7 * (w[0] * x + w[1] * y + w[2] * z) + 3 * w[3]);
-        v[i] = static_cast<float>(s + (u(rng) > 0.97 ? 2 * u(rng) : 0.0));
-      }
-  return v;
-}
 
 // The planes [z0, z1) of a volume, copied: a piece sees nothing else.
 std::vector<float> copied_planes(const ScalarVolume& vol, int z0, int z1) {
@@ -71,18 +53,19 @@ void expect_equal_mesh_arrays(const Mesh& got, const Mesh& want) {
 
 }  // namespace
 
-// Every cut of the layers into runs — one piece, a layer each, uneven runs — gives the chunked
-// mesher's arrays over the whole lattice, element for element, for every mesher, both inside
-// conventions, an anisotropic frame away from the origin, and a lattice whose last layer is thin.
+// Cuts of the layers into runs of every kind — one piece, a layer each, uneven runs — give the
+// chunked mesher's arrays over the whole lattice, element for element, for every mesher, both
+// inside conventions, an anisotropic frame away from the origin, and last layers of 7 cells, of a
+// whole 13 and of 1.
 TEST(MeshPieces, JoinedPiecesEqualTheWholeLatticesChunks) {
   const Vec3i n{21, 17, 40};  // 39 cells along z: layers of 8 leave a last one of 7
-  const std::vector<float> v = pieces_test_volume(n, 5);
+  const std::vector<float> v = test::wave_volume(n, 5, 4, 0.7, true);
   ScalarVolume vol{n, v.data()};
   vol.spacing_units = {0.5, 0.75, 1.3};
   vol.origin_units = {-3.1, 2.0, 0.7};
   for (Mesher m : kPieceMeshers)
     for (bool above : {false, true})
-      for (int edge : {4, 8, 13}) {
+      for (int edge : {4, 8, 13, 19}) {
         SCOPED_TRACE(std::string(mesher_name(m)) + (above ? " above" : "") + " chunk edge " +
                      std::to_string(edge));
         MeshOptions o;
@@ -117,7 +100,7 @@ TEST(MeshPieces, PlanesAreWhatTheLayersReadAndNoFewer) {
   EXPECT_EQ(mesh_layer_planes(n, 8, 4, 5), std::make_pair(29, 40));
   for (const auto& [first, end] : {std::pair{-1, 1}, {2, 2}, {3, 1}, {0, 6}})
     EXPECT_THROW(mesh_layer_planes(n, 8, first, end), InvalidArgument) << first << ", " << end;
-  const std::vector<float> v = pieces_test_volume(n, 6);
+  const std::vector<float> v = test::wave_volume(n, 6, 4, 0.7, true);
   ScalarVolume frame{n, nullptr};
   MeshOptions o;
   o.chunk_edge = 8;
@@ -141,7 +124,7 @@ TEST(MeshPieces, PlanesAreWhatTheLayersReadAndNoFewer) {
 // Damaged, mismatched, overlapping and missing pieces are refused, naming the piece and the cause.
 TEST(MeshPieces, DamagedOrMismatchedPiecesAreRefusedByName) {
   const Vec3i n{12, 11, 20};
-  const std::vector<float> v = pieces_test_volume(n, 7);
+  const std::vector<float> v = test::wave_volume(n, 7, 4, 0.7, true);
   const ScalarVolume vol{n, v.data()};
   MeshOptions o;
   o.chunk_edge = 6;  // 19 cells: layers 0..3
@@ -176,6 +159,21 @@ TEST(MeshPieces, DamagedOrMismatchedPiecesAreRefusedByName) {
   std::vector<std::uint8_t> index = b;
   for (std::size_t k = index.size() - 4; k < index.size(); ++k) index[k] = 0xff;
   refused({a, index}, "an index past the chunk's vertices");
+  // Forged headers that agree with each other: a lattice whose chunks the bytes cannot hold
+  // (2^64 chunks in all: the count must not wrap), or past 2^30 samples along an axis.
+  const auto forged = [&](std::vector<std::uint8_t> p, Vec3i samples, std::int32_t edge,
+                          std::int32_t first, std::int32_t end) {
+    for (int k = 0; k < 3; ++k)  // after the marker, version and byte order
+      std::memcpy(p.data() + 12 + 4 * k, &samples[k], 4);
+    std::memcpy(p.data() + 72, &edge, 4);   // after the lattice's origin and spacing
+    std::memcpy(p.data() + 91, &first, 4);  // after the algorithm, iso and flags
+    std::memcpy(p.data() + 95, &end, 4);
+    return p;
+  };
+  const Vec3i huge{(1 << 23) + 1, (1 << 23) + 1, (1 << 21) + 1};
+  refused({forged(a, huge, 2, 0, 1), forged(b, huge, 2, 1, 1 << 20)}, "more than its bytes hold");
+  refused({forged(a, {1 << 30 | 1, 8, 8}, 4, 0, 1)}, "a lattice size outside 2..2^30");
+  EXPECT_THROW(mesh_chunk_layers({(1 << 30) + 1, 4, 4}, 4), InvalidArgument);
   // Random bytes flipped: refused or joined, never a crash (ASan and UBSan watch this in CI).
   std::mt19937 rng(9);
   for (int trial = 0; trial < 300; ++trial) {

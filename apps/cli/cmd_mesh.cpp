@@ -69,14 +69,7 @@ int run_mesh(const MeshSettings& s) {
   set_activity("meshing " + s.in);
   double mesh_ms = 0;
   if (volume_input) {
-    std::vector<float> values(static_cast<std::size_t>(npy->count()));
-    for (std::int64_t i = 0; i < npy->count(); ++i) {
-      const double v = npy->value(i);
-      if (std::abs(v) > std::numeric_limits<float>::max())  // NaN passes on, refused by name below
-        throw FormatError(s.in, npy->file_offset_of(i),
-                          "value " + std::to_string(v) + " does not fit a float32 sample");
-      values[static_cast<std::size_t>(i)] = static_cast<float>(v);
-    }
+    const std::vector<float> values = float_samples(*npy, s.in);
     ScalarVolume volume{npy->dims, values.data()};
     if (!s.spacing.empty()) volume.spacing_units = {s.spacing[0], s.spacing[1], s.spacing[2]};
     for (int a = 0; a < 3; ++a)

@@ -6,7 +6,8 @@
 //   mpirun -np N voxfield-mpi edit IN -e EDITS.jsonl -o OUT.npy [field options] [--stats S.json]
 //   mpirun -np N voxfield-mpi bench --size X,Y,Z [--spheres K] [--repeat R] [field options]
 //   mpirun -np N voxfield-mpi mesh IN.npy -o OUT.{ply,obj,stl,glb} [--algorithm mc|sn|dc]
-//          [--iso V] [--inside below|above] [--spacing sx,sy,sz] [--chunk C] [--stats S.json]
+//          [--iso V] [--inside below|above] [--spacing sx,sy,sz] [--chunk C]
+//          [--balance content|count] [--threads T] [--stats S.json]
 //
 // `field` writes byte for byte what `voxfield field` writes for the same input and options; each
 // rank holds only its slab of a .npy input and of the field. `edit` writes what `voxfield edit`

@@ -75,22 +75,11 @@ int run_mesh(MPI_Comm comm, const MeshSettings& s) {
   ScalarVolume frame{header.dims, nullptr};
   if (!s.spacing.empty()) frame.spacing_units = {s.spacing[0], s.spacing[1], s.spacing[2]};
   const double t0 = MPI_Wtime();
-  // Planes [z0, z1) of the file as floats (a value past float's range is refused, naming its place
-  // in the file, as voxfield mesh does).
+  // Planes [z0, z1) of the file as floats (a value past float's range refused, as voxfield mesh
+  // refuses it).
   const auto read_planes = [&](int z0, int z1) {
     return mpi::collectively(comm, [&] {
-      std::vector<float> values;
-      if (z1 <= z0) return values;
-      const NpyVolume part = read_npy_part(s.in, z0, z1);
-      values.resize(static_cast<std::size_t>(part.count()));
-      for (std::int64_t i = 0; i < part.count(); ++i) {
-        const double v = part.value(i);
-        if (std::abs(v) > std::numeric_limits<float>::max())  // NaN passes on, refused by name
-          throw FormatError(s.in, part.file_offset_of(i),
-                            "value " + std::to_string(v) + " does not fit a float32 sample");
-        values[static_cast<std::size_t>(i)] = static_cast<float>(v);
-      }
-      return values;
+      return z1 > z0 ? float_samples(read_npy_part(s.in, z0, z1), s.in) : std::vector<float>{};
     });
   };
   mpi::ExchangeStats ex;
@@ -108,13 +97,19 @@ int run_mesh(MPI_Comm comm, const MeshSettings& s) {
     return mpi::collectively(
         comm, [&] { return mpi::partition_mesh_layers(header.dims, s.chunk, size, weights); });
   }();
-  const auto [z0, z1] = layers.planes(rank);
-  const std::vector<float> planes = read_planes(z0, z1);
+  std::vector<float> planes = [&] {
+    const auto [z0, z1] = layers.planes(rank);
+    return read_planes(z0, z1);
+  }();
   const double load_ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
   MPI_Barrier(comm);  // the mesh's time starts together on every rank
   const double t1 = MPI_Wtime();
-  const Mesh mesh =
-      mpi::mesh_volume(comm, layers, frame, planes.empty() ? nullptr : planes.data(), options, &ex);
+  const Mesh mesh = [&] {
+    // The planes go once the mesh is made: rank 0 encodes it without them.
+    const std::vector<float> held = std::move(planes);
+    return mpi::mesh_volume(comm, layers, frame, held.empty() ? nullptr : held.data(), options,
+                            &ex);
+  }();
   const double mesh_ms = max_over(comm, (MPI_Wtime() - t1) * 1e3);
   nlohmann::json exchange = exchange_json(comm, ex);
   const double peak_mb = max_over(comm, static_cast<double>(peak_rss_bytes()) / 1048576.0);

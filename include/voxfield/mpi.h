@@ -224,10 +224,11 @@ void save_world_vfw(MPI_Comm comm, const SlabPartition& partition, const World& 
 
 // Meshes of a lattice no rank holds whole (a scan or a simulation's float volume, a distributed
 // field). The lattice's chunk layers (mesh_pieces.h: the chunked mesher's chunks grouped along z)
-// are dealt to the ranks in runs of near-equal length; each rank meshes its run from the sample
-// planes that run reads — its own planes and three on either side — and rank 0 joins the pieces
-// with the chunked mesher's weld. The mesh equals MeshChunks(volume, options).merged() of the whole
-// lattice array for array (and mesh_volume's triangle for triangle), for any number of ranks.
+// are dealt to the ranks in runs of near-equal length or weight; each rank meshes its run from the
+// sample planes that run reads — its cells' planes, three below and two above — and rank 0 joins
+// the pieces with the chunked mesher's weld. The mesh equals MeshChunks(volume, options).merged()
+// of the whole lattice array for array (and mesh_volume's triangle for triangle), for any number of
+// ranks.
 
 // Rank r meshes chunk layers [layers[r], layers[r + 1]).
 struct MeshLayers {

@@ -90,6 +90,10 @@ NpyVolume read_npy_header(const std::filesystem::path& path, const NpyReadOption
 // read_npy throws, and InvalidArgument for slices outside the array.
 NpyVolume read_npy_part(const std::filesystem::path& path, std::int32_t z0, std::int32_t z1,
                         const NpyReadOptions& options = {});
+// The values as float32 samples, x fastest (what the meshers take): FormatError naming `path` and
+// the value's byte offset in the file for a value past float32's range. NaN passes on (the meshers
+// refuse it by its place in the volume).
+std::vector<float> float_samples(const NpyVolume& volume, const std::string& path);
 // Encodes as format 1.0 (2.0 when the header needs it), Fortran order, little-endian.
 std::vector<std::uint8_t> encode_npy(const NpyVolume& volume);
 // The header encode_npy writes before the values of a 3-D array (dims, then `components` when

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <limits>
 
 #include "byte_reader.h"
 #include "voxfield/file.h"
@@ -214,6 +215,18 @@ Vec3i NpyVolume::file_index_of(std::int64_t i) const {
   return file_origin + Vec3i{static_cast<std::int32_t>(i % X),
                              static_cast<std::int32_t>((i / X) % Y),
                              static_cast<std::int32_t>(i / (X * Y))};
+}
+
+std::vector<float> float_samples(const NpyVolume& volume, const std::string& path) {
+  std::vector<float> values(static_cast<std::size_t>(volume.count()));
+  for (std::int64_t i = 0; i < volume.count(); ++i) {
+    const double v = volume.value(i);
+    if (std::abs(v) > std::numeric_limits<float>::max())  // false for NaN, which passes on
+      throw FormatError(path, volume.file_offset_of(i),
+                        "value " + std::to_string(v) + " does not fit a float32 sample");
+    values[static_cast<std::size_t>(i)] = static_cast<float>(v);
+  }
+  return values;
 }
 
 std::uint64_t NpyVolume::file_offset_of(std::int64_t i) const {

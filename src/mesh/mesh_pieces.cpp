@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <functional>
 #include <string>
@@ -33,6 +34,10 @@ using detail::mesh::ChunkPart;
 constexpr char kMagic[4] = {'V', 'X', 'M', 'P'};
 constexpr std::uint32_t kVersion = 1;
 constexpr std::uint32_t kByteOrder = 0x01020304;
+constexpr int kMaxSamples = 1 << 30;
+// The fewest bytes a piece of `chunks` chunks takes: the header and each chunk's counts and flag.
+constexpr std::uint64_t kHeaderBytes = 4 + 4 + 4 + 3 * 4 + 6 * 8 + 4 + 4 + 8 + 3 + 4 + 4;
+constexpr std::uint64_t kChunkBytes = 8 + 8 + 1;
 
 // What a piece says of its lattice and options: pieces join only when theirs are equal.
 struct Header {
@@ -50,6 +55,13 @@ struct Header {
            has_gradient == o.has_gradient;
   }
 };
+
+// Chunks in a piece's layers.
+std::uint64_t chunks_of(const Header& h) {
+  const ChunkGrid grid(h.samples, h.chunk_edge);
+  return mul_sat(mul_sat(static_cast<std::uint64_t>(grid.count.x), grid.count.y),
+                 static_cast<std::uint64_t>(h.end_layer - h.first_layer));
+}
 
 class Writer {
  public:
@@ -92,6 +104,7 @@ class Reader {
     at_ += static_cast<std::size_t>(n) * sizeof(T);
   }
   bool done() const { return at_ == bytes_.size(); }
+  std::uint64_t left() const { return bytes_.size() - at_; }
 
  private:
   std::span<const std::uint8_t> bytes_;
@@ -128,14 +141,24 @@ Header read_header(Reader& r) {
   h.first_layer = r.get<std::int32_t>("layers");
   h.end_layer = r.get<std::int32_t>("layers");
   for (int a = 0; a < 3; ++a)
-    if (h.samples[a] < 2) r.fail("a lattice under 2 samples along an axis");
+    if (h.samples[a] < 2 || h.samples[a] > kMaxSamples)
+      r.fail("a lattice size outside 2..2^30 samples along an axis");
   if (h.chunk_edge < 2 || h.chunk_edge > 256) r.fail("a chunk edge outside 2..256");
   if (h.algorithm < 0 || h.algorithm > 2) r.fail("an unknown mesher");
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(h.origin[static_cast<std::size_t>(a)]) ||
+        !std::isfinite(h.spacing[static_cast<std::size_t>(a)]))
+      r.fail("an origin or spacing that is not finite");
+  if (!std::isfinite(h.iso)) r.fail("an iso value that is not finite");
   try {
     check_layers(h.samples, h.chunk_edge, h.first_layer, h.end_layer, "layers");
   } catch (const InvalidArgument& e) {
     r.fail(e.what());
   }
+  // Every chunk the header declares takes at least its counts: a header cannot promise more
+  // chunks than its bytes hold (nor make the join allocate for them).
+  if (mul_sat(chunks_of(h), kChunkBytes) > r.left())
+    r.fail("declares " + std::to_string(chunks_of(h)) + " chunks, more than its bytes hold");
   return h;
 }
 
@@ -164,6 +187,9 @@ void read_part(Reader& r, ChunkPart& p) {
 int mesh_chunk_layers(Vec3i samples, int chunk_edge) {
   if (samples.x < 2 || samples.y < 2 || samples.z < 2)
     throw InvalidArgument("mesh: the lattice needs at least 2 samples along each axis");
+  // voxfield's coordinate range (a chunk count per axis then fits an int with room to spare).
+  if (samples.x > kMaxSamples || samples.y > kMaxSamples || samples.z > kMaxSamples)
+    throw InvalidArgument("mesh: a lattice of more than 2^30 samples along an axis");
   if (chunk_edge < 2 || chunk_edge > 256)
     throw InvalidArgument("mesh: chunk edge " + std::to_string(chunk_edge) + " is outside 2..256");
   return ChunkGrid(samples, chunk_edge).count.z;
@@ -207,20 +233,22 @@ std::vector<std::uint8_t> mesh_piece(const ScalarVolume& frame, int planes_z0, i
   const Lattice lattice = checked_lattice(whole, options, false, &fill);
   const ChunkGrid grid(frame.size, options.chunk_edge);
   const std::int64_t per_layer = static_cast<std::int64_t>(grid.count.x) * grid.count.y;
+  const std::int64_t count = per_layer * (end_layer - first_layer);
+  require_memory(mul_sat(static_cast<std::uint64_t>(count), 256), 0, "mesh",
+                 "chunks of " + std::to_string(options.chunk_edge) + " cells (" +
+                     std::to_string(count) + " in the piece; choose a larger --chunk)");
   std::vector<std::int64_t> chunks;
+  chunks.reserve(static_cast<std::size_t>(count));
   for (std::int64_t c = first_layer * per_layer; c < end_layer * per_layer; ++c)
     chunks.push_back(c);
-  require_memory(mul_sat(chunks.size(), 256), 0, "mesh",
-                 "chunks of " + std::to_string(options.chunk_edge) + " cells (" +
-                     std::to_string(chunks.size()) + " in the piece; choose a larger --chunk)");
   std::vector<ChunkPart> parts(chunks.size());
   mesh_chunks(lattice, grid, options, chunks, parts);
 
   Writer w;
   // The exact size first: one allocation, no copies as the piece grows.
-  std::size_t size = 4 + 4 + 4 + 3 * 4 + 6 * 8 + 4 + 4 + 8 + 3 + 4 + 4;
+  std::size_t size = kHeaderBytes;
   for (const ChunkPart& p : parts)
-    size += 8 + 8 + 1 + p.positions.size() * (12 + 12 + 8 + 8 + 1 + 1) + p.colors.size() * 3 +
+    size += kChunkBytes + p.positions.size() * (12 + 12 + 8 + 8 + 1 + 1) + p.colors.size() * 3 +
             p.indices.size() * 4;
   w.bytes.reserve(size);
   for (const char c : kMagic) w.put(c);
@@ -256,10 +284,10 @@ std::vector<std::uint8_t> mesh_piece(const ScalarVolume& frame, int planes_z0, i
 Mesh join_mesh_pieces(const std::vector<std::span<const std::uint8_t>>& pieces) {
   using namespace detail::mesh;
   if (pieces.empty()) throw InvalidArgument("join_mesh_pieces: no pieces");
-  // The decoded parts take about the pieces' bytes again.
+  // The decoded parts take about the pieces' bytes again, beside the pieces themselves.
   std::uint64_t bytes = 0;
   for (const auto& p : pieces) bytes = add_sat(bytes, p.size());
-  require_memory(bytes, 0, "join_mesh_pieces", "the pieces' chunks");
+  require_memory(add_sat(bytes, bytes), 0, "join_mesh_pieces", "the pieces and their chunks");
   std::vector<Header> headers;
   std::vector<Reader> readers;
   for (std::size_t i = 0; i < pieces.size(); ++i) {
@@ -270,7 +298,17 @@ Mesh join_mesh_pieces(const std::vector<std::span<const std::uint8_t>>& pieces) 
   }
   const Header& h = headers.front();
   const ChunkGrid grid(h.samples, h.chunk_edge);
-  const std::size_t per_layer = static_cast<std::size_t>(grid.count.x) * grid.count.y;
+  // Every piece's chunks are backed by its bytes (read_header), so their sum is bounded by the
+  // pieces' size; the whole grid's chunks must be too, or some layer is missing.
+  const std::uint64_t per_layer_chunks =
+      mul_sat(static_cast<std::uint64_t>(grid.count.x), static_cast<std::uint64_t>(grid.count.y));
+  const std::uint64_t all_chunks =
+      mul_sat(per_layer_chunks, static_cast<std::uint64_t>(grid.count.z));
+  if (mul_sat(all_chunks, kChunkBytes) > bytes)
+    throw InvalidArgument("join_mesh_pieces: the pieces hold fewer than the lattice's " +
+                          std::to_string(all_chunks) + " chunks");
+  require_memory(mul_sat(all_chunks, 256), 0, "join_mesh_pieces", "the lattice's chunks");
+  const std::size_t per_layer = static_cast<std::size_t>(per_layer_chunks);
   // Which piece holds each layer: every layer once.
   std::vector<int> holder(static_cast<std::size_t>(grid.count.z), -1);
   for (std::size_t i = 0; i < headers.size(); ++i)

@@ -1,8 +1,9 @@
 // voxfield — meshes of a lattice split over the ranks of an MPI job (mpi.h).
 //
 // The chunked mesher's chunks grouped into layers along z (mesh_pieces.h) are dealt to the ranks
-// in runs; a run reads its own sample planes and three on either side, so a rank needs nothing
-// from the others while meshing. Each rank's piece — its chunks' parts with their vertices' lattice
+// in runs, of equal length or of equal weight (the surface each layer holds); a run reads its
+// cells' sample planes, three below and two above, so a rank needs nothing from the others while
+// meshing. Each rank's piece — its chunks' parts with their vertices' lattice
 // element keys — goes to rank 0, which joins them with the chunked mesher's weld: border vertices
 // are computed the same way on both sides of a cut and welded by key, so the cut leaves no crack
 // and no duplicate, and the mesh is the same array for array for any number of ranks.
@@ -13,6 +14,7 @@
 #include <string>
 
 #include "collective.h"
+#include "voxfield/limits.h"
 #include "voxfield/mesh_pieces.h"
 #include "voxfield/mpi.h"
 
@@ -75,8 +77,7 @@ std::vector<double> mesh_layer_weights(MPI_Comm comm, Vec3i samples, int z0, int
   // Per plane: the crossed edges counted by the rank holding it, and how many ranks hold it.
   std::vector<std::uint64_t> own(2 * nz, 0);
   detail::collectively(comm, stats, [&] {
-    const int layers = mesh_chunk_layers(samples, options.chunk_edge);  // checks samples, edge
-    (void)layers;
+    mesh_chunk_layers(samples, options.chunk_edge);  // refuses a bad lattice or chunk edge
     if (!(z0 >= 0 && z0 <= z1 && z1 <= samples.z) || (z1 > z0 && !planes))
       throw InvalidArgument("mesh_layer_weights: planes [" + std::to_string(z0) + ", " +
                             std::to_string(z1) + ") are not within the lattice's " +
@@ -148,6 +149,18 @@ std::vector<std::vector<std::uint8_t>> gather_pieces(MPI_Comm comm, std::vector<
     MPI_Gather(&own_size, 1, MPI_UINT64_T, sizes.data(), 1, MPI_UINT64_T, 0, comm);
   }
   std::vector<std::vector<std::uint8_t>> pieces;
+  // Rank 0 makes room for every piece before any is sent: past the memory limit, or where the
+  // allocation fails, every rank learns it here instead of waiting on a rank 0 that has left.
+  detail::collectively(comm, stats, [&] {
+    if (rank != 0) return;
+    std::uint64_t total = 0;
+    for (const std::uint64_t n : sizes) total = add_sat(total, n);
+    require_memory(total, 0, "mpi::mesh_volume", "the pieces of the mesh on rank 0");
+    pieces.resize(static_cast<std::size_t>(size));
+    for (int r = 1; r < size; ++r)
+      pieces[static_cast<std::size_t>(r)].resize(
+          static_cast<std::size_t>(sizes[static_cast<std::size_t>(r)]));
+  });
   detail::CollectiveTimer t(stats);
   if (rank != 0) {
     for (std::size_t at = 0; at < own.size(); at += kMessageBytes) {
@@ -157,11 +170,9 @@ std::vector<std::vector<std::uint8_t>> gather_pieces(MPI_Comm comm, std::vector<
     if (stats) stats->bytes_sent += own_size;
     return pieces;
   }
-  pieces.resize(static_cast<std::size_t>(size));
   pieces[0] = std::move(own);
   for (int r = 1; r < size; ++r) {
     std::vector<std::uint8_t>& piece = pieces[static_cast<std::size_t>(r)];
-    piece.resize(static_cast<std::size_t>(sizes[static_cast<std::size_t>(r)]));
     for (std::size_t at = 0; at < piece.size(); at += kMessageBytes) {
       const int n = static_cast<int>(std::min(kMessageBytes, piece.size() - at));
       MPI_Recv(piece.data() + at, n, MPI_BYTE, r, kPieceTag, comm, MPI_STATUS_IGNORE);
@@ -194,8 +205,17 @@ Mesh mesh_volume(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& fr
                       layers.layers[static_cast<std::size_t>(rank) + 1]);
   });
   if (stats) stats->compute_ms += detail::ms_since(t0);
+  // The pieces travel on a communicator of their own, so that no message of the application's on
+  // `comm` can match theirs.
+  struct OwnComm {
+    MPI_Comm c = MPI_COMM_NULL;
+    explicit OwnComm(MPI_Comm from) { MPI_Comm_dup(from, &c); }
+    ~OwnComm() { MPI_Comm_free(&c); }
+    OwnComm(const OwnComm&) = delete;
+    OwnComm& operator=(const OwnComm&) = delete;
+  } own(comm);
   const std::vector<std::vector<std::uint8_t>> pieces =
-      gather_pieces(comm, std::move(piece), stats);
+      gather_pieces(own.c, std::move(piece), stats);
   const auto t1 = std::chrono::steady_clock::now();
   Mesh mesh = detail::collectively(comm, stats, [&] {
     if (rank != 0) return Mesh{};

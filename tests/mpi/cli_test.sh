@@ -171,10 +171,14 @@ done
 "$VF" mesh wave64.npy -o ref.ply --inside above 2>/dev/null
 MPIEXEC -np 3 "$VFM" mesh wave64.npy -o out.ply --inside above --chunk 5 2>/dev/null
 same_triangles ref.ply out.ply "float64, inside above, 3 ranks"
+# Dealt by count (no first pass): rank 0 receives rank 1's piece, and nothing else.
+"$VF" mesh wave.npy -o ref.ply 2>/dev/null
+MPIEXEC -np 2 "$VFM" mesh wave.npy -o out.ply --chunk 8 --balance count --stats mesh.json 2>/dev/null
+same_triangles ref.ply out.ply "by count, 2 ranks"
 /usr/bin/python3 -c "
 import json; s = json.load(open('mesh.json'))
-assert s['ranks'] == 2 and s['watertight'] is False and len(s['chunk_layers']) == 3, s
-assert s['exchange']['bytes_received_total'] > 0, s"
+assert s['ranks'] == 2 and s['balance'] == 'count' and s['chunk_layers'] == [0, 3, 6], s
+assert s['watertight'] is False and s['exchange']['bytes_received_total'] > 10000, s"
 # The other formats: binary STL and glTF sizes follow the counts alone; OBJ's text, the vertices'
 # numbers, so there the lines of each kind are counted.
 for fmt in obj stl glb; do
