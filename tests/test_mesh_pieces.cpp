@@ -91,6 +91,26 @@ TEST(MeshPieces, JoinedPiecesEqualTheWholeLatticesChunks) {
       }
 }
 
+// A flat surface in one layer: the other layers' chunks have no vertices, and their parts travel
+// and join empty (UBSan caught a copy of no bytes into an empty part's null array).
+TEST(MeshPieces, ChunksWithoutSurfaceJoin) {
+  const Vec3i n{9, 8, 30};
+  std::vector<float> v(static_cast<std::size_t>(n.x) * n.y * n.z);
+  for (std::size_t i = 0; i < v.size(); ++i)
+    v[i] = static_cast<float>(static_cast<double>(i / 72) - 13.5);  // z - 13.5
+  const ScalarVolume vol{n, v.data()};
+  for (Mesher m : kPieceMeshers) {
+    MeshOptions o;
+    o.algorithm = m;
+    o.chunk_edge = 4;
+    std::vector<std::vector<std::uint8_t>> each;
+    for (int k = 0; k < mesh_chunk_layers(n, 4); ++k) each.push_back(piece_of(vol, o, k, k + 1));
+    const Mesh want = MeshChunks(vol, o).merged();
+    ASSERT_GT(want.triangle_count(), 0u);
+    expect_equal_mesh_arrays(join_all(each), want);
+  }
+}
+
 // What a run of layers reads: three planes before its cells to two past its last corner, clipped
 // to the lattice; a piece given fewer planes is refused before meshing.
 TEST(MeshPieces, PlanesAreWhatTheLayersReadAndNoFewer) {

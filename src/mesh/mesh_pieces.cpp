@@ -100,6 +100,7 @@ class Reader {
     if (n > (bytes_.size() - at_) / sizeof(T))
       fail(std::string("ends inside its ") + what + " (" + std::to_string(n) + " declared)");
     out.resize(static_cast<std::size_t>(n));
+    if (n == 0) return;  // an empty vector's data() may be null, which memcpy must not get
     std::memcpy(out.data(), bytes_.data() + at_, static_cast<std::size_t>(n) * sizeof(T));
     at_ += static_cast<std::size_t>(n) * sizeof(T);
   }
