@@ -21,7 +21,7 @@ LAYERS = ["core", "gpu", "distance", "vectors", "csg", "mesh", "io", "render", "
 MODULE_LAYER = {"grid": "core", "edit": "core", "scene": "core", "gpu": "gpu", "distance": "distance",
                 "vectors": "vectors", "csg": "csg", "mesh": "mesh", "io": "io", "render": "render", "live": "live", "mpi": "mpi"}
 PUBLIC_LAYER = {
-    "box.h": "core", "error.h": "core", "parallel.h": "core", "limits.h": "core", "grid.h": "core",
+    "box.h": "core", "error.h": "core", "parallel.h": "core", "limits.h": "core", "chunk_memory.h": "core", "grid.h": "core",
     "detail/grid_impl.h": "core", "detail/assert.h": "core", "world.h": "core", "edit.h": "core", "edit_stream.h": "core",
     "scene.h": "core", "image.h": "core", "interrupt.h": "core", "primitives.h": "core", "png.h": "io",
     "hash.h": "core",

@@ -2,13 +2,15 @@
 // against brute force: every voxel's minimum of (x - i)^2 + f[i] and its smallest minimising index,
 // on random lines built to hold ties (small costs over few distinct values), lines without sites,
 // single sites, and lines at the 32-bit kernel's bounds (n^2 and the costs near 2^29). The
-// division-free kernel must also agree with Meijster's scan, value for value and site for site.
+// division-free kernel must also agree with Meijster's scan, value for value and site for site,
+// and its lock-step form (envelope_lanes.h) with it, lane by lane.
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <random>
 #include <vector>
 
+#include "distance/envelope_lanes.h"
 #include "distance/line_transforms.h"
 
 using namespace voxfield::detail;
@@ -114,5 +116,81 @@ TEST(LineTransforms, LinesWithOneSiteOrNoneGiveItsParabolaOrNothing) {
       EXPECT_EQ(r.out[x], (x - n / 2) * (x - n / 2) + 5);
       EXPECT_EQ(r.arg[x], n / 2);
     }
+  }
+}
+
+namespace {
+
+// Four lines through the lock-step kernel at once; each lane's result, as division_free's.
+std::vector<LineResult> four_lanes(const std::vector<std::vector<std::int32_t>>& lines,
+                                   bool with_sites) {
+  const int n = static_cast<int>(lines[0].size());
+  std::vector<LineResult> r(
+      4, LineResult{std::vector<std::int32_t>(n, -7), std::vector<std::int32_t>(n, -7)});
+  const std::int32_t* f[4];
+  std::int32_t* out[4];
+  std::int32_t* arg[4];
+  for (int k = 0; k < 4; ++k) {
+    f[k] = lines[k].data();
+    out[k] = r[k].out.data();
+    arg[k] = r[k].arg.data();
+  }
+  std::vector<std::int32_t> s(4 * envelope_lane_stride(n)), h(4 * envelope_lane_stride(n));
+  envelope_euclidean_int32_lanes<4>(n, f, out, with_sites ? arg : nullptr, s.data(), h.data());
+  return r;
+}
+
+}  // namespace
+
+TEST(LineTransforms, TheLockStepEnvelopeEqualsTheOneLineKernelInEveryLane) {
+  // Lanes of one batch differ in how many sites they hold and how many pops they need, so they
+  // finish building and writing back at different steps.
+  std::mt19937 rng(113);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const int n = 1 + static_cast<int>(rng() % 120);
+    std::vector<std::vector<std::int32_t>> lines(4, std::vector<std::int32_t>(n));
+    for (auto& line : lines) {
+      const int air_percent = static_cast<int>(rng() % 100);
+      const int spread = 1 + static_cast<int>(rng() % (trial % 3 == 0 ? 4 : 3000));
+      for (auto& v : line)
+        v = static_cast<int>(rng() % 100) < air_percent ? kInf
+                                                        : static_cast<std::int32_t>(rng() % spread);
+      line[rng() % n] = static_cast<std::int32_t>(rng() % spread);  // at least one site
+    }
+    const bool with_sites = trial % 2 == 0;
+    const std::vector<LineResult> got = four_lanes(lines, with_sites);
+    for (int k = 0; k < 4; ++k) {
+      const LineResult ref = division_free(lines[k]);
+      ASSERT_EQ(got[k].out, ref.out) << "trial " << trial << ", lane " << k;
+      if (with_sites) {
+        ASSERT_EQ(got[k].arg, ref.arg) << "trial " << trial << ", lane " << k;
+      } else {
+        ASSERT_EQ(got[k].arg, std::vector<std::int32_t>(n, -7)) << "sites written unasked";
+      }
+      const auto [value, site] = brute_force_at(lines[k], n - 1);
+      ASSERT_EQ(got[k].out[n - 1], value);
+      if (with_sites) {
+        ASSERT_EQ(got[k].arg[n - 1], site);
+      }
+    }
+  }
+}
+
+TEST(LineTransforms, TheLockStepEnvelopeHoldsAtTheThirtyTwoBitBounds) {
+  std::mt19937 rng(11);
+  const int n = 23170;  // n^2 < 2^29
+  std::vector<std::vector<std::int32_t>> lines(4, std::vector<std::int32_t>(n));
+  for (int k = 0; k < 4; ++k) {
+    for (auto& v : lines[k]) {
+      const std::uint32_t r = rng();
+      v = r % (k + 2) == 0 ? kInf : static_cast<std::int32_t>(r % static_cast<std::uint32_t>(kInf));
+    }
+    lines[k][k == 0 ? n - 1 : 0] = kInf - 1;
+  }
+  const std::vector<LineResult> got = four_lanes(lines, true);
+  for (int k = 0; k < 4; ++k) {
+    const LineResult ref = meijster(lines[k]);
+    EXPECT_EQ(got[k].out, ref.out) << "lane " << k;
+    EXPECT_EQ(got[k].arg, ref.arg) << "lane " << k;
   }
 }

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "voxfield/box.h"
+#include "voxfield/chunk_memory.h"
 #include "voxfield/detail/assert.h"
 #include "voxfield/error.h"
 
@@ -159,10 +160,11 @@ class Grid {
   // chunk lies outside a bounded grid's bounds; voxels of a chunk beyond the bounds are discarded
   // (reset to the background).
   void generate_chunks(const std::vector<Vec3i>& chunks, const std::function<void(Vec3i, T*)>& f);
-  // Takes ownership of one dense array of edge^3 values (x fastest) per coordinate, replacing what
-  // was stored there; uniform ones are collapsed (scanned in parallel). Same bounds rule as
-  // generate_chunks. Throws InvalidArgument (changing nothing) when the sizes disagree.
-  void adopt_chunks(const std::vector<Vec3i>& chunks, std::vector<std::unique_ptr<T[]>> data);
+  // Takes ownership of one dense array of edge^3 values (x fastest, from make_chunk_array) per
+  // coordinate, replacing what was stored there; uniform ones are collapsed (scanned in parallel).
+  // Same bounds rule as generate_chunks. Throws InvalidArgument (changing nothing) when the counts
+  // or an array's size disagree.
+  void adopt_chunks(const std::vector<Vec3i>& chunks, std::vector<ChunkArray<T>> data);
 
   // Writes the voxels of one dense chunk inside edit_chunk, by local index (x fastest). Writes keep
   // the chunk's O(1) collapse counter up to date, so an edit of a few voxels costs a few voxels —
@@ -219,8 +221,8 @@ class Grid {
 
  private:
   struct Chunk {
-    std::unique_ptr<T[]> voxels;  // null for a uniform chunk
-    T uniform{};                  // value of a uniform chunk
+    ChunkArray<T> voxels;  // null for a uniform chunk (chunk_memory.h: from the reuse cache)
+    T uniform{};           // value of a uniform chunk
     // For dense chunks: `ref` is the value the chunk held when it was expanded and ref_count how
     // many voxels still hold it, so that set() can collapse the chunk in O(1).
     T ref{};

@@ -2,6 +2,7 @@
 // the engines behind the pure-Python modules of python/voxfield/.
 #include <pybind11/pybind11.h>
 
+#include "voxfield/chunk_memory.h"
 #include "voxfield/error.h"
 #include "voxfield/interrupt.h"
 
@@ -42,4 +43,17 @@ PYBIND11_MODULE(_voxfield, m) {
   voxfield::python::bind_vectors(m);
   voxfield::python::bind_vdb(m);
   voxfield::python::bind_world(m);
+  // The cache of chunk voxel arrays kept between calls (voxfield/chunk_memory.h).
+  m.def("chunk_cache_limit", &voxfield::chunk_cache_limit);
+  m.def("set_chunk_cache_limit", &voxfield::set_chunk_cache_limit, py::arg("bytes"));
+  m.def("trim_chunk_cache", &voxfield::trim_chunk_cache);
+  m.def("chunk_memory_stats", [] {
+    const voxfield::ChunkMemoryStats s = voxfield::chunk_memory_stats();
+    py::dict d;
+    d["cached_bytes"] = s.cached_bytes;
+    d["limit_bytes"] = s.limit_bytes;
+    d["reused"] = s.reused;
+    d["allocated"] = s.allocated;
+    return d;
+  });
 }

@@ -149,9 +149,13 @@ void for_each_row(const Grid<T>& grid, const Box3i& box, F&& row) {
 }
 
 // Writes out[x] = value(x) for x in [x0, x1) of one output row (`stride` bytes apart; constant
-// for contiguous outputs, so the loop vectorises there).
+// for contiguous outputs, so the loop vectorises there). `value` is copied into a local first, and
+// the lambdas passed here capture their constants by value: the output is written through char*,
+// which may alias anything whose address escaped, so constants reached through a reference would
+// be reloaded for every element and keep the loop scalar.
 template <class Out, class F>
-inline void write_row(char* row, py::ssize_t stride, int x0, int x1, F&& value) {
+inline void write_row(char* row, py::ssize_t stride, int x0, int x1, const F& value_ref) {
+  const F value = value_ref;
   if (stride == static_cast<py::ssize_t>(sizeof(Out))) {
     for (int x = x0; x < x1; ++x) {
       const Out v = value(x);
@@ -176,7 +180,7 @@ void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, 
       std::is_integral_v<T> ? encoding.decode(std::numeric_limits<T>::max()) : INFINITY;
   // f32 storage holds the distance itself (scale 1, bias 0): no per-element division.
   const bool identity = encoding.scale == 1 && encoding.bias == 0;
-  const auto magnitude = [&](T stored, double& sign) {
+  const auto magnitude = [saturated, identity, encoding](T stored, double& sign) {
     const double v = std::is_floating_point_v<T> && identity
                          ? static_cast<double>(stored)
                          : encoding.decode(static_cast<double>(stored));
@@ -184,7 +188,7 @@ void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, 
     const double a = std::abs(v);
     return a >= saturated ? INFINITY : a;
   };
-  const auto euclidean = [&](T stored) {
+  const auto euclidean = [magnitude, clamp, clamp_f32](T stored) {
     double sign;
     const double a = magnitude(stored, sign);
     double d = clamp;
@@ -193,7 +197,7 @@ void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, 
     if (a < clamp_f32) d = std::min(std::sqrt(std::nearbyint(a * a)), clamp);
     return d * sign;
   };
-  const auto integer = [&](T stored) {
+  const auto integer = [magnitude, clamp](T stored) {
     double sign;
     const double a = magnitude(stored, sign);
     // No zero element anywhere: -1 (SciPy leaves -1 there too).
@@ -213,22 +217,24 @@ void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, 
   for_each_row(values, box, [&](int y, int z, int x0, int x1, const T* row, T uniform) {
     char* out = dist.data + z * dist.strides[0] + y * dist.strides[1];
     if (!table.empty() && row) {
-      write_row<std::int32_t>(out, dist.strides[2], x0, x1,
-                              [&](int x) { return table[row[x - x0]]; });
+      const std::int32_t* t = table.data();
+      write_row<std::int32_t>(out, dist.strides[2], x0, x1, [t, row, x0](int x) {
+        return t[static_cast<std::size_t>(row[x - x0])];
+      });
     } else if (metric == Metric::kEuclidean) {
       if (!row) {
         const double d = euclidean(uniform);
-        write_row<double>(out, dist.strides[2], x0, x1, [&](int) { return d; });
+        write_row<double>(out, dist.strides[2], x0, x1, [d](int) { return d; });
       } else {
         write_row<double>(out, dist.strides[2], x0, x1,
-                          [&](int x) { return euclidean(row[x - x0]); });
+                          [euclidean, row, x0](int x) { return euclidean(row[x - x0]); });
       }
     } else if (!row) {
       const std::int32_t d = integer(uniform);
-      write_row<std::int32_t>(out, dist.strides[2], x0, x1, [&](int) { return d; });
+      write_row<std::int32_t>(out, dist.strides[2], x0, x1, [d](int) { return d; });
     } else {
       write_row<std::int32_t>(out, dist.strides[2], x0, x1,
-                              [&](int x) { return integer(row[x - x0]); });
+                              [integer, row, x0](int x) { return integer(row[x - x0]); });
     }
   });
 }

@@ -22,6 +22,12 @@ clamp, storage and spacing, nearest sites).
 by voxfield's exact separable transforms on every core, with what SciPy lacks: ``signed``,
 ``max_distance`` and ``threads``.
 
+Memory: voxfield keeps the voxel arrays of grids and fields it frees for the next call (a second
+transform of the same size touches no fresh page), up to ``chunk_cache_limit()`` bytes — a
+sixteenth of physical memory, at most 1 GiB, unless the environment variable
+``VOXFIELD_CHUNK_CACHE`` says otherwise ("512M"; "0" turns it off). ``set_chunk_cache_limit``,
+``trim_chunk_cache`` and ``chunk_memory_stats`` manage it.
+
 voxfield's errors are Python exceptions: ``InvalidArgument`` and ``FormatError`` (ValueError),
 ``ResourceLimitError`` (MemoryError), ``IoError`` (OSError), ``Cancelled`` (KeyboardInterrupt);
 their messages name the file and, for malformed files, the byte offset.
@@ -36,5 +42,29 @@ from . import vectors
 from . import vdb
 from . import world
 
+
+def chunk_cache_limit():
+    """Bytes of freed voxel arrays voxfield keeps for reuse (0: none kept)."""
+    return _voxfield.chunk_cache_limit()
+
+
+def set_chunk_cache_limit(nbytes):
+    """Sets the limit in bytes (0 disables the cache) and hands back what exceeds it."""
+    nbytes = int(nbytes)
+    if nbytes < 0:
+        raise ValueError(f"set_chunk_cache_limit: {nbytes} bytes is negative")
+    _voxfield.set_chunk_cache_limit(nbytes)
+
+
+def trim_chunk_cache():
+    """Hands every cached voxel array back to the system; the limit stays."""
+    _voxfield.trim_chunk_cache()
+
+
+def chunk_memory_stats():
+    """{'cached_bytes', 'limit_bytes', 'reused', 'allocated'}: the cache now, and since start."""
+    return dict(_voxfield.chunk_memory_stats())
+
+
 __all__ = ["ndimage", "csg", "mesh", "vectors", "vdb", "world", "Error", "InvalidArgument", "FormatError", "ResourceLimitError", "IoError",
-           "Cancelled"]
+           "Cancelled", "chunk_cache_limit", "set_chunk_cache_limit", "trim_chunk_cache", "chunk_memory_stats"]

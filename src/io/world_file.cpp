@@ -191,7 +191,7 @@ Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
   }
 
   std::vector<Vec3i> coords;
-  std::vector<std::unique_ptr<T[]>> data;
+  std::vector<ChunkArray<T>> data;
   for (std::uint64_t i = 0; i < count; ++i) {
     Vec3i c;
     c.x = get<std::int32_t>(r, "chunk coordinate");
@@ -204,7 +204,7 @@ Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
       g.fill(bounds ? g.chunk_box(c).intersect(*bounds) : g.chunk_box(c), v);
       continue;
     }
-    std::unique_ptr<T[]> voxels(new T[static_cast<std::size_t>(g.chunk_volume())]);
+    ChunkArray<T> voxels = make_chunk_array<T>(static_cast<std::size_t>(g.chunk_volume()));
     const auto size = get<std::uint32_t>(r, "chunk size");
     auto packed = r.take(size, "chunk data");
     uLongf out = static_cast<uLongf>(raw);

@@ -256,3 +256,31 @@ def test_empty_and_byte_swapped_arrays():
     big = np.zeros(a.shape, ">f8")
     vn.distance_transform_edt(a, distances=big)
     np.testing.assert_array_equal(big, sn.distance_transform_edt(a))
+
+
+def test_repeated_transforms_reuse_voxel_memory_and_agree():
+    """A second transform of the same size takes its arrays from the cache of freed ones (the
+    reused count grows), and gives the result a transform with the cache turned off gives."""
+    a = random_volume((70, 60, 50), density=0.995)
+    saved = voxfield.chunk_cache_limit()
+    try:
+        voxfield.set_chunk_cache_limit(0)
+        assert voxfield.chunk_memory_stats()["cached_bytes"] == 0
+        d0, i0 = vn.distance_transform_edt(a, return_indices=True)
+        voxfield.set_chunk_cache_limit(256 << 20)
+        vn.distance_transform_edt(a, return_indices=True)
+        stats = voxfield.chunk_memory_stats()
+        assert 0 < stats["cached_bytes"] <= 256 << 20 and stats["limit_bytes"] == 256 << 20
+        reused = stats["reused"]
+        d1, i1 = vn.distance_transform_edt(a, return_indices=True)
+        assert voxfield.chunk_memory_stats()["reused"] > reused
+        np.testing.assert_array_equal(d1, d0)
+        np.testing.assert_array_equal(i1, i0)
+        np.testing.assert_array_equal(d1, sn.distance_transform_edt(a))
+        voxfield.trim_chunk_cache()
+        assert voxfield.chunk_memory_stats()["cached_bytes"] == 0
+        assert voxfield.chunk_cache_limit() == 256 << 20
+        with pytest.raises(ValueError, match="negative"):
+            voxfield.set_chunk_cache_limit(-1)
+    finally:
+        voxfield.set_chunk_cache_limit(saved)

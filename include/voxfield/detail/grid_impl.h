@@ -44,7 +44,7 @@ Grid<T>::Grid(const Grid& other)
     copy.ref = src.ref;
     copy.ref_count = src.ref_count;
     if (src.voxels) {
-      copy.voxels.reset(new T[n]);
+      copy.voxels = make_chunk_array<T>(static_cast<std::size_t>(n));
       std::copy(src.voxels.get(), src.voxels.get() + n, copy.voxels.get());
     }
     chunks_.emplace(coord, std::move(copy));
@@ -81,7 +81,7 @@ T Grid<T>::get(Vec3i p) const {
 template <class T>
 typename Grid<T>::Chunk& Grid<T>::expand(Chunk& chunk) {
   const std::int64_t n = chunk_volume();
-  chunk.voxels.reset(new T[n]);
+  chunk.voxels = make_chunk_array<T>(static_cast<std::size_t>(n));
   std::fill(chunk.voxels.get(), chunk.voxels.get() + n, chunk.uniform);
   chunk.ref = chunk.uniform;
   chunk.ref_count = n;
@@ -406,8 +406,8 @@ void Grid<T>::generate_chunks(const std::vector<Vec3i>& chunks,
   for (const Vec3i c : chunks) require_chunk_in_range(c, "generate_chunks");
   const std::int64_t n = chunk_volume();
   // Produce every chunk into fresh storage first, so that a throwing f leaves the grid unchanged.
-  std::vector<std::unique_ptr<T[]>> produced(chunks.size());
-  for (auto& p : produced) p.reset(new T[n]);
+  std::vector<ChunkArray<T>> produced(chunks.size());
+  for (auto& p : produced) p = make_chunk_array<T>(static_cast<std::size_t>(n));
   parallel_for(chunks.size(), 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) f(chunks[i], produced[i].get());
   });
@@ -415,8 +415,7 @@ void Grid<T>::generate_chunks(const std::vector<Vec3i>& chunks,
 }
 
 template <class T>
-void Grid<T>::adopt_chunks(const std::vector<Vec3i>& chunks,
-                           std::vector<std::unique_ptr<T[]>> data) {
+void Grid<T>::adopt_chunks(const std::vector<Vec3i>& chunks, std::vector<ChunkArray<T>> data) {
   if (data.size() != chunks.size()) {
     throw InvalidArgument("adopt_chunks: " + std::to_string(data.size()) + " arrays for " +
                           std::to_string(chunks.size()) + " chunks");
@@ -424,6 +423,12 @@ void Grid<T>::adopt_chunks(const std::vector<Vec3i>& chunks,
   for (std::size_t i = 0; i < chunks.size(); ++i) {
     if (!data[i])
       throw InvalidArgument("adopt_chunks: null array for chunk " + to_string(chunks[i]));
+    if (data[i].get_deleter().bytes != static_cast<std::size_t>(chunk_volume()) * sizeof(T)) {
+      throw InvalidArgument("adopt_chunks: the array for chunk " + to_string(chunks[i]) +
+                            " holds " + std::to_string(data[i].get_deleter().bytes) +
+                            " bytes, not " +
+                            std::to_string(chunk_volume() * std::int64_t{sizeof(T)}));
+    }
     require_chunk_in_range(chunks[i], "adopt_chunks");
     if (bounds_ && chunk_box(chunks[i]).intersect(*bounds_).empty()) {
       throw InvalidArgument("adopt_chunks: chunk " + to_string(chunks[i]) +

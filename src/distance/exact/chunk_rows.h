@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "../field_plan.h"
+#include "voxfield/chunk_memory.h"
 
 namespace voxfield::detail::exact {
 
@@ -26,7 +27,7 @@ struct ChunkedVolume {
   int edge = 0, shift = 0;
   Vec3i nchunks;
   std::vector<Vec3i> coords;
-  std::vector<std::unique_ptr<T[]>> chunks;
+  std::vector<ChunkArray<T>> chunks;
 
   ChunkedVolume(const Box3i& aligned, int chunk_edge) : box(aligned), edge(chunk_edge) {
     shift = std::countr_zero(static_cast<unsigned>(chunk_edge));
@@ -39,7 +40,7 @@ struct ChunkedVolume {
       for (int y = 0; y < nchunks.y; ++y)
         for (int x = 0; x < nchunks.x; ++x) coords.push_back(c0 + Vec3i{x, y, z});
     const std::size_t volume = std::size_t{1} << (3 * shift);
-    for (auto& c : chunks) c.reset(new T[volume]);
+    for (auto& c : chunks) c = make_chunk_array<T>(volume);
   }
   // Pointer to the `edge` voxels of the row (chunk column cx, y, z), x fastest.
   T* row(int cx, int y, int z) {

@@ -18,6 +18,7 @@
 #include <memory>
 #include <type_traits>
 
+#include "../envelope_lanes.h"
 #include "../field_plan.h"
 #include "../line_transforms.h"
 #include "../truncated_min_convolution.h"
@@ -49,6 +50,9 @@ struct Scratch {
   const A& operator[](std::size_t i) const { return p[i]; }
 };
 
+// Lines solved side by side by kernels that have a lock-step form (envelope_lanes.h).
+inline constexpr int kEnvelopeLanes = 4;
+
 template <class V>
 struct SliceBuffers {
   Scratch<V> f, h, tmp;
@@ -61,8 +65,10 @@ struct SliceBuffers {
     arg_x.resize(n);
     arg_y.resize(n);
     targ.resize(n);
-    s.resize(static_cast<std::size_t>(std::max(X, Y)));
-    t.resize(static_cast<std::size_t>(std::max(X, Y)));
+    // The envelope's stacks: room for the lock-step kernel's lanes (solve_lines).
+    const std::size_t stack = kEnvelopeLanes * envelope_lane_stride(std::max(X, Y));
+    s.resize(stack);
+    t.resize(stack);
   }
 };
 
@@ -91,22 +97,72 @@ void to_rows(const A* in, A* out, int X, int Y, int x_lo, int x_hi) {
 // One line through the envelope kernel, with shortcuts for the lines that are common in real
 // worlds and need no envelope: all sites (cost 0 everywhere: inside solid matter) and no site at
 // all (open air far from everything).
-template <class Kernel, class V>
-void solve_line(const Kernel& k, int n, const V* f, V* out, std::int32_t* arg, std::int32_t* s,
-                std::int32_t* t, V inf) {
+// Returns false, writing nothing, for a line that needs the envelope.
+template <class V>
+bool solve_line_shortcut(int n, const V* f, V* out, std::int32_t* arg, V inf) {
   bool all_zero = true, all_inf = true;
   for (int i = 0; i < n; ++i) {
     all_zero &= f[i] == V(0);
     all_inf &= !(f[i] < inf);
   }
-  if (all_zero || all_inf) {
-    std::fill(out, out + n, all_zero ? V(0) : inf);
-    if (arg) {
-      for (int i = 0; i < n; ++i) arg[i] = all_zero ? i : -1;
-    }
-    return;
+  if (!all_zero && !all_inf) return false;
+  std::fill(out, out + n, all_zero ? V(0) : inf);
+  if (arg) {
+    for (int i = 0; i < n; ++i) arg[i] = all_zero ? i : -1;
   }
-  k(n, f, out, arg, s, t);
+  return true;
+}
+
+template <class Kernel, class V>
+void solve_line(const Kernel& k, int n, const V* f, V* out, std::int32_t* arg, std::int32_t* s,
+                std::int32_t* t, V inf) {
+  if (!solve_line_shortcut(n, f, out, arg, inf)) k(n, f, out, arg, s, t);
+}
+
+// The unit-spacing Euclidean kernel in 32-bit costs, with its lock-step form for solve_lines.
+struct EuclideanInt32Kernel {
+  void operator()(int n, const std::int32_t* f, std::int32_t* out, std::int32_t* arg,
+                  std::int32_t* s, std::int32_t* t) const {
+    envelope_euclidean_int32(n, f, out, arg, s, t);
+  }
+  void lanes(int n, const std::int32_t* const* f, std::int32_t* const* out,
+             std::int32_t* const* arg, std::int32_t* s, std::int32_t* t) const {
+    envelope_euclidean_int32_lanes<kEnvelopeLanes>(n, f, out, arg, s, t);
+  }
+};
+
+// `count` lines of n voxels: line i reads f + i * n and writes out + i * n (and arg + i * n when
+// arg is not null). Lines that need the envelope go through the kernel's lock-step form
+// kEnvelopeLanes at a time where it has one, the rest one by one.
+template <class Kernel, class V>
+void solve_lines(const Kernel& k, int count, int n, const V* f, V* out, std::int32_t* arg,
+                 std::int32_t* s, std::int32_t* t, V inf) {
+  if constexpr (requires(const Kernel& kk, std::int32_t* p) {
+                  kk.lanes(0, nullptr, nullptr, nullptr, p, p);
+                }) {
+    const V* lf[kEnvelopeLanes];
+    V* lo[kEnvelopeLanes];
+    std::int32_t* la[kEnvelopeLanes];
+    int pending = 0;
+    for (int i = 0; i < count; ++i) {
+      const std::size_t o = static_cast<std::size_t>(i) * n;
+      const V* fi = f + o;
+      if (solve_line_shortcut(n, fi, out + o, arg ? arg + o : nullptr, inf)) continue;
+      lf[pending] = fi;
+      lo[pending] = out + o;
+      la[pending] = arg ? arg + o : nullptr;
+      if (++pending == kEnvelopeLanes) {
+        k.lanes(n, lf, lo, arg ? la : nullptr, s, t);
+        pending = 0;
+      }
+    }
+    for (int i = 0; i < pending; ++i) k(n, lf[i], lo[i], la[i], s, t);
+  } else {
+    for (int i = 0; i < count; ++i) {
+      const std::size_t o = static_cast<std::size_t>(i) * n;
+      solve_line(k, n, f + o, out + o, arg ? arg + o : nullptr, s, t, inf);
+    }
+  }
 }
 
 // 2-D solve of one slice with an envelope kernel (Chebyshev, Euclidean): pass B along x on rows,
@@ -120,22 +176,16 @@ void solve_slice_envelope2(const KernelX& kx, const KernelY& ky, int X, int Y, S
                            bool track_sites, V inf, int x_lo, int x_hi, V drop_above) {
   std::int32_t* arg_x = track_sites ? b.arg_x.data() : nullptr;
   std::int32_t* targ = track_sites ? b.targ.data() : nullptr;
-  for (int y = 0; y < Y; ++y) {
-    const std::size_t o = static_cast<std::size_t>(y) * X;
-    solve_line(kx, X, b.f.data() + o, b.h.data() + o, arg_x ? arg_x + o : nullptr, b.s.data(),
-               b.t.data(), inf);
-  }
+  solve_lines(kx, Y, X, b.f.data(), b.h.data(), arg_x, b.s.data(), b.t.data(), inf);
   if (drop_above < inf) {
     V* h = b.h.data();
     for (std::size_t i = 0; i < static_cast<std::size_t>(X) * Y; ++i)
       h[i] = h[i] > drop_above ? inf : h[i];
   }
   to_columns(b.h.data(), b.tmp.data(), X, Y, x_lo, x_hi);
-  for (int x = x_lo; x < x_hi; ++x) {
-    const std::size_t o = static_cast<std::size_t>(x) * Y;
-    solve_line(ky, Y, b.tmp.data() + o, b.f.data() + o, targ ? targ + o : nullptr, b.s.data(),
-               b.t.data(), inf);
-  }
+  const std::size_t o = static_cast<std::size_t>(x_lo) * Y;
+  solve_lines(ky, x_hi - x_lo, Y, b.tmp.data() + o, b.f.data() + o, targ ? targ + o : nullptr,
+              b.s.data(), b.t.data(), inf);
   to_rows(b.f.data(), b.h.data(), X, Y, x_lo, x_hi);
   if (track_sites) to_rows(b.targ.data(), b.arg_y.data(), X, Y, x_lo, x_hi);
 }
@@ -272,8 +322,7 @@ void dispatch_solver(const Plan& p, Vec3i extent, Fn&& fn) {
                                        static_cast<double>(extent.y) * extent.y +
                                        static_cast<double>(extent.z) * extent.z <
                                    (1 << 29)) {
-    auto k = [](int n, const std::int32_t* f, std::int32_t* o, std::int32_t* a, std::int32_t* s,
-                std::int32_t* t) { envelope_euclidean_int32(n, f, o, a, s, t); };
+    const EuclideanInt32Kernel k;
     auto solve = [k, sites, d = drop(EuclideanInt32::kInf)](
                      int X, int Y, SliceBuffers<std::int32_t>& b, int lo, int hi) {
       solve_slice_envelope(k, k, X, Y, b, sites, EuclideanInt32::kInf, lo, hi, d);

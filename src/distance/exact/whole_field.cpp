@@ -231,9 +231,9 @@ DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy,
   progress.throw_if_cancelled();  // before anything is handed out
 
   // Hand the chunks to the grids (uniform ones collapse).
-  std::vector<std::unique_ptr<T[]>> typed(g.chunks.size());
+  std::vector<ChunkArray<T>> typed(g.chunks.size());
   for (std::size_t i = 0; i < g.chunks.size(); ++i)
-    typed[i].reset(reinterpret_cast<T*>(g.chunks[i].release()));
+    typed[i] = retype_chunk_array<T>(std::move(g.chunks[i]));
   values.adopt_chunks(g.coords, std::move(typed));
   if (sites) sites_grid->adopt_chunks(sites->coords, std::move(sites->chunks));
   out.values = std::move(values);
