@@ -2,7 +2,8 @@
 # Packages only the benchmarks need: the peers voxfield is compared with, and plotting.
 set -euo pipefail
 packages=(python3-scipy python3-matplotlib libopenvdb-dev libdynamicedt3d-dev
-          python3-vtk9 python3-skimage)  # meshing peers: VTK's flying edges, scikit-image's marching cubes
+          python3-vtk9 python3-skimage  # meshing peers: VTK's flying edges, scikit-image's marching cubes
+          mricron-data python3-nibabel)  # a real MRI volume (ch2better, 301 x 370 x 316) and its reader
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -125,11 +125,13 @@ TEST(ChunkMemory, GridsRefuseArraysOfAnotherSize) {
 }
 
 TEST(ChunkMemory, AFieldComputedIntoReusedMemoryEqualsOneComputedIntoFresh) {
-  Grid<std::uint8_t> world(16, 0, Box3i{{0, 0, 0}, {80, 64, 48}});
+  // Bounds that end inside chunks: the transform fills the voxels of its edge chunks beyond them.
+  const Box3i bounds{{0, 0, 0}, {75, 61, 45}};
+  Grid<std::uint8_t> world(16, 0, bounds);
   std::mt19937 rng(5);
   for (int i = 0; i < 300; ++i)
     world.set(
-        {static_cast<int>(rng() % 80), static_cast<int>(rng() % 64), static_cast<int>(rng() % 48)},
+        {static_cast<int>(rng() % 75), static_cast<int>(rng() % 61), static_cast<int>(rng() % 45)},
         1);
   DistanceOptions o;
   o.metric = Metric::kEuclidean;
@@ -141,10 +143,18 @@ TEST(ChunkMemory, AFieldComputedIntoReusedMemoryEqualsOneComputedIntoFresh) {
     fresh = compute_distance_field(world, o);
   }
   const CacheLimit some(std::uint64_t{256} << 20);
-  // Dirty arrays of the field's chunk sizes first, so that the second field is written over them.
-  for (int i = 0; i < 64; ++i) {
-    ChunkArray<float> f = make_chunk_array<float>(16 * 16 * 16);
-    std::memset(f.get(), 0x5b, 16 * 16 * 16 * sizeof(float));
+  // Dirty arrays of the field's and the sites' chunk sizes first, all held at once and then freed,
+  // so that the fields below are written over them.
+  {
+    constexpr std::size_t kVoxels = 16 * 16 * 16;
+    std::vector<ChunkArray<float>> values;
+    std::vector<ChunkArray<SiteOffset>> offsets;
+    for (int i = 0; i < 64; ++i) {
+      values.push_back(make_chunk_array<float>(kVoxels));
+      std::memset(values.back().get(), 0x5b, kVoxels * sizeof(float));
+      offsets.push_back(make_chunk_array<SiteOffset>(kVoxels));
+      std::memset(static_cast<void*>(offsets.back().get()), 0x3c, kVoxels * sizeof(SiteOffset));
+    }
   }
   compute_distance_field(world, o);  // its freed chunks are cached
   const std::uint64_t reused_before = chunk_memory_stats().reused;

@@ -10,6 +10,7 @@ Usage: PYTHONPATH=build/release/python /usr/bin/python3 bench/peers/ndimage_benc
 with two builds' PYTHONPATH in turn, alternated, to compare one binding against another.
 """
 
+import os
 import statistics
 import sys
 import time
@@ -53,6 +54,13 @@ def main():
         c = rng.integers(20, n - 20, 3)
         r = rng.integers(6, 24)
         volumes["spheres-256 (zeros outside 40 balls)"] |= (z - c[0]) ** 2 + (y - c[1]) ** 2 + (x - c[2]) ** 2 < r * r
+    # A real scan: the Colin 27 MRI template that Debian's mricron-data ships (scripts/install-bench-deps.sh),
+    # its head (intensity > 0) against the air around it, in the file's own Fortran order.
+    mri = "/usr/share/mricron/templates/ch2better.nii.gz"
+    if os.path.exists(mri):
+        import nibabel
+        volumes["mri ch2better 301×370×316 (zeros outside the head, Fortran order)"] = \
+            np.asarray(nibabel.load(mri).dataobj) > 0
     if voxfield_only:
         print("| volume | call | voxfield 1 thread ms | voxfield 2 threads ms |")
         print("|---|---|---|---|")

@@ -11,9 +11,12 @@
 //
 // The limit is process-wide: what set_chunk_cache_limit() set, else the environment variable
 // VOXFIELD_CHUNK_CACHE (bytes, or "512M" style: limits.h's parse_byte_size; "0" disables the
-// cache), else a sixteenth of physical memory capped at 1 GiB. Only memory that held voxels before
-// is ever kept: a process that never frees a grid caches nothing. trim_chunk_cache() hands all of
-// it back (e.g. after a burst of work). Every function here is thread-safe.
+// cache; a value that cannot be read makes every chunk allocation throw InvalidArgument naming it,
+// until the program sets a limit), else a sixteenth of physical memory capped at 1 GiB. Cached
+// bytes are not charged to the memory limit of limits.h, which bounds what one call may allocate.
+// Only memory that held voxels before is ever kept: a process that never frees a grid caches
+// nothing. trim_chunk_cache() hands all of it back (e.g. after a burst of work). Every function
+// here is thread-safe.
 #pragma once
 
 #include <cstddef>

@@ -284,3 +284,32 @@ def test_repeated_transforms_reuse_voxel_memory_and_agree():
             voxfield.set_chunk_cache_limit(-1)
     finally:
         voxfield.set_chunk_cache_limit(saved)
+
+
+def test_the_chunk_cache_limit_from_the_environment():
+    """VOXFIELD_CHUNK_CACHE sets the limit ("0" in any unit turns the cache off); a value that
+    cannot be read stops every transform with an error that names it, until a limit is set."""
+    script = (
+        "import numpy as np, voxfield\n"
+        "from voxfield import ndimage as vn\n"
+        "a = np.ones((9, 8, 7), bool); a[4, 4, 4] = False\n"
+        "try:\n"
+        "    vn.distance_transform_edt(a)\n"
+        "    print('ok', voxfield.chunk_cache_limit())\n"
+        "except ValueError as e:\n"
+        "    print('refused', e)\n"
+        "    voxfield.set_chunk_cache_limit(1 << 20)\n"
+        "    print('then', vn.distance_transform_edt(a)[0, 0, 0] > 0, voxfield.chunk_cache_limit())\n"
+    )
+
+    def run(value):
+        env = dict(os.environ, VOXFIELD_CHUNK_CACHE=value)
+        return subprocess.run(["/usr/bin/python3", "-c", script], env=env, capture_output=True, text=True,
+                              check=True).stdout.split("\n")
+
+    assert run("64M")[0] == f"ok {64 << 20}"
+    assert run("0")[0] == "ok 0"
+    assert run("0M")[0] == "ok 0"
+    out = run("lots")
+    assert out[0].startswith("refused") and "VOXFIELD_CHUNK_CACHE" in out[0]
+    assert out[1] == f"then True {1 << 20}"

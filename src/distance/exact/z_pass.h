@@ -72,6 +72,10 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
   std::uint32_t ds[128], da[128];
   std::int32_t ls[128], la[128];  // z of the last solid / air site seen (sites only)
   const int x0 = g.box.begin.x + cx * e;
+  // The lanes of this chunk column inside the domain: only those are stored. The others belong to
+  // voxels outside the domain, which keep the background the driver filled them with (passes B
+  // and C never revisit them; pass A's raw g there read as NaN or as a tiny distance in f32).
+  const int i_lo = std::max(0, p.domain.begin.x - x0), i_hi = std::min(e, p.domain.end.x - x0);
   // Lane i's column index into `beyond`, or -1 outside the domain (or without `beyond`).
   auto column = [&](int y, int i) -> std::int64_t {
     const int x = x0 + i;
@@ -127,7 +131,7 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
       const std::uint8_t* __restrict w = world.row(cx, y, z);
       const std::uint32_t* __restrict c = col.data() + static_cast<std::size_t>(z - z0) * e;
       U* __restrict out = g.row(cx, y, z);
-      for (int i = 0; i < e; ++i) {
+      for (int i = i_lo; i < i_hi; ++i) {
         const bool solid = w[i] != 0;
         dsr[i] = solid ? 0u : std::min(dsr[i] + 1u, cap);
         std::uint32_t v;
@@ -147,7 +151,7 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
     for (int z = z0; z < z1; ++z) {
       const std::uint8_t* w = world.row(cx, y, z);
       SiteOffset* so = sites->row(cx, y, z);
-      for (int i = 0; i < e; ++i) {
+      for (int i = i_lo; i < i_hi; ++i) {
         const bool solid = w[i] != 0;
         if (solid)
           ls[i] = z;
@@ -162,7 +166,7 @@ void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
     for (int z = z1 - 1; z >= z0; --z) {
       const std::uint8_t* w = world.row(cx, y, z);
       SiteOffset* so = sites->row(cx, y, z);
-      for (int i = 0; i < e; ++i) {
+      for (int i = i_lo; i < i_hi; ++i) {
         const bool solid = w[i] != 0;
         if (solid)
           ls[i] = z;
