@@ -416,40 +416,45 @@ TEST(ExactDistance, VoxelsOutsideTheDomainInItsEdgeChunksReadTheBackground) {
   World w;  // chunk edge 32; content in one chunk, the domain reaching into its neighbours
   for (const Vec3i p : {Vec3i{3, 5, 7}, Vec3i{9, 2, 2}, Vec3i{4, 12, 20}}) w.voxels.set(p, 1);
   for (const Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
-    for (const Storage st : {Storage::kF32, Storage::kU8})
+    for (const Storage st : {Storage::kF32, Storage::kU8, Storage::kU16})
       for (const double clamp : {0.0, 6.0})
-        for (const bool is_signed : {false, true}) {
-          DistanceOptions o;
-          o.metric = m;
-          o.storage = st;
-          o.max_distance = clamp;
-          o.signed_distance = is_signed;
-          o.nearest_sites = true;
-          const DistanceField f = compute_distance_field(w, o);
-          const double background = f.distance({100000, 0, 0});  // in no chunk at all
-          const std::string what = "metric " + std::to_string(static_cast<int>(m)) + ", storage " +
-                                   std::to_string(static_cast<int>(st)) + ", clamp " +
-                                   std::to_string(clamp) + (is_signed ? ", signed" : "");
-          ASSERT_FALSE(std::isnan(background)) << what;
-          int outside = 0;
-          const int edge = f.chunk_edge();
-          // Whole x rows across the edge chunks, at y and z just outside, on and inside the domain.
-          const Box3i d = f.domain;
-          const int ys[] = {d.begin.y - 1, d.begin.y, (d.begin.y + d.end.y) / 2, d.end.y - 1,
-                            d.end.y};
-          const int zs[] = {d.begin.z - 1, d.begin.z, (d.begin.z + d.end.z) / 2, d.end.z - 1,
-                            d.end.z};
-          for (const int z : zs)
-            for (const int y : ys)
-              for (int x = -edge; x < 2 * edge; ++x) {
-                const Vec3i p{x, y, z};
-                if (f.domain.contains(p)) continue;
-                ++outside;
-                ASSERT_EQ(f.distance(p), background) << what << " at " << to_string(p);
-                ASSERT_TRUE(f.sites->get(p).none()) << what << " at " << to_string(p);
-              }
-          EXPECT_GT(outside, 0);
-        }
+        for (const bool is_signed : {false, true})
+          for (const bool with_sites : {false, true}) {
+            DistanceOptions o;
+            o.metric = m;
+            o.storage = st;
+            o.max_distance = clamp;
+            o.signed_distance = is_signed;
+            o.nearest_sites = with_sites;  // without: the truncated passes where the clamp allows
+            const DistanceField f = compute_distance_field(w, o);
+            const double background = f.distance({100000, 0, 0});  // in no chunk at all
+            const std::string what = "metric " + std::to_string(static_cast<int>(m)) +
+                                     ", storage " + std::to_string(static_cast<int>(st)) +
+                                     ", clamp " + std::to_string(clamp) +
+                                     (is_signed ? ", signed" : "");
+            ASSERT_FALSE(std::isnan(background)) << what;
+            int outside = 0;
+            const int edge = f.chunk_edge();
+            // Whole x rows across the edge chunks, at y and z just outside, on and inside the
+            // domain.
+            const Box3i d = f.domain;
+            const int ys[] = {d.begin.y - 1, d.begin.y, (d.begin.y + d.end.y) / 2, d.end.y - 1,
+                              d.end.y};
+            const int zs[] = {d.begin.z - 1, d.begin.z, (d.begin.z + d.end.z) / 2, d.end.z - 1,
+                              d.end.z};
+            for (const int z : zs)
+              for (const int y : ys)
+                for (int x = -edge; x < 2 * edge; ++x) {
+                  const Vec3i p{x, y, z};
+                  if (f.domain.contains(p)) continue;
+                  ++outside;
+                  ASSERT_EQ(f.distance(p), background) << what << " at " << to_string(p);
+                  if (with_sites) {
+                    ASSERT_EQ(f.sites->get(p), SiteOffset{}) << what << " at " << to_string(p);
+                  }
+                }
+            EXPECT_GT(outside, 0);
+          }
 }
 
 TEST(ExactDistance, RejectsBadOptions) {

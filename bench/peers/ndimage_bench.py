@@ -1,8 +1,8 @@
 """voxfield.ndimage against scipy.ndimage in one process, on the same arrays: distance_transform_edt
 (distances only, and with indices) and distance_transform_cdt (taxicab), voxfield on 1 and 2
 threads; medians of RUNS timed calls after a warm-up, min-max in brackets, and the warm-up call's
-own time, started with voxfield's cache of freed voxel arrays emptied (docs/limits.md): a first
-call pays for fresh memory, later ones reuse it. Checks the results are SciPy's before timing.
+own time, started with voxfield's cache of freed voxel arrays emptied (docs/limits.md; glibc may
+still hold what the cache handed back, so it is not a fresh process's first call). Checks the results are SciPy's before timing.
 
 Usage: PYTHONPATH=build/release/python /usr/bin/python3 bench/peers/ndimage_bench.py [RUNS] [--voxfield-only]
 

@@ -1,13 +1,14 @@
 // voxfield — memory for chunks' voxel arrays, kept between calls for reuse.
 //
 // Why: a whole field is computed into freshly allocated chunks, read out and freed, and the next
-// call does the same. glibc's malloc hands chunk-sized arrays (32³ floats are 128 KiB, its mmap
-// threshold) straight to and from the kernel, which faults and zeroes every 4 KiB page again on
-// first touch. On this project's virtual machine that was half of a Python
-// `distance_transform_edt` of a 256³ volume on one thread (420 ms; 200 ms when glibc was told to
-// keep freed memory: docs/benchmarks.md). So every Grid's voxel arrays come from here: a freed
-// array goes onto a list of its size and the next request of that size takes it back, warm and
-// resident, up to a limit of cached bytes; beyond the limit arrays go back to the system at once.
+// call does the same. glibc's malloc may hand chunk-sized arrays (32³ floats are 128 KiB, its
+// initial mmap threshold) straight to and from the kernel, and trims its heap, and the kernel
+// faults and zeroes every 4 KiB page again on first touch. On this project's virtual machine that
+// was about half of a Python `distance_transform_edt` of a 256³ volume on one thread (418–475 ms;
+// 182–252 ms when glibc was told to keep freed memory: docs/benchmarks.md). So every Grid's voxel
+// arrays come from here: a freed array goes onto a list of its size and the next request of that
+// size takes it back, warm and resident, up to a limit of cached bytes; beyond the limit arrays go
+// back to the system at once.
 //
 // The limit is process-wide: what set_chunk_cache_limit() set, else the environment variable
 // VOXFIELD_CHUNK_CACHE (bytes, or "512M" style: limits.h's parse_byte_size; "0" disables the

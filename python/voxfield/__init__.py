@@ -23,7 +23,7 @@ by voxfield's exact separable transforms on every core, with what SciPy lacks: `
 ``max_distance`` and ``threads``.
 
 Memory: voxfield keeps the voxel arrays of grids and fields it frees for the next call (a second
-transform of the same size touches no fresh page), up to ``chunk_cache_limit()`` bytes — a
+transform of the same size takes its chunk arrays from them rather than from fresh pages), up to ``chunk_cache_limit()`` bytes — a
 sixteenth of physical memory, at most 1 GiB, unless the environment variable
 ``VOXFIELD_CHUNK_CACHE`` says otherwise ("512M"; "0" turns it off). ``set_chunk_cache_limit``,
 ``trim_chunk_cache`` and ``chunk_memory_stats`` manage it.

@@ -7,6 +7,7 @@ for the real volumes)."""
 
 import os
 import subprocess
+import sys
 import threading
 import time
 
@@ -304,7 +305,7 @@ def test_the_chunk_cache_limit_from_the_environment():
 
     def run(value):
         env = dict(os.environ, VOXFIELD_CHUNK_CACHE=value)
-        return subprocess.run(["/usr/bin/python3", "-c", script], env=env, capture_output=True, text=True,
+        return subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True,
                               check=True).stdout.split("\n")
 
     assert run("64M")[0] == f"ok {64 << 20}"
