@@ -70,6 +70,7 @@ int run_mesh(const MeshSettings& s) {
   double mesh_ms = 0;
   if (volume_input) {
     const std::vector<float> values = float_samples(*npy, s.in);
+    std::vector<std::uint8_t>().swap(npy->bytes);  // its pages are free for the mesh's arrays
     ScalarVolume volume{npy->dims, values.data()};
     if (!s.spacing.empty()) volume.spacing_units = {s.spacing[0], s.spacing[1], s.spacing[2]};
     for (int a = 0; a < 3; ++a)

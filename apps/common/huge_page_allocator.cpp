@@ -14,5 +14,11 @@
 
 // thp:always advises every mapping jemalloc makes for huge pages (the kernel then backs whole
 // 2 MiB ranges at the first fault); metadata_thp:auto does so for its own metadata once that is
-// large enough to matter.
-const char* malloc_conf = "thp:always,metadata_thp:auto";
+// large enough to matter. oversize_threshold:0 serves large blocks (8 MiB and up) from the ordinary
+// arenas, which keep freed pages for reuse for a while (dirty_decay_ms, 10 s), rather than from
+// jemalloc's dedicated arena for them, which hands freed pages back to the kernel at once: a later
+// large block, such as the mesh written after its input's raw bytes are dropped, then reuses pages
+// already faulted in instead of faulting and zeroing new ones. `voxfield mesh` of the 256³
+// terrain's field, marching cubes on one thread: 1880 page faults and 70 ms of meshing before,
+// 1490 and 65 ms after (docs/benchmarks.md); the peak memory did not grow.
+const char* malloc_conf = "thp:always,metadata_thp:auto,oversize_threshold:0";

@@ -219,6 +219,26 @@ DualVertex dual_cell_vertex(const Block& block, const Lattice& lattice, int qx, 
 // CellVertex returns) are known, for a pass that places vertices itself.
 DualVertex dual_vertex_at(const Lattice& lattice, int qx, int qy, int qz, const double* v,
                           const std::array<double, 3>& mean, bool with_source);
+// dual_vertex_at's parts, for a pass that evaluates a row of cells at once.
+// The gradient of the cell's trilinear interpolant at (u, w1, w2) in the cell, per world unit:
+// along each axis the corner differences blended by the other two coordinates. Inline and free
+// of branches, so that a loop over many cells vectorises.
+inline std::array<double, 3> trilinear_gradient(const double* v, double u, double w1, double w2,
+                                                const std::array<double, 3>& spacing) {
+  const auto blend = [](double d00, double d10, double d01, double d11, double s, double t) {
+    return (1 - s) * (1 - t) * d00 + s * (1 - t) * d10 + (1 - s) * t * d01 + s * t * d11;
+  };
+  return {blend(v[1] - v[0], v[3] - v[2], v[5] - v[4], v[7] - v[6], w1, w2) / spacing[0],
+          blend(v[2] - v[0], v[3] - v[1], v[6] - v[4], v[7] - v[5], u, w2) / spacing[1],
+          blend(v[4] - v[0], v[5] - v[1], v[6] - v[2], v[7] - v[3], u, w1) / spacing[2]};
+}
+// The normal where that gradient is zero (a saddle of the interpolant, e.g. two inside corners
+// touching diagonally): away from the inside corners' mean, in world units.
+std::array<double, 3> saddle_normal(const double* v, double u, double w1, double w2,
+                                    const std::array<double, 3>& spacing);
+// The colour source: the inside corner of cell q nearest (u, w1, w2), the lowest-numbered on a tie.
+std::uint64_t nearest_inside_corner(const Lattice& lattice, int qx, int qy, int qz, const double* v,
+                                    double u, double w1, double w2);
 // A normal scaled to unit length in floats (+z where it has no direction): ChunkPart::add's rule,
 // shared by the whole-volume passes. (Three divisions, as the GPU mesher's shader does them.)
 inline std::array<float, 3> unit_normal(std::array<double, 3> normal) {

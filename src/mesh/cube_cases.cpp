@@ -226,8 +226,12 @@ CubeCases::CubeCases() {
     ambiguous_[inside] = ambiguous;
     for (std::size_t e = 0; e < 12; ++e) {
       const CubeEdge& edge = cube_edges()[e];
-      if ((inside >> edge.from & 1) != (inside >> edge.to & 1))
+      if ((inside >> edge.from & 1) != (inside >> edge.to & 1)) {
         crossed_[inside] = static_cast<std::uint16_t>(crossed_[inside] | 1u << e);
+        for (int a = 0; a < 3; ++a)
+          if (a != edge.axis)
+            corner_sums_[inside][static_cast<std::size_t>(a)] += edge.from >> a & 1;
+      }
     }
     offset_[inside] = static_cast<std::uint16_t>(next_offset);
     std::vector<int> faces;

@@ -51,6 +51,11 @@ class CubeCases {
   // Edges (bit e: cube edge e) whose two corners differ for corner mask `inside`: the edges a
   // cell crosses, so the meshers visit those alone without a branch per edge.
   std::uint16_t crossed_edges(unsigned inside) const { return crossed_[inside]; }
+  // Per axis a, the sum over those edges not along a of their corners' coordinate a (0 or 1):
+  // what the crossings add up to on a beside the crossing fractions of a's own edges.
+  const std::array<std::uint8_t, 3>& corner_sums(unsigned inside) const {
+    return corner_sums_[inside];
+  }
   // Faces (bit 2a + s) with four crossings for corner mask `inside` (bit c: corner c inside).
   std::uint8_t ambiguous_faces(unsigned inside) const { return ambiguous_[inside]; }
   // The triangulation for `inside` where `joined` (one bit per ambiguous face, in face order,
@@ -87,33 +92,50 @@ class CubeCases {
   CubeCases();
   std::array<std::uint8_t, 256> ambiguous_{};
   std::array<std::uint16_t, 256> crossed_{};
+  std::array<std::array<std::uint8_t, 3>, 256> corner_sums_{};
   std::array<std::uint16_t, 257> offset_{};
   std::array<CubeCase, 1024> cases_{};
 };
 
 // Surface nets' vertex in the cell's coordinates: the mean of the crossings of the edges a corner
 // mask crosses, each edge contributing t_of(edge) (where along it the surface crosses, 0..1) on
-// its axis and its corner's fixed coordinates on the other two. One summation, in edge order, for
-// every path that places these vertices, so that they agree bit for bit however t is found.
-// (The tables come in as arguments: a hot caller looks them up once, not once per cell.)
-template <class CrossingOf>
-std::array<double, 3> crossing_mean(const CubeCases& table, const std::array<CubeEdge, 12>& edges,
-                                    unsigned inside, CrossingOf&& t_of) {
-  // Three scalars, not an array indexed by axis: the array lived in memory and its read-back
-  // stalled store forwarding.
-  double mx = 0, my = 0, mz = 0;
-  int count = 0;
-  for (unsigned bits = table.crossed_edges(inside); bits != 0; bits &= bits - 1) {
-    const unsigned e = static_cast<unsigned>(std::countr_zero(bits));
-    const CubeEdge& edge = edges[e];
-    const double t = t_of(e);
-    mx += edge.axis == 0 ? t : (edge.from & 1);
-    my += edge.axis == 1 ? t : (edge.from >> 1 & 1);
-    mz += edge.axis == 2 ? t : (edge.from >> 2 & 1);
-    ++count;
+// its axis and its corner's fixed coordinates on the other two. Per axis, the sum is the fractions
+// of that axis's crossed edges, in edge order, plus the fixed coordinates (an integer, from the
+// table): one summation for every path that places these vertices, so that they agree bit for
+// bit however t is found. (The table comes in as an argument: a hot caller looks it up once.)
+struct CrossingSums {
+  double x, y, z;
+  int count;  // > 0 for a cell the surface crosses
+};
+// t_of is called for the crossed edges only; with `kReadsAnyEdge`, for every edge (t_of then
+// reads without side effects, whatever an edge not crossed holds), and the sums are selected
+// without a branch per edge — the edges a noisy volume's cells cross are unpredictable.
+template <bool kReadsAnyEdge = false, class CrossingOf>
+CrossingSums crossing_sums(const CubeCases& table, unsigned inside, CrossingOf&& t_of) {
+  const unsigned crossed = table.crossed_edges(inside);
+  double sum[3];
+  for (unsigned a = 0; a < 3; ++a) {
+    double s = 0;
+    for (unsigned j = 0; j < 4; ++j) {
+      const unsigned e = 4 * a + j;
+      if constexpr (kReadsAnyEdge) {
+        const double t = t_of(e);
+        s += (crossed >> e & 1) ? t : 0.0;  // + 0 leaves a sum unchanged
+      } else if (crossed >> e & 1) {
+        s += t_of(e);
+      }
+    }
+    sum[a] = s + table.corner_sums(inside)[a];
   }
+  return {sum[0], sum[1], sum[2], std::popcount(crossed)};
+}
+// The mean itself: the sums divided by their count (the whole-volume pass divides a row of
+// cells' sums at once, with the same divisions).
+template <class CrossingOf>
+std::array<double, 3> crossing_mean(const CubeCases& table, unsigned inside, CrossingOf&& t_of) {
+  const CrossingSums s = crossing_sums(table, inside, t_of);
   // (The cell has a crossing: a quad reached it.)
-  return {mx / count, my / count, mz / count};
+  return {s.x / s.count, s.y / s.count, s.z / s.count};
 }
 
 }  // namespace voxfield::detail::mesh

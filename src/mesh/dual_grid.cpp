@@ -26,47 +26,43 @@ DualVertex dual_cell_vertex(const Block& block, const Lattice& lattice, int qx, 
 
 DualVertex dual_vertex_at(const Lattice& lattice, int qx, int qy, int qz, const double* v,
                           const std::array<double, 3>& mean, bool with_source) {
-  const Vec3i q{qx, qy, qz};
   const double u = mean[0], w1 = mean[1], w2 = mean[2];
-  // Gradient of the trilinear interpolant: along each axis, the corner differences blended by
-  // the other two local coordinates.
-  auto blend = [](double d00, double d10, double d01, double d11, double s, double t) {
-    return (1 - s) * (1 - t) * d00 + s * (1 - t) * d10 + (1 - s) * t * d01 + s * t * d11;
-  };
-  std::array<double, 3> normal{
-      blend(v[1] - v[0], v[3] - v[2], v[5] - v[4], v[7] - v[6], w1, w2) / lattice.spacing[0],
-      blend(v[2] - v[0], v[3] - v[1], v[6] - v[4], v[7] - v[5], u, w2) / lattice.spacing[1],
-      blend(v[4] - v[0], v[5] - v[1], v[6] - v[2], v[7] - v[3], u, w1) / lattice.spacing[2]};
-  if (lattice.gradient)
-    normal = lattice.exact_normal(lattice_position(lattice, {q.x + u, q.y + w1, q.z + w2}));
-  if (normal[0] == 0 && normal[1] == 0 && normal[2] == 0) {
-    // A saddle of the interpolant (e.g. two inside corners touching diagonally): point away
-    // from the inside corners' mean instead, in world units.
-    std::array<double, 3> inside{0, 0, 0};
-    int count = 0;
-    for (int c = 0; c < 8; ++c)
-      if (v[c] < 0) {
-        inside[0] += c & 1, inside[1] += c >> 1 & 1, inside[2] += c >> 2 & 1;
-        ++count;
-      }
-    const std::array<double, 3> at{u, w1, w2};
-    for (std::size_t a = 0; a < 3; ++a)
-      normal[a] = (at[a] - inside[a] / count) * lattice.spacing[a];
-  }
-  std::uint64_t source = 0;
-  if (with_source) {
-    // The colour source: the inside corner nearest the vertex (the lowest-numbered on a tie).
-    int nearest = -1;
-    double best = 1e9;
-    for (int c = 0; c < 8; ++c) {
-      if (!(v[c] < 0)) continue;
-      const double dx = (c & 1) - u, dy = (c >> 1 & 1) - w1, dz = (c >> 2 & 1) - w2;
-      const double d = dx * dx + dy * dy + dz * dz;
-      if (d < best) best = d, nearest = c;
+  const std::array<double, 3> position = lattice_position(lattice, {qx + u, qy + w1, qz + w2});
+  std::array<double, 3> normal = lattice.gradient
+                                     ? lattice.exact_normal(position)
+                                     : trilinear_gradient(v, u, w1, w2, lattice.spacing);
+  if (normal[0] == 0 && normal[1] == 0 && normal[2] == 0)
+    normal = saddle_normal(v, u, w1, w2, lattice.spacing);
+  return {position, normal,
+          with_source ? nearest_inside_corner(lattice, qx, qy, qz, v, u, w1, w2) : 0};
+}
+
+std::array<double, 3> saddle_normal(const double* v, double u, double w1, double w2,
+                                    const std::array<double, 3>& spacing) {
+  std::array<double, 3> inside{0, 0, 0};
+  int count = 0;
+  for (int c = 0; c < 8; ++c)
+    if (v[c] < 0) {
+      inside[0] += c & 1, inside[1] += c >> 1 & 1, inside[2] += c >> 2 & 1;
+      ++count;
     }
-    source = lattice.index(q.x + (nearest & 1), q.y + (nearest >> 1 & 1), q.z + (nearest >> 2 & 1));
+  const std::array<double, 3> at{u, w1, w2};
+  std::array<double, 3> normal;
+  for (std::size_t a = 0; a < 3; ++a) normal[a] = (at[a] - inside[a] / count) * spacing[a];
+  return normal;
+}
+
+std::uint64_t nearest_inside_corner(const Lattice& lattice, int qx, int qy, int qz, const double* v,
+                                    double u, double w1, double w2) {
+  int nearest = -1;
+  double best = 1e9;
+  for (int c = 0; c < 8; ++c) {
+    if (!(v[c] < 0)) continue;
+    const double dx = (c & 1) - u, dy = (c >> 1 & 1) - w1, dz = (c >> 2 & 1) - w2;
+    const double d = dx * dx + dy * dy + dz * dz;
+    if (d < best) best = d, nearest = c;
   }
-  return {lattice_position(lattice, {q.x + u, q.y + w1, q.z + w2}), normal, source};
+  return lattice.index(qx + (nearest & 1), qy + (nearest >> 1 & 1), qz + (nearest >> 2 & 1));
 }
 
 void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk, const Block& block,

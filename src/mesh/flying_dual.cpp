@@ -17,6 +17,8 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include "bit_rows.h"
@@ -174,6 +176,80 @@ void FlyingDual::write_vertices(int z, const WeldOutput& out) const {
   }
 }
 
+namespace {
+
+// A row of cells' surface-nets vertices, placed together: gathered cell by cell (corner values,
+// crossing sums), placed in one loop over the row free of branches — the vertices' divisions and
+// square roots then overlap and vectorise instead of each waiting on the one before — and
+// scattered with the rare cases. The arithmetic is dual_vertex_at's and unit_normal's, operation
+// for operation, so the vertices are the chunked driver's bit for bit.
+struct CellRow {
+  std::array<std::vector<double>, 8> v;  // the corners' s values
+  std::vector<double> x, count;          // the cell's x; its crossed edges
+  std::array<std::vector<double>, 3> sum, mean;
+  std::array<std::vector<float>, 3> position, normal;
+  // The gradient is zero there: saddle_normal() applies. (As wide as a double: a narrower flag
+  // would keep the placing loop from vectorising.)
+  std::vector<std::int64_t> saddle;
+  explicit CellRow(std::size_t cells) : x(cells), count(cells), saddle(cells) {
+    for (auto& a : v) a.resize(cells);
+    for (std::size_t a = 0; a < 3; ++a) {
+      sum[a].resize(cells), mean[a].resize(cells);
+      position[a].resize(cells), normal[a].resize(cells);
+    }
+  }
+  // Places cells [0, k) of cell row (y, z).
+  void place(const Lattice& l, int y, int z, std::size_t k) {
+    // Raw pointers that promise not to alias (through the vectors, every store could move their
+    // own data pointers), and ivdep: without them GCC 12 neither keeps the pointers in registers
+    // nor vectorises the loop.
+    const double* __restrict c0 = v[0].data();
+    const double* __restrict c1 = v[1].data();
+    const double* __restrict c2 = v[2].data();
+    const double* __restrict c3 = v[3].data();
+    const double* __restrict c4 = v[4].data();
+    const double* __restrict c5 = v[5].data();
+    const double* __restrict c6 = v[6].data();
+    const double* __restrict c7 = v[7].data();
+    const double* __restrict cx = x.data();
+    const double* __restrict cn = count.data();
+    const double* __restrict s0 = sum[0].data();
+    const double* __restrict s1 = sum[1].data();
+    const double* __restrict s2 = sum[2].data();
+    double* __restrict m0 = mean[0].data();
+    double* __restrict m1 = mean[1].data();
+    double* __restrict m2 = mean[2].data();
+    float* __restrict p0 = position[0].data();
+    float* __restrict p1 = position[1].data();
+    float* __restrict p2 = position[2].data();
+    float* __restrict n0 = normal[0].data();
+    float* __restrict n1 = normal[1].data();
+    float* __restrict n2 = normal[2].data();
+    std::int64_t* __restrict flat = saddle.data();
+    const double qy = y, qz = z;
+    const std::array<double, 3> origin = l.origin, spacing = l.spacing;
+    constexpr double kMax = std::numeric_limits<double>::max();
+#pragma GCC ivdep
+    for (std::size_t i = 0; i < k; ++i) {
+      const double u = s0[i] / cn[i], w1 = s1[i] / cn[i], w2 = s2[i] / cn[i];
+      m0[i] = u, m1[i] = w1, m2[i] = w2;
+      const double c[8] = {c0[i], c1[i], c2[i], c3[i], c4[i], c5[i], c6[i], c7[i]};
+      const std::array<double, 3> n = trilinear_gradient(c, u, w1, w2, spacing);
+      p0[i] = static_cast<float>(origin[0] + (cx[i] + u) * spacing[0]);
+      p1[i] = static_cast<float>(origin[1] + (qy + w1) * spacing[1]);
+      p2[i] = static_cast<float>(origin[2] + (qz + w2) * spacing[2]);
+      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      const bool unit = length > 0 && length <= kMax;  // unit_normal's test (NaN fails both)
+      n0[i] = unit ? static_cast<float>(n[0] / length) : 0.0f;
+      n1[i] = unit ? static_cast<float>(n[1] / length) : 0.0f;
+      n2[i] = unit ? static_cast<float>(n[2] / length) : 1.0f;
+      flat[i] = n[0] == 0 && n[1] == 0 && n[2] == 0;
+    }
+  }
+};
+
+}  // namespace
+
 // Surface nets' vertices of plane z with each crossed edge interpolated once: a cell's vertex is
 // the mean of its edges' crossings, and every edge is shared by four cells, so the crossings are
 // found per sample row first (t = s0 / (s0 - s1), surface_nets_vertex's arithmetic on the same
@@ -185,7 +261,8 @@ void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const
   const std::size_t words = words_, nx = static_cast<std::size_t>(n.x);
   // Crossings of x-edges on sample rows (y', z + dz), kept for two y' (by parity) per layer dz;
   // of z-edges from rows (y', z) to (y', z + 1), two y'; of y-edges from (y, z + dz) to
-  // (y + 1, z + dz), the current y only. Entries of edges not crossed are never read.
+  // (y + 1, z + dz), the current y only. Entries of edges not crossed hold a finite stale value
+  // (or the initial zero), read and discarded by crossing_sums<true>.
   std::vector<double> store(8 * nx);
   double* tx[2][2] = {{&store[0], &store[nx]}, {&store[2 * nx], &store[3 * nx]}};
   double* tz[2] = {&store[4 * nx], &store[5 * nx]};
@@ -215,6 +292,7 @@ void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const
   between(0, z, 0, z + 1, tz[0]);
   const CubeCases& table = CubeCases::get();
   const auto& edges = cube_edges();
+  CellRow cells(nx);
   for (int y = 0; y + 1 < n.y; ++y) {
     const int p = y & 1, q = p ^ 1;
     along_x(y + 1, z, tx[0][q]);
@@ -235,7 +313,8 @@ void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const
     const float* row[4] = {block_.row(0, y, z), block_.row(0, y + 1, z), block_.row(0, y, z + 1),
                            block_.row(0, y + 1, z + 1)};
     prefetch_ahead(lattice_, y, z);
-    std::uint64_t g = first_vertex_[r];
+    // Gather: each reached cell's corner values and crossing sums, in cell order.
+    std::size_t k = 0;
     for (std::size_t w = 0; w < words; ++w)
       for (std::uint64_t m = used[w]; m; m &= m - 1) {
         const int x = static_cast<int>(64 * w) + std::countr_zero(m);
@@ -245,16 +324,30 @@ void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const
           v[c] = block_.s_of(row[c >> 1][x + (c & 1)]);
           inside |= static_cast<unsigned>(v[c] < 0) << c;
         }
-        const DualVertex vertex = dual_vertex_at(
-            lattice_, x, y, z, v,
-            crossing_mean(table, edges, inside, [&](unsigned e) { return tp[e][x]; }), out.sources);
-        out.positions[g] = {static_cast<float>(vertex.position[0]),
-                            static_cast<float>(vertex.position[1]),
-                            static_cast<float>(vertex.position[2])};
-        out.normals[g] = unit_normal(vertex.normal);
-        if (out.sources) out.sources[g] = vertex.source;
-        ++g;
+        const CrossingSums sums =
+            crossing_sums<true>(table, inside, [&](unsigned e) { return tp[e][x]; });
+        for (std::size_t c = 0; c < 8; ++c) cells.v[c][k] = v[c];
+        cells.x[k] = x;
+        cells.sum[0][k] = sums.x, cells.sum[1][k] = sums.y, cells.sum[2][k] = sums.z;
+        cells.count[k] = sums.count;
+        ++k;
       }
+    cells.place(lattice_, y, z, k);
+    // Scatter, with dual_vertex_at's rare cases: saddles and colour sources.
+    std::uint64_t g = first_vertex_[r];
+    for (std::size_t i = 0; i < k; ++i, ++g) {
+      out.positions[g] = {cells.position[0][i], cells.position[1][i], cells.position[2][i]};
+      out.normals[g] = {cells.normal[0][i], cells.normal[1][i], cells.normal[2][i]};
+      if (!cells.saddle[i] && !out.sources) continue;
+      double v[8];
+      for (std::size_t c = 0; c < 8; ++c) v[c] = cells.v[c][i];
+      const double u = cells.mean[0][i], w1 = cells.mean[1][i], w2 = cells.mean[2][i];
+      if (cells.saddle[i])
+        out.normals[g] = unit_normal(saddle_normal(v, u, w1, w2, lattice_.spacing));
+      if (out.sources)
+        out.sources[g] =
+            nearest_inside_corner(lattice_, static_cast<int>(cells.x[i]), y, z, v, u, w1, w2);
+    }
   }
 }
 

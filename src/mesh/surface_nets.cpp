@@ -18,7 +18,7 @@ std::array<double, 3> surface_nets_vertex(const Block&, const Lattice& lattice, 
   unsigned mask = 0;
   for (unsigned c = 0; c < 8; ++c) mask |= static_cast<unsigned>(v[c] < 0) << c;
   const auto& edges = cube_edges();
-  return crossing_mean(CubeCases::get(), edges, mask, [&](unsigned e) {
+  return crossing_mean(CubeCases::get(), mask, [&](unsigned e) {
     const CubeEdge& edge = edges[e];
     const double s0 = v[edge.from], s1 = v[edge.to];
     // Lattice::crossing's interpolation, inline unless there is a function to solve on.
