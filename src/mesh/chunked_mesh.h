@@ -191,17 +191,23 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
 // A dual quad — the four cells around a crossed edge, counter-clockwise seen from the edge's +axis
 // ((0,0), (1,0), (1,1), (0,1) in its two other axes' offsets) — as two triangles split along the
 // shorter diagonal (distance2 between two vertices), turned over when the outside is towards
-// -axis (in0: the edge's lower sample is inside).
+// -axis (in0: the edge's lower sample is inside): six indices written at `out`, returning the
+// end. Written in place rather than returned as an array (the array came back through memory and
+// its read stalled on the stores that wrote it), with selects rather than branches (which side is
+// shorter is a coin toss on a noisy volume).
 template <class Distance2>
-std::array<std::uint32_t, 6> quad_triangles(std::uint32_t v00, std::uint32_t v10, std::uint32_t v11,
-                                            std::uint32_t v01, bool in0, Distance2&& distance2) {
-  std::array<std::uint32_t, 6> t;
-  if (distance2(v00, v11) <= distance2(v10, v01))
-    t = {v00, v10, v11, v00, v11, v01};
-  else
-    t = {v00, v10, v01, v10, v11, v01};
-  if (!in0) std::swap(t[1], t[2]), std::swap(t[4], t[5]);
-  return t;
+std::uint32_t* put_quad(std::uint32_t* out, std::uint32_t v00, std::uint32_t v10, std::uint32_t v11,
+                        std::uint32_t v01, bool in0, Distance2&& distance2) {
+  // Split along 00-11: (00, 10, 11), (00, 11, 01); along 10-01: (00, 10, 01), (10, 11, 01).
+  const bool along_00_11 = distance2(v00, v11) <= distance2(v10, v01);
+  const std::uint32_t t2 = along_00_11 ? v11 : v01, t3 = along_00_11 ? v00 : v10;
+  out[0] = v00;
+  out[1] = in0 ? v10 : t2;
+  out[2] = in0 ? t2 : v10;
+  out[3] = t3;
+  out[4] = in0 ? v11 : v01;
+  out[5] = in0 ? v01 : v11;
+  return out + 6;
 }
 
 // A dual mesher's vertex of cell q: its position in the volume's frame, its normal (not yet unit

@@ -108,8 +108,9 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
   // e_b x e_c = e_a), split along the shorter diagonal, turned over when the outside is towards -a.
   auto quad = [&](std::uint32_t v00, std::uint32_t v10, std::uint32_t v11, std::uint32_t v01,
                   bool in0) {
-    const auto t = quad_triangles(v00, v10, v11, v01, in0, distance2);
-    part.indices.insert(part.indices.end(), t.begin(), t.end());
+    const std::size_t at = part.indices.size();
+    part.indices.resize(at + 6);
+    put_quad(part.indices.data() + at, v00, v10, v11, v01, in0, distance2);
   };
   const int row_cells = cells.end.x - cells.begin.x;
   // Per cell of a row: the inside bits of its sample and of the next along x, y and z (bits 0..3),

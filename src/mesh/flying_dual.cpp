@@ -389,8 +389,7 @@ void FlyingDual::write_quads(int z, const WeldOutput& out) const {
     const std::uint64_t* b = inside_->row(y, z);
     const auto quad = [&](std::uint32_t v00, std::uint32_t v10, std::uint32_t v11,
                           std::uint32_t v01, bool in0) {
-      const auto t = quad_triangles(v00, v10, v11, v01, in0, distance2);
-      index = std::copy(t.begin(), t.end(), index);
+      index = put_quad(index, v00, v10, v11, v01, in0, distance2);
     };
     const auto id = [&](int k, int x) { return static_cast<std::uint32_t>(ranks.id(k, x)); };
     for (std::size_t w = 0; w < words_; ++w)
