@@ -307,6 +307,55 @@ World solid_world() {
   return w;
 }
 
+// --grid / LoadOptions::vdb_grid: the world comes from the grid of that name, read by its type's
+// rule; OpenVDB's own iterators count what each rule should find. A missing name is refused with
+// the file and the grids it has; a grid name for another format is refused too.
+TEST(VdbRead, WorldsComeFromTheGridOfTheGivenName) {
+  openvdb::initialize();
+  const openvdb::GridPtrVec grids = sample_grids(false);
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("voxfield-vdb-grid-" + std::to_string(::getpid()) + ".vdb");
+  write_file_atomic(path, file_bytes(grids, openvdb::io::COMPRESS_BLOSC));
+  const auto load = [&](const std::string& name) {
+    LoadOptions o;
+    o.vdb_grid = name;
+    return load_world(path, o).world;
+  };
+  // Bools: active and true voxels, tiles included.
+  std::int64_t active_true = 0;
+  const auto bools = openvdb::gridConstPtrCast<openvdb::BoolGrid>(grids[3]);
+  for (auto it = bools->cbeginValueOn(); it; ++it)
+    if (*it) active_true += static_cast<std::int64_t>(it.getVoxelCount());
+  EXPECT_EQ(load("bools").solid_count(), active_true);
+  // The level set: the inside (value < 0), inactive interior tiles and leaf voxels alike.
+  std::int64_t inside = 0;
+  const auto sphere = openvdb::gridConstPtrCast<openvdb::FloatGrid>(grids[0]);
+  for (auto it = sphere->cbeginValueAll(); it; ++it)
+    if (*it < 0) inside += static_cast<std::int64_t>(it.getVoxelCount());
+  EXPECT_GT(inside, 1000);
+  EXPECT_EQ(load("sphere").solid_count(), inside);
+  // Without a name the rule picks the Int32 grid "ints", whose values pass 255: refused by name.
+  EXPECT_NE(error_of([&] { (void)load(""); }).find("grid \"ints\" has material"),
+            std::string::npos);
+  const std::string missing = error_of([&] { (void)load("density"); });
+  EXPECT_NE(missing.find(path.string() + " has no grid named 'density'"), std::string::npos)
+      << missing;
+  EXPECT_NE(missing.find("'sphere' (float), 'ints' (int32), 'doubles' (double), 'bools' (bool), "
+                         "'vectors' (vec3s)"),
+            std::string::npos)
+      << missing;
+  std::filesystem::remove(path);
+  const auto npy = std::filesystem::temp_directory_path() /
+                   ("voxfield-vdb-grid-" + std::to_string(::getpid()) + ".npy");
+  write_file_atomic(
+      npy, encode_world(solid_world(), Box3i{{-64, -32, -32}, {32, 32, 32}}, WorldFormat::kNpy));
+  LoadOptions o;
+  o.vdb_grid = "bools";
+  EXPECT_NE(error_of([&] { (void)load_world(npy, o); }).find("is for .vdb files"),
+            std::string::npos);
+  std::filesystem::remove(npy);
+}
+
 // voxfield's own .vdb files load back as the worlds they came from: materials, palette and
 // extent from a world's file; the solid voxels from a signed field's level set.
 TEST(VdbRead, VoxfieldsFilesLoadBackAsTheirWorlds) {

@@ -11,6 +11,7 @@ command writes nothing.
 Usage: vdb_oracle_test.py VOXFIELD_BINARY VOX_FILE WORK_DIR
 """
 
+import json
 import os
 import subprocess
 import sys
@@ -157,6 +158,27 @@ got = np.load(os.path.join(WORK, "sphere.npy"))  # voxfield's .npy: [z, y, x] ov
 check(got.shape == inside.T.shape and np.array_equal(got != 0, inside.T != 0),
       f"sphere: voxfield's inside {got.shape} {int((got != 0).sum())} voxels, pyopenvdb's "
       f"{inside.T.shape} {int(inside.sum())}")
+
+# --grid: a file holding the sphere and a fog volume; each command reads the grid it is told.
+fog = vdb.FloatGrid(0.0)
+fog.name = "fog"
+fog.fill((40, 0, 0), (43, 4, 5), 0.25, True)
+pair = os.path.join(WORK, "pair.vdb")
+vdb.write(pair, grids=[sphere, fog])
+run("convert", pair, "--grid", "sphere", os.path.join(WORK, "pair-sphere.npy"))
+check(np.array_equal(np.load(os.path.join(WORK, "pair-sphere.npy")), got), "--grid sphere: not the sphere")
+run("convert", pair, "--grid", "fog", os.path.join(WORK, "pair-fog.npy"))
+check(int((np.load(os.path.join(WORK, "pair-fog.npy")) != 0).sum()) == fog.activeVoxelCount() == 4 * 5 * 6,
+      "--grid fog: not the fog's active voxels")
+p = run("info", pair, "--grid", "fog", "--json")
+check(json.loads(p.stdout)["solid_voxels"] == 120, f"info --grid fog: {p.stdout[:300]}")
+out = os.path.join(WORK, "never.npy")
+p = run("convert", pair, "--grid", "density", out, ok=False)
+check(p.returncode == 1 and f"{pair} has no grid named 'density'; its grids: 'sphere' (float), 'fog' (float)" in p.stderr,
+      f"--grid density: {p.returncode} {p.stderr}")
+check(not os.path.exists(out), "a failed convert wrote its output")
+p = run("mesh", pair, "--grid", "fog", "-o", os.path.join(WORK, "fog.stl"), "--stats", os.path.join(WORK, "fog.json"))
+check(json.load(open(os.path.join(WORK, "fog.json")))["watertight"], "mesh --grid fog: not watertight")
 
 # A truncated .vdb: refused naming the file; a failed command writes nothing.
 cut = os.path.join(WORK, "cut.vdb")

@@ -32,7 +32,7 @@ int run_compare(const CompareSettings& s) {
   outputs.expect(s.json, "--json");
   for (const auto& name : s.algorithms) (void)parse_algorithm(name);
   set_activity("loading " + s.in);
-  const LoadedWorld in = load_world(s.in, {s.field.chunk_edge});
+  const LoadedWorld in = load_world(s.in, s.field.load_options());
   set_activity("comparing the algorithms on " + s.in);
   DistanceOptions o = s.field.options();
   o.domain = in.extent;

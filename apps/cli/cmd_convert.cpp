@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "cli.h"
+#include "field_args.h"
 #include "progress.h"
 #include "voxfield/mesh_read.h"
 
@@ -13,6 +14,7 @@ namespace {
 struct ConvertSettings {
   std::string in, out;
   double voxel_size = 0;
+  std::string grid;
 };
 
 int run_convert(const ConvertSettings& s) {
@@ -21,6 +23,7 @@ int run_convert(const ConvertSettings& s) {
   outputs.expect_world(s.out, "OUT", /*may_be_input=*/true);
   if (mesh_input_format_of(s.in)) {
     if (!(s.voxel_size > 0)) throw UsageError(s.in + ": a mesh needs --voxel-size (in its units)");
+    if (!s.grid.empty()) throw UsageError(s.in + ": --grid picks a .vdb input's grid");
     set_activity("reading " + s.in);
     const TriangleMesh mesh = read_mesh(s.in);
     MeshVoxelOptions o;
@@ -42,6 +45,7 @@ int run_convert(const ConvertSettings& s) {
   set_activity("loading " + s.in);
   LoadOptions lo;
   lo.chunk_edge = 0;  // a .vfw keeps the chunk edge it was saved with
+  lo.vdb_grid = s.grid;
   const LoadedWorld w = load_world(s.in, lo);
   set_activity("writing " + s.out);
   outputs.stage(s.out, encode_world(w.world, w.extent, world_format_of(s.out)));
@@ -58,8 +62,9 @@ void add_convert(CLI::App& app, Action& action) {
                                      "Convert a world between .vox, .npy and .vfw, or to .vdb, or "
                                      "voxelise a mesh (chosen by extension); the output is written "
                                      "atomically");
-  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw, or a mesh: .obj, .ply, .stl, .off")
+  cmd->add_option("IN", s->in, "input .vox, .npy, .vfw or .vdb, or a mesh: .obj, .ply, .stl, .off")
       ->required();
+  add_grid_option(cmd, s->grid);
   cmd->add_option("--voxel-size", s->voxel_size,
                   "for a mesh: the voxels' edge in the mesh's units (solid where the generalized "
                   "winding number at a voxel's centre is >= 1/2)");

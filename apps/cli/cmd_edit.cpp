@@ -52,7 +52,7 @@ int run_edit(const EditSettings& s) {
 
   // The world is bounded to the input's volume: edits reaching outside are clipped to it.
   set_activity("loading " + s.in);
-  const LoadedWorld in = load_world(s.in, {s.field.chunk_edge});
+  const LoadedWorld in = load_world(s.in, s.field.load_options());
   if (in.extent.empty()) throw InvalidArgument(s.in + ": the input holds no volume");
   World world = rechunk_world(in.world, s.field.chunk_edge, in.extent, s.in);
   set_activity("building the field of " + s.in);

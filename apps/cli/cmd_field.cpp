@@ -51,6 +51,7 @@ int run_mesh_field(const FieldSettings& s, Outputs& outputs) {
   refuse(s.algorithm != "exact" || s.backend != "cpu" || !s.field.focus.empty(),
          "a mesh's field has one algorithm, on the CPU (no --algorithm, --backend or --focus)");
   refuse(!s.sites.empty() || !s.packed.empty(), "--sites and --packed apply to worlds");
+  refuse(!s.field.grid.empty(), "--grid picks a .vdb input's grid");
   refuse(output_extension(s.out) != ".npy", "a mesh's field is written as .npy");
   set_activity("reading " + s.in);
   const TriangleMesh mesh = read_mesh(s.in);
@@ -116,7 +117,7 @@ int run_field(const FieldSettings& s) {
                           " algorithm does not track nearest sites");
   }
   set_activity("loading " + s.in);
-  const LoadedWorld in = load_world(s.in, {s.field.chunk_edge});
+  const LoadedWorld in = load_world(s.in, s.field.load_options());
   o.domain = in.extent;  // the output covers the input's volume, indexed like it
   if (o.domain->empty()) throw InvalidArgument(s.in + ": the input holds no volume");
   AlgorithmStats stats;

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "cli.h"
+#include "field_args.h"
 
 namespace voxfield::cli {
 namespace {
@@ -13,6 +14,7 @@ struct InfoSettings {
   std::string path;
   bool json = false;
   int chunk_edge = 32;
+  std::string grid;
 };
 
 nlohmann::json box_json(const Box3i& b) {
@@ -59,6 +61,7 @@ int run_info(const InfoSettings& s) {
   set_activity("loading " + s.path);
   LoadOptions lo;
   lo.chunk_edge = s.chunk_edge;
+  lo.vdb_grid = s.grid;
   const LoadedWorld in = load_world(s.path, lo);
   set_activity("describing " + s.path);
   const WorldSummary sum(in.world);
@@ -166,7 +169,8 @@ void add_info(CLI::App& app, Action& action) {
       app.add_subcommand("info",
                          "Describe a .vox, .npy or .vfw file: dimensions, bounding box, "
                          "solid voxels, models, chunks, memory, palette");
-  cmd->add_option("FILE", s->path, "input .vox, .npy or .vfw")->required();
+  cmd->add_option("FILE", s->path, "input .vox, .npy, .vfw or .vdb")->required();
+  add_grid_option(cmd, s->grid);
   cmd->add_flag("--json", s->json, "print JSON instead of text");
   cmd->add_option("--chunk", s->chunk_edge, "chunk edge used to load the world (8..128)")
       ->check(CLI::IsMember({8, 16, 32, 64, 128}));

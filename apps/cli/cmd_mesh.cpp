@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "cli.h"
+#include "field_args.h"
 #include "live_field.h"
 #include "voxfield/gpu_mesh.h"
 #include "voxfield/mesh.h"
@@ -20,7 +21,7 @@ namespace voxfield::cli {
 namespace {
 
 struct MeshSettings {
-  std::string in, out, stats, algorithm = "mc", inside = "below", backend = "cpu";
+  std::string in, out, stats, algorithm = "mc", inside = "below", backend = "cpu", grid;
   std::optional<double> iso;
   std::optional<std::string> metric;
   std::vector<double> spacing;
@@ -59,6 +60,8 @@ int run_mesh(const MeshSettings& s) {
   std::optional<NpyVolume> npy;
   if (std::filesystem::path(s.in).extension() == ".npy") npy = read_npy(s.in);
   const bool volume_input = npy && is_float(npy->dtype);
+  if (npy && !s.grid.empty())
+    throw UsageError("--grid picks a .vdb input's grid; " + s.in + " is a .npy array");
   if (volume_input && s.metric)
     throw UsageError("--metric is for worlds (meshed through their exact signed field); " + s.in +
                      " is a float volume, meshed as it is");
@@ -101,6 +104,7 @@ int run_mesh(const MeshSettings& s) {
           "--inside and --spacing are for float volumes; a world's solid voxels are inside, one "
           "unit per voxel");
     LoadOptions lo;
+    lo.vdb_grid = s.grid;
     const World world = npy ? world_from_npy(*npy, s.in) : load_world(s.in, lo).world;
     // mesh_world's domain: the content grown past the surface (by more for an offset surface).
     const double world_iso = options.iso;
@@ -184,6 +188,7 @@ void add_mesh(CLI::App& app, Action& action) {
                          "Mesh the surface of a world (.vox, .vfw, integer .npy: through its exact "
                          "signed distance field) or the iso-surface of a float .npy volume");
   cmd->add_option("IN", s->in, "input world or float32/float64 .npy volume")->required();
+  add_grid_option(cmd, s->grid);
   cmd->add_option("-o,--output", s->out, "output .ply, .obj, .stl or .glb (written atomically)")
       ->required();
   cmd->add_option("--algorithm", s->algorithm,

@@ -22,6 +22,7 @@ struct RenderSettings {
   bool no_shadows = false, no_ao = false;
   double fog = 0;
   std::optional<int> slice;
+  std::string grid;
 };
 
 int run_render(const RenderSettings& s) {
@@ -31,7 +32,10 @@ int run_render(const RenderSettings& s) {
   outputs.expect(s.out, "-o");
   outputs.expect(s.stats, "--stats");
   set_activity("loading " + s.in);
-  const LoadedWorld in = load_world(s.in, {s.chunk_edge});
+  LoadOptions lo;
+  lo.chunk_edge = s.chunk_edge;
+  lo.vdb_grid = s.grid;
+  const LoadedWorld in = load_world(s.in, lo);
   set_activity("rendering " + s.in);
   if (in.extent.empty()) throw InvalidArgument(s.in + ": the input holds no volume");
 
@@ -121,7 +125,8 @@ void add_render(CLI::App& app, Action& action) {
   auto s = std::make_shared<RenderSettings>();
   CLI::App* cmd =
       app.add_subcommand("render", "Ray-march a frame of a world on the CPU and write a PNG");
-  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
+  cmd->add_option("IN", s->in, "input .vox, .npy, .vfw or .vdb")->required();
+  add_grid_option(cmd, s->grid);
   cmd->add_option("-o,--output", s->out, "output .png")->required();
   cmd->add_option("--width", s->width, "image width in pixels")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", s->height, "image height in pixels")->check(CLI::Range(1, 16384));

@@ -35,6 +35,20 @@ void FieldArgs::add_to(CLI::App* cmd) {
       ->check(CLI::IsMember({8, 16, 32, 64, 128}));
   cmd->add_option("--threads", threads, "threads to use, 1..1024 (default: all cores)")
       ->check(CLI::Range(1, 1024));
+  add_grid_option(cmd, grid);
+}
+
+void add_grid_option(CLI::App* cmd, std::string& grid) {
+  cmd->add_option("--grid", grid,
+                  "a .vdb input's grid to read the world from, by name (default: voxfield's "
+                  "world grid, else the first int32 grid, else the first)");
+}
+
+LoadOptions FieldArgs::load_options() const {
+  LoadOptions o;
+  o.chunk_edge = chunk_edge;
+  o.vdb_grid = grid;
+  return o;
 }
 
 DistanceOptions FieldArgs::options() const {

@@ -10,6 +10,7 @@
 #include "voxfield/algorithms.h"
 #include "voxfield/file.h"
 #include "voxfield/npy.h"
+#include "voxfield/world_io.h"
 
 namespace voxfield::cli {
 
@@ -22,14 +23,21 @@ struct FieldArgs {
   std::vector<int> focus;
   int chunk_edge = 32;
   int threads = 0;
+  std::string grid;  // --grid: a .vdb input's grid
 
   void add_to(CLI::App* cmd);
+  // How the input world is loaded: the chunk edge and --grid.
+  LoadOptions load_options() const;
   DistanceOptions options() const;
   // The settings every stats file starts with: metric, signed, max_distance, storage, dims,
   // threads, chunk.
   nlohmann::json describe(const DistanceOptions& o, Vec3i dims) const;
   std::optional<Box3i> focus_box() const;
 };
+
+// --grid NAME: which grid of a .vdb input holds the world (LoadOptions::vdb_grid); without it, the
+// first of voxfield's kind "world", else the first Int32 grid, else the first.
+void add_grid_option(CLI::App* cmd, std::string& grid);
 
 // Every algorithm's name, for --algorithm's check.
 std::vector<std::string> algorithm_names();

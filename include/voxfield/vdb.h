@@ -152,19 +152,20 @@ VdbFile decode_vdb(std::span<const std::uint8_t> bytes, const std::string& name,
 // decode_vdb on a file's contents; IoError naming the path when it cannot be read.
 VdbFile read_vdb(const std::filesystem::path& path, const VdbReadOptions& options = {});
 
-// The world a .vdb file holds, from its first grid of voxfield's kind "world", else its first
-// Int32 grid, else its first grid: Int32 grids give each active voxel its value as the material
-// (values outside 0..255 are refused), Bool grids material 1 where active and true, level sets
-// material 1 inside (value < 0, active or not), other Float / Double grids material 1 where
-// active and > 0 (a fog volume's density), Vec3f grids material 1 where active and non-zero.
-// A palette and extent written by voxfield come back from the metadata. Throws FormatError naming
-// `name`, ResourceLimitError past the memory limit.
+// The world a .vdb file holds, from the grid named `grid_name` when one is given (InvalidArgument
+// naming the file and listing its grids when it has none of that name), else from its first grid
+// of voxfield's kind "world", else its first Int32 grid, else its first grid: Int32 grids give each
+// active voxel its value as the material (values outside 0..255 are refused), Bool grids material 1
+// where active and true, level sets material 1 inside (value < 0, active or not), other Float /
+// Double grids material 1 where active and > 0 (a fog volume's density), Vec3f grids material 1
+// where active and non-zero. A palette and extent written by voxfield come back from the metadata.
+// Throws FormatError naming `name`, ResourceLimitError past the memory limit.
 struct VdbWorld {
   World world;
   Box3i extent;             // voxfield's recorded extent united with the content
   std::string description;  // one line: format, grid, type, class, voxel size
 };
 VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_edge,
-                        std::uint64_t memory_limit_bytes = 0);
+                        std::uint64_t memory_limit_bytes = 0, const std::string& grid_name = "");
 
 }  // namespace voxfield

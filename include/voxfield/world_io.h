@@ -28,6 +28,9 @@ struct LoadOptions {
   // Of the returned world; 0: a .vfw keeps the edge it was saved with, other files get 32.
   int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge;
   std::uint64_t memory_limit_bytes = 0;  // 0: the process default (limits.h)
+  // A .vdb file's grid to read the world from, by name; empty: world_from_vdb's rule (vdb.h).
+  // Other formats refuse a name (InvalidArgument): they hold one world.
+  std::string vdb_grid;
 };
 
 // A world read from any supported file, with what the file said about itself.

@@ -162,9 +162,10 @@ void bind_world(py::module_& parent) {
           "[i, j, k] is voxel origin + (i, j, k)), or an empty one; chunk: 8..128, a power of two")
       .def_static(
           "load",
-          [](const std::string& path, int chunk) {
+          [](const std::string& path, int chunk, const std::optional<std::string>& grid) {
             LoadOptions o;
             o.chunk_edge = chunk;
+            o.vdb_grid = grid.value_or("");
             LoadedWorld in;
             {
               py::gil_scoped_release release;
@@ -172,8 +173,10 @@ void bind_world(py::module_& parent) {
             }
             return std::make_unique<PyWorld>(std::move(in.world), in.extent);
           },
-          py::arg("path"), py::arg("chunk") = 32,
-          "Reads a .vox, .npy or .vfw file (the type from its extension); errors name the file")
+          py::arg("path"), py::arg("chunk") = 32, py::arg("grid") = py::none(),
+          "Reads a .vox, .npy, .vfw or .vdb file (the type from its extension); grid: a .vdb "
+          "file's grid to read, by name (default: voxfield's world grid, else the first int32 "
+          "grid, else the first); errors name the file")
       .def(
           "save",
           [](const PyWorld& w, const std::string& path) {

@@ -175,20 +175,38 @@ std::vector<std::uint8_t> VdbGrid::dense_active(const Box3i& box,
   return out;
 }
 
-VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_edge,
-                        std::uint64_t memory_limit_bytes) {
-  if (file.grids.empty())
-    throw FormatError(name, 0, "holds no float, double, bool, int32 or vec3s grid");
-  const VdbGrid* grid = nullptr;
+namespace {
+
+// The grid a world comes from: the one named `grid_name` when given (else InvalidArgument naming
+// the file and listing its grids), else the first of voxfield's kind "world", else the first Int32
+// grid, else the first.
+const VdbGrid& world_grid(const VdbFile& file, const std::string& name,
+                          const std::string& grid_name) {
+  if (!grid_name.empty()) {
+    std::string names;
+    for (const VdbGrid& g : file.grids) {
+      if (g.name == grid_name) return g;
+      names += std::string(names.empty() ? "" : ", ") + "'" + g.name + "' (" +
+               vdb_value_type_name(g.value_type) + ")";
+    }
+    throw InvalidArgument(name + " has no grid named '" + grid_name + "'; its grids: " + names);
+  }
   for (const VdbGrid& g : file.grids) {
     const VdbMetadata* kind = find_meta(g, "voxfield_kind");
-    if (kind && kind->text == "world" && g.value_type == VdbValueType::kInt32) grid = &g;
-    if (grid) break;
+    if (kind && kind->text == "world" && g.value_type == VdbValueType::kInt32) return g;
   }
   for (const VdbGrid& g : file.grids)
-    if (!grid && g.value_type == VdbValueType::kInt32) grid = &g;
-  if (!grid) grid = &file.grids.front();
-  const VdbGrid& g = *grid;
+    if (g.value_type == VdbValueType::kInt32) return g;
+  return file.grids.front();
+}
+
+}  // namespace
+
+VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_edge,
+                        std::uint64_t memory_limit_bytes, const std::string& grid_name) {
+  if (file.grids.empty())
+    throw FormatError(name, 0, "holds no float, double, bool, int32 or vec3s grid");
+  const VdbGrid& g = world_grid(file, name, grid_name);
   const SolidRule rule = rule_for(g);
 
   VdbWorld out;

@@ -73,6 +73,9 @@ const char* world_format_name(WorldFormat f) {
 
 LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& options) {
   const WorldFormat format = world_format_of(path);
+  if (!options.vdb_grid.empty() && format != WorldFormat::kVdb)
+    throw InvalidArgument(path.string() + ": a grid name ('" + options.vdb_grid +
+                          "') is for .vdb files, which hold several grids");
   check_magic(path, format);
   const std::uint64_t limit = effective_memory_limit(options.memory_limit_bytes);
   const int edge =
@@ -130,8 +133,8 @@ LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& opt
       vo.memory_limit_bytes = limit;
       const VdbFile file = read_vdb(path, vo);
       // The decoded file is held while the world is built from it.
-      VdbWorld w =
-          world_from_vdb(file, path.string(), edge, remaining_memory(limit, file.memory_bytes()));
+      VdbWorld w = world_from_vdb(file, path.string(), edge,
+                                  remaining_memory(limit, file.memory_bytes()), options.vdb_grid);
       out.world = std::move(w.world);
       out.extent = w.extent;
       out.description = std::move(w.description);

@@ -28,7 +28,9 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
       World part = world_from_npy(read_npy_part(path, z0, z1), path.string(), chunk_edge);
       return WorldSlab{std::move(part), partition, "npy", true};
     }
-    LoadedWorld whole = load_world(path, {chunk_edge});
+    LoadOptions lo;
+    lo.chunk_edge = chunk_edge;
+    LoadedWorld whole = load_world(path, lo);
     if (whole.extent.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
     const SlabPartition partition = partition_slabs(whole.extent, size, chunk_edge);
     // Only the slab and its ghost slices are kept once the file is read.

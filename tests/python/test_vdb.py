@@ -14,6 +14,7 @@ import pytest
 
 import voxfield
 import voxfield.vdb
+from voxfield.world import World
 
 
 def sample_grids(half):
@@ -123,3 +124,21 @@ def test_damaged_files_raise_format_errors_naming_the_file(tmp_path):
         voxfield.vdb.read(str(tmp_path / "missing.vdb"))
     with pytest.raises(voxfield.ResourceLimitError, match="memory limit"):
         voxfield.vdb.read(path, memory_limit=len(data) + 4096)  # the bytes fit, the trees not
+
+
+def test_world_load_reads_the_grid_of_the_given_name(tmp_path):
+    mask = openvdb.BoolGrid(False)
+    mask.name = "mask"
+    mask.fill((0, 0, 0), (3, 3, 3), True, True)
+    density = openvdb.FloatGrid(0.0)
+    density.name = "density"
+    density.fill((10, 10, 10), (11, 12, 13), 0.5, True)
+    density.fill((10, 10, 13), (11, 12, 13), 0.0, True)  # active but empty: not solid
+    path = str(tmp_path / "two.vdb")
+    openvdb.write(path, grids=[mask, density])
+    assert World.load(path).solid_count == mask.activeVoxelCount() == 64
+    w = World.load(path, grid="density")
+    assert w.solid_count == density.activeVoxelCount() - 6 == 18
+    assert w.content_bounds == ((10, 10, 10), (12, 13, 13))
+    with pytest.raises(ValueError, match=r"two\.vdb has no grid named 'fog'; its grids: 'mask' \(bool\), 'density' \(float\)"):
+        World.load(path, grid="fog")
