@@ -88,9 +88,9 @@ struct VdbTile {
   std::array<double, 3> value{};  // components beyond the grid's are 0
 };
 
-// A leaf: leaf_edge^3 voxels from `origin`, their values in `VdbGrid::leaf_values` from
-// `first_value` (components interleaved, x slowest then y then z, OpenVDB's order), their active
-// flags as a bit mask in the same order.
+// A leaf: leaf_edge^3 voxels from `origin`, their values in the grid's leaf values from
+// `first_value` (VdbGrid::leaf_value; components interleaved, x slowest then y then z, OpenVDB's
+// order), their active flags as a bit mask in the same order.
 struct VdbLeaf {
   Vec3i origin;
   std::size_t first_value = 0;
@@ -114,7 +114,17 @@ struct VdbGrid {
   int leaf_edge = 8;
   std::vector<VdbTile> tiles;
   std::vector<VdbLeaf> leaves;
-  std::vector<double> leaf_values;
+  // The leaves' values, components interleaved: as floats for float and vec3s grids — their
+  // values are floats in the file (halves widen to floats exactly), so doubles would only double
+  // the memory — and as doubles for double, int32 and bool grids. One of the two is used.
+  std::vector<float> leaf_floats;
+  std::vector<double> leaf_doubles;
+  bool leaves_hold_floats() const {
+    return value_type == VdbValueType::kFloat || value_type == VdbValueType::kVec3f;
+  }
+  double leaf_value(std::size_t i) const {
+    return leaves_hold_floats() ? leaf_floats[i] : leaf_doubles[i];
+  }
 
   bool leaf_active(const VdbLeaf& leaf, int i) const {
     return (leaf.active_bits[static_cast<std::size_t>(i) >> 6] >> (i & 63)) & 1u;

@@ -198,7 +198,8 @@ void read_transform(ByteReader& r, VdbGrid& g) {
 
 // What a grid's tree and a metadata map hold in memory, as the memory limit counts them.
 std::uint64_t tree_bytes(const VdbGrid& g) {
-  std::uint64_t n = g.leaf_values.size() * sizeof(double) + g.tiles.size() * sizeof(VdbTile);
+  std::uint64_t n = g.leaf_floats.size() * sizeof(float) + g.leaf_doubles.size() * sizeof(double) +
+                    g.tiles.size() * sizeof(VdbTile);
   for (const VdbLeaf& l : g.leaves) n += sizeof(VdbLeaf) + l.active_bits.size() * 8;
   return n;
 }
@@ -313,7 +314,8 @@ VdbFile decode_vdb(std::span<const std::uint8_t> bytes, const std::string& name,
       g.background = p.background;
       g.tiles = p.tiles;
       g.leaves = p.leaves;
-      g.leaf_values = p.leaf_values;
+      g.leaf_floats = p.leaf_floats;
+      g.leaf_doubles = p.leaf_doubles;
     }
     read_grids[d.unique_name] = file.grids.size();
     file.grids.push_back(std::move(g));

@@ -2,6 +2,7 @@
 // and the world a file holds (vdb.h says which grid and which voxels become solid). The
 // memory a world or a dense box will take is counted before anything is allocated.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -33,7 +34,7 @@ struct DenseIndex {
   }
 };
 
-// f(voxel, index of its first component in leaf_values) for every voxel of a leaf.
+// f(voxel, index of its first component in the leaf values) for every voxel of a leaf.
 template <typename F>
 void for_each_leaf_voxel(const VdbGrid& g, const VdbLeaf& leaf, F&& f) {
   const int e = g.leaf_edge;
@@ -69,6 +70,14 @@ SolidRule rule_for(const VdbGrid& g) {
   if (g.grid_class == "level set") return SolidRule::kInside;
   if (kind && kind->text == "unsigned distance") return SolidRule::kZero;  // distance to solid
   return SolidRule::kPositive;
+}
+
+// The components of the leaf value from index `first` (components beyond the grid's are 0).
+std::array<double, 3> leaf_components(const VdbGrid& g, std::size_t first) {
+  std::array<double, 3> v{};
+  for (std::size_t c = 0; c < static_cast<std::size_t>(g.components); ++c)
+    v[c] = g.leaf_value(first + c);
+  return v;
 }
 
 // The material a value makes under a rule, or -1 for a material outside 0..255.
@@ -144,7 +153,7 @@ std::vector<double> VdbGrid::dense(const Box3i& box, std::uint64_t memory_limit_
     if (leaf_box(*this, l).intersect(box).empty()) continue;
     for_each_leaf_voxel(*this, l, [&](Vec3i p, int, std::size_t first) {
       if (!box.contains(p)) return;
-      for (std::size_t c = 0; c < comps; ++c) out[index(p) + c] = leaf_values[first + c];
+      for (std::size_t c = 0; c < comps; ++c) out[index(p) + c] = leaf_value(first + c);
     });
   }
   return out;
@@ -241,7 +250,8 @@ VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_
     if (need > limit) break;
     bool solid = false;
     for_each_leaf_voxel(g, l, [&](Vec3i, int i, std::size_t first) {
-      solid = solid || material_of(rule, &g.leaf_values[first], g.leaf_active(l, i)) != 0;
+      solid =
+          solid || material_of(rule, leaf_components(g, first).data(), g.leaf_active(l, i)) != 0;
     });
     if (solid) count_dense(l.origin, g.leaf_edge);
   }
@@ -257,11 +267,11 @@ VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_
   }
   for (const VdbLeaf& l : g.leaves) {
     for_each_leaf_voxel(g, l, [&](Vec3i p, int i, std::size_t first) {
-      const int m = material_of(rule, &g.leaf_values[first], g.leaf_active(l, i));
+      const int m = material_of(rule, leaf_components(g, first).data(), g.leaf_active(l, i));
       if (m < 0)
         throw FormatError(name, 0,
                           "grid \"" + g.name + "\" has material " +
-                              format_number(g.leaf_values[first]) + " at (" + std::to_string(p.x) +
+                              format_number(g.leaf_value(first)) + " at (" + std::to_string(p.x) +
                               ", " + std::to_string(p.y) + ", " + std::to_string(p.z) +
                               ") (outside 0..255)");
       if (m != 0) voxels.set(p, static_cast<std::uint8_t>(m));
