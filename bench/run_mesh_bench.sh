@@ -36,7 +36,7 @@ inputs+=("$out/inputs/scan.npy")
 # scripts/install-bench-deps.sh; read with nibabel), 301 x 370 x 316 whole-number intensities 0-130,
 # meshed at 89.5 (between the 75th and 90th percentiles: a surface through the brain's tissue,
 # 3.8 M triangles) and shifted so that the surface is at level 0 for every mesher. No sample lies
-# on it, where scikit-image breaks ties otherwise than voxfield and VTK (at 90: 2.7 % fewer triangles).
+# on it, where scikit-image breaks ties otherwise than voxfield and VTK (at 90: 2.6 % fewer triangles).
 mri=/usr/share/mricron/templates/ch2better.nii.gz
 if [ -f "$mri" ]; then
   /usr/bin/python3 - "$mri" "$out/inputs/mri-colin27.npy" <<'PY'

@@ -159,26 +159,43 @@ check(got.shape == inside.T.shape and np.array_equal(got != 0, inside.T != 0),
       f"sphere: voxfield's inside {got.shape} {int((got != 0).sum())} voxels, pyopenvdb's "
       f"{inside.T.shape} {int(inside.sum())}")
 
-# --grid: a file holding the sphere and a fog volume; each command reads the grid it is told.
+# --grid: a file holding a fog volume and then the sphere, so that the default rule (no Int32
+# grid: the first grid) reads the fog and only --grid reads the sphere.
 fog = vdb.FloatGrid(0.0)
 fog.name = "fog"
 fog.fill((40, 0, 0), (43, 4, 5), 0.25, True)
 pair = os.path.join(WORK, "pair.vdb")
-vdb.write(pair, grids=[sphere, fog])
-run("convert", pair, "--grid", "sphere", os.path.join(WORK, "pair-sphere.npy"))
-check(np.array_equal(np.load(os.path.join(WORK, "pair-sphere.npy")), got), "--grid sphere: not the sphere")
+vdb.write(pair, grids=[fog, sphere])
+run("convert", pair, os.path.join(WORK, "pair-default.npy"))
 run("convert", pair, "--grid", "fog", os.path.join(WORK, "pair-fog.npy"))
-check(int((np.load(os.path.join(WORK, "pair-fog.npy")) != 0).sum()) == fog.activeVoxelCount() == 4 * 5 * 6,
-      "--grid fog: not the fog's active voxels")
-p = run("info", pair, "--grid", "fog", "--json")
-check(json.loads(p.stdout)["solid_voxels"] == 120, f"info --grid fog: {p.stdout[:300]}")
+run("convert", pair, "--grid", "sphere", os.path.join(WORK, "pair-sphere.npy"))
+fog_world = np.load(os.path.join(WORK, "pair-fog.npy"))
+check(int((fog_world != 0).sum()) == fog.activeVoxelCount() == 4 * 5 * 6, "--grid fog: not the fog's active voxels")
+check(np.array_equal(np.load(os.path.join(WORK, "pair-default.npy")), fog_world), "no --grid: not the first grid")
+check(np.array_equal(np.load(os.path.join(WORK, "pair-sphere.npy")), got), "--grid sphere: not the sphere's inside")
+p = run("info", pair, "--grid", "sphere", "--json")
+check(json.loads(p.stdout)["solid_voxels"] == int(inside.sum()), f"info --grid sphere: {p.stdout[:300]}")
+# mesh and field read the chosen grid: the same triangles and distances as from its world's .npy.
+for cmd, extra in [("mesh", ["--stats"]), ("field", ["--stats"])]:
+    counts = []
+    for src, grid in [(pair, ["--grid", "sphere"]), (os.path.join(WORK, "pair-sphere.npy"), [])]:
+        out = os.path.join(WORK, f"{cmd}-{len(grid)}." + ("stl" if cmd == "mesh" else "npy"))
+        stats = os.path.join(WORK, f"{cmd}-{len(grid)}.json")
+        run(cmd, src, *grid, "-o", out, *extra, stats)
+        counts.append(json.load(open(stats))["triangles"] if cmd == "mesh" else np.load(out))
+    same = counts[0] == counts[1] if cmd == "mesh" else np.array_equal(counts[0], counts[1])
+    check(same, f"{cmd} --grid sphere: differs from the sphere's world")
 out = os.path.join(WORK, "never.npy")
 p = run("convert", pair, "--grid", "density", out, ok=False)
-check(p.returncode == 1 and f"{pair} has no grid named 'density'; its grids: 'sphere' (float), 'fog' (float)" in p.stderr,
+check(p.returncode == 1 and f"{pair} has no grid named 'density'; its grids: 'fog' (float), 'sphere' (float)" in p.stderr,
       f"--grid density: {p.returncode} {p.stderr}")
 check(not os.path.exists(out), "a failed convert wrote its output")
-p = run("mesh", pair, "--grid", "fog", "-o", os.path.join(WORK, "fog.stl"), "--stats", os.path.join(WORK, "fog.json"))
-check(json.load(open(os.path.join(WORK, "fog.json")))["watertight"], "mesh --grid fog: not watertight")
+for args in [("convert", VOX, "--grid", "fog", out), ("mesh", os.path.join(WORK, "pair-fog.npy"), "--grid", "fog", "-o",
+             os.path.join(WORK, "never.stl")), ("render", VOX, "--grid", "fog", "-o", os.path.join(WORK, "never.png"))]:
+    p = run(*args, ok=False)
+    check(p.returncode == 2 and "is not a .vdb file" in p.stderr, f"{args[0]} --grid on {args[1]}: {p.returncode} {p.stderr}")
+check(not any(os.path.exists(os.path.join(WORK, f)) for f in ["never.npy", "never.stl", "never.png"]),
+      "a refused --grid wrote an output")
 
 # A truncated .vdb: refused naming the file; a failed command writes nothing.
 cut = os.path.join(WORK, "cut.vdb")

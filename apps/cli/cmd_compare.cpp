@@ -26,6 +26,7 @@ double median(std::vector<double> v) {
 }
 
 int run_compare(const CompareSettings& s) {
+  check_grid_input(s.in, s.field.grid);
   std::optional<ThreadLimit> limit;
   if (s.field.threads > 0) limit.emplace(s.field.threads);
   Outputs outputs({s.in});
@@ -124,6 +125,7 @@ void add_compare(CLI::App& app, Action& action) {
       "compare", "Run every algorithm on one input: time and error against the exact field");
   cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
   s->field.add_to(cmd);
+  add_grid_option(cmd, s->field.grid);
   cmd->add_option("--algorithms", s->algorithms, "comma-separated subset (default: all)")
       ->delimiter(',');
   cmd->add_option("--runs", s->runs, "runs per algorithm; the median time is shown")

@@ -18,12 +18,12 @@ struct ConvertSettings {
 };
 
 int run_convert(const ConvertSettings& s) {
+  check_grid_input(s.in, s.grid);
   // Converting a file onto itself is safe: the input is read whole before the output is written.
   Outputs outputs({s.in});
   outputs.expect_world(s.out, "OUT", /*may_be_input=*/true);
   if (mesh_input_format_of(s.in)) {
     if (!(s.voxel_size > 0)) throw UsageError(s.in + ": a mesh needs --voxel-size (in its units)");
-    if (!s.grid.empty()) throw UsageError(s.in + ": --grid picks a .vdb input's grid");
     set_activity("reading " + s.in);
     const TriangleMesh mesh = read_mesh(s.in);
     MeshVoxelOptions o;

@@ -28,6 +28,7 @@ double percentile(std::vector<double> v, double q) {
 }
 
 int run_edit(const EditSettings& s) {
+  check_grid_input(s.in, s.field.grid);
   std::optional<ThreadLimit> limit;
   if (s.field.threads > 0) limit.emplace(s.field.threads);
   // Outputs, options and the whole script are checked before the world is loaded: a mistake
@@ -123,6 +124,7 @@ void add_edit(CLI::App& app, Action& action) {
       ->required();
   cmd->add_option("-o,--output", s->out, "output .npy of the final field")->required();
   s->field.add_to(cmd);
+  add_grid_option(cmd, s->field.grid);
   cmd->add_option("--backend", s->backend,
                   "cpu (default), vulkan or auto: where the field lives and is updated")
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));

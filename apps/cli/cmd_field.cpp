@@ -51,7 +51,6 @@ int run_mesh_field(const FieldSettings& s, Outputs& outputs) {
   refuse(s.algorithm != "exact" || s.backend != "cpu" || !s.field.focus.empty(),
          "a mesh's field has one algorithm, on the CPU (no --algorithm, --backend or --focus)");
   refuse(!s.sites.empty() || !s.packed.empty(), "--sites and --packed apply to worlds");
-  refuse(!s.field.grid.empty(), "--grid picks a .vdb input's grid");
   refuse(output_extension(s.out) != ".npy", "a mesh's field is written as .npy");
   set_activity("reading " + s.in);
   const TriangleMesh mesh = read_mesh(s.in);
@@ -93,6 +92,7 @@ int run_mesh_field(const FieldSettings& s, Outputs& outputs) {
 }
 
 int run_field(const FieldSettings& s) {
+  check_grid_input(s.in, s.field.grid);
   std::optional<ThreadLimit> limit;
   if (s.field.threads > 0) limit.emplace(s.field.threads);
   // Everything that can be wrong with the options is found before the world is loaded.
@@ -187,6 +187,7 @@ void add_field(CLI::App& app, Action& action) {
                   "output .npy, or .vdb (an OpenVDB float grid: a level set when signed)")
       ->required();
   s->field.add_to(cmd);
+  add_grid_option(cmd, s->field.grid);
   cmd->add_option("--backend", s->backend,
                   "cpu (default), vulkan (any Vulkan device, software included) or auto "
                   "(a hardware GPU if there is one, else the CPU)")

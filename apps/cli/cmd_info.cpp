@@ -58,6 +58,7 @@ struct WorldSummary {
 int print_text(const InfoSettings& s, const LoadedWorld& in, const WorldSummary& sum);
 
 int run_info(const InfoSettings& s) {
+  check_grid_input(s.path, s.grid);
   set_activity("loading " + s.path);
   LoadOptions lo;
   lo.chunk_edge = s.chunk_edge;
@@ -167,7 +168,7 @@ void add_info(CLI::App& app, Action& action) {
   auto s = std::make_shared<InfoSettings>();
   CLI::App* cmd =
       app.add_subcommand("info",
-                         "Describe a .vox, .npy or .vfw file: dimensions, bounding box, "
+                         "Describe a .vox, .npy, .vfw or .vdb file: dimensions, bounding box, "
                          "solid voxels, models, chunks, memory, palette");
   cmd->add_option("FILE", s->path, "input .vox, .npy, .vfw or .vdb")->required();
   add_grid_option(cmd, s->grid);

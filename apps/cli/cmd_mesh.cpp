@@ -35,6 +35,7 @@ bool is_float(DType t) {
 }
 
 int run_mesh(const MeshSettings& s) {
+  check_grid_input(s.in, s.grid);
   MeshOptions options;
   options.algorithm = parse_mesher(s.algorithm);
   options.chunk_edge = s.chunk;
@@ -60,8 +61,6 @@ int run_mesh(const MeshSettings& s) {
   std::optional<NpyVolume> npy;
   if (std::filesystem::path(s.in).extension() == ".npy") npy = read_npy(s.in);
   const bool volume_input = npy && is_float(npy->dtype);
-  if (npy && !s.grid.empty())
-    throw UsageError("--grid picks a .vdb input's grid; " + s.in + " is a .npy array");
   if (volume_input && s.metric)
     throw UsageError("--metric is for worlds (meshed through their exact signed field); " + s.in +
                      " is a float volume, meshed as it is");
@@ -73,7 +72,8 @@ int run_mesh(const MeshSettings& s) {
   double mesh_ms = 0;
   if (volume_input) {
     const std::vector<float> values = float_samples(*npy, s.in);
-    std::vector<std::uint8_t>().swap(npy->bytes);  // its pages are free for the mesh's arrays
+    // The raw bytes are converted: freed before meshing, they no longer add to the peak memory.
+    std::vector<std::uint8_t>().swap(npy->bytes);
     ScalarVolume volume{npy->dims, values.data()};
     if (!s.spacing.empty()) volume.spacing_units = {s.spacing[0], s.spacing[1], s.spacing[2]};
     for (int a = 0; a < 3; ++a)
@@ -187,7 +187,9 @@ void add_mesh(CLI::App& app, Action& action) {
       app.add_subcommand("mesh",
                          "Mesh the surface of a world (.vox, .vfw, integer .npy: through its exact "
                          "signed distance field) or the iso-surface of a float .npy volume");
-  cmd->add_option("IN", s->in, "input world or float32/float64 .npy volume")->required();
+  cmd->add_option("IN", s->in,
+                  "input world (.vox, .npy, .vfw or .vdb) or float32/float64 .npy volume")
+      ->required();
   add_grid_option(cmd, s->grid);
   cmd->add_option("-o,--output", s->out, "output .ply, .obj, .stl or .glb (written atomically)")
       ->required();

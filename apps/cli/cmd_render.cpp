@@ -26,6 +26,7 @@ struct RenderSettings {
 };
 
 int run_render(const RenderSettings& s) {
+  check_grid_input(s.in, s.grid);
   std::optional<ThreadLimit> limit;
   if (s.threads > 0) limit.emplace(s.threads);
   Outputs outputs({s.in});

@@ -1,4 +1,4 @@
-// voxfield CLI — parsing of the distance-field options.
+// voxfield CLI — parsing of the distance-field options and of a .vdb input's --grid.
 #include "field_args.h"
 
 #include <sys/resource.h>
@@ -7,7 +7,10 @@
 #include "voxfield/limits.h"
 #include "voxfield/parallel.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cstring>
+#include <filesystem>
 
 namespace voxfield::cli {
 
@@ -35,13 +38,20 @@ void FieldArgs::add_to(CLI::App* cmd) {
       ->check(CLI::IsMember({8, 16, 32, 64, 128}));
   cmd->add_option("--threads", threads, "threads to use, 1..1024 (default: all cores)")
       ->check(CLI::Range(1, 1024));
-  add_grid_option(cmd, grid);
 }
 
 void add_grid_option(CLI::App* cmd, std::string& grid) {
   cmd->add_option("--grid", grid,
                   "a .vdb input's grid to read the world from, by name (default: voxfield's "
                   "world grid, else the first int32 grid, else the first)");
+}
+
+void check_grid_input(const std::string& in, const std::string& grid) {
+  std::string ext = std::filesystem::path(in).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (!grid.empty() && ext != ".vdb")
+    throw UsageError("--grid picks a .vdb input's grid; " + in + " is not a .vdb file");
 }
 
 LoadOptions FieldArgs::load_options() const {

@@ -23,7 +23,7 @@ struct FieldArgs {
   std::vector<int> focus;
   int chunk_edge = 32;
   int threads = 0;
-  std::string grid;  // --grid: a .vdb input's grid
+  std::string grid;  // --grid (add_grid_option): a .vdb input's grid
 
   void add_to(CLI::App* cmd);
   // How the input world is loaded: the chunk edge and --grid.
@@ -38,6 +38,8 @@ struct FieldArgs {
 // --grid NAME: which grid of a .vdb input holds the world (LoadOptions::vdb_grid); without it, the
 // first of voxfield's kind "world", else the first Int32 grid, else the first.
 void add_grid_option(CLI::App* cmd, std::string& grid);
+// Refuses (UsageError, before anything is read) a --grid for an input that is not a .vdb file.
+void check_grid_input(const std::string& in, const std::string& grid);
 
 // Every algorithm's name, for --algorithm's check.
 std::vector<std::string> algorithm_names();

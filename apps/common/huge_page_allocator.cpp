@@ -14,11 +14,13 @@
 
 // thp:always advises every mapping jemalloc makes for huge pages (the kernel then backs whole
 // 2 MiB ranges at the first fault); metadata_thp:auto does so for its own metadata once that is
-// large enough to matter. oversize_threshold:0 serves large blocks (8 MiB and up) from the ordinary
-// arenas, which keep freed pages for reuse for a while (dirty_decay_ms, 10 s), rather than from
-// jemalloc's dedicated arena for them, which hands freed pages back to the kernel at once: a later
-// large block, such as the mesh written after its input's raw bytes are dropped, then reuses pages
-// already faulted in instead of faulting and zeroing new ones. `voxfield mesh` of the 256³
-// terrain's field, marching cubes on one thread: 1880 page faults and 70 ms of meshing before,
-// 1490 and 65 ms after (docs/benchmarks.md); the peak memory did not grow.
+// large enough to matter. oversize_threshold:0 turns off jemalloc's dedicated arena for blocks of
+// 8 MiB and more, so they come from the ordinary arenas. Measured, not derived: `voxfield mesh` of
+// the 256³ terrain's field (marching cubes, one thread) faults 1 890 pages instead of 1 500 and
+// meshes in 64-65 ms instead of 69-70; `perf record -e page-faults --call-graph dwarf` puts the
+// faults saved in the first writes to the mesher's own bookkeeping (its bit rows and row counts),
+// which now land in memory the run freed before. What it does not do: keep a freed block of 8 MiB
+// or more for reuse on the main thread — Debian's jemalloc 5.3.0 gives arena 0 its own 8 MiB
+// threshold for returning those to the kernel at once (strace shows the input's bytes returned
+// either way). docs/benchmarks.md has the runs.
 const char* malloc_conf = "thp:always,metadata_thp:auto,oversize_threshold:0";

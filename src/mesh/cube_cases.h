@@ -113,6 +113,7 @@ struct CrossingSums {
 template <bool kReadsAnyEdge = false, class CrossingOf>
 CrossingSums crossing_sums(const CubeCases& table, unsigned inside, CrossingOf&& t_of) {
   const unsigned crossed = table.crossed_edges(inside);
+  // Edges 4a..4a+3 run along axis a (the numbering above; cube_edges() is built from it).
   double sum[3];
   for (unsigned a = 0; a < 3; ++a) {
     double s = 0;

@@ -229,7 +229,11 @@ struct CellRow {
     const double qy = y, qz = z;
     const std::array<double, 3> origin = l.origin, spacing = l.spacing;
     constexpr double kMax = std::numeric_limits<double>::max();
+#if defined(__clang__)
+#pragma clang loop vectorize(assume_safety)
+#else
 #pragma GCC ivdep
+#endif
     for (std::size_t i = 0; i < k; ++i) {
       const double u = s0[i] / cn[i], w1 = s1[i] / cn[i], w2 = s2[i] / cn[i];
       m0[i] = u, m1[i] = w1, m2[i] = w2;
