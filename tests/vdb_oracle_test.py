@@ -5,7 +5,9 @@ run; pyopenvdb must see a level set (signed) or a scalar grid (unsigned) with th
 background, voxel size and metadata, holding at every voxel of the domain the .npy's distance
 (for a level set, less half a voxel: the distance to the surface midway between voxel centres).
 voxfield reads .vdb back with its own parser: the world file as the world it came from, and a
-level set pyopenvdb writes as its inside; a truncated file is refused naming the file, and a failed
+level set pyopenvdb writes as its inside; --grid NAME reads the named grid of a file of several
+(convert, info, mesh and field against the chosen grid's world) and is refused for a missing name
+and for inputs that are not .vdb; a truncated file is refused naming the file, and a failed
 command writes nothing.
 
 Usage: vdb_oracle_test.py VOXFIELD_BINARY VOX_FILE WORK_DIR
@@ -170,8 +172,13 @@ run("convert", pair, os.path.join(WORK, "pair-default.npy"))
 run("convert", pair, "--grid", "fog", os.path.join(WORK, "pair-fog.npy"))
 run("convert", pair, "--grid", "sphere", os.path.join(WORK, "pair-sphere.npy"))
 fog_world = np.load(os.path.join(WORK, "pair-fog.npy"))
-check(int((fog_world != 0).sum()) == fog.activeVoxelCount() == 4 * 5 * 6, "--grid fog: not the fog's active voxels")
+check(int((fog_world != 0).sum()) == fog.activeVoxelCount() == 4 * 5 * 6, "the fog's world: not its active voxels")
 check(np.array_equal(np.load(os.path.join(WORK, "pair-default.npy")), fog_world), "no --grid: not the first grid")
+# The fog second, where the default would read the sphere: --grid fog still reads the fog.
+pair2 = os.path.join(WORK, "pair2.vdb")
+vdb.write(pair2, grids=[sphere, fog])
+run("convert", pair2, "--grid", "fog", os.path.join(WORK, "pair2-fog.npy"))
+check(np.array_equal(np.load(os.path.join(WORK, "pair2-fog.npy")), fog_world), "--grid fog: not the fog")
 check(np.array_equal(np.load(os.path.join(WORK, "pair-sphere.npy")), got), "--grid sphere: not the sphere's inside")
 p = run("info", pair, "--grid", "sphere", "--json")
 check(json.loads(p.stdout)["solid_voxels"] == int(inside.sum()), f"info --grid sphere: {p.stdout[:300]}")

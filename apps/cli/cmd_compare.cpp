@@ -123,7 +123,7 @@ void add_compare(CLI::App& app, Action& action) {
   auto s = std::make_shared<CompareSettings>();
   CLI::App* cmd = app.add_subcommand(
       "compare", "Run every algorithm on one input: time and error against the exact field");
-  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw")->required();
+  cmd->add_option("IN", s->in, "input .vox, .npy, .vfw or .vdb")->required();
   s->field.add_to(cmd);
   add_grid_option(cmd, s->field.grid);
   cmd->add_option("--algorithms", s->algorithms, "comma-separated subset (default: all)")

@@ -112,7 +112,8 @@ void add_edit(CLI::App& app, Action& action) {
   CLI::App* cmd = app.add_subcommand("edit",
                                      "Apply scripted edits (JSON lines) with incremental exact "
                                      "distance updates; write the final field");
-  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw (the world is bounded to its volume)")
+  cmd->add_option("IN", s->in,
+                  "input .vox, .npy, .vfw or .vdb (the world is bounded to its volume)")
       ->required();
   cmd->add_option(
          "-e,--edits", s->edits,

@@ -181,7 +181,7 @@ void add_field(CLI::App& app, Action& action) {
   CLI::App* cmd = app.add_subcommand(
       "field",
       "Compute a distance field and write it as .npy (a[x, y, z], like the input) or .vdb");
-  cmd->add_option("IN", s->in, "input .vox, .npy or .vfw, or a mesh: .obj, .ply, .stl, .off")
+  cmd->add_option("IN", s->in, "input .vox, .npy, .vfw or .vdb, or a mesh: .obj, .ply, .stl, .off")
       ->required();
   cmd->add_option("-o,--output", s->out,
                   "output .npy, or .vdb (an OpenVDB float grid: a level set when signed)")

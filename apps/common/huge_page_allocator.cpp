@@ -16,7 +16,7 @@
 // 2 MiB ranges at the first fault); metadata_thp:auto does so for its own metadata once that is
 // large enough to matter. oversize_threshold:0 turns off jemalloc's dedicated arena for blocks of
 // 8 MiB and more, so they come from the ordinary arenas. Measured, not derived: `voxfield mesh` of
-// the 256³ terrain's field (marching cubes, one thread) faults 1 890 pages instead of 1 500 and
+// the 256³ terrain's field (marching cubes, one thread) faults 1 500 pages instead of 1 890 and
 // meshes in 64-65 ms instead of 69-70; `perf record -e page-faults --call-graph dwarf` puts the
 // faults saved in the first writes to the mesher's own bookkeeping (its bit rows and row counts),
 // which now land in memory the run freed before. What it does not do: keep a freed block of 8 MiB
