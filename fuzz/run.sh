@@ -39,6 +39,13 @@ for m in ephtracy_chr_cat ephtracy_chr_knight mmmm_chr_mayor vengi_robo ephtracy
   [ -s "$seeds/vdb/$m-sdf.vdb" ] ||
     "$cli" field "$corpus/$m.vox" -o "$seeds/vdb/$m-sdf.vdb" --signed --max-distance 3 >/dev/null 2>&1
 done
+# A world in a frame (a voxelised cube keeps the mesh's units): a .vfw with a frame section and a
+# .vdb whose transform scales and translates.
+printf 'v 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\nv 0 0 2\nv 2 0 2\nv 2 2 2\nv 0 2 2\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 3 4 8 7\nf 1 5 8 4\nf 2 3 7 6\n' >"$seeds/cube.obj"
+for ext in vfw vdb; do
+  [ -s "$seeds/$ext/framed.$ext" ] ||
+    "$cli" convert "$seeds/cube.obj" "$seeds/$ext/framed.$ext" --voxel-size 0.5 >/dev/null 2>&1
+done
 find "$seeds/vdb" -size +$((4 * max_seed))c -delete
 
 # One harness: its seeds, its scratch corpus, its log; a finding prints the log's tail and fails.

@@ -24,7 +24,7 @@ PUBLIC_LAYER = {
     "box.h": "core", "error.h": "core", "parallel.h": "core", "limits.h": "core", "chunk_memory.h": "core", "grid.h": "core",
     "detail/grid_impl.h": "core", "detail/assert.h": "core", "world.h": "core", "edit.h": "core", "edit_stream.h": "core",
     "scene.h": "core", "image.h": "core", "interrupt.h": "core", "primitives.h": "core", "png.h": "io",
-    "hash.h": "core",
+    "hash.h": "core", "voxel_frame.h": "core",
     "gpu.h": "gpu", "gpu_vulkan.h": "gpu",
     "distance.h": "distance", "algorithms.h": "distance", "dynamic_field.h": "distance",
     "dissertation_format.h": "distance", "gpu_distance.h": "distance", "distance_slab.h": "distance",

@@ -469,8 +469,19 @@ want = np.where((d > 0).any(1), np.linalg.norm(np.maximum(d, 0), axis=1), d.max(
 assert a.dtype == np.float32 and a.shape == (8, 8, 8), (a.dtype, a.shape)
 assert np.abs(a.reshape(-1) - want).max() < 1e-6, np.abs(a.reshape(-1) - want).max()"
 check "mesh voxelised" 0 "$V" convert "$tmp/cube.obj" "$tmp/cube.npy" --voxel-size 0.5
+expect_grep "an .npy drops the frame, said" "$tmp/err" "cube.npy keeps no frame"
 check "mesh voxels" 0 /usr/bin/python3 -c "
 import numpy as np; a = np.load('$tmp/cube.npy'); assert a.shape == (4, 4, 4) and (a == 1).all(), a"
+# A voxelised mesh keeps the mesh's units as its frame: meshed again (the voxels' faces), it lands
+# on the cube [0, 2]^3.
+check "mesh voxelised to .vfw" 0 "$V" convert "$tmp/cube.obj" "$tmp/cube.vfw" --voxel-size 0.5
+check "info shows the frame" 0 "$V" info "$tmp/cube.vfw"
+expect_grep "info frame" "$tmp/out" "frame:         origin (0, 0, 0), voxel size (0.5, 0.5, 0.5)"
+check "framed world meshed" 0 "$V" mesh "$tmp/cube.vfw" -o "$tmp/cube-again.obj"
+check "framed mesh in the cube's units" 0 /usr/bin/python3 -c "
+import numpy as np
+v = np.array([[float(t) for t in l.split()[1:4]] for l in open('$tmp/cube-again.obj') if l.startswith('v ')])
+assert np.abs(v.min(0)).max() < 1e-6 and np.abs(v.max(0) - 2).max() < 1e-6, (v.min(0), v.max(0))"
 printf 'v 0 0 0\nv 1 0 0\nf 1 2 3\n' >"$tmp/bad.obj"
 check "bad mesh refused" 1 "$V" field "$tmp/bad.obj" -o "$tmp/bad.npy" --voxel-size 0.5
 expect_grep "bad mesh names file and byte" "$tmp/err" "bad.obj: at byte 22: the face names vertex 3"

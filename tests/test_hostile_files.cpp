@@ -13,6 +13,7 @@
 #include "voxfield/npy.h"
 #include "voxfield/vox.h"
 #include "voxfield/world_file.h"
+#include "world_file_bytes.h"
 
 using namespace voxfield;
 using namespace voxfield::test;
@@ -199,25 +200,6 @@ TEST(HostileVox, DeliberateLeniencies) {
 
 namespace {
 
-// Recomputes a .vfw's header and section checksums after a test has patched its bytes.
-void fix_checksums(Bytes& b) {
-  auto crc = [](const std::uint8_t* p, std::size_t n) {
-    return static_cast<std::uint32_t>(crc32(0, p, static_cast<uInt>(n)));
-  };
-  std::uint32_t sections;
-  std::memcpy(&sections, b.data() + 12, 4);
-  const std::uint32_t h = crc(b.data(), 16);
-  std::memcpy(b.data() + 16, &h, 4);
-  std::size_t at = 20;
-  for (std::uint32_t s = 0; s < sections; ++s) {
-    std::uint64_t size;
-    std::memcpy(&size, b.data() + at + 4, 8);
-    const std::uint32_t c = crc(b.data() + at + 12, static_cast<std::size_t>(size));
-    std::memcpy(b.data() + at + 12 + size, &c, 4);
-    at += 12 + static_cast<std::size_t>(size) + 4;
-  }
-}
-
 // The world section's grid starts after the section header (12 bytes) and the palette (1024).
 constexpr std::size_t kGridAt = 20 + 12 + 1024;
 
@@ -239,7 +221,7 @@ TEST(HostileWorldFile, CoordinatesBoundsAndDuplicatesAreChecked) {
   Bytes b = good;  // bounds of +-2^31 (the probe's render crash)
   put_i32(b, bounds_at, INT32_MIN);
   put_i32(b, bounds_at + 12, INT32_MAX);
-  fix_checksums(b);
+  test::fix_world_file_checksums(b);
   EXPECT_NE(error_of([&] {
               parse_world_file(b, "b.vfw");
             }).find("outside the supported coordinate range"),
@@ -253,18 +235,18 @@ TEST(HostileWorldFile, CoordinatesBoundsAndDuplicatesAreChecked) {
   const std::size_t uchunk_at = kGridAt + 10 + 8;
   b = ugood;
   put_i32(b, uchunk_at, INT32_MIN);
-  fix_checksums(b);
+  test::fix_world_file_checksums(b);
   EXPECT_NE(error_of([&] {
               parse_world_file(b, "far.vfw");
             }).find("outside the supported coordinate range"),
             std::string::npos);
   b = ugood;  // a chunk coordinate whose voxels overflow 32 bits (2^28 chunks of 8)
   put_i32(b, uchunk_at, 1 << 28);
-  fix_checksums(b);
+  test::fix_world_file_checksums(b);
   EXPECT_THROW(parse_world_file(b, "near.vfw"), FormatError);
   b = ugood;  // the second chunk given the first one's coordinate
   put_i32(b, uchunk_at + 12 + 1 + 1, 0);
-  fix_checksums(b);
+  test::fix_world_file_checksums(b);
   EXPECT_NE(error_of([&] { parse_world_file(b, "dup.vfw"); }).find("appears twice"),
             std::string::npos);
   (void)chunk_at;
@@ -312,7 +294,7 @@ TEST(HostileWorldFile, UniformChunksCutByTheBoundsAreCountedAsDense) {
   file.insert(file.end(), 1024, 0);  // palette
   file.insert(file.end(), grid.begin(), grid.end());
   file.insert(file.end(), 4, 0);  // checksum, fixed below
-  fix_checksums(file);
+  test::fix_world_file_checksums(file);
   WorldFileReadOptions tight;
   tight.memory_limit_bytes = 32 * kMiB;
   const std::string msg = error_of([&] { parse_world_file(file, "cut.vfw", tight); });
@@ -336,14 +318,14 @@ TEST(HostileWorldFile, FieldOptionsAreValidated) {
   auto patched = [&](std::size_t offset, double v) {
     Bytes b = good;
     std::memcpy(b.data() + field_at + offset, &v, 8);
-    fix_checksums(b);
+    test::fix_world_file_checksums(b);
     return error_of([&] { parse_world_file(b, "f.vfw"); });
   };
   EXPECT_NE(patched(4, std::nan("")).find("invalid clamp"), std::string::npos);
   EXPECT_NE(patched(12, -1.0).find("invalid voxel spacing"), std::string::npos);
   Bytes inv = good;  // domain begin.x = 9 > end.x = 8
   put_i32(inv, field_at + 44, 9);
-  fix_checksums(inv);
+  test::fix_world_file_checksums(inv);
   EXPECT_NE(error_of([&] { parse_world_file(inv, "f.vfw"); }).find("inverted field domain"),
             std::string::npos);
 }

@@ -42,9 +42,10 @@ World sample_world() {
 }
 
 TEST(Vdb, WorldsAreInt32MaterialGridsWithTheirPaletteAndExtent) {
-  const World w = sample_world();
+  World w = sample_world();
+  w.frame.voxel_size_world = {0.5, 0.5, 2};
   const Box3i extent{{-70, -50, -45}, {50, 60, 41}};
-  const std::vector<std::uint8_t> bytes = encode_vdb_world(w, extent, {0.5, 0.5, 2});
+  const std::vector<std::uint8_t> bytes = encode_vdb_world(w, extent);
   // OpenVDB's view: one Int32 grid whose active voxels are the solid voxels with their material.
   const openvdb::GridPtrVecPtr grids = grids_of(bytes);
   ASSERT_EQ(grids->size(), 1u);
@@ -53,6 +54,9 @@ TEST(Vdb, WorldsAreInt32MaterialGridsWithTheirPaletteAndExtent) {
   EXPECT_EQ(grid->getName(), "materials");
   EXPECT_EQ(static_cast<std::int64_t>(grid->activeVoxelCount()), w.solid_count());
   EXPECT_EQ(grid->transform().voxelSize(), openvdb::Vec3d(0.5, 0.5, 2));
+  // Index (i, j, k) maps to the voxel's centre in the frame, ((i, j, k) + 1/2) * size.
+  EXPECT_EQ(grid->transform().indexToWorld(openvdb::Coord(-3, 4, 5)),
+            openvdb::Vec3d(-1.25, 2.25, 11));
   const Box3i content = w.voxels.content_bounds();
   auto access = grid->getConstAccessor();
   std::int64_t checked = 0;
@@ -79,7 +83,61 @@ TEST(Vdb, WorldsAreInt32MaterialGridsWithTheirPaletteAndExtent) {
   EXPECT_EQ(grid->metaValue<openvdb::Vec3i>("voxfield_extent_max"), openvdb::Vec3i(49, 59, 40));
   // Uniform chunks were written as tiles, not as voxels.
   EXPECT_GT(grid->tree().activeTileCount(), 0u);
-  EXPECT_THROW((void)encode_vdb_world(w, extent, {1, 0, 1}), InvalidArgument);
+  World flat = w;
+  flat.frame.voxel_size_world = {1, 0, 1};
+  EXPECT_THROW((void)encode_vdb_world(flat, extent), InvalidArgument);
+}
+
+// A world in a rotated, anisotropic, displaced frame: OpenVDB's own transform puts every voxel
+// centre where the frame does, and the file reads back in the same frame.
+TEST(Vdb, AWorldsFrameIsItsGridsTransform) {
+  World w = sample_world();
+  w.frame.origin_world = {100.25, -7, 3.5};
+  w.frame.voxel_size_world = {0.1, 0.2, 0.3};
+  w.frame.rotation = VectorVolume::rotation_about(40, {1, -1, 2});
+  const Box3i extent = w.voxels.content_bounds();
+  const std::vector<std::uint8_t> bytes = encode_vdb_world(w, extent);
+  const auto grid = openvdb::gridPtrCast<openvdb::Int32Grid>((*grids_of(bytes))[0]);
+  ASSERT_TRUE(grid);
+  double worst = 0;
+  for (const Vec3i v : {Vec3i{0, 0, 0}, Vec3i{-5, 17, 3}, extent.begin, extent.end}) {
+    const openvdb::Vec3d got = grid->transform().indexToWorld(openvdb::Coord(v.x, v.y, v.z));
+    const Vec3d want = w.frame.voxel_centre_world(v);
+    for (int a = 0; a < 3; ++a) worst = std::max(worst, std::abs(got[a] - want[a]));
+  }
+  EXPECT_LT(worst, 1e-12);
+  const VdbWorld back = world_from_vdb(decode_vdb(bytes, "framed.vdb"), "framed.vdb", 16);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(back.world.frame.origin_world[a], w.frame.origin_world[a], 1e-12);
+    EXPECT_NEAR(back.world.frame.voxel_size_world[a], w.frame.voxel_size_world[a], 1e-15);
+    for (int b = 0; b < 3; ++b)
+      EXPECT_NEAR(back.world.frame.rotation[a][b], w.frame.rotation[a][b], 1e-14);
+  }
+  // A field of the framed world, measured in its voxel size, is written in world units; measured
+  // in voxels (an isotropic frame), its values are scaled; out of proportion, refused.
+  DistanceOptions o;
+  o.metric = Metric::kEuclidean;
+  o.signed_distance = true;
+  o.max_distance = 4;
+  o.spacing = {0.1, 0.2, 0.3};
+  DistanceField f = compute_distance_field(w, o);
+  const auto lf = openvdb::gridPtrCast<openvdb::FloatGrid>((*grids_of(encode_vdb_field(f)))[0]);
+  ASSERT_TRUE(lf);
+  EXPECT_NEAR(lf->transform().indexToWorld(openvdb::Coord(2, 3, 4))[0],
+              w.frame.voxel_centre_world({2, 3, 4}).x, 1e-12);
+  EXPECT_NEAR(lf->background(), 4 - 0.05, 1e-6);  // the clamp less half the smallest edge
+  World iso = w;
+  iso.frame.voxel_size_world = {0.25, 0.25, 0.25};
+  DistanceOptions unit = o;
+  unit.spacing = {1, 1, 1};
+  const DistanceField fi = compute_distance_field(iso, unit);
+  const auto li = openvdb::gridPtrCast<openvdb::FloatGrid>((*grids_of(encode_vdb_field(fi)))[0]);
+  EXPECT_NEAR(li->background(), (4 - 0.5) * 0.25, 1e-6);  // voxels times the edge
+  const Vec3i p = w.voxels.content_bounds().begin;
+  EXPECT_NEAR(li->tree().getValue(openvdb::Coord(p.x, p.y, p.z)),
+              0.25 * (fi.distance(p) + (fi.distance(p) < 0 ? 0.5 : -0.5)), 1e-6);
+  const DistanceField skewed = compute_distance_field(w, unit);
+  EXPECT_THROW((void)encode_vdb_field(skewed), InvalidArgument);
 }
 
 World blob_world() {

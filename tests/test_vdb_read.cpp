@@ -359,10 +359,11 @@ TEST(VdbRead, WorldsComeFromTheGridOfTheGivenName) {
 // voxfield's own .vdb files load back as the worlds they came from: materials, palette and
 // extent from a world's file; the solid voxels from a signed field's level set.
 TEST(VdbRead, VoxfieldsFilesLoadBackAsTheirWorlds) {
-  const World w = solid_world();
+  World w = solid_world();
+  w.frame.voxel_size_world = {0.5, 0.5, 2};
   const Box3i extent{{-70, -40, -35}, {40, 50, 41}};
   const auto path = std::filesystem::temp_directory_path() / "voxfield-vdb-read-world.vdb";
-  write_file_atomic(path, encode_vdb_world(w, extent, {0.5, 0.5, 2}));
+  write_file_atomic(path, encode_vdb_world(w, extent));
   const LoadedWorld back = load_world(path);
   std::filesystem::remove(path);
   EXPECT_EQ(back.format, WorldFormat::kVdb);
@@ -370,6 +371,7 @@ TEST(VdbRead, VoxfieldsFilesLoadBackAsTheirWorlds) {
   EXPECT_EQ(back.world.palette, w.palette);
   EXPECT_NE(back.description.find("voxel size 0.5 x 0.5 x 2"), std::string::npos)
       << back.description;
+  EXPECT_EQ(back.world.frame, w.frame);  // halves and quarters: exact in binary
   const Box3i c = w.voxels.content_bounds();
   ASSERT_EQ(back.world.voxels.content_bounds(), c);
   for (int z = c.begin.z; z < c.end.z; ++z)
@@ -377,12 +379,16 @@ TEST(VdbRead, VoxfieldsFilesLoadBackAsTheirWorlds) {
       for (int x = c.begin.x; x < c.end.x; ++x)
         ASSERT_EQ(back.world.voxels.get({x, y, z}), w.voxels.get({x, y, z})) << x << " " << y;
 
+  // The field measured in the frame's voxel size: a level set in the world's units.
   DistanceOptions o;
+  o.metric = Metric::kEuclidean;
+  o.spacing = {0.5, 0.5, 2};
   o.signed_distance = true;
   o.max_distance = 4;
   o.domain = Box3i{{-80, -50, -40}, {40, 40, 40}};
   const VdbFile field = decode_vdb(encode_vdb_field(compute_distance_field(w, o)), "f.vdb");
   const VdbWorld solid = world_from_vdb(field, "f.vdb", 32);
+  EXPECT_EQ(solid.world.frame, w.frame);
   EXPECT_EQ(solid.world.solid_count(), w.solid_count());
   for (int z = c.begin.z; z < c.end.z; ++z)
     for (int y = c.begin.y; y < c.end.y; ++y)

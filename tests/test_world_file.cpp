@@ -12,7 +12,9 @@
 #include <thread>
 
 #include "voxfield/scene.h"
+#include "voxfield/vectors.h"
 #include "voxfield/world_file.h"
+#include "world_file_bytes.h"
 #include "world_voxels.h"
 
 #include <zlib.h>
@@ -47,7 +49,7 @@ TEST(WorldFile, RoundTripsWorldsAndFieldsExactly) {
   const DistanceField f2 = compute_distance_field(w, fo2);
   const auto bytes = encode_world_file(w, {&f1, &f2});
   const WorldFile back = parse_world_file(bytes, "rt.vfw");
-  EXPECT_EQ(back.version, kWorldFileVersion);
+  EXPECT_EQ(back.version, 1u);  // the identity frame: the format before frames, for older readers
   EXPECT_EQ(back.world.palette, w.palette);
   EXPECT_EQ(back.world.voxels.bounds(), w.voxels.bounds());
   EXPECT_EQ(test::dense_voxels(back.world, *w.voxels.bounds()),
@@ -91,7 +93,7 @@ TEST(WorldFile, CorruptionTruncationAndFutureVersionsAreRejected) {
   }
   // A future version: patch the version and fix the header checksum so only the version is wrong.
   auto future = good;
-  future[8] = 2;
+  future[8] = static_cast<std::uint8_t>(kWorldFileVersion + 1);
   const std::uint32_t c =
       static_cast<std::uint32_t>(crc32(crc32(0, nullptr, 0), future.data(), 16));
   std::memcpy(future.data() + 16, &c, 4);
@@ -101,6 +103,73 @@ TEST(WorldFile, CorruptionTruncationAndFutureVersionsAreRejected) {
   } catch (const FormatError& e) {
     EXPECT_NE(std::string(e.what()).find("newer voxfield"), std::string::npos) << e.what();
   }
+}
+
+TEST(WorldFile, FramesRoundTripAndBadOnesAreRefused) {
+  SceneOptions o;
+  o.size = {30, 20, 25};
+  World w = make_spheres(o);
+  w.frame.origin_world = {-12.5, 3.25, 1e3};
+  w.frame.voxel_size_world = {0.1, 0.1, 0.25};
+  w.frame.rotation = VectorVolume::rotation_about(30, {1, 2, 3});
+  const DistanceField f = compute_distance_field(w, {});
+  EXPECT_EQ(f.frame, w.frame);  // a field carries its world's frame
+  const auto bytes = encode_world_file(w, {&f});
+  const WorldFile back = parse_world_file(bytes, "framed.vfw");
+  EXPECT_EQ(back.version, 2u);
+  EXPECT_EQ(back.world.frame, w.frame);  // bit for bit: stored as doubles
+  ASSERT_EQ(back.fields.size(), 1u);
+  EXPECT_EQ(back.fields[0].frame, w.frame);
+  EXPECT_EQ(test::dense_voxels(back.world, *w.voxels.bounds()),
+            test::dense_voxels(w, *w.voxels.bounds()));
+  // The frame section follows the world's: 12 bytes of section head, 15 doubles.
+  std::uint64_t world_bytes = 0;
+  std::memcpy(&world_bytes, bytes.data() + 24, 8);
+  const std::size_t frame_at = 20 + 12 + world_bytes + 4;
+  std::uint32_t kind = 0;
+  std::memcpy(&kind, bytes.data() + frame_at, 4);
+  ASSERT_EQ(kind, 3u);
+  const std::size_t values_at = frame_at + 12;
+  auto patched = [&](int value_index, double v) {
+    auto bad = bytes;
+    std::memcpy(bad.data() + values_at + 8 * value_index, &v, 8);
+    test::fix_world_file_checksums(bad);
+    return bad;
+  };
+  const std::pair<int, double> bad_values[] = {
+      {0, std::nan("")},  // origin x
+      {4, 0.0},           // voxel size y
+      {5, -0.25},         // voxel size z
+      {6, 2.0},           // a rotation entry: rows no longer unit
+  };
+  for (const auto& [i, v] : bad_values) {
+    try {
+      parse_world_file(patched(i, v), "bad-frame.vfw");
+      FAIL() << "value " << i << " = " << v << " was accepted";
+    } catch (const FormatError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad-frame.vfw"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("frame"), std::string::npos) << e.what();
+    }
+  }
+  // A mirror (one rotation row negated) is refused: a frame turns, it does not reflect.
+  auto mirrored = bytes;
+  for (int c = 0; c < 3; ++c) {
+    double v = 0;
+    std::memcpy(&v, mirrored.data() + values_at + 8 * (6 + c), 8);
+    v = -v;
+    std::memcpy(mirrored.data() + values_at + 8 * (6 + c), &v, 8);
+  }
+  test::fix_world_file_checksums(mirrored);
+  EXPECT_THROW(parse_world_file(mirrored, "mirror.vfw"), FormatError);
+  // A frame section in a version-1 file: that version has none.
+  auto old = bytes;
+  old[8] = 1;
+  test::fix_world_file_checksums(old);
+  EXPECT_THROW(parse_world_file(old, "v1.vfw"), FormatError);
+  // And a world in the identity frame is written as before frames, as version 1.
+  World plain = w;
+  plain.frame = {};
+  EXPECT_EQ(parse_world_file(encode_world_file(plain), "plain.vfw").version, 1u);
 }
 
 TEST(WorldFile, KillingASaveNeverDamagesThePreviousFile) {
@@ -146,6 +215,10 @@ TEST(WorldFile, PartsAssembleIntoTheWholeFile) {
                                  10 + static_cast<int>(rng() % 90)}};
       World w(edge, bounds);
       w.palette[3] = {1, 2, 3, 4};
+      if (trial % 3 == 1) {  // a frame: its section goes in the tail
+        w.frame.origin_world = {1.5, -2, 1e-3};
+        w.frame.voxel_size_world = {0.5, 0.5, 2};
+      }
       for (int k = 0; k < 400; ++k) {
         const Vec3i s = bounds.size();
         w.voxels.set(
@@ -173,7 +246,7 @@ TEST(WorldFile, PartsAssembleIntoTheWholeFile) {
         summaries.push_back({parts.back().chunks, parts.back().records.size(), parts.back().crc});
       }
       const WorldFileFrame frame =
-          encode_world_file_frame(w.palette, edge, w.voxels.bounds(), summaries);
+          encode_world_file_frame(w.palette, edge, w.voxels.bounds(), summaries, w.frame);
       std::vector<std::uint8_t> assembled = frame.head;
       for (const WorldFilePart& p : parts)
         assembled.insert(assembled.end(), p.records.begin(), p.records.end());
@@ -182,6 +255,7 @@ TEST(WorldFile, PartsAssembleIntoTheWholeFile) {
                                   << " parts";
       const WorldFile back = parse_world_file(assembled, "assembled.vfw");
       EXPECT_EQ(test::dense_voxels(back.world, bounds), test::dense_voxels(w, bounds));
+      EXPECT_EQ(back.world.frame, w.frame);
     }
   }
 }

@@ -17,6 +17,15 @@ struct ConvertSettings {
   std::string grid;
 };
 
+// .vfw and .vdb keep a world's frame; .vox and .npy have nowhere to put it. Not an error (the
+// voxels are what those formats are for), but said, so that nobody wonders where it went.
+void note_frame_left_out(const World& world, const std::string& out) {
+  const WorldFormat f = world_format_of(out);
+  if (world.frame.is_identity() || f == WorldFormat::kVfw || f == WorldFormat::kVdb) return;
+  std::cerr << "voxfield: note: " << out << " keeps no frame; the world's ("
+            << describe(world.frame) << ") is left out (.vfw and .vdb keep it)\n";
+}
+
 int run_convert(const ConvertSettings& s) {
   check_grid_input(s.in, s.grid);
   // Converting a file onto itself is safe: the input is read whole before the output is written.
@@ -38,6 +47,7 @@ int run_convert(const ConvertSettings& s) {
     std::cerr << "voxfield: wrote " << s.out << " (" << mesh.triangles.size() << " triangles, "
               << world.solid_count() << " solid voxels in "
               << to_string(world.voxels.bounds()->size()) << ")\n";
+    note_frame_left_out(world, s.out);
     return 0;
   }
   if (s.voxel_size != 0)
@@ -51,6 +61,7 @@ int run_convert(const ConvertSettings& s) {
   outputs.stage(s.out, encode_world(w.world, w.extent, world_format_of(s.out)));
   outputs.commit();
   std::cerr << "voxfield: wrote " << s.out << " (" << w.world.solid_count() << " solid voxels)\n";
+  note_frame_left_out(w.world, s.out);
   return 0;
 }
 

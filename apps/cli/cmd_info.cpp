@@ -81,6 +81,11 @@ int run_info(const InfoSettings& s) {
   j["extent"] = box_json(in.extent);
   j["bounding_box"] = box_json(content);
   j["solid_voxels"] = solid;
+  const VoxelFrame& f = in.world.frame;
+  auto vec = [](Vec3d v) { return nlohmann::json{v.x, v.y, v.z}; };
+  j["frame"] = {{"origin_world", vec(f.origin_world)},
+                {"voxel_size_world", vec(f.voxel_size_world)},
+                {"rotation", {vec(f.rotation[0]), vec(f.rotation[1]), vec(f.rotation[2])}}};
   j["palette_entries_used"] = materials_used;
   j["chunks"] = {{"edge", g.chunk_edge()},
                  {"total", g.chunk_count()},
@@ -133,6 +138,10 @@ int print_text(const InfoSettings& s, const LoadedWorld& in, const WorldSummary&
   std::cout << "bounding box:  " << (content.empty() ? std::string("(empty)") : to_string(content))
             << "\n";
   std::cout << "solid voxels:  " << solid << "\n";
+  std::cout << "frame:         "
+            << (in.world.frame.is_identity() ? std::string("voxel units (the identity)")
+                                             : describe(in.world.frame))
+            << "\n";
   if (in.vox) {
     const VoxFileInfo& v = *in.vox;
     std::cout << "models:        " << v.models.size();

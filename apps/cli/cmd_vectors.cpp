@@ -103,7 +103,7 @@ int run_world_vectors(const VectorSettings& s, OutKind kind, Outputs& outputs) {
       outputs.stage(s.out, encode_vf(volume, field.texture()));
       break;
     case OutKind::kVdb:
-      outputs.stage(s.out, encode_vdb_world_vectors(box, field.texture()));
+      outputs.stage(s.out, encode_vdb_world_vectors(box, field.texture(), in.world.frame));
       break;
     case OutKind::kPng: {
       VectorViewOptions view;

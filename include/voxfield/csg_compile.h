@@ -197,7 +197,8 @@ struct VoxelizeStats {
   double ms = 0;
 };
 
-// Voxel (i, j, k) has its centre at box.lo + (i + 1/2, j + 1/2, k + 1/2) * voxel_size; it is solid
+// Voxel (i, j, k) has its centre at box.lo + (i + 1/2, j + 1/2, k + 1/2) * voxel_size — the
+// world's frame (origin box.lo, that voxel size), so its meshes land in model units; it is solid
 // (its material from the paints) where the model's value there is <= 0. `field`, x fastest, holds
 // that value in model units (clamped to +-max_distance when given).
 struct Voxelized {

@@ -19,6 +19,7 @@
 #include <variant>
 
 #include "voxfield/grid.h"
+#include "voxfield/voxel_frame.h"
 #include "voxfield/world.h"
 
 namespace voxfield {
@@ -87,6 +88,9 @@ struct DistanceField {
   std::variant<Grid<std::uint8_t>, Grid<std::uint16_t>, Grid<float>> values;
   // Offsets to the nearest site, when options.nearest_sites.
   std::optional<Grid<SiteOffset>> sites;
+  // Where its voxels sit in the world: its world's frame (voxel_frame.h). It places the field; the
+  // values stay in voxel edges times options.spacing.
+  VoxelFrame frame;
 
   // The distance at p (decoded; +inf where nothing is within reach of an unclamped f32 field).
   double distance(Vec3i p) const;

@@ -70,6 +70,7 @@ class DynamicField {
  private:
   std::shared_ptr<Context> context_;
   std::unique_ptr<FieldEngine> engine_;
+  VoxelFrame frame_;  // the world's when bound: download()'s fields carry it
   Vec3i reach_{0, 0, 0};
   int chunk_shift_ = 0;
   std::vector<PassTiming> timings_;

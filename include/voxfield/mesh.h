@@ -149,8 +149,14 @@ MeshCounts mesh_volume_into(const ScalarVolume& volume, const MeshOptions& optio
 // The domain is the content grown past the surface by two voxels of air (beyond a bounded world's
 // bounds is air, so the surface closes there too). InvalidArgument for an iso that is not finite,
 // beyond ±1000 voxels, or strictly between -1 and 1 other than 0 (the field steps from -1 to +1
-// between a solid and an air centre).
+// between a solid and an air centre). The mesh is placed in the world's frame (place_in_frame):
+// in the identity frame, voxel coordinates as above; iso stays in voxels.
 Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric = Metric::kEuclidean);
+
+// Moves a mesh made in voxel coordinates into `frame`'s world: positions by world_from_vox,
+// normals by world_normal (unit, perpendicular to the placed surface). Winding is kept: a frame
+// turns and scales, never mirrors. InvalidArgument for an invalid frame.
+void place_in_frame(Mesh& mesh, const VoxelFrame& frame);
 
 // What a mesh is, topologically and geometrically.
 struct MeshStats {

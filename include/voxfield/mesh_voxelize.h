@@ -85,8 +85,9 @@ struct MeshVoxelOptions {
 Box3i mesh_voxel_box(const TriangleMesh& mesh, const MeshVoxelOptions& options);
 
 // A world with `material` where the winding number at the voxel's centre is >= 1/2, bounded by
-// mesh_voxel_box. Throws InvalidArgument (options, the mesh), ResourceLimitError (the box against
-// the memory limit), Cancelled.
+// mesh_voxel_box, in the frame of the mesh's units (voxel size options.voxel_size, origin 0): its
+// meshes and .vdb files come out where the mesh was. Throws InvalidArgument (options, the mesh),
+// ResourceLimitError (the box against the memory limit), Cancelled.
 World voxelize_mesh(const TriangleMesh& mesh, const MeshVoxelOptions& options);
 
 struct MeshDistanceOptions : MeshVoxelOptions {

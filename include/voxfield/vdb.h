@@ -2,8 +2,12 @@
 // tools that handle volumes (Museth, "VDB: High-resolution sparse volumes with dynamic topology",
 // ACM TOG 2013). Written with OpenVDB 10 itself.
 //
-// Frames: VDB voxel (i, j, k) is voxfield voxel (i, j, k); the grid's transform maps it to world
-// units, its centre at (i, j, k) * voxel size (a field's spacing; 1 for worlds unless given).
+// Frames: VDB voxel (i, j, k) is voxfield voxel (i, j, k); the grid's transform is the world's
+// frame (voxel_frame.h), mapping the index to the voxel's centre, origin + R * (voxel size ⊙
+// ((i, j, k) + 1/2)) — so a .vdb lines up with the meshes, renders and rays of the same world. In
+// the identity frame that is (i, j, k) + 1/2 (a field's: ((i, j, k) + 1/2) ⊙ spacing). Reading
+// takes the frame back from the transform (any rotation and positive scale per axis; a shear or
+// mirror is reported and read in the identity frame).
 //  * A world: an Int32 grid "materials" (0 = air, the background; solid voxels active with their
 //    material), its palette and extent in the grid's metadata.
 //  * A signed distance field: a Float grid of class level set — the distance to the surface
@@ -16,7 +20,7 @@
 //    active where the strength is above 0. A volume's field: texel (i, j, k) at VDB index (i, j,
 //    k), the transform mapping it to the volume's voxel centre, rotation included. A world's flow
 //    (vector_world.h): on the world's own lattice, texel (i, j, k) of the box at VDB voxel
-//    box.begin + (i, j, k), the transform a world's (unit scale), so it lies on the world's grid.
+//    box.begin + (i, j, k), the transform the world's frame, so it lies on the world's grid.
 //  * An unsigned distance field: a Float grid of class "unknown" (not "fog volume": to every tool a
 //    fog volume is a density, and a distance is not one), background as above.
 // Fields carry voxfield's metric, clamp, storage and domain in their metadata.
@@ -44,14 +48,16 @@
 
 namespace voxfield {
 
-// The bytes of a .vdb file holding `world` as an Int32 grid "materials" with voxel size
-// `voxel_size_units`; `extent` (united with the content) is kept in the metadata. Throws
-// InvalidArgument for a voxel size that is not finite and > 0.
-std::vector<std::uint8_t> encode_vdb_world(const World& world, const Box3i& extent,
-                                           std::array<double, 3> voxel_size_units = {1, 1, 1});
-// The bytes of a .vdb file holding `field` as one Float grid named `grid_name` (its voxel size:
-// the field's spacing). Throws InvalidArgument for a field with no finite non-zero distance to
-// bound its background (an unclamped field of an empty world).
+// The bytes of a .vdb file holding `world` as an Int32 grid "materials", its transform the
+// world's frame; `extent` (united with the content) is kept in the metadata. Throws
+// InvalidArgument for an invalid frame.
+std::vector<std::uint8_t> encode_vdb_world(const World& world, const Box3i& extent);
+// The bytes of a .vdb file holding `field` as one Float grid named `grid_name`, in its frame's
+// world units: a field in the identity frame with its spacing as the voxel size (its values
+// as they are); a field in a frame whose spacing is k times smaller than the frame's voxel size on
+// every axis with its values times k. Throws InvalidArgument for a spacing out of proportion with
+// the frame's voxel size (no factor makes its distances world units), or a field with no finite
+// non-zero distance to bound its background (an unclamped field of an empty world).
 std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
                                            const std::string& grid_name = "distance");
 
@@ -61,9 +67,11 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
 std::vector<std::uint8_t> encode_vdb_vectors(const VectorVolume& volume,
                                              const VectorTexture& texture);
 // The bytes of a .vdb file holding a world's flow over `box` (WorldVectorField: the texture's
-// resolution is the box's size) on the world's lattice, as encode_vdb_world places voxels.
-// Throws InvalidArgument for a texture of another size.
-std::vector<std::uint8_t> encode_vdb_world_vectors(const Box3i& box, const VectorTexture& texture);
+// resolution is the box's size) on the world's lattice in the world's `frame`, as
+// encode_vdb_world places voxels; directions are carried into the frame. Throws InvalidArgument
+// for a texture of another size or an invalid frame.
+std::vector<std::uint8_t> encode_vdb_world_vectors(const Box3i& box, const VectorTexture& texture,
+                                                   const VoxelFrame& frame = {});
 
 // ---------------------------------------------------------------------------------------------
 // Reading

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "voxfield/grid.h"
+#include "voxfield/voxel_frame.h"
 
 namespace voxfield {
 
@@ -28,6 +29,9 @@ struct World {
   // Material per voxel; 0 = air (the background).
   Grid<std::uint8_t> voxels;
   Palette palette = default_palette();
+  // Where the voxels sit in the world (voxel_frame.h); the identity unless given — by a .vdb's
+  // transform, a voxelised mesh's voxel size, a .vfw that stored one, or the caller.
+  VoxelFrame frame;
 
   explicit World(int chunk_edge = Grid<std::uint8_t>::kDefaultChunkEdge,
                  std::optional<Box3i> bounds = std::nullopt)

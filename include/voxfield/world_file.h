@@ -15,7 +15,9 @@
 
 namespace voxfield {
 
-inline constexpr std::uint32_t kWorldFileVersion = 1;
+// The newest format version this build reads and writes: 2 added the world's frame (a world in
+// the identity frame is still written as version 1).
+inline constexpr std::uint32_t kWorldFileVersion = 2;
 
 struct WorldFile {
   World world;
@@ -57,10 +59,12 @@ struct WorldFileFrame {
 // chunk_z_end).
 WorldFilePart encode_world_file_part(const Grid<std::uint8_t>& voxels, std::int32_t chunk_z_begin,
                                      std::int32_t chunk_z_end);
-// What precedes and follows the parts of a world with this palette, chunk edge and bounds.
+// What precedes and follows the parts of a world with this palette, chunk edge, bounds and
+// voxel frame (the frame section, when not the identity, is in the tail).
 WorldFileFrame encode_world_file_frame(const Palette& palette, int chunk_edge,
                                        const std::optional<Box3i>& bounds,
-                                       std::span<const WorldFilePartSummary> parts);
+                                       std::span<const WorldFilePartSummary> parts,
+                                       const VoxelFrame& voxel_frame = {});
 
 void write_world_file(const World& world, const std::filesystem::path& path,
                       const std::vector<const DistanceField*>& fields = {});

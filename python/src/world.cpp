@@ -32,6 +32,7 @@ namespace py = pybind11;
 namespace voxfield::python {
 
 void bind_edit(py::module_& m, py::class_<PyWorld>& world);  // edit.cpp
+void bind_frame(py::class_<PyWorld>& world);                 // world_frame.cpp
 
 DenseField dense_field(const DistanceField& f, bool sites) {
   DenseField d;
@@ -258,6 +259,7 @@ void bind_world(py::module_& parent) {
           "Sets every voxel of [begin, end) to material (0: air)")
       .def("__repr__", &world_repr);
   bind_edit(m, world);
+  bind_frame(world);
 
   m.def(
       "distance_field",

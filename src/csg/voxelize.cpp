@@ -213,6 +213,9 @@ Voxelized voxelize(const Model& model, const VoxelizeOptions& options) {
   progress.throw_if_cancelled();
   out.world = World(Grid<std::uint8_t>::kDefaultChunkEdge, grid);
   out.world.palette = model.palette;
+  // Voxel (i, j, k)'s centre at box.lo + ((i, j, k) + 1/2) * voxel size: the world's frame.
+  out.world.frame.origin_world = out.box.lo;
+  out.world.frame.voxel_size_world = Vec3d{1, 1, 1} * options.voxel_size;
   out.world.voxels.copy_from_dense(grid, materials.data());
   total.voxels = grid.volume();
   total.whole_nodes = static_cast<std::int64_t>(whole.code.size());

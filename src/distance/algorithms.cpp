@@ -216,6 +216,7 @@ DistanceField compute_with_solver(const World& world, const DistanceOptions& o,
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (stats_out) *stats_out = stats;
     f.options.interrupter = nullptr;  // the field outlives the caller's interrupter
+    f.frame = world.frame;
     return f;
   };
   switch (o.storage) {

@@ -91,7 +91,9 @@ int DistanceField::chunk_edge() const {
 }
 
 DistanceField compute_distance_field(const World& world, const DistanceOptions& options) {
-  return compute_distance_field(world.voxels, options);
+  DistanceField f = compute_distance_field(world.voxels, options);
+  f.frame = world.frame;
+  return f;
 }
 
 }  // namespace voxfield

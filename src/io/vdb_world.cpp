@@ -310,12 +310,23 @@ VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_
     if (ok && a.x < b.x && a.y < b.y && a.z < b.z) out.extent = Box3i{a, b};
   }
   out.extent = out.extent.unite(voxels.content_bounds());
+  // The frame: the transform takes index (i, j, k) to the voxel's centre, voxel coordinates
+  // (i, j, k) + 1/2, so the frame's origin lies half a voxel back along each axis.
+  std::array<double, 12> m = g.index_to_world;
+  for (int row = 0; row < 3; ++row)
+    m[4 * row + 3] -= 0.5 * (m[4 * row] + m[4 * row + 1] + m[4 * row + 2]);
+  std::string frame_note;
+  try {
+    out.world.frame = VoxelFrame::from_matrix(m, name);
+  } catch (const InvalidArgument&) {
+    frame_note = " (a transform that shears or mirrors: read in the identity frame)";
+  }
   out.description = "OpenVDB .vdb, format " + std::to_string(file.format_version) + " (OpenVDB " +
                     std::to_string(file.library_major) + "." + std::to_string(file.library_minor) +
                     "), grid \"" + g.name + "\" " + vdb_value_type_name(g.value_type) +
                     (g.half_float ? " (half)" : "") + ", class " + g.grid_class + ", voxel size " +
                     format_number(g.voxel_size[0]) + " x " + format_number(g.voxel_size[1]) +
-                    " x " + format_number(g.voxel_size[2]);
+                    " x " + format_number(g.voxel_size[2]) + frame_note;
   return out;
 }
 

@@ -27,14 +27,50 @@ void ensure_initialized() {
   std::call_once(once, [] { openvdb::initialize(); });
 }
 
-// A scale transform: voxel (i, j, k)'s centre at (i, j, k) * size.
-openvdb::math::Transform::Ptr scale_transform(std::array<double, 3> size_units) {
-  for (double s : size_units)
-    if (!std::isfinite(s) || !(s > 0))
-      throw InvalidArgument("vdb: a voxel size must be finite and > 0");
+// The transform of a voxfield frame: VDB index (i, j, k) is voxel (i, j, k), whose centre is at
+// voxel coordinates (i, j, k) + 1/2, so index to world is
+//   world = origin + A * ((i, j, k) + 1/2),  A = R * diag(voxel size).
+// OpenVDB's matrices act on row vectors: row a is the image of index axis a (column a of A), row 3
+// the translation.
+openvdb::math::Transform::Ptr frame_transform(const VoxelFrame& frame) {
+  frame.validate("vdb: the frame");
+  const std::array<double, 12> a = frame.world_from_vox_matrix();
+  const Vec3d centre0 = frame.world_from_vox({0.5, 0.5, 0.5});
   openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
-  m.setToScale(openvdb::math::Vec3d(size_units[0], size_units[1], size_units[2]));
+  for (int c = 0; c < 3; ++c) {
+    for (int axis = 0; axis < 3; ++axis) m[axis][c] = a[4 * c + axis];
+    m[3][c] = centre0[c];
+  }
   return openvdb::math::Transform::createLinearTransform(m);
+}
+
+// The frame a field is written in and the factor from its values to that frame's world units. A
+// field in the identity frame is written with its spacing as the voxel size (its values are in
+// those units already). A field in a frame needs its spacing in proportion to the frame's voxel
+// size — k * spacing = voxel size on every axis — and its values are multiplied by k; otherwise
+// its Euclidean distances were measured in other proportions than the world's and no factor turns
+// them into world units.
+std::pair<VoxelFrame, double> field_world_units(const DistanceField& field) {
+  const std::array<double, 3>& spacing = field.options.spacing;
+  if (field.frame.is_identity()) {
+    VoxelFrame f;
+    f.voxel_size_world = {spacing[0], spacing[1], spacing[2]};
+    return {f, 1.0};
+  }
+  const Vec3d& size = field.frame.voxel_size_world;
+  const double k = size.x / spacing[0];
+  for (int a = 0; a < 3; ++a) {
+    if (!(std::abs(size[a] - k * spacing[a]) <= 1e-12 * size[a])) {
+      char text[96];
+      std::snprintf(text, sizeof text, "(%.9g, %.9g, %.9g)", spacing[0], spacing[1], spacing[2]);
+      throw InvalidArgument(
+          std::string("vdb: the field was measured with spacing ") + text +
+          " but its world's frame is " + describe(field.frame) +
+          ": a level set needs distances in the world's units (compute the field with the "
+          "voxel size as its spacing)");
+    }
+  }
+  return {field.frame, k};
 }
 
 // Grid metadata voxfield writes (beside OpenVDB's own "file_bbox_min" and so on).
@@ -87,12 +123,11 @@ void insert_box(openvdb::GridBase& grid, const char* min_key, const char* max_ke
 
 }  // namespace
 
-std::vector<std::uint8_t> encode_vdb_world(const World& world, const Box3i& extent,
-                                           std::array<double, 3> voxel_size_units) {
+std::vector<std::uint8_t> encode_vdb_world(const World& world, const Box3i& extent) {
   ensure_initialized();
   openvdb::Int32Grid::Ptr grid = openvdb::Int32Grid::create(0);
   grid->setName("materials");
-  grid->setTransform(scale_transform(voxel_size_units));
+  grid->setTransform(frame_transform(world.frame));
   const Grid<std::uint8_t>& g = world.voxels;
   auto access = grid->getAccessor();
   g.for_each_chunk([&](const ChunkView<std::uint8_t>& c) {
@@ -134,7 +169,9 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
   // voxels, half the smallest edge (exact across faces normal to that axis).
   const double offset =
       is_signed ? 0.5 * std::min({o.spacing[0], o.spacing[1], o.spacing[2]}) : 0.0;
-  const auto level = [&](double d) { return d > 0 ? d - offset : d < 0 ? d + offset : d; };
+  // The grid's world units: its frame's, k per unit of the field's values.
+  const auto [frame, k] = field_world_units(field);
+  const auto level = [&](double d) { return k * (d > 0 ? d - offset : d < 0 ? d + offset : d); };
   // Visits every stored chunk of the field within its domain with the decoded values.
   const auto for_each_value = [&](auto&& on_uniform, auto&& on_voxel) {
     std::visit(
@@ -187,7 +224,7 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
   const auto bg = static_cast<float>(background);
   openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(bg);
   grid->setName(grid_name);
-  grid->setTransform(scale_transform(o.spacing));
+  grid->setTransform(frame_transform(frame));
   grid->setGridClass(is_signed ? openvdb::GRID_LEVEL_SET : openvdb::GRID_UNKNOWN);
   auto access = grid->getAccessor();
   // Active where |d| is below the background; beyond it, the outside is the background itself
@@ -216,8 +253,8 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
   grid->insertMeta(kKind,
                    openvdb::StringMetadata(is_signed ? "signed distance" : "unsigned distance"));
   grid->insertMeta(kMetric, openvdb::StringMetadata(metric_name(o.metric)));
-  grid->insertMeta(kClamp, openvdb::DoubleMetadata(clamp));
-  grid->insertMeta(kSurfaceOffset, openvdb::DoubleMetadata(offset));
+  grid->insertMeta(kClamp, openvdb::DoubleMetadata(k * clamp));
+  grid->insertMeta(kSurfaceOffset, openvdb::DoubleMetadata(k * offset));
   grid->insertMeta(kStorage, openvdb::StringMetadata(storage_name(o.storage)));
   insert_box(*grid, kDomainMin, kDomainMax, field.domain);
   return write_grids({grid});
@@ -227,8 +264,12 @@ namespace {
 
 // A vector texture as the grids "vectors" (direction x strength) and "strength", both zero in the
 // background, active where the strength is above 0; texel (i, j, k) at VDB index first + (i, j, k).
+// `voxel_frame`, when given, carries directions taken in voxel coordinates into the world: the
+// displacement p - q a direction points along becomes R * (voxel size ⊙ (p - q)), so it turns
+// (and, on anisotropic voxels, bends) with the frame. Strengths are fractions of a radius and stay.
 std::vector<std::uint8_t> write_vectors(const VectorTexture& texture, Vec3i first,
-                                        const openvdb::math::Transform::Ptr& transform) {
+                                        const openvdb::math::Transform::Ptr& transform,
+                                        const VoxelFrame* voxel_frame = nullptr) {
   openvdb::Vec3fGrid::Ptr vectors = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.f));
   openvdb::FloatGrid::Ptr strength = openvdb::FloatGrid::create(0.f);
   vectors->setName("vectors");
@@ -242,8 +283,17 @@ std::vector<std::uint8_t> write_vectors(const VectorTexture& texture, Vec3i firs
   for (int k = 0; k < n.z; ++k)
     for (int j = 0; j < n.y; ++j)
       for (int i = 0; i < n.x; ++i, ++index) {
-        const VectorTexel t = texture.get(index);
+        VectorTexel t = texture.get(index);
         if (!(t.strength > 0)) continue;
+        if (voxel_frame && !voxel_frame->is_identity()) {
+          const Vec3d d = voxel_frame->world_direction({t.x, t.y, t.z});
+          const double length = d.length();
+          if (length > 0) {
+            t.x = static_cast<float>(d.x / length);
+            t.y = static_cast<float>(d.y / length);
+            t.z = static_cast<float>(d.z / length);
+          }
+        }
         const openvdb::Coord at(first.x + i, first.y + j, first.z + k);
         put_vector.setValueOn(at,
                               openvdb::Vec3f(t.x * t.strength, t.y * t.strength, t.z * t.strength));
@@ -288,12 +338,13 @@ std::vector<std::uint8_t> encode_vdb_vectors(const VectorVolume& volume,
                        openvdb::math::Transform::createLinearTransform(m));
 }
 
-std::vector<std::uint8_t> encode_vdb_world_vectors(const Box3i& box, const VectorTexture& texture) {
+std::vector<std::uint8_t> encode_vdb_world_vectors(const Box3i& box, const VectorTexture& texture,
+                                                   const VoxelFrame& frame) {
   if (texture.resolution() != box.size())
     throw InvalidArgument("vdb: the texture's resolution " + to_string(texture.resolution()) +
                           " is not the box's " + to_string(box.size()));
   ensure_initialized();
-  return write_vectors(texture, box.begin, scale_transform({1, 1, 1}));
+  return write_vectors(texture, box.begin, frame_transform(frame), &frame);
 }
 
 }  // namespace voxfield

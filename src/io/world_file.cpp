@@ -2,7 +2,10 @@
 //
 // Layout, all little-endian:
 //   header   "VXFWORLD" u32 version u32 section_count u32 crc32(previous 16 bytes)
-//   sections u32 kind (1 world, 2 distance field), u64 bytes, payload, u32 crc32(payload)
+//   sections u32 kind (1 world, 3 frame, 2 distance field), u64 bytes, payload, u32 crc32(payload)
+// The frame section (format version 2) follows the world's when its frame is not the identity:
+// 3 x f64 origin, 3 x f64 voxel size, 9 x f64 rotation (rows). A world in the identity frame is
+// written as version 1, byte for byte what voxfield wrote before frames, so older readers read it.
 // A grid inside a payload: u32 chunk_edge, u32 value_bytes, background value, u8 bounded
 // [+ 6 x i32 bounds], u64 chunk_count, then per chunk: 3 x i32 coordinate, u8 kind (0 uniform: one
 // value follows; 1 dense: u32 size + zlib stream of edge^3 values, x fastest).
@@ -24,7 +27,7 @@ namespace voxfield {
 namespace {
 
 constexpr char kMagic[8] = {'V', 'X', 'F', 'W', 'O', 'R', 'L', 'D'};
-enum SectionKind : std::uint32_t { kWorldSection = 1, kFieldSection = 2 };
+enum SectionKind : std::uint32_t { kWorldSection = 1, kFieldSection = 2, kFrameSection = 3 };
 
 class Out {
  public:
@@ -305,19 +308,52 @@ void put_section(Out& file, std::uint32_t kind, const Out& payload) {
   file.put<std::uint32_t>(crc(payload.b.data(), payload.b.size()));
 }
 
+// The header: version 2 when a frame section follows the world, 1 (the format before frames)
+// otherwise.
+void put_header(Out& file, const VoxelFrame& frame, std::uint32_t sections) {
+  file.bytes(kMagic, 8);
+  file.put<std::uint32_t>(frame.is_identity() ? 1 : kWorldFileVersion);
+  file.put<std::uint32_t>(sections);
+  file.put<std::uint32_t>(crc(file.b.data(), 16));
+}
+
+void put_frame_section(Out& file, const VoxelFrame& frame) {
+  if (frame.is_identity()) return;
+  frame.validate("world file: the world's frame");
+  Out p;
+  for (int a = 0; a < 3; ++a) p.put<double>(frame.origin_world[a]);
+  for (int a = 0; a < 3; ++a) p.put<double>(frame.voxel_size_world[a]);
+  for (const Vec3d& row : frame.rotation)
+    for (int a = 0; a < 3; ++a) p.put<double>(row[a]);
+  put_section(file, kFrameSection, p);
+}
+
+VoxelFrame get_frame(detail::ByteReader& r, std::uint64_t at) {
+  VoxelFrame f;
+  for (int a = 0; a < 3; ++a) f.origin_world[a] = get<double>(r, "frame origin");
+  for (int a = 0; a < 3; ++a) f.voxel_size_world[a] = get<double>(r, "frame voxel size");
+  for (Vec3d& row : f.rotation)
+    for (int a = 0; a < 3; ++a) row[a] = get<double>(r, "frame rotation");
+  try {
+    f.validate("the world's frame");
+  } catch (const InvalidArgument& e) {
+    r.fail_at(at, e.what());
+  }
+  return f;
+}
+
 }  // namespace
 
 std::vector<std::uint8_t> encode_world_file(const World& world,
                                             const std::vector<const DistanceField*>& fields) {
   Out file;
-  file.bytes(kMagic, 8);
-  file.put<std::uint32_t>(kWorldFileVersion);
-  file.put<std::uint32_t>(static_cast<std::uint32_t>(1 + fields.size()));
-  file.put<std::uint32_t>(crc(file.b.data(), 16));
+  put_header(file, world.frame,
+             static_cast<std::uint32_t>(1 + !world.frame.is_identity() + fields.size()));
   Out w;
   for (const Rgba& c : world.palette) w.put(c);
   put_grid(w, world.voxels);
   put_section(file, kWorldSection, w);
+  put_frame_section(file, world.frame);
   for (const DistanceField* f : fields) {
     Out p;
     put_field(p, *f);
@@ -341,7 +377,8 @@ WorldFilePart encode_world_file_part(const Grid<std::uint8_t>& voxels, std::int3
 
 WorldFileFrame encode_world_file_frame(const Palette& palette, int chunk_edge,
                                        const std::optional<Box3i>& bounds,
-                                       std::span<const WorldFilePartSummary> parts) {
+                                       std::span<const WorldFilePartSummary> parts,
+                                       const VoxelFrame& voxel_frame) {
   if (chunk_edge < 8 || chunk_edge > 128 || (chunk_edge & (chunk_edge - 1)) != 0)
     throw InvalidArgument("world file: chunk edge " + std::to_string(chunk_edge) +
                           " is not a power of two in 8..128");
@@ -360,16 +397,14 @@ WorldFileFrame encode_world_file_frame(const Palette& palette, int chunk_edge,
     section_crc = crc32_combine(section_crc, p.crc, static_cast<z_off_t>(p.bytes));
   WorldFileFrame frame;
   Out head;
-  head.bytes(kMagic, 8);
-  head.put<std::uint32_t>(kWorldFileVersion);
-  head.put<std::uint32_t>(1);
-  head.put<std::uint32_t>(crc(head.b.data(), 16));
+  put_header(head, voxel_frame, voxel_frame.is_identity() ? 1 : 2);
   head.put<std::uint32_t>(kWorldSection);
   head.put<std::uint64_t>(payload.b.size() + record_bytes);
   head.bytes(payload.b.data(), payload.b.size());
   frame.head = std::move(head.b);
   Out tail;
   tail.put<std::uint32_t>(static_cast<std::uint32_t>(section_crc));
+  put_frame_section(tail, voxel_frame);
   frame.tail = std::move(tail.b);
   return frame;
 }
@@ -407,6 +442,10 @@ WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::strin
       if (s != 0) r.fail_at(at, "the world section must come first");
       for (Rgba& c : out.world.palette) c = get<Rgba>(payload, "palette");
       out.world.voxels = get_grid<std::uint8_t>(payload, budget);
+    } else if (kind == kFrameSection) {
+      if (s != 1 || out.version < 2)
+        r.fail_at(at, "a frame section that does not follow the world (or in a version 1 file)");
+      out.world.frame = get_frame(payload, at);
     } else if (kind == kFieldSection) {
       if (s == 0) r.fail_at(at, "a field section before the world");
       out.fields.push_back(get_field(payload, budget));
@@ -422,6 +461,7 @@ WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::strin
     if (!payload.at_end()) r.fail_at(payload.offset(), "trailing bytes in a section");
   }
   if (!r.at_end()) r.fail("trailing bytes after the last section");
+  for (DistanceField& f : out.fields) f.frame = out.world.frame;
   return out;
 }
 

@@ -177,6 +177,7 @@ World rechunk_world(const World& world, int chunk_edge, std::optional<Box3i> bou
   }
   out.voxels = g.rechunked(chunk_edge, bounds);
   out.palette = world.palette;
+  out.frame = world.frame;
   return out;
 }
 

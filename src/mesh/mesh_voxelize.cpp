@@ -122,6 +122,8 @@ World voxelize_mesh(const TriangleMesh& mesh, const MeshVoxelOptions& options) {
   progress.throw_if_cancelled();
   for (std::uint8_t& m : dense) m = m ? options.material : 0;
   World world(Grid<std::uint8_t>::kDefaultChunkEdge, box);
+  // Voxel (i, j, k)'s centre at ((i, j, k) + 1/2) * voxel size in the mesh's units: the frame.
+  world.frame.voxel_size_world = Vec3d{1, 1, 1} * v;
   world.voxels.copy_from_dense(box, dense.data());
   world.voxels.compact();
   return world;

@@ -151,7 +151,21 @@ Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
     const Rgba c = world.palette[material];
     mesh.colors[i] = {c.r, c.g, c.b};
   }
+  place_in_frame(mesh, world.frame);
   return mesh;
+}
+
+void place_in_frame(Mesh& mesh, const VoxelFrame& frame) {
+  if (frame.is_identity()) return;
+  frame.validate("mesh: the world's frame");
+  // Per vertex in doubles, rounded once to float: a frame far from the origin (a scan's
+  // millimetres, a map's metres) keeps what float positions can hold.
+  auto to_float = [](Vec3d v) {
+    return std::array<float, 3>{static_cast<float>(v.x), static_cast<float>(v.y),
+                                static_cast<float>(v.z)};
+  };
+  for (auto& p : mesh.positions) p = to_float(frame.world_from_vox({p[0], p[1], p[2]}));
+  for (auto& n : mesh.normals) n = to_float(frame.world_normal({n[0], n[1], n[2]}));
 }
 
 }  // namespace voxfield

@@ -72,7 +72,7 @@ void save_world_vfw(MPI_Comm comm, const SlabPartition& partition, const World& 
       records += all[i + 1];
     }
     const WorldFileFrame frame =
-        encode_world_file_frame(world.palette, edge, partition.domain, parts);
+        encode_world_file_frame(world.palette, edge, partition.domain, parts, world.frame);
     if (!transaction) transaction = &own.emplace();
     // '\0' after the name: the one byte no path holds.
     staged = transaction->stage_shared(path, frame.head).string() + std::string(1, '\0') +

@@ -482,14 +482,16 @@ DistanceField compute_distance_field(Context& context, const World& world,
   }
   FieldEngine engine(context.impl(), world, options);
   engine.run(engine.all_chunks(), {{plan.domain, plan.domain}}, /*download=*/true, timings);
-  return engine.read_back();
+  DistanceField f = engine.read_back();
+  f.frame = world.frame;
+  return f;
 }
 
 // ---- DynamicField ----------------------------------------------------------------------------
 
 DynamicField::DynamicField(std::shared_ptr<Context> context, const World& world,
                            DistanceOptions options)
-    : context_(std::move(context)) {
+    : context_(std::move(context)), frame_(world.frame) {
   if (!context_) throw InvalidArgument("gpu::DynamicField needs a context");
   if (!options.domain) {
     if (!world.voxels.bounds())
@@ -539,7 +541,9 @@ DynamicDistanceField::UpdateStats DynamicField::update(const DirtyRegions& dirty
 
 DistanceField DynamicField::download() {
   engine_->run({}, {}, /*download=*/true, nullptr);
-  return engine_->read_back();
+  DistanceField f = engine_->read_back();
+  f.frame = frame_;
+  return f;
 }
 
 }  // namespace voxfield::gpu

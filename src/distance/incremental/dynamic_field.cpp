@@ -218,6 +218,7 @@ void DynamicDistanceField::rebuild(Interrupter* interrupter) {
   if (interrupter) o.interrupter = interrupter;
   DistanceField fresh = compute_distance_field(world_->voxels, o);
   fresh.options.interrupter = nullptr;  // the field outlives the caller's interrupter
+  fresh.frame = world_->frame;
   field_ = std::move(fresh);
 }
 

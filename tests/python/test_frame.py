@@ -1,0 +1,118 @@
+"""World frames against OpenVDB's own transforms (pyopenvdb, Debian python3-openvdb).
+
+A .vdb grid with a rotated, anisotropic, displaced transform loads as a World whose frame puts
+every voxel centre where OpenVDB's indexToWorld does; voxfield's own .vdb and .vfw files keep the
+frame; a framed world's mesh is its voxel-space mesh carried into the frame; bad frames raise
+ValueError and leave the frame as it was.
+
+Run by CTest with PYTHONPATH pointing at the build's python/ directory.
+"""
+
+import math
+
+import numpy as np
+import pyopenvdb as openvdb
+import pytest
+
+from voxfield.world import World, mesh
+
+
+def rotation_about(degrees, axis):
+    """Rodrigues' formula, written here from the definition."""
+    u = np.asarray(axis, dtype=float)
+    u = u / np.linalg.norm(u)
+    a = math.radians(degrees)
+    k = np.array([[0, -u[2], u[1]], [u[2], 0, -u[0]], [-u[1], u[0], 0]])
+    return np.eye(3) + math.sin(a) * k + (1 - math.cos(a)) * (k @ k)
+
+
+ROTATION = rotation_about(25.0, (1.0, 2.0, -0.5))
+SIZE = np.array([0.5, 0.25, 2.0])
+TRANSLATION = np.array([10.0, -3.5, 100.0])  # where index (0, 0, 0)'s centre lands
+
+
+def framed_vdb(path):
+    """A bool grid of a small blob under a rotated, anisotropic, displaced transform."""
+    grid = openvdb.BoolGrid(background=False)
+    grid.name = "blob"
+    linear = ROTATION * SIZE  # column a scaled by SIZE[a]: world = linear @ ijk + TRANSLATION
+    matrix = [list(linear[:, 0]) + [0.0], list(linear[:, 1]) + [0.0], list(linear[:, 2]) + [0.0],
+              list(TRANSLATION) + [1.0]]
+    grid.transform = openvdb.createLinearTransform(matrix)
+    acc = grid.getAccessor()
+    for i in range(-4, 5):
+        for j in range(-4, 5):
+            for k in range(-3, 4):
+                if i * i + j * j + 2 * k * k <= 14:
+                    acc.setValueOn((i, j, k), True)
+    openvdb.write(str(path), grids=[grid])
+    return grid
+
+
+def test_a_vdb_transform_becomes_the_worlds_frame(tmp_path):
+    grid = framed_vdb(tmp_path / "blob.vdb")
+    world = World.load(str(tmp_path / "blob.vdb"))
+    np.testing.assert_allclose(world.voxel_size_world, SIZE, rtol=1e-12)
+    np.testing.assert_allclose(world.rotation, ROTATION, atol=1e-12)
+    ijk = np.array([[0, 0, 0], [3, -2, 1], [-4, 4, -3], [17, 5, -9]])
+    want = np.array([grid.transform.indexToWorld(tuple(int(v) for v in p)) for p in ijk])
+    np.testing.assert_allclose(world.to_world(ijk + 0.5), want, atol=1e-9)
+    np.testing.assert_allclose(world.to_voxels(want), ijk + 0.5, atol=1e-9)
+    assert world.solid_count == grid.activeVoxelCount()
+
+
+def test_voxfields_own_files_keep_the_frame(tmp_path):
+    framed_vdb(tmp_path / "blob.vdb")
+    world = World.load(str(tmp_path / "blob.vdb"))
+    world.save(str(tmp_path / "blob.vfw"))
+    back = World.load(str(tmp_path / "blob.vfw"))
+    assert back.origin_world == world.origin_world  # doubles, stored as doubles
+    assert back.voxel_size_world == world.voxel_size_world
+    np.testing.assert_array_equal(back.rotation, world.rotation)
+    # pyopenvdb cannot open Int32 grids (test_vdb.cpp checks OpenVDB's own transform of them): the
+    # .vdb is read back by voxfield, and the voxels' centres compared.
+    world.save(str(tmp_path / "again.vdb"))
+    again = World.load(str(tmp_path / "again.vdb"))
+    ijk = np.array([[0, 0, 0], [2, 1, -1], [-30, 12, 7]]) + 0.5
+    np.testing.assert_allclose(again.to_world(ijk), world.to_world(ijk), atol=1e-9)
+    assert again.solid_count == world.solid_count
+
+
+def test_a_framed_worlds_mesh_is_its_voxel_mesh_in_the_frame(tmp_path):
+    framed_vdb(tmp_path / "blob.vdb")
+    framed = World.load(str(tmp_path / "blob.vdb"))
+    plain = World.load(str(tmp_path / "blob.vdb"))
+    plain.origin_world = (0.0, 0.0, 0.0)
+    plain.voxel_size_world = (1.0, 1.0, 1.0)
+    plain.rotation = np.eye(3)
+    v_world, f_world, n_world, _ = mesh(framed)
+    v_vox, f_vox, n_vox, _ = mesh(plain)
+    np.testing.assert_array_equal(f_world, f_vox)  # the same triangles, the same winding
+    np.testing.assert_allclose(v_world, framed.to_world(v_vox.astype(np.float64)), atol=1e-4)
+    # Normals: perpendicular to the carried triangles' edges, still unit.
+    a, b, c = (v_world[f_world[:, i]].astype(np.float64) for i in range(3))
+    face_normal = np.cross(b - a, c - a)
+    face_normal /= np.linalg.norm(face_normal, axis=1, keepdims=True)
+    mean_vertex_normal = n_world[f_world].astype(np.float64).mean(axis=1)
+    mean_vertex_normal /= np.linalg.norm(mean_vertex_normal, axis=1, keepdims=True)
+    # The voxel surface is flat between edges: each face's vertex normals agree with the face.
+    assert np.median(np.einsum("ij,ij->i", face_normal, mean_vertex_normal)) > 0.99
+    np.testing.assert_allclose(np.linalg.norm(n_world, axis=1), 1.0, atol=1e-5)
+
+
+def test_bad_frames_are_refused_and_keep_the_old_one():
+    world = World(np.ones((3, 3, 3), dtype=np.uint8))
+    world.voxel_size_world = (0.5, 0.5, 0.5)
+    for bad in [(0.0, 1.0, 1.0), (1.0, -1.0, 1.0), (math.nan, 1.0, 1.0), (math.inf, 1.0, 1.0)]:
+        with pytest.raises(ValueError, match="voxel size"):
+            world.voxel_size_world = bad
+    with pytest.raises(ValueError, match="origin"):
+        world.origin_world = (0.0, math.inf, 0.0)
+    with pytest.raises(ValueError, match="mirror"):
+        world.rotation = np.diag([1.0, 1.0, -1.0])
+    with pytest.raises(ValueError, match="orthonormal"):
+        world.rotation = np.array([[1.0, 0.1, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    with pytest.raises(ValueError, match="points"):
+        world.to_world(np.zeros((4, 2)))
+    assert world.voxel_size_world == (0.5, 0.5, 0.5)
+    np.testing.assert_array_equal(world.rotation, np.eye(3))
