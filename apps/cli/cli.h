@@ -48,8 +48,9 @@ class UsageError : public InvalidArgument {
 void set_activity(std::string what);
 const std::string& activity();
 
-// CLI11 validators whose messages read well: finite numbers >= 0 (NaN and infinity refused), and
-// camera specifications (checked for syntax when the command line is parsed).
+// CLI11 validators whose messages read well: finite numbers (NaN and infinity refused), >= 0 or
+// > 0, and camera specifications (checked for syntax when the command line is parsed).
+CLI::Validator finite_number();
 CLI::Validator finite_non_negative();
 CLI::Validator finite_positive();
 CLI::Validator camera_spec();

@@ -1,6 +1,8 @@
 // voxfield convert IN OUT: between .vox, .npy and .vfw (in an .npy, non-zero = that material), and
 // to .vdb (an OpenVDB Int32 grid of materials; vdb.h); a triangle mesh (.obj, .ply, .stl, .off)
-// is voxelised by its generalized winding number (mesh_voxelize.h) at --voxel-size.
+// is voxelised by its generalized winding number (mesh_voxelize.h) at --voxel-size, in the mesh's
+// units as its frame. A world written to .vfw or .vdb can be given a frame (--voxel-size,
+// --origin; docs/frames.md).
 #include <iostream>
 
 #include "cli.h"
@@ -13,9 +15,19 @@ namespace {
 
 struct ConvertSettings {
   std::string in, out;
-  double voxel_size = 0;
+  std::vector<double> voxel_size;  // one edge (a mesh's, or a world's cubic voxels) or three
+  std::vector<double> origin;      // x, y, z: where a world's voxel corner (0, 0, 0) lies
   std::string grid;
 };
+
+// The frame --voxel-size and --origin give a world read from a file, over the one it came with
+// (docs/frames.md); what they do not give stays.
+void set_frame(World& world, const ConvertSettings& s) {
+  if (s.voxel_size.size() == 1) world.frame.voxel_size_world = Vec3d{1, 1, 1} * s.voxel_size[0];
+  if (s.voxel_size.size() == 3)
+    world.frame.voxel_size_world = {s.voxel_size[0], s.voxel_size[1], s.voxel_size[2]};
+  if (s.origin.size() == 3) world.frame.origin_world = {s.origin[0], s.origin[1], s.origin[2]};
+}
 
 // .vfw and .vdb keep a world's frame; .vox and .npy have nowhere to put it. Not an error (the
 // voxels are what those formats are for), but said, so that nobody wonders where it went.
@@ -31,12 +43,16 @@ int run_convert(const ConvertSettings& s) {
   // Converting a file onto itself is safe: the input is read whole before the output is written.
   Outputs outputs({s.in});
   outputs.expect_world(s.out, "OUT", /*may_be_input=*/true);
+  if (s.voxel_size.size() == 2) throw UsageError("--voxel-size takes one edge or three (sx,sy,sz)");
   if (mesh_input_format_of(s.in)) {
-    if (!(s.voxel_size > 0)) throw UsageError(s.in + ": a mesh needs --voxel-size (in its units)");
+    if (s.voxel_size.size() != 1)
+      throw UsageError(s.in + ": a mesh needs --voxel-size (one edge, in its units)");
+    if (!s.origin.empty())
+      throw UsageError("--origin: a voxelised mesh's frame is the mesh's own units");
     set_activity("reading " + s.in);
     const TriangleMesh mesh = read_mesh(s.in);
     MeshVoxelOptions o;
-    o.voxel_size = s.voxel_size;
+    o.voxel_size = s.voxel_size[0];
     o.padding_voxels = 0;
     o.interrupter = progress();
     set_activity("voxelising " + s.in);
@@ -50,13 +66,16 @@ int run_convert(const ConvertSettings& s) {
     note_frame_left_out(world, s.out);
     return 0;
   }
-  if (s.voxel_size != 0)
-    throw UsageError("--voxel-size applies to mesh inputs (.obj, .ply, .stl, .off)");
+  if ((!s.voxel_size.empty() || !s.origin.empty()) && world_format_of(s.out) != WorldFormat::kVfw &&
+      world_format_of(s.out) != WorldFormat::kVdb)
+    throw UsageError("--voxel-size and --origin set the world's frame, which " + s.out +
+                     " cannot keep (.vfw and .vdb keep it)");
   set_activity("loading " + s.in);
   LoadOptions lo;
   lo.chunk_edge = 0;  // a .vfw keeps the chunk edge it was saved with
   lo.vdb_grid = s.grid;
-  const LoadedWorld w = load_world(s.in, lo);
+  LoadedWorld w = load_world(s.in, lo);
+  set_frame(w.world, s);
   set_activity("writing " + s.out);
   outputs.stage(s.out, encode_world(w.world, w.extent, world_format_of(s.out)));
   outputs.commit();
@@ -78,7 +97,17 @@ void add_convert(CLI::App& app, Action& action) {
   add_grid_option(cmd, s->grid);
   cmd->add_option("--voxel-size", s->voxel_size,
                   "for a mesh: the voxels' edge in the mesh's units (solid where the generalized "
-                  "winding number at a voxel's centre is >= 1/2)");
+                  "winding number at a voxel's centre is >= 1/2); for a world written to .vfw or "
+                  ".vdb: its voxels' size in world units, S or SX,SY,SZ (its frame)")
+      ->delimiter(',')
+      ->expected(1, 3)
+      ->check(finite_positive());
+  cmd->add_option("--origin", s->origin,
+                  "for a world written to .vfw or .vdb: X,Y,Z, where its voxel corner (0,0,0) "
+                  "lies in world units (its frame)")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(finite_number());
   cmd->add_option("OUT", s->out, "output .vox, .npy, .vfw or .vdb")->required();
   cmd->callback([s, &action] { action = [s] { return run_convert(*s); }; });
 }

@@ -20,7 +20,7 @@ const std::string& activity() {
   return g_activity;
 }
 
-CLI::Validator finite_non_negative() {
+CLI::Validator finite_number() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
         double v = 0;
@@ -31,7 +31,19 @@ CLI::Validator finite_non_negative() {
         } catch (const std::exception&) {
           return "\"" + text + "\" is not a number";
         }
-        if (!std::isfinite(v) || v < 0) return "must be a finite number >= 0, got " + text;
+        if (!std::isfinite(v)) return "must be a finite number, got " + text;
+        return {};
+      },
+      "NUMBER");
+}
+
+CLI::Validator finite_non_negative() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::string copy = text;
+        const std::string e = finite_number().operator()(copy);
+        if (!e.empty()) return e;
+        if (std::stod(text) < 0) return "must be a finite number >= 0, got " + text;
         return {};
       },
       "NUMBER >= 0");
