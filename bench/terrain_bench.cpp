@@ -195,7 +195,7 @@ int main(int argc, char** argv) {
     std::printf(
         "| %s | %.0f | %.5f | %.1f MB | %lld of %lld | %llu | %.0f | %zu | %.3f / %.3f | %.3f / "
         "%.3f | %.3f / %.3f / %.3f | %.0f kB | %.1f MB | %s | %s |\n",
-        terrain_storage_name(storage), terrain.clamp_units(), terrain.step_units(),
+        terrain_storage_name(storage), terrain.max_distance_units(), terrain.step_units(),
         static_cast<double>(memory.bytes) / 1e6, static_cast<long long>(memory.uniform_chunks),
         static_cast<long long>(memory.chunks), static_cast<unsigned long long>(chunk_bytes),
         first_ms, first.triangle_count(), bs.p50, bs.p99, ms.p50, ms.p99, ts.mean, ts.p50, ts.p99,

@@ -27,7 +27,7 @@ PUBLIC_LAYER = {
     "hash.h": "core", "voxel_frame.h": "core",
     "gpu.h": "gpu", "gpu_vulkan.h": "gpu",
     "distance.h": "distance", "algorithms.h": "distance", "dynamic_field.h": "distance",
-    "dissertation_format.h": "distance", "gpu_distance.h": "distance", "distance_slab.h": "distance",
+    "dissertation_format.h": "distance", "gpu_distance.h": "distance", "distance_executor.h": "distance", "distance_slab.h": "distance",
     "vectors.h": "vectors", "vector_world.h": "vectors", "gpu_vectors.h": "vectors", "vector_agents.h": "vectors", "gpu_vectors_vulkan.h": "vectors", "vector_files.h": "io",
     "csg.h": "csg", "csg_compile.h": "csg", "csg_files.h": "io",
     "mesh.h": "mesh", "mesh_chunks.h": "mesh", "mesh_pieces.h": "mesh", "terrain.h": "mesh", "gpu_mesh.h": "mesh", "gpu_terrain.h": "mesh", "gpu_terrain_vulkan.h": "mesh", "csg_mesh.h": "mesh", "mesh_optimize.h": "mesh", "mesh_files.h": "io", "mesh_voxelize.h": "mesh", "mesh_read.h": "io",

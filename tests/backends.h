@@ -10,8 +10,8 @@
 #include <memory>
 #include <string>
 
+#include "voxfield/distance_executor.h"
 #include "voxfield/gpu.h"
-#include "voxfield/gpu_distance.h"
 
 namespace voxfield::testing_backends {
 
@@ -50,33 +50,16 @@ inline constexpr bool kSanitizedBuild = false;
 inline constexpr bool kSanitizedBuild = false;
 #endif
 
-// The exact field on `backend`.
-inline DistanceField exact_field(Backend backend, const World& world,
-                                 const DistanceOptions& options) {
-  if (backend == Backend::kVulkan)
-    return gpu::compute_distance_field(*vulkan_context(), world, options);
-  return compute_distance_field(world, options);
+// The executor of `backend`: the CPU, or the shared Vulkan context.
+inline Executor executor_of(Backend backend) {
+  return backend == Backend::kVulkan ? Executor(vulkan_context()) : Executor();
 }
 
-// The incremental field on `backend`, behind the one interface both halves share.
-class IncrementalField {
- public:
-  IncrementalField(Backend backend, const World& world, const DistanceOptions& options) {
-    if (backend == Backend::kVulkan)
-      gpu_ = std::make_unique<gpu::DynamicField>(vulkan_context(), world, options);
-    else
-      cpu_ = std::make_unique<DynamicDistanceField>(world, options);
-  }
-  DynamicDistanceField::UpdateStats update(const DirtyRegions& dirty) {
-    return gpu_ ? gpu_->update(dirty) : cpu_->update(dirty);
-  }
-  DistanceField field() { return gpu_ ? gpu_->download() : cpu_->field(); }
-  const DistanceOptions& options() const { return gpu_ ? gpu_->options() : cpu_->options(); }
-
- private:
-  std::unique_ptr<DynamicDistanceField> cpu_;
-  std::unique_ptr<gpu::DynamicField> gpu_;
-};
+// The exact field on `backend`, through the distance module's one API.
+inline DistanceField exact_field(Backend backend, const World& world,
+                                 const DistanceOptions& options) {
+  return compute_distance_field(executor_of(backend), world, options);
+}
 
 // Fails the current test if the validation layer reported anything since the last call.
 inline void expect_no_validation_messages(Backend backend) {

@@ -483,8 +483,9 @@ import numpy as np
 v = np.array([[float(t) for t in l.split()[1:4]] for l in open('$tmp/cube-again.obj') if l.startswith('v ')])
 assert np.abs(v.min(0)).max() < 1e-6 and np.abs(v.max(0) - 2).max() < 1e-6, (v.min(0), v.max(0))"
 # A frame given to a world: a scan's anisotropic voxels and where it lies. Its level set in world
-# units needs the field measured in those voxels (--spacing); OpenVDB's transform then puts voxel
-# (i, j, k)'s centre at origin + ((i, j, k) + 1/2) * size.
+# units is measured in those voxels (by default for a .vdb, said on stderr; refused when another
+# --spacing or metric is asked for); OpenVDB's transform then puts voxel (i, j, k)'s centre at
+# origin + ((i, j, k) + 1/2) * size.
 check "frame given" 0 "$V" convert "$tmp/cube.npy" "$tmp/scan.vfw" --voxel-size 0.5,0.5,2 --origin 10,0,-5
 check "info of the given frame" 0 "$V" info "$tmp/scan.vfw" --json
 expect_grep "given voxel size" "$tmp/out" '"voxel_size_world": \['
@@ -493,10 +494,13 @@ expect_grep "frame to .npy refused" "$tmp/err" "cannot keep"
 [ ! -e "$tmp/x.npy" ] && passes=$((passes+1)) || { echo "FAIL: a refused frame wrote its output"; fails=$((fails+1)); }
 check "two voxel sizes refused" 2 "$V" convert "$tmp/cube.npy" "$tmp/x.vfw" --voxel-size 1,2
 check "a non-finite origin refused" 2 "$V" convert "$tmp/cube.npy" "$tmp/x.vfw" --origin 0,nan,0
-check "an anisotropic level set needs its spacing" 1 "$V" field "$tmp/scan.vfw" --metric euclidean --signed --max-distance 3 -o "$tmp/scan.vdb"
+check "an anisotropic level set in voxels refused" 1 "$V" field "$tmp/scan.vfw" --metric euclidean --signed --max-distance 3 --spacing 1,1,1 -o "$tmp/scan.vdb"
 expect_grep "spacing named" "$tmp/err" "spacing"
+check "an anisotropic Manhattan level set refused" 1 "$V" field "$tmp/scan.vfw" --metric manhattan --signed --max-distance 3 -o "$tmp/scan.vdb"
+expect_grep "metric named" "$tmp/err" "Manhattan"
 [ ! -e "$tmp/scan.vdb" ] && passes=$((passes+1)) || { echo "FAIL: a refused level set wrote its output"; fails=$((fails+1)); }
-check "a level set in world units" 0 "$V" field "$tmp/scan.vfw" --metric euclidean --signed --max-distance 3 --spacing 0.5,0.5,2 -o "$tmp/scan.vdb"
+check "a level set in world units" 0 "$V" field "$tmp/scan.vfw" --metric euclidean --signed --max-distance 3 -o "$tmp/scan.vdb"
+expect_grep "measured in the voxel size, said" "$tmp/err" "measuring in the world's voxel size 0.5 x 0.5 x 2"
 check "its transform, by OpenVDB" 0 /usr/bin/python3 -c "
 import numpy as np, pyopenvdb as vdb
 g = vdb.read('$tmp/scan.vdb', 'distance')

@@ -315,7 +315,7 @@ TEST_P(DynamicFieldOn, IncrementalUpdatesEqualFullRebuilds) {
     o.storage = c.storage;
     o.nearest_sites = c.sites;
     o.spacing = c.spacing;
-    IncrementalField live(b, w, o);
+    IncrementalDistanceField live(executor_of(b), w, o);
     DirtyRegions dirty(
         16, seed % 2 ? DirtyRegions::Track::kOccupancy : DirtyRegions::Track::kAnyChange);
     for (int i = 0; i < updates; ++i) {

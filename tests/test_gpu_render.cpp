@@ -103,8 +103,8 @@ TEST(Gpu, ResidentScenesFollowEditsWithOnlyTheirChunksCopied) {
   World w = random_world({64, 48, 32}, 8, 0.003, 41);
   w.voxels.fill(Box3i{{0, 0, 0}, {64, 48, 4}}, 120);
   RenderSceneOptions so = DynamicRenderScene::default_options();
-  so.skip_clamp = 10;
-  so.lighting_clamp = 6;
+  so.skip_max_distance_vox = 10;
+  so.lighting_max_distance_vox = 6;
   DynamicRenderScene live(w, so);
   gpu::SceneRenderer renderer(ctx);
   RenderOptions o;

@@ -446,8 +446,8 @@ TEST(Render, ScenesFollowEditsExactly) {
   for (Metric m : {Metric::kManhattan, Metric::kEuclidean}) {
     RenderSceneOptions so = DynamicRenderScene::default_options();
     so.skip_metric = m;
-    so.skip_clamp = m == Metric::kEuclidean ? 6 : 12;
-    so.lighting_clamp = 5;
+    so.skip_max_distance_vox = m == Metric::kEuclidean ? 6 : 12;
+    so.lighting_max_distance_vox = 5;
     DynamicRenderScene live(w, so);
     std::mt19937 rng(5 + static_cast<unsigned>(m));
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
@@ -472,7 +472,9 @@ TEST(Render, ScenesFollowEditsExactly) {
       const DynamicRenderScene::UpdateStats st = live.update(dirty);
       // Only chunks within the fields' reach of a changed voxel can change: the changed box grown
       // by the larger clamp (and one voxel of rounding), counted in chunks of edge 8.
-      const int reach = static_cast<int>(std::ceil(std::max(so.skip_clamp, so.lighting_clamp))) + 1;
+      const int reach = static_cast<int>(std::ceil(
+                            std::max(so.skip_max_distance_vox, so.lighting_max_distance_vox))) +
+                        1;
       const Box3i grown = dirty.bounds().empty() ? Box3i{}
                                                  : Box3i{dirty.bounds().begin - Vec3i::splat(reach),
                                                          dirty.bounds().end + Vec3i::splat(reach)}
@@ -513,8 +515,8 @@ TEST(Render, SceneUpdatesTouchOnlyTheChunksAnEditReaches) {
   World w(16, Box3i::from_size({128, 128, 64}));
   w.voxels.fill(Box3i{{0, 0, 0}, {128, 128, 8}}, 3);
   RenderSceneOptions so = DynamicRenderScene::default_options();
-  so.skip_clamp = 8;
-  so.lighting_clamp = 8;
+  so.skip_max_distance_vox = 8;
+  so.lighting_max_distance_vox = 8;
   DynamicRenderScene live(w, so);
   DirtyRegions dirty(16, DirtyRegions::Track::kAnyChange);
   apply_edit(w, {EditOp::kPlace, SphereBrush{{64, 64, 12}, 3}, 9}, &dirty);
@@ -528,6 +530,6 @@ TEST(Render, SceneUpdatesTouchOnlyTheChunksAnEditReaches) {
   EXPECT_EQ(live.update(dirty).chunks_changed, 0u);
   EXPECT_THROW(DynamicRenderScene(World(8)), InvalidArgument);  // unbounded
   RenderSceneOptions bad = so;
-  bad.skip_clamp = 300;
+  bad.skip_max_distance_vox = 300;
   EXPECT_THROW(DynamicRenderScene(w, bad), InvalidArgument);
 }

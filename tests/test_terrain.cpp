@@ -85,7 +85,7 @@ TEST(Terrain, SamplesAreTheDocumentedQuantisationOfTheClampedValue) {
       TerrainOptions o = options_of(s, n);
       o.positive_inside = positive_inside;
       TerrainField t(o);
-      const double clamp = t.clamp_units();
+      const double clamp = t.max_distance_units();
       EXPECT_EQ(clamp, o.spacing_units * (s == TerrainStorage::kI8 ? 2 : 4));
       // Fresh: air at the clamp everywhere, one uniform chunk each.
       EXPECT_EQ(t.value({5, 6, 7}), (positive_inside ? -1 : 1) * quantised(s, clamp, clamp));
@@ -175,7 +175,7 @@ TEST(Terrain, BrushesEqualTheirFormulaAppliedToEverySample) {
     const TerrainOptions o = options_of(s, n, 8);
     TerrainField t(o);
     t.assign(ground, 2);
-    const double clamp = t.clamp_units();
+    const double clamp = t.max_distance_units();
     int changed_any = 0;
     for (int round = 0; round < 24; ++round) {
       TerrainBrush b;
@@ -411,13 +411,13 @@ TEST(Terrain, BadRequestsAreRefusedAndChangeNothing) {
   bad.spacing_units = 0;
   EXPECT_NE(refused(bad).find("spacing"), std::string::npos);
   bad = o;
-  bad.clamp_units = std::nan("");
+  bad.max_distance_units = std::nan("");
   EXPECT_NE(refused(bad).find("clamp"), std::string::npos);
   bad = o;
-  bad.clamp_units = 1e-320;  // its step would underflow to zero
+  bad.max_distance_units = 1e-320;  // its step would underflow to zero
   EXPECT_NE(refused(bad).find("cannot be stored in i16"), std::string::npos);
   bad.storage = TerrainStorage::kF32;
-  bad.clamp_units = 1e300;  // no float holds it
+  bad.max_distance_units = 1e300;  // no float holds it
   EXPECT_NE(refused(bad).find("cannot be stored in f32"), std::string::npos);
   bad = o;
   bad.origin_units[1] = INFINITY;

@@ -126,13 +126,15 @@ TEST(Vdb, AWorldsFrameIsItsGridsTransform) {
   EXPECT_NEAR(lf->transform().indexToWorld(openvdb::Coord(2, 3, 4))[0],
               w.frame.voxel_centre_world({2, 3, 4}).x, 1e-12);
   EXPECT_NEAR(lf->background(), 4 - 0.05, 1e-6);  // the clamp less half the smallest edge
+  EXPECT_EQ(lf->metaValue<double>("voxfield_max_distance"), 4);
   World iso = w;
   iso.frame.voxel_size_world = {0.25, 0.25, 0.25};
   DistanceOptions unit = o;
   unit.spacing = {1, 1, 1};
   const DistanceField fi = compute_distance_field(iso, unit);
   const auto li = openvdb::gridPtrCast<openvdb::FloatGrid>((*grids_of(encode_vdb_field(fi)))[0]);
-  EXPECT_NEAR(li->background(), (4 - 0.5) * 0.25, 1e-6);  // voxels times the edge
+  EXPECT_NEAR(li->background(), (4 - 0.5) * 0.25, 1e-6);         // voxels times the edge
+  EXPECT_EQ(li->metaValue<double>("voxfield_max_distance"), 1);  // in world units too
   const Vec3i p = w.voxels.content_bounds().begin;
   EXPECT_NEAR(li->tree().getValue(openvdb::Coord(p.x, p.y, p.z)),
               0.25 * (fi.distance(p) + (fi.distance(p) < 0 ? 0.5 : -0.5)), 1e-6);
@@ -155,6 +157,40 @@ World blob_world() {
 // Every metric, sign, clamp and storage: the grid's class, background and voxel size, and at every
 // voxel of the domain OpenVDB reads the field's distance (clamped to the background), active where
 // it lies below the background.
+// A world's flow in a rotated, anisotropic frame: on the world's lattice (OpenVDB's transform puts
+// texel (i, j, k) of the box at the frame's centre of voxel box.begin + (i, j, k)), each direction
+// carried into the world — R * (size ⊙ d), normalised — times its strength.
+TEST(Vdb, AWorldsFlowIsWrittenInItsFrame) {
+  VoxelFrame frame;
+  frame.origin_world = {3, -1, 7};
+  frame.voxel_size_world = {0.5, 1, 2};
+  frame.rotation = VectorVolume::rotation_about(60, {0, 0, 1});
+  const Box3i box{{-2, 3, 1}, {2, 6, 3}};
+  VectorTexture t(box.size(), VectorStorage::kRgba32f);
+  const VectorTexel texels[] = {{1, 0, 0, 0.5f}, {0, 0.6f, 0.8f, 1}, {0, 0, -1, 0.25f}};
+  for (std::int64_t i = 0; i < 3; ++i) t.set(i * 7, texels[i]);
+  const auto grids = grids_of(encode_vdb_world_vectors(box, t, frame));
+  openvdb::Vec3SGrid::Ptr vectors;
+  for (const auto& g : *grids)
+    if (g->getName() == "vectors") vectors = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
+  ASSERT_TRUE(vectors);
+  EXPECT_EQ(static_cast<int>(vectors->activeVoxelCount()), 3);
+  const Vec3i n = box.size();
+  for (std::int64_t i = 0; i < 3; ++i) {
+    const std::int64_t at = i * 7;
+    const Vec3i v = box.begin + Vec3i{static_cast<int>(at % n.x), static_cast<int>(at / n.x % n.y),
+                                      static_cast<int>(at / (n.x * n.y))};
+    const openvdb::Coord c(v.x, v.y, v.z);
+    const openvdb::Vec3d centre = vectors->transform().indexToWorld(c);
+    const Vec3d want_centre = frame.voxel_centre_world(v);
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(centre[a], want_centre[a], 1e-12);
+    const VectorTexel& d = texels[i];
+    const Vec3d world = frame.world_direction({d.x, d.y, d.z}).normalized() * d.strength;
+    const openvdb::Vec3f got = vectors->tree().getValue(c);
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(got[a], world[a], 1e-6) << i << " axis " << a;
+  }
+}
+
 TEST(Vdb, FieldsAreLevelSetsOrScalarGridsHoldingTheirDistances) {
   const World w = blob_world();
   int cases = 0;

@@ -86,6 +86,13 @@ TEST(VoxelFrame, MatricesBecomeFramesAndShearsAreRefused) {
     EXPECT_NEAR(back.voxel_size_world[a], f.voxel_size_world[a], 1e-12);
     for (int b = 0; b < 3; ++b) EXPECT_NEAR(back.rotation[a][b], f.rotation[a][b], 1e-12);
   }
+  // A rotation stored in floats (to ~1e-7) is taken, made exactly orthonormal.
+  std::array<double, 12> rounded = f.world_from_vox_matrix();
+  for (double& v : rounded) v = static_cast<double>(static_cast<float>(v));
+  const VoxelFrame from_floats = VoxelFrame::from_matrix(rounded, "floats");
+  EXPECT_NO_THROW(from_floats.validate("floats"));
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) EXPECT_NEAR(from_floats.rotation[a][b], f.rotation[a][b], 1e-6);
   std::array<double, 12> shear{1, 0.5, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
   EXPECT_THROW((void)VoxelFrame::from_matrix(shear, "shear"), InvalidArgument);
   std::array<double, 12> mirror{-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
@@ -139,12 +146,9 @@ TEST_P(FieldFrameOn, FieldsCarryTheirWorldsFrame) {
   EXPECT_EQ(testing_backends::exact_field(b, w, o).frame, w.frame);
   AlgorithmOptions jfa;
   jfa.algorithm = Algorithm::kJfa;
-  const DistanceField family =
-      b == Backend::kVulkan
-          ? gpu::compute_distance_field(*testing_backends::vulkan_context(), w, o, jfa)
-          : compute_distance_field(w, o, jfa);
+  const DistanceField family = compute_distance_field(testing_backends::executor_of(b), w, o, jfa);
   EXPECT_EQ(family.frame, w.frame);
-  testing_backends::IncrementalField live(b, w, o);
+  IncrementalDistanceField live(testing_backends::executor_of(b), w, o);
   EXPECT_EQ(live.field().frame, w.frame);
   DirtyRegions dirty(16);
   w.voxels.set({15, 15, 15}, 2);

@@ -161,6 +161,18 @@ TEST(WorldFile, FramesRoundTripAndBadOnesAreRefused) {
   }
   test::fix_world_file_checksums(mirrored);
   EXPECT_THROW(parse_world_file(mirrored, "mirror.vfw"), FormatError);
+  // Two frame sections: the second does not follow the world.
+  auto twice = bytes;
+  const std::size_t frame_end = values_at + 15 * 8 + 4;
+  twice.insert(twice.begin() + static_cast<std::ptrdiff_t>(frame_end),
+               bytes.begin() + static_cast<std::ptrdiff_t>(frame_at),
+               bytes.begin() + static_cast<std::ptrdiff_t>(frame_end));
+  std::uint32_t sections = 0;
+  std::memcpy(&sections, twice.data() + 12, 4);
+  ++sections;
+  std::memcpy(twice.data() + 12, &sections, 4);
+  test::fix_world_file_checksums(twice);
+  EXPECT_THROW(parse_world_file(twice, "twice.vfw"), FormatError);
   // A frame section in a version-1 file: that version has none.
   auto old = bytes;
   old[8] = 1;

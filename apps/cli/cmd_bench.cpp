@@ -11,10 +11,10 @@
 #include <random>
 #include <sstream>
 
+#include "backend_choice.h"
 #include "cli.h"
 #include "field_args.h"
-#include "live_field.h"
-#include "voxfield/dynamic_field.h"
+#include "voxfield/distance_executor.h"
 #include "voxfield/edit_stream.h"
 #include "voxfield/parallel.h"
 #include "voxfield/scene.h"
@@ -73,9 +73,9 @@ int run_bench_edits(const BenchEditsSettings& s) {
   const double generate_ms = ms_since(t0);
   const DistanceOptions o = s.field.options();
   t0 = std::chrono::steady_clock::now();
-  LiveField field(world, o, s.backend);
+  IncrementalDistanceField field(choose_executor(s.backend), world, o);
   const double build_ms = ms_since(t0);
-  const gpu::Counters gpu_before = field.gpu_counters();
+  const gpu::Counters gpu_before = gpu_counters(field.executor());
 
   // The dissertation's stream: seeded positions anywhere in the world, radii in [min, max],
   // materials 0..255 where 0 (air) deletes.
@@ -127,7 +127,7 @@ int run_bench_edits(const BenchEditsSettings& s) {
           field.field().values);
     }
   }
-  const gpu::Counters gpu_after = field.gpu_counters();
+  const gpu::Counters gpu_after = gpu_counters(field.executor());
   const TimeSummary lat = summarise(latency_ms), upd = summarise(update_ms);
   const std::size_t field_bytes = field.memory_bytes();
   const std::size_t world_bytes = world.voxels.memory().bytes;
@@ -157,7 +157,7 @@ int run_bench_edits(const BenchEditsSettings& s) {
   if (field.on_gpu()) {
     // Per update, hardware-independent: what the dissertation's design spent a fence on per pass.
     const double n = std::max(1, s.edits);
-    gpu_stats = field.gpu_json();
+    gpu_stats = gpu_json(field.executor());
     gpu_stats["per_update"] = {
         {"submits", (gpu_after.submits - gpu_before.submits) / n},
         {"fence_waits", (gpu_after.fence_waits - gpu_before.fence_waits) / n},

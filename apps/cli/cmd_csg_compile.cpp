@@ -9,9 +9,9 @@
 
 #include <unistd.h>
 
+#include "backend_choice.h"
 #include "cli.h"
 #include "csg_commands.h"
-#include "live_field.h"
 #include "progress.h"
 #include "voxfield/csg.h"
 #include "voxfield/csg_compile.h"

@@ -5,10 +5,10 @@
 #include <iostream>
 #include <numeric>
 
+#include "backend_choice.h"
 #include "cli.h"
 #include "field_args.h"
-#include "live_field.h"
-#include "voxfield/dynamic_field.h"
+#include "voxfield/distance_executor.h"
 #include "voxfield/edit_script.h"
 #include "voxfield/parallel.h"
 
@@ -58,7 +58,7 @@ int run_edit(const EditSettings& s) {
   World world = rechunk_world(in.world, s.field.chunk_edge, in.extent, s.in);
   set_activity("building the field of " + s.in);
   const auto t_build = std::chrono::steady_clock::now();
-  LiveField field(world, o, s.backend);
+  IncrementalDistanceField field(choose_executor(s.backend), world, o);
   const double build_ms = ms_since(t_build);
 
   DirtyRegions dirty(world.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
@@ -83,7 +83,7 @@ int run_edit(const EditSettings& s) {
   const Vec3i d = in.extent.size();
   nlohmann::json j = s.field.describe(o, d);
   j["backend"] = field.on_gpu() ? "vulkan" : "cpu";
-  if (field.on_gpu()) j["gpu"] = field.gpu_json();
+  if (field.on_gpu()) j["gpu"] = gpu_json(field.executor());
   j.update(nlohmann::json{
       {"build_ms", build_ms},
       {"edits", edits.size()},

@@ -7,9 +7,9 @@
 #include <fstream>
 #include <iostream>
 
+#include "backend_choice.h"
 #include "cli.h"
 #include "field_args.h"
-#include "live_field.h"
 #include "progress.h"
 #include "voxfield/dissertation_format.h"
 #include "voxfield/gpu_distance.h"
@@ -32,13 +32,6 @@ struct FieldSettings {
 
 // A mesh's field: always signed (by the winding number) and Euclidean, in the mesh's units, f32.
 // The output's extension, lower case (".npy", ".vdb", ...).
-std::string output_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
 int run_mesh_field(const FieldSettings& s, Outputs& outputs) {
   const auto refuse = [&](bool bad, const std::string& what) {
     if (bad) throw UsageError(s.in + ": " + what);
@@ -51,7 +44,7 @@ int run_mesh_field(const FieldSettings& s, Outputs& outputs) {
   refuse(s.algorithm != "exact" || s.backend != "cpu" || !s.field.focus.empty(),
          "a mesh's field has one algorithm, on the CPU (no --algorithm, --backend or --focus)");
   refuse(!s.sites.empty() || !s.packed.empty(), "--sites and --packed apply to worlds");
-  refuse(output_extension(s.out) != ".npy", "a mesh's field is written as .npy");
+  refuse(lowercase_extension(s.out) != ".npy", "a mesh's field is written as .npy");
   set_activity("reading " + s.in);
   const TriangleMesh mesh = read_mesh(s.in);
   MeshDistanceOptions o;
@@ -102,7 +95,7 @@ int run_field(const FieldSettings& s) {
   if (mesh_input_format_of(s.in)) return run_mesh_field(s, outputs);
   if (s.voxel_size != 0)
     throw UsageError("--voxel-size applies to mesh inputs (.obj, .ply, .stl, .off)");
-  const bool vdb_output = output_extension(s.out) == ".vdb";  // else .npy
+  const bool vdb_output = lowercase_extension(s.out) == ".vdb";  // else .npy
   outputs.expect(s.sites, "--sites");
   outputs.expect(s.packed, "--packed");
   DistanceOptions o = s.field.options();
@@ -120,6 +113,17 @@ int run_field(const FieldSettings& s) {
   const LoadedWorld in = load_world(s.in, s.field.load_options());
   o.domain = in.extent;  // the output covers the input's volume, indexed like it
   if (o.domain->empty()) throw InvalidArgument(s.in + ": the input holds no volume");
+  // A .vdb level set holds world distances: a world with anisotropic voxels (a scan's 1 x 1 x 3
+  // mm) is measured in its voxel size unless --spacing says otherwise. Isotropic voxels need no
+  // spacing (the writer scales voxels to world units), nor does a .npy (values in voxels).
+  const Vec3d size = in.world.frame.voxel_size_world;
+  if (vdb_output && s.field.spacing.empty() && o.metric == Metric::kEuclidean &&
+      !(size.x == size.y && size.y == size.z)) {
+    o.spacing = {size.x, size.y, size.z};
+    std::cerr << "voxfield: measuring in the world's voxel size " << size.x << " x " << size.y
+              << " x " << size.z << " (--spacing), so that " << s.out
+              << " holds distances in its units\n";
+  }
   AlgorithmStats stats;
   const auto gpu_context = choose_backend(s.backend);
   std::vector<gpu::PassTiming> pass_timings;

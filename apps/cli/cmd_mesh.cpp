@@ -7,9 +7,9 @@
 #include <limits>
 #include <optional>
 
+#include "backend_choice.h"
 #include "cli.h"
 #include "field_args.h"
-#include "live_field.h"
 #include "voxfield/gpu_mesh.h"
 #include "voxfield/mesh.h"
 #include "voxfield/mesh_files.h"

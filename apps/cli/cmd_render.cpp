@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <iostream>
 
+#include "backend_choice.h"
 #include "cli.h"
 #include "field_args.h"
-#include "live_field.h"
 #include "progress.h"
 #include "voxfield/gpu_render.h"
 #include "voxfield/parallel.h"

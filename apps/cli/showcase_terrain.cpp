@@ -222,7 +222,7 @@ void showcase_terrain(const fs::path& out, std::uint64_t seed, std::ostream& md,
     TerrainOptions to;
     to.samples = kSize;
     to.storage = r.storage;
-    md << "| " << terrain_storage_name(r.storage) << " | ±" << TerrainField(to).clamp_units()
+    md << "| " << terrain_storage_name(r.storage) << " | ±" << TerrainField(to).max_distance_units()
        << " | " << format_bytes(r.before.bytes) << " → " << format_bytes(r.after.bytes) << " | "
        << r.after.uniform_chunks << " of " << r.after.chunks << " | "
        << fixed(r.edit_ms[r.edit_ms.size() / 2], 2) << " / " << fixed(r.edit_ms.back(), 2)

@@ -7,7 +7,7 @@
 #include <memory>
 #include <string>
 
-#include "live_field.h"
+#include "backend_choice.h"
 #include "voxfield/gpu_vectors.h"
 
 namespace voxfield::cli {

@@ -113,7 +113,7 @@ class Demo {
   char save_path_[256] = "demo-world.vfw";
   char load_path_[256] = "";
   int ui_size_ = 128, ui_chunk_ = 16, ui_metric_ = 0, ui_backend_ = 0;
-  float ui_clamp_ = 32;
+  float ui_max_distance_ = 32;
   VkDescriptorPool imgui_pool_ = VK_NULL_HANDLE;
   int screenshots_ = 0;
 };

@@ -11,7 +11,7 @@ namespace {
 RenderSceneOptions scene_options(const WorldSettings& s) {
   RenderSceneOptions o = DynamicRenderScene::default_options();
   o.skip_metric = s.metric;
-  o.skip_clamp = s.clamp;
+  o.skip_max_distance_vox = s.max_distance_vox;
   return o;
 }
 
@@ -72,10 +72,10 @@ DynamicRenderScene::UpdateStats DemoWorld::apply(std::span<const Edit> edits) {
   return st;
 }
 
-void DemoWorld::set_field(Metric metric, double clamp) {
+void DemoWorld::set_field(Metric metric, double max_distance_vox) {
   WorldSettings next = settings_;
   next.metric = metric;
-  next.clamp = clamp;
+  next.max_distance_vox = max_distance_vox;
   // Build first: bad options leave the current scene as it was.
   auto live = std::make_unique<DynamicRenderScene>(*world_, scene_options(next));
   live_ = std::move(live);

@@ -21,7 +21,7 @@ struct WorldSettings {
   int size = 128;  // terrain of size x size x size/2 voxels (ignored when loading)
   int chunk_edge = 16;
   Metric metric = Metric::kManhattan;  // the field rays skip by
-  double clamp = 32;  // its clamp (voxels): how far a skip reaches, and an edit's reach
+  double max_distance_vox = 32;        // the clamp: how far a skip reaches, and an edit's reach
   std::uint64_t seed = 6683787;
 };
 
@@ -39,7 +39,7 @@ class DemoWorld {
     return apply(std::span<const Edit>(&edit, 1));
   }
   // Rebuilds the fields for new metric / clamp settings (a full computation).
-  void set_field(Metric metric, double clamp);
+  void set_field(Metric metric, double max_distance_vox);
 
   // Writes the world (.vfw keeps the palette and bounds; .vox and .npy as the CLI writes them),
   // atomically.

@@ -47,7 +47,7 @@ Demo::Demo(const Options& o) : options_(o) {
   }
   ui_size_ = o.world.size;
   ui_chunk_ = o.world.chunk_edge;
-  ui_clamp_ = static_cast<float>(o.world.clamp);
+  ui_max_distance_ = static_cast<float>(o.world.max_distance_vox);
   ui_metric_ = static_cast<int>(o.world.metric);
   vectors_settings_ = o.vectors;
   terrain_settings_ = o.terrain;
@@ -524,7 +524,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
   app.add_option("--metric", metric, "metric of the field rays skip by")
       ->check(CLI::IsMember({"manhattan", "chebyshev", "euclidean"}));
-  app.add_option("--clamp", o.world.clamp, "its clamp in voxels (an edit's reach)");
+  app.add_option("--max-distance", o.world.max_distance_vox,
+                 "its max distance (clamp) in voxels: an edit's reach");
   app.add_option("--width", o.width, "window width")->check(CLI::Range(64, 8192));
   app.add_option("--height", o.height, "window height")->check(CLI::Range(64, 8192));
   app.add_flag("--validation", o.validation,

@@ -112,10 +112,11 @@ void Demo::panel() {
   if (ImGui::CollapsingHeader("Field")) {
     const char* metrics[] = {"manhattan", "chebyshev", "euclidean"};
     ImGui::Combo("metric", &ui_metric_, metrics, 3);
-    ImGui::SliderFloat("clamp", &ui_clamp_, 1, ui_metric_ == 2 ? 63 : 255, "%.0f voxels");
+    ImGui::SliderFloat("max distance", &ui_max_distance_, 1, ui_metric_ == 2 ? 63 : 255,
+                       "%.0f voxels");
     if (ImGui::Button("rebuild the fields")) {
       try {
-        world_->set_field(static_cast<Metric>(ui_metric_), ui_clamp_);
+        world_->set_field(static_cast<Metric>(ui_metric_), ui_max_distance_);
         status_ = "fields rebuilt";
       } catch (const Error& e) {
         status_ = e.what();

@@ -130,4 +130,28 @@ std::shared_ptr<Context> select_backend(Backend backend, const ContextOptions& o
                                         std::string* why = nullptr);
 
 }  // namespace gpu
+
+// Where a module's work runs, chosen once and handed to its one API (distance_executor.h): the
+// CPU (the default, and what an executor without a device is), or a Vulkan device shared by
+// everything made with it.
+class Executor {
+ public:
+  Executor() = default;  // the CPU
+  explicit Executor(std::shared_ptr<gpu::Context> device) : device_(std::move(device)) {}
+  // gpu::select_backend's choice: kCpu the CPU; kVulkan a device (GpuUnavailable if there is none);
+  // kAuto a hardware GPU if there is one, otherwise the CPU. `why` receives one line.
+  static Executor choose(Backend backend, const gpu::ContextOptions& options = {},
+                         std::string* why = nullptr) {
+    return Executor(gpu::select_backend(backend, options, why));
+  }
+
+  bool on_gpu() const { return device_ != nullptr; }
+  Backend backend() const { return on_gpu() ? Backend::kVulkan : Backend::kCpu; }
+  // The device (null on the CPU).
+  gpu::Context* device() const { return device_.get(); }
+  const std::shared_ptr<gpu::Context>& shared_device() const { return device_; }
+
+ private:
+  std::shared_ptr<gpu::Context> device_;
+};
 }  // namespace voxfield

@@ -83,10 +83,10 @@ struct RenderSceneOptions {
   // Clamp of the skip field in voxels; 0 = as far as u8 storage reaches (255 voxels for
   // Manhattan and Chebyshev, 63 for Euclidean, stored in quarter voxels). A clamped field skips
   // less far in open space but follows edits locally: DynamicRenderScene wants 16-32.
-  double skip_clamp = 0;
+  double skip_max_distance_vox = 0;
   // The Euclidean field behind ambient occlusion and soft shadows (clamped, u8 quarter voxels).
   bool lighting_field = true;
-  double lighting_clamp = 16;
+  double lighting_max_distance_vox = 16;
 };
 
 // A world prepared for rendering: the fields rays skip by and shade with, copied with the
@@ -140,7 +140,7 @@ class DynamicRenderScene {
  public:
   // Throws InvalidArgument for an unbounded world or bad options (a skip clamp beyond u8's reach).
   explicit DynamicRenderScene(const World& world, RenderSceneOptions options = default_options());
-  // skip_clamp 32 (Manhattan) — the showcase's and the demo's choice.
+  // skip_max_distance_vox 32 (Manhattan) — the showcase's and the demo's choice.
   static RenderSceneOptions default_options();
 
   struct UpdateStats {

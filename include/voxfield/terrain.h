@@ -42,12 +42,12 @@ struct TerrainOptions {
   std::array<double, 3> origin_units{0, 0, 0};
   double spacing_units = 1;  // between neighbouring samples (the thesis: 0.1 m)
   TerrainStorage storage = TerrainStorage::kI16;
-  // Stored values are clamped to ±clamp_units; 0 picks the storage's default: two samples'
+  // Stored values are clamped to ±max_distance_units; 0 picks the storage's default: two samples'
   // spacing for i8 (a step of 1/63.5 of the spacing), four for i16 and f32. Normals read central
   // differences a sample from the surface, so a clamp under about two spacings bends them; a
   // larger one makes each edit reach further (an edit visits its shape's box grown by the clamp
   // and the blend radius).
-  double clamp_units = 0;
+  double max_distance_units = 0;
   int chunk_edge = 16;  // samples per storage chunk edge, 4..64
   bool positive_inside = false;
   std::optional<Palette> palette;  // vertex colours by material; none: meshes have no colours
@@ -83,8 +83,8 @@ class TerrainField {
   TerrainField(TerrainField&&) noexcept;
   TerrainField& operator=(TerrainField&&) noexcept;
 
-  const TerrainOptions& options() const;  // with clamp_units resolved
-  double clamp_units() const;
+  const TerrainOptions& options() const;  // with max_distance_units resolved
+  double max_distance_units() const;
   double step_units() const;  // 0 for f32
   Vec3i size() const;
   Vec3i chunk_count() const;

@@ -4,7 +4,8 @@
 //
 // Frames: VDB voxel (i, j, k) is voxfield voxel (i, j, k); the grid's transform is the world's
 // frame (voxel_frame.h), mapping the index to the voxel's centre, origin + R * (voxel size ⊙
-// ((i, j, k) + 1/2)) — so a .vdb lines up with the meshes, renders and rays of the same world. In
+// ((i, j, k) + 1/2)) — so a .vdb lines up with the meshes of the same world (and with its
+// renders and rays, placed in voxel coordinates, in the identity frame). In
 // the identity frame that is (i, j, k) + 1/2 (a field's: ((i, j, k) + 1/2) ⊙ spacing). Reading
 // takes the frame back from the transform (any rotation and positive scale per axis; a shear or
 // mirror is reported and read in the identity frame).

@@ -53,8 +53,9 @@ struct VoxelFrame {
   void validate(const std::string& what) const;
 
   // The frame of a 3 x 4 affine matrix m (rows, world = m * (p_vox, 1)): voxel sizes are the
-  // columns' lengths and the rotation the normalised columns. Throws InvalidArgument when the
-  // matrix is not a rotation times a positive scale (a shear or a mirror), naming `what`.
+  // columns' lengths and the rotation the normalised columns, made exactly orthonormal when they
+  // are within 1e-5 of it (a rotation stored in floats). Throws InvalidArgument when the matrix
+  // is not a rotation times a positive scale (a shear or a mirror), naming `what`.
   static VoxelFrame from_matrix(const std::array<double, 12>& m, const std::string& what);
 };
 

@@ -59,7 +59,8 @@ std::string repr(const TerrainField& t) {
   const TerrainField::Memory m = t.memory();
   return "voxfield.mesh.Terrain(samples=(" + std::to_string(o.samples.x) + ", " +
          std::to_string(o.samples.y) + ", " + std::to_string(o.samples.z) + "), storage='" +
-         terrain_storage_name(o.storage) + "', clamp=" + std::to_string(t.clamp_units()) +
+         terrain_storage_name(o.storage) +
+         "', max_distance=" + std::to_string(t.max_distance_units()) +
          ", bytes=" + std::to_string(m.bytes) + ")";
 }
 
@@ -101,7 +102,7 @@ void bind_mesh(py::module_& parent) {
                            "A deformable terrain field: a signed lattice in i8, i16 or f32 chunks, "
                            "edited by brushes (docs/meshing.md, 'Terrain fields')")
       .def(py::init([](std::vector<int> samples, const std::string& storage, double spacing,
-                       std::vector<double> origin, double clamp, int chunk, bool positive_inside,
+                       std::vector<double> origin, double max_distance, int chunk, bool positive_inside,
                        std::optional<py::array_t<std::uint8_t, py::array::c_style |
                                                                 py::array::forcecast>> palette) {
              if (samples.size() != 3) throw InvalidArgument("samples takes three integers");
@@ -111,7 +112,7 @@ void bind_mesh(py::module_& parent) {
              o.spacing_units = spacing;
              const Vec3d at = vec(origin, "origin");
              o.origin_units = {at.x, at.y, at.z};
-             o.clamp_units = clamp;
+             o.max_distance_units = max_distance;
              o.chunk_edge = chunk;
              o.positive_inside = positive_inside;
              if (palette) {
@@ -125,10 +126,10 @@ void bind_mesh(py::module_& parent) {
              return std::make_unique<PyTerrain>(o);
            }),
            py::arg("samples"), py::arg("storage") = "i16", py::arg("spacing") = 1.0,
-           py::arg("origin") = std::vector<double>{0, 0, 0}, py::arg("clamp") = 0.0,
+           py::arg("origin") = std::vector<double>{0, 0, 0}, py::arg("max_distance") = 0.0,
            py::arg("chunk") = 16, py::arg("positive_inside") = false,
            py::arg("palette") = py::none(),
-           "samples: (nx, ny, nz); storage 'i8', 'i16' or 'f32'; clamp in world units (0: the "
+           "samples: (nx, ny, nz); storage 'i8', 'i16' or 'f32'; max_distance (the clamp) in world units (0: the "
            "storage's default); palette: uint8 (256, 3) colours by material for meshes")
       .def("__repr__",
            [](const PyTerrain& t) {
@@ -142,8 +143,8 @@ void bind_mesh(py::module_& parent) {
                                return py::make_tuple(n.x, n.y, n.z);
                              })
       .def_property_readonly(
-          "clamp", [](const PyTerrain& t) { return t.field.clamp_units(); },
-          "stored values lie within ±clamp")
+          "max_distance", [](const PyTerrain& t) { return t.field.max_distance_units(); },
+          "stored values lie within ±max_distance (the clamp, world units)")
       .def_property_readonly(
           "step", [](const PyTerrain& t) { return t.field.step_units(); },
           "the quantisation step (0 for f32)")

@@ -25,15 +25,16 @@ Vec3d as_vec(const std::array<double, 3>& a) {
   return {a[0], a[1], a[2]};
 }
 
-// Changes the world's frame under the write lock, refusing (ValueError) what validate refuses and
+// Changes the world's frame under the write lock — read, changed and written in one hold, so two
+// threads setting different parts keep both — refusing (ValueError) what validate refuses and
 // keeping the frame it had then.
 template <class Change>
 void change_frame(PyWorld& w, Change&& change) {
-  VoxelFrame f = reading(w, [&] { return w.world.frame; });
-  change(f);
-  f.validate("World.frame");
   py::gil_scoped_release release;
   const std::unique_lock write(w.lock);
+  VoxelFrame f = w.world.frame;
+  change(f);
+  f.validate("World.frame");
   w.world.frame = f;
 }
 
@@ -93,10 +94,10 @@ void bind_frame(py::class_<PyWorld>& world) {
           [](PyWorld& w, const Doubles& r) {
             if (r.ndim() != 2 || r.shape(0) != 3 || r.shape(1) != 3)
               throw InvalidArgument("World.rotation must be a (3, 3) array");
-            change_frame(w, [&](VoxelFrame& f) {
-              for (int row = 0; row < 3; ++row)
-                for (int c = 0; c < 3; ++c) f.rotation[row][c] = r.at(row, c);
-            });
+            std::array<Vec3d, 3> rows;  // copied while the GIL is held
+            for (int row = 0; row < 3; ++row)
+              for (int c = 0; c < 3; ++c) rows[row][c] = r.at(row, c);
+            change_frame(w, [&](VoxelFrame& f) { f.rotation = rows; });
           },
           "(3, 3): the rotation from the voxel axes to the world's (orthonormal, det +1)")
       .def(

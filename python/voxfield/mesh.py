@@ -9,9 +9,9 @@ default, 'descent'). ``algorithm``: ``"mc"`` (marching cubes: a closed oriented 
 ``"sn"`` (surface nets) or ``"dc"`` (dual contouring). The triangles do not depend on ``chunk``
 (only the order vertices are numbered in does) or on ``threads`` (not even the order). A float32 Fortran-ordered array is read in place; others are converted once.
 
-``Terrain(samples, storage="i16", spacing=1.0, origin=(0, 0, 0), clamp=0.0, chunk=16,
+``Terrain(samples, storage="i16", spacing=1.0, origin=(0, 0, 0), max_distance=0.0, chunk=16,
 positive_inside=False, palette=None)`` is voxfield's terrain field: signed distances stored per
-chunk in i8, i16 or f32, clamped to ±clamp, uniform chunks stored once. ``assign(values,
+chunk in i8, i16 or f32, clamped to ±max_distance, uniform chunks stored once. ``assign(values,
 material)`` fills it from an array; ``apply(shape, mode, centre, radius, end, half_extents,
 smooth, material)`` adds or subtracts a sphere, box or capsule (sharp, or blended by a polynomial
 smooth minimum over ``smooth`` units) and returns the box of samples it changed; ``values()`` and

@@ -24,7 +24,7 @@ class Terrain:
         storage: str = "i16",
         spacing: float = 1.0,
         origin: Sequence[float] = ...,
-        clamp: float = 0.0,
+        max_distance: float = 0.0,
         chunk: int = 16,
         positive_inside: bool = False,
         palette: npt.ArrayLike | None = None,
@@ -32,7 +32,7 @@ class Terrain:
     @property
     def samples(self) -> tuple[int, int, int]: ...
     @property
-    def clamp(self) -> float: ...
+    def max_distance(self) -> float: ...
     @property
     def step(self) -> float: ...
     @property

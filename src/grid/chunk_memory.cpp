@@ -8,7 +8,6 @@
 #include "voxfield/chunk_memory.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
@@ -56,18 +55,6 @@ std::uint64_t default_limit() {
                        : std::uint64_t{256} << 20;
 }
 
-// "0", "00", "0M", "0 GiB": a zero in any unit (parse_byte_size refuses zero; here it means off).
-bool is_zero_size(std::string_view text) {
-  std::size_t i = 0;
-  while (i < text.size() && text[i] == ' ') ++i;
-  const std::size_t digits = i;
-  while (i < text.size() && text[i] == '0') ++i;
-  if (i == digits) return false;
-  while (i < text.size() && (std::isalpha(static_cast<unsigned char>(text[i])) || text[i] == ' '))
-    ++i;
-  return i == text.size();
-}
-
 // Reads the environment once, under the lock. Never throws: a value that cannot be read disables
 // the cache and makes every allocation throw, naming it, until set_chunk_cache_limit() is called.
 void resolve_limit(Cache& c) noexcept {
@@ -79,9 +66,8 @@ void resolve_limit(Cache& c) noexcept {
     return;
   }
   c.limit = 0;
-  if (is_zero_size(env)) return;
   try {
-    c.limit = parse_byte_size(env, "VOXFIELD_CHUNK_CACHE");
+    c.limit = parse_byte_size(env, "VOXFIELD_CHUNK_CACHE", ZeroSize::kAllowed);  // 0: off
   } catch (const std::exception& e) {
     try {
       c.limit_error = e.what();

@@ -43,7 +43,7 @@ void set_default_memory_limit(std::uint64_t bytes) {
   g_limit.store(bytes, std::memory_order_relaxed);
 }
 
-std::uint64_t parse_byte_size(std::string_view text, std::string_view what) {
+std::uint64_t parse_byte_size(std::string_view text, std::string_view what, ZeroSize zero) {
   auto bad = [&](const char* why) -> std::uint64_t {
     throw InvalidArgument(std::string(what) + ": \"" + std::string(text) + "\" " + why +
                           " (expected bytes or a size such as 512M, 8G)");
@@ -86,7 +86,7 @@ std::uint64_t parse_byte_size(std::string_view text, std::string_view what) {
   }
   if (v > (UINT64_MAX >> shift)) return bad("is too large");
   v <<= shift;
-  if (v == 0) return bad("must be more than 0 bytes");
+  if (v == 0 && zero == ZeroSize::kRefused) return bad("must be more than 0 bytes");
   return v;
 }
 

@@ -1,6 +1,7 @@
 // voxfield — the voxel-to-world frame (voxel_frame.h): the affine map, its inverse and checks.
 #include "voxfield/voxel_frame.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -13,6 +14,9 @@ namespace {
 // degrees) is orthonormal to ~1e-15; 1e-9 leaves room for one written in floats' worth of digits
 // being refused, which is the point — such a matrix would skew the world by 1e-7.
 constexpr double kRotationTolerance = 1e-9;
+// How far from orthonormal a rotation read from a file may be and still be taken as one: floats'
+// precision, with room.
+constexpr double kFloatRotationTolerance = 1e-5;
 
 bool finite(Vec3d v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -111,6 +115,23 @@ VoxelFrame VoxelFrame::from_matrix(const std::array<double, 12>& m, const std::s
     for (int row = 0; row < 3; ++row) f.rotation[row][c] = axis[row] / length;
   }
   f.origin_world = {m[3], m[7], m[11]};
+  // A rotation stored in floats (most tools' transforms) is orthonormal to ~1e-7, not to
+  // validate's 1e-9: within kFloatRotationTolerance it is made exactly orthonormal (Gram-Schmidt
+  // on the columns), a change far below the file's own precision. A shear or mirror is not.
+  double worst = 0;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      const Vec3d ca = column(f.rotation, a), cb = column(f.rotation, b);
+      worst = std::max(worst, std::abs(dot(ca, cb) - (a == b ? 1.0 : 0.0)));
+    }
+  if (worst > kRotationTolerance && worst < kFloatRotationTolerance &&
+      determinant(f.rotation) > 0) {
+    const Vec3d c0 = column(f.rotation, 0), c1 = column(f.rotation, 1);
+    const Vec3d u0 = c0.normalized();
+    const Vec3d u1 = (c1 - u0 * dot(u0, c1)).normalized();
+    const Vec3d u2 = cross(u0, u1);
+    for (int row = 0; row < 3; ++row) f.rotation[row] = {u0[row], u1[row], u2[row]};
+  }
   try {
     f.validate(what);
   } catch (const InvalidArgument&) {

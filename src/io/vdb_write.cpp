@@ -66,8 +66,9 @@ std::pair<VoxelFrame, double> field_world_units(const DistanceField& field) {
       throw InvalidArgument(
           std::string("vdb: the field was measured with spacing ") + text +
           " but its world's frame is " + describe(field.frame) +
-          ": a level set needs distances in the world's units (compute the field with the "
-          "voxel size as its spacing)");
+          ": a level set needs distances in the world's units — a Euclidean field measured with "
+          "the voxel size as its spacing (the CLI's --spacing); Manhattan and Chebyshev "
+          "distances over anisotropic voxels have no value in world units");
     }
   }
   return {field.frame, k};
@@ -75,12 +76,12 @@ std::pair<VoxelFrame, double> field_world_units(const DistanceField& field) {
 
 // Grid metadata voxfield writes (beside OpenVDB's own "file_bbox_min" and so on).
 constexpr const char* kKind = "voxfield_kind";  // "world", "signed distance", "unsigned distance"
-constexpr const char* kPalette = "voxfield_palette";       // 256 RGBA, 8 hex digits each
-constexpr const char* kExtentMin = "voxfield_extent_min";  // Vec3i, inclusive
-constexpr const char* kExtentMax = "voxfield_extent_max";  // Vec3i, inclusive
-constexpr const char* kMetric = "voxfield_metric";         // "euclidean", ...
-constexpr const char* kClamp = "voxfield_clamp";           // double; 0: unclamped
-constexpr const char* kStorage = "voxfield_storage";       // "u8", "u16", "f32"
+constexpr const char* kPalette = "voxfield_palette";           // 256 RGBA, 8 hex digits each
+constexpr const char* kExtentMin = "voxfield_extent_min";      // Vec3i, inclusive
+constexpr const char* kExtentMax = "voxfield_extent_max";      // Vec3i, inclusive
+constexpr const char* kMetric = "voxfield_metric";             // "euclidean", ...
+constexpr const char* kMaxDistance = "voxfield_max_distance";  // double, world units; 0: no clamp
+constexpr const char* kStorage = "voxfield_storage";           // "u8", "u16", "f32"
 // What was taken off |distance| (half a voxel for level sets, 0 for unsigned fields).
 constexpr const char* kSurfaceOffset = "voxfield_surface_offset";
 constexpr const char* kDomainMin = "voxfield_domain_min";  // Vec3i, inclusive
@@ -253,7 +254,7 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
   grid->insertMeta(kKind,
                    openvdb::StringMetadata(is_signed ? "signed distance" : "unsigned distance"));
   grid->insertMeta(kMetric, openvdb::StringMetadata(metric_name(o.metric)));
-  grid->insertMeta(kClamp, openvdb::DoubleMetadata(k * clamp));
+  grid->insertMeta(kMaxDistance, openvdb::DoubleMetadata(k * clamp));
   grid->insertMeta(kSurfaceOffset, openvdb::DoubleMetadata(k * offset));
   grid->insertMeta(kStorage, openvdb::StringMetadata(storage_name(o.storage)));
   insert_box(*grid, kDomainMin, kDomainMax, field.domain);

@@ -75,19 +75,20 @@ TerrainField::TerrainField(const TerrainOptions& options) : impl_(std::make_uniq
     throw InvalidArgument("terrain: the spacing must be finite and > 0");
   for (double v : o.origin_units)
     if (!std::isfinite(v)) throw InvalidArgument("terrain: the origin must be finite");
-  if (o.clamp_units == 0)
-    o.clamp_units = o.spacing_units * (o.storage == TerrainStorage::kI8 ? 2 : 4);
-  if (!(o.clamp_units > 0) || !std::isfinite(o.clamp_units))
+  if (o.max_distance_units == 0)
+    o.max_distance_units = o.spacing_units * (o.storage == TerrainStorage::kI8 ? 2 : 4);
+  if (!(o.max_distance_units > 0) || !std::isfinite(o.max_distance_units))
     throw InvalidArgument("terrain: the clamp must be finite and > 0 (0 picks the default)");
   Impl& s = *impl_;
   s.options = o;
-  s.codec = detail::terrain::Codec(o.storage, o.clamp_units);
+  s.codec = detail::terrain::Codec(o.storage, o.max_distance_units);
   // The step must be a normal double (a clamp so small its step underflows cannot be encoded),
   // and an f32 clamp a finite float (else every sample would store infinity).
   if ((o.storage != TerrainStorage::kF32 && !std::isnormal(s.codec.step)) ||
-      (o.storage == TerrainStorage::kF32 && !(o.clamp_units <= std::numeric_limits<float>::max() &&
-                                              o.clamp_units >= std::numeric_limits<float>::min())))
-    throw InvalidArgument("terrain: a clamp of " + std::to_string(o.clamp_units) +
+      (o.storage == TerrainStorage::kF32 &&
+       !(o.max_distance_units <= std::numeric_limits<float>::max() &&
+         o.max_distance_units >= std::numeric_limits<float>::min())))
+    throw InvalidArgument("terrain: a clamp of " + std::to_string(o.max_distance_units) +
                           " units cannot be stored in " + terrain_storage_name(o.storage));
   for (int a = 0; a < 3; ++a) s.chunks[a] = (o.samples[a] + o.chunk_edge - 1) / o.chunk_edge;
   const std::uint64_t count = static_cast<std::uint64_t>(s.chunks.x) *
@@ -96,7 +97,7 @@ TerrainField::TerrainField(const TerrainOptions& options) : impl_(std::make_uniq
   require_memory(mul_sat(count, sizeof(Chunk)), 0, "terrain " + to_string(o.samples),
                  "its chunk table");
   s.chunk.resize(count);
-  const std::uint32_t air = s.codec.encode(o.clamp_units);
+  const std::uint32_t air = s.codec.encode(o.max_distance_units);
   for (Chunk& c : s.chunk) c.uniform = air;
 }
 
@@ -112,7 +113,7 @@ TerrainField& TerrainField::operator=(TerrainField&&) noexcept = default;
 const TerrainOptions& TerrainField::options() const {
   return impl_->options;
 }
-double TerrainField::clamp_units() const {
+double TerrainField::max_distance_units() const {
   return impl_->codec.clamp;
 }
 double TerrainField::step_units() const {

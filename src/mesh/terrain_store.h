@@ -21,11 +21,11 @@ struct Codec {
   int bytes = 2;
 
   Codec() = default;
-  Codec(TerrainStorage s, double clamp_units)
+  Codec(TerrainStorage s, double max_distance_units)
       : storage(s),
-        clamp(clamp_units),
-        step(s == TerrainStorage::kI8    ? clamp_units / 127
-             : s == TerrainStorage::kI16 ? clamp_units / 32767
+        clamp(max_distance_units),
+        step(s == TerrainStorage::kI8    ? max_distance_units / 127
+             : s == TerrainStorage::kI16 ? max_distance_units / 32767
                                          : 0),
         bytes(s == TerrainStorage::kI8    ? 1
               : s == TerrainStorage::kI16 ? 2

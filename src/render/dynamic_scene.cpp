@@ -29,7 +29,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 RenderSceneOptions DynamicRenderScene::default_options() {
   RenderSceneOptions o;
   o.skip_metric = Metric::kManhattan;
-  o.skip_clamp = 32;
+  o.skip_max_distance_vox = 32;
   return o;
 }
 

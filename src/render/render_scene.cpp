@@ -88,22 +88,22 @@ DistanceOptions skip_field_options(const RenderSceneOptions& options, const Box3
   o.metric = options.skip_metric;
   o.storage = Storage::kU8;
   const double most = o.metric == Metric::kEuclidean ? 63 : 255;
-  if (!(options.skip_clamp >= 0 && options.skip_clamp <= most))
+  if (!(options.skip_max_distance_vox >= 0 && options.skip_max_distance_vox <= most))
     throw InvalidArgument("render: the skip clamp must lie in [0, " +
                           std::to_string(static_cast<int>(most)) + "] voxels for the " +
                           metric_name(o.metric) + " metric (0 = the most)");
-  o.max_distance = options.skip_clamp > 0 ? options.skip_clamp : most;
+  o.max_distance = options.skip_max_distance_vox > 0 ? options.skip_max_distance_vox : most;
   o.domain = box;
   return o;
 }
 
 DistanceOptions light_field_options(const RenderSceneOptions& options, const Box3i& box) {
-  if (!(options.lighting_clamp > 0 && options.lighting_clamp <= 63))
+  if (!(options.lighting_max_distance_vox > 0 && options.lighting_max_distance_vox <= 63))
     throw InvalidArgument("render: lighting clamp must lie in (0, 63] voxels");
   DistanceOptions o;
   o.metric = Metric::kEuclidean;
   o.storage = Storage::kU8;
-  o.max_distance = options.lighting_clamp;
+  o.max_distance = options.lighting_max_distance_vox;
   o.domain = box;
   return o;
 }
@@ -436,9 +436,10 @@ RenderScene::RenderScene(const World& world, const DistanceField& skip, const Di
   s.world = &world;
   s.box = default_box(world, box);
   s.options.skip_metric = skip.options.metric;
-  s.options.skip_clamp = std::isfinite(skip.options.max_distance) ? skip.options.max_distance : 0;
+  s.options.skip_max_distance_vox =
+      std::isfinite(skip.options.max_distance) ? skip.options.max_distance : 0;
   s.options.lighting_field = light != nullptr;
-  if (light) s.options.lighting_clamp = light->options.max_distance;
+  if (light) s.options.lighting_max_distance_vox = light->options.max_distance;
   s.build(world, skip, light);
 }
 

@@ -98,6 +98,15 @@ def test_a_framed_worlds_mesh_is_its_voxel_mesh_in_the_frame(tmp_path):
     # The voxel surface is flat between edges: each face's vertex normals agree with the face.
     assert np.median(np.einsum("ij,ij->i", face_normal, mean_vertex_normal)) > 0.99
     np.testing.assert_allclose(np.linalg.norm(n_world, axis=1), 1.0, atol=1e-5)
+    # An offset surface is round, its normals in every direction: carried by the map itself (not
+    # its inverse transpose) they would lean off the anisotropic surface.
+    v2, f2, n2, _ = mesh(framed, iso=2.0)
+    a, b, c = (v2[f2[:, i]].astype(np.float64) for i in range(3))
+    face_normal = np.cross(b - a, c - a)
+    face_normal /= np.linalg.norm(face_normal, axis=1, keepdims=True)
+    vertex_normal = n2[f2].astype(np.float64).mean(axis=1)
+    vertex_normal /= np.linalg.norm(vertex_normal, axis=1, keepdims=True)
+    assert np.median(np.einsum("ij,ij->i", face_normal, vertex_normal)) > 0.98
 
 
 def test_bad_frames_are_refused_and_keep_the_old_one():

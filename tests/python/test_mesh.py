@@ -103,7 +103,7 @@ def test_terrain_brushes_follow_their_formula():
     px, py, pz = 1.0 + 0.5 * x, -2.0 + 0.5 * y, 0.5 * z
     ground = pz - 5.0
     t.assign(ground, material=2)
-    clamp = t.clamp
+    clamp = t.max_distance
     before = np.clip(ground, -clamp, clamp).astype(np.float32)
     np.testing.assert_array_equal(t.values(), before)
     # A smooth sphere added: the polynomial smooth minimum of the stored values and the sphere.

@@ -43,7 +43,7 @@ def terrain_triangles() -> int:
     (x0, _, _), (x1, _, _) = changed
     v, f, nrm, colors = terrain.mesh("mc", 16)
     assert colors.dtype == np.uint8 and terrain.values().shape == (n, n, n) and terrain.memory["bytes"] > 0
-    return int(f.shape[0]) + x1 - x0 + terrain.samples[0] + int(terrain.clamp + terrain.step)
+    return int(f.shape[0]) + x1 - x0 + terrain.samples[0] + int(terrain.max_distance + terrain.step)
 
 
 def mesh_input_figures() -> float:

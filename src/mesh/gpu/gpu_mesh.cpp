@@ -347,7 +347,7 @@ Mesh marching_cubes(Context& context, const TerrainField& terrain, const GpuMesh
   // whatever the field's convention; a positive-inside field is meshed from its decoded values
   // (inside above 0, s = 0 - v), so the device negates codes as it decodes to give the CPU's
   // signed zeros: the codes are uploaded negated — exactly, as their range is symmetric.
-  const detail::terrain::Codec codec(o.storage, terrain.clamp_units());
+  const detail::terrain::Codec codec(o.storage, terrain.max_distance_units());
   f.step = codec.step;
   f.width = o.storage == TerrainStorage::kI8    ? L::VF_MC_I8
             : o.storage == TerrainStorage::kI16 ? L::VF_MC_I16
