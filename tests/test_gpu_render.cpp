@@ -10,6 +10,7 @@
 #include "voxfield/edit.h"
 #include "voxfield/gpu_render.h"
 #include "voxfield/gpu_render_vulkan.h"
+#include "voxfield/render_executor.h"
 
 using namespace voxfield;
 using test::gpu_tests_wanted;
@@ -181,6 +182,37 @@ TEST(Gpu, ResidentScenesFollowEditsWithOnlyTheirChunksCopied) {
 // schedule give one image, which matches the CPU renderer's (same octree, camera and shading; the
 // GPU marches in floats, so a ray grazing an edge may end a cell earlier or later: at most 1 % of
 // pixels more than 8 levels apart, mean difference under 1 level).
+// The render module's one API (render_executor.h) draws on the backend its executor names: on the
+// CPU the CPU renderer's frames bit for bit, on the device the GPU renderer's, and a SceneView on a
+// device follows an edit as a freshly uploaded scene does.
+TEST(Gpu, TheExecutorApiDrawsOnTheChosenBackend) {
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = validated_context();
+  ctx->clear_validation_messages();
+  World w = random_world({40, 32, 24}, 8, 0.01, 5);
+  RenderSceneOptions so = DynamicRenderScene::default_options();
+  so.skip_max_distance_vox = 8;
+  DynamicRenderScene live(w, so);
+  RenderOptions o;
+  o.width = 64;
+  o.height = 48;
+  const Camera cam = Camera::framing(live.scene().box(), 1.5);
+  const Executor cpu = Executor::choose(Backend::kCpu), device(ctx);
+  EXPECT_FALSE(cpu.on_gpu());
+  EXPECT_EQ(device.backend(), Backend::kVulkan);
+  EXPECT_EQ(render(cpu, live.scene(), cam, o).rgb, render(live.scene(), cam, o).rgb);
+  EXPECT_EQ(render(device, live.scene(), cam, o).rgb, gpu::render(*ctx, live.scene(), cam, o).rgb);
+  SceneView cpu_view(cpu), device_view(device);
+  (void)device_view.render(live.scene(), cam, o);
+  DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
+  apply_edit(w, {EditOp::kPlace, SphereBrush{{20, 16, 12}, 5}, 77}, &dirty);
+  live.update(dirty);
+  const RenderScene fresh(w, live.skip_field(), live.light_field());
+  EXPECT_EQ(cpu_view.render(live.scene(), cam, o).rgb, render(fresh, cam, o).rgb);
+  EXPECT_EQ(device_view.render(live.scene(), cam, o).rgb, gpu::render(*ctx, fresh, cam, o).rgb);
+  EXPECT_TRUE(ctx->validation_messages().empty());
+}
+
 TEST(Gpu, CsgFramesMatchTheCpuAndEveryEvaluatorAgrees) {
   if (!gpu_tests_wanted()) GTEST_SKIP();
   auto ctx = validated_context();

@@ -7,10 +7,9 @@
 #include "cli.h"
 #include "field_args.h"
 #include "progress.h"
-#include "voxfield/gpu_render.h"
 #include "voxfield/parallel.h"
 #include "voxfield/png.h"
-#include "voxfield/render.h"
+#include "voxfield/render_executor.h"
 
 namespace voxfield::cli {
 namespace {
@@ -62,14 +61,13 @@ int run_render(const RenderSettings& s) {
   const RenderScene scene(in.world, so, in.extent);
   // With --repeat, the frame is rendered several times and the median time reported (the
   // image is the same every time: rendering is deterministic).
-  const auto gpu_context = choose_backend(s.backend);
+  const Executor executor = choose_executor(s.backend);
   RenderStats st;
   Image image;
   std::vector<double> times;
   std::vector<gpu::PassTiming> pass_timings;
   for (int r = 0; r < s.repeat; ++r) {
-    image = gpu_context ? gpu::render(*gpu_context, scene, camera, o, &st, &pass_timings)
-                        : render(scene, camera, o, &st, progress());
+    image = render(executor, scene, camera, o, &st, progress(), &pass_timings);
     times.push_back(st.ms);
   }
   std::sort(times.begin(), times.end());
@@ -100,13 +98,13 @@ int run_render(const RenderSettings& s) {
                      {"skip", s.skip},
                      {"skip_metric", s.metric},
                      {"threads", max_threads()},
-                     {"backend", gpu_context ? "vulkan" : "cpu"},
+                     {"backend", backend_name(executor.backend())},
                      {"field_ms", scene.field_ms()},
                      {"primary_rays_per_second", st.rays_per_second()},
                      {"primary", counters(st.primary)},
                      {"shadow", counters(st.shadow)}};
-    if (gpu_context) {
-      j["gpu"] = gpu_json(*gpu_context);
+    if (executor.on_gpu()) {
+      j["gpu"] = gpu_json(executor);
       j["gpu"]["passes"] = pass_timings_json(pass_timings);
     }
     if (o.view == RenderView::kError) {
