@@ -178,10 +178,6 @@ TEST(Gpu, ResidentScenesFollowEditsWithOnlyTheirChunksCopied) {
   EXPECT_TRUE(late.empty()) << late.size() << " validation messages, first: " << late.front();
 }
 
-// CSG models on Vulkan (gpu::render_csg): compiled variants, the interpreter and the mixed
-// schedule give one image, which matches the CPU renderer's (same octree, camera and shading; the
-// GPU marches in floats, so a ray grazing an edge may end a cell earlier or later: at most 1 % of
-// pixels more than 8 levels apart, mean difference under 1 level).
 // The render module's one API (render_executor.h) draws on the backend its executor names: on the
 // CPU the CPU renderer's frames bit for bit, on the device the GPU renderer's, and a SceneView on a
 // device follows an edit as a freshly uploaded scene does.
@@ -213,6 +209,10 @@ TEST(Gpu, TheExecutorApiDrawsOnTheChosenBackend) {
   EXPECT_TRUE(ctx->validation_messages().empty());
 }
 
+// CSG models on Vulkan (gpu::render_csg): compiled variants, the interpreter and the mixed
+// schedule give one image, which matches the CPU renderer's (same octree, camera and shading; the
+// GPU marches in floats, so a ray grazing an edge may end a cell earlier or later: at most 1 % of
+// pixels more than 8 levels apart, mean difference under 1 level).
 TEST(Gpu, CsgFramesMatchTheCpuAndEveryEvaluatorAgrees) {
   if (!gpu_tests_wanted()) GTEST_SKIP();
   auto ctx = validated_context();

@@ -73,7 +73,14 @@ TEST(MemoryLimit, SizesParseAndRefusalsSayWhatAndWhy) {
   EXPECT_EQ(parse_byte_size("8G"), std::uint64_t{8} << 30);
   EXPECT_EQ(parse_byte_size("2GiB"), std::uint64_t{2} << 30);
   EXPECT_THROW(parse_byte_size("8X"), InvalidArgument);
+  EXPECT_EQ(parse_byte_size(" 8 GiB "), std::uint64_t{8} << 30);
   EXPECT_THROW(parse_byte_size("0"), InvalidArgument);
+  EXPECT_THROW(parse_byte_size("0 GiB"), InvalidArgument);
+  // A cache's size may be 0 (off), in any unit.
+  EXPECT_EQ(parse_byte_size("0", "cache", ZeroSize::kAllowed), 0u);
+  EXPECT_EQ(parse_byte_size("0 GiB", "cache", ZeroSize::kAllowed), 0u);
+  EXPECT_EQ(parse_byte_size("64M", "cache", ZeroSize::kAllowed), std::uint64_t{64} << 20);
+  EXPECT_THROW(parse_byte_size("none", "cache", ZeroSize::kAllowed), InvalidArgument);
   EXPECT_THROW(parse_byte_size("99999999999999999999"), InvalidArgument);
   EXPECT_THROW(parse_byte_size("17179869184T"), InvalidArgument);  // 2^64 bytes
   EXPECT_EQ(format_bytes(1536), "1.5 KiB");

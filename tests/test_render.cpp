@@ -16,6 +16,7 @@
 #include "voxfield/parallel.h"
 #include "voxfield/png.h"
 #include "voxfield/render.h"
+#include "voxfield/render_executor.h"
 
 using namespace voxfield;
 
@@ -532,4 +533,31 @@ TEST(Render, SceneUpdatesTouchOnlyTheChunksAnEditReaches) {
   RenderSceneOptions bad = so;
   bad.skip_max_distance_vox = 300;
   EXPECT_THROW(DynamicRenderScene(w, bad), InvalidArgument);
+}
+
+// The render module's one API on the CPU executor (every build has it): the CPU renderer's frames
+// bit for bit, and a SceneView following an edit as a scene built afresh does. The Vulkan half is
+// checked in test_gpu_render.cpp.
+TEST(Render, TheCpuExecutorDrawsTheCpuRenderersFrames) {
+  World w = random_world({40, 32, 24}, 8, 5, 12);
+  RenderSceneOptions so = DynamicRenderScene::default_options();
+  so.skip_max_distance_vox = 8;
+  DynamicRenderScene live(w, so);
+  RenderOptions o;
+  o.width = 64;
+  o.height = 48;
+  const Camera cam = Camera::framing(live.scene().box(), 1.5);
+  const Executor cpu = Executor::choose(Backend::kCpu);
+  ASSERT_FALSE(cpu.on_gpu());
+  std::vector<gpu::PassTiming> timings{{"stale", 1}};
+  EXPECT_EQ(render(cpu, live.scene(), cam, o, nullptr, nullptr, &timings).rgb,
+            render(live.scene(), cam, o).rgb);
+  EXPECT_TRUE(timings.empty());  // no device, no passes
+  SceneView view(cpu);
+  (void)view.render(live.scene(), cam, o);
+  DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
+  apply_edit(w, {EditOp::kPlace, SphereBrush{{20, 16, 12}, 5}, 77}, &dirty);
+  live.update(dirty);
+  const RenderScene fresh(w, live.skip_field(), live.light_field());
+  EXPECT_EQ(view.render(live.scene(), cam, o).rgb, render(fresh, cam, o).rgb);
 }

@@ -271,3 +271,58 @@ TEST(WorldFile, PartsAssembleIntoTheWholeFile) {
     }
   }
 }
+
+// A slab of a world file (voxfield-mpi's ranks): only the chunks reaching into the z range are
+// decoded — equal to the whole file's there, none elsewhere — fields are skipped, the frame kept,
+// the memory limit charged for the slab alone, and every checksum still checked.
+TEST(WorldFile, SlabsDecodeOnlyTheirChunks) {
+  const Box3i bounds{{-5, 3, -20}, {35, 33, 45}};
+  World w(8, bounds);
+  std::mt19937 rng(11);
+  for (int k = 0; k < 3000; ++k) {
+    const Vec3i s = bounds.size();
+    w.voxels.set(bounds.begin + Vec3i{static_cast<int>(rng() % s.x), static_cast<int>(rng() % s.y),
+                                      static_cast<int>(rng() % s.z)},
+                 static_cast<std::uint8_t>(1 + rng() % 9));
+  }
+  w.voxels.fill({{-5, 3, 8}, {35, 33, 17}}, 4);  // uniform chunks, and ones the layer cuts
+  w.frame.voxel_size_world = {0.5, 0.5, 0.5};
+  const DistanceField f = compute_distance_field(w, {});
+  const auto bytes = encode_world_file(w, {&f});
+  const WorldFile whole = parse_world_file(bytes, "whole.vfw");
+  for (const auto& [z0, z1] : std::vector<std::pair<int, int>>{
+           {-20, -12}, {-3, 9}, {8, 17}, {30, 45}, {44, 100}, {0, 0}}) {
+    WorldFileReadOptions o;
+    o.keep_z = std::pair<std::int32_t, std::int32_t>{z0, z1};
+    const WorldFile part = parse_world_file(bytes, "slab.vfw", o);
+    const std::string what = "z in [" + std::to_string(z0) + ", " + std::to_string(z1) + ")";
+    EXPECT_TRUE(part.fields.empty()) << what;
+    EXPECT_EQ(part.world.frame, w.frame) << what;
+    EXPECT_EQ(part.world.palette, w.palette) << what;
+    EXPECT_EQ(part.world.voxels.bounds(), w.voxels.bounds()) << what;
+    for (const Vec3i c : part.world.voxels.chunk_coords()) {
+      const Box3i b = part.world.voxels.chunk_box(c);
+      EXPECT_TRUE(b.begin.z < z1 && z0 < b.end.z) << what << ": chunk " << to_string(c);
+    }
+    const Box3i slab = bounds.intersect(
+        {{bounds.begin.x, bounds.begin.y, z0}, {bounds.end.x, bounds.end.y, std::max(z0, z1)}});
+    if (!slab.empty()) {
+      EXPECT_EQ(test::dense_voxels(part.world, slab), test::dense_voxels(whole.world, slab))
+          << what;
+    } else {
+      EXPECT_EQ(part.world.voxels.chunk_count(), 0u) << what;
+    }
+  }
+  // The limit counts the slab: one that refuses the whole world admits a thin slab.
+  WorldFileReadOptions tight;
+  tight.memory_limit_bytes = 40 * (8 * 8 * 8 + 96);
+  EXPECT_THROW(parse_world_file(bytes, "tight.vfw", tight), ResourceLimitError);
+  tight.keep_z = std::pair<std::int32_t, std::int32_t>{-20, -16};
+  EXPECT_NO_THROW(parse_world_file(bytes, "tight.vfw", tight));
+  // A corrupted byte anywhere is still found, in chunks the slab skips too.
+  auto bad = bytes;
+  bad[bad.size() / 2] ^= 0x40;
+  WorldFileReadOptions o;
+  o.keep_z = std::pair<std::int32_t, std::int32_t>{-20, -16};
+  EXPECT_THROW(parse_world_file(bad, "bad.vfw", o), FormatError);
+}

@@ -117,12 +117,14 @@ int run_field(const FieldSettings& s) {
   // mm) is measured in its voxel size unless --spacing says otherwise. Isotropic voxels need no
   // spacing (the writer scales voxels to world units), nor does a .npy (values in voxels).
   const Vec3d size = in.world.frame.voxel_size_world;
-  if (vdb_output && s.field.spacing.empty() && o.metric == Metric::kEuclidean &&
-      !(size.x == size.y && size.y == size.z)) {
+  // (On the CPU: the GPU backend measures in voxels only, and its refusal would name a spacing
+  // nobody gave; the writer's own refusal names --spacing.)
+  if (vdb_output && s.backend == "cpu" && s.field.spacing.empty() &&
+      o.metric == Metric::kEuclidean && !(size.x == size.y && size.y == size.z)) {
     o.spacing = {size.x, size.y, size.z};
     std::cerr << "voxfield: measuring in the world's voxel size " << size.x << " x " << size.y
               << " x " << size.z << " (--spacing), so that " << s.out
-              << " holds distances in its units\n";
+              << " holds distances in its units (--max-distance too)\n";
   }
   AlgorithmStats stats;
   const auto gpu_context = choose_backend(s.backend);

@@ -40,6 +40,8 @@ class IncrementalDistanceField {
   void rebuild();
 
   // The current field: the CPU's own, or the device's read back once per change (bytes moved).
+  // The reference is valid until the next update() or rebuild() (on a device it names the copy
+  // read back, which they drop); not thread-safe.
   const DistanceField& field();
   const DistanceOptions& options() const;
   Vec3i reach() const;

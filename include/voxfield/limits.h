@@ -34,9 +34,9 @@ inline std::uint64_t effective_memory_limit(std::uint64_t limit) {
 
 // Whether a size of 0 (in any unit) is a value — "off", for a cache — or refused.
 enum class ZeroSize { kRefused, kAllowed };
-// "123", "64K", "512M", "8G", "1T" (binary units, case-insensitive, optional trailing "B" or
-// "iB") -> bytes. Throws InvalidArgument naming `what` for anything else, and for 0 unless `zero`
-// allows it.
+// "123", "64K", "512M", "8G", "1T", "8 GiB" (binary units, case-insensitive, optional trailing "B"
+// or "iB", spaces around the number) -> bytes. Throws InvalidArgument naming `what` for anything
+// else, and for 0 unless `zero` allows it.
 std::uint64_t parse_byte_size(std::string_view text, std::string_view what = "memory limit",
                               ZeroSize zero = ZeroSize::kRefused);
 // "1.5 GiB", "12.0 MiB", "980 B".

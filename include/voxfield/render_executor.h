@@ -32,7 +32,9 @@ class SceneView {
   SceneView& operator=(const SceneView&) = delete;
 
   // A frame of `scene` as it is now (on a device: synced first, one submit when anything
-  // changed). As render() above.
+  // changed). As render() above, except that stats->ms and `timings` cover the frame, not the
+  // sync. After a GpuUnavailable of any kind (out of memory included) the device copy may be
+  // stale: destroy the view and make a new one.
   Image render(const RenderScene& scene, const Camera& camera, const RenderOptions& options,
                RenderStats* stats = nullptr, Interrupter* interrupter = nullptr,
                std::vector<gpu::PassTiming>* timings = nullptr);

@@ -6,8 +6,10 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "voxfield/distance.h"
@@ -29,6 +31,12 @@ struct WorldFileReadOptions {
   // Refuse (ResourceLimitError) a file whose chunks would decode to more; 0: the process default
   // (limits.h). Counted from the chunk headers before anything is decompressed.
   std::uint64_t memory_limit_bytes = 0;
+  // A slab of the world: decode only the chunks that reach into z in [keep_z->first,
+  // keep_z->second), and no distance field. Every record and checksum is still checked; the other
+  // chunks are never decompressed nor charged against the memory limit. An empty range decodes
+  // no chunk: the palette, the grid's head (chunk edge, bounds) and the frame alone. (What
+  // voxfield-mpi's ranks read: each holds the file's compressed bytes and its own slab.)
+  std::optional<std::pair<std::int32_t, std::int32_t>> keep_z;
 };
 
 std::vector<std::uint8_t> encode_world_file(const World& world,

@@ -102,7 +102,8 @@ void bind_mesh(py::module_& parent) {
                            "A deformable terrain field: a signed lattice in i8, i16 or f32 chunks, "
                            "edited by brushes (docs/meshing.md, 'Terrain fields')")
       .def(py::init([](std::vector<int> samples, const std::string& storage, double spacing,
-                       std::vector<double> origin, double max_distance, int chunk, bool positive_inside,
+                       std::vector<double> origin, double max_distance, int chunk,
+                       bool positive_inside,
                        std::optional<py::array_t<std::uint8_t, py::array::c_style |
                                                                 py::array::forcecast>> palette) {
              if (samples.size() != 3) throw InvalidArgument("samples takes three integers");
@@ -129,8 +130,9 @@ void bind_mesh(py::module_& parent) {
            py::arg("origin") = std::vector<double>{0, 0, 0}, py::arg("max_distance") = 0.0,
            py::arg("chunk") = 16, py::arg("positive_inside") = false,
            py::arg("palette") = py::none(),
-           "samples: (nx, ny, nz); storage 'i8', 'i16' or 'f32'; max_distance (the clamp) in world units (0: the "
-           "storage's default); palette: uint8 (256, 3) colours by material for meshes")
+           "samples: (nx, ny, nz); storage 'i8', 'i16' or 'f32'; max_distance (the clamp) in "
+           "world units (0: the storage's default); palette: uint8 (256, 3) colours by material "
+           "for meshes")
       .def("__repr__",
            [](const PyTerrain& t) {
              py::gil_scoped_release release;

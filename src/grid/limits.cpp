@@ -48,6 +48,9 @@ std::uint64_t parse_byte_size(std::string_view text, std::string_view what, Zero
     throw InvalidArgument(std::string(what) + ": \"" + std::string(text) + "\" " + why +
                           " (expected bytes or a size such as 512M, 8G)");
   };
+  // Spaces around the number and before the unit are allowed ("8 GiB", as format_bytes writes).
+  while (!text.empty() && text.front() == ' ') text.remove_prefix(1);
+  while (!text.empty() && text.back() == ' ') text.remove_suffix(1);
   std::size_t i = 0;
   std::uint64_t v = 0;
   while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) {
@@ -57,6 +60,7 @@ std::uint64_t parse_byte_size(std::string_view text, std::string_view what, Zero
     ++i;
   }
   if (i == 0) return bad("is not a size");
+  while (i < text.size() && text[i] == ' ') ++i;
   std::string unit;
   for (; i < text.size(); ++i)
     unit += static_cast<char>(std::toupper(static_cast<unsigned char>(text[i])));

@@ -128,8 +128,20 @@ class Budget {
 
 constexpr std::uint64_t kBytesPerChunkNode = 96;  // hash node and bookkeeping of a stored chunk
 
+// Which chunks a reader decodes: all, or those reaching into z in [z_begin, z_end) (a slab).
+struct ChunkFilter {
+  bool all = true;
+  std::int32_t z_begin = 0, z_end = 0;
+  template <class T>
+  bool keeps(const Grid<T>& g, Vec3i chunk) const {
+    if (all) return true;
+    const Box3i b = g.chunk_box(chunk);
+    return z_begin < z_end && b.begin.z < z_end && z_begin < b.end.z;
+  }
+};
+
 template <class T>
-Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
+Grid<T> get_grid(detail::ByteReader& r, Budget& budget, const ChunkFilter& filter = {}) {
   const auto edge = get<std::uint32_t>(r, "chunk edge");
   if (edge < 8 || edge > 128 || (edge & (edge - 1)) != 0)
     r.fail("chunk edge " + std::to_string(edge) + " is not a power of two in 8..128");
@@ -160,7 +172,7 @@ Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
   {
     detail::ByteReader scan = r;
     std::unordered_set<Vec3i, Vec3iHash> seen;
-    std::uint64_t dense = 0;
+    std::uint64_t dense = 0, kept = 0;
     for (std::uint64_t i = 0; i < count; ++i) {
       const std::uint64_t at = scan.offset();
       Vec3i c;
@@ -176,20 +188,22 @@ Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
       if (bounds && g.chunk_box(c).intersect(*bounds).empty())
         scan.fail_at(at, "chunk " + to_string(c) + " lies outside the grid bounds");
       if (!seen.insert(c).second) scan.fail_at(at, "chunk " + to_string(c) + " appears twice");
+      const bool keep = filter.keeps(g, c);  // only what is decoded is charged
+      kept += keep;
       if (kind == 0) {
         // A uniform chunk the bounds cut through is stored densely (the part outside holds the
         // background), unless it holds the background itself.
         const T v = get<T>(scan, "uniform value");
-        if (bounds && !bounds->contains(g.chunk_box(c)) && !(v == background)) ++dense;
+        if (keep && bounds && !bounds->contains(g.chunk_box(c)) && !(v == background)) ++dense;
       } else if (kind == 1) {
         scan.skip(get<std::uint32_t>(scan, "chunk size"), "chunk data");
-        ++dense;
+        dense += keep;
       } else {
         scan.fail_at(at + 12, "unknown chunk kind " + std::to_string(kind));
       }
     }
-    budget.charge(add_sat(mul_sat(dense, raw), mul_sat(count, kBytesPerChunkNode)),
-                  "a grid of " + std::to_string(count) + " chunks (" + std::to_string(dense) +
+    budget.charge(add_sat(mul_sat(dense, raw), mul_sat(kept, kBytesPerChunkNode)),
+                  "a grid of " + std::to_string(kept) + " chunks (" + std::to_string(dense) +
                       " dense, " + std::to_string(raw) + " bytes each)");
   }
 
@@ -201,6 +215,13 @@ Grid<T> get_grid(detail::ByteReader& r, Budget& budget) {
     c.y = get<std::int32_t>(r, "chunk coordinate");
     c.z = get<std::int32_t>(r, "chunk coordinate");
     const auto kind = get<std::uint8_t>(r, "chunk kind");
+    if (!filter.keeps(g, c)) {  // checked by the first pass; its bytes are never decompressed
+      if (kind == 0)
+        r.skip(sizeof(T), "uniform value");
+      else
+        r.skip(get<std::uint32_t>(r, "chunk size"), "chunk data");
+      continue;
+    }
     if (kind == 0) {
       // Uniform chunks stay single values: no voxel array is allocated for them.
       const T v = get<T>(r, "uniform value");
@@ -441,13 +462,19 @@ WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::strin
     if (kind == kWorldSection) {
       if (s != 0) r.fail_at(at, "the world section must come first");
       for (Rgba& c : out.world.palette) c = get<Rgba>(payload, "palette");
-      out.world.voxels = get_grid<std::uint8_t>(payload, budget);
+      ChunkFilter filter;
+      if (options.keep_z) filter = {false, options.keep_z->first, options.keep_z->second};
+      out.world.voxels = get_grid<std::uint8_t>(payload, budget, filter);
     } else if (kind == kFrameSection) {
       if (s != 1 || out.version < 2)
         r.fail_at(at, "a frame section that does not follow the world (or in a version 1 file)");
       out.world.frame = get_frame(payload, at);
     } else if (kind == kFieldSection) {
       if (s == 0) r.fail_at(at, "a field section before the world");
+      if (options.keep_z) {  // a slab of the world only: the field's bytes are checked, not read
+        payload.skip(payload.remaining(), "field");
+        continue;
+      }
       out.fields.push_back(get_field(payload, budget));
       const DistanceField& f = out.fields.back();
       const int edge = out.world.voxels.chunk_edge();

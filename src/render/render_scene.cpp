@@ -89,9 +89,10 @@ DistanceOptions skip_field_options(const RenderSceneOptions& options, const Box3
   o.storage = Storage::kU8;
   const double most = o.metric == Metric::kEuclidean ? 63 : 255;
   if (!(options.skip_max_distance_vox >= 0 && options.skip_max_distance_vox <= most))
-    throw InvalidArgument("render: the skip clamp must lie in [0, " +
-                          std::to_string(static_cast<int>(most)) + "] voxels for the " +
-                          metric_name(o.metric) + " metric (0 = the most)");
+    throw InvalidArgument(
+        "render: skip_max_distance_vox (the skip field's clamp) must lie in [0, " +
+        std::to_string(static_cast<int>(most)) + "] voxels for the " + metric_name(o.metric) +
+        " metric (0 = the most)");
   o.max_distance = options.skip_max_distance_vox > 0 ? options.skip_max_distance_vox : most;
   o.domain = box;
   return o;
@@ -99,7 +100,9 @@ DistanceOptions skip_field_options(const RenderSceneOptions& options, const Box3
 
 DistanceOptions light_field_options(const RenderSceneOptions& options, const Box3i& box) {
   if (!(options.lighting_max_distance_vox > 0 && options.lighting_max_distance_vox <= 63))
-    throw InvalidArgument("render: lighting clamp must lie in (0, 63] voxels");
+    throw InvalidArgument(
+        "render: lighting_max_distance_vox (the lighting field's clamp) must lie in (0, 63] "
+        "voxels");
   DistanceOptions o;
   o.metric = Metric::kEuclidean;
   o.storage = Storage::kU8;

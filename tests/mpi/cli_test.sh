@@ -113,6 +113,21 @@ for n in 1 2 3 4; do
   same ref.vfw out.vfw "edit --save-world, $n ranks"
   same ref.npy out.npy "edit --save-world, $n ranks (field)"
 done
+# That bounded .vfw as input: every rank decodes only its slab's chunks (read_in_parts), in the
+# file's chunks of 8 or re-chunked to 16, the field byte-identical to voxfield's.
+"$VF" field ref.vfw -o ref.npy --metric euclidean --signed 2>/dev/null
+for n in 1 3; do
+  for chunk in 8 16; do
+    MPIEXEC -np "$n" "$VFM" field ref.vfw -o out.npy --chunk "$chunk" --stats stats.json \
+      --metric euclidean --signed 2>/dev/null
+    same ref.npy out.npy "$n ranks, ref.vfw, chunk $chunk"
+  done
+done
+/usr/bin/python3 - <<'PY'
+import json
+s = json.load(open("stats.json"))
+assert s["ranks"] == 3 and s["read_in_parts"] is True, s
+PY
 # Slabs not cut on chunks cannot share a .vfw: refused, and the field is not written either.
 /usr/bin/python3 -c "import numpy as np; np.save('short.npy', np.ones((8, 8, 20), np.uint8))"
 EXPECT_RANKS=4 expect_failure 1 "needs slabs cut on chunk boundaries" edit short.npy -e edits.jsonl -o bad.npy \
