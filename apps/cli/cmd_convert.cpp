@@ -17,6 +17,7 @@ struct ConvertSettings {
   std::string in, out;
   std::vector<double> voxel_size;  // one edge (a mesh's, or a world's cubic voxels) or three
   std::vector<double> origin;      // x, y, z: where a world's voxel corner (0, 0, 0) lies
+  std::vector<double> rotate;      // degrees, then the axis x, y, z
   std::string grid;
 };
 
@@ -27,6 +28,8 @@ void set_frame(World& world, const ConvertSettings& s) {
   if (s.voxel_size.size() == 3)
     world.frame.voxel_size_world = {s.voxel_size[0], s.voxel_size[1], s.voxel_size[2]};
   if (s.origin.size() == 3) world.frame.origin_world = {s.origin[0], s.origin[1], s.origin[2]};
+  if (s.rotate.size() == 4)
+    world.frame.rotation = rotation_about(s.rotate[0], {s.rotate[1], s.rotate[2], s.rotate[3]});
 }
 
 // .vfw and .vdb keep a world's frame; .vox and .npy have nowhere to put it. Not an error (the
@@ -47,8 +50,8 @@ int run_convert(const ConvertSettings& s) {
   if (mesh_input_format_of(s.in)) {
     if (s.voxel_size.size() != 1)
       throw UsageError(s.in + ": a mesh needs --voxel-size (one edge, in its units)");
-    if (!s.origin.empty())
-      throw UsageError("--origin: a voxelised mesh's frame is the mesh's own units");
+    if (!s.origin.empty() || !s.rotate.empty())
+      throw UsageError("--origin, --rotate: a voxelised mesh's frame is the mesh's own units");
     set_activity("reading " + s.in);
     const TriangleMesh mesh = read_mesh(s.in);
     MeshVoxelOptions o;
@@ -66,10 +69,12 @@ int run_convert(const ConvertSettings& s) {
     note_frame_left_out(world, s.out);
     return 0;
   }
-  if ((!s.voxel_size.empty() || !s.origin.empty()) && world_format_of(s.out) != WorldFormat::kVfw &&
-      world_format_of(s.out) != WorldFormat::kVdb)
-    throw UsageError("--voxel-size and --origin set the world's frame, which " + s.out +
+  if ((!s.voxel_size.empty() || !s.origin.empty() || !s.rotate.empty()) &&
+      world_format_of(s.out) != WorldFormat::kVfw && world_format_of(s.out) != WorldFormat::kVdb)
+    throw UsageError("--voxel-size, --origin and --rotate set the world's frame, which " + s.out +
                      " cannot keep (.vfw and .vdb keep it)");
+  if (!s.rotate.empty() && Vec3d{s.rotate[1], s.rotate[2], s.rotate[3]}.length() == 0)
+    throw UsageError("--rotate DEG,AX,AY,AZ: the axis must not be zero");
   set_activity("loading " + s.in);
   LoadOptions lo;
   lo.chunk_edge = 0;  // a .vfw keeps the chunk edge it was saved with
@@ -107,6 +112,12 @@ void add_convert(CLI::App& app, Action& action) {
                   "lies in world units (its frame)")
       ->delimiter(',')
       ->expected(3)
+      ->check(finite_number());
+  cmd->add_option("--rotate", s->rotate,
+                  "for a world written to .vfw or .vdb: DEG,AX,AY,AZ, its voxel axes turned DEG "
+                  "degrees about the axis (AX,AY,AZ) in the world (its frame)")
+      ->delimiter(',')
+      ->expected(4)
       ->check(finite_number());
   cmd->add_option("OUT", s->out, "output .vox, .npy, .vfw or .vdb")->required();
   cmd->callback([s, &action] { action = [s] { return run_convert(*s); }; });

@@ -41,7 +41,8 @@ struct VectorVolume {
   std::array<Vec3d, 3> rotation{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
   Vec3i resolution{64, 64, 64};
 
-  // Rotation by `degrees` about `axis` (normalised here; throws InvalidArgument for a zero axis).
+  // Rotation by `degrees` about `axis` (voxfield::rotation_about in voxel_frame.h; throws
+  // InvalidArgument for a zero axis).
   static std::array<Vec3d, 3> rotation_about(double degrees, Vec3d axis);
 
   std::int64_t voxel_count() const;

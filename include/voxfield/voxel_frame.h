@@ -59,6 +59,10 @@ struct VoxelFrame {
   static VoxelFrame from_matrix(const std::array<double, 12>& m, const std::string& what);
 };
 
+// The rotation by `angle_deg` degrees about `axis` (normalised here), as rows (Rodrigues' formula).
+// Throws InvalidArgument for a zero or non-finite axis or a non-finite angle.
+std::array<Vec3d, 3> rotation_about(double angle_deg, Vec3d axis);
+
 // "origin (x, y, z), voxel size (sx, sy, sz)[, rotated]" for reports.
 std::string describe(const VoxelFrame& frame);
 

@@ -142,6 +142,18 @@ VoxelFrame VoxelFrame::from_matrix(const std::array<double, 12>& m, const std::s
   return f;
 }
 
+std::array<Vec3d, 3> rotation_about(double angle_deg, Vec3d axis) {
+  if (!finite(axis) || axis.length() == 0 || !std::isfinite(angle_deg))
+    throw InvalidArgument(
+        "rotation: the axis must be a finite non-zero vector and the angle finite");
+  const Vec3d u = axis.normalized();
+  const double a = angle_deg * 3.14159265358979323846 / 180.0, c = std::cos(a), s = std::sin(a),
+               t = 1 - c;
+  return {{{t * u.x * u.x + c, t * u.x * u.y - s * u.z, t * u.x * u.z + s * u.y},
+           {t * u.x * u.y + s * u.z, t * u.y * u.y + c, t * u.y * u.z - s * u.x},
+           {t * u.x * u.z - s * u.y, t * u.y * u.z + s * u.x, t * u.z * u.z + c}}};
+}
+
 std::string describe(const VoxelFrame& frame) {
   std::string s =
       "origin " + vec(frame.origin_world) + ", voxel size " + vec(frame.voxel_size_world);

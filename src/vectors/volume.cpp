@@ -8,6 +8,7 @@
 #include "voxfield/error.h"
 #include "voxfield/interrupt.h"
 #include "voxfield/parallel.h"
+#include "voxfield/voxel_frame.h"
 
 namespace voxfield {
 namespace {
@@ -25,16 +26,7 @@ Vec3d column(const std::array<Vec3d, 3>& r, int c) {
 }  // namespace
 
 std::array<Vec3d, 3> VectorVolume::rotation_about(double degrees, Vec3d axis) {
-  if (!finite(axis) || axis.length() == 0 || !std::isfinite(degrees))
-    throw InvalidArgument(
-        "rotation: the axis must be a finite non-zero vector and the angle finite");
-  const Vec3d u = axis.normalized();
-  const double a = degrees * 3.14159265358979323846 / 180.0, c = std::cos(a), s = std::sin(a),
-               t = 1 - c;
-  // Rodrigues' rotation formula, as rows.
-  return {{{t * u.x * u.x + c, t * u.x * u.y - s * u.z, t * u.x * u.z + s * u.y},
-           {t * u.x * u.y + s * u.z, t * u.y * u.y + c, t * u.y * u.z - s * u.x},
-           {t * u.x * u.z - s * u.y, t * u.y * u.z + s * u.x, t * u.z * u.z + c}}};
+  return voxfield::rotation_about(degrees, axis);
 }
 
 std::int64_t VectorVolume::voxel_count() const {
