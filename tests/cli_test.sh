@@ -486,16 +486,6 @@ assert np.abs(v.min(0)).max() < 1e-6 and np.abs(v.max(0) - 2).max() < 1e-6, (v.m
 # units is measured in those voxels (by default for a .vdb, said on stderr; refused when another
 # --spacing or metric is asked for); OpenVDB's transform then puts voxel (i, j, k)'s centre at
 # origin + ((i, j, k) + 1/2) * size.
-# A .npy's margins of air survive a .vfw: the file is bounded by the array's extent.
-/usr/bin/python3 -c "import numpy as np; a = np.zeros((10, 12, 14), np.uint8); a[5, 5, 5] = 3; np.save('$tmp/margin.npy', a)"
-check "npy with margins to vfw" 0 "$V" convert "$tmp/margin.npy" "$tmp/margin.vfw"
-check "its extent" 0 "$V" info "$tmp/margin.vfw" --json
-cp "$tmp/out" "$tmp/margin.json"
-check "the array's extent kept" 0 /usr/bin/python3 -c "
-import json; d = json.load(open('$tmp/margin.json'))['dims']; assert d == [10, 12, 14], d"
-check "and back to npy" 0 "$V" convert "$tmp/margin.vfw" "$tmp/margin2.npy"
-check "the same array" 0 /usr/bin/python3 -c "
-import numpy as np; a, b = np.load('$tmp/margin.npy'), np.load('$tmp/margin2.npy'); assert a.shape == b.shape and (a == b).all(), (a.shape, b.shape)"
 check "frame given" 0 "$V" convert "$tmp/cube.npy" "$tmp/scan.vfw" --voxel-size 0.5,0.5,2 --origin 10,0,-5
 check "info of the given frame" 0 "$V" info "$tmp/scan.vfw" --json
 expect_grep "given voxel size" "$tmp/out" '"voxel_size_world": \['
@@ -505,6 +495,7 @@ expect_grep "frame to .npy refused" "$tmp/err" "cannot keep"
 check "two voxel sizes refused" 2 "$V" convert "$tmp/cube.npy" "$tmp/x.vfw" --voxel-size 1,2
 check "a non-finite origin refused" 2 "$V" convert "$tmp/cube.npy" "$tmp/x.vfw" --origin 0,nan,0
 check "a zero rotation axis refused" 2 "$V" convert "$tmp/cube.npy" "$tmp/x.vfw" --rotate 30,0,0,0
+[ ! -e "$tmp/x.vfw" ] && passes=$((passes+1)) || { echo "FAIL: a refused frame wrote its output"; fails=$((fails+1)); }
 # Turned 90 degrees about z: the voxel x axis runs along world y, so OpenVDB puts index (1, 0, 0)
 # one voxel edge up y from index (0, 0, 0).
 # (pyopenvdb cannot open the world's Int32 grid: its level set's Float grid carries the frame.)

@@ -319,7 +319,8 @@ TEST(WorldFile, SlabsDecodeOnlyTheirChunks) {
   EXPECT_THROW(parse_world_file(bytes, "tight.vfw", tight), ResourceLimitError);
   tight.keep_z = std::pair<std::int32_t, std::int32_t>{-20, -16};
   EXPECT_NO_THROW(parse_world_file(bytes, "tight.vfw", tight));
-  // A corrupted byte anywhere is still found, in chunks the slab skips too.
+  // A corrupted byte is still found where the slab decodes nothing (here the field section, which
+  // it skips): every section's checksum is checked.
   auto bad = bytes;
   bad[bad.size() / 2] ^= 0x40;
   WorldFileReadOptions o;

@@ -114,8 +114,8 @@ void add_convert(CLI::App& app, Action& action) {
       ->expected(3)
       ->check(finite_number());
   cmd->add_option("--rotate", s->rotate,
-                  "for a world written to .vfw or .vdb: DEG,AX,AY,AZ, its voxel axes turned DEG "
-                  "degrees about the axis (AX,AY,AZ) in the world (its frame)")
+                  "for a world written to .vfw or .vdb: DEG,AX,AY,AZ, its frame's rotation set to "
+                  "DEG degrees about the axis (AX,AY,AZ), replacing the one read")
       ->delimiter(',')
       ->expected(4)
       ->check(finite_number());

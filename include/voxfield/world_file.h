@@ -32,8 +32,9 @@ struct WorldFileReadOptions {
   // (limits.h). Counted from the chunk headers before anything is decompressed.
   std::uint64_t memory_limit_bytes = 0;
   // A slab of the world: decode only the chunks that reach into z in [keep_z->first,
-  // keep_z->second), and no distance field. Every record and checksum is still checked; the other
-  // chunks are never decompressed nor charged against the memory limit. An empty range decodes
+  // keep_z->second), and no distance field. Every checksum and every world chunk record is still
+  // checked; the other chunks are never decompressed nor charged against the memory limit, and a
+  // field section is checked by its checksum alone. An empty range decodes
   // no chunk: the palette, the grid's head (chunk edge, bounds) and the frame alone. (What
   // voxfield-mpi's ranks read: each holds the file's compressed bytes and its own slab.)
   std::optional<std::pair<std::int32_t, std::int32_t>> keep_z;

@@ -55,8 +55,7 @@ World rechunk_world(const World& world, int chunk_edge, std::optional<Box3i> bou
                     const std::string& who, std::uint64_t memory_limit_bytes = 0);
 
 // The bytes of `world` in a format; for .npy the box `extent` united with the content is written
-// (a 1^3 box when both are empty); a .vfw of an unbounded world is bounded by that box, so that it
-// reads back with the same extent.
+// (a 1^3 box when both are empty).
 std::vector<std::uint8_t> encode_world(const World& world, const Box3i& extent, WorldFormat format);
 // encode_world by the path's extension, then write_file_atomic.
 void save_world(const World& world, const Box3i& extent, const std::filesystem::path& path);

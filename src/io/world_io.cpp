@@ -193,14 +193,8 @@ std::vector<std::uint8_t> encode_world(const World& world, const Box3i& extent,
                      "a dense volume of " + std::to_string(box.volume()) + " voxels");
       return encode_npy(npy_from_world(world, box));
     }
-    case WorldFormat::kVfw: {
-      // The file keeps the extent as the world's bounds: an unbounded world (from a .npy or a .vox)
-      // would otherwise come back as its content alone, its margins of air lost — and a bounded
-      // .vfw is what voxfield-mpi's ranks can read a slab each.
-      const Box3i box = extent.unite(world.voxels.content_bounds());
-      if (world.voxels.bounds() || box.empty()) return encode_world_file(world);
-      return encode_world_file(rechunk_world(world, world.voxels.chunk_edge(), box, "world file"));
-    }
+    case WorldFormat::kVfw:
+      return encode_world_file(world);
     case WorldFormat::kVdb:
       return encode_vdb_world(world, extent);
   }

@@ -31,8 +31,8 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
     };
     if (format == WorldFormat::kVfw) {
       // A bounded world's domain is in the file's head: each rank holds the compressed bytes and
-      // decodes only its slab's chunks (every record and checksum still checked). An unbounded
-      // world's domain is its content, known only once decoded: read whole, below.
+      // decodes only its slab's chunks (every checksum and world chunk record still checked). An
+      // unbounded world's domain is its content, known only once decoded: read whole, below.
       const std::uint64_t limit = effective_memory_limit(0);
       const std::vector<std::uint8_t> bytes = read_file(path, limit);
       WorldFileReadOptions head_only;
