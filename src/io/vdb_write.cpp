@@ -12,6 +12,7 @@
 #include <limits>
 #include <mutex>
 #include <sstream>
+#include <utility>
 #include <variant>
 
 #include "voxfield/error.h"
@@ -171,7 +172,10 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
   const double offset =
       is_signed ? 0.5 * std::min({o.spacing[0], o.spacing[1], o.spacing[2]}) : 0.0;
   // The grid's world units: its frame's, k per unit of the field's values.
-  const auto [frame, k] = field_world_units(field);
+  // (Not a structured binding: clang before 16 cannot capture one in the lambda below.)
+  const std::pair<VoxelFrame, double> units = field_world_units(field);
+  const VoxelFrame& frame = units.first;
+  const double k = units.second;
   const auto level = [&](double d) { return k * (d > 0 ? d - offset : d < 0 ? d + offset : d); };
   // Visits every stored chunk of the field within its domain with the decoded values.
   const auto for_each_value = [&](auto&& on_uniform, auto&& on_voxel) {
