@@ -131,8 +131,22 @@ struct VdbGrid {
   bool leaves_hold_floats() const {
     return value_type == VdbValueType::kFloat || value_type == VdbValueType::kVec3f;
   }
+  std::size_t leaf_value_bytes() const {
+    return leaves_hold_floats() ? sizeof(float) : sizeof(double);
+  }
+  // f(leaf_floats) or f(leaf_doubles), whichever holds the values: the one place the width is
+  // chosen, so a loop over many values inside f branches once, not per value.
+  template <class F>
+  decltype(auto) with_leaf_values(F&& f) const {
+    return leaves_hold_floats() ? f(leaf_floats) : f(leaf_doubles);
+  }
+  template <class F>
+  decltype(auto) with_leaf_values(F&& f) {
+    return leaves_hold_floats() ? f(leaf_floats) : f(leaf_doubles);
+  }
+  // One value (a branch per call: loops over many go through with_leaf_values).
   double leaf_value(std::size_t i) const {
-    return leaves_hold_floats() ? leaf_floats[i] : leaf_doubles[i];
+    return with_leaf_values([i](const auto& values) { return static_cast<double>(values[i]); });
   }
 
   bool leaf_active(const VdbLeaf& leaf, int i) const {

@@ -108,10 +108,7 @@ class TreeReader {
     grid_.leaves.reserve(grid_.leaves.size() + leaf_count);
     const std::size_t values = leaf_count * (std::size_t{1} << (3 * grid_.log2_dims.back())) *
                                static_cast<std::size_t>(grid_.components);
-    if (grid_.leaves_hold_floats())
-      grid_.leaf_floats.reserve(grid_.leaf_floats.size() + values);
-    else
-      grid_.leaf_doubles.reserve(grid_.leaf_doubles.size() + values);
+    grid_.with_leaf_values([values](auto& held) { held.reserve(held.size() + values); });
     for (Child& child : root_children)
       for (PendingLeaf& leaf : child.leaves) read_leaf_buffers(leaf);
   }
@@ -339,8 +336,7 @@ class TreeReader {
       if (!bit(child_mask, i)) {
         add_tile(at, child_shift, values[i], bit(value_mask, i));
       } else if (children_are_leaves) {
-        charge(sizeof(VdbLeaf) + ((grid_.leaves_hold_floats() ? std::size_t{4} : std::size_t{8})
-                                  << (3 * grid_.log2_dims.back())) *
+        charge(sizeof(VdbLeaf) + (grid_.leaf_value_bytes() << (3 * grid_.log2_dims.back())) *
                                      static_cast<std::size_t>(grid_.components),
                "its leaves");
         leaves.push_back({at, read_mask(grid_.log2_dims.back(), "leaf value mask")});
@@ -355,31 +351,28 @@ class TreeReader {
     const int dim = grid_.log2_dims.back();
     const std::size_t count = std::size_t{1} << (3 * dim);
     const std::size_t comps = static_cast<std::size_t>(grid_.components);
-    const bool floats = grid_.leaves_hold_floats();
-    const std::size_t first = floats ? grid_.leaf_floats.size() : grid_.leaf_doubles.size();
-    if (floats)
-      grid_.leaf_floats.resize(first + count * comps);
-    else
-      grid_.leaf_doubles.resize(first + count * comps);
-    if (grid_.value_type == VdbValueType::kBool) {
-      // Bool leaves: their value mask again (OpenVDB keeps this copy), the origin, then one bit
-      // per voxel, never compressed.
-      leaf.mask = read_mask(dim, "leaf value mask");
-      r_.skip(12, "bool leaf origin");
-      const auto bits = read_mask(dim, "bool leaf values");
-      double* out = grid_.leaf_doubles.data() + first;
-      for (std::size_t i = 0; i < count; ++i) out[i] = bit(bits, i) ? 1 : 0;
-    } else {
-      // A file's reader uses the topology's mask and seeks over this copy (io::File).
-      r_.skip(count / 8, "leaf value mask");
-      std::vector<Value>& values = level_values_.back();
-      read_values(count, leaf.mask, dim, values);
-      // (A float grid's values were decoded from floats or halves: narrowing them back is exact.)
-      if (floats)
-        store(values, count, comps, grid_.leaf_floats.data() + first);
-      else
-        store(values, count, comps, grid_.leaf_doubles.data() + first);
-    }
+    std::size_t first = 0;
+    grid_.with_leaf_values([&](auto& held) {
+      first = held.size();
+      held.resize(first + count * comps);
+      auto* out = held.data() + first;
+      if (grid_.value_type == VdbValueType::kBool) {
+        // Bool leaves: their value mask again (OpenVDB keeps this copy), the origin, then one
+        // bit per voxel, never compressed.
+        leaf.mask = read_mask(dim, "leaf value mask");
+        r_.skip(12, "bool leaf origin");
+        const auto bits = read_mask(dim, "bool leaf values");
+        for (std::size_t i = 0; i < count; ++i) out[i] = bit(bits, i) ? 1 : 0;
+      } else {
+        // A file's reader uses the topology's mask and seeks over this copy (io::File).
+        r_.skip(count / 8, "leaf value mask");
+        std::vector<Value>& values = level_values_.back();
+        read_values(count, leaf.mask, dim, values);
+        // (A float grid's values were decoded from floats or halves: narrowing them back is
+        // exact.)
+        store(values, count, comps, out);
+      }
+    });
     grid_.leaves.push_back({leaf.origin, first, std::move(leaf.mask)});
   }
 

@@ -72,11 +72,12 @@ SolidRule rule_for(const VdbGrid& g) {
   return SolidRule::kPositive;
 }
 
-// The components of the leaf value from index `first` (components beyond the grid's are 0).
-std::array<double, 3> leaf_components(const VdbGrid& g, std::size_t first) {
+// The components of the leaf value from index `first` of the grid's leaf values (`values`, as
+// VdbGrid::with_leaf_values gives them; components beyond the grid's are 0).
+template <class Values>
+std::array<double, 3> leaf_components(const VdbGrid& g, const Values& values, std::size_t first) {
   std::array<double, 3> v{};
-  for (std::size_t c = 0; c < static_cast<std::size_t>(g.components); ++c)
-    v[c] = g.leaf_value(first + c);
+  for (std::size_t c = 0; c < static_cast<std::size_t>(g.components); ++c) v[c] = values[first + c];
   return v;
 }
 
@@ -149,13 +150,15 @@ std::vector<double> VdbGrid::dense(const Box3i& box, std::uint64_t memory_limit_
         for (int x = b.begin.x; x < b.end.x; ++x)
           for (std::size_t c = 0; c < comps; ++c) out[index({x, y, z}) + c] = t.value[c];
   }
-  for (const VdbLeaf& l : leaves) {
-    if (leaf_box(*this, l).intersect(box).empty()) continue;
-    for_each_leaf_voxel(*this, l, [&](Vec3i p, int, std::size_t first) {
-      if (!box.contains(p)) return;
-      for (std::size_t c = 0; c < comps; ++c) out[index(p) + c] = leaf_value(first + c);
-    });
-  }
+  with_leaf_values([&](const auto& values) {
+    for (const VdbLeaf& l : leaves) {
+      if (leaf_box(*this, l).intersect(box).empty()) continue;
+      for_each_leaf_voxel(*this, l, [&](Vec3i p, int, std::size_t first) {
+        if (!box.contains(p)) return;
+        for (std::size_t c = 0; c < comps; ++c) out[index(p) + c] = values[first + c];
+      });
+    }
+  });
   return out;
 }
 
@@ -246,15 +249,17 @@ VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_
     const std::uint64_t per_edge = std::uint64_t(t.edge) >> shift;  // OpenVDB's nodes and
     need = add_sat(need, mul_sat(per_edge * per_edge * per_edge, uniform_chunk));  // chunks: 2^n
   }
-  for (const VdbLeaf& l : g.leaves) {
-    if (need > limit) break;
-    bool solid = false;
-    for_each_leaf_voxel(g, l, [&](Vec3i, int i, std::size_t first) {
-      solid =
-          solid || material_of(rule, leaf_components(g, first).data(), g.leaf_active(l, i)) != 0;
-    });
-    if (solid) count_dense(l.origin, g.leaf_edge);
-  }
+  g.with_leaf_values([&](const auto& values) {
+    for (const VdbLeaf& l : g.leaves) {
+      if (need > limit) break;
+      bool solid = false;
+      for_each_leaf_voxel(g, l, [&](Vec3i, int i, std::size_t first) {
+        solid = solid || material_of(rule, leaf_components(g, values, first).data(),
+                                     g.leaf_active(l, i)) != 0;
+      });
+      if (solid) count_dense(l.origin, g.leaf_edge);
+    }
+  });
   require_memory(need, limit, name, "its world (grid \"" + g.name + "\")");
 
   for (const VdbTile& t : g.tiles) {
@@ -265,18 +270,19 @@ VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_
                             " (outside 0..255)");
     if (m != 0) voxels.fill(tile_box(t), static_cast<std::uint8_t>(m));
   }
-  for (const VdbLeaf& l : g.leaves) {
-    for_each_leaf_voxel(g, l, [&](Vec3i p, int i, std::size_t first) {
-      const int m = material_of(rule, leaf_components(g, first).data(), g.leaf_active(l, i));
-      if (m < 0)
-        throw FormatError(name, 0,
-                          "grid \"" + g.name + "\" has material " +
-                              format_number(g.leaf_value(first)) + " at (" + std::to_string(p.x) +
-                              ", " + std::to_string(p.y) + ", " + std::to_string(p.z) +
-                              ") (outside 0..255)");
-      if (m != 0) voxels.set(p, static_cast<std::uint8_t>(m));
-    });
-  }
+  g.with_leaf_values([&](const auto& values) {
+    for (const VdbLeaf& l : g.leaves)
+      for_each_leaf_voxel(g, l, [&](Vec3i p, int i, std::size_t first) {
+        const auto v = leaf_components(g, values, first);
+        const int m = material_of(rule, v.data(), g.leaf_active(l, i));
+        if (m < 0)
+          throw FormatError(name, 0,
+                            "grid \"" + g.name + "\" has material " + format_number(v[0]) +
+                                " at (" + std::to_string(p.x) + ", " + std::to_string(p.y) + ", " +
+                                std::to_string(p.z) + ") (outside 0..255)");
+        if (m != 0) voxels.set(p, static_cast<std::uint8_t>(m));
+      });
+  });
   voxels.compact();
 
   if (const VdbMetadata* p = find_meta(g, "voxfield_palette"); p && p->text.size() == 256 * 8) {
