@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "csg_examples.h"
+#include "executor_scene.h"
 #include "gpu_suite.h"
 #include "image_compare.h"
 #include "voxfield/csg_compile.h"
@@ -185,27 +186,19 @@ TEST(Gpu, TheExecutorApiDrawsOnTheChosenBackend) {
   if (!gpu_tests_wanted()) GTEST_SKIP();
   auto ctx = validated_context();
   ctx->clear_validation_messages();
-  World w = random_world({40, 32, 24}, 8, 0.01, 5);
-  RenderSceneOptions so = DynamicRenderScene::default_options();
-  so.skip_max_distance_vox = 8;
-  DynamicRenderScene live(w, so);
-  RenderOptions o;
-  o.width = 64;
-  o.height = 48;
-  const Camera cam = Camera::framing(live.scene().box(), 1.5);
+  test::ExecutorScene s(random_world({40, 32, 24}, 8, 0.01, 5));
+  const Camera& cam = s.camera();
+  const RenderOptions& o = s.options();
   const Executor cpu = Executor::choose(Backend::kCpu), device(ctx);
   EXPECT_FALSE(cpu.on_gpu());
   EXPECT_EQ(device.backend(), Backend::kVulkan);
-  EXPECT_EQ(render(cpu, live.scene(), cam, o).rgb, render(live.scene(), cam, o).rgb);
-  EXPECT_EQ(render(device, live.scene(), cam, o).rgb, gpu::render(*ctx, live.scene(), cam, o).rgb);
+  EXPECT_EQ(render(cpu, s.scene(), cam, o).rgb, render(s.scene(), cam, o).rgb);
+  EXPECT_EQ(render(device, s.scene(), cam, o).rgb, gpu::render(*ctx, s.scene(), cam, o).rgb);
   SceneView cpu_view(cpu), device_view(device);
-  (void)device_view.render(live.scene(), cam, o);
-  DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
-  apply_edit(w, {EditOp::kPlace, SphereBrush{{20, 16, 12}, 5}, 77}, &dirty);
-  live.update(dirty);
-  const RenderScene fresh(w, live.skip_field(), live.light_field());
-  EXPECT_EQ(cpu_view.render(live.scene(), cam, o).rgb, render(fresh, cam, o).rgb);
-  EXPECT_EQ(device_view.render(live.scene(), cam, o).rgb, gpu::render(*ctx, fresh, cam, o).rgb);
+  (void)device_view.render(s.scene(), cam, o);
+  const RenderScene fresh = s.edit();
+  EXPECT_EQ(cpu_view.render(s.scene(), cam, o).rgb, render(fresh, cam, o).rgb);
+  EXPECT_EQ(device_view.render(s.scene(), cam, o).rgb, gpu::render(*ctx, fresh, cam, o).rgb);
   EXPECT_TRUE(ctx->validation_messages().empty());
 }
 

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <random>
 
+#include "executor_scene.h"
 #include "image_compare.h"
 #include "voxfield/edit.h"
 #include "voxfield/error.h"
@@ -539,25 +540,16 @@ TEST(Render, SceneUpdatesTouchOnlyTheChunksAnEditReaches) {
 // bit for bit, and a SceneView following an edit as a scene built afresh does. The Vulkan half is
 // checked in test_gpu_render.cpp.
 TEST(Render, TheCpuExecutorDrawsTheCpuRenderersFrames) {
-  World w = random_world({40, 32, 24}, 8, 5, 12);
-  RenderSceneOptions so = DynamicRenderScene::default_options();
-  so.skip_max_distance_vox = 8;
-  DynamicRenderScene live(w, so);
-  RenderOptions o;
-  o.width = 64;
-  o.height = 48;
-  const Camera cam = Camera::framing(live.scene().box(), 1.5);
+  test::ExecutorScene s(random_world({40, 32, 24}, 8, 5, 12));
   const Executor cpu = Executor::choose(Backend::kCpu);
   ASSERT_FALSE(cpu.on_gpu());
   std::vector<gpu::PassTiming> timings{{"stale", 1}};
-  EXPECT_EQ(render(cpu, live.scene(), cam, o, nullptr, nullptr, &timings).rgb,
-            render(live.scene(), cam, o).rgb);
+  EXPECT_EQ(render(cpu, s.scene(), s.camera(), s.options(), nullptr, nullptr, &timings).rgb,
+            render(s.scene(), s.camera(), s.options()).rgb);
   EXPECT_TRUE(timings.empty());  // no device, no passes
   SceneView view(cpu);
-  (void)view.render(live.scene(), cam, o);
-  DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
-  apply_edit(w, {EditOp::kPlace, SphereBrush{{20, 16, 12}, 5}, 77}, &dirty);
-  live.update(dirty);
-  const RenderScene fresh(w, live.skip_field(), live.light_field());
-  EXPECT_EQ(view.render(live.scene(), cam, o).rgb, render(fresh, cam, o).rgb);
+  (void)view.render(s.scene(), s.camera(), s.options());
+  const RenderScene fresh = s.edit();
+  EXPECT_EQ(view.render(s.scene(), s.camera(), s.options()).rgb,
+            render(fresh, s.camera(), s.options()).rgb);
 }
