@@ -272,6 +272,33 @@ TEST(WorldFile, PartsAssembleIntoTheWholeFile) {
   }
 }
 
+// Where a world's content can lie, from its chunk records alone (voxfield-mpi bounds an unbounded
+// world's domain by it before any rank decodes its slab): the union of the stored chunks' boxes
+// that hold anything but air (chunk-granular, never smaller than the content), whatever a slab
+// read decodes, within the grid's bounds.
+TEST(WorldFile, StoredChunksBoxCoversTheContentFromTheRecordsAlone) {
+  World w(8);                                    // unbounded
+  w.voxels.set({3, -9, 30}, 2);                  // in chunk [0, -16, 24] .. [8, -8, 32]
+  w.voxels.fill({{-16, 0, -8}, {-8, 8, 0}}, 5);  // one uniform chunk of a material
+  const auto bytes = encode_world_file(w, {});
+  const Box3i expect{{-16, -16, -8}, {8, 8, 32}};
+  EXPECT_TRUE(expect.contains(w.voxels.content_bounds()));
+  for (const auto& keep : std::vector<std::optional<std::pair<std::int32_t, std::int32_t>>>{
+           std::nullopt, std::pair<std::int32_t, std::int32_t>{0, 0},
+           std::pair<std::int32_t, std::int32_t>{-8, 0}}) {
+    WorldFileReadOptions o;
+    o.keep_z = keep;
+    EXPECT_EQ(parse_world_file(bytes, "w.vfw", o).stored_chunks_box, expect);
+  }
+  // Within the grid's bounds when it has them; empty for a world of air.
+  World bounded(8, Box3i{{0, -4, 0}, {20, 20, 36}});
+  bounded.voxels.set({3, -4, 30}, 2);
+  EXPECT_EQ(parse_world_file(encode_world_file(bounded, {}), "b.vfw").stored_chunks_box,
+            (Box3i{{0, -4, 24}, {8, 0, 32}}));
+  EXPECT_TRUE(
+      parse_world_file(encode_world_file(World(8), {}), "air.vfw").stored_chunks_box.empty());
+}
+
 // A slab of a world file (voxfield-mpi's ranks): only the chunks reaching into the z range are
 // decoded — equal to the whole file's there, none elsewhere — fields are skipped, the frame kept,
 // the memory limit charged for the slab alone, and every checksum still checked.

@@ -171,18 +171,19 @@ struct WorldSlab {
   World world;  // the slab's voxels and its ghost slices, at their place in the whole world
   SlabPartition partition;
   std::string format;  // "npy", "vox" or "vfw"
-  // Each rank decoded only its slab: a .npy's part read alone, a bounded .vfw's chunks decompressed
-  // alone (the compressed file read by every rank). Else each decoded the whole world.
+  // Each rank decoded only its slab: a .npy's part read alone, a .vfw's chunks decompressed alone
+  // (the compressed file read by every rank). Else (a .vox) each decoded the whole world.
   bool read_in_parts = false;
 };
 
 // Loads `path` for this rank, keeping its slab and `ghost_slices` slices on either side: a .npy is
-// read a part per rank (read_npy_part), so no rank ever holds more; a bounded .vfw (what
-// `voxfield edit --save-world` and voxfield-mpi write) is read as compressed bytes by every rank,
-// which decompresses only its slab's chunks (WorldFileReadOptions::keep_z) — the file's size plus
-// the slab per rank; a .vox or an unbounded .vfw is decoded whole by every rank, which then keeps
-// its part (the memory of one whole world per rank, while loading). The domain is the file's volume
-// (the .npy shape, the .vox/.vfw extent), as `voxfield field` uses.
+// read a part per rank (read_npy_part), so no rank ever holds more; a .vfw is read as compressed
+// bytes by every rank, which decompresses only its slab's chunks (WorldFileReadOptions::keep_z) —
+// the file's size plus the slab per rank. An unbounded .vfw's domain is its content's bounds: each
+// rank first decodes an equal share of the z-range its stored chunks cover and the ranks unite what
+// they find. A .vox is decoded whole by every rank, which then keeps its part (the memory of one
+// whole world per rank, while loading; a .vox holds at most a few 256³ models). The domain is the
+// file's volume (the .npy shape, the .vox/.vfw extent), as `voxfield field` uses.
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
                           int ghost_slices = 0);
 

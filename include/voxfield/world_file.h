@@ -25,6 +25,10 @@ struct WorldFile {
   World world;
   std::vector<DistanceField> fields;
   std::uint32_t version = kWorldFileVersion;
+  // The union of the boxes of the world's stored chunks that may hold anything but air (dense
+  // ones, and uniform ones of a material), within the grid's bounds: where the world's content
+  // lies, known from the chunk records alone — also for the chunks a keep_z read skips.
+  Box3i stored_chunks_box;
 };
 
 struct WorldFileReadOptions {

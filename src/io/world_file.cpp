@@ -140,8 +140,11 @@ struct ChunkFilter {
   }
 };
 
+// `stored` (when not null) gets the union of the boxes of the chunks stored with anything but
+// the background (WorldFile::stored_chunks_box), kept by the filter or not.
 template <class T>
-Grid<T> get_grid(detail::ByteReader& r, Budget& budget, const ChunkFilter& filter = {}) {
+Grid<T> get_grid(detail::ByteReader& r, Budget& budget, const ChunkFilter& filter = {},
+                 Box3i* stored = nullptr) {
   const auto edge = get<std::uint32_t>(r, "chunk edge");
   if (edge < 8 || edge > 128 || (edge & (edge - 1)) != 0)
     r.fail("chunk edge " + std::to_string(edge) + " is not a power of two in 8..128");
@@ -190,14 +193,17 @@ Grid<T> get_grid(detail::ByteReader& r, Budget& budget, const ChunkFilter& filte
       if (!seen.insert(c).second) scan.fail_at(at, "chunk " + to_string(c) + " appears twice");
       const bool keep = filter.keeps(g, c);  // only what is decoded is charged
       kept += keep;
+      const Box3i box = bounds ? g.chunk_box(c).intersect(*bounds) : g.chunk_box(c);
       if (kind == 0) {
         // A uniform chunk the bounds cut through is stored densely (the part outside holds the
         // background), unless it holds the background itself.
         const T v = get<T>(scan, "uniform value");
         if (keep && bounds && !bounds->contains(g.chunk_box(c)) && !(v == background)) ++dense;
+        if (stored && !(v == background)) *stored = stored->unite(box);
       } else if (kind == 1) {
         scan.skip(get<std::uint32_t>(scan, "chunk size"), "chunk data");
         dense += keep;
+        if (stored) *stored = stored->unite(box);
       } else {
         scan.fail_at(at + 12, "unknown chunk kind " + std::to_string(kind));
       }
@@ -464,7 +470,7 @@ WorldFile parse_world_file(std::span<const std::uint8_t> bytes, const std::strin
       for (Rgba& c : out.world.palette) c = get<Rgba>(payload, "palette");
       ChunkFilter filter;
       if (options.keep_z) filter = {false, options.keep_z->first, options.keep_z->second};
-      out.world.voxels = get_grid<std::uint8_t>(payload, budget, filter);
+      out.world.voxels = get_grid<std::uint8_t>(payload, budget, filter, &out.stored_chunks_box);
     } else if (kind == kFrameSection) {
       if (s != 1 || out.version < 2)
         r.fail_at(at, "a frame section that does not follow the world (or in a version 1 file)");

@@ -1,6 +1,10 @@
-// voxfield — a rank's slab of a world file (mpi.h): .npy arrays read a part per rank, bounded .vfw
-// worlds decoded a slab per rank, other formats loaded whole by every rank.
+// voxfield — a rank's slab of a world file (mpi.h): .npy arrays read a part per rank, .vfw worlds
+// decoded a slab per rank, other formats loaded whole by every rank.
+#include <mpi.h>
+
 #include <algorithm>
+#include <array>
+#include <limits>
 
 #include "collective.h"
 #include "voxfield/file.h"
@@ -11,55 +15,101 @@
 
 namespace voxfield::mpi {
 
+namespace {
+
+// This rank's slab of `domain`'s partition and `ghost` slices on either side, within the domain.
+Box3i kept_box(const Box3i& domain, const SlabPartition& partition, int rank, int ghost) {
+  const Box3i slab = partition.slab(rank);
+  const std::int64_t g = std::max(ghost, 0);
+  return {{domain.begin.x, domain.begin.y,
+           static_cast<std::int32_t>(std::max<std::int64_t>(domain.begin.z, slab.begin.z - g))},
+          {domain.end.x, domain.end.y,
+           static_cast<std::int32_t>(std::min<std::int64_t>(domain.end.z, slab.end.z + g))}};
+}
+
+// The union of every rank's box (empty boxes add nothing).
+Box3i unite_over_ranks(MPI_Comm comm, const Box3i& mine) {
+  constexpr std::int32_t kMax = std::numeric_limits<std::int32_t>::max();
+  // Minima of the begins and of the negated ends, in one reduction; an empty box offers none.
+  std::array<std::int32_t, 6> v{kMax, kMax, kMax, kMax, kMax, kMax};
+  if (!mine.empty())
+    for (int k = 0; k < 3; ++k) {
+      v[static_cast<std::size_t>(k)] = mine.begin[k];
+      v[static_cast<std::size_t>(k) + 3] = -mine.end[k];
+    }
+  std::array<std::int32_t, 6> all{};
+  MPI_Allreduce(v.data(), all.data(), 6, MPI_INT32_T, MPI_MIN, comm);
+  if (all[0] == kMax) return {};
+  return {{all[0], all[1], all[2]}, {-all[3], -all[4], -all[5]}};
+}
+
+// A .vfw: every rank holds the compressed bytes and decodes only its slab's chunks (every checksum
+// and world chunk record still checked). A bounded world's domain is in the file's head. An
+// unbounded one's is its content's bounds, as `voxfield field` takes them: the chunk records say
+// which z-range may hold content (WorldFile::stored_chunks_box), each rank decodes an equal share
+// of it and bounds what it finds, and the union of the ranks' bounds is the domain — so no rank
+// ever decodes more than about two slabs, whatever the world's size.
+WorldSlab vfw_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge, int ghost) {
+  int rank = 0, size = 0;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  struct Head {
+    std::vector<std::uint8_t> bytes;
+    WorldFileReadOptions options;
+    std::optional<Box3i> bounds;
+    Box3i content;  // of this rank's share of an unbounded world's stored chunks
+  };
+  Head h = detail::collectively(comm, nullptr, [&] {
+    Head out;
+    const std::uint64_t limit = effective_memory_limit(0);
+    out.bytes = read_file(path, limit);
+    out.options.memory_limit_bytes = remaining_memory(limit, out.bytes.size());
+    out.options.keep_z = std::pair<std::int32_t, std::int32_t>{0, 0};
+    const WorldFile head = parse_world_file(out.bytes, path.string(), out.options);
+    out.bounds = head.world.voxels.bounds();
+    const Box3i stored = head.stored_chunks_box;
+    if (!out.bounds && !stored.empty()) {
+      const std::int64_t z0 = stored.begin.z, slices = stored.size().z;
+      WorldFileReadOptions share = out.options;
+      share.keep_z = std::pair<std::int32_t, std::int32_t>{
+          static_cast<std::int32_t>(z0 + slices * rank / size),
+          static_cast<std::int32_t>(z0 + slices * (rank + 1) / size)};
+      out.content = parse_world_file(out.bytes, path.string(), share).world.voxels.content_bounds();
+    }
+    return out;
+  });
+  const Box3i domain = h.bounds ? *h.bounds : unite_over_ranks(comm, h.content);
+  return detail::collectively(comm, nullptr, [&] {
+    if (domain.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
+    const SlabPartition partition = partition_slabs(domain, size, chunk_edge);
+    const Box3i keep = kept_box(domain, partition, rank, ghost);
+    WorldFileReadOptions slab_only = h.options;
+    slab_only.keep_z = std::pair<std::int32_t, std::int32_t>{keep.begin.z, keep.end.z};
+    const WorldFile part = parse_world_file(h.bytes, path.string(), slab_only);
+    World world = rechunk_world(part.world, chunk_edge, keep, path.string());
+    return WorldSlab{std::move(world), partition, "vfw", true};
+  });
+}
+
+}  // namespace
+
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
                           int ghost_slices) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
+  // (The format is named by the extension alone: every rank agrees on it without a word.)
+  const WorldFormat format =
+      detail::collectively(comm, nullptr, [&] { return world_format_of(path); });
+  if (format == WorldFormat::kVfw) return vfw_slab(comm, path, chunk_edge, ghost_slices);
   return detail::collectively(comm, nullptr, [&] {
-    const WorldFormat format = world_format_of(path);
-    // The slab and its ghost slices, once the domain is known.
-    const auto kept_box = [&](const Box3i& domain, const SlabPartition& partition) {
-      const Box3i slab = partition.slab(rank);
-      const int ghost = std::max(ghost_slices, 0);
-      return Box3i{{domain.begin.x, domain.begin.y,
-                    static_cast<std::int32_t>(std::max<std::int64_t>(
-                        domain.begin.z, std::int64_t{slab.begin.z} - ghost))},
-                   {domain.end.x, domain.end.y,
-                    static_cast<std::int32_t>(
-                        std::min<std::int64_t>(domain.end.z, std::int64_t{slab.end.z} + ghost))}};
-    };
-    if (format == WorldFormat::kVfw) {
-      // A bounded world's domain is in the file's head: each rank holds the compressed bytes and
-      // decodes only its slab's chunks (every checksum and world chunk record still checked). An
-      // unbounded world's domain is its content, known only once decoded: read whole, below.
-      const std::uint64_t limit = effective_memory_limit(0);
-      const std::vector<std::uint8_t> bytes = read_file(path, limit);
-      WorldFileReadOptions head_only;
-      head_only.memory_limit_bytes = remaining_memory(limit, bytes.size());
-      head_only.keep_z = std::pair<std::int32_t, std::int32_t>{0, 0};
-      const WorldFile head = parse_world_file(bytes, path.string(), head_only);
-      if (const std::optional<Box3i> bounds = head.world.voxels.bounds()) {
-        const SlabPartition partition = partition_slabs(*bounds, size, chunk_edge);
-        const Box3i keep = kept_box(*bounds, partition);
-        WorldFileReadOptions slab_only = head_only;
-        slab_only.keep_z = std::pair<std::int32_t, std::int32_t>{keep.begin.z, keep.end.z};
-        const WorldFile part = parse_world_file(bytes, path.string(), slab_only);
-        World world = rechunk_world(part.world, chunk_edge, keep, path.string());
-        return WorldSlab{std::move(world), partition, "vfw", true};
-      }
-    }
     if (format == WorldFormat::kNpy) {
       const NpyVolume head = read_npy_header(path);
-      const SlabPartition partition =
-          partition_slabs(Box3i::from_size(head.dims), size, chunk_edge);
-      const Box3i slab = partition.slab(rank);
-      const int ghost = std::max(ghost_slices, 0);
-      const std::int32_t z0 =
-          static_cast<std::int32_t>(std::max<std::int64_t>(0, std::int64_t{slab.begin.z} - ghost));
-      const std::int32_t z1 = static_cast<std::int32_t>(
-          std::min<std::int64_t>(head.dims.z, std::int64_t{slab.end.z} + ghost));
-      World part = world_from_npy(read_npy_part(path, z0, z1), path.string(), chunk_edge);
+      const Box3i domain = Box3i::from_size(head.dims);
+      const SlabPartition partition = partition_slabs(domain, size, chunk_edge);
+      const Box3i keep = kept_box(domain, partition, rank, ghost_slices);
+      World part =
+          world_from_npy(read_npy_part(path, keep.begin.z, keep.end.z), path.string(), chunk_edge);
       return WorldSlab{std::move(part), partition, "npy", true};
     }
     LoadOptions lo;
@@ -68,7 +118,7 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
     if (whole.extent.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
     const SlabPartition partition = partition_slabs(whole.extent, size, chunk_edge);
     // Only the slab and its ghost slices are kept once the file is read.
-    const Box3i keep = kept_box(whole.extent, partition);
+    const Box3i keep = kept_box(whole.extent, partition, rank, ghost_slices);
     World part = rechunk_world(whole.world, chunk_edge, keep, path.string());
     part.palette = whole.world.palette;
     return WorldSlab{std::move(part), partition, world_format_name(format), false};

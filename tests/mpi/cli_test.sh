@@ -144,7 +144,39 @@ if [ ! -f "$vox" ]; then echo "FAIL: $vox is missing (../shared beside the repos
   "$VF" field "$vox" -o ref.npy --metric euclidean --signed 2>/dev/null
   MPIEXEC -np 3 "$VFM" field "$vox" -o out.npy --metric euclidean --signed 2>/dev/null
   same ref.npy out.npy "3 ranks, dotvox_axes.vox"
+  # The same world as a .vfw that `voxfield convert` writes unbounded: its domain is its content
+  # (not the .vox model's size), which the ranks bound between them from their shares of the
+  # stored chunks before each decodes its slab (read_in_parts).
+  "$VF" convert "$vox" axes.vfw 2>/dev/null
+  "$VF" field axes.vfw -o ref.npy --metric euclidean --signed 2>/dev/null
+  for n in 1 2 4; do
+    MPIEXEC -np "$n" "$VFM" field axes.vfw -o out.npy --metric euclidean --signed \
+      --stats stats.json 2>/dev/null
+    same ref.npy out.npy "$n ranks, dotvox_axes.vox as an unbounded .vfw"
+  done
+  /usr/bin/python3 -c "import json; s = json.load(open('stats.json')); assert s['read_in_parts'] is True, s"
 fi
+# An unbounded .vfw whose content lies away from every face of the array it came from (in the
+# default chunks of 32, which the ranks' shares cut through): the field covers the content's
+# bounds, as voxfield's does.
+/usr/bin/python3 - <<'PY'
+import numpy as np
+a = np.zeros((30, 26, 61), np.uint8)
+a[5:19, 7:20, 11:52] = np.random.default_rng(5).integers(0, 3, (14, 13, 41))
+np.save("margins.npy", a)
+np.save("air.npy", np.zeros((9, 9, 9), np.uint8))
+PY
+"$VF" convert margins.npy margins.vfw 2>/dev/null
+"$VF" field margins.vfw -o ref.npy --metric manhattan --max-distance 6 --storage u8 2>/dev/null
+for n in 1 3 4; do
+  for chunk in 8 16; do
+    MPIEXEC -np "$n" "$VFM" field margins.vfw -o out.npy --chunk "$chunk" --metric manhattan \
+      --max-distance 6 --storage u8 2>/dev/null
+    same ref.npy out.npy "$n ranks, an unbounded .vfw with margins, chunk $chunk"
+  done
+done
+"$VF" convert air.npy air.vfw 2>/dev/null
+EXPECT_RANKS=3 expect_failure 1 "air.vfw: the input holds no volume" field air.vfw -o bad.npy
 
 expect_failure 1 "missing.npy: cannot open" field missing.npy -o bad.npy
 expect_failure 1 "a\[.*holds 0.5, not a material index" field fraction.npy -o bad.npy
