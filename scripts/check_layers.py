@@ -33,7 +33,7 @@ PUBLIC_LAYER = {
     "mesh.h": "mesh", "mesh_chunks.h": "mesh", "mesh_pieces.h": "mesh", "terrain.h": "mesh", "gpu_mesh.h": "mesh", "gpu_terrain.h": "mesh", "gpu_terrain_vulkan.h": "mesh", "csg_mesh.h": "mesh", "mesh_optimize.h": "mesh", "mesh_files.h": "io", "mesh_voxelize.h": "mesh", "mesh_read.h": "io",
     "file.h": "io", "npy.h": "io", "vox.h": "io", "world_file.h": "io", "world_io.h": "io", "vdb.h": "io",
     "edit_script.h": "io",
-    "render.h": "render", "mesh_render.h": "render", "csg_render.h": "render", "gpu_render.h": "render", "gpu_render_vulkan.h": "render", "render_executor.h": "render",
+    "render.h": "render", "mesh_render.h": "render", "csg_render.h": "render", "gpu_render.h": "render", "gpu_render_vulkan.h": "render", "render_executor.h": "render", "render_relay.h": "render",
     "live_world.h": "live", "mpi.h": "mpi",
 }
 # Headers of the GPU compute layer that the modules above it may include (its internal interface).

@@ -34,6 +34,7 @@
 #include "voxfield/error.h"
 #include "voxfield/file.h"
 #include "voxfield/mesh.h"
+#include "voxfield/render.h"
 #include "voxfield/world.h"
 
 namespace voxfield::mpi {
@@ -226,6 +227,21 @@ void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const Distan
 void save_world_vfw(MPI_Comm comm, const SlabPartition& partition, const World& world,
                     const std::filesystem::path& path, ExchangeStats* stats = nullptr,
                     FileTransaction* into = nullptr);
+
+// Frames of the world the ranks hold in slabs, drawn where it lies (render_relay.h): each rank
+// walks the rays that cross its slab, primary and shadow rays alike, and sends each on to the rank
+// whose slab it enters; each pixel is shaded by the rank where its primary ray hit. Rank 0 returns
+// the frame — render(RenderScene(whole world, scene_options, partition.domain), camera, options)
+// byte for byte — and the others an empty image. `world` must hold the rank's slab and
+// relay_ghost_slices(scene_options) slices on either side along z (load_world_slab's
+// ghost_slices), the slabs cut on the world's chunk boundaries (partition_slabs with the chunk edge
+// when the domain has a chunk layer per rank). The skip field is computed over the ranks
+// (compute_distance_field above), the lighting field by each rank over its slab and ghost slices.
+// Views: shaded and chunks. `stats`: this rank's walks (a relayed ray counts once per rank).
+Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
+             const RenderSceneOptions& scene_options, const Camera& camera,
+             const RenderOptions& options, RenderStats* stats = nullptr,
+             ExchangeStats* exchange = nullptr);
 
 // Meshes of a lattice no rank holds whole (a scan or a simulation's float volume, a distributed
 // field). The lattice's chunk layers (mesh_pieces.h: the chunked mesher's chunks grouped along z)

@@ -1,15 +1,14 @@
 // voxfield renderer — frames: primary rays per pixel over tiles, shading and the debug views.
 //
-// Shading goes beyond the dissertation's colour x local occlusion: palette albedo in linear light,
-// a sun with soft shadows and a sky dome with ambient occlusion — both read from a clamped
-// Euclidean field (the "distance field soft shadows" of Quilez's SDF rendering notes, made exact in
-// occlusion by tracing the shadow ray with the same DDA) — optional fog, and a sky gradient for
-// misses.
+// Shading goes beyond the dissertation's colour x local occlusion (hit_shading.h): palette albedo
+// in linear light, a sun with soft shadows and a sky dome with ambient occlusion, optional fog, and
+// a sky gradient for misses.
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 
+#include "hit_shading.h"
 #include "shading.h"
 #include "traverse.h"
 #include "voxfield/error.h"
@@ -44,10 +43,6 @@ namespace {
 using render_detail::Dda;
 using render_detail::traverse;
 
-using render_detail::kGround;
-using render_detail::kSkyAmbient;
-using render_detail::kSunLight;
-using render_detail::mix;
 using render_detail::Rgb;
 using render_detail::sky;
 using render_detail::tone_map;
@@ -67,113 +62,33 @@ struct Frame {
   const RenderScene::Impl& s;
   const RenderOptions& o;
   Camera::Projector projector;
-  Vec3d sun;
+  render_detail::HitShading light;
   const SkipSource* approx = nullptr;  // the error view's approximate field
   int slice_z = 0;
   double heat_max = 1;
-
-  std::uint8_t light_at_voxel(Vec3i v) const {
-    return s.light.read(s.table.chunk_index(v), s.table.brick_index(v));
-  }
 
   std::uint8_t skip_at(Vec3i v) const {
     return s.skip.distance(s.table.chunk_index(v), s.table.brick_index(v));
   }
 
-  // The lighting field at a point, interpolated between voxel centres (clamped to the box).
-  double light_at(const Vec3d& q) const {
-    const Box3i& box = s.box;
-    const double fx = q.x - 0.5, fy = q.y - 0.5, fz = q.z - 0.5;
-    const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy)),
-              z0 = static_cast<int>(std::floor(fz));
-    const double tx = fx - x0, ty = fy - y0, tz = fz - z0;
-    double sum = 0;
-    for (int corner = 0; corner < 8; ++corner) {
-      const int dx = corner & 1, dy = (corner >> 1) & 1, dz = corner >> 2;
-      const Vec3i v{std::clamp(x0 + dx, box.begin.x, box.end.x - 1),
-                    std::clamp(y0 + dy, box.begin.y, box.end.y - 1),
-                    std::clamp(z0 + dz, box.begin.z, box.end.z - 1)};
-      const double w = (dx ? tx : 1 - tx) * (dy ? ty : 1 - ty) * (dz ? tz : 1 - tz);
-      sum += w * light_at_voxel(v);
-    }
-    return sum * s.light_inv_scale;
-  }
-
-  // Ambient occlusion: how much closer the nearest geometry is than it would be over an open
-  // plane, at three points along the normal. Over a flat open face the field grows exactly as
-  // s + 0.5 (voxel centres sit half a voxel behind the face), so open faces get no occlusion.
-  double ambient_occlusion(const Vec3d& p, const Vec3d& n) const {
-    static constexpr double kStep[3] = {0.5, 1.5, 3.0}, kWeight[3] = {0.5, 0.3, 0.2};
-    double occlusion = 0;
-    for (int i = 0; i < 3; ++i) {
-      const double open = kStep[i] + 0.5;
-      const double e = light_at(p + n * kStep[i]);
-      occlusion += kWeight[i] * std::clamp((open - e) / open, 0.0, 1.0);
-    }
-    return std::clamp(1 - 1.7 * occlusion, 0.0, 1.0);
-  }
-
-  // Soft shadow towards the sun: 0 when the DDA finds a solid voxel (exact occlusion), else the
-  // penumbra estimate min(k * clearance / t) over the voxels the shadow ray reads, the clearance
-  // coming from the Euclidean field (its distance to the nearest solid voxel centre, less the
-  // ~0.75 voxel a ray can pass from a voxel centre and a solid voxel's surface from its own).
-  double soft_shadow(const Vec3d& p, const Vec3d& n, TraversalCounters& c) const {
-    constexpr double kSoftness = 5, kNear = 1.5;
-    const Ray r{p + n * 1e-4, sun};
+  // The soft shadow of a hit: its shadow ray walked through the whole scene.
+  double soft_shadow(const RayHit& h, const Ray& ray, TraversalCounters& c) const {
     double lit = 1;
-    const RayHit hit =
-        traverse(s, s.box, r, SkipMode::kDistance, s.skip, c, [&](const Dda& d, std::size_t chunk) {
-          if (d.t < kNear) return;
-          const double e = s.light.read(chunk, s.table.brick_index(d.v)) * s.light_inv_scale;
-          lit = std::min(lit, kSoftness * (e - 0.75) / d.t);
-        });
-    if (hit.hit) return 0;
-    lit = std::clamp(lit, 0.0, 1.0);
-    return lit * lit * (3 - 2 * lit);
-  }
-
-  static Vec3d normal_of(const RayHit& h, const Vec3d& dir) {
-    int axis = h.face_axis, sign = h.face_sign;
-    if (axis < 0) {  // the ray started inside: face the viewer along its dominant axis
-      axis = std::abs(dir.x) >= std::abs(dir.y) && std::abs(dir.x) >= std::abs(dir.z) ? 0
-             : std::abs(dir.y) >= std::abs(dir.z)                                     ? 1
-                                                                                      : 2;
-      sign = dir[axis] > 0 ? -1 : 1;
-    }
-    Vec3d n;
-    (axis == 0 ? n.x : axis == 1 ? n.y : n.z) = sign;
-    return n;
+    const RayHit blocker =
+        traverse(s, s.box, light.shadow_ray(h, ray), SkipMode::kDistance, s.skip, c,
+                 [&](const Dda& d, std::size_t chunk) { lit = light.penumbra(lit, d, chunk); });
+    return render_detail::HitShading::shadow_of(blocker.hit, lit);
   }
 
   Rgb shade(const RayHit& h, const Ray& ray, bool shadows,
             TraversalCounters& shadow_counters) const {
-    const Vec3d n = normal_of(h, ray.direction);
-    const Vec3d p = ray.origin + ray.direction * h.t;
-    const auto& a = s.albedo[h.material];
-    const Rgb albedo{a[0], a[1], a[2]};
-    const double ndotl = std::max(0.0, dot(n, sun));
-    double shadow = 1;
-    if (shadows && o.soft_shadows && ndotl > 0) shadow = soft_shadow(p, n, shadow_counters);
-    const double ao = o.ambient_occlusion ? ambient_occlusion(p, n) : 1;
-    const Rgb ambient = mix(kGround, kSkyAmbient, 0.5 + 0.5 * n.z) * (0.35 + 0.65 * ao);
-    Rgb c = albedo * (kSunLight * (ndotl * shadow) + ambient);
-    if (o.fog_density > 0) c = mix(c, sky(ray.direction), 1 - std::exp(-o.fog_density * h.t));
-    return c;
+    const double shadow =
+        shadows && light.wants_shadow(h, ray) ? soft_shadow(h, ray, shadow_counters) : 1;
+    return light.shade(h, ray, shadow);
   }
 
   void chunk_overlay(const RayHit& h, const Ray& ray, Rgb& c) const {
-    const Vec3d p = ray.origin + ray.direction * h.t;
-    const double edge = s.table.chunk_edge();
-    const double width = std::max(0.04, 0.75 * projector.footprint(h.t));
-    bool line = false;
-    for (int a = 0; a < 3; ++a) {
-      if (a == h.face_axis) continue;
-      const double m = p[a] - edge * std::floor(p[a] / edge);
-      line = line || std::min(m, edge - m) < width;
-    }
-    const bool dense = s.dense_material[s.table.chunk_index(h.voxel)] != 0;
-    c = mix(c, dense ? Rgb{0.15, 0.35, 1.0} : Rgb{1.0, 0.55, 0.1}, 0.15);
-    if (line) c = mix(c, Rgb{0.02, 0.02, 0.02}, 0.85);
+    light.chunk_overlay(h, ray, projector.footprint(h.t), c);
   }
 
   void pixel(int px, int py, std::uint8_t* out, RenderStats& st) const {
@@ -246,9 +161,9 @@ struct Frame {
 
 }  // namespace
 
-Image render(const RenderScene& scene, const Camera& camera, const RenderOptions& o,
-             RenderStats* stats, Interrupter* interrupter) {
-  const RenderScene::Impl& s = scene.impl();
+namespace render_detail {
+
+void check_frame_options(const RenderScene::Impl& s, const RenderOptions& o) {
   if (o.width <= 0 || o.height <= 0 || o.width > 16384 || o.height > 16384)
     throw InvalidArgument("render: image size " + std::to_string(o.width) + "x" +
                           std::to_string(o.height) + " is out of range (1..16384 per side)");
@@ -260,9 +175,17 @@ Image render(const RenderScene& scene, const Camera& camera, const RenderOptions
   if (!(o.fog_density >= 0)) throw InvalidArgument("render: fog density must be >= 0");
   if (!(o.sun_direction.length() > 0))
     throw InvalidArgument("render: the sun direction must be non-zero");
+}
+
+}  // namespace render_detail
+
+Image render(const RenderScene& scene, const Camera& camera, const RenderOptions& o,
+             RenderStats* stats, Interrupter* interrupter) {
+  const RenderScene::Impl& s = scene.impl();
+  render_detail::check_frame_options(s, o);
 
   Image image(o.width, o.height);
-  Frame f{s, o, camera.projector(o.width, o.height), o.sun_direction.normalized()};
+  Frame f{s, o, camera.projector(o.width, o.height), {s, o, o.sun_direction.normalized()}};
 
   SkipSource approx;
   if (o.view == RenderView::kDistance) {

@@ -1,0 +1,92 @@
+// voxfield — frames of a world that no one process holds (voxfield-mpi render): each part of the
+// world, a slab along z, walks the rays that cross it and hands each on where it leaves.
+//
+// Sort-last compositing usually has every part draw its own image and keeps each pixel's nearest
+// hit; shadows that one part casts on another are then lost, and a skipping ray's walk would depend
+// on where it started. Here the walk itself is relayed. A traversal is a function of its ray and
+// of the DDA's state at the voxel it has reached (render/dda.h: every event time comes from one
+// formula, never accumulated), and that state is the voxel, the time the ray entered it and the
+// face it crossed — so a part that resumes a ray there visits exactly the voxels, skips included,
+// that one walk through the whole world visits. Primary rays and the sun's shadow rays are both
+// relayed; a pixel is shaded by the part where its primary ray hit, with the shadow its shadow ray
+// found wherever that ended. The frame equals render() of the whole world's scene byte for byte,
+// for any cut into parts on chunk boundaries.
+//
+// One part's steps: start() the primary rays that begin in it, then walk() the legs other parts
+// hand over until no part has any left (each returns the legs that left its part, to be routed by
+// their voxel's z), then shade() with every pixel's shadow, and finish() the frame from every
+// part's shaded pixels. mpi.h's mpi::render runs them over the ranks of a job.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "voxfield/distance.h"
+#include "voxfield/render.h"
+#include "voxfield/world.h"
+
+namespace voxfield {
+
+// A ray's walk paused at the first voxel outside the part that walked it. Plain bytes (it crosses
+// processes as they are).
+struct RayLeg {
+  Vec3d origin;                // the ray's origin (a shadow ray's lies just off its pixel's hit)
+  Vec3i voxel;                 // where the walk resumes
+  double t = 0;                // the ray parameter at which it entered `voxel`
+  double lit = 1;              // a shadow ray's penumbra estimate so far
+  std::uint32_t pixel = 0;     // y * width + x
+  std::int8_t face_axis = -1;  // the axis crossed to enter `voxel`
+  std::uint8_t shadow = 0;     // 0: the pixel's primary ray; 1: the shadow ray of its hit
+};
+
+// The slices beyond its part, on either side along z, that a part's world must hold (within the
+// whole box): the lighting field's clamp and ambient occlusion's reach.
+int relay_ghost_slices(const RenderSceneOptions& options);
+
+// The skip field RenderScene computes for the box `whole`, which every part reads over its own
+// slab: computed elsewhere for the whole box (voxfield-mpi: over the ranks, exactly).
+DistanceOptions relay_skip_field_options(const RenderSceneOptions& options, const Box3i& whole);
+
+class RelayFrame {
+ public:
+  // One part of a frame of the box `whole` of a world. `part`: a slab of it (the whole x-y extent)
+  // cut along z on the world's chunk boundaries (or at the box's faces). `world`: the part's voxels
+  // and relay_ghost_slices(scene_options) slices on either side (within `whole`; beyond is not
+  // read), kept alive by the caller. `skip`: a field of relay_skip_field_options(scene_options,
+  // whole) whose values over `part` are the whole box's. The part's lighting field is computed
+  // here. Views: shaded and chunks. Throws InvalidArgument for another view, a part that is not
+  // such a slab, fields or options that do not fit (as render() and RenderScene do).
+  RelayFrame(const World& world, const Box3i& whole, const Box3i& part, const DistanceField& skip,
+             const RenderSceneOptions& scene_options, const Camera& camera,
+             const RenderOptions& options);
+  ~RelayFrame();
+  RelayFrame(const RelayFrame&) = delete;
+  RelayFrame& operator=(const RelayFrame&) = delete;
+
+  // Walks the primary rays of the pixels whose walk through `whole` starts in `part` (each part
+  // finds the same ones for itself); returns the legs that left the part for another.
+  std::vector<RayLeg> start();
+  // Resumes legs whose voxel lies in `part`; returns the legs that left it (InvalidArgument for a
+  // leg that is not this part's or names no pixel).
+  std::vector<RayLeg> walk(std::span<const RayLeg> legs);
+  // Per pixel (y * width + x): the shadow of the pixels whose shadow ray ended in this part (1
+  // where the hit here needs none), +inf elsewhere. Their minimum over the parts is every hit
+  // pixel's shadow.
+  const std::vector<double>& shadows() const;
+  // Per pixel, RGBA: the colour of each pixel whose primary ray hit in this part (alpha 255), zero
+  // elsewhere, given every pixel's shadow (the minimum of the parts' shadows()).
+  std::vector<std::uint8_t> shade(std::span<const double> shadow) const;
+  // The frame from the per-byte maximum of every part's shade(): the sky where no part hit.
+  Image finish(std::span<const std::uint8_t> rgba) const;
+  // What this part walked: rays and their steps, skips and reads (a relayed ray counts once per
+  // part it crossed), and ms the time in start() and walk().
+  const RenderStats& stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace voxfield

@@ -1,0 +1,119 @@
+// voxfield — frames of a world split over the ranks (mpi.h): the rays relayed between the slabs
+// (render_relay.h), each leg sent to the rank whose slab holds its voxel, until no rank has one.
+// Then every pixel's shadow is the minimum over the ranks of the shadows their walks ended with,
+// and the frame the per-byte maximum of the ranks' shaded pixels (each pixel shaded by one rank
+// alone, the others' bytes zero), which rank 0 finishes with the sky.
+#include <mpi.h>
+
+#include <algorithm>
+#include <memory>
+#include <type_traits>
+#include <vector>
+
+#include "collective.h"
+#include "voxfield/mpi.h"
+#include "voxfield/render_relay.h"
+
+namespace voxfield::mpi {
+
+namespace {
+
+static_assert(std::is_trivially_copyable_v<RayLeg>, "legs cross processes as bytes");
+
+// The rank whose slab holds slice z.
+int owner_of(const SlabPartition& partition, std::int32_t z) {
+  const auto it = std::upper_bound(partition.z.begin() + 1, partition.z.end() - 1, z);
+  return static_cast<int>(it - (partition.z.begin() + 1));
+}
+
+// Sends every leg to the rank of its voxel's slab; returns the legs this rank received.
+std::vector<RayLeg> route(MPI_Comm comm, const SlabPartition& partition,
+                          const std::vector<RayLeg>& legs, ExchangeStats* stats) {
+  const int size = partition.ranks();
+  std::vector<std::vector<RayLeg>> to(static_cast<std::size_t>(size));
+  for (const RayLeg& leg : legs)
+    to[static_cast<std::size_t>(owner_of(partition, leg.voxel.z))].push_back(leg);
+  std::vector<int> send_counts(static_cast<std::size_t>(size)), send_offsets(send_counts.size());
+  std::vector<RayLeg> out;
+  out.reserve(legs.size());
+  for (int r = 0; r < size; ++r) {
+    const auto& mine = to[static_cast<std::size_t>(r)];
+    send_offsets[static_cast<std::size_t>(r)] = static_cast<int>(out.size());
+    send_counts[static_cast<std::size_t>(r)] = static_cast<int>(mine.size());
+    out.insert(out.end(), mine.begin(), mine.end());
+  }
+  detail::CollectiveTimer timer(stats);
+  std::vector<int> receive_counts(send_counts.size()), receive_offsets(send_counts.size());
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm);
+  std::size_t received = 0;
+  for (std::size_t r = 0; r < receive_counts.size(); ++r) {
+    receive_offsets[r] = static_cast<int>(received);
+    received += static_cast<std::size_t>(receive_counts[r]);
+  }
+  std::vector<RayLeg> in(received);
+  MPI_Datatype leg_type;
+  MPI_Type_contiguous(static_cast<int>(sizeof(RayLeg)), MPI_BYTE, &leg_type);
+  MPI_Type_commit(&leg_type);
+  MPI_Alltoallv(out.data(), send_counts.data(), send_offsets.data(), leg_type, in.data(),
+                receive_counts.data(), receive_offsets.data(), leg_type, comm);
+  MPI_Type_free(&leg_type);
+  if (stats) {
+    stats->bytes_sent += out.size() * sizeof(RayLeg);
+    stats->bytes_received += in.size() * sizeof(RayLeg);
+  }
+  return in;
+}
+
+}  // namespace
+
+Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
+             const RenderSceneOptions& scene_options, const Camera& camera,
+             const RenderOptions& options, RenderStats* stats, ExchangeStats* exchange) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  const Box3i whole = partition.domain;
+  detail::collectively(comm, exchange, [&] {
+    detail::require_partition(comm, partition);
+    (void)relay_skip_field_options(scene_options, whole);  // the options are checked first
+  });
+  const DistanceField skip = compute_distance_field(
+      comm, partition, world.voxels, relay_skip_field_options(scene_options, whole), exchange);
+  const std::unique_ptr<RelayFrame> part = detail::collectively(comm, exchange, [&] {
+    return std::make_unique<RelayFrame>(world, whole, partition.slab(rank), skip, scene_options,
+                                        camera, options);
+  });
+  std::vector<RayLeg> legs = detail::collectively(comm, exchange, [&] { return part->start(); });
+  for (;;) {
+    std::uint64_t mine = legs.size(), in_flight = 0;
+    {
+      detail::CollectiveTimer timer(exchange);
+      MPI_Allreduce(&mine, &in_flight, 1, MPI_UINT64_T, MPI_SUM, comm);
+    }
+    if (in_flight == 0) break;
+    const std::vector<RayLeg> in = route(comm, partition, legs, exchange);
+    legs = detail::collectively(comm, exchange, [&] { return part->walk(in); });
+  }
+  const std::vector<double>& ends = part->shadows();
+  std::vector<double> shadow(ends.size());
+  {
+    detail::CollectiveTimer timer(exchange);
+    MPI_Allreduce(ends.data(), shadow.data(), static_cast<int>(ends.size()), MPI_DOUBLE, MPI_MIN,
+                  comm);
+  }
+  const std::vector<std::uint8_t> rgba =
+      detail::collectively(comm, exchange, [&] { return part->shade(shadow); });
+  std::vector<std::uint8_t> frame_rgba(rank == 0 ? rgba.size() : 0);
+  {
+    detail::CollectiveTimer timer(exchange);
+    MPI_Reduce(rgba.data(), frame_rgba.data(), static_cast<int>(rgba.size()), MPI_UINT8_T, MPI_MAX,
+               0, comm);
+  }
+  if (exchange) {
+    exchange->bytes_sent += ends.size() * sizeof(double) + rgba.size();
+    exchange->bytes_received += ends.size() * sizeof(double) + frame_rgba.size();
+  }
+  if (stats) *stats = part->stats();
+  return rank == 0 ? part->finish(frame_rgba) : Image{};
+}
+
+}  // namespace voxfield::mpi

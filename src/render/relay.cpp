@@ -1,0 +1,308 @@
+// voxfield renderer — frames relayed part by part across scenes (render_relay.h).
+//
+// Each part walks rays with the frame renderer's own traversal step (traverse.h's visit) inside its
+// slab; a ray that leaves the slab for another part of the whole box becomes a RayLeg carrying the
+// DDA's state, which the next part resumes with Dda::start — the state a walk through the whole box
+// has at that voxel (dda.h), so the walk goes on exactly as one process's would. A soft shadow's
+// penumbra travels with its leg: the minimum over the voxels read is the same whichever part read
+// them.
+#include "voxfield/render_relay.h"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "hit_shading.h"
+#include "scene_impl.h"
+#include "shading.h"
+#include "traverse.h"
+#include "voxfield/error.h"
+#include "voxfield/parallel.h"
+
+namespace voxfield {
+
+using render_detail::Dda;
+using render_detail::HitShading;
+using render_detail::Rgb;
+using render_detail::SkipWeights;
+using render_detail::Step;
+
+namespace {
+
+// Ambient occlusion reads the lighting field at most 3 voxels along a hit face's normal, then the
+// 8 voxel centres around that point: up to 4 slices beyond the hit's own part.
+constexpr int kAmbientReach = 4;
+
+// `box` grown by `slices` along z, within `whole`.
+Box3i grown_along_z(const Box3i& box, int slices, const Box3i& whole) {
+  Box3i b = box;
+  b.begin.z = std::max<std::int64_t>(whole.begin.z, std::int64_t{box.begin.z} - slices);
+  b.end.z = std::min<std::int64_t>(whole.end.z, std::int64_t{box.end.z} + slices);
+  return b;
+}
+
+void check_part(const Box3i& whole, const Box3i& part, int chunk_edge) {
+  const auto on_chunk = [&](std::int32_t z, std::int32_t face) {
+    return z == face || z % chunk_edge == 0;
+  };
+  if (part.empty() || !whole.contains(part) || part.begin.x != whole.begin.x ||
+      part.begin.y != whole.begin.y || part.end.x != whole.end.x || part.end.y != whole.end.y ||
+      !on_chunk(part.begin.z, whole.begin.z) || !on_chunk(part.end.z, whole.end.z))
+    throw InvalidArgument("render: the part " + to_string(part) + " is not a slab of " +
+                          to_string(whole) + " cut on chunk boundaries (edge " +
+                          std::to_string(chunk_edge) + ")");
+}
+
+// The part's scene: the box it reads (its slab and ambient occlusion's reach), the skip field's
+// values over the slab with 0 (no skip, never read from here) beyond, and a lighting field
+// computed from the part's world.
+RenderScene part_scene(const World& world, const Box3i& whole, const Box3i& part,
+                       const DistanceField& skip, const RenderSceneOptions& options) {
+  const DistanceOptions want = relay_skip_field_options(options, whole);
+  if (skip.options.metric != want.metric || skip.options.storage != want.storage ||
+      skip.options.max_distance != want.max_distance || skip.options.signed_distance)
+    throw InvalidArgument("render: the part's skip field is not the scene's (" +
+                          std::string(metric_name(want.metric)) + ", u8, clamped at " +
+                          std::to_string(want.max_distance) + ")");
+  if (!skip.domain.contains(part))
+    throw InvalidArgument("render: the skip field's domain " + to_string(skip.domain) +
+                          " does not cover the part " + to_string(part));
+  const Box3i box = grown_along_z(part, kAmbientReach, whole);
+  DistanceField extended = skip;
+  extended.domain = box;
+  auto& values = std::get<Grid<std::uint8_t>>(extended.values);
+  values = values.rechunked(values.chunk_edge(), box);
+  if (box.begin.z < part.begin.z) values.fill({box.begin, {box.end.x, box.end.y, part.begin.z}}, 0);
+  if (part.end.z < box.end.z) values.fill({{box.begin.x, box.begin.y, part.end.z}, box.end}, 0);
+  std::optional<DistanceField> light;
+  if (options.lighting_field) {
+    light = compute_distance_field(
+        world,
+        light_field_options(options, grown_along_z(part, relay_ghost_slices(options), whole)));
+  }
+  return RenderScene(world, extended, light ? &*light : nullptr, box);
+}
+
+}  // namespace
+
+int relay_ghost_slices(const RenderSceneOptions& options) {
+  if (!options.lighting_field) return kAmbientReach;
+  // The lighting field over the part and ambient occlusion's reach is exact when every site within
+  // its clamp of those slices is in view.
+  (void)light_field_options(options, {});  // checks the clamp
+  return kAmbientReach + static_cast<int>(std::ceil(options.lighting_max_distance_vox)) + 1;
+}
+
+DistanceOptions relay_skip_field_options(const RenderSceneOptions& options, const Box3i& whole) {
+  return skip_field_options(options, whole);
+}
+
+struct RelayFrame::Impl {
+  Box3i whole, part;
+  RenderScene scene;
+  RenderOptions o;
+  Camera::Projector projector;
+  HitShading light;
+  std::vector<RayHit> hits;
+  std::vector<double> shadow_ends;
+  RenderStats stats;
+  std::mutex merge;
+
+  Impl(const World& world, const Box3i& whole_box, const Box3i& part_box, const DistanceField& skip,
+       const RenderSceneOptions& scene_options, const Camera& camera, const RenderOptions& options)
+      : whole(whole_box),
+        part(part_box),
+        scene(part_scene(world, whole_box, part_box, skip, scene_options)),
+        o(options),
+        projector(camera.projector(options.width, options.height)),
+        light{scene.impl(), o, options.sun_direction.normalized()} {}
+
+  std::size_t pixels() const { return static_cast<std::size_t>(o.width) * o.height; }
+  Ray primary_ray(std::uint32_t pixel) const {
+    return projector.ray(pixel % static_cast<std::uint32_t>(o.width) + 0.5,
+                         pixel / static_cast<std::uint32_t>(o.width) + 0.5);
+  }
+  static RayLeg leg_of(const Ray& ray, const Dda& d, std::uint32_t pixel, bool shadow, double lit) {
+    RayLeg leg;
+    leg.origin = ray.origin;
+    leg.voxel = d.v;
+    leg.t = d.t;
+    leg.lit = lit;
+    leg.pixel = pixel;
+    leg.face_axis = static_cast<std::int8_t>(d.face_axis);
+    leg.shadow = shadow ? 1 : 0;
+    return leg;
+  }
+
+  // Walks a ray from dda's voxel (in the part) until it hits, leaves the whole box, or leaves the
+  // part for another (then a leg goes to `out`).
+  void run(const Ray& ray, Dda& dda, std::uint32_t pixel, bool shadow, double lit,
+           std::vector<RayLeg>& out, RenderStats& st) {
+    const RenderScene::Impl& s = scene.impl();
+    const SkipWeights sw(s.skip.metric, ray);
+    TraversalCounters& c = shadow ? st.shadow : st.primary;
+    const auto on_air = [&](const Dda& d, std::size_t chunk) {
+      if (shadow) lit = light.penumbra(lit, d, chunk);
+    };
+    RayHit hit;
+    for (;;) {
+      const Step step = render_detail::visit(s, part, shadow ? SkipMode::kDistance : o.skip, s.skip,
+                                             sw, dda, c, on_air, hit);
+      if (step == Step::kContinue) continue;
+      if (step == Step::kHit) {
+        if (shadow) {
+          shadow_ends[pixel] = HitShading::shadow_of(true, lit);
+        } else {
+          primary_hit(pixel, ray, hit, out, st);
+        }
+      } else if (whole.contains(dda.v)) {
+        out.push_back(leg_of(ray, dda, pixel, shadow, lit));
+      } else if (shadow) {
+        shadow_ends[pixel] = HitShading::shadow_of(false, lit);
+      }
+      return;
+    }
+  }
+
+  // A primary ray hit here: the pixel is this part's to shade, and its shadow ray starts here.
+  void primary_hit(std::uint32_t pixel, const Ray& ray, const RayHit& hit, std::vector<RayLeg>& out,
+                   RenderStats& st) {
+    hits[pixel] = hit;
+    if (!light.wants_shadow(hit, ray)) {
+      shadow_ends[pixel] = 1;
+      return;
+    }
+    const Ray r = light.shadow_ray(hit, ray);
+    Dda d;
+    if (!render_detail::start_in_box(whole, r, d)) {
+      shadow_ends[pixel] = HitShading::shadow_of(false, 1);
+      return;
+    }
+    ++st.shadow.rays;
+    if (!part.contains(d.v)) {
+      out.push_back(leg_of(r, d, pixel, true, 1));
+      return;
+    }
+    run(r, d, pixel, true, 1, out, st);
+  }
+
+  // f(index, legs_out, stats) for indices in parallel; the legs and counters merged after.
+  template <class F>
+  std::vector<RayLeg> in_parallel(std::size_t n, F&& f) {
+    std::vector<RayLeg> all;
+    const auto t0 = std::chrono::steady_clock::now();
+    parallel_for(n, 256, [&](std::size_t b, std::size_t e) {
+      std::vector<RayLeg> out;
+      RenderStats st;
+      for (std::size_t i = b; i < e; ++i) f(i, out, st);
+      const std::lock_guard<std::mutex> lock(merge);
+      all.insert(all.end(), out.begin(), out.end());
+      stats.primary.add(st.primary);
+      stats.shadow.add(st.shadow);
+    });
+    stats.ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return all;
+  }
+};
+
+RelayFrame::RelayFrame(const World& world, const Box3i& whole, const Box3i& part,
+                       const DistanceField& skip, const RenderSceneOptions& scene_options,
+                       const Camera& camera, const RenderOptions& options) {
+  if (options.view != RenderView::kShaded && options.view != RenderView::kChunks)
+    throw InvalidArgument(std::string("render: the ") + render_view_name(options.view) +
+                          " view is not drawn part by part (shaded and chunks are)");
+  check_part(whole, part, world.voxels.chunk_edge());
+  impl_ = std::make_unique<Impl>(world, whole, part, skip, scene_options, camera, options);
+  render_detail::check_frame_options(impl_->scene.impl(), options);
+  impl_->hits.assign(impl_->pixels(), RayHit{});
+  impl_->shadow_ends.assign(impl_->pixels(), std::numeric_limits<double>::infinity());
+  impl_->stats.width = options.width;
+  impl_->stats.height = options.height;
+}
+
+RelayFrame::~RelayFrame() = default;
+
+std::vector<RayLeg> RelayFrame::start() {
+  Impl& f = *impl_;
+  return f.in_parallel(f.pixels(), [&](std::size_t i, std::vector<RayLeg>& out, RenderStats& st) {
+    const auto pixel = static_cast<std::uint32_t>(i);
+    const Ray ray = f.primary_ray(pixel);
+    Dda d;
+    if (!render_detail::start_in_box(f.whole, ray, d) || !f.part.contains(d.v)) return;
+    ++st.primary.rays;
+    f.run(ray, d, pixel, false, 1, out, st);
+  });
+}
+
+std::vector<RayLeg> RelayFrame::walk(std::span<const RayLeg> legs) {
+  Impl& f = *impl_;
+  for (const RayLeg& leg : legs)
+    if (leg.pixel >= f.pixels() || !f.part.contains(leg.voxel) || leg.face_axis < -1 ||
+        leg.face_axis > 2 || leg.shadow > 1)
+      throw InvalidArgument("render: a ray leg for pixel " + std::to_string(leg.pixel) + " at " +
+                            to_string(leg.voxel) + " does not belong to the part " +
+                            to_string(f.part));
+  return f.in_parallel(legs.size(), [&](std::size_t i, std::vector<RayLeg>& out, RenderStats& st) {
+    const RayLeg& leg = legs[i];
+    const bool shadow = leg.shadow != 0;
+    const Ray ray = shadow ? Ray{leg.origin, f.light.sun} : f.primary_ray(leg.pixel);
+    Dda d;
+    d.start(ray, leg.voxel, leg.t, leg.face_axis);
+    ++(shadow ? st.shadow : st.primary).rays;
+    f.run(ray, d, leg.pixel, shadow, leg.lit, out, st);
+  });
+}
+
+const std::vector<double>& RelayFrame::shadows() const {
+  return impl_->shadow_ends;
+}
+
+std::vector<std::uint8_t> RelayFrame::shade(std::span<const double> shadow) const {
+  const Impl& f = *impl_;
+  if (shadow.size() != f.pixels())
+    throw InvalidArgument("render: " + std::to_string(shadow.size()) + " shadows for " +
+                          std::to_string(f.pixels()) + " pixels");
+  std::vector<std::uint8_t> rgba(4 * f.pixels(), 0);
+  parallel_for(f.pixels(), 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const RayHit& h = f.hits[i];
+      if (!h.hit) continue;
+      const Ray ray = f.primary_ray(static_cast<std::uint32_t>(i));
+      Rgb c = f.light.shade(h, ray, shadow[i]);
+      if (f.o.view == RenderView::kChunks)
+        f.light.chunk_overlay(h, ray, f.projector.footprint(h.t), c);
+      render_detail::tone_map().write(c, rgba.data() + 4 * i);
+      rgba[4 * i + 3] = 255;
+    }
+  });
+  return rgba;
+}
+
+Image RelayFrame::finish(std::span<const std::uint8_t> rgba) const {
+  const Impl& f = *impl_;
+  if (rgba.size() != 4 * f.pixels())
+    throw InvalidArgument("render: " + std::to_string(rgba.size()) + " bytes of RGBA for " +
+                          std::to_string(f.pixels()) + " pixels");
+  Image image(f.o.width, f.o.height);
+  for (std::size_t i = 0; i < f.pixels(); ++i) {
+    std::uint8_t* px = image.pixel(static_cast<int>(i % static_cast<std::size_t>(f.o.width)),
+                                   static_cast<int>(i / static_cast<std::size_t>(f.o.width)));
+    if (rgba[4 * i + 3] == 255) {
+      for (int c = 0; c < 3; ++c) px[c] = rgba[4 * i + static_cast<std::size_t>(c)];
+    } else {
+      render_detail::tone_map().write(
+          render_detail::sky(f.primary_ray(static_cast<std::uint32_t>(i)).direction), px);
+    }
+  }
+  return image;
+}
+
+const RenderStats& RelayFrame::stats() const {
+  return impl_->stats;
+}
+
+}  // namespace voxfield

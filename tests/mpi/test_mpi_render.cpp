@@ -1,0 +1,158 @@
+// Frames drawn where the world lies (mpi::render, render_relay.h) against one process: run under
+// mpirun with 1..N ranks, every rank builds the same world, keeps its slab and ghost slices, and
+// rank 0's frame must equal render() of the whole world's scene byte for byte — soft shadows cast
+// across slabs, ambient occlusion at slab borders, skipping rays, fog, the chunks view and cameras
+// from above, below and inside included; bad options must fail on every rank alike.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <random>
+#include <string>
+
+#include "voxfield/mpi.h"
+#include "voxfield/render.h"
+#include "voxfield/render_relay.h"
+
+namespace voxfield {
+namespace {
+
+MPI_Comm comm() {
+  return MPI_COMM_WORLD;
+}
+int rank() {
+  int r = 0;
+  MPI_Comm_rank(comm(), &r);
+  return r;
+}
+int ranks() {
+  int n = 0;
+  MPI_Comm_size(comm(), &n);
+  return n;
+}
+
+// Ground, pillars and floating blocks over 8 chunk layers along z, so that slabs of every rank
+// count cast shadows on one another, with a sprinkle of single voxels.
+World scene_world(std::uint32_t seed, const Box3i& domain, int edge) {
+  std::mt19937 rng(seed);
+  World w(edge, domain);
+  const Vec3i lo = domain.begin, size = domain.size();
+  w.voxels.fill({lo, {domain.end.x, domain.end.y, lo.z + 3}}, 1);
+  const auto at = [&](int n) { return static_cast<int>(rng() % static_cast<unsigned>(n)); };
+  for (int k = 0; k < 14; ++k) {
+    const Vec3i a{lo.x + at(size.x - 6), lo.y + at(size.y - 6), lo.z + at(size.z - 8)};
+    const Vec3i extent{2 + at(5), 2 + at(5), 2 + at(k % 3 ? 6 : size.z - (a.z - lo.z))};
+    w.voxels.fill(Box3i{a, a + extent}.intersect(domain), static_cast<std::uint8_t>(2 + k % 5));
+  }
+  for (int k = 0; k < 150; ++k)
+    w.voxels.set({lo.x + at(size.x), lo.y + at(size.y), lo.z + at(size.z)},
+                 static_cast<std::uint8_t>(1 + at(7)));
+  return w;
+}
+
+struct Case {
+  std::string what;
+  RenderSceneOptions scene;
+  Camera camera;
+  RenderOptions options;
+};
+
+void check(const Case& c, const World& whole, const Box3i& domain, int edge) {
+  const mpi::SlabPartition p = mpi::partition_slabs(domain, ranks(), edge);
+  const int ghost = relay_ghost_slices(c.scene);
+  const Box3i slab = p.slab(rank());
+  const Box3i keep{{domain.begin.x, domain.begin.y, std::max(domain.begin.z, slab.begin.z - ghost)},
+                   {domain.end.x, domain.end.y, std::min(domain.end.z, slab.end.z + ghost)}};
+  World mine(edge, keep);
+  mine.voxels = whole.voxels.rechunked(edge, keep);
+  mine.palette = whole.palette;
+  RenderStats stats;
+  mpi::ExchangeStats exchange;
+  const Image frame = mpi::render(comm(), p, mine, c.scene, c.camera, c.options, &stats, &exchange);
+  // Every pixel's primary ray that enters the box is walked by one rank at least.
+  std::int64_t walked = stats.primary.rays, all_walked = 0;
+  MPI_Allreduce(&walked, &all_walked, 1, MPI_INT64_T, MPI_SUM, comm());
+  EXPECT_GT(all_walked, 0) << c.what;
+  if (rank() != 0) {
+    EXPECT_TRUE(frame.rgb.empty()) << c.what;
+    return;
+  }
+  const Image expect = render(RenderScene(whole, c.scene, domain), c.camera, c.options);
+  ASSERT_EQ(frame.width, expect.width) << c.what;
+  ASSERT_EQ(frame.height, expect.height) << c.what;
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < expect.rgb.size(); ++i) differ += frame.rgb[i] != expect.rgb[i];
+  EXPECT_EQ(differ, 0u) << c.what << ": bytes that differ from one process's frame";
+}
+
+TEST(MpiRender, FramesEqualOneProcessByteForByte) {
+  const int edge = 8;
+  const Box3i domain{{-7, 5, -16}, {41, 45, 48}};  // 8 chunk layers along z
+  const World w = scene_world(17, domain, edge);
+  RenderOptions o;
+  o.width = 96;
+  o.height = 64;
+  const double aspect = 1.5;
+  std::vector<Case> cases;
+  cases.push_back({"shaded, framing camera", {}, Camera::framing(domain, aspect), o});
+  cases.push_back({"shaded, from above", {}, Camera::top(domain, aspect), o});
+  Case low{"a low sun, from below the ground, fog",
+           {},
+           Camera::parse("eye=17,25,-40:target=17,25,10:up=0,1,0", domain, aspect),
+           o};
+  low.options.sun_direction = {0.9, 0.2, 0.15};
+  low.options.fog_density = 0.01;
+  cases.push_back(low);
+  Case inside{"from inside, the sun below",
+              {},
+              Camera::parse("eye=30,12,20:target=0,40,0:fov=80", domain, aspect),
+              o};
+  inside.options.sun_direction = {-0.3, 0.4, -0.8};
+  cases.push_back(inside);
+  Case chunks{"the chunks view, Euclidean skip clamped at 12, no skipping for primary rays",
+              {},
+              Camera::framing(domain, aspect, 35),
+              o};
+  chunks.scene.skip_metric = Metric::kEuclidean;
+  chunks.scene.skip_max_distance_vox = 12;
+  chunks.scene.lighting_max_distance_vox = 9.5;
+  chunks.options.view = RenderView::kChunks;
+  chunks.options.skip = SkipMode::kNone;
+  cases.push_back(chunks);
+  Case plain{"no lighting field", {}, Camera::framing(domain, aspect), o};
+  plain.scene.lighting_field = false;
+  plain.options.ambient_occlusion = false;
+  plain.options.soft_shadows = false;
+  plain.options.skip = SkipMode::kChunks;
+  cases.push_back(plain);
+  for (const Case& c : cases) check(c, w, domain, edge);
+}
+
+TEST(MpiRender, BadOptionsFailOnEveryRankAlike) {
+  const int edge = 8;
+  const Box3i domain{{0, 0, 0}, {24, 24, 32}};
+  const World w = scene_world(3, domain, edge);
+  const mpi::SlabPartition p = mpi::partition_slabs(domain, ranks(), ranks() <= 4 ? edge : 1);
+  RenderOptions o;
+  o.width = 32;
+  o.height = 24;
+  o.view = RenderView::kDistance;
+  const Camera cam = Camera::framing(domain, 32.0 / 24);
+  try {
+    (void)mpi::render(comm(), p, w, {}, cam, o);
+    ADD_FAILURE() << "the distance view was drawn";
+  } catch (const mpi::RankError& e) {
+    EXPECT_NE(std::string(e.what()).find("not drawn part by part"), std::string::npos) << e.what();
+  }
+  o.view = RenderView::kShaded;
+  RenderSceneOptions bad;
+  bad.skip_max_distance_vox = 300;
+  try {
+    (void)mpi::render(comm(), p, w, bad, cam, o);
+    ADD_FAILURE() << "a skip clamp of 300 was taken";
+  } catch (const mpi::RankError& e) {
+    EXPECT_NE(std::string(e.what()).find("skip_max_distance_vox"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace voxfield
