@@ -1,4 +1,5 @@
-// voxfield-mpi: exact distance fields of volumes split over the processes of an MPI job.
+// voxfield-mpi: exact distance fields, meshes and frames of volumes split over the processes of
+// an MPI job.
 //
 //   mpirun -np N voxfield-mpi field IN -o OUT.npy [--metric M] [--signed] [--max-distance D]
 //          [--storage S] [--spacing sx,sy,sz] [--sites S.npy] [--stats S.json] [--chunk C]
@@ -8,6 +9,9 @@
 //   mpirun -np N voxfield-mpi mesh IN.npy -o OUT.{ply,obj,stl,glb} [--algorithm mc|sn|dc]
 //          [--iso V] [--inside below|above] [--spacing sx,sy,sz] [--chunk C]
 //          [--balance content|count] [--threads T] [--stats S.json]
+//   mpirun -np N voxfield-mpi render IN -o OUT.png [--width W] [--height H] [--camera C]
+//          [--view shaded|chunks] [--metric M] [--skip S] [--no-shadows] [--no-ao] [--fog F]
+//          [--chunk C] [--threads T] [--stats S.json]
 //
 // `field` writes byte for byte what `voxfield field` writes for the same input and options; each
 // rank holds only its slab of a .npy input and of the field. `edit` writes what `voxfield edit`
@@ -15,8 +19,10 @@
 // can reach beyond it, with incremental updates of its own field. `bench` generates a world of
 // random spheres slab by slab (no file) and prints, per run, the time, the rate and the bytes
 // exchanged. `mesh` meshes a float volume, each rank the chunk layers of its planes (mpi.h), and
-// writes the mesh `voxfield mesh` writes, triangle for triangle. Every rank parses the same command
-// line; rank 0 alone prints. A failure on any rank is reported by rank 0 as "voxfield-mpi: rank R:
+// writes the mesh `voxfield mesh` writes, triangle for triangle. `render` draws the frame `voxfield
+// render` draws, byte for byte, each rank walking the rays that cross its slab and handing them
+// on (render_relay.h). Every rank parses the same command line; rank 0 alone prints. A failure on
+// any rank is reported by rank 0 as "voxfield-mpi: rank R:
 // ..." and every rank exits with 1 (2 for usage errors).
 #include <mpi.h>
 
@@ -28,6 +34,7 @@
 #include "bench_world.h"
 #include "mesh_command.h"
 #include "rank_stats.h"
+#include "render_command.h"
 #include "voxfield/distance.h"
 #include "voxfield/edit_script.h"
 #include "voxfield/error.h"
@@ -265,7 +272,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   voxfield::install_signal_cleanup();
-  CLI::App app{"voxfield-mpi: exact distance fields and meshes over the processes of an MPI job"};
+  CLI::App app{
+      "voxfield-mpi: exact distance fields, meshes and frames over the processes of an MPI job"};
   app.require_subcommand(1);
   std::string memory_limit;
   app.add_option("--memory-limit", memory_limit,
@@ -307,6 +315,8 @@ int main(int argc, char** argv) {
   fb.add_to(bench);
   mpi_cli::MeshSettings mesh_settings;
   CLI::App* mesh = mpi_cli::add_mesh_command(app, mesh_settings);
+  mpi_cli::RenderSettings render_settings;
+  CLI::App* render = mpi_cli::add_render_command(app, render_settings);
   int code = 0;
   try {
     app.parse(argc, argv);
@@ -318,6 +328,8 @@ int main(int argc, char** argv) {
       code = run_edit(comm, fe, edit_in, edit_script, edit_out, edit_stats, edit_save);
     } else if (mesh->parsed()) {
       code = mpi_cli::run_mesh(comm, mesh_settings);
+    } else if (render->parsed()) {
+      code = mpi_cli::run_render(comm, render_settings);
     } else {
       code = run_bench(comm, fb, dims, spheres, repeat);
     }

@@ -228,6 +228,10 @@ void save_world_vfw(MPI_Comm comm, const SlabPartition& partition, const World& 
                     const std::filesystem::path& path, ExchangeStats* stats = nullptr,
                     FileTransaction* into = nullptr);
 
+// The bounds of the world's content (voxels that are not air) over every rank's slab — ghost
+// slices count once, in the slab that owns them: what a camera frames.
+Box3i content_bounds(MPI_Comm comm, const SlabPartition& partition, const World& world);
+
 // Frames of the world the ranks hold in slabs, drawn where it lies (render_relay.h): each rank
 // walks the rays that cross its slab, primary and shadow rays alike, and sends each on to the rank
 // whose slab it enters; each pixel is shaded by the rank where its primary ray hit. Rank 0 returns

@@ -32,13 +32,14 @@ namespace voxfield {
 // A ray's walk paused at the first voxel outside the part that walked it. Plain bytes (it crosses
 // processes as they are).
 struct RayLeg {
-  Vec3d origin;                // the ray's origin (a shadow ray's lies just off its pixel's hit)
-  Vec3i voxel;                 // where the walk resumes
-  double t = 0;                // the ray parameter at which it entered `voxel`
-  double lit = 1;              // a shadow ray's penumbra estimate so far
-  std::uint32_t pixel = 0;     // y * width + x
-  std::int8_t face_axis = -1;  // the axis crossed to enter `voxel`
-  std::uint8_t shadow = 0;     // 0: the pixel's primary ray; 1: the shadow ray of its hit
+  Vec3d origin;                 // the ray's origin (a shadow ray's lies just off its pixel's hit)
+  double t = 0;                 // the ray parameter at which it entered `voxel`
+  double lit = 1;               // a shadow ray's penumbra estimate so far
+  Vec3i voxel;                  // where the walk resumes
+  std::uint32_t pixel = 0;      // y * width + x
+  std::int8_t face_axis = -1;   // the axis crossed to enter `voxel`
+  std::uint8_t shadow = 0;      // 0: the pixel's primary ray; 1: the shadow ray of its hit
+  std::uint8_t unused[6] = {};  // 64 bytes with no padding: every byte sent is set
 };
 
 // The slices beyond its part, on either side along z, that a part's world must hold (within the

@@ -2,6 +2,8 @@
 #include "collective.h"
 
 #include <algorithm>
+#include <array>
+#include <limits>
 
 #include "voxfield/error.h"
 
@@ -97,5 +99,34 @@ std::string mpi_error_text(int code) {
   return std::string(text, static_cast<std::size_t>(length));
 }
 
+Box3i unite_over_ranks(MPI_Comm comm, const Box3i& mine, ExchangeStats* stats) {
+  constexpr std::int32_t kMax = std::numeric_limits<std::int32_t>::max();
+  // Minima of the begins and of the negated ends, in one reduction; an empty box offers none.
+  std::array<std::int32_t, 6> v{kMax, kMax, kMax, kMax, kMax, kMax};
+  if (!mine.empty())
+    for (int k = 0; k < 3; ++k) {
+      v[static_cast<std::size_t>(k)] = mine.begin[k];
+      v[static_cast<std::size_t>(k) + 3] = -mine.end[k];
+    }
+  std::array<std::int32_t, 6> all{};
+  {
+    CollectiveTimer t(stats);
+    MPI_Allreduce(v.data(), all.data(), 6, MPI_INT32_T, MPI_MIN, comm);
+  }
+  if (all[0] == kMax) return {};
+  return {{all[0], all[1], all[2]}, {-all[3], -all[4], -all[5]}};
+}
+
 }  // namespace detail
+
+Box3i content_bounds(MPI_Comm comm, const SlabPartition& partition, const World& world) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  const Box3i mine = collectively(comm, [&] {
+    detail::require_partition(comm, partition);
+    return world.voxels.content_bounds().intersect(partition.slab(rank));
+  });
+  return detail::unite_over_ranks(comm, mine, nullptr);
+}
+
 }  // namespace voxfield::mpi

@@ -66,6 +66,9 @@ struct FilePiece {
 std::string write_pieces(MPI_Comm comm, const std::string& temporary, const std::string& target,
                          const std::vector<FilePiece>& pieces);
 
+// The union of every rank's box (empty boxes add nothing): one all-reduce of six integers.
+Box3i unite_over_ranks(MPI_Comm comm, const Box3i& mine, ExchangeStats* stats);
+
 // The text of an MPI error code.
 std::string mpi_error_text(int code);
 

@@ -18,7 +18,8 @@ namespace voxfield::mpi {
 
 namespace {
 
-static_assert(std::is_trivially_copyable_v<RayLeg>, "legs cross processes as bytes");
+static_assert(std::is_trivially_copyable_v<RayLeg> && sizeof(RayLeg) == 64,
+              "legs cross processes as bytes, every one of them set");
 
 // The rank whose slab holds slice z.
 int owner_of(const SlabPartition& partition, std::int32_t z) {

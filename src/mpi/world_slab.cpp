@@ -3,8 +3,6 @@
 #include <mpi.h>
 
 #include <algorithm>
-#include <array>
-#include <limits>
 
 #include "collective.h"
 #include "voxfield/file.h"
@@ -25,22 +23,6 @@ Box3i kept_box(const Box3i& domain, const SlabPartition& partition, int rank, in
            static_cast<std::int32_t>(std::max<std::int64_t>(domain.begin.z, slab.begin.z - g))},
           {domain.end.x, domain.end.y,
            static_cast<std::int32_t>(std::min<std::int64_t>(domain.end.z, slab.end.z + g))}};
-}
-
-// The union of every rank's box (empty boxes add nothing).
-Box3i unite_over_ranks(MPI_Comm comm, const Box3i& mine) {
-  constexpr std::int32_t kMax = std::numeric_limits<std::int32_t>::max();
-  // Minima of the begins and of the negated ends, in one reduction; an empty box offers none.
-  std::array<std::int32_t, 6> v{kMax, kMax, kMax, kMax, kMax, kMax};
-  if (!mine.empty())
-    for (int k = 0; k < 3; ++k) {
-      v[static_cast<std::size_t>(k)] = mine.begin[k];
-      v[static_cast<std::size_t>(k) + 3] = -mine.end[k];
-    }
-  std::array<std::int32_t, 6> all{};
-  MPI_Allreduce(v.data(), all.data(), 6, MPI_INT32_T, MPI_MIN, comm);
-  if (all[0] == kMax) return {};
-  return {{all[0], all[1], all[2]}, {-all[3], -all[4], -all[5]}};
 }
 
 // A .vfw: every rank holds the compressed bytes and decodes only its slab's chunks (every checksum
@@ -78,7 +60,7 @@ WorldSlab vfw_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
     }
     return out;
   });
-  const Box3i domain = h.bounds ? *h.bounds : unite_over_ranks(comm, h.content);
+  const Box3i domain = h.bounds ? *h.bounds : detail::unite_over_ranks(comm, h.content, nullptr);
   return detail::collectively(comm, nullptr, [&] {
     if (domain.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
     const SlabPartition partition = partition_slabs(domain, size, chunk_edge);

@@ -53,7 +53,9 @@ void check_part(const Box3i& whole, const Box3i& part, int chunk_edge) {
       !on_chunk(part.begin.z, whole.begin.z) || !on_chunk(part.end.z, whole.end.z))
     throw InvalidArgument("render: the part " + to_string(part) + " is not a slab of " +
                           to_string(whole) + " cut on chunk boundaries (edge " +
-                          std::to_string(chunk_edge) + ")");
+                          std::to_string(chunk_edge) +
+                          "): the walks resume chunk by chunk (fewer parts or a smaller chunk "
+                          "edge)");
 }
 
 // The part's scene: the box it reads (its slab and ambient occlusion's reach), the skip field's

@@ -189,6 +189,38 @@ expect_failure 1 "junk.npy: at byte 0: not a .npy file" field junk.npy -o bad.np
 /usr/bin/python3 -c "import numpy as np; np.save('thin.npy', np.ones((4, 4, 1), np.uint8))"
 expect_failure 1 "fewer than the 2" field thin.npy -o bad.npy
 
+# Frames: voxfield-mpi render draws voxfield render's PNG byte for byte on 1-4 ranks (rays and
+# soft-shadow rays handed from slab to slab), on a real .vox in chunks of 8 and on a .npy world read
+# a slab per rank, from the automatic camera, from the top with fog, and in the chunks view.
+if [ -f "$vox" ]; then
+  trex=$(dirname "$vox")/ephtracy_T-Rex.vox
+  "$VF" render "$trex" -o ref.png --width 160 --height 100 --chunk 8 2>/dev/null
+  for n in 1 2 4; do
+    MPIEXEC -np "$n" "$VFM" render "$trex" -o out.png --width 160 --height 100 --chunk 8 \
+      --stats stats.json 2>/dev/null
+    same ref.png out.png "render, $n ranks, ephtracy_T-Rex.vox"
+  done
+  /usr/bin/python3 - <<'PY'
+import json
+s = json.load(open("stats.json"))
+assert s["ranks"] == 4 and s["slabs"][0] == 0 and len(s["slabs"]) == 5, s
+assert s["primary"]["rays"] > 0 and s["shadow"]["rays"] > 0, s
+PY
+fi
+for view in "--camera top --fog 0.02" "--view chunks --metric euclidean --skip chunks"; do
+  # shellcheck disable=SC2086
+  "$VF" render f.npy -o ref.png --width 120 --height 90 --chunk 8 $view 2>/dev/null
+  for n in 1 3; do
+    # shellcheck disable=SC2086
+    MPIEXEC -np "$n" "$VFM" render f.npy -o out.png --width 120 --height 90 --chunk 8 $view 2>/dev/null
+    same ref.png out.png "render, $n ranks, f.npy, $view"
+  done
+done
+rm -f bad.png
+expect_failure 2 "distance not in" render f.npy -o bad.png --view distance
+expect_failure 1 "cut on chunk boundaries" render f.npy -o bad.png --chunk 64
+if [ -e bad.png ]; then echo "FAIL: a failed render wrote bad.png"; fail=1; fi
+
 # Meshes: a float volume meshed over 1..4 ranks (each reading only its chunk layers' planes) gives
 # voxfield mesh's triangles bit for bit — its whole-volume pass numbers the same vertices by row,
 # so the triangles are compared as sets of corner positions — for every mesher, in every format.

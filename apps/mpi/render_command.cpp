@@ -1,0 +1,128 @@
+// voxfield-mpi render (render_command.h).
+#include "render_command.h"
+
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+
+#include "rank_stats.h"
+#include "voxfield/error.h"
+#include "voxfield/file.h"
+#include "voxfield/mpi.h"
+#include "voxfield/parallel.h"
+#include "voxfield/png.h"
+#include "voxfield/render_relay.h"
+
+namespace voxfield::mpi_cli {
+
+CLI::App* add_render_command(CLI::App& app, RenderSettings& s) {
+  CLI::App* cmd = app.add_subcommand(
+      "render", "a frame of a world, as `voxfield render` (each rank walks the rays in its slab)");
+  cmd->add_option("IN", s.in, "input .npy (read a slab per rank), .vox or .vfw")->required();
+  cmd->add_option("-o,--output", s.out, "output .png (written by rank 0)")->required();
+  cmd->add_option("--width", s.width, "image width in pixels")->check(CLI::Range(1, 16384));
+  cmd->add_option("--height", s.height, "image height in pixels")->check(CLI::Range(1, 16384));
+  cmd->add_option("--camera", s.camera,
+                  "auto | top | eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height] (voxel "
+                  "units, z up)");
+  cmd->add_option("--view", s.view, "shaded | chunks")->check(CLI::IsMember({"shaded", "chunks"}));
+  cmd->add_option("--metric", s.metric,
+                  "field rays skip by: manhattan (default), chebyshev, euclidean")
+      ->check(CLI::IsMember({"manhattan", "chebyshev", "euclidean"}));
+  cmd->add_option("--skip", s.skip, "none (plain DDA), chunks, distance (default)")
+      ->check(CLI::IsMember({"none", "chunks", "distance"}));
+  cmd->add_flag("--no-shadows", s.no_shadows, "no soft shadows");
+  cmd->add_flag("--no-ao", s.no_ao, "no ambient occlusion");
+  cmd->add_option("--fog", s.fog, "fog density per voxel (0 = none)")->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--chunk", s.chunk, "chunk edge: 8, 16, 32, 64 or 128; slabs are cut on chunks")
+      ->check(CLI::IsMember({8, 16, 32, 64, 128}));
+  cmd->add_option("--threads", s.threads, "threads per rank (default: all cores)")
+      ->check(CLI::Range(1, 1024));
+  cmd->add_option("--stats", s.stats, "timings, ray counters and exchange figures as JSON");
+  return cmd;
+}
+
+int run_render(MPI_Comm comm, const RenderSettings& s) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  std::optional<ThreadLimit> limit;
+  if (s.threads > 0) limit.emplace(s.threads);
+  RenderSceneOptions so;
+  so.skip_metric = parse_metric(s.metric);
+  so.lighting_field = !(s.no_shadows && s.no_ao);
+  RenderOptions o;
+  o.width = s.width;
+  o.height = s.height;
+  o.view = parse_render_view(s.view);
+  o.skip = parse_skip_mode(s.skip);
+  o.soft_shadows = !s.no_shadows;
+  o.ambient_occlusion = !s.no_ao;
+  o.fog_density = s.fog;
+  mpi::check_outputs(comm, {}, {s.out, s.stats});
+  const double t0 = MPI_Wtime();
+  // Each rank holds its slab and the slices its lighting reads beyond it.
+  const mpi::WorldSlab slab = mpi::load_world_slab(comm, s.in, s.chunk, relay_ghost_slices(so));
+  const double load_ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
+  const Box3i& domain = slab.partition.domain;
+  // Automatic cameras frame what is there, as voxfield render's do: the content, within the
+  // file's extent.
+  const Box3i content = mpi::content_bounds(comm, slab.partition, slab.world);
+  const Camera camera = mpi::collectively(comm, [&] {
+    return Camera::parse(s.camera, s.camera == "top" || content.empty() ? domain : content,
+                         static_cast<double>(s.width) / s.height);
+  });
+  mpi::ExchangeStats ex;
+  RenderStats st;
+  MPI_Barrier(comm);  // the frame's time starts together on every rank
+  const double t1 = MPI_Wtime();
+  const Image image = mpi::render(comm, slab.partition, slab.world, so, camera, o, &st, &ex);
+  const double render_ms = max_over(comm, (MPI_Wtime() - t1) * 1e3);
+  const auto counters = [&](const TraversalCounters& c) {
+    return nlohmann::json{
+        {"rays", sum_over(comm, static_cast<std::uint64_t>(c.rays))},
+        {"steps", sum_over(comm, static_cast<std::uint64_t>(c.steps))},
+        {"voxel_reads", sum_over(comm, static_cast<std::uint64_t>(c.voxel_reads))},
+        {"chunk_skips", sum_over(comm, static_cast<std::uint64_t>(c.chunk_skips))},
+        {"distance_skips", sum_over(comm, static_cast<std::uint64_t>(c.distance_skips))}};
+  };
+  const nlohmann::json primary = counters(st.primary), shadow = counters(st.shadow);
+  const nlohmann::json exchange = exchange_json(comm, ex);
+  mpi::collectively(comm, [&] {
+    if (rank != 0) return;
+    FileTransaction outputs;
+    // The frame's content hash as voxfield render --stats prints it, to compare the two.
+    std::ostringstream hash_text;
+    hash_text << std::hex << std::setw(16) << std::setfill('0') << content_hash(image);
+    outputs.stage(s.out, encode_png(image));
+    if (!s.stats.empty()) {
+      nlohmann::json j{{"input", s.in},
+                       {"output", s.out},
+                       {"ms", render_ms},
+                       {"load_ms_max", load_ms},
+                       {"image_hash", hash_text.str()},
+                       {"width", s.width},
+                       {"height", s.height},
+                       {"view", s.view},
+                       {"skip", s.skip},
+                       {"skip_metric", s.metric},
+                       {"ranks", size},
+                       {"threads", max_threads()},
+                       {"read_in_parts", slab.read_in_parts},
+                       {"slabs", slab.partition.z},
+                       {"primary", primary},
+                       {"shadow", shadow}};
+      j["exchange"] = exchange;
+      outputs.stage(s.stats, j.dump(2) + "\n");
+    }
+    outputs.commit();
+  });
+  if (rank == 0)
+    std::cerr << "voxfield-mpi: wrote " << s.out << " (" << s.width << "x" << s.height << ", "
+              << s.view << " view, " << size << " ranks, " << render_ms << " ms)\n";
+  return 0;
+}
+
+}  // namespace voxfield::mpi_cli
