@@ -236,12 +236,13 @@ Box3i content_bounds(MPI_Comm comm, const SlabPartition& partition, const World&
 // walks the rays that cross its slab, primary and shadow rays alike, and sends each on to the rank
 // whose slab it enters; each pixel is shaded by the rank where its primary ray hit. Rank 0 returns
 // the frame — render(RenderScene(whole world, scene_options, partition.domain), camera, options)
-// byte for byte — and the others an empty image. `world` must hold the rank's slab and
-// relay_ghost_slices(scene_options) slices on either side along z (load_world_slab's
-// ghost_slices), the slabs cut on the world's chunk boundaries (partition_slabs with the chunk edge
-// when the domain has a chunk layer per rank). The skip field is computed over the ranks
-// (compute_distance_field above), the lighting field by each rank over its slab and ghost slices.
-// Views: shaded and chunks. `stats`: this rank's walks (a relayed ray counts once per rank).
+// byte for byte, for a world whose content lies within the domain — and the others an empty
+// image. `world` must hold the rank's relay_world_box (its slab and relay_ghost_slices slices on
+// either side along z: load_world_slab's ghost_slices), the slabs cut on the world's chunk
+// boundaries (partition_slabs with the chunk edge when the domain has a chunk layer per rank). The
+// skip field is computed over the ranks (compute_distance_field above), the lighting field by each
+// rank over its slab and ghost slices. Views: shaded and chunks. `stats`: this rank's walks (a
+// relayed ray counts once per rank).
 Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
              const RenderSceneOptions& scene_options, const Camera& camera,
              const RenderOptions& options, RenderStats* stats = nullptr,

@@ -46,6 +46,15 @@ struct RayLeg {
 // whole box): the lighting field's clamp and ambient occlusion's reach.
 int relay_ghost_slices(const RenderSceneOptions& options);
 
+// The box a part's world must hold: the part and relay_ghost_slices along z, within `whole`.
+Box3i relay_world_box(const Box3i& whole, const Box3i& part, const RenderSceneOptions& options);
+
+// What RelayFrame refuses before any field is computed (InvalidArgument): a view other than
+// shaded and chunks, a part that is not a slab of `whole` cut on chunk boundaries of `chunk_edge`,
+// options render() or RenderScene refuse.
+void check_relay_frame(const Box3i& whole, const Box3i& part, int chunk_edge,
+                       const RenderSceneOptions& scene_options, const RenderOptions& options);
+
 // The skip field RenderScene computes for the box `whole`, which every part reads over its own
 // slab: computed elsewhere for the whole box (voxfield-mpi: over the ranks, exactly).
 DistanceOptions relay_skip_field_options(const RenderSceneOptions& options, const Box3i& whole);
@@ -53,12 +62,14 @@ DistanceOptions relay_skip_field_options(const RenderSceneOptions& options, cons
 class RelayFrame {
  public:
   // One part of a frame of the box `whole` of a world. `part`: a slab of it (the whole x-y extent)
-  // cut along z on the world's chunk boundaries (or at the box's faces). `world`: the part's voxels
-  // and relay_ghost_slices(scene_options) slices on either side (within `whole`; beyond is not
-  // read), kept alive by the caller. `skip`: a field of relay_skip_field_options(scene_options,
-  // whole) whose values over `part` are the whole box's. The part's lighting field is computed
-  // here. Views: shaded and chunks. Throws InvalidArgument for another view, a part that is not
-  // such a slab, fields or options that do not fit (as render() and RenderScene do).
+  // cut along z on the world's chunk boundaries (or at the box's faces). `world`: the voxels of
+  // relay_world_box(whole, part, scene_options), kept alive by the caller; whole chunks are read
+  // where they straddle the box's faces, so outside `whole` the world must hold what the whole
+  // scene's world holds there (nothing, when `whole` bounds the content, as a file's extent does).
+  // `skip`: a field of relay_skip_field_options(scene_options, whole) whose values over `part` are
+  // the whole box's. The part's lighting field is computed here. Views: shaded and chunks. Throws
+  // InvalidArgument for another view, a part that is not such a slab, fields or options that do not
+  // fit (as render() and RenderScene do).
   RelayFrame(const World& world, const Box3i& whole, const Box3i& part, const DistanceField& skip,
              const RenderSceneOptions& scene_options, const Camera& camera,
              const RenderOptions& options);
@@ -70,7 +81,7 @@ class RelayFrame {
   // finds the same ones for itself); returns the legs that left the part for another.
   std::vector<RayLeg> start();
   // Resumes legs whose voxel lies in `part`; returns the legs that left it (InvalidArgument for a
-  // leg that is not this part's or names no pixel).
+  // leg that is not this part's, names no pixel, or shares its pixel with another).
   std::vector<RayLeg> walk(std::span<const RayLeg> legs);
   // Per pixel (y * width + x): the shadow of the pixels whose shadow ray ended in this part (1
   // where the hit here needs none), +inf elsewhere. Their minimum over the parts is every hit
@@ -81,8 +92,9 @@ class RelayFrame {
   std::vector<std::uint8_t> shade(std::span<const double> shadow) const;
   // The frame from the per-byte maximum of every part's shade(): the sky where no part hit.
   Image finish(std::span<const std::uint8_t> rgba) const;
-  // What this part walked: rays and their steps, skips and reads (a relayed ray counts once per
-  // part it crossed), and ms the time in start() and walk().
+  // What this part walked: rays and their steps, skips and reads (a ray counts once in each part
+  // it crossed, and only if it entered the whole box: render() counts every pixel's), and ms the
+  // time in start() and walk().
   const RenderStats& stats() const;
 
  private:

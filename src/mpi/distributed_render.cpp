@@ -27,43 +27,67 @@ int owner_of(const SlabPartition& partition, std::int32_t z) {
   return static_cast<int>(it - (partition.z.begin() + 1));
 }
 
-// Sends every leg to the rank of its voxel's slab; returns the legs this rank received.
+// Sends every leg to the rank of its voxel's slab; returns the legs this rank received. Every
+// allocation is agreed on before the next collective call, so a rank that runs out of memory fails
+// the job on every rank instead of leaving the others waiting.
 std::vector<RayLeg> route(MPI_Comm comm, const SlabPartition& partition,
-                          const std::vector<RayLeg>& legs, ExchangeStats* stats) {
-  const int size = partition.ranks();
-  std::vector<std::vector<RayLeg>> to(static_cast<std::size_t>(size));
-  for (const RayLeg& leg : legs)
-    to[static_cast<std::size_t>(owner_of(partition, leg.voxel.z))].push_back(leg);
-  std::vector<int> send_counts(static_cast<std::size_t>(size)), send_offsets(send_counts.size());
-  std::vector<RayLeg> out;
-  out.reserve(legs.size());
-  for (int r = 0; r < size; ++r) {
-    const auto& mine = to[static_cast<std::size_t>(r)];
-    send_offsets[static_cast<std::size_t>(r)] = static_cast<int>(out.size());
-    send_counts[static_cast<std::size_t>(r)] = static_cast<int>(mine.size());
-    out.insert(out.end(), mine.begin(), mine.end());
+                          const std::vector<RayLeg>& legs, MPI_Datatype leg_type,
+                          ExchangeStats* stats) {
+  const auto size = static_cast<std::size_t>(partition.ranks());
+  std::vector<int> send_counts(size), send_offsets(size), receive_counts(size),
+      receive_offsets(size);
+  const std::vector<RayLeg> out = detail::collectively(comm, stats, [&] {
+    std::vector<std::vector<RayLeg>> to(size);
+    for (const RayLeg& leg : legs)
+      to[static_cast<std::size_t>(owner_of(partition, leg.voxel.z))].push_back(leg);
+    std::vector<RayLeg> sorted;
+    sorted.reserve(legs.size());
+    for (std::size_t r = 0; r < size; ++r) {
+      send_offsets[r] = static_cast<int>(sorted.size());
+      send_counts[r] = static_cast<int>(to[r].size());
+      sorted.insert(sorted.end(), to[r].begin(), to[r].end());
+    }
+    return sorted;
+  });
+  {
+    detail::CollectiveTimer timer(stats);
+    MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm);
   }
-  detail::CollectiveTimer timer(stats);
-  std::vector<int> receive_counts(send_counts.size()), receive_offsets(send_counts.size());
-  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm);
-  std::size_t received = 0;
-  for (std::size_t r = 0; r < receive_counts.size(); ++r) {
-    receive_offsets[r] = static_cast<int>(received);
-    received += static_cast<std::size_t>(receive_counts[r]);
+  std::vector<RayLeg> in = detail::collectively(comm, stats, [&] {
+    std::size_t received = 0;
+    for (std::size_t r = 0; r < size; ++r) {
+      receive_offsets[r] = static_cast<int>(received);
+      received += static_cast<std::size_t>(receive_counts[r]);
+    }
+    return std::vector<RayLeg>(received);
+  });
+  {
+    detail::CollectiveTimer timer(stats);
+    MPI_Alltoallv(out.data(), send_counts.data(), send_offsets.data(), leg_type, in.data(),
+                  receive_counts.data(), receive_offsets.data(), leg_type, comm);
   }
-  std::vector<RayLeg> in(received);
-  MPI_Datatype leg_type;
-  MPI_Type_contiguous(static_cast<int>(sizeof(RayLeg)), MPI_BYTE, &leg_type);
-  MPI_Type_commit(&leg_type);
-  MPI_Alltoallv(out.data(), send_counts.data(), send_offsets.data(), leg_type, in.data(),
-                receive_counts.data(), receive_offsets.data(), leg_type, comm);
-  MPI_Type_free(&leg_type);
   if (stats) {
     stats->bytes_sent += out.size() * sizeof(RayLeg);
     stats->bytes_received += in.size() * sizeof(RayLeg);
   }
   return in;
 }
+
+// A leg as MPI sees it: its bytes, one element.
+class LegType {
+ public:
+  LegType() {
+    MPI_Type_contiguous(static_cast<int>(sizeof(RayLeg)), MPI_BYTE, &type_);
+    MPI_Type_commit(&type_);
+  }
+  ~LegType() { MPI_Type_free(&type_); }
+  LegType(const LegType&) = delete;
+  LegType& operator=(const LegType&) = delete;
+  MPI_Datatype get() const { return type_; }
+
+ private:
+  MPI_Datatype type_ = MPI_DATATYPE_NULL;
+};
 
 }  // namespace
 
@@ -73,9 +97,11 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   const Box3i whole = partition.domain;
+  // Everything that can be refused is, before any field is computed.
   detail::collectively(comm, exchange, [&] {
     detail::require_partition(comm, partition);
-    (void)relay_skip_field_options(scene_options, whole);  // the options are checked first
+    check_relay_frame(whole, partition.slab(rank), world.voxels.chunk_edge(), scene_options,
+                      options);
   });
   const DistanceField skip = compute_distance_field(
       comm, partition, world.voxels, relay_skip_field_options(scene_options, whole), exchange);
@@ -83,6 +109,7 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
     return std::make_unique<RelayFrame>(world, whole, partition.slab(rank), skip, scene_options,
                                         camera, options);
   });
+  const LegType leg_type;
   std::vector<RayLeg> legs = detail::collectively(comm, exchange, [&] { return part->start(); });
   for (;;) {
     std::uint64_t mine = legs.size(), in_flight = 0;
@@ -91,11 +118,12 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
       MPI_Allreduce(&mine, &in_flight, 1, MPI_UINT64_T, MPI_SUM, comm);
     }
     if (in_flight == 0) break;
-    const std::vector<RayLeg> in = route(comm, partition, legs, exchange);
+    const std::vector<RayLeg> in = route(comm, partition, legs, leg_type.get(), exchange);
     legs = detail::collectively(comm, exchange, [&] { return part->walk(in); });
   }
   const std::vector<double>& ends = part->shadows();
-  std::vector<double> shadow(ends.size());
+  std::vector<double> shadow =
+      detail::collectively(comm, exchange, [&] { return std::vector<double>(ends.size()); });
   {
     detail::CollectiveTimer timer(exchange);
     MPI_Allreduce(ends.data(), shadow.data(), static_cast<int>(ends.size()), MPI_DOUBLE, MPI_MIN,
@@ -103,7 +131,8 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
   }
   const std::vector<std::uint8_t> rgba =
       detail::collectively(comm, exchange, [&] { return part->shade(shadow); });
-  std::vector<std::uint8_t> frame_rgba(rank == 0 ? rgba.size() : 0);
+  std::vector<std::uint8_t> frame_rgba = detail::collectively(
+      comm, exchange, [&] { return std::vector<std::uint8_t>(rank == 0 ? rgba.size() : 0); });
   {
     detail::CollectiveTimer timer(exchange);
     MPI_Reduce(rgba.data(), frame_rgba.data(), static_cast<int>(rgba.size()), MPI_UINT8_T, MPI_MAX,

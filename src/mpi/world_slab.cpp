@@ -60,7 +60,10 @@ WorldSlab vfw_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
     }
     return out;
   });
-  const Box3i domain = h.bounds ? *h.bounds : detail::unite_over_ranks(comm, h.content, nullptr);
+  // (Every rank takes part in the union, bounded file or not: a collective call must not depend
+  // on what each rank read.)
+  const Box3i content = detail::unite_over_ranks(comm, h.content, nullptr);
+  const Box3i domain = h.bounds ? *h.bounds : content;
   return detail::collectively(comm, nullptr, [&] {
     if (domain.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
     const SlabPartition partition = partition_slabs(domain, size, chunk_edge);

@@ -16,10 +16,6 @@
 
 namespace voxfield::render_detail {
 
-// What render() checks of its options against a scene before drawing (InvalidArgument): the image
-// size, the tile size, a lighting field for ambient occlusion and shadows, the fog, the sun.
-void check_frame_options(const RenderScene::Impl& s, const RenderOptions& o);
-
 struct HitShading {
   const RenderScene::Impl& s;
   const RenderOptions& o;

@@ -34,7 +34,7 @@ namespace {
 
 // Ambient occlusion reads the lighting field at most 3 voxels along a hit face's normal, then the
 // 8 voxel centres around that point: up to 4 slices beyond the hit's own part.
-constexpr int kAmbientReach = 4;
+constexpr int kAmbientReachSlices = 4;
 
 // `box` grown by `slices` along z, within `whole`.
 Box3i grown_along_z(const Box3i& box, int slices, const Box3i& whole) {
@@ -72,7 +72,7 @@ RenderScene part_scene(const World& world, const Box3i& whole, const Box3i& part
   if (!skip.domain.contains(part))
     throw InvalidArgument("render: the skip field's domain " + to_string(skip.domain) +
                           " does not cover the part " + to_string(part));
-  const Box3i box = grown_along_z(part, kAmbientReach, whole);
+  const Box3i box = grown_along_z(part, kAmbientReachSlices, whole);
   DistanceField extended = skip;
   extended.domain = box;
   auto& values = std::get<Grid<std::uint8_t>>(extended.values);
@@ -82,8 +82,7 @@ RenderScene part_scene(const World& world, const Box3i& whole, const Box3i& part
   std::optional<DistanceField> light;
   if (options.lighting_field) {
     light = compute_distance_field(
-        world,
-        light_field_options(options, grown_along_z(part, relay_ghost_slices(options), whole)));
+        world, light_field_options(options, relay_world_box(whole, part, options)));
   }
   return RenderScene(world, extended, light ? &*light : nullptr, box);
 }
@@ -91,11 +90,26 @@ RenderScene part_scene(const World& world, const Box3i& whole, const Box3i& part
 }  // namespace
 
 int relay_ghost_slices(const RenderSceneOptions& options) {
-  if (!options.lighting_field) return kAmbientReach;
+  if (!options.lighting_field) return kAmbientReachSlices;
   // The lighting field over the part and ambient occlusion's reach is exact when every site within
-  // its clamp of those slices is in view.
+  // its clamp of those slices is in view (a site farther away reads as the clamp either way).
   (void)light_field_options(options, {});  // checks the clamp
-  return kAmbientReach + static_cast<int>(std::ceil(options.lighting_max_distance_vox)) + 1;
+  return kAmbientReachSlices + static_cast<int>(std::ceil(options.lighting_max_distance_vox));
+}
+
+Box3i relay_world_box(const Box3i& whole, const Box3i& part, const RenderSceneOptions& options) {
+  return grown_along_z(part, relay_ghost_slices(options), whole);
+}
+
+void check_relay_frame(const Box3i& whole, const Box3i& part, int chunk_edge,
+                       const RenderSceneOptions& scene_options, const RenderOptions& options) {
+  if (options.view != RenderView::kShaded && options.view != RenderView::kChunks)
+    throw InvalidArgument(std::string("render: the ") + render_view_name(options.view) +
+                          " view is not drawn part by part (shaded and chunks are)");
+  check_part(whole, part, chunk_edge);
+  (void)relay_skip_field_options(scene_options, whole);
+  (void)relay_ghost_slices(scene_options);
+  render_detail::check_frame_options(scene_options.lighting_field, options);
 }
 
 DistanceOptions relay_skip_field_options(const RenderSceneOptions& options, const Box3i& whole) {
@@ -146,6 +160,7 @@ struct RelayFrame::Impl {
     const RenderScene::Impl& s = scene.impl();
     const SkipWeights sw(s.skip.metric, ray);
     TraversalCounters& c = shadow ? st.shadow : st.primary;
+    ++c.rays;  // a walk here: a ray relayed across parts counts once in each
     const auto on_air = [&](const Dda& d, std::size_t chunk) {
       if (shadow) lit = light.penumbra(lit, d, chunk);
     };
@@ -183,7 +198,6 @@ struct RelayFrame::Impl {
       shadow_ends[pixel] = HitShading::shadow_of(false, 1);
       return;
     }
-    ++st.shadow.rays;
     if (!part.contains(d.v)) {
       out.push_back(leg_of(r, d, pixel, true, 1));
       return;
@@ -214,12 +228,8 @@ struct RelayFrame::Impl {
 RelayFrame::RelayFrame(const World& world, const Box3i& whole, const Box3i& part,
                        const DistanceField& skip, const RenderSceneOptions& scene_options,
                        const Camera& camera, const RenderOptions& options) {
-  if (options.view != RenderView::kShaded && options.view != RenderView::kChunks)
-    throw InvalidArgument(std::string("render: the ") + render_view_name(options.view) +
-                          " view is not drawn part by part (shaded and chunks are)");
-  check_part(whole, part, world.voxels.chunk_edge());
+  check_relay_frame(whole, part, world.voxels.chunk_edge(), scene_options, options);
   impl_ = std::make_unique<Impl>(world, whole, part, skip, scene_options, camera, options);
-  render_detail::check_frame_options(impl_->scene.impl(), options);
   impl_->hits.assign(impl_->pixels(), RayHit{});
   impl_->shadow_ends.assign(impl_->pixels(), std::numeric_limits<double>::infinity());
   impl_->stats.width = options.width;
@@ -235,26 +245,30 @@ std::vector<RayLeg> RelayFrame::start() {
     const Ray ray = f.primary_ray(pixel);
     Dda d;
     if (!render_detail::start_in_box(f.whole, ray, d) || !f.part.contains(d.v)) return;
-    ++st.primary.rays;
     f.run(ray, d, pixel, false, 1, out, st);
   });
 }
 
 std::vector<RayLeg> RelayFrame::walk(std::span<const RayLeg> legs) {
   Impl& f = *impl_;
-  for (const RayLeg& leg : legs)
+  // Each pixel has one ray in flight at most (its shadow ray starts where its primary ray ended),
+  // which is what lets the walks write their pixel's results in parallel.
+  std::vector<std::uint8_t> taken(legs.empty() ? 0 : f.pixels(), 0);
+  for (const RayLeg& leg : legs) {
     if (leg.pixel >= f.pixels() || !f.part.contains(leg.voxel) || leg.face_axis < -1 ||
         leg.face_axis > 2 || leg.shadow > 1)
       throw InvalidArgument("render: a ray leg for pixel " + std::to_string(leg.pixel) + " at " +
                             to_string(leg.voxel) + " does not belong to the part " +
                             to_string(f.part));
+    if (taken[leg.pixel]++)
+      throw InvalidArgument("render: two ray legs for pixel " + std::to_string(leg.pixel));
+  }
   return f.in_parallel(legs.size(), [&](std::size_t i, std::vector<RayLeg>& out, RenderStats& st) {
     const RayLeg& leg = legs[i];
     const bool shadow = leg.shadow != 0;
     const Ray ray = shadow ? Ray{leg.origin, f.light.sun} : f.primary_ray(leg.pixel);
     Dda d;
     d.start(ray, leg.voxel, leg.t, leg.face_axis);
-    ++(shadow ? st.shadow : st.primary).rays;
     f.run(ray, d, leg.pixel, shadow, leg.lit, out, st);
   });
 }

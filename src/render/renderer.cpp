@@ -163,12 +163,12 @@ struct Frame {
 
 namespace render_detail {
 
-void check_frame_options(const RenderScene::Impl& s, const RenderOptions& o) {
+void check_frame_options(bool has_light, const RenderOptions& o) {
   if (o.width <= 0 || o.height <= 0 || o.width > 16384 || o.height > 16384)
     throw InvalidArgument("render: image size " + std::to_string(o.width) + "x" +
                           std::to_string(o.height) + " is out of range (1..16384 per side)");
   if (o.tile_size <= 0) throw InvalidArgument("render: tile size must be positive");
-  if ((o.ambient_occlusion || o.soft_shadows) && !s.has_light)
+  if ((o.ambient_occlusion || o.soft_shadows) && !has_light)
     throw InvalidArgument(
         "render: ambient occlusion and soft shadows need the scene's lighting field "
         "(RenderSceneOptions::lighting_field)");
@@ -182,7 +182,7 @@ void check_frame_options(const RenderScene::Impl& s, const RenderOptions& o) {
 Image render(const RenderScene& scene, const Camera& camera, const RenderOptions& o,
              RenderStats* stats, Interrupter* interrupter) {
   const RenderScene::Impl& s = scene.impl();
-  render_detail::check_frame_options(s, o);
+  render_detail::check_frame_options(s.has_light, o);
 
   Image image(o.width, o.height);
   Frame f{s, o, camera.projector(o.width, o.height), {s, o, o.sun_direction.normalized()}};

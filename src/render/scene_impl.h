@@ -106,6 +106,12 @@ struct RenderScene::Impl {
 // (clamp at most 255); Euclidean ones in quarter voxels (clamp at most 63); clamp 0 = the most.
 // Throws InvalidArgument for a clamp out of that range.
 DistanceOptions skip_field_options(const RenderSceneOptions& options, const Box3i& box);
+namespace render_detail {
+// What a frame checks of its options before drawing (InvalidArgument): the image size, the tile
+// size, a lighting field (`has_light`) for ambient occlusion and shadows, the fog, the sun.
+void check_frame_options(bool has_light, const RenderOptions& o);
+}  // namespace render_detail
+
 // Options of the u8 Euclidean lighting field (throws InvalidArgument for a clamp out of (0, 63]).
 DistanceOptions light_field_options(const RenderSceneOptions& options, const Box3i& box);
 

@@ -216,6 +216,12 @@ for view in "--camera top --fog 0.02" "--view chunks --metric euclidean --skip c
     same ref.png out.png "render, $n ranks, f.npy, $view"
   done
 done
+# An unbounded .vfw read a slab per rank, its domain (the content's bounds) starting off a chunk.
+"$VF" render margins.vfw -o ref.png --width 100 --height 80 --chunk 8 2>/dev/null
+for n in 1 3; do
+  MPIEXEC -np "$n" "$VFM" render margins.vfw -o out.png --width 100 --height 80 --chunk 8 2>/dev/null
+  same ref.png out.png "render, $n ranks, margins.vfw"
+done
 rm -f bad.png
 expect_failure 2 "distance not in" render f.npy -o bad.png --view distance
 expect_failure 1 "cut on chunk boundaries" render f.npy -o bad.png --chunk 64

@@ -58,10 +58,7 @@ struct Case {
 
 void check(const Case& c, const World& whole, const Box3i& domain, int edge) {
   const mpi::SlabPartition p = mpi::partition_slabs(domain, ranks(), edge);
-  const int ghost = relay_ghost_slices(c.scene);
-  const Box3i slab = p.slab(rank());
-  const Box3i keep{{domain.begin.x, domain.begin.y, std::max(domain.begin.z, slab.begin.z - ghost)},
-                   {domain.end.x, domain.end.y, std::min(domain.end.z, slab.end.z + ghost)}};
+  const Box3i keep = relay_world_box(domain, p.slab(rank()), c.scene);
   World mine(edge, keep);
   mine.voxels = whole.voxels.rechunked(edge, keep);
   mine.palette = whole.palette;
@@ -86,7 +83,8 @@ void check(const Case& c, const World& whole, const Box3i& domain, int edge) {
 
 TEST(MpiRender, FramesEqualOneProcessByteForByte) {
   const int edge = 8;
-  const Box3i domain{{-7, 5, -16}, {41, 45, 48}};  // 8 chunk layers along z
+  // 8 chunk layers along z; the first starts off a chunk boundary (at the domain's face).
+  const Box3i domain{{-7, 5, -13}, {41, 45, 48}};
   const World w = scene_world(17, domain, edge);
   RenderOptions o;
   o.width = 96;
@@ -94,7 +92,7 @@ TEST(MpiRender, FramesEqualOneProcessByteForByte) {
   const double aspect = 1.5;
   std::vector<Case> cases;
   cases.push_back({"shaded, framing camera", {}, Camera::framing(domain, aspect), o});
-  cases.push_back({"shaded, from above", {}, Camera::top(domain, aspect), o});
+  cases.push_back({"shaded, orthographic from above", {}, Camera::top(domain, aspect), o});
   Case low{"a low sun, from below the ground, fog",
            {},
            Camera::parse("eye=17,25,-40:target=17,25,10:up=0,1,0", domain, aspect),
@@ -118,6 +116,13 @@ TEST(MpiRender, FramesEqualOneProcessByteForByte) {
   chunks.options.view = RenderView::kChunks;
   chunks.options.skip = SkipMode::kNone;
   cases.push_back(chunks);
+  Case flat{"Chebyshev skip, a sun on the horizon, orthographic from the side",
+            {},
+            Camera::parse("eye=17,-60,20:target=17,25,10:ortho=70", domain, aspect),
+            o};
+  flat.scene.skip_metric = Metric::kChebyshev;
+  flat.options.sun_direction = {0.6, 0.8, 0};
+  cases.push_back(flat);
   Case plain{"no lighting field", {}, Camera::framing(domain, aspect), o};
   plain.scene.lighting_field = false;
   plain.options.ambient_occlusion = false;
