@@ -11,6 +11,7 @@
 #include <fstream>
 #include <random>
 
+#include "mpi_ranks.h"
 #include "voxfield/dynamic_field.h"
 #include "voxfield/file.h"
 #include "voxfield/limits.h"
@@ -20,19 +21,9 @@
 namespace voxfield {
 namespace {
 
-MPI_Comm comm() {
-  return MPI_COMM_WORLD;
-}
-int rank() {
-  int r = 0;
-  MPI_Comm_rank(comm(), &r);
-  return r;
-}
-int ranks() {
-  int n = 0;
-  MPI_Comm_size(comm(), &n);
-  return n;
-}
+using test::comm;
+using test::rank;
+using test::ranks;
 
 template <class T>
 std::vector<T> dense(const Grid<T>& g, const Box3i& box) {

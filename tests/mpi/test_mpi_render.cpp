@@ -9,6 +9,7 @@
 #include <random>
 #include <string>
 
+#include "mpi_ranks.h"
 #include "voxfield/mpi.h"
 #include "voxfield/render.h"
 #include "voxfield/render_relay.h"
@@ -16,19 +17,9 @@
 namespace voxfield {
 namespace {
 
-MPI_Comm comm() {
-  return MPI_COMM_WORLD;
-}
-int rank() {
-  int r = 0;
-  MPI_Comm_rank(comm(), &r);
-  return r;
-}
-int ranks() {
-  int n = 0;
-  MPI_Comm_size(comm(), &n);
-  return n;
-}
+using test::comm;
+using test::rank;
+using test::ranks;
 
 // Ground, pillars and floating blocks over 8 chunk layers along z, so that slabs of every rank
 // count cast shadows on one another, with a sprinkle of single voxels.
