@@ -73,17 +73,21 @@ RenderScene part_scene(const World& world, const Box3i& whole, const Box3i& part
     throw InvalidArgument("render: the skip field's domain " + to_string(skip.domain) +
                           " does not cover the part " + to_string(part));
   const Box3i box = grown_along_z(part, kAmbientReachSlices, whole);
-  DistanceField extended = skip;
-  extended.domain = box;
-  auto& values = std::get<Grid<std::uint8_t>>(extended.values);
-  values = values.rechunked(values.chunk_edge(), box);
-  if (box.begin.z < part.begin.z) values.fill({box.begin, {box.end.x, box.end.y, part.begin.z}}, 0);
-  if (part.end.z < box.end.z) values.fill({{box.begin.x, box.begin.y, part.end.z}, box.end}, 0);
   std::optional<DistanceField> light;
   if (options.lighting_field) {
     light = compute_distance_field(
         world, light_field_options(options, relay_world_box(whole, part, options)));
   }
+  if (skip.domain.contains(box))  // one part, or a skip field given beyond the slab: as it is
+    return RenderScene(world, skip, light ? &*light : nullptr, box);
+  // Else one copy of the skip values, over the scene's box.
+  const auto& values = std::get<Grid<std::uint8_t>>(skip.values);
+  DistanceField extended{skip.options,  box,
+                         skip.encoding, values.rechunked(values.chunk_edge(), box),
+                         std::nullopt,  skip.frame};
+  auto& grid = std::get<Grid<std::uint8_t>>(extended.values);
+  if (box.begin.z < part.begin.z) grid.fill({box.begin, {box.end.x, box.end.y, part.begin.z}}, 0);
+  if (part.end.z < box.end.z) grid.fill({{box.begin.x, box.begin.y, part.end.z}, box.end}, 0);
   return RenderScene(world, extended, light ? &*light : nullptr, box);
 }
 
