@@ -3,7 +3,7 @@
 # showcase's 256^3 terrain, its exact signed Euclidean field computed by one process and by
 # voxfield-mpi on 1, 2 and 4 ranks, each rank reading only its slab of the .npy; the files must be
 # identical, byte for byte; then that field meshed by one process and over 2 and 4 ranks: the same
-# triangles. Appends a section with the times and the bytes exchanged to the report.
+# triangles; then a frame of the terrain drawn over 2 and 4 ranks: voxfield render's PNG. Appends a section with the times and the bytes exchanged to the report.
 # Usage: showcase_mpi.sh OUT_DIR   (skipped, saying so, when voxfield-mpi was not built)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -55,6 +55,25 @@ PY
 done
 mesh_one=$(/usr/bin/python3 -c "import json; j = json.load(open('$out/mpi-mesh-one.json')); print('%d triangles in %.0f ms' % (j['triangles'], j['ms']))")
 rm -f "$out/mpi-one-process.npy" "$out/mpi-mesh-one.ply"
+# A frame of the terrain drawn where it lies (`voxfield-mpi render`): the rays, and the soft
+# shadows' rays, handed from slab to slab; the PNG must be voxfield render's, byte for byte.
+frame_opts=(--width 640 --height 360 --chunk 32)
+"$B/voxfield" render "$out/terrain.npy" -o "$out/mpi-frame.png" "${frame_opts[@]}" >/dev/null 2>&1
+frame_rows=""
+for n in 2 4; do
+  mpirun --oversubscribe -np "$n" "$B/voxfield-mpi" render "$out/terrain.npy" -o "$out/mpi-frame-$n.png" \
+    "${frame_opts[@]}" --stats "$out/mpi-frame-$n.json" 2>/dev/null
+  same=no
+  cmp -s "$out/mpi-frame.png" "$out/mpi-frame-$n.png" && same=yes
+  frame_rows+=$(/usr/bin/python3 - "$out/mpi-frame-$n.json" "$same" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+print("| %d | %s | %.0f | %d | %d | %d | %s |" % (j["ranks"], " ".join(str(z) for z in j["slabs"]), j["ms"],
+      j["primary"]["rays"], j["shadow"]["rays"], j["exchange"]["bytes_sent_total"], sys.argv[2]))
+PY
+)$'\n'
+  rm -f "$out/mpi-frame-$n.png"
+done
 {
   printf '\n## Beyond one machine (MPI)\n\n'
   printf 'The terrain'"'"'s exact signed Euclidean field by `voxfield-mpi` (docs/mpi.md): each rank reads only its\n'
@@ -70,9 +89,16 @@ rm -f "$out/mpi-one-process.npy" "$out/mpi-mesh-one.ply"
   printf '| ranks | chunk layers (cuts) | triangles | ms | bytes received (pieces to rank 0, weights) | same triangles as one process |\n'
   printf '|---|---|---|---|---|---|\n'
   printf '%s' "$mesh_rows"
+  printf '\nA frame of the terrain over the ranks (`voxfield-mpi render`): each rank walks the rays that cross\n'
+  printf 'its slab and hands each on, with the DDA'"'"'s exact state, to the rank it enters, soft-shadow rays\n'
+  printf 'included; each pixel is shaded by the rank where it hit. The PNG must equal `voxfield render`'"'"'s.\n\n'
+  printf '![The terrain, drawn over the ranks](mpi-frame.png)\n\n'
+  printf '| ranks | slabs (z cuts) | ms (fields, scene, frame) | walks, primary | walks, shadow | bytes sent | PNG identical to one process |\n'
+  printf '|---|---|---|---|---|---|---|\n'
+  printf '%s' "$frame_rows"
 } >> "$report"
 if grep -q '| no |$' "$report"; then
-  echo "voxfield: an MPI field or mesh differs from one process's (see $report)" >&2
+  echo "voxfield: an MPI field, mesh or frame differs from one process's (see $report)" >&2
   exit 1
 fi
 echo "voxfield: MPI section added to $report"
