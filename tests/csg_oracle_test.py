@@ -212,6 +212,9 @@ def definition_part(tmp):
     check(np.allclose(f, want_f, atol=1e-5), "voxelize --field equals the definition at the voxel centres")
     w = np.load(os.path.join(tmp, "w.npy"))
     check(((w != 0) == (want_f <= 0)).mean() > 0.9999, "voxelize: solid where the value is <= 0")
+    # The voxels' frame (0.25 model units from (-3, -3, -3)) has no place in a .npy: said.
+    check("w.npy keeps no frame" in p.stderr and "voxel size (0.25, 0.25, 0.25)" in p.stderr,
+          "voxelize to .npy says the frame is left out: " + p.stderr.strip())
     # A failed run writes nothing: an unreadable points file after a valid model.
     out = os.path.join(tmp, "never.npy")
     open(os.path.join(tmp, "bad.npy"), "wb").write(b"not an npy")

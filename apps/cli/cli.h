@@ -64,4 +64,8 @@ double ms_since(std::chrono::steady_clock::time_point start);
 // A content hash (hash.h) as 16 hex digits, for stats files: results can be pinned beside times.
 std::string hash_hex(std::uint64_t hash);
 
+// Says on stderr what writing `world` to `out` leaves out (frame_left_out, world_io.h), if
+// anything, so that nobody wonders where a frame went.
+void note_frame_left_out(const World& world, const std::string& out);
+
 }  // namespace voxfield::cli

@@ -32,15 +32,6 @@ void set_frame(World& world, const ConvertSettings& s) {
     world.frame.rotation = rotation_about(s.rotate[0], {s.rotate[1], s.rotate[2], s.rotate[3]});
 }
 
-// .vfw and .vdb keep a world's frame; .vox and .npy have nowhere to put it. Not an error (the
-// voxels are what those formats are for), but said, so that nobody wonders where it went.
-void note_frame_left_out(const World& world, const std::string& out) {
-  const WorldFormat f = world_format_of(out);
-  if (world.frame.is_identity() || f == WorldFormat::kVfw || f == WorldFormat::kVdb) return;
-  std::cerr << "voxfield: note: " << out << " keeps no frame; the world's ("
-            << describe(world.frame) << ") is left out (.vfw and .vdb keep it)\n";
-}
-
 int run_convert(const ConvertSettings& s) {
   check_grid_input(s.in, s.grid);
   // Converting a file onto itself is safe: the input is read whole before the output is written.

@@ -184,6 +184,7 @@ int run_voxelize(const CsgSettings& s) {
   set_activity("writing " + s.out);
   const Box3i extent = Box3i::from_size(v.dims);
   outputs.stage(s.out, encode_world(v.world, extent, world_format_of(s.out)));
+  note_frame_left_out(v.world, s.out);
   if (o.field)
     outputs.stage(s.field, encode_npy(make_npy(DType::kFloat32, v.dims, v.field.data())));
   const csg::VoxelizeStats& st = v.stats;

@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <iostream>
 
 #include "cli.h"
 
@@ -49,6 +50,11 @@ void Outputs::expect_world(const std::string& path, const std::string& option, b
 void Outputs::stage_json(const std::string& path, const nlohmann::json& j) {
   if (path.empty()) return;  // not asked for
   tx_.stage(path, std::string_view(j.dump(2) + "\n"));
+}
+
+void note_frame_left_out(const World& world, const std::string& out) {
+  const std::string note = frame_left_out(world, out);
+  if (!note.empty()) std::cerr << "voxfield: note: " << note << "\n";
 }
 
 std::string hash_hex(std::uint64_t hash) {

@@ -59,5 +59,10 @@ World rechunk_world(const World& world, int chunk_edge, std::optional<Box3i> bou
 std::vector<std::uint8_t> encode_world(const World& world, const Box3i& extent, WorldFormat format);
 // encode_world by the path's extension, then write_file_atomic.
 void save_world(const World& world, const Box3i& extent, const std::filesystem::path& path);
+// What a save of `world` to `path` leaves out, said for its user: "P keeps no frame; the world's
+// (...) is left out (.vfw and .vdb keep it)" when the world has a frame other than the identity
+// and the format (.vox, .npy) has nowhere to put it; empty otherwise. Not an error: the voxels are
+// what those formats are for.
+std::string frame_left_out(const World& world, const std::filesystem::path& path);
 
 }  // namespace voxfield

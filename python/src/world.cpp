@@ -181,13 +181,20 @@ void bind_world(py::module_& parent) {
       .def(
           "save",
           [](const PyWorld& w, const std::string& path) {
-            py::gil_scoped_release release;
-            const std::shared_lock read(w.lock);
-            save_world(w.world, w.extent, path);
+            std::string left_out;
+            {
+              py::gil_scoped_release release;
+              const std::shared_lock read(w.lock);
+              save_world(w.world, w.extent, path);
+              left_out = frame_left_out(w.world, path);
+            }
+            // Said once the file is written (a warning raised as an error leaves it written).
+            if (!left_out.empty() && PyErr_WarnEx(PyExc_UserWarning, left_out.c_str(), 1) != 0)
+              throw py::error_already_set();
           },
           py::arg("path"),
           "Writes .vox, .npy, .vfw or .vdb (by extension) atomically: a failed save leaves the "
-          "old file")
+          "old file. A frame .vox and .npy cannot keep is left out with a UserWarning")
       .def_property_readonly(
           "solid_count",
           [](const PyWorld& w) { return reading(w, [&] { return w.world.solid_count(); }); })

@@ -205,4 +205,11 @@ void save_world(const World& world, const Box3i& extent, const std::filesystem::
   write_file_atomic(path, encode_world(world, extent, world_format_of(path)));
 }
 
+std::string frame_left_out(const World& world, const std::filesystem::path& path) {
+  const WorldFormat f = world_format_of(path);
+  if (world.frame.is_identity() || f == WorldFormat::kVfw || f == WorldFormat::kVdb) return {};
+  return path.string() + " keeps no frame; the world's (" + describe(world.frame) +
+         ") is left out (.vfw and .vdb keep it)";
+}
+
 }  // namespace voxfield

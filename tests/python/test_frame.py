@@ -9,6 +9,7 @@ Run by CTest with PYTHONPATH pointing at the build's python/ directory.
 """
 
 import math
+import warnings
 
 import numpy as np
 import pyopenvdb as openvdb
@@ -64,7 +65,9 @@ def test_a_vdb_transform_becomes_the_worlds_frame(tmp_path):
 def test_voxfields_own_files_keep_the_frame(tmp_path):
     framed_vdb(tmp_path / "blob.vdb")
     world = World.load(str(tmp_path / "blob.vdb"))
-    world.save(str(tmp_path / "blob.vfw"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # .vfw keeps the frame: nothing to say
+        world.save(str(tmp_path / "blob.vfw"))
     back = World.load(str(tmp_path / "blob.vfw"))
     assert back.origin_world == world.origin_world  # doubles, stored as doubles
     assert back.voxel_size_world == world.voxel_size_world
@@ -76,6 +79,10 @@ def test_voxfields_own_files_keep_the_frame(tmp_path):
     ijk = np.array([[0, 0, 0], [2, 1, -1], [-30, 12, 7]]) + 0.5
     np.testing.assert_allclose(again.to_world(ijk), world.to_world(ijk), atol=1e-9)
     assert again.solid_count == world.solid_count
+    # A .npy has nowhere to put the frame: said, and the voxels written all the same.
+    with pytest.warns(UserWarning, match="blob.npy keeps no frame"):
+        world.save(str(tmp_path / "blob.npy"))
+    assert World.load(str(tmp_path / "blob.npy")).solid_count == world.solid_count
 
 
 def normal_agreement(vertices, faces, normals):
