@@ -3,7 +3,8 @@
 # showcase's 256^3 terrain, its exact signed Euclidean field computed by one process and by
 # voxfield-mpi on 1, 2 and 4 ranks, each rank reading only its slab of the .npy; the files must be
 # identical, byte for byte; then that field meshed by one process and over 2 and 4 ranks: the same
-# triangles; then a frame of the terrain drawn over 2 and 4 ranks: voxfield render's PNG. Appends a section with the times and the bytes exchanged to the report.
+# triangles; then a frame of the terrain drawn over 2 and 4 ranks: voxfield render's PNG. Appends
+# a section with the times and the bytes exchanged to the report.
 # Usage: showcase_mpi.sh OUT_DIR   (skipped, saying so, when voxfield-mpi was not built)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -72,8 +73,9 @@ print("| %d | %s | %.0f | %d | %d | %d | %s |" % (j["ranks"], " ".join(str(z) fo
       j["primary"]["rays"], j["shadow"]["rays"], j["exchange"]["bytes_sent_total"], sys.argv[2]))
 PY
 )$'\n'
-  rm -f "$out/mpi-frame-$n.png"
+  [ "$n" -eq 4 ] || rm -f "$out/mpi-frame-$n.png"  # the 4 ranks' frame is pictured
 done
+rm -f "$out/mpi-frame.png"
 {
   printf '\n## Beyond one machine (MPI)\n\n'
   printf 'The terrain'"'"'s exact signed Euclidean field by `voxfield-mpi` (docs/mpi.md): each rank reads only its\n'
@@ -92,7 +94,7 @@ done
   printf '\nA frame of the terrain over the ranks (`voxfield-mpi render`): each rank walks the rays that cross\n'
   printf 'its slab and hands each on, with the DDA'"'"'s exact state, to the rank it enters, soft-shadow rays\n'
   printf 'included; each pixel is shaded by the rank where it hit. The PNG must equal `voxfield render`'"'"'s.\n\n'
-  printf '![The terrain, drawn over the ranks](mpi-frame.png)\n\n'
+  printf '![The terrain, drawn over 4 ranks](mpi-frame-4.png)\n\n'
   printf '| ranks | slabs (z cuts) | ms (fields, scene, frame) | walks, primary | walks, shadow | bytes sent | PNG identical to one process |\n'
   printf '|---|---|---|---|---|---|---|\n'
   printf '%s' "$frame_rows"

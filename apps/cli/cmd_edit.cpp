@@ -77,8 +77,10 @@ int run_edit(const EditSettings& s) {
 
   set_activity("writing " + s.out);
   outputs.stage(s.out, encode_npy(field_volume(field.field(), field.field().domain)));
-  if (!s.save_world.empty())
+  if (!s.save_world.empty()) {
     outputs.stage(s.save_world, encode_world(world, in.extent, world_format_of(s.save_world)));
+    note_frame_left_out(world, s.save_world);
+  }
   const double total = std::accumulate(edit_ms.begin(), edit_ms.end(), 0.0);
   const Vec3i d = in.extent.size();
   nlohmann::json j = s.field.describe(o, d);

@@ -181,16 +181,14 @@ void bind_world(py::module_& parent) {
       .def(
           "save",
           [](const PyWorld& w, const std::string& path) {
-            std::string left_out;
-            {
-              py::gil_scoped_release release;
-              const std::shared_lock read(w.lock);
-              save_world(w.world, w.extent, path);
-              left_out = frame_left_out(w.world, path);
-            }
-            // Said once the file is written (a warning raised as an error leaves it written).
+            // Said before the file is written (not under the world's lock: a warning handler may
+            // be any Python code), so that a warning raised as an error leaves the old file.
+            const std::string left_out = reading(w, [&] { return frame_left_out(w.world, path); });
             if (!left_out.empty() && PyErr_WarnEx(PyExc_UserWarning, left_out.c_str(), 1) != 0)
               throw py::error_already_set();
+            py::gil_scoped_release release;
+            const std::shared_lock read(w.lock);
+            save_world(w.world, w.extent, path);
           },
           py::arg("path"),
           "Writes .vox, .npy, .vfw or .vdb (by extension) atomically: a failed save leaves the "

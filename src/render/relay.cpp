@@ -58,9 +58,9 @@ void check_part(const Box3i& whole, const Box3i& part, int chunk_edge) {
                           "edge)");
 }
 
-// The part's scene: the box it reads (its slab and ambient occlusion's reach), the skip field's
-// values over the slab with 0 (no skip, never read from here) beyond, and a lighting field
-// computed from the part's world.
+// The part's scene: the box it reads (its slab and ambient occlusion's reach), the skip field as
+// given when it covers that box (walks never read it beyond the slab), else its values over the
+// slab with 0 (no skip) beyond, and a lighting field computed from the part's world.
 RenderScene part_scene(const World& world, const Box3i& whole, const Box3i& part,
                        const DistanceField& skip, const RenderSceneOptions& options) {
   const DistanceOptions want = relay_skip_field_options(options, whole);

@@ -189,7 +189,8 @@ expect_failure 1 "junk.npy: at byte 0: not a .npy file" field junk.npy -o bad.np
 expect_failure 1 "fewer than the 2" field thin.npy -o bad.npy
 
 # Frames: voxfield-mpi render draws voxfield render's PNG byte for byte on 2-4 ranks (rays and
-# soft-shadow rays handed from slab to slab; one rank and many more cases are test_mpi_render's), on a real .vox in chunks of 8 and on a .npy world read
+# soft-shadow rays handed from slab to slab; one rank and many more cases are test_mpi_render's),
+# on a real .vox in chunks of 8 and on a .npy world read
 # a slab per rank, from the automatic camera, from the top with fog, and in the chunks view.
 if [ -f "$vox" ]; then
   trex=$(dirname "$vox")/ephtracy_T-Rex.vox

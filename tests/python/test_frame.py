@@ -83,6 +83,12 @@ def test_voxfields_own_files_keep_the_frame(tmp_path):
     with pytest.warns(UserWarning, match="blob.npy keeps no frame"):
         world.save(str(tmp_path / "blob.npy"))
     assert World.load(str(tmp_path / "blob.npy")).solid_count == world.solid_count
+    # Warnings raised as errors: the save fails before writing, and the old file stays.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(UserWarning, match="keeps no frame"):
+            world.save(str(tmp_path / "never.npy"))
+    assert not (tmp_path / "never.npy").exists()
 
 
 def normal_agreement(vertices, faces, normals):
