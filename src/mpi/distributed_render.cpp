@@ -143,7 +143,10 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
     exchange->bytes_received += ends.size() * sizeof(double) + frame_rgba.size();
   }
   if (stats) *stats = part->stats();
-  return rank == 0 ? part->finish(frame_rgba) : Image{};
+  // (Agreed on too: a rank 0 that failed here would leave the others waiting in the caller's next
+  // collective call.)
+  return detail::collectively(comm, exchange,
+                              [&] { return rank == 0 ? part->finish(frame_rgba) : Image{}; });
 }
 
 }  // namespace voxfield::mpi
