@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <iostream>
 
-#include "../common/render_flags.h"
 #include "backend_choice.h"
 #include "cli.h"
 #include "field_args.h"
@@ -15,9 +14,12 @@
 namespace voxfield::cli {
 namespace {
 
-struct RenderSettings : apps::RenderFlags {
-  std::string in, out, camera = "auto", algorithm = "jfa", stats, backend = "cpu";
-  int chunk_edge = 32, threads = 0, repeat = 1;
+struct RenderSettings {
+  std::string in, out, camera = "auto", view = "shaded", algorithm = "jfa", metric = "manhattan",
+                       skip = "distance", stats, backend = "cpu";
+  int width = 1280, height = 720, chunk_edge = 32, threads = 0, repeat = 1;
+  bool no_shadows = false, no_ao = false;
+  double fog = 0;
   std::optional<int> slice;
   std::string grid;
 };
@@ -37,8 +39,17 @@ int run_render(const RenderSettings& s) {
   set_activity("rendering " + s.in);
   if (in.extent.empty()) throw InvalidArgument(s.in + ": the input holds no volume");
 
-  const RenderSceneOptions so = s.scene_options();
-  RenderOptions o = s.frame_options();
+  RenderSceneOptions so;
+  so.skip_metric = parse_metric(s.metric);
+  so.lighting_field = !(s.no_shadows && s.no_ao);
+  RenderOptions o;
+  o.width = s.width;
+  o.height = s.height;
+  o.view = parse_render_view(s.view);
+  o.skip = parse_skip_mode(s.skip);
+  o.soft_shadows = !s.no_shadows;
+  o.ambient_occlusion = !s.no_ao;
+  o.fog_density = s.fog;
   o.slice_z = s.slice;
   o.error_algorithm = parse_algorithm(s.algorithm);
   const double aspect = static_cast<double>(s.width) / s.height;

@@ -50,8 +50,17 @@ int run_render(MPI_Comm comm, const RenderSettings& s) {
   MPI_Comm_size(comm, &size);
   std::optional<ThreadLimit> limit;
   if (s.threads > 0) limit.emplace(s.threads);
-  const RenderSceneOptions so = s.scene_options();
-  const RenderOptions o = s.frame_options();
+  RenderSceneOptions so;
+  so.skip_metric = parse_metric(s.metric);
+  so.lighting_field = !(s.no_shadows && s.no_ao);
+  RenderOptions o;
+  o.width = s.width;
+  o.height = s.height;
+  o.view = parse_render_view(s.view);
+  o.skip = parse_skip_mode(s.skip);
+  o.soft_shadows = !s.no_shadows;
+  o.ambient_occlusion = !s.no_ao;
+  o.fog_density = s.fog;
   mpi::check_outputs(comm, {}, {s.out, s.stats});
   const double t0 = MPI_Wtime();
   // Each rank holds its slab and the slices its lighting reads beyond it.

@@ -7,13 +7,14 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "../common/render_flags.h"
-
 namespace voxfield::mpi_cli {
 
-struct RenderSettings : apps::RenderFlags {
-  std::string in, out, stats, camera = "auto";
-  int chunk = 32, threads = 0;
+struct RenderSettings {
+  std::string in, out, stats, camera = "auto", view = "shaded", metric = "manhattan",
+                              skip = "distance";
+  int width = 1280, height = 720, chunk = 32, threads = 0;
+  bool no_shadows = false, no_ao = false;
+  double fog = 0;
 };
 
 // The subcommand and its options, as `voxfield render` names them.
