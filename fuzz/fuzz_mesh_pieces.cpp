@@ -3,7 +3,9 @@
 // real pieces of a small lattice — layers [0, 1) and [1, 3), every mesher by turns — and reads the
 // input as damage to them: its first byte picks the mesher, the next two cut the second piece to a
 // length, then each three bytes set one byte of either piece at an offset. Any input must join or
-// throw voxfield::Error; a mesh that joins must index only its own vertices.
+// throw voxfield::Error; a mesh that joins must index only its own vertices. The same pieces are
+// welded share by share too (PieceWeld, as the ranks of voxfield-mpi mesh weld them), with the
+// same contract.
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -15,6 +17,7 @@
 #include "fuzz_common.h"
 #include "voxfield/error.h"
 #include "voxfield/mesh_pieces.h"
+#include "weld_in_turn.h"
 
 namespace {
 
@@ -63,9 +66,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         (static_cast<std::size_t>(data[at] & 0x7f) << 8 | data[at + 1]) % p.size();
     p[offset] = data[at + 2];
   }
+  const std::vector<std::span<const std::uint8_t>> spans{std::span<const std::uint8_t>(piece[0]),
+                                                         std::span<const std::uint8_t>(piece[1])};
   try {
-    const voxfield::Mesh mesh = voxfield::join_mesh_pieces(
-        {std::span<const std::uint8_t>(piece[0]), std::span<const std::uint8_t>(piece[1])});
+    const voxfield::Mesh mesh = voxfield::join_mesh_pieces(spans);
+    for (const std::uint32_t index : mesh.indices)
+      if (index >= mesh.vertex_count()) std::abort();
+  } catch (const voxfield::Error&) {
+  }
+  try {
+    const voxfield::Mesh mesh = voxfield::test::weld_in_turn(spans);
     for (const std::uint32_t index : mesh.indices)
       if (index >= mesh.vertex_count()) std::abort();
   } catch (const voxfield::Error&) {

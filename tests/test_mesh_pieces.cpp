@@ -3,10 +3,12 @@
 // pieces refused by name.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <random>
 #include <span>
 
+#include "../fuzz/weld_in_turn.h"
 #include "error_text.h"
 #include "mesh_compare.h"
 #include "voxfield/error.h"
@@ -88,6 +90,15 @@ TEST(MeshPieces, JoinedPiecesEqualTheWholeLatticesChunks) {
         expect_equal_mesh_arrays(join_all(each), want);
         ThreadLimit one(1);
         expect_equal_mesh_arrays(join_all(runs), want);
+        // Welded share by share, each learning only from its neighbours (PieceWeld).
+        const auto in_order = [](const std::vector<std::vector<std::uint8_t>>& p) {
+          return std::vector<std::span<const std::uint8_t>>(p.begin(), p.end());
+        };
+        std::vector<std::span<const std::uint8_t>> each_in_order = in_order(each);
+        std::reverse(each_in_order.begin(), each_in_order.end());
+        expect_equal_mesh_arrays(test::weld_in_turn(in_order(whole)), want);
+        expect_equal_mesh_arrays(test::weld_in_turn(each_in_order), want);
+        expect_equal_mesh_arrays(test::weld_in_turn(in_order(runs)), want);
       }
 }
 

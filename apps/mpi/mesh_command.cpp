@@ -23,7 +23,8 @@ CLI::App* add_mesh_command(CLI::App& app, MeshSettings& s) {
       "mesh",
       "the iso-surface of a float .npy volume, as `voxfield mesh` (each rank reads its planes)");
   cmd->add_option("IN", s.in, "input float32/float64 .npy volume")->required();
-  cmd->add_option("-o,--output", s.out, "output .ply, .obj, .stl or .glb (written by rank 0)")
+  cmd->add_option("-o,--output", s.out,
+                  "output .ply, .obj, .stl or .glb (each rank writes its share)")
       ->required();
   cmd->add_option("--algorithm", s.algorithm,
                   "mc (marching cubes), sn (surface nets) or dc (dual contouring)")
@@ -60,7 +61,7 @@ int run_mesh(MPI_Comm comm, const MeshSettings& s) {
   options.iso = s.iso;
   options.inside_above = s.inside == "above";
   options.chunk_edge = s.chunk;
-  const MeshFormat format = mesh_format_of(s.out);
+  (void)mesh_format_of(s.out);  // an unknown extension is refused before any work
   mpi::check_outputs(comm, {}, {s.out, s.stats});
   // Every rank reads the header; a world (integer or bool .npy) is not a float volume.
   const NpyVolume header = mpi::collectively(comm, [&] {
@@ -104,30 +105,31 @@ int run_mesh(MPI_Comm comm, const MeshSettings& s) {
   const double load_ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
   MPI_Barrier(comm);  // the mesh's time starts together on every rank
   const double t1 = MPI_Wtime();
-  const Mesh mesh = [&] {
-    // The planes go once the mesh is made: rank 0 encodes it without them.
+  // Each rank writes its share of the file; rank 0 stages it in the outputs' transaction, which
+  // commits it with the stats once every rank has written.
+  std::optional<FileTransaction> outputs;
+  if (rank == 0) outputs.emplace();
+  const mpi::MeshFileSummary mesh = [&] {
+    // The planes go once the mesh is made: the ranks encode their shares without them.
     const std::vector<float> held = std::move(planes);
-    return mpi::mesh_volume(comm, layers, frame, held.empty() ? nullptr : held.data(), options,
-                            &ex);
+    return mpi::write_mesh_volume(comm, layers, frame, held.empty() ? nullptr : held.data(),
+                                  options, s.out, !s.stats.empty(), &ex,
+                                  outputs ? &*outputs : nullptr);
   }();
-  const double mesh_ms = max_over(comm, (MPI_Wtime() - t1) * 1e3);
+  // The census (--stats only) is timed apart: "ms" is the mesh made and written.
+  const double census_ms = max_over(comm, mesh.census_ms);
+  const double mesh_ms = max_over(comm, (MPI_Wtime() - t1) * 1e3 - mesh.census_ms);
   nlohmann::json exchange = exchange_json(comm, ex);
   const double peak_mb = max_over(comm, static_cast<double>(peak_rss_bytes()) / 1048576.0);
-  // Rank 0 encodes and writes; the others wait for its outcome.
-  std::optional<FileTransaction> outputs;
-  std::size_t triangles = 0, vertices = 0;
   mpi::collectively(comm, [&] {
     if (rank != 0) return;
-    outputs.emplace();
-    outputs->stage(s.out, encode_mesh(mesh, format));
-    const MeshStats st = mesh_stats(mesh);
-    triangles = st.triangles;
-    vertices = st.vertices;
     if (!s.stats.empty()) {
+      const MeshStats& st = *mesh.census;
       nlohmann::json j{{"input", s.in},
                        {"output", s.out},
                        {"algorithm", mesher_name(options.algorithm)},
                        {"ms", mesh_ms},
+                       {"census_ms_max", census_ms},
                        {"load_ms_max", load_ms},
                        {"ranks", size},
                        {"threads", max_threads()},
@@ -145,6 +147,7 @@ int run_mesh(MPI_Comm comm, const MeshSettings& s) {
     }
     outputs->commit();
   });
+  const std::uint64_t triangles = mesh.triangles, vertices = mesh.vertices;
   if (rank == 0)
     std::cerr << "voxfield-mpi: wrote " << s.out << " (" << triangles << " triangles, " << vertices
               << " vertices, " << mesher_name(options.algorithm) << ", " << size << " ranks, "

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <utility>
 #include <vector>
@@ -25,6 +26,10 @@
 #include "voxfield/mesh.h"
 
 namespace voxfield {
+
+namespace detail::mesh {
+struct PieceParts;
+}
 
 // Chunk layers of a lattice of `samples` (each axis >= 2) cut into chunks of `chunk_edge` cells:
 // ceil((samples.z - 1) / chunk_edge).
@@ -50,5 +55,59 @@ std::vector<std::uint8_t> mesh_piece(const ScalarVolume& frame, int planes_z0, i
 // malformed piece, pieces of different lattices or options, overlapping or missing layers, or
 // more vertices than 32-bit indices hold; ResourceLimitError past the memory limit.
 Mesh join_mesh_pieces(const std::vector<std::span<const std::uint8_t>>& pieces);
+
+// One piece's share of the joined mesh, for programs that never bring the pieces together (the
+// ranks of an MPI job writing one mesh file: voxfield::mpi::write_mesh_volume). The pieces of
+// every layer, in layer order, each learning only from its neighbours (the nearest pieces before
+// and after it), number their vertices and triangles as join_mesh_pieces numbers the joined
+// mesh's:
+//   1. PieceWeld(piece) welds the piece's own chunks. An exclusive scan of owned_vertices() over
+//      the pieces in order gives each its first vertex number.
+//   2. lend(first_vertex) to both neighbours: the vertices its end layers own that a chunk beside
+//      them may use. borrow() what the neighbours lend.
+//   3. orphan_keys() to the piece after: vertices it uses that no chunk owns (surface nets: a cell
+//      only a neighbour's quads reach). Every piece claim_orphans(the piece before's keys; none
+//      for the first): the piece before takes those it shares. An exclusive scan of
+//      claimed_orphans(), plus every piece's owned vertices, gives each its first orphan number.
+//   4. number_orphans(first_orphan) to the piece after, which borrow()s them.
+// Then part() is a mesh of every vertex its triangles use — its owned vertices first (numbered
+// from first_vertex), its claimed orphans next (from first_orphan), then those of its neighbours —
+// and its triangles (in the joined mesh's order, from its first chunk's); global() gives each of
+// part()'s vertices its number in the joined mesh.
+struct WeldKey {
+  std::uint64_t key = 0;     // the vertex's lattice element
+  std::uint64_t number = 0;  // its number in the joined mesh
+};
+
+class PieceWeld {
+ public:
+  // Checks the piece as join_mesh_pieces does (InvalidArgument naming the cause).
+  explicit PieceWeld(std::span<const std::uint8_t> piece);
+  // Meshes the piece as mesh_piece does (its arguments, what it throws), with no bytes between.
+  PieceWeld(const ScalarVolume& frame, int planes_z0, int plane_count, const float* planes,
+            const MeshOptions& options, int first_layer, int end_layer);
+  ~PieceWeld();
+  PieceWeld(PieceWeld&&) noexcept;
+  PieceWeld& operator=(PieceWeld&&) noexcept;
+
+  int first_layer() const;
+  int end_layer() const;
+  std::uint64_t owned_vertices() const;
+  std::vector<WeldKey> lend(std::uint64_t first_vertex);
+  // Resolves the vertices it uses that `keys` name (those it does not use are ignored).
+  void borrow(std::span<const WeldKey> keys);
+  std::vector<std::uint64_t> orphan_keys() const;
+  void claim_orphans(std::span<const std::uint64_t> taken_before);
+  std::uint64_t claimed_orphans() const;
+  std::vector<WeldKey> number_orphans(std::uint64_t first_orphan);
+  // InvalidArgument when a vertex is still unnumbered (a step missed) or a number passes 32 bits.
+  Mesh part() const;
+  std::vector<std::uint32_t> global() const;
+
+ private:
+  explicit PieceWeld(detail::mesh::PieceParts&& piece);
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace voxfield

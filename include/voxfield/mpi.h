@@ -252,7 +252,8 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
 // field). The lattice's chunk layers (mesh_pieces.h: the chunked mesher's chunks grouped along z)
 // are dealt to the ranks in runs of near-equal length or weight; each rank meshes its run from the
 // sample planes that run reads — its cells' planes, three below and two above — and rank 0 joins
-// the pieces with the chunked mesher's weld. The mesh equals MeshChunks(volume, options).merged()
+// the pieces with the chunked mesher's weld (write_mesh_volume: each rank writes its share of the
+// file, nothing gathered). The mesh equals MeshChunks(volume, options).merged()
 // of the whole lattice array for array (and mesh_volume's triangle for triangle), for any number of
 // ranks.
 
@@ -295,5 +296,30 @@ std::vector<double> mesh_layer_weights(MPI_Comm comm, Vec3i samples, int z0, int
 // fails (a NaN sample, the memory limit, mismatched options).
 Mesh mesh_volume(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& frame,
                  const float* planes, const MeshOptions& options, ExchangeStats* stats = nullptr);
+
+// What write_mesh_volume wrote: the joined mesh's counts and, when asked for, its census.
+struct MeshFileSummary {
+  std::uint64_t vertices = 0, triangles = 0;
+  // mesh_stats of the joined mesh: every count equal; area and volume summed over the ranks in
+  // another order, so equal within rounding.
+  std::optional<MeshStats> census;
+  double census_ms = 0;  // this rank's time in the census (a part of the call's)
+};
+
+// Collective: meshes as mesh_volume does and writes the mesh to `path` (the format its extension
+// names, mesh_files.h) with no rank ever holding more than its own share of it. Each rank welds
+// its piece with what its neighbours lend it (PieceWeld: vertex numbers across the cuts, orphans
+// first used before its layers) and writes its vertices and triangles at their places in the
+// file: the bytes write_mesh writes for mesh_volume's mesh, atomically (staged beside the target
+// by rank 0, renamed once every rank has written; a failure anywhere leaves the target as it
+// was). `census`: also mesh_stats over the ranks (each edge the cuts split counted by the rank
+// holding its lower vertex). `into` (rank 0's; null on the others): the file is staged in the
+// caller's transaction and the caller commits it (collectively); null: committed before
+// returning. Throws RankError on every rank when any fails.
+MeshFileSummary write_mesh_volume(MPI_Comm comm, const MeshLayers& layers,
+                                  const ScalarVolume& frame, const float* planes,
+                                  const MeshOptions& options, const std::filesystem::path& path,
+                                  bool census = false, ExchangeStats* stats = nullptr,
+                                  FileTransaction* into = nullptr);
 
 }  // namespace voxfield::mpi

@@ -21,6 +21,7 @@
 
 #include "chunked_mesh.h"
 #include "mesh_internal.h"
+#include "piece_parts.h"
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
 
@@ -82,9 +83,11 @@ class Writer {
 // piece and what was cut short).
 class Reader {
  public:
-  Reader(std::span<const std::uint8_t> bytes, std::size_t piece) : bytes_(bytes), piece_(piece) {}
+  Reader(std::span<const std::uint8_t> bytes, std::size_t piece,
+         const char* who = "join_mesh_pieces")
+      : bytes_(bytes), piece_(piece), who_(who) {}
   [[noreturn]] void fail(const std::string& why) const {
-    throw InvalidArgument("join_mesh_pieces: piece " + std::to_string(piece_) + " (byte " +
+    throw InvalidArgument(std::string(who_) + ": piece " + std::to_string(piece_) + " (byte " +
                           std::to_string(at_) + "): " + why);
   }
   template <class T>
@@ -110,6 +113,7 @@ class Reader {
  private:
   std::span<const std::uint8_t> bytes_;
   std::size_t piece_, at_ = 0;
+  const char* who_;
 };
 
 void check_layers(Vec3i samples, int chunk_edge, int first_layer, int end_layer, const char* who) {
@@ -185,30 +189,26 @@ void read_part(Reader& r, ChunkPart& p) {
 
 }  // namespace
 
-int mesh_chunk_layers(Vec3i samples, int chunk_edge) {
-  if (samples.x < 2 || samples.y < 2 || samples.z < 2)
-    throw InvalidArgument("mesh: the lattice needs at least 2 samples along each axis");
-  // voxfield's coordinate range (a chunk count per axis then fits an int with room to spare).
-  if (samples.x > kMaxSamples || samples.y > kMaxSamples || samples.z > kMaxSamples)
-    throw InvalidArgument("mesh: a lattice of more than 2^30 samples along an axis");
-  if (chunk_edge < 2 || chunk_edge > 256)
-    throw InvalidArgument("mesh: chunk edge " + std::to_string(chunk_edge) + " is outside 2..256");
-  return ChunkGrid(samples, chunk_edge).count.z;
+namespace detail::mesh {
+
+PieceParts decode_piece(std::span<const std::uint8_t> piece, std::size_t index, const char* who) {
+  require_memory(piece.size(), 0, who, "the piece's chunks");
+  Reader r(piece, index, who);
+  const Header h = read_header(r);
+  PieceParts d;
+  d.samples = h.samples;
+  d.chunk_edge = h.chunk_edge;
+  d.first_layer = h.first_layer;
+  d.end_layer = h.end_layer;
+  d.parts.resize(static_cast<std::size_t>(chunks_of(h)));
+  for (ChunkPart& p : d.parts) read_part(r, p);
+  if (!r.done()) r.fail("bytes past its last chunk");
+  return d;
 }
 
-std::pair<int, int> mesh_layer_planes(Vec3i samples, int chunk_edge, int first_layer,
-                                      int end_layer) {
-  check_layers(samples, chunk_edge, first_layer, end_layer, "mesh_layer_planes");
-  // Block::load's reads: three samples before a chunk's cells to two past its last corner.
-  const int cells_begin = first_layer * chunk_edge;
-  const int cells_end = std::min(end_layer * chunk_edge, samples.z - 1);
-  return {std::max(cells_begin - 3, 0), std::min(cells_end + 3, samples.z)};
-}
-
-std::vector<std::uint8_t> mesh_piece(const ScalarVolume& frame, int planes_z0, int plane_count,
-                                     const float* planes, const MeshOptions& options,
-                                     int first_layer, int end_layer) {
-  using namespace detail::mesh;
+PieceParts mesh_piece_parts(const ScalarVolume& frame, int planes_z0, int plane_count,
+                            const float* planes, const MeshOptions& options, int first_layer,
+                            int end_layer) {
   const auto [need_begin, need_end] =
       mesh_layer_planes(frame.size, options.chunk_edge, first_layer, end_layer);
   if (!planes || planes_z0 > need_begin ||
@@ -242,9 +242,45 @@ std::vector<std::uint8_t> mesh_piece(const ScalarVolume& frame, int planes_z0, i
   chunks.reserve(static_cast<std::size_t>(count));
   for (std::int64_t c = first_layer * per_layer; c < end_layer * per_layer; ++c)
     chunks.push_back(c);
-  std::vector<ChunkPart> parts(chunks.size());
-  mesh_chunks(lattice, grid, options, chunks, parts);
+  PieceParts piece;
+  piece.samples = frame.size;
+  piece.chunk_edge = options.chunk_edge;
+  piece.first_layer = first_layer;
+  piece.end_layer = end_layer;
+  piece.parts.resize(chunks.size());
+  mesh_chunks(lattice, grid, options, chunks, piece.parts);
+  return piece;
+}
 
+}  // namespace detail::mesh
+
+int mesh_chunk_layers(Vec3i samples, int chunk_edge) {
+  if (samples.x < 2 || samples.y < 2 || samples.z < 2)
+    throw InvalidArgument("mesh: the lattice needs at least 2 samples along each axis");
+  // voxfield's coordinate range (a chunk count per axis then fits an int with room to spare).
+  if (samples.x > kMaxSamples || samples.y > kMaxSamples || samples.z > kMaxSamples)
+    throw InvalidArgument("mesh: a lattice of more than 2^30 samples along an axis");
+  if (chunk_edge < 2 || chunk_edge > 256)
+    throw InvalidArgument("mesh: chunk edge " + std::to_string(chunk_edge) + " is outside 2..256");
+  return ChunkGrid(samples, chunk_edge).count.z;
+}
+
+std::pair<int, int> mesh_layer_planes(Vec3i samples, int chunk_edge, int first_layer,
+                                      int end_layer) {
+  check_layers(samples, chunk_edge, first_layer, end_layer, "mesh_layer_planes");
+  // Block::load's reads: three samples before a chunk's cells to two past its last corner.
+  const int cells_begin = first_layer * chunk_edge;
+  const int cells_end = std::min(end_layer * chunk_edge, samples.z - 1);
+  return {std::max(cells_begin - 3, 0), std::min(cells_end + 3, samples.z)};
+}
+
+std::vector<std::uint8_t> mesh_piece(const ScalarVolume& frame, int planes_z0, int plane_count,
+                                     const float* planes, const MeshOptions& options,
+                                     int first_layer, int end_layer) {
+  const std::vector<ChunkPart> parts =
+      detail::mesh::mesh_piece_parts(frame, planes_z0, plane_count, planes, options, first_layer,
+                                     end_layer)
+          .parts;
   Writer w;
   // The exact size first: one allocation, no copies as the piece grows.
   std::size_t size = kHeaderBytes;

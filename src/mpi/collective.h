@@ -69,6 +69,28 @@ std::string write_pieces(MPI_Comm comm, const std::string& temporary, const std:
 // The union of every rank's box (empty boxes add nothing): one all-reduce of six integers.
 Box3i unite_over_ranks(MPI_Comm comm, const Box3i& mine, ExchangeStats* stats);
 
+// A duplicate of a communicator, freed on leaving scope: an operation's point-to-point messages
+// travel on it, so that none of the application's messages on the original can match theirs.
+struct OwnComm {
+  MPI_Comm comm = MPI_COMM_NULL;
+  explicit OwnComm(MPI_Comm from) { MPI_Comm_dup(from, &comm); }
+  ~OwnComm() { MPI_Comm_free(&comm); }
+  OwnComm(const OwnComm&) = delete;
+  OwnComm& operator=(const OwnComm&) = delete;
+};
+
+// The layers are dealt to `ranks` ranks, cut for the frame's lattice and the options' chunk edge,
+// and cover every layer once in rank order (InvalidArgument naming `who` otherwise).
+void check_mesh_layers(const MeshLayers& layers, const ScalarVolume& frame,
+                       const MeshOptions& options, int ranks, const char* who);
+
+// Collective: this rank's mesh piece (mesh_pieces.h) of the layers it is dealt, empty on a rank
+// without layers; `who` names the operation in errors (distributed_mesh.cpp).
+std::vector<std::uint8_t> rank_mesh_piece(MPI_Comm comm, const MeshLayers& layers,
+                                          const ScalarVolume& frame, const float* planes,
+                                          const MeshOptions& options, const char* who,
+                                          ExchangeStats* stats);
+
 // The text of an MPI error code.
 std::string mpi_error_text(int code);
 

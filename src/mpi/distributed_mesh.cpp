@@ -184,38 +184,61 @@ std::vector<std::vector<std::uint8_t>> gather_pieces(MPI_Comm comm, std::vector<
 
 }  // namespace
 
-Mesh mesh_volume(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& frame,
-                 const float* planes, const MeshOptions& options, ExchangeStats* stats) {
+namespace detail {
+
+void check_mesh_layers(const MeshLayers& layers, const ScalarVolume& frame,
+                       const MeshOptions& options, int ranks, const char* who) {
+  if (layers.ranks() != ranks)
+    throw InvalidArgument(std::string(who) + ": the layers are dealt to " +
+                          std::to_string(layers.ranks()) + " ranks, the communicator has " +
+                          std::to_string(ranks));
+  if (!(layers.samples == frame.size) || layers.chunk_edge != options.chunk_edge)
+    throw InvalidArgument(std::string(who) +
+                          ": the layers were cut for another lattice size or chunk edge");
+  // The runs must cover every layer once, in order (a layer no rank meshes is a hole).
+  const int count = mesh_chunk_layers(layers.samples, layers.chunk_edge);
+  for (std::size_t r = 0; r < layers.layers.size(); ++r)
+    if ((r == 0 && layers.layers[r] != 0) ||
+        (r + 1 == layers.layers.size() && layers.layers[r] != count) ||
+        (r > 0 && layers.layers[r] < layers.layers[r - 1]))
+      throw InvalidArgument(std::string(who) + ": the runs of layers do not cover the lattice's " +
+                            std::to_string(count) + " layers once, in rank order");
+}
+
+std::vector<std::uint8_t> rank_mesh_piece(MPI_Comm comm, const MeshLayers& layers,
+                                          const ScalarVolume& frame, const float* planes,
+                                          const MeshOptions& options, const char* who,
+                                          ExchangeStats* stats) {
   int rank = 0, size = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<std::uint8_t> piece = detail::collectively(comm, stats, [&] {
-    if (layers.ranks() != size)
-      throw InvalidArgument("mpi::mesh_volume: the layers are dealt to " +
-                            std::to_string(layers.ranks()) + " ranks, the communicator has " +
-                            std::to_string(size));
-    if (!(layers.samples == frame.size) || layers.chunk_edge != options.chunk_edge)
-      throw InvalidArgument(
-          "mpi::mesh_volume: the layers were cut for another lattice size or chunk edge");
+  std::vector<std::uint8_t> piece = collectively(comm, stats, [&] {
+    check_mesh_layers(layers, frame, options, size, who);
     if (layers.empty(rank)) return std::vector<std::uint8_t>{};
     const auto [z0, z1] = layers.planes(rank);
     return mesh_piece(frame, z0, z1 - z0, planes, options,
                       layers.layers[static_cast<std::size_t>(rank)],
                       layers.layers[static_cast<std::size_t>(rank) + 1]);
   });
-  if (stats) stats->compute_ms += detail::ms_since(t0);
+  if (stats) stats->compute_ms += ms_since(t0);
+  return piece;
+}
+
+}  // namespace detail
+
+Mesh mesh_volume(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& frame,
+                 const float* planes, const MeshOptions& options, ExchangeStats* stats) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  std::vector<std::uint8_t> piece =
+      detail::rank_mesh_piece(comm, layers, frame, planes, options, "mpi::mesh_volume", stats);
   // The pieces travel on a communicator of their own, so that no message of the application's on
   // `comm` can match theirs.
-  struct OwnComm {
-    MPI_Comm c = MPI_COMM_NULL;
-    explicit OwnComm(MPI_Comm from) { MPI_Comm_dup(from, &c); }
-    ~OwnComm() { MPI_Comm_free(&c); }
-    OwnComm(const OwnComm&) = delete;
-    OwnComm& operator=(const OwnComm&) = delete;
-  } own(comm);
+  const detail::OwnComm own(comm);
   const std::vector<std::vector<std::uint8_t>> pieces =
-      gather_pieces(own.c, std::move(piece), stats);
+      gather_pieces(own.comm, std::move(piece), stats);
   const auto t1 = std::chrono::steady_clock::now();
   Mesh mesh = detail::collectively(comm, stats, [&] {
     if (rank != 0) return Mesh{};
