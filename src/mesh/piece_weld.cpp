@@ -68,9 +68,8 @@ struct PieceWeld::Impl {
 PieceWeld::PieceWeld(std::span<const std::uint8_t> bytes)
     : PieceWeld(detail::mesh::decode_piece(bytes, 0, "PieceWeld")) {}
 
-PieceWeld::PieceWeld(const ScalarVolume& frame, int planes_z0, int plane_count,
-                     const float* planes, const MeshOptions& options, int first_layer,
-                     int end_layer)
+PieceWeld::PieceWeld(const ScalarVolume& frame, int planes_z0, int plane_count, const float* planes,
+                     const MeshOptions& options, int first_layer, int end_layer)
     : PieceWeld(detail::mesh::mesh_piece_parts(frame, planes_z0, plane_count, planes, options,
                                                first_layer, end_layer)) {}
 
