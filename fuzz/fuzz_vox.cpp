@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <utility>
 #include <vector>
 
 #include "fuzz_common.h"
@@ -30,6 +31,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // the writer's speed rather than the parser (the parser has already run on the input).
     const voxfield::Box3i content = in.world.voxels.content_bounds();
     if (content.volume() > (std::int64_t{1} << 16)) return 0;
+    // A slab of the world (as each rank of an MPI job reads it): the lower half of the content
+    // and no more.
+    if (!content.empty()) {
+      voxfield::VoxImportOptions half = options;
+      const int mid = content.begin.z + (content.end.z - content.begin.z + 1) / 2;
+      half.keep_z = std::pair<std::int32_t, std::int32_t>{content.begin.z, mid};
+      const voxfield::VoxImport slab = voxfield::parse_vox({data, size}, "fuzz.vox", half);
+      const voxfield::Box3i got = slab.world.voxels.content_bounds();
+      if (got.empty() || got.end.z > mid || got.begin.z != content.begin.z) std::abort();
+    }
     const voxfield::VoxImport back =
         voxfield::parse_vox(voxfield::encode_vox(in.world), "fuzz-reencoded.vox", options);
     if (back.world.solid_count() != in.world.solid_count() ||

@@ -3,8 +3,10 @@
 // against hand-made files.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <optional>
+#include <utility>
 
 #include "vox_builder.h"
 #include "voxfield/file.h"
@@ -93,6 +95,37 @@ TEST_P(Corpus, MatchesTheCorpusReadme) {
     EXPECT_TRUE(test::dense_voxels(back.world, content) == test::dense_voxels(in.world, content));
   }
   for (int m = 1; m < 256; ++m) EXPECT_EQ(back.world.palette[m], in.world.palette[m]) << m;
+}
+
+// A slab (VoxImportOptions::keep_z) places exactly the whole world's voxels within it and no
+// other, and the scene's description (the extent the slabs are cut from) is the whole file's.
+TEST_P(Corpus, SlabsPlaceExactlyTheirVoxels) {
+  const CorpusFile& f = GetParam();
+  const std::vector<std::uint8_t> bytes = read_file(kCorpus / f.name);
+  const VoxImport whole = parse_vox(bytes, f.name);
+  const Box3i extent = vox_extent(whole.info);
+  if (extent.empty()) GTEST_SKIP() << "no volume";
+  const int z0 = extent.begin.z, z1 = extent.end.z, mid = (z0 + z1) / 2;
+  // Below the extent into its middle, the rest and past it, one slice, and none.
+  for (const auto& [a, b] : {std::pair{z0 - 5, mid}, std::pair{mid, z1 + 7},
+                             std::pair{mid, mid + 1}, std::pair{mid, mid}}) {
+    SCOPED_TRACE("z in [" + std::to_string(a) + ", " + std::to_string(b) + ")");
+    VoxImportOptions o;
+    o.keep_z = std::pair<std::int32_t, std::int32_t>{a, b};
+    const VoxImport slab = parse_vox(bytes, f.name, o);
+    EXPECT_EQ(vox_extent(slab.info), extent);
+    EXPECT_EQ(slab.info.instances.size(), whole.info.instances.size());
+    Box3i box = extent;
+    box.begin.z = std::max(a, z0);
+    box.end.z = std::min(b, z1);
+    const Box3i content = slab.world.voxels.content_bounds();
+    if (box.empty()) {
+      EXPECT_TRUE(content.empty());
+      continue;
+    }
+    EXPECT_TRUE(content.empty() || box.unite(content) == box) << "voxels outside the slab";
+    EXPECT_TRUE(test::dense_voxels(slab.world, box) == test::dense_voxels(whole.world, box));
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedCorpus, Corpus, ::testing::ValuesIn(kFiles), [](const auto& info) {

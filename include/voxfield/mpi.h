@@ -172,8 +172,9 @@ struct WorldSlab {
   World world;  // the slab's voxels and its ghost slices, at their place in the whole world
   SlabPartition partition;
   std::string format;  // "npy", "vox" or "vfw"
-  // Each rank decoded only its slab: a .npy's part read alone, a .vfw's chunks decompressed alone
-  // (the compressed file read by every rank). Else (a .vox) each decoded the whole world.
+  // Each rank built only its slab: a .npy's part read alone, a .vfw's chunks decompressed alone,
+  // a .vox's voxels placed within the slab alone (the file read by every rank). Else (a .vdb)
+  // each decoded the whole world.
   bool read_in_parts = false;
 };
 
@@ -182,9 +183,11 @@ struct WorldSlab {
 // bytes by every rank, which decompresses only its slab's chunks (WorldFileReadOptions::keep_z) —
 // the file's size plus the slab per rank. An unbounded .vfw's domain is its content's bounds: each
 // rank first decodes an equal share of the z-range its stored chunks cover and the ranks unite what
-// they find. A .vox is decoded whole by every rank, which then keeps its part (the memory of one
-// whole world per rank, while loading; a .vox holds at most a few 256³ models). The domain is the
-// file's volume (the .npy shape, the .vox/.vfw extent), as `voxfield field` uses.
+// they find. A .vox is read by every rank, which places only its slab's voxels
+// (VoxImportOptions::keep_z) — the file, its models' voxel lists and the slab per rank; its scene
+// is read twice (described, then placed), the extent coming first. A .vdb is decoded whole by
+// every rank, which then keeps its part. The domain is the file's volume (the .npy shape, the
+// .vox/.vfw/.vdb extent), as `voxfield field` uses.
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
                           int ghost_slices = 0);
 

@@ -23,8 +23,10 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "voxfield/world.h"
@@ -60,12 +62,20 @@ struct VoxImportOptions {
   // Refuse (ResourceLimitError) a file whose models, instances and world chunks would need more;
   // 0: the process default (limits.h).
   std::uint64_t memory_limit_bytes = 0;
+  // Place only the voxels with keep_z->first <= z < keep_z->second (the world's chunks, and the
+  // memory counted for them, are then those of that slab); the whole scene is still read and
+  // described in VoxImport::info. A slab of a world for one rank of an MPI job (mpi.h).
+  std::optional<std::pair<std::int32_t, std::int32_t>> keep_z;
 };
 
 struct VoxImport {
   World world;
   VoxFileInfo info;
 };
+
+// The volume a file declares: the visible instances' boxes united (hidden ones too when
+// `include_hidden`), or for a file without a scene graph the placed model's SIZE box.
+Box3i vox_extent(const VoxFileInfo& info, bool include_hidden = false, int frame = 0);
 
 // Parses a .vox file held in memory; `name` is used in error messages.
 VoxImport parse_vox(std::span<const std::uint8_t> bytes, const std::string& name,

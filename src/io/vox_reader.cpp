@@ -393,6 +393,17 @@ class VoxParser {
 
 }  // namespace
 
+Box3i vox_extent(const VoxFileInfo& info, bool include_hidden, int frame) {
+  Box3i extent;
+  if (info.has_scene_graph) {
+    for (const auto& inst : info.instances)
+      if (include_hidden || !inst.hidden) extent = extent.unite(inst.world_box);
+  } else if (frame >= 0 && static_cast<std::size_t>(frame) < info.models.size()) {
+    extent = Box3i::from_size(info.models[static_cast<std::size_t>(frame)].size);
+  }
+  return extent;
+}
+
 VoxImport parse_vox(std::span<const std::uint8_t> bytes, const std::string& name,
                     const VoxImportOptions& options) {
   return VoxParser(bytes, name, options).run();

@@ -59,14 +59,26 @@ void Scene::place(World& world, VoxFileInfo& info) {
   }
   check_world_memory(world.voxels);
   for (const Placement& pl : placements_) {
+    if (!in_slab(pl.box)) continue;
     const ModelData& m = models[static_cast<std::size_t>(pl.model)];
     const std::array<std::int64_t, 3> pivot{m.info.size.x / 2, m.info.size.y / 2,
                                             m.info.size.z / 2};
     m.for_each_voxel([&](int x, int y, int z, std::uint8_t c) {
       const auto p = pl.frame.place({x, y, z}, pivot);
-      world.voxels.set({static_cast<int>(p[0]), static_cast<int>(p[1]), static_cast<int>(p[2])}, c);
+      if (in_slab(p[2]))
+        world.voxels.set({static_cast<int>(p[0]), static_cast<int>(p[1]), static_cast<int>(p[2])},
+                         c);
     });
   }
+}
+
+bool Scene::in_slab(std::int64_t z) const {
+  return !options_.keep_z || (z >= options_.keep_z->first && z < options_.keep_z->second);
+}
+
+bool Scene::in_slab(const Box3i& box) const {
+  return !options_.keep_z ||
+         (box.end.z > options_.keep_z->first && box.begin.z < options_.keep_z->second);
 }
 
 // Walks the scene graph depth first; `name` is the _name of the nearest transform above.
@@ -164,8 +176,15 @@ void Scene::check_world_memory(const Grid<std::uint8_t>& g) const {
     }
   };
   for (const Placement& pl : placements_) {
+    if (!in_slab(pl.box)) continue;
     const ModelData& m = models[static_cast<std::size_t>(pl.model)];
-    const Vec3i lo = g.chunk_of(pl.box.begin), hi = g.chunk_of(pl.box.end - Vec3i::splat(1));
+    // The box's part within the slab: only its chunks are touched.
+    Box3i box = pl.box;
+    if (options_.keep_z) {
+      box.begin.z = std::max(box.begin.z, options_.keep_z->first);
+      box.end.z = std::min(box.end.z, options_.keep_z->second);
+    }
+    const Vec3i lo = g.chunk_of(box.begin), hi = g.chunk_of(box.end - Vec3i::splat(1));
     const std::int64_t box_chunks =
         std::int64_t{hi.x - lo.x + 1} * (hi.y - lo.y + 1) * (hi.z - lo.z + 1);
     if (m.solid_count() < box_chunks) {
@@ -173,6 +192,7 @@ void Scene::check_world_memory(const Grid<std::uint8_t>& g) const {
                                               m.info.size.z / 2};
       m.for_each_voxel([&](int x, int y, int z, std::uint8_t) {
         const auto p = pl.frame.place({x, y, z}, pivot);
+        if (!in_slab(p[2])) return;
         add({static_cast<int>(p[0] >> shift), static_cast<int>(p[1] >> shift),
              static_cast<int>(p[2] >> shift)},
             pl.offset);

@@ -100,6 +100,9 @@ class Scene {
     Box3i box;             // where the model's SIZE box lands
   };
 
+  // Within options_.keep_z (everything when there is none).
+  bool in_slab(std::int64_t z) const;
+  bool in_slab(const Box3i& box) const;
   void visit(std::int32_t id, const Affine& parent, bool hidden, int depth, std::uint64_t from,
              const std::string& name, VoxFileInfo& info);
   void place_instance(const Node& n, const Affine& xf, bool hidden, const std::string& name,

@@ -90,12 +90,7 @@ LoadedWorld load_world(const std::filesystem::path& path, const LoadOptions& opt
       VoxImport in = read_vox(path, vo);
       out.world = std::move(in.world);
       const VoxFileInfo& info = in.info;
-      if (info.has_scene_graph) {
-        for (const auto& inst : info.instances)
-          if (!inst.hidden) out.extent = out.extent.unite(inst.world_box);
-      } else if (!info.models.empty()) {
-        out.extent = Box3i::from_size(info.models[0].size);
-      }
+      out.extent = vox_extent(info);
       out.description = "MagicaVoxel .vox, version " + std::to_string(info.version);
       out.vox = std::move(in.info);
       break;

@@ -8,6 +8,7 @@
 #include "voxfield/file.h"
 #include "voxfield/limits.h"
 #include "voxfield/npy.h"
+#include "voxfield/vox.h"
 #include "voxfield/world_file.h"
 #include "voxfield/world_io.h"
 
@@ -96,6 +97,25 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
       World part =
           world_from_npy(read_npy_part(path, keep.begin.z, keep.end.z), path.string(), chunk_edge);
       return WorldSlab{std::move(part), partition, "npy", true};
+    }
+    if (format == WorldFormat::kVox) {
+      // Read once; the scene described first (nothing placed: its extent gives the slabs), then
+      // only this rank's slab and ghost slices placed.
+      const std::uint64_t limit = effective_memory_limit(0);
+      const std::vector<std::uint8_t> bytes = read_file(path, limit);
+      VoxImportOptions vo;
+      vo.chunk_edge = chunk_edge;
+      vo.memory_limit_bytes = remaining_memory(limit, bytes.size());
+      vo.keep_z = std::pair<std::int32_t, std::int32_t>{0, 0};
+      const Box3i extent = vox_extent(parse_vox(bytes, path.string(), vo).info);
+      if (extent.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
+      const SlabPartition partition = partition_slabs(extent, size, chunk_edge);
+      const Box3i keep = kept_box(extent, partition, rank, ghost_slices);
+      vo.keep_z = std::pair<std::int32_t, std::int32_t>{keep.begin.z, keep.end.z};
+      const VoxImport slab = parse_vox(bytes, path.string(), vo);
+      World part = rechunk_world(slab.world, chunk_edge, keep, path.string());
+      part.palette = slab.world.palette;
+      return WorldSlab{std::move(part), partition, "vox", true};
     }
     LoadOptions lo;
     lo.chunk_edge = chunk_edge;

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # voxfield-mpi against voxfield: the same input and options must give byte-identical files on 1, 2,
-# 3 and 4 ranks — Fortran- and C-order .npy (read a slab per rank) and a real .vox (loaded whole by
-# every rank) — and bad input must fail on every rank with one clear message and no output.
+# 3 and 4 ranks — Fortran- and C-order .npy (read a slab per rank) and a real .vox (each rank placing
+# only its slab's voxels) — and bad input must fail on every rank with one clear message and no output.
 # Usage: cli_test.sh VOXFIELD VOXFIELD_MPI MPIEXEC
 set -euo pipefail
 VF=$1 VFM=$2 MPIEXEC_BIN=$3
@@ -142,8 +142,9 @@ vox=$(dirname "$0")/../../../shared/data/vox/dotvox_axes.vox
 # The shared corpus lies beside the repository (README); its absence is a failure, not a skip.
 if [ ! -f "$vox" ]; then echo "FAIL: $vox is missing (../shared beside the repository)"; fail=1; else
   "$VF" field "$vox" -o ref.npy --metric euclidean --signed 2>/dev/null
-  MPIEXEC -np 3 "$VFM" field "$vox" -o out.npy --metric euclidean --signed 2>/dev/null
+  MPIEXEC -np 3 "$VFM" field "$vox" -o out.npy --metric euclidean --signed --stats vox.json 2>/dev/null
   same ref.npy out.npy "3 ranks, dotvox_axes.vox"
+  /usr/bin/python3 -c "import json; s = json.load(open('vox.json')); assert s['read_in_parts'] is True, s"
   # The same world as a .vfw that `voxfield convert` writes unbounded: its domain is its content
   # (not the .vox model's size), which the ranks bound between them from their shares of the
   # stored chunks before each decodes its slab (read_in_parts).
