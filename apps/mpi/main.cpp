@@ -5,6 +5,7 @@
 //          [--storage S] [--spacing sx,sy,sz] [--sites S.npy] [--stats S.json] [--chunk C]
 //          [--threads T] [--memory-limit B]
 //   mpirun -np N voxfield-mpi edit IN -e EDITS.jsonl -o OUT.npy [field options] [--stats S.json]
+//          [--balance volume|content|edits] [--save-world W.vfw]
 //   mpirun -np N voxfield-mpi bench --size X,Y,Z [--spheres K] [--repeat R] [field options]
 //   mpirun -np N voxfield-mpi mesh IN.npy -o OUT.{ply,obj,stl,glb} [--algorithm mc|sn|dc]
 //          [--iso V] [--inside below|above] [--spacing sx,sy,sz] [--chunk C]
@@ -148,7 +149,7 @@ double percentile(std::vector<double> v, double q) {
 
 int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
              const std::string& edits_path, const std::string& out, const std::string& stats,
-             const std::string& save_world) {
+             const std::string& save_world, const std::string& balance) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
@@ -170,7 +171,26 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   });
   const std::vector<Edit>& edits = script_and_ghost.first;
   const int ghost = script_and_ghost.second;
-  mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk, ghost);
+  const double l0 = MPI_Wtime();
+  mpi::WorldSlab slab = [&] {
+    // By the script's edits: what each unit of slices will recompute, known before any reading.
+    if (balance == "edits")
+      return mpi::load_world_slab(comm, in, f.chunk, ghost, [&](const Box3i& domain) {
+        return mpi::partition_slabs(domain, size, f.chunk,
+                                    mpi::edit_unit_weights(domain, f.chunk, edits, ghost));
+      });
+    mpi::WorldSlab equal = mpi::load_world_slab(comm, in, f.chunk, ghost);
+    if (balance != "content") return equal;
+    // By content: the chunks holding air and solid (the surface), counted in the slabs of equal
+    // volume; then the world read again in the slabs they weigh.
+    const std::vector<double> weights =
+        mpi::content_unit_weights(comm, equal.partition, equal.world, f.chunk);
+    equal.world = World();  // let go before the second reading
+    return mpi::load_world_slab(comm, in, f.chunk, ghost, [&](const Box3i& domain) {
+      return mpi::partition_slabs(domain, size, f.chunk, weights);
+    });
+  }();
+  const double load_ms = max_over(comm, (MPI_Wtime() - l0) * 1e3);
   const double t0 = MPI_Wtime();
   mpi::SlabEditor editor(comm, slab.partition, slab.world, o);
   slab.world = World();  // the editor holds its own copy
@@ -192,13 +212,19 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   MPI_Allreduce(edit_ms.data(), slowest.data(), static_cast<int>(edit_ms.size()), MPI_DOUBLE,
                 MPI_MAX, comm);
   const double total = std::accumulate(slowest.begin(), slowest.end(), 0.0);
+  // The ranks run through the script without waiting for each other: the stream takes as long as
+  // the rank with the most work.
+  const double stream_ms = max_over(comm, std::accumulate(edit_ms.begin(), edit_ms.end(), 0.0));
   nlohmann::json j = f.describe(o, slab.partition.domain.size(), size);
   j.update(nlohmann::json{
+      {"load_ms", load_ms},
       {"build_ms", build_ms},
+      {"balance", balance},
       {"edits", edits.size()},
       {"ghost_slices", ghost},
       {"edit_ms", slowest},
       {"total_ms", total},
+      {"stream_ms", stream_ms},
       {"p50_ms", percentile(slowest, 0.5)},
       {"p99_ms", percentile(slowest, 0.99)},
       {"ranks_reached_per_edit", edits.empty() ? 0.0
@@ -288,7 +314,7 @@ int main(int argc, char** argv) {
   field->add_option("--stats", stats, "timing and exchange figures as JSON");
   f.add_to(field);
   FieldSettings fe;
-  std::string edit_in, edit_script, edit_out, edit_stats, edit_save;
+  std::string edit_in, edit_script, edit_out, edit_stats, edit_save, edit_balance = "volume";
   CLI::App* edit = app.add_subcommand(
       "edit", "scripted edits with incremental exact updates, as `voxfield edit`");
   edit->add_option("IN", edit_in, "input .npy (read a slab per rank), .vox or .vfw")->required();
@@ -299,6 +325,11 @@ int main(int argc, char** argv) {
   edit->add_option("--stats", edit_stats, "per-edit latency of the slowest rank, as JSON");
   edit->add_option("--save-world", edit_save,
                    "also write the edited world as one .vfw (every rank its chunks)");
+  edit->add_option("--balance", edit_balance,
+                   "cut the slabs by volume (default), by content (the chunks holding air and "
+                   "solid, counted in a first reading) or by the script's edits (what each will "
+                   "recompute)")
+      ->check(CLI::IsMember({"volume", "content", "edits"}));
   fe.add_to(edit);
   std::vector<int> dims;
   int spheres = 200, repeat = 3;
@@ -325,7 +356,8 @@ int main(int argc, char** argv) {
     if (field->parsed()) {
       code = run_field(comm, f, in, out, sites, stats);
     } else if (edit->parsed()) {
-      code = run_edit(comm, fe, edit_in, edit_script, edit_out, edit_stats, edit_save);
+      code =
+          run_edit(comm, fe, edit_in, edit_script, edit_out, edit_stats, edit_save, edit_balance);
     } else if (mesh->parsed()) {
       code = mpi_cli::run_mesh(comm, mesh_settings);
     } else if (render->parsed()) {

@@ -22,6 +22,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -53,6 +54,17 @@ struct SlabPartition {
 // slices. Throws InvalidArgument when the domain has fewer slices
 // than ranks (every rank must own one) or is empty.
 SlabPartition partition_slabs(const Box3i& domain, int ranks, int align = 1);
+
+// The units partition_slabs cuts at: `align` slices each from the first multiple of `align` at or
+// below the domain's start, clipped to the domain (the first and last may be thinner).
+std::vector<Box3i> slab_units(const Box3i& domain, int align);
+// Slabs of near-equal weight (unit_weights[k] >= 0: the work in slab_units(domain, align)[k]),
+// cut at unit boundaries, every rank keeping at least one unit: a terrain's surface, or the edits
+// of a script, lie in a few units that slabs of equal volume would hand to one or two ranks. With
+// fewer units than ranks, or no weight at all, the slabs of equal volume. InvalidArgument also for
+// weights not one per unit, negative or not finite.
+SlabPartition partition_slabs(const Box3i& domain, int ranks, int align,
+                              const std::vector<double>& unit_weights);
 
 // What a rank failed with, thrown on every rank of a collective operation that failed on any.
 class RankError : public Error {
@@ -133,6 +145,13 @@ DistanceField compute_distance_field(MPI_Comm comm, const SlabPartition& partiti
 // whose every value may depend on every voxel (give --max-distance, or integer storage).
 int edit_ghost_slices(const DistanceOptions& options);
 
+// Per unit of slab_units(domain, align): the work a script's edits bring it, for partition_slabs —
+// each edit's brush box grown by `ghost_slices` on every side (what its field update may
+// recompute), clipped to the domain, counted in voxels within the unit. Local (every rank computes
+// the same from the same script).
+std::vector<double> edit_unit_weights(const Box3i& domain, int align,
+                                      const std::vector<Edit>& edits, int ghost_slices);
+
 // A rank's slab of a world and its exact field, kept under edits. Constructing is collective (it
 // agrees on failures); apply() is local to the rank and may be called any number of times between
 // collective calls.
@@ -190,6 +209,21 @@ struct WorldSlab {
 // .vox/.vfw/.vdb extent), as `voxfield field` uses.
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
                           int ghost_slices = 0);
+// The same with the slabs cut by cut(domain) once the domain is known (every rank must cut it
+// alike; InvalidArgument unless it is a partition of that domain into the communicator's ranks):
+// slabs weighed by content (content_unit_weights) or by a script's edits (edit_unit_weights).
+using SlabCut = std::function<SlabPartition(const Box3i& domain)>;
+WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
+                          int ghost_slices, const SlabCut& cut);
+
+// Collective: per unit of slab_units(partition.domain, align), the chunks of the ranks' worlds
+// within the unit's slices that hold both air and solid voxels (where a world's surface lies, and
+// the edits of it land; a chunk of two materials is not one) plus a 64th of all its chunks (every
+// chunk's field is computed, surface or not). Each
+// rank counts the chunks of its own slab of `world` (chunked on `align`); the ranks sum them.
+std::vector<double> content_unit_weights(MPI_Comm comm, const SlabPartition& partition,
+                                         const World& world, int align,
+                                         ExchangeStats* stats = nullptr);
 
 // What write_field_npy writes.
 struct FieldFiles {

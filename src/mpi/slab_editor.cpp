@@ -5,6 +5,7 @@
 // rank keeps its slab and that many ghost slices on either side as a bounded world, applies every
 // edit clipped to that box, and lets its own DynamicDistanceField follow: over the slab its values
 // are the whole field's (the ghost slices' values are not, and are never handed out).
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -23,6 +24,26 @@ int edit_ghost_slices(const DistanceOptions& options) {
         "an unclamped f32 value may depend on every voxel of the domain");
   const double slices = std::ceil(clamp / options.spacing[2]);
   return static_cast<int>(std::min<double>(slices, std::numeric_limits<std::int32_t>::max() / 4));
+}
+
+std::vector<double> edit_unit_weights(const Box3i& domain, int align,
+                                      const std::vector<Edit>& edits, int ghost_slices) {
+  const std::vector<Box3i> units = slab_units(domain, align);
+  std::vector<double> weights(units.size(), 0.0);
+  const std::int32_t g = std::max(ghost_slices, 0);
+  for (const Edit& e : edits) {
+    Box3i reach = brush_bounds(e.brush);
+    if (reach.empty()) continue;
+    for (int k = 0; k < 3; ++k) {
+      reach.begin[k] = static_cast<std::int32_t>(std::max<std::int64_t>(
+          std::int64_t{reach.begin[k]} - g, std::numeric_limits<std::int32_t>::min()));
+      reach.end[k] = static_cast<std::int32_t>(std::min<std::int64_t>(
+          std::int64_t{reach.end[k]} + g, std::numeric_limits<std::int32_t>::max()));
+    }
+    for (std::size_t u = 0; u < units.size(); ++u)
+      weights[u] += static_cast<double>(reach.intersect(units[u]).volume());
+  }
+  return weights;
 }
 
 SlabEditor::SlabEditor(MPI_Comm comm, const SlabPartition& partition, const World& world,

@@ -26,13 +26,27 @@ Box3i kept_box(const Box3i& domain, const SlabPartition& partition, int rank, in
            static_cast<std::int32_t>(std::min<std::int64_t>(domain.end.z, slab.end.z + g))}};
 }
 
+// cut(domain), checked to be a partition of that domain into `ranks` slabs.
+SlabPartition checked_cut(const SlabCut& cut, const Box3i& domain, int ranks) {
+  SlabPartition p = cut(domain);
+  bool ok = p.domain == domain && p.ranks() == ranks && p.z.front() == domain.begin.z &&
+            p.z.back() == domain.end.z;
+  for (std::size_t r = 1; ok && r < p.z.size(); ++r) ok = p.z[r] > p.z[r - 1];
+  if (!ok)
+    throw InvalidArgument("load_world_slab: the slabs cut for " + to_string(domain) +
+                          " are not a partition of it into " + std::to_string(ranks) +
+                          " non-empty slabs");
+  return p;
+}
+
 // A .vfw: every rank holds the compressed bytes and decodes only its slab's chunks (every checksum
 // and world chunk record still checked). A bounded world's domain is in the file's head. An
 // unbounded one's is its content's bounds, as `voxfield field` takes them: the chunk records say
 // which z-range may hold content (WorldFile::stored_chunks_box), each rank decodes an equal share
 // of it and bounds what it finds, and the union of the ranks' bounds is the domain — so no rank
 // ever decodes more than about two slabs, whatever the world's size.
-WorldSlab vfw_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge, int ghost) {
+WorldSlab vfw_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge, int ghost,
+                   const SlabCut& cut) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
@@ -67,7 +81,7 @@ WorldSlab vfw_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
   const Box3i domain = h.bounds ? *h.bounds : content;
   return detail::collectively(comm, nullptr, [&] {
     if (domain.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
-    const SlabPartition partition = partition_slabs(domain, size, chunk_edge);
+    const SlabPartition partition = checked_cut(cut, domain, size);
     const Box3i keep = kept_box(domain, partition, rank, ghost);
     WorldFileReadOptions slab_only = h.options;
     slab_only.keep_z = std::pair<std::int32_t, std::int32_t>{keep.begin.z, keep.end.z};
@@ -81,18 +95,27 @@ WorldSlab vfw_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
 
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
                           int ghost_slices) {
+  int size = 0;
+  MPI_Comm_size(comm, &size);
+  return load_world_slab(comm, path, chunk_edge, ghost_slices, [&](const Box3i& domain) {
+    return partition_slabs(domain, size, chunk_edge);
+  });
+}
+
+WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
+                          int ghost_slices, const SlabCut& cut) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
   // (The format is named by the extension alone: every rank agrees on it without a word.)
   const WorldFormat format =
       detail::collectively(comm, nullptr, [&] { return world_format_of(path); });
-  if (format == WorldFormat::kVfw) return vfw_slab(comm, path, chunk_edge, ghost_slices);
+  if (format == WorldFormat::kVfw) return vfw_slab(comm, path, chunk_edge, ghost_slices, cut);
   return detail::collectively(comm, nullptr, [&] {
     if (format == WorldFormat::kNpy) {
       const NpyVolume head = read_npy_header(path);
       const Box3i domain = Box3i::from_size(head.dims);
-      const SlabPartition partition = partition_slabs(domain, size, chunk_edge);
+      const SlabPartition partition = checked_cut(cut, domain, size);
       const Box3i keep = kept_box(domain, partition, rank, ghost_slices);
       World part =
           world_from_npy(read_npy_part(path, keep.begin.z, keep.end.z), path.string(), chunk_edge);
@@ -109,7 +132,7 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
       vo.keep_z = std::pair<std::int32_t, std::int32_t>{0, 0};
       const Box3i extent = vox_extent(parse_vox(bytes, path.string(), vo).info);
       if (extent.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
-      const SlabPartition partition = partition_slabs(extent, size, chunk_edge);
+      const SlabPartition partition = checked_cut(cut, extent, size);
       const Box3i keep = kept_box(extent, partition, rank, ghost_slices);
       vo.keep_z = std::pair<std::int32_t, std::int32_t>{keep.begin.z, keep.end.z};
       const VoxImport slab = parse_vox(bytes, path.string(), vo);
@@ -121,7 +144,7 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
     lo.chunk_edge = chunk_edge;
     LoadedWorld whole = load_world(path, lo);
     if (whole.extent.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
-    const SlabPartition partition = partition_slabs(whole.extent, size, chunk_edge);
+    const SlabPartition partition = checked_cut(cut, whole.extent, size);
     // Only the slab and its ghost slices are kept once the file is read.
     const Box3i keep = kept_box(whole.extent, partition, rank, ghost_slices);
     World part = rechunk_world(whole.world, chunk_edge, keep, path.string());

@@ -220,6 +220,51 @@ TEST(MpiField, PartitionsCoverTheDomainInOrder) {
   EXPECT_THROW(mpi::partition_slabs(Box3i{}, 1, 1), InvalidArgument);
 }
 
+// Weighted slabs: units tile the domain; each cut lies on a unit boundary where the running weight
+// is nearest its share, every rank keeping at least one unit; bad weights refused. The edits' and
+// the content's weights fall where the edits and the surface are.
+TEST(MpiField, SlabsWeighedByWorkCutWhereTheWorkIs) {
+  const Box3i d{{0, 0, -5}, {16, 16, 75}};  // units of 16: [-5,0) [0,16) ... [64,75): 6
+  const std::vector<Box3i> units = mpi::slab_units(d, 16);
+  ASSERT_EQ(units.size(), 6u);
+  EXPECT_EQ(units.front().begin.z, -5);
+  EXPECT_EQ(units.front().end.z, 0);
+  EXPECT_EQ(units.back().begin.z, 64);
+  EXPECT_EQ(units.back().end.z, 75);
+  const std::vector<double> w{0, 0, 0, 10, 10, 0};  // the work in [32, 64)
+  EXPECT_EQ(mpi::partition_slabs(d, 2, 16, w).z, (std::vector<std::int32_t>{-5, 48, 75}));
+  // Four ranks over two units of work: each rank still gets a unit.
+  EXPECT_EQ(mpi::partition_slabs(d, 4, 16, w).z, (std::vector<std::int32_t>{-5, 32, 48, 64, 75}));
+  EXPECT_EQ(mpi::partition_slabs(d, 6, 16, w).z,
+            (std::vector<std::int32_t>{-5, 0, 16, 32, 48, 64, 75}));
+  // No weight at all, or more ranks than units: the slabs of equal volume.
+  EXPECT_EQ(mpi::partition_slabs(d, 3, 16, std::vector<double>(6, 0.0)).z,
+            mpi::partition_slabs(d, 3, 16).z);
+  EXPECT_EQ(mpi::partition_slabs(d, 7, 16, w).z, mpi::partition_slabs(d, 7, 16).z);
+  EXPECT_THROW(mpi::partition_slabs(d, 2, 16, std::vector<double>(5, 1.0)), InvalidArgument);
+  EXPECT_THROW(mpi::partition_slabs(d, 2, 16, {0, 0, -1, 0, 0, 0}), InvalidArgument);
+  EXPECT_THROW(mpi::partition_slabs(d, 2, 16, {0, 0, std::nan(""), 0, 0, 0}), InvalidArgument);
+  // A sphere of radius 2 at z 40, its reach grown by 3 slices: z in [35, 46), all within unit 3.
+  Edit e;
+  e.brush = SphereBrush{{5, 5, 40}, 2};
+  const std::vector<double> ew = mpi::edit_unit_weights(d, 16, {e, e}, 3);
+  ASSERT_EQ(ew.size(), 6u);
+  const Box3i reach = brush_bounds(e.brush).grown(3).intersect(d);
+  EXPECT_EQ(ew[3], 2.0 * static_cast<double>(reach.volume()));
+  EXPECT_EQ(ew[0] + ew[1] + ew[2] + ew[4] + ew[5], 0.0);
+  // Content: a flat ground at z 40 in a world chunked by 16 — its surface chunk is in unit 3; the
+  // solid chunks below are uniform, and air holds none.
+  World ground;
+  ground.voxels = Grid<std::uint8_t>(16);
+  ground.voxels.fill(Box3i{{0, 0, -16}, {16, 16, 40}}, 1);
+  const mpi::SlabPartition p = mpi::partition_slabs(d, ranks(), 16);
+  const std::vector<double> cw = mpi::content_unit_weights(comm(), p, ground, 16);
+  ASSERT_EQ(cw.size(), 6u);
+  for (std::size_t k = 0; k < cw.size(); ++k) {
+    EXPECT_EQ(cw[k], (k == 3 ? 1.0 : 0.0) + 1.0 / 64) << "unit " << k;
+  }
+}
+
 TEST(MpiField, AFailureOnOneRankReachesEveryRank) {
   if (ranks() < 2) GTEST_SKIP() << "needs two ranks";
   Box3i domain;

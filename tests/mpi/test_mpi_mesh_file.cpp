@@ -100,6 +100,7 @@ TEST(MpiMeshFile, IsTheFileOneProcessWritesInEveryFormat) {
   for (Mesher m : {Mesher::kMarchingCubes, Mesher::kSurfaceNets, Mesher::kDualContouring})
     for (int edge : {4, 12, 36})  // 36: one layer, so only the last rank has any
       for (const char* ext : {".ply", ".obj", ".stl", ".glb"}) {
+        if (edge != 4 && std::string(ext) != ".glb") continue;  // every format once per mesher
         SCOPED_TRACE(std::string(mesher_name(m)) + " chunk edge " + std::to_string(edge) + " " +
                      ext);
         MeshOptions o;
