@@ -110,7 +110,8 @@ int run_mesh(MPI_Comm comm, const MeshSettings& s) {
   std::optional<FileTransaction> outputs;
   if (rank == 0) outputs.emplace();
   const mpi::MeshFileSummary mesh = [&] {
-    // The planes go once the mesh is made: the ranks encode their shares without them.
+    // The planes go when the file is written (the mesh is made from them first; a rank's peak is
+    // its planes, its chunks' parts and its share of the mesh, encoded or not).
     const std::vector<float> held = std::move(planes);
     return mpi::write_mesh_volume(comm, layers, frame, held.empty() ? nullptr : held.data(),
                                   options, s.out, !s.stats.empty(), &ex,

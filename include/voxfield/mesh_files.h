@@ -55,8 +55,9 @@ std::vector<std::uint8_t> encode_mesh_head(MeshFormat format, const MeshTotals& 
 
 // Appends a run's encoding for `section`: a vertex section's run is vertices [first, end) of
 // `part`; the triangle section's run is every triangle of `part`, its vertex i being vertex
-// global[i] of the whole mesh (i itself when `global` is empty). The caller checks the part (as
-// encode_mesh checks a mesh) before.
+// global[i] of the whole mesh (i itself when `global` is empty). InvalidArgument for a run past
+// the part's vertices, arrays of unequal lengths, an index past the vertices, `global` not one
+// number per vertex, or colours asked of a part without them.
 void encode_mesh_section(MeshFormat format, MeshSection section, const Mesh& part,
                          std::size_t first, std::size_t end, std::span<const std::uint32_t> global,
                          std::vector<std::uint8_t>& out);

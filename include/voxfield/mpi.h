@@ -349,10 +349,10 @@ struct MeshFileSummary {
 // first used before its layers) and writes its vertices and triangles at their places in the
 // file: the bytes write_mesh writes for mesh_volume's mesh, atomically (staged beside the target
 // by rank 0, renamed once every rank has written; a failure anywhere leaves the target as it
-// was). `census`: also mesh_stats over the ranks (each edge the cuts split counted by the rank
-// holding its lower vertex). `into` (rank 0's; null on the others): the file is staged in the
-// caller's transaction and the caller commits it (collectively); null: committed before
-// returning. Throws RankError on every rank when any fails.
+// was). `census` (the same on every rank): also mesh_stats over the ranks (each edge the cuts split
+// counted by the rank holding its lower vertex). `into` (rank 0's; null on the others): the file is
+// staged in the caller's transaction and the caller commits it (collectively); null: committed
+// before returning. Throws RankError on every rank when any fails.
 MeshFileSummary write_mesh_volume(MPI_Comm comm, const MeshLayers& layers,
                                   const ScalarVolume& frame, const float* planes,
                                   const MeshOptions& options, const std::filesystem::path& path,

@@ -284,6 +284,19 @@ std::vector<std::uint8_t> encode_mesh_head(MeshFormat format, const MeshTotals& 
 void encode_mesh_section(MeshFormat format, MeshSection section, const Mesh& m, std::size_t first,
                          std::size_t end, std::span<const std::uint32_t> global,
                          std::vector<std::uint8_t>& out) {
+  // The run's arguments, checked as encode_mesh checks a whole mesh's arrays.
+  const std::size_t n = m.vertex_count();
+  if (first > end || end > n || m.normals.size() != n ||
+      (!m.colors.empty() && m.colors.size() != n) || m.indices.size() % 3 != 0 ||
+      (section == MeshSection::kColors && m.colors.empty() && end > first) ||
+      (!global.empty() && global.size() != n))
+    throw InvalidArgument("mesh: a run of vertices [" + std::to_string(first) + ", " +
+                          std::to_string(end) + ") or numbers that do not match the part's " +
+                          std::to_string(n) + " vertices");
+  if (section == MeshSection::kTriangles)
+    for (const std::uint32_t i : m.indices)
+      if (i >= n)
+        throw InvalidArgument("mesh: index " + std::to_string(i) + " is past the last vertex");
   const auto number = [&](std::size_t index) {
     const std::uint32_t local = m.indices[index];
     return global.empty() ? local : global[local];

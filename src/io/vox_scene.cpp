@@ -78,7 +78,8 @@ bool Scene::in_slab(std::int64_t z) const {
 
 bool Scene::in_slab(const Box3i& box) const {
   return !options_.keep_z ||
-         (box.end.z > options_.keep_z->first && box.begin.z < options_.keep_z->second);
+         (options_.keep_z->first < options_.keep_z->second && box.end.z > options_.keep_z->first &&
+          box.begin.z < options_.keep_z->second);
 }
 
 // Walks the scene graph depth first; `name` is the _name of the nearest transform above.

@@ -4,8 +4,9 @@
 // of their first user. A piece holds a run of chunk layers, so its owned vertices are one run of
 // those numbers and its claimed orphans another; what it borrows across its end layers, and the
 // orphans it shares with the piece before, are the only numbers it must learn from others. A
-// vertex's element lies within one cell of every chunk that uses it, and a chunk is at least two
-// cells deep, so its owner and users span at most two adjacent layers: neighbours suffice.
+// vertex's element lies within one cell of every chunk that uses it, and every layer but the last
+// is at least two cells deep (the chunk edge), so its owner and users span at most two adjacent
+// layers: neighbours suffice.
 #include <algorithm>
 #include <limits>
 #include <string>

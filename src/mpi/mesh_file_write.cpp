@@ -18,6 +18,7 @@
 
 #include "collective.h"
 #include "voxfield/file.h"
+#include "voxfield/limits.h"
 #include "voxfield/mesh_files.h"
 #include "voxfield/mesh_pieces.h"
 #include "voxfield/mpi.h"
@@ -37,7 +38,15 @@ std::vector<T> shift(MPI_Comm comm, int to, int from, const std::vector<T>& out,
   std::uint64_t count_out = out.size(), count_in = 0;
   MPI_Sendrecv(&count_out, 1, MPI_UINT64_T, to, kWeldTag, &count_in, 1, MPI_UINT64_T, from,
                kWeldTag, comm, MPI_STATUS_IGNORE);
-  std::vector<T> in(from == MPI_PROC_NULL ? 0 : static_cast<std::size_t>(count_in));
+  // Room for what arrives, agreed on by every rank before any item moves: a rank that cannot
+  // make it fails the job instead of leaving its neighbours waiting.
+  std::vector<T> in;
+  detail::collectively(comm, stats, [&] {
+    if (from == MPI_PROC_NULL) return;
+    require_memory(mul_sat(count_in, sizeof(T)), 0, "mpi::write_mesh_volume",
+                   "the vertex keys a neighbour lends across a cut");
+    in.resize(static_cast<std::size_t>(count_in));
+  });
   const auto* send = reinterpret_cast<const std::uint8_t*>(out.data());
   auto* receive = reinterpret_cast<std::uint8_t*>(in.data());
   const std::size_t send_bytes = to == MPI_PROC_NULL ? 0 : out.size() * sizeof(T);
@@ -366,12 +375,22 @@ MeshStats census_over_ranks(MPI_Comm comm, const Share& s, ExchangeStats* stats)
   {
     detail::CollectiveTimer t(stats);
     MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm);
+  }
+  // Room for the uses that arrive, agreed on before any moves (MPI counts bytes in an int).
+  detail::collectively(comm, stats, [&] {
     std::size_t bytes = 0;
     for (std::size_t r = 0; r < receive_counts.size(); ++r) {
+      if (bytes > static_cast<std::size_t>(std::numeric_limits<int>::max()) -
+                      static_cast<std::size_t>(receive_counts[r]))
+        throw ResourceLimitError("mpi::write_mesh_volume: the census's seam edges pass 2 GiB");
       receive_at[r] = static_cast<int>(bytes);
       bytes += static_cast<std::size_t>(receive_counts[r]);
     }
+    require_memory(bytes, 0, "mpi::write_mesh_volume", "the seam edges' uses");
     incoming.resize(bytes / sizeof(EdgeUse));
+  });
+  {
+    detail::CollectiveTimer t(stats);
     MPI_Alltoallv(outgoing.data(), send_counts.data(), send_at.data(), MPI_BYTE, incoming.data(),
                   receive_counts.data(), receive_at.data(), MPI_BYTE, comm);
     if (stats) {  // what travels: a rank's uses of the edges it writes stay with it

@@ -116,10 +116,21 @@ std::vector<double> content_unit_weights(MPI_Comm comm, const SlabPartition& par
       // A chunk is counted by the rank whose slab holds its first slice within the domain.
       const std::int32_t z = std::max(v.box.begin.z, partition.domain.begin.z);
       if (v.uniform() || z < slab.begin.z || z >= slab.end.z) continue;
-      // A surface: air and solid both (a chunk of two materials is not one).
-      const std::size_t n = static_cast<std::size_t>(v.box.volume());
-      const std::size_t air = static_cast<std::size_t>(std::count(v.voxels, v.voxels + n, 0));
-      if (air == 0 || air == n) continue;
+      // A surface: air and solid both within the domain (a chunk of two materials is not one; the
+      // voxels of an edge chunk past the domain are no one's).
+      const Box3i in = v.box.intersect(partition.domain);
+      const Vec3i e = v.box.size();
+      std::int64_t air = 0;
+      for (int z = in.begin.z; z < in.end.z; ++z)
+        for (int y = in.begin.y; y < in.end.y; ++y) {
+          const std::uint8_t* row = v.voxels +
+                                    (static_cast<std::size_t>(z - v.box.begin.z) * e.y +
+                                     static_cast<std::size_t>(y - v.box.begin.y)) *
+                                        e.x +
+                                    (in.begin.x - v.box.begin.x);
+          air += std::count(row, row + (in.end.x - in.begin.x), 0);
+        }
+      if (air == 0 || air == in.volume()) continue;
       const std::int64_t k = (std::int64_t{z} - base) / a;
       if (k >= 0 && k < static_cast<std::int64_t>(mine.size()))
         mine[static_cast<std::size_t>(k)] += 1;

@@ -135,6 +135,10 @@ TEST(MpiMeshFile, RanksWithoutLayersAnywhere) {
     if (ranks() >= 3) layers.layers[2] = 0;
     SCOPED_TRACE(std::string(mesher_name(m)));
     expect_file_of_whole(layers, whole, ScalarVolume{n, nullptr}, o, dir / "holes.ply");
+    // The last rank empty: the rank before it holds the top layers.
+    layers = mpi::partition_mesh_layers(n, 4, ranks());
+    layers.layers[static_cast<std::size_t>(ranks()) - 1] = layers.layers.back();
+    expect_file_of_whole(layers, whole, ScalarVolume{n, nullptr}, o, dir / "last.obj");
     if (ranks() >= 4) {
       // An empty run between two others: [0, 5, 5, 10] and so on.
       layers = mpi::partition_mesh_layers(n, 4, ranks());
