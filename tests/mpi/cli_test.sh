@@ -107,10 +107,10 @@ for opts in "--metric euclidean --signed --max-distance 6" "--metric manhattan -
 done
 # Slabs cut by content (a first reading counts the surface chunks) and by the script's edits: the
 # same field, the cuts where the work is.
+"$VF" edit f.npy -e edits.jsonl -o ref.npy --chunk 8 --max-distance 6 2>/dev/null
 for balance in content edits; do
   MPIEXEC -np 3 "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 --max-distance 6 \
     --balance "$balance" --stats bal.json 2>/dev/null
-  "$VF" edit f.npy -e edits.jsonl -o ref.npy --chunk 8 --max-distance 6 2>/dev/null
   same ref.npy out.npy "edit --balance $balance, 3 ranks"
   /usr/bin/python3 -c "import json; s = json.load(open('bal.json')); assert s['balance'] == '$balance' and len(s['slabs']) == 4 and s['stream_ms'] >= 0, s"
 done
