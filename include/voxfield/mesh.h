@@ -171,6 +171,17 @@ struct MeshStats {
     return triangles > 0 && boundary_edges == 0 && nonmanifold_edges == 0 && misoriented_edges == 0;
   }
   std::int64_t euler_characteristic = 0;  // V - E + F (2 for a sphere, 0 for a torus)
+  // Counts one distinct edge, used by `uses` triangles of which `forward` run from its lower
+  // vertex to its upper one (the census of mesh_stats, and of meshes spread over programs).
+  void count_edge(std::uint64_t uses, std::uint64_t forward) {
+    ++edges;
+    if (uses == 1)
+      ++boundary_edges;
+    else if (uses > 2)
+      ++nonmanifold_edges;
+    else if (forward != 1)
+      ++misoriented_edges;
+  }
   double area_units2 = 0;
   double signed_volume_units3 = 0;  // positive when the triangles face out (closed meshes only)
 };

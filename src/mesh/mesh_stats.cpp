@@ -59,14 +59,7 @@ MeshStats mesh_stats(const Mesh& mesh) {
       const std::uint64_t* j = i;
       int forward = 0;
       while (j < end && (*j >> 1) == (*i >> 1)) forward += static_cast<int>(*j++ & 1);
-      const std::ptrdiff_t count = j - i;
-      ++s.edges;
-      if (count == 1)
-        ++s.boundary_edges;
-      else if (count > 2)
-        ++s.nonmanifold_edges;
-      else if (forward != 1)
-        ++s.misoriented_edges;
+      s.count_edge(static_cast<std::uint64_t>(j - i), static_cast<std::uint64_t>(forward));
       i = j;
     }
   }

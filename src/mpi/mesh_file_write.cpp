@@ -311,14 +311,7 @@ void count_edges(std::vector<EdgeUse>& uses, MeshStats& s) {
     std::size_t j = i;
     std::uint64_t forward = 0;
     while (j < uses.size() && uses[j].edge == uses[i].edge) forward += uses[j++].forward;
-    const std::size_t count = j - i;
-    ++s.edges;
-    if (count == 1)
-      ++s.boundary_edges;
-    else if (count > 2)
-      ++s.nonmanifold_edges;
-    else if (forward != 1)
-      ++s.misoriented_edges;
+    s.count_edge(j - i, forward);
     i = j;
   }
 }
