@@ -108,7 +108,8 @@ std::vector<double> content_unit_weights(MPI_Comm comm, const SlabPartition& par
     std::vector<double> mine(units.size(), 0.0);
     if (units.empty()) return mine;
     const std::int64_t a = align;
-    const std::int64_t base = units.front().end.z - a;  // the first unit's aligned start
+    const std::int64_t begin = partition.domain.begin.z;
+    const std::int64_t base = (begin >= 0 ? begin / a : (begin - a + 1) / a) * a;  // as slab_units
     const Box3i slab = partition.slab(rank);
     const Grid<std::uint8_t>& g = world.voxels;
     for (const Vec3i c : g.chunk_coords()) {
@@ -121,10 +122,10 @@ std::vector<double> content_unit_weights(MPI_Comm comm, const SlabPartition& par
       const Box3i in = v.box.intersect(partition.domain);
       const Vec3i e = v.box.size();
       std::int64_t air = 0;
-      for (int z = in.begin.z; z < in.end.z; ++z)
+      for (int vz = in.begin.z; vz < in.end.z; ++vz)
         for (int y = in.begin.y; y < in.end.y; ++y) {
           const std::uint8_t* row = v.voxels +
-                                    (static_cast<std::size_t>(z - v.box.begin.z) * e.y +
+                                    (static_cast<std::size_t>(vz - v.box.begin.z) * e.y +
                                      static_cast<std::size_t>(y - v.box.begin.y)) *
                                         e.x +
                                     (in.begin.x - v.box.begin.x);

@@ -263,6 +263,13 @@ TEST(MpiField, SlabsWeighedByWorkCutWhereTheWorkIs) {
   for (std::size_t k = 0; k < cw.size(); ++k) {
     EXPECT_EQ(cw[k], (k == 3 ? 1.0 : 0.0) + 1.0 / 64) << "unit " << k;
   }
+  // A domain within one unit, off the chunk grid (every rank a slice of it): its one unit holds
+  // the surface, counted once over the ranks; the voxels past the domain are no one's.
+  const Box3i thin{{0, 0, 37}, {16, 16, 37 + std::max(ranks(), 4)}};  // the ground at 40 within
+  const std::vector<double> tw =
+      mpi::content_unit_weights(comm(), mpi::partition_slabs(thin, ranks(), 16), ground, 16);
+  ASSERT_EQ(tw.size(), 1u);
+  EXPECT_EQ(tw[0], 1.0 + 1.0 / 64);
 }
 
 TEST(MpiField, AFailureOnOneRankReachesEveryRank) {
