@@ -84,13 +84,6 @@ struct OwnComm {
 void check_mesh_layers(const MeshLayers& layers, const ScalarVolume& frame,
                        const MeshOptions& options, int ranks, const char* who);
 
-// Collective: this rank's mesh piece (mesh_pieces.h) of the layers it is dealt, empty on a rank
-// without layers; `who` names the operation in errors (distributed_mesh.cpp).
-std::vector<std::uint8_t> rank_mesh_piece(MPI_Comm comm, const MeshLayers& layers,
-                                          const ScalarVolume& frame, const float* planes,
-                                          const MeshOptions& options, const char* who,
-                                          ExchangeStats* stats);
-
 // The text of an MPI error code.
 std::string mpi_error_text(int code);
 

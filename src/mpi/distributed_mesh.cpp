@@ -205,26 +205,6 @@ void check_mesh_layers(const MeshLayers& layers, const ScalarVolume& frame,
                             std::to_string(count) + " layers once, in rank order");
 }
 
-std::vector<std::uint8_t> rank_mesh_piece(MPI_Comm comm, const MeshLayers& layers,
-                                          const ScalarVolume& frame, const float* planes,
-                                          const MeshOptions& options, const char* who,
-                                          ExchangeStats* stats) {
-  int rank = 0, size = 1;
-  MPI_Comm_rank(comm, &rank);
-  MPI_Comm_size(comm, &size);
-  const auto t0 = std::chrono::steady_clock::now();
-  std::vector<std::uint8_t> piece = collectively(comm, stats, [&] {
-    check_mesh_layers(layers, frame, options, size, who);
-    if (layers.empty(rank)) return std::vector<std::uint8_t>{};
-    const auto [z0, z1] = layers.planes(rank);
-    return mesh_piece(frame, z0, z1 - z0, planes, options,
-                      layers.layers[static_cast<std::size_t>(rank)],
-                      layers.layers[static_cast<std::size_t>(rank) + 1]);
-  });
-  if (stats) stats->compute_ms += ms_since(t0);
-  return piece;
-}
-
 }  // namespace detail
 
 Mesh mesh_volume(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& frame,
@@ -232,8 +212,16 @@ Mesh mesh_volume(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& fr
   int rank = 0, size = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
-  std::vector<std::uint8_t> piece =
-      detail::rank_mesh_piece(comm, layers, frame, planes, options, "mpi::mesh_volume", stats);
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<std::uint8_t> piece = detail::collectively(comm, stats, [&] {
+    detail::check_mesh_layers(layers, frame, options, size, "mpi::mesh_volume");
+    if (layers.empty(rank)) return std::vector<std::uint8_t>{};
+    const auto [z0, z1] = layers.planes(rank);
+    return mesh_piece(frame, z0, z1 - z0, planes, options,
+                      layers.layers[static_cast<std::size_t>(rank)],
+                      layers.layers[static_cast<std::size_t>(rank) + 1]);
+  });
+  if (stats) stats->compute_ms += detail::ms_since(t0);
   // The pieces travel on a communicator of their own, so that no message of the application's on
   // `comm` can match theirs.
   const detail::OwnComm own(comm);
