@@ -396,6 +396,78 @@ TEST(VdbRead, VoxfieldsFilesLoadBackAsTheirWorlds) {
         ASSERT_EQ(solid.world.voxels.get({x, y, z}) != 0, w.voxels.get({x, y, z}) != 0);
 }
 
+// A clipped read (an MPI rank's slab): the tiles and leaves that overlap the clip, exactly as a
+// whole read has them, and nothing else held; the bounds still those of the whole tree; the world
+// of a clipped read the whole world's voxels within the clip, for every grid type, compression
+// and half floats. The dropped leaves' values are stepped over by their stored sizes: a wrong
+// step would misread every leaf after them.
+TEST(VdbRead, ClippedReadsKeepWhatOverlapsTheClipAndBoundTheRest) {
+  openvdb::initialize();
+  const Box3i clips[] = {Box3i{{-5, -7, -3}, {13, 6, 20}}, Box3i{},
+                         Box3i{{-(1 << 20), -(1 << 20), 0}, {1 << 20, 1 << 20, 4}}};
+  for (bool half : {false, true}) {
+    const openvdb::GridPtrVec grids = sample_grids(half);
+    for (std::uint32_t c : kCompressions) {
+      const std::vector<std::uint8_t> bytes = file_bytes(grids, c);
+      const VdbFile whole = decode_vdb(bytes, "sample.vdb");
+      for (const Box3i& clip : clips) {
+        const std::string what = "compression " + openvdb::io::compressionToString(c) +
+                                 (half ? ", half" : "") + ", clip " + to_string(clip);
+        VdbReadOptions o;
+        o.clip = clip;
+        const VdbFile part = decode_vdb(bytes, "sample.vdb", o);
+        ASSERT_EQ(part.grids.size(), whole.grids.size()) << what;
+        if (clip.empty()) EXPECT_LT(part.memory_bytes(), whole.memory_bytes() / 4) << what;
+        for (std::size_t i = 0; i < whole.grids.size(); ++i) {
+          const VdbGrid &w = whole.grids[i], &g = part.grids[i];
+          const std::string grid = what + ", grid " + w.name;
+          EXPECT_EQ(g.clip, clip) << grid;
+          EXPECT_EQ(g.stored_bounds(), w.stored_bounds()) << grid;
+          EXPECT_EQ(g.active_bounds(), w.active_bounds()) << grid;
+          std::size_t t = 0;
+          for (const VdbTile& tile : w.tiles) {
+            const Box3i box{tile.origin, tile.origin + Vec3i::splat(tile.edge)};
+            if (box.intersect(clip).empty()) continue;
+            ASSERT_LT(t, g.tiles.size()) << grid;
+            EXPECT_EQ(g.tiles[t].origin, tile.origin) << grid;
+            EXPECT_EQ(g.tiles[t].value, tile.value) << grid;
+            EXPECT_EQ(g.tiles[t++].active, tile.active) << grid;
+          }
+          EXPECT_EQ(t, g.tiles.size()) << grid;
+          const std::size_t per_leaf =
+              (std::size_t{1} << (3 * w.log2_dims.back())) * static_cast<std::size_t>(w.components);
+          std::size_t l = 0;
+          for (const VdbLeaf& leaf : w.leaves) {
+            const Box3i box{leaf.origin, leaf.origin + Vec3i::splat(w.leaf_edge)};
+            if (box.intersect(clip).empty()) continue;
+            ASSERT_LT(l, g.leaves.size()) << grid;
+            const VdbLeaf& kept = g.leaves[l++];
+            ASSERT_EQ(kept.origin, leaf.origin) << grid;
+            EXPECT_EQ(kept.active_bits, leaf.active_bits) << grid;
+            for (std::size_t k = 0; k < per_leaf; ++k)
+              ASSERT_EQ(g.leaf_value(kept.first_value + k), w.leaf_value(leaf.first_value + k))
+                  << grid;
+          }
+          EXPECT_EQ(l, g.leaves.size()) << grid;
+        }
+        // The level set's inside, as a world: the whole one's voxels within the clip.
+        const World in_whole = world_from_vdb(whole, "sample.vdb", 16, 0, "sphere").world;
+        const VdbWorld in_part = world_from_vdb(part, "sample.vdb", 16, 0, "sphere");
+        EXPECT_EQ(in_part.stored, whole.grids[0].stored_bounds()) << what;
+        const Box3i content = in_whole.voxels.content_bounds();
+        ASSERT_GT(content.volume(), 1000) << what;
+        EXPECT_TRUE(clip.contains(in_part.world.voxels.content_bounds())) << what;
+        for (int z = content.begin.z; z < content.end.z; ++z)
+          for (int y = content.begin.y; y < content.end.y; ++y)
+            for (int x = content.begin.x; x < content.end.x; ++x)
+              ASSERT_EQ(in_part.world.voxels.get({x, y, z}),
+                        clip.contains(Vec3i{x, y, z}) ? in_whole.voxels.get({x, y, z}) : 0)
+                  << what << " at " << x << " " << y << " " << z;
+      }
+    }
+  }
+}
+
 // Prefixes of files and hundreds of corrupted copies: an Error naming the file, or a
 // successful read, never a crash (the ASan build runs this too).
 TEST(VdbRead, DamagedFilesAreRefusedWithTheFileAndCause) {

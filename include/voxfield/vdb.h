@@ -38,6 +38,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -128,6 +129,11 @@ struct VdbGrid {
   // the memory — and as doubles for double, int32 and bool grids. One of the two is used.
   std::vector<float> leaf_floats;
   std::vector<double> leaf_doubles;
+  // Read with VdbReadOptions::clip: the clip box, and the bounds of the tiles and leaves that lay
+  // wholly outside it and were dropped unread (what stored_bounds and active_bounds still count).
+  // The kept tiles and leaves may reach past the clip; world_from_vdb places only what lies in it.
+  std::optional<Box3i> clip;
+  Box3i dropped_stored, dropped_active;
   bool leaves_hold_floats() const {
     return value_type == VdbValueType::kFloat || value_type == VdbValueType::kVec3f;
   }
@@ -153,7 +159,7 @@ struct VdbGrid {
     return (leaf.active_bits[static_cast<std::size_t>(i) >> 6] >> (i & 63)) & 1u;
   }
   // The voxels the tree stores anything but the inactive background for (tiles and leaves), and
-  // the active ones; empty boxes for an empty tree.
+  // the active ones; empty boxes for an empty tree. A clipped read's dropped nodes included.
   Box3i stored_bounds() const;
   Box3i active_bounds() const;
   // Every value over `box`, x fastest (voxfield's order), `components` per voxel; the
@@ -175,6 +181,11 @@ struct VdbFile {
 
 struct VdbReadOptions {
   std::uint64_t memory_limit_bytes = 0;  // 0: the process default (limits.h)
+  // Keep only the tiles and leaves that overlap this box (an MPI rank's slab): the others are
+  // dropped, their values skipped undecoded (their sizes still checked against the bytes), and
+  // neither held nor charged to the memory limit. An empty box keeps nothing but the topology's
+  // bounds (VdbGrid::dropped_stored), the metadata and the transforms.
+  std::optional<Box3i> clip;
 };
 
 // Parses a .vdb file's bytes; `name` names it in errors. Throws FormatError (file, offset and
@@ -195,7 +206,8 @@ VdbFile read_vdb(const std::filesystem::path& path, const VdbReadOptions& option
 // Throws FormatError naming `name`, ResourceLimitError past the memory limit.
 struct VdbWorld {
   World world;
-  Box3i extent;             // voxfield's recorded extent united with the content
+  Box3i extent;             // voxfield's recorded extent united with the content (in the clip)
+  Box3i stored;             // the grid's stored_bounds(): where content may lie, clip or not
   std::string description;  // one line: format, grid, type, class, voxel size
 };
 VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_edge,

@@ -291,6 +291,7 @@ VdbFile decode_vdb(std::span<const std::uint8_t> bytes, const std::string& name,
     how.compression = in.u32("grid compression flags");
     how.memory_limit_bytes = options.memory_limit_bytes;
     how.used_bytes = &used;
+    how.clip = options.clip;
     g.metadata = read_metadata(in);
     used = add_sat(used, metadata_bytes(g.metadata));
     if (auto it = g.metadata.find("class"); it != g.metadata.end()) g.grid_class = it->second.text;
@@ -316,6 +317,9 @@ VdbFile decode_vdb(std::span<const std::uint8_t> bytes, const std::string& name,
       g.leaves = p.leaves;
       g.leaf_floats = p.leaf_floats;
       g.leaf_doubles = p.leaf_doubles;
+      g.clip = p.clip;
+      g.dropped_stored = p.dropped_stored;
+      g.dropped_active = p.dropped_active;
     }
     read_grids[d.unique_name] = file.grids.size();
     file.grids.push_back(std::move(g));

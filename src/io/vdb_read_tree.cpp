@@ -6,7 +6,9 @@
 // only its active values plus up to two inactive ones and a mask choosing between them) and are
 // zip or Blosc compressed per node. Every count is checked against the bytes left, every
 // decompressed size against what the node needs, and what the tree holds against the memory
-// limit, so no input can make the reader read out of bounds or allocate without bound.
+// limit, so no input can make the reader read out of bounds or allocate without bound. A clipped
+// read (an MPI rank's slab) drops the nodes outside the clip: their values are stepped over by
+// their stored sizes, never decompressed.
 #include "vdb_read_tree.h"
 
 #include <blosc.h>
@@ -55,6 +57,7 @@ class TreeReader {
  public:
   TreeReader(ByteReader& r, VdbGrid& grid, const VdbTreeReading& how)
       : r_(r), grid_(grid), how_(how) {
+    grid_.clip = how.clip;
     full_bytes_ = component_bytes(false) * grid.components;
     stored_bytes_ = component_bytes(grid.half_float) * grid.components;
     full_decode_ = decoder(false);
@@ -103,7 +106,8 @@ class TreeReader {
     if (std::adjacent_find(origins.begin(), origins.end()) != origins.end())
       r_.fail("two root tiles or children at the same origin");
     std::size_t leaf_count = 0;
-    for (const Child& child : root_children) leaf_count += child.leaves.size();
+    for (const Child& child : root_children)
+      for (const PendingLeaf& leaf : child.leaves) leaf_count += leaf.dropped ? 0 : 1;
     // Every leaf's values were counted with its topology: held once, without regrowth.
     grid_.leaves.reserve(grid_.leaves.size() + leaf_count);
     const std::size_t values = leaf_count * (std::size_t{1} << (3 * grid_.log2_dims.back())) *
@@ -117,7 +121,28 @@ class TreeReader {
   struct PendingLeaf {
     Vec3i origin;
     std::vector<std::uint64_t> mask;
+    bool dropped = false;  // outside the clip: its values are skipped
   };
+
+  // Whether a node's box lies wholly outside the clip (dropped), its bounds then counted.
+  bool drop(const Box3i& box, bool stored, const std::vector<std::uint64_t>* active_bits,
+            bool active) {
+    if (!how_.clip || !box.intersect(*how_.clip).empty()) return false;
+    if (stored) grid_.dropped_stored = grid_.dropped_stored.unite(box);
+    if (active) grid_.dropped_active = grid_.dropped_active.unite(box);
+    if (active_bits) {
+      const int dim = grid_.log2_dims.back();
+      const std::size_t count = std::size_t{1} << (3 * dim);
+      for (std::size_t i = 0; i < count; ++i)
+        if (bit(*active_bits, i)) {
+          const Vec3i p = box.begin + Vec3i{static_cast<int>(i >> (2 * dim)),
+                                            static_cast<int>((i >> dim) & ((1u << dim) - 1)),
+                                            static_cast<int>(i & ((1u << dim) - 1))};
+          grid_.dropped_active = grid_.dropped_active.unite(Box3i{p, p + Vec3i::splat(1)});
+        }
+    }
+    return true;
+  }
 
   std::size_t component_bytes(bool half) const {
     switch (grid_.value_type) {
@@ -225,13 +250,14 @@ class TreeReader {
   }
 
   // `count` values stored as readData writes them: raw, or a zip / Blosc block led by its
-  // 64-bit size (negative: stored raw). Returns their bytes, `count` * stored size.
-  std::vector<std::uint8_t> read_data(std::size_t count) {
+  // 64-bit size (negative: stored raw). Returns their bytes, `count` * stored size; nothing when
+  // not `kept` (the values are stepped over, never decompressed).
+  std::vector<std::uint8_t> read_data(std::size_t count, bool kept) {
     const std::size_t need = count * stored_bytes_;
     std::vector<std::uint8_t> out;
     if (!(how_.compression & (kVdbCompressZip | kVdbCompressBlosc))) {
       const auto raw = r_.take(need, "node values");
-      out.assign(raw.begin(), raw.end());
+      if (kept) out.assign(raw.begin(), raw.end());
       return out;
     }
     const std::uint64_t at = r_.offset();
@@ -242,12 +268,13 @@ class TreeReader {
                            std::to_string(static_cast<std::uint64_t>(-(size + 1)) + 1) +
                            " bytes where the node holds " + std::to_string(need));
       const auto raw = r_.take(need, "node values");
-      out.assign(raw.begin(), raw.end());
+      if (kept) out.assign(raw.begin(), raw.end());
       return out;
     }
     const auto packed =
         r_.take(static_cast<std::size_t>(std::min<std::uint64_t>(size, r_.remaining() + 1)),
                 "compressed node values");
+    if (!kept) return out;
     out.resize(need);
     if (how_.compression & kVdbCompressBlosc) {
       std::size_t declared = 0;
@@ -268,9 +295,10 @@ class TreeReader {
   }
 
   // OpenVDB's readCompressedValues: `count` values of a node whose value mask is `active`, into
-  // `values` (one buffer per tree level, reused from node to node: a top node holds 32768).
+  // `values` (one buffer per tree level, reused from node to node: a top node holds 32768);
+  // stepped over when not `kept`.
   void read_values(std::size_t count, const std::vector<std::uint64_t>& active, int log2_dim,
-                   std::vector<Value>& values) {
+                   std::vector<Value>& values, bool kept = true) {
     std::uint8_t flag = kNoMaskAndAllVals;
     const std::uint64_t at = r_.offset();
     if (how_.format_version >= 222) flag = r_.u8("node compression flag");
@@ -294,8 +322,10 @@ class TreeReader {
     // Half floats with nothing to store store nothing, not even a block size (HalfReader).
     const bool real =
         grid_.value_type != VdbValueType::kBool && grid_.value_type != VdbValueType::kInt32;
-    const std::vector<std::uint8_t> bytes =
-        grid_.half_float && real && stored == 0 ? std::vector<std::uint8_t>{} : read_data(stored);
+    const std::vector<std::uint8_t> bytes = grid_.half_float && real && stored == 0
+                                                ? std::vector<std::uint8_t>{}
+                                                : read_data(stored, kept);
+    if (!kept) return;
     values.resize(count);
     if (stored == count) {
       for (std::size_t i = 0; i < count; ++i)
@@ -312,6 +342,7 @@ class TreeReader {
 
   void add_tile(Vec3i origin, int shift, const Value& v, bool active) {
     if (!active && v == grid_.background) return;
+    if (drop(Box3i{origin, origin + Vec3i::splat(1 << shift)}, true, nullptr, active)) return;
     charge(sizeof(VdbTile), "its tiles");
     grid_.tiles.push_back({origin, std::int32_t{1} << shift, active, v});
   }
@@ -336,10 +367,15 @@ class TreeReader {
       if (!bit(child_mask, i)) {
         add_tile(at, child_shift, values[i], bit(value_mask, i));
       } else if (children_are_leaves) {
-        charge(sizeof(VdbLeaf) + (grid_.leaf_value_bytes() << (3 * grid_.log2_dims.back())) *
-                                     static_cast<std::size_t>(grid_.components),
+        PendingLeaf leaf{at, read_mask(grid_.log2_dims.back(), "leaf value mask")};
+        leaf.dropped = drop(Box3i{at, at + Vec3i::splat(grid_.leaf_edge)}, true, &leaf.mask, false);
+        // A dropped leaf holds only its mask until its values are stepped over.
+        charge(leaf.dropped
+                   ? sizeof(PendingLeaf) + leaf.mask.size() * sizeof(std::uint64_t)
+                   : sizeof(VdbLeaf) + (grid_.leaf_value_bytes() << (3 * grid_.log2_dims.back())) *
+                                           static_cast<std::size_t>(grid_.components),
                "its leaves");
-        leaves.push_back({at, read_mask(grid_.log2_dims.back(), "leaf value mask")});
+        leaves.push_back(std::move(leaf));
       } else {
         read_internal_topology(at, level + 1, leaves);
       }
@@ -351,6 +387,15 @@ class TreeReader {
     const int dim = grid_.log2_dims.back();
     const std::size_t count = std::size_t{1} << (3 * dim);
     const std::size_t comps = static_cast<std::size_t>(grid_.components);
+    if (leaf.dropped) {
+      if (grid_.value_type == VdbValueType::kBool) {
+        r_.skip(count / 8 + 12 + count / 8, "bool leaf mask, origin and values");
+      } else {
+        r_.skip(count / 8, "leaf value mask");
+        read_values(count, leaf.mask, dim, level_values_.back(), /*kept=*/false);
+      }
+      return;
+    }
     std::size_t first = 0;
     grid_.with_leaf_values([&](auto& held) {
       first = held.size();

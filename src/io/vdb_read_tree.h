@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 
 #include "byte_reader.h"
 #include "voxfield/vdb.h"
@@ -19,6 +20,7 @@ struct VdbTreeReading {
   std::uint32_t compression = 0;  // the grid's flags
   std::uint64_t memory_limit_bytes = 0;
   std::uint64_t* used_bytes = nullptr;  // what the file's trees hold so far, across grids
+  std::optional<Box3i> clip;            // VdbReadOptions::clip
 };
 
 // Reads a tree's topology and then its buffers from `r` into `grid`, whose value type, component

@@ -110,14 +110,14 @@ std::string format_number(double v) {
 }  // namespace
 
 Box3i VdbGrid::stored_bounds() const {
-  Box3i b;
+  Box3i b = dropped_stored;
   for (const VdbTile& t : tiles) b = b.unite(tile_box(t));
   for (const VdbLeaf& l : leaves) b = b.unite(leaf_box(*this, l));
   return b;
 }
 
 Box3i VdbGrid::active_bounds() const {
-  Box3i b;
+  Box3i b = dropped_active;
   for (const VdbTile& t : tiles)
     if (t.active) b = b.unite(tile_box(t));
   for (const VdbLeaf& l : leaves) {
@@ -232,32 +232,61 @@ VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_
   // chunks solid leaf voxels make dense.
   std::uint64_t need = 0;
   std::unordered_set<Vec3i, Vec3iHash> dense;
-  auto count_dense = [&](Vec3i origin, int edge) {
-    const Vec3i lo = voxels.chunk_of(origin), hi = voxels.chunk_of(origin + Vec3i::splat(edge - 1));
+  // The chunks over `box`: those it covers whole are uniform, the others dense. Only the chunk
+  // rows that reach the box's faces are walked (a tile may cover millions of chunks).
+  auto count_chunks = [&](const Box3i& box) {
+    const std::int64_t edge = std::int64_t{1} << shift;
+    const Vec3i lo = voxels.chunk_of(box.begin), hi = voxels.chunk_of(box.end - Vec3i::splat(1));
+    auto whole_along = [&](int a, std::int64_t c) {  // chunk c of axis a lies in the box
+      return c * edge >= box.begin[a] && (c + 1) * edge <= std::int64_t{box.end[a]};
+    };
+    std::uint64_t whole = 1;
+    for (int a = 0; a < 3; ++a) {
+      std::uint64_t n = 0;
+      for (const std::int64_t c : {std::int64_t{lo[a]}, std::int64_t{hi[a]}})
+        n += whole_along(a, c) ? 0 : 1;
+      const std::uint64_t span = static_cast<std::uint64_t>(std::int64_t{hi[a]} - lo[a] + 1);
+      n = lo[a] == hi[a] ? (whole_along(a, lo[a]) ? 0 : 1) : n;
+      whole = mul_sat(whole, span - n);
+    }
+    need = add_sat(need, mul_sat(whole, uniform_chunk));
+    bool aligned = true;  // on the chunk grid (an unclipped tile of a chunk or more): all whole
+    for (int a = 0; a < 3; ++a) aligned = aligned && whole_along(a, lo[a]) && whole_along(a, hi[a]);
+    if (aligned) return;
+    auto visit = [&](int x, int y, int z) {
+      if (!(whole_along(0, x) && whole_along(1, y) && whole_along(2, z)) &&
+          dense.insert({x, y, z}).second)
+        need = add_sat(need, dense_chunk);
+    };
     for (int z = lo.z; z <= hi.z && need <= limit; ++z)
-      for (int y = lo.y; y <= hi.y; ++y)
-        for (int x = lo.x; x <= hi.x; ++x)
-          if (dense.insert({x, y, z}).second) need = add_sat(need, dense_chunk);
+      for (int y = lo.y; y <= hi.y && need <= limit; ++y) {
+        if (whole_along(1, y) && whole_along(2, z)) {  // a row inside but for its ends
+          visit(lo.x, y, z);
+          if (hi.x != lo.x) visit(hi.x, y, z);
+          continue;
+        }
+        for (int x = lo.x; x <= hi.x && need <= limit; ++x) visit(x, y, z);
+      }
   };
+  // What of a node lies in the clip (all of it when the file was read whole).
+  auto clipped = [&](const Box3i& box) { return g.clip ? box.intersect(*g.clip) : box; };
   for (const VdbTile& t : g.tiles) {
     if (need > limit) break;
-    if (material_of(rule, t.value.data(), t.active) == 0) continue;
-    if (t.edge < (1 << shift)) {
-      count_dense(t.origin, t.edge);
-      continue;
-    }
-    const std::uint64_t per_edge = std::uint64_t(t.edge) >> shift;  // OpenVDB's nodes and
-    need = add_sat(need, mul_sat(per_edge * per_edge * per_edge, uniform_chunk));  // chunks: 2^n
+    const Box3i box = clipped(tile_box(t));
+    if (box.empty() || material_of(rule, t.value.data(), t.active) == 0) continue;
+    count_chunks(box);
   }
   g.with_leaf_values([&](const auto& values) {
     for (const VdbLeaf& l : g.leaves) {
       if (need > limit) break;
+      const Box3i box = clipped(leaf_box(g, l));
       bool solid = false;
-      for_each_leaf_voxel(g, l, [&](Vec3i, int i, std::size_t first) {
-        solid = solid || material_of(rule, leaf_components(g, values, first).data(),
-                                     g.leaf_active(l, i)) != 0;
+      for_each_leaf_voxel(g, l, [&](Vec3i p, int i, std::size_t first) {
+        solid =
+            solid || (box.contains(p) && material_of(rule, leaf_components(g, values, first).data(),
+                                                     g.leaf_active(l, i)) != 0);
       });
-      if (solid) count_dense(l.origin, g.leaf_edge);
+      if (solid) count_chunks(box);
     }
   });
   require_memory(need, limit, name, "its world (grid \"" + g.name + "\")");
@@ -268,11 +297,13 @@ VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_
       throw FormatError(name, 0,
                         "grid \"" + g.name + "\" has material " + format_number(t.value[0]) +
                             " (outside 0..255)");
-    if (m != 0) voxels.fill(tile_box(t), static_cast<std::uint8_t>(m));
+    const Box3i box = clipped(tile_box(t));
+    if (m != 0 && !box.empty()) voxels.fill(box, static_cast<std::uint8_t>(m));
   }
   g.with_leaf_values([&](const auto& values) {
     for (const VdbLeaf& l : g.leaves)
       for_each_leaf_voxel(g, l, [&](Vec3i p, int i, std::size_t first) {
+        if (g.clip && !g.clip->contains(p)) return;
         const auto v = leaf_components(g, values, first);
         const int m = material_of(rule, v.data(), g.leaf_active(l, i));
         if (m < 0)
@@ -316,6 +347,7 @@ VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_
     if (ok && a.x < b.x && a.y < b.y && a.z < b.z) out.extent = Box3i{a, b};
   }
   out.extent = out.extent.unite(voxels.content_bounds());
+  out.stored = g.stored_bounds();
   // The frame: the transform takes index (i, j, k) to the voxel's centre, voxel coordinates
   // (i, j, k) + 1/2, so the frame's origin lies half a voxel back along each axis.
   std::array<double, 12> m = g.index_to_world;
