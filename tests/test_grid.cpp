@@ -144,6 +144,18 @@ TEST_P(GridEdges, UniformChunksCollapse) {
   k.fill({{0, 0, edge / 2}, {edge, edge, edge}}, 4);
   EXPECT_EQ(k.memory().dense_chunks, 0u);
   EXPECT_EQ(k.memory().uniform_chunks, 1u);
+  // Eight fills of a chunk's octants (a .vdb's small tiles): dense until the last one lands, then
+  // one value; filled back with the background octant by octant, the chunk goes.
+  for (const std::uint8_t value : {std::uint8_t{6}, std::uint8_t{0}}) {
+    const int h = edge / 2;
+    for (int i = 0; i < 8; ++i) {
+      const Vec3i o{(i & 1) * h, ((i >> 1) & 1) * h, (i >> 2) * h};
+      k.fill({o, o + Vec3i::splat(h)}, value);
+      EXPECT_EQ(k.memory().dense_chunks, i < 7 ? 1u : 0u) << int(value) << " octant " << i;
+    }
+    EXPECT_EQ(k.chunk_count(), value == 0 ? 0u : 1u);
+    EXPECT_EQ(k.get({edge - 1, 0, 1}), value);
+  }
   // Uniform by per-voxel writes of a new value: compact() collapses it.
   Grid<std::uint8_t> m(edge);
   for (int z = 0; z < edge; ++z)

@@ -126,6 +126,7 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
                           {"ms", field_ms},
                           {"mvox_per_s", static_cast<double>(domain.volume()) / (field_ms * 1e3)},
                           {"load_ms_max", max_over(comm, load_ms)},
+                          {"format", slab.format},
                           {"read_in_parts", slab.read_in_parts},
                           {"slabs", slab.partition.z}});
   j["exchange"] = exchange_json(comm, ex);

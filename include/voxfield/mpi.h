@@ -190,10 +190,10 @@ class SlabEditor {
 struct WorldSlab {
   World world;  // the slab's voxels and its ghost slices, at their place in the whole world
   SlabPartition partition;
-  std::string format;  // "npy", "vox" or "vfw"
+  std::string format;  // "npy", "vox", "vfw" or "vdb"
   // Each rank built only its slab: a .npy's part read alone, a .vfw's chunks decompressed alone,
-  // a .vox's voxels placed within the slab alone (the file read by every rank). Else (a .vdb)
-  // each decoded the whole world.
+  // a .vox's voxels placed within the slab alone, a .vdb's leaves decoded within the slab alone
+  // (the file read by every rank). Every format voxfield reads is read so.
   bool read_in_parts = false;
 };
 
@@ -204,9 +204,12 @@ struct WorldSlab {
 // rank first decodes an equal share of the z-range its stored chunks cover and the ranks unite what
 // they find. A .vox is read by every rank, which places only its slab's voxels
 // (VoxImportOptions::keep_z) — the file, its models' voxel lists and the slab per rank; its scene
-// is read twice (described, then placed), the extent coming first. A .vdb is decoded whole by
-// every rank, which then keeps its part. The domain is the file's volume (the .npy shape, the
-// .vox/.vfw/.vdb extent), as `voxfield field` uses.
+// is read twice (described, then placed), the extent coming first. A .vdb is read by every rank,
+// which decodes only the tiles and leaves of its slab (VdbReadOptions::clip: the others' values
+// are stepped over undecoded); its domain, voxfield's recorded extent united with the solid
+// voxels, comes from an equal z-share of the tree's stored bounds decoded by each rank first. The
+// domain is the file's volume (the .npy shape, the .vox/.vfw/.vdb extent), as `voxfield field`
+// uses.
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
                           int ghost_slices = 0);
 // The same with the slabs cut by cut(domain) once the domain is known (every rank must cut it

@@ -1,13 +1,15 @@
-// voxfield — a rank's slab of a world file (mpi.h): .npy arrays read a part per rank, .vfw worlds
-// decoded a slab per rank, other formats loaded whole by every rank.
+// voxfield — a rank's slab of a world file (mpi.h): .npy arrays read a part per rank, .vfw, .vox
+// and .vdb files decoded a slab per rank.
 #include <mpi.h>
 
 #include <algorithm>
+#include <optional>
 
 #include "collective.h"
 #include "voxfield/file.h"
 #include "voxfield/limits.h"
 #include "voxfield/npy.h"
+#include "voxfield/vdb.h"
 #include "voxfield/vox.h"
 #include "voxfield/world_file.h"
 #include "voxfield/world_io.h"
@@ -91,6 +93,62 @@ WorldSlab vfw_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
   });
 }
 
+// A .vdb: every rank holds the file's bytes and decodes only the leaves and tiles of its slab
+// (VdbReadOptions::clip; the others' values are stepped over). The domain is voxfield's recorded
+// extent united with the content, as `voxfield field` takes it: the tree's topology (read with an
+// empty clip) bounds where content may lie, each rank decodes an equal z-share of that and bounds
+// the solid voxels it finds, and the union over the ranks is the domain.
+WorldSlab vdb_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge, int ghost,
+                   const SlabCut& cut) {
+  int rank = 0, size = 0;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  struct Head {
+    std::vector<std::uint8_t> bytes;
+    VdbReadOptions options;
+    Box3i content;  // of this rank's share: the recorded extent and the solid voxels found
+    std::optional<VdbWorld> whole;  // one rank's share is the whole tree: read once
+  };
+  const std::string name = path.string();
+  const std::uint64_t limit = effective_memory_limit(0);
+  auto world_in = [&](const Head& h, const Box3i& clip) {
+    VdbReadOptions o = h.options;
+    o.clip = clip;
+    const VdbFile file = decode_vdb(h.bytes, name, o);
+    return world_from_vdb(file, name, chunk_edge,
+                          remaining_memory(o.memory_limit_bytes, file.memory_bytes()));
+  };
+  Head h = detail::collectively(comm, nullptr, [&] {
+    Head out;
+    out.bytes = read_file(path, limit);
+    out.options.memory_limit_bytes = remaining_memory(limit, out.bytes.size());
+    const VdbWorld topology = world_in(out, Box3i{});
+    out.content = topology.extent;
+    const Box3i stored = topology.stored;
+    if (!stored.empty()) {
+      const std::int64_t z0 = stored.begin.z, slices = stored.size().z;
+      Box3i share = stored;
+      share.begin.z = static_cast<std::int32_t>(z0 + slices * rank / size);
+      share.end.z = static_cast<std::int32_t>(z0 + slices * (rank + 1) / size);
+      if (size == 1) {
+        out.whole = world_in(out, stored);
+        out.content = out.whole->extent;
+      } else if (!share.empty()) {
+        out.content = out.content.unite(world_in(out, share).extent);
+      }
+    }
+    return out;
+  });
+  const Box3i domain = detail::unite_over_ranks(comm, h.content, nullptr);
+  return detail::collectively(comm, nullptr, [&] {
+    if (domain.empty()) throw InvalidArgument(name + ": the input holds no volume");
+    const SlabPartition partition = checked_cut(cut, domain, size);
+    const Box3i keep = kept_box(domain, partition, rank, ghost);
+    const VdbWorld part = h.whole ? std::move(*h.whole) : world_in(h, keep);
+    return WorldSlab{rechunk_world(part.world, chunk_edge, keep, name), partition, "vdb", true};
+  });
+}
+
 }  // namespace
 
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
@@ -111,6 +169,7 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
   const WorldFormat format =
       detail::collectively(comm, nullptr, [&] { return world_format_of(path); });
   if (format == WorldFormat::kVfw) return vfw_slab(comm, path, chunk_edge, ghost_slices, cut);
+  if (format == WorldFormat::kVdb) return vdb_slab(comm, path, chunk_edge, ghost_slices, cut);
   return detail::collectively(comm, nullptr, [&] {
     if (format == WorldFormat::kNpy) {
       const NpyVolume head = read_npy_header(path);

@@ -169,6 +169,20 @@ if [ ! -f "$vox" ]; then echo "FAIL: $vox is missing (../shared beside the repos
     same ref.npy out.npy "$n ranks, dotvox_axes.vox as an unbounded .vfw"
   done
   /usr/bin/python3 -c "import json; s = json.load(open('stats.json')); assert s['read_in_parts'] is True, s"
+  # The same world as a .vdb (an Int32 grid with its recorded extent), and as the level set of its
+  # signed field (the solid voxels its inside, no extent recorded: the domain is what the ranks
+  # find in their shares of the tree): every rank decodes only its slab's leaves.
+  "$VF" convert "$vox" axes.vdb 2>/dev/null
+  "$VF" field "$vox" -o axes-sdf.vdb --metric euclidean --signed --max-distance 4 2>/dev/null
+  for input in axes.vdb axes-sdf.vdb; do
+    "$VF" field "$input" -o ref.npy --metric euclidean --signed 2>/dev/null
+    for n in 1 3; do
+      MPIEXEC -np "$n" "$VFM" field "$input" -o out.npy --metric euclidean --signed \
+        --stats stats.json 2>/dev/null
+      same ref.npy out.npy "$n ranks, dotvox_axes.vox as $input"
+    done
+    /usr/bin/python3 -c "import json; s = json.load(open('stats.json')); assert s['read_in_parts'] is True and s['format'] == 'vdb', s"
+  done
 fi
 # An unbounded .vfw whose content lies away from every face of the array it came from (in the
 # default chunks of 32, which the ranks' shares cut through): the field covers the content's
