@@ -37,7 +37,9 @@ for r in $(seq 1 "$repeat"); do
   done
 done
 rm -f "$out/terrain.vfw" "$out/one.npy" "$out/mpi.npy"
-/usr/bin/python3 - "$out" "${#binaries[@]}" "$(ls -l "$out/terrain-sdf.vdb" | awk '{print $5}')" <<'PY' | tee "$out/table.md"
+vdb_bytes=$(stat -c %s "$out/terrain-sdf.vdb")
+rm -f "$out/terrain-sdf.vdb"
+/usr/bin/python3 - "$out" "${#binaries[@]}" "$vdb_bytes" <<'PY' | tee "$out/table.md"
 import glob, json, sys
 out, binaries, file_bytes = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 print(f"The level set: {file_bytes / 1e6:.1f} MB as a .vdb.\n")
