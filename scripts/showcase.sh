@@ -7,13 +7,17 @@ bash scripts/install-deps.sh
 bash scripts/install-bench-deps.sh  # the peers the report sets voxfield beside
 cmake --preset release >/dev/null
 cmake --build --preset release
-./build/release/bin/voxfield showcase --out out "$@"
-out=out
+out=""
 prev=""
 for a in "$@"; do
   if [ "$prev" = "--out" ]; then out=$a; fi
   case "$a" in --out=*) out=${a#--out=} ;; esac
   prev=$a
 done
+if [ -z "$out" ]; then  # the report's directory: out/ unless the arguments name one
+  out=out
+  set -- --out out "$@"
+fi
+./build/release/bin/voxfield showcase "$@"
 bash scripts/showcase_mpi.sh "$out"  # the same terrain's field over MPI ranks, identical to one process
 node web/build-report.mjs "$out"      # report.html beside report.md, the terrain orbitable in the page

@@ -223,8 +223,9 @@ class Grid {
   struct Chunk {
     ChunkArray<T> voxels;  // null for a uniform chunk (chunk_memory.h: from the reuse cache)
     T uniform{};           // value of a uniform chunk
-    // For dense chunks: `ref` is the value the chunk held when it was expanded and ref_count how
-    // many voxels still hold it, so that set() can collapse the chunk in O(1).
+    // For dense chunks: a reference value (the one the chunk held when it was expanded, or the
+    // one a later write re-anchored it on: compact(), a fill or a copy of one other value) and
+    // ref_count, how many voxels hold it, so that writes can collapse the chunk in O(1).
     T ref{};
     std::int64_t ref_count = 0;
   };

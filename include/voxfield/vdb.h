@@ -182,9 +182,10 @@ struct VdbFile {
 struct VdbReadOptions {
   std::uint64_t memory_limit_bytes = 0;  // 0: the process default (limits.h)
   // Keep only the tiles and leaves that overlap this box (an MPI rank's slab): the others are
-  // dropped, their values skipped undecoded (their sizes still checked against the bytes), and
-  // neither held nor charged to the memory limit. An empty box keeps nothing but the topology's
-  // bounds (VdbGrid::dropped_stored), the metadata and the transforms.
+  // dropped, their values skipped undecoded (their sizes still checked against the bytes; a
+  // damaged block among them goes unseen), and not held: a dropped leaf is charged to the memory
+  // limit for its mask alone. An empty box keeps nothing but the topology's bounds
+  // (VdbGrid::dropped_stored), the metadata and the transforms. The clip applies to every grid.
   std::optional<Box3i> clip;
 };
 

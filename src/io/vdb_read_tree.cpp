@@ -124,24 +124,25 @@ class TreeReader {
     bool dropped = false;  // outside the clip: its values are skipped
   };
 
-  // Whether a node's box lies wholly outside the clip (dropped), its bounds then counted.
-  bool drop(const Box3i& box, bool stored, const std::vector<std::uint64_t>* active_bits,
-            bool active) {
+  // Whether a node's box lies wholly outside the clip (dropped); its stored box is then counted,
+  // and all of it as active for an active tile.
+  bool drop(const Box3i& box, bool active) {
     if (!how_.clip || !box.intersect(*how_.clip).empty()) return false;
-    if (stored) grid_.dropped_stored = grid_.dropped_stored.unite(box);
+    grid_.dropped_stored = grid_.dropped_stored.unite(box);
     if (active) grid_.dropped_active = grid_.dropped_active.unite(box);
-    if (active_bits) {
-      const int dim = grid_.log2_dims.back();
-      const std::size_t count = std::size_t{1} << (3 * dim);
-      for (std::size_t i = 0; i < count; ++i)
-        if (bit(*active_bits, i)) {
-          const Vec3i p = box.begin + Vec3i{static_cast<int>(i >> (2 * dim)),
-                                            static_cast<int>((i >> dim) & ((1u << dim) - 1)),
-                                            static_cast<int>(i & ((1u << dim) - 1))};
-          grid_.dropped_active = grid_.dropped_active.unite(Box3i{p, p + Vec3i::splat(1)});
-        }
-    }
     return true;
+  }
+  // A dropped leaf's active voxels, from the mask a whole read keeps for it.
+  void drop_active(Vec3i origin, const std::vector<std::uint64_t>& mask) {
+    const int dim = grid_.log2_dims.back();
+    const std::size_t count = std::size_t{1} << (3 * dim);
+    for (std::size_t i = 0; i < count; ++i)
+      if (bit(mask, i)) {
+        const Vec3i p = origin + Vec3i{static_cast<int>(i >> (2 * dim)),
+                                       static_cast<int>((i >> dim) & ((1u << dim) - 1)),
+                                       static_cast<int>(i & ((1u << dim) - 1))};
+        grid_.dropped_active = grid_.dropped_active.unite(Box3i{p, p + Vec3i::splat(1)});
+      }
   }
 
   std::size_t component_bytes(bool half) const {
@@ -342,7 +343,7 @@ class TreeReader {
 
   void add_tile(Vec3i origin, int shift, const Value& v, bool active) {
     if (!active && v == grid_.background) return;
-    if (drop(Box3i{origin, origin + Vec3i::splat(1 << shift)}, true, nullptr, active)) return;
+    if (drop(Box3i{origin, origin + Vec3i::splat(1 << shift)}, active)) return;
     charge(sizeof(VdbTile), "its tiles");
     grid_.tiles.push_back({origin, std::int32_t{1} << shift, active, v});
   }
@@ -368,7 +369,7 @@ class TreeReader {
         add_tile(at, child_shift, values[i], bit(value_mask, i));
       } else if (children_are_leaves) {
         PendingLeaf leaf{at, read_mask(grid_.log2_dims.back(), "leaf value mask")};
-        leaf.dropped = drop(Box3i{at, at + Vec3i::splat(grid_.leaf_edge)}, true, &leaf.mask, false);
+        leaf.dropped = drop(Box3i{at, at + Vec3i::splat(grid_.leaf_edge)}, false);
         // A dropped leaf holds only its mask until its values are stepped over.
         charge(leaf.dropped
                    ? sizeof(PendingLeaf) + leaf.mask.size() * sizeof(std::uint64_t)
@@ -389,11 +390,14 @@ class TreeReader {
     const std::size_t comps = static_cast<std::size_t>(grid_.components);
     if (leaf.dropped) {
       if (grid_.value_type == VdbValueType::kBool) {
-        r_.skip(count / 8 + 12 + count / 8, "bool leaf mask, origin and values");
+        // (A whole read keeps this copy of the mask for a bool leaf: so do its bounds.)
+        leaf.mask = read_mask(dim, "leaf value mask");
+        r_.skip(12 + count / 8, "bool leaf origin and values");
       } else {
         r_.skip(count / 8, "leaf value mask");
         read_values(count, leaf.mask, dim, level_values_.back(), /*kept=*/false);
       }
+      drop_active(leaf.origin, leaf.mask);
       return;
     }
     std::size_t first = 0;

@@ -232,8 +232,17 @@ VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_
   // chunks solid leaf voxels make dense.
   std::uint64_t need = 0;
   std::unordered_set<Vec3i, Vec3iHash> dense;
-  // The chunks over `box`: those it covers whole are uniform, the others dense. Only the chunk
-  // rows that reach the box's faces are walked (a tile may cover millions of chunks).
+  // Every chunk over `box` dense: a leaf's voxels are placed one by one.
+  auto count_dense = [&](const Box3i& box) {
+    const Vec3i lo = voxels.chunk_of(box.begin), hi = voxels.chunk_of(box.end - Vec3i::splat(1));
+    for (int z = lo.z; z <= hi.z && need <= limit; ++z)
+      for (int y = lo.y; y <= hi.y; ++y)
+        for (int x = lo.x; x <= hi.x; ++x)
+          if (dense.insert({x, y, z}).second) need = add_sat(need, dense_chunk);
+  };
+  // The chunks over a tile's `box`: those it covers whole are uniform (a fill stores one value),
+  // the others dense. Only the chunk rows that reach the box's faces are walked (a tile may cover
+  // millions of chunks).
   auto count_chunks = [&](const Box3i& box) {
     const std::int64_t edge = std::int64_t{1} << shift;
     const Vec3i lo = voxels.chunk_of(box.begin), hi = voxels.chunk_of(box.end - Vec3i::splat(1));
@@ -286,7 +295,7 @@ VdbWorld world_from_vdb(const VdbFile& file, const std::string& name, int chunk_
             solid || (box.contains(p) && material_of(rule, leaf_components(g, values, first).data(),
                                                      g.leaf_active(l, i)) != 0);
       });
-      if (solid) count_chunks(box);
+      if (solid) count_dense(box);
     }
   });
   require_memory(need, limit, name, "its world (grid \"" + g.name + "\")");

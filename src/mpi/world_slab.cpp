@@ -110,7 +110,6 @@ WorldSlab vdb_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
     std::optional<VdbWorld> whole;  // one rank's share is the whole tree: read once
   };
   const std::string name = path.string();
-  const std::uint64_t limit = effective_memory_limit(0);
   auto world_in = [&](const Head& h, const Box3i& clip) {
     VdbReadOptions o = h.options;
     o.clip = clip;
@@ -120,6 +119,7 @@ WorldSlab vdb_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
   };
   Head h = detail::collectively(comm, nullptr, [&] {
     Head out;
+    const std::uint64_t limit = effective_memory_limit(0);
     out.bytes = read_file(path, limit);
     out.options.memory_limit_bytes = remaining_memory(limit, out.bytes.size());
     const VdbWorld topology = world_in(out, Box3i{});
@@ -180,35 +180,24 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
           world_from_npy(read_npy_part(path, keep.begin.z, keep.end.z), path.string(), chunk_edge);
       return WorldSlab{std::move(part), partition, "npy", true};
     }
-    if (format == WorldFormat::kVox) {
-      // Read once; the scene described first (nothing placed: its extent gives the slabs), then
-      // only this rank's slab and ghost slices placed.
-      const std::uint64_t limit = effective_memory_limit(0);
-      const std::vector<std::uint8_t> bytes = read_file(path, limit);
-      VoxImportOptions vo;
-      vo.chunk_edge = chunk_edge;
-      vo.memory_limit_bytes = remaining_memory(limit, bytes.size());
-      vo.keep_z = std::pair<std::int32_t, std::int32_t>{0, 0};
-      const Box3i extent = vox_extent(parse_vox(bytes, path.string(), vo).info);
-      if (extent.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
-      const SlabPartition partition = checked_cut(cut, extent, size);
-      const Box3i keep = kept_box(extent, partition, rank, ghost_slices);
-      vo.keep_z = std::pair<std::int32_t, std::int32_t>{keep.begin.z, keep.end.z};
-      const VoxImport slab = parse_vox(bytes, path.string(), vo);
-      World part = rechunk_world(slab.world, chunk_edge, keep, path.string());
-      part.palette = slab.world.palette;
-      return WorldSlab{std::move(part), partition, "vox", true};
-    }
-    LoadOptions lo;
-    lo.chunk_edge = chunk_edge;
-    LoadedWorld whole = load_world(path, lo);
-    if (whole.extent.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
-    const SlabPartition partition = checked_cut(cut, whole.extent, size);
-    // Only the slab and its ghost slices are kept once the file is read.
-    const Box3i keep = kept_box(whole.extent, partition, rank, ghost_slices);
-    World part = rechunk_world(whole.world, chunk_edge, keep, path.string());
-    part.palette = whole.world.palette;
-    return WorldSlab{std::move(part), partition, world_format_name(format), false};
+    // A .vox (the last of world_format_of's formats): read once; the scene described first
+    // (nothing placed: its extent gives the slabs), then only this rank's slab and ghost slices
+    // placed.
+    const std::uint64_t limit = effective_memory_limit(0);
+    const std::vector<std::uint8_t> bytes = read_file(path, limit);
+    VoxImportOptions vo;
+    vo.chunk_edge = chunk_edge;
+    vo.memory_limit_bytes = remaining_memory(limit, bytes.size());
+    vo.keep_z = std::pair<std::int32_t, std::int32_t>{0, 0};
+    const Box3i extent = vox_extent(parse_vox(bytes, path.string(), vo).info);
+    if (extent.empty()) throw InvalidArgument(path.string() + ": the input holds no volume");
+    const SlabPartition partition = checked_cut(cut, extent, size);
+    const Box3i keep = kept_box(extent, partition, rank, ghost_slices);
+    vo.keep_z = std::pair<std::int32_t, std::int32_t>{keep.begin.z, keep.end.z};
+    const VoxImport slab = parse_vox(bytes, path.string(), vo);
+    World part = rechunk_world(slab.world, chunk_edge, keep, path.string());
+    part.palette = slab.world.palette;
+    return WorldSlab{std::move(part), partition, "vox", true};
   });
 }
 
