@@ -28,6 +28,15 @@ Box3i kept_box(const Box3i& domain, const SlabPartition& partition, int rank, in
            static_cast<std::int32_t>(std::min<std::int64_t>(domain.end.z, slab.end.z + g))}};
 }
 
+// This rank's equal share of `box` along z (what it decodes to help bound a domain).
+Box3i z_share(const Box3i& box, int rank, int ranks) {
+  const std::int64_t z0 = box.begin.z, slices = box.size().z;
+  Box3i share = box;
+  share.begin.z = static_cast<std::int32_t>(z0 + slices * rank / ranks);
+  share.end.z = static_cast<std::int32_t>(z0 + slices * (rank + 1) / ranks);
+  return share;
+}
+
 // cut(domain), checked to be a partition of that domain into `ranks` slabs.
 SlabPartition checked_cut(const SlabCut& cut, const Box3i& domain, int ranks) {
   SlabPartition p = cut(domain);
@@ -68,11 +77,9 @@ WorldSlab vfw_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
     out.bounds = head.world.voxels.bounds();
     const Box3i stored = head.stored_chunks_box;
     if (!out.bounds && !stored.empty()) {
-      const std::int64_t z0 = stored.begin.z, slices = stored.size().z;
+      const Box3i mine = z_share(stored, rank, size);
       WorldFileReadOptions share = out.options;
-      share.keep_z = std::pair<std::int32_t, std::int32_t>{
-          static_cast<std::int32_t>(z0 + slices * rank / size),
-          static_cast<std::int32_t>(z0 + slices * (rank + 1) / size)};
+      share.keep_z = std::pair<std::int32_t, std::int32_t>{mine.begin.z, mine.end.z};
       out.content = parse_world_file(out.bytes, path.string(), share).world.voxels.content_bounds();
     }
     return out;
@@ -126,10 +133,7 @@ WorldSlab vdb_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
     out.content = topology.extent;
     const Box3i stored = topology.stored;
     if (!stored.empty()) {
-      const std::int64_t z0 = stored.begin.z, slices = stored.size().z;
-      Box3i share = stored;
-      share.begin.z = static_cast<std::int32_t>(z0 + slices * rank / size);
-      share.end.z = static_cast<std::int32_t>(z0 + slices * (rank + 1) / size);
+      const Box3i share = z_share(stored, rank, size);
       if (size == 1) {
         out.whole = world_in(out, stored);
         out.content = out.whole->extent;
