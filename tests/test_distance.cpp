@@ -268,6 +268,21 @@ TEST_P(ExactDistanceOn, RandomWorldsAgainstBruteForce) {
                        density);
           ++seed;
         }
+  // Unit-spacing Euclidean fields without sites, unclamped or with a clamp beyond the truncated
+  // passes' reach: windowed min-plus, and the envelope for the lines whose windows grow too wide
+  // (the sparse, wider world).
+  for (bool sgn : {false, true})
+    for (double clamp : {0.0, 80.0})
+      for (double density : {0.004, 0.05, 0.5}) {
+        const Storage st = seed % 2 ? Storage::kF32 : Storage::kU16;
+        check_case(
+            {Metric::kEuclidean, sgn, clamp, st, unit, 16, 1 + static_cast<int>(seed % 2), false},
+            seed, {23, 17, 19}, density);
+        if (density < 0.01)
+          check_case({Metric::kEuclidean, sgn, clamp, st, unit, 32, 2, false}, seed + 2000,
+                     {67, 41, 9}, density / 4);
+        ++seed;
+      }
   for (bool sgn : {false, true})
     for (double clamp : {0.0, 4.0})
       for (Storage st : {Storage::kF32, Storage::kU16}) {

@@ -12,6 +12,7 @@
 
 #include "distance/envelope_lanes.h"
 #include "distance/line_transforms.h"
+#include "distance/window_lanes.h"
 
 using namespace voxfield::detail;
 
@@ -174,6 +175,94 @@ TEST(LineTransforms, TheLockStepEnvelopeEqualsTheOneLineKernelInEveryLane) {
       }
     }
   }
+}
+
+TEST(LineTransforms, TheLockStepEnvelopeLeavesOutZeroCostSitesInsideTheirRunsExactly) {
+  // Lines as real volumes give them: runs of solid matter (cost 0), of air beyond the clamp (no
+  // site) and of costs from earlier passes. The kernel builds only the ends of each zero run.
+  std::mt19937 rng(2027);
+  for (int trial = 0; trial < 3000; ++trial) {
+    const int n = 1 + static_cast<int>(rng() % 200);
+    std::vector<std::vector<std::int32_t>> lines(4, std::vector<std::int32_t>(n));
+    for (auto& line : lines) {
+      for (int x = 0; x < n;) {
+        const int run = 1 + static_cast<int>(rng() % 40);
+        const int kind = static_cast<int>(rng() % 3);
+        for (int i = 0; i < run && x < n; ++i, ++x)
+          line[x] = kind == 0 ? 0 : kind == 1 ? kInf : static_cast<std::int32_t>(rng() % 900);
+      }
+      line[rng() % n] = 0;  // at least one site
+    }
+    const bool with_sites = trial % 2 == 0;
+    const std::vector<LineResult> got = four_lanes(lines, with_sites);
+    for (int k = 0; k < 4; ++k) {
+      const LineResult ref = division_free(lines[k]);
+      ASSERT_EQ(got[k].out, ref.out) << "trial " << trial << ", lane " << k;
+      if (with_sites) {
+        ASSERT_EQ(got[k].arg, ref.arg) << "trial " << trial << ", lane " << k;
+      }
+      for (int x = 0; x < n; x += 7) {
+        const auto [value, site] = brute_force_at(lines[k], x);
+        ASSERT_EQ(got[k].out[x], value) << "trial " << trial << ", lane " << k << ", x " << x;
+        if (with_sites) {
+          ASSERT_EQ(got[k].arg[x], site);
+        }
+      }
+    }
+  }
+}
+
+TEST(LineTransforms, TheWindowedMinPlusEqualsTheEnvelopeInEveryLaneOrGivesUp) {
+  // Eight lines interleaved (lane k of element i at i * stride + k, inside a wider array), of
+  // every kind: no site, one site far away, dense costs, runs of solid matter. With a budget
+  // large enough every lane equals the envelope's values; with a small one the kernel may give
+  // up (false) but never returns true with a wrong value.
+  std::mt19937 rng(77);
+  int gave_up = 0, solved = 0;
+  for (int trial = 0; trial < 1500; ++trial) {
+    const int n = 1 + static_cast<int>(rng() % 150);
+    const std::size_t stride = kWindowLanes + rng() % 5;
+    std::vector<std::vector<std::int32_t>> lines(kWindowLanes, std::vector<std::int32_t>(n));
+    for (auto& line : lines) {
+      const int kind = static_cast<int>(rng() % 4);
+      for (int x = 0; x < n; ++x) {
+        const std::uint32_t r = rng();
+        line[x] = kind == 0   ? kInf
+                  : kind == 1 ? (r % 97 == 0 ? static_cast<std::int32_t>(r % 50) : kInf)
+                  : kind == 2
+                      ? static_cast<std::int32_t>(r % 2000)
+                      : (r % 3 == 0 ? 0 : (r % 3 == 1 ? kInf : static_cast<std::int32_t>(r % 40)));
+      }
+    }
+    std::vector<std::int32_t> f(static_cast<std::size_t>(n) * stride, -5);
+    std::vector<std::int32_t> out(f.size(), -9);
+    for (int k = 0; k < kWindowLanes; ++k)
+      for (int x = 0; x < n; ++x) f[static_cast<std::size_t>(x) * stride + k] = lines[k][x];
+    const bool small_budget = trial % 3 == 0;
+    const std::int64_t budget =
+        small_budget ? 4 * static_cast<std::int64_t>(n) : std::int64_t{1} << 40;
+    const bool ok = window_min_plus_lanes(n, f.data(), stride, out.data(), stride, budget);
+    if (!small_budget) {
+      ASSERT_TRUE(ok) << "trial " << trial;
+    }
+    if (!ok) {
+      ++gave_up;
+      continue;
+    }
+    ++solved;
+    for (int k = 0; k < kWindowLanes; ++k) {
+      const LineResult ref = division_free(lines[k]);
+      for (int x = 0; x < n; ++x)
+        ASSERT_EQ(out[static_cast<std::size_t>(x) * stride + k], ref.out[x])
+            << "trial " << trial << ", lane " << k << ", x " << x;
+    }
+    for (std::size_t i = 0; i < out.size(); ++i)
+      if (i % stride >= static_cast<std::size_t>(kWindowLanes)) {
+        ASSERT_EQ(out[i], -9) << "wrote outside its lanes";
+      }
+  }
+  EXPECT_GT(gave_up, 50);  // the small budgets do run out on the sparse lines
+  EXPECT_GT(solved, 1000);
 }
 
 TEST(LineTransforms, TheLockStepEnvelopeHoldsAtTheThirtyTwoBitBounds) {

@@ -11,7 +11,8 @@
 // (pushing it) and the write-back one of "move to the next parabola" or "emit this voxel", chosen
 // by selects rather than branches; several lines run side by side so that one line's chain of
 // dependent loads overlaps the others'. Steps per line: its sites plus the pops (at most as many)
-// to build, n plus the stack's length to write back.
+// to build, n plus the stack's length to write back; sites of cost 0 that sit between two others
+// are not built at all (below).
 #pragma once
 
 #include <cstddef>
@@ -44,10 +45,18 @@ void envelope_euclidean_int32_lanes(int n, const std::int32_t* const* f, std::in
     S[k][-2] = S[k][-1] = H[k][-2] = H[k][-1] = 0;
     // The voxels holding sites, listed first (in out[k], which the write-back overwrites later):
     // voxels without one would cost the build a step each, and sparse lines are mostly those.
+    // Sites of cost 0 inside a run of them are left out too: such a voxel is its own nearest
+    // site, and beyond the run the run's end is strictly nearer at the same cost, so it never
+    // minimises elsewhere (the write-back gives it its 0 itself). In real volumes these are the
+    // voxels inside solid matter, often most of a line.
     int count = 0;
+    bool zero_before = false, zero_here = n > 0 && f[k][0] == 0;
     for (int x = 0; x < n; ++x) {
+      const bool zero_after = x + 1 < n && f[k][x + 1] == 0;
       out[k][count] = x;
-      count += static_cast<int>(f[k][x] < kInf);
+      count += static_cast<int>((f[k][x] < kInf) & !(zero_before & zero_here & zero_after));
+      zero_before = zero_here;
+      zero_here = zero_after;
     }
     m[k] = count;
     i[k] = 0;
@@ -93,8 +102,10 @@ void envelope_euclidean_int32_lanes(int n, const std::int32_t* const* f, std::in
       const int jk = j[k];
       const std::int64_t s0 = S[k][jk], s1 = S[k][jk + 1], h0 = H[k][jk], h1 = H[k][jk + 1];
       const bool next = (jk < q[k]) & (2 * (s1 - s0) * xk > h1 - h0);
-      out[k][xk] = static_cast<std::int32_t>(std::int64_t{xk} * xk - 2 * s0 * xk + h0);
-      if (arg != nullptr) arg[k][xk] = static_cast<std::int32_t>(s0);
+      const bool own_site = f[k][xk] == 0;  // cost 0 here: x is its own nearest site
+      const auto value = static_cast<std::int32_t>(std::int64_t{xk} * xk - 2 * s0 * xk + h0);
+      out[k][xk] = own_site ? 0 : value;
+      if (arg != nullptr) arg[k][xk] = own_site ? xk : static_cast<std::int32_t>(s0);
       j[k] = jk + static_cast<int>(next);
       x[k] = xk + static_cast<int>(!next);
     }

@@ -22,6 +22,7 @@
 #include "../field_plan.h"
 #include "../line_transforms.h"
 #include "../truncated_min_convolution.h"
+#include "../window_lanes.h"
 
 namespace voxfield::detail::exact {
 
@@ -57,6 +58,7 @@ template <class V>
 struct SliceBuffers {
   Scratch<V> f, h, tmp;
   Scratch<std::int32_t> arg_x, arg_y, targ, s, t;
+  Scratch<std::int32_t> lane_in, lane_out;  // lines copied out of a windowed pass for the envelope
   void resize(int X, int Y) {
     const std::size_t n = static_cast<std::size_t>(X) * Y;
     f.resize(n);
@@ -69,6 +71,8 @@ struct SliceBuffers {
     const std::size_t stack = kEnvelopeLanes * envelope_lane_stride(std::max(X, Y));
     s.resize(stack);
     t.resize(stack);
+    lane_in.resize(kWindowLanes * static_cast<std::size_t>(std::max(X, Y)));
+    lane_out.resize(kWindowLanes * static_cast<std::size_t>(std::max(X, Y)));
   }
 };
 
@@ -190,9 +194,46 @@ void solve_slice_envelope2(const KernelX& kx, const KernelY& ky, int X, int Y, S
   if (track_sites) to_rows(b.targ.data(), b.arg_y.data(), X, Y, x_lo, x_hi);
 }
 
+// Average window steps per voxel above which a group of lines goes to the envelope instead
+// (window_lanes.h). A step is an add and a min over kWindowLanes lanes. Measured on one thread
+// (voxfield-bench-field, spheres and terrain at 256³, and voxfield.ndimage on the MRI volume and
+// the random one; the machine's noise about ±10 %): 24 steps gave 470–510 / 290–330 / 517 / 316
+// ms, 96 gave 295–355 / 237–280 / 445–450 / 283–330, no limit at all 372–381 / 308–313 / 457 /
+// 300–350, and the envelope alone 339 / 305 ms on the first two.
+inline constexpr std::int64_t kWindowStepsPerVoxel = 96;
+
+// 2-D solve of a whole slice of unit-spacing Euclidean costs, values only, by windowed min-plus
+// (window_lanes.h): along y on the row-major slice (its lanes the columns), transposed, along x
+// (its lanes the rows), transposed back. The passes' order does not change the values (the sum
+// of squares is separable); the clamp's drop applies after the first, as in the envelope's.
+inline void solve_slice_windowed(const EuclideanInt32Kernel& k, int X, int Y,
+                                 SliceBuffers<std::int32_t>& b, std::int32_t drop_above) {
+  constexpr std::int32_t kInf = EuclideanInt32::kInf;
+  const auto envelope = [&](int lines, int n, const std::int32_t* in, std::int32_t* out) {
+    solve_lines(k, lines, n, in, out, nullptr, b.s.data(), b.t.data(), kInf);
+  };
+  window_lines_or_envelope(X, Y, b.f.data(), static_cast<std::size_t>(X), b.h.data(),
+                           kWindowStepsPerVoxel, b.lane_in.data(), b.lane_out.data(), envelope);
+  if (drop_above < kInf) {
+    std::int32_t* h = b.h.data();
+    for (std::size_t i = 0; i < static_cast<std::size_t>(X) * Y; ++i)
+      h[i] = h[i] > drop_above ? kInf : h[i];
+  }
+  to_columns(b.h.data(), b.tmp.data(), X, Y, 0, X);
+  window_lines_or_envelope(Y, X, b.tmp.data(), static_cast<std::size_t>(Y), b.f.data(),
+                           kWindowStepsPerVoxel, b.lane_in.data(), b.lane_out.data(), envelope);
+  to_rows(b.f.data(), b.h.data(), X, Y, 0, X);
+}
+
 template <class Kernel, class V>
 void solve_slice_envelope(const Kernel& kx, const Kernel& ky, int X, int Y, SliceBuffers<V>& b,
                           bool track_sites, V inf, int x_lo, int x_hi, V drop_above) {
+  if constexpr (std::is_same_v<Kernel, EuclideanInt32Kernel>) {
+    if (!track_sites && x_lo == 0 && x_hi == X) {
+      solve_slice_windowed(kx, X, Y, b, drop_above);
+      return;
+    }
+  }
   solve_slice_envelope2(kx, ky, X, Y, b, track_sites, inf, x_lo, x_hi, drop_above);
 }
 
