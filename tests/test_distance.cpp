@@ -232,6 +232,35 @@ void check_case(Backend backend, const Case& c, std::uint32_t seed, Vec3i size, 
         }
       }
   EXPECT_EQ(reported, 0);
+
+  // The same distances written straight into a dense array (compute_distance_field_into), in
+  // double: x fastest, or z fastest (as a Fortran-ordered NumPy array of (z, y, x) would be).
+  if (backend != Backend::kCpu) return;
+  DistanceOptions dense_o = o;
+  dense_o.nearest_sites = false;
+  const Vec3i n = bounds.size();
+  const bool z_fastest = seed % 2 == 1;
+  const std::array<std::ptrdiff_t, 3> stride =
+      z_fastest ? std::array<std::ptrdiff_t, 3>{std::ptrdiff_t{n.z} * n.y, n.z, 1}
+                : std::array<std::ptrdiff_t, 3>{1, n.x, std::ptrdiff_t{n.x} * n.y};
+  std::vector<double> dense(static_cast<std::size_t>(bounds.volume()), -12345.0);
+  compute_distance_field_into(w.voxels, dense_o, DenseDistances<double>{dense.data(), stride});
+  i = 0;
+  for (int z = 0; z < n.z; ++z)
+    for (int y = 0; y < n.y; ++y)
+      for (int x = 0; x < n.x; ++x, ++i) {
+        const OracleResult& r = expect[i];
+        const bool neg = solid[i] && c.is_signed;
+        const double d = r.has_site ? std::min(r.distance, clamp) : clamp;
+        const double want = neg ? -d : d;
+        const double got = dense[x * stride[0] + y * stride[1] + z * stride[2]];
+        const double tol = unit ? 0.0 : 1e-9 * std::max(1.0, std::abs(want));
+        if (!(std::abs(got - want) <= tol) && !(std::isinf(got) && got == want) && reported++ < 5) {
+          ADD_FAILURE() << "dense value at " << x << "," << y << "," << z << ": got " << got
+                        << " want " << want;
+        }
+      }
+  EXPECT_EQ(reported, 0);
 }
 
 }  // namespace
@@ -470,6 +499,43 @@ TEST(ExactDistance, VoxelsOutsideTheDomainInItsEdgeChunksReadTheBackground) {
                 }
             EXPECT_GT(outside, 0);
           }
+}
+
+TEST(ExactDistance, DenseOutputRefusesSitesAndNoArrayAndKeepsTheDomain) {
+  World w(16, Box3i::from_size({9, 7, 5}));
+  w.voxels.set({4, 3, 2}, 1);
+  DistanceOptions o;
+  o.metric = Metric::kEuclidean;
+  std::vector<float> out(9 * 7 * 5, -1.0f);
+  const DenseDistances<float> dense{out.data(), {1, 9, 63}};
+  o.nearest_sites = true;
+  EXPECT_THROW(compute_distance_field_into(w.voxels, o, dense), InvalidArgument);
+  o.nearest_sites = false;
+  EXPECT_THROW(compute_distance_field_into(w.voxels, o, DenseDistances<float>{}), InvalidArgument);
+  o.max_distance = -1;
+  EXPECT_THROW(compute_distance_field_into(w.voxels, o, dense), InvalidArgument);
+  EXPECT_EQ(out, std::vector<float>(out.size(), -1.0f)) << "a refused call wrote output";
+  // A domain that is a part of the world: the array covers the domain, from its first voxel.
+  o.max_distance = 0;
+  o.domain = Box3i{{2, 1, 1}, {7, 6, 4}};
+  std::vector<float> part(5 * 5 * 3, -1.0f);
+  compute_distance_field_into(w.voxels, o, DenseDistances<float>{part.data(), {1, 5, 25}});
+  for (int z = 0; z < 3; ++z)
+    for (int y = 0; y < 5; ++y)
+      for (int x = 0; x < 5; ++x) {
+        const double dx = x + 2 - 4, dy = y + 1 - 3, dz = z + 1 - 2;
+        EXPECT_FLOAT_EQ(part[x + 5 * y + 25 * z], std::sqrt(dx * dx + dy * dy + dz * dz));
+      }
+  // No site anywhere: +inf unclamped, the clamp otherwise.
+  World empty(16, Box3i::from_size({4, 4, 4}));
+  std::vector<double> none(64, 0.0);
+  DistanceOptions e;
+  e.metric = Metric::kEuclidean;
+  compute_distance_field_into(empty.voxels, e, DenseDistances<double>{none.data(), {1, 4, 16}});
+  for (double v : none) EXPECT_EQ(v, std::numeric_limits<double>::infinity());
+  e.max_distance = 2.5;
+  compute_distance_field_into(empty.voxels, e, DenseDistances<double>{none.data(), {1, 4, 16}});
+  for (double v : none) EXPECT_EQ(v, 2.5);
 }
 
 TEST(ExactDistance, RejectsBadOptions) {

@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -110,5 +111,28 @@ DistanceField compute_distance_field(const World& world, const DistanceOptions& 
 // The same for any occupancy grid (non-zero = solid).
 DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy,
                                      const DistanceOptions& options);
+
+// A caller's dense array of distances over a field's domain: the voxel at domain.begin + (x, y, z)
+// is data[x * stride[0] + y * stride[1] + z * stride[2]] (strides in elements, any order: x
+// fastest is {1, nx, nx * ny}; NumPy's C order of a (z, y, x) array is the same). The caller
+// keeps the array alive and large enough for the domain.
+template <class T>
+struct DenseDistances {
+  T* data = nullptr;
+  std::array<std::ptrdiff_t, 3> stride{0, 0, 0};
+};
+
+// The exact field of `occupancy` written straight into `out` instead of a DistanceField: the
+// distance in distance units (a square root taken in double from the exact squared distance),
+// negative inside for signed fields, the clamp D where no site lies within it (+inf unclamped when
+// there is none at all). For callers that want a dense array anyway (voxfield.ndimage, image
+// pipelines): no field grid is built, encoded and copied. `options.storage` does not apply;
+// `options.nearest_sites` must be false (InvalidArgument), as must any option
+// compute_distance_field refuses. Cancelling through the interrupter throws Cancelled and leaves
+// `out` partly written.
+void compute_distance_field_into(const Grid<std::uint8_t>& occupancy,
+                                 const DistanceOptions& options, const DenseDistances<double>& out);
+void compute_distance_field_into(const Grid<std::uint8_t>& occupancy,
+                                 const DistanceOptions& options, const DenseDistances<float>& out);
 
 }  // namespace voxfield

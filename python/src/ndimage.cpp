@@ -11,8 +11,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <optional>
@@ -325,6 +327,21 @@ void distance_transform(const py::array& input, const std::string& metric_name,
                                                                                 : Storage::kF32;
   PythonSignals signals;
   o.interrupter = &signals;
+  // Euclidean distances alone go straight into the float64 output, where its strides are whole
+  // elements: no field grid, no second pass over the volume.
+  if (from_values && metric == Metric::kEuclidean &&
+      reinterpret_cast<std::uintptr_t>(dist.data) % alignof(double) == 0 &&
+      std::all_of(dist.strides.begin(), dist.strides.end(), [](py::ssize_t b) {
+        return b % static_cast<py::ssize_t>(sizeof(double)) == 0;
+      })) {
+    constexpr py::ssize_t kSize = sizeof(double);
+    // NumPy's axes 0, 1, 2 are voxfield's z, y, x.
+    const DenseDistances<double> out{
+        reinterpret_cast<double*>(dist.data),
+        {dist.strides[2] / kSize, dist.strides[1] / kSize, dist.strides[0] / kSize}};
+    compute_distance_field_into(occupancy, o, out);
+    return;
+  }
   const DistanceField field = compute_distance_field(occupancy, o);
   if (from_values) {
     std::visit(

@@ -10,6 +10,8 @@
 // & Huttenlocher 2012) has its own pair, its inputs and outputs being the solver's 16-bit rows.
 #pragma once
 
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include "../truncated_min_convolution.h"
@@ -120,6 +122,35 @@ void write_row(const Encoder<T>& encoder, const SliceCosts<V>& costs, const Slic
       so.dz = column_is_site ? std::int16_t{0} : dz[col];
     }
     sites[i] = so;
+  }
+}
+
+// Distances of `count` solved costs of one slice row into a caller's dense array (`stride`
+// elements apart): the square root of the cost for Euclidean fields (`euclid`; costs are squared
+// distances), the cost itself otherwise, `none` (the clamp, or +inf unclamped) where no site is
+// within the clamp (a cost of `inf` or more, or above `clamp`). Signed fields pass the solid
+// voxels' costs to air in f1 and which voxels are solid in `solid`: those read negated. The
+// square root is taken in double: an integer squared distance gives the correctly rounded
+// distance, as SciPy's.
+template <class V, class Out>
+void write_dense_row(const V* f0, const V* f1, const std::uint8_t* solid, V inf, V clamp,
+                     bool euclid, double none, int count, Out* out, std::ptrdiff_t stride) {
+  const auto distance = [inf, clamp, euclid, none](V c) {
+    const double v = static_cast<double>(c);
+    return c < inf && c <= clamp ? (euclid ? std::sqrt(v) : v) : none;
+  };
+  if (f1 == nullptr) {
+    if (stride == 1) {
+      for (int i = 0; i < count; ++i) out[i] = static_cast<Out>(distance(f0[i]));
+    } else {
+      for (int i = 0; i < count; ++i) out[i * stride] = static_cast<Out>(distance(f0[i]));
+    }
+    return;
+  }
+  for (int i = 0; i < count; ++i) {
+    const bool inside = solid[i] != 0;
+    const double d = distance(inside ? f1[i] : f0[i]);
+    out[i * stride] = static_cast<Out>(inside ? -d : d);
   }
 }
 

@@ -50,19 +50,19 @@ using detail::exact::SliceBuffers;
 using detail::exact::SliceCosts;
 using detail::exact::SolidRows;
 using detail::exact::truncated_passes;
+using detail::exact::write_dense_row;
 using detail::exact::write_row;
 
-// Passes B and C and encoding of the whole field, slice by slice, through a solver of
-// slice_solvers.h: each slice's g is gathered from the chunk rows, solved, and written back into
-// the same rows as final values (T and U have the same size).
-template <class T, class U, class V, class Solve>
+// Passes B and C of the whole field, slice by slice, through a solver of slice_solvers.h: each
+// slice's g is gathered from the chunk rows and solved, and `store(z, buf, solid, dz)` writes its
+// results (buf[0].h, buf[1].h for the solid voxels of signed fields, row-major) where they go.
+template <class U, class V, class Solve, class Store>
 void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
-                 ChunkedVolume<SiteOffset>* sites, const Solve& solve, const Encoder<T>& encoder,
-                 std::uint32_t cap_vox, V inf, Progress& progress) {
+                 ChunkedVolume<SiteOffset>* sites, const Solve& solve, const SliceCosts<V>& costs,
+                 std::uint32_t cap_vox, Progress& progress, const Store& store) {
   constexpr U kInfU = std::numeric_limits<U>::max();
   const int X = p.domain.size().x, Y = p.domain.size().y;
   const int by = p.domain.begin.y;
-  const SliceCosts<V> costs(p, inf);
   const U cap_u = static_cast<U>(std::min<std::uint64_t>(cap_vox, kInfU));
   const int passes = p.is_signed ? 2 : 1;
   // Ranges of several slices each, so that the buffers are allocated a few times per thread only.
@@ -90,22 +90,17 @@ void pass_slices(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
         });
       }
       for (int k = 0; k < passes; ++k) solve(X, Y, buf[k], 0, X);
-      for (int y = 0; y < Y; ++y) {
-        for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
-          write_row(encoder, costs, buf, solid.data(), dz.data(), X, y, xo, count,
-                    reinterpret_cast<T*>(g.row(cx, by + y, z)) + lx,
-                    sites ? sites->row(cx, by + y, z) + lx : nullptr);
-        });
-      }
+      store(z, static_cast<const SliceBuffers<V>*>(buf), solid.data(), dz.data());
     }
   });
 }
 
 // Passes B and C and encoding of a whole field through TruncatedMinConvolution: pass_slices'
 // work, slice by slice, with the window the whole slice.
-template <class T, class U>
+// `store(z, conv, solid)` writes a solved slice (conv[1] for the solid voxels of signed fields).
+template <class U, class Store>
 void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
-                           const Encoder<T>& encoder, std::uint32_t cap, Progress& progress) {
+                           std::uint32_t cap, Progress& progress, const Store& store) {
   using Conv = TruncatedMinConvolution;
   const int X = p.domain.size().x, Y = p.domain.size().y;
   const int by = p.domain.begin.y;
@@ -132,18 +127,46 @@ void pass_slices_truncated(const Plan& p, const SolidRows& world, ChunkedVolume<
         });
       }
       for (int k = 0; k < passes; ++k) conv[k].solve();
-      // Encode and write the final values back into the same slice.
-      for (int y = 0; y < Y; ++y) {
-        for_each_row_segment(p, g.edge, g.shift, [&](int cx, int lx, int count, int xo) {
-          T* out = reinterpret_cast<T*>(g.row(cx, by + y, z)) + lx;  // T and U have the same size
-          encode_truncated_row(
-              encoder, conv, y, xo, count,
-              p.is_signed ? solid.data() + static_cast<std::size_t>(y) * X + xo : nullptr, out,
-              drop);
-        });
+      store(z, static_cast<const Conv*>(conv), solid.data());
+    }
+  });
+}
+
+// Largest g worth keeping, in voxels along z: beyond it a column's site is farther than the clamp.
+template <class U>
+std::uint32_t g_cap(const Plan& p) {
+  constexpr std::uint64_t kInfU = std::numeric_limits<U>::max();
+  std::uint64_t cap = kInfU;
+  if (std::isfinite(p.clamp)) {
+    const double vox = std::floor(p.clamp / p.spacing[2]) + 1;
+    cap = static_cast<std::uint64_t>(std::min<double>(vox, static_cast<double>(kInfU)));
+  }
+  return static_cast<std::uint32_t>(
+      std::min<std::uint64_t>(cap, std::numeric_limits<std::uint32_t>::max() - 1));
+}
+
+// Pass A over every chunk column of the domain, into g (and the sites' z offsets).
+template <class U>
+void pass_a(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
+            ChunkedVolume<SiteOffset>* sites, std::uint32_t cap, const ColumnsBeyond* beyond,
+            Progress& progress) {
+  const int ncx = g.nchunks.x;
+  parallel_for(static_cast<std::size_t>(ncx) * g.nchunks.y, 1, [&](std::size_t b, std::size_t e) {
+    std::vector<std::uint32_t> col;
+    for (std::size_t i = b; i < e; ++i) {
+      if (!progress.advance()) return;  // one unit per chunk column
+      const int cx = static_cast<int>(i % ncx), cy = static_cast<int>(i / ncx);
+      if (p.is_signed) {
+        pass_z<U, true>(p, world, g, sites, cx, cy, cap, col, beyond);
+      } else {
+        pass_z<U, false>(p, world, g, sites, cx, cy, cap, col, beyond);
       }
     }
   });
+}
+
+std::int64_t progress_units(const Plan& p, Vec3i nchunks) {
+  return static_cast<std::int64_t>(nchunks.x) * nchunks.y + p.domain.size().z;
 }
 
 // The whole field of storage T, g held in place in U (T's size) between the passes.
@@ -170,6 +193,7 @@ DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy,
   ChunkedVolume<U> g(p.aligned, edge);
   std::optional<ChunkedVolume<SiteOffset>> sites;
   if (p.sites) sites.emplace(p.aligned, edge);
+  ChunkedVolume<SiteOffset>* sp = sites ? &*sites : nullptr;
   const SolidRows world(occupancy, p.aligned);
 
   // Chunks reaching outside the domain keep the background there.
@@ -189,43 +213,44 @@ DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy,
     });
   }
 
-  // Largest g worth keeping: beyond it a column's site is farther than the clamp.
-  constexpr std::uint64_t kInfU = std::numeric_limits<U>::max();
-  std::uint64_t cap = kInfU;
-  if (std::isfinite(p.clamp)) {
-    const double vox = std::floor(p.clamp / p.spacing[2]) + 1;
-    cap = static_cast<std::uint64_t>(std::min<double>(vox, static_cast<double>(kInfU)));
-  }
-  cap = std::min<std::uint64_t>(cap, std::numeric_limits<std::uint32_t>::max() - 1);
-  const std::uint32_t cap32 = static_cast<std::uint32_t>(cap);
+  const std::uint32_t cap = g_cap<U>(p);
+  Progress progress(options.interrupter, "exact distance field", progress_units(p, g.nchunks));
+  pass_a(p, world, g, sp, cap, beyond, progress);
 
-  // Pass A.
-  const int ncx = g.nchunks.x, ncy = g.nchunks.y;
-  Progress progress(options.interrupter, "exact distance field",
-                    static_cast<std::int64_t>(ncx) * ncy + p.domain.size().z);
-  parallel_for(static_cast<std::size_t>(ncx) * ncy, 1, [&](std::size_t b, std::size_t e) {
-    std::vector<std::uint32_t> col;
-    ChunkedVolume<SiteOffset>* sp = sites ? &*sites : nullptr;
-    for (std::size_t i = b; i < e; ++i) {
-      if (!progress.advance()) return;  // one unit per chunk column
-      const int cx = static_cast<int>(i % ncx), cy = static_cast<int>(i / ncx);
-      if (p.is_signed) {
-        pass_z<U, true>(p, world, g, sp, cx, cy, cap32, col, beyond);
-      } else {
-        pass_z<U, false>(p, world, g, sp, cx, cy, cap32, col, beyond);
-      }
-    }
-  });
-
-  // Passes B and C, and encoding.
+  // Passes B and C, and encoding: each slice's values are written back into its own chunk rows.
   const Encoder<T> encoder(p);
-  ChunkedVolume<SiteOffset>* sp = sites ? &*sites : nullptr;
+  const int X = p.domain.size().x, Y = p.domain.size().y, by = p.domain.begin.y;
   if (truncated_passes(p, p.sites)) {
-    pass_slices_truncated<T, U>(p, world, g, encoder, cap32, progress);
+    using Conv = TruncatedMinConvolution;
+    const auto drop = static_cast<Conv::Cost>(std::floor(p.clamp * p.clamp));
+    pass_slices_truncated(
+        p, world, g, cap, progress, [&](int z, const Conv* conv, const std::uint8_t* solid) {
+          for (int y = 0; y < Y; ++y) {
+            for_each_row_segment(p, edge, g.shift, [&](int cx, int lx, int count, int xo) {
+              // T and U have the same size.
+              T* row = reinterpret_cast<T*>(g.row(cx, by + y, z)) + lx;
+              encode_truncated_row(
+                  encoder, conv, y, xo, count,
+                  p.is_signed ? solid + static_cast<std::size_t>(y) * X + xo : nullptr, row, drop);
+            });
+          }
+        });
   } else {
     dispatch_solver(p, solver_extent, [&](auto tag, const auto& solve, auto inf) {
       using V = decltype(tag);
-      pass_slices<T, U, V>(p, world, g, sp, solve, encoder, cap32, inf, progress);
+      const SliceCosts<V> costs(p, inf);
+      pass_slices(p, world, g, sp, solve, costs, cap, progress,
+                  [&](int z, const SliceBuffers<V>* buf, const std::uint8_t* solid,
+                      const std::int16_t* dz) {
+                    for (int y = 0; y < Y; ++y) {
+                      for_each_row_segment(
+                          p, edge, g.shift, [&](int cx, int lx, int count, int xo) {
+                            write_row(encoder, costs, buf, solid, dz, X, y, xo, count,
+                                      reinterpret_cast<T*>(g.row(cx, by + y, z)) + lx,
+                                      sp ? sp->row(cx, by + y, z) + lx : nullptr);
+                          });
+                    }
+                  });
     });
   }
   progress.throw_if_cancelled();  // before anything is handed out
@@ -239,6 +264,57 @@ DistanceField compute_whole_field(const Grid<std::uint8_t>& occupancy,
   out.values = std::move(values);
   out.sites = std::move(sites_grid);
   return out;
+}
+
+// The whole field written into a caller's dense array: the same passes, g in chunks of 32-bit
+// voxels that are freed (to the chunk cache) afterwards, each slice's distances decoded from its
+// costs straight into the array (no field grid, no encoding, no second pass over the volume).
+template <class Out>
+void compute_whole_field_dense(const Grid<std::uint8_t>& occupancy, const DistanceOptions& options,
+                               const Plan& p, const DenseDistances<Out>& out) {
+  if (p.domain.empty()) return;
+  using U = std::uint32_t;
+  ChunkedVolume<U> g(p.aligned, occupancy.chunk_edge());
+  const SolidRows world(occupancy, p.aligned);
+  const std::uint32_t cap = g_cap<U>(p);
+  Progress progress(options.interrupter, "exact distance field", progress_units(p, g.nchunks));
+  pass_a<U>(p, world, g, nullptr, cap, nullptr, progress);
+
+  const int X = p.domain.size().x, Y = p.domain.size().y;
+  const double none = std::isfinite(p.clamp) ? p.clamp : std::numeric_limits<double>::infinity();
+  const bool euclid = p.metric == Metric::kEuclidean;
+  const auto row_at = [&](int z, int y) {
+    return out.data + (static_cast<std::ptrdiff_t>(z - p.domain.begin.z) * out.stride[2] +
+                       static_cast<std::ptrdiff_t>(y) * out.stride[1]);
+  };
+  if (truncated_passes(p, false)) {
+    using Conv = TruncatedMinConvolution;
+    pass_slices_truncated(
+        p, world, g, cap, progress, [&](int z, const Conv* conv, const std::uint8_t* solid) {
+          for (int y = 0; y < Y; ++y)
+            write_dense_row(conv[0].out_row(y), p.is_signed ? conv[1].out_row(y) : nullptr,
+                            p.is_signed ? solid + static_cast<std::size_t>(y) * X : nullptr,
+                            Conv::kInf, static_cast<Conv::Cost>(Conv::kInf - 1), true, none, X,
+                            row_at(z, y), out.stride[0]);
+        });
+  } else {
+    dispatch_solver(p, p.domain.size(), [&](auto tag, const auto& solve, auto inf) {
+      using V = decltype(tag);
+      const SliceCosts<V> costs(p, inf);
+      pass_slices(
+          p, world, g, static_cast<ChunkedVolume<SiteOffset>*>(nullptr), solve, costs, cap,
+          progress,
+          [&](int z, const SliceBuffers<V>* buf, const std::uint8_t* solid, const std::int16_t*) {
+            for (int y = 0; y < Y; ++y) {
+              const std::size_t o = static_cast<std::size_t>(y) * X;
+              write_dense_row(buf[0].h.data() + o, p.is_signed ? buf[1].h.data() + o : nullptr,
+                              p.is_signed ? solid + o : nullptr, costs.inf, costs.clamp, euclid,
+                              none, X, row_at(z, y), out.stride[0]);
+            }
+          });
+    });
+  }
+  progress.throw_if_cancelled();
 }
 
 }  // namespace
@@ -266,6 +342,33 @@ DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy,
                                      const DistanceOptions& o) {
   const Plan p = detail::make_field_plan(occupancy, o);
   return detail::exact::compute_exact_field(occupancy, o, p, nullptr, p.domain.size());
+}
+
+namespace {
+
+template <class Out>
+void compute_into(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o,
+                  const DenseDistances<Out>& out) {
+  if (o.nearest_sites)
+    throw InvalidArgument(
+        "compute_distance_field_into: nearest sites are not written into a dense array (use "
+        "compute_distance_field)");
+  if (out.data == nullptr) throw InvalidArgument("compute_distance_field_into: no output array");
+  DistanceOptions values_only = o;
+  values_only.storage = Storage::kF32;  // the plan's checks of integer storage do not apply
+  const Plan p = detail::make_field_plan(occupancy, values_only);
+  compute_whole_field_dense(occupancy, values_only, p, out);
+}
+
+}  // namespace
+
+void compute_distance_field_into(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o,
+                                 const DenseDistances<double>& out) {
+  compute_into(occupancy, o, out);
+}
+void compute_distance_field_into(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o,
+                                 const DenseDistances<float>& out) {
+  compute_into(occupancy, o, out);
 }
 
 }  // namespace voxfield
