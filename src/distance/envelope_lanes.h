@@ -17,6 +17,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "line_transforms.h"
 
@@ -39,6 +40,7 @@ void envelope_euclidean_int32_lanes(int n, const std::int32_t* const* f, std::in
   std::int32_t* S[kLanes];  // S[k][i], H[k][i]: the i-th parabola of lane k's stack (i >= -2)
   std::int32_t* H[kLanes];
   int i[kLanes], m[kLanes], q[kLanes];  // next site, sites, top of the stack (-1: empty)
+  bool left_out = false;                 // whether any lane left a run's inside out
   for (int k = 0; k < kLanes; ++k) {
     S[k] = s + k * stride + 2;
     H[k] = h + k * stride + 2;
@@ -49,15 +51,18 @@ void envelope_euclidean_int32_lanes(int n, const std::int32_t* const* f, std::in
     // site, and beyond the run the run's end is strictly nearer at the same cost, so it never
     // minimises elsewhere (the write-back gives it its 0 itself). In real volumes these are the
     // voxels inside solid matter, often most of a line.
-    int count = 0;
+    int count = 0, runs = 0;
     bool zero_before = false, zero_here = n > 0 && f[k][0] == 0;
     for (int x = 0; x < n; ++x) {
       const bool zero_after = x + 1 < n && f[k][x + 1] == 0;
+      const bool inside_run = zero_before & zero_here & zero_after;
       out[k][count] = x;
-      count += static_cast<int>((f[k][x] < kInf) & !(zero_before & zero_here & zero_after));
+      count += static_cast<int>((f[k][x] < kInf) & !inside_run);
+      runs += static_cast<int>(inside_run);
       zero_before = zero_here;
       zero_here = zero_after;
     }
+    left_out |= runs > 0;
     m[k] = count;
     i[k] = 0;
     q[k] = -1;
@@ -93,22 +98,36 @@ void envelope_euclidean_int32_lanes(int n, const std::int32_t* const* f, std::in
     x[k] = 0;
     j[k] = 0;
   }
-  for (bool busy = true; busy;) {
-    busy = false;
-    for (int k = 0; k < kLanes; ++k) {
-      const int xk = x[k];
-      if (xk >= n) continue;
-      busy = true;
-      const int jk = j[k];
-      const std::int64_t s0 = S[k][jk], s1 = S[k][jk + 1], h0 = H[k][jk], h1 = H[k][jk + 1];
-      const bool next = (jk < q[k]) & (2 * (s1 - s0) * xk > h1 - h0);
-      const bool own_site = f[k][xk] == 0;  // cost 0 here: x is its own nearest site
-      const auto value = static_cast<std::int32_t>(std::int64_t{xk} * xk - 2 * s0 * xk + h0);
-      out[k][xk] = own_site ? 0 : value;
-      if (arg != nullptr) arg[k][xk] = own_site ? xk : static_cast<std::int32_t>(s0);
-      j[k] = jk + static_cast<int>(next);
-      x[k] = xk + static_cast<int>(!next);
+  // Voxels of a left-out run take their own 0; without any (lines of no solid matter, where the
+  // extra test would only cost) the plain write-back runs.
+  const auto write_back = [&](auto runs_left_out) {
+    for (bool busy = true; busy;) {
+      busy = false;
+      for (int k = 0; k < kLanes; ++k) {
+        const int xk = x[k];
+        if (xk >= n) continue;
+        busy = true;
+        const int jk = j[k];
+        const std::int64_t s0 = S[k][jk], s1 = S[k][jk + 1], h0 = H[k][jk], h1 = H[k][jk + 1];
+        const bool next = (jk < q[k]) & (2 * (s1 - s0) * xk > h1 - h0);
+        auto value = static_cast<std::int32_t>(std::int64_t{xk} * xk - 2 * s0 * xk + h0);
+        auto site = static_cast<std::int32_t>(s0);
+        if constexpr (decltype(runs_left_out)::value) {
+          const bool own_site = f[k][xk] == 0;  // cost 0 here: x is its own nearest site
+          value = own_site ? 0 : value;
+          site = own_site ? xk : site;
+        }
+        out[k][xk] = value;
+        if (arg != nullptr) arg[k][xk] = site;
+        j[k] = jk + static_cast<int>(next);
+        x[k] = xk + static_cast<int>(!next);
+      }
     }
+  };
+  if (left_out) {
+    write_back(std::true_type{});
+  } else {
+    write_back(std::false_type{});
   }
 }
 
