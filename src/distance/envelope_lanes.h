@@ -40,7 +40,7 @@ void envelope_euclidean_int32_lanes(int n, const std::int32_t* const* f, std::in
   std::int32_t* S[kLanes];  // S[k][i], H[k][i]: the i-th parabola of lane k's stack (i >= -2)
   std::int32_t* H[kLanes];
   int i[kLanes], m[kLanes], q[kLanes];  // next site, sites, top of the stack (-1: empty)
-  bool left_out = false;                 // whether any lane left a run's inside out
+  bool left_out = false;                // whether any lane left a run's inside out
   for (int k = 0; k < kLanes; ++k) {
     S[k] = s + k * stride + 2;
     H[k] = h + k * stride + 2;
