@@ -115,7 +115,7 @@ DistanceField compute_distance_field(const Grid<std::uint8_t>& occupancy,
 // A caller's dense array of distances over a field's domain: the voxel at domain.begin + (x, y, z)
 // is data[x * stride[0] + y * stride[1] + z * stride[2]] (strides in elements, any order: x
 // fastest is {1, nx, nx * ny}; NumPy's C order of a (z, y, x) array is the same). The caller
-// keeps the array alive and large enough for the domain.
+// keeps the array alive and large enough for the domain, and no two voxels may share an element.
 template <class T>
 struct DenseDistances {
   T* data = nullptr;
@@ -123,13 +123,15 @@ struct DenseDistances {
 };
 
 // The exact field of `occupancy` written straight into `out` instead of a DistanceField: the
-// distance in distance units (a square root taken in double from the exact squared distance),
-// negative inside for signed fields, the clamp D where no site lies within it (+inf unclamped when
-// there is none at all). For callers that want a dense array anyway (voxfield.ndimage, image
-// pipelines): no field grid is built, encoded and copied. `options.storage` does not apply;
-// `options.nearest_sites` must be false (InvalidArgument), as must any option
-// compute_distance_field refuses. Cancelling through the interrupter throws Cancelled and leaves
-// `out` partly written.
+// distance in distance units (a square root taken in double from the exact squared distance);
+// where no site lies within the clamp D, D (+inf unclamped); solid voxels of signed fields read
+// minus their distance to air (-D, -inf beyond). For callers that want a dense array anyway
+// (voxfield.ndimage, image pipelines): no field grid is built, encoded and copied. The array
+// covers `options.domain`, which must be given unless the grid has bounds (then it defaults to
+// them). Refused (InvalidArgument, nothing written): `options.nearest_sites`, a null array, a
+// zero stride along an axis longer than one voxel, and the options compute_distance_field refuses
+// for f32 storage (`options.storage` does not apply). Cancelling through the interrupter throws
+// Cancelled and leaves `out` partly written.
 void compute_distance_field_into(const Grid<std::uint8_t>& occupancy,
                                  const DistanceOptions& options, const DenseDistances<double>& out);
 void compute_distance_field_into(const Grid<std::uint8_t>& occupancy,

@@ -171,12 +171,12 @@ inline void write_row(char* row, py::ssize_t stride, int x0, int x1, const F& va
   }
 }
 
-// The distances from the field's values (see distance_transform).
+// The int32 distances of an integer metric (taxicab, chessboard) from the field's values (see
+// distance_transform).
 template <class T>
 void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, const Box3i& box,
-                       Metric metric, double max_distance, const Strided& dist) {
+                       double max_distance, const Strided& dist) {
   const double clamp = max_distance > 0 ? max_distance : INFINITY;
-  const double clamp_f32 = static_cast<double>(static_cast<float>(clamp));
   // Integer storage saturates at its range: a stored extreme is "beyond", as +inf in f32.
   const double saturated =
       std::is_integral_v<T> ? encoding.decode(std::numeric_limits<T>::max()) : INFINITY;
@@ -190,15 +190,6 @@ void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, 
     const double a = std::abs(v);
     return a >= saturated ? INFINITY : a;
   };
-  const auto euclidean = [magnitude, clamp, clamp_f32](T stored) {
-    double sign;
-    const double a = magnitude(stored, sign);
-    double d = clamp;
-    // A clamped element reads float(D), which may round below D: anything at or above float(D)
-    // is the clamp (a true distance that close to D differs from it by < 1 float ulp).
-    if (a < clamp_f32) d = std::min(std::sqrt(std::nearbyint(a * a)), clamp);
-    return d * sign;
-  };
   const auto integer = [magnitude, clamp](T stored) {
     double sign;
     const double a = magnitude(stored, sign);
@@ -206,12 +197,11 @@ void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, 
     return std::isfinite(a) ? static_cast<std::int32_t>(sign * std::min(a, clamp))
                             : std::int32_t{-1};
   };
-  // Integer metrics in integer storage: every stored value's output, decoded once (at most 2^16
-  // of them) and looked up per element, where the volume has more elements than the table.
+  // Integer storage: every stored value's output, decoded once (at most 2^16 of them) and looked
+  // up per element, where the volume has more elements than the table.
   std::vector<std::int32_t> table;
   if constexpr (std::is_integral_v<T>) {
-    if (metric != Metric::kEuclidean &&
-        box.volume() > std::int64_t{std::numeric_limits<T>::max()} + 1) {
+    if (box.volume() > std::int64_t{std::numeric_limits<T>::max()} + 1) {
       table.resize(std::size_t{std::numeric_limits<T>::max()} + 1);
       for (std::size_t v = 0; v < table.size(); ++v) table[v] = integer(static_cast<T>(v));
     }
@@ -223,14 +213,6 @@ void write_from_values(const Grid<T>& values, const DistanceEncoding& encoding, 
       write_row<std::int32_t>(out, dist.strides[2], x0, x1, [t, row, x0](int x) {
         return t[static_cast<std::size_t>(row[x - x0])];
       });
-    } else if (metric == Metric::kEuclidean) {
-      if (!row) {
-        const double d = euclidean(uniform);
-        write_row<double>(out, dist.strides[2], x0, x1, [d](int) { return d; });
-      } else {
-        write_row<double>(out, dist.strides[2], x0, x1,
-                          [euclidean, row, x0](int x) { return euclidean(row[x - x0]); });
-      }
     } else if (!row) {
       const std::int32_t d = integer(uniform);
       write_row<std::int32_t>(out, dist.strides[2], x0, x1, [d](int) { return d; });
@@ -310,32 +292,29 @@ void distance_transform(const py::array& input, const std::string& metric_name,
   o.max_distance = max_distance;
   o.domain = box;
   if (metric == Metric::kEuclidean) o.spacing = spacing;
-  // Without indices the sites are needed only for anisotropic Euclidean distances: an isotropic
-  // field's f32 value v is sqrt(d^2) rounded to float, and round(v^2) recovers the integer d^2
-  // exactly while d^2 < 2^22, so float64 sqrt(d^2) is SciPy's value bit for bit. Integer metrics
-  // are exact in f32. The site transform costs more, and its grid 6 bytes per element.
+  // Unit-sampled Euclidean distances without indices go straight into the float64 output
+  // (compute_distance_field_into): the exact squared distance is an integer, and its float64
+  // square root is SciPy's value bit for bit. Integer metrics are exact in a field's storage and
+  // are read from its values. Everything else (anisotropic sampling, indices) needs the nearest
+  // sites: SciPy sums each axis' squared offset in its own order, and the sites give the offsets.
   const bool unit = spacing == std::array<double, 3>{1, 1, 1};
-  const double largest_d2 = static_cast<double>(n[0] - 1) * (n[0] - 1) +
-                            static_cast<double>(n[1] - 1) * (n[1] - 1) +
-                            static_cast<double>(n[2] - 1) * (n[2] - 1);
-  const bool from_values =
-      !indices && (metric != Metric::kEuclidean || (unit && largest_d2 < double(1 << 22)));
-  o.nearest_sites = !from_values;
+  const bool aligned = reinterpret_cast<std::uintptr_t>(dist.data) % alignof(double) == 0 &&
+                       std::all_of(dist.strides.begin(), dist.strides.end(), [](py::ssize_t b) {
+                         return b % static_cast<py::ssize_t>(sizeof(double)) == 0;
+                       });
+  const bool dense = !indices && metric == Metric::kEuclidean && unit && aligned;
+  const bool from_values = !indices && metric != Metric::kEuclidean;
+  o.nearest_sites = !dense && !from_values;
   // Integer metrics in 16 bits where every distance fits (half the field's memory and traffic).
   const double largest_l1 = static_cast<double>(n[0] + n[1] + n[2] - 3);
-  o.storage = from_values && metric != Metric::kEuclidean && largest_l1 < 32767 ? Storage::kU16
-                                                                                : Storage::kF32;
+  o.storage = from_values && largest_l1 < 32767 ? Storage::kU16 : Storage::kF32;
   PythonSignals signals;
   o.interrupter = &signals;
-  // Euclidean distances alone go straight into the float64 output, where its strides are whole
-  // elements: no field grid, no second pass over the volume.
-  if (from_values && metric == Metric::kEuclidean &&
-      reinterpret_cast<std::uintptr_t>(dist.data) % alignof(double) == 0 &&
-      std::all_of(dist.strides.begin(), dist.strides.end(), [](py::ssize_t b) {
-        return b % static_cast<py::ssize_t>(sizeof(double)) == 0;
-      })) {
+  if (dense) {
+    // voxfield.ndimage passes aligned, native float64 outputs only (a copy otherwise); a caller
+    // of this private function that does not take the sites' path. NumPy's axes 0, 1, 2 are
+    // voxfield's z, y, x.
     constexpr py::ssize_t kSize = sizeof(double);
-    // NumPy's axes 0, 1, 2 are voxfield's z, y, x.
     const DenseDistances<double> out{
         reinterpret_cast<double*>(dist.data),
         {dist.strides[2] / kSize, dist.strides[1] / kSize, dist.strides[0] / kSize}};
@@ -345,9 +324,7 @@ void distance_transform(const py::array& input, const std::string& metric_name,
   const DistanceField field = compute_distance_field(occupancy, o);
   if (from_values) {
     std::visit(
-        [&](const auto& grid) {
-          write_from_values(grid, field.encoding, box, metric, max_distance, dist);
-        },
+        [&](const auto& grid) { write_from_values(grid, field.encoding, box, max_distance, dist); },
         field.values);
     return;
   }

@@ -69,10 +69,11 @@ def _check_common(max_distance, threads):
 
 
 def _run(a, metric, sampling, signed, max_distance, threads, dt, ft):
-    # The engine writes native-endian values: byte-swapped outputs get them through a copy.
+    # The engine writes native-endian values to aligned memory: byte-swapped or misaligned
+    # outputs get them through a copy.
     outs = [dt, ft]
-    tmp = [o if o is None or o.dtype.isnative else np.empty(o.shape, o.dtype.newbyteorder("="))
-           for o in outs]
+    tmp = [o if o is None or (o.dtype.isnative and o.flags.aligned)
+           else np.empty(o.shape, o.dtype.newbyteorder("=")) for o in outs]
     _voxfield._distance_transform(a, metric, sampling, bool(signed), float(max_distance), threads,
                                   tmp[0], tmp[1])
     for o, t in zip(outs, tmp):

@@ -47,10 +47,10 @@ void envelope_euclidean_int32_lanes(int n, const std::int32_t* const* f, std::in
     S[k][-2] = S[k][-1] = H[k][-2] = H[k][-1] = 0;
     // The voxels holding sites, listed first (in out[k], which the write-back overwrites later):
     // voxels without one would cost the build a step each, and sparse lines are mostly those.
-    // Sites of cost 0 inside a run of them are left out too: such a voxel is its own nearest
-    // site, and beyond the run the run's end is strictly nearer at the same cost, so it never
-    // minimises elsewhere (the write-back gives it its 0 itself). In real volumes these are the
-    // voxels inside solid matter, often most of a line.
+    // Sites of cost 0 inside a run of them are left out too (costs are never negative): such a
+    // voxel is its own nearest site, and beyond the run the run's end is strictly nearer at the
+    // same cost, so it never minimises elsewhere (the write-back gives it its 0 itself). In real
+    // volumes these are the voxels inside solid matter, often most of a line.
     int count = 0, runs = 0;
     bool zero_before = false, zero_here = n > 0 && f[k][0] == 0;
     for (int x = 0; x < n; ++x) {

@@ -6,12 +6,12 @@
 // in linear time whatever the distances, but it is a chain of dependent, data-dependent steps
 // (~10 cycles per voxel on the profile of a 256³ transform). The minimum can also be taken over
 // a window: only sites i with (x - i)² <= out[x] can be the minimum, and out[x] is bounded by its
-// neighbour's, sqrt(out[x]) <= sqrt(out[x - 1]) + 1 (move the neighbour's nearest site along by
-// one voxel). So the window at x reaches floor(sqrt(out[x - 1])) + 1 voxels each way — a few
-// voxels near surfaces and inside solid matter, which is most of a real volume — and every step
-// of it is an add and a min over W lines at once, without branches, when the W lines lie side by
-// side in memory (lane k of element i at f[i * stride + k]): the columns of a row-major slice,
-// the rows of a column-major one. That is the truncated min-convolution of
+// neighbour's, sqrt(out[x]) <= sqrt(out[x - 1]) + 1 (keep the neighbour's nearest site: it is at
+// most one voxel farther from x). So the window at x reaches floor(sqrt(out[x - 1])) + 1 voxels
+// each way — a few voxels near surfaces and inside solid matter, which is most of a real volume —
+// and every step of it is an add and a min over W lines at once, without branches, when the W lines
+// lie side by side in memory (lane k of element i at f[i * stride + k]): the columns of a row-major
+// slice, the rows of a column-major one. That is the truncated min-convolution of
 // truncated_min_convolution.h with a reach read from the field as it goes instead of a clamp.
 //
 // The window is the widest of the W lanes', and far from every site (open air) it grows past
@@ -32,15 +32,62 @@
 
 namespace voxfield::detail {
 
-// Eight 32-bit lanes: SSE4.1 where the build targets it (the default x86-64-v2), plain loops
-// otherwise (a build for baseline x86-64).
-struct Lanes {
-#if defined(__SSE4_1__)
-  __m128i a, b;
-  static Lanes splat(std::int32_t v) {
-    return {_mm_set1_epi32(v), _mm_set1_epi32(v)};
+// Eight 32-bit lanes: in SSE4.1 registers where the build targets it (the default x86-64-v2),
+// in plain loops otherwise (a build for baseline x86-64; the tests run both).
+struct ScalarLanes {
+  std::int32_t v[8];
+  static ScalarLanes splat(std::int32_t x) {
+    ScalarLanes r;
+    for (auto& e : r.v) e = x;
+    return r;
   }
-  static Lanes load(const std::int32_t* p) {
+  static ScalarLanes load(const std::int32_t* p) {
+    ScalarLanes r;
+    for (int k = 0; k < 8; ++k) r.v[k] = p[k];
+    return r;
+  }
+  void store(std::int32_t* p) const {
+    for (int k = 0; k < 8; ++k) p[k] = v[k];
+  }
+  friend ScalarLanes min(ScalarLanes x, ScalarLanes y) {
+    for (int k = 0; k < 8; ++k) x.v[k] = std::min(x.v[k], y.v[k]);
+    return x;
+  }
+  friend ScalarLanes operator+(ScalarLanes x, ScalarLanes y) {
+    for (int k = 0; k < 8; ++k) x.v[k] += y.v[k];
+    return x;
+  }
+  friend ScalarLanes operator&(ScalarLanes x, ScalarLanes y) {
+    for (int k = 0; k < 8; ++k) x.v[k] &= y.v[k];
+    return x;
+  }
+  friend ScalarLanes operator>(ScalarLanes x, ScalarLanes y) {
+    for (int k = 0; k < 8; ++k) x.v[k] = x.v[k] > y.v[k] ? -1 : 0;
+    return x;
+  }
+  bool none() const {
+    std::int32_t any = 0;
+    for (std::int32_t e : v) any |= e;
+    return any == 0;
+  }
+  ScalarLanes isqrt() const {
+    ScalarLanes r;
+    for (int k = 0; k < 8; ++k) {
+      std::int64_t s = static_cast<std::int64_t>(std::sqrt(static_cast<double>(v[k])));
+      s += (s + 1) * (s + 1) <= v[k];
+      s -= s * s > v[k];
+      r.v[k] = static_cast<std::int32_t>(s);
+    }
+    return r;
+  }
+  std::int32_t max_lane() const { return *std::max_element(v, v + 8); }
+};
+
+#if defined(__SSE4_1__)
+struct SseLanes {
+  __m128i a, b;
+  static SseLanes splat(std::int32_t v) { return {_mm_set1_epi32(v), _mm_set1_epi32(v)}; }
+  static SseLanes load(const std::int32_t* p) {
     return {_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)),
             _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 4))};
   }
@@ -48,29 +95,29 @@ struct Lanes {
     _mm_storeu_si128(reinterpret_cast<__m128i*>(p), a);
     _mm_storeu_si128(reinterpret_cast<__m128i*>(p + 4), b);
   }
-  friend Lanes min(Lanes x, Lanes y) {
+  friend SseLanes min(SseLanes x, SseLanes y) {
     return {_mm_min_epi32(x.a, y.a), _mm_min_epi32(x.b, y.b)};
   }
-  friend Lanes operator+(Lanes x, Lanes y) {
+  friend SseLanes operator+(SseLanes x, SseLanes y) {
     return {_mm_add_epi32(x.a, y.a), _mm_add_epi32(x.b, y.b)};
   }
-  friend Lanes operator&(Lanes x, Lanes y) {
+  friend SseLanes operator&(SseLanes x, SseLanes y) {
     return {_mm_and_si128(x.a, y.a), _mm_and_si128(x.b, y.b)};
   }
-  friend Lanes operator>(Lanes x, Lanes y) {  // all ones where x > y
+  friend SseLanes operator>(SseLanes x, SseLanes y) {  // all ones where x > y
     return {_mm_cmpgt_epi32(x.a, y.a), _mm_cmpgt_epi32(x.b, y.b)};
   }
-  bool none() const {
-    return _mm_testz_si128(_mm_or_si128(a, b), _mm_or_si128(a, b)) != 0;
-  }
-  // floor(sqrt(v)) per lane for 0 <= v < 2^30: the float root, raised by one where it fell short
-  // (v above 2^24 rounds when converted).
-  Lanes isqrt() const {
+  bool none() const { return _mm_testz_si128(_mm_or_si128(a, b), _mm_or_si128(a, b)) != 0; }
+  // floor(sqrt(v)) per lane for 0 <= v < 2^30: the float root (v above 2^24 rounds when
+  // converted) raised by one where it fell short...
+  SseLanes isqrt() const {
     const auto one = [](__m128i v) {
       __m128i r = _mm_cvttps_epi32(_mm_sqrt_ps(_mm_cvtepi32_ps(v)));
       const __m128i r1 = _mm_add_epi32(r, _mm_set1_epi32(1));
       const __m128i fine = _mm_cmpgt_epi32(_mm_mullo_epi32(r1, r1), v);  // all ones: r is the root
-      return _mm_sub_epi32(r, _mm_andnot_si128(fine, _mm_set1_epi32(-1)));
+      r = _mm_sub_epi32(r, _mm_andnot_si128(fine, _mm_set1_epi32(-1)));
+      // ... and lowered by one where it came out above (v just below a square rounds up to it).
+      return _mm_add_epi32(r, _mm_cmpgt_epi32(_mm_mullo_epi32(r, r), v));
     };
     return {one(a), one(b)};
   }
@@ -80,76 +127,36 @@ struct Lanes {
     m = _mm_max_epi32(m, _mm_shuffle_epi32(m, _MM_SHUFFLE(2, 3, 0, 1)));
     return _mm_cvtsi128_si32(m);
   }
-#else
-  std::int32_t v[8];
-  static Lanes splat(std::int32_t x) {
-    Lanes r;
-    for (auto& e : r.v) e = x;
-    return r;
-  }
-  static Lanes load(const std::int32_t* p) {
-    Lanes r;
-    for (int k = 0; k < 8; ++k) r.v[k] = p[k];
-    return r;
-  }
-  void store(std::int32_t* p) const {
-    for (int k = 0; k < 8; ++k) p[k] = v[k];
-  }
-  friend Lanes min(Lanes x, Lanes y) {
-    for (int k = 0; k < 8; ++k) x.v[k] = std::min(x.v[k], y.v[k]);
-    return x;
-  }
-  friend Lanes operator+(Lanes x, Lanes y) {
-    for (int k = 0; k < 8; ++k) x.v[k] += y.v[k];
-    return x;
-  }
-  friend Lanes operator&(Lanes x, Lanes y) {
-    for (int k = 0; k < 8; ++k) x.v[k] &= y.v[k];
-    return x;
-  }
-  friend Lanes operator>(Lanes x, Lanes y) {
-    for (int k = 0; k < 8; ++k) x.v[k] = x.v[k] > y.v[k] ? -1 : 0;
-    return x;
-  }
-  bool none() const {
-    std::int32_t any = 0;
-    for (std::int32_t e : v) any |= e;
-    return any == 0;
-  }
-  Lanes isqrt() const {
-    Lanes r;
-    for (int k = 0; k < 8; ++k) {
-      std::int64_t s = static_cast<std::int64_t>(std::sqrt(static_cast<double>(v[k])));
-      s += (s + 1) * (s + 1) <= v[k];
-      r.v[k] = static_cast<std::int32_t>(s);
-    }
-    return r;
-  }
-  std::int32_t max_lane() const {
-    return *std::max_element(v, v + 8);
-  }
-#endif
 };
+using Lanes = SseLanes;
+#else
+using Lanes = ScalarLanes;
+#endif
 
 // Lines solved side by side by window_min_plus_lanes: two SSE registers of 32-bit lanes.
 inline constexpr int kWindowLanes = 8;
 
 // kWindowLanes lines of n voxels, lane k of element i at f[i * f_stride + k], into
-// out[i * out_stride + k]: out = min_i f[i] + (x - i)², EuclideanInt32::kInf where a lane has no
-// site (f < kInf) at all. Values only (no nearest sites). Returns false, with out partly
-// written, once the windows have cost more than `budget` steps; true when every lane is solved.
-inline bool window_min_plus_lanes(int n, const std::int32_t* f, std::size_t f_stride,
-                                  std::int32_t* out, std::size_t out_stride, std::int64_t budget) {
+// out[i * out_stride + k]: out = min(kInf, min_i f[i] + (x - i)²) with kInf =
+// EuclideanInt32::kInf — the envelope's values, except that a cost of kInf or more (no site, or
+// none within reach of the 32-bit costs) reads kInf, where the envelope may give kInf + d²: both
+// are "no site" to every reader. Values only (no nearest sites). The costs must be 0 <= f <=
+// kInf and n² < 2^29 (EuclideanInt32's range). Returns false, with out partly written, once the
+// windows have cost more than `budget` steps (a step: one element of each lane read); true when
+// every lane is solved.
+template <class L = Lanes>
+bool window_min_plus_lanes(int n, const std::int32_t* f, std::size_t f_stride, std::int32_t* out,
+                           std::size_t out_stride, std::int64_t budget) {
   constexpr std::int32_t kInf = EuclideanInt32::kInf;
-  Lanes lowest = Lanes::splat(kInf);
+  L lowest = L::splat(kInf);
   for (int i = 0; i < n; ++i)
-    lowest = min(lowest, Lanes::load(f + static_cast<std::size_t>(i) * f_stride));
-  // Lanes with a site have finite results everywhere, the others none: only the former bound the
+    lowest = min(lowest, L::load(f + static_cast<std::size_t>(i) * f_stride));
+  // L with a site have finite results everywhere, the others none: only the former bound the
   // window (live: all ones in them).
-  const Lanes live = Lanes::splat(kInf) > lowest;
+  const L live = L::splat(kInf) > lowest;
   if (live.none()) {
     for (int i = 0; i < n; ++i)
-      Lanes::splat(kInf).store(out + static_cast<std::size_t>(i) * out_stride);
+      L::splat(kInf).store(out + static_cast<std::size_t>(i) * out_stride);
     return true;
   }
   int reach = n - 1;  // the first voxel looks along the whole line
@@ -158,19 +165,17 @@ inline bool window_min_plus_lanes(int n, const std::int32_t* f, std::size_t f_st
     budget -= left + right + 1;
     if (budget < 0) return false;
     const std::int32_t* fx = f + static_cast<std::size_t>(x) * f_stride;
-    Lanes best = Lanes::load(fx);
+    L best = L::load(fx);
     const int both = std::min(left, right);
     for (int d = 1; d <= both; ++d) {
       const std::size_t o = static_cast<std::size_t>(d) * f_stride;
-      best = min(best, min(Lanes::load(fx - o), Lanes::load(fx + o)) + Lanes::splat(d * d));
+      best = min(best, min(L::load(fx - o), L::load(fx + o)) + L::splat(d * d));
     }
     for (int d = both + 1; d <= left; ++d)
-      best =
-          min(best, Lanes::load(fx - static_cast<std::size_t>(d) * f_stride) + Lanes::splat(d * d));
+      best = min(best, L::load(fx - static_cast<std::size_t>(d) * f_stride) + L::splat(d * d));
     for (int d = both + 1; d <= right; ++d)
-      best =
-          min(best, Lanes::load(fx + static_cast<std::size_t>(d) * f_stride) + Lanes::splat(d * d));
-    best = min(best, Lanes::splat(kInf));
+      best = min(best, L::load(fx + static_cast<std::size_t>(d) * f_stride) + L::splat(d * d));
+    best = min(best, L::splat(kInf));
     best.store(out + static_cast<std::size_t>(x) * out_stride);
     // The next window: floor(sqrt(best)) + 1 over the lanes with a site.
     reach = (best.isqrt() & live).max_lane() + 1;
@@ -183,14 +188,15 @@ inline bool window_min_plus_lanes(int n, const std::int32_t* f, std::size_t f_st
 // outgrow `steps_per_voxel` window steps per voxel on average, and the last count % W lines,
 // through the lower envelope (`envelope`: solve_lines-like, on `lines` contiguous lines of n) after
 // copying them out into `scratch_in` / `scratch_out` (W * n entries each). After a group fails, the
-// next `kRest` groups go to the envelope at once: neighbouring lines see much the same distances.
+// next `kGroupsAfterGivingUp` groups go to the envelope at once: neighbouring lines see much the
+// same distances.
 template <class Envelope>
 void window_lines_or_envelope(int count, int n, const std::int32_t* f, std::size_t stride,
                               std::int32_t* out, std::int64_t steps_per_voxel,
                               std::int32_t* scratch_in, std::int32_t* scratch_out,
                               const Envelope& envelope) {
   constexpr int W = kWindowLanes;
-  constexpr int kRest = 3;
+  constexpr int kGroupsAfterGivingUp = 3;
   const auto through_envelope = [&](int first, int lines) {
     for (int i = 0; i < n; ++i)
       for (int k = 0; k < lines; ++k)
@@ -211,7 +217,7 @@ void window_lines_or_envelope(int count, int n, const std::int32_t* f, std::size
                                      steps_per_voxel * n)) {
       continue;
     } else {
-      rest = kRest;
+      rest = kGroupsAfterGivingUp;
     }
     through_envelope(line, W);
   }

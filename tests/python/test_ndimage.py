@@ -259,6 +259,21 @@ def test_empty_and_byte_swapped_arrays():
     np.testing.assert_array_equal(big, sn.distance_transform_edt(a))
 
 
+def test_misaligned_outputs_and_long_lines():
+    # A float64 output that is not 8-byte aligned (a view one byte into a buffer) gets its
+    # distances through a copy; clamps that are not floats and lines whose squared distances pass
+    # 2^22 (the float round trip's limit) are exact too.
+    a = random_volume((9, 8, 7))
+    raw = np.zeros(a.size * 8 + 1, np.uint8)
+    dist = raw[1:].view(np.float64).reshape(a.shape)
+    assert not dist.flags.aligned
+    vn.distance_transform_edt(a, distances=dist, max_distance=4.00000001)
+    np.testing.assert_array_equal(dist, np.minimum(sn.distance_transform_edt(a), 4.00000001))
+    line = np.ones(5000, bool)
+    line[17] = False
+    np.testing.assert_array_equal(vn.distance_transform_edt(line), sn.distance_transform_edt(line))
+
+
 def test_repeated_transforms_reuse_voxel_memory_and_agree():
     """A second transform of the same size takes its arrays from the cache of freed ones (the
     reused count grows), and gives the result a transform with the cache turned off gives."""

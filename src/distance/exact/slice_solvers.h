@@ -71,8 +71,10 @@ struct SliceBuffers {
     const std::size_t stack = kEnvelopeLanes * envelope_lane_stride(std::max(X, Y));
     s.resize(stack);
     t.resize(stack);
-    lane_in.resize(kWindowLanes * static_cast<std::size_t>(std::max(X, Y)));
-    lane_out.resize(kWindowLanes * static_cast<std::size_t>(std::max(X, Y)));
+    if constexpr (std::is_same_v<V, std::int32_t>) {  // the windowed passes' costs only
+      lane_in.resize(kWindowLanes * static_cast<std::size_t>(std::max(X, Y)));
+      lane_out.resize(kWindowLanes * static_cast<std::size_t>(std::max(X, Y)));
+    }
   }
 };
 

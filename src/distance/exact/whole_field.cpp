@@ -20,6 +20,7 @@
 #include <cstring>
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "chunk_rows.h"
@@ -289,13 +290,13 @@ void compute_whole_field_dense(const Grid<std::uint8_t>& occupancy, const Distan
   };
   if (truncated_passes(p, false)) {
     using Conv = TruncatedMinConvolution;
+    const auto drop = static_cast<Conv::Cost>(std::floor(p.clamp * p.clamp));
     pass_slices_truncated(
         p, world, g, cap, progress, [&](int z, const Conv* conv, const std::uint8_t* solid) {
           for (int y = 0; y < Y; ++y)
             write_dense_row(conv[0].out_row(y), p.is_signed ? conv[1].out_row(y) : nullptr,
                             p.is_signed ? solid + static_cast<std::size_t>(y) * X : nullptr,
-                            Conv::kInf, static_cast<Conv::Cost>(Conv::kInf - 1), true, none, X,
-                            row_at(z, y), out.stride[0]);
+                            Conv::kInf, drop, true, none, X, row_at(z, y), out.stride[0]);
         });
   } else {
     dispatch_solver(p, p.domain.size(), [&](auto tag, const auto& solve, auto inf) {
@@ -354,9 +355,19 @@ void compute_into(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o,
         "compute_distance_field_into: nearest sites are not written into a dense array (use "
         "compute_distance_field)");
   if (out.data == nullptr) throw InvalidArgument("compute_distance_field_into: no output array");
+  if (!o.domain && !occupancy.bounds())
+    throw InvalidArgument(
+        "compute_distance_field_into: give options.domain (or bounds to the grid): the array "
+        "covers it");
   DistanceOptions values_only = o;
   values_only.storage = Storage::kF32;  // the plan's checks of integer storage do not apply
   const Plan p = detail::make_field_plan(occupancy, values_only);
+  // Slices are written in parallel: two voxels at one element would race.
+  const Vec3i n = p.domain.size();
+  for (int axis = 0; axis < 3; ++axis)
+    if (n[axis] > 1 && out.stride[static_cast<std::size_t>(axis)] == 0)
+      throw InvalidArgument("compute_distance_field_into: stride 0 along an axis of " +
+                            std::to_string(n[axis]) + " voxels");
   compute_whole_field_dense(occupancy, values_only, p, out);
 }
 
