@@ -20,4 +20,6 @@ if [ -z "$out" ]; then  # the report's directory: out/ unless the arguments name
 fi
 ./build/release/bin/voxfield showcase "$@"
 bash scripts/showcase_mpi.sh "$out"  # the same terrain's field over MPI ranks, identical to one process
+# voxfield.ndimage beside scipy.ndimage on a real MRI scan: the same float64 bits, and how much faster
+PYTHONPATH=build/release/python /usr/bin/python3 scripts/showcase_python.py "$out"
 node web/build-report.mjs "$out"      # report.html beside report.md, the terrain orbitable in the page
