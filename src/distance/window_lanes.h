@@ -151,7 +151,7 @@ bool window_min_plus_lanes(int n, const std::int32_t* f, std::size_t f_stride, s
   L lowest = L::splat(kInf);
   for (int i = 0; i < n; ++i)
     lowest = min(lowest, L::load(f + static_cast<std::size_t>(i) * f_stride));
-  // L with a site have finite results everywhere, the others none: only the former bound the
+  // Lanes with a site have finite results everywhere, the others none: only the former bound the
   // window (live: all ones in them).
   const L live = L::splat(kInf) > lowest;
   if (live.none()) {
