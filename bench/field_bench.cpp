@@ -7,13 +7,13 @@
 #include <malloc.h>
 #include <CLI/CLI.hpp>
 
-#include <cstring>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "bench_util.h"
 #include "voxfield/chunk_memory.h"
 #include "voxfield/distance.h"
+#include "voxfield/hash.h"
 #include "voxfield/npy.h"
 #include "voxfield/parallel.h"
 #include "voxfield/scene.h"
@@ -94,12 +94,7 @@ int main(int argc, char** argv) {
           const bench::Timing tm =
               bench::time_runs(runs, [&] { compute_distance_field_into(in.world.voxels, o, out); });
           // FNV-1a of the doubles, x fastest: not the field hash of the other storages.
-          std::uint64_t hash = 14695981039346656037ull;
-          for (double v : dense) {
-            unsigned char b[sizeof v];
-            std::memcpy(b, &v, sizeof v);
-            for (unsigned char c : b) hash = (hash ^ c) * 1099511628211ull;
-          }
+          const std::uint64_t hash = fnv1a(kFnvOffset, dense.data(), dense.size() * sizeof(double));
           std::printf("%-26s %-10s %4d %9.1f %9.1f %9.1f %10.0f %12s  %016llx\n", in.name.c_str(),
                       m.c_str(), t, tm.median_ms, tm.min_ms, tm.max_ms,
                       voxels / (tm.median_ms * 1e3), "-", static_cast<unsigned long long>(hash));
