@@ -390,8 +390,8 @@ int run_showcase(const ShowcaseSettings& s) {
     if (!exact) throw Error("showcase: the incrementally updated fields differ from full rebuilds");
   }
 
-  showcase_vectors(s.out, s.seed, md, timings);
-  showcase_csg(s.examples, s.out, md, timings);
+  showcase_vectors(s.out, s.seed, s.size, md, timings);
+  showcase_csg(s.examples, s.out, s.size, md, timings);
   const double total_ms = ms_since(t_start);
 
   md << "\n## Timings\n\n| stage | ms | |\n|---|---|---|\n";

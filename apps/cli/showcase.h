@@ -2,6 +2,7 @@
 // section has its own showcase_*.cpp).
 #pragma once
 
+#include <algorithm>
 #include <filesystem>
 #include <iomanip>
 #include <memory>
@@ -35,6 +36,14 @@ inline std::shared_ptr<gpu::Context> showcase_vulkan(std::ostream& md) {
   }
 }
 
+// A picture's edge in pixels in a showcase of `size`³ worlds: `full` at the default size (256)
+// and above, down to a quarter of it below 64. The sections whose scenes do not follow --size
+// (the CSG models, the vector fields) draw their pictures this size, so that the small runs the
+// tests make (--size 48, under the sanitizers too) stay short.
+inline int picture_pixels(int full, int size) {
+  return full * std::clamp(size, 64, 256) / 256;
+}
+
 inline std::string fixed(double v, int digits) {
   std::ostringstream os;
   os << std::fixed << std::setprecision(digits) << v;
@@ -61,12 +70,12 @@ void showcase_terrain(const std::filesystem::path& out, std::uint64_t seed, std:
 
 // Vector fields: agents flying through a volume, fixed steps, the visualiser, every algorithm
 // against the definition, .fga and .vf exports; the flow around a terrain's solids under an edit.
-void showcase_vectors(const std::filesystem::path& out, std::uint64_t seed, std::ostream& md,
-                      std::vector<Timing>& timings);
+void showcase_vectors(const std::filesystem::path& out, std::uint64_t seed, int size,
+                      std::ostream& md, std::vector<Timing>& timings);
 
 // The voxel compiler: the example CSG models (under `examples`/csg) compiled, pictured shaded and
 // by variant, two voxelised into .vox files (pruned and whole-tree voxelisations checked equal).
-void showcase_csg(const std::filesystem::path& examples, const std::filesystem::path& out,
+void showcase_csg(const std::filesystem::path& examples, const std::filesystem::path& out, int size,
                   std::ostream& md, std::vector<Timing>& timings);
 
 }  // namespace voxfield::cli

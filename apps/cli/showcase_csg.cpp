@@ -27,7 +27,7 @@ namespace {
 // The models drawn on Vulkan as Palecek proposes (each variant its own generated kernel, the
 // interpreter meanwhile), against the CPU's pictures.
 void showcase_csg_vulkan(const std::filesystem::path& examples, const std::filesystem::path& out,
-                         std::ostream& md, std::vector<Timing>& timings) {
+                         int size, std::ostream& md, std::vector<Timing>& timings) {
   const std::shared_ptr<gpu::Context> ctx = showcase_vulkan(md);
   if (!ctx) return;
   md << "\nThe same models sphere-traced on Vulkan (" << ctx->device().name
@@ -42,8 +42,8 @@ void showcase_csg_vulkan(const std::filesystem::path& examples, const std::files
   for (const char* name : {"gear", "building"}) {
     const csg::Model model = csg::load_model(examples / "csg" / (std::string(name) + ".sdf"));
     CsgRenderOptions o;
-    o.width = 480;
-    o.height = 360;
+    o.width = picture_pixels(480, size);
+    o.height = picture_pixels(360, size);
     const Image cpu = render_csg(model, o);
     CsgRenderStats st;
     gpu::CsgGpuStats gs;
@@ -62,15 +62,16 @@ void showcase_csg_vulkan(const std::filesystem::path& examples, const std::files
        << fixed(st.render_ms, 0) << " |\n";
     pictures += std::string("| ") + name + " | ![cpu](csg-" + name + ".png) | ![vulkan](csg-" +
                 name + "-vulkan.png) |\n";
-    timings.push_back({std::string("CSG ") + name + ": render 480x360 on Vulkan", st.render_ms,
-                       std::to_string(gs.dispatches) + " dispatches"});
+    timings.push_back({std::string("CSG ") + name + ": render " + std::to_string(o.width) + "x" +
+                           std::to_string(o.height) + " on Vulkan",
+                       st.render_ms, std::to_string(gs.dispatches) + " dispatches"});
   }
   md << pictures;
 }
 
 }  // namespace
 
-void showcase_csg(const std::filesystem::path& examples, const std::filesystem::path& out,
+void showcase_csg(const std::filesystem::path& examples, const std::filesystem::path& out, int size,
                   std::ostream& md, std::vector<Timing>& timings) {
   namespace fs = std::filesystem;
   md << "\n## The voxel compiler: CSG models\n\n";
@@ -96,8 +97,9 @@ void showcase_csg(const std::filesystem::path& examples, const std::filesystem::
     const fs::path path = examples / "csg" / (std::string(name) + ".sdf");
     const csg::Model model = csg::load_model(path);
     CsgRenderOptions o;
-    o.width = 480;
-    o.height = 360;
+    o.width = picture_pixels(480, size);
+    o.height = picture_pixels(360, size);
+    const std::string picture = std::to_string(o.width) + "x" + std::to_string(o.height);
     CsgRenderStats st, whole_st, var_st, small_st;
     const Image shaded = render_csg(model, o, &st);
     o.view = CsgRenderOptions::View::kVariants;
@@ -105,8 +107,8 @@ void showcase_csg(const std::filesystem::path& examples, const std::filesystem::
     o.view = CsgRenderOptions::View::kShaded;
     // The whole tape traced at a fifth of the size (it costs up to 100 times more per ray), against
     // the pruned tapes at the same size: the instructions per picture compare like with like.
-    o.width = 96;
-    o.height = 72;
+    o.width = o.width / 5;
+    o.height = o.height / 5;
     (void)render_csg(model, o, &small_st);
     o.prune = false;
     (void)render_csg(model, o, &whole_st);
@@ -116,7 +118,7 @@ void showcase_csg(const std::filesystem::path& examples, const std::filesystem::
     csg::OctreeOptions oo;
     oo.depth = 6;
     const csg::Octree tree = csg::build_octree(tape, model, oo);
-    timings.push_back({std::string("CSG ") + name + ": octree + render 480x360",
+    timings.push_back({std::string("CSG ") + name + ": octree + render " + picture,
                        st.octree_ms + st.render_ms, std::to_string(st.variants) + " variants"});
     md << "| " << name << " | " << csg::model_info(model).nodes << " | " << tree.stats.variants
        << " | " << fixed(tree.stats.mean_nodes, 2) << " / " << tree.stats.whole_nodes << " | "
@@ -194,7 +196,7 @@ void showcase_csg(const std::filesystem::path& examples, const std::filesystem::
        << words * 4 / 1024 << " KiB in " << fixed(ms, 0) << " ms (one thread).\n";
     timings.push_back({"CSG gear: SPIR-V of its variants and the interpreter", ms,
                        std::to_string(tree.variants.size() + 1) + " shaders"});
-    showcase_csg_vulkan(examples, out, md, timings);
+    showcase_csg_vulkan(examples, out, size, md, timings);
   }
   md << "\nOpen `building.vox` and `gear.vox` in MagicaVoxel; `voxfield csg MODEL compile -o DIR "
         "[--spirv]` writes each variant's GLSL (and SPIR-V), the cells' parameters and a "

@@ -91,17 +91,18 @@ void showcase_world_flow(const std::filesystem::path& out, std::uint64_t seed, s
 // The reactive sheet over the same field, and the same steps on the Vulkan backend when a device
 // is there: the field byte for byte the CPU's, with its counters.
 void showcase_sheet_and_gpu(const std::filesystem::path& out, const VectorVolume& volume,
-                            const VectorTexture& cpu_field, int steps, std::ostream& md,
+                            const VectorTexture& cpu_field, int steps, int size, std::ostream& md,
                             std::vector<Timing>& timings) {
   VectorViewOptions view;
-  view.width = 640;
-  view.height = 480;
+  view.width = picture_pixels(640, size);
+  view.height = picture_pixels(480, size);
   view.sheet = true;
   view.sheet_push = 1.2;
   auto start = std::chrono::steady_clock::now();
   write_png(render_vectors(volume, cpu_field, view), out / "vectors-sheet.png");
-  timings.push_back(
-      {"vector-field visualiser with the reactive sheet (640×480)", ms_since(start), ""});
+  timings.push_back({"vector-field visualiser with the reactive sheet (" +
+                         std::to_string(view.width) + "×" + std::to_string(view.height) + ")",
+                     ms_since(start), ""});
   md << "\nThe same field pushing a sheet of cloth (what grass or water does with it through "
         "`voxfield_vectors.glsl`): each point is displaced along z by the field's vector at its "
         "rest position, tinted by its direction.\n\n![the reactive sheet](vectors-sheet.png)\n";
@@ -135,8 +136,8 @@ void showcase_sheet_and_gpu(const std::filesystem::path& out, const VectorVolume
 
 }  // namespace
 
-void showcase_vectors(const std::filesystem::path& out, std::uint64_t seed, std::ostream& md,
-                      std::vector<Timing>& timings) {
+void showcase_vectors(const std::filesystem::path& out, std::uint64_t seed, int size,
+                      std::ostream& md, std::vector<Timing>& timings) {
   const VectorVolume volume = vector_agents_volume({64, 64, 64});
   const double dt = 1.0 / 60;
   const int steps = 90;
@@ -155,10 +156,12 @@ void showcase_vectors(const std::filesystem::path& out, std::uint64_t seed, std:
 
   auto start = std::chrono::steady_clock::now();
   VectorViewOptions view;
-  view.width = 640;
-  view.height = 480;
+  view.width = picture_pixels(640, size);
+  view.height = picture_pixels(480, size);
   write_png(render_vectors(volume, sim.field(), view), out / "vectors.png");
-  timings.push_back({"vector-field visualiser (640×480)", ms_since(start), ""});
+  timings.push_back({"vector-field visualiser (" + std::to_string(view.width) + "×" +
+                         std::to_string(view.height) + ")",
+                     ms_since(start), ""});
   const std::string fga = encode_fga(volume, sim.field());
   write_file_atomic(out / "vectors.fga",
                     {reinterpret_cast<const std::uint8_t*>(fga.data()), fga.size()});
@@ -191,7 +194,7 @@ void showcase_vectors(const std::filesystem::path& out, std::uint64_t seed, std:
        << fixed(e.max_strength_error, 4) << " |\n";
   }
   md << "\nFiles: `vectors.fga` (Unreal), `vectors.vf` (Unity VFX Graph).\n";
-  showcase_sheet_and_gpu(out, volume, sim.field(), steps, md, timings);
+  showcase_sheet_and_gpu(out, volume, sim.field(), steps, size, md, timings);
   showcase_world_flow(out, seed, md, timings);
 }
 
