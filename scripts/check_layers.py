@@ -30,7 +30,7 @@ PUBLIC_LAYER = {
     "dissertation_format.h": "distance", "gpu_distance.h": "distance", "distance_executor.h": "distance", "distance_slab.h": "distance",
     "vectors.h": "vectors", "vector_world.h": "vectors", "gpu_vectors.h": "vectors", "vector_agents.h": "vectors", "gpu_vectors_vulkan.h": "vectors", "vector_files.h": "io",
     "csg.h": "csg", "csg_compile.h": "csg", "csg_files.h": "io",
-    "mesh.h": "mesh", "mesh_chunks.h": "mesh", "mesh_pieces.h": "mesh", "terrain.h": "mesh", "gpu_mesh.h": "mesh", "gpu_terrain.h": "mesh", "gpu_terrain_vulkan.h": "mesh", "csg_mesh.h": "mesh", "mesh_optimize.h": "mesh", "mesh_files.h": "io", "mesh_voxelize.h": "mesh", "mesh_read.h": "io",
+    "mesh.h": "mesh", "mesh_chunks.h": "mesh", "mesh_pieces.h": "mesh", "mesh_slab.h": "mesh", "terrain.h": "mesh", "gpu_mesh.h": "mesh", "gpu_terrain.h": "mesh", "gpu_terrain_vulkan.h": "mesh", "csg_mesh.h": "mesh", "mesh_optimize.h": "mesh", "mesh_files.h": "io", "mesh_voxelize.h": "mesh", "mesh_read.h": "io",
     "file.h": "io", "npy.h": "io", "vox.h": "io", "world_file.h": "io", "world_io.h": "io", "vdb.h": "io",
     "edit_script.h": "io",
     "render.h": "render", "mesh_render.h": "render", "csg_render.h": "render", "gpu_render.h": "render", "gpu_render_vulkan.h": "render", "render_executor.h": "render", "render_relay.h": "render",

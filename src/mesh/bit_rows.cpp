@@ -59,7 +59,8 @@ bool inside_bits(const float* v, int count, float iso, bool inside_above, std::u
 
 }  // namespace
 
-InsideBits::InsideBits(const Lattice& lattice, Progress& progress) : ny_(lattice.n.y) {
+InsideBits::InsideBits(const Lattice& lattice, Progress& progress, int z_offset)
+    : ny_(lattice.n.y) {
   const Vec3i n = lattice.n;
   const std::size_t rows = static_cast<std::size_t>(n.y) * static_cast<std::size_t>(n.z);
   words_ = static_cast<std::size_t>(n.x) / 64 + 1;
@@ -86,7 +87,7 @@ InsideBits::InsideBits(const Lattice& lattice, Progress& progress) : ny_(lattice
   for (const std::int64_t bad : first_bad)
     if (bad >= 0) {
       const int x = static_cast<int>(bad % n.x), y = static_cast<int>(bad / n.x % n.y),
-                z = static_cast<int>(bad / n.x / n.y);
+                z = static_cast<int>(bad / n.x / n.y) + z_offset;
       throw InvalidArgument("mesh: sample (" + std::to_string(x) + ", " + std::to_string(y) + ", " +
                             std::to_string(z) + ") is " +
                             (std::isnan(lattice.values[bad]) ? "NaN" : "infinite"));

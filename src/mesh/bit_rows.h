@@ -138,9 +138,10 @@ void count_rows(int planes, std::size_t rows, Progress& progress,
 // Every sample of a dense lattice as an inside bit (pass 1 of both Flying Edges meshers).
 class InsideBits {
  public:
-  // Throws InvalidArgument naming the first NaN or infinite sample, ResourceLimitError past the
+  // Throws InvalidArgument naming the first NaN or infinite sample (its plane numbered from
+  // `z_offset`: a slab's lattice names the whole one's planes), ResourceLimitError past the
   // memory limit, Cancelled when `progress` is cancelled (one unit per plane).
-  InsideBits(const Lattice& lattice, Progress& progress);
+  InsideBits(const Lattice& lattice, Progress& progress, int z_offset = 0);
   std::size_t words() const { return words_; }
   const std::uint64_t* row(int y, int z) const {
     return bits_.data() + words_ * (static_cast<std::size_t>(y) +

@@ -75,17 +75,19 @@ struct RowSamples {
   float iso;
   bool negate;
   std::ptrdiff_t sy, sz;
+  int z_offset;  // FlyingEdges's: plane z here is plane z + z_offset of the lattice meshed
   // Per axis, the differences' spans (one and two spacings) and, where a span is a power of two
   // (unit spacings), its exact inverse: x * (1 / span) then rounds the same real number as
   // x / span, so the gradient is the same bit for bit for a multiplication's cost.
   std::array<std::array<double, 2>, 3> span{}, inverse{};
   std::array<bool, 3> exact_inverse{};
-  explicit RowSamples(const Lattice& l)
+  RowSamples(const Lattice& l, int z_offset_planes)
       : lattice(l),
         iso(static_cast<float>(l.iso)),
         negate(l.sign < 0),
         sy(l.n.x),
-        sz(static_cast<std::ptrdiff_t>(l.n.x) * l.n.y) {
+        sz(static_cast<std::ptrdiff_t>(l.n.x) * l.n.y),
+        z_offset(z_offset_planes) {
     for (std::size_t a = 0; a < 3; ++a) {
       int exponent = 0;
       const double mantissa = std::frexp(l.spacing[a], &exponent);
@@ -128,7 +130,10 @@ Vertex edge_vertex(const RowSamples& in, int x, int y, int z, int axis) {
   const std::ptrdiff_t i1 = i0 + (axis == 0 ? 1 : axis == 1 ? in.sy : in.sz);
   const double s0 = in.s(i0), s1 = in.s(i1);
   const double t = s0 / (s0 - s1);  // the signs differ, so s0 != s1
-  std::array<double, 3> at{static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)};
+  // (The plane in the whole lattice's numbering before the fraction is added: a slab's vertex is
+  // then the same double as the whole lattice's.)
+  std::array<double, 3> at{static_cast<double>(x), static_cast<double>(y),
+                           static_cast<double>(z + in.z_offset)};
   at[static_cast<std::size_t>(axis)] += t;
   const auto position = lattice_position(in.lattice, at);
   const int qx = x + (axis == 0), qy = y + (axis == 1), qz = z + (axis == 2);
@@ -140,7 +145,7 @@ Vertex edge_vertex(const RowSamples& in, int x, int y, int z, int axis) {
   return {{static_cast<float>(position[0]), static_cast<float>(position[1]),
            static_cast<float>(position[2])},
           unit_normal(normal),
-          static_cast<std::uint64_t>(s0 < 0 ? i0 : i1)};
+          static_cast<std::uint64_t>((s0 < 0 ? i0 : i1) + in.sz * in.z_offset)};
 }
 
 // edge_vertex() called out of line. (Inlined into centre_vertex(), GCC 12 at -O3 gave some means
@@ -205,15 +210,16 @@ void for_each_active_cell(const std::uint64_t* const b[4], std::size_t words, in
 
 }  // namespace
 
-FlyingEdges::FlyingEdges(const Lattice& lattice, Interrupter* interrupter)
+FlyingEdges::FlyingEdges(const Lattice& lattice, Interrupter* interrupter, int z_offset)
     : lattice_(lattice),
       progress_(std::make_unique<Progress>(interrupter, "marching cubes",
-                                           3 * static_cast<std::int64_t>(lattice.n.z))) {
+                                           3 * static_cast<std::int64_t>(lattice.n.z))),
+      z_offset_(z_offset) {
   const Vec3i n = lattice.n;
   const std::size_t rows = static_cast<std::size_t>(n.y) * static_cast<std::size_t>(n.z);
   require_memory(mul_sat(rows, 2 * 8 + 3 * 4), 0, "mesh", "marching cubes' row bookkeeping");
   // Pass 1: bit rows (and the refusal of a NaN or infinite sample).
-  inside_ = std::make_unique<InsideBits>(lattice, *progress_);
+  inside_ = std::make_unique<InsideBits>(lattice, *progress_, z_offset);
   words_ = inside_->words();
   Progress& progress = *progress_;
   // Pass 2: each row's counts, then their prefix sums.
@@ -229,7 +235,7 @@ FlyingEdges::FlyingEdges(const Lattice& lattice, Interrupter* interrupter)
 
 void FlyingEdges::count_plane(int z) {
   const Vec3i n = lattice_.n;
-  const RowSamples in(lattice_);
+  const RowSamples in(lattice_, z_offset_);
   const CubeCases& table = CubeCases::get();
   static const CaseCounts counts(table);
   std::vector<std::uint64_t> scratch(words_);
@@ -271,12 +277,31 @@ void FlyingEdges::count_plane(int z) {
 }
 
 void FlyingEdges::write(const WeldOutput& out) const {
-  for_each_plane(lattice_.n.z, *progress_, [&](int z) { write_plane(z, out); });
+  write_planes(0, lattice_.n.z, lattice_.n.z, out);
 }
 
-void FlyingEdges::write_plane(int z, const WeldOutput& out) const {
+std::uint64_t FlyingEdges::vertices_before(int z) const {
+  return first_vertex_[static_cast<std::size_t>(lattice_.n.y) * static_cast<std::size_t>(z)];
+}
+
+std::uint64_t FlyingEdges::indices_before(int z) const {
+  return first_index_[static_cast<std::size_t>(lattice_.n.y) * static_cast<std::size_t>(z)];
+}
+
+void FlyingEdges::write_planes(int z_begin, int z_end, int triangles_end,
+                               const WeldOutput& out) const {
+  const std::uint64_t first_vertex = vertices_before(z_begin),
+                      first_index = indices_before(z_begin);
+  for_each_plane(z_end - z_begin, *progress_, [&](int k) {
+    const int z = z_begin + k;
+    write_plane(z, first_vertex, first_index, z < triangles_end, out);
+  });
+}
+
+void FlyingEdges::write_plane(int z, std::uint64_t first_vertex, std::uint64_t first_index,
+                              bool triangles, const WeldOutput& out) const {
   const Vec3i n = lattice_.n;
-  const RowSamples in(lattice_);
+  const RowSamples in(lattice_, z_offset_);
   const CubeCases& table = CubeCases::get();
   const auto put = [&](std::uint64_t g, const Vertex& v) {
     out.positions[g] = v.position;
@@ -289,7 +314,7 @@ void FlyingEdges::write_plane(int z, const WeldOutput& out) const {
     prefetch_ahead(lattice_, y, z);
     const std::uint64_t* b = inside_->row(y, z);
     // This row's edge vertices: its x-edge crossings, then its y-edge and z-edge ones.
-    std::uint64_t g = first_vertex_[r];
+    std::uint64_t g = first_vertex_[r] - first_vertex;
     const auto emit = [&](const std::uint64_t* mask, int axis) {
       for (std::size_t w = 0; w < words_; ++w)
         for (std::uint64_t m = mask[w]; m; m &= m - 1)
@@ -316,14 +341,16 @@ void FlyingEdges::write_plane(int z, const WeldOutput& out) const {
     for (int j = 1; j < 4; ++j) x_crossings(rows[j], words_, n.x, counts.mask(j));
     differences(rows[2], rows[3], words_, counts.mask(5));
     differences(rows[1], rows[3], words_, counts.mask(7));
-    for (int j = 0; j < 4; ++j) counts.set_base(j, first_vertex_[row_of[j]]);
-    counts.set_base(4, first_vertex_[r] + x_count_[r]);
-    counts.set_base(5, first_vertex_[row_of[2]] + x_count_[row_of[2]]);
+    // (Numbers from first_vertex: the rows' first vertices less the slab's.)
+    const auto first = [&](std::size_t row) { return first_vertex_[row] - first_vertex; };
+    for (int j = 0; j < 4; ++j) counts.set_base(j, first(row_of[j]));
+    counts.set_base(4, first(r) + x_count_[r]);
+    counts.set_base(5, first(row_of[2]) + x_count_[row_of[2]]);
     counts.set_base(6, counts.base(4) + y_count_[r]);
-    counts.set_base(7, first_vertex_[row_of[1]] + x_count_[row_of[1]] + y_count_[row_of[1]]);
+    counts.set_base(7, first(row_of[1]) + x_count_[row_of[1]] + y_count_[row_of[1]]);
     counts.count();
     std::uint64_t centre_next = counts.base(6) + z_count_[r];
-    std::uint32_t* index = out.indices + first_index_[r];
+    std::uint32_t* index = triangles ? out.indices + (first_index_[r] - first_index) : nullptr;
     const float* v0 = lattice_.values + in.index(0, y, z);
     for_each_active_cell(rows, words_, n.x, [&](int x, unsigned inside) {
       unsigned joined = 0;
@@ -349,8 +376,9 @@ void FlyingEdges::write_plane(int z, const WeldOutput& out) const {
             static_cast<std::uint32_t>(centre_next);
         put(centre_next++, centre_vertex(in, cc, c, x, y, z));
       }
-      for (int k = 0; k < 3 * cc.triangle_count; ++k)
-        *index++ = ids[cc.edges[static_cast<std::size_t>(k)]];
+      if (triangles)
+        for (int k = 0; k < 3 * cc.triangle_count; ++k)
+          *index++ = ids[cc.edges[static_cast<std::size_t>(k)]];
     });
   }
 }

@@ -30,13 +30,23 @@ class FlyingEdges {
   // Classifies and counts (the first two passes). Throws InvalidArgument for a NaN or infinite
   // sample (naming the first) or more vertices than 32-bit indices hold, ResourceLimitError when
   // the bookkeeping passes the memory limit, Cancelled when the interrupter asks.
-  FlyingEdges(const Lattice& lattice, Interrupter* interrupter);
+  // `z_offset`: the lattice is planes [z_offset, z_offset + n.z) of a larger one (a slab of it,
+  // mesh_slab.cpp), whose frame the positions, sources and messages are in — the positions bit for
+  // bit those of the whole lattice's rows wherever the slab holds their gradients' stencils.
+  FlyingEdges(const Lattice& lattice, Interrupter* interrupter, int z_offset = 0);
   std::size_t vertices() const { return vertices_; }
   std::size_t indices() const { return indices_; }
   // Writes the mesh into arrays of at least vertices() / indices() elements (out.colors is
   // ignored: this path has no colours; out.sources, when not null, gets each vertex's inside
   // sample). Throws Cancelled when the interrupter asks (the arrays then hold part of the mesh).
   void write(const WeldOutput& out) const;
+  // The vertices and indices of the rows before sample plane z (0 <= z <= n.z).
+  std::uint64_t vertices_before(int z) const;
+  std::uint64_t indices_before(int z) const;
+  // Writes the vertices of sample planes [z_begin, z_end)'s rows, numbered from
+  // vertices_before(z_begin), and the triangles of cell planes [z_begin, triangles_end) (<= z_end)
+  // from indices_before(z_begin): write() is write_planes(0, n.z, n.z, out).
+  void write_planes(int z_begin, int z_end, int triangles_end, const WeldOutput& out) const;
 
  private:
   const Lattice& lattice_;
@@ -50,9 +60,13 @@ class FlyingEdges {
   std::vector<std::uint64_t> first_vertex_, first_index_;
   std::vector<std::uint32_t> x_count_, y_count_, z_count_;
   std::size_t vertices_ = 0, indices_ = 0;
+  int z_offset_ = 0;
 
   void count_plane(int z);
-  void write_plane(int z, const WeldOutput& out) const;
+  // Plane z's rows, numbered from vertex `first_vertex` and index `first_index`; its cells'
+  // triangles only when `triangles` (their centre vertices always: they are its rows' vertices).
+  void write_plane(int z, std::uint64_t first_vertex, std::uint64_t first_index, bool triangles,
+                   const WeldOutput& out) const;
 };
 
 // Whether a lattice can take the dual path: surface nets or dual contouring over samples in one

@@ -1,0 +1,64 @@
+// voxfield — marching cubes of a slab of sample planes in Flying Edges' passes (mesh_slab.h).
+//
+// The slab's planes stand in for a lattice of their own, meshed by FlyingEdges with their offset
+// in the whole one: positions, sources and messages in the whole lattice's frame. Its counts
+// cover every plane it holds; only the rows of [z_begin, z_end] are written (those of z_end for
+// their vertices alone), each with the gradient stencils it has in the whole lattice.
+#include "voxfield/mesh_slab.h"
+
+#include <algorithm>
+#include <string>
+
+#include "flying_edges.h"
+#include "mesh_internal.h"
+#include "voxfield/error.h"
+
+namespace voxfield {
+
+bool mesh_slab_applies(const MeshOptions& options) {
+  return options.algorithm == Mesher::kMarchingCubes && !options.value && !options.gradient;
+}
+
+std::pair<int, int> mesh_slab_planes(int samples_z, int z_begin, int z_end) {
+  return {std::max(z_begin - 1, 0), std::min(z_end + 3, samples_z)};
+}
+
+MeshSlab mesh_slab(const ScalarVolume& frame, int planes_z0, int plane_count, const float* planes,
+                   const MeshOptions& options, int z_begin, int z_end) {
+  using detail::mesh::FlyingEdges;
+  if (!mesh_slab_applies(options))
+    throw InvalidArgument(
+        "mesh_slab: meshes by marching cubes without an analytic value or gradient");
+  const int nz = frame.size.z;
+  if (!(z_begin >= 0 && z_begin < z_end && z_end <= nz))
+    throw InvalidArgument("mesh_slab: planes [" + std::to_string(z_begin) + ", " +
+                          std::to_string(z_end) + ") are not a slab of the lattice's " +
+                          std::to_string(nz));
+  const auto [w0, w1] = mesh_slab_planes(nz, z_begin, z_end);
+  if (!planes || plane_count < 0 || planes_z0 > w0 ||
+      static_cast<std::int64_t>(planes_z0) + plane_count < w1)
+    throw InvalidArgument("mesh_slab: planes [" + std::to_string(z_begin) + ", " +
+                          std::to_string(z_end) + ") read sample planes [" + std::to_string(w0) +
+                          ", " + std::to_string(w1) + "), the slab holds [" +
+                          std::to_string(planes_z0) + ", " +
+                          std::to_string(static_cast<std::int64_t>(planes_z0) + plane_count) + ")");
+  // The whole lattice's checks (its far corner, spacing, options), then its planes [w0, w1).
+  ScalarVolume whole = frame;
+  whole.values = planes;
+  detail::mesh::Lattice lattice = detail::mesh::checked_lattice(whole, options, false);
+  const std::size_t plane = static_cast<std::size_t>(frame.size.x) * frame.size.y;
+  lattice.n.z = w1 - w0;
+  lattice.values = planes + plane * static_cast<std::size_t>(w0 - planes_z0);
+  const FlyingEdges passes(lattice, options.interrupter, w0);
+  // Local planes: the slab's own [b, e), plane z_end's rows up to v (their vertices only).
+  const int b = z_begin - w0, e = z_end - w0, v = std::min(z_end + 1, nz) - w0;
+  MeshSlab slab;
+  slab.owned_vertices = passes.vertices_before(e) - passes.vertices_before(b);
+  const detail::mesh::WeldOutput out =
+      detail::mesh::size_mesh(slab.part, passes.vertices_before(v) - passes.vertices_before(b),
+                              passes.indices_before(e) - passes.indices_before(b), false, nullptr);
+  passes.write_planes(b, v, e, out);
+  return slab;
+}
+
+}  // namespace voxfield
