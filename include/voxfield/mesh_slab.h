@@ -37,6 +37,9 @@ struct MeshSlab {
   // within `part`. No colours.
   Mesh part;
   std::uint64_t owned_vertices = 0;
+  // The first of them: the vertices of plane z_begin's rows, among which are all that the slab
+  // before's triangles use.
+  std::uint64_t first_plane_vertices = 0;
 };
 
 // Meshes the rows of sample planes [z_begin, z_end) of the lattice `frame` describes (its size,

@@ -291,11 +291,13 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
 // Meshes of a lattice no rank holds whole (a scan or a simulation's float volume, a distributed
 // field). The lattice's chunk layers (mesh_pieces.h: the chunked mesher's chunks grouped along z)
 // are dealt to the ranks in runs of near-equal length or weight; each rank meshes its run from the
-// sample planes that run reads — its cells' planes, three below and two above — and rank 0 joins
-// the pieces with the chunked mesher's weld (write_mesh_volume: each rank writes its share of the
-// file, nothing gathered). The mesh equals MeshChunks(volume, options).merged()
-// of the whole lattice array for array (and mesh_volume's triangle for triangle), for any number of
-// ranks.
+// sample planes that run reads — its cells' planes, three below and two above. Marching cubes
+// (mesh_slab_applies): each rank meshes its run's planes as a slab in the whole-volume passes
+// (mesh_slab.h), and the mesh equals mesh_volume(volume, options) — what one process makes —
+// array for array. Surface nets and dual contouring: rank 0 joins the pieces with the chunked
+// mesher's weld, and the mesh equals MeshChunks(volume, options).merged() array for array (and
+// mesh_volume's triangle for triangle). Either for any number of ranks; write_mesh_volume writes
+// it with each rank writing its share of the file, nothing gathered.
 
 // Rank r meshes chunk layers [layers[r], layers[r + 1]).
 struct MeshLayers {
@@ -308,6 +310,10 @@ struct MeshLayers {
   // The sample planes [first, second) rank `rank` must hold: what its layers read ([0, 0) when it
   // has none).
   std::pair<int, int> planes(int rank) const;
+  // The sample planes [first, second) whose rows rank `rank`'s slab owns when marching cubes
+  // meshes by slabs (mesh_slab.h): its layers' cell planes, and the lattice's last plane for the
+  // last rank with layers ([0, 0) when it has none).
+  std::pair<int, int> slab(int rank) const;
 };
 
 // Runs of ceil or floor(layers / ranks) layers, in rank order. InvalidArgument for a lattice under

@@ -54,6 +54,7 @@ MeshSlab mesh_slab(const ScalarVolume& frame, int planes_z0, int plane_count, co
   const int b = z_begin - w0, e = z_end - w0, v = std::min(z_end + 1, nz) - w0;
   MeshSlab slab;
   slab.owned_vertices = passes.vertices_before(e) - passes.vertices_before(b);
+  slab.first_plane_vertices = passes.vertices_before(b + 1) - passes.vertices_before(b);
   const detail::mesh::WeldOutput out =
       detail::mesh::size_mesh(slab.part, passes.vertices_before(v) - passes.vertices_before(b),
                               passes.indices_before(e) - passes.indices_before(b), false, nullptr);

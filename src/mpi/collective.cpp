@@ -117,6 +117,18 @@ Box3i unite_over_ranks(MPI_Comm comm, const Box3i& mine, ExchangeStats* stats) {
   return {{all[0], all[1], all[2]}, {-all[3], -all[4], -all[5]}};
 }
 
+std::pair<std::uint64_t, std::uint64_t> exclusive_scan(MPI_Comm comm, std::uint64_t mine,
+                                                       ExchangeStats* stats) {
+  CollectiveTimer t(stats);
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  std::uint64_t before = 0, total = 0;
+  MPI_Exscan(&mine, &before, 1, MPI_UINT64_T, MPI_SUM, comm);
+  if (rank == 0) before = 0;  // MPI leaves rank 0's result undefined
+  MPI_Allreduce(&mine, &total, 1, MPI_UINT64_T, MPI_SUM, comm);
+  return {before, total};
+}
+
 }  // namespace detail
 
 Box3i content_bounds(MPI_Comm comm, const SlabPartition& partition, const World& world) {

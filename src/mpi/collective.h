@@ -69,6 +69,10 @@ std::string write_pieces(MPI_Comm comm, const std::string& temporary, const std:
 // The union of every rank's box (empty boxes add nothing): one all-reduce of six integers.
 Box3i unite_over_ranks(MPI_Comm comm, const Box3i& mine, ExchangeStats* stats);
 
+// An exclusive scan of `mine` over the ranks in rank order (0 on rank 0), and the total.
+std::pair<std::uint64_t, std::uint64_t> exclusive_scan(MPI_Comm comm, std::uint64_t mine,
+                                                       ExchangeStats* stats);
+
 // A duplicate of a communicator, freed on leaving scope: an operation's point-to-point messages
 // travel on it, so that none of the application's messages on the original can match theirs.
 struct OwnComm {

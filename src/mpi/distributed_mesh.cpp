@@ -3,25 +3,45 @@
 // The chunked mesher's chunks grouped into layers along z (mesh_pieces.h) are dealt to the ranks
 // in runs, of equal length or of equal weight (the surface each layer holds); a run reads its
 // cells' sample planes, three below and two above, so a rank needs nothing from the others while
-// meshing. Each rank's piece — its chunks' parts with their vertices' lattice
-// element keys — goes to rank 0, which joins them with the chunked mesher's weld: border vertices
-// are computed the same way on both sides of a cut and welded by key, so the cut leaves no crack
-// and no duplicate, and the mesh is the same array for array for any number of ranks.
+// meshing.
+//
+// Marching cubes: each rank meshes its run's sample planes as a slab in the whole-volume passes
+// (mesh_slab.h), which number vertices and triangles by lattice row — its vertices and triangles
+// are one run of the mesh one process makes, so an exclusive scan of the vertex counts numbers
+// them and rank 0 only lays the runs end to end.
+//
+// Surface nets and dual contouring: each rank's piece — its chunks' parts with their vertices'
+// lattice element keys — goes to rank 0, which joins them with the chunked mesher's weld: border
+// vertices are computed the same way on both sides of a cut and welded by key, so the cut leaves
+// no crack and no duplicate, and the mesh is the same array for array for any number of ranks.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <limits>
+#include <optional>
 #include <span>
 #include <string>
 
 #include "collective.h"
 #include "voxfield/limits.h"
 #include "voxfield/mesh_pieces.h"
+#include "voxfield/mesh_slab.h"
 #include "voxfield/mpi.h"
 
 namespace voxfield::mpi {
 
 bool MeshLayers::empty(int rank) const {
   return layers[static_cast<std::size_t>(rank)] == layers[static_cast<std::size_t>(rank) + 1];
+}
+
+std::pair<int, int> MeshLayers::slab(int rank) const {
+  if (empty(rank)) return {0, 0};
+  const int last_plane = samples.z - 1;
+  const int begin = layers[static_cast<std::size_t>(rank)] * chunk_edge;
+  const int end = std::min(layers[static_cast<std::size_t>(rank) + 1] * chunk_edge, last_plane);
+  return {begin, end == last_plane ? samples.z : end};
 }
 
 std::pair<int, int> MeshLayers::planes(int rank) const {
@@ -182,6 +202,88 @@ std::vector<std::vector<std::uint8_t>> gather_pieces(MPI_Comm comm, std::vector<
   return pieces;
 }
 
+// A rank's run of the mesh, for rank 0: its vertex and index counts, its vertices' positions and
+// normals, its triangles' indices numbered in the whole mesh.
+std::vector<std::uint8_t> run_bytes(const MeshSlab& slab, std::uint64_t first_vertex) {
+  const std::uint64_t counts[2] = {slab.owned_vertices, slab.part.indices.size()};
+  const std::size_t vertex_bytes = static_cast<std::size_t>(slab.owned_vertices) * 12;
+  std::vector<std::uint8_t> bytes(sizeof counts + 2 * vertex_bytes + 4 * counts[1]);
+  std::uint8_t* at = bytes.data();
+  const auto put = [&](const void* from, std::size_t n) {
+    if (n > 0) std::memcpy(at, from, n);
+    at += n;
+  };
+  put(counts, sizeof counts);
+  put(slab.part.positions.data(), vertex_bytes);
+  put(slab.part.normals.data(), vertex_bytes);
+  for (const std::uint32_t i : slab.part.indices) {
+    const auto number = static_cast<std::uint32_t>(first_vertex + i);
+    put(&number, 4);
+  }
+  return bytes;
+}
+
+// The runs laid end to end, in rank order (rank 0 made room for them: gather_pieces).
+Mesh lay_runs(const std::vector<std::vector<std::uint8_t>>& runs, std::uint64_t vertices,
+              std::uint64_t indices) {
+  require_memory(add_sat(mul_sat(vertices, 24), mul_sat(indices, 4)), 0, "mpi::mesh_volume",
+                 "the mesh on rank 0");
+  Mesh mesh;
+  mesh.positions.reserve(static_cast<std::size_t>(vertices));
+  mesh.normals.reserve(static_cast<std::size_t>(vertices));
+  mesh.indices.reserve(static_cast<std::size_t>(indices));
+  for (const std::vector<std::uint8_t>& run : runs) {
+    if (run.empty()) continue;
+    std::uint64_t counts[2];
+    std::memcpy(counts, run.data(), sizeof counts);
+    const std::uint8_t* at = run.data() + sizeof counts;
+    const std::size_t n = static_cast<std::size_t>(counts[0]);
+    const auto* p = reinterpret_cast<const std::array<float, 3>*>(at);
+    mesh.positions.insert(mesh.positions.end(), p, p + n);
+    const auto* q = reinterpret_cast<const std::array<float, 3>*>(at + 12 * n);
+    mesh.normals.insert(mesh.normals.end(), q, q + n);
+    const auto* i = reinterpret_cast<const std::uint32_t*>(at + 24 * n);
+    mesh.indices.insert(mesh.indices.end(), i, i + counts[1]);
+  }
+  return mesh;
+}
+
+// mesh_volume for marching cubes: each rank's slab (mesh_slab.h), a scan of the vertex counts,
+// the runs laid end to end on rank 0.
+Mesh mesh_by_slabs(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& frame,
+                   const float* planes, const MeshOptions& options, ExchangeStats* stats) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  const auto t0 = std::chrono::steady_clock::now();
+  std::optional<MeshSlab> slab;
+  detail::collectively(comm, stats, [&] {
+    if (layers.empty(rank)) return;
+    const auto [z0, z1] = layers.planes(rank);
+    const auto [s0, s1] = layers.slab(rank);
+    slab = mesh_slab(frame, z0, z1 - z0, planes, options, s0, s1);
+  });
+  if (stats) stats->compute_ms += detail::ms_since(t0);
+  const auto [first_vertex, vertices] =
+      detail::exclusive_scan(comm, slab ? slab->owned_vertices : 0, stats);
+  const std::uint64_t indices =
+      detail::exclusive_scan(comm, slab ? slab->part.indices.size() : 0, stats).second;
+  std::vector<std::uint8_t> run = detail::collectively(comm, stats, [&] {
+    if (vertices > std::numeric_limits<std::uint32_t>::max())
+      throw InvalidArgument("mpi::mesh_volume: the mesh has " + std::to_string(vertices) +
+                            " vertices, more than 32-bit indices hold");
+    return slab ? run_bytes(*slab, first_vertex) : std::vector<std::uint8_t>{};
+  });
+  slab.reset();
+  const detail::OwnComm own(comm);
+  const std::vector<std::vector<std::uint8_t>> runs = gather_pieces(own.comm, std::move(run), stats);
+  const auto t1 = std::chrono::steady_clock::now();
+  Mesh mesh = detail::collectively(comm, stats, [&, vertices = vertices] {
+    return rank == 0 ? lay_runs(runs, vertices, indices) : Mesh{};
+  });
+  if (stats) stats->compute_ms += detail::ms_since(t1);
+  return mesh;
+}
+
 }  // namespace
 
 namespace detail {
@@ -212,9 +314,12 @@ Mesh mesh_volume(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& fr
   int rank = 0, size = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
+  detail::collectively(comm, stats, [&] {
+    detail::check_mesh_layers(layers, frame, options, size, "mpi::mesh_volume");
+  });
+  if (mesh_slab_applies(options)) return mesh_by_slabs(comm, layers, frame, planes, options, stats);
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::uint8_t> piece = detail::collectively(comm, stats, [&] {
-    detail::check_mesh_layers(layers, frame, options, size, "mpi::mesh_volume");
     if (layers.empty(rank)) return std::vector<std::uint8_t>{};
     const auto [z0, z1] = layers.planes(rank);
     return mesh_piece(frame, z0, z1 - z0, planes, options,

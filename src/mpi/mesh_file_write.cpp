@@ -1,12 +1,14 @@
 // voxfield — one mesh file written by every rank, each its own share of the mesh (mpi.h:
 // write_mesh_volume): byte for byte the file one process writes, with nothing gathered anywhere.
 //
-// The joined mesh numbers owned vertices chunk by chunk and orphans after them (weld.cpp), so a
-// rank's chunk layers own one run of vertex numbers and claim another run of orphans, and its
-// triangles are one run of the triangles. Each rank learns its runs' first numbers by exclusive
-// scans and the numbers of what it uses across the cuts from its neighbours (PieceWeld), then
-// encodes its runs of every section of the file (mesh_files.h) and writes them where the scans of
-// the sections' byte counts put them. The head depends only on totals every rank has (counts,
+// Marching cubes: a rank's slab (mesh_slab.h) owns one run of the mesh's vertex numbers and one
+// of its triangles, and computes the next rank's first rows itself; an exclusive scan numbers
+// them. The other meshers: the joined mesh numbers owned vertices chunk by chunk and orphans after
+// them (weld.cpp), so a rank's chunk layers own one run of vertex numbers and claim another run of
+// orphans, and its triangles are one run of the triangles; each rank learns its runs' first
+// numbers by exclusive scans and the numbers of what it uses across the cuts from its neighbours
+// (PieceWeld). Either way each rank then encodes its runs of every section of the file
+// (mesh_files.h) and writes them where the scans of the sections' byte counts put them. The head depends only on totals every rank has (counts,
 // colours, the positions' bounds), and rank 0 stages it.
 #include <algorithm>
 #include <array>
@@ -21,6 +23,7 @@
 #include "voxfield/limits.h"
 #include "voxfield/mesh_files.h"
 #include "voxfield/mesh_pieces.h"
+#include "voxfield/mesh_slab.h"
 #include "voxfield/mpi.h"
 
 namespace voxfield::mpi {
@@ -66,19 +69,6 @@ std::vector<T> shift(MPI_Comm comm, int to, int from, const std::vector<T>& out,
   return in;
 }
 
-// An exclusive scan of `mine` over the ranks, and the total.
-std::pair<std::uint64_t, std::uint64_t> scan(MPI_Comm comm, std::uint64_t mine,
-                                             ExchangeStats* stats) {
-  detail::CollectiveTimer t(stats);
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  std::uint64_t before = 0, total = 0;
-  MPI_Exscan(&mine, &before, 1, MPI_UINT64_T, MPI_SUM, comm);
-  if (rank == 0) before = 0;  // MPI leaves rank 0's result undefined
-  MPI_Allreduce(&mine, &total, 1, MPI_UINT64_T, MPI_SUM, comm);
-  return {before, total};
-}
-
 // The nearest rank before (step -1) or after (+1) `rank` that holds layers; MPI_PROC_NULL if none.
 int neighbour(const MeshLayers& layers, int rank, int step) {
   for (int r = rank + step; r >= 0 && r < layers.ranks(); r += step)
@@ -99,6 +89,8 @@ struct Share {
   std::vector<std::uint8_t> seam;
 };
 
+void share_totals(MPI_Comm comm, Share& s, std::uint64_t vertices, ExchangeStats* stats);
+
 Share weld_share(MPI_Comm comm, const MeshLayers& layers, std::optional<PieceWeld> weld,
                  ExchangeStats* stats) {
   int rank = 0;
@@ -114,7 +106,7 @@ Share weld_share(MPI_Comm comm, const MeshLayers& layers, std::optional<PieceWel
   };
   Share s;
   s.owned = weld ? weld->owned_vertices() : 0;
-  const auto [first_vertex, all_owned] = scan(comm, s.owned, stats);
+  const auto [first_vertex, all_owned] = detail::exclusive_scan(comm, s.owned, stats);
   s.first_vertex = first_vertex;
   // Vertices the cuts share: each rank lends its end layers' to both neighbours.
   std::vector<WeldKey> lent;
@@ -136,7 +128,7 @@ Share weld_share(MPI_Comm comm, const MeshLayers& layers, std::optional<PieceWel
     if (weld) weld->claim_orphans(taken);
   });
   s.orphans = weld ? weld->claimed_orphans() : 0;
-  const auto [first_orphan, all_orphans] = scan(comm, s.orphans, stats);
+  const auto [first_orphan, all_orphans] = detail::exclusive_scan(comm, s.orphans, stats);
   s.first_orphan = all_owned + first_orphan;
   std::vector<WeldKey> numbered;
   compute([&] {
@@ -156,7 +148,13 @@ Share weld_share(MPI_Comm comm, const MeshLayers& layers, std::optional<PieceWel
     if (after != MPI_PROC_NULL)
       for (const WeldKey& k : numbered) s.seam[s.owned + (k.number - s.first_orphan)] = 1;
   });
-  // The totals, and the positions' bounds over the vertices this rank writes.
+  share_totals(comm, s, all_owned + all_orphans, stats);
+  return s;
+}
+
+// The share's first triangle and the totals: `vertices`, the triangles, colours, and the
+// positions' bounds over every rank's written vertices.
+void share_totals(MPI_Comm comm, Share& s, std::uint64_t vertices, ExchangeStats* stats) {
   std::array<float, 3> lo{}, hi{};
   lo.fill(std::numeric_limits<float>::infinity());
   hi.fill(-std::numeric_limits<float>::infinity());
@@ -165,9 +163,9 @@ Share weld_share(MPI_Comm comm, const MeshLayers& layers, std::optional<PieceWel
       lo[a] = std::min(lo[a], s.part.positions[i][a]);
       hi[a] = std::max(hi[a], s.part.positions[i][a]);
     }
-  const auto [first_triangle, triangles] = scan(comm, s.part.triangle_count(), stats);
+  const auto [first_triangle, triangles] = detail::exclusive_scan(comm, s.part.triangle_count(), stats);
   s.first_triangle = first_triangle;
-  s.totals.vertices = all_owned + all_orphans;
+  s.totals.vertices = vertices;
   s.totals.triangles = triangles;
   {
     detail::CollectiveTimer t(stats);
@@ -178,6 +176,38 @@ Share weld_share(MPI_Comm comm, const MeshLayers& layers, std::optional<PieceWel
     MPI_Allreduce(hi.data(), s.totals.hi.data(), 3, MPI_FLOAT, MPI_MAX, comm);
   }
   if (s.totals.vertices == 0) s.totals.lo = s.totals.hi = {0, 0, 0};
+}
+
+// Marching cubes by slabs (mesh_slab.h): the slab's own vertices are its run of the mesh's
+// numbers, from an exclusive scan; its triangles also use the next rank's first rows, which it
+// computed itself. The vertices other ranks' triangles may use (the seam): its first plane's
+// rows, when a rank before it holds layers, and the next rank's rows it holds.
+Share slab_share(MPI_Comm comm, const MeshLayers& layers, std::optional<MeshSlab> slab,
+                 ExchangeStats* stats) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  Share s;
+  s.owned = slab ? slab->owned_vertices : 0;
+  const auto [first_vertex, vertices] = detail::exclusive_scan(comm, s.owned, stats);
+  s.first_vertex = first_vertex;
+  s.first_orphan = vertices;  // (no orphans: every vertex is a row's)
+  detail::collectively(comm, stats, [&] {
+    if (!slab) return;
+    if (first_vertex + slab->part.vertex_count() > std::numeric_limits<std::uint32_t>::max() + 1ull)
+      throw InvalidArgument("mpi::write_mesh_volume: the mesh has more vertices than 32-bit "
+                            "indices hold");
+    const std::uint64_t first_plane = slab->first_plane_vertices;
+    s.part = std::move(slab->part);
+    slab.reset();
+    s.global.resize(s.part.vertex_count());
+    for (std::size_t i = 0; i < s.global.size(); ++i)
+      s.global[i] = static_cast<std::uint32_t>(first_vertex + i);
+    s.seam.assign(s.part.vertex_count(), 0);
+    std::fill(s.seam.begin() + static_cast<std::ptrdiff_t>(s.owned), s.seam.end(), 1);
+    if (neighbour(layers, rank, -1) != MPI_PROC_NULL)
+      std::fill_n(s.seam.begin(), static_cast<std::ptrdiff_t>(first_plane), 1);
+  });
+  share_totals(comm, s, vertices, stats);
   return s;
 }
 
@@ -250,19 +280,27 @@ MeshFileSummary write_mesh_volume(MPI_Comm comm, const MeshLayers& layers,
   MPI_Comm_size(comm, &size);
   // This rank's chunks, meshed straight into its weld.
   const auto t0 = std::chrono::steady_clock::now();
-  std::optional<PieceWeld> weld = detail::collectively(comm, stats, [&] {
+  // Marching cubes as slabs of the whole-volume passes, the other meshers as chunked pieces.
+  const bool slabs = mesh_slab_applies(options);
+  std::optional<MeshSlab> slab;
+  std::optional<PieceWeld> weld;
+  detail::collectively(comm, stats, [&] {
     detail::check_mesh_layers(layers, frame, options, size, "mpi::write_mesh_volume");
-    std::optional<PieceWeld> w;
-    if (!layers.empty(rank)) {
-      const auto [z0, z1] = layers.planes(rank);
-      w.emplace(frame, z0, z1 - z0, planes, options, layers.layers[static_cast<std::size_t>(rank)],
-                layers.layers[static_cast<std::size_t>(rank) + 1]);
+    if (layers.empty(rank)) return;
+    const auto [z0, z1] = layers.planes(rank);
+    if (slabs) {
+      const auto [s0, s1] = layers.slab(rank);
+      slab = mesh_slab(frame, z0, z1 - z0, planes, options, s0, s1);
+    } else {
+      weld.emplace(frame, z0, z1 - z0, planes, options,
+                   layers.layers[static_cast<std::size_t>(rank)],
+                   layers.layers[static_cast<std::size_t>(rank) + 1]);
     }
-    return w;
   });
   if (stats) stats->compute_ms += detail::ms_since(t0);
   const detail::OwnComm own(comm);
-  Share share = weld_share(own.comm, layers, std::move(weld), stats);
+  Share share = slabs ? slab_share(own.comm, layers, std::move(slab), stats)
+                      : weld_share(own.comm, layers, std::move(weld), stats);
   MeshFileSummary summary;
   summary.vertices = share.totals.vertices;
   summary.triangles = share.totals.triangles;
