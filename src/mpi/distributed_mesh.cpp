@@ -275,7 +275,8 @@ Mesh mesh_by_slabs(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& 
   });
   slab.reset();
   const detail::OwnComm own(comm);
-  const std::vector<std::vector<std::uint8_t>> runs = gather_pieces(own.comm, std::move(run), stats);
+  const std::vector<std::vector<std::uint8_t>> runs =
+      gather_pieces(own.comm, std::move(run), stats);
   const auto t1 = std::chrono::steady_clock::now();
   Mesh mesh = detail::collectively(comm, stats, [&, vertices = vertices] {
     return rank == 0 ? lay_runs(runs, vertices, indices) : Mesh{};

@@ -8,8 +8,9 @@
 // orphans, and its triangles are one run of the triangles; each rank learns its runs' first
 // numbers by exclusive scans and the numbers of what it uses across the cuts from its neighbours
 // (PieceWeld). Either way each rank then encodes its runs of every section of the file
-// (mesh_files.h) and writes them where the scans of the sections' byte counts put them. The head depends only on totals every rank has (counts,
-// colours, the positions' bounds), and rank 0 stages it.
+// (mesh_files.h) and writes them where the scans of the sections' byte counts put them. The head
+// depends only on totals every rank has (counts, colours, the positions' bounds), and rank 0 stages
+// it.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -163,7 +164,8 @@ void share_totals(MPI_Comm comm, Share& s, std::uint64_t vertices, ExchangeStats
       lo[a] = std::min(lo[a], s.part.positions[i][a]);
       hi[a] = std::max(hi[a], s.part.positions[i][a]);
     }
-  const auto [first_triangle, triangles] = detail::exclusive_scan(comm, s.part.triangle_count(), stats);
+  const auto [first_triangle, triangles] =
+      detail::exclusive_scan(comm, s.part.triangle_count(), stats);
   s.first_triangle = first_triangle;
   s.totals.vertices = vertices;
   s.totals.triangles = triangles;
@@ -194,8 +196,9 @@ Share slab_share(MPI_Comm comm, const MeshLayers& layers, std::optional<MeshSlab
   detail::collectively(comm, stats, [&] {
     if (!slab) return;
     if (first_vertex + slab->part.vertex_count() > std::numeric_limits<std::uint32_t>::max() + 1ull)
-      throw InvalidArgument("mpi::write_mesh_volume: the mesh has more vertices than 32-bit "
-                            "indices hold");
+      throw InvalidArgument(
+          "mpi::write_mesh_volume: the mesh has more vertices than 32-bit "
+          "indices hold");
     const std::uint64_t first_plane = slab->first_plane_vertices;
     s.part = std::move(slab->part);
     slab.reset();
