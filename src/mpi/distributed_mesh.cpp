@@ -263,8 +263,11 @@ Mesh mesh_by_slabs(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& 
     slab = mesh_slab(frame, z0, z1 - z0, planes, options, s0, s1);
   });
   if (stats) stats->compute_ms += detail::ms_since(t0);
-  const auto [first_vertex, vertices] =
+  // (Plain variables, not a structured binding: the lambdas below capture them, which clang 14
+  // refuses for bindings.)
+  const std::pair<std::uint64_t, std::uint64_t> scanned =
       detail::exclusive_scan(comm, slab ? slab->owned_vertices : 0, stats);
+  const std::uint64_t first_vertex = scanned.first, vertices = scanned.second;
   const std::uint64_t indices =
       detail::exclusive_scan(comm, slab ? slab->part.indices.size() : 0, stats).second;
   std::vector<std::uint8_t> run = detail::collectively(comm, stats, [&] {
@@ -278,9 +281,8 @@ Mesh mesh_by_slabs(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& 
   const std::vector<std::vector<std::uint8_t>> runs =
       gather_pieces(own.comm, std::move(run), stats);
   const auto t1 = std::chrono::steady_clock::now();
-  Mesh mesh = detail::collectively(comm, stats, [&, vertices = vertices] {
-    return rank == 0 ? lay_runs(runs, vertices, indices) : Mesh{};
-  });
+  Mesh mesh = detail::collectively(
+      comm, stats, [&] { return rank == 0 ? lay_runs(runs, vertices, indices) : Mesh{}; });
   if (stats) stats->compute_ms += detail::ms_since(t1);
   return mesh;
 }

@@ -190,7 +190,9 @@ Share slab_share(MPI_Comm comm, const MeshLayers& layers, std::optional<MeshSlab
   MPI_Comm_rank(comm, &rank);
   Share s;
   s.owned = slab ? slab->owned_vertices : 0;
-  const auto [first_vertex, vertices] = detail::exclusive_scan(comm, s.owned, stats);
+  const std::pair<std::uint64_t, std::uint64_t> scanned =
+      detail::exclusive_scan(comm, s.owned, stats);
+  const std::uint64_t first_vertex = scanned.first, vertices = scanned.second;
   s.first_vertex = first_vertex;
   s.first_orphan = vertices;  // (no orphans: every vertex is a row's)
   detail::collectively(comm, stats, [&] {
