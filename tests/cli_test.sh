@@ -522,6 +522,20 @@ for ijk in [(0, 0, 0), (3, 1, 2), (-2, 5, 1)]:
     want = np.array([10, 0, -5]) + (np.array(ijk) + 0.5) * (0.5, 0.5, 2)
     assert np.allclose(g.transform.indexToWorld(ijk), want), (ijk, g.transform.indexToWorld(ijk))
 assert abs(g.background - (3 - 0.25)) < 1e-6, g.background  # the clamp less half the smallest edge"
+# A camera in the world's frame (--camera-frame world) draws the frame the same camera placed in
+# voxels by hand draws: voxel v at (100, -50, 3) + v / 4, so voxel (70, -30, 45) is world
+# (117.5, -57.5, 14.25) and (16, 16, 6) is (104, -46, 4.5).
+check "a terrain for framed cameras" 0 "$V" generate terrain --size 32 -o "$tmp/t32.npy"
+check "framed terrain" 0 "$V" convert "$tmp/t32.npy" "$tmp/t32.vfw" --voxel-size 0.25 --origin 100,-50,3
+check "render, camera in voxels" 0 "$V" render "$tmp/t32.vfw" -o "$tmp/cam-vox.png" --width 96 --height 64 \
+  --camera "eye=70,-30,45:target=16,16,6"
+check "render, camera in the world" 0 "$V" render "$tmp/t32.vfw" -o "$tmp/cam-world.png" --width 96 --height 64 \
+  --camera "eye=117.5,-57.5,14.25:target=104,-46,4.5" --camera-frame world
+check "the same frame either way" 0 cmp "$tmp/cam-vox.png" "$tmp/cam-world.png"
+check "a world camera on anisotropic voxels refused" 1 "$V" render "$tmp/scan.vfw" -o "$tmp/cam-scan.png" \
+  --camera "eye=30,-10,40:target=11,1,-4" --camera-frame world
+expect_grep "anisotropic camera message" "$tmp/err" "cubic voxels; this world's are 0.5 x 0.5 x 2"
+[ ! -e "$tmp/cam-scan.png" ] && passes=$((passes+1)) || { echo "FAIL: a refused camera wrote its frame"; fails=$((fails+1)); }
 printf 'v 0 0 0\nv 1 0 0\nf 1 2 3\n' >"$tmp/bad.obj"
 check "bad mesh refused" 1 "$V" field "$tmp/bad.obj" -o "$tmp/bad.npy" --voxel-size 0.5
 expect_grep "bad mesh names file and byte" "$tmp/err" "bad.obj: at byte 22: the face names vertex 3"

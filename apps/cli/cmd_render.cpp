@@ -22,6 +22,7 @@ struct RenderSettings {
   double fog = 0;
   std::optional<int> slice;
   std::string grid;
+  std::string camera_frame = "voxels";
 };
 
 int run_render(const RenderSettings& s) {
@@ -55,8 +56,10 @@ int run_render(const RenderSettings& s) {
   const double aspect = static_cast<double>(s.width) / s.height;
   // Automatic cameras frame what is there: the content, within the file's extent.
   const Box3i content = in.world.voxels.content_bounds().intersect(in.extent);
-  const Camera camera =
+  Camera camera =
       Camera::parse(s.camera, s.camera == "top" || content.empty() ? in.extent : content, aspect);
+  if (s.camera_frame == "world" && s.camera != "auto" && s.camera != "top")
+    camera = camera.in_voxels(in.world.frame);
 
   const RenderScene scene(in.world, so, in.extent);
   // With --repeat, the frame is rendered several times and the median time reported (the
@@ -130,9 +133,14 @@ void add_render(CLI::App& app, Action& action) {
   cmd->add_option("--width", s->width, "image width in pixels")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", s->height, "image height in pixels")->check(CLI::Range(1, 16384));
   cmd->add_option("--camera", s->camera,
-                  "auto | top | eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height] (voxel "
-                  "units, z up)")
+                  "auto | top | eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height] (z up; "
+                  "voxel units, or the world's with --camera-frame world)")
       ->check(camera_spec());
+  cmd->add_option("--camera-frame", s->camera_frame,
+                  "voxels (default) or world: an eye=...:target=... camera in the world's frame "
+                  "(a .vfw's origin, voxel size and rotation; cubic voxels); auto and top frame "
+                  "the content either way")
+      ->check(CLI::IsMember({"voxels", "world"}));
   cmd->add_option("--view", s->view, "shaded | distance | error | chunks")
       ->check(CLI::IsMember({"shaded", "distance", "error", "chunks"}));
   cmd->add_option("--algorithm", s->algorithm,

@@ -25,8 +25,13 @@ CLI::App* add_render_command(CLI::App& app, RenderSettings& s) {
   cmd->add_option("--width", s.width, "image width in pixels")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", s.height, "image height in pixels")->check(CLI::Range(1, 16384));
   cmd->add_option("--camera", s.camera,
-                  "auto | top | eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height] (voxel "
-                  "units, z up)");
+                  "auto | top | eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height] (z up; "
+                  "voxel units, or the world's with --camera-frame world)");
+  cmd->add_option("--camera-frame", s.camera_frame,
+                  "voxels (default) or world: an eye=...:target=... camera in the world's frame "
+                  "(a .vfw's origin, voxel size and rotation; cubic voxels); auto and top frame "
+                  "the content either way")
+      ->check(CLI::IsMember({"voxels", "world"}));
   cmd->add_option("--view", s.view, "shaded | chunks")->check(CLI::IsMember({"shaded", "chunks"}));
   cmd->add_option("--metric", s.metric,
                   "field rays skip by: manhattan (default), chebyshev, euclidean")
@@ -71,8 +76,11 @@ int run_render(MPI_Comm comm, const RenderSettings& s) {
   // file's extent.
   const Box3i content = mpi::content_bounds(comm, slab.partition, slab.world);
   const Camera camera = mpi::collectively(comm, [&] {
-    return Camera::parse(s.camera, s.camera == "top" || content.empty() ? domain : content,
-                         static_cast<double>(s.width) / s.height);
+    const Camera c =
+        Camera::parse(s.camera, s.camera == "top" || content.empty() ? domain : content,
+                      static_cast<double>(s.width) / s.height);
+    const bool world = s.camera_frame == "world" && s.camera != "auto" && s.camera != "top";
+    return world ? c.in_voxels(slab.world.frame) : c;
   });
   mpi::ExchangeStats ex;
   RenderStats st;

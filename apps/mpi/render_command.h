@@ -15,6 +15,7 @@ struct RenderSettings {
   int width = 1280, height = 720, chunk = 32, threads = 0;
   bool no_shadows = false, no_ao = false;
   double fog = 0;
+  std::string camera_frame = "voxels";
 };
 
 // The subcommand and its options, as `voxfield render` names them.

@@ -40,6 +40,8 @@ struct VoxelFrame {
   }
   // A direction's image (no translation): R * (voxel_size_world ⊙ d_vox).
   Vec3d world_direction(Vec3d d_vox) const;
+  // Its inverse: a world direction in voxel coordinates, (R^T d_world) / voxel_size_world.
+  Vec3d vox_direction(Vec3d d_world) const;
   // A surface normal given in voxel coordinates, carried into the world and normalised: the
   // inverse transpose, R * (n_vox / voxel_size_world), so that it stays perpendicular to the
   // surface under an anisotropic scale. A zero normal stays zero.

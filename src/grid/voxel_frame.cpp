@@ -64,9 +64,13 @@ Vec3d VoxelFrame::world_from_vox(Vec3d p_vox) const {
   return origin_world + world_direction(p_vox);
 }
 
-Vec3d VoxelFrame::vox_from_world(Vec3d p_world) const {
-  const Vec3d local = times_transposed(rotation, p_world - origin_world);
+Vec3d VoxelFrame::vox_direction(Vec3d d_world) const {
+  const Vec3d local = times_transposed(rotation, d_world);
   return {local.x / voxel_size_world.x, local.y / voxel_size_world.y, local.z / voxel_size_world.z};
+}
+
+Vec3d VoxelFrame::vox_from_world(Vec3d p_world) const {
+  return vox_direction(p_world - origin_world);
 }
 
 Vec3d VoxelFrame::world_normal(Vec3d n_vox) const {

@@ -161,6 +161,27 @@ Camera Camera::parse(const std::string& spec, const Box3i& box, double aspect) {
   return c;
 }
 
+Camera Camera::in_voxels(const VoxelFrame& frame) const {
+  frame.validate("camera: the world's frame");
+  const Vec3d s = frame.voxel_size_world;
+  // Equal to a part in 10^12 (what a size read from a file and multiplied keeps): the voxels
+  // are cubes, and the rays stay those of the world's camera.
+  const double size = (s.x + s.y + s.z) / 3;
+  if (std::abs(s.x - size) > 1e-12 * size || std::abs(s.y - size) > 1e-12 * size ||
+      std::abs(s.z - size) > 1e-12 * size) {
+    std::ostringstream os;
+    os << "camera: a camera in world units needs cubic voxels; this world's are " << s.x << " x "
+       << s.y << " x " << s.z << " (give the camera in voxels instead)";
+    throw InvalidArgument(os.str());
+  }
+  Camera c = *this;
+  c.eye = frame.vox_from_world(eye);
+  c.target = frame.vox_from_world(target);
+  c.up = frame.vox_direction(up);  // a direction: no translation (its length does not matter)
+  c.ortho_height = ortho_height / size;
+  return c;
+}
+
 Camera::Projector Camera::projector(int width, int height) const {
   Projector p;
   p.projection = projection;

@@ -247,6 +247,12 @@ done
 "$VF" render margins.vfw -o ref.png --width 100 --height 80 --chunk 8 2>/dev/null
 MPIEXEC -np 3 "$VFM" render margins.vfw -o out.png --width 100 --height 80 --chunk 8 2>/dev/null
 same ref.png out.png "render, 3 ranks, margins.vfw"
+# A camera in the world's frame: voxel v of framed.vfw lies at (100, -50, 3) + v / 4.
+"$VF" convert f.npy framed.vfw --voxel-size 0.25 --origin 100,-50,3 2>/dev/null
+"$VF" render framed.vfw -o ref.png --width 100 --height 80 --chunk 8 --camera "eye=60,-20,40:target=12,12,8" 2>/dev/null
+MPIEXEC -np 2 "$VFM" render framed.vfw -o out.png --width 100 --height 80 --chunk 8 \
+  --camera "eye=115,-55,13:target=103,-47,5" --camera-frame world 2>/dev/null
+same ref.png out.png "render, 2 ranks, a camera in the world's frame"
 rm -f bad.png
 expect_failure 2 "distance not in" render f.npy -o bad.png --view distance
 expect_failure 1 "cut on chunk boundaries" render f.npy -o bad.png --chunk 64

@@ -1,0 +1,128 @@
+// Cameras given in a world's frame (Camera::in_voxels): the frame a user places in world
+// coordinates is the frame placed in voxels by hand — the same camera, the same pixels — for
+// frames of cubic voxels with any origin and rotation; anisotropic voxels refused by name.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <set>
+#include <string>
+
+#include "image_compare.h"
+#include "voxfield/error.h"
+#include "voxfield/render.h"
+#include "voxfield/scene.h"
+
+using namespace voxfield;
+
+namespace {
+
+// A world's frame: turned by `degrees` about `axis`, voxels of edge `size`, voxel (0, 0, 0) at
+// `origin`.
+VoxelFrame frame_of(double degrees, Vec3d axis, double size, Vec3d origin) {
+  const double a = degrees * std::numbers::pi / 180, c = std::cos(a), s = std::sin(a);
+  const Vec3d k = axis * (1 / axis.length());
+  VoxelFrame f;
+  f.origin_world = origin;
+  f.voxel_size_world = {size, size, size};
+  // Rodrigues' rotation matrix, row by row.
+  f.rotation = {
+      {{c + k.x * k.x * (1 - c), k.x * k.y * (1 - c) - k.z * s, k.x * k.z * (1 - c) + k.y * s},
+       {k.y * k.x * (1 - c) + k.z * s, c + k.y * k.y * (1 - c), k.y * k.z * (1 - c) - k.x * s},
+       {k.z * k.x * (1 - c) - k.y * s, k.z * k.y * (1 - c) + k.x * s, c + k.z * k.z * (1 - c)}}};
+  return f;
+}
+
+// The camera `in_vox` as a user of `frame` writes it: in world coordinates.
+Camera in_world(const Camera& in_vox, const VoxelFrame& frame) {
+  Camera c = in_vox;
+  c.eye = frame.world_from_vox(in_vox.eye);
+  c.target = frame.world_from_vox(in_vox.target);
+  c.up = frame.world_direction(in_vox.up);
+  c.ortho_height = in_vox.ortho_height * frame.voxel_size_world.x;
+  return c;
+}
+
+void expect_near(Vec3d a, Vec3d b, double tolerance) {
+  EXPECT_NEAR(a.x, b.x, tolerance);
+  EXPECT_NEAR(a.y, b.y, tolerance);
+  EXPECT_NEAR(a.z, b.z, tolerance);
+}
+
+}  // namespace
+
+// Exact frames (power-of-two voxel sizes, whole-number origins, no rotation) give the very camera
+// and the very pixels; turned frames give the camera to within rounding and the same picture.
+TEST(CameraFrame, AWorldCameraDrawsWhatTheSameCameraInVoxelsDraws) {
+  SceneOptions so;
+  so.size = {48, 40, 24};
+  World world = make_terrain(so);
+  Camera by_hand;
+  by_hand.eye = {70, -30, 45};
+  by_hand.target = {24, 20, 6};
+  by_hand.up = {0, 0, 1};
+  RenderOptions o;
+  o.width = 160;
+  o.height = 96;
+  const RenderScene scene(world);
+  const Image want = render(scene, by_hand, o);
+  std::set<std::uint32_t> colours;  // terrain in view, not sky alone
+  for (std::size_t i = 0; i + 2 < want.rgb.size(); i += 3)
+    colours.insert(std::uint32_t{want.rgb[i]} << 16 | std::uint32_t{want.rgb[i + 1]} << 8 |
+                   want.rgb[i + 2]);
+  ASSERT_GT(colours.size(), 200u);
+  for (const VoxelFrame& frame :
+       {frame_of(0, {0, 0, 1}, 0.25, {100, -50, 3}), frame_of(0, {0, 0, 1}, 8, {-4, 0, 0})}) {
+    const Camera c = in_world(by_hand, frame).in_voxels(frame);
+    EXPECT_EQ(c.eye, by_hand.eye);
+    EXPECT_EQ(c.target, by_hand.target);
+    EXPECT_EQ(c.up, by_hand.up);
+    const Image got = render(scene, c, o);
+    EXPECT_TRUE(got.rgb == want.rgb);
+  }
+  for (const VoxelFrame& frame : {frame_of(90, {0, 0, 1}, 0.05, {12.5, 3, -7}),
+                                  frame_of(33, {1, 2, -0.5}, 1.7, {1e4, -2e3, 350})}) {
+    SCOPED_TRACE(frame.rotation[0].x);
+    const Camera c = in_world(by_hand, frame).in_voxels(frame);
+    expect_near(c.eye, by_hand.eye, 1e-9);
+    expect_near(c.target, by_hand.target, 1e-9);
+    expect_near(c.up * (1 / c.up.length()), by_hand.up, 1e-12);
+    // Rays a part in 10^12 apart: a pixel may flip where a ray grazes an edge, no more.
+    const test::ImageDiff d = test::compare_images(render(scene, c, o), want, 0);
+    EXPECT_LE(d.off, d.pixels / 1000);
+  }
+}
+
+// An orthographic camera's height is in world units: it shrinks by the voxel edge.
+TEST(CameraFrame, OrthographicHeightsAreWorldUnits) {
+  Camera c;
+  c.projection = Camera::Projection::kOrthographic;
+  c.eye = {0, 0, 10};
+  c.target = {0, 0, 0};
+  c.up = {0, 1, 0};
+  c.ortho_height = 3;
+  const Camera v = c.in_voxels(frame_of(0, {0, 0, 1}, 0.5, {0, 0, 0}));
+  EXPECT_EQ(v.ortho_height, 6);
+  EXPECT_EQ(v.eye, (Vec3d{0, 0, 20}));
+  EXPECT_EQ(v.projection, Camera::Projection::kOrthographic);
+}
+
+TEST(CameraFrame, AnisotropicOrInvalidFramesAreRefusedByName) {
+  Camera c;
+  VoxelFrame scan;
+  scan.voxel_size_world = {1, 1, 3};
+  try {
+    (void)c.in_voxels(scan);
+    ADD_FAILURE() << "anisotropic voxels accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("1 x 1 x 3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cubic voxels"), std::string::npos) << e.what();
+  }
+  VoxelFrame bad;
+  bad.voxel_size_world = {0, 0, 0};
+  EXPECT_THROW((void)c.in_voxels(bad), InvalidArgument);
+  // Sizes equal to a part in 10^12 are cubes (a size read from a file and multiplied).
+  VoxelFrame nearly;
+  nearly.voxel_size_world = {0.1, 0.1 * (1 + 1e-14), 0.1};
+  EXPECT_NO_THROW((void)c.in_voxels(nearly));
+}
