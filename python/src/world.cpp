@@ -338,7 +338,10 @@ void bind_world(py::module_& parent) {
       "render",
       [](const PyWorld& w, int width, int height, const std::string& camera,
          const std::string& view, bool shadows, bool ambient_occlusion, double fog,
-         const std::string& metric, int threads) {
+         const std::string& metric, int threads, const std::string& camera_frame) {
+        if (camera_frame != "voxels" && camera_frame != "world")
+          throw InvalidArgument("render: camera_frame is \"voxels\" or \"world\", not \"" +
+                                camera_frame + "\"");
         RenderSceneOptions so;
         so.skip_metric = parse_metric(metric);
         so.lighting_field = shadows || ambient_occlusion;
@@ -361,8 +364,10 @@ void bind_world(py::module_& parent) {
           if (extent.empty()) throw InvalidArgument("render: the world holds no volume");
           // As the CLI: automatic cameras frame the content, within the extent.
           const Box3i content = w.world.voxels.content_bounds().intersect(extent);
-          const Camera cam =
+          Camera cam =
               Camera::parse(camera, camera == "top" || content.empty() ? extent : content, aspect);
+          if (camera_frame == "world" && camera != "auto" && camera != "top")
+            cam = cam.in_voxels(w.world.frame);
           const RenderScene scene(w.world, so, extent);
           image = voxfield::render(scene, cam, o, nullptr, &signals);
         }
@@ -373,7 +378,7 @@ void bind_world(py::module_& parent) {
       py::arg("world"), py::arg("width") = 640, py::arg("height") = 360, py::arg("camera") = "auto",
       py::arg("view") = "shaded", py::arg("shadows") = true, py::arg("ambient_occlusion") = true,
       py::arg("fog") = 0.0, py::arg("metric") = "manhattan", py::arg("threads") = 0,
-      "See voxfield.world.render");
+      py::arg("camera_frame") = "voxels", "See voxfield.world.render");
 
   m.def(
       "mesh",

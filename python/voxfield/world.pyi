@@ -108,6 +108,7 @@ def render(
     fog: float = 0.0,
     metric: str = "manhattan",
     threads: int = 0,
+    camera_frame: str = "voxels",
 ) -> npt.NDArray[np.uint8]: ...
 def mesh(
     world: World,

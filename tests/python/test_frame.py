@@ -15,7 +15,7 @@ import numpy as np
 import pyopenvdb as openvdb
 import pytest
 
-from voxfield.world import World, mesh
+from voxfield.world import World, mesh, render
 
 
 def rotation_about(degrees, axis):
@@ -119,6 +119,24 @@ def test_a_framed_worlds_mesh_is_its_voxel_mesh_in_the_frame(tmp_path):
     # An offset surface is round, its normals in every direction: carried by the map itself (not
     # its inverse transpose) they would lean off the anisotropic surface (median 0.42).
     assert normal_agreement(*mesh(framed, iso=2.0)[:3]) > 0.98
+
+
+def test_a_camera_in_the_worlds_frame_draws_the_same_camera_in_voxels():
+    rng = np.random.default_rng(5)
+    world = World((rng.random((24, 20, 12)) < 0.2).astype(np.uint8) * 3)
+    world.origin_world = (100.0, -50.0, 3.0)
+    world.voxel_size_world = (0.25, 0.25, 0.25)
+    by_hand = render(world, 96, 64, camera="eye=40,-12,30:target=12,10,5", shadows=False)
+    # Voxel v lies at (100, -50, 3) + v / 4.
+    placed = render(world, 96, 64, camera="eye=110,-53,10.5:target=103,-47.5,4.25", shadows=False,
+                    camera_frame="world")
+    np.testing.assert_array_equal(placed, by_hand)
+    assert len(np.unique(by_hand.reshape(-1, 3), axis=0)) > 20  # voxels in view, not sky alone
+    world.voxel_size_world = (0.25, 0.25, 1.0)
+    with pytest.raises(ValueError, match="cubic voxels"):
+        render(world, 32, 32, camera="eye=110,-53,10.5:target=103,-47.5,4.25", camera_frame="world")
+    with pytest.raises(ValueError, match="camera_frame"):
+        render(world, 32, 32, camera_frame="metres")
 
 
 def test_bad_frames_are_refused_and_keep_the_old_one():
