@@ -121,8 +121,18 @@ TEST(CameraFrame, AnisotropicOrInvalidFramesAreRefusedByName) {
   VoxelFrame bad;
   bad.voxel_size_world = {0, 0, 0};
   EXPECT_THROW((void)c.in_voxels(bad), InvalidArgument);
-  // Sizes equal to a part in 10^12 are cubes (a size read from a file and multiplied).
+  // Sizes equal to a part in 10^6 are cubes (a float pipeline's rotated transform); beyond, not.
   VoxelFrame nearly;
-  nearly.voxel_size_world = {0.1, 0.1 * (1 + 1e-14), 0.1};
+  nearly.voxel_size_world = {0.1, 0.1 * (1 + 1e-8), 0.1};
   EXPECT_NO_THROW((void)c.in_voxels(nearly));
+  nearly.voxel_size_world = {0.1, 0.1 * (1 + 1e-5), 0.1};
+  EXPECT_THROW((void)c.in_voxels(nearly), InvalidArgument);
+}
+
+// Only a placed camera has a frame to be given in: "auto", "top" and an empty spec frame the box.
+TEST(CameraFrame, FramingSpecsAreNotPlacedCameras) {
+  EXPECT_TRUE(Camera::frames_the_box(""));
+  EXPECT_TRUE(Camera::frames_the_box("auto"));
+  EXPECT_TRUE(Camera::frames_the_box("top"));
+  EXPECT_FALSE(Camera::frames_the_box("eye=1,2,3:target=0,0,0"));
 }

@@ -3,8 +3,10 @@
 // end are its arrays bit for bit, whatever the cuts; bad slabs and planes refused by name.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,8 +35,22 @@ MeshSlab slab_of(const ScalarVolume& vol, const MeshOptions& o, int z0, int z1) 
 // voxfield-mpi lay them: owned vertices in order, triangles shifted by the vertices before.
 Mesh laid_end_to_end(const ScalarVolume& vol, const MeshOptions& o, const std::vector<int>& cuts) {
   Mesh all;
+  std::optional<MeshSlab> before;
   for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
     const MeshSlab s = slab_of(vol, o, cuts[k], cuts[k + 1]);
+    // The slab before computed this slab's first plane's rows itself: the same vertices, bit for
+    // bit, and as many as first_plane_vertices says (an MPI rank's seam with its neighbour).
+    if (before) {
+      const std::size_t lent = before->part.positions.size() - before->owned_vertices;
+      EXPECT_EQ(lent, s.first_plane_vertices);
+      EXPECT_LE(lent, s.part.positions.size());
+      if (lent > s.part.positions.size()) return all;
+      const auto from = static_cast<std::ptrdiff_t>(before->owned_vertices);
+      EXPECT_TRUE(std::equal(before->part.positions.begin() + from, before->part.positions.end(),
+                             s.part.positions.begin()));
+      EXPECT_TRUE(std::equal(before->part.normals.begin() + from, before->part.normals.end(),
+                             s.part.normals.begin()));
+    }
     const std::size_t first = all.positions.size();
     // Its triangles use its own vertices and the next slab's first rows, nothing else.
     for (const std::uint32_t i : s.part.indices) EXPECT_LT(i, s.part.positions.size());
@@ -48,6 +64,7 @@ Mesh laid_end_to_end(const ScalarVolume& vol, const MeshOptions& o, const std::v
     for (const std::uint32_t i : s.part.indices)
       all.indices.push_back(static_cast<std::uint32_t>(first + i));
     EXPECT_TRUE(s.part.colors.empty());
+    before = s;
   }
   return all;
 }

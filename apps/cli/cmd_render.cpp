@@ -58,7 +58,7 @@ int run_render(const RenderSettings& s) {
   const Box3i content = in.world.voxels.content_bounds().intersect(in.extent);
   Camera camera =
       Camera::parse(s.camera, s.camera == "top" || content.empty() ? in.extent : content, aspect);
-  if (s.camera_frame == "world" && s.camera != "auto" && s.camera != "top")
+  if (s.camera_frame == "world" && !Camera::frames_the_box(s.camera))
     camera = camera.in_voxels(in.world.frame);
 
   const RenderScene scene(in.world, so, in.extent);

@@ -79,7 +79,7 @@ int run_render(MPI_Comm comm, const RenderSettings& s) {
     const Camera c =
         Camera::parse(s.camera, s.camera == "top" || content.empty() ? domain : content,
                       static_cast<double>(s.width) / s.height);
-    const bool world = s.camera_frame == "world" && s.camera != "auto" && s.camera != "top";
+    const bool world = s.camera_frame == "world" && !Camera::frames_the_box(s.camera);
     return world ? c.in_voxels(slab.world.frame) : c;
   });
   mpi::ExchangeStats ex;

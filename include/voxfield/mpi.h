@@ -353,10 +353,12 @@ struct MeshFileSummary {
 };
 
 // Collective: meshes as mesh_volume does and writes the mesh to `path` (the format its extension
-// names, mesh_files.h) with no rank ever holding more than its own share of it. Each rank welds
-// its piece with what its neighbours lend it (PieceWeld: vertex numbers across the cuts, orphans
-// first used before its layers) and writes its vertices and triangles at their places in the
-// file: the bytes write_mesh writes for mesh_volume's mesh, atomically (staged beside the target
+// names, mesh_files.h) with no rank ever holding more than its own share of it. Marching cubes:
+// each rank's slab is one run of the mesh's vertices and triangles (an exclusive scan numbers
+// them). The dual meshers: each rank welds its piece with what its neighbours lend it
+// (PieceWeld: vertex numbers across the cuts, orphans first used before its layers). Each rank
+// writes its vertices and triangles at their places in the file: the bytes write_mesh writes for
+// mesh_volume's mesh (the one process's mesh named above), atomically (staged beside the target
 // by rank 0, renamed once every rank has written; a failure anywhere leaves the target as it
 // was). `census` (the same on every rank): also mesh_stats over the ranks (each edge the cuts split
 // counted by the rank holding its lower vertex). `into` (rank 0's; null on the others): the file is

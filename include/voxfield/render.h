@@ -47,14 +47,19 @@ struct Camera {
   // "top", "auto" or "eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height]" (ortho=
   // makes it orthographic). Throws InvalidArgument naming the bad part.
   static Camera parse(const std::string& spec, const Box3i& box, double aspect);
+  // Whether parse() frames the box for `spec` ("auto", "top" or empty) rather than placing the
+  // camera where the spec says: only a placed camera has a frame to be given in.
+  static bool frames_the_box(const std::string& spec) {
+    return spec.empty() || spec == "auto" || spec == "top";
+  }
 
   // This camera given in the world frame of `frame` (eye, target and up in world coordinates,
   // the orthographic height in world units), as the renderer takes it: in voxel coordinates. A
   // rotation, a translation and one scale carry a pinhole camera onto a pinhole camera, so the
   // frame drawn is the world's view exactly — the same rays, hits and pixels as a camera placed
-  // in voxels by hand. Voxels that are not cubes would skew the rays (a pinhole camera in the
-  // world is no pinhole camera in voxels): refused (InvalidArgument naming the voxel size), as
-  // is a frame that validate() refuses.
+  // in voxels by hand. Voxels that are not cubes (beyond a part in 10^6) would turn it into a
+  // pinhole camera with skewed, non-square image axes, which Camera does not express: refused
+  // (InvalidArgument naming the voxel size), as is a frame that validate() refuses.
   Camera in_voxels(const VoxelFrame& frame) const;
 
   // Rays through the pixels of a width x height image, with the camera's basis computed once.

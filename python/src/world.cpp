@@ -366,7 +366,7 @@ void bind_world(py::module_& parent) {
           const Box3i content = w.world.voxels.content_bounds().intersect(extent);
           Camera cam =
               Camera::parse(camera, camera == "top" || content.empty() ? extent : content, aspect);
-          if (camera_frame == "world" && camera != "auto" && camera != "top")
+          if (camera_frame == "world" && !Camera::frames_the_box(camera))
             cam = cam.in_voxels(w.world.frame);
           const RenderScene scene(w.world, so, extent);
           image = voxfield::render(scene, cam, o, nullptr, &signals);

@@ -31,8 +31,9 @@ class FlyingEdges {
   // sample (naming the first) or more vertices than 32-bit indices hold, ResourceLimitError when
   // the bookkeeping passes the memory limit, Cancelled when the interrupter asks.
   // `z_offset`: the lattice is planes [z_offset, z_offset + n.z) of a larger one (a slab of it,
-  // mesh_slab.cpp), whose frame the positions, sources and messages are in — the positions bit for
-  // bit those of the whole lattice's rows wherever the slab holds their gradients' stencils.
+  // mesh_slab.cpp), whose frame the positions, sources and messages are in — positions bit for
+  // bit those of the whole lattice, normals too wherever the slab holds their gradients' stencils
+  // (a plane either side of the edge's ends).
   FlyingEdges(const Lattice& lattice, Interrupter* interrupter, int z_offset = 0);
   std::size_t vertices() const { return vertices_; }
   std::size_t indices() const { return indices_; }

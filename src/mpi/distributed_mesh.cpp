@@ -238,12 +238,16 @@ Mesh lay_runs(const std::vector<std::vector<std::uint8_t>>& runs, std::uint64_t 
     std::memcpy(counts, run.data(), sizeof counts);
     const std::uint8_t* at = run.data() + sizeof counts;
     const std::size_t n = static_cast<std::size_t>(counts[0]);
-    const auto* p = reinterpret_cast<const std::array<float, 3>*>(at);
-    mesh.positions.insert(mesh.positions.end(), p, p + n);
-    const auto* q = reinterpret_cast<const std::array<float, 3>*>(at + 12 * n);
-    mesh.normals.insert(mesh.normals.end(), q, q + n);
-    const auto* i = reinterpret_cast<const std::uint32_t*>(at + 24 * n);
-    mesh.indices.insert(mesh.indices.end(), i, i + counts[1]);
+    const std::size_t m = static_cast<std::size_t>(counts[1]);
+    const std::size_t v0 = mesh.positions.size(), i0 = mesh.indices.size();
+    mesh.positions.resize(v0 + n);
+    mesh.normals.resize(v0 + n);
+    mesh.indices.resize(i0 + m);
+    if (n > 0) {
+      std::memcpy(mesh.positions.data() + v0, at, 12 * n);
+      std::memcpy(mesh.normals.data() + v0, at + 12 * n, 12 * n);
+    }
+    if (m > 0) std::memcpy(mesh.indices.data() + i0, at + 24 * n, 4 * m);
   }
   return mesh;
 }
@@ -271,9 +275,10 @@ Mesh mesh_by_slabs(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& 
   const std::uint64_t indices =
       detail::exclusive_scan(comm, slab ? slab->part.indices.size() : 0, stats).second;
   std::vector<std::uint8_t> run = detail::collectively(comm, stats, [&] {
-    if (vertices > std::numeric_limits<std::uint32_t>::max())
-      throw InvalidArgument("mpi::mesh_volume: the mesh has " + std::to_string(vertices) +
-                            " vertices, more than 32-bit indices hold");
+    // One process's bound (count_rows): the same meshes refused.
+    if (vertices > std::numeric_limits<std::uint32_t>::max() - 1)
+      throw InvalidArgument("mesh: " + std::to_string(vertices) +
+                            " vertices do not fit 32-bit indices; mesh a smaller volume");
     return slab ? run_bytes(*slab, first_vertex) : std::vector<std::uint8_t>{};
   });
   slab.reset();

@@ -196,11 +196,11 @@ Share slab_share(MPI_Comm comm, const MeshLayers& layers, std::optional<MeshSlab
   s.first_vertex = first_vertex;
   s.first_orphan = vertices;  // (no orphans: every vertex is a row's)
   detail::collectively(comm, stats, [&] {
+    // One process's bound (count_rows): the same meshes refused.
+    if (vertices > std::numeric_limits<std::uint32_t>::max() - 1)
+      throw InvalidArgument("mesh: " + std::to_string(vertices) +
+                            " vertices do not fit 32-bit indices; mesh a smaller volume");
     if (!slab) return;
-    if (first_vertex + slab->part.vertex_count() > std::numeric_limits<std::uint32_t>::max() + 1ull)
-      throw InvalidArgument(
-          "mpi::write_mesh_volume: the mesh has more vertices than 32-bit "
-          "indices hold");
     const std::uint64_t first_plane = slab->first_plane_vertices;
     s.part = std::move(slab->part);
     slab.reset();

@@ -2,6 +2,7 @@
 // and the CLI's camera strings.
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <numbers>
 #include <sstream>
 #include <vector>
@@ -120,7 +121,7 @@ Camera Camera::top(const Box3i& box, double aspect) {
 
 Camera Camera::parse(const std::string& spec, const Box3i& box, double aspect) {
   if (spec == "top") return top(box, aspect);
-  if (spec == "auto" || spec.empty()) return framing(box, aspect);
+  if (frames_the_box(spec)) return framing(box, aspect);
   Camera c;
   bool has_eye = false, has_target = false;
   std::stringstream ss(spec);
@@ -164,14 +165,16 @@ Camera Camera::parse(const std::string& spec, const Box3i& box, double aspect) {
 Camera Camera::in_voxels(const VoxelFrame& frame) const {
   frame.validate("camera: the world's frame");
   const Vec3d s = frame.voxel_size_world;
-  // Equal to a part in 10^12 (what a size read from a file and multiplied keeps): the voxels
-  // are cubes, and the rays stay those of the world's camera.
+  // Equal to a part in 10^6: cubes, as a float pipeline's transform states them (a .vdb's
+  // rotated matrix is rescued within 1e-5, VoxelFrame::from_matrix, and its columns' lengths then
+  // differ in the eighth digit); the rays stay those of the world's camera within that.
   const double size = (s.x + s.y + s.z) / 3;
-  if (std::abs(s.x - size) > 1e-12 * size || std::abs(s.y - size) > 1e-12 * size ||
-      std::abs(s.z - size) > 1e-12 * size) {
+  if (std::abs(s.x - size) > 1e-6 * size || std::abs(s.y - size) > 1e-6 * size ||
+      std::abs(s.z - size) > 1e-6 * size) {
     std::ostringstream os;
-    os << "camera: a camera in world units needs cubic voxels; this world's are " << s.x << " x "
-       << s.y << " x " << s.z << " (give the camera in voxels instead)";
+    os << std::setprecision(9) << "camera: a camera in world units needs cubic voxels; this "
+       << "world's are " << s.x << " x " << s.y << " x " << s.z
+       << " (give the camera in voxels instead)";
     throw InvalidArgument(os.str());
   }
   Camera c = *this;
