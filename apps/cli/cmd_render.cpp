@@ -56,10 +56,9 @@ int run_render(const RenderSettings& s) {
   const double aspect = static_cast<double>(s.width) / s.height;
   // Automatic cameras frame what is there: the content, within the file's extent.
   const Box3i content = in.world.voxels.content_bounds().intersect(in.extent);
-  Camera camera =
-      Camera::parse(s.camera, s.camera == "top" || content.empty() ? in.extent : content, aspect);
-  if (s.camera_frame == "world" && !Camera::frames_the_box(s.camera))
-    camera = camera.in_voxels(in.world.frame);
+  const Camera camera =
+      Camera::parse(s.camera, s.camera == "top" || content.empty() ? in.extent : content, aspect,
+                    s.camera_frame == "world" ? &in.world.frame : nullptr);
 
   const RenderScene scene(in.world, so, in.extent);
   // With --repeat, the frame is rendered several times and the median time reported (the

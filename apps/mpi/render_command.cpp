@@ -76,11 +76,9 @@ int run_render(MPI_Comm comm, const RenderSettings& s) {
   // file's extent.
   const Box3i content = mpi::content_bounds(comm, slab.partition, slab.world);
   const Camera camera = mpi::collectively(comm, [&] {
-    const Camera c =
-        Camera::parse(s.camera, s.camera == "top" || content.empty() ? domain : content,
-                      static_cast<double>(s.width) / s.height);
-    const bool world = s.camera_frame == "world" && !Camera::frames_the_box(s.camera);
-    return world ? c.in_voxels(slab.world.frame) : c;
+    return Camera::parse(s.camera, s.camera == "top" || content.empty() ? domain : content,
+                         static_cast<double>(s.width) / s.height,
+                         s.camera_frame == "world" ? &slab.world.frame : nullptr);
   });
   mpi::ExchangeStats ex;
   RenderStats st;

@@ -45,8 +45,11 @@ struct Camera {
   // exactly along the limiting axis (both, when the aspect ratios agree), centred on the other.
   static Camera top(const Box3i& box, double aspect);
   // "top", "auto" or "eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height]" (ortho=
-  // makes it orthographic). Throws InvalidArgument naming the bad part.
-  static Camera parse(const std::string& spec, const Box3i& box, double aspect);
+  // makes it orthographic). Throws InvalidArgument naming the bad part. `placed_in`, when given:
+  // a placed camera's coordinates and heights are in that world frame (in_voxels, which may
+  // refuse it); auto and top frame the box either way.
+  static Camera parse(const std::string& spec, const Box3i& box, double aspect,
+                      const VoxelFrame* placed_in = nullptr);
   // Whether parse() frames the box for `spec` ("auto", "top" or empty) rather than placing the
   // camera where the spec says: only a placed camera has a frame to be given in.
   static bool frames_the_box(const std::string& spec) {

@@ -364,10 +364,9 @@ void bind_world(py::module_& parent) {
           if (extent.empty()) throw InvalidArgument("render: the world holds no volume");
           // As the CLI: automatic cameras frame the content, within the extent.
           const Box3i content = w.world.voxels.content_bounds().intersect(extent);
-          Camera cam =
-              Camera::parse(camera, camera == "top" || content.empty() ? extent : content, aspect);
-          if (camera_frame == "world" && !Camera::frames_the_box(camera))
-            cam = cam.in_voxels(w.world.frame);
+          const Camera cam =
+              Camera::parse(camera, camera == "top" || content.empty() ? extent : content, aspect,
+                            camera_frame == "world" ? &w.world.frame : nullptr);
           const RenderScene scene(w.world, so, extent);
           image = voxfield::render(scene, cam, o, nullptr, &signals);
         }

@@ -119,7 +119,8 @@ Camera Camera::top(const Box3i& box, double aspect) {
   return c;
 }
 
-Camera Camera::parse(const std::string& spec, const Box3i& box, double aspect) {
+Camera Camera::parse(const std::string& spec, const Box3i& box, double aspect,
+                     const VoxelFrame* placed_in) {
   if (spec == "top") return top(box, aspect);
   if (frames_the_box(spec)) return framing(box, aspect);
   Camera c;
@@ -159,7 +160,7 @@ Camera Camera::parse(const std::string& spec, const Box3i& box, double aspect) {
   if (forward.length() == 0) throw InvalidArgument("camera: eye and target coincide");
   if (cross(forward, c.up).length() <= 1e-9 * forward.length() * c.up.length())
     throw InvalidArgument("camera: up is parallel to the view direction (or zero)");
-  return c;
+  return placed_in ? c.in_voxels(*placed_in) : c;
 }
 
 Camera Camera::in_voxels(const VoxelFrame& frame) const {
