@@ -8,7 +8,8 @@
 # libFuzzer finds go to a scratch corpus, not into the repository; a crash stops that harness, its
 # report (on stdout, with the log's tail) names the crashing input under $FUZZ_OUT, and the run
 # fails once every harness has finished.
-# Usage: bash fuzz/run.sh [SECONDS] [HARNESS...]   (needs build/fuzz and build/release/bin/voxfield)
+# Usage: bash fuzz/run.sh [SECONDS] [HARNESS...]   (needs build/fuzz and build/release/bin/voxfield,
+# or the optimised CLI named by VOXFIELD_CLI)
 # FUZZ_JOBS=N runs N harnesses at once (one per core for CI's smoke);
 # FUZZ_RUNS=N stops each harness after N executions instead (with SECONDS still the cap);
 # FUZZ_TIMEOUT=S sets the per-input time-out (default 20 s; a campaign at nice 19 beside a build
@@ -18,7 +19,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-25}; shift || true
 harnesses=${*:-"vox npy vfw vdb edit_script options vector_sources csg_model openscad mesh mesh_pieces"}
 bin=build/fuzz/bin
-cli=build/release/bin/voxfield
+cli=${VOXFIELD_CLI:-build/release/bin/voxfield}
 corpus=../shared/data/vox
 out=${FUZZ_OUT:-$(mktemp -d)}
 mkdir -p "$out"

@@ -11,8 +11,9 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 phase_start=$SECONDS
 phase_done() { echo "=== $1: $((SECONDS - phase_start)) s ==="; phase_start=$SECONDS; }
+# release-ci is the release preset built as unity batches (CMakePresets.json says why);
 # cpu-only-ci is the cpu-only preset at -O1 (what CI checks there does not depend on optimisation).
-presets=${VOXFIELD_TEST_PRESETS:-"release cpu-only-ci asan-ubsan tsan"}
+presets=${VOXFIELD_TEST_PRESETS:-"release-ci cpu-only-ci asan-ubsan tsan"}
 for preset in $presets; do
   echo "=== voxfield tests: $preset ==="
   cmake --preset "$preset" >/dev/null
@@ -24,7 +25,11 @@ done
 fuzz_seconds=${VOXFIELD_FUZZ_SECONDS:-15}
 if [ "$fuzz_seconds" -gt 0 ]; then
   echo "=== voxfield fuzz smoke: ${fuzz_seconds}s per harness ==="
-  cmake --preset release >/dev/null && cmake --build --preset release --target voxfield_cli  # makes the seeds
+  # The seeds are made by an optimised CLI: the one this run built, or release's.
+  cli_preset=release
+  case " $presets " in *" release-ci "*) cli_preset=release-ci ;; esac
+  cmake --preset $cli_preset >/dev/null && cmake --build --preset $cli_preset --target voxfield_cli
+  export VOXFIELD_CLI=build/$cli_preset/bin/voxfield
   cmake --preset fuzz >/dev/null
   cmake --build --preset fuzz
   phase_done "fuzz build"

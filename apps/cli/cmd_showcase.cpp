@@ -259,7 +259,7 @@ int run_showcase(const ShowcaseSettings& s) {
         "voxels), the world below the cut shaded.\n\n![distance](terrain-distance.png)\n";
 
   showcase_meshing(terrain, s.out, fs::path(s.out) / "terrain-sdf.npy", s.peers, hero, md, timings);
-  showcase_mesh_input(terrain, s.out, md, timings);
+  showcase_mesh_input(terrain, s.size, s.out, md, timings);
   showcase_terrain(s.out, s.seed, md, timings);
 
   // Where the dissertation's approximations let rays skip through geometry, on the small terrain.

@@ -38,8 +38,8 @@ inline std::shared_ptr<gpu::Context> showcase_vulkan(std::ostream& md) {
 
 // A picture's edge in pixels in a showcase of `size`³ worlds: `full` at the default size (256)
 // and above, down to a quarter of it below 64. The sections whose scenes do not follow --size
-// (the CSG models, the vector fields) draw their pictures this size, so that the small runs the
-// tests make (--size 48, under the sanitizers too) stay short.
+// (the CSG models, the vector fields, the Stanford bunny) draw their pictures this size, so that
+// the small runs the tests make (--size 48, under the sanitizers too) stay short.
 inline int picture_pixels(int full, int size) {
   return full * std::clamp(size, 64, 256) / 256;
 }
@@ -56,8 +56,8 @@ inline std::string fixed(double v, int digits) {
 // Meshes in: a block of `terrain` meshed, written as `out`/terrain-block.obj, read back, voxelised
 // and set against the block; its signed distance field; the Stanford bunny when
 // scripts/fetch-test-meshes.sh has fetched it.
-void showcase_mesh_input(const World& terrain, const std::filesystem::path& out, std::ostream& md,
-                         std::vector<Timing>& timings);
+void showcase_mesh_input(const World& terrain, int size, const std::filesystem::path& out,
+                         std::ostream& md, std::vector<Timing>& timings);
 void showcase_meshing(const World& terrain, const std::filesystem::path& out,
                       const std::filesystem::path& sdf_npy,
                       const std::filesystem::path& peers_script, const Camera& hero,

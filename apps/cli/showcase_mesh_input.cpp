@@ -22,7 +22,7 @@ namespace voxfield::cli {
 
 namespace fs = std::filesystem;
 
-void showcase_mesh_input(const World& terrain, const fs::path& out, std::ostream& md,
+void showcase_mesh_input(const World& terrain, int size, const fs::path& out, std::ostream& md,
                          std::vector<Timing>& timings) {
   // A 96³ block from the terrain's middle, as a world of its own (air around it: a closed surface).
   const Box3i whole =
@@ -99,7 +99,9 @@ void showcase_mesh_input(const World& terrain, const fs::path& out, std::ostream
   // The bunny stands on y (OBJ's habit); voxfield's worlds stand on z: a quarter turn about x.
   for (auto& p : bunny.positions) p = {p[0], -p[2], p[1]};
   MeshVoxelOptions bo;
-  bo.voxel_size = 0.012;
+  // 0.012 units (the bunny about 130 voxels tall) at the default size; coarser in the small runs
+  // the tests make, as the pictures are (picture_pixels).
+  bo.voxel_size = 0.012 * 256 / std::clamp(size, 64, 256);
   bo.padding_voxels = 0;
   t = std::chrono::steady_clock::now();
   World bunny_world = voxelize_mesh(bunny, bo);
@@ -108,15 +110,17 @@ void showcase_mesh_input(const World& terrain, const fs::path& out, std::ostream
   write_vox(bunny_world, out / "bunny.vox");
   const RenderScene scene(bunny_world);
   RenderOptions ro;
-  ro.width = ro.height = 720;
+  ro.width = ro.height = picture_pixels(720, size);
   const Camera cam = Camera::framing(bunny_world.voxels.content_bounds(), 1.0);
   write_png(render(scene, cam, ro), out / "bunny.png");
   md << "\nThe Stanford bunny (`" << bunny_path.string() << "`, " << bunny.triangles.size()
-     << " triangles, from Debian's glmark2-data) voxelised at 0.012: " << bunny_world.solid_count()
-     << " voxels in " << fixed(bunny_ms, 0)
+     << " triangles, from Debian's glmark2-data) voxelised at " << bo.voxel_size << ": "
+     << bunny_world.solid_count() << " voxels in " << fixed(bunny_ms, 0)
      << " ms, saved as `bunny.vox`.\n\n![the bunny](bunny.png)\n";
+  std::ostringstream at;
+  at << bo.voxel_size;
   timings.push_back({"voxelise the Stanford bunny (" + std::to_string(bunny.triangles.size()) +
-                         " triangles) at 0.012",
+                         " triangles) at " + at.str(),
                      bunny_ms, std::to_string(bunny_world.solid_count()) + " voxels"});
   // The voxelised bunny keeps the mesh's units as its frame (docs/frames.md): meshed again, it
   // lands where the bunny was, and its .vfw keeps the frame for the next tool.
@@ -140,7 +144,8 @@ void showcase_mesh_input(const World& terrain, const fs::path& out, std::ostream
   double off = 0;
   for (int a = 0; a < 3; ++a)
     off = std::max({off, std::abs(lo_in[a] - lo_out[a]), std::abs(hi_in[a] - hi_out[a])});
-  md << "\nIn its frame (origin 0, voxel size 0.012, the mesh's units; `bunny.vfw` keeps it), the "
+  md << "\nIn its frame (origin 0, voxel size " << bo.voxel_size
+     << ", the mesh's units; `bunny.vfw` keeps it), the "
         "voxelised bunny meshed again by surface nets (`bunny-remeshed.obj`, "
      << remeshed.triangle_count() << " triangles, " << fixed(remesh_ms, 0)
      << " ms) lands on the bunny: its bounding box is within " << fixed(off / bo.voxel_size, 2)
