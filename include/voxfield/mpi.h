@@ -272,9 +272,10 @@ void save_world_vfw(MPI_Comm comm, const SlabPartition& partition, const World& 
 // slices count once, in the slab that owns them: what a camera frames.
 Box3i content_bounds(MPI_Comm comm, const SlabPartition& partition, const World& world);
 
-// Frames of the world the ranks hold in slabs, drawn where it lies (render_relay.h): each rank
-// walks the rays that cross its slab, primary and shadow rays alike, and sends each on to the rank
-// whose slab it enters; each pixel is shaded by the rank where its primary ray hit. Rank 0 returns
+// Frames of the world the ranks hold in slabs, drawn where it lies (render_relay.h): every rank
+// walks its stretch of every primary ray at once, the first hit along each ray is the pixel's
+// (MPI_MINLOC), and the shadow rays of those hits are relayed, each sent on to the rank whose slab
+// it enters; each pixel is shaded by the rank where its primary ray first hit. Rank 0 returns
 // the frame — render(RenderScene(whole world, scene_options, partition.domain), camera, options)
 // byte for byte, for a world whose content lies within the domain — and the others an empty
 // image. `world` must hold the rank's relay_world_box (its slab and relay_ghost_slices slices on
@@ -282,7 +283,7 @@ Box3i content_bounds(MPI_Comm comm, const SlabPartition& partition, const World&
 // boundaries (partition_slabs with the chunk edge when the domain has a chunk layer per rank). The
 // skip field is computed over the ranks (compute_distance_field above), the lighting field by each
 // rank over its slab and ghost slices. Views: shaded and chunks. `stats`: this rank's walks (a
-// relayed ray counts once per rank).
+// ray counts once per rank that walked a stretch of it).
 Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
              const RenderSceneOptions& scene_options, const Camera& camera,
              const RenderOptions& options, RenderStats* stats = nullptr,

@@ -3,22 +3,28 @@
 //
 // Sort-last compositing usually has every part draw its own image and keeps each pixel's nearest
 // hit; shadows that one part casts on another are then lost, and a skipping ray's walk would depend
-// on where it started. Here the walk itself is relayed. A traversal is a function of its ray and
-// of the DDA's state at the voxel it has reached (render/dda.h: every event time comes from one
-// formula, never accumulated), and that state is the voxel, the time the ray entered it and the
-// face it crossed — so a part that resumes a ray there visits exactly the voxels, skips included,
-// that one walk through the whole world visits. Primary rays and the sun's shadow rays are both
-// relayed; a pixel is shaded by the part where its primary ray hit, with the shadow its shadow ray
-// found wherever that ended. The frame equals render() of the whole world's scene byte for byte,
-// for any cut into parts on chunk boundaries.
+// on where it started. Here the walks follow the one walk through the whole world. A traversal is
+// a function of its ray and of the DDA's state at the voxel it has reached (render/dda.h: every
+// event time comes from one formula, never accumulated, and a skip lands where the plain DDA
+// would), and that state is the voxel, the time the ray entered it and the face it crossed. A
+// primary ray's first hit is the first solid voxel of the plain DDA's sequence, so every part walks
+// its own stretch of every primary ray at once, from the state the plain DDA has where the ray
+// enters the part; the hit that comes first along the ray is the pixel's. A shadow ray's penumbra
+// depends on every voxel it read, so it is relayed: a part resumes it where the last one left it
+// and visits exactly the voxels, skips included, that one walk visits. A pixel is shaded by the
+// part where its primary ray first hit, with the shadow its shadow ray found wherever that ended.
+// The frame equals render() of the whole world's scene byte for byte, for any cut into parts on
+// chunk boundaries.
 //
-// One part's steps: start() the primary rays that begin in it, then walk() the legs other parts
-// hand over until no part has any left (each returns the legs that left its part, to be routed by
-// their voxel's z), then shade() with every pixel's shadow, and finish() the frame from every
-// part's shaded pixels. mpi.h's mpi::render runs them over the ranks of a job.
+// One part's steps: start() its stretches of the primary rays, which gives its hit per pixel; then
+// start_shadows() with every pixel's first hit (the minimum over the parts' RelayHits), then walk()
+// the legs other parts hand over until no part has any left (each returns the legs that left its
+// part, to be routed by their voxel's z), then shade() with every pixel's shadow, and finish() the
+// frame from every part's shaded pixels. mpi.h's mpi::render runs them over the ranks of a job.
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -29,17 +35,26 @@
 
 namespace voxfield {
 
-// A ray's walk paused at the first voxel outside the part that walked it. Plain bytes (it crosses
-// processes as they are).
+// A shadow ray's walk paused at the first voxel outside the part that walked it. Plain bytes (it
+// crosses processes as they are).
 struct RayLeg {
-  Vec3d origin;                 // the ray's origin (a shadow ray's lies just off its pixel's hit)
+  Vec3d origin;                 // the shadow ray's origin, just off its pixel's hit
   double t = 0;                 // the ray parameter at which it entered `voxel`
-  double lit = 1;               // a shadow ray's penumbra estimate so far
+  double lit = 1;               // the penumbra estimate so far
   Vec3i voxel;                  // where the walk resumes
   std::uint32_t pixel = 0;      // y * width + x
   std::int8_t face_axis = -1;   // the axis crossed to enter `voxel`
-  std::uint8_t shadow = 0;      // 0: the pixel's primary ray; 1: the shadow ray of its hit
-  std::uint8_t unused[6] = {};  // 64 bytes with no padding: every byte sent is set
+  std::uint8_t unused[7] = {};  // 64 bytes with no padding: every byte sent is set
+};
+
+// A part's hit for a pixel's primary ray: the ray parameter at which the ray entered the hit voxel
+// (+inf: no hit in the part) and the part's place along the ray (smaller: met first). Ordered by t,
+// then by place, the smallest over the parts is the pixel's first hit: two parts' hits can share a
+// t where the ray crosses a voxel edge on their border, and the plain DDA enters the part it meets
+// first first. The layout of MPI's MPI_DOUBLE_INT (mpi::render reduces it with MPI_MINLOC).
+struct RelayHit {
+  double t = std::numeric_limits<double>::infinity();
+  std::int32_t along = 0;
 };
 
 // The slices beyond its part, on either side along z, that a part's world must hold (within the
@@ -77,11 +92,16 @@ class RelayFrame {
   RelayFrame(const RelayFrame&) = delete;
   RelayFrame& operator=(const RelayFrame&) = delete;
 
-  // Walks the primary rays of the pixels whose walk through `whole` starts in `part` (each part
-  // finds the same ones for itself); returns the legs that left the part for another.
-  std::vector<RayLeg> start();
-  // Resumes legs whose voxel lies in `part`; returns the legs that left it (InvalidArgument for a
-  // leg that is not this part's, names no pixel, or shares its pixel with another).
+  // Walks every primary ray's stretch in `part`, from where the plain DDA through `whole` enters
+  // it, whichever part the ray crossed before; returns this part's hit per pixel (y * width + x).
+  const std::vector<RelayHit>& start();
+  // Given every pixel's first hit (per pixel, the smallest of the parts' start() by t, then by
+  // place), keeps the hits that are their pixel's first and starts their shadow rays; returns the
+  // legs that left the part for another (InvalidArgument for a count that is not the pixels').
+  std::vector<RayLeg> start_shadows(std::span<const RelayHit> first);
+  // Resumes shadow legs whose voxel lies in `part`; returns the legs that left it
+  // (InvalidArgument for a leg that is not this part's, names no pixel, or shares its pixel with
+  // another).
   std::vector<RayLeg> walk(std::span<const RayLeg> legs);
   // Per pixel (y * width + x): the shadow of the pixels whose shadow ray ended in this part (1
   // where the hit here needs none), +inf elsewhere. Their minimum over the parts is every hit
@@ -93,8 +113,9 @@ class RelayFrame {
   // The frame from the per-byte maximum of every part's shade(): the sky where no part hit.
   Image finish(std::span<const std::uint8_t> rgba) const;
   // What this part walked: rays and their steps, skips and reads (a ray counts once in each part
-  // it crossed, and only if it entered the whole box: render() counts every pixel's), and ms the
-  // time in start() and walk().
+  // that walked a stretch of it, and only if it entered the whole box: render() counts every
+  // pixel's; a primary ray's stretches past its first hit are walked too), and ms the time in
+  // start(), start_shadows() and walk().
   const RenderStats& stats() const;
 
  private:

@@ -1,11 +1,14 @@
-// voxfield — frames of a world split over the ranks (mpi.h): the rays relayed between the slabs
-// (render_relay.h), each leg sent to the rank whose slab holds its voxel, until no rank has one.
-// Then every pixel's shadow is the minimum over the ranks of the shadows their walks ended with,
-// and the frame the per-byte maximum of the ranks' shaded pixels (each pixel shaded by one rank
-// alone, the others' bytes zero), which rank 0 finishes with the sky.
+// voxfield — frames of a world split over the ranks (mpi.h; render_relay.h): every rank walks its
+// stretch of every primary ray at once, and every pixel's first hit is the MINLOC over the ranks of
+// their hits. The shadow rays of those hits are relayed between the slabs, each leg sent to the
+// rank whose slab holds its voxel, until no rank has one. Then every pixel's shadow is the minimum
+// over the ranks of the shadows their walks ended with, and the frame the per-byte maximum of the
+// ranks' shaded pixels (each pixel shaded by one rank alone, the others' bytes zero), which rank 0
+// finishes with the sky.
 #include <mpi.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <memory>
 #include <type_traits>
 #include <vector>
@@ -20,6 +23,11 @@ namespace {
 
 static_assert(std::is_trivially_copyable_v<RayLeg> && sizeof(RayLeg) == 64,
               "legs cross processes as bytes, every one of them set");
+// MPI_DOUBLE_INT is the pair struct { double; int; }.
+static_assert(std::is_trivially_copyable_v<RelayHit> && offsetof(RelayHit, t) == 0 &&
+                  offsetof(RelayHit, along) == sizeof(double) &&
+                  sizeof(std::int32_t) == sizeof(int),
+              "hits are reduced as MPI_DOUBLE_INT");
 
 // The rank whose slab holds slice z.
 int owner_of(const SlabPartition& partition, std::int32_t z) {
@@ -110,7 +118,17 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
                                         camera, options);
   });
   const LegType leg_type;
-  std::vector<RayLeg> legs = detail::collectively(comm, exchange, [&] { return part->start(); });
+  const std::vector<RelayHit>& mine =
+      *detail::collectively(comm, exchange, [&] { return &part->start(); });
+  std::vector<RelayHit> first =
+      detail::collectively(comm, exchange, [&] { return std::vector<RelayHit>(mine.size()); });
+  {
+    detail::CollectiveTimer timer(exchange);
+    MPI_Allreduce(mine.data(), first.data(), static_cast<int>(mine.size()), MPI_DOUBLE_INT,
+                  MPI_MINLOC, comm);
+  }
+  std::vector<RayLeg> legs =
+      detail::collectively(comm, exchange, [&] { return part->start_shadows(first); });
   for (;;) {
     std::uint64_t mine = legs.size(), in_flight = 0;
     {
@@ -139,8 +157,10 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
                0, comm);
   }
   if (exchange) {
-    exchange->bytes_sent += ends.size() * sizeof(double) + rgba.size();
-    exchange->bytes_received += ends.size() * sizeof(double) + frame_rgba.size();
+    exchange->bytes_sent +=
+        mine.size() * sizeof(RelayHit) + ends.size() * sizeof(double) + rgba.size();
+    exchange->bytes_received +=
+        first.size() * sizeof(RelayHit) + ends.size() * sizeof(double) + frame_rgba.size();
   }
   if (stats) *stats = part->stats();
   // (Agreed on too: a rank 0 that failed here would leave the others waiting in the caller's next

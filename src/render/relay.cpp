@@ -1,11 +1,14 @@
 // voxfield renderer — frames relayed part by part across scenes (render_relay.h).
 //
 // Each part walks rays with the frame renderer's own traversal step (traverse.h's visit) inside its
-// slab; a ray that leaves the slab for another part of the whole box becomes a RayLeg carrying the
-// DDA's state, which the next part resumes with Dda::start — the state a walk through the whole box
-// has at that voxel (dda.h), so the walk goes on exactly as one process's would. A soft shadow's
-// penumbra travels with its leg: the minimum over the voxels read is the same whichever part read
-// them.
+// slab. Every walk, skips included, visits the plain DDA's voxels in the plain DDA's order with its
+// times and faces (dda.h), so a part can start a primary ray where the plain DDA enters the part
+// (Dda::leave of the box between the ray's entry into the whole box and the part) without waiting
+// for the parts before it: all parts walk their stretches of every primary ray at once, and the
+// first hit along the ray is the pixel's. A shadow ray that leaves the slab becomes a RayLeg
+// carrying the DDA's state, which the next part resumes with Dda::start, its penumbra travelling
+// along (the minimum over the voxels read is the same whichever part read them); it cannot start
+// early, since its estimate depends on every voxel before.
 #include "voxfield/render_relay.h"
 
 #include <chrono>
@@ -127,6 +130,7 @@ struct RelayFrame::Impl {
   Camera::Projector projector;
   HitShading light;
   std::vector<RayHit> hits;
+  std::vector<RelayHit> candidates;  // this part's hit per pixel, for the pixel's first
   std::vector<double> shadow_ends;
   RenderStats stats;
   std::mutex merge;
@@ -145,7 +149,7 @@ struct RelayFrame::Impl {
     return projector.ray(pixel % static_cast<std::uint32_t>(o.width) + 0.5,
                          pixel / static_cast<std::uint32_t>(o.width) + 0.5);
   }
-  static RayLeg leg_of(const Ray& ray, const Dda& d, std::uint32_t pixel, bool shadow, double lit) {
+  static RayLeg leg_of(const Ray& ray, const Dda& d, std::uint32_t pixel, double lit) {
     RayLeg leg;
     leg.origin = ray.origin;
     leg.voxel = d.v;
@@ -153,12 +157,39 @@ struct RelayFrame::Impl {
     leg.lit = lit;
     leg.pixel = pixel;
     leg.face_axis = static_cast<std::int8_t>(d.face_axis);
-    leg.shadow = shadow ? 1 : 0;
     return leg;
   }
 
+  // The part's place along a ray (smaller first): parts are slabs along z, met in increasing z by
+  // a ray rising and in decreasing z by one falling (one that keeps its z stays in one part).
+  std::int32_t along(const Ray& ray) const {
+    return ray.direction.z < 0 ? -part.begin.z : part.begin.z;
+  }
+
+  // Moves a walk that entered the whole box outside the part to the voxel where the plain DDA
+  // enters the part: leaving the box that reaches from dda's voxel to the part along z and to the
+  // whole box's faces along x and y lands there, on the plain DDA's voxel, time and face (dda.h).
+  // False when the ray moves away from the part or leaves the whole box first.
+  bool enter_part(Dda& dda) const {
+    int caps[3] = {0, 0, 0};
+    if (dda.step[2] > 0 && dda.v.z < part.begin.z) {
+      caps[2] = part.begin.z - dda.v.z - 1;
+    } else if (dda.step[2] < 0 && dda.v.z >= part.end.z) {
+      caps[2] = dda.v.z - part.end.z;
+    } else {
+      return false;
+    }
+    for (int a = 0; a < 2; ++a)
+      caps[a] = dda.step[a] > 0 ? whole.end[a] - 1 - dda.v[a] : dda.v[a] - whole.begin[a];
+    const Dda::Exit e = dda.exit_of(caps);
+    if (e.axis != 2) return false;
+    dda.leave(caps, e);
+    return true;
+  }
+
   // Walks a ray from dda's voxel (in the part) until it hits, leaves the whole box, or leaves the
-  // part for another (then a leg goes to `out`).
+  // part for another (a shadow ray then goes on as a leg in `out`; the part a primary ray goes on
+  // to walks it from there itself).
   void run(const Ray& ray, Dda& dda, std::uint32_t pixel, bool shadow, double lit,
            std::vector<RayLeg>& out, RenderStats& st) {
     const RenderScene::Impl& s = scene.impl();
@@ -177,21 +208,24 @@ struct RelayFrame::Impl {
         if (shadow) {
           shadow_ends[pixel] = HitShading::shadow_of(true, lit);
         } else {
-          primary_hit(pixel, ray, hit, out, st);
+          hits[pixel] = hit;
+          candidates[pixel] = {hit.t, along(ray)};
         }
+      } else if (!shadow) {
+        // Left the part (the next part walks the rest) or the whole box: no hit here.
       } else if (whole.contains(dda.v)) {
-        out.push_back(leg_of(ray, dda, pixel, shadow, lit));
-      } else if (shadow) {
+        out.push_back(leg_of(ray, dda, pixel, lit));
+      } else {
         shadow_ends[pixel] = HitShading::shadow_of(false, lit);
       }
       return;
     }
   }
 
-  // A primary ray hit here: the pixel is this part's to shade, and its shadow ray starts here.
-  void primary_hit(std::uint32_t pixel, const Ray& ray, const RayHit& hit, std::vector<RayLeg>& out,
-                   RenderStats& st) {
-    hits[pixel] = hit;
+  // The pixel's first hit is here: the pixel is this part's to shade, and its shadow ray starts
+  // here.
+  void first_hit(std::uint32_t pixel, const Ray& ray, const RayHit& hit, std::vector<RayLeg>& out,
+                 RenderStats& st) {
     if (!light.wants_shadow(hit, ray)) {
       shadow_ends[pixel] = 1;
       return;
@@ -203,7 +237,7 @@ struct RelayFrame::Impl {
       return;
     }
     if (!part.contains(d.v)) {
-      out.push_back(leg_of(r, d, pixel, true, 1));
+      out.push_back(leg_of(r, d, pixel, 1));
       return;
     }
     run(r, d, pixel, true, 1, out, st);
@@ -235,6 +269,7 @@ RelayFrame::RelayFrame(const World& world, const Box3i& whole, const Box3i& part
   check_relay_frame(whole, part, world.voxels.chunk_edge(), scene_options, options);
   impl_ = std::make_unique<Impl>(world, whole, part, skip, scene_options, camera, options);
   impl_->hits.assign(impl_->pixels(), RayHit{});
+  impl_->candidates.assign(impl_->pixels(), RelayHit{});
   impl_->shadow_ends.assign(impl_->pixels(), std::numeric_limits<double>::infinity());
   impl_->stats.width = options.width;
   impl_->stats.height = options.height;
@@ -242,14 +277,34 @@ RelayFrame::RelayFrame(const World& world, const Box3i& whole, const Box3i& part
 
 RelayFrame::~RelayFrame() = default;
 
-std::vector<RayLeg> RelayFrame::start() {
+const std::vector<RelayHit>& RelayFrame::start() {
   Impl& f = *impl_;
-  return f.in_parallel(f.pixels(), [&](std::size_t i, std::vector<RayLeg>& out, RenderStats& st) {
+  (void)f.in_parallel(f.pixels(), [&](std::size_t i, std::vector<RayLeg>& out, RenderStats& st) {
     const auto pixel = static_cast<std::uint32_t>(i);
     const Ray ray = f.primary_ray(pixel);
     Dda d;
-    if (!render_detail::start_in_box(f.whole, ray, d) || !f.part.contains(d.v)) return;
+    if (!render_detail::start_in_box(f.whole, ray, d)) return;
+    if (!f.part.contains(d.v) && !f.enter_part(d)) return;
     f.run(ray, d, pixel, false, 1, out, st);
+  });
+  return f.candidates;
+}
+
+std::vector<RayLeg> RelayFrame::start_shadows(std::span<const RelayHit> first) {
+  Impl& f = *impl_;
+  if (first.size() != f.pixels())
+    throw InvalidArgument("render: " + std::to_string(first.size()) + " first hits for " +
+                          std::to_string(f.pixels()) + " pixels");
+  return f.in_parallel(f.pixels(), [&](std::size_t i, std::vector<RayLeg>& out, RenderStats& st) {
+    RayHit& hit = f.hits[i];
+    if (!hit.hit) return;
+    const RelayHit mine = f.candidates[i];
+    if (first[i].t != mine.t || first[i].along != mine.along) {
+      hit.hit = false;  // a part before this one along the ray hit first
+      return;
+    }
+    const auto pixel = static_cast<std::uint32_t>(i);
+    f.first_hit(pixel, f.primary_ray(pixel), hit, out, st);
   });
 }
 
@@ -260,7 +315,7 @@ std::vector<RayLeg> RelayFrame::walk(std::span<const RayLeg> legs) {
   std::vector<std::uint8_t> taken(legs.empty() ? 0 : f.pixels(), 0);
   for (const RayLeg& leg : legs) {
     if (leg.pixel >= f.pixels() || !f.part.contains(leg.voxel) || leg.face_axis < -1 ||
-        leg.face_axis > 2 || leg.shadow > 1)
+        leg.face_axis > 2)
       throw InvalidArgument("render: a ray leg for pixel " + std::to_string(leg.pixel) + " at " +
                             to_string(leg.voxel) + " does not belong to the part " +
                             to_string(f.part));
@@ -269,11 +324,10 @@ std::vector<RayLeg> RelayFrame::walk(std::span<const RayLeg> legs) {
   }
   return f.in_parallel(legs.size(), [&](std::size_t i, std::vector<RayLeg>& out, RenderStats& st) {
     const RayLeg& leg = legs[i];
-    const bool shadow = leg.shadow != 0;
-    const Ray ray = shadow ? Ray{leg.origin, f.light.sun} : f.primary_ray(leg.pixel);
+    const Ray ray{leg.origin, f.light.sun};
     Dda d;
     d.start(ray, leg.voxel, leg.t, leg.face_axis);
-    f.run(ray, d, leg.pixel, shadow, leg.lit, out, st);
+    f.run(ray, d, leg.pixel, true, leg.lit, out, st);
   });
 }
 

@@ -123,6 +123,27 @@ TEST(MpiRender, FramesEqualOneProcessByteForByte) {
   for (const Case& c : cases) check(c, w, domain, edge);
 }
 
+// Every rank walks its stretch of every primary ray at once, and the first hit along the ray is the
+// pixel's. Hits on two ranks can share their t: where a ray crosses a voxel edge lying on a slab
+// border, the plain DDA crosses x (entering a voxel above the border) and z (entering the one
+// below) at one t. Here the middle row of an image of odd height looks along (1, 0, -1) from a
+// whole-number eye, so each of its rays crosses x and z together, and meets the face x = 40 of a
+// wall at z = 32, the border between slabs at 2 and 4 ranks: the voxel above the border, entered
+// through its x face, is the hit (the one below, entered at the same t through its z face, would
+// shade another way).
+TEST(MpiRender, RaysThroughVoxelEdgesOnASlabBorderKeepTheirFirstHit) {
+  const int edge = 8;
+  const Box3i domain{{0, 0, 0}, {64, 40, 64}};
+  World w(edge, domain);
+  w.voxels.fill({{0, 0, 0}, {64, 40, 2}}, 1);
+  w.voxels.fill({{40, 0, 0}, {44, 40, 64}}, 3);
+  RenderOptions o;
+  o.width = 96;
+  o.height = 63;  // odd: the middle row's rays have no vertical component in the image
+  const Camera cam = Camera::parse("eye=10,20,62:target=40,20,32:fov=70", domain, 96.0 / 63);
+  check({"rays through voxel edges on a slab border", {}, cam, o}, w, domain, edge);
+}
+
 TEST(MpiRender, BadOptionsFailOnEveryRankAlike) {
   const int edge = 8;
   const Box3i domain{{0, 0, 0}, {24, 24, 32}};
