@@ -26,7 +26,6 @@ timed() {  # timed NAME ROUND CMD...: the command's wall seconds into NAME-ROUND
   shift 2
   /usr/bin/time -f %e -o "$out/$name-$r.s" "$@" >/dev/null 2>&1
 }
-declare -A frames
 for r in $(seq 1 "$repeat"); do
   timed one1 "$r" taskset -c 0 "$B/voxfield" render "$out/terrain.npy" -o "$out/one.png" --threads 1 \
     --stats "$out/one1-$r.json"

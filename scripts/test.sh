@@ -11,9 +11,13 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 phase_start=$SECONDS
 phase_done() { echo "=== $1: $((SECONDS - phase_start)) s ==="; phase_start=$SECONDS; }
-# release-ci is the release preset built as unity batches (CMakePresets.json says why);
-# cpu-only-ci is the cpu-only preset at -O1 (what CI checks there does not depend on optimisation).
-presets=${VOXFIELD_TEST_PRESETS:-"release-ci cpu-only-ci asan-ubsan tsan"}
+# The optimised build: release-ci (release built as unity batches, CMakePresets.json says why) on a
+# fresh tree, as in CI; a tree that already has a release build (the showcase's, a developer's)
+# tests that one instead of building the same code again. cpu-only-ci is the cpu-only preset at
+# -O1 (what CI checks there does not depend on optimisation).
+optimised=release-ci
+if [ -f build/release/build.ninja ]; then optimised=release; fi
+presets=${VOXFIELD_TEST_PRESETS:-"$optimised cpu-only-ci asan-ubsan tsan"}
 for preset in $presets; do
   echo "=== voxfield tests: $preset ==="
   cmake --preset "$preset" >/dev/null

@@ -21,9 +21,9 @@
 // random spheres slab by slab (no file) and prints, per run, the time, the rate and the bytes
 // exchanged. `mesh` meshes a float volume, each rank the chunk layers of its planes (mpi.h), and
 // writes the mesh `voxfield mesh` writes, triangle for triangle. `render` draws the frame `voxfield
-// render` draws, byte for byte, each rank walking the rays that cross its slab and handing them
-// on (render_relay.h). Every rank parses the same command line; rank 0 alone prints. A failure on
-// any rank is reported by rank 0 as "voxfield-mpi: rank R:
+// render` draws, byte for byte, each rank walking its stretch of every primary ray and the shadow
+// rays that cross its slab, handing those on (render_relay.h). Every rank parses the same command
+// line; rank 0 alone prints. A failure on any rank is reported by rank 0 as "voxfield-mpi: rank R:
 // ..." and every rank exits with 1 (2 for usage errors).
 #include <mpi.h>
 

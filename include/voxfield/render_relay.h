@@ -1,5 +1,6 @@
 // voxfield — frames of a world that no one process holds (voxfield-mpi render): each part of the
-// world, a slab along z, walks the rays that cross it and hands each on where it leaves.
+// world, a slab along z, walks its stretch of every primary ray, and walks the shadow rays that
+// cross it, handing each on where it leaves.
 //
 // Sort-last compositing usually has every part draw its own image and keeps each pixel's nearest
 // hit; shadows that one part casts on another are then lost, and a skipping ray's walk would depend
@@ -47,11 +48,13 @@ struct RayLeg {
   std::uint8_t unused[7] = {};  // 64 bytes with no padding: every byte sent is set
 };
 
-// A part's hit for a pixel's primary ray: the ray parameter at which the ray entered the hit voxel
-// (+inf: no hit in the part) and the part's place along the ray (smaller: met first). Ordered by t,
-// then by place, the smallest over the parts is the pixel's first hit: two parts' hits can share a
-// t where the ray crosses a voxel edge on their border, and the plain DDA enters the part it meets
-// first first. The layout of MPI's MPI_DOUBLE_INT (mpi::render reduces it with MPI_MINLOC).
+// A part's hit for a pixel's primary ray: when the ray entered the hit voxel (its ray parameter, or
+// the ray's entry into the whole box if that is later: +inf for no hit in the part) and the part's
+// place along the ray (smaller: met first). Ordered by t, then by place, the smallest over the
+// parts is the pixel's first hit: two parts' hits can share a t where the ray crosses a voxel edge
+// on their border (or within an ulp of its entry into the box, where the box's planes and the
+// DDA's formula round apart), and the plain DDA enters the part it meets first first. The layout
+// of MPI's MPI_DOUBLE_INT (mpi::render reduces it with MPI_MINLOC).
 struct RelayHit {
   double t = std::numeric_limits<double>::infinity();
   std::int32_t along = 0;

@@ -23,10 +23,15 @@ namespace {
 
 static_assert(std::is_trivially_copyable_v<RayLeg> && sizeof(RayLeg) == 64,
               "legs cross processes as bytes, every one of them set");
-// MPI_DOUBLE_INT is the pair struct { double; int; }.
-static_assert(std::is_trivially_copyable_v<RelayHit> && offsetof(RelayHit, t) == 0 &&
-                  offsetof(RelayHit, along) == sizeof(double) &&
-                  sizeof(std::int32_t) == sizeof(int),
+// MPI_DOUBLE_INT is the pair struct { double; int; }, elements that far apart.
+struct DoubleInt {
+  double value;
+  int index;
+};
+static_assert(std::is_trivially_copyable_v<RelayHit> && std::is_standard_layout_v<RelayHit> &&
+                  offsetof(RelayHit, t) == offsetof(DoubleInt, value) &&
+                  offsetof(RelayHit, along) == offsetof(DoubleInt, index) &&
+                  sizeof(RelayHit) == sizeof(DoubleInt) && sizeof(std::int32_t) == sizeof(int),
               "hits are reduced as MPI_DOUBLE_INT");
 
 // The rank whose slab holds slice z.
@@ -115,11 +120,10 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
       comm, partition, world.voxels, relay_skip_field_options(scene_options, whole), exchange);
   // The part's lighting field and scene, then its stretches of the primary rays, agreed on once:
   // the ranks whose slabs hold the content spend longer on the first, the ranks whose air the
-  // rays cross on the second (the 256^3 terrain on 2 ranks: 258 + 74 ms below, 148 + 166 above;
-  // agreed on between them, the frame waited for 258 + 166).
+  // rays cross on the second, and neither waits for the other in between.
   std::unique_ptr<RelayFrame> part;
   std::vector<RelayHit> first;
-  const std::vector<RelayHit>& mine = *detail::collectively(comm, exchange, [&] {
+  const std::vector<RelayHit>& hits_here = *detail::collectively(comm, exchange, [&] {
     part = std::make_unique<RelayFrame>(world, whole, partition.slab(rank), skip, scene_options,
                                         camera, options);
     const std::vector<RelayHit>& hits = part->start();
@@ -129,8 +133,8 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
   const LegType leg_type;
   {
     detail::CollectiveTimer timer(exchange);
-    MPI_Allreduce(mine.data(), first.data(), static_cast<int>(mine.size()), MPI_DOUBLE_INT,
-                  MPI_MINLOC, comm);
+    MPI_Allreduce(hits_here.data(), first.data(), static_cast<int>(hits_here.size()),
+                  MPI_DOUBLE_INT, MPI_MINLOC, comm);
   }
   std::vector<RayLeg> legs =
       detail::collectively(comm, exchange, [&] { return part->start_shadows(first); });
@@ -163,7 +167,7 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
   }
   if (exchange) {
     exchange->bytes_sent +=
-        mine.size() * sizeof(RelayHit) + ends.size() * sizeof(double) + rgba.size();
+        hits_here.size() * sizeof(RelayHit) + ends.size() * sizeof(double) + rgba.size();
     exchange->bytes_received +=
         first.size() * sizeof(RelayHit) + ends.size() * sizeof(double) + frame_rgba.size();
   }

@@ -11,6 +11,7 @@
 // early, since its estimate depends on every voxel before.
 #include "voxfield/render_relay.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -209,7 +210,6 @@ struct RelayFrame::Impl {
           shadow_ends[pixel] = HitShading::shadow_of(true, lit);
         } else {
           hits[pixel] = hit;
-          candidates[pixel] = {hit.t, along(ray)};
         }
       } else if (!shadow) {
         // Left the part (the next part walks the rest) or the whole box: no hit here.
@@ -284,8 +284,14 @@ const std::vector<RelayHit>& RelayFrame::start() {
     const Ray ray = f.primary_ray(pixel);
     Dda d;
     if (!render_detail::start_in_box(f.whole, ray, d)) return;
+    // The time the ray enters the whole box comes from the box's planes, its later events from the
+    // DDA's formula, which can be an ulp earlier (a z crossing right after an entry through x or
+    // y): no hit is ordered before it, so the part met first keeps a tie there too.
+    const double entry_t = d.t;
     if (!f.part.contains(d.v) && !f.enter_part(d)) return;
     f.run(ray, d, pixel, false, 1, out, st);
+    const RayHit& hit = f.hits[pixel];
+    if (hit.hit) f.candidates[pixel] = {std::max(hit.t, entry_t), f.along(ray)};
   });
   return f.candidates;
 }

@@ -142,6 +142,26 @@ TEST(MpiRender, RaysThroughVoxelEdgesOnASlabBorderKeepTheirFirstHit) {
   o.height = 63;  // odd: the middle row's rays have no vertical component in the image
   const Camera cam = Camera::parse("eye=10,20,62:target=40,20,32:fov=70", domain, 96.0 / 63);
   check({"rays through voxel edges on a slab border", {}, cam, o}, w, domain, edge);
+  // And level: the middle row's rays keep z = 33.5 exactly, in one slab, which the others skip.
+  const Camera level = Camera::parse("eye=10,20,33.5:target=60,20,33.5:fov=60", domain, 96.0 / 63);
+  check({"level rays, in one slab", {}, level, o}, w, domain, edge);
+}
+
+// The time a ray enters the whole box comes from the box's planes (traverse.h's start_in_box), its
+// later events from the DDA's formula (dda.h), which can be an ulp earlier. The centre pixel of
+// this 95 x 63 image looks along (40, 0, -2) exactly and enters the box through the face x = 0 at
+// z = 32, on the slab border at 2 and 4 ranks, with its z crossing an ulp before its entry: the
+// wall's voxel above the border, entered first, is the hit, not the one below.
+TEST(MpiRender, ARayEnteringTheBoxOnASlabBorderKeepsItsFirstHit) {
+  const int edge = 8;
+  const Box3i domain{{0, 0, 0}, {64, 64, 64}};
+  World w(edge, domain);
+  w.voxels.fill({{0, 0, 0}, {4, 64, 64}}, 2);
+  RenderOptions o;
+  o.width = 95;
+  o.height = 63;
+  const Camera cam = Camera::parse("eye=-40,20,34:target=0,20,32:fov=50", domain, 95.0 / 63);
+  check({"a ray entering the box on a slab border", {}, cam, o}, w, domain, edge);
 }
 
 TEST(MpiRender, BadOptionsFailOnEveryRankAlike) {
