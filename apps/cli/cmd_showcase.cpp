@@ -221,10 +221,10 @@ int run_showcase(const ShowcaseSettings& s) {
     return st;
   };
   RenderOptions wide;
-  wide.width = 1280;
-  wide.height = 720;
+  wide.width = picture_pixels(1280, s.size);
+  wide.height = picture_pixels(720, s.size);
   RenderOptions square = wide;
-  square.width = square.height = 720;
+  square.width = square.height = picture_pixels(720, s.size);
   {
     const RenderScene before(edited, skip_field.field(), &light_field.field());
     frame(before, hero, wide, "terrain-before.png", "shaded");
@@ -258,9 +258,10 @@ int run_showcase(const ShowcaseSettings& s) {
         "darker band every 8 "
         "voxels), the world below the cut shaded.\n\n![distance](terrain-distance.png)\n";
 
-  showcase_meshing(terrain, s.out, fs::path(s.out) / "terrain-sdf.npy", s.peers, hero, md, timings);
+  showcase_meshing(terrain, s.size, s.out, fs::path(s.out) / "terrain-sdf.npy", s.peers, hero, md,
+                   timings);
   showcase_mesh_input(terrain, s.size, s.out, md, timings);
-  showcase_terrain(s.out, s.seed, md, timings);
+  showcase_terrain(s.out, s.seed, s.size, md, timings);
 
   // Where the dissertation's approximations let rays skip through geometry, on the small terrain.
   {
@@ -277,8 +278,8 @@ int run_showcase(const ShowcaseSettings& s) {
     std::string images;
     for (Algorithm a : {Algorithm::kJfaSeed, Algorithm::kBruteChunked, Algorithm::kJfa}) {
       RenderOptions ev;
-      ev.width = 640;
-      ev.height = 360;
+      ev.width = picture_pixels(640, s.size);
+      ev.height = picture_pixels(360, s.size);
       ev.view = RenderView::kError;
       ev.error_algorithm = a;
       const std::string file = std::string("error-") + algorithm_name(a) + ".png";

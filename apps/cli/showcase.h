@@ -37,9 +37,10 @@ inline std::shared_ptr<gpu::Context> showcase_vulkan(std::ostream& md) {
 }
 
 // A picture's edge in pixels in a showcase of `size`³ worlds: `full` at the default size (256)
-// and above, down to a quarter of it below 64. The sections whose scenes do not follow --size
-// (the CSG models, the vector fields, the Stanford bunny) draw their pictures this size, so that
-// the small runs the tests make (--size 48, under the sanitizers too) stay short.
+// and above, down to a quarter of it below 64. Every picture is drawn this size (the sections
+// whose scenes do not follow --size too: the CSG models, the vector fields, the Stanford bunny,
+// the terrain field), so that the small runs the tests make (--size 48, under the sanitizers too)
+// stay short.
 inline int picture_pixels(int full, int size) {
   return full * std::clamp(size, 64, 256) / 256;
 }
@@ -58,15 +59,15 @@ inline std::string fixed(double v, int digits) {
 // scripts/fetch-test-meshes.sh has fetched it.
 void showcase_mesh_input(const World& terrain, int size, const std::filesystem::path& out,
                          std::ostream& md, std::vector<Timing>& timings);
-void showcase_meshing(const World& terrain, const std::filesystem::path& out,
+void showcase_meshing(const World& terrain, int world_size, const std::filesystem::path& out,
                       const std::filesystem::path& sdf_npy,
                       const std::filesystem::path& peers_script, const Camera& hero,
                       std::ostream& md, std::vector<Timing>& timings);
 
 // A deformable terrain field: smooth hills in i8 / i16 / f32, shaped by brushes with incremental
 // re-meshing (checked equal to fresh meshes), pictured before and after, exported as a .glb.
-void showcase_terrain(const std::filesystem::path& out, std::uint64_t seed, std::ostream& md,
-                      std::vector<Timing>& timings);
+void showcase_terrain(const std::filesystem::path& out, std::uint64_t seed, int size,
+                      std::ostream& md, std::vector<Timing>& timings);
 
 // Vector fields: agents flying through a volume, fixed steps, the visualiser, every algorithm
 // against the definition, .fga and .vf exports; the flow around a terrain's solids under an edit.

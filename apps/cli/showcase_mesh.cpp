@@ -67,9 +67,9 @@ nlohmann::json run_peers(const fs::path& script, const fs::path& sdf_npy, const 
 
 }  // namespace
 
-void showcase_meshing(const World& terrain, const fs::path& out, const fs::path& sdf_npy,
-                      const fs::path& peers_script, const Camera& hero, std::ostream& md,
-                      std::vector<Timing>& timings) {
+void showcase_meshing(const World& terrain, int world_size, const fs::path& out,
+                      const fs::path& sdf_npy, const fs::path& peers_script, const Camera& hero,
+                      std::ostream& md, std::vector<Timing>& timings) {
   md << "\n## Meshes of the terrain\n\n"
      << "The terrain's surface as triangles, through its exact signed Euclidean field (`voxfield "
         "mesh`): marching "
@@ -165,6 +165,8 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
 
   // Pictures: the whole terrain from the hero camera, and a close-up with the triangles' edges.
   MeshRenderOptions ro;
+  ro.width = picture_pixels(1280, world_size);
+  ro.height = picture_pixels(720, world_size);
   const Box3i content = terrain.voxels.content_bounds();
   const int cx = (content.begin.x + content.end.x) / 2, cy = (content.begin.y + content.end.y) / 2;
   const int r = std::max(8, content.size().x / 8);
@@ -180,7 +182,9 @@ void showcase_meshing(const World& terrain, const fs::path& out, const fs::path&
     const std::string tag = mesher_name(kinds[i]);
     MeshRenderStats st;
     write_png(render_mesh(meshes[i], hero, ro, &st), out / ("terrain-mesh-" + tag + ".png"));
-    timings.push_back({"picture of the " + tag + " mesh (CPU rasteriser, 1280×720)", st.ms, ""});
+    timings.push_back({"picture of the " + tag + " mesh (CPU rasteriser, " +
+                           std::to_string(ro.width) + "×" + std::to_string(ro.height) + ")",
+                       st.ms, ""});
     MeshRenderOptions edges = ro;
     edges.edges = true;
     write_png(render_mesh(meshes[i], near, edges), out / ("terrain-mesh-" + tag + "-edges.png"));

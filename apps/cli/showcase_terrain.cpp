@@ -95,7 +95,8 @@ struct StorageRun {
 // frame drawn by classify + HistoPyramid + one indirect draw, compared with the CPU picture.
 void showcase_terrain_gpu(const fs::path& out, const Palette& palette,
                           const std::vector<NamedBrush>& brushes, const Camera& camera,
-                          const Mesh& cpu_mesh, std::ostream& md, std::vector<Timing>& timings) {
+                          const MeshRenderOptions& ro, const Mesh& cpu_mesh, std::ostream& md,
+                          std::vector<Timing>& timings) {
   const std::shared_ptr<gpu::Context> context = showcase_vulkan(md);
   if (!context) return;
   try {
@@ -113,7 +114,6 @@ void showcase_terrain_gpu(const fs::path& out, const Palette& palette,
       sent += b;
       largest = std::max(largest, b);
     }
-    MeshRenderOptions ro;
     gpu::TerrainDrawStats st;
     const Image frame = renderer.render(terrain_view(camera, ro), &st);
     write_png(frame, out / "terrain-field-gpu.png");
@@ -150,7 +150,7 @@ void showcase_terrain_gpu(const fs::path& out, const Palette& palette,
 
 }  // namespace
 
-void showcase_terrain(const fs::path& out, std::uint64_t seed, std::ostream& md,
+void showcase_terrain(const fs::path& out, std::uint64_t seed, int size, std::ostream& md,
                       std::vector<Timing>& timings) {
   Palette palette{};
   palette[1] = {92, 128, 64, 255};    // grass
@@ -195,6 +195,8 @@ void showcase_terrain(const fs::path& out, std::uint64_t seed, std::ostream& md,
   const Box3i box = Box3i::from_size(kSize);
   const Camera camera = Camera::framing(box, 16.0 / 9.0, 42);
   MeshRenderOptions ro;
+  ro.width = picture_pixels(1280, size);
+  ro.height = picture_pixels(720, size);
   MeshRenderStats st;
   write_png(render_mesh(before_mesh, camera, ro), out / "terrain-field-before.png");
   write_png(render_mesh(after_mesh, camera, ro, &st), out / "terrain-field-after.png");
@@ -239,7 +241,7 @@ void showcase_terrain(const fs::path& out, std::uint64_t seed, std::ostream& md,
   md << "\n(A dense float32 copy of this field would be "
      << format_bytes(static_cast<std::uint64_t>(box.volume()) * 4)
      << "; docs/benchmarks.md measures the widths at 512³.)\n";
-  showcase_terrain_gpu(out, palette, brushes, camera, after_mesh, md, timings);
+  showcase_terrain_gpu(out, palette, brushes, camera, ro, after_mesh, md, timings);
 }
 
 }  // namespace voxfield::cli
