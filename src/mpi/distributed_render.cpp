@@ -119,8 +119,8 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
   const DistanceField skip = compute_distance_field(
       comm, partition, world.voxels, relay_skip_field_options(scene_options, whole), exchange);
   // The part's lighting field and scene, then its stretches of the primary rays, agreed on once:
-  // the ranks whose slabs hold the content spend longer on the first, the ranks whose air the
-  // rays cross on the second, and neither waits for the other in between.
+  // the ranks differ in each (the first follows the content of their slabs, the second where the
+  // rays cross them), and a rank slower in one need not be slower in both.
   std::unique_ptr<RelayFrame> part;
   std::vector<RelayHit> first;
   const std::vector<RelayHit>& hits_here = *detail::collectively(comm, exchange, [&] {
