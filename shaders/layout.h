@@ -133,8 +133,8 @@ struct FimParams {
 // the lighting arena slot and the uniform lighting value.
 struct RenderParams {
   vec4f eye;      // xyz; w = 1 for orthographic
-  vec4f forward;  // unit vectors of the camera basis
-  vec4f right;
+  vec4f forward;  // the camera basis in voxels (Camera::Projector); w: its sky_scale's x,
+  vec4f right;    // y and z
   vec4f up;
   vec4f sun;        // unit vector towards the sun; w = fog density
   ivec4 box_begin;  // the render box

@@ -66,6 +66,18 @@ TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
   const RenderScene scene(w);
   const Camera cam = Camera::framing(scene.box(), 1.5);
   expect_images_close(gpu::render(*ctx, scene, cam, fog), render(scene, cam, fog), "fog");
+  // Cameras placed in a world of non-cubic voxels: the GPU walks the same stretched rays.
+  VoxelFrame scan;
+  scan.voxel_size_world = {0.8, 1, 1.6};
+  for (Camera placed : {cam, Camera::top(scene.box(), 1.5)}) {
+    placed.eye = scan.world_from_vox(placed.eye);
+    placed.target = scan.world_from_vox(placed.target);
+    placed.up = scan.world_direction(placed.up);
+    const Camera stretched = placed.in_voxels(scan);
+    ASSERT_TRUE(stretched.world_frame.has_value());
+    expect_images_close(gpu::render(*ctx, scene, stretched, fog), render(scene, stretched, fog),
+                        "a camera in a frame of non-cubic voxels");
+  }
   const auto messages = ctx->validation_messages();
   EXPECT_TRUE(messages.empty()) << messages.size()
                                 << " validation messages, first: " << messages.front();

@@ -135,10 +135,11 @@ void add_render(CLI::App& app, Action& action) {
                   "auto | top | eye=x,y,z:target=x,y,z[:up=x,y,z][:fov=deg][:ortho=height] (z up; "
                   "voxel units, or the world's with --camera-frame world)")
       ->check(camera_spec());
-  cmd->add_option("--camera-frame", s->camera_frame,
-                  "voxels (default) or world: an eye=...:target=... camera in the world's frame "
-                  "(a .vfw's origin, voxel size and rotation; cubic voxels); auto and top frame "
-                  "the content either way")
+  cmd->add_option(
+         "--camera-frame", s->camera_frame,
+         "voxels (default) or world: an eye=...:target=... camera in the world's frame "
+         "(a .vfw's origin, voxel size and rotation, of any voxel shape); auto and top frame "
+         "the content either way")
       ->check(CLI::IsMember({"voxels", "world"}));
   cmd->add_option("--view", s->view, "shaded | distance | error | chunks")
       ->check(CLI::IsMember({"shaded", "distance", "error", "chunks"}));

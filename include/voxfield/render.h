@@ -37,6 +37,10 @@ struct Camera {
   Vec3d eye{0, 0, 0}, target{0, 0, -1}, up{0, 0, 1};  // z is up, as in MagicaVoxel
   double fov_degrees = 60;                            // perspective: vertical field of view
   double ortho_height = 1;  // orthographic: world units spanned by the image height
+  // Set by in_voxels() for a frame whose voxels are not cubes: eye, target, up and ortho_height
+  // are then in this frame's world coordinates, and projector() carries every ray into voxels.
+  // Unset (every camera otherwise): they are in voxel coordinates.
+  std::optional<VoxelFrame> world_frame;
 
   // Perspective view from above one corner, as close as keeps all eight corners of the box in
   // the image (3 % margin).
@@ -58,23 +62,33 @@ struct Camera {
 
   // This camera given in the world frame of `frame` (eye, target and up in world coordinates,
   // the orthographic height in world units), as the renderer takes it: in voxel coordinates. A
-  // rotation, a translation and one scale carry a pinhole camera onto a pinhole camera, so the
-  // frame drawn is the world's view exactly — the same rays, hits and pixels as a camera placed
-  // in voxels by hand. Voxels that are not cubes (beyond a part in 10^6) would turn it into a
-  // pinhole camera with skewed, non-square image axes, which Camera does not express: refused
-  // (InvalidArgument naming the voxel size), as is a frame that validate() refuses.
+  // rotation, a translation and one scale carry a pinhole camera onto a pinhole camera, so for
+  // cubic voxels (equal to a part in 10^6) the result is a plain camera in voxels and the frame
+  // drawn is the world's view exactly — the same rays, hits and pixels as a camera placed in
+  // voxels by hand. Voxels that are not cubes (a scan's 1 x 1 x 3 mm) stretch the camera's image
+  // axes in voxel space, which eye, target and up cannot say: the camera keeps its world
+  // coordinates and the frame (world_frame), and its projector maps each ray into voxels — still
+  // exactly the world's view. Throws InvalidArgument for a frame that validate() refuses, or for
+  // a camera already placed in one.
   Camera in_voxels(const VoxelFrame& frame) const;
 
   // Rays through the pixels of a width x height image, with the camera's basis computed once.
   struct Projector {
     Projection projection = Projection::kPerspective;
-    Vec3d eye, forward, right, up;  // orthonormal basis
-    double scale = 1;               // tan(fov / 2), or ortho_height / 2
+    // In voxel coordinates: an orthonormal basis, or (a camera with a world_frame) the world's
+    // orthonormal basis carried into voxels, skewed and stretched by the voxels' shape.
+    Vec3d eye, forward, right, up;
+    double scale = 1;  // tan(fov / 2), or ortho_height / 2
+    // What a ray's direction in voxels is multiplied by (then normalised) to look up the sky:
+    // (1, 1, 1), or for a camera with a world_frame the voxels' world edge lengths — the world
+    // ray's direction along the voxel axes — so the sky is the world's view of it too.
+    Vec3d sky_scale{1, 1, 1};
     int width = 1, height = 1;
     // The ray through (px, py) in pixels, (0, 0) the top-left corner: pixel centres are at +0.5.
-    // Directions are unit vectors, so t measures voxels.
+    // Directions are unit vectors in voxel coordinates, so t measures voxels.
     Ray ray(double px, double py) const;
-    // Size of one pixel, in voxels, at distance t along a ray.
+    // Size of one pixel, in voxels, at distance t along a ray: the chunk view's line width
+    // (approximate for a camera with a world_frame, whose pixels are not squares in voxels).
     double footprint(double t) const {
       return (projection == Projection::kOrthographic ? 1 : t) * 2 * scale / height;
     }

@@ -2,7 +2,6 @@
 // and the CLI's camera strings.
 #include <algorithm>
 #include <cmath>
-#include <iomanip>
 #include <numbers>
 #include <sstream>
 #include <vector>
@@ -164,21 +163,20 @@ Camera Camera::parse(const std::string& spec, const Box3i& box, double aspect,
 }
 
 Camera Camera::in_voxels(const VoxelFrame& frame) const {
+  if (world_frame) throw InvalidArgument("camera: already placed in a world's frame");
   frame.validate("camera: the world's frame");
   const Vec3d s = frame.voxel_size_world;
   // Equal to a part in 10^6: cubes, as a float pipeline's transform states them (a .vdb's
   // rotated matrix is rescued within 1e-5, VoxelFrame::from_matrix, and its columns' lengths then
   // differ in the eighth digit); the rays stay those of the world's camera within that.
   const double size = (s.x + s.y + s.z) / 3;
+  Camera c = *this;
   if (std::abs(s.x - size) > 1e-6 * size || std::abs(s.y - size) > 1e-6 * size ||
       std::abs(s.z - size) > 1e-6 * size) {
-    std::ostringstream os;
-    os << std::setprecision(9) << "camera: a camera in world units needs cubic voxels; this "
-       << "world's are " << s.x << " x " << s.y << " x " << s.z
-       << " (give the camera in voxels instead)";
-    throw InvalidArgument(os.str());
+    // Not cubes: the image axes, orthonormal in the world, are not in voxels (projector()).
+    c.world_frame = frame;
+    return c;
   }
-  Camera c = *this;
   c.eye = frame.vox_from_world(eye);
   c.target = frame.vox_from_world(target);
   c.up = frame.vox_direction(up);  // a direction: no translation (its length does not matter)
@@ -197,6 +195,19 @@ Camera::Projector Camera::projector(int width, int height) const {
                                                     : std::tan(radians(fov_degrees) / 2);
   p.width = width;
   p.height = height;
+  if (world_frame) {
+    // The world's camera, every ray carried into voxels by the frame's linear map M: a
+    // perspective ray's direction M (forward + sx right + sy up) is built from the mapped basis
+    // as the plain one is and then normalised; an orthographic ray starts at M's image of its
+    // world origin and runs along M forward, normalised here so that t measures voxels.
+    const VoxelFrame& f = *world_frame;
+    p.eye = f.vox_from_world(eye);
+    p.forward = f.vox_direction(p.forward);
+    p.right = f.vox_direction(p.right);
+    p.up = f.vox_direction(p.up);
+    if (projection == Projection::kOrthographic) p.forward = p.forward.normalized();
+    p.sky_scale = f.voxel_size_world;
+  }
   return p;
 }
 

@@ -19,7 +19,8 @@ namespace voxfield::render_detail {
 struct HitShading {
   const RenderScene::Impl& s;
   const RenderOptions& o;
-  Vec3d sun;  // normalised
+  Vec3d sun;                 // normalised
+  Vec3d sky_scale{1, 1, 1};  // the camera's (Camera::Projector::sky_scale), for the fog's sky
 
   static constexpr double kSoftness = 5, kNear = 1.5;
 
@@ -109,7 +110,8 @@ struct HitShading {
     const double ao = o.ambient_occlusion ? ambient_occlusion(p, n) : 1;
     const Rgb ambient = mix(kGround, kSkyAmbient, 0.5 + 0.5 * n.z) * (0.35 + 0.65 * ao);
     Rgb c = albedo * (kSunLight * (ndotl * shadow) + ambient);
-    if (o.fog_density > 0) c = mix(c, sky(ray.direction), 1 - std::exp(-o.fog_density * h.t));
+    if (o.fog_density > 0)
+      c = mix(c, sky(ray.direction, sky_scale), 1 - std::exp(-o.fog_density * h.t));
     return c;
   }
 

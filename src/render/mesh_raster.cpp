@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "voxfield/error.h"
@@ -21,11 +22,26 @@
 
 namespace voxfield {
 
+namespace {
+
+// A mesh is drawn in its own coordinates, through the camera's orthonormal basis: a camera placed
+// in a frame of non-cubic voxels (Camera::world_frame) has none there.
+Camera::Projector mesh_projector(const Camera& camera, const MeshRenderOptions& options,
+                                 const char* what) {
+  if (camera.world_frame)
+    throw InvalidArgument(std::string(what) +
+                          ": a camera placed in a world of non-cubic voxels draws voxels; give a "
+                          "mesh's camera in the mesh's coordinates");
+  return camera.projector(options.width, options.height);
+}
+
+}  // namespace
+
 gpu::TerrainView terrain_view(const Camera& camera, const MeshRenderOptions& options) {
   if (options.edges)
     throw InvalidArgument(
         "the GPU terrain renderer does not draw triangle edges (use render_mesh)");
-  const Camera::Projector pr = camera.projector(options.width, options.height);
+  const Camera::Projector pr = mesh_projector(camera, options, "the GPU terrain renderer");
   gpu::TerrainView v;
   v.width = options.width;
   v.height = options.height;
@@ -52,7 +68,7 @@ Image render_mesh(const Mesh& mesh, const Camera& camera, const MeshRenderOption
   for (std::size_t i = 0; i < image.rgb.size(); i += 3)
     std::copy(options.background.begin(), options.background.end(),
               image.rgb.begin() + static_cast<std::ptrdiff_t>(i));
-  const Camera::Projector pr = camera.projector(options.width, options.height);
+  const Camera::Projector pr = mesh_projector(camera, options, "render_mesh");
   const bool ortho = pr.projection == Camera::Projection::kOrthographic;
   const double w = options.width, h = options.height;
   // Every vertex in view space: along right, up and forward (the depth).

@@ -143,7 +143,7 @@ struct RelayFrame::Impl {
         scene(part_scene(world, whole_box, part_box, skip, scene_options)),
         o(options),
         projector(camera.projector(options.width, options.height)),
-        light{scene.impl(), o, options.sun_direction.normalized()} {}
+        light{scene.impl(), o, options.sun_direction.normalized(), projector.sky_scale} {}
 
   std::size_t pixels() const { return static_cast<std::size_t>(o.width) * o.height; }
   Ray primary_ray(std::uint32_t pixel) const {
@@ -375,7 +375,9 @@ Image RelayFrame::finish(std::span<const std::uint8_t> rgba) const {
       for (int c = 0; c < 3; ++c) px[c] = rgba[4 * i + static_cast<std::size_t>(c)];
     } else {
       render_detail::tone_map().write(
-          render_detail::sky(f.primary_ray(static_cast<std::uint32_t>(i)).direction), px);
+          render_detail::sky(f.primary_ray(static_cast<std::uint32_t>(i)).direction,
+                             f.projector.sky_scale),
+          px);
     }
   }
   return image;

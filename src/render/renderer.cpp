@@ -98,7 +98,7 @@ struct Frame {
       case RenderView::kShaded:
       case RenderView::kChunks: {
         const RayHit h = traverse(s, s.box, ray, o.skip, s.skip, st.primary, noop);
-        Rgb c = h.hit ? shade(h, ray, true, st.shadow) : sky(ray.direction);
+        Rgb c = h.hit ? shade(h, ray, true, st.shadow) : sky(ray.direction, projector.sky_scale);
         if (h.hit && o.view == RenderView::kChunks) chunk_overlay(h, ray, c);
         tone_map().write(c, out);
         return;
@@ -120,7 +120,8 @@ struct Frame {
           return;
         }
         const RayHit h = traverse(s, cut, ray, o.skip, s.skip, st.primary, noop);
-        tone_map().write(h.hit ? shade(h, ray, false, st.shadow) : sky(ray.direction), out);
+        tone_map().write(
+            h.hit ? shade(h, ray, false, st.shadow) : sky(ray.direction, projector.sky_scale), out);
         return;
       }
       case RenderView::kError: {
@@ -138,7 +139,8 @@ struct Frame {
         TraversalCounters unused;
         const RayHit skipped = traverse(s, s.box, ray, SkipMode::kDistance, *approx, unused, noop);
         st.max_error = std::max(st.max_error, worst);
-        const Rgb c = exact.hit ? shade(exact, ray, false, st.shadow) : sky(ray.direction);
+        const Rgb c = exact.hit ? shade(exact, ray, false, st.shadow)
+                                : sky(ray.direction, projector.sky_scale);
         const double grey = 0.8 * (0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b);
         tone_map().write({grey, grey, grey}, out);
         if (skipped.hit != exact.hit || skipped.voxel != exact.voxel) {
@@ -185,7 +187,8 @@ Image render(const RenderScene& scene, const Camera& camera, const RenderOptions
   render_detail::check_frame_options(s.has_light, o);
 
   Image image(o.width, o.height);
-  Frame f{s, o, camera.projector(o.width, o.height), {s, o, o.sun_direction.normalized()}};
+  const Camera::Projector projector = camera.projector(o.width, o.height);
+  Frame f{s, o, projector, {s, o, o.sun_direction.normalized(), projector.sky_scale}};
 
   SkipSource approx;
   if (o.view == RenderView::kDistance) {

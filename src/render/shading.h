@@ -40,6 +40,12 @@ inline Rgb sky(const Vec3d& dir) {
   if (z < 0) return mix(kSkyHorizon, kGround, std::min(1.0, -z * 3));
   return mix(kSkyHorizon, kSkyZenith, std::pow(z, 0.6));
 }
+// The sky along a ray of direction `dir` (voxels) of a camera whose projector's sky_scale is
+// `scale` (Camera::Projector): the world's sky for a camera placed in non-cubic voxels.
+inline Rgb sky(const Vec3d& dir, const Vec3d& scale) {
+  if (scale == Vec3d{1, 1, 1}) return sky(dir);
+  return sky(Vec3d{dir.x * scale.x, dir.y * scale.y, dir.z * scale.z}.normalized());
+}
 
 // Exposure (1 - exp(-1.25 x)) then sRGB encoding, through one table over linear light in
 // [0, kMaxLinear) — no exp or pow per pixel.

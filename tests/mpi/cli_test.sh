@@ -253,6 +253,14 @@ same ref.png out.png "render, 3 ranks, margins.vfw"
 MPIEXEC -np 2 "$VFM" render framed.vfw -o out.png --width 100 --height 80 --chunk 8 \
   --camera "eye=115,-55,13:target=103,-47,5" --camera-frame world 2>/dev/null
 same ref.png out.png "render, 2 ranks, a camera in the world's frame"
+# ...and in a frame of voxels that are not cubes (its rays stretched into voxels), as one process.
+rm -f ref.png out.png
+"$VF" convert f.npy stretched.vfw --voxel-size 0.25,0.25,1 --origin 100,-50,3 2>/dev/null
+"$VF" render stretched.vfw -o ref.png --width 100 --height 80 --chunk 8 \
+  --camera "eye=115,-55,40:target=103,-47,12" --camera-frame world 2>/dev/null
+MPIEXEC -np 2 "$VFM" render stretched.vfw -o out.png --width 100 --height 80 --chunk 8 \
+  --camera "eye=115,-55,40:target=103,-47,12" --camera-frame world 2>/dev/null
+same ref.png out.png "render, 2 ranks, a camera in a frame of non-cubic voxels"
 rm -f bad.png
 expect_failure 2 "distance not in" render f.npy -o bad.png --view distance
 expect_failure 1 "cut on chunk boundaries" render f.npy -o bad.png --chunk 64

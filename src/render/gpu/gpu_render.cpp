@@ -303,9 +303,9 @@ void ResidentScene::record_render(Recorder& rec, const Camera& camera, const Ren
   const Camera::Projector pj = camera.projector(o.width, o.height);
   L::RenderParams rp{};
   rp.eye = v4(pj.eye, pj.projection == Camera::Projection::kOrthographic ? 1 : 0);
-  rp.forward = v4(pj.forward);
-  rp.right = v4(pj.right);
-  rp.up = v4(pj.up);
+  rp.forward = v4(pj.forward, pj.sky_scale.x);
+  rp.right = v4(pj.right, pj.sky_scale.y);
+  rp.up = v4(pj.up, pj.sky_scale.z);
   rp.sun = v4(o.sun_direction.normalized(), o.fog_density);
   rp.box_begin = {s.box.begin.x, s.box.begin.y, s.box.begin.z, 0};
   rp.box_end = {s.box.end.x, s.box.end.y, s.box.end.z, 0};

@@ -249,6 +249,13 @@ vec3 sky(vec3 dir) {
   return mix(kSkyHorizon, kSkyZenith, pow(dir.z, 0.6));
 }
 
+// The sky along a ray: the camera's sky_scale (in the basis' w) makes it the world's for a camera
+// placed in non-cubic voxels (shading.h).
+vec3 sky_along(vec3 dir) {
+  const vec3 s = vec3(rp.forward.w, rp.right.w, rp.up.w);
+  return sky(s == vec3(1.0) ? dir : normalize(dir * s));
+}
+
 float light_at(vec3 q) {
   const vec3 f = q - 0.5;
   const ivec3 b = ivec3(floor(f));
@@ -363,7 +370,7 @@ void main() {
   }
   vec3 color;
   if (!start_in_box(origin, dir) || !trace(dir, false, false)) {
-    color = sky(dir);
+    color = sky_along(dir);
   } else {
     const ivec3 voxel = d_v;
     const float t = d_t;
@@ -384,7 +391,7 @@ void main() {
     const float ao = (rp.flags & VF_RENDER_AO) != 0u ? ambient_occlusion(p, n) : 1.0;
     const vec3 ambient = mix(kGround, kSkyAmbient, 0.5 + 0.5 * n.z) * (0.35 + 0.65 * ao);
     color = albedo[material].xyz * (kSunLight * (ndotl * shadow) + ambient);
-    if (rp.sun.w > 0.0) color = mix(color, sky(dir), 1.0 - exp(-rp.sun.w * t));
+    if (rp.sun.w > 0.0) color = mix(color, sky_along(dir), 1.0 - exp(-rp.sun.w * t));
     if ((rp.flags & VF_RENDER_CHUNKS) != 0u) {
       // Chunk view: grid lines about a pixel wide, chunks tinted by storage.
       const float edge = float(1 << rp.first_chunk.w);
