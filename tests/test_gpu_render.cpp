@@ -99,12 +99,27 @@ TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
     error.error_algorithm = alg;
     RenderStats cpu_stats;
     const Image cpu_image = render(scene, cam, error, &cpu_stats);
+    // The approximation is computed on the device (its own submit, the algorithm's dispatches
+    // beside the frame's one), then read back once into the frame's skip source.
+    const gpu::Counters before = ctx->counters();
     expect_images_close(gpu::render(*ctx, scene, cam, error), cpu_image,
                         std::string("error view ") + algorithm_name(alg));
+    const gpu::Counters after = ctx->counters();
+    EXPECT_GE(after.submits - before.submits, 2) << algorithm_name(alg);
+    EXPECT_GT(after.dispatches - before.dispatches, 2) << algorithm_name(alg);
     if (alg == Algorithm::kJfaSeed) {
       EXPECT_GT(cpu_stats.max_error, 0);  // the view has something to show
     }
   }
+  // A SceneRenderer keeps the approximation while the scene and the algorithm stay: the next
+  // error frame is its own submit alone.
+  gpu::SceneRenderer renderer(ctx);
+  renderer.sync(scene);
+  error.error_algorithm = Algorithm::kJfa;
+  (void)renderer.render(cam, error);
+  const gpu::Counters kept = ctx->counters();
+  expect_images_close(renderer.render(cam, error), render(scene, cam, error), "kept");
+  EXPECT_EQ(ctx->counters().submits - kept.submits, 1);
 }
 
 TEST(Gpu, ResidentScenesFollowEditsWithOnlyTheirChunksCopied) {

@@ -275,6 +275,11 @@ double RenderScene::Impl::heat_max(int z) const {
 }
 
 SkipSource RenderScene::Impl::approximation(Algorithm algorithm) const {
+  return make_skip_source(
+      compute_distance_field(*world, skip_options, approximation_options(algorithm)));
+}
+
+AlgorithmOptions RenderScene::Impl::approximation_options(Algorithm algorithm) const {
   AlgorithmOptions ao;
   ao.algorithm = algorithm;
   if (algorithm == Algorithm::kLod) {
@@ -285,7 +290,7 @@ SkipSource RenderScene::Impl::approximation(Algorithm algorithm) const {
                    std::max(sz.z * 5 / 8, lo.z + 1)};
     ao.focus = Box3i{box.begin + lo, box.begin + hi};
   }
-  return make_skip_source(compute_distance_field(*world, skip_options, ao));
+  return ao;
 }
 
 SkipSource RenderScene::Impl::make_skip_source(const DistanceField& field) const {

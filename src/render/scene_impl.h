@@ -94,8 +94,10 @@ struct RenderScene::Impl {
   // A skip source over this scene's table from another field.
   SkipSource make_skip_source(const DistanceField& field) const;
   // The error view's approximation: the skip field's options computed by `algorithm` (lod: FIM
-  // in the middle of the box), as a skip source.
+  // in the middle of the box; approximation_options), as a skip source. The GPU renderer computes
+  // the same field on its device and makes it a skip source with make_skip_source.
   SkipSource approximation(Algorithm algorithm) const;
+  AlgorithmOptions approximation_options(Algorithm algorithm) const;
   // Re-reads chunk i from the world and the fields (the fields already checked to fit).
   // Returns whether anything of the chunk changed.
   bool refresh_chunk(std::size_t i, const Grid<std::uint8_t>& skip_grid,

@@ -9,11 +9,14 @@
 // into an application's command buffer needs no host-visible memory of voxfield's.
 #include <chrono>
 #include <cstring>
+#include <optional>
 
 #include "../scene_impl.h"
 #include "gpu/recorder.h"
 #include "render_shaders.h"
 #include "shaders/layout.h"
+#include "voxfield/detail/assert.h"
+#include "voxfield/gpu_distance.h"
 #include "voxfield/gpu_render_vulkan.h"
 
 namespace voxfield::gpu {
@@ -65,8 +68,11 @@ class ResidentScene {
  public:
   // The ray marcher's kernel is made with the scene (on first use in the process), not inside
   // the first frame.
-  explicit ResidentScene(Context::Impl& ctx)
-      : ctx_(ctx), kernel_(ctx.kernel(shaders::render())), sets_(ctx) {}
+  explicit ResidentScene(Context& context)
+      : context_(context),
+        ctx_(context.impl()),
+        kernel_(ctx_.kernel(shaders::render())),
+        sets_(ctx_) {}
   ResidentScene(const ResidentScene&) = delete;
   ResidentScene& operator=(const ResidentScene&) = delete;
 
@@ -81,6 +87,11 @@ class ResidentScene {
            skip_.size() >= std::max<std::size_t>(s.skip.cells.arena.size(), 16) &&
            light_.size() >= std::max<std::size_t>(s.has_light ? s.light.arena.size() : 0, 16);
   }
+  // Computes the error view's approximation of `s` when a frame of `o` needs one that is not
+  // resident: on the device, by the dissertation's GPU algorithms (gpu_distance.h; brute force,
+  // the CPU's reference, on the CPU). Its own submit and fence wait, so it runs before a frame's
+  // recording starts (the context's upload buffer may hold that recording's staged copies).
+  void prepare_approximation(const RenderScene::Impl& s, const RenderOptions& o);
   // Records a frame: parameters and the dispatch. Needs a synced scene.
   void record_render(Recorder& rec, const Camera& camera, const RenderOptions& o, bool bgra,
                      bool timed);
@@ -92,11 +103,11 @@ class ResidentScene {
 
  private:
   void ensure_pixels(VkDeviceSize bytes);
-  // Records the copy of the error view's approximation when the scene or the algorithm changed
-  // since the last one (computed on the CPU as the CPU renderer does, staged in a buffer of its
-  // own so a sync in the same command buffer does not overwrite it).
-  void record_approximation(Recorder& rec, Algorithm algorithm);
+  // Records the copy of the approximation prepare_approximation() computed, if any (staged in a
+  // buffer of its own so a sync in the same command buffer does not overwrite it).
+  void record_approximation(Recorder& rec);
 
+  Context& context_;
   Context::Impl& ctx_;
   const Kernel& kernel_;
   const RenderScene::Impl* scene_ = nullptr;
@@ -108,6 +119,7 @@ class ResidentScene {
   // that read them have completed (one frame in flight).
   std::vector<Buffer> retired_;
   Buffer approx_info_, approx_arena_, approx_staging_;
+  std::optional<SkipSource> approx_computed_;  // prepared, not yet recorded
   std::uint64_t approx_scene_ = 0,
                 approx_generation_ = 0;  // what the resident approximation was made from
   int approx_algorithm_ = -1;
@@ -246,12 +258,29 @@ void ResidentScene::ensure_pixels(VkDeviceSize bytes) {
   descriptors_stale_ = true;
 }
 
-void ResidentScene::record_approximation(Recorder& rec, Algorithm algorithm) {
-  const RenderScene::Impl& s = *scene_;
+void ResidentScene::prepare_approximation(const RenderScene::Impl& s, const RenderOptions& o) {
+  if (o.view != RenderView::kError) return;
+  const Algorithm algorithm = o.error_algorithm;
   if (approx_scene_ == s.id && approx_generation_ == s.generation &&
       approx_algorithm_ == static_cast<int>(algorithm))
     return;
-  const SkipSource approx = s.approximation(algorithm);
+  approx_computed_.reset();
+  if (algorithm == Algorithm::kBrute || algorithm == Algorithm::kBruteChunked)
+    approx_computed_ = s.approximation(algorithm);
+  else
+    approx_computed_ = s.make_skip_source(voxfield::gpu::compute_distance_field(
+        context_, *s.world, s.skip_options, s.approximation_options(algorithm)));
+  approx_scene_ = s.id;
+  approx_generation_ = s.generation;
+  approx_algorithm_ = static_cast<int>(algorithm);
+  approx_inv_scale_ = approx_computed_->inv_scale;
+}
+
+void ResidentScene::record_approximation(Recorder& rec) {
+  if (!approx_computed_) return;
+  const SkipSource approx = std::move(*approx_computed_);
+  approx_computed_.reset();
+  const RenderScene::Impl& s = *scene_;
   const std::size_t chunks = s.table.chunk_count();
   std::vector<std::uint32_t> info(2 * chunks);
   for (std::size_t i = 0; i < chunks; ++i) {
@@ -278,10 +307,6 @@ void ResidentScene::record_approximation(Recorder& rec, Algorithm algorithm) {
   rec.copy({{&approx_staging_, &approx_info_, {&to_info, 1}},
             {&approx_staging_, &approx_arena_,
              arena_bytes > 0 ? std::span(&to_arena, 1) : std::span<const VkBufferCopy>()}});
-  approx_scene_ = s.id;
-  approx_generation_ = s.generation;
-  approx_algorithm_ = static_cast<int>(algorithm);
-  approx_inv_scale_ = approx.inv_scale;
 }
 
 void ResidentScene::record_render(Recorder& rec, const Camera& camera, const RenderOptions& o,
@@ -291,7 +316,11 @@ void ResidentScene::record_render(Recorder& rec, const Camera& camera, const Ren
   check_options(s, o);
   ensure_pixels(static_cast<VkDeviceSize>(o.width) * o.height * 4);
   const bool error = o.view == RenderView::kError;
-  if (error) record_approximation(rec, o.error_algorithm);
+  if (error) {
+    VOXFIELD_ASSERT(approx_scene_ == s.id && approx_generation_ == s.generation &&
+                    approx_algorithm_ == static_cast<int>(o.error_algorithm));  // prepared
+    record_approximation(rec);
+  }
   for (Buffer* b : {&approx_info_, &approx_arena_})
     if (b->handle() == VK_NULL_HANDLE)
       *b = Buffer(ctx_, 16, kUsage, false);  // bound even when unused
@@ -350,6 +379,7 @@ Image render_and_read(Context::Impl& ctx, ResidentScene& resident, const RenderS
   const VkDeviceSize image_bytes = static_cast<VkDeviceSize>(o.width) * o.height * 4;
   Buffer& readback = ctx.readback_buffer(image_bytes);
   const auto t0 = std::chrono::steady_clock::now();
+  resident.prepare_approximation(sync ? sync->impl() : *resident.scene(), o);
   Recorder rec(ctx, &resident.sets());
   if (sync) resident.record_sync(rec, *sync);
   resident.record_render(rec, camera, o, /*bgra=*/false, timings != nullptr);
@@ -380,7 +410,7 @@ Image render_and_read(Context::Impl& ctx, ResidentScene& resident, const RenderS
 Image render(Context& context, const RenderScene& scene, const Camera& camera,
              const RenderOptions& o, RenderStats* stats, std::vector<PassTiming>* timings) {
   check_options(scene.impl(), o);
-  ResidentScene resident(context.impl());
+  ResidentScene resident(context);
   return render_and_read(context.impl(), resident, &scene, camera, o, stats, timings);
 }
 
@@ -390,7 +420,7 @@ Image render(Context& context, const RenderScene& scene, const Camera& camera,
 struct SceneRenderer::Impl {
   std::shared_ptr<Context> context;
   ResidentScene resident;
-  explicit Impl(std::shared_ptr<Context> c) : context(std::move(c)), resident(context->impl()) {}
+  explicit Impl(std::shared_ptr<Context> c) : context(std::move(c)), resident(*context) {}
 };
 
 SceneRenderer::SceneRenderer(std::shared_ptr<Context> context) {
@@ -421,6 +451,8 @@ Context& SceneRenderer::context() {
 VkBuffer record_render(SceneRenderer& renderer, VkCommandBuffer cmd, const Camera& camera,
                        const RenderOptions& options, PixelOrder order) {
   ResidentScene& r = renderer.impl().resident;
+  if (!r.scene()) throw InvalidArgument("GPU render: no scene synced yet");
+  r.prepare_approximation(*r.scene(), options);
   Recorder rec(renderer.context().impl(), cmd, r.sets());
   r.record_render(rec, camera, options, order == PixelOrder::kBgra, /*timed=*/false);
   // The application copies the pixels out with a transfer.
