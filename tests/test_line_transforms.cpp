@@ -4,15 +4,18 @@
 // single sites, and lines at the 32-bit kernel's bounds (n^2 and the costs near 2^29). The
 // division-free kernel must also agree with Meijster's scan, value for value and site for site,
 // and its lock-step form (envelope_lanes.h) with it, lane by lane; the windowed min-plus
-// (window_lanes.h), in SSE registers and in plain loops, with it lane by lane, values only.
+// (window_lanes.h), in SSE registers and in plain loops, with it lane by lane, values only; and the
+// local passes' two-dimensional truncated min-convolution against its definition.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <vector>
 
 #include "distance/envelope_lanes.h"
 #include "distance/line_transforms.h"
+#include "distance/truncated_min_convolution.h"
 #include "distance/window_lanes.h"
 
 using namespace voxfield::detail;
@@ -370,4 +373,57 @@ TEST(LineTransforms, TheLockStepEnvelopeHoldsAtTheThirtyTwoBitBounds) {
     EXPECT_EQ(got[k].out, ref.out) << "lane " << k;
     EXPECT_EQ(got[k].arg, ref.arg) << "lane " << k;
   }
+}
+
+// The local passes' truncated min-convolution (src/distance/truncated_min_convolution.h) against
+// the definition: the least f(x', y') + (x - x')² + (y - y')² over the whole slice, "none" above
+// the squared clamp. Random slices with sparse and dense sites, windows touching the slice's
+// edges and not, widths that are and are not whole vectors, reaches up to the largest allowed.
+TEST(TruncatedMinConvolution, EqualsTheClampedTwoDimensionalTransform) {
+  using Conv = TruncatedMinConvolution;
+  std::mt19937 rng(2012);
+  Conv conv;
+  int checked = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const int nx = 1 + static_cast<int>(rng() % 90), ny = 1 + static_cast<int>(rng() % 90);
+    const int mx = 1 + static_cast<int>(rng() % nx), my = 1 + static_cast<int>(rng() % ny);
+    const int ox = static_cast<int>(rng() % (nx - mx + 1)),
+              oy = static_cast<int>(rng() % (ny - my + 1));
+    const int reaches[] = {1, 3, 16, 33, Conv::kMaxReach};
+    const int reach = reaches[trial % 5];
+    const double clamp = reach + (trial % 2 ? 0.5 : 0.0);
+    const auto drop = static_cast<Conv::Cost>(std::floor(clamp * clamp));
+    const double density = trial % 3 == 0 ? 0.002 : trial % 3 == 1 ? 0.05 : 0.6;
+    std::vector<int> f(static_cast<std::size_t>(nx) * ny);
+    for (int& v : f) {
+      // Column costs as the z pass leaves them: squares of 0..reach, or none.
+      const bool site = std::uniform_real_distribution<double>(0, 1)(rng) < density;
+      const int dz = static_cast<int>(rng() % (reach + 1));
+      v = site ? dz * dz : -1;
+    }
+    conv.prepare(nx, ny, ox, oy, mx, my, reach, drop);
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x) {
+        const int v = f[static_cast<std::size_t>(y) * nx + x];
+        conv.f_row(y)[x] = v < 0 ? Conv::kInf : static_cast<Conv::Cost>(v);
+      }
+    conv.solve();
+    for (int j = 0; j < my; ++j)
+      for (int i = 0; i < mx; ++i) {
+        long best = -1;
+        for (int y = 0; y < ny; ++y)
+          for (int x = 0; x < nx; ++x) {
+            const int v = f[static_cast<std::size_t>(y) * nx + x];
+            if (v < 0) continue;
+            const long c = v + static_cast<long>(x - (ox + i)) * (x - (ox + i)) +
+                           static_cast<long>(y - (oy + j)) * (y - (oy + j));
+            if (best < 0 || c < best) best = c;
+          }
+        const long expected = best < 0 || best > drop ? Conv::kInf : best;
+        ASSERT_EQ(conv.out_row(j)[i], expected)
+            << "trial " << trial << " at (" << ox + i << ", " << oy + j << ")";
+        ++checked;
+      }
+  }
+  EXPECT_GT(checked, 20000);
 }
