@@ -151,7 +151,8 @@ struct RenderParams {
   int slice_z;             // distance view: the cut plane (voxels above it are hidden)
   float heat_max;          // distance view: the distance at the top of the heat ramp
   float approx_inv_scale;  // error view: stored approximate value * this = voxels
-  uint pad1, pad2;
+  float footprint_scale;   // Camera::Projector::footprint_scale
+  uint pad2;
 };
 
 // ---- vector fields (src/vectors/gpu)

@@ -77,6 +77,10 @@ TEST(Gpu, RayMarchedFramesMatchTheCpuRenderer) {
     ASSERT_TRUE(stretched.world_frame.has_value());
     expect_images_close(gpu::render(*ctx, scene, stretched, fog), render(scene, stretched, fog),
                         "a camera in a frame of non-cubic voxels");
+    RenderOptions chunks = fog;  // the grid lines' width from the stretched pixel footprint
+    chunks.view = RenderView::kChunks;
+    expect_images_close(gpu::render(*ctx, scene, stretched, chunks),
+                        render(scene, stretched, chunks), "chunks, non-cubic voxels");
   }
   const auto messages = ctx->validation_messages();
   EXPECT_TRUE(messages.empty()) << messages.size()

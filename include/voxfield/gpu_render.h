@@ -15,8 +15,11 @@ namespace voxfield::gpu {
 // Renders a frame of `scene` with the ray-marching compute shader: the CPU renderer's traversal,
 // data and shading, in floats — images match the CPU's within the tolerance tests/test_gpu.cpp
 // states. Every view (the error view's counts, rays_through_geometry and max_error, stay zero:
-// the CPU renderer reports them). One submit; stats->ms
-// covers upload, render and read-back. For many frames of a changing scene, use SceneRenderer.
+// the CPU renderer reports them). One submit; stats->ms covers upload, render and read-back.
+// The error view first computes its approximation on the device (gpu_distance.h; brute force on
+// the CPU): one more submit and fence wait, outside stats->ms. For many frames of a changing
+// scene, use SceneRenderer, which keeps the approximation until the scene or the algorithm
+// changes.
 Image render(Context& context, const RenderScene& scene, const Camera& camera,
              const RenderOptions& options, RenderStats* stats = nullptr,
              std::vector<PassTiming>* timings = nullptr);

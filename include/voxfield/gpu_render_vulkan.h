@@ -16,7 +16,10 @@ namespace voxfield::gpu {
 // reused by the next frame: wait for `cmd` before recording another frame. SceneRenderer::sync()
 // may run while the frame executes (its copies wait for it on the queue; buffers it replaces live
 // until the sync after), or between recording the frame and submitting it: the frame begins with a
-// barrier on everything submitted before it on the queue.
+// barrier on everything submitted before it on the queue. An error view whose approximation is
+// not resident computes it first, on the adopted queue with a submit and a fence wait of its own
+// (gpu_render.h): do not use that queue from another thread meanwhile. Its copy to the frame's
+// buffers is recorded into `cmd` and is taken as done from then on: submit every frame recorded.
 // Throws InvalidArgument as SceneRenderer::render does.
 VkBuffer record_render(SceneRenderer& renderer, VkCommandBuffer cmd, const Camera& camera,
                        const RenderOptions& options, PixelOrder order);

@@ -69,7 +69,8 @@ struct Camera {
   // axes in voxel space, which eye, target and up cannot say: the camera keeps its world
   // coordinates and the frame (world_frame), and its projector maps each ray into voxels — still
   // exactly the world's view. Throws InvalidArgument for a frame that validate() refuses, or for
-  // a camera already placed in one.
+  // a camera that already keeps a world_frame (a camera placed in cubic voxels is a plain camera
+  // in voxels again: placing it twice carries it twice).
   Camera in_voxels(const VoxelFrame& frame) const;
 
   // Rays through the pixels of a width x height image, with the camera's basis computed once.
@@ -81,16 +82,22 @@ struct Camera {
     double scale = 1;  // tan(fov / 2), or ortho_height / 2
     // What a ray's direction in voxels is multiplied by (then normalised) to look up the sky:
     // (1, 1, 1), or for a camera with a world_frame the voxels' world edge lengths — the world
-    // ray's direction along the voxel axes — so the sky is the world's view of it too.
+    // ray's direction along the voxel axes, so non-cubic voxels do not bend the sky. (Its zenith
+    // stays the voxels' z axis, as the sun stays in voxel terms, for every frame.)
     Vec3d sky_scale{1, 1, 1};
     int width = 1, height = 1;
     // The ray through (px, py) in pixels, (0, 0) the top-left corner: pixel centres are at +0.5.
     // Directions are unit vectors in voxel coordinates, so t measures voxels.
     Ray ray(double px, double py) const;
-    // Size of one pixel, in voxels, at distance t along a ray: the chunk view's line width
-    // (approximate for a camera with a world_frame, whose pixels are not squares in voxels).
+    // Voxels per unit of `scale`'s frame along the image's height: 1, or for a camera with a
+    // world_frame the length of the mapped up (over the mapped forward's, perspective: t is
+    // then voxels along a ray, the world's distance about t / |forward|).
+    double footprint_scale = 1;
+    // Size of one pixel, in voxels, at distance t along a ray: the chunk view's line width (for a
+    // camera with a world_frame, along the image's height: its pixels are not squares in voxels).
     double footprint(double t) const {
-      return (projection == Projection::kOrthographic ? 1 : t) * 2 * scale / height;
+      return (projection == Projection::kOrthographic ? 1 : t) * 2 * scale / height *
+             footprint_scale;
     }
   };
   Projector projector(int width, int height) const;

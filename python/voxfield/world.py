@@ -21,7 +21,8 @@ ambient_occlusion=True, fog=0.0, metric="manhattan", threads=0, camera_frame="vo
 frame of voxfield's DDA ray marcher as uint8 (height, width, 3) RGB, the same pixels as ``voxfield
 render`` writes: ``camera`` "auto", "top" or "eye=x,y,z:target=x,y,z[:up=..][:fov=deg][:ortho=h]",
 in voxel coordinates, or in the world's frame with ``camera_frame="world"`` (the world's view,
-whatever its voxels' shape; ambient occlusion, shadows, the sun and fog stay in voxel terms); ``view`` "shaded", "distance" (a heat map of the field on a cut), "error" or
+whatever its voxels' shape; ambient occlusion, shadows, the sun and fog stay in voxel terms);
+``view`` "shaded", "distance" (a heat map of the field on a cut), "error" or
 "chunks"; ``metric``: the skip field's.
 
 ``approximate(world, algorithm="jfa", metric="euclidean", signed=False, max_distance=0.0,

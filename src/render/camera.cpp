@@ -205,6 +205,9 @@ Camera::Projector Camera::projector(int width, int height) const {
     p.forward = f.vox_direction(p.forward);
     p.right = f.vox_direction(p.right);
     p.up = f.vox_direction(p.up);
+    p.footprint_scale = projection == Projection::kOrthographic
+                            ? p.up.length()
+                            : p.up.length() / p.forward.length();
     if (projection == Projection::kOrthographic) p.forward = p.forward.normalized();
     p.sky_scale = f.voxel_size_world;
   }

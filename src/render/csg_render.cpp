@@ -15,6 +15,7 @@
 #include "csg_frame.h"
 #include "shading.h"
 #include "voxfield/csg_render.h"
+#include "voxfield/error.h"
 #include "voxfield/parallel.h"
 
 namespace voxfield {
@@ -165,6 +166,12 @@ Rgb variant_colour(int variant) {
 }
 
 CsgFrame prepare_csg_frame(const csg::Model& model, const CsgRenderOptions& o) {
+  // A model is traced in its own units: a camera placed in a world of non-cubic voxels carries
+  // its rays into that world's voxels, which are not the model's.
+  if (o.camera && o.camera->world_frame)
+    throw InvalidArgument(
+        "CSG render: a camera placed in a world of non-cubic voxels draws voxels; give the "
+        "model's camera in the model's units");
   CsgFrame f;
   std::optional<csg::Bounds> box = csg::box_or_bounds(model, o.box);
   {  // a little margin, so that surfaces on the bounds are inside the traced box

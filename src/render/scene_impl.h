@@ -95,7 +95,8 @@ struct RenderScene::Impl {
   SkipSource make_skip_source(const DistanceField& field) const;
   // The error view's approximation: the skip field's options computed by `algorithm` (lod: FIM
   // in the middle of the box; approximation_options), as a skip source. The GPU renderer computes
-  // the same field on its device and makes it a skip source with make_skip_source.
+  // the field on its device (bit for bit for exact and jump flooding; FIM, hybrid and lod within
+  // 1e-4 voxels, so a stored step may differ) and makes it a skip source with make_skip_source.
   SkipSource approximation(Algorithm algorithm) const;
   AlgorithmOptions approximation_options(Algorithm algorithm) const;
   // Re-reads chunk i from the world and the fields (the fields already checked to fit).

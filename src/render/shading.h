@@ -41,7 +41,8 @@ inline Rgb sky(const Vec3d& dir) {
   return mix(kSkyHorizon, kSkyZenith, std::pow(z, 0.6));
 }
 // The sky along a ray of direction `dir` (voxels) of a camera whose projector's sky_scale is
-// `scale` (Camera::Projector): the world's sky for a camera placed in non-cubic voxels.
+// `scale` (Camera::Projector): for a camera placed in non-cubic voxels, the sky of the world ray's
+// direction along the voxel axes.
 inline Rgb sky(const Vec3d& dir, const Vec3d& scale) {
   if (scale == Vec3d{1, 1, 1}) return sky(dir);
   return sky(Vec3d{dir.x * scale.x, dir.y * scale.y, dir.z * scale.z}.normalized());

@@ -264,12 +264,20 @@ void ResidentScene::prepare_approximation(const RenderScene::Impl& s, const Rend
   if (approx_scene_ == s.id && approx_generation_ == s.generation &&
       approx_algorithm_ == static_cast<int>(algorithm))
     return;
+  // Nothing resident until the new approximation is made (a throw below leaves none, so the next
+  // error frame computes it again).
   approx_computed_.reset();
-  if (algorithm == Algorithm::kBrute || algorithm == Algorithm::kBruteChunked)
+  approx_algorithm_ = -1;
+  // The skip source reads no sites; the device's algorithms take unit spacing only (brute force,
+  // the CPU's reference, and a skip field of another spacing stay on the CPU).
+  DistanceOptions options = s.skip_options;
+  options.nearest_sites = false;
+  const bool unit = options.spacing == std::array<double, 3>{1, 1, 1};
+  if (algorithm == Algorithm::kBrute || algorithm == Algorithm::kBruteChunked || !unit)
     approx_computed_ = s.approximation(algorithm);
   else
     approx_computed_ = s.make_skip_source(voxfield::gpu::compute_distance_field(
-        context_, *s.world, s.skip_options, s.approximation_options(algorithm)));
+        context_, *s.world, options, s.approximation_options(algorithm)));
   approx_scene_ = s.id;
   approx_generation_ = s.generation;
   approx_algorithm_ = static_cast<int>(algorithm);
@@ -278,8 +286,9 @@ void ResidentScene::prepare_approximation(const RenderScene::Impl& s, const Rend
 
 void ResidentScene::record_approximation(Recorder& rec) {
   if (!approx_computed_) return;
-  const SkipSource approx = std::move(*approx_computed_);
-  approx_computed_.reset();
+  // Kept pending until its copy is recorded: a buffer that fails to allocate leaves it for the
+  // next frame.
+  const SkipSource& approx = *approx_computed_;
   const RenderScene::Impl& s = *scene_;
   const std::size_t chunks = s.table.chunk_count();
   std::vector<std::uint32_t> info(2 * chunks);
@@ -307,6 +316,7 @@ void ResidentScene::record_approximation(Recorder& rec) {
   rec.copy({{&approx_staging_, &approx_info_, {&to_info, 1}},
             {&approx_staging_, &approx_arena_,
              arena_bytes > 0 ? std::span(&to_arena, 1) : std::span<const VkBufferCopy>()}});
+  approx_computed_.reset();
 }
 
 void ResidentScene::record_render(Recorder& rec, const Camera& camera, const RenderOptions& o,
@@ -344,6 +354,7 @@ void ResidentScene::record_render(Recorder& rec, const Camera& camera, const Ren
   rp.width = static_cast<std::uint32_t>(o.width);
   rp.height = static_cast<std::uint32_t>(o.height);
   rp.scale = static_cast<float>(pj.scale);
+  rp.footprint_scale = static_cast<float>(pj.footprint_scale);
   rp.metric = static_cast<std::uint32_t>(s.skip.metric);
   rp.skip_inv_scale = static_cast<float>(s.skip.inv_scale);
   rp.light_inv_scale = static_cast<float>(s.light_inv_scale);
@@ -377,11 +388,11 @@ Image render_and_read(Context::Impl& ctx, ResidentScene& resident, const RenderS
                       std::vector<PassTiming>* timings) {
   if (!sync && !resident.scene()) throw InvalidArgument("GPU render: no scene synced yet");
   check_options(sync ? sync->impl() : *resident.scene(), o);
-  const VkDeviceSize image_bytes = static_cast<VkDeviceSize>(o.width) * o.height * 4;
-  Buffer& readback = ctx.readback_buffer(image_bytes);
   // The error view's approximation first (its own submit, outside the frame's time, as the CPU
   // renderer leaves its approximation out of RenderStats::ms).
   resident.prepare_approximation(sync ? sync->impl() : *resident.scene(), o);
+  const VkDeviceSize image_bytes = static_cast<VkDeviceSize>(o.width) * o.height * 4;
+  Buffer& readback = ctx.readback_buffer(image_bytes);
   const auto t0 = std::chrono::steady_clock::now();
   Recorder rec(ctx, &resident.sets());
   if (sync) resident.record_sync(rec, *sync);
@@ -455,6 +466,7 @@ VkBuffer record_render(SceneRenderer& renderer, VkCommandBuffer cmd, const Camer
                        const RenderOptions& options, PixelOrder order) {
   ResidentScene& r = renderer.impl().resident;
   if (!r.scene()) throw InvalidArgument("GPU render: no scene synced yet");
+  check_options(*r.scene(), options);  // before computing an approximation for a frame refused
   r.prepare_approximation(*r.scene(), options);
   Recorder rec(renderer.context().impl(), cmd, r.sets());
   r.record_render(rec, camera, options, order == PixelOrder::kBgra, /*timed=*/false);

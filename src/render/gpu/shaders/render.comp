@@ -395,7 +395,8 @@ void main() {
     if ((rp.flags & VF_RENDER_CHUNKS) != 0u) {
       // Chunk view: grid lines about a pixel wide, chunks tinted by storage.
       const float edge = float(1 << rp.first_chunk.w);
-      const float foot = (rp.eye.w != 0.0 ? 1.0 : t) * 2.0 * rp.scale / float(rp.height);
+      const float foot =
+          (rp.eye.w != 0.0 ? 1.0 : t) * 2.0 * rp.scale / float(rp.height) * rp.footprint_scale;
       const float width = max(0.04, 0.75 * foot);
       bool line = false;
       for (int a = 0; a < 3; ++a) {
