@@ -179,6 +179,12 @@ TEST(Gpu, ResidentScenesFollowEditsWithOnlyTheirChunksCopied) {
     EXPECT_EQ(incremental.rgb, gpu::render(*ctx, live.scene(), cam, o).rgb) << "batch " << batch;
     const RenderScene fresh(w, live.skip_field(), live.light_field());
     EXPECT_EQ(incremental.rgb, gpu::render(*ctx, fresh, cam, o).rgb) << "batch " << batch;
+    // The error view's approximation follows the edits: computed again for the edited scene.
+    RenderOptions error = o;
+    error.view = RenderView::kError;
+    error.error_algorithm = Algorithm::kJfaSeed;
+    EXPECT_EQ(renderer.render(cam, error).rgb, gpu::render(*ctx, fresh, cam, error).rgb)
+        << "error view, batch " << batch;
   }
   const auto messages = ctx->validation_messages();
   EXPECT_TRUE(messages.empty()) << messages.size()
