@@ -101,6 +101,23 @@ struct RowSamples {
   float s_of(float v) const { return negate ? iso - v : v - iso; }
   float s(std::ptrdiff_t i) const { return s_of(lattice.values[i]); }
   std::ptrdiff_t index(int x, int y, int z) const { return x + sy * y + sz * z; }
+  // Central differences at a sample whose six neighbours all lie in the lattice: gradient()'s
+  // arithmetic without its per-axis face tests.
+  std::array<double, 3> inner_gradient(std::ptrdiff_t i) const {
+    const std::ptrdiff_t step[3] = {1, sy, sz};
+    std::array<double, 3> g;
+    for (std::size_t a = 0; a < 3; ++a) {
+      const double difference = static_cast<double>(s(i + step[a])) - s(i - step[a]);
+      g[a] = exact_inverse[a] ? difference * inverse[a][1] : difference / span[a][1];
+    }
+    return g;
+  }
+  // Whether the edge from (x, y, z) along `axis` has both ends' six neighbours in the lattice.
+  bool inner_edge(int x, int y, int z, int axis) const {
+    const Vec3i n = lattice.n;
+    return x >= 1 && y >= 1 && z >= 1 && x + 1 + (axis == 0) < n.x &&
+           y + 1 + (axis == 1) < n.y && z + 1 + (axis == 2) < n.z;
+  }
   // Central differences, one-sided on the lattice's faces (Block::gradient, the same rounding).
   std::array<double, 3> gradient(int x, int y, int z) const {
     const std::ptrdiff_t i = index(x, y, z);
@@ -137,7 +154,9 @@ Vertex edge_vertex(const RowSamples& in, int x, int y, int z, int axis) {
   at[static_cast<std::size_t>(axis)] += t;
   const auto position = lattice_position(in.lattice, at);
   const int qx = x + (axis == 0), qy = y + (axis == 1), qz = z + (axis == 2);
-  const auto g0 = in.gradient(x, y, z), g1 = in.gradient(qx, qy, qz);
+  const bool inner = in.inner_edge(x, y, z, axis);
+  const auto g0 = inner ? in.inner_gradient(i0) : in.gradient(x, y, z);
+  const auto g1 = inner ? in.inner_gradient(i1) : in.gradient(qx, qy, qz);
   std::array<double, 3> normal{g0[0] + t * (g1[0] - g0[0]), g0[1] + t * (g1[1] - g0[1]),
                                g0[2] + t * (g1[2] - g0[2])};
   if (normal[0] == 0 && normal[1] == 0 && normal[2] == 0)
