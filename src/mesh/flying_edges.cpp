@@ -115,8 +115,8 @@ struct RowSamples {
   // Whether the edge from (x, y, z) along `axis` has both ends' six neighbours in the lattice.
   bool inner_edge(int x, int y, int z, int axis) const {
     const Vec3i n = lattice.n;
-    return x >= 1 && y >= 1 && z >= 1 && x + 1 + (axis == 0) < n.x &&
-           y + 1 + (axis == 1) < n.y && z + 1 + (axis == 2) < n.z;
+    return x >= 1 && y >= 1 && z >= 1 && x + 1 + (axis == 0) < n.x && y + 1 + (axis == 1) < n.y &&
+           z + 1 + (axis == 2) < n.z;
   }
   // Central differences, one-sided on the lattice's faces (Block::gradient, the same rounding).
   std::array<double, 3> gradient(int x, int y, int z) const {
