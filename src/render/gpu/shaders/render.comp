@@ -249,8 +249,8 @@ vec3 sky(vec3 dir) {
   return mix(kSkyHorizon, kSkyZenith, pow(dir.z, 0.6));
 }
 
-// The sky along a ray: the camera's sky_scale (in the basis' w) makes it the world's for a camera
-// placed in non-cubic voxels (shading.h).
+// The sky along a ray: for a camera placed in non-cubic voxels, the camera's sky_scale (in the
+// basis' w) turns the ray into the world ray's direction along the voxel axes (shading.h).
 vec3 sky_along(vec3 dir) {
   const vec3 s = vec3(rp.forward.w, rp.right.w, rp.up.w);
   return sky(s == vec3(1.0) ? dir : normalize(dir * s));
