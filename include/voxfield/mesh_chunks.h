@@ -13,11 +13,13 @@
 #include <memory>
 #include <vector>
 
+#include "voxfield/edit.h"
 #include "voxfield/mesh.h"
 
 namespace voxfield {
 
 class TerrainField;
+class DistanceField;
 
 class MeshChunks {
  public:
@@ -48,6 +50,57 @@ class MeshChunks {
   // All chunks welded: equal, array for array, to MeshChunks(volume, options).merged() now, and
   // triangle for triangle to mesh_volume(volume, options).
   Mesh merged() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// A voxel world's surface kept chunk by chunk through its edits: what mesh_world() gives, re-meshed
+// only where edits reach. It keeps what that surface is made from — the world's exact signed
+// field, clamped at |iso| + 3 voxels (a DynamicDistanceField, bit for bit a full rebuild after
+// every update) — over a fixed lattice: the world's bounds grown by the air mesh_world() puts
+// around the content, so the surface closes at the bounds as it does there. Because that field
+// reaches past the bounds, where the world stores nothing, it is computed on a copy of the
+// world's voxels without bounds, refreshed in the boxes the edits changed (one byte per stored
+// voxel; uniform chunks cost nothing).
+//
+// merged() has the same triangles as mesh_world(world, options, metric) for the edited world —
+// positions, normals and colours (at iso 0 bit for bit; offset surfaces within float rounding of
+// the lattice's other origin) — and an edit re-meshes the chunks within |iso| + 6 samples of
+// what it changed. Chunk meshes are in voxel coordinates placed in the world's frame, as
+// mesh_world()'s.
+class WorldMeshChunks {
+ public:
+  // Binds to `world`, which must be bounded (InvalidArgument otherwise: the lattice must stay
+  // fixed) and must outlive this object, and meshes it. Errors as mesh_world()'s (iso out of
+  // range, the memory limit, Cancelled through options.interrupter, which watches this first
+  // mesh only).
+  WorldMeshChunks(const World& world, const MeshOptions& options,
+                  Metric metric = Metric::kEuclidean);
+  ~WorldMeshChunks();
+  WorldMeshChunks(WorldMeshChunks&&) noexcept;
+  WorldMeshChunks& operator=(WorldMeshChunks&&) noexcept;
+
+  // After edits of the world recorded in `dirty` — with DirtyRegions::Track::kAnyChange, so that
+  // a repaint, which changes no distance, re-colours its chunks — updates the field and re-meshes
+  // the chunks the changes reach; returns those chunks. The caller clears `dirty` afterwards.
+  // InvalidArgument when the world's bounds changed. Each chunk's new mesh is built aside and
+  // replaces its old one whole, after all of them are built; but the field is written region by
+  // region (DynamicDistanceField::update), so after an exception the chunks are the old ones and
+  // the field part new: call rebuild().
+  std::vector<Vec3i> update(const DirtyRegions& dirty);
+  // Copies the world again, recomputes the field and re-meshes every chunk (after a palette
+  // change, or an exception in update()).
+  void rebuild();
+
+  Vec3i chunk_count() const;
+  // Chunk `c`'s own mesh. InvalidArgument for a chunk outside chunk_count().
+  Mesh chunk_mesh(Vec3i c) const;
+  // All chunks welded.
+  Mesh merged() const;
+  // The signed field the surface is meshed from (over the lattice's voxels).
+  const DistanceField& field() const;
 
  private:
   struct Impl;

@@ -36,6 +36,19 @@ MeshOptions terrain_options(const TerrainField& terrain, const MeshOptions& opti
 Lattice terrain_lattice(const TerrainField& terrain, const MeshOptions& terrain_options,
                         TerrainSamples& keep);
 
+// What mesh_world() and WorldMeshChunks share (mesh_world.cpp). How many voxels of air the
+// lattice reaches past the solid content for a world surface at `iso` (InvalidArgument for an
+// iso mesh_world refuses); the signed field the surface is meshed from, clamped where the meshers
+// stop reading; the lattice over `domain` (samples at voxel centres); the material that colours a
+// vertex made from sample `p` (an air sample of an offset surface: its nearest voxel's); and an
+// offset surface's exact normals from the field's nearest sites.
+int world_surface_margin(double iso);
+DistanceOptions world_field_options(double iso, Metric metric, const Box3i& domain);
+ScalarVolume world_lattice_frame(const Box3i& domain);
+std::uint8_t world_vertex_material(const World& world, const DistanceField& field, Vec3i p);
+std::function<std::array<double, 3>(const std::array<double, 3>&)> offset_gradient(
+    const World& world, const DistanceField& field, Metric metric, bool outside);
+
 // Meshes the chunks numbered `chunks` (ChunkGrid::coord order) into parts[i], in parallel, with
 // progress and cancellation through options.interrupter.
 void mesh_chunks(const Lattice& lattice, const ChunkGrid& grid, const MeshOptions& options,

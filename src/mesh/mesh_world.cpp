@@ -20,7 +20,7 @@
 
 namespace voxfield {
 
-namespace {
+namespace detail::mesh {
 
 // The exact gradient of a world's signed field at a point of an offset surface, from the field's
 // nearest sites: Hermite data for dual contouring, and every mesher's normals. Outside (iso > 0)
@@ -83,10 +83,7 @@ std::function<std::array<double, 3>(const std::array<double, 3>&)> offset_gradie
   };
 }
 
-}  // namespace
-
-Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
-  const double iso = options.iso;
+int world_surface_margin(double iso) {
   if (!(std::abs(iso) <= 1000))
     throw InvalidArgument("mesh: the iso value of a world (" + std::to_string(iso) +
                           " voxels) must be finite and within ±1000");
@@ -95,11 +92,48 @@ Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
   if (iso != 0 && std::abs(iso) < 1)
     throw InvalidArgument("mesh: a world's offset surface is at least 1 voxel out (or in); iso " +
                           std::to_string(iso) + " lies between neighbouring voxel centres");
+  // The surface lies up to iso voxels out: the domain reaches two voxels past it.
+  return 1 + static_cast<int>(std::ceil(std::max(iso, 0.0))) + (iso > 0 ? 1 : 0);
+}
+
+DistanceOptions world_field_options(double iso, Metric metric, const Box3i& domain) {
+  DistanceOptions o;
+  o.metric = metric;
+  o.signed_distance = true;
+  o.max_distance = std::abs(iso) + 3;
+  o.domain = domain;
+  // An offset surface's normals come from the nearest sites (offset_gradient), and its vertices
+  // from air samples take their colour from their nearest voxel.
+  o.nearest_sites = iso != 0;
+  return o;
+}
+
+ScalarVolume world_lattice_frame(const Box3i& domain) {
+  ScalarVolume volume;
+  volume.size = domain.size();
+  for (int a = 0; a < 3; ++a)
+    volume.origin_units[static_cast<std::size_t>(a)] = domain.begin[a] + 0.5;
+  return volume;
+}
+
+std::uint8_t world_vertex_material(const World& world, const DistanceField& field, Vec3i p) {
+  std::uint8_t material = world.voxels.get(p);
+  if (material == 0 && field.sites) {  // an air sample of an offset surface: its nearest voxel
+    const SiteOffset off = field.sites->get(p);
+    if (!off.none()) material = world.voxels.get({p.x + off.dx, p.y + off.dy, p.z + off.dz});
+  }
+  return material;
+}
+
+}  // namespace detail::mesh
+
+Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
+  using namespace detail::mesh;
+  const double iso = options.iso;
+  const int margin = world_surface_margin(iso);
   const Box3i content = world.voxels.content_bounds();
   if (content.empty()) return Mesh{};
-  // The surface lies up to iso voxels out: the domain reaches two voxels past it.
-  const Box3i domain =
-      content.grown(1 + static_cast<int>(std::ceil(std::max(iso, 0.0))) + (iso > 0 ? 1 : 0));
+  const Box3i domain = content.grown(margin);
   const Vec3i size = domain.size();
   // Voxels beyond a bounded world's bounds are air: where the grown content leaves the bounds, the
   // field is computed on an unbounded copy so that the surface closes there with exact distances.
@@ -113,28 +147,18 @@ Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
   // The float samples: 4 bytes per voxel of the domain, on top of the field itself.
   require_memory(mul_sat(static_cast<std::uint64_t>(domain.volume()), 8), 0, "mesh",
                  "the world's signed distance samples");
-  DistanceOptions field_options;
-  field_options.metric = metric;
-  field_options.signed_distance = true;
-  field_options.max_distance = std::abs(iso) + 3;
-  field_options.domain = domain;
-  // An offset surface's normals come from the nearest sites (below), and its vertices from air
-  // samples take their colour from their nearest voxel.
-  field_options.nearest_sites = iso != 0;
-  const DistanceField field = compute_distance_field(source, field_options);
+  const DistanceField field =
+      compute_distance_field(source, world_field_options(iso, metric, domain));
   std::vector<float> samples(static_cast<std::size_t>(domain.volume()));
   std::get<Grid<float>>(field.values).copy_to_dense(domain, samples.data());
 
-  ScalarVolume volume;
-  volume.size = size;
+  ScalarVolume volume = world_lattice_frame(domain);
   volume.values = samples.data();
-  for (int a = 0; a < 3; ++a)
-    volume.origin_units[static_cast<std::size_t>(a)] = domain.begin[a] + 0.5;
   MeshOptions o = options;
   o.inside_above = false;
   if (iso != 0) o.gradient = offset_gradient(source, field, metric, iso > 0);
   std::vector<std::uint64_t> sources;
-  Mesh mesh = detail::mesh::mesh_lattice(volume, o, &sources, /*voxel_faces=*/iso == 0);
+  Mesh mesh = mesh_lattice(volume, o, &sources, /*voxel_faces=*/iso == 0);
   mesh.colors.resize(mesh.positions.size());
   const std::uint64_t nx = static_cast<std::uint64_t>(size.x),
                       nxy = nx * static_cast<std::uint64_t>(size.y);
@@ -143,12 +167,7 @@ Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
     const Vec3i p{domain.begin.x + static_cast<int>(s % nx),
                   domain.begin.y + static_cast<int>(s / nx % static_cast<std::uint64_t>(size.y)),
                   domain.begin.z + static_cast<int>(s / nxy)};
-    std::uint8_t material = world.voxels.get(p);
-    if (material == 0 && field.sites) {  // an air sample of an offset surface: its nearest voxel
-      const SiteOffset off = field.sites->get(p);
-      if (!off.none()) material = world.voxels.get({p.x + off.dx, p.y + off.dy, p.z + off.dz});
-    }
-    const Rgba c = world.palette[material];
+    const Rgba c = world.palette[world_vertex_material(world, field, p)];
     mesh.colors[i] = {c.r, c.g, c.b};
   }
   place_in_frame(mesh, world.frame);
