@@ -1,6 +1,7 @@
 // LiveWorld under concurrency: edits submitted from several threads while another thread updates
 // and readers keep checking that every snapshot is consistent (the field is exactly the field of
-// the world it is shown with). Run under ThreadSanitizer by scripts/test.sh (preset tsan).
+// the world it is shown with, and a kept mesh exactly its mesh). Run under ThreadSanitizer by
+// scripts/test.sh (preset tsan).
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -8,6 +9,7 @@
 #include <random>
 #include <thread>
 
+#include "mesh_compare.h"
 #include "voxfield/live_world.h"
 
 using namespace voxfield;
@@ -105,4 +107,66 @@ TEST(LiveWorld, ConcurrentEditsUpdatesAndReadersStayConsistent) {
   });
   // Bad edits are refused in the submitting thread.
   EXPECT_THROW(live.submit({EditOp::kPlace, SphereBrush{{0, 0, 0}, -2}, 1}), InvalidArgument);
+}
+
+// A kept mesh through concurrent edits: every snapshot a reader takes has the mesh of exactly the
+// world it is shown with (mesh_world's triangles), and updates say which chunks they re-meshed.
+TEST(LiveWorld, KeptMeshFollowsConcurrentEdits) {
+  const Box3i bounds = Box3i::from_size({40, 32, 24});
+  World start(8, bounds);
+  start.voxels.fill(Box3i{{0, 0, 0}, {40, 32, 6}}, 2);  // a floor touching the bounds
+  DistanceOptions o;
+  o.metric = Metric::kManhattan;
+  o.max_distance = kClamp;
+  LiveWorld live(std::move(start), o);
+  EXPECT_THROW(live.read_mesh([](const World&, const WorldMeshChunks&) { return 0; }),
+               InvalidArgument);
+  MeshOptions mo;
+  mo.algorithm = Mesher::kSurfaceNets;
+  mo.chunk_edge = 8;
+  live.keep_mesh(mo);
+  constexpr int kWriters = 2, kEditsEach = 40;
+  std::atomic<int> writers_done{0}, remeshed{0}, snapshots{0}, inconsistent{0};
+  std::atomic<bool> stop_reader{false};
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kWriters; ++t)
+    threads.emplace_back([&, t] {
+      std::mt19937 rng(300 + t);
+      for (int i = 0; i < kEditsEach; ++i) {
+        Edit e;
+        e.op = i % 3 == 0 ? EditOp::kCarve : i % 3 == 1 ? EditOp::kPlace : EditOp::kPaint;
+        e.material = static_cast<std::uint8_t>(1 + rng() % 9);
+        e.brush = SphereBrush{{static_cast<double>(rng() % 40), static_cast<double>(rng() % 32),
+                               static_cast<double>(rng() % 12)},
+                              static_cast<double>(1 + rng() % 3)};
+        live.submit(e);
+        if (i % 4 == 3) std::this_thread::sleep_for(std::chrono::milliseconds(3));
+      }
+      ++writers_done;
+    });
+  threads.emplace_back([&] {  // the updater
+    while (writers_done.load() < kWriters || live.pending() > 0)
+      remeshed += static_cast<int>(live.update().remeshed_chunks.size());
+  });
+  threads.emplace_back([&] {  // a reader comparing each snapshot's mesh with its world's
+    while (!stop_reader.load()) {
+      live.read_mesh([&](const World& w, const WorldMeshChunks& mesh) {
+        if (test::corner_triangles(mesh.merged()) != test::corner_triangles(mesh_world(w, mo)))
+          ++inconsistent;
+        return 0;
+      });
+      ++snapshots;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  });
+  for (int t = 0; t <= kWriters; ++t) threads[static_cast<std::size_t>(t)].join();
+  stop_reader = true;
+  threads.back().join();
+  EXPECT_GT(snapshots.load(), 0);
+  EXPECT_EQ(inconsistent.load(), 0);
+  EXPECT_GT(remeshed.load(), 0);
+  live.read_mesh([&](const World& w, const WorldMeshChunks& mesh) {
+    EXPECT_TRUE(test::corner_triangles(mesh.merged()) == test::corner_triangles(mesh_world(w, mo)));
+    return 0;
+  });
 }

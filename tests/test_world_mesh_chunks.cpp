@@ -63,6 +63,10 @@ World ground(bool anchors) {
       for (int z = 0; z < h; ++z)
         w.voxels.set({x, y, z}, static_cast<std::uint8_t>(1 + (x / 8 + z / 4) % 3));
     }
+  // A ledge on top, the content's highest voxels: the surface over them is not symmetric, so
+  // its normals show whether the air above them is sampled far enough.
+  w.voxels.fill(Box3i{{20, 20, 12}, {22, 21, 14}}, 3);
+  w.voxels.set({22, 20, 12}, 3);
   if (anchors) {
     w.voxels.set({47, 39, 31}, 4);
     w.voxels.set({0, 0, 31}, 4);
@@ -124,8 +128,9 @@ TEST(WorldMeshChunks, KeepsMeshWorldThroughAnEditStream) {
         }
         // Every re-meshed chunk reads a sample within the reach of a changed voxel: its cells
         // (lattice from the bounds grown by the margin) three samples before to two past.
-        const int margin =
-            1 + static_cast<int>(std::ceil(std::max(surface.iso, 0.0))) + (surface.iso > 0 ? 1 : 0);
+        const int margin = surface.iso == 0  ? 2
+                           : surface.iso > 0 ? 2 + static_cast<int>(std::ceil(surface.iso))
+                                             : 1;
         for (const Vec3i& c : remeshed)
           for (int a = 0; a < 3; ++a) {
             const int first_sample = c[a] * o.chunk_edge - margin;  // in voxels
@@ -141,24 +146,27 @@ TEST(WorldMeshChunks, KeepsMeshWorldThroughAnEditStream) {
 // Without anchors the kept lattice is larger than mesh_world's (the bounds against the content),
 // and the surface still closes where the content touches the bounds; a repaint re-colours.
 TEST(WorldMeshChunks, ClosesAtTheBoundsAndRepaints) {
-  World world = ground(/*anchors=*/false);
-  MeshOptions o;
-  o.algorithm = Mesher::kSurfaceNets;
-  o.chunk_edge = 16;
-  WorldMeshChunks kept(world, o);
-  expect_mesh_world(kept, world, o, Metric::kEuclidean, "before the repaint");
-  const Mesh before = kept.merged();
-  DirtyRegions dirty(world.voxels.chunk_edge(), DirtyRegions::Track::kAnyChange);
-  Edit paint;
-  paint.op = EditOp::kPaint;
-  paint.material = 9;
-  paint.brush = BoxBrush{{10, 10, 0}, {20, 20, 31}};
-  ASSERT_GT(apply_edit(world, paint, &dirty).voxels_changed, 0);
-  EXPECT_FALSE(kept.update(dirty).empty());
-  const Mesh after = kept.merged();
-  expect_mesh_world(kept, world, o, Metric::kEuclidean, "after the repaint");
-  EXPECT_EQ(after.positions.size(), before.positions.size());
-  EXPECT_FALSE(after.colors == before.colors);  // the same surface, other colours
+  for (Mesher m : {Mesher::kMarchingCubes, Mesher::kSurfaceNets, Mesher::kDualContouring}) {
+    SCOPED_TRACE(mesher_name(m));
+    World world = ground(/*anchors=*/false);
+    MeshOptions o;
+    o.algorithm = m;
+    o.chunk_edge = 16;
+    WorldMeshChunks kept(world, o);
+    expect_mesh_world(kept, world, o, Metric::kEuclidean, "before the repaint");
+    const Mesh before = kept.merged();
+    DirtyRegions dirty(world.voxels.chunk_edge(), DirtyRegions::Track::kAnyChange);
+    Edit paint;
+    paint.op = EditOp::kPaint;
+    paint.material = 9;
+    paint.brush = BoxBrush{{10, 10, 0}, {20, 20, 31}};
+    ASSERT_GT(apply_edit(world, paint, &dirty).voxels_changed, 0);
+    EXPECT_FALSE(kept.update(dirty).empty());
+    const Mesh after = kept.merged();
+    expect_mesh_world(kept, world, o, Metric::kEuclidean, "after the repaint");
+    EXPECT_EQ(after.positions.size(), before.positions.size());
+    EXPECT_FALSE(after.colors == before.colors);  // the same surface, other colours
+  }
 }
 
 // The reach, pinned: toggling one voxel at every offset around a chunk border of the lattice
@@ -176,7 +184,7 @@ TEST(WorldMeshChunks, OneVoxelAtEveryOffsetFromABorder) {
     o.iso = surface.iso;
     o.chunk_edge = 8;
     WorldMeshChunks kept(world, o, surface.metric);
-    const int margin = surface.iso > 0 ? 2 + static_cast<int>(surface.iso) : 1;
+    const int margin = surface.iso > 0 ? 2 + static_cast<int>(surface.iso) : 2;
     const int border = 3 * o.chunk_edge - margin;  // voxel x where lattice chunk 3 begins
     const int span = static_cast<int>(surface.iso) + 6;
     for (int x = border - span; x <= border + span; ++x) {

@@ -12,11 +12,14 @@
 // one.
 #pragma once
 
+#include <memory>
 #include <mutex>
 #include <shared_mutex>
 #include <vector>
 
 #include "voxfield/dynamic_field.h"
+#include "voxfield/error.h"
+#include "voxfield/mesh_chunks.h"
 
 namespace voxfield {
 
@@ -35,6 +38,7 @@ class LiveWorld {
     std::size_t edits = 0;               // edits applied
     std::int64_t voxels_changed = 0;     // voxels whose material changed
     std::int64_t voxels_recomputed = 0;  // field values recomputed
+    std::vector<Vec3i> remeshed_chunks;  // the kept mesh's chunks re-meshed (keep_mesh)
   };
   // Applies every queued edit and updates the field. Safe to call from any thread; concurrent
   // calls run one after the other.
@@ -52,6 +56,19 @@ class LiveWorld {
 
   std::size_t pending() const;
 
+  // Meshes the world's surface now (WorldMeshChunks: the world must be bounded; its errors) and
+  // keeps it through every later update. Calling it again replaces the kept mesh.
+  void keep_mesh(const MeshOptions& options, Metric metric = Metric::kEuclidean);
+  // Calls f(const World&, const WorldMeshChunks&) with a consistent snapshot, as read() does.
+  // InvalidArgument when no mesh is kept.
+  template <class F>
+  auto read_mesh(F&& f) const {
+    { std::lock_guard turnstile(turnstile_); }
+    std::shared_lock lock(state_mutex_);
+    if (!mesh_) throw InvalidArgument("LiveWorld::read_mesh: no mesh is kept (call keep_mesh)");
+    return f(world_, *mesh_);
+  }
+
  private:
   mutable std::shared_mutex state_mutex_;  // guards world_ and field_
   mutable std::mutex turnstile_;           // held by an update while it waits for state_mutex_
@@ -60,6 +77,7 @@ class LiveWorld {
   std::vector<Edit> queue_;
   World world_;
   DynamicDistanceField field_;
+  std::unique_ptr<WorldMeshChunks> mesh_;  // bound to world_, when kept
 };
 
 }  // namespace voxfield

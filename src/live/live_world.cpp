@@ -33,11 +33,38 @@ LiveWorld::UpdateStats LiveWorld::update() {
     std::lock_guard turnstile(turnstile_);  // new readers wait here until the update is in
     exclusive.lock();
   }
-  DirtyRegions dirty(world_.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
+  // A kept mesh needs every change (a repaint re-colours it); the field alone, only the solid
+  // and air changes it depends on.
+  DirtyRegions dirty(world_.voxels.chunk_edge(),
+                     mesh_ ? DirtyRegions::Track::kAnyChange : DirtyRegions::Track::kOccupancy);
   for (const Edit& e : edits) stats.voxels_changed += apply_edit(world_, e, &dirty).voxels_changed;
   stats.edits = edits.size();
   stats.voxels_recomputed = field_.update(dirty).voxels_recomputed;
+  if (mesh_) {
+    try {
+      stats.remeshed_chunks = mesh_->update(dirty);
+    } catch (...) {
+      // The mesh's field may be part new (WorldMeshChunks::update): mesh the world again, so that
+      // readers never see a mesh of another world; if that fails too, keep no mesh.
+      try {
+        mesh_->rebuild();
+      } catch (...) {
+        mesh_.reset();
+      }
+      throw;
+    }
+  }
   return stats;
+}
+
+void LiveWorld::keep_mesh(const MeshOptions& options, Metric metric) {
+  std::lock_guard one_at_a_time(update_mutex_);
+  std::unique_lock exclusive(state_mutex_, std::defer_lock);
+  {
+    std::lock_guard turnstile(turnstile_);
+    exclusive.lock();
+  }
+  mesh_ = std::make_unique<WorldMeshChunks>(world_, options, metric);
 }
 
 }  // namespace voxfield

@@ -92,7 +92,12 @@ int world_surface_margin(double iso) {
   if (iso != 0 && std::abs(iso) < 1)
     throw InvalidArgument("mesh: a world's offset surface is at least 1 voxel out (or in); iso " +
                           std::to_string(iso) + " lies between neighbouring voxel centres");
-  // The surface lies up to iso voxels out: the domain reaches two voxels past it.
+  // The surface lies up to iso voxels out: the domain reaches two voxels past it. At iso 0 the
+  // first air sample past the voxels' surface is a corner of the cells the surface crosses, and
+  // its central difference reads one more: so two samples of air, or the normals there would
+  // turn one-sided where the content ends — unlike the same surface elsewhere (and unlike a
+  // WorldMeshChunks, whose lattice ends at the bounds, not the content).
+  if (iso == 0) return 2;
   return 1 + static_cast<int>(std::ceil(std::max(iso, 0.0))) + (iso > 0 ? 1 : 0);
 }
 
