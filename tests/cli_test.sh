@@ -612,7 +612,8 @@ expect_grep "showcase meshes" "$tmp/showcase/report.md" "| marching cubes | [0-9
 expect_grep "showcase vector fields" "$tmp/showcase/report.md" "| splat | [0-9.]* | 0.000 | 0.00 | 0.0000 |"
 expect_grep "showcase world flow exact under edits" "$tmp/showcase/report.md" "byte-identical\*\* to a rebuild"
 expect_grep "showcase mesh voxelised back exactly" "$tmp/showcase/report.md" "solid voxels; 0 differ from the block's"
-for png in terrain-before terrain-after terrain-top-before terrain-top-after terrain-chunks terrain-distance error-jfa-seed vectors flow-before flow-after bunny bunny-slices; do
+expect_grep "showcase world mesh kept through edits" "$tmp/showcase/report.md" "exactly the triangles of meshing the edited world from scratch"
+for png in terrain-before terrain-after terrain-top-before terrain-top-after terrain-chunks terrain-distance error-jfa-seed vectors flow-before flow-after bunny bunny-slices terrain-mesh-edited; do
   [ -s "$tmp/showcase/$png.png" ] && grep -q "($png.png)" "$tmp/showcase/report.md" && passes=$((passes+1)) \
     || { echo "FAIL: showcase frame $png missing or not in the report"; fails=$((fails+1)); }
 done
