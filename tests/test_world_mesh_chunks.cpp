@@ -216,6 +216,34 @@ TEST(WorldMeshChunks, MeshesInTheWorldsFrame) {
   for (const auto& p : chunk.positions) EXPECT_TRUE(placed.count(p)) << p[0] << " " << p[1];
 }
 
+// An unbounded world kept over a box: mesh_world of the world cut to the box, through edits inside
+// and across the box's faces.
+TEST(WorldMeshChunks, KeepsAnUnboundedWorldOverABox) {
+  const World bounded = ground(/*anchors=*/false);
+  World world(8);  // the same voxels without bounds, and more beyond the box
+  world.voxels = bounded.voxels.rechunked(8, std::nullopt);
+  world.voxels.fill(Box3i{{40, 30, 0}, {60, 50, 9}}, 5);
+  const Box3i box{{2, 3, 0}, {44, 36, 30}};
+  MeshOptions o;
+  o.chunk_edge = 16;
+  WorldMeshChunks kept(world, o, Metric::kEuclidean, box);
+  std::mt19937 rng(99);
+  for (int edit = 0; edit < 6; ++edit) {
+    if (edit > 0) {
+      DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
+      Edit e = random_edit(rng);
+      if (edit % 2 == 0) e.brush = SphereBrush{{43, 20 + edit, 8}, 3};  // across the box's face
+      apply_edit(world, e, &dirty);
+      kept.update(dirty);
+    }
+    World cut(8, box);
+    cut.voxels = world.voxels.rechunked(8, box);
+    expect_mesh_world(kept, cut, o, Metric::kEuclidean, "after edit " + std::to_string(edit));
+  }
+  EXPECT_THROW(WorldMeshChunks(world, o, Metric::kEuclidean, Box3i{{5, 5, 5}, {5, 9, 9}}),
+               InvalidArgument);
+}
+
 TEST(WorldMeshChunks, RefusesWhatItCannotKeep) {
   MeshOptions o;
   World unbounded;

@@ -56,8 +56,9 @@ class LiveWorld {
 
   std::size_t pending() const;
 
-  // Meshes the world's surface now (WorldMeshChunks: the world must be bounded; its errors) and
-  // keeps it through every later update. Calling it again replaces the kept mesh.
+  // Meshes the world's surface now (WorldMeshChunks over the world's bounds, or over the field's
+  // domain for an unbounded world; its errors) and keeps it through every later update. Calling
+  // it again replaces the kept mesh.
   void keep_mesh(const MeshOptions& options, Metric metric = Metric::kEuclidean);
   // Calls f(const World&, const WorldMeshChunks&) with a consistent snapshot, as read() does.
   // InvalidArgument when no mesh is kept.

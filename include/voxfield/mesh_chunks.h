@@ -11,6 +11,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "voxfield/edit.h"
@@ -59,11 +60,11 @@ class MeshChunks {
 // A voxel world's surface kept chunk by chunk through its edits: what mesh_world() gives, re-meshed
 // only where edits reach. It keeps what that surface is made from — the world's exact signed
 // field, clamped at |iso| + 3 voxels (a DynamicDistanceField, bit for bit a full rebuild after
-// every update) — over a fixed lattice: the world's bounds grown by the air mesh_world() puts
-// around the content, so the surface closes at the bounds as it does there. Because that field
-// reaches past the bounds, where the world stores nothing, it is computed on a copy of the
-// world's voxels without bounds, refreshed in the boxes the edits changed (one byte per stored
-// voxel; uniform chunks cost nothing).
+// every update) — over a fixed lattice: the world's bounds (or a box) grown by the air
+// mesh_world() puts around the content, so the surface closes at the bounds as it does there.
+// Because that field reaches past the bounds, where the world stores nothing, it is computed on a
+// copy of the world's voxels without bounds, refreshed in the boxes the edits changed (one byte per
+// stored voxel; uniform chunks cost nothing).
 //
 // merged() has the same triangles as mesh_world(world, options, metric) for the edited world —
 // positions, normals and colours (at iso 0 bit for bit; offset surfaces within float rounding of
@@ -72,12 +73,15 @@ class MeshChunks {
 // mesh_world()'s.
 class WorldMeshChunks {
  public:
-  // Binds to `world`, which must be bounded (InvalidArgument otherwise: the lattice must stay
-  // fixed) and must outlive this object, and meshes it. Errors as mesh_world()'s (iso out of
-  // range, the memory limit, Cancelled through options.interrupter, which watches this first
-  // mesh only).
+  // Binds to `world` (which must outlive this object) and meshes the voxels inside `box` — by
+  // default the world's bounds; for an unbounded world the box must be given (InvalidArgument
+  // otherwise: the lattice must stay fixed), and voxels outside it are taken for air (merged()
+  // is then mesh_world() of the world cut to the box; edits outside it change nothing). A box
+  // reaching past a bounded world's bounds is cut to them. Errors as mesh_world()'s (iso out of
+  // range, the memory limit, Cancelled through options.interrupter, which watches this first mesh
+  // only); InvalidArgument for an empty box.
   WorldMeshChunks(const World& world, const MeshOptions& options,
-                  Metric metric = Metric::kEuclidean);
+                  Metric metric = Metric::kEuclidean, std::optional<Box3i> box = std::nullopt);
   ~WorldMeshChunks();
   WorldMeshChunks(WorldMeshChunks&&) noexcept;
   WorldMeshChunks& operator=(WorldMeshChunks&&) noexcept;

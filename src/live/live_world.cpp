@@ -64,7 +64,10 @@ void LiveWorld::keep_mesh(const MeshOptions& options, Metric metric) {
     std::lock_guard turnstile(turnstile_);
     exclusive.lock();
   }
-  mesh_ = std::make_unique<WorldMeshChunks>(world_, options, metric);
+  // An unbounded world's fixed volume is its field's domain.
+  std::optional<Box3i> box;
+  if (!world_.voxels.bounds()) box = field_.options().domain;
+  mesh_ = std::make_unique<WorldMeshChunks>(world_, options, metric, box);
 }
 
 }  // namespace voxfield

@@ -23,8 +23,9 @@ namespace voxfield {
 struct WorldMeshChunks::Impl {
   const World* world = nullptr;
   Metric metric = Metric::kEuclidean;
-  Box3i bounds;  // the world's bounds when bound
-  Box3i domain;  // the lattice's voxels: the bounds grown by the air around the surface
+  std::optional<Box3i> world_bounds;  // the world's bounds when bound (they must not change)
+  Box3i bounds;  // the voxels meshed: the world's bounds, or the box given (cut to them)
+  Box3i domain;  // the lattice's voxels: `bounds` grown by the air around the surface
   // The world's voxels without bounds: the field reaches past the bounds, where the world stores
   // nothing (air there, read as the background), and a bounded grid's field could not hold it.
   World unbounded;
@@ -40,28 +41,42 @@ struct WorldMeshChunks::Impl {
     l.color = &color;
     return l;
   }
+  // The world's voxels inside `bounds`, without bounds.
   void copy_world() {
-    unbounded.voxels = world->voxels.rechunked(world->voxels.chunk_edge(), std::nullopt);
+    const int edge = world->voxels.chunk_edge();
+    unbounded.voxels = world->voxels.bounds() == bounds
+                           ? world->voxels.rechunked(edge, std::nullopt)
+                           : world->voxels.rechunked(edge, bounds).rechunked(edge, std::nullopt);
   }
   void check_bounds() const {
-    if (world->voxels.bounds() != bounds)
+    if (world->voxels.bounds() != world_bounds)
       throw InvalidArgument(
           "WorldMeshChunks: the world's bounds changed; build a new WorldMeshChunks");
   }
 };
 
-WorldMeshChunks::WorldMeshChunks(const World& world, const MeshOptions& options, Metric metric)
+WorldMeshChunks::WorldMeshChunks(const World& world, const MeshOptions& options, Metric metric,
+                                 std::optional<Box3i> box)
     : impl_(std::make_unique<Impl>()) {
   using namespace detail::mesh;
   Impl& s = *impl_;
-  if (!world.voxels.bounds())
+  if (!box && !world.voxels.bounds())
     throw InvalidArgument(
-        "WorldMeshChunks: the world has no bounds; a kept mesh needs a fixed lattice (give the "
-        "world bounds, or mesh it once with mesh_world)");
+        "WorldMeshChunks: the world has no bounds and no box was given; a kept mesh needs a fixed "
+        "lattice (give a box, or mesh it once with mesh_world)");
   const int margin = world_surface_margin(options.iso);
+  if (box)
+    for (int a = 0; a < 3; ++a)
+      if (!bound_in_range(box->begin[a]) || !bound_in_range(box->end[a]))
+        throw InvalidArgument("WorldMeshChunks: the box " + to_string(*box) +
+                              " leaves the supported coordinate range");
   s.world = &world;
   s.metric = metric;
-  s.bounds = *world.voxels.bounds();
+  s.world_bounds = world.voxels.bounds();
+  s.bounds = box ? (s.world_bounds ? box->intersect(*s.world_bounds) : *box) : *s.world_bounds;
+  if (s.bounds.empty())
+    throw InvalidArgument("WorldMeshChunks: the box " + (box ? to_string(*box) : "") +
+                          " holds no voxel of the world");
   s.domain = s.bounds.grown(margin);
   s.unbounded = World(world.voxels.chunk_edge());
   s.copy_world();
