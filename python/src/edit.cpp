@@ -1,7 +1,8 @@
 // voxfield.world's editing: brushes applied to a World (place, carve, paint with a sphere, box,
 // rotated box or capsule; docs/distance.md, "Editing"), the boxes they changed (dirty regions,
-// per chunk), and LiveField — an exact distance field kept equal to a rebuild through those edits
-// by voxfield's incremental update, recomputing only what an edit can change.
+// per chunk), LiveField — an exact distance field kept equal to a rebuild through those edits by
+// voxfield's incremental update, recomputing only what an edit can change — and LiveMesh, the
+// world's surface kept per chunk through them (WorldMeshChunks).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -9,11 +10,13 @@
 #include <optional>
 #include <string>
 
+#include "mesh_arrays.h"
 #include "py_world.h"
 #include "signals.h"
 #include "voxfield/dynamic_field.h"
 #include "voxfield/edit.h"
 #include "voxfield/error.h"
+#include "voxfield/mesh_chunks.h"
 
 namespace py = pybind11;
 
@@ -80,6 +83,12 @@ struct PyLiveField {
   PyWorld& world;
   std::optional<DynamicDistanceField> field;
   bool sites = false;
+};
+
+// A world's surface kept per chunk through the edits made with its apply().
+struct PyLiveMesh {
+  PyWorld& world;
+  std::optional<WorldMeshChunks> mesh;
 };
 
 #define VOXFIELD_EDIT_ARGS                                                                  \
@@ -185,6 +194,99 @@ void bind_edit(py::module_& m, py::class_<PyWorld>& world) {
             return to_python(d);
           },
           "(distances, encoding[, sites]): see LiveField.field()");
+
+  py::class_<PyLiveMesh>(m, "LiveMesh",
+                         "A World's surface kept per chunk, re-meshed where edits applied with "
+                         "its apply() reach")
+      .def(py::init([](PyWorld& w, const std::string& algorithm, double iso,
+                       const std::string& metric, int chunk, OptionalBox box) {
+             MeshOptions o;
+             o.algorithm = parse_mesher(algorithm);
+             o.iso = iso;
+             o.chunk_edge = chunk;
+             const Metric mt = parse_metric(metric);
+             PythonSignals signals;
+             o.interrupter = &signals;
+             auto f = std::make_unique<PyLiveMesh>(PyLiveMesh{w, std::nullopt});
+             py::gil_scoped_release release;
+             const std::shared_lock read(w.lock);
+             // The volume is fixed: by default the extent with the content, as arrays see it.
+             const Box3i volume = box_of(w, box);
+             if (volume.empty()) throw InvalidArgument("LiveMesh: the world holds no volume");
+             f->mesh.emplace(w.world, o, mt, volume);
+             return f;
+           }),
+           py::keep_alive<1, 2>(), py::arg("world"), py::arg("algorithm") = "mc",
+           py::arg("iso") = 0.0, py::arg("metric") = "euclidean", py::arg("chunk") = 32,
+           py::arg("box") = py::none(), "See voxfield.world.LiveMesh")
+      .def(
+          "apply",
+          [](PyLiveMesh& f, const std::string& op, const std::string& shape, OptionalVec center,
+             double radius, OptionalInts min, OptionalInts max, OptionalVec a, OptionalVec b,
+             OptionalVec half_extent, OptionalVec rotation_deg, int material) {
+            const Edit e = make_edit(op, shape, center, radius, min, max, a, b, half_extent,
+                                     rotation_deg, material);
+            PyWorld& w = f.world;
+            // Every change: a repaint re-colours the mesh.
+            DirtyRegions dirty(w.world.voxels.chunk_edge(), DirtyRegions::Track::kAnyChange);
+            EditResult r;
+            std::vector<Vec3i> chunks;
+            {
+              py::gil_scoped_release release;
+              const std::unique_lock write(w.lock);
+              r = apply_edit(w.world, e, &dirty);
+              try {
+                chunks = f.mesh->update(dirty);
+              } catch (...) {
+                // The mesh's field may be part new (WorldMeshChunks::update): meshed again, so
+                // that the mesh never silently lags its world.
+                f.mesh->rebuild();
+                throw;
+              }
+            }
+            py::tuple out = result(r, dirty);
+            py::list remeshed;
+            for (const Vec3i& c : chunks) remeshed.append(triple(c));
+            return py::make_tuple(out[0], out[1], out[2], remeshed);
+          },
+          VOXFIELD_EDIT_ARGS,
+          "Applies one edit to the world and re-meshes the chunks it reaches; returns (changed box "
+          "or None, voxels changed, per-chunk dirty boxes, chunks re-meshed)")
+      .def(
+          "rebuild",
+          [](PyLiveMesh& f) {
+            py::gil_scoped_release release;
+            const std::unique_lock write(f.world.lock);  // the mesh's field is written
+            f.mesh->rebuild();
+          },
+          "Meshes the world again (after edits made to it outside apply(), or a new palette)")
+      .def(
+          "mesh",
+          [](const PyLiveMesh& f) {
+            Mesh mesh;
+            {
+              py::gil_scoped_release release;
+              const std::shared_lock read(f.world.lock);
+              mesh = f.mesh->merged();
+            }
+            return to_arrays(mesh, true);
+          },
+          "(vertices, faces, normals, colors) of the whole surface, as voxfield.world.mesh")
+      .def(
+          "chunk_mesh",
+          [](const PyLiveMesh& f, Triple chunk) {
+            Mesh mesh;
+            {
+              py::gil_scoped_release release;
+              const std::shared_lock read(f.world.lock);
+              mesh = f.mesh->chunk_mesh(vec3(chunk));
+            }
+            return to_arrays(mesh, true);
+          },
+          py::arg("chunk"), "(vertices, faces, normals, colors) of one chunk's own mesh")
+      .def_property_readonly(
+          "chunk_count", [](const PyLiveMesh& f) { return triple(f.mesh->chunk_count()); },
+          "Chunks per axis");
 }
 
 }  // namespace voxfield::python

@@ -47,6 +47,13 @@ LiveField keeps its world alive.
 ``mesh(world, algorithm="mc", iso=0.0, metric="euclidean", chunk=32, threads=0)`` meshes the
 surface through the world's exact signed field (``iso`` with |iso| >= 1: an offset surface of the
 metric's balls) and returns ``(vertices, faces, normals, colors)``, colours from the palette.
+``LiveMesh(world, algorithm="mc", iso=0.0, metric="euclidean", chunk=32, box=None)`` meshes it
+once over ``box`` (default: the extent; voxels outside it are air to the mesh) and keeps it
+through edits made with its own ``apply`` (same keywords; it also returns the chunks it
+re-meshed), re-meshing only the chunks an edit reaches: ``mesh()`` is then ``mesh(world, ...)``
+of the edited world, triangle for triangle; ``chunk_mesh((i, j, k))`` one chunk's own mesh (for a
+renderer to re-upload), ``chunk_count`` the chunks per axis, ``rebuild()`` catches up with edits
+made another way. A LiveMesh keeps its world alive.
 """
 
 from dataclasses import dataclass
@@ -57,7 +64,8 @@ import numpy as np
 from ._voxfield import world as _world
 from ._voxfield.world import World, mesh, render
 
-__all__ = ["World", "Field", "LiveField", "distance_field", "approximate", "render", "mesh"]
+__all__ = ["World", "Field", "LiveField", "LiveMesh", "distance_field", "approximate", "render",
+           "mesh"]
 
 
 @dataclass
@@ -139,6 +147,17 @@ class LiveField(_world.LiveField):
         if box is not None:
             box = (tuple(int(v) for v in box[0]), tuple(int(v) for v in box[1]))
         super().__init__(world, metric, signed, max_distance, storage, spacing, sites, box)
+
+
+class LiveMesh(_world.LiveMesh):
+    """A World's surface kept per chunk through its ``apply`` edits (see above)."""
+
+    def __init__(self, world: World, algorithm: str = "mc", iso: float = 0.0,
+                 metric: str = "euclidean", chunk: int = 32,
+                 box: Optional[Tuple[Sequence[int], Sequence[int]]] = None) -> None:
+        if box is not None:
+            box = (tuple(int(v) for v in box[0]), tuple(int(v) for v in box[1]))
+        super().__init__(world, algorithm, float(iso), metric, int(chunk), box)
 
 
 def _world_error(message: str) -> Exception:

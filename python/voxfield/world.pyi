@@ -5,7 +5,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["World", "Field", "LiveField", "distance_field", "approximate", "render", "mesh"]
+__all__ = ["World", "Field", "LiveField", "LiveMesh", "distance_field", "approximate", "render",
+           "mesh"]
 
 class World:
     def __init__(
@@ -155,3 +156,47 @@ class LiveField:
     ]: ...
     def rebuild(self) -> None: ...
     def field(self) -> Field: ...
+
+class LiveMesh:
+    def __init__(
+        self,
+        world: World,
+        algorithm: str = "mc",
+        iso: float = 0.0,
+        metric: str = "euclidean",
+        chunk: int = 32,
+        box: tuple[Sequence[int], Sequence[int]] | None = None,
+    ) -> None: ...
+    def apply(
+        self,
+        op: str,
+        shape: str,
+        *,
+        center: Sequence[float] | None = None,
+        radius: float = 1.0,
+        min: Sequence[int] | None = None,
+        max: Sequence[int] | None = None,
+        a: Sequence[float] | None = None,
+        b: Sequence[float] | None = None,
+        half_extent: Sequence[float] | None = None,
+        rotation_deg: Sequence[float] | None = None,
+        material: int = 1,
+    ) -> tuple[
+        tuple[tuple[int, int, int], tuple[int, int, int]] | None,
+        int,
+        list[tuple[tuple[int, int, int], tuple[int, int, int]]],
+        list[tuple[int, int, int]],
+    ]: ...
+    def rebuild(self) -> None: ...
+    def mesh(
+        self,
+    ) -> tuple[
+        npt.NDArray[np.float32], npt.NDArray[np.uint32], npt.NDArray[np.float32], npt.NDArray[np.uint8]
+    ]: ...
+    def chunk_mesh(
+        self, chunk: Sequence[int]
+    ) -> tuple[
+        npt.NDArray[np.float32], npt.NDArray[np.uint32], npt.NDArray[np.float32], npt.NDArray[np.uint8]
+    ]: ...
+    @property
+    def chunk_count(self) -> tuple[int, int, int]: ...

@@ -228,6 +228,35 @@ def test_live_fields_stay_equal_to_a_rebuild():
         assert live.field().distances.shape == (28, 24, 20)
 
 
+def _triangles(vertices, faces, normals, colors):
+    """The triangle set independent of vertex numbering: each triangle's corners (position,
+    normal, colour), rotated to start at the smallest corner, the rows sorted."""
+    corners = np.concatenate([vertices, normals, colors.astype(np.float32)], axis=1)[faces]
+    keys = [tuple(map(tuple, tri)) for tri in corners]
+    return sorted(tri[tri.index(min(tri)):] + tri[:tri.index(min(tri))] for tri in keys)
+
+
+def test_live_meshes_stay_equal_to_meshing_the_edited_world():
+    a = random_world((30, 26, 22), density=0.05)
+    for algorithm in ("mc", "sn", "dc"):
+        w = World(a, origin=(1, 2, -1))
+        kept = voxfield.world.LiveMesh(w, algorithm=algorithm, chunk=8)
+        assert kept.chunk_count == (5, 4, 4)  # the extent and two samples of air each side
+        rng = np.random.default_rng(5)
+        for n in range(8):
+            c = [float(v) for v in rng.uniform((4, 5, 2), (28, 25, 18))]
+            op = ("place", "carve", "paint")[n % 3]
+            _, count, _, remeshed = kept.apply(op, "sphere", center=c, radius=2.5, material=4 + n)
+            assert (count > 0) == (len(remeshed) > 0)
+            got = _triangles(*kept.mesh())
+            want = _triangles(*voxfield.world.mesh(w, algorithm=algorithm))
+            assert got == want, f"{algorithm} after edit {n}"
+        del w  # the LiveMesh keeps its world alive
+        assert len(kept.mesh()[1]) > 0
+        with pytest.raises(voxfield.InvalidArgument, match="outside"):
+            kept.chunk_mesh((9, 0, 0))
+
+
 def test_edit_errors_name_the_argument():
     w = World(random_world())
     with pytest.raises(voxfield.InvalidArgument, match="center"):

@@ -88,6 +88,10 @@ def world_field() -> float:
     frame = world.render(w, 32, 18, shadows=False)
     vertices, faces, normals, colors = world.mesh(w, algorithm="sn")
     assert frame.shape == (18, 32, 3) and len(faces) > 0 and colors.dtype == np.uint8
+    kept = world.LiveMesh(w, algorithm="sn", chunk=4)
+    _, _, _, remeshed = kept.apply("place", "box", min=(6, 6, 6), max=(7, 7, 7), material=2)
+    assert remeshed and all(len(c) == 3 for c in remeshed) and len(kept.chunk_count) == 3
+    assert len(kept.mesh()[1]) > 0 and kept.chunk_mesh(remeshed[0])[0].dtype == np.float32
     return float(f.decoded()[0, 0, 0]) + float(w.to_numpy().sum()) * 0
 
 
