@@ -234,5 +234,49 @@ for metric, distance, tol in (("manhattan", lambda d: np.abs(d).sum(1), 1e-4),
     st = json.load(open(stats))
     check(st["watertight"] and st["euler_characteristic"] == 2, f"offset {metric}: {st}")
 
+# `voxfield edit --mesh`: the surface kept through an edit script (re-meshed chunk by chunk) holds
+# the triangles `voxfield mesh` makes of the edited world — positions, normals and colours — for
+# every mesher; a paint re-colours it; the stats count what each edit re-meshed.
+scene = np.zeros((40, 32, 24), np.uint8)
+scene[:, :, :6] = 2
+scene[8:20, 6:14, 6:12] = 5
+world_in = os.path.join(work, "kept-in.npy")
+np.save(world_in, scene)
+script = os.path.join(work, "kept.jsonl")
+with open(script, "w") as f:
+    f.write('{"op":"carve","shape":"sphere","center":[14,10,11],"radius":4}\n'
+            '{"op":"place","shape":"capsule","a":[25,20,6],"b":[35,28,10],"radius":2,"material":7}\n'
+            '{"op":"paint","shape":"box","min":[0,0,0],"max":[12,31,5],"material":9}\n'
+            '{"op":"carve","shape":"box","min":[30,2,3],"max":[39,8,5]}\n')
+
+
+def corner_rows(pos, idx, verts):
+    attrs = np.stack([verts[k].astype(np.float64) for k in ("nx", "ny", "nz", "red", "green", "blue")], 1)
+    rows = np.concatenate([pos.astype(np.float64), attrs], 1)
+    return triangles(rows, idx)
+
+
+for algo in ["mc", "sn", "dc"]:
+    kept, full = os.path.join(work, f"kept-{algo}.ply"), os.path.join(work, f"kept-full-{algo}.ply")
+    edited, stats = os.path.join(work, f"kept-world-{algo}.npy"), os.path.join(work, f"kept-{algo}.json")
+    r = run("edit", world_in, "-e", script, "-o", os.path.join(work, f"kept-field-{algo}.npy"),
+            "--save-world", edited, "--mesh", kept, "--mesh-algorithm", algo, "--mesh-chunk", "8",
+            "--stats", stats)
+    check(r.returncode == 0, f"edit --mesh {algo}: {r.stderr}")
+    if r.returncode != 0:
+        continue
+    r = run("mesh", edited, "-o", full, "--algorithm", algo)
+    check(r.returncode == 0, f"mesh of the edited world {algo}: {r.stderr}")
+    a, b = read_ply(kept), read_ply(full)
+    check(len(a[1]) == len(b[1]) and corner_rows(*a) == corner_rows(*b),
+          f"edit --mesh {algo}: {len(a[1])} triangles kept, {len(b[1])} meshed from scratch, or other corners")
+    m = json.load(open(stats))["mesh"]
+    check(m["triangles"] == len(a[1]) and len(m["chunks_remeshed"]) == 4 and
+          all(0 < c < m["chunks"] for c in m["chunks_remeshed"]), f"edit --mesh {algo} stats: {m}")
+r = run("edit", world_in, "-e", script, "-o", os.path.join(work, "kept-bad.npy"), "--mesh",
+        os.path.join(work, "kept.txt"))
+check(r.returncode != 0 and not os.path.exists(os.path.join(work, "kept-bad.npy")),
+      f"edit --mesh to an unknown format writes nothing: rc {r.returncode}")
+
 print("mesh oracle:", "FAILED" if failures else "ok")
 sys.exit(1 if failures else 0)

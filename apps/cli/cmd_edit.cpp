@@ -1,5 +1,6 @@
 // voxfield edit IN -e EDITS.jsonl -o FIELD.npy: scripted edits, each followed by an incremental
-// exact distance update; writes the final field (and world), and per-edit latencies.
+// exact distance update (and, with --mesh, a re-mesh of the surface's chunks it reaches); writes
+// the final field (world, mesh) and per-edit latencies.
 #include <algorithm>
 #include <fstream>
 #include <iostream>
@@ -10,6 +11,8 @@
 #include "field_args.h"
 #include "voxfield/distance_executor.h"
 #include "voxfield/edit_script.h"
+#include "voxfield/mesh_chunks.h"
+#include "voxfield/mesh_files.h"
 #include "voxfield/parallel.h"
 
 namespace voxfield::cli {
@@ -17,6 +20,8 @@ namespace {
 
 struct EditSettings {
   std::string in, edits, out, stats, save_world, backend = "cpu";
+  std::string mesh, mesh_algorithm = "mc";
+  int mesh_chunk = 16;
   FieldArgs field;
 };
 
@@ -47,6 +52,12 @@ int run_edit(const EditSettings& s) {
   outputs.expect(s.out, "-o");
   outputs.expect(s.stats, "--stats");
   outputs.expect_world(s.save_world, "--save-world");
+  outputs.expect(s.mesh, "--mesh");
+  const std::optional<MeshFormat> mesh_format =
+      s.mesh.empty() ? std::nullopt : std::optional<MeshFormat>(mesh_format_of(s.mesh));
+  MeshOptions mo;
+  mo.algorithm = parse_mesher(s.mesh_algorithm);
+  mo.chunk_edge = s.mesh_chunk;
   EditScriptOptions eo;
   eo.chunk_edge = s.field.chunk_edge;
   const std::vector<Edit> edits = read_edit_script(s.edits, eo);
@@ -60,17 +71,34 @@ int run_edit(const EditSettings& s) {
   const auto t_build = std::chrono::steady_clock::now();
   IncrementalDistanceField field(choose_executor(s.backend), world, o);
   const double build_ms = ms_since(t_build);
+  // The surface kept through the edits (its own exact signed field: mesh_chunks.h).
+  std::optional<WorldMeshChunks> kept;
+  double mesh_build_ms = 0;
+  if (mesh_format) {
+    set_activity("meshing " + s.in);
+    const auto t_mesh = std::chrono::steady_clock::now();
+    kept.emplace(world, mo);
+    mesh_build_ms = ms_since(t_mesh);
+  }
 
-  DirtyRegions dirty(world.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy);
-  std::vector<double> edit_ms;
-  std::vector<std::int64_t> recomputed, changed;
+  // A kept mesh needs every change (a repaint re-colours it); the field alone, only the solid
+  // and air changes it depends on.
+  DirtyRegions dirty(world.voxels.chunk_edge(),
+                     kept ? DirtyRegions::Track::kAnyChange : DirtyRegions::Track::kOccupancy);
+  std::vector<double> edit_ms, mesh_ms;
+  std::vector<std::int64_t> recomputed, changed, remeshed;
   set_activity("applying the edits of " + s.edits);
   for (const Edit& e : edits) {
     const auto t0 = std::chrono::steady_clock::now();
     const EditResult r = apply_edit(world, e, &dirty);
     const auto st = field.update(dirty);
-    dirty.clear();
     edit_ms.push_back(ms_since(t0));
+    if (kept) {
+      const auto t1 = std::chrono::steady_clock::now();
+      remeshed.push_back(static_cast<std::int64_t>(kept->update(dirty).size()));
+      mesh_ms.push_back(ms_since(t1));
+    }
+    dirty.clear();
     recomputed.push_back(st.voxels_recomputed);
     changed.push_back(r.voxels_changed);
   }
@@ -99,6 +127,24 @@ int run_edit(const EditSettings& s) {
       {"max_ms", edit_ms.empty() ? 0 : *std::max_element(edit_ms.begin(), edit_ms.end())},
       {"total_voxels_recomputed",
        std::accumulate(recomputed.begin(), recomputed.end(), std::int64_t{0})}});
+  if (kept) {
+    set_activity("writing " + s.mesh);
+    const Mesh mesh = kept->merged();
+    outputs.stage(s.mesh, encode_mesh(mesh, *mesh_format));
+    const double mesh_total = std::accumulate(mesh_ms.begin(), mesh_ms.end(), 0.0);
+    j["mesh"] = nlohmann::json{
+        {"algorithm", mesher_name(mo.algorithm)},
+        {"chunk", mo.chunk_edge},
+        {"build_ms", mesh_build_ms},
+        {"update_ms", mesh_ms},
+        {"chunks_remeshed", remeshed},
+        {"chunks", kept->chunk_count().x * kept->chunk_count().y * kept->chunk_count().z},
+        {"total_ms", mesh_total},
+        {"p50_ms", percentile(mesh_ms, 0.5)},
+        {"p99_ms", percentile(mesh_ms, 0.99)},
+        {"vertices", mesh.vertex_count()},
+        {"triangles", mesh.triangle_count()}};
+  }
   if (!s.stats.empty()) outputs.stage_json(s.stats, j);
   outputs.commit();
   std::cerr << "voxfield: " << edits.size() << " edits, " << total << " ms in all (p50 "
@@ -135,6 +181,15 @@ void add_edit(CLI::App& app, Action& action) {
                   "write per-edit latency (edit_ms), voxels_recomputed and totals as JSON");
   cmd->add_option("--save-world", s->save_world,
                   "also write the edited world (.vox, .npy or .vfw, by extension)");
+  cmd->add_option("--mesh", s->mesh,
+                  "also keep the world's surface meshed through the edits (only the chunks each "
+                  "edit reaches re-meshed) and write it (.ply, .obj, .stl or .glb): what voxfield "
+                  "mesh gives for the edited world");
+  cmd->add_option("--mesh-algorithm", s->mesh_algorithm, "mc (default), sn or dc")
+      ->check(
+          CLI::IsMember({"mc", "sn", "dc", "marching-cubes", "surface-nets", "dual-contouring"}));
+  cmd->add_option("--mesh-chunk", s->mesh_chunk, "cells per mesh chunk edge (2..256, default 16)")
+      ->check(CLI::Range(2, 256));
   cmd->callback([s, &action] { action = [s] { return run_edit(*s); }; });
 }
 
