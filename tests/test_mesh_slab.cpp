@@ -1,6 +1,7 @@
-// Marching cubes of slabs of sample planes, each from only the planes it reads (mesh_slab.h),
-// against mesh_volume over the whole lattice: the slabs' owned vertices and triangles laid end to
-// end are its arrays bit for bit, whatever the cuts; bad slabs and planes refused by name.
+// Slabs of sample planes meshed by marching cubes, surface nets and dual contouring, each from only
+// the planes it reads (mesh_slab.h), against mesh_volume over the whole lattice: the slabs' owned
+// vertices and triangles laid end to end are its arrays bit for bit, whatever the cuts; bad slabs
+// and planes refused by name.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -22,7 +23,7 @@ namespace {
 
 // Slab [z0, z1) meshed from a copy of exactly the planes it reads (ASan catches a read past them).
 MeshSlab slab_of(const ScalarVolume& vol, const MeshOptions& o, int z0, int z1) {
-  const auto [p0, p1] = mesh_slab_planes(vol.size.z, z0, z1);
+  const auto [p0, p1] = mesh_slab_planes(vol.size.z, z0, z1, o.algorithm);
   const std::size_t plane = static_cast<std::size_t>(vol.size.x) * vol.size.y;
   const std::vector<float> planes(vol.values + plane * static_cast<std::size_t>(p0),
                                   vol.values + plane * static_cast<std::size_t>(p1));
@@ -32,37 +33,46 @@ MeshSlab slab_of(const ScalarVolume& vol, const MeshOptions& o, int z0, int z1) 
 }
 
 // The slabs cut at `cuts` (0 = c0 < c1 < ... < ck = n.z) laid end to end, as the ranks of
-// voxfield-mpi lay them: owned vertices in order, triangles shifted by the vertices before.
+// voxfield-mpi lay them: owned vertices in order, triangles numbered by MeshSlab::number.
 Mesh laid_end_to_end(const ScalarVolume& vol, const MeshOptions& o, const std::vector<int>& cuts) {
   Mesh all;
   std::optional<MeshSlab> before;
+  const bool dual = o.algorithm != Mesher::kMarchingCubes;
   for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
     const MeshSlab s = slab_of(vol, o, cuts[k], cuts[k + 1]);
-    // The slab before computed this slab's first plane's rows itself: the same vertices, bit for
-    // bit, and as many as first_plane_vertices says (an MPI rank's seam with its neighbour).
+    EXPECT_EQ(s.lent_from_before, dual);
+    const std::size_t lent = s.part.positions.size() - s.owned_vertices;
+    // The vertices a slab computes that its neighbour owns are the neighbour's, bit for bit, and
+    // as many as the neighbour's seam says (an MPI rank's seam with its neighbour): marching cubes
+    // lends the next slab's first plane (checked from the next slab), the dual meshers the slab
+    // before's last cell plane.
     if (before) {
-      const std::size_t lent = before->part.positions.size() - before->owned_vertices;
-      EXPECT_EQ(lent, s.first_plane_vertices);
-      EXPECT_LE(lent, s.part.positions.size());
-      if (lent > s.part.positions.size()) return all;
-      const auto from = static_cast<std::ptrdiff_t>(before->owned_vertices);
-      EXPECT_TRUE(std::equal(before->part.positions.begin() + from, before->part.positions.end(),
-                             s.part.positions.begin()));
-      EXPECT_TRUE(std::equal(before->part.normals.begin() + from, before->part.normals.end(),
-                             s.part.normals.begin()));
+      const MeshSlab& lender = dual ? *before : s;
+      const MeshSlab& user = dual ? s : *before;
+      const std::size_t used = user.part.positions.size() - user.owned_vertices;
+      const std::uint64_t seam = dual ? lender.last_plane_vertices : lender.first_plane_vertices;
+      EXPECT_EQ(used, seam);
+      EXPECT_LE(seam, lender.owned_vertices);
+      if (seam > lender.owned_vertices) return all;
+      const auto from = static_cast<std::ptrdiff_t>(dual ? lender.owned_vertices - seam : 0);
+      const auto at = static_cast<std::ptrdiff_t>(user.owned_vertices);
+      EXPECT_TRUE(std::equal(user.part.positions.begin() + at, user.part.positions.end(),
+                             lender.part.positions.begin() + from));
+      EXPECT_TRUE(std::equal(user.part.normals.begin() + at, user.part.normals.end(),
+                             lender.part.normals.begin() + from));
+    } else if (dual) {
+      EXPECT_EQ(lent, 0u);  // the first slab borrows nothing
     }
     const std::size_t first = all.positions.size();
-    // Its triangles use its own vertices and the next slab's first rows, nothing else.
+    // Its triangles use its own vertices and the lent ones, nothing else.
     for (const std::uint32_t i : s.part.indices) EXPECT_LT(i, s.part.positions.size());
-    if (k + 2 == cuts.size()) {
-      EXPECT_EQ(s.owned_vertices, s.part.positions.size());
-    }
+    if (!dual && k + 2 == cuts.size()) EXPECT_EQ(lent, 0u);  // the last slab lends nothing
     all.positions.insert(all.positions.end(), s.part.positions.begin(),
                          s.part.positions.begin() + static_cast<std::ptrdiff_t>(s.owned_vertices));
     all.normals.insert(all.normals.end(), s.part.normals.begin(),
                        s.part.normals.begin() + static_cast<std::ptrdiff_t>(s.owned_vertices));
     for (const std::uint32_t i : s.part.indices)
-      all.indices.push_back(static_cast<std::uint32_t>(first + i));
+      all.indices.push_back(static_cast<std::uint32_t>(s.number(i, first)));
     EXPECT_TRUE(s.part.colors.empty());
     before = s;
   }
@@ -91,22 +101,25 @@ TEST(MeshSlab, SlabsLaidEndToEndAreTheWholeLatticesMesh) {
   for (float& s : rounded) s = static_cast<float>(std::round(s * 2) / 2);
   const ScalarVolume ties{n, rounded.data()};
   for (const ScalarVolume* volume : std::vector<const ScalarVolume*>{&vol, &ties})
-    for (bool above : {false, true}) {
-      SCOPED_TRACE(std::string(volume == &vol ? "waves" : "ties") + (above ? " above" : ""));
-      MeshOptions o;
-      o.inside_above = above;
-      const Mesh want = mesh_volume(*volume, o);
-      ASSERT_GT(want.triangle_count(), 200u);
-      std::vector<int> each, runs{0};
-      for (int z = 0; z <= n.z; ++z) each.push_back(z);
-      for (int z = 0; z < n.z;) runs.push_back(z = std::min(n.z, z + 1 + z % 4));
-      expect_same_arrays(laid_end_to_end(*volume, o, {0, n.z}), want);
-      expect_same_arrays(laid_end_to_end(*volume, o, each), want);
-      expect_same_arrays(laid_end_to_end(*volume, o, runs), want);
-      expect_same_arrays(laid_end_to_end(*volume, o, {0, 1, 2, n.z - 2, n.z - 1, n.z}), want);
-      ThreadLimit one(1);
-      expect_same_arrays(laid_end_to_end(*volume, o, {0, 9, 10, 20, n.z}), want);
-    }
+    for (bool above : {false, true})
+      for (Mesher m : {Mesher::kMarchingCubes, Mesher::kSurfaceNets, Mesher::kDualContouring}) {
+        SCOPED_TRACE(std::string(volume == &vol ? "waves" : "ties") + (above ? " above " : " ") +
+                     mesher_name(m));
+        MeshOptions o;
+        o.inside_above = above;
+        o.algorithm = m;
+        const Mesh want = mesh_volume(*volume, o);
+        ASSERT_GT(want.triangle_count(), 200u);
+        std::vector<int> each, runs{0};
+        for (int z = 0; z <= n.z; ++z) each.push_back(z);
+        for (int z = 0; z < n.z;) runs.push_back(z = std::min(n.z, z + 1 + z % 4));
+        expect_same_arrays(laid_end_to_end(*volume, o, {0, n.z}), want);
+        expect_same_arrays(laid_end_to_end(*volume, o, each), want);
+        expect_same_arrays(laid_end_to_end(*volume, o, runs), want);
+        expect_same_arrays(laid_end_to_end(*volume, o, {0, 1, 2, n.z - 2, n.z - 1, n.z}), want);
+        ThreadLimit one(1);
+        expect_same_arrays(laid_end_to_end(*volume, o, {0, 9, 10, 20, n.z}), want);
+      }
 }
 
 // The smallest lattice along z (2 planes: one cell plane) cut after its first plane.
@@ -118,6 +131,9 @@ TEST(MeshSlab, TwoPlanes) {
   ASSERT_GT(want.triangle_count(), 0u);
   expect_same_arrays(laid_end_to_end(vol, {}, {0, 1, 2}), want);
   expect_same_arrays(laid_end_to_end(vol, {}, {0, 2}), want);
+  MeshOptions sn;
+  sn.algorithm = Mesher::kSurfaceNets;
+  expect_same_arrays(laid_end_to_end(vol, sn, {0, 1, 2}), mesh_volume(vol, sn));
 }
 
 TEST(MeshSlab, BadSlabsPlanesAndOptionsAreRefused) {
@@ -142,9 +158,10 @@ TEST(MeshSlab, BadSlabsPlanesAndOptionsAreRefused) {
   refused(4, 5, v.data() + 4 * plane, o, 4, 6, "read sample planes [3, 9), the slab holds [4, 9)");
   refused(3, 5, v.data() + 3 * plane, o, 4, 6, "read sample planes [3, 9), the slab holds [3, 8)");
   refused(0, n.z, nullptr, o, 4, 6, "read sample planes");
-  MeshOptions sn;
-  sn.algorithm = Mesher::kSurfaceNets;
-  refused(0, n.z, v.data(), sn, 4, 6, "marching cubes");
+  // The dual meshers read three planes before: slab [4, 6) reads [1, 9).
+  MeshOptions dc;
+  dc.algorithm = Mesher::kDualContouring;
+  refused(2, 7, v.data() + 2 * plane, dc, 4, 6, "read sample planes [1, 9), the slab holds [2, 9)");
   MeshOptions analytic;
   analytic.value = [](const std::array<double, 3>&) { return 0.0; };
   refused(0, n.z, v.data(), analytic, 4, 6, "analytic");

@@ -48,6 +48,12 @@ void Block::view(const Lattice& lattice) {
   dy_ = 0;
 }
 
+void Block::view_planes(const Lattice& whole, const float* planes, int z_offset) {
+  view(whole);
+  data_ = planes;
+  base_ = -sz_ * static_cast<std::ptrdiff_t>(z_offset);  // plane z_offset is planes[0]
+}
+
 bool Block::load(const Lattice& lattice, const Box3i& cells) {
   lattice_ = &lattice;
   iso_ = static_cast<float>(lattice.iso);

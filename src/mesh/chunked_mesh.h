@@ -91,6 +91,10 @@ class Block {
   // Views a dense lattice's whole array (lattice.values): no copy and no scan, so row_signs() is
   // not available — for the whole-volume passes, which classify the samples themselves.
   void view(const Lattice& lattice);
+  // Views planes [z_offset, z_offset + n) of `whole` (n as many as `planes` holds), read in the
+  // whole lattice's coordinates and clamped at its faces: a slab of it (mesh_slab.h). Reads must
+  // stay within the planes held.
+  void view_planes(const Lattice& whole, const float* planes, int z_offset);
   // The value with the inside convention folded in (negative inside).
   float s_of(float value) const { return negate_ ? iso_ - value : value - iso_; }
   bool inside(float value) const { return negate_ ? value > iso_ : value < iso_; }

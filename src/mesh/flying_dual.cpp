@@ -58,9 +58,11 @@ void FlyingDual::quads(int y, int z, Masks& m) const {
   std::fill(m.y.begin(), m.y.end(), 0);
   std::fill(m.z.begin(), m.z.end(), 0);
   // A quad needs the cells on both sides along its two other axes: the edge's other coordinates
-  // lie strictly inside the lattice (dual_grid.cpp's rule: cells before and after it).
-  const bool inner_y = y >= 1 && y <= n.y - 2, inner_z = z >= 1 && z <= n.z - 2;
-  const bool below_y = y <= n.y - 2, below_z = z <= n.z - 2;
+  // lie strictly inside the lattice (dual_grid.cpp's rule: cells before and after it) — the whole
+  // lattice's, for a slab; rows past the planes held are never asked for (the slab's window).
+  const int zg = z + z_offset_, nz = whole_.n.z;
+  const bool inner_y = y >= 1 && y <= n.y - 2, inner_z = zg >= 1 && zg <= nz - 2;
+  const bool below_y = y <= n.y - 2, below_z = zg <= nz - 2 && z + 1 < n.z;
   const std::uint64_t* b = inside_->row(y, z);
   if (inner_y && inner_z) x_crossings(b, words, n.x, m.x.data());
   const auto inner_x = [&](std::uint64_t* mask) {
@@ -99,7 +101,13 @@ void FlyingDual::cells(int y, int z, Masks& scratch, std::uint64_t* used) const 
 }
 
 FlyingDual::FlyingDual(const Lattice& lattice, const MeshOptions& options)
+    : FlyingDual(lattice, options, 0, lattice.n.z, 0, lattice.n.z) {}
+
+FlyingDual::FlyingDual(const Lattice& lattice, const MeshOptions& options, int z_offset,
+                       int whole_z, int slab_begin, int slab_end)
     : lattice_(lattice),
+      whole_(lattice),
+      z_offset_(z_offset),
       place_(options.algorithm == Mesher::kSurfaceNets ? surface_nets_vertex
                                                        : dual_contouring_vertex),
       progress_(std::make_unique<Progress>(
@@ -107,13 +115,20 @@ FlyingDual::FlyingDual(const Lattice& lattice, const MeshOptions& options)
           options.algorithm == Mesher::kSurfaceNets ? "surface nets" : "dual contouring",
           4 * static_cast<std::int64_t>(lattice.n.z))) {
   const Vec3i n = lattice.n;
+  whole_.n.z = whole_z;
+  whole_.values = nullptr;
+  // Cells exist below the whole lattice's last plane; a slab's quads use the cell plane before it.
+  quads_begin_ = slab_begin;
+  quads_end_ = slab_end;
+  cells_begin_ = slab_begin + z_offset > 0 ? slab_begin - 1 : slab_begin;
+  cells_end_ = std::min(slab_end, whole_z - 1 - z_offset);
   const std::size_t rows = static_cast<std::size_t>(n.y) * static_cast<std::size_t>(n.z);
   require_memory(mul_sat(rows, 2 * 8), 0, "mesh", "the dual mesher's row bookkeeping");
-  inside_ = std::make_unique<InsideBits>(lattice, *progress_);
+  inside_ = std::make_unique<InsideBits>(lattice, *progress_, z_offset);
   words_ = inside_->words();
   require_memory(mul_sat(mul_sat(rows, words_), 8), 0, "mesh", "the dual mesher's reached cells");
   resize_on_huge_pages(reached_, rows * words_);
-  block_.view(lattice);
+  block_.view_planes(whole_, lattice.values, z_offset);
   Progress& progress = *progress_;
   count_rows(
       n.z, rows, progress, [this](int z) { count_plane(z); }, first_vertex_, first_index_);
@@ -126,15 +141,28 @@ const std::uint64_t* FlyingDual::reached(int y, int z) const {
          words_ * (static_cast<std::size_t>(y) + static_cast<std::size_t>(lattice_.n.y) * z);
 }
 
+std::uint64_t FlyingDual::vertices_before(int z) const {
+  return first_vertex_[static_cast<std::size_t>(lattice_.n.y) * static_cast<std::size_t>(z)];
+}
+
+std::uint64_t FlyingDual::indices_before(int z) const {
+  return first_index_[static_cast<std::size_t>(lattice_.n.y) * static_cast<std::size_t>(z)];
+}
+
 void FlyingDual::count_plane(int z) {
   const Vec3i n = lattice_.n;
+  const bool counts_quads = z >= quads_begin_ && z < quads_end_,
+             counts_cells = z >= cells_begin_ && z < cells_end_;
+  if (!counts_quads && !counts_cells) return;  // its rows count nothing
   Masks m(words_), scratch(words_);
   for (int y = 0; y < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
-    quads(y, z, m);
-    first_index_[r + 1] = 6 * (population(m.x.data(), words_) + population(m.y.data(), words_) +
-                               population(m.z.data(), words_));
-    if (y + 1 < n.y && z + 1 < n.z) {
+    if (counts_quads) {
+      quads(y, z, m);
+      first_index_[r + 1] = 6 * (population(m.x.data(), words_) + population(m.y.data(), words_) +
+                                 population(m.z.data(), words_));
+    }
+    if (y + 1 < n.y && counts_cells) {
       std::uint64_t* used = reached_.data() + words_ * r;  // this plane's own rows
       cells(y, z, scratch, used);
       first_vertex_[r + 1] = population(used, words_);
@@ -157,7 +185,8 @@ void FlyingDual::write(const WeldOutput& out) const {
 
 void FlyingDual::write_vertices(int z, const WeldOutput& out) const {
   const Vec3i n = lattice_.n;
-  if (z + 1 >= n.z) return;
+  if (z < cells_begin_ || z >= cells_end_) return;
+  const int zg = z + z_offset_;
   for (int y = 0; y + 1 < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
     prefetch_ahead(lattice_, y, z);
@@ -166,7 +195,7 @@ void FlyingDual::write_vertices(int z, const WeldOutput& out) const {
     for (std::size_t w = 0; w < words_; ++w)
       for (std::uint64_t m = used[w]; m; m &= m - 1) {
         const int x = static_cast<int>(64 * w) + std::countr_zero(m);
-        const DualVertex v = dual_cell_vertex(block_, lattice_, x, y, z, place_, out.sources);
+        const DualVertex v = dual_cell_vertex(block_, whole_, x, y, zg, place_, out.sources);
         out.positions[g] = {static_cast<float>(v.position[0]), static_cast<float>(v.position[1]),
                             static_cast<float>(v.position[2])};
         out.normals[g] = unit_normal(v.normal);
@@ -261,7 +290,8 @@ struct CellRow {
 // bit for bit, at a quarter of the divisions.
 void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const {
   const Vec3i n = lattice_.n;
-  if (z + 1 >= n.z) return;
+  if (z < cells_begin_ || z >= cells_end_) return;
+  const int zg = z + z_offset_;  // samples are read, and vertices placed, in the whole lattice
   const std::size_t words = words_, nx = static_cast<std::size_t>(n.x);
   // Crossings of x-edges on sample rows (y', z + dz), kept for two y' (by parity) per layer dz;
   // of z-edges from rows (y', z) to (y', z + 1), two y'; of y-edges from (y, z + dz) to
@@ -284,12 +314,12 @@ void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const
   };
   const auto along_x = [&](int y, int zz, double* t) {
     x_crossings(inside_->row(y, zz), words, n.x, mask.data());
-    const float* r = block_.row(0, y, zz);
+    const float* r = block_.row(0, y, zz + z_offset_);
     crossings(r, r + 1, n.x - 1, t);
   };
   const auto between = [&](int y0, int z0, int y1, int z1, double* t) {
     differences(inside_->row(y0, z0), inside_->row(y1, z1), words, mask.data());
-    crossings(block_.row(0, y0, z0), block_.row(0, y1, z1), n.x, t);
+    crossings(block_.row(0, y0, z0 + z_offset_), block_.row(0, y1, z1 + z_offset_), n.x, t);
   };
   along_x(0, z, tx[0][0]);
   along_x(0, z + 1, tx[1][0]);
@@ -314,8 +344,8 @@ void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const
       const int yp = dy ? q : p;
       tp[e] = edges[e].axis == 0 ? tx[dz][yp] : edges[e].axis == 1 ? ty[dz] + dx : tz[yp] + dx;
     }
-    const float* row[4] = {block_.row(0, y, z), block_.row(0, y + 1, z), block_.row(0, y, z + 1),
-                           block_.row(0, y + 1, z + 1)};
+    const float* row[4] = {block_.row(0, y, zg), block_.row(0, y + 1, zg), block_.row(0, y, zg + 1),
+                           block_.row(0, y + 1, zg + 1)};
     prefetch_ahead(lattice_, y, z);
     // Gather: each reached cell's corner values and crossing sums, in cell order.
     std::size_t k = 0;
@@ -336,7 +366,7 @@ void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const
         cells.count[k] = sums.count;
         ++k;
       }
-    cells.place(lattice_, y, z, k);
+    cells.place(whole_, y, zg, k);
     // Scatter, with dual_vertex_at's rare cases: saddles and colour sources.
     std::uint64_t g = first_vertex_[r];
     for (std::size_t i = 0; i < k; ++i, ++g) {
@@ -350,13 +380,14 @@ void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const
         out.normals[g] = unit_normal(saddle_normal(v, u, w1, w2, lattice_.spacing));
       if (out.sources)
         out.sources[g] =
-            nearest_inside_corner(lattice_, static_cast<int>(cells.x[i]), y, z, v, u, w1, w2);
+            nearest_inside_corner(whole_, static_cast<int>(cells.x[i]), y, zg, v, u, w1, w2);
     }
   }
 }
 
 void FlyingDual::write_quads(int z, const WeldOutput& out) const {
   const Vec3i n = lattice_.n;
+  if (z < quads_begin_ || z >= quads_end_) return;
   Masks m(words_);
   // The reached cells of the cell rows around a sample row's edges: 0 (y - 1, z - 1),
   // 1 (y, z - 1), 2 (y, z), 3 (y - 1, z), each with its running counts; a row past the lattice's
@@ -379,7 +410,7 @@ void FlyingDual::write_quads(int z, const WeldOutput& out) const {
     if (index == end) continue;
     const int cy[4] = {y - 1, y, y, y - 1}, cz[4] = {z - 1, z - 1, z, z};
     for (int k = 0; k < 4; ++k) {
-      if (cy[k] < 0 || cz[k] < 0 || cy[k] > n.y - 2 || cz[k] > n.z - 2) {
+      if (cy[k] < 0 || cz[k] < cells_begin_ || cy[k] > n.y - 2 || cz[k] >= cells_end_) {
         ranks.borrow(k, none.data());
         ranks.set_base(k, 0);
         continue;

@@ -80,13 +80,29 @@ class FlyingDual {
  public:
   // Classifies and counts; throws as FlyingEdges does.
   FlyingDual(const Lattice& lattice, const MeshOptions& options);
+  // A slab of a larger lattice (mesh_slab.cpp): `lattice` holds planes [z_offset, z_offset +
+  // lattice.n.z) of a lattice of `whole_z` planes, in whose frame positions, sources, messages and
+  // the rules at the faces are. Only the vertices of cell planes [slab_begin - 1, slab_end) (the
+  // slab's own and, when there is one, the plane before, whose vertices its quads use) and the
+  // quads of sample planes [slab_begin, slab_end) are counted and written, numbered from the first
+  // of them (local plane numbers; the lattice must hold what they read: mesh_slab_planes).
+  FlyingDual(const Lattice& lattice, const MeshOptions& options, int z_offset, int whole_z,
+             int slab_begin, int slab_end);
   std::size_t vertices() const { return vertices_; }
   std::size_t indices() const { return indices_; }
   // As FlyingEdges::write.
   void write(const WeldOutput& out) const;
+  // The vertices of the cell rows and the indices of the sample rows before local plane z.
+  std::uint64_t vertices_before(int z) const;
+  std::uint64_t indices_before(int z) const;
 
  private:
-  const Lattice& lattice_;
+  const Lattice& lattice_;  // the planes held (the whole lattice, or a slab's)
+  Lattice whole_;           // the lattice meshed: positions, sources, faces (values unused)
+  int z_offset_ = 0;        // local plane z is plane z + z_offset_ of whole_
+  // Local planes counted and written: cells' vertices in [cells_begin_, cells_end_), sample rows'
+  // quads in [quads_begin_, quads_end_).
+  int cells_begin_ = 0, cells_end_ = 0, quads_begin_ = 0, quads_end_ = 0;
   CellVertex place_;
   std::unique_ptr<Progress> progress_;  // units are planes, 4 per plane
   std::unique_ptr<InsideBits> inside_;
