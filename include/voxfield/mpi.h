@@ -292,13 +292,13 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
 // Meshes of a lattice no rank holds whole (a scan or a simulation's float volume, a distributed
 // field). The lattice's chunk layers (mesh_pieces.h: the chunked mesher's chunks grouped along z)
 // are dealt to the ranks in runs of near-equal length or weight; each rank meshes its run from the
-// sample planes that run reads — its cells' planes, three below and two above. Marching cubes
-// (mesh_slab_applies): each rank meshes its run's planes as a slab in the whole-volume passes
-// (mesh_slab.h), and the mesh equals mesh_volume(volume, options) — what one process makes —
-// array for array. Surface nets and dual contouring: rank 0 joins the pieces with the chunked
-// mesher's weld, and the mesh equals MeshChunks(volume, options).merged() array for array (and
-// mesh_volume's triangle for triangle). Either for any number of ranks; write_mesh_volume writes
-// it with each rank writing its share of the file, nothing gathered.
+// sample planes that run reads — its cells' planes, three below and two above. Every mesher
+// without an analytic value or gradient (mesh_slab_applies): each rank meshes its run's planes as
+// a slab in the whole-volume passes (mesh_slab.h), and the mesh equals mesh_volume(volume,
+// options) — what one process makes — array for array. With one: rank 0 joins the pieces with the
+// chunked mesher's weld, and the mesh equals MeshChunks(volume, options).merged() array for array
+// (and mesh_volume's triangle for triangle). Either for any number of ranks; write_mesh_volume
+// writes it with each rank writing its share of the file, nothing gathered.
 
 // Rank r meshes chunk layers [layers[r], layers[r + 1]).
 struct MeshLayers {
@@ -311,9 +311,9 @@ struct MeshLayers {
   // The sample planes [first, second) rank `rank` must hold: what its layers read ([0, 0) when it
   // has none).
   std::pair<int, int> planes(int rank) const;
-  // The sample planes [first, second) whose rows rank `rank`'s slab owns when marching cubes
-  // meshes by slabs (mesh_slab.h): its layers' cell planes, and the lattice's last plane for the
-  // last rank with layers ([0, 0) when it has none).
+  // The sample planes [first, second) whose rows rank `rank`'s slab owns when meshing by slabs
+  // (mesh_slab.h): its layers' cell planes, and the lattice's last plane for the last rank with
+  // layers ([0, 0) when it has none).
   std::pair<int, int> slab(int rank) const;
 };
 
@@ -354,12 +354,12 @@ struct MeshFileSummary {
 };
 
 // Collective: meshes as mesh_volume does and writes the mesh to `path` (the format its extension
-// names, mesh_files.h) with no rank ever holding more than its own share of it. Marching cubes:
-// each rank's slab is one run of the mesh's vertices and triangles (an exclusive scan numbers
-// them). The dual meshers: each rank welds its piece with what its neighbours lend it
-// (PieceWeld: vertex numbers across the cuts, orphans first used before its layers). Each rank
-// writes its vertices and triangles at their places in the file: the bytes write_mesh writes for
-// mesh_volume's mesh (the one process's mesh named above), atomically (staged beside the target
+// names, mesh_files.h) with no rank ever holding more than its own share of it. By slabs: each
+// rank's slab is one run of the mesh's vertices and triangles (an exclusive scan numbers them).
+// By pieces (an analytic value or gradient): each rank welds its piece with what its neighbours
+// lend it (PieceWeld: vertex numbers across the cuts, orphans first used before its layers). Each
+// rank writes its vertices and triangles at their places in the file: the bytes write_mesh writes
+// for mesh_volume's mesh (the one process's mesh named above), atomically (staged beside the target
 // by rank 0, renamed once every rank has written; a failure anywhere leaves the target as it
 // was). `census` (the same on every rank): also mesh_stats over the ranks (each edge the cuts split
 // counted by the rank holding its lower vertex). `into` (rank 0's; null on the others): the file is

@@ -5,12 +5,12 @@
 // cells' sample planes, three below and two above, so a rank needs nothing from the others while
 // meshing.
 //
-// Marching cubes: each rank meshes its run's sample planes as a slab in the whole-volume passes
-// (mesh_slab.h), which number vertices and triangles by lattice row — its vertices and triangles
-// are one run of the mesh one process makes, so an exclusive scan of the vertex counts numbers
-// them and rank 0 only lays the runs end to end.
+// Every mesher without an analytic value or gradient: each rank meshes its run's sample planes as
+// a slab in the whole-volume passes (mesh_slab.h), which number vertices and triangles by lattice
+// row — its vertices and triangles are one run of the mesh one process makes, so an exclusive scan
+// of the vertex counts numbers them and rank 0 only lays the runs end to end.
 //
-// Surface nets and dual contouring: each rank's piece — its chunks' parts with their vertices'
+// With an analytic value or gradient: each rank's piece — its chunks' parts with their vertices'
 // lattice element keys — goes to rank 0, which joins them with the chunked mesher's weld: border
 // vertices are computed the same way on both sides of a cut and welded by key, so the cut leaves
 // no crack and no duplicate, and the mesh is the same array for array for any number of ranks.
@@ -217,7 +217,7 @@ std::vector<std::uint8_t> run_bytes(const MeshSlab& slab, std::uint64_t first_ve
   put(slab.part.positions.data(), vertex_bytes);
   put(slab.part.normals.data(), vertex_bytes);
   for (const std::uint32_t i : slab.part.indices) {
-    const auto number = static_cast<std::uint32_t>(first_vertex + i);
+    const auto number = static_cast<std::uint32_t>(slab.number(i, first_vertex));
     put(&number, 4);
   }
   return bytes;
@@ -252,8 +252,8 @@ Mesh lay_runs(const std::vector<std::vector<std::uint8_t>>& runs, std::uint64_t 
   return mesh;
 }
 
-// mesh_volume for marching cubes: each rank's slab (mesh_slab.h), a scan of the vertex counts,
-// the runs laid end to end on rank 0.
+// mesh_volume by slabs (mesh_slab.h): each rank's slab, a scan of the vertex counts, the runs
+// laid end to end on rank 0.
 Mesh mesh_by_slabs(MPI_Comm comm, const MeshLayers& layers, const ScalarVolume& frame,
                    const float* planes, const MeshOptions& options, ExchangeStats* stats) {
   int rank = 0;

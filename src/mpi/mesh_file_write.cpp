@@ -1,16 +1,17 @@
 // voxfield — one mesh file written by every rank, each its own share of the mesh (mpi.h:
 // write_mesh_volume): byte for byte the file one process writes, with nothing gathered anywhere.
 //
-// Marching cubes: a rank's slab (mesh_slab.h) owns one run of the mesh's vertex numbers and one
-// of its triangles, and computes the next rank's first rows itself; an exclusive scan numbers
-// them. The other meshers: the joined mesh numbers owned vertices chunk by chunk and orphans after
-// them (weld.cpp), so a rank's chunk layers own one run of vertex numbers and claim another run of
-// orphans, and its triangles are one run of the triangles; each rank learns its runs' first
-// numbers by exclusive scans and the numbers of what it uses across the cuts from its neighbours
-// (PieceWeld). Either way each rank then encodes its runs of every section of the file
-// (mesh_files.h) and writes them where the scans of the sections' byte counts put them. The head
-// depends only on totals every rank has (counts, colours, the positions' bounds), and rank 0 stages
-// it.
+// Without an analytic value or gradient, every mesher: a rank's slab (mesh_slab.h) owns one run of
+// the mesh's vertex numbers and one of its triangles, and computes the neighbour's vertices its
+// triangles use itself (marching cubes, the next rank's first rows; surface nets and dual
+// contouring, the rank before's last cell plane); an exclusive scan numbers them. Otherwise: the
+// joined mesh numbers owned vertices chunk by chunk and orphans after them (weld.cpp), so a rank's
+// chunk layers own one run of vertex numbers and claim another run of orphans, and its triangles
+// are one run of the triangles; each rank learns its runs' first numbers by exclusive scans and
+// the numbers of what it uses across the cuts from its neighbours (PieceWeld). Either way each rank
+// then encodes its runs of every section of the file (mesh_files.h) and writes them where the scans
+// of the sections' byte counts put them. The head depends only on totals every rank has (counts,
+// colours, the positions' bounds), and rank 0 stages it.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -180,10 +181,11 @@ void share_totals(MPI_Comm comm, Share& s, std::uint64_t vertices, ExchangeStats
   if (s.totals.vertices == 0) s.totals.lo = s.totals.hi = {0, 0, 0};
 }
 
-// Marching cubes by slabs (mesh_slab.h): the slab's own vertices are its run of the mesh's
-// numbers, from an exclusive scan; its triangles also use the next rank's first rows, which it
-// computed itself. The vertices other ranks' triangles may use (the seam): its first plane's
-// rows, when a rank before it holds layers, and the next rank's rows it holds.
+// By slabs (mesh_slab.h): the slab's own vertices are its run of the mesh's numbers, from an
+// exclusive scan; its triangles also use a neighbour's vertices, which it computed itself (the
+// next rank's first rows, or the rank before's last cell plane). The vertices other ranks'
+// triangles may use (the seam): those lent, and of its own those a neighbour holding layers uses
+// (its first plane's rows to the rank before, its last cell plane's to the next).
 Share slab_share(MPI_Comm comm, const MeshLayers& layers, std::optional<MeshSlab> slab,
                  ExchangeStats* stats) {
   int rank = 0;
@@ -201,16 +203,20 @@ Share slab_share(MPI_Comm comm, const MeshLayers& layers, std::optional<MeshSlab
       throw InvalidArgument("mesh: " + std::to_string(vertices) +
                             " vertices do not fit 32-bit indices; mesh a smaller volume");
     if (!slab) return;
-    const std::uint64_t first_plane = slab->first_plane_vertices;
+    const std::uint64_t first_plane = slab->first_plane_vertices,
+                        last_plane = slab->last_plane_vertices;
+    s.global.resize(slab->part.vertex_count());
+    for (std::size_t i = 0; i < s.global.size(); ++i)
+      s.global[i] = static_cast<std::uint32_t>(slab->number(i, first_vertex));
     s.part = std::move(slab->part);
     slab.reset();
-    s.global.resize(s.part.vertex_count());
-    for (std::size_t i = 0; i < s.global.size(); ++i)
-      s.global[i] = static_cast<std::uint32_t>(first_vertex + i);
     s.seam.assign(s.part.vertex_count(), 0);
     std::fill(s.seam.begin() + static_cast<std::ptrdiff_t>(s.owned), s.seam.end(), 1);
     if (neighbour(layers, rank, -1) != MPI_PROC_NULL)
       std::fill_n(s.seam.begin(), static_cast<std::ptrdiff_t>(first_plane), 1);
+    if (neighbour(layers, rank, +1) != MPI_PROC_NULL)
+      std::fill(s.seam.begin() + static_cast<std::ptrdiff_t>(s.owned - last_plane),
+                s.seam.begin() + static_cast<std::ptrdiff_t>(s.owned), 1);
   });
   share_totals(comm, s, vertices, stats);
   return s;
@@ -285,7 +291,7 @@ MeshFileSummary write_mesh_volume(MPI_Comm comm, const MeshLayers& layers,
   MPI_Comm_size(comm, &size);
   // This rank's chunks, meshed straight into its weld.
   const auto t0 = std::chrono::steady_clock::now();
-  // Marching cubes as slabs of the whole-volume passes, the other meshers as chunked pieces.
+  // Slabs of the whole-volume passes; chunked pieces for an analytic value or gradient.
   const bool slabs = mesh_slab_applies(options);
   std::optional<MeshSlab> slab;
   std::optional<PieceWeld> weld;

@@ -1,8 +1,8 @@
 // Meshes over the ranks of an MPI job (mpi.h's mesh_volume) against one process: every rank builds
 // the same random volume but hands the mesher only the sample planes its layers read; rank 0's mesh
-// must equal one process's over the whole lattice array for array — mesh_volume's for marching
-// cubes (slabs of the whole-volume passes), the chunked mesher's for the dual meshers — for any
-// number of ranks (more ranks than layers included), and a failure on one rank reaches all.
+// must equal one process's over the whole lattice array for array — mesh_volume's for every mesher
+// (slabs of the whole-volume passes), the chunked mesher's with an analytic gradient (pieces) —
+// for any number of ranks (more ranks than layers included), and a failure on one rank reaches all.
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -12,6 +12,7 @@
 #include "../wave_volume.h"
 #include "voxfield/mesh_chunks.h"
 #include "voxfield/mesh_pieces.h"
+#include "voxfield/mesh_slab.h"
 #include "voxfield/mpi.h"
 
 namespace voxfield {
@@ -37,9 +38,15 @@ std::vector<float> my_planes(const mpi::MeshLayers& layers, const std::vector<fl
           whole.begin() + static_cast<std::ptrdiff_t>(plane * z1)};
 }
 
-// What one process makes of the whole lattice, as mpi::mesh_volume promises it.
+// What one process makes of the whole lattice, as mpi::mesh_volume promises it: mesh_volume's
+// arrays by slabs; the chunked driver's with an analytic gradient (pieces).
 Mesh one_process(const ScalarVolume& vol, const MeshOptions& o) {
-  return o.algorithm == Mesher::kMarchingCubes ? mesh_volume(vol, o) : MeshChunks(vol, o).merged();
+  return mesh_slab_applies(o) ? mesh_volume(vol, o) : MeshChunks(vol, o).merged();
+}
+
+// An analytic gradient (any function of the position will do): the options take the pieces path.
+std::array<double, 3> towards_centre(const std::array<double, 3>& p) {
+  return {p[0] - 5.0, p[1] - 10.0, 0.3 * (p[2] - 14.0)};
 }
 
 TEST(MpiMesh, EqualsOneProcessOnAnyNumberOfRanks) {
@@ -51,33 +58,37 @@ TEST(MpiMesh, EqualsOneProcessOnAnyNumberOfRanks) {
   frame.spacing_units = {0.5, 1.0, 0.8};
   frame.origin_units = {1.5, -2.0, 0.25};
   for (Mesher m : {Mesher::kMarchingCubes, Mesher::kSurfaceNets, Mesher::kDualContouring})
-    for (int edge : {5, 12, 36}) {  // 36: one layer, so only the last rank has any
-      SCOPED_TRACE(std::string(mesher_name(m)) + " chunk edge " + std::to_string(edge));
-      MeshOptions o;
-      o.algorithm = m;
-      o.chunk_edge = edge;
-      const mpi::MeshLayers layers = mpi::partition_mesh_layers(n, edge, ranks);
-      EXPECT_EQ(layers.layers.front(), 0);
-      EXPECT_EQ(layers.layers.back(), mesh_chunk_layers(n, edge));
-      const std::vector<float> planes = my_planes(layers, whole, n, rank);
-      mpi::ExchangeStats stats;
-      const Mesh got = mpi::mesh_volume(comm, layers, frame, planes.data(), o, &stats);
-      if (rank != 0) {
-        EXPECT_EQ(got.triangle_count(), 0u);
-        continue;
+    for (int edge : {5, 12, 36})  // 36: one layer, so only the last rank has any
+      for (bool analytic : {false, true}) {
+        if (analytic && edge == 36) continue;
+        SCOPED_TRACE(std::string(mesher_name(m)) + " chunk edge " + std::to_string(edge) +
+                     (analytic ? " analytic gradient" : ""));
+        MeshOptions o;
+        o.algorithm = m;
+        o.chunk_edge = edge;
+        if (analytic) o.gradient = towards_centre;
+        const mpi::MeshLayers layers = mpi::partition_mesh_layers(n, edge, ranks);
+        EXPECT_EQ(layers.layers.front(), 0);
+        EXPECT_EQ(layers.layers.back(), mesh_chunk_layers(n, edge));
+        const std::vector<float> planes = my_planes(layers, whole, n, rank);
+        mpi::ExchangeStats stats;
+        const Mesh got = mpi::mesh_volume(comm, layers, frame, planes.data(), o, &stats);
+        if (rank != 0) {
+          EXPECT_EQ(got.triangle_count(), 0u);
+          continue;
+        }
+        ScalarVolume vol = frame;
+        vol.values = whole.data();
+        const Mesh want = one_process(vol, o);
+        ASSERT_GT(want.triangle_count(), 100u);
+        ASSERT_EQ(got.positions.size(), want.positions.size());
+        EXPECT_TRUE(got.positions == want.positions);
+        EXPECT_TRUE(got.normals == want.normals);
+        EXPECT_TRUE(got.indices == want.indices);
+        if (ranks > 1 && !layers.empty(1)) {
+          EXPECT_GT(stats.bytes_received, 0u);
+        }
       }
-      ScalarVolume vol = frame;
-      vol.values = whole.data();
-      const Mesh want = one_process(vol, o);
-      ASSERT_GT(want.triangle_count(), 100u);
-      ASSERT_EQ(got.positions.size(), want.positions.size());
-      EXPECT_TRUE(got.positions == want.positions);
-      EXPECT_TRUE(got.normals == want.normals);
-      EXPECT_TRUE(got.indices == want.indices);
-      if (ranks > 1 && !layers.empty(1)) {
-        EXPECT_GT(stats.bytes_received, 0u);
-      }
-    }
 }
 
 // Layers dealt by weight: cuts where the running weight is nearest each rank's share, empty runs

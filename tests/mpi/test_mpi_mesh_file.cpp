@@ -1,13 +1,14 @@
 // One mesh file written by every rank, each its own share (mpi.h's write_mesh_volume), against one
 // process: the file must be byte for byte what encode_mesh writes for one process's mesh of the
-// whole lattice (mesh_volume's for marching cubes, the chunked mesher's for the dual meshers), in
-// every format, for every mesher (surface nets' orphans included), any number of ranks, ranks
+// whole lattice (mesh_volume's by slabs, the chunked mesher's with an analytic gradient: orphans
+// included), in every format, for every mesher, any number of ranks, ranks
 // without layers anywhere in the order; the census must equal mesh_stats of that mesh; and a
 // failure on any rank leaves the target as it was.
 #include <gtest/gtest.h>
 #include <mpi.h>
 #include <unistd.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -17,6 +18,7 @@
 #include "voxfield/mesh_chunks.h"
 #include "voxfield/mesh_files.h"
 #include "voxfield/mesh_pieces.h"
+#include "voxfield/mesh_slab.h"
 #include "voxfield/mpi.h"
 
 namespace voxfield {
@@ -68,8 +70,7 @@ void expect_file_of_whole(const mpi::MeshLayers& layers, const std::vector<float
       comm(), layers, frame, planes.empty() ? nullptr : planes.data(), o, path, true);
   ScalarVolume vol = frame;
   vol.values = whole.data();
-  const Mesh want =
-      o.algorithm == Mesher::kMarchingCubes ? mesh_volume(vol, o) : MeshChunks(vol, o).merged();
+  const Mesh want = mesh_slab_applies(o) ? mesh_volume(vol, o) : MeshChunks(vol, o).merged();
   ASSERT_GT(want.triangle_count(), 100u);
   EXPECT_EQ(got.vertices, want.vertex_count());
   EXPECT_EQ(got.triangles, want.triangle_count());
@@ -119,10 +120,17 @@ TEST(MpiMeshFile, RanksWithoutLayersAnywhere) {
   const SharedDir dir;
   const Vec3i n{17, 15, 41};  // 40 cells: 10 layers of 4
   const std::vector<float> whole = test::wave_volume(n, 4, 2, 0.5, false);
-  for (Mesher m : {Mesher::kMarchingCubes, Mesher::kSurfaceNets}) {
+  // Marching cubes and surface nets by slabs, and surface nets with an analytic gradient (by
+  // pieces: PieceWeld's neighbours).
+  for (int k = 0; k < 3; ++k) {
+    const Mesher m = k == 0 ? Mesher::kMarchingCubes : Mesher::kSurfaceNets;
     MeshOptions o;
     o.algorithm = m;
     o.chunk_edge = 4;
+    if (k == 2)
+      o.gradient = [](const std::array<double, 3>& p) {
+        return std::array<double, 3>{p[0] - 8.0, p[1] - 7.0, 0.5 * (p[2] - 20.0)};
+      };
     mpi::MeshLayers layers = mpi::partition_mesh_layers(n, 4, ranks());
     if (ranks() == 1) {
       // One rank cannot leave layers to another: runs that miss layers are refused.
@@ -135,7 +143,7 @@ TEST(MpiMeshFile, RanksWithoutLayersAnywhere) {
     // Rank 0 empty, and (with three ranks or more) rank 1's run handed to rank 2.
     layers.layers[1] = 0;
     if (ranks() >= 3) layers.layers[2] = 0;
-    SCOPED_TRACE(std::string(mesher_name(m)));
+    SCOPED_TRACE(std::string(mesher_name(m)) + (k == 2 ? " analytic gradient" : ""));
     expect_file_of_whole(layers, whole, ScalarVolume{n, nullptr}, o, dir / "holes.ply");
     // The last rank empty: the rank before it holds the top layers.
     layers = mpi::partition_mesh_layers(n, 4, ranks());
