@@ -256,6 +256,9 @@ TEST(WorldMeshChunks, RefusesWhatItCannotKeep) {
   WorldMeshChunks kept(world, o);
   EXPECT_THROW(kept.chunk_mesh(kept.chunk_count()), InvalidArgument);
   EXPECT_TRUE(kept.update(DirtyRegions(8, DirtyRegions::Track::kAnyChange)).empty());
+  DirtyRegions occupancy(8, DirtyRegions::Track::kOccupancy);  // would miss repaints
+  occupancy.add(Box3i{{1, 1, 1}, {2, 2, 2}});
+  EXPECT_THROW(kept.update(occupancy), InvalidArgument);
   world.voxels = world.voxels.rechunked(8, Box3i{{0, 0, 0}, {64, 64, 64}});
   DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
   dirty.add(Box3i{{0, 0, 0}, {1, 1, 1}});

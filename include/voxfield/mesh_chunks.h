@@ -89,10 +89,10 @@ class WorldMeshChunks {
   // After edits of the world recorded in `dirty` — with DirtyRegions::Track::kAnyChange, so that
   // a repaint, which changes no distance, re-colours its chunks — updates the field and re-meshes
   // the chunks the changes reach; returns those chunks. The caller clears `dirty` afterwards.
-  // InvalidArgument when the world's bounds changed. Each chunk's new mesh is built aside and
-  // replaces its old one whole, after all of them are built; but the field is written region by
-  // region (DynamicDistanceField::update), so after an exception the chunks are the old ones and
-  // the field part new: call rebuild().
+  // InvalidArgument when the world's bounds changed or `dirty` tracks occupancy only. Each chunk's
+  // new mesh is built aside and replaces its old one whole, after all of them are built; but the
+  // field is written region by region (DynamicDistanceField::update), so after an exception the
+  // chunks are the old ones and the field part new: call rebuild().
   std::vector<Vec3i> update(const DirtyRegions& dirty);
   // Copies the world again, recomputes the field and re-meshes every chunk (after a palette
   // change, or an exception in update()).

@@ -112,6 +112,12 @@ WorldMeshChunks& WorldMeshChunks::operator=(WorldMeshChunks&&) noexcept = defaul
 std::vector<Vec3i> WorldMeshChunks::update(const DirtyRegions& dirty) {
   Impl& s = *impl_;
   s.check_bounds();
+  // Occupancy alone misses repaints, which change no distance but the colours: refused rather
+  // than left stale.
+  if (dirty.track() != DirtyRegions::Track::kAnyChange)
+    throw InvalidArgument(
+        "WorldMeshChunks::update: the changes were recorded for occupancy only; a repaint "
+        "re-colours the mesh, so record them with DirtyRegions::Track::kAnyChange");
   if (dirty.empty()) return {};
   const std::vector<Box3i> boxes = dirty.boxes();
   // The copy first (the field reads it), box by box: the edits' boxes, not the world.
