@@ -220,28 +220,37 @@ TEST(WorldMeshChunks, MeshesInTheWorldsFrame) {
 // and across the box's faces.
 TEST(WorldMeshChunks, KeepsAnUnboundedWorldOverABox) {
   const World bounded = ground(/*anchors=*/false);
-  World world(8);  // the same voxels without bounds, and more beyond the box
-  world.voxels = bounded.voxels.rechunked(8, std::nullopt);
-  world.voxels.fill(Box3i{{40, 30, 0}, {60, 50, 9}}, 5);
+  World start(8);  // the same voxels without bounds, and more beyond the box
+  start.voxels = bounded.voxels.rechunked(8, std::nullopt);
+  start.voxels.fill(Box3i{{40, 30, 0}, {60, 50, 9}}, 5);
   const Box3i box{{2, 3, 0}, {44, 36, 30}};
-  MeshOptions o;
-  o.chunk_edge = 16;
-  WorldMeshChunks kept(world, o, Metric::kEuclidean, box);
-  std::mt19937 rng(99);
-  for (int edit = 0; edit < 6; ++edit) {
-    if (edit > 0) {
-      DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
-      Edit e = random_edit(rng);
-      if (edit % 2 == 0) e.brush = SphereBrush{{43, 20 + edit, 8}, 3};  // across the box's face
-      apply_edit(world, e, &dirty);
-      kept.update(dirty);
+  for (const double iso : {0.0, 2.0}) {  // an offset surface's colours come from the box's voxels
+    SCOPED_TRACE("iso " + std::to_string(iso));
+    World world = start;
+    MeshOptions o;
+    o.chunk_edge = 16;
+    o.iso = iso;
+    WorldMeshChunks kept(world, o, Metric::kEuclidean, box);
+    std::mt19937 rng(99);
+    for (int edit = 0; edit < 6; ++edit) {
+      if (edit > 0) {
+        DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
+        Edit e = random_edit(rng);
+        if (edit % 2 == 0) e.brush = SphereBrush{{43, 20 + edit, 8}, 3};  // across the box's face
+        apply_edit(world, e, &dirty);
+        kept.update(dirty);
+      }
+      World cut(8, box);
+      cut.voxels = world.voxels.rechunked(8, box);
+      expect_mesh_world(kept, cut, o, Metric::kEuclidean, "after edit " + std::to_string(edit));
     }
-    World cut(8, box);
-    cut.voxels = world.voxels.rechunked(8, box);
-    expect_mesh_world(kept, cut, o, Metric::kEuclidean, "after edit " + std::to_string(edit));
   }
-  EXPECT_THROW(WorldMeshChunks(world, o, Metric::kEuclidean, Box3i{{5, 5, 5}, {5, 9, 9}}),
-               InvalidArgument);
+  EXPECT_THROW(
+      WorldMeshChunks(start, MeshOptions{}, Metric::kEuclidean, Box3i{{5, 5, 5}, {5, 9, 9}}),
+      InvalidArgument);
+  MeshOptions bad;
+  bad.chunk_edge = 1;  // refused before the field is built
+  EXPECT_THROW(WorldMeshChunks(start, bad, Metric::kEuclidean, box), InvalidArgument);
 }
 
 TEST(WorldMeshChunks, RefusesWhatItCannotKeep) {

@@ -107,11 +107,7 @@ int run_mesh(const MeshSettings& s) {
     lo.vdb_grid = s.grid;
     const World world = npy ? world_from_npy(*npy, s.in) : load_world(s.in, lo).world;
     // mesh_world's domain: the content grown past the surface (by more for an offset surface).
-    const double world_iso = options.iso;
-    const Vec3i size = world.voxels.content_bounds()
-                           .grown(1 + static_cast<int>(std::ceil(std::max(world_iso, 0.0))) +
-                                  (world_iso > 0 ? 1 : 0))
-                           .size();
+    const Vec3i size = world.voxels.content_bounds().grown(mesh_world_margin(options.iso)).size();
     for (int a = 0; a < 3; ++a)
       chunks = (a ? chunks : 1) * ((size[a] - 1 + s.chunk - 1) / std::max(1, s.chunk));
     start = std::chrono::steady_clock::now();

@@ -61,7 +61,11 @@ class LiveWorld {
   // it again replaces the kept mesh.
   void keep_mesh(const MeshOptions& options, Metric metric = Metric::kEuclidean);
   // Calls f(const World&, const WorldMeshChunks&) with a consistent snapshot, as read() does.
-  // InvalidArgument when no mesh is kept.
+  // InvalidArgument when no mesh is kept (none asked for, or an update threw and meshing the
+  // world again failed too: keep_mesh() again).
+  //
+  // update() after a throw: the world holds the edits applied before it (their field may lag:
+  // DynamicDistanceField::update), and a kept mesh is made again from the world as it is.
   template <class F>
   auto read_mesh(F&& f) const {
     { std::lock_guard turnstile(turnstile_); }

@@ -152,6 +152,9 @@ MeshCounts mesh_volume_into(const ScalarVolume& volume, const MeshOptions& optio
 // between a solid and an air centre). The mesh is placed in the world's frame (place_in_frame):
 // in the identity frame, voxel coordinates as above; iso stays in voxels.
 Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric = Metric::kEuclidean);
+// How many voxels of air mesh_world's lattice reaches past the content at `iso` (2 at iso 0;
+// InvalidArgument for an iso mesh_world refuses): its lattice is the content box grown by this.
+int mesh_world_margin(double iso);
 
 // Moves a mesh made in voxel coordinates into `frame`'s world: positions by world_from_vox,
 // normals by world_normal (unit, perpendicular to the placed surface). Winding is kept: a frame

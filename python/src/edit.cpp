@@ -88,8 +88,17 @@ struct PyLiveField {
 // A world's surface kept per chunk through the edits made with its apply().
 struct PyLiveMesh {
   PyWorld& world;
-  std::optional<WorldMeshChunks> mesh;
+  std::optional<WorldMeshChunks> mesh;  // none after an update and the meshing after it failed
 };
+
+template <class LiveMesh>
+auto& kept_mesh(LiveMesh& f) {
+  if (!f.mesh)
+    throw InvalidArgument(
+        "LiveMesh: the mesh was lost when an update and meshing the world again both failed; "
+        "make a new LiveMesh");
+  return *f.mesh;
+}
 
 #define VOXFIELD_EDIT_ARGS                                                                  \
   py::arg("op"), py::arg("shape"), py::kw_only(),                                           \
@@ -212,7 +221,9 @@ void bind_edit(py::module_& m, py::class_<PyWorld>& world) {
              const std::shared_lock read(w.lock);
              // The volume is fixed: by default the extent with the content, as arrays see it.
              const Box3i volume = box_of(w, box);
-             if (volume.empty()) throw InvalidArgument("LiveMesh: the world holds no volume");
+             if (volume.empty())
+               throw InvalidArgument(box ? "LiveMesh: the box holds no voxels"
+                                         : "LiveMesh: the world holds no volume");
              f->mesh.emplace(w.world, o, mt, volume);
              return f;
            }),
@@ -234,13 +245,18 @@ void bind_edit(py::module_& m, py::class_<PyWorld>& world) {
             {
               py::gil_scoped_release release;
               const std::unique_lock write(w.lock);
+              WorldMeshChunks& mesh = kept_mesh(f);
               r = apply_edit(w.world, e, &dirty);
               try {
-                chunks = f.mesh->update(dirty);
+                chunks = mesh.update(dirty);
               } catch (...) {
                 // The mesh's field may be part new (WorldMeshChunks::update): meshed again, so
-                // that the mesh never silently lags its world.
-                f.mesh->rebuild();
+                // that the mesh never silently lags its world; if that fails too, none is kept.
+                try {
+                  mesh.rebuild();
+                } catch (...) {
+                  f.mesh.reset();
+                }
                 throw;
               }
             }
@@ -257,7 +273,7 @@ void bind_edit(py::module_& m, py::class_<PyWorld>& world) {
           [](PyLiveMesh& f) {
             py::gil_scoped_release release;
             const std::unique_lock write(f.world.lock);  // the mesh's field is written
-            f.mesh->rebuild();
+            kept_mesh(f).rebuild();
           },
           "Meshes the world again (after edits made to it outside apply(), or a new palette)")
       .def(
@@ -267,7 +283,7 @@ void bind_edit(py::module_& m, py::class_<PyWorld>& world) {
             {
               py::gil_scoped_release release;
               const std::shared_lock read(f.world.lock);
-              mesh = f.mesh->merged();
+              mesh = kept_mesh(f).merged();
             }
             return to_arrays(mesh, true);
           },
@@ -279,13 +295,16 @@ void bind_edit(py::module_& m, py::class_<PyWorld>& world) {
             {
               py::gil_scoped_release release;
               const std::shared_lock read(f.world.lock);
-              mesh = f.mesh->chunk_mesh(vec3(chunk));
+              mesh = kept_mesh(f).chunk_mesh(vec3(chunk));
             }
             return to_arrays(mesh, true);
           },
           py::arg("chunk"), "(vertices, faces, normals, colors) of one chunk's own mesh")
       .def_property_readonly(
-          "chunk_count", [](const PyLiveMesh& f) { return triple(f.mesh->chunk_count()); },
+          "chunk_count",
+          [](const PyLiveMesh& f) {
+            return triple(reading(f.world, [&] { return kept_mesh(f).chunk_count(); }));
+          },
           "Chunks per axis");
 }
 

@@ -37,37 +37,49 @@ LiveWorld::UpdateStats LiveWorld::update() {
   // and air changes it depends on.
   DirtyRegions dirty(world_.voxels.chunk_edge(),
                      mesh_ ? DirtyRegions::Track::kAnyChange : DirtyRegions::Track::kOccupancy);
-  for (const Edit& e : edits) stats.voxels_changed += apply_edit(world_, e, &dirty).voxels_changed;
-  stats.edits = edits.size();
-  stats.voxels_recomputed = field_.update(dirty).voxels_recomputed;
-  if (mesh_) {
-    try {
-      stats.remeshed_chunks = mesh_->update(dirty);
-    } catch (...) {
-      // The mesh's field may be part new (WorldMeshChunks::update): mesh the world again, so that
-      // readers never see a mesh of another world; if that fails too, keep no mesh.
+  try {
+    for (const Edit& e : edits)
+      stats.voxels_changed += apply_edit(world_, e, &dirty).voxels_changed;
+    stats.edits = edits.size();
+    // Repaints alone change no distance: the field is left as it is (with occupancy tracking
+    // they record nothing anyway).
+    if (dirty.removes_solid() || dirty.adds_solid())
+      stats.voxels_recomputed = field_.update(dirty).voxels_recomputed;
+    if (mesh_) stats.remeshed_chunks = mesh_->update(dirty);
+  } catch (...) {
+    // The world may hold edits the mesh has not seen, and the mesh's field may be part new
+    // (WorldMeshChunks::update): mesh the world again, so that readers never see a mesh of
+    // another world; if that fails too, keep no mesh (read_mesh then says so).
+    if (mesh_) {
       try {
         mesh_->rebuild();
       } catch (...) {
         mesh_.reset();
       }
-      throw;
     }
+    throw;
   }
   return stats;
 }
 
 void LiveWorld::keep_mesh(const MeshOptions& options, Metric metric) {
+  // No update runs meanwhile (update_mutex_), so the world stays as it is while the mesh is made
+  // with readers still reading; they wait only for the swap.
   std::lock_guard one_at_a_time(update_mutex_);
+  std::unique_ptr<WorldMeshChunks> fresh;
+  {
+    std::shared_lock read(state_mutex_);
+    // An unbounded world's fixed volume is its field's domain.
+    std::optional<Box3i> box;
+    if (!world_.voxels.bounds()) box = field_.options().domain;
+    fresh = std::make_unique<WorldMeshChunks>(world_, options, metric, box);
+  }
   std::unique_lock exclusive(state_mutex_, std::defer_lock);
   {
     std::lock_guard turnstile(turnstile_);
     exclusive.lock();
   }
-  // An unbounded world's fixed volume is its field's domain.
-  std::optional<Box3i> box;
-  if (!world_.voxels.bounds()) box = field_.options().domain;
-  mesh_ = std::make_unique<WorldMeshChunks>(world_, options, metric, box);
+  mesh_ = std::move(fresh);
 }
 
 }  // namespace voxfield

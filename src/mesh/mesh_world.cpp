@@ -132,6 +132,10 @@ std::uint8_t world_vertex_material(const World& world, const DistanceField& fiel
 
 }  // namespace detail::mesh
 
+int mesh_world_margin(double iso) {
+  return detail::mesh::world_surface_margin(iso);
+}
+
 Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
   using namespace detail::mesh;
   const double iso = options.iso;

@@ -78,17 +78,8 @@ WorldMeshChunks::WorldMeshChunks(const World& world, const MeshOptions& options,
     throw InvalidArgument("WorldMeshChunks: the box " + (box ? to_string(*box) : "") +
                           " holds no voxel of the world");
   s.domain = s.bounds.grown(margin);
-  s.unbounded = World(world.voxels.chunk_edge());
-  s.copy_world();
-  DistanceOptions field_options = world_field_options(options.iso, metric, s.domain);
-  field_options.interrupter = options.interrupter;
-  s.field.emplace(s.unbounded, field_options);
-
   s.kept.options = options;
   s.kept.options.inside_above = false;
-  if (options.iso != 0)
-    s.kept.options.gradient =
-        offset_gradient(s.unbounded, s.field->field(), metric, options.iso > 0);
   s.fill = [&s](const Box3i& region, float* out) {
     const Box3i voxels{region.begin + s.domain.begin, region.end + s.domain.begin};
     std::get<Grid<float>>(s.field->field().values).copy_to_dense(voxels, out);
@@ -99,9 +90,20 @@ WorldMeshChunks::WorldMeshChunks(const World& world, const MeshOptions& options,
     const Vec3i p{s.domain.begin.x + static_cast<int>(index % nx),
                   s.domain.begin.y + static_cast<int>(index / nx % ny),
                   s.domain.begin.z + static_cast<int>(index / nx / ny)};
-    const Rgba c = s.world->palette[world_vertex_material(*s.world, s.field->field(), p)];
+    // The material from the voxels meshed (outside a box: air, whatever the world holds there).
+    const Rgba c = s.world->palette[world_vertex_material(s.unbounded, s.field->field(), p)];
     return std::array<std::uint8_t, 3>{c.r, c.g, c.b};
   };
+  (void)s.lattice();  // the options checked (chunk edge, frame) before the field is built
+
+  s.unbounded = World(world.voxels.chunk_edge());
+  s.copy_world();
+  DistanceOptions field_options = world_field_options(options.iso, metric, s.domain);
+  field_options.interrupter = options.interrupter;
+  s.field.emplace(s.unbounded, field_options);
+  if (options.iso != 0)
+    s.kept.options.gradient =
+        offset_gradient(s.unbounded, s.field->field(), metric, options.iso > 0);
   s.kept.mesh_all(s.lattice());
 }
 
