@@ -12,6 +12,7 @@
 #include <set>
 #include <string>
 
+#include "mesh_compare.h"
 #include "voxfield/edit.h"
 #include "voxfield/error.h"
 #include "voxfield/mesh_chunks.h"
@@ -20,27 +21,6 @@ using namespace voxfield;
 
 namespace {
 
-// A mesh's triangles independent of its vertex numbering, each corner as its position, normal and
-// colour bits, rotated to start at the smallest corner (orientation kept), the list sorted.
-using Corner = std::array<std::uint32_t, 7>;
-std::vector<std::array<Corner, 3>> triangles_of(const Mesh& m) {
-  std::vector<std::array<Corner, 3>> out(m.triangle_count());
-  for (std::size_t t = 0; t < out.size(); ++t) {
-    for (std::size_t k = 0; k < 3; ++k) {
-      const std::uint32_t v = m.indices[3 * t + k];
-      for (std::size_t a = 0; a < 3; ++a) {
-        out[t][k][a] = std::bit_cast<std::uint32_t>(m.positions[v][a]);
-        out[t][k][3 + a] = std::bit_cast<std::uint32_t>(m.normals[v][a]);
-      }
-      const auto& c = m.colors.at(v);
-      out[t][k][6] = c[0] | c[1] << 8 | c[2] << 16;
-    }
-    std::rotate(out[t].begin(), std::min_element(out[t].begin(), out[t].end()), out[t].end());
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
 void expect_mesh_world(const WorldMeshChunks& kept, const World& world, const MeshOptions& o,
                        Metric metric, const std::string& what) {
   const Mesh mine = kept.merged();
@@ -48,7 +28,7 @@ void expect_mesh_world(const WorldMeshChunks& kept, const World& world, const Me
   ASSERT_GT(full.triangle_count(), 0u) << what;
   ASSERT_EQ(mine.triangle_count(), full.triangle_count()) << what;
   ASSERT_EQ(mine.vertex_count(), full.vertex_count()) << what;
-  EXPECT_TRUE(triangles_of(mine) == triangles_of(full)) << what;
+  EXPECT_TRUE(test::corner_triangles<true>(mine) == test::corner_triangles<true>(full)) << what;
 }
 
 // Ground with hills and a few colours in a 48 x 40 x 32 box; with `anchors`, two voxels in
