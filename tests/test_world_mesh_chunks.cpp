@@ -216,7 +216,8 @@ TEST(WorldMeshChunks, KeepsAnUnboundedWorldOverABox) {
       if (edit > 0) {
         DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
         Edit e = random_edit(rng);
-        if (edit % 2 == 0) e.brush = SphereBrush{{43, 20 + edit, 8}, 3};  // across the box's face
+        if (edit % 2 == 0)
+          e.brush = SphereBrush{{43.0, 20.0 + edit, 8.0}, 3};  // across the box's face
         apply_edit(world, e, &dirty);
         kept.update(dirty);
       }

@@ -20,7 +20,7 @@
 namespace voxfield {
 
 class TerrainField;
-class DistanceField;
+struct DistanceField;
 
 class MeshChunks {
  public:

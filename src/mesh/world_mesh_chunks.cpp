@@ -75,8 +75,9 @@ WorldMeshChunks::WorldMeshChunks(const World& world, const MeshOptions& options,
   s.world_bounds = world.voxels.bounds();
   s.bounds = box ? (s.world_bounds ? box->intersect(*s.world_bounds) : *box) : *s.world_bounds;
   if (s.bounds.empty())
-    throw InvalidArgument("WorldMeshChunks: the box " + (box ? to_string(*box) : "") +
-                          " holds no voxel of the world");
+    throw InvalidArgument(box ? "WorldMeshChunks: the box " + to_string(*box) +
+                                    " holds no voxel of the world"
+                              : std::string("WorldMeshChunks: the world's bounds are empty"));
   s.domain = s.bounds.grown(margin);
   s.kept.options = options;
   s.kept.options.inside_above = false;
@@ -131,7 +132,8 @@ std::vector<Vec3i> WorldMeshChunks::update(const DirtyRegions& dirty) {
     s.world->voxels.copy_to_dense(b, voxels.data());
     s.unbounded.voxels.copy_from_dense(b, voxels.data());
   }
-  s.field->update(dirty);
+  // Repaints alone move no distance and no site: only colours, read from the copy.
+  if (dirty.removes_solid() || dirty.adds_solid()) s.field->update(dirty);
   // The samples whose value, colour or nearest site may have moved: each change grown by the
   // field's reach, in the lattice's coordinates.
   const Vec3i reach = s.field->reach();
