@@ -91,9 +91,7 @@ int run_edit(const EditSettings& s) {
   for (const Edit& e : edits) {
     const auto t0 = std::chrono::steady_clock::now();
     const EditResult r = apply_edit(world, e, &dirty);
-    // A repaint changes no distance (recorded only for a kept mesh): the field is left alone.
-    decltype(field.update(dirty)) st{};
-    if (dirty.removes_solid() || dirty.adds_solid()) st = field.update(dirty);
+    const auto st = field.update(dirty);
     edit_ms.push_back(ms_since(t0));
     if (kept) {
       const auto t1 = std::chrono::steady_clock::now();

@@ -39,7 +39,8 @@ class DynamicDistanceField {
   // Recomputes the whole field, reporting to `interrupter` when given (as compute_distance_field
   // does). Strong guarantee: if it throws (Cancelled included) the field is the one before.
   void rebuild(Interrupter* interrupter = nullptr);
-  // Recomputes what the recorded changes can affect. The caller clears `dirty` afterwards.
+  // Recomputes what the recorded changes can affect (nothing when none removed or added a solid
+  // voxel: repaints). The caller clears `dirty` afterwards.
   // Not the strong exception guarantee: the field is written region by region, so if update()
   // throws (out of memory, while recomputing or storing a region) the regions before hold their
   // new values, the one being stored may hold some, the rest their old ones — a valid field, but

@@ -209,10 +209,7 @@ void bind_edit(py::module_& m, py::class_<PyWorld>& world) {
                          "its apply() reach")
       .def(py::init([](PyWorld& w, const std::string& algorithm, double iso,
                        const std::string& metric, int chunk, OptionalBox box) {
-             MeshOptions o;
-             o.algorithm = parse_mesher(algorithm);
-             o.iso = iso;
-             o.chunk_edge = chunk;
+             MeshOptions o = world_mesh_options(algorithm, iso, chunk);
              const Metric mt = parse_metric(metric);
              PythonSignals signals;
              o.interrupter = &signals;

@@ -15,6 +15,7 @@
 
 #include "voxfield/distance.h"
 #include "voxfield/error.h"
+#include "voxfield/mesh.h"
 #include "voxfield/world.h"
 
 namespace voxfield::python {
@@ -56,6 +57,15 @@ auto reading(const PyWorld& w, F&& f) {
 inline Box3i box_of(const PyWorld& w, const OptionalBox& box) {
   if (box) return Box3i{vec3(box->first), vec3(box->second)};
   return w.extent.unite(w.world.voxels.content_bounds());
+}
+
+// A world mesher's options from Python's keywords (voxfield.world.mesh and LiveMesh).
+inline MeshOptions world_mesh_options(const std::string& algorithm, double iso, int chunk) {
+  MeshOptions o;
+  o.algorithm = parse_mesher(algorithm);
+  o.iso = iso;
+  o.chunk_edge = chunk;
+  return o;
 }
 
 // The options of a field; its domain is set by with_domain, under the world's lock.

@@ -383,10 +383,7 @@ void bind_world(py::module_& parent) {
       "mesh",
       [](const PyWorld& w, const std::string& algorithm, double iso, const std::string& metric,
          int chunk, int threads) {
-        MeshOptions o;
-        o.algorithm = parse_mesher(algorithm);
-        o.iso = iso;
-        o.chunk_edge = chunk;
+        MeshOptions o = world_mesh_options(algorithm, iso, chunk);
         const Metric mt = parse_metric(metric);
         PythonSignals signals;
         o.interrupter = &signals;

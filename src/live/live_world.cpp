@@ -41,10 +41,7 @@ LiveWorld::UpdateStats LiveWorld::update() {
     for (const Edit& e : edits)
       stats.voxels_changed += apply_edit(world_, e, &dirty).voxels_changed;
     stats.edits = edits.size();
-    // Repaints alone change no distance: the field is left as it is (with occupancy tracking
-    // they record nothing anyway).
-    if (dirty.removes_solid() || dirty.adds_solid())
-      stats.voxels_recomputed = field_.update(dirty).voxels_recomputed;
+    stats.voxels_recomputed = field_.update(dirty).voxels_recomputed;
     if (mesh_) stats.remeshed_chunks = mesh_->update(dirty);
   } catch (...) {
     // The world may hold edits the mesh has not seen, and the mesh's field may be part new

@@ -132,8 +132,7 @@ std::vector<Vec3i> WorldMeshChunks::update(const DirtyRegions& dirty) {
     s.world->voxels.copy_to_dense(b, voxels.data());
     s.unbounded.voxels.copy_from_dense(b, voxels.data());
   }
-  // Repaints alone move no distance and no site: only colours, read from the copy.
-  if (dirty.removes_solid() || dirty.adds_solid()) s.field->update(dirty);
+  s.field->update(dirty);  // (nothing to do for repaints alone: only colours, read from the copy)
   // The samples whose value, colour or nearest site may have moved: each change grown by the
   // field's reach, in the lattice's coordinates.
   const Vec3i reach = s.field->reach();

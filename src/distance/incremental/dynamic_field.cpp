@@ -224,7 +224,9 @@ void DynamicDistanceField::rebuild(Interrupter* interrupter) {
 
 DynamicDistanceField::UpdateStats DynamicDistanceField::update(const DirtyRegions& dirty) {
   UpdateStats stats;
-  if (dirty.empty()) return stats;
+  // Changes that neither removed nor added a solid voxel (repaints, recorded with
+  // DirtyRegions::Track::kAnyChange) move no distance and no site: nothing to recompute.
+  if (dirty.empty() || (!dirty.removes_solid() && !dirty.adds_solid())) return stats;
   const detail::FieldPlan plan = detail::make_field_plan(world_->voxels, options_);
   // Changes that only add sites (placing into air) can only lower an unsigned field: its new
   // value is min(old value, distance to the new sites), and the new sites lie in the changed
