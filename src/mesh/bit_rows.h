@@ -7,6 +7,7 @@
 // place among its row's crossings — its number — is a population count.
 #pragma once
 
+#include <array>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -86,10 +87,10 @@ class RowRanks {
   void borrow(int k, const std::uint64_t* row) { rows_[static_cast<std::size_t>(k)] = row; }
   void set_base(int k, std::uint64_t base) { base_[static_cast<std::size_t>(k)] = base; }
   std::uint64_t base(int k) const { return base_[static_cast<std::size_t>(k)]; }
-  // After the masks are filled: the running counts of each.
+  // After the masks are filled and their bases set: the running counts of each (from its base).
   void count() {
     for (std::size_t k = 0; k < base_.size(); ++k) {
-      std::uint64_t sum = 0;
+      std::uint64_t sum = base_[k];
       for (std::size_t w = 0; w < words_; ++w) {
         before_[k * words_ + w] = sum;
         sum += bit_count(rows_[k][w]);
@@ -98,8 +99,17 @@ class RowRanks {
   }
   std::uint64_t id(int k, int x) const {
     const std::size_t kk = static_cast<std::size_t>(k), w = static_cast<std::size_t>(x) >> 6;
-    return base_[kk] + before_[kk * words_ + w] +
+    return before_[kk * words_ + w] +
            bit_count(rows_[kk][w] & low_bits(static_cast<unsigned>(x) & 63));
+  }
+  // id(k, x) of masks 0 … K - 1 at once, whether bit x of each is set or not (where it is not,
+  // the number the next set bit has): no branch per mask for callers that need most of them.
+  template <std::size_t K>
+  void ids_at(int x, std::array<std::uint64_t, K>& out) const {
+    const std::size_t w = static_cast<std::size_t>(x) >> 6;
+    const std::uint64_t below = low_bits(static_cast<unsigned>(x) & 63);
+    for (std::size_t k = 0; k < K; ++k)
+      out[k] = before_[k * words_ + w] + bit_count(rows_[k][w] & below);
   }
 
  private:

@@ -197,20 +197,26 @@ void dual_grid_chunk(const Lattice& lattice, const ChunkGrid& grid, Vec3i chunk,
 // shorter diagonal (distance2 between two vertices), turned over when the outside is towards
 // -axis (in0: the edge's lower sample is inside): six indices written at `out`, returning the
 // end. Written in place rather than returned as an array (the array came back through memory and
-// its read stalled on the stores that wrote it), with selects rather than branches (which side is
-// shorter is a coin toss on a noisy volume).
+// its read stalled on the stores that wrote it), and picked from a table of the four orders rather
+// than by branches or selects (which side is shorter, and which side of the edge is inside, are
+// coin tosses on a noisy volume: GCC 12 compiled the selects into two branches that were
+// mispredicted on every other quad).
 template <class Distance2>
 std::uint32_t* put_quad(std::uint32_t* out, std::uint32_t v00, std::uint32_t v10, std::uint32_t v11,
                         std::uint32_t v01, bool in0, Distance2&& distance2) {
-  // Split along 00-11: (00, 10, 11), (00, 11, 01); along 10-01: (00, 10, 01), (10, 11, 01).
+  // Split along 00-11: (00, 10, 11), (00, 11, 01); along 10-01: (00, 10, 01), (10, 11, 01); both
+  // turned over (second and third corners swapped) unless in0. Entries index {00, 10, 11, 01}.
+  static constexpr std::uint8_t kOrder[4][6] = {
+      {0, 3, 1, 1, 3, 2},  // along 10-01, turned over
+      {0, 1, 3, 1, 2, 3},  // along 10-01
+      {0, 2, 1, 0, 3, 2},  // along 00-11, turned over
+      {0, 1, 2, 0, 2, 3},  // along 00-11
+  };
   const bool along_00_11 = distance2(v00, v11) <= distance2(v10, v01);
-  const std::uint32_t t2 = along_00_11 ? v11 : v01, t3 = along_00_11 ? v00 : v10;
-  out[0] = v00;
-  out[1] = in0 ? v10 : t2;
-  out[2] = in0 ? t2 : v10;
-  out[3] = t3;
-  out[4] = in0 ? v11 : v01;
-  out[5] = in0 ? v01 : v11;
+  const std::uint32_t v[4] = {v00, v10, v11, v01};
+  const std::uint8_t* order =
+      kOrder[2 * static_cast<unsigned>(along_00_11) + static_cast<unsigned>(in0)];
+  for (int k = 0; k < 6; ++k) out[k] = v[order[k]];
   return out + 6;
 }
 

@@ -427,17 +427,21 @@ void FlyingDual::write_quads(int z, const WeldOutput& out) const {
       index = put_quad(index, v00, v10, v11, v01, in0, distance2);
     };
     const auto id = [&](int k, int x) { return static_cast<std::uint32_t>(ranks.id(k, x)); };
-    for (std::size_t w = 0; w < words_; ++w)
-      for (std::uint64_t any = m.x[w] | m.y[w] | m.z[w]; any; any &= any - 1) {
-        const int bit = std::countr_zero(any), x = static_cast<int>(64 * w) + bit;
-        const bool in0 = (b[w] >> bit & 1) != 0;
-        if (m.x[w] >> bit & 1)  // cells (x, y-1, z-1), (x, y, z-1), (x, y, z), (x, y-1, z)
-          quad(id(0, x), id(1, x), id(2, x), id(3, x), in0);
-        if (m.y[w] >> bit & 1)  // cells (x-1, y, z-1), (x-1, y, z), (x, y, z), (x, y, z-1)
-          quad(id(1, x - 1), id(2, x - 1), id(2, x), id(1, x), in0);
-        if (m.z[w] >> bit & 1)  // cells (x-1, y-1, z), (x, y-1, z), (x, y, z), (x-1, y, z)
-          quad(id(3, x - 1), id(3, x), id(2, x), id(2, x - 1), in0);
-      }
+    // The row's x-edge quads, then its y- and z-edge ones: a loop per axis rather than a test
+    // per crossed edge of which axes it is crossed on (unpredictable on a noisy volume).
+    const auto each = [&](const std::vector<std::uint64_t>& mask, auto&& f) {
+      for (std::size_t w = 0; w < words_; ++w)
+        for (std::uint64_t bits = mask[w]; bits; bits &= bits - 1) {
+          const int bit = std::countr_zero(bits);
+          f(static_cast<int>(64 * w) + bit, (b[w] >> bit & 1) != 0);
+        }
+    };
+    // Cells (x, y-1, z-1), (x, y, z-1), (x, y, z), (x, y-1, z).
+    each(m.x, [&](int x, bool in0) { quad(id(0, x), id(1, x), id(2, x), id(3, x), in0); });
+    // Cells (x-1, y, z-1), (x-1, y, z), (x, y, z), (x, y, z-1).
+    each(m.y, [&](int x, bool in0) { quad(id(1, x - 1), id(2, x - 1), id(2, x), id(1, x), in0); });
+    // Cells (x-1, y-1, z), (x, y-1, z), (x, y, z), (x-1, y, z).
+    each(m.z, [&](int x, bool in0) { quad(id(3, x - 1), id(3, x), id(2, x), id(2, x - 1), in0); });
   }
 }
 

@@ -51,22 +51,27 @@ struct CaseCounts {
   }
 };
 
-// Where each of the cube's 12 edges (cube_cases.h numbering) finds its crossing among a cell
-// row's eight crossing masks — the x-edges of the four sample rows (y, z), (y + 1, z),
-// (y, z + 1), (y + 1, z + 1); the y-edges of rows (y, z) and (y, z + 1); the z-edges of rows
-// (y, z) and (y + 1, z) — and at which x past the cell's own.
-struct EdgeSlot {
-  std::uint8_t mask, dx;
-};
-constexpr std::array<EdgeSlot, 12> kEdgeSlots = [] {
-  std::array<EdgeSlot, 12> s{};
-  for (std::uint8_t j = 0; j < 4; ++j) {
-    s[j] = {j, 0};  // x: row y + (j & 1), z + (j >> 1)
-    s[4 + j] = {static_cast<std::uint8_t>(4 + (j >> 1)), static_cast<std::uint8_t>(j & 1)};  // y
-    s[8 + j] = {static_cast<std::uint8_t>(6 + (j >> 1)), static_cast<std::uint8_t>(j & 1)};  // z
+// A cell row's eight crossing masks: the x-edges of the four sample rows (y, z), (y + 1, z),
+// (y, z + 1), (y + 1, z + 1) (masks 0-3: edge j of the cube, cube_cases.h numbering), the y-edges
+// of rows (y, z) and (y, z + 1) (masks 4, 5: edges 4-5 and 6-7, at x and x + 1), the z-edges of
+// rows (y, z) and (y + 1, z) (masks 6, 7: edges 8-9 and 10-11, at x and x + 1).
+//
+// The numbers of all twelve edges' crossings in the cell at x, from the masks' numbers at x
+// (RowRanks::ids_at): a y- or z-edge's crossing at x + 1 is numbered after the one at x when
+// that one exists, which the cell's own crossed edges say. Crossings the cell has not get a
+// number too, never read: all twelve without a branch per edge, which costs less than the
+// mispredicted loop exits of visiting only the crossed ones (2-5 of them, varying cell to cell).
+std::array<std::uint32_t, CubeCase::kCentre + 2> edge_ids(const std::array<std::uint64_t, 8>& at,
+                                                          unsigned crossed) {
+  std::array<std::uint32_t, CubeCase::kCentre + 2> ids{};
+  for (std::size_t j = 0; j < 4; ++j) ids[j] = static_cast<std::uint32_t>(at[j]);
+  for (std::size_t k = 0; k < 4; ++k) {
+    const std::size_t edge = 4 + 2 * k;
+    ids[edge] = static_cast<std::uint32_t>(at[4 + k]);
+    ids[edge + 1] = static_cast<std::uint32_t>(at[4 + k] + (crossed >> edge & 1));
   }
-  return s;
-}();
+  return ids;
+}
 
 // The samples with the inside convention folded in, as Block reads them (chunked_mesh.h): the
 // same float arithmetic, so vertices come out bit for bit as the chunked driver's.
@@ -202,7 +207,7 @@ Vertex centre_vertex(const RowSamples& in, const CubeCase& cc, int c, int x, int
 
 namespace {
 
-// Calls f(x, inside) for every cell of cell row (rows b[0..3], see kEdgeSlots) whose corners are
+// Calls f(x, inside) for every cell of cell row (rows b[0..3], see edge_ids) whose corners are
 // not all on one side, x increasing; inside is its corner mask (bit c: corner c inside).
 template <class F>
 void for_each_active_cell(const std::uint64_t* const b[4], std::size_t words, int nx, F&& f) {
@@ -370,6 +375,8 @@ void FlyingEdges::write_plane(int z, std::uint64_t first_vertex, std::uint64_t f
     counts.count();
     std::uint64_t centre_next = counts.base(6) + z_count_[r];
     std::uint32_t* index = triangles ? out.indices + (first_index_[r] - first_index) : nullptr;
+    std::uint32_t* const plane_indices_end =
+        triangles ? out.indices + (indices_before(z + 1) - first_index) : nullptr;
     const float* v0 = lattice_.values + in.index(0, y, z);
     for_each_active_cell(rows, words_, n.x, [&](int x, unsigned inside) {
       unsigned joined = 0;
@@ -383,21 +390,27 @@ void FlyingEdges::write_plane(int z, std::uint64_t first_vertex, std::uint64_t f
       // Every crossing's number once, however many triangles use it; ids[kCentre + c] is
       // centre vertex c, which belongs to this cell alone (its crossings are recomputed here,
       // bit for bit those another row writes).
-      std::array<std::uint32_t, CubeCase::kCentre + 2> ids;
-      for (unsigned m = table.crossed_edges(inside); m; m &= m - 1) {
-        const int edge = std::countr_zero(m);
-        const EdgeSlot s = kEdgeSlots[static_cast<std::size_t>(edge)];
-        ids[static_cast<std::size_t>(edge)] =
-            static_cast<std::uint32_t>(counts.id(s.mask, x + s.dx));
-      }
+      std::array<std::uint64_t, 8> at;
+      counts.ids_at(x, at);
+      std::array<std::uint32_t, CubeCase::kCentre + 2> ids =
+          edge_ids(at, table.crossed_edges(inside));
       for (int c = 0; c < cc.centre_count; ++c) {
         ids[static_cast<std::size_t>(CubeCase::kCentre + c)] =
             static_cast<std::uint32_t>(centre_next);
         put(centre_next++, centre_vertex(in, cc, c, x, y, z));
       }
-      if (triangles)
-        for (int k = 0; k < 3 * cc.triangle_count; ++k)
-          *index++ = ids[cc.edges[static_cast<std::size_t>(k)]];
+      if (!triangles) return;
+      const int count = 3 * cc.triangle_count;
+      int k = 0;
+      // Four triangles' indices at once where the plane's range has room past them (what is
+      // written past this cell's own, the next cells of the plane overwrite): a fixed count
+      // instead of a loop whose exit is mispredicted every few cells. A fifth triangle and
+      // the plane's last cells take the loop.
+      if (plane_indices_end - index >= 12) {
+        for (; k < 12; ++k) index[k] = ids[cc.edges[static_cast<std::size_t>(k)]];
+      }
+      for (; k < count; ++k) index[k] = ids[cc.edges[static_cast<std::size_t>(k)]];
+      index += count;
     });
   }
 }
