@@ -120,8 +120,10 @@ CrossingSums crossing_sums(const CubeCases& table, unsigned inside, CrossingOf&&
     for (unsigned j = 0; j < 4; ++j) {
       const unsigned e = 4 * a + j;
       if constexpr (kReadsAnyEdge) {
-        const double t = t_of(e);
-        s += (crossed >> e & 1) ? t : 0.0;  // + 0 leaves a sum unchanged
+        // t, or +0 (which leaves a sum unchanged) for an edge not crossed, by masking its bits:
+        // GCC 12 turns a select here into a branch, mispredicted on every other noisy cell.
+        const std::uint64_t keep = 0 - static_cast<std::uint64_t>(crossed >> e & 1);
+        s += std::bit_cast<double>(std::bit_cast<std::uint64_t>(t_of(e)) & keep);
       } else if (crossed >> e & 1) {
         s += t_of(e);
       }
