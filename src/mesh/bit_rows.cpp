@@ -60,13 +60,14 @@ bool inside_bits(const float* v, int count, float iso, bool inside_above, std::u
 }  // namespace
 
 InsideBits::InsideBits(const Lattice& lattice, Progress& progress, int z_offset)
-    : ny_(lattice.n.y) {
+    : ny_(lattice.n.y), planes_(static_cast<std::size_t>(lattice.n.z)) {
   const Vec3i n = lattice.n;
   const std::size_t rows = static_cast<std::size_t>(n.y) * static_cast<std::size_t>(n.z);
   words_ = static_cast<std::size_t>(n.x) / 64 + 1;
   require_memory(mul_sat(mul_sat(rows, words_), 8), 0, "mesh", "the lattice's inside bits");
   // On huge pages: their small pages' faults would cost more than the pass that fills them.
   resize_on_huge_pages(bits_, rows * words_);  // zeroed: the padding past each row stays 0
+  uniform_.resize(rows);
   const float iso = static_cast<float>(lattice.iso);
   const bool above = lattice.sign < 0;
   // The first sample of each plane that is NaN or infinite, if any.
@@ -76,12 +77,15 @@ InsideBits::InsideBits(const Lattice& lattice, Progress& progress, int z_offset)
       const std::size_t at = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
       const float* values = lattice.values + at * static_cast<std::size_t>(n.x);
       std::int64_t& bad = first_bad[static_cast<std::size_t>(z)];
-      if (inside_bits(values, n.x, iso, above, bits_.data() + at * words_) && bad < 0)
+      std::uint64_t* row = bits_.data() + at * words_;
+      if (inside_bits(values, n.x, iso, above, row) && bad < 0)
         for (int x = 0; x < n.x; ++x)
           if (!std::isfinite(values[x])) {
             bad = static_cast<std::int64_t>(at) * n.x + x;
             break;
           }
+      const std::uint64_t inside = population(row, words_);
+      uniform_[at] = inside == 0 ? 0 : inside == static_cast<std::uint64_t>(n.x) ? 1 : kMixed;
     }
   });
   for (const std::int64_t bad : first_bad)

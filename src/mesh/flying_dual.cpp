@@ -157,6 +157,9 @@ void FlyingDual::count_plane(int z) {
   Masks m(words_), scratch(words_);
   for (int y = 0; y < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
+    // No quad starts on a quiet row and no quad reaches its cell row (rows y..y+1, z..z+1 all
+    // alike): its counts and reached cells stay 0.
+    if (inside_->quiet(y, z)) continue;
     if (counts_quads) {
       quads(y, z, m);
       first_index_[r + 1] = 6 * (population(m.x.data(), words_) + population(m.y.data(), words_) +
@@ -404,10 +407,10 @@ void FlyingDual::write_quads(int z, const WeldOutput& out) const {
   };
   for (int y = 0; y < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
-    quads(y, z, m);
     std::uint32_t* index = out.indices + first_index_[r];
     std::uint32_t* const end = out.indices + first_index_[r + 1];
     if (index == end) continue;
+    quads(y, z, m);
     const int cy[4] = {y - 1, y, y, y - 1}, cz[4] = {z - 1, z - 1, z, z};
     for (int k = 0; k < 4; ++k) {
       if (cy[k] < 0 || cz[k] < cells_begin_ || cy[k] > n.y - 2 || cz[k] >= cells_end_) {

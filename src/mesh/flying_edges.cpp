@@ -265,6 +265,10 @@ void FlyingEdges::count_plane(int z) {
   std::vector<std::uint64_t> scratch(words_);
   for (int y = 0; y < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
+    if (inside_->quiet(y, z)) {  // its counts stay 0
+      first_vertex_[r + 1] = first_index_[r + 1] = 0;
+      continue;
+    }
     const std::uint64_t* b = inside_->row(y, z);
     x_crossings(b, words_, n.x, scratch.data());
     x_count_[r] = static_cast<std::uint32_t>(population(scratch.data(), words_));
@@ -336,6 +340,7 @@ void FlyingEdges::write_plane(int z, std::uint64_t first_vertex, std::uint64_t f
   for (int y = 0; y < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
     prefetch_ahead(lattice_, y, z);
+    if (inside_->quiet(y, z)) continue;  // no crossing, no cell crossed
     const std::uint64_t* b = inside_->row(y, z);
     // This row's edge vertices: its x-edge crossings, then its y-edge and z-edge ones.
     std::uint64_t g = first_vertex_[r] - first_vertex;
