@@ -267,7 +267,8 @@ struct CellRow {
 #pragma GCC ivdep
 #endif
     for (std::size_t i = 0; i < k; ++i) {
-      const double u = s0[i] / cn[i], w1 = s1[i] / cn[i], w2 = s2[i] / cn[i];
+      const double share = 1 / cn[i];  // crossing_mean's arithmetic
+      const double u = s0[i] * share, w1 = s1[i] * share, w2 = s2[i] * share;
       m0[i] = u, m1[i] = w1, m2[i] = w2;
       const double c[8] = {c0[i], c1[i], c2[i], c3[i], c4[i], c5[i], c6[i], c7[i]};
       const std::array<double, 3> n = trilinear_gradient(c, u, w1, w2, spacing);
@@ -276,9 +277,10 @@ struct CellRow {
       p2[i] = static_cast<float>(origin[2] + (qz + w2) * spacing[2]);
       const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
       const bool unit = length > 0 && length <= kMax;  // unit_normal's test (NaN fails both)
-      n0[i] = unit ? static_cast<float>(n[0] / length) : 0.0f;
-      n1[i] = unit ? static_cast<float>(n[1] / length) : 0.0f;
-      n2[i] = unit ? static_cast<float>(n[2] / length) : 1.0f;
+      const double inverse = 1 / length;               // unit_normal's arithmetic
+      n0[i] = unit ? static_cast<float>(n[0] * inverse) : 0.0f;
+      n1[i] = unit ? static_cast<float>(n[1] * inverse) : 0.0f;
+      n2[i] = unit ? static_cast<float>(n[2] * inverse) : 1.0f;
       flat[i] = n[0] == 0 && n[1] == 0 && n[2] == 0;
     }
   }

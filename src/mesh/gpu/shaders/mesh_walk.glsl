@@ -34,7 +34,8 @@ void emit(dvec3 position, dvec3 normal, out vec3 pos, out vec3 nrm) {
   precise double length = sqrt(length2z);
   dvec3 n = dvec3(0.0LF, 0.0LF, 1.0LF);
   if (length > 0.0LF && !isinf(length) && !isnan(length)) {
-    precise dvec3 scaled = dvec3(normal.x / length, normal.y / length, normal.z / length);
+    precise double inverse = 1.0LF / length;
+    precise dvec3 scaled = dvec3(normal.x * inverse, normal.y * inverse, normal.z * inverse);
     n = scaled;
   }
   pos = vec3(position);
