@@ -101,6 +101,49 @@ TEST(Npy, EveryDtypeRoundTrips) {
   }
 }
 
+TEST(Npy, FloatSamplesAreEachValueAsAFloat) {
+  // Every dtype, bytes that make negative, large and fractional values: the meshers' float
+  // samples are value(i) rounded to float, sample by sample.
+  const DType all[] = {DType::kBool,   DType::kInt8,    DType::kUInt8,  DType::kInt16,
+                       DType::kUInt16, DType::kInt32,   DType::kUInt32, DType::kInt64,
+                       DType::kUInt64, DType::kFloat32, DType::kFloat64};
+  std::mt19937 rng(7);
+  for (DType t : all) {
+    NpyVolume v{t, {5, 3, 2}, std::vector<std::uint8_t>(30 * dtype_size(t))};
+    for (auto& b : v.bytes) b = static_cast<std::uint8_t>(rng());
+    if (t == DType::kBool)
+      for (auto& b : v.bytes) b = b & 1;
+    if (t == DType::kFloat32 || t == DType::kFloat64)  // finite values (random bytes may not be)
+      for (std::int64_t i = 0; i < 30; ++i) {
+        const double x = (static_cast<double>(rng()) - 2147483648.0) / 1024.0;
+        if (t == DType::kFloat32) {
+          const float f = static_cast<float>(x);
+          std::memcpy(v.bytes.data() + 4 * i, &f, 4);
+        } else {
+          std::memcpy(v.bytes.data() + 8 * i, &x, 8);
+        }
+      }
+    const std::vector<float> samples = float_samples(v, "s.npy");
+    ASSERT_EQ(samples.size(), 30u) << dtype_name(t);
+    for (std::int64_t i = 0; i < 30; ++i)
+      EXPECT_EQ(samples[static_cast<std::size_t>(i)], static_cast<float>(v.value(i)))
+          << dtype_name(t) << " sample " << i;
+  }
+  // A float64 past float32's range is refused, naming the file and the sample's byte.
+  NpyVolume big{DType::kFloat64, {3, 2, 1}, std::vector<std::uint8_t>(6 * 8)};
+  big.file_data_offset = 128;
+  const double huge = 1e300;
+  std::memcpy(big.bytes.data() + 8 * 4, &huge, 8);  // sample (1, 1, 0)
+  try {
+    float_samples(big, "big.npy");
+    FAIL() << "a float64 of 1e300 became a float32 sample";
+  } catch (const FormatError& e) {
+    EXPECT_EQ(e.offset(), 128u + 8 * 4) << e.what();
+    EXPECT_NE(std::string(e.what()).find("big.npy"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("does not fit a float32 sample"), std::string::npos);
+  }
+}
+
 TEST(Npy, RejectsOtherShapesDtypesAndTruncation) {
   const std::vector<std::uint8_t> d(12);
   EXPECT_THROW(
