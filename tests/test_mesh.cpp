@@ -439,6 +439,29 @@ TEST(Mesh, WholeVolumePassesMatchTheChunkedDriverAtWordAndLatticeEdges) {
           EXPECT_EQ(std::count(used.begin(), used.end(), false), 0) << "unreferenced vertices";
         }
     }
+  // Balls in air across a row's two words: most rows are quiet (they and their neighbours in y
+  // and z all outside, or all inside for inside above), and the passes skip them.
+  {
+    const Vec3i n{70, 20, 18};
+    std::vector<float> v(static_cast<std::size_t>(n.x) * n.y * n.z);
+    for (int z = 0; z < n.z; ++z)
+      for (int y = 0; y < n.y; ++y)
+        for (int x = 0; x < n.x; ++x)
+          v[static_cast<std::size_t>(x + n.x * (y + n.y * z))] =
+              static_cast<float>(std::min(std::hypot(x - 20.3, y - 9.2, z - 8.6) - 6.1,
+                                          std::hypot(x - 60.1, y - 12.7, z - 10.4) - 3.3));
+    const ScalarVolume vol{n, v.data()};
+    for (Mesher m : kMeshers)
+      for (bool above : {false, true}) {
+        SCOPED_TRACE(std::string(mesher_name(m)) + " balls" + (above ? " above" : ""));
+        MeshOptions o = with(m, 3);
+        o.inside_above = above;
+        const Mesh whole = mesh_volume(vol, o);
+        ASSERT_GT(whole.triangle_count(), 500u);
+        EXPECT_TRUE(test::corner_triangles(whole) ==
+                    test::corner_triangles(MeshChunks(vol, o).merged()));
+      }
+  }
   // A NaN in a row's second word is found by the vectorised scan and named.
   std::vector<float> v(70 * 3 * 3, 1.0f);
   v[66 + 70 * (1 + 3 * 2)] = std::numeric_limits<float>::quiet_NaN();

@@ -100,11 +100,22 @@ TEST(MeshSlab, SlabsLaidEndToEndAreTheWholeLatticesMesh) {
   std::vector<float> rounded(v);  // many samples exactly at the iso value 0
   for (float& s : rounded) s = static_cast<float>(std::round(s * 2) / 2);
   const ScalarVolume ties{n, rounded.data()};
-  for (const ScalarVolume* volume : std::vector<const ScalarVolume*>{&vol, &ties})
+  // A ball in air: most rows, and whole planes at both ends, are quiet (all outside, the passes
+  // skip them), slabs' first and last planes among them.
+  std::vector<float> ball(v.size());
+  for (int z = 0; z < n.z; ++z)
+    for (int y = 0; y < n.y; ++y)
+      for (int x = 0; x < n.x; ++x)
+        ball[static_cast<std::size_t>(x + n.x * (y + n.y * z))] =
+            static_cast<float>(std::hypot(x - 11.3, y - 8.2, z - 14.6) - 6.4);
+  const ScalarVolume in_air{n, ball.data()};
+  for (const ScalarVolume* volume : std::vector<const ScalarVolume*>{&vol, &ties, &in_air})
     for (bool above : {false, true})
       for (Mesher m : {Mesher::kMarchingCubes, Mesher::kSurfaceNets, Mesher::kDualContouring}) {
-        SCOPED_TRACE(std::string(volume == &vol ? "waves" : "ties") + (above ? " above " : " ") +
-                     mesher_name(m));
+        SCOPED_TRACE(std::string(volume == &vol    ? "waves"
+                                 : volume == &ties ? "ties"
+                                                   : "ball") +
+                     (above ? " above " : " ") + mesher_name(m));
         MeshOptions o;
         o.inside_above = above;
         o.algorithm = m;

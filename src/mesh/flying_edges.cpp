@@ -58,9 +58,10 @@ struct CaseCounts {
 //
 // The numbers of all twelve edges' crossings in the cell at x, from the masks' numbers at x
 // (RowRanks::ids_at): a y- or z-edge's crossing at x + 1 is numbered after the one at x when
-// that one exists, which the cell's own crossed edges say. Crossings the cell has not get a
-// number too, never read: all twelve without a branch per edge, which costs less than the
-// mispredicted loop exits of visiting only the crossed ones (2-5 of them, varying cell to cell).
+// that one exists, which the cell's own crossed edges say. Edges the cell does not cross get a
+// number too, which no triangle of the cell uses (only indices the next cells overwrite): all
+// twelve without a branch per edge, which costs less than the mispredicted loop exits of visiting
+// only the crossed ones (3-12 of them, varying cell to cell).
 std::array<std::uint32_t, CubeCase::kCentre + 2> edge_ids(const std::array<std::uint64_t, 8>& at,
                                                           unsigned crossed) {
   std::array<std::uint32_t, CubeCase::kCentre + 2> ids{};
@@ -409,8 +410,9 @@ void FlyingEdges::write_plane(int z, std::uint64_t first_vertex, std::uint64_t f
       int k = 0;
       // Four triangles' indices at once where the plane's range has room past them (what is
       // written past this cell's own, the next cells of the plane overwrite): a fixed count
-      // instead of a loop whose exit is mispredicted every few cells. A fifth triangle and
-      // the plane's last cells take the loop.
+      // instead of a loop whose exit is mispredicted every few cells. Triangles past the
+      // fourth (a cell has up to 12, fanned from a centre) and the plane's last cells take the
+      // loop.
       if (plane_indices_end - index >= 12) {
         for (; k < 12; ++k) index[k] = ids[cc.edges[static_cast<std::size_t>(k)]];
       }
