@@ -14,6 +14,7 @@
 #include <limits>
 
 #include "byte_reader.h"
+#include "npy_sample_types.h"
 #include "voxfield/file.h"
 #include "voxfield/limits.h"
 #include "voxfield/npy.h"
@@ -165,13 +166,6 @@ std::string number_text(double m) {
   return buf;
 }
 
-template <class T>
-double load_as_double(const std::uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof(T));
-  return static_cast<double>(v);
-}
-
 }  // namespace
 
 std::size_t dtype_size(DType t) {
@@ -183,31 +177,8 @@ const char* dtype_name(DType t) {
 
 double NpyVolume::value(std::int64_t i) const {
   const std::uint8_t* p = bytes.data() + static_cast<std::size_t>(i) * dtype_size(dtype);
-  switch (dtype) {
-    case DType::kBool:
-      return *p ? 1.0 : 0.0;
-    case DType::kInt8:
-      return load_as_double<std::int8_t>(p);
-    case DType::kUInt8:
-      return load_as_double<std::uint8_t>(p);
-    case DType::kInt16:
-      return load_as_double<std::int16_t>(p);
-    case DType::kUInt16:
-      return load_as_double<std::uint16_t>(p);
-    case DType::kInt32:
-      return load_as_double<std::int32_t>(p);
-    case DType::kUInt32:
-      return load_as_double<std::uint32_t>(p);
-    case DType::kInt64:
-      return load_as_double<std::int64_t>(p);
-    case DType::kUInt64:
-      return load_as_double<std::uint64_t>(p);
-    case DType::kFloat32:
-      return load_as_double<float>(p);
-    case DType::kFloat64:
-      return load_as_double<double>(p);
-  }
-  return 0.0;
+  return detail::npy::with_sample_type(
+      dtype, [&]<class T>() { return detail::npy::sample_as_double<T>(p); });
 }
 
 Vec3i NpyVolume::file_index_of(std::int64_t i) const {
