@@ -22,7 +22,7 @@ MODULE_LAYER = {"grid": "core", "edit": "core", "scene": "core", "gpu": "gpu", "
                 "vectors": "vectors", "csg": "csg", "mesh": "mesh", "io": "io", "render": "render", "live": "live", "mpi": "mpi"}
 PUBLIC_LAYER = {
     "box.h": "core", "error.h": "core", "parallel.h": "core", "limits.h": "core", "chunk_memory.h": "core", "grid.h": "core",
-    "detail/grid_impl.h": "core", "detail/assert.h": "core", "world.h": "core", "edit.h": "core", "edit_stream.h": "core",
+    "detail/grid_impl.h": "core", "detail/assert.h": "core", "detail/vector_clones.h": "core", "world.h": "core", "edit.h": "core", "edit_stream.h": "core",
     "scene.h": "core", "image.h": "core", "interrupt.h": "core", "primitives.h": "core", "png.h": "io",
     "hash.h": "core", "voxel_frame.h": "core",
     "gpu.h": "gpu", "gpu_vulkan.h": "gpu",

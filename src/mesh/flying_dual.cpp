@@ -25,6 +25,7 @@
 #include "cube_cases.h"
 #include "flying_edges.h"
 #include "mesh_memory.h"
+#include "voxfield/detail/vector_clones.h"
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
 #include "voxfield/parallel.h"
@@ -230,8 +231,9 @@ struct CellRow {
       position[a].resize(cells), normal[a].resize(cells);
     }
   }
-  // Places cells [0, k) of cell row (y, z).
-  void place(const Lattice& l, int y, int z, std::size_t k) {
+  // Places cells [0, k) of cell row (y, z). (Measured on the noise volume: a second copy in AVX2
+  // takes 4 % off surface nets' whole pass; the passes around it gained nothing from AVX2.)
+  VOXFIELD_AVX2_CLONE void place(const Lattice& l, int y, int z, std::size_t k) {
     // Raw pointers that promise not to alias (through the vectors, every store could move their
     // own data pointers), and ivdep: without them GCC 12 neither keeps the pointers in registers
     // nor vectorises the loop.

@@ -17,6 +17,7 @@
 #include "../truncated_min_convolution.h"
 #include "encoder.h"
 #include "slice_solvers.h"
+#include "voxfield/detail/vector_clones.h"
 
 namespace voxfield::detail::exact {
 
@@ -46,9 +47,12 @@ struct SliceCosts {
 // split the cost into the distance to solid (f0, for air voxels) and to air (f1, not null, for
 // solid ones). `solid`, when not null, receives which voxels are solid: the write-back needs them
 // for signed fields and nearest sites, and a caller that holds them already passes null.
+// (gather_row and write_row twice: in AVX2 too, vector_clones.h — loops of conversions and
+// selects over a row that vectorise.)
 template <class V, class G>
-void gather_row(const SliceCosts<V>& costs, const G* g, G cap_vox, const std::uint8_t* world,
-                int count, V* f0, V* f1, std::uint8_t* solid) {
+VOXFIELD_AVX2_CLONE void gather_row(const SliceCosts<V>& costs, const G* g, G cap_vox,
+                                    const std::uint8_t* world, int count, V* f0, V* f1,
+                                    std::uint8_t* solid) {
   // Copied out: V pointers could otherwise alias these fields, and the loops would reload them.
   const V inf = costs.inf, clamp = costs.clamp;
   const bool euclid = costs.euclid, unit_spacing = costs.unit_spacing;
@@ -87,9 +91,10 @@ void gather_row(const SliceCosts<V>& costs, const G* g, G cap_vox, const std::ui
 // row: buf[0].h holds the solved costs (buf[1].h the distances to air of a signed field), `solid`
 // which voxels are solid (for signed fields and sites) and `dz` pass A's z offsets (sites only).
 template <class T, class V>
-void write_row(const Encoder<T>& encoder, const SliceCosts<V>& costs, const SliceBuffers<V>* buf,
-               const std::uint8_t* solid, const std::int16_t* dz, int width, int y, int x0,
-               int count, T* out, SiteOffset* sites) {
+VOXFIELD_AVX2_CLONE void write_row(const Encoder<T>& encoder, const SliceCosts<V>& costs,
+                                   const SliceBuffers<V>* buf, const std::uint8_t* solid,
+                                   const std::int16_t* dz, int width, int y, int x0, int count,
+                                   T* out, SiteOffset* sites) {
   const V inf = costs.inf, clamp = costs.clamp;
   const bool is_signed = costs.is_signed;
   const std::size_t o = static_cast<std::size_t>(y) * width + x0;

@@ -23,6 +23,7 @@
 #include "../line_transforms.h"
 #include "../truncated_min_convolution.h"
 #include "../window_lanes.h"
+#include "voxfield/detail/vector_clones.h"
 
 namespace voxfield::detail::exact {
 
@@ -241,8 +242,9 @@ void solve_slice_envelope(const Kernel& kx, const Kernel& ky, int X, int Y, Slic
 
 // 2-D solve of one slice for Manhattan: min-plus sweeps along x per row, then along y across whole
 // rows at once (contiguous, vectorisable). Ties keep the smaller index, as the envelope does.
-inline void solve_slice_manhattan(int X, int Y, SliceBuffers<std::int32_t>& b, bool track_sites,
-                                  int x_lo, int x_hi) {
+// (Twice: in AVX2 too, vector_clones.h: the y sweeps are whole rows of integer lanes.)
+VOXFIELD_AVX2_CLONE inline void solve_slice_manhattan(int X, int Y, SliceBuffers<std::int32_t>& b,
+                                                      bool track_sites, int x_lo, int x_hi) {
   constexpr std::int32_t kInf = kManhattanInf;
   std::int32_t* h = b.h.data();
   if (track_sites) {

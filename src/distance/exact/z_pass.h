@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "chunk_rows.h"
+#include "voxfield/detail/vector_clones.h"
 
 namespace voxfield::detail::exact {
 
@@ -59,10 +60,13 @@ inline void z_sweep_step(const std::uint8_t* __restrict w, G* __restrict ds, G* 
 // thread-local buffer small enough for the cache, so each output voxel is written exactly once.
 // U: the unsigned integer the output storage holds g in; g >= cap is stored as kInf ("none").
 // `beyond`, when given, holds the sites of the columns outside the domain's z range.
+// (Twice: in AVX2 too, vector_clones.h — the sweeps are lanes of integer min and add, twice as
+// many per instruction; with the slice passes' copies, 11 % off one thread's Manhattan transform.)
 template <class U, bool kSigned>
-void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
-            ChunkedVolume<SiteOffset>* sites, int cx, int cy, std::uint32_t cap,
-            std::vector<std::uint32_t>& col, const ColumnsBeyond* beyond = nullptr) {
+VOXFIELD_AVX2_CLONE void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
+                                ChunkedVolume<SiteOffset>* sites, int cx, int cy, std::uint32_t cap,
+                                std::vector<std::uint32_t>& col,
+                                const ColumnsBeyond* beyond = nullptr) {
   constexpr U kInf = std::numeric_limits<U>::max();
   const int e = g.edge;
   const int y0 = std::max(p.domain.begin.y, g.box.begin.y + cy * e);
