@@ -61,7 +61,8 @@ inline void z_sweep_step(const std::uint8_t* __restrict w, G* __restrict ds, G* 
 // U: the unsigned integer the output storage holds g in; g >= cap is stored as kInf ("none").
 // `beyond`, when given, holds the sites of the columns outside the domain's z range.
 // (Twice: in AVX2 too, vector_clones.h — the sweeps are lanes of integer min and add, twice as
-// many per instruction; with the slice passes' copies, 11 % off one thread's Manhattan transform.)
+// many per instruction; with the slice passes' copies, 10-14 % off one thread's Manhattan
+// transform.)
 template <class U, bool kSigned>
 VOXFIELD_AVX2_CLONE void pass_z(const Plan& p, const SolidRows& world, ChunkedVolume<U>& g,
                                 ChunkedVolume<SiteOffset>* sites, int cx, int cy, std::uint32_t cap,
