@@ -315,15 +315,16 @@ TEST(LineTransforms, TheWindowedMinPlusHoldsAtTheThirtyTwoBitBounds) {
 }
 
 TEST(LineTransforms, WindowedLinesGoToTheEnvelopeWhenTheirWindowsOutgrowTheBudget) {
-  // 21 lines of 300 (two groups of eight and five left over), interleaved with stride 21: lines
+  // 2W + 5 lines of 300 (two groups of W = kWindowLanes and five left over), interleaved: lines
   // near a site everywhere (cheap windows) and lines with one site at an end (windows of up to
   // 600 steps). With a budget of 16 steps per voxel the cheap group is solved by windows, the wide
   // one and the five left over by the envelope; every line equals the envelope's result.
-  const int n = 300, count = 21;
+  constexpr int W = kWindowLanes;
+  const int n = 300, count = 2 * W + 5;
   std::mt19937 rng(31);
   std::vector<std::vector<std::int32_t>> lines(count, std::vector<std::int32_t>(n, kInf));
   for (int l = 0; l < count; ++l) {
-    if (l >= 8 && l < 16) {
+    if (l >= W && l < 2 * W) {
       lines[l][l % 2 ? 0 : n - 1] = static_cast<std::int32_t>(rng() % 30);
     } else {
       for (int x = 0; x < n; ++x)
@@ -347,7 +348,7 @@ TEST(LineTransforms, WindowedLinesGoToTheEnvelopeWhenTheirWindowsOutgrowTheBudge
   };
   window_lines_or_envelope(count, n, f.data(), count, out.data(), 16, scratch_in.data(),
                            scratch_out.data(), envelope);
-  EXPECT_EQ(envelope_lines, (std::vector<int>{8, 5}));  // the wide group, then the five left over
+  EXPECT_EQ(envelope_lines, (std::vector<int>{W, 5}));  // the wide group, then the five left over
   for (int l = 0; l < count; ++l) {
     const LineResult ref = division_free(lines[l]);
     for (int x = 0; x < n; ++x)

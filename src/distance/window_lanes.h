@@ -32,10 +32,18 @@
 
 namespace voxfield::detail {
 
-// Eight 32-bit lanes: in SSE4.1 registers where the build targets it (the default x86-64-v2),
-// in plain loops otherwise (a build for baseline x86-64; the tests run both).
+// Lines solved side by side by window_min_plus_lanes, one 32-bit lane each.
+inline constexpr int kWindowLanes = 16;
+
+// Sixteen 32-bit lanes: in SSE4.1 registers where the build targets it (the default x86-64-v2),
+// in plain loops otherwise (a build for baseline x86-64; the tests run both). Sixteen, not the
+// eight of two registers: each voxel's window waits on the one before (its reach is a square root
+// and a maximum over the lanes of the previous result), and that chain, not the window's adds and
+// mins, bounds the transform; sixteen lines share one chain. Measured, one thread, 256³ spheres
+// and terrain (docs/benchmarks.md): 8 lanes 287-289 / 218-220 ms, 16 lanes 242-248 / 186-190,
+// 32 lanes 261-263 / 185-192 (the windows, the widest of the lanes', grow with more lanes).
 struct ScalarLanes {
-  std::int32_t v[8];
+  std::int32_t v[kWindowLanes];
   static ScalarLanes splat(std::int32_t x) {
     ScalarLanes r;
     for (auto& e : r.v) e = x;
@@ -43,26 +51,26 @@ struct ScalarLanes {
   }
   static ScalarLanes load(const std::int32_t* p) {
     ScalarLanes r;
-    for (int k = 0; k < 8; ++k) r.v[k] = p[k];
+    for (int k = 0; k < kWindowLanes; ++k) r.v[k] = p[k];
     return r;
   }
   void store(std::int32_t* p) const {
-    for (int k = 0; k < 8; ++k) p[k] = v[k];
+    for (int k = 0; k < kWindowLanes; ++k) p[k] = v[k];
   }
   friend ScalarLanes min(ScalarLanes x, ScalarLanes y) {
-    for (int k = 0; k < 8; ++k) x.v[k] = std::min(x.v[k], y.v[k]);
+    for (int k = 0; k < kWindowLanes; ++k) x.v[k] = std::min(x.v[k], y.v[k]);
     return x;
   }
   friend ScalarLanes operator+(ScalarLanes x, ScalarLanes y) {
-    for (int k = 0; k < 8; ++k) x.v[k] += y.v[k];
+    for (int k = 0; k < kWindowLanes; ++k) x.v[k] += y.v[k];
     return x;
   }
   friend ScalarLanes operator&(ScalarLanes x, ScalarLanes y) {
-    for (int k = 0; k < 8; ++k) x.v[k] &= y.v[k];
+    for (int k = 0; k < kWindowLanes; ++k) x.v[k] &= y.v[k];
     return x;
   }
   friend ScalarLanes operator>(ScalarLanes x, ScalarLanes y) {
-    for (int k = 0; k < 8; ++k) x.v[k] = x.v[k] > y.v[k] ? -1 : 0;
+    for (int k = 0; k < kWindowLanes; ++k) x.v[k] = x.v[k] > y.v[k] ? -1 : 0;
     return x;
   }
   bool none() const {
@@ -72,7 +80,7 @@ struct ScalarLanes {
   }
   ScalarLanes isqrt() const {
     ScalarLanes r;
-    for (int k = 0; k < 8; ++k) {
+    for (int k = 0; k < kWindowLanes; ++k) {
       std::int64_t s = static_cast<std::int64_t>(std::sqrt(static_cast<double>(v[k])));
       s += (s + 1) * (s + 1) <= v[k];
       s -= s * s > v[k];
@@ -80,49 +88,63 @@ struct ScalarLanes {
     }
     return r;
   }
-  std::int32_t max_lane() const { return *std::max_element(v, v + 8); }
+  std::int32_t max_lane() const { return *std::max_element(v, v + kWindowLanes); }
 };
 
 #if defined(__SSE4_1__)
 struct SseLanes {
-  __m128i a, b;
-  static SseLanes splat(std::int32_t v) { return {_mm_set1_epi32(v), _mm_set1_epi32(v)}; }
+  static constexpr int R = kWindowLanes / 4;  // registers of four lanes
+  __m128i r[R];
+  // The lanes from f(register), register by register.
+  template <class F>
+  static SseLanes each(F&& f) {
+    SseLanes out;
+    for (int k = 0; k < R; ++k) out.r[k] = f(k);
+    return out;
+  }
+  static SseLanes splat(std::int32_t v) {
+    return each([&](int) { return _mm_set1_epi32(v); });
+  }
   static SseLanes load(const std::int32_t* p) {
-    return {_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)),
-            _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 4))};
+    return each(
+        [&](int k) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 4 * k)); });
   }
   void store(std::int32_t* p) const {
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(p), a);
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(p + 4), b);
+    for (int k = 0; k < R; ++k) _mm_storeu_si128(reinterpret_cast<__m128i*>(p + 4 * k), r[k]);
   }
   friend SseLanes min(SseLanes x, SseLanes y) {
-    return {_mm_min_epi32(x.a, y.a), _mm_min_epi32(x.b, y.b)};
+    return each([&](int k) { return _mm_min_epi32(x.r[k], y.r[k]); });
   }
   friend SseLanes operator+(SseLanes x, SseLanes y) {
-    return {_mm_add_epi32(x.a, y.a), _mm_add_epi32(x.b, y.b)};
+    return each([&](int k) { return _mm_add_epi32(x.r[k], y.r[k]); });
   }
   friend SseLanes operator&(SseLanes x, SseLanes y) {
-    return {_mm_and_si128(x.a, y.a), _mm_and_si128(x.b, y.b)};
+    return each([&](int k) { return _mm_and_si128(x.r[k], y.r[k]); });
   }
-  friend SseLanes operator>(SseLanes x, SseLanes y) {  // all ones where x > y
-    return {_mm_cmpgt_epi32(x.a, y.a), _mm_cmpgt_epi32(x.b, y.b)};
+  friend SseLanes operator>(SseLanes x, SseLanes y) {
+    return each([&](int k) { return _mm_cmpgt_epi32(x.r[k], y.r[k]); });
   }
-  bool none() const { return _mm_testz_si128(_mm_or_si128(a, b), _mm_or_si128(a, b)) != 0; }
+  bool none() const {
+    __m128i a = r[0];
+    for (int k = 1; k < R; ++k) a = _mm_or_si128(a, r[k]);
+    return _mm_testz_si128(a, a) != 0;
+  }
   // floor(sqrt(v)) per lane for 0 <= v < 2^30: the float root (v above 2^24 rounds when
-  // converted) raised by one where it fell short...
+  // converted) raised by one where it fell short, lowered by one where it came out above (v just
+  // below a square rounds up to it).
   SseLanes isqrt() const {
-    const auto one = [](__m128i v) {
-      __m128i r = _mm_cvttps_epi32(_mm_sqrt_ps(_mm_cvtepi32_ps(v)));
-      const __m128i r1 = _mm_add_epi32(r, _mm_set1_epi32(1));
-      const __m128i fine = _mm_cmpgt_epi32(_mm_mullo_epi32(r1, r1), v);  // all ones: r is the root
-      r = _mm_sub_epi32(r, _mm_andnot_si128(fine, _mm_set1_epi32(-1)));
-      // ... and lowered by one where it came out above (v just below a square rounds up to it).
-      return _mm_add_epi32(r, _mm_cmpgt_epi32(_mm_mullo_epi32(r, r), v));
-    };
-    return {one(a), one(b)};
+    return each([&](int k) {
+      const __m128i v = r[k];
+      __m128i q = _mm_cvttps_epi32(_mm_sqrt_ps(_mm_cvtepi32_ps(v)));
+      const __m128i q1 = _mm_add_epi32(q, _mm_set1_epi32(1));
+      const __m128i fine = _mm_cmpgt_epi32(_mm_mullo_epi32(q1, q1), v);
+      q = _mm_sub_epi32(q, _mm_andnot_si128(fine, _mm_set1_epi32(-1)));
+      return _mm_add_epi32(q, _mm_cmpgt_epi32(_mm_mullo_epi32(q, q), v));
+    });
   }
   std::int32_t max_lane() const {
-    __m128i m = _mm_max_epi32(a, b);
+    __m128i m = r[0];
+    for (int k = 1; k < R; ++k) m = _mm_max_epi32(m, r[k]);
     m = _mm_max_epi32(m, _mm_shuffle_epi32(m, _MM_SHUFFLE(1, 0, 3, 2)));
     m = _mm_max_epi32(m, _mm_shuffle_epi32(m, _MM_SHUFFLE(2, 3, 0, 1)));
     return _mm_cvtsi128_si32(m);
@@ -132,9 +154,6 @@ using Lanes = SseLanes;
 #else
 using Lanes = ScalarLanes;
 #endif
-
-// Lines solved side by side by window_min_plus_lanes: two SSE registers of 32-bit lanes.
-inline constexpr int kWindowLanes = 8;
 
 // kWindowLanes lines of n voxels, lane k of element i at f[i * f_stride + k], into
 // out[i * out_stride + k]: out = min(kInf, min_i f[i] + (x - i)²) with kInf =
