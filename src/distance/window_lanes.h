@@ -121,7 +121,7 @@ struct SseLanes {
   friend SseLanes operator&(SseLanes x, SseLanes y) {
     return each([&](int k) { return _mm_and_si128(x.r[k], y.r[k]); });
   }
-  friend SseLanes operator>(SseLanes x, SseLanes y) {
+  friend SseLanes operator>(SseLanes x, SseLanes y) {  // all ones where x > y
     return each([&](int k) { return _mm_cmpgt_epi32(x.r[k], y.r[k]); });
   }
   bool none() const {

@@ -232,7 +232,7 @@ struct CellRow {
     }
   }
   // Places cells [0, k) of cell row (y, z). (Measured on the noise volume: a second copy in AVX2
-  // takes 4 % off surface nets' whole pass; the passes around it gained nothing from AVX2.)
+  // takes 3.6-6 % off surface nets' whole pass; the passes around it gained nothing from AVX2.)
   VOXFIELD_AVX2_CLONE void place(const Lattice& l, int y, int z, std::size_t k) {
     // Raw pointers that promise not to alias (through the vectors, every store could move their
     // own data pointers), and ivdep: without them GCC 12 neither keeps the pointers in registers
