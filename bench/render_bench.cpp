@@ -93,20 +93,20 @@ int main(int argc, char** argv) {
       bench::Timing t;
       std::uint64_t frame_hash = 0;  // the frame, pinned beside its time (none when tracing only)
       if (c.trace_only) {
-        // The primary rays alone, traced over rows in parallel, no shading and no image.
+        // The primary rays alone, no shading and no image: made and traced as one batch by
+        // trace_rays, the entry point of ray casts that are not pictures.
         const auto proj = cam.projector(w, h);
-        std::vector<TraversalCounters> rows(static_cast<std::size_t>(h));
+        std::vector<Ray> rays(static_cast<std::size_t>(w) * h);
+        std::vector<RayHit> hits(rays.size());
         t = bench::time_runs(runs, [&] {
           parallel_for(static_cast<std::size_t>(h), 4, [&](std::size_t b, std::size_t e) {
-            for (std::size_t y = b; y < e; ++y) {
-              TraversalCounters local;
+            for (std::size_t y = b; y < e; ++y)
               for (int px = 0; px < w; ++px)
-                trace_ray(scene, proj.ray(px + 0.5, y + 0.5), c.skip, &local);
-              rows[y] = local;
-            }
+                rays[y * w + px] = proj.ray(px + 0.5, static_cast<double>(y) + 0.5);
           });
+          st.primary = {};
+          trace_rays(scene, rays, hits, c.skip, &st.primary);
         });
-        for (const auto& r : rows) st.primary.add(r);
       } else {
         Image frame;
         t = bench::time_runs(runs, [&] { frame = render(scene, cam, o, &st); });

@@ -115,20 +115,40 @@ TEST(Render, SkippingNeverChangesAHit) {
   }
 }
 
+// Batches walk their rays in turns (src/render/ray_group.h): every hit and every counter must be
+// what the rays traced one by one give, for every metric and skip mode, and for a batch whose
+// last group is partial.
 TEST(Render, BatchTracingEqualsSingleRays) {
-  const World w = random_world({50, 40, 30}, 8, 23, 20);
-  RenderSceneOptions so;
-  so.lighting_field = false;
-  const RenderScene scene(w, so);
-  const std::vector<Ray> rays = test_rays(scene.box(), 8, 2000);
-  std::vector<RayHit> hits(rays.size());
-  TraversalCounters batch, single;
-  trace_rays(scene, rays, hits, SkipMode::kDistance, &batch);
-  for (std::size_t i = 0; i < rays.size(); ++i)
-    expect_same_hit(hits[i], trace_ray(scene, rays[i], SkipMode::kDistance, &single),
-                    "ray " + std::to_string(i));
-  EXPECT_EQ(batch.voxel_reads, single.voxel_reads);
-  EXPECT_EQ(batch.rays, static_cast<std::int64_t>(rays.size()));
+  const World w = random_world({50, 40, 30}, 8, 23, 20, 30);
+  for (Metric metric : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean}) {
+    RenderSceneOptions so;
+    so.skip_metric = metric;
+    so.lighting_field = false;
+    const RenderScene scene(w, so);
+    std::vector<Ray> rays = test_rays(scene.box(), 8, 2000);
+    rays.resize(rays.size() - 3);  // not a whole number of groups
+    for (SkipMode mode : {SkipMode::kNone, SkipMode::kChunks, SkipMode::kDistance}) {
+      const std::string what = std::string(metric_name(metric)) + " " + skip_mode_name(mode);
+      std::vector<RayHit> hits(rays.size());
+      TraversalCounters batch, single;
+      trace_rays(scene, rays, hits, mode, &batch);
+      int hit_count = 0;
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        expect_same_hit(hits[i], trace_ray(scene, rays[i], mode, &single),
+                        what + " ray " + std::to_string(i));
+        hit_count += hits[i].hit;
+      }
+      EXPECT_GT(hit_count, 300) << what;
+      EXPECT_LT(hit_count, static_cast<int>(rays.size()) - 300) << what;  // misses too
+      EXPECT_EQ(batch.rays, static_cast<std::int64_t>(rays.size())) << what;
+      EXPECT_EQ(batch.steps, single.steps) << what;
+      EXPECT_EQ(batch.voxel_reads, single.voxel_reads) << what;
+      EXPECT_EQ(batch.chunk_skips, single.chunk_skips) << what;
+      EXPECT_EQ(batch.distance_skips, single.distance_skips) << what;
+    }
+  }
+  const RenderScene scene(w);
+  const std::vector<Ray> rays = test_rays(scene.box(), 8, 10);
   std::vector<RayHit> short_hits(3);
   EXPECT_THROW(trace_rays(scene, rays, short_hits), InvalidArgument);
 }
@@ -347,6 +367,31 @@ TEST(Render, FramesDoNotDependOnThreadsOrTiles) {
   o.tile_size = 7;
   const Image many = render(scene, cam, o);
   EXPECT_EQ(one.rgb, many.rgb);
+}
+
+// Frames skipping by the distance field walk their primary rays in turns (ray_group.h); frames
+// without skips walk them one by one. They must be the same picture, with the same counts.
+TEST(Render, FramesDoNotDependOnHowRaysSkip) {
+  const World w = random_world({70, 60, 40}, 8, 31, 40, 50);
+  for (Metric metric : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean}) {
+    RenderSceneOptions so;
+    so.skip_metric = metric;
+    const RenderScene scene(w, so);
+    RenderOptions o;
+    o.width = 83;  // rows of whole and partial groups
+    o.height = 47;
+    o.tile_size = 13;
+    const Camera cam = Camera::framing(scene.box(), 1.6);
+    RenderStats plain_stats, skip_stats;
+    o.skip = SkipMode::kNone;
+    const Image plain = render(scene, cam, o, &plain_stats);
+    o.skip = SkipMode::kDistance;
+    const Image skipping = render(scene, cam, o, &skip_stats);
+    EXPECT_EQ(plain.rgb, skipping.rgb) << metric_name(metric);
+    EXPECT_EQ(plain_stats.primary.rays, skip_stats.primary.rays);
+    EXPECT_EQ(plain_stats.shadow.rays, skip_stats.shadow.rays);
+    EXPECT_LT(skip_stats.primary.voxel_reads * 2, plain_stats.primary.voxel_reads);
+  }
 }
 
 TEST(Render, ShadowsDarkenWhatTheOverhangCovers) {

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "hit_shading.h"
+#include "ray_group.h"
 #include "shading.h"
 #include "traverse.h"
 #include "voxfield/error.h"
@@ -91,18 +92,34 @@ struct Frame {
     light.chunk_overlay(h, ray, projector.footprint(h.t), c);
   }
 
+  // The shaded view's (and the chunk view's) pixel for its primary ray's hit.
+  void shaded_pixel(const Ray& ray, const RayHit& h, std::uint8_t* out, RenderStats& st) const {
+    Rgb c = h.hit ? shade(h, ray, true, st.shadow) : sky(ray.direction, projector.sky_scale);
+    if (h.hit && o.view == RenderView::kChunks) chunk_overlay(h, ray, c);
+    tone_map().write(c, out);
+  }
+
+  // Pixels [x0, x1) of row y in the shaded or chunk view: the primary rays walked in groups whose
+  // voxel reads overlap (ray_group.h), then shaded one by one.
+  void shaded_row(Image& image, int y, int x0, int x1, RenderStats& st) const {
+    Ray rays[render_detail::kRayGroup];
+    RayHit hits[render_detail::kRayGroup];
+    for (int x = x0; x < x1; x += render_detail::kRayGroup) {
+      const int n = std::min(render_detail::kRayGroup, x1 - x);
+      for (int i = 0; i < n; ++i) rays[i] = projector.ray(x + i + 0.5, y + 0.5);
+      render_detail::traverse_group(s, s.box, rays, n, o.skip, s.skip, st.primary, hits);
+      for (int i = 0; i < n; ++i) shaded_pixel(rays[i], hits[i], image.pixel(x + i, y), st);
+    }
+  }
+
   void pixel(int px, int py, std::uint8_t* out, RenderStats& st) const {
     const Ray ray = projector.ray(px + 0.5, py + 0.5);
     const auto noop = [](const Dda&, std::size_t) {};
     switch (o.view) {
       case RenderView::kShaded:
-      case RenderView::kChunks: {
-        const RayHit h = traverse(s, s.box, ray, o.skip, s.skip, st.primary, noop);
-        Rgb c = h.hit ? shade(h, ray, true, st.shadow) : sky(ray.direction, projector.sky_scale);
-        if (h.hit && o.view == RenderView::kChunks) chunk_overlay(h, ray, c);
-        tone_map().write(c, out);
+      case RenderView::kChunks:
+        shaded_pixel(ray, traverse(s, s.box, ray, o.skip, s.skip, st.primary, noop), out, st);
         return;
-      }
       case RenderView::kDistance: {
         Box3i cut = s.box;
         cut.end.z = slice_z + 1;
@@ -211,8 +228,15 @@ Image render(const RenderScene& scene, const Camera& camera, const RenderOptions
       const int x0 = static_cast<int>(tile % tiles_x) * ts,
                 y0 = static_cast<int>(tile / tiles_x) * ts;
       RenderStats& st = tile_stats[tile];
-      for (int y = y0; y < std::min(y0 + ts, o.height); ++y)
-        for (int x = x0; x < std::min(x0 + ts, o.width); ++x) f.pixel(x, y, image.pixel(x, y), st);
+      const int x1 = std::min(x0 + ts, o.width);
+      const bool shaded = o.view == RenderView::kShaded || o.view == RenderView::kChunks;
+      for (int y = y0; y < std::min(y0 + ts, o.height); ++y) {
+        if (shaded) {
+          f.shaded_row(image, y, x0, x1, st);
+          continue;
+        }
+        for (int x = x0; x < x1; ++x) f.pixel(x, y, image.pixel(x, y), st);
+      }
       progress.advance();
     }
   });

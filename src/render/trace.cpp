@@ -1,7 +1,9 @@
-// voxfield renderer — tracing single rays (the public entry point used by tests and tools).
+// voxfield renderer — tracing single rays and batches of them (the public entry points used by
+// tests and tools; a batch walks its rays in groups whose voxel reads overlap, ray_group.h).
 #include <algorithm>
 #include <vector>
 
+#include "ray_group.h"
 #include "traverse.h"
 #include "voxfield/error.h"
 #include "voxfield/parallel.h"
@@ -55,10 +57,14 @@ void trace_rays(const RenderScene& scene, std::span<const Ray> rays, std::span<R
   constexpr std::size_t kGrain = 256;
   std::vector<TraversalCounters> parts((rays.size() + kGrain - 1) / kGrain);
   parallel_for(parts.size(), 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t part = b; part < e; ++part)
-      for (std::size_t i = part * kGrain; i < std::min(rays.size(), (part + 1) * kGrain); ++i)
-        hits[i] = render_detail::traverse(s, s.box, rays[i], mode, s.skip, parts[part],
-                                          [](const render_detail::Dda&, std::size_t) {});
+    for (std::size_t part = b; part < e; ++part) {
+      const std::size_t end = std::min(rays.size(), (part + 1) * kGrain);
+      for (std::size_t i = part * kGrain; i < end; i += render_detail::kRayGroup) {
+        const int n = static_cast<int>(std::min<std::size_t>(render_detail::kRayGroup, end - i));
+        render_detail::traverse_group(s, s.box, rays.data() + i, n, mode, s.skip, parts[part],
+                                      hits.data() + i);
+      }
+    }
   });
   if (counters)
     for (const TraversalCounters& p : parts) counters->add(p);

@@ -123,43 +123,41 @@ inline RayHit make_hit(const Dda& dda, std::uint8_t material) {
 
 enum class Step { kContinue, kHit, kMiss };
 
-// One iteration of the traversal at dda.v: a hit, a miss (the ray left `box`), or the DDA moved on
-// (one step, or a skip out of an empty chunk or a box the distance field clears). on_air(dda,
-// chunk) is called at every air voxel the traversal stops at (with kNone: every air voxel on the
-// ray).
+// The first half of a traversal step at an air-or-unknown voxel dda.v of chunk `chunk`, when the
+// chunk holds no solid voxel: leave the chunk in one step, or farther when the field allows it.
+// Every voxel of the chunk is at least the chunk's smallest value away from geometry, so that
+// bound needs no voxel read.
 template <class OnAir>
-inline Step visit(const RenderScene::Impl& s, const Box3i& box, SkipMode mode,
-                  const SkipSource& skip, const SkipWeights& sw, Dda& dda, TraversalCounters& c,
-                  OnAir& on_air, RayHit& hit) {
-  if (!box.contains(dda.v)) return Step::kMiss;
-  const ChunkTable& table = s.table;
-  const std::size_t chunk = table.chunk_index(dda.v);
-  if (mode != SkipMode::kNone && s.empty_chunk[chunk]) {
-    // Leave the chunk in one step, or farther when the field allows it. Every voxel of the chunk
-    // is at least the chunk's smallest value away from geometry, so that bound needs no voxel read.
-    const Box3i cb = table.chunk_box_of(dda.v);
-    int caps[3];
-    for (int a = 0; a < 3; ++a)
-      caps[a] = dda.step[a] > 0 ? cb.end[a] - 1 - dda.v[a] : dda.v[a] - cb.begin[a];
-    const Dda::Exit exit = dda.exit_of(caps);
-    on_air(dda, chunk);
-    ++c.steps;
-    if (mode == SkipMode::kDistance) {
-      int dcaps[3];
-      skip_caps(skip, sw, skip.chunk_min[chunk], dcaps);
-      const Dda::Exit dexit = dda.exit_of(dcaps);
-      if (dexit.t > exit.t || (dexit.t == exit.t && dexit.axis > exit.axis)) {
-        dda.leave(dcaps, dexit);
-        ++c.distance_skips;
-        return Step::kContinue;
-      }
+inline void leave_empty_chunk(const RenderScene::Impl& s, SkipMode mode, const SkipSource& skip,
+                              const SkipWeights& sw, Dda& dda, std::size_t chunk,
+                              TraversalCounters& c, OnAir& on_air) {
+  const Box3i cb = s.table.chunk_box_of(dda.v);
+  int caps[3];
+  for (int a = 0; a < 3; ++a)
+    caps[a] = dda.step[a] > 0 ? cb.end[a] - 1 - dda.v[a] : dda.v[a] - cb.begin[a];
+  const Dda::Exit exit = dda.exit_of(caps);
+  on_air(dda, chunk);
+  ++c.steps;
+  if (mode == SkipMode::kDistance) {
+    int dcaps[3];
+    skip_caps(skip, sw, skip.chunk_min[chunk], dcaps);
+    const Dda::Exit dexit = dda.exit_of(dcaps);
+    if (dexit.t > exit.t || (dexit.t == exit.t && dexit.axis > exit.axis)) {
+      dda.leave(dcaps, dexit);
+      ++c.distance_skips;
+      return;
     }
-    dda.leave(caps, exit);
-    ++c.chunk_skips;
-    return Step::kContinue;
   }
-  ++c.voxel_reads;
-  const std::uint16_t cell = skip.read(chunk, table.brick_index(dda.v));
+  dda.leave(caps, exit);
+  ++c.chunk_skips;
+}
+
+// The second half: what the voxel dda.v of chunk `chunk` holds has been read (`cell`, material in
+// the high byte): a hit, or the DDA moves on by one step or a skip the distance field clears.
+template <class OnAir>
+inline Step after_read(SkipMode mode, const SkipSource& skip, const SkipWeights& sw, Dda& dda,
+                       std::size_t chunk, std::uint16_t cell, TraversalCounters& c, OnAir& on_air,
+                       RayHit& hit) {
   const auto material = static_cast<std::uint8_t>(cell >> 8);
   if (material != 0) {
     hit = make_hit(dda, material);
@@ -178,6 +176,25 @@ inline Step visit(const RenderScene::Impl& s, const Box3i& box, SkipMode mode,
   }
   dda.step_once();
   return Step::kContinue;
+}
+
+// One iteration of the traversal at dda.v: a hit, a miss (the ray left `box`), or the DDA moved on
+// (one step, or a skip out of an empty chunk or a box the distance field clears). on_air(dda,
+// chunk) is called at every air voxel the traversal stops at (with kNone: every air voxel on the
+// ray).
+template <class OnAir>
+inline Step visit(const RenderScene::Impl& s, const Box3i& box, SkipMode mode,
+                  const SkipSource& skip, const SkipWeights& sw, Dda& dda, TraversalCounters& c,
+                  OnAir& on_air, RayHit& hit) {
+  if (!box.contains(dda.v)) return Step::kMiss;
+  const std::size_t chunk = s.table.chunk_index(dda.v);
+  if (mode != SkipMode::kNone && s.empty_chunk[chunk]) {
+    leave_empty_chunk(s, mode, skip, sw, dda, chunk, c, on_air);
+    return Step::kContinue;
+  }
+  ++c.voxel_reads;
+  return after_read(mode, skip, sw, dda, chunk, skip.read(chunk, s.table.brick_index(dda.v)), c,
+                    on_air, hit);
 }
 
 // The first solid voxel along the ray inside `box` (a sub-box of the scene's).
