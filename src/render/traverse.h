@@ -72,11 +72,16 @@ inline void skip_caps(const SkipSource& skip, const SkipWeights& sw, std::uint8_
     rest[a] = sw.w[a] > 0 ? share - caps[a] : -1;
     used += caps[a];
   }
-  for (int left = r - used; left > 0; --left) {
-    const int a = rest[0] >= rest[1] && rest[0] >= rest[2] ? 0 : rest[1] >= rest[2] ? 1 : 2;
-    ++caps[a];
-    rest[a] = -1;
-  }
+  // The `left` (0, 1 or 2: the remainders sum to less than 3) axes of largest remainder get one
+  // more voxel each, ties to the lower axis. Ranked without branches: which axes win is different
+  // at nearly every skip, and a loop picking them mispredicted most of its turns.
+  const int left = r - used;
+  const int rank0 = (rest[1] > rest[0]) + (rest[2] > rest[0]);
+  const int rank1 = (rest[0] >= rest[1]) + (rest[2] > rest[1]);
+  const int rank2 = (rest[0] >= rest[2]) + (rest[1] >= rest[2]);
+  caps[0] += rank0 < left;
+  caps[1] += rank1 < left;
+  caps[2] += rank2 < left;
 }
 
 // Clips the ray to `box` and starts the DDA at its first voxel. False when the ray misses.
