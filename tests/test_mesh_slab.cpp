@@ -66,7 +66,9 @@ Mesh laid_end_to_end(const ScalarVolume& vol, const MeshOptions& o, const std::v
     const std::size_t first = all.positions.size();
     // Its triangles use its own vertices and the lent ones, nothing else.
     for (const std::uint32_t i : s.part.indices) EXPECT_LT(i, s.part.positions.size());
-    if (!dual && k + 2 == cuts.size()) EXPECT_EQ(lent, 0u);  // the last slab lends nothing
+    if (!dual && k + 2 == cuts.size()) {
+      EXPECT_EQ(lent, 0u);  // the last slab lends nothing
+    }
     all.positions.insert(all.positions.end(), s.part.positions.begin(),
                          s.part.positions.begin() + static_cast<std::ptrdiff_t>(s.owned_vertices));
     all.normals.insert(all.normals.end(), s.part.normals.begin(),

@@ -15,7 +15,7 @@
 // skip lands on precisely the voxel, face and t the plain DDA reaches when it first leaves the box.
 // It is safe (cannot pass through geometry) whenever the box holds no solid voxel: the chunk
 // table knows empty chunks, and a distance field bounds a box around every air voxel (why, per
-// metric, at skip_caps() in trace.cpp).
+// metric, at skip_caps() in traverse.h).
 #pragma once
 
 #include <algorithm>

@@ -17,8 +17,8 @@
 
 namespace voxfield::render_detail {
 
-// Rays walked in turns. Eight keep about as many loads in flight as a core's fill buffers
-// hold, and fit in one row of a frame's default 16-pixel tile twice.
+// Rays walked in turns: two groups to a row of a frame's default 16-pixel tile. Not tuned
+// beyond one quick sitting (4 was a little slower than 8, 16 no faster).
 inline constexpr int kRayGroup = 8;
 
 // Traces rays[0..n), n <= kRayGroup, through `box`: hits[i] is what traverse(s, box, rays[i],
@@ -35,8 +35,9 @@ inline void traverse_group(const RenderScene::Impl& s, const Box3i& box, const R
   };
   const auto no_air = [](const Dda&, std::size_t) {};
   if (mode != SkipMode::kDistance) {
-    // Without distance skips a ray reads dozens of voxels, mostly neighbours in one brick: the
-    // turns cost more than they hide (the plain DDA ran 1.1-1.2x slower in turns).
+    // Without distance skips a ray reads many voxels (15 on the 512³ terrain skipping empty
+    // chunks only, 107 with none), mostly neighbours in one brick: the turns cost more than they
+    // hide (both modes ran slower in turns: docs/rendering.md).
     for (int i = 0; i < n; ++i) hits[i] = traverse(s, box, rays[i], mode, skip, c, no_air);
     return;
   }

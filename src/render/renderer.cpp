@@ -112,14 +112,14 @@ struct Frame {
     }
   }
 
+  // A pixel of the distance or the error view (shaded_row() draws the other two).
   void pixel(int px, int py, std::uint8_t* out, RenderStats& st) const {
     const Ray ray = projector.ray(px + 0.5, py + 0.5);
     const auto noop = [](const Dda&, std::size_t) {};
     switch (o.view) {
       case RenderView::kShaded:
       case RenderView::kChunks:
-        shaded_pixel(ray, traverse(s, s.box, ray, o.skip, s.skip, st.primary, noop), out, st);
-        return;
+        return;  // not drawn pixel by pixel
       case RenderView::kDistance: {
         Box3i cut = s.box;
         cut.end.z = slice_z + 1;

@@ -72,7 +72,8 @@ inline void skip_caps(const SkipSource& skip, const SkipWeights& sw, std::uint8_
     rest[a] = sw.w[a] > 0 ? share - caps[a] : -1;
     used += caps[a];
   }
-  // The `left` (0, 1 or 2: the remainders sum to less than 3) axes of largest remainder get one
+  // The `left` (0, 1 or 2: the remainders sum to less than 3, save rounding) axes of largest
+  // remainder get one
   // more voxel each, ties to the lower axis. Ranked without branches: which axes win is different
   // at nearly every skip, and a loop picking them mispredicted most of its turns.
   const int left = r - used;
@@ -128,8 +129,8 @@ inline RayHit make_hit(const Dda& dda, std::uint8_t material) {
 
 enum class Step { kContinue, kHit, kMiss };
 
-// The first half of a traversal step at an air-or-unknown voxel dda.v of chunk `chunk`, when the
-// chunk holds no solid voxel: leave the chunk in one step, or farther when the field allows it.
+// A traversal step at voxel dda.v of chunk `chunk` when the chunk holds no solid voxel (no voxel
+// is read): leave the chunk in one step, or farther when the field allows it.
 // Every voxel of the chunk is at least the chunk's smallest value away from geometry, so that
 // bound needs no voxel read.
 template <class OnAir>
@@ -157,8 +158,9 @@ inline void leave_empty_chunk(const RenderScene::Impl& s, SkipMode mode, const S
   ++c.chunk_skips;
 }
 
-// The second half: what the voxel dda.v of chunk `chunk` holds has been read (`cell`, material in
-// the high byte): a hit, or the DDA moves on by one step or a skip the distance field clears.
+// A traversal step at voxel dda.v of chunk `chunk` in any other chunk, once the voxel has been read
+// (`cell`, material in the high byte): a hit, or the DDA moves on by one step or a skip the
+// distance field clears.
 template <class OnAir>
 inline Step after_read(SkipMode mode, const SkipSource& skip, const SkipWeights& sw, Dda& dda,
                        std::size_t chunk, std::uint16_t cell, TraversalCounters& c, OnAir& on_air,
