@@ -31,7 +31,6 @@ inline void traverse_group(const RenderScene::Impl& s, const Box3i& box, const R
     SkipWeights sw;
     std::size_t chunk = 0;
     const std::uint16_t* cell = nullptr;  // the voxel to read next (prefetched)
-    int ray = 0;
   };
   const auto no_air = [](const Dda&, std::size_t) {};
   if (mode != SkipMode::kDistance) {
@@ -41,7 +40,7 @@ inline void traverse_group(const RenderScene::Impl& s, const Box3i& box, const R
     for (int i = 0; i < n; ++i) hits[i] = traverse(s, box, rays[i], mode, skip, c, no_air);
     return;
   }
-  Walk walks[kRayGroup];
+  Walk walks[kRayGroup];  // walks[i] walks rays[i]
   // Walks w on to the next voxel it must read and prefetches that voxel; false when the ray left
   // the box (a miss).
   const auto to_next_read = [&](Walk& w) {
@@ -62,22 +61,21 @@ inline void traverse_group(const RenderScene::Impl& s, const Box3i& box, const R
     ++c.rays;
     hits[i] = {};
     Walk& w = walks[i];
-    w.ray = i;
     if (!start_in_box(box, rays[i], w.dda)) continue;
     w.sw = SkipWeights(skip.metric, rays[i]);
     if (to_next_read(w)) live[live_count++] = i;
   }
   while (live_count > 0) {
     for (int k = 0; k < live_count;) {
-      Walk& w = walks[live[k]];
+      const int i = live[k];
+      Walk& w = walks[i];
       ++c.voxel_reads;
-      const Step step =
-          after_read(mode, skip, w.sw, w.dda, w.chunk, *w.cell, c, no_air, hits[w.ray]);
+      const Step step = after_read(mode, skip, w.sw, w.dda, w.chunk, *w.cell, c, no_air, hits[i]);
       if (step == Step::kContinue && to_next_read(w)) {
         ++k;
         continue;
       }
-      // A hit (hits[w.ray] is set) or a miss (it stays empty): this ray is done.
+      // A hit (hits[i] is set) or a miss (it stays empty): this ray is done.
       live[k] = live[--live_count];
     }
   }
