@@ -217,10 +217,10 @@ struct RayHit {
 // Work done by traversals, summed over rays.
 struct TraversalCounters {
   std::int64_t rays = 0;
-  std::int64_t steps = 0;           // DDA state changes (a bulk skip counts once)
-  std::int64_t voxel_reads = 0;     // voxels whose material / distance was read
-  std::int64_t chunk_skips = 0;     // empty chunks crossed in one step
-  std::int64_t distance_skips = 0;  // skips of more than one voxel by the distance field
+  std::int64_t steps = 0;        // DDA state changes (a bulk skip counts once)
+  std::int64_t voxel_reads = 0;  // voxels whose material / distance was read
+  std::int64_t chunk_skips = 0;  // empty chunks left in one step (with distance skips: and beyond)
+  std::int64_t distance_skips = 0;  // skips of more than one voxel from an air voxel read
   void add(const TraversalCounters& o) {
     rays += o.rays;
     steps += o.steps;

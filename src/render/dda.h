@@ -97,28 +97,38 @@ struct Dda {
 
   // Moves to the voxel the plain DDA enters when it leaves that box (see the header comment).
   void leave(const int caps[3], Exit e) {
-    int n[3] = {0, 0, 0};
     for (int b = 0; b < 3; ++b) {
       if (step[b] == 0) continue;
       if (b == e.axis) {
-        n[b] = caps[b] + 1;
+        advance(b, caps[b] + 1);
         continue;
       }
-      // Smallest j in [0, caps[b]] whose event comes at or after the exit event. Crossings are
-      // 1 / |direction_b| apart in t, which gives j up to rounding; the exact comparisons with
-      // t_at() then settle it (they decide, not the estimate, so the result is exact).
-      const auto before = [&](int j) {
-        const double tb = t_at(b, j);
-        return tb < e.t || (tb == e.t && b < e.axis);
-      };
+      // The smallest j in [0, caps[b]] whose event comes at or after the exit event (the events
+      // before it are a prefix: t_at is monotone in j; and j = caps[b] comes after, as the exit
+      // is the box's first). Crossings are 1 / |direction_b| apart in t, which gives j up to
+      // rounding; exact comparisons with t_at() then settle it (they decide, not the estimate,
+      // so the result is exact). The last t_at() they evaluate is the axis' next event.
+      const auto before = [&](double tb) { return tb < e.t || (tb == e.t && b < e.axis); };
       int j = static_cast<int>(
-          std::clamp((e.t - t_next[b]) * abs_dir[b], 0.0, static_cast<double>(caps[b])));
-      while (j > 0 && !before(j - 1)) --j;
-      while (j < caps[b] && before(j)) ++j;
-      n[b] = j;
+          std::clamp(std::ceil((e.t - t_next[b]) * abs_dir[b]), 0.0, static_cast<double>(caps[b])));
+      double tj = t_at(b, j);
+      if (before(tj)) {
+        do {
+          ++j;
+          tj = t_at(b, j);
+        } while (j < caps[b] && before(tj));
+      } else {
+        while (j > 0) {
+          const double earlier = t_at(b, j - 1);
+          if (before(earlier)) break;
+          --j;
+          tj = earlier;
+        }
+      }
+      v[b] += j * step[b];
+      boundary[b] += j * step[b];
+      t_next[b] = tj;
     }
-    for (int b = 0; b < 3; ++b)
-      if (n[b] != 0) advance(b, n[b]);
     t = e.t;
     face_axis = e.axis;
   }

@@ -194,7 +194,7 @@ struct RelayFrame::Impl {
   void run(const Ray& ray, Dda& dda, std::uint32_t pixel, bool shadow, double lit,
            std::vector<RayLeg>& out, RenderStats& st) {
     const RenderScene::Impl& s = scene.impl();
-    const SkipWeights sw(s.skip.metric, ray);
+    const SkipWeights sw(s.skip.metric, ray, /*samples_air=*/shadow);
     TraversalCounters& c = shadow ? st.shadow : st.primary;
     ++c.rays;  // a walk here: a ray relayed across parts counts once in each
     const auto on_air = [&](const Dda& d, std::size_t chunk) {

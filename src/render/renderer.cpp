@@ -75,9 +75,10 @@ struct Frame {
   // The soft shadow of a hit: its shadow ray walked through the whole scene.
   double soft_shadow(const RayHit& h, const Ray& ray, TraversalCounters& c) const {
     double lit = 1;
-    const RayHit blocker =
-        traverse(s, s.box, light.shadow_ray(h, ray), SkipMode::kDistance, s.skip, c,
-                 [&](const Dda& d, std::size_t chunk) { lit = light.penumbra(lit, d, chunk); });
+    const RayHit blocker = traverse(
+        s, s.box, light.shadow_ray(h, ray), SkipMode::kDistance, s.skip, c,
+        [&](const Dda& d, std::size_t chunk) { lit = light.penumbra(lit, d, chunk); },
+        /*samples_air=*/true);
     return render_detail::HitShading::shadow_of(blocker.hit, lit);
   }
 

@@ -13,8 +13,13 @@ namespace voxfield::render_detail {
 // Per-ray constants turning a stored skip distance into the caps of a box free of solid voxels.
 struct SkipWeights {
   double w[3] = {0, 0, 0};
+  // Whether an empty chunk is left through the box extended beyond it (leave_empty_chunk).
+  // Walks that sample the air where they stop (soft shadows' penumbra) keep the shorter skips:
+  // fewer stops would sample less of the air and lighten the penumbra.
+  bool beyond_empty_chunks = true;
   SkipWeights() = default;
-  SkipWeights(Metric metric, const Ray& ray) {
+  SkipWeights(Metric metric, const Ray& ray, bool samples_air = false)
+      : beyond_empty_chunks(!samples_air) {
     const double ax = std::abs(ray.direction.x), ay = std::abs(ray.direction.y),
                  az = std::abs(ray.direction.z);
     double norm = 1;
@@ -131,8 +136,13 @@ enum class Step { kContinue, kHit, kMiss };
 
 // A traversal step at voxel dda.v of chunk `chunk` when the chunk holds no solid voxel (no voxel
 // is read): leave the chunk in one step, or farther when the field allows it.
-// Every voxel of the chunk is at least the chunk's smallest value away from geometry, so that
-// bound needs no voxel read.
+// Every voxel of the chunk is at least the chunk's smallest value away from geometry, so the box
+// reaching from v to the chunk's far faces, extended beyond them by the caps that value gives
+// (skip_caps), holds no solid voxel either: a voxel u of it lies within sum c_a (Manhattan),
+// max c_a (Chebyshev) or sqrt(sum c_a^2) (Euclidean) of the chunk's nearest voxel — inside that
+// voxel's air ball, by the same argument as at skip_caps. That box contains the chunk and the box
+// the value gives around v, so it is left no earlier than either. A walk that samples the air
+// (sw.beyond_empty_chunks false) leaves by the farther of those two instead.
 template <class OnAir>
 inline void leave_empty_chunk(const RenderScene::Impl& s, SkipMode mode, const SkipSource& skip,
                               const SkipWeights& sw, Dda& dda, std::size_t chunk,
@@ -141,20 +151,25 @@ inline void leave_empty_chunk(const RenderScene::Impl& s, SkipMode mode, const S
   int caps[3];
   for (int a = 0; a < 3; ++a)
     caps[a] = dda.step[a] > 0 ? cb.end[a] - 1 - dda.v[a] : dda.v[a] - cb.begin[a];
-  const Dda::Exit exit = dda.exit_of(caps);
   on_air(dda, chunk);
   ++c.steps;
   if (mode == SkipMode::kDistance) {
     int dcaps[3];
     skip_caps(skip, sw, skip.chunk_min[chunk], dcaps);
-    const Dda::Exit dexit = dda.exit_of(dcaps);
-    if (dexit.t > exit.t || (dexit.t == exit.t && dexit.axis > exit.axis)) {
-      dda.leave(dcaps, dexit);
-      ++c.distance_skips;
+    if (!sw.beyond_empty_chunks) {
+      const Dda::Exit exit = dda.exit_of(caps), dexit = dda.exit_of(dcaps);
+      if (dexit.t > exit.t || (dexit.t == exit.t && dexit.axis > exit.axis)) {
+        dda.leave(dcaps, dexit);
+        ++c.distance_skips;
+      } else {
+        dda.leave(caps, exit);
+        ++c.chunk_skips;
+      }
       return;
     }
+    for (int a = 0; a < 3; ++a) caps[a] += dcaps[a];
   }
-  dda.leave(caps, exit);
+  dda.leave(caps, dda.exit_of(caps));
   ++c.chunk_skips;
 }
 
@@ -204,14 +219,16 @@ inline Step visit(const RenderScene::Impl& s, const Box3i& box, SkipMode mode,
                     on_air, hit);
 }
 
-// The first solid voxel along the ray inside `box` (a sub-box of the scene's).
+// The first solid voxel along the ray inside `box` (a sub-box of the scene's). samples_air: on_air
+// samples the air where the walk stops (SkipWeights::beyond_empty_chunks).
 template <class OnAir>
 RayHit traverse(const RenderScene::Impl& s, const Box3i& box, const Ray& ray, SkipMode mode,
-                const SkipSource& skip, TraversalCounters& c, OnAir&& on_air) {
+                const SkipSource& skip, TraversalCounters& c, OnAir&& on_air,
+                bool samples_air = false) {
   ++c.rays;
   Dda dda;
   if (!start_in_box(box, ray, dda)) return {};
-  const SkipWeights sw(skip.metric, ray);
+  const SkipWeights sw(skip.metric, ray, samples_air);
   RayHit hit;
   for (;;) {
     switch (visit(s, box, mode, skip, sw, dda, c, on_air, hit)) {

@@ -213,12 +213,22 @@ bool trace(vec3 dir, bool shadow, bool approx) {
       const ivec3 lo = (d_v >> s) << s, hi = lo + ivec3(1 << s);
       ivec3 caps;
       for (int a = 0; a < 3; ++a) caps[a] = d_step[a] > 0 ? hi[a] - 1 - d_v[a] : d_v[a] - lo[a];
-      float et; int ea;
-      exit_of(caps, et, ea);
       const ivec3 dcaps = skip_caps(w, min_of(approx, chunk));
-      float dt; int da;
-      exit_of(dcaps, dt, da);
-      if (dt > et || (dt == et && da > ea)) leave(dcaps, dt, da); else leave(caps, et, ea);
+      float et; int ea;
+      if (shadow) {
+        // Shadow rays sample the air where they stop: the farther of the chunk's box and the
+        // distance's box (leave_empty_chunk in src/render/traverse.h).
+        exit_of(caps, et, ea);
+        float dt; int da;
+        exit_of(dcaps, dt, da);
+        if (dt > et || (dt == et && da > ea)) leave(dcaps, dt, da); else leave(caps, et, ea);
+        continue;
+      }
+      // The chunk's box extended beyond its far faces by the caps of its smallest distance
+      // (leave_empty_chunk says why it holds no solid voxel).
+      caps += dcaps;
+      exit_of(caps, et, ea);
+      leave(caps, et, ea);
       continue;
     }
     const uint cell = cell_of(approx, chunk, d_v);
