@@ -73,9 +73,9 @@ TEST(RenderTraversal, ManhattanCapsGoToTheLargestRemainders) {
 
 // Dda::leave against Dda::step_once: the same voxel, face, t and next events on every axis, bit for
 // bit, for boxes from a single voxel to hundreds of voxels ahead. The rays include the cases where
-// events tie (axis-aligned and diagonal directions from integer and half-integer origins), far
-// origins (t in the thousands, where the skip's estimate of the crossings is off by rounding) and
-// nearly axis-aligned directions.
+// events tie (axis-aligned and diagonal directions from integer and half-integer origins, where the
+// skip's estimate of the crossings is one short), far origins, and nearly axis-aligned directions
+// (large t between crossings).
 TEST(RenderTraversal, ASkipLandsWhereThePlainDdaLeavesTheBox) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> unit(-1, 1), frac(0, 1);

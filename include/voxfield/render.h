@@ -219,8 +219,12 @@ struct TraversalCounters {
   std::int64_t rays = 0;
   std::int64_t steps = 0;        // DDA state changes (a bulk skip counts once)
   std::int64_t voxel_reads = 0;  // voxels whose material / distance was read
-  std::int64_t chunk_skips = 0;  // empty chunks left in one step (with distance skips: and beyond)
-  std::int64_t distance_skips = 0;  // skips of more than one voxel from an air voxel read
+  // Empty chunks left in one step (with distance skips, primary rays leave them farther: through
+  // the chunk's box extended by its smallest distance).
+  std::int64_t chunk_skips = 0;
+  // Skips of more than one voxel by the distance field: from an air voxel read, and for shadow
+  // rays also out of an empty chunk when the distance's box reaches farther than the chunk's.
+  std::int64_t distance_skips = 0;
   void add(const TraversalCounters& o) {
     rays += o.rays;
     steps += o.steps;

@@ -11,7 +11,8 @@
 // Bulk skip ("leave"): given a box that contains the current voxel and extends caps[a] voxels
 // ahead along each axis, the first event that leaves the box is the smallest (t_a(caps[a]), a).
 // Every event before it is processed by the plain DDA too, and on each other axis b they are
-// exactly the j with (t_b(j), b) < (t*, a*) — counted by binary search with the same formula. So a
+// exactly the j with (t_b(j), b) < (t*, a*) — counted from an estimate that exact comparisons with
+// the same formula settle. So a
 // skip lands on precisely the voxel, face and t the plain DDA reaches when it first leaves the box.
 // It is safe (cannot pass through geometry) whenever the box holds no solid voxel: the chunk
 // table knows empty chunks, and a distance field bounds a box around every air voxel (why, per
