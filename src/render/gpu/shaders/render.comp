@@ -121,23 +121,30 @@ void exit_of(ivec3 caps, out float et, out int ea) {
   }
 }
 
-bool before(int b, int j, float et, int ea) {
-  const float tb = t_at(b, j);
-  return tb < et || (tb == et && b < ea);
-}
+bool before(int b, float tb, float et, int ea) { return tb < et || (tb == et && b < ea); }
 
+// Dda::leave (src/render/dda.h): the crossings before the exit counted from a ceil estimate that
+// exact comparisons settle, the last crossing time compared kept as the axis' next event.
 void leave(ivec3 caps, float et, int ea) {
-  ivec3 n = ivec3(0);
   for (int b = 0; b < 3; ++b) {
     if (d_step[b] == 0) continue;
-    if (b == ea) { n[b] = caps[b] + 1; continue; }
-    int j = int(clamp((et - d_tnext[b]) * d_abs[b], 0.0, float(caps[b])));
-    while (j > 0 && !before(b, j - 1, et, ea)) --j;
-    while (j < caps[b] && before(b, j, et, ea)) ++j;
-    n[b] = j;
+    if (b == ea) { advance(b, caps[b] + 1); continue; }
+    int j = int(clamp(ceil((et - d_tnext[b]) * d_abs[b]), 0.0, float(caps[b])));
+    float tj = t_at(b, j);
+    if (before(b, tj, et, ea)) {
+      do { ++j; tj = t_at(b, j); } while (j < caps[b] && before(b, tj, et, ea));
+    } else {
+      while (j > 0) {
+        const float earlier = t_at(b, j - 1);
+        if (before(b, earlier, et, ea)) break;
+        --j;
+        tj = earlier;
+      }
+    }
+    d_v[b] += j * d_step[b];
+    d_boundary[b] += j * d_step[b];
+    d_tnext[b] = tj;
   }
-  for (int b = 0; b < 3; ++b)
-    if (n[b] != 0) advance(b, n[b]);
   d_t = et;
   d_face = ea;
 }
