@@ -149,10 +149,29 @@ struct RenderParams {
   float light_inv_scale;
   uint flags;              // VF_RENDER_* bits
   int slice_z;             // distance view: the cut plane (voxels above it are hidden)
-  float heat_max;          // distance view: the distance at the top of the heat ramp
+  uint heat_top;           // distance view: the largest stored skip distance on the cut (at
+                           // least 1); the heat ramp's top is max(1, heat_top * skip_inv_scale)
   float approx_inv_scale;  // error view: stored approximate value * this = voxels
   float footprint_scale;   // Camera::Projector::footprint_scale
   uint pad2;
+};
+
+// Push constants of the passes that pack a device-resident scene's cells from fields computed on
+// the device (src/render/gpu/shaders/scene_pack.comp): 64 bytes. The fields are u8, over the
+// render box, with the layout Header describes; the chunk table is the render box's.
+VF_CONST(uint, VF_PACK_SUMMARISE, 0u);  // per listed chunk: distance and light range, solids
+VF_CONST(uint, VF_PACK_WRITE, 1u);      // the listed chunks' cells into their arena slots
+VF_CONST(uint, VF_PACK_HEAT, 2u);       // the distance view's RenderParams::heat_top
+struct ScenePackParams {
+  ivec4 first_chunk;     // chunk coordinate of chunk-table entry 0; w = chunk shift
+  ivec4 chunk_dims;      // chunks per axis; w = voxels per chunk
+  uint mode;             // VF_PACK_*
+  uint items;            // listed chunks (summarise, write)
+  uint has_light;        // 1: a lighting field is bound and packed
+  int slice_z;           // heat: the cut
+  uint skip_background;  // the fields' stored values outside their domain
+  uint light_background;
+  uint pad0, pad1;
 };
 
 // ---- vector fields (src/vectors/gpu)
@@ -252,6 +271,7 @@ static_assert(sizeof(PassParams) == 96, "push-constant size of PassParams");
 static_assert(sizeof(JfaParams) == 32, "push-constant size of JfaParams");
 static_assert(sizeof(FimParams) == 64, "push-constant size of FimParams");
 static_assert(sizeof(RenderParams) == 192, "std430 size of RenderParams");
+static_assert(sizeof(ScenePackParams) == 64, "push-constant size of ScenePackParams");
 static_assert(sizeof(VectorParams) == 96, "push-constant size of VectorParams");
 static_assert(sizeof(VectorViewParams) == 208, "std430 size of VectorViewParams");
 }  // namespace voxfield::gpu::layout

@@ -38,6 +38,22 @@ DistanceField compute_distance_field(Context& context, const World& world,
                                      std::vector<PassTiming>* timings = nullptr);
 
 class FieldEngine;
+class Buffer;  // a device buffer of the compute layer (src/gpu/vulkan_context.h)
+
+// Where a DynamicField's data lies on the device, for the GPU halves of voxfield's other modules
+// (the render module's DeviceRenderScene packs its cells from them in place): the layout header
+// (shaders/layout.h: Header), the world's page table and brick pool, and the stored values, rows
+// of Header::field_size.w values padded to whole words. Valid until the next update() or
+// rebuild(), which may move the brick pool to a larger buffer.
+struct ResidentField {
+  Buffer* header = nullptr;
+  Buffer* pages = nullptr;
+  Buffer* bricks = nullptr;
+  Buffer* values = nullptr;
+  Box3i domain;
+  DistanceEncoding encoding;
+  std::uint32_t background_bits = 0;  // the stored value of voxels outside the domain
+};
 
 // A distance field that lives on the GPU and follows its world through edits, like
 // DynamicDistanceField: update() uploads the chunks that changed (only those, through a reusable
@@ -66,6 +82,9 @@ class DynamicField {
   Context& context() { return *context_; }
   // Timestamps of the last build or update's passes (empty without timestamp support).
   const std::vector<PassTiming>& last_timings() const { return timings_; }
+  // Bytes the last build or update copied to the device (header, page entries, bricks).
+  std::size_t last_upload_bytes() const;
+  ResidentField resident();
 
  private:
   std::shared_ptr<Context> context_;

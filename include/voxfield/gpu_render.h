@@ -51,6 +51,58 @@ class SceneRenderer {
   std::unique_ptr<Impl> impl_;
 };
 
+// A DynamicRenderScene that lives on the device: the skip and lighting fields are computed there
+// (gpu::DynamicField: exact, the CPU's values bit for bit) and the ray marcher's cells are packed
+// from them there, so the fields are drawn where they were computed, without a trip through the
+// host. After edits of the world, update() uploads the chunks that changed, updates both fields
+// incrementally and re-packs the chunks they reached, the chunks DynamicRenderScene re-reads.
+// What comes back to the host: 8 bytes per packed chunk (its smallest and largest stored distance
+// and lighting value, and whether it holds a solid voxel), from which the host decides which
+// chunks are stored voxel by voxel, as RenderScene decides. Frames are SceneRenderer's frames of
+// a DynamicRenderScene of the same world and options, pixel for pixel. Not thread-safe; one frame
+// at a time.
+class DeviceRenderScene {
+ public:
+  // Binds to `world` (bounded: its bounds are the render box; it must outlive the scene) and
+  // builds both fields and the cells. Throws InvalidArgument as DynamicRenderScene and
+  // gpu::DynamicField do (unit spacing, u8 fields within the device's storage-buffer range),
+  // GpuUnavailable on device errors.
+  DeviceRenderScene(std::shared_ptr<Context> context, const World& world,
+                    RenderSceneOptions options = DynamicRenderScene::default_options());
+  ~DeviceRenderScene();
+  DeviceRenderScene(const DeviceRenderScene&) = delete;
+  DeviceRenderScene& operator=(const DeviceRenderScene&) = delete;
+
+  // Hardware-independent counters of a build or an update, and its times (on lavapipe, CPU
+  // emulation).
+  struct UpdateStats {
+    double field_ms = 0;  // both fields on the device, submits and fence waits included
+    double scene_ms = 0;  // summarising and packing the chunks they reached
+    std::int64_t voxels_recomputed = 0;
+    std::size_t chunks_repacked = 0;
+    std::size_t bytes_up = 0;    // host to device: changed world chunks, chunk lists, entries
+    std::size_t bytes_down = 0;  // device to host: the packed chunks' summaries
+    int submits = 0;             // each with one fence wait
+  };
+  // Brings the fields and the cells up to date after the edits recorded in `dirty` (tracking
+  // every material change, DirtyRegions::Track::kAnyChange). The caller clears `dirty` afterwards.
+  // The fields keep DynamicField's guarantees; after a throw, build the scene again.
+  UpdateStats update(const DirtyRegions& dirty);
+  const UpdateStats& build_stats() const;
+
+  // A frame, read back (as SceneRenderer::render).
+  Image render(const Camera& camera, const RenderOptions& options, RenderStats* stats = nullptr,
+               std::vector<PassTiming>* timings = nullptr);
+  const Box3i& box() const;
+  Context& context();
+
+  struct Impl;
+  Impl& impl() { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
 // ---- CSG models ---------------------------------------------------------------------------------
 
 struct CsgGpuOptions {

@@ -23,5 +23,9 @@ namespace voxfield::gpu {
 // Throws InvalidArgument as SceneRenderer::render does.
 VkBuffer record_render(SceneRenderer& renderer, VkCommandBuffer cmd, const Camera& camera,
                        const RenderOptions& options, PixelOrder order);
+// The same for a scene packed on the device (DeviceRenderScene): update() may run between frames,
+// not while one executes (it submits and waits on the adopted queue).
+VkBuffer record_render(DeviceRenderScene& scene, VkCommandBuffer cmd, const Camera& camera,
+                       const RenderOptions& options, PixelOrder order);
 
 }  // namespace voxfield::gpu

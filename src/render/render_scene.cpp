@@ -264,22 +264,42 @@ int RenderScene::Impl::slice_z(const RenderOptions& o) const {
   return z;
 }
 
-double RenderScene::Impl::heat_max(int z) const {
-  int top = 1;
+std::uint32_t RenderScene::Impl::heat_top(int z) const {
+  std::uint32_t top = 1;
   for (int y = box.begin.y; y < box.end.y; ++y)
     for (int x = box.begin.x; x < box.end.x; ++x) {
       const Vec3i v{x, y, z};
-      top = std::max<int>(top, skip.distance(table.chunk_index(v), table.brick_index(v)));
+      top = std::max<std::uint32_t>(top, skip.distance(table.chunk_index(v), table.brick_index(v)));
     }
-  return std::max(1.0, top * skip.inv_scale);
+  return top;
+}
+
+double RenderScene::Impl::heat_max(int z) const {
+  return std::max(1.0, heat_top(z) * skip.inv_scale);
 }
 
 SkipSource RenderScene::Impl::approximation(Algorithm algorithm) const {
-  return make_skip_source(
-      compute_distance_field(*world, skip_options, approximation_options(algorithm)));
+  return render_detail::approximation(table, *world, skip_options, algorithm);
 }
 
 AlgorithmOptions RenderScene::Impl::approximation_options(Algorithm algorithm) const {
+  return render_detail::approximation_options(box, algorithm);
+}
+
+SkipSource RenderScene::Impl::make_skip_source(const DistanceField& field) const {
+  return render_detail::make_skip_source(table, *world, field);
+}
+
+namespace render_detail {
+
+SkipSource approximation(const ChunkTable& table, const World& world,
+                         const DistanceOptions& skip_options, Algorithm algorithm) {
+  return make_skip_source(
+      table, world,
+      compute_distance_field(world, skip_options, approximation_options(table.box(), algorithm)));
+}
+
+AlgorithmOptions approximation_options(const Box3i& box, Algorithm algorithm) {
   AlgorithmOptions ao;
   ao.algorithm = algorithm;
   if (algorithm == Algorithm::kLod) {
@@ -293,24 +313,27 @@ AlgorithmOptions RenderScene::Impl::approximation_options(Algorithm algorithm) c
   return ao;
 }
 
-SkipSource RenderScene::Impl::make_skip_source(const DistanceField& field) const {
+SkipSource make_skip_source(const ChunkTable& table, const World& world,
+                            const DistanceField& field) {
   SkipSource src;
   src.metric = field.options.metric;
   src.inv_scale = 1.0 / field.encoding.scale;
   const auto& grid = std::get<Grid<std::uint8_t>>(field.values);
-  src.cells = empty_bricks<std::uint16_t>(table, grid, &world->voxels);
+  src.cells = empty_bricks<std::uint16_t>(table, grid, &world.voxels);
   const std::size_t n = table.chunk_count();
   src.chunk_min.assign(n, 0);
-  for (std::size_t i = 0; i < n; ++i) place_chunk(src.cells, table, i, grid, &world->voxels);
+  for (std::size_t i = 0; i < n; ++i) place_chunk(src.cells, table, i, grid, &world.voxels);
   parallel_for(n, 4, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       if (src.cells.slot[i] != BrickedChunks<std::uint16_t>::kUniform)
-        copy_chunk(src.cells, table, i, grid, &world->voxels);
+        copy_chunk(src.cells, table, i, grid, &world.voxels);
       src.chunk_min[i] = chunk_min(grid, table.chunk_coord(i), src.cells.chunk_volume);
     }
   });
   return src;
 }
+
+}  // namespace render_detail
 
 void RenderScene::Impl::build(const World& w, const DistanceField& skip_field,
                               const DistanceField* light_field) {

@@ -98,7 +98,9 @@ struct RenderScene::Impl {
   // InvalidArgument outside it) and the largest distance on it, which the heat map is scaled by.
   int slice_z(const RenderOptions& o) const;
   double heat_max(int slice_z) const;
-  // A skip source over this scene's table from another field.
+  // The largest stored skip distance on the cut, at least 1 (heat_max = that * skip.inv_scale).
+  std::uint32_t heat_top(int slice_z) const;
+  // A skip source over this scene's table from another field (render_detail::make_skip_source).
   SkipSource make_skip_source(const DistanceField& field) const;
   // The error view's approximation: the skip field's options computed by `algorithm` (lod: FIM
   // in the middle of the box; approximation_options), as a skip source. The GPU renderer computes
@@ -120,6 +122,15 @@ namespace render_detail {
 // What a frame checks of its options before drawing (InvalidArgument): the image size, the tile
 // size, a lighting field (`has_light`) for ambient occlusion and shadows, the fog, the sun.
 void check_frame_options(bool has_light, const RenderOptions& o);
+// A skip source over `table` from an unsigned u8 field of `world` (cells: the field's stored
+// value, the material above it), as RenderScene makes its own.
+SkipSource make_skip_source(const ChunkTable& table, const World& world,
+                            const DistanceField& field);
+// The error view's algorithm options for a render box (lod: FIM in its middle).
+AlgorithmOptions approximation_options(const Box3i& box, Algorithm algorithm);
+// The error view's approximation of `world`'s skip field (`skip_options`), computed on the CPU.
+SkipSource approximation(const ChunkTable& table, const World& world,
+                         const DistanceOptions& skip_options, Algorithm algorithm);
 }  // namespace render_detail
 
 // Options of the u8 Euclidean lighting field (throws InvalidArgument for a clamp out of (0, 63]).

@@ -154,6 +154,9 @@ class FieldEngine {
                   L::VF_UNIFORM);  // all air until uploaded
     header_buf_ = Buffer(ctx, sizeof header_, kStorage, false);
     pages_buf_ = Buffer(ctx, pages_.size() * 4, kStorage, false);
+    // A pool of one brick to begin with: a world of uniform chunks alone still binds one.
+    bricks_buf_ = Buffer(ctx, chunk_bytes_, kStorage, false);
+    slot_capacity_ = 1;
     field_buf_ = Buffer(ctx, field_bytes_, kStorage, false);
     // Nearest sites: 8 bytes per voxel of the domain (three int16 offsets, padded).
     site_bytes_ = options.nearest_sites ? static_cast<VkDeviceSize>(plan_.domain.volume()) * 8 : 0;
@@ -180,6 +183,7 @@ class FieldEngine {
     Staging up;
     Uploads uploads;
     stage(chunks, regions, up, uploads);
+    upload_bytes_ = up.bytes.size();
     Buffer& upload = ctx_.upload_buffer(std::max<VkDeviceSize>(up.bytes.size(), 16));
     if (!up.bytes.empty()) std::memcpy(upload.mapped(), up.bytes.data(), up.bytes.size());
     Buffer* readback = download ? &ctx_.readback_buffer(field_bytes_ + site_bytes_) : nullptr;
@@ -189,6 +193,12 @@ class FieldEngine {
     if (readback) record_readback(rec, *readback);
     rec.submit();
     if (timings) *timings = rec.timings();
+  }
+
+  std::size_t upload_bytes() const { return upload_bytes_; }
+  ResidentField resident() {
+    return {&header_buf_, &pages_buf_,    &bricks_buf_,    &field_buf_,
+            plan_.domain, plan_.encoding, header_.none_pos};
   }
 
   // The field as last read back.
@@ -463,6 +473,7 @@ class FieldEngine {
   Vec3i chunk_origin_{0, 0, 0}, chunk_dims_{0, 0, 0};
   std::size_t chunk_bytes_ = 0;
   VkDeviceSize field_bytes_ = 0, work_bytes_ = 0, site_bytes_ = 0;
+  std::size_t upload_bytes_ = 0;      // staged by the last run
   std::vector<std::uint32_t> pages_;  // the host's copy of the page table
   std::vector<std::uint32_t> free_slots_;
   std::uint32_t used_slots_ = 0, slot_capacity_ = 0;
@@ -537,6 +548,14 @@ DynamicDistanceField::UpdateStats DynamicField::update(const DirtyRegions& dirty
     ++stats.regions;
   }
   return stats;
+}
+
+std::size_t DynamicField::last_upload_bytes() const {
+  return engine_->upload_bytes();
+}
+
+ResidentField DynamicField::resident() {
+  return engine_->resident();
 }
 
 DistanceField DynamicField::download() {

@@ -36,5 +36,11 @@ const DistanceOptions& DynamicField::options() const {
 std::size_t DynamicField::field_bytes() const {
   built_without_vulkan();
 }
+std::size_t DynamicField::last_upload_bytes() const {
+  built_without_vulkan();
+}
+ResidentField DynamicField::resident() {
+  built_without_vulkan();
+}
 
 }  // namespace voxfield::gpu

@@ -26,6 +26,28 @@ Context& SceneRenderer::context() {
   built_without_vulkan();
 }
 
+struct DeviceRenderScene::Impl {};
+DeviceRenderScene::DeviceRenderScene(std::shared_ptr<Context>, const World&, RenderSceneOptions) {
+  built_without_vulkan();
+}
+DeviceRenderScene::~DeviceRenderScene() = default;
+DeviceRenderScene::UpdateStats DeviceRenderScene::update(const DirtyRegions&) {
+  built_without_vulkan();
+}
+const DeviceRenderScene::UpdateStats& DeviceRenderScene::build_stats() const {
+  built_without_vulkan();
+}
+Image DeviceRenderScene::render(const Camera&, const RenderOptions&, RenderStats*,
+                                std::vector<PassTiming>*) {
+  built_without_vulkan();
+}
+const Box3i& DeviceRenderScene::box() const {
+  built_without_vulkan();
+}
+Context& DeviceRenderScene::context() {
+  built_without_vulkan();
+}
+
 Image render_csg(Context&, const csg::Model&, const CsgRenderOptions&, CsgRenderStats*,
                  const CsgGpuOptions&, CsgGpuStats*) {
   built_without_vulkan();

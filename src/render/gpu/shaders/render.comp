@@ -355,7 +355,7 @@ void main() {
       const uint cell = skip_cell(chunk_index(d_v), d_v);
       if ((cell >> 8) == 0u) {
         const float distance = float(cell & 0xFFu) * rp.skip_inv_scale;
-        uvec3 b = heat(distance / rp.heat_max);
+        uvec3 b = heat(distance / max(1.0, float(rp.heat_top) * rp.skip_inv_scale));
         if (int(distance) % 8 == 0) b = b * 3u / 4u;
         pixels[i] = pack_bytes(b);
         return;

@@ -1,0 +1,242 @@
+// Scenes whose fields are computed, kept and packed on the device (gpu::DeviceRenderScene) against
+// the host's DynamicRenderScene drawn by a SceneRenderer: the same shader reading the same values,
+// so every frame must be equal pixel for pixel, through every view and a stream of edits — and
+// only the world's changed chunks go up, only the packed chunks' summaries come back
+// (voxfield_gpu_tests; validation layer on, synchronisation validation included).
+#include <gtest/gtest.h>
+
+#include "gpu_suite.h"
+#include "render/gpu/device_scene.h"  // its buffers, read back to compare cell by cell
+#include "render/scene_impl.h"
+#include "voxfield/edit.h"
+#include "voxfield/gpu_render.h"
+#include "voxfield/gpu_render_vulkan.h"
+
+using namespace voxfield;
+using test::gpu_tests_wanted;
+using test::random_world;
+using test::validated_context;
+
+namespace {
+
+// The frames compared: the shaded view with ambient occlusion and soft shadows from two cameras,
+// the chunk view, the distance view on three cuts, and the error view; and from straight above.
+struct Views {
+  std::vector<Camera> cameras;
+  std::vector<RenderOptions> options;
+};
+
+Views views_of(const Box3i& box, bool lighting) {
+  Views v;
+  v.cameras = {Camera::framing(box, 1.5)};
+  Camera low = Camera::framing(box, 1.2);
+  low.eye = {box.begin.x - 9.0, box.begin.y - 7.0, box.end.z * 0.6};
+  v.cameras.push_back(low);
+  v.cameras.push_back(Camera::top(box, 80.0 / 56.0));  // the distance view's every column
+  RenderOptions o;
+  o.width = 80;
+  o.height = 56;
+  o.ambient_occlusion = lighting;
+  o.soft_shadows = lighting;
+  v.options.push_back(o);
+  RenderOptions chunks = o;
+  chunks.view = RenderView::kChunks;
+  v.options.push_back(chunks);
+  for (int z : {box.begin.z + 2, (box.begin.z + box.end.z) / 2, box.end.z - 1}) {
+    RenderOptions d = o;
+    d.view = RenderView::kDistance;
+    d.slice_z = z;
+    v.options.push_back(d);
+  }
+  RenderOptions error = o;
+  error.view = RenderView::kError;
+  error.error_algorithm = Algorithm::kJfaSeed;
+  v.options.push_back(error);
+  return v;
+}
+
+void expect_same_frames(gpu::DeviceRenderScene& device, gpu::SceneRenderer& host,
+                        const Views& views, const std::string& what) {
+  for (std::size_t c = 0; c < views.cameras.size(); ++c)
+    for (const RenderOptions& o : views.options)
+      EXPECT_EQ(device.render(views.cameras[c], o).rgb, host.render(views.cameras[c], o).rgb)
+          << what << ", camera " << c << ", view " << static_cast<int>(o.view) << ", slice "
+          << o.slice_z.value_or(-1);
+}
+
+// Every chunk's table entry and every voxel's cell and lighting value on the device equal the
+// host scene's: the values a frame could read, and those it reads nowhere (the voxels of a chunk
+// outside the box hold the fields' background on both).
+void expect_same_cells(gpu::DeviceRenderScene& device, const RenderScene& host_scene,
+                       const std::string& what) {
+  gpu::DeviceRenderScene::Impl& d = device.impl();
+  const RenderScene::Impl& h = host_scene.impl();
+  const std::size_t n = h.table.chunk_count();
+  ASSERT_EQ(d.table.chunk_count(), n);
+  const auto words = [](const std::vector<std::uint8_t>& bytes) {
+    std::vector<std::uint32_t> w(bytes.size() / 4);
+    std::memcpy(w.data(), bytes.data(), w.size() * 4);
+    return w;
+  };
+  const std::vector<std::uint32_t> info = words(d.read_back(d.info_buf, n * 16));
+  const std::vector<std::uint8_t> skip =
+      d.read_back(d.skip_arena, std::size_t{d.skip_slots.used} * d.chunk_volume * 2);
+  const std::vector<std::uint8_t> light =
+      h.has_light ? d.read_back(d.light_arena, std::size_t{d.light_slots.used} * d.chunk_volume)
+                  : std::vector<std::uint8_t>();
+  int bad = 0;
+  for (std::size_t i = 0; i < n && bad < 5; ++i) {
+    const std::uint32_t* e = &info[4 * i];
+    const std::string chunk = what + ", chunk " + to_string(h.table.chunk_coord(i));
+    EXPECT_EQ((e[1] >> 16) & 0xFF, h.skip.chunk_min[i]) << chunk;
+    EXPECT_EQ((e[1] >> 24) & 1, h.empty_chunk[i]) << chunk;
+    EXPECT_EQ((e[1] >> 25) & 1, h.dense_material[i]) << chunk;
+    for (std::uint32_t k = 0; k < d.chunk_volume; ++k) {
+      std::uint16_t cell = static_cast<std::uint16_t>(e[1] & 0xFFFF);
+      if (e[0] != gpu::layout::VF_UNIFORM)
+        std::memcpy(&cell, &skip[(std::size_t{e[0]} * d.chunk_volume + k) * 2], 2);
+      if (cell != h.skip.read(i, k)) {
+        ADD_FAILURE() << chunk << ", brick index " << k << ": cell " << cell << " on the device, "
+                      << h.skip.read(i, k) << " on the host";
+        ++bad;
+        break;
+      }
+      if (!h.has_light) continue;
+      const std::uint8_t l = e[2] == gpu::layout::VF_UNIFORM
+                                 ? static_cast<std::uint8_t>(e[3])
+                                 : light[std::size_t{e[2]} * d.chunk_volume + k];
+      if (l != h.light.read(i, k)) {
+        ADD_FAILURE() << chunk << ", brick index " << k << ": lighting " << int{l}
+                      << " on the device, " << int{h.light.read(i, k)} << " on the host";
+        ++bad;
+        break;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+TEST(Gpu, DeviceScenesDrawWhatHostScenesDrawThroughEdits) {
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = validated_context();
+  ctx->clear_validation_messages();
+  struct Case {
+    Vec3i size;
+    Metric metric;
+    double clamp;
+    bool lighting;
+  };
+  // A box that ends inside chunks (the fields' background fills them), each skip metric, and a
+  // scene without a lighting field.
+  for (const Case& k : {Case{{61, 45, 30}, Metric::kManhattan, 10, true},
+                        Case{{48, 40, 24}, Metric::kEuclidean, 6, true},
+                        Case{{40, 32, 24}, Metric::kChebyshev, 0, false}}) {
+    const std::string what = std::string(metric_name(k.metric)) + " " + to_string(k.size);
+    World w = random_world(k.size, 8, 0.004, 17);
+    w.voxels.fill(Box3i{{0, 0, 0}, {k.size.x, k.size.y, 3}}, 120);
+    RenderSceneOptions so = DynamicRenderScene::default_options();
+    so.skip_metric = k.metric;
+    so.skip_max_distance_vox = k.clamp;
+    so.lighting_field = k.lighting;
+    so.lighting_max_distance_vox = 6;
+    DynamicRenderScene live(w, so);
+    gpu::SceneRenderer host(ctx);
+    host.sync(live.scene());
+    gpu::DeviceRenderScene device(ctx, w, so);
+    const gpu::DeviceRenderScene::UpdateStats& built = device.build_stats();
+    // Every chunk of the box is packed once.
+    EXPECT_EQ(
+        built.chunks_repacked,
+        static_cast<std::size_t>((k.size.x + 7) / 8 * ((k.size.y + 7) / 8) * ((k.size.z + 7) / 8)))
+        << what;
+    EXPECT_EQ(built.bytes_down, built.chunks_repacked * 8) << what;
+    const Views views = views_of(live.scene().box(), k.lighting);
+    expect_same_cells(device, live.scene(), what + ", built");
+    expect_same_frames(device, host, views, what + ", built");
+
+    std::mt19937 rng(5);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
+    for (int batch = 0; batch < 4; ++batch) {
+      for (int e = 0; e < 3; ++e) {
+        const EditOp op = uni(0, 2) == 0 ? EditOp::kCarve
+                          : uni(0, 1)    ? EditOp::kPlace
+                                         : EditOp::kPaint;
+        apply_edit(w,
+                   {op,
+                    SphereBrush{{uni(0, k.size.x - 1) * 1.0, uni(0, k.size.y - 1) * 1.0,
+                                 uni(0, k.size.z - 1) * 1.0},
+                                uni(1, 5) * 1.0},
+                    static_cast<std::uint8_t>(uni(1, 255))},
+                   &dirty);
+      }
+      if (batch == 2) w.palette[120] = Rgba{200, 30, 40, 255};  // a palette edit travels too
+      const std::int64_t world_chunks = static_cast<std::int64_t>(dirty.boxes().size());
+      live.update(dirty);
+      host.sync(live.scene());
+      const gpu::Counters before = ctx->counters();
+      const gpu::DeviceRenderScene::UpdateStats st = device.update(dirty);
+      const gpu::Counters after = ctx->counters();
+      dirty.clear();
+      const std::string at = what + ", batch " + std::to_string(batch);
+      // Down: only the summaries, 8 bytes per packed chunk — no field value.
+      EXPECT_EQ(after.bytes_downloaded - before.bytes_downloaded,
+                static_cast<std::int64_t>(st.bytes_down))
+          << at;
+      EXPECT_EQ(st.bytes_down, st.chunks_repacked * 8) << at;
+      // Up: the changed world chunks once per field (a chunk's bytes and its page entry), the
+      // chunk lists (16 bytes an item, twice), the table entries and the palette.
+      const std::int64_t fields = k.lighting ? 2 : 1;
+      EXPECT_LE(after.bytes_uploaded - before.bytes_uploaded,
+                fields * world_chunks * (512 + 16 + 16) +
+                    static_cast<std::int64_t>(st.chunks_repacked) * (16 + 16 + 16) + 256 * 16 +
+                    fields * 16)
+          << at;
+      EXPECT_EQ(after.submits - before.submits, st.submits) << at;
+      EXPECT_EQ(st.submits, fields + 2) << at;
+      expect_same_cells(device, live.scene(), at);
+      expect_same_frames(device, host, views, at);
+    }
+  }
+  const auto messages = ctx->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
+}
+
+TEST(Gpu, DeviceScenesOfUniformWorldsAndBadInput) {
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = validated_context();
+  ctx->clear_validation_messages();
+  // No chunk stored voxel by voxel: an empty world, then a world of whole-chunk blocks. The
+  // device's brick pool is empty; the frames still equal the host's.
+  World w(8, Box3i::from_size({32, 32, 16}));
+  RenderSceneOptions so = DynamicRenderScene::default_options();
+  so.skip_max_distance_vox = 12;
+  so.lighting_max_distance_vox = 5;
+  for (int round = 0; round < 2; ++round) {
+    if (round == 1) w.voxels.fill(Box3i{{8, 8, 0}, {24, 16, 8}}, 9);
+    DynamicRenderScene live(w, so);
+    gpu::SceneRenderer host(ctx);
+    host.sync(live.scene());
+    gpu::DeviceRenderScene device(ctx, w, so);
+    const Views views = views_of(live.scene().box(), true);
+    expect_same_cells(device, live.scene(), "round " + std::to_string(round));
+    expect_same_frames(device, host, views, "round " + std::to_string(round));
+  }
+  World unbounded(8);
+  unbounded.voxels.set({1, 1, 1}, 3);
+  EXPECT_THROW(gpu::DeviceRenderScene(ctx, unbounded), InvalidArgument);
+  EXPECT_THROW(gpu::DeviceRenderScene(nullptr, w), InvalidArgument);
+  RenderSceneOptions far = so;
+  far.skip_max_distance_vox = 300;  // beyond u8's reach
+  EXPECT_THROW(gpu::DeviceRenderScene(ctx, w, far), InvalidArgument);
+  gpu::DeviceRenderScene device(ctx, w, so);
+  RenderOptions bad;
+  bad.view = RenderView::kDistance;
+  bad.slice_z = 99;
+  EXPECT_THROW(device.render(Camera::framing(device.box(), 1.5), bad), InvalidArgument);
+  const auto messages = ctx->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
+}
