@@ -16,6 +16,7 @@
 #include <random>
 
 #include "gpu_suite.h"
+#include "shaders/layout.h"
 #include "voxfield/edit.h"
 #include "voxfield/gpu_distance.h"
 #include "voxfield/gpu_vulkan.h"
@@ -271,6 +272,57 @@ TEST(Gpu, BrickPoolReusesAndGrowsCorrectly) {
   EXPECT_EQ(ctx->counters().submits - before.submits, 1);
   expect_same_field(live.download(), compute_distance_field(w, o),
                     "after freeing one slot and filling 48 chunks");
+  const auto messages = ctx->validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
+}
+
+TEST(Gpu, FieldsShareOneResidentWorld) {
+  // A second field on the first's resident world: the device holds the world once, the second
+  // field's updates upload nothing, and both fields stay equal to the CPU's through edits that
+  // make the shared brick pool grow (the second field then reads the moved pool).
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = validated_context();
+  ctx->clear_validation_messages();
+  World w(8, Box3i::from_size({48, 40, 24}));
+  w.voxels.set({5, 5, 5}, 4);
+  DistanceOptions a;
+  a.metric = Metric::kManhattan;
+  a.max_distance = 6;
+  a.storage = Storage::kU8;
+  DistanceOptions b;
+  b.metric = Metric::kEuclidean;
+  b.signed_distance = true;
+  b.storage = Storage::kF32;
+  gpu::DynamicField owner(ctx, w, a);
+  const gpu::Counters before_build = ctx->counters();
+  gpu::DynamicField rider(owner, b);
+  // Its header only: no page entry, no brick.
+  EXPECT_EQ(ctx->counters().bytes_uploaded - before_build.bytes_uploaded,
+            static_cast<std::int64_t>(sizeof(gpu::layout::Header)));
+  EXPECT_EQ(rider.resident().bricks, owner.resident().bricks);
+  DirtyRegions dirty(8, DirtyRegions::Track::kOccupancy);
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> px(0, 47), py(0, 39), pz(0, 23), pr(2, 6);
+  for (int i = 0; i < 8; ++i) {
+    apply_edit(w,
+               {i % 3 == 2 ? EditOp::kCarve : EditOp::kPlace,
+                SphereBrush{{double(px(rng)), double(py(rng)), double(pz(rng))}, double(pr(rng))},
+                static_cast<std::uint8_t>(1 + i)},
+               &dirty);
+    owner.update(dirty);
+    const gpu::Counters before = ctx->counters();
+    rider.update(dirty);
+    EXPECT_EQ(ctx->counters().bytes_uploaded, before.bytes_uploaded) << "edit " << i;
+    dirty.clear();
+    expect_same_field(owner.download(), compute_distance_field(w, a),
+                      "owner after edit " + std::to_string(i));
+    expect_same_field(rider.download(), compute_distance_field(w, b),
+                      "rider after edit " + std::to_string(i));
+  }
+  DistanceOptions elsewhere = a;
+  elsewhere.domain = Box3i{{0, 0, 0}, {16, 16, 16}};  // other chunks than the owner's
+  EXPECT_THROW(gpu::DynamicField(owner, elsewhere), InvalidArgument);
   const auto messages = ctx->validation_messages();
   EXPECT_TRUE(messages.empty()) << messages.size()
                                 << " validation messages, first: " << messages.front();

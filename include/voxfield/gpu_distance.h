@@ -65,6 +65,11 @@ class DynamicField {
   // or options.domain) and builds the field on the GPU. Throws InvalidArgument as
   // compute_distance_field(Context&...) does, GpuUnavailable on device errors.
   DynamicField(std::shared_ptr<Context> context, const World& world, DistanceOptions options);
+  // Another field of `owner`'s world on owner's resident world — its page table and brick pool,
+  // so the device holds one copy of the world however many fields derive from it. The domain
+  // (default: owner's) must touch the same chunks as owner's (InvalidArgument otherwise).
+  // update() of this field uploads nothing: call owner.update() with the same edits first.
+  DynamicField(DynamicField& owner, DistanceOptions options);
   ~DynamicField();
   DynamicField(const DynamicField&) = delete;
   DynamicField& operator=(const DynamicField&) = delete;

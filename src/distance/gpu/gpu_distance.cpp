@@ -20,6 +20,7 @@
 #include "../incremental/update_regions.h"
 #include "distance_shaders.h"
 #include "gpu/recorder.h"
+#include "resident_world.h"
 #include "shaders/layout.h"
 #include "voxfield/gpu_distance.h"
 
@@ -61,17 +62,6 @@ std::uint32_t clamp_cost(const detail::FieldPlan& plan) {
   return static_cast<std::uint32_t>(std::min<double>(c, L::VF_INF - 1.0));
 }
 
-// Bytes for the upload buffer, each piece 16-byte aligned.
-struct Staging {
-  std::vector<std::uint8_t> bytes;
-  VkDeviceSize add(const void* data, std::size_t n) {
-    const VkDeviceSize offset = (bytes.size() + 15) / 16 * 16;
-    bytes.resize(offset + n);
-    if (n > 0) std::memcpy(bytes.data() + offset, data, n);
-    return offset;
-  }
-};
-
 // Values of T per word of the resident field (u8: 4, u16: 2, f32: 1).
 std::size_t lanes_of(Storage s) {
   return s == Storage::kU8 ? 4 : s == Storage::kU16 ? 2 : 1;
@@ -110,7 +100,10 @@ DistanceField build_field(const World& world, const DistanceOptions& options,
 
 class FieldEngine {
  public:
-  FieldEngine(Context::Impl& ctx, const World& world, const DistanceOptions& options)
+  // Keeps its own resident world, or rides on `shared` (another field's, over the same chunks),
+  // which its runs then neither upload to nor grow.
+  FieldEngine(Context::Impl& ctx, const World& world, const DistanceOptions& options,
+              std::shared_ptr<ResidentWorld> shared = nullptr)
       : ctx_(ctx),
         kernels_{ctx.kernel(shaders::edt_sites()), ctx.kernel(shaders::edt_lines()),
                  ctx.kernel(shaders::edt_encode())},
@@ -137,26 +130,15 @@ class FieldEngine {
                             " bytes per buffer, more than this device's storage-buffer range (" +
                             std::to_string(ctx.limits.maxStorageBufferRange) + ")");
     make_header();
-    const int shift = world.voxels.chunk_shift();
-    chunk_origin_ = {plan_.domain.begin.x >> shift, plan_.domain.begin.y >> shift,
-                     plan_.domain.begin.z >> shift};
-    const Vec3i last{(plan_.domain.end.x - 1) >> shift, (plan_.domain.end.y - 1) >> shift,
-                     (plan_.domain.end.z - 1) >> shift};
-    chunk_dims_ = last - chunk_origin_ + Vec3i::splat(1);
-    header_.chunk_origin = {chunk_origin_.x, chunk_origin_.y, chunk_origin_.z, 0};
-    header_.chunk_dims = {chunk_dims_.x, chunk_dims_.y, chunk_dims_.z,
-                          chunk_dims_.x * chunk_dims_.y * chunk_dims_.z};
-    chunk_bytes_ = static_cast<std::size_t>(world.voxels.chunk_volume());
-    header_.chunk_edge = static_cast<std::uint32_t>(world.voxels.chunk_edge());
-    header_.chunk_shift = static_cast<std::uint32_t>(shift);
-    header_.chunk_words = static_cast<std::uint32_t>(chunk_bytes_ / 4);
-    pages_.assign(static_cast<std::size_t>(header_.chunk_dims.w),
-                  L::VF_UNIFORM);  // all air until uploaded
+    owns_world_ = shared == nullptr;
+    resident_ =
+        shared ? std::move(shared) : std::make_shared<ResidentWorld>(ctx, world, plan_.domain);
+    if (&resident_->world() != &world || !resident_->covers(plan_.domain))
+      throw InvalidArgument(
+          "GPU: a field shares the resident world of a field of the same world over the same "
+          "chunks only");
+    resident_->describe(header_);
     header_buf_ = Buffer(ctx, sizeof header_, kStorage, false);
-    pages_buf_ = Buffer(ctx, pages_.size() * 4, kStorage, false);
-    // A pool of one brick to begin with: a world of uniform chunks alone still binds one.
-    bricks_buf_ = Buffer(ctx, chunk_bytes_, kStorage, false);
-    slot_capacity_ = 1;
     field_buf_ = Buffer(ctx, field_bytes_, kStorage, false);
     // Nearest sites: 8 bytes per voxel of the domain (three int16 offsets, padded).
     site_bytes_ = options.nearest_sites ? static_cast<VkDeviceSize>(plan_.domain.volume()) * 8 : 0;
@@ -168,13 +150,9 @@ class FieldEngine {
   const DistanceOptions& options() const { return options_; }
 
   // Every chunk the domain touches.
-  std::vector<Vec3i> all_chunks() const {
-    std::vector<Vec3i> chunks;
-    for (int z = 0; z < chunk_dims_.z; ++z)
-      for (int y = 0; y < chunk_dims_.y; ++y)
-        for (int x = 0; x < chunk_dims_.x; ++x) chunks.push_back(chunk_origin_ + Vec3i{x, y, z});
-    return chunks;
-  }
+  std::vector<Vec3i> all_chunks() const { return resident_->all_chunks(); }
+  const std::shared_ptr<ResidentWorld>& resident_world() const { return resident_; }
+  const World& world() const { return world_; }
 
   // Uploads `chunks` (those inside the page table), recomputes `regions`, optionally reads the
   // whole field back: one command buffer, one submit, one fence wait.
@@ -197,8 +175,8 @@ class FieldEngine {
 
   std::size_t upload_bytes() const { return upload_bytes_; }
   ResidentField resident() {
-    return {&header_buf_, &pages_buf_,    &bricks_buf_,    &field_buf_,
-            plan_.domain, plan_.encoding, header_.none_pos};
+    return {&header_buf_, &resident_->pages(), &resident_->bricks(), &field_buf_,
+            plan_.domain, plan_.encoding,      header_.none_pos};
   }
 
   // The field as last read back.
@@ -231,24 +209,18 @@ class FieldEngine {
   }
 
  private:
-  // What a run copies from the upload buffer, and the old pool a grown one copies its bricks from
-  // (kept alive until the copy out of it has run).
-  struct Uploads {
-    std::vector<VkBufferCopy> page_copies, brick_copies;
-    std::optional<Buffer> old_pool;
-    VkDeviceSize old_pool_bytes = 0;
-  };
+  using Uploads = ResidentWorld::Uploads;
 
-  // Step 1, stage: the header (first run only), the changed page entries and bricks into `up`,
-  // and work buffers large enough for the largest region.
+  // Step 1, stage: the header (first run only), the changed page entries and bricks into `up`
+  // (a field on another's resident world leaves them to that field's runs), and work buffers
+  // large enough for the largest region.
   void stage(const std::vector<Vec3i>& chunks, const std::vector<detail::UpdateRegion>& regions,
              Staging& up, Uploads& uploads) {
     if (first_run_) {
       const VkDeviceSize at = up.add(&header_, sizeof header_);
       header_copy_ = VkBufferCopy{at, 0, sizeof header_};
     }
-    sync_chunks(chunks, up, uploads.page_copies, uploads.brick_copies, uploads.old_pool,
-                uploads.old_pool_bytes);
+    if (owns_world_) resident_->stage(chunks, up, uploads);
     VkDeviceSize largest = 4;
     for (const auto& r : regions)
       largest = std::max<VkDeviceSize>(largest, static_cast<VkDeviceSize>(r.in.volume()) * 4);
@@ -259,14 +231,10 @@ class FieldEngine {
   // page entries and bricks. (The recorder orders them after the previous submission's passes,
   // which read the buffers they overwrite.)
   void record_transfers(Recorder& rec, Buffer& upload, Uploads& uploads) {
-    // A grown pool's old bricks first: changed chunks may be written over them.
-    if (uploads.old_pool) rec.copy(*uploads.old_pool, 0, bricks_buf_, 0, uploads.old_pool_bytes);
     const std::span<const VkBufferCopy> header =
         first_run_ ? std::span<const VkBufferCopy>(&header_copy_, 1)
                    : std::span<const VkBufferCopy>();
-    rec.copy({{&upload, &header_buf_, header},
-              {&upload, &pages_buf_, uploads.page_copies},
-              {&upload, &bricks_buf_, uploads.brick_copies}});
+    resident_->record(rec, upload, uploads, &header_buf_, header);
     first_run_ = false;
   }
 
@@ -368,80 +336,6 @@ class FieldEngine {
     }
   }
 
-  std::size_t page_index(Vec3i c) const {
-    const Vec3i r = c - chunk_origin_;
-    return (static_cast<std::size_t>(r.z) * chunk_dims_.y + r.y) * chunk_dims_.x + r.x;
-  }
-
-  // Brings the page table and brick pool in line with the world for `chunks`.
-  void sync_chunks(const std::vector<Vec3i>& chunks, Staging& up,
-                   std::vector<VkBufferCopy>& page_copies, std::vector<VkBufferCopy>& brick_copies,
-                   std::optional<Buffer>& old_pool, VkDeviceSize& old_bytes) {
-    struct Change {
-      std::size_t page;
-      const std::uint8_t* voxels;
-      std::uint8_t value;
-    };
-    std::vector<Change> changes;
-    // Slots the update may need beyond the free list (frees within the update are not counted:
-    // the estimate can only be high, never low).
-    std::uint32_t new_dense = 0;
-    for (const Vec3i& c : chunks) {
-      if (c.x < chunk_origin_.x || c.y < chunk_origin_.y || c.z < chunk_origin_.z) continue;
-      const Vec3i r = c - chunk_origin_;
-      if (r.x >= chunk_dims_.x || r.y >= chunk_dims_.y || r.z >= chunk_dims_.z) continue;
-      const ChunkView<std::uint8_t> v = world_.voxels.chunk_view(c);
-      const std::size_t page = page_index(c);
-      changes.push_back({page, v.voxels, v.uniform_value});
-      const bool had_slot = (pages_[page] & L::VF_UNIFORM) == 0;
-      if (v.voxels && !had_slot) ++new_dense;
-    }
-    const std::uint32_t reusable = static_cast<std::uint32_t>(free_slots_.size());
-    const std::uint32_t needed = used_slots_ + (new_dense > reusable ? new_dense - reusable : 0);
-    if (needed > slot_capacity_) {
-      // Grow the pool (amortised doubling); the old bricks are copied over on the GPU.
-      const std::uint32_t capacity =
-          std::max<std::uint32_t>(needed + needed / 4 + 8, slot_capacity_ * 2);
-      Buffer grown(ctx_, static_cast<VkDeviceSize>(capacity) * chunk_bytes_, kStorage, false);
-      if (used_slots_ > 0) {
-        old_bytes = static_cast<VkDeviceSize>(used_slots_) * chunk_bytes_;
-        old_pool.emplace(std::move(bricks_buf_));
-      }
-      bricks_buf_ = std::move(grown);
-      slot_capacity_ = capacity;
-    }
-    for (const Change& ch : changes) {
-      std::uint32_t& entry = pages_[ch.page];
-      const bool had_slot = (entry & L::VF_UNIFORM) == 0;
-      std::uint32_t next;
-      if (!ch.voxels) {
-        if (had_slot) free_slots_.push_back(entry);
-        next = L::VF_UNIFORM | ch.value;
-      } else {
-        std::uint32_t slot;
-        if (had_slot) {
-          slot = entry;
-        } else if (!free_slots_.empty()) {
-          slot = free_slots_.back();
-          free_slots_.pop_back();
-        } else {
-          slot = used_slots_++;
-        }
-        // The pool was sized above; a slot beyond it would be an out-of-range GPU copy.
-        if (slot >= slot_capacity_)
-          throw Error("GPU: internal error: brick pool slot " + std::to_string(slot) +
-                      " beyond its capacity " + std::to_string(slot_capacity_));
-        brick_copies.push_back({up.add(ch.voxels, chunk_bytes_),
-                                static_cast<VkDeviceSize>(slot) * chunk_bytes_, chunk_bytes_});
-        next = slot;
-      }
-      if (next != entry || first_run_) {
-        entry = next;
-        page_copies.push_back({up.add(&entry, 4), ch.page * 4, 4});
-      }
-    }
-  }
-
   void grow_work_buffers(VkDeviceSize bytes) {
     for (Buffer& b : cost_) b = Buffer(ctx_, bytes, kStorage, false);
     // Nearest sites: 8 bytes per voxel for each of the three cost buffers.
@@ -453,8 +347,9 @@ class FieldEngine {
 
   // The exact transform's binding plan (shaders/layout.h), the same for its three kernels.
   std::array<Buffer*, 11> bindings() {
-    return {&header_buf_, &pages_buf_, &bricks_buf_, &cost_[0],    &cost_[1],        &cost_[2],
-            &scratch_s_,  &scratch_t_, &field_buf_,  &work_sites_, &field_sites_buf_};
+    return {&header_buf_, &resident_->pages(), &resident_->bricks(), &cost_[0],
+            &cost_[1],    &cost_[2],           &scratch_s_,          &scratch_t_,
+            &field_buf_,  &work_sites_,        &field_sites_buf_};
   }
 
   Context::Impl& ctx_;
@@ -470,15 +365,12 @@ class FieldEngine {
   detail::FieldPlan plan_;
   L::Header header_{};
   VkBufferCopy header_copy_{};
-  Vec3i chunk_origin_{0, 0, 0}, chunk_dims_{0, 0, 0};
-  std::size_t chunk_bytes_ = 0;
   VkDeviceSize field_bytes_ = 0, work_bytes_ = 0, site_bytes_ = 0;
-  std::size_t upload_bytes_ = 0;      // staged by the last run
-  std::vector<std::uint32_t> pages_;  // the host's copy of the page table
-  std::vector<std::uint32_t> free_slots_;
-  std::uint32_t used_slots_ = 0, slot_capacity_ = 0;
+  std::size_t upload_bytes_ = 0;  // staged by the last run
+  std::shared_ptr<ResidentWorld> resident_;
+  bool owns_world_ = true;
   bool first_run_ = true;
-  Buffer header_buf_, pages_buf_, bricks_buf_ = {}, field_buf_, cost_[3], scratch_s_, scratch_t_;
+  Buffer header_buf_, field_buf_, cost_[3], scratch_s_, scratch_t_;
   Buffer work_sites_, field_sites_buf_;
 };
 
@@ -511,6 +403,17 @@ DynamicField::DynamicField(std::shared_ptr<Context> context, const World& world,
     options.domain = *world.voxels.bounds();
   }
   engine_ = std::make_unique<FieldEngine>(context_->impl(), world, options);
+  reach_ = detail::field_reach(engine_->plan());
+  chunk_shift_ = world.voxels.chunk_shift();
+  rebuild();
+}
+
+DynamicField::DynamicField(DynamicField& owner, DistanceOptions options)
+    : context_(owner.context_), frame_(owner.frame_) {
+  const World& world = owner.engine_->world();
+  if (!options.domain) options.domain = owner.engine_->plan().domain;
+  engine_ = std::make_unique<FieldEngine>(context_->impl(), world, options,
+                                          owner.engine_->resident_world());
   reach_ = detail::field_reach(engine_->plan());
   chunk_shift_ = world.voxels.chunk_shift();
   rebuild();

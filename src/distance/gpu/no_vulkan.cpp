@@ -20,6 +20,9 @@ class FieldEngine {};
 DynamicField::DynamicField(std::shared_ptr<Context>, const World&, DistanceOptions) {
   built_without_vulkan();
 }
+DynamicField::DynamicField(DynamicField&, DistanceOptions) {
+  built_without_vulkan();
+}
 DynamicField::~DynamicField() = default;
 void DynamicField::rebuild() {
   built_without_vulkan();

@@ -50,7 +50,8 @@ Impl::Impl(std::shared_ptr<Context> c, const World& w, const RenderSceneOptions&
       skip_options(skip_field_options(options, box)),
       pack(ctx.kernel(shaders::scene_pack())),
       frames(*context) {
-  if (options.lighting_field) light.emplace(context, w, light_field_options(options, box));
+  // The lighting field rides on the skip field's resident world: one copy of the world.
+  if (options.lighting_field) light.emplace(skip, light_field_options(options, box));
   skip_inv_scale = 1.0 / skip.resident().encoding.scale;
   if (light) light_inv_scale = 1.0 / light->resident().encoding.scale;
   const std::size_t n = table.chunk_count();
