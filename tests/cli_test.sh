@@ -303,6 +303,16 @@ assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['gpu']['fence
   check "render gpu stats" 0 $PY -c "
 import json; j = json.load(open('$tmp/rgpu.json'))
 assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['width'] == 96, j"
+  # Fields computed on the device and drawn there: the same picture as fields from the host; only
+  # 8 bytes per chunk come back (its summary), and nothing of the fields.
+  check "render --fields device" 0 $GPU "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/kdev.png" --width 96 \
+      --height 64 --backend vulkan --fields device --stats "$tmp/rdev.json"
+  cmp -s "$tmp/kgpu.png" "$tmp/kdev.png" && passes=$((passes+1)) || { echo "FAIL: device fields draw another picture"; fails=$((fails+1)); }
+  check "render device fields stats" 0 $PY -c "
+import json; j = json.load(open('$tmp/rdev.json')); d = j['device_fields']
+assert j['fields'] == 'device' and d['bytes_down'] == 8 * d['chunks_packed'] > 0 and d['submits'] == 4, j"
+  check "render --fields device on the cpu" 1 "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/x.png" --fields device
+  expect_grep "device fields without a device message" "$tmp/err" "needs a Vulkan device"
   check "render: error view on the gpu" 0 $GPU "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/rerr.png" --backend vulkan \
       --view error --algorithm jfa-seed --width 96 --height 64
   check "render: a cut outside the box on the gpu" 1 $GPU "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/x.png" \

@@ -16,7 +16,7 @@ namespace {
 
 struct RenderSettings {
   std::string in, out, camera = "auto", view = "shaded", algorithm = "jfa", metric = "manhattan",
-                       skip = "distance", stats, backend = "cpu";
+                       skip = "distance", stats, backend = "cpu", fields = "auto";
   int width = 1280, height = 720, chunk_edge = 32, threads = 0, repeat = 1;
   bool no_shadows = false, no_ao = false;
   double fog = 0;
@@ -60,16 +60,32 @@ int run_render(const RenderSettings& s) {
       Camera::parse(s.camera, s.camera == "top" || content.empty() ? in.extent : content, aspect,
                     s.camera_frame == "world" ? &in.world.frame : nullptr);
 
-  const RenderScene scene(in.world, so, in.extent);
   // With --repeat, the frame is rendered several times and the median time reported (the
   // image is the same every time: rendering is deterministic).
   const Executor executor = choose_executor(s.backend);
+  if (s.fields == "device" && !executor.on_gpu())
+    throw InvalidArgument("--fields device needs a Vulkan device (--backend vulkan)");
+  // Fields computed where the frame is drawn on a hardware GPU; on a CPU device (lavapipe) the
+  // host computes them faster (docs/benchmarks.md), unless asked.
+  const bool device_fields =
+      executor.on_gpu() &&
+      (s.fields == "device" || (s.fields == "auto" && executor.device()->device().hardware));
+  std::optional<RenderScene> host_scene;
+  std::optional<gpu::DeviceRenderScene> device_scene;
+  if (device_fields)
+    device_scene.emplace(executor.shared_device(), in.world, so, in.extent);
+  else
+    host_scene.emplace(in.world, so, in.extent);
+  const double field_ms =
+      device_scene ? device_scene->build_stats().field_ms + device_scene->build_stats().scene_ms
+                   : host_scene->field_ms();
   RenderStats st;
   Image image;
   std::vector<double> times;
   std::vector<gpu::PassTiming> pass_timings;
   for (int r = 0; r < s.repeat; ++r) {
-    image = render(executor, scene, camera, o, &st, progress(), &pass_timings);
+    image = device_scene ? device_scene->render(camera, o, &st, &pass_timings)
+                         : render(executor, *host_scene, camera, o, &st, progress(), &pass_timings);
     times.push_back(st.ms);
   }
   std::sort(times.begin(), times.end());
@@ -79,7 +95,8 @@ int run_render(const RenderSettings& s) {
   std::ostream& status = s.out == "-" ? std::cerr : std::cout;
   status << "voxfield render: " << s.out << " (" << s.width << "x" << s.height << ", " << s.view
          << " view), " << st.ms << " ms, " << st.rays_per_second() / 1e6
-         << " M primary rays/s, fields " << scene.field_ms() << " ms\n";
+         << " M primary rays/s, fields " << field_ms << " ms"
+         << (device_fields ? " (on the device)" : "") << "\n";
   if (o.view == RenderView::kError)
     status << "  " << s.algorithm << ": " << st.rays_through_geometry
            << " rays skip through geometry, largest error on a ray " << st.max_error << " voxels\n";
@@ -101,13 +118,23 @@ int run_render(const RenderSettings& s) {
                      {"skip_metric", s.metric},
                      {"threads", max_threads()},
                      {"backend", backend_name(executor.backend())},
-                     {"field_ms", scene.field_ms()},
+                     {"field_ms", field_ms},
+                     {"fields", device_fields ? "device" : "host"},
                      {"primary_rays_per_second", st.rays_per_second()},
                      {"primary", counters(st.primary)},
                      {"shadow", counters(st.shadow)}};
     if (executor.on_gpu()) {
       j["gpu"] = gpu_json(executor);
       j["gpu"]["passes"] = pass_timings_json(pass_timings);
+    }
+    if (device_scene) {
+      const gpu::DeviceRenderScene::UpdateStats& b = device_scene->build_stats();
+      j["device_fields"] = {{"field_ms", b.field_ms},
+                            {"scene_ms", b.scene_ms},
+                            {"chunks_packed", b.chunks_repacked},
+                            {"bytes_up", b.bytes_up},
+                            {"bytes_down", b.bytes_down},
+                            {"submits", b.submits}};
     }
     if (o.view == RenderView::kError) {
       j["algorithm"] = s.algorithm;
@@ -152,6 +179,11 @@ void add_render(CLI::App& app, Action& action) {
   cmd->add_option("--backend", s->backend,
                   "cpu (default), vulkan or auto; the GPU draws the shaded and chunks views")
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
+  cmd->add_option("--fields", s->fields,
+                  "with --backend vulkan: where the skip and lighting fields are computed — "
+                  "device (they never leave it), host, or auto (default: the device when it is a "
+                  "hardware GPU, the host on a CPU device such as lavapipe)")
+      ->check(CLI::IsMember({"auto", "host", "device"}));
   cmd->add_option("--skip", s->skip, "none (plain DDA), chunks, distance (default)")
       ->check(CLI::IsMember({"none", "chunks", "distance"}));
   cmd->add_option("--slice", s->slice, "distance view: z of the cut plane (default: the middle)");

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "voxfield/csg_render.h"
@@ -63,12 +64,13 @@ class SceneRenderer {
 // at a time.
 class DeviceRenderScene {
  public:
-  // Binds to `world` (bounded: its bounds are the render box; it must outlive the scene) and
-  // builds both fields and the cells. Throws InvalidArgument as DynamicRenderScene and
-  // gpu::DynamicField do (unit spacing, u8 fields within the device's storage-buffer range),
-  // GpuUnavailable on device errors.
+  // Binds to `world` (it must outlive the scene) and builds both fields and the cells over `box`
+  // (default: the world's bounds; InvalidArgument for an unbounded world without one, and for an
+  // empty box). Throws InvalidArgument as DynamicRenderScene and gpu::DynamicField do (unit
+  // spacing, u8 fields within the device's storage-buffer range), GpuUnavailable on device errors.
   DeviceRenderScene(std::shared_ptr<Context> context, const World& world,
-                    RenderSceneOptions options = DynamicRenderScene::default_options());
+                    RenderSceneOptions options = DynamicRenderScene::default_options(),
+                    std::optional<Box3i> box = std::nullopt);
   ~DeviceRenderScene();
   DeviceRenderScene(const DeviceRenderScene&) = delete;
   DeviceRenderScene& operator=(const DeviceRenderScene&) = delete;

@@ -27,23 +27,26 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-const World& bounded(const World& world) {
-  if (!world.voxels.bounds() || world.voxels.bounds()->empty())
-    throw InvalidArgument(
-        "DeviceRenderScene: the world must be bounded, with a non-empty box (its bounds are the "
-        "render box)");
-  return world;
+// The render box: `box`, else the world's bounds.
+Box3i render_box(const World& world, const std::optional<Box3i>& box) {
+  if (!box && !world.voxels.bounds())
+    throw InvalidArgument("DeviceRenderScene: an unbounded world needs a render box");
+  const Box3i b = box ? *box : *world.voxels.bounds();
+  if (b.empty())
+    throw InvalidArgument("DeviceRenderScene: nothing to render (empty box " + to_string(b) + ")");
+  return b;
 }
 
 }  // namespace
 
 using Impl = DeviceRenderScene::Impl;
 
-Impl::Impl(std::shared_ptr<Context> c, const World& w, const RenderSceneOptions& options)
+Impl::Impl(std::shared_ptr<Context> c, const World& w, const RenderSceneOptions& options,
+           const Box3i& render_box)
     : context(std::move(c)),
       ctx(context->impl()),
-      world(bounded(w)),
-      box(*w.voxels.bounds()),
+      world(w),
+      box(render_box),
       table(box, w.voxels.chunk_edge()),
       chunk_volume(static_cast<std::uint32_t>(w.voxels.chunk_volume())),
       skip(context, w, skip_field_options(options, box)),
@@ -65,7 +68,9 @@ Impl::Impl(std::shared_ptr<Context> c, const World& w, const RenderSceneOptions&
   built.submits = light ? 2 : 1;
   std::vector<std::size_t> all(n);
   for (std::size_t i = 0; i < n; ++i) all[i] = i;
+  const auto t0 = std::chrono::steady_clock::now();
   repack(all, true, built);
+  built.scene_ms = ms_since(t0);
 }
 
 // The pack kernel's bindings (scene_pack.comp), `params` for the heat pass.
@@ -254,9 +259,11 @@ std::vector<std::uint8_t> Impl::read_back(Buffer& b, std::size_t bytes) {
 }
 
 DeviceRenderScene::DeviceRenderScene(std::shared_ptr<Context> context, const World& world,
-                                     RenderSceneOptions options) {
+                                     RenderSceneOptions options, std::optional<Box3i> box) {
   if (!context) throw InvalidArgument("gpu::DeviceRenderScene: no context");
-  impl_ = std::make_unique<Impl>(std::move(context), world, options);
+  const auto t0 = std::chrono::steady_clock::now();
+  impl_ = std::make_unique<Impl>(std::move(context), world, options, render_box(world, box));
+  impl_->built.field_ms = ms_since(t0) - impl_->built.scene_ms;
 }
 
 DeviceRenderScene::~DeviceRenderScene() = default;

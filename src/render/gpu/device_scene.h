@@ -58,7 +58,8 @@ struct DeviceRenderScene::Impl {
   std::uint64_t generation = 1;
   UpdateStats built;
 
-  Impl(std::shared_ptr<Context> c, const World& w, const RenderSceneOptions& options);
+  Impl(std::shared_ptr<Context> c, const World& w, const RenderSceneOptions& options,
+       const Box3i& box);
 
   // Summarises `chunks` (table indices, ascending), places them, and packs the entries and cells
   // of those that changed. Counts into `st`.

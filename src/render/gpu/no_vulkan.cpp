@@ -27,7 +27,8 @@ Context& SceneRenderer::context() {
 }
 
 struct DeviceRenderScene::Impl {};
-DeviceRenderScene::DeviceRenderScene(std::shared_ptr<Context>, const World&, RenderSceneOptions) {
+DeviceRenderScene::DeviceRenderScene(std::shared_ptr<Context>, const World&, RenderSceneOptions,
+                                     std::optional<Box3i>) {
   built_without_vulkan();
 }
 DeviceRenderScene::~DeviceRenderScene() = default;
