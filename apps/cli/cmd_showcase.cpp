@@ -257,6 +257,10 @@ int run_showcase(const ShowcaseSettings& s) {
      << ": the exact Manhattan distance of every air voxel on the cut (blue near, red far; a "
         "darker band every 8 "
         "voxels), the world below the cut shaded.\n\n![distance](terrain-distance.png)\n";
+  {
+    const RenderScene before(edited, skip_field.field(), &light_field.field());
+    showcase_device_scene(s.out, edited, box, before, hero, wide, md, timings);
+  }
 
   showcase_meshing(terrain, s.size, s.out, fs::path(s.out) / "terrain-sdf.npy", s.peers, hero, md,
                    timings);

@@ -69,6 +69,14 @@ void showcase_meshing(const World& terrain, int world_size, const std::filesyste
 void showcase_terrain(const std::filesystem::path& out, std::uint64_t seed, int size,
                       std::ostream& md, std::vector<Timing>& timings);
 
+// The terrain drawn on Vulkan with its skip and lighting fields computed there (the showcase's
+// Manhattan 32 and Euclidean 16 over `box`), against `host_scene`'s frame of the same fields
+// computed on the CPU: the picture, equality pixel for pixel, the bytes each way.
+void showcase_device_scene(const std::filesystem::path& out, const World& world, const Box3i& box,
+                           const RenderScene& host_scene, const Camera& camera,
+                           const RenderOptions& options, std::ostream& md,
+                           std::vector<Timing>& timings);
+
 // Vector fields: agents flying through a volume, fixed steps, the visualiser, every algorithm
 // against the definition, .fga and .vf exports; the flow around a terrain's solids under an edit.
 void showcase_vectors(const std::filesystem::path& out, std::uint64_t seed, int size,
