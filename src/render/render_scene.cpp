@@ -79,6 +79,21 @@ ChunkTable::ChunkTable(const Box3i& box, int chunk_edge) : box_(box), edge_(chun
   dims_ = last - first_ + Vec3i::splat(1);
 }
 
+std::vector<std::size_t> ChunkTable::chunks_touching(std::span<const Box3i> boxes) const {
+  std::vector<std::size_t> chunks;
+  for (const Box3i& b : boxes) {
+    const Box3i clipped = b.intersect(box_);
+    if (clipped.empty()) continue;
+    for (int cz = clipped.begin.z >> shift_; cz <= (clipped.end.z - 1) >> shift_; ++cz)
+      for (int cy = clipped.begin.y >> shift_; cy <= (clipped.end.y - 1) >> shift_; ++cy)
+        for (int cx = clipped.begin.x >> shift_; cx <= (clipped.end.x - 1) >> shift_; ++cx)
+          chunks.push_back(chunk_index(Vec3i{cx << shift_, cy << shift_, cz << shift_}));
+  }
+  std::sort(chunks.begin(), chunks.end());
+  chunks.erase(std::unique(chunks.begin(), chunks.end()), chunks.end());
+  return chunks;
+}
+
 }  // namespace render_detail
 
 using render_detail::srgb_to_linear;
@@ -383,19 +398,7 @@ std::size_t RenderScene::update(const DistanceField& skip_field, const DistanceF
   if (s.world->voxels.chunk_edge() != s.table.chunk_edge())
     throw InvalidArgument("render: the world's chunk edge changed since the scene was made");
 
-  // The chunks of the render box the boxes touch, each once, in index order.
-  std::vector<std::size_t> chunks;
-  const int shift = s.table.shift();
-  for (const Box3i& b : boxes) {
-    const Box3i clipped = b.intersect(s.box);
-    if (clipped.empty()) continue;
-    for (int cz = clipped.begin.z >> shift; cz <= (clipped.end.z - 1) >> shift; ++cz)
-      for (int cy = clipped.begin.y >> shift; cy <= (clipped.end.y - 1) >> shift; ++cy)
-        for (int cx = clipped.begin.x >> shift; cx <= (clipped.end.x - 1) >> shift; ++cx)
-          chunks.push_back(s.table.chunk_index(Vec3i{cx << shift, cy << shift, cz << shift}));
-  }
-  std::sort(chunks.begin(), chunks.end());
-  chunks.erase(std::unique(chunks.begin(), chunks.end()), chunks.end());
+  const std::vector<std::size_t> chunks = s.table.chunks_touching(boxes);
   if (chunks.empty()) return 0;
 
   const auto& skip_grid = std::get<Grid<std::uint8_t>>(skip_field.values);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -51,6 +52,8 @@ class ChunkTable {
   int chunk_edge() const { return edge_; }
   int shift() const { return shift_; }
   std::size_t chunk_count() const { return static_cast<std::size_t>(dims_.x) * dims_.y * dims_.z; }
+  // The chunks that `boxes` touch inside box(), each once, in index order.
+  std::vector<std::size_t> chunks_touching(std::span<const Box3i> boxes) const;
 
   // Chunk index of voxel v, which must lie in box().
   std::size_t chunk_index(Vec3i v) const {

@@ -19,10 +19,6 @@ namespace {
 
 namespace L = layout;
 
-constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -61,9 +57,9 @@ Impl::Impl(std::shared_ptr<Context> c, const World& w, const RenderSceneOptions&
   info.assign(n, {L::VF_UNIFORM, 0, L::VF_UNIFORM, 0});
   skip_slots.slot.assign(n, L::VF_UNIFORM);
   light_slots.slot.assign(n, L::VF_UNIFORM);
-  info_buf = Buffer(ctx, std::max<std::size_t>(n * 16, 16), kUsage, false);
-  palette_buf = Buffer(ctx, 256 * 16, kUsage, false);
-  dummy = Buffer(ctx, 16, kUsage, false);
+  info_buf = Buffer(ctx, std::max<std::size_t>(n * 16, 16), kSceneBufferUsage, false);
+  palette_buf = Buffer(ctx, 256 * 16, kSceneBufferUsage, false);
+  dummy = Buffer(ctx, 16, kSceneBufferUsage, false);
   built.bytes_up = skip.last_upload_bytes() + (light ? light->last_upload_bytes() : 0);
   built.submits = light ? 2 : 1;
   std::vector<std::size_t> all(n);
@@ -104,9 +100,9 @@ L::ScenePackParams Impl::pack_params(std::uint32_t mode, std::size_t items) {
 
 void Impl::ensure_items(std::size_t items) {
   if (items_buf.size() < std::max<std::size_t>(items * 16, 16))
-    items_buf = Buffer(ctx, std::max<std::size_t>(items * 16, 16), kUsage, false);
+    items_buf = Buffer(ctx, std::max<std::size_t>(items * 16, 16), kSceneBufferUsage, false);
   if (summaries_buf.size() < std::max<std::size_t>(items * 8, 16))
-    summaries_buf = Buffer(ctx, std::max<std::size_t>(items * 8, 16), kUsage, false);
+    summaries_buf = Buffer(ctx, std::max<std::size_t>(items * 8, 16), kSceneBufferUsage, false);
 }
 
 // Grows an arena to `slots` slots of `slot_bytes`, its live prefix copied on the device.
@@ -114,8 +110,8 @@ void Impl::ensure_arena(Recorder& rec, Buffer& arena, std::vector<Buffer>& retir
                         std::uint32_t slots, std::size_t slot_bytes) {
   const std::size_t bytes = std::max<std::size_t>(std::size_t{slots} * slot_bytes, 16);
   if (arena.handle() != VK_NULL_HANDLE && arena.size() >= bytes) return;
-  Buffer bigger(ctx, std::max(bytes, static_cast<std::size_t>(arena.size()) * 3 / 2), kUsage,
-                false);
+  Buffer bigger(ctx, std::max(bytes, static_cast<std::size_t>(arena.size()) * 3 / 2),
+                kSceneBufferUsage, false);
   if (arena.handle() != VK_NULL_HANDLE) {
     rec.copy(arena, 0, bigger, 0, arena.size());
     retired.push_back(std::move(arena));
@@ -289,18 +285,9 @@ DeviceRenderScene::UpdateStats DeviceRenderScene::update(const DirtyRegions& dir
     const Vec3i l = s.light->reach();
     reach = {std::max(reach.x, l.x), std::max(reach.y, l.y), std::max(reach.z, l.z)};
   }
-  std::vector<std::size_t> chunks;
-  const int shift = s.table.shift();
-  for (const Box3i& b : dirty.boxes()) {
-    const Box3i clipped = Box3i{b.begin - reach, b.end + reach}.intersect(s.box);
-    if (clipped.empty()) continue;
-    for (int cz = clipped.begin.z >> shift; cz <= (clipped.end.z - 1) >> shift; ++cz)
-      for (int cy = clipped.begin.y >> shift; cy <= (clipped.end.y - 1) >> shift; ++cy)
-        for (int cx = clipped.begin.x >> shift; cx <= (clipped.end.x - 1) >> shift; ++cx)
-          chunks.push_back(s.table.chunk_index(Vec3i{cx << shift, cy << shift, cz << shift}));
-  }
-  std::sort(chunks.begin(), chunks.end());
-  chunks.erase(std::unique(chunks.begin(), chunks.end()), chunks.end());
+  std::vector<Box3i> boxes = dirty.boxes();
+  for (Box3i& b : boxes) b = Box3i{b.begin - reach, b.end + reach};
+  const std::vector<std::size_t> chunks = s.table.chunks_touching(boxes);
   const auto t1 = std::chrono::steady_clock::now();
   s.repack(chunks, false, st);
   ++s.generation;

@@ -18,10 +18,6 @@ namespace {
 
 namespace L = layout;
 
-constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-
 L::vec4f v4(const Vec3d& v, double w = 0) {
   return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z),
           static_cast<float>(w)};
@@ -58,7 +54,7 @@ Frames::Frames(Context& context)
 
 void Frames::ensure_pixels(VkDeviceSize bytes) {
   if (pixels_.handle() != VK_NULL_HANDLE && pixels_.size() >= bytes) return;
-  pixels_ = Buffer(ctx_, bytes, kUsage, false);
+  pixels_ = Buffer(ctx_, bytes, kSceneBufferUsage, false);
   descriptors_stale_ = true;
 }
 
@@ -107,8 +103,8 @@ void Frames::record_approximation(Recorder& rec, const FrameScene& s) {
   const std::size_t arena_bytes = std::size_t{approx.cells.slots_used} * approx.cells.slot_bytes();
   if (approx_info_.size() < std::max<std::size_t>(info_bytes, 16) ||
       approx_arena_.size() < std::max<std::size_t>(arena_bytes, 16)) {
-    approx_info_ = Buffer(ctx_, std::max<std::size_t>(info_bytes, 16), kUsage, false);
-    approx_arena_ = Buffer(ctx_, std::max<std::size_t>(arena_bytes, 16), kUsage, false);
+    approx_info_ = Buffer(ctx_, std::max<std::size_t>(info_bytes, 16), kSceneBufferUsage, false);
+    approx_arena_ = Buffer(ctx_, std::max<std::size_t>(arena_bytes, 16), kSceneBufferUsage, false);
     descriptors_stale_ = true;
   }
   if (approx_staging_.size() < info_bytes + arena_bytes)
@@ -128,7 +124,7 @@ void Frames::record_render(Recorder& rec, const FrameScene& s, const Camera& cam
                            const RenderOptions& o, bool bgra, bool timed) {
   check_frame(s, o);
   ensure_pixels(static_cast<VkDeviceSize>(o.width) * o.height * 4);
-  if (!params_.handle()) params_ = Buffer(ctx_, sizeof(L::RenderParams), kUsage, false);
+  if (!params_.handle()) params_ = Buffer(ctx_, sizeof(L::RenderParams), kSceneBufferUsage, false);
   const bool error = o.view == RenderView::kError;
   if (error) {
     VOXFIELD_ASSERT(approx_scene_ == s.id && approx_generation_ == s.generation &&
@@ -137,7 +133,7 @@ void Frames::record_render(Recorder& rec, const FrameScene& s, const Camera& cam
   }
   for (Buffer* b : {&approx_info_, &approx_arena_})
     if (b->handle() == VK_NULL_HANDLE)
-      *b = Buffer(ctx_, 16, kUsage, false);  // bound even when unused
+      *b = Buffer(ctx_, 16, kSceneBufferUsage, false);  // bound even when unused
   if (descriptors_stale_) {
     sets_.reset();  // the last frame that used them has completed (gpu_render_vulkan.h)
     descriptors_stale_ = false;

@@ -12,6 +12,11 @@
 
 namespace voxfield::gpu {
 
+// The scene's and the frame's device buffers: bound to shaders, filled and read by copies.
+constexpr VkBufferUsageFlags kSceneBufferUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                                 VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                                 VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+
 // What a frame reads of its scene: the facts the shader's parameters carry and the buffers it
 // binds (shaders/layout.h: RenderParams and the chunk table's four words per chunk).
 struct FrameScene {

@@ -95,10 +95,6 @@ class ResidentScene {
 
 namespace {
 
-constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-
 // Copy regions into one destination buffer, staged contiguously.
 struct Staged {
   std::vector<VkBufferCopy> regions;
@@ -122,7 +118,7 @@ bool ResidentScene::record_sync(Recorder& rec, const RenderScene& scene) {
   auto ensure = [&](Buffer& b, std::size_t bytes, bool keep) {
     bytes = std::max<std::size_t>(bytes, 16);
     if (b.handle() != VK_NULL_HANDLE && b.size() >= bytes) return;
-    Buffer bigger(ctx_, bytes, kUsage, false);
+    Buffer bigger(ctx_, bytes, kSceneBufferUsage, false);
     if (keep && !whole && b.handle() != VK_NULL_HANDLE) {
       grown.emplace_back(&b, std::move(b));
     } else {
