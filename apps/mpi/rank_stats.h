@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "voxfield/mpi.h"
 
@@ -37,6 +38,34 @@ inline nlohmann::json exchange_json(MPI_Comm comm, const mpi::ExchangeStats& s) 
           {"bytes_sent_total", sum_over(comm, s.bytes_sent)},
           {"bytes_received_total", sum_over(comm, s.bytes_received)},
           {"collectives_per_rank", s.collectives}};
+}
+
+// Every rank's phases of a frame (mpi::RenderPhases), gathered on rank 0 (empty elsewhere): per
+// phase the ms of each rank, and of those the ms waited in collective calls.
+inline nlohmann::json phases_json(MPI_Comm comm, const mpi::RenderPhases& p) {
+  const mpi::RenderPhase* each[] = {&p.skip, &p.scene, &p.first_hits, &p.shadows, &p.shade};
+  const char* names[] = {"skip", "scene", "first_hits", "shadows", "shade"};
+  constexpr int kValues = 2 * 5 + 1;
+  std::vector<double> mine;
+  for (const mpi::RenderPhase* phase : each) mine.insert(mine.end(), {phase->ms, phase->wait_ms});
+  mine.push_back(p.relay_rounds);
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  std::vector<double> all(rank == 0 ? static_cast<std::size_t>(kValues) * size : 0);
+  MPI_Gather(mine.data(), kValues, MPI_DOUBLE, all.data(), kValues, MPI_DOUBLE, 0, comm);
+  nlohmann::json out = nlohmann::json::object();
+  if (rank != 0) return out;
+  for (int k = 0; k < 5; ++k) {
+    nlohmann::json ms = nlohmann::json::array(), wait = nlohmann::json::array();
+    for (int r = 0; r < size; ++r) {
+      ms.push_back(all[static_cast<std::size_t>(r * kValues + 2 * k)]);
+      wait.push_back(all[static_cast<std::size_t>(r * kValues + 2 * k + 1)]);
+    }
+    out[names[k]] = {{"ms", ms}, {"wait_ms", wait}};
+  }
+  out["relay_rounds"] = static_cast<int>(all[kValues - 1]);
+  return out;
 }
 
 }  // namespace voxfield::mpi_cli

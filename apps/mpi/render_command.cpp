@@ -85,8 +85,11 @@ int run_render(MPI_Comm comm, const RenderSettings& s) {
   RenderStats st;
   MPI_Barrier(comm);  // the frame's time starts together on every rank
   const double t1 = MPI_Wtime();
-  const Image image = mpi::render(comm, slab.partition, slab.world, so, camera, o, &st, &ex);
+  mpi::RenderPhases phases;
+  const Image image =
+      mpi::render(comm, slab.partition, slab.world, so, camera, o, &st, &ex, &phases);
   const double render_ms = max_over(comm, (MPI_Wtime() - t1) * 1e3);
+  const nlohmann::json per_rank_phases = phases_json(comm, phases);
   const auto counters = [&](const TraversalCounters& c) {
     return nlohmann::json{
         {"rays", sum_over(comm, static_cast<std::uint64_t>(c.rays))},
@@ -122,6 +125,7 @@ int run_render(MPI_Comm comm, const RenderSettings& s) {
                        {"primary", primary},
                        {"shadow", shadow}};
       j["exchange"] = exchange;
+      j["phases"] = per_rank_phases;
       outputs.stage(s.stats, j.dump(2) + "\n");
     }
     outputs.commit();

@@ -272,6 +272,23 @@ void save_world_vfw(MPI_Comm comm, const SlabPartition& partition, const World& 
 // slices count once, in the slab that owns them: what a camera frames.
 Box3i content_bounds(MPI_Comm comm, const SlabPartition& partition, const World& world);
 
+// One rank's frame of mpi::render, phase by phase: each phase's time on this rank from its start
+// to the end of the collective call that closes it, and of that the time spent inside collective
+// calls (waiting for slower ranks included) — so ms - wait_ms is the rank's own work, and a rank
+// whose waits are long has less to do than another in that phase.
+struct RenderPhase {
+  double ms = 0;
+  double wait_ms = 0;
+};
+struct RenderPhases {
+  RenderPhase skip;        // the skip field over the ranks (compute_distance_field)
+  RenderPhase scene;       // the lighting field, the part's scene, its stretches of primary rays
+  RenderPhase first_hits;  // every pixel's first hit agreed (MPI_MINLOC)
+  RenderPhase shadows;     // the shadow rays started and relayed to the slabs they enter
+  RenderPhase shade;       // shadows agreed, pixels shaded, the frame composited on rank 0
+  int relay_rounds = 0;    // rounds of the shadow relay
+};
+
 // Frames of the world the ranks hold in slabs, drawn where it lies (render_relay.h): every rank
 // walks its stretch of every primary ray at once, the first hit along each ray is the pixel's
 // (MPI_MINLOC), and the shadow rays of those hits are relayed, each sent on to the rank whose slab
@@ -283,11 +300,11 @@ Box3i content_bounds(MPI_Comm comm, const SlabPartition& partition, const World&
 // boundaries (partition_slabs with the chunk edge when the domain has a chunk layer per rank). The
 // skip field is computed over the ranks (compute_distance_field above), the lighting field by each
 // rank over its slab and ghost slices. Views: shaded and chunks. `stats`: this rank's walks (a
-// ray counts once per rank that walked a stretch of it).
+// ray counts once per rank that walked a stretch of it); `phases`: where its time went.
 Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
              const RenderSceneOptions& scene_options, const Camera& camera,
              const RenderOptions& options, RenderStats* stats = nullptr,
-             ExchangeStats* exchange = nullptr);
+             ExchangeStats* exchange = nullptr, RenderPhases* phases = nullptr);
 
 // Meshes of a lattice no rank holds whole (a scan or a simulation's float volume, a distributed
 // field). The lattice's chunk layers (mesh_pieces.h: the chunked mesher's chunks grouped along z)

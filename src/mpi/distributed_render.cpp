@@ -102,14 +102,38 @@ class LegType {
   MPI_Datatype type_ = MPI_DATATYPE_NULL;
 };
 
+// Closes one phase after another: its time since the last close, and the exchange time it added.
+class PhaseClock {
+ public:
+  explicit PhaseClock(const ExchangeStats* exchange)
+      : exchange_(exchange), start_(MPI_Wtime()), waited_(exchange->exchange_ms) {}
+  void close(RenderPhase& phase) {
+    const double now = MPI_Wtime();
+    phase.ms = (now - start_) * 1e3;
+    phase.wait_ms = exchange_->exchange_ms - waited_;
+    start_ = now;
+    waited_ = exchange_->exchange_ms;
+  }
+
+ private:
+  const ExchangeStats* exchange_;
+  double start_, waited_;
+};
+
 }  // namespace
 
 Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
              const RenderSceneOptions& scene_options, const Camera& camera,
-             const RenderOptions& options, RenderStats* stats, ExchangeStats* exchange) {
+             const RenderOptions& options, RenderStats* stats, ExchangeStats* exchange_stats,
+             RenderPhases* phases) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   const Box3i whole = partition.domain;
+  // The phases' waits are the exchange time each adds, so the exchange is always counted.
+  ExchangeStats own_exchange;
+  ExchangeStats* exchange = exchange_stats ? exchange_stats : &own_exchange;
+  RenderPhases timed;
+  PhaseClock clock(exchange);
   // Everything that can be refused is, before any field is computed.
   detail::collectively(comm, exchange, [&] {
     detail::require_partition(comm, partition);
@@ -118,6 +142,7 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
   });
   const DistanceField skip = compute_distance_field(
       comm, partition, world.voxels, relay_skip_field_options(scene_options, whole), exchange);
+  clock.close(timed.skip);
   // The part's lighting field and scene, then its stretches of the primary rays, agreed on once:
   // the ranks differ in each (the first follows the content of their slabs, the second where the
   // rays cross them), and a rank slower in one need not be slower in both.
@@ -130,12 +155,14 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
     first.resize(hits.size());
     return &hits;
   });
+  clock.close(timed.scene);
   const LegType leg_type;
   {
     detail::CollectiveTimer timer(exchange);
     MPI_Allreduce(hits_here.data(), first.data(), static_cast<int>(hits_here.size()),
                   MPI_DOUBLE_INT, MPI_MINLOC, comm);
   }
+  clock.close(timed.first_hits);
   std::vector<RayLeg> legs =
       detail::collectively(comm, exchange, [&] { return part->start_shadows(first); });
   for (;;) {
@@ -147,7 +174,9 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
     if (in_flight == 0) break;
     const std::vector<RayLeg> in = route(comm, partition, legs, leg_type.get(), exchange);
     legs = detail::collectively(comm, exchange, [&] { return part->walk(in); });
+    ++timed.relay_rounds;
   }
+  clock.close(timed.shadows);
   const std::vector<double>& ends = part->shadows();
   std::vector<double> shadow =
       detail::collectively(comm, exchange, [&] { return std::vector<double>(ends.size()); });
@@ -174,8 +203,11 @@ Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
   if (stats) *stats = part->stats();
   // (Agreed on too: a rank 0 that failed here would leave the others waiting in the caller's next
   // collective call.)
-  return detail::collectively(comm, exchange,
-                              [&] { return rank == 0 ? part->finish(frame_rgba) : Image{}; });
+  Image frame = detail::collectively(
+      comm, exchange, [&] { return rank == 0 ? part->finish(frame_rgba) : Image{}; });
+  clock.close(timed.shade);
+  if (phases) *phases = timed;
+  return frame;
 }
 
 }  // namespace voxfield::mpi

@@ -234,6 +234,16 @@ import json
 s = json.load(open("stats.json"))
 assert s["ranks"] == 4 and s["slabs"][0] == 0 and len(s["slabs"]) == 5, s
 assert s["primary"]["rays"] > 0 and s["shadow"]["rays"] > 0, s
+# Where each rank's frame went: five phases per rank, each rank's phases within the frame's time
+# (the slowest rank's, from a common start), their waits within them, a relay round at least.
+p = s["phases"]
+names = ["skip", "scene", "first_hits", "shadows", "shade"]
+for r in range(4):
+    total = sum(p[n]["ms"][r] for n in names)
+    assert 0 < total <= s["ms"] * 1.001 + 0.5, (r, total, s["ms"])
+    for n in names:
+        assert 0 <= p[n]["wait_ms"][r] <= p[n]["ms"][r] + 1e-6, (r, n, p[n])
+assert p["relay_rounds"] >= 1, p
 PY
 fi
 for view in "--camera top --fog 0.02" "--view chunks --metric euclidean --skip chunks"; do
