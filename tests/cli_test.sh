@@ -299,7 +299,7 @@ assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['gpu']['fence
   check "bench edits --backend vulkan --verify" 0 $GPU "$V" bench edits --world 40 --chunk 8 --edits 30 --metric euclidean \
       --signed --max-distance 5 --storage u8 --verify --backend vulkan --json "$tmp/gedits.json"
   check "render --backend vulkan" 0 $GPU "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/kgpu.png" --width 96 --height 64 \
-      --backend vulkan --stats "$tmp/rgpu.json"
+      --backend vulkan --fields host --stats "$tmp/rgpu.json"
   check "render gpu stats" 0 $PY -c "
 import json; j = json.load(open('$tmp/rgpu.json'))
 assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['width'] == 96, j"
@@ -310,7 +310,8 @@ assert j['backend'] == 'vulkan' and j['gpu']['submits'] == 1 and j['width'] == 9
   cmp -s "$tmp/kgpu.png" "$tmp/kdev.png" && passes=$((passes+1)) || { echo "FAIL: device fields draw another picture"; fails=$((fails+1)); }
   check "render device fields stats" 0 $PY -c "
 import json; j = json.load(open('$tmp/rdev.json')); d = j['device_fields']
-assert j['fields'] == 'device' and d['bytes_down'] == 8 * d['chunks_packed'] > 0 and d['submits'] == 4, j"
+assert j['fields'] == 'device' and d['bytes_down'] == 8 * d['chunks_packed'] > 0 and d['submits'] == 4, j
+g = j['gpu']; assert g['submits'] == d['submits'] + 1 and g['bytes_downloaded'] == d['bytes_down'] + 96 * 64 * 4, j"
   check "render --fields device on the cpu" 1 "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/x.png" --fields device
   expect_grep "device fields without a device message" "$tmp/err" "needs a Vulkan device"
   check "render: error view on the gpu" 0 $GPU "$V" render "$C/ephtracy_chr_knight.vox" -o "$tmp/rerr.png" --backend vulkan \

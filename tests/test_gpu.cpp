@@ -301,6 +301,7 @@ TEST(Gpu, FieldsShareOneResidentWorld) {
   EXPECT_EQ(ctx->counters().bytes_uploaded - before_build.bytes_uploaded,
             static_cast<std::int64_t>(sizeof(gpu::layout::Header)));
   EXPECT_EQ(rider.resident().bricks, owner.resident().bricks);
+  const VkDeviceSize pool_before = owner.resident().bricks->size();
   DirtyRegions dirty(8, DirtyRegions::Track::kOccupancy);
   std::mt19937 rng(3);
   std::uniform_int_distribution<int> px(0, 47), py(0, 39), pz(0, 23), pr(2, 6);
@@ -320,9 +321,11 @@ TEST(Gpu, FieldsShareOneResidentWorld) {
     expect_same_field(rider.download(), compute_distance_field(w, b),
                       "rider after edit " + std::to_string(i));
   }
+  EXPECT_GT(owner.resident().bricks->size(), pool_before);  // the pool grew and moved
   DistanceOptions elsewhere = a;
   elsewhere.domain = Box3i{{0, 0, 0}, {16, 16, 16}};  // other chunks than the owner's
   EXPECT_THROW(gpu::DynamicField(owner, elsewhere), InvalidArgument);
+  EXPECT_THROW(gpu::DynamicField(rider, a), InvalidArgument);  // a rider owns no world to ride on
   const auto messages = ctx->validation_messages();
   EXPECT_TRUE(messages.empty()) << messages.size()
                                 << " validation messages, first: " << messages.front();

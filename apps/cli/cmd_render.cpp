@@ -67,18 +67,22 @@ int run_render(const RenderSettings& s) {
     throw InvalidArgument("--fields device needs a Vulkan device (--backend vulkan)");
   // Fields computed where the frame is drawn on a hardware GPU; on a CPU device (lavapipe) the
   // host computes them faster (docs/benchmarks.md), unless asked.
-  const bool device_fields =
-      executor.on_gpu() &&
-      (s.fields == "device" || (s.fields == "auto" && executor.device()->device().hardware));
   std::optional<RenderScene> host_scene;
   std::optional<gpu::DeviceRenderScene> device_scene;
-  if (device_fields)
-    device_scene.emplace(executor.shared_device(), in.world, so, in.extent);
-  else
-    host_scene.emplace(in.world, so, in.extent);
+  if (executor.on_gpu() &&
+      (s.fields == "device" || (s.fields == "auto" && executor.device()->device().hardware))) {
+    try {
+      device_scene.emplace(executor.shared_device(), in.world, so, in.extent);
+    } catch (const InvalidArgument& e) {
+      if (s.fields == "device") throw;
+      // What the device cannot hold (a box beyond its storage-buffer range) the host computes.
+      std::cerr << "voxfield: the fields on the host: " << e.what() << "\n";
+    }
+  }
+  const bool device_fields = device_scene.has_value();
+  if (!device_scene) host_scene.emplace(in.world, so, in.extent);
   const double field_ms =
-      device_scene ? device_scene->build_stats().field_ms + device_scene->build_stats().scene_ms
-                   : host_scene->field_ms();
+      device_scene ? device_scene->build_stats().field_ms : host_scene->field_ms();
   RenderStats st;
   Image image;
   std::vector<double> times;

@@ -66,9 +66,11 @@ class DynamicField {
   // compute_distance_field(Context&...) does, GpuUnavailable on device errors.
   DynamicField(std::shared_ptr<Context> context, const World& world, DistanceOptions options);
   // Another field of `owner`'s world on owner's resident world — its page table and brick pool,
-  // so the device holds one copy of the world however many fields derive from it. The domain
-  // (default: owner's) must touch the same chunks as owner's (InvalidArgument otherwise).
-  // update() of this field uploads nothing: call owner.update() with the same edits first.
+  // so the device holds one copy of the world however many fields derive from it — and on its
+  // work buffers (both fields' passes run one submission at a time). The domain (default:
+  // owner's) must touch the same chunks as owner's, and owner must own its world, not ride on
+  // another's (InvalidArgument otherwise). update() of this field uploads nothing: call
+  // owner.update() with the same edits first.
   DynamicField(DynamicField& owner, DistanceOptions options);
   ~DynamicField();
   DynamicField(const DynamicField&) = delete;

@@ -98,12 +98,31 @@ DistanceField build_field(const World& world, const DistanceOptions& options,
 
 }  // namespace
 
+// The exact transform's work buffers: three cost buffers, the envelope scans' scratch, and the
+// nearest sites of each cost buffer. Grown to the largest region a run computes, never shrunk.
+struct WorkBuffers {
+  Buffer cost[3], scratch_s, scratch_t, sites;
+  VkDeviceSize bytes = 0;
+  bool with_sites = false;
+  void grow(Context::Impl& ctx, VkDeviceSize needed, bool need_sites) {
+    if (needed <= bytes && (with_sites || !need_sites)) return;
+    bytes = std::max(bytes, needed);
+    with_sites = with_sites || need_sites;
+    for (Buffer& b : cost) b = Buffer(ctx, bytes, kStorage, false);
+    // Nearest sites: 8 bytes per voxel for each of the three cost buffers.
+    sites = Buffer(ctx, with_sites ? bytes * 6 : 16, kStorage, false);
+    scratch_s = Buffer(ctx, bytes, kStorage, false);
+    scratch_t = Buffer(ctx, bytes, kStorage, false);
+  }
+};
+
 class FieldEngine {
  public:
   // Keeps its own resident world, or rides on `shared` (another field's, over the same chunks),
   // which its runs then neither upload to nor grow.
   FieldEngine(Context::Impl& ctx, const World& world, const DistanceOptions& options,
-              std::shared_ptr<ResidentWorld> shared = nullptr)
+              std::shared_ptr<ResidentWorld> shared = nullptr,
+              std::shared_ptr<WorkBuffers> work = nullptr)
       : ctx_(ctx),
         kernels_{ctx.kernel(shaders::edt_sites()), ctx.kernel(shaders::edt_lines()),
                  ctx.kernel(shaders::edt_encode())},
@@ -138,6 +157,7 @@ class FieldEngine {
           "GPU: a field shares the resident world of a field of the same world over the same "
           "chunks only");
     resident_->describe(header_);
+    work_ = work ? std::move(work) : std::make_shared<WorkBuffers>();
     header_buf_ = Buffer(ctx, sizeof header_, kStorage, false);
     field_buf_ = Buffer(ctx, field_bytes_, kStorage, false);
     // Nearest sites: 8 bytes per voxel of the domain (three int16 offsets, padded).
@@ -152,6 +172,8 @@ class FieldEngine {
   // Every chunk the domain touches.
   std::vector<Vec3i> all_chunks() const { return resident_->all_chunks(); }
   const std::shared_ptr<ResidentWorld>& resident_world() const { return resident_; }
+  const std::shared_ptr<WorkBuffers>& work_buffers() const { return work_; }
+  bool owns_world() const { return owns_world_; }
   const World& world() const { return world_; }
 
   // Uploads `chunks` (those inside the page table), recomputes `regions`, optionally reads the
@@ -161,7 +183,10 @@ class FieldEngine {
     Staging up;
     Uploads uploads;
     stage(chunks, regions, up, uploads);
-    upload_bytes_ = up.bytes.size();
+    // What the copies carry (the staging's alignment padding stays behind).
+    upload_bytes_ = first_run_ ? sizeof header_ : 0;
+    for (const auto* copies : {&uploads.page_copies, &uploads.brick_copies})
+      for (const VkBufferCopy& c : *copies) upload_bytes_ += static_cast<std::size_t>(c.size);
     Buffer& upload = ctx_.upload_buffer(std::max<VkDeviceSize>(up.bytes.size(), 16));
     if (!up.bytes.empty()) std::memcpy(upload.mapped(), up.bytes.data(), up.bytes.size());
     Buffer* readback = download ? &ctx_.readback_buffer(field_bytes_ + site_bytes_) : nullptr;
@@ -220,11 +245,18 @@ class FieldEngine {
       const VkDeviceSize at = up.add(&header_, sizeof header_);
       header_copy_ = VkBufferCopy{at, 0, sizeof header_};
     }
-    if (owns_world_) resident_->stage(chunks, up, uploads);
+    // The work buffers first: a region too large for them is refused before anything changes.
     VkDeviceSize largest = 4;
     for (const auto& r : regions)
       largest = std::max<VkDeviceSize>(largest, static_cast<VkDeviceSize>(r.in.volume()) * 4);
-    if (largest > work_bytes_) grow_work_buffers(largest);
+    const VkDeviceSize widest = largest * (options_.nearest_sites ? 6 : 1);
+    if (widest > ctx_.limits.maxStorageBufferRange)
+      throw InvalidArgument("GPU: a region of " + std::to_string(largest / 4) +
+                            " voxels needs work buffers of " + std::to_string(widest) +
+                            " bytes, more than this device's storage-buffer range (" +
+                            std::to_string(ctx_.limits.maxStorageBufferRange) + ")");
+    work_->grow(ctx_, largest, options_.nearest_sites);
+    if (owns_world_) resident_->stage(chunks, up, uploads);
   }
 
   // Step 2, transfers, recorded before every pass: a grown pool's old bricks, the header, changed
@@ -336,20 +368,12 @@ class FieldEngine {
     }
   }
 
-  void grow_work_buffers(VkDeviceSize bytes) {
-    for (Buffer& b : cost_) b = Buffer(ctx_, bytes, kStorage, false);
-    // Nearest sites: 8 bytes per voxel for each of the three cost buffers.
-    work_sites_ = Buffer(ctx_, options_.nearest_sites ? bytes * 6 : 16, kStorage, false);
-    scratch_s_ = Buffer(ctx_, bytes, kStorage, false);
-    scratch_t_ = Buffer(ctx_, bytes, kStorage, false);
-    work_bytes_ = bytes;
-  }
-
   // The exact transform's binding plan (shaders/layout.h), the same for its three kernels.
   std::array<Buffer*, 11> bindings() {
-    return {&header_buf_, &resident_->pages(), &resident_->bricks(), &cost_[0],
-            &cost_[1],    &cost_[2],           &scratch_s_,          &scratch_t_,
-            &field_buf_,  &work_sites_,        &field_sites_buf_};
+    WorkBuffers& w = *work_;
+    return {&header_buf_,     &resident_->pages(), &resident_->bricks(), &w.cost[0],  &w.cost[1],
+            &w.cost[2],       &w.scratch_s,        &w.scratch_t,         &field_buf_, &w.sites,
+            &field_sites_buf_};
   }
 
   Context::Impl& ctx_;
@@ -365,13 +389,15 @@ class FieldEngine {
   detail::FieldPlan plan_;
   L::Header header_{};
   VkBufferCopy header_copy_{};
-  VkDeviceSize field_bytes_ = 0, work_bytes_ = 0, site_bytes_ = 0;
+  VkDeviceSize field_bytes_ = 0, site_bytes_ = 0;
   std::size_t upload_bytes_ = 0;  // staged by the last run
   std::shared_ptr<ResidentWorld> resident_;
   bool owns_world_ = true;
   bool first_run_ = true;
-  Buffer header_buf_, field_buf_, cost_[3], scratch_s_, scratch_t_;
-  Buffer work_sites_, field_sites_buf_;
+  // The passes' work buffers, shared with the fields on the same resident world (their runs are
+  // submitted and waited for one at a time).
+  std::shared_ptr<WorkBuffers> work_;
+  Buffer header_buf_, field_buf_, field_sites_buf_;
 };
 
 DistanceField compute_distance_field(Context& context, const World& world,
@@ -410,10 +436,14 @@ DynamicField::DynamicField(std::shared_ptr<Context> context, const World& world,
 
 DynamicField::DynamicField(DynamicField& owner, DistanceOptions options)
     : context_(owner.context_), frame_(owner.frame_) {
+  if (!owner.engine_->owns_world())
+    throw InvalidArgument(
+        "GPU: a field rides on the field that owns the resident world, not on another rider");
   const World& world = owner.engine_->world();
   if (!options.domain) options.domain = owner.engine_->plan().domain;
-  engine_ = std::make_unique<FieldEngine>(context_->impl(), world, options,
-                                          owner.engine_->resident_world());
+  engine_ =
+      std::make_unique<FieldEngine>(context_->impl(), world, options,
+                                    owner.engine_->resident_world(), owner.engine_->work_buffers());
   reach_ = detail::field_reach(engine_->plan());
   chunk_shift_ = world.voxels.chunk_shift();
   rebuild();

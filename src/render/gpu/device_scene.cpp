@@ -12,6 +12,7 @@
 #include "../shading.h"
 #include "device_scene.h"
 #include "render_shaders.h"
+#include "voxfield/detail/assert.h"
 #include "voxfield/gpu_render_vulkan.h"
 
 namespace voxfield::gpu {
@@ -51,6 +52,8 @@ Impl::Impl(std::shared_ptr<Context> c, const World& w, const RenderSceneOptions&
       frames(*context) {
   // The lighting field rides on the skip field's resident world: one copy of the world.
   if (options.lighting_field) light.emplace(skip, light_field_options(options, box));
+  // The pack reads both fields through the skip field's header: one domain, the box.
+  VOXFIELD_ASSERT(!light || light->resident().domain == skip.resident().domain);
   skip_inv_scale = 1.0 / skip.resident().encoding.scale;
   if (light) light_inv_scale = 1.0 / light->resident().encoding.scale;
   const std::size_t n = table.chunk_count();
@@ -105,19 +108,25 @@ void Impl::ensure_items(std::size_t items) {
     summaries_buf = Buffer(ctx, std::max<std::size_t>(items * 8, 16), kSceneBufferUsage, false);
 }
 
-// Grows an arena to `slots` slots of `slot_bytes`, its live prefix copied on the device.
 void Impl::ensure_arena(Recorder& rec, Buffer& arena, std::vector<Buffer>& retired,
-                        std::uint32_t slots, std::size_t slot_bytes) {
+                        std::uint32_t slots, std::uint32_t live_slots, std::size_t slot_bytes) {
   const std::size_t bytes = std::max<std::size_t>(std::size_t{slots} * slot_bytes, 16);
   if (arena.handle() != VK_NULL_HANDLE && arena.size() >= bytes) return;
-  Buffer bigger(ctx, std::max(bytes, static_cast<std::size_t>(arena.size()) * 3 / 2),
-                kSceneBufferUsage, false);
+  const std::size_t grown = std::max(bytes, static_cast<std::size_t>(arena.size()) * 3 / 2);
+  if (grown > ctx.limits.maxStorageBufferRange)
+    throw InvalidArgument("DeviceRenderScene: its cells need an arena of " + std::to_string(grown) +
+                          " bytes, more than this device's storage-buffer range (" +
+                          std::to_string(ctx.limits.maxStorageBufferRange) + ")");
+  Buffer bigger(ctx, grown, kSceneBufferUsage, false);
   if (arena.handle() != VK_NULL_HANDLE) {
-    rec.copy(arena, 0, bigger, 0, arena.size());
+    // The old buffer lives in `retired` (reserved by the caller, so it does not move) until the
+    // copy of its live slots has run.
     retired.push_back(std::move(arena));
+    arena = std::move(bigger);
+    if (live_slots > 0) rec.copy(retired.back(), 0, arena, 0, std::size_t{live_slots} * slot_bytes);
+  } else {
+    arena = std::move(bigger);
   }
-  arena = std::move(bigger);
-  frames.buffers_replaced();
 }
 
 void Impl::repack(const std::vector<std::size_t>& chunks, bool whole, UpdateStats& st) {
@@ -144,6 +153,7 @@ void Impl::repack(const std::vector<std::size_t>& chunks, bool whole, UpdateStat
     ++st.submits;
   }
   // On the host: which chunks are stored voxel by voxel, their slots and table entries.
+  const std::uint32_t skip_live = skip_slots.used, light_live = light_slots.used;
   std::vector<std::size_t> changed;
   std::vector<std::uint32_t> write;  // items of the cells' pass
   for (std::size_t k = 0; k < n; ++k) {
@@ -176,8 +186,9 @@ void Impl::repack(const std::vector<std::size_t>& chunks, bool whole, UpdateStat
   const bool palette_changed = whole || world.palette != palette;
   std::vector<Buffer> retired;  // replaced arenas, until the copies out of them have run
   Recorder rec(ctx);
-  ensure_arena(rec, skip_arena, retired, skip_slots.used, std::size_t{chunk_volume} * 2);
-  ensure_arena(rec, light_arena, retired, light ? light_slots.used : 0, chunk_volume);
+  retired.reserve(2);
+  ensure_arena(rec, skip_arena, retired, skip_slots.used, skip_live, std::size_t{chunk_volume} * 2);
+  ensure_arena(rec, light_arena, retired, light ? light_slots.used : 0, light_live, chunk_volume);
   const std::size_t items_bytes = write.size() * 4;
   std::size_t staged = items_bytes + changed.size() * 16 + (palette_changed ? 256 * 16 : 0);
   Buffer& upload = ctx.upload_buffer(std::max<std::size_t>(staged, 16));
@@ -216,7 +227,15 @@ void Impl::repack(const std::vector<std::size_t>& chunks, bool whole, UpdateStat
   st.bytes_up += at;
   ++st.submits;
   st.chunks_repacked += n;
-  frames.buffers_replaced();  // the fields' pools may have moved since the last frame
+  // The frames' descriptor sets name these buffers (the heat pass binds the pack's): when one was
+  // replaced — an arena grown here, the brick pool by the fields' update — they go.
+  const std::array<VkBuffer, 5> bound{skip.resident().bricks->handle(), skip_arena.handle(),
+                                      light_arena.handle(), items_buf.handle(),
+                                      summaries_buf.handle()};
+  if (bound != bound_handles) {
+    bound_handles = bound;
+    frames.buffers_replaced();
+  }
 }
 
 FrameScene Impl::frame_scene() {

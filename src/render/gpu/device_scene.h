@@ -57,6 +57,7 @@ struct DeviceRenderScene::Impl {
   Palette palette{};
   std::uint64_t generation = 1;
   UpdateStats built;
+  std::array<VkBuffer, 5> bound_handles{};  // what the frames' sets last saw (repack)
 
   Impl(std::shared_ptr<Context> c, const World& w, const RenderSceneOptions& options,
        const Box3i& box);
@@ -74,8 +75,10 @@ struct DeviceRenderScene::Impl {
   std::array<Buffer*, 10> bindings(Buffer* params);
   layout::ScenePackParams pack_params(std::uint32_t mode, std::size_t items);
   void ensure_items(std::size_t items);
+  // Grows an arena to hold `slots` slots of `slot_bytes` (InvalidArgument beyond the device's
+  // storage-buffer range), its `live_slots` copied on the device.
   void ensure_arena(Recorder& rec, Buffer& arena, std::vector<Buffer>& retired, std::uint32_t slots,
-                    std::size_t slot_bytes);
+                    std::uint32_t live_slots, std::size_t slot_bytes);
 };
 
 }  // namespace voxfield::gpu

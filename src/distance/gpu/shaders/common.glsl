@@ -45,16 +45,7 @@ void store_site(uint buffer_index, uint i, uvec2 s) { work_sites[buffer_index * 
 uvec2 pack_site(ivec3 l) { return uvec2(uint(l.x) | (uint(l.y) << 16), uint(l.z)); }
 ivec3 unpack_site(uvec2 s) { return ivec3(int(s.x & 0xFFFFu), int(s.x >> 16), int(s.y)); }
 
-// Material of voxel v (world coordinates), through the page table and the brick pool.
-uint material_at(ivec3 v) {
-  const int shift = int(h.chunk_shift);
-  const ivec3 rel = (v >> shift) - h.chunk_origin.xyz;
-  const uint entry = pages[(rel.z * h.chunk_dims.y + rel.y) * h.chunk_dims.x + rel.x];
-  if ((entry & VF_UNIFORM) != 0u) return entry & 0xFFu;
-  const ivec3 l = v & int(h.chunk_edge - 1u);
-  const uint index = (uint(l.z) << (2 * shift)) | (uint(l.y) << shift) | uint(l.x);
-  return (bricks[entry * h.chunk_words + (index >> 2)] >> ((index & 3u) * 8u)) & 0xFFu;
-}
+#include "resident_world.glsl"
 
 // Index of a compute-box voxel (coordinates relative to the box) in the cost buffers.
 uint voxel_index(ivec3 l) {

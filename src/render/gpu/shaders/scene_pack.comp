@@ -49,16 +49,7 @@ uint stored_at(bool light, ivec3 v) {
   return (bits >> (uint(f.x & 3) * 8u)) & 0xFFu;
 }
 
-// Material of voxel v, through the world's page table and brick pool (as the field passes read it).
-uint material_at(ivec3 v) {
-  const int shift = int(h.chunk_shift);
-  const ivec3 rel = (v >> shift) - h.chunk_origin.xyz;
-  const uint entry = pages[(rel.z * h.chunk_dims.y + rel.y) * h.chunk_dims.x + rel.x];
-  if ((entry & VF_UNIFORM) != 0u) return entry & 0xFFu;
-  const ivec3 l = v & int(h.chunk_edge - 1u);
-  const uint index = (uint(l.z) << (2 * shift)) | (uint(l.y) << shift) | uint(l.x);
-  return (bricks[entry * h.chunk_words + (index >> 2)] >> ((index & 3u) * 8u)) & 0xFFu;
-}
+#include "resident_world.glsl"
 
 // The first voxel of chunk-table entry `chunk`.
 ivec3 chunk_origin(uint chunk) {
@@ -143,8 +134,8 @@ void heat() {
   const uint stride = gl_NumWorkGroups.x * gl_WorkGroupSize.x;
   uint top = 1u;
   for (uint i = gl_GlobalInvocationID.x; i < columns; i += stride) {
-    const ivec3 v = h.field_begin.xyz +
-                    ivec3(int(i) % h.field_size.x, int(i) / h.field_size.x, p.slice_z - h.field_begin.z);
+    const ivec3 f = ivec3(int(i) % h.field_size.x, int(i) / h.field_size.x, 0);
+    const ivec3 v = ivec3(h.field_begin.x + f.x, h.field_begin.y + f.y, p.slice_z);
     top = max(top, stored_at(false, v));
   }
   atomicMax(rp.heat_top, top);
