@@ -40,6 +40,14 @@ awk -F, 'NR > 1 && ($7 < 1 || $9 != 0 || $6 > 1) { bad = 1 } END { exit bad }' "
   fail "vulkan: a frame without a dispatch, with more than one submit of voxfield's, or with a read-back"
 awk -F, 'NR == 2 { first = $8 } NR > 2 && $8 > max { max = $8 } END { exit !(max < first) }' "$out/vulkan.csv" ||
   fail "vulkan: a later frame copied as much as the whole scene"
+# The fields computed and kept on the device (gpu::DeviceRenderScene): every frame still dispatches
+# the ray marcher, and what comes back is at most the packed chunks' summaries (8 bytes each; the
+# 64 x 64 x 32 world has 32 chunks of 16), never a field or a frame.
+run vulkan-fields --backend vulkan --fields device --validation
+grep -q "its fields computed there" "$out/vulkan-fields.err" ||
+  fail "vulkan-fields: the demo did not say its fields are computed on the device"
+awk -F, 'NR > 1 && ($7 < 1 || $9 > 32 * 8) { bad = 1 } END { exit bad }' "$out/vulkan-fields.csv" ||
+  fail "vulkan-fields: a frame without a dispatch, or reading back more than the chunks' summaries"
 run cpu --backend cpu
 grep -q "CPU renderer" "$out/cpu.err" || fail "cpu: the demo did not say it draws with the CPU renderer"
 # No Vulkan driver at all: the CPU renderer's frames, presented through OpenGL.

@@ -23,6 +23,7 @@ struct Options {
   WorldSettings world;
   std::string load;
   std::string backend = "auto";
+  std::string fields = "auto";  // where the Vulkan path's fields live: auto, host, device
   int width = 1280, height = 720;
   bool validation = false;
   bool benchmark = false;
@@ -39,6 +40,7 @@ struct Options {
 struct RenderPath {
   std::shared_ptr<gpu::Context> context;  // null: the CPU renderer
   std::unique_ptr<gpu::SceneRenderer> renderer;
+  bool device_fields = false;  // the world's fields computed and kept on the device
   std::string why;
 };
 
@@ -62,6 +64,9 @@ class Demo {
 
  private:
   void choose_path(const std::string& backend);
+  // Keeps the world's fields on the path's device; false (the reason in the status line) when the
+  // device cannot hold them.
+  bool follow_on_device();
   void frame_camera();
   void handle_input(double dt_s);
   void edit_at_cursor(EditOp op);

@@ -61,6 +61,13 @@ void DemoWorld::make_scene() {
   live_ = std::make_unique<DynamicRenderScene>(*world_, scene_options(settings_));
 }
 
+void DemoWorld::follow_on_device(std::shared_ptr<gpu::Context> context) {
+  device_.reset();
+  device_context_.reset();
+  device_ = std::make_unique<gpu::DeviceRenderScene>(context, *world_, scene_options(settings_));
+  device_context_ = std::move(context);
+}
+
 DynamicRenderScene::UpdateStats DemoWorld::apply(std::span<const Edit> edits) {
   dirty_.clear();
   for (const Edit& edit : edits) {
@@ -68,6 +75,7 @@ DynamicRenderScene::UpdateStats DemoWorld::apply(std::span<const Edit> edits) {
     ++edits_;
   }
   DynamicRenderScene::UpdateStats st = live_->update(dirty_);
+  if (device_) device_->update(dirty_);
   dirty_.clear();
   return st;
 }
@@ -78,7 +86,12 @@ void DemoWorld::set_field(Metric metric, double max_distance_vox) {
   next.max_distance_vox = max_distance_vox;
   // Build first: bad options leave the current scene as it was.
   auto live = std::make_unique<DynamicRenderScene>(*world_, scene_options(next));
+  std::unique_ptr<gpu::DeviceRenderScene> device;
+  if (device_context_)
+    device =
+        std::make_unique<gpu::DeviceRenderScene>(device_context_, *world_, scene_options(next));
   live_ = std::move(live);
+  device_ = std::move(device);
   settings_ = next;
 }
 

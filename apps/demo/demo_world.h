@@ -2,8 +2,9 @@
 //
 // Edits go through voxfield's incremental path: apply_edit records the changed boxes, and
 // DynamicRenderScene brings both render fields and the scene up to date in time proportional to
-// the edit. Only a change of metric, clamp, size or chunk edge rebuilds everything, and only when
-// the user asks for it.
+// the edit (and, with the fields on a device, gpu::DeviceRenderScene does the same there). Only a
+// change of metric, clamp, size or chunk edge rebuilds everything, and only when the user asks for
+// it.
 #pragma once
 
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include <string>
 
 #include "voxfield/edit.h"
+#include "voxfield/gpu_render.h"
 #include "voxfield/render.h"
 
 namespace voxfield::demo {
@@ -40,6 +42,16 @@ class DemoWorld {
   }
   // Rebuilds the fields for new metric / clamp settings (a full computation).
   void set_field(Metric metric, double max_distance_vox);
+  // Also keeps the fields on `context`'s device from now on (gpu::DeviceRenderScene): computed
+  // there, updated there by every apply() and set_field(), drawn there. The host's scene stays
+  // (the cursor picks voxels in it). Throws what DeviceRenderScene throws, keeping no device copy.
+  void follow_on_device(std::shared_ptr<gpu::Context> context);
+  gpu::DeviceRenderScene* device_scene() { return device_.get(); }
+  // Drops the device's copy (before the device goes).
+  void stop_device() {
+    device_.reset();
+    device_context_.reset();
+  }
 
   // Writes the world (.vfw keeps the palette and bounds; .vox and .npy as the CLI writes them),
   // atomically.
@@ -57,6 +69,8 @@ class DemoWorld {
   WorldSettings settings_;
   std::unique_ptr<World> world_;  // fixed address: the scene refers to it
   std::unique_ptr<DynamicRenderScene> live_;
+  std::shared_ptr<gpu::Context> device_context_;  // set by follow_on_device
+  std::unique_ptr<gpu::DeviceRenderScene> device_;
   DirtyRegions dirty_;
   std::int64_t edits_ = 0;
   std::string origin_;  // "terrain 128x128x64" or the file name

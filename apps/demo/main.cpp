@@ -128,6 +128,7 @@ Demo::~Demo() {
   ImGui::DestroyContext();
   vectors_.reset();
   terrain_.reset();
+  world_->stop_device();
   path_ = RenderPath{};  // voxfield's objects on the device go before the device
   if (imgui_pool_) vkDestroyDescriptorPool(vk_->device(), imgui_pool_, nullptr);
 }
@@ -137,6 +138,7 @@ void Demo::choose_path(const std::string& backend) {
   const bool vectors = vectors_ != nullptr, terrain = terrain_ != nullptr;
   vectors_.reset();  // its field may live on the device about to go
   terrain_.reset();
+  world_->stop_device();
   path_ = RenderPath{};
   const Backend b = parse_backend(backend);
   if (!vk_) {
@@ -157,11 +159,29 @@ void Demo::choose_path(const std::string& backend) {
       path_ = RenderPath{};
       path_.why = std::string("CPU renderer (no usable Vulkan compute: ") + e.what() + ")";
     }
+    // Fields computed and kept where they are drawn: on a hardware GPU, or when asked (on a CPU
+    // device the host computes them faster).
+    if (path_.renderer &&
+        (options_.fields == "device" || (options_.fields == "auto" && vk_->device_is_hardware()))) {
+      path_.device_fields = follow_on_device();
+      path_.why += path_.device_fields ? ", its fields computed there" : ", fields from the host";
+    }
   }
   ui_backend_ = path_.renderer ? 1 : 0;
   std::cerr << "voxfield-demo: " << path_.why << "\n";
   if (vectors) set_mode(Mode::kVectors);
   if (terrain) set_mode(Mode::kTerrain);
+}
+
+bool Demo::follow_on_device() {
+  try {
+    world_->follow_on_device(path_.context);
+    return true;
+  } catch (const Error& e) {
+    status_ = std::string("fields stay on the host: ") + e.what();
+    std::cerr << "voxfield-demo: " << status_ << "\n";
+    return false;
+  }
 }
 
 void Demo::frame_camera() {
@@ -328,11 +348,13 @@ bool Demo::draw(VulkanWindow::Screenshot* shot) {
   copy.imageExtent = {static_cast<std::uint32_t>(ro.width), static_cast<std::uint32_t>(ro.height),
                       1};
   if (gpu_can_draw()) {
-    path_.renderer->sync(world_->scene());
+    gpu::DeviceRenderScene* device_scene = world_->device_scene();
+    if (!device_scene) path_.renderer->sync(world_->scene());
     fill = [&](VkCommandBuffer cmd, VkImage image) {
-      const VkBuffer pixels =
-          gpu::record_render(*path_.renderer, cmd, cam, ro,
-                             vk_->bgra() ? gpu::PixelOrder::kBgra : gpu::PixelOrder::kRgba);
+      const gpu::PixelOrder order = vk_->bgra() ? gpu::PixelOrder::kBgra : gpu::PixelOrder::kRgba;
+      const VkBuffer pixels = device_scene
+                                  ? gpu::record_render(*device_scene, cmd, cam, ro, order)
+                                  : gpu::record_render(*path_.renderer, cmd, cam, ro, order);
       vkCmdCopyBufferToImage(cmd, pixels, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
     };
   } else {
@@ -522,6 +544,10 @@ int main(int argc, char** argv) {
   app.add_option("--backend", o.backend,
                  "who draws: cpu, vulkan, auto (a hardware GPU, else the CPU)")
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}));
+  app.add_option("--fields", o.fields,
+                 "with the Vulkan ray marcher: where the fields are computed and kept — device, "
+                 "host, or auto (the device when it is a hardware GPU)")
+      ->check(CLI::IsMember({"auto", "host", "device"}));
   app.add_option("--metric", metric, "metric of the field rays skip by")
       ->check(CLI::IsMember({"manhattan", "chebyshev", "euclidean"}));
   app.add_option("--max-distance", o.world.max_distance_vox,

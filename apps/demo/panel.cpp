@@ -133,10 +133,13 @@ void Demo::panel() {
       s.size = ui_size_;
       s.chunk_edge = ui_chunk_;
       try {
+        auto next = std::make_unique<DemoWorld>(s);
         wait_idle();
-        world_ = std::make_unique<DemoWorld>(s);
+        world_->stop_device();
+        world_ = std::move(next);
         frame_camera();
         status_ = "regenerated";
+        if (path_.device_fields) path_.device_fields = follow_on_device();
       } catch (const Error& e) {
         status_ = e.what();
       }
@@ -157,9 +160,11 @@ void Demo::panel() {
         s.chunk_edge = ui_chunk_;
         auto loaded = std::make_unique<DemoWorld>(s, load_path_);
         wait_idle();
+        world_->stop_device();
         world_ = std::move(loaded);
         frame_camera();
         status_ = std::string("loaded ") + load_path_;
+        if (path_.device_fields) path_.device_fields = follow_on_device();
       } catch (const Error& e) {
         status_ = e.what();  // the current world stays
       }
