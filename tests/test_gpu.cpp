@@ -331,6 +331,40 @@ TEST(Gpu, FieldsShareOneResidentWorld) {
                                 << " validation messages, first: " << messages.front();
 }
 
+TEST(Gpu, WorkBuffersBeyondTheStorageBufferRangeAreRefused) {
+  // The exact transform's work buffers hold 4 bytes per voxel of a region (24 more with nearest
+  // sites): a device whose storage-buffer range cannot bind them refuses the field with
+  // InvalidArgument, before anything is uploaded, instead of binding past the range. The range is
+  // lowered on a real context to make a small world too large.
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  auto ctx = validated_context();
+  World w = random_world({32, 32, 16}, 8, 0.01, 4);  // 16 384 voxels: 64 KiB per cost buffer
+  DistanceOptions o;
+  o.metric = Metric::kManhattan;
+  o.max_distance = 6;
+  o.storage = Storage::kU8;
+  std::uint32_t& range = ctx->impl().limits.maxStorageBufferRange;
+  struct Restore {
+    std::uint32_t& range;
+    std::uint32_t saved;
+    ~Restore() { range = saved; }
+  } restore{range, range};
+  range = 64 * 1024;  // the u8 field (16 KiB) fits, a cost buffer exactly fits
+  const gpu::Counters before = ctx->counters();
+  EXPECT_NO_THROW(gpu::DynamicField(ctx, w, o));
+  o.nearest_sites = true;  // 6 x 64 KiB of sites
+  try {
+    gpu::DynamicField refused(ctx, w, o);
+    ADD_FAILURE() << "a work buffer beyond the storage-buffer range was made";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("storage-buffer range"), std::string::npos) << e.what();
+  }
+  range = 64 * 1024 - 4;  // now not even a cost buffer
+  o.nearest_sites = false;
+  EXPECT_THROW(gpu::DynamicField(ctx, w, o), InvalidArgument);
+  EXPECT_GT(ctx->counters().submits, before.submits);  // (the first field was built)
+}
+
 TEST(Gpu, JumpFloodingEqualsTheCpu) {
   if (!gpu_tests_wanted()) GTEST_SKIP();
   auto ctx = validated_context();

@@ -73,9 +73,12 @@ int run_render(const RenderSettings& s) {
       (s.fields == "device" || (s.fields == "auto" && executor.device()->device().hardware))) {
     try {
       device_scene.emplace(executor.shared_device(), in.world, so, in.extent);
-    } catch (const InvalidArgument& e) {
-      if (s.fields == "device") throw;
-      // What the device cannot hold (a box beyond its storage-buffer range) the host computes.
+    } catch (const Error& e) {
+      // What the device cannot hold (a box beyond its storage-buffer range or its memory) the
+      // host computes, unless the device was asked for.
+      const bool too_large = dynamic_cast<const InvalidArgument*>(&e) != nullptr ||
+                             dynamic_cast<const GpuOutOfMemory*>(&e) != nullptr;
+      if (s.fields == "device" || !too_large) throw;
       std::cerr << "voxfield: the fields on the host: " << e.what() << "\n";
     }
   }

@@ -40,7 +40,9 @@ struct Options {
 struct RenderPath {
   std::shared_ptr<gpu::Context> context;  // null: the CPU renderer
   std::unique_ptr<gpu::SceneRenderer> renderer;
-  bool device_fields = false;  // the world's fields computed and kept on the device
+  // The world's fields wanted on the device (each new world tries; DemoWorld::device_scene() says
+  // whether they are there).
+  bool device_fields = false;
   std::string why;
 };
 

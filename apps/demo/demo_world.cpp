@@ -1,6 +1,8 @@
 // voxfield-demo — the world being painted.
 #include "demo_world.h"
 
+#include <iostream>
+
 #include "voxfield/error.h"
 #include "voxfield/scene.h"
 #include "voxfield/world_io.h"
@@ -75,7 +77,15 @@ DynamicRenderScene::UpdateStats DemoWorld::apply(std::span<const Edit> edits) {
     ++edits_;
   }
   DynamicRenderScene::UpdateStats st = live_->update(dirty_);
-  if (device_) device_->update(dirty_);
+  if (device_) {
+    try {
+      device_->update(dirty_);
+    } catch (const Error& e) {
+      // The host's scene is up to date: draw from it from now on rather than stop.
+      std::cerr << "voxfield-demo: the fields stay on the host from now on: " << e.what() << "\n";
+      stop_device();
+    }
+  }
   dirty_.clear();
   return st;
 }
@@ -86,13 +96,15 @@ void DemoWorld::set_field(Metric metric, double max_distance_vox) {
   next.max_distance_vox = max_distance_vox;
   // Build first: bad options leave the current scene as it was.
   auto live = std::make_unique<DynamicRenderScene>(*world_, scene_options(next));
-  std::unique_ptr<gpu::DeviceRenderScene> device;
-  if (device_context_)
-    device =
-        std::make_unique<gpu::DeviceRenderScene>(device_context_, *world_, scene_options(next));
   live_ = std::move(live);
-  device_ = std::move(device);
   settings_ = next;
+  if (device_context_) {
+    // The old device copy goes first (never two on the device at once). One the device cannot
+    // hold leaves the host's new fields to draw from, and its error to say so.
+    device_.reset();
+    device_ =
+        std::make_unique<gpu::DeviceRenderScene>(device_context_, *world_, scene_options(next));
+  }
 }
 
 void DemoWorld::save(const std::filesystem::path& path) const {

@@ -40,7 +40,9 @@ class DemoWorld {
   DynamicRenderScene::UpdateStats apply(const Edit& edit) {
     return apply(std::span<const Edit>(&edit, 1));
   }
-  // Rebuilds the fields for new metric / clamp settings (a full computation).
+  // Rebuilds the fields for new metric / clamp settings (a full computation). With the fields on a
+  // device, a device that cannot hold the new ones throws after the host's are rebuilt, keeping
+  // no device copy (frames then come from the host's scene).
   void set_field(Metric metric, double max_distance_vox);
   // Also keeps the fields on `context`'s device from now on (gpu::DeviceRenderScene): computed
   // there, updated there by every apply() and set_field(), drawn there. The host's scene stays

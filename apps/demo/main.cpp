@@ -161,11 +161,11 @@ void Demo::choose_path(const std::string& backend) {
     }
     // Fields computed and kept where they are drawn: on a hardware GPU, or when asked (on a CPU
     // device the host computes them faster).
-    if (path_.renderer &&
-        (options_.fields == "device" || (options_.fields == "auto" && vk_->device_is_hardware()))) {
-      path_.device_fields = follow_on_device();
-      path_.why += path_.device_fields ? ", its fields computed there" : ", fields from the host";
-    }
+    path_.device_fields =
+        path_.renderer != nullptr &&
+        (options_.fields == "device" || (options_.fields == "auto" && vk_->device_is_hardware()));
+    if (path_.device_fields)
+      path_.why += follow_on_device() ? ", its fields computed there" : ", fields from the host";
   }
   ui_backend_ = path_.renderer ? 1 : 0;
   std::cerr << "voxfield-demo: " << path_.why << "\n";

@@ -65,6 +65,10 @@ void Demo::panel() {
                                ? path_.why.c_str()
                                : (path_.renderer ? "CPU renderer (this view is not on the GPU yet)"
                                                  : path_.why.c_str()));
+  if (path_.device_fields)
+    ImGui::TextWrapped("%s", world_->device_scene()
+                                 ? "fields: computed and kept on the device"
+                                 : "fields: on the host (the device could not hold them)");
   ImGui::Text("%s, chunk %d", world_->origin().c_str(), world_->settings().chunk_edge);
   ImGui::Separator();
   ImGui::Text("frame %.1f ms (%.1f FPS)", last_.frame_ms,
@@ -139,7 +143,7 @@ void Demo::panel() {
         world_ = std::move(next);
         frame_camera();
         status_ = "regenerated";
-        if (path_.device_fields) path_.device_fields = follow_on_device();
+        if (path_.device_fields) follow_on_device();
       } catch (const Error& e) {
         status_ = e.what();
       }
@@ -164,7 +168,7 @@ void Demo::panel() {
         world_ = std::move(loaded);
         frame_camera();
         status_ = std::string("loaded ") + load_path_;
-        if (path_.device_fields) path_.device_fields = follow_on_device();
+        if (path_.device_fields) follow_on_device();
       } catch (const Error& e) {
         status_ = e.what();  // the current world stays
       }

@@ -104,15 +104,24 @@ struct WorkBuffers {
   Buffer cost[3], scratch_s, scratch_t, sites;
   VkDeviceSize bytes = 0;
   bool with_sites = false;
+  // The largest buffer a grow to `needed` bytes per cost buffer would make.
+  VkDeviceSize widest_after(VkDeviceSize needed, bool need_sites) const {
+    // Nearest sites: 8 bytes per voxel for each of the three cost buffers.
+    return std::max(bytes, needed) * (with_sites || need_sites ? 6 : 1);
+  }
   void grow(Context::Impl& ctx, VkDeviceSize needed, bool need_sites) {
     if (needed <= bytes && (with_sites || !need_sites)) return;
-    bytes = std::max(bytes, needed);
-    with_sites = with_sites || need_sites;
-    for (Buffer& b : cost) b = Buffer(ctx, bytes, kStorage, false);
-    // Nearest sites: 8 bytes per voxel for each of the three cost buffers.
-    sites = Buffer(ctx, with_sites ? bytes * 6 : 16, kStorage, false);
-    scratch_s = Buffer(ctx, bytes, kStorage, false);
-    scratch_t = Buffer(ctx, bytes, kStorage, false);
+    const VkDeviceSize n = std::max(bytes, needed);
+    const bool s = with_sites || need_sites;
+    // Made before any is kept: a failed allocation (GpuOutOfMemory) leaves the old set and sizes.
+    WorkBuffers next;
+    for (Buffer& b : next.cost) b = Buffer(ctx, n, kStorage, false);
+    next.sites = Buffer(ctx, s ? n * 6 : 16, kStorage, false);
+    next.scratch_s = Buffer(ctx, n, kStorage, false);
+    next.scratch_t = Buffer(ctx, n, kStorage, false);
+    next.bytes = n;
+    next.with_sites = s;
+    *this = std::move(next);
   }
 };
 
@@ -249,10 +258,10 @@ class FieldEngine {
     VkDeviceSize largest = 4;
     for (const auto& r : regions)
       largest = std::max<VkDeviceSize>(largest, static_cast<VkDeviceSize>(r.in.volume()) * 4);
-    const VkDeviceSize widest = largest * (options_.nearest_sites ? 6 : 1);
+    const VkDeviceSize widest = work_->widest_after(largest, options_.nearest_sites);
     if (widest > ctx_.limits.maxStorageBufferRange)
       throw InvalidArgument("GPU: a region of " + std::to_string(largest / 4) +
-                            " voxels needs work buffers of " + std::to_string(widest) +
+                            " voxels needs a work buffer of " + std::to_string(widest) +
                             " bytes, more than this device's storage-buffer range (" +
                             std::to_string(ctx_.limits.maxStorageBufferRange) + ")");
     work_->grow(ctx_, largest, options_.nearest_sites);

@@ -112,11 +112,14 @@ void Impl::ensure_arena(Recorder& rec, Buffer& arena, std::vector<Buffer>& retir
                         std::uint32_t slots, std::uint32_t live_slots, std::size_t slot_bytes) {
   const std::size_t bytes = std::max<std::size_t>(std::size_t{slots} * slot_bytes, 16);
   if (arena.handle() != VK_NULL_HANDLE && arena.size() >= bytes) return;
-  const std::size_t grown = std::max(bytes, static_cast<std::size_t>(arena.size()) * 3 / 2);
-  if (grown > ctx.limits.maxStorageBufferRange)
-    throw InvalidArgument("DeviceRenderScene: its cells need an arena of " + std::to_string(grown) +
+  const std::size_t range = ctx.limits.maxStorageBufferRange;
+  if (bytes > range)
+    throw InvalidArgument("DeviceRenderScene: its cells need an arena of " + std::to_string(bytes) +
                           " bytes, more than this device's storage-buffer range (" +
-                          std::to_string(ctx.limits.maxStorageBufferRange) + ")");
+                          std::to_string(range) + ")");
+  // Half again for the edits to come, within the range.
+  const std::size_t grown =
+      std::min(range, std::max(bytes, static_cast<std::size_t>(arena.size()) * 3 / 2));
   Buffer bigger(ctx, grown, kSceneBufferUsage, false);
   if (arena.handle() != VK_NULL_HANDLE) {
     // The old buffer lives in `retired` (reserved by the caller, so it does not move) until the
@@ -227,8 +230,12 @@ void Impl::repack(const std::vector<std::size_t>& chunks, bool whole, UpdateStat
   st.bytes_up += at;
   ++st.submits;
   st.chunks_repacked += n;
+  forget_moved_buffers();
+}
+
+void Impl::forget_moved_buffers() {
   // The frames' descriptor sets name these buffers (the heat pass binds the pack's): when one was
-  // replaced — an arena grown here, the brick pool by the fields' update — they go.
+  // replaced — an arena grown by a pack, the brick pool by the fields' update — they go.
   const std::array<VkBuffer, 5> bound{skip.resident().bricks->handle(), skip_arena.handle(),
                                       light_arena.handle(), items_buf.handle(),
                                       summaries_buf.handle()};
@@ -309,6 +316,7 @@ DeviceRenderScene::UpdateStats DeviceRenderScene::update(const DirtyRegions& dir
   const std::vector<std::size_t> chunks = s.table.chunks_touching(boxes);
   const auto t1 = std::chrono::steady_clock::now();
   s.repack(chunks, false, st);
+  s.forget_moved_buffers();  // (also when nothing was packed: the fields' pool may have moved)
   ++s.generation;
   st.scene_ms = ms_since(t1);
   return st;

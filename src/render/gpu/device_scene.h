@@ -67,6 +67,8 @@ struct DeviceRenderScene::Impl {
   void repack(const std::vector<std::size_t>& chunks, bool whole, UpdateStats& st);
   // What a frame reads.
   FrameScene frame_scene();
+  // Resets the frames' descriptor sets when a buffer they may name was replaced.
+  void forget_moved_buffers();
   // The first `bytes` of a buffer of the scene, read back (tests; one submit).
   std::vector<std::uint8_t> read_back(Buffer& b, std::size_t bytes);
 
