@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "bench_gpu.h"
 #include "bench_util.h"
 #include "voxfield/edit_stream.h"
 #include "voxfield/error.h"
@@ -53,15 +54,8 @@ int main(int argc, char** argv) {
                  "usage: voxfield-bench-scene-gpu [EDGE >= 16] [EDITS >= 1] [RADIUS >= 1]\n");
     return 2;
   }
-  std::shared_ptr<gpu::Context> ctx;
-  try {
-    gpu::ContextOptions co;
-    co.allow_software = true;
-    ctx = gpu::Context::create(co);
-  } catch (const Error& e) {
-    std::fprintf(stderr, "voxfield-bench-scene-gpu: no Vulkan device: %s\n", e.what());
-    return 1;
-  }
+  const std::shared_ptr<gpu::Context> ctx = bench::vulkan_device("voxfield-bench-scene-gpu");
+  if (!ctx) return 1;
   const gpu::DeviceInfo info = ctx->device();
   SceneOptions so;
   so.size = Vec3i::splat(n);

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_gpu.h"
 #include "bench_util.h"
 #include "voxfield/error.h"
 #include "voxfield/gpu_terrain.h"
@@ -36,15 +37,8 @@ int main(int argc, char** argv) {
                  "[HEIGHT]\n");
     return 2;
   }
-  std::shared_ptr<gpu::Context> ctx;
-  try {
-    gpu::ContextOptions co;
-    co.allow_software = true;
-    ctx = gpu::Context::create(co);
-  } catch (const Error& e) {
-    std::fprintf(stderr, "voxfield-bench-terrain-gpu: no Vulkan device: %s\n", e.what());
-    return 1;
-  }
+  const std::shared_ptr<gpu::Context> ctx = bench::vulkan_device("voxfield-bench-terrain-gpu");
+  if (!ctx) return 1;
   const gpu::DeviceInfo info = ctx->device();
   std::printf(
       "voxfield-bench-terrain-gpu: hills %d x %d x %d, %d smooth spheres of radius %.1f (blend 2), "
