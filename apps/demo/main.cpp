@@ -350,7 +350,8 @@ bool Demo::draw(VulkanWindow::Screenshot* shot) {
   if (gpu_can_draw()) {
     gpu::DeviceRenderScene* device_scene = world_->device_scene();
     if (!device_scene) path_.renderer->sync(world_->scene());
-    fill = [&](VkCommandBuffer cmd, VkImage image) {
+    // (device_scene by value: the frame is recorded after this block ends.)
+    fill = [&, device_scene](VkCommandBuffer cmd, VkImage image) {
       const gpu::PixelOrder order = vk_->bgra() ? gpu::PixelOrder::kBgra : gpu::PixelOrder::kRgba;
       const VkBuffer pixels = device_scene
                                   ? gpu::record_render(*device_scene, cmd, cam, ro, order)
