@@ -2,6 +2,8 @@
 // context, whether GPU tests are wanted, and seeded random worlds.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -21,6 +23,14 @@ namespace voxfield::test {
 
 inline std::shared_ptr<gpu::Context> validated_context() {
   return testing_backends::vulkan_context();
+}
+
+// The validation layer (synchronisation validation included) said nothing since the context's
+// messages were last cleared.
+inline void expect_no_validation_messages(gpu::Context& ctx) {
+  const auto messages = ctx.validation_messages();
+  EXPECT_TRUE(messages.empty()) << messages.size()
+                                << " validation messages, first: " << messages.front();
 }
 
 // The text of the installed shader include voxfield_vectors.glsl, for test kernels to prepend.

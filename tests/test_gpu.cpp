@@ -326,9 +326,7 @@ TEST(Gpu, FieldsShareOneResidentWorld) {
   elsewhere.domain = Box3i{{0, 0, 0}, {16, 16, 16}};  // other chunks than the owner's
   EXPECT_THROW(gpu::DynamicField(owner, elsewhere), InvalidArgument);
   EXPECT_THROW(gpu::DynamicField(rider, a), InvalidArgument);  // a rider owns no world to ride on
-  const auto messages = ctx->validation_messages();
-  EXPECT_TRUE(messages.empty()) << messages.size()
-                                << " validation messages, first: " << messages.front();
+  test::expect_no_validation_messages(*ctx);
 }
 
 TEST(Gpu, WorkBuffersBeyondTheStorageBufferRangeAreRefused) {

@@ -221,9 +221,7 @@ TEST(Gpu, DeviceScenesDrawWhatHostScenesDrawThroughEdits) {
       expect_same_frames(device, host, views, at);
     }
   }
-  const auto messages = ctx->validation_messages();
-  EXPECT_TRUE(messages.empty()) << messages.size()
-                                << " validation messages, first: " << messages.front();
+  test::expect_no_validation_messages(*ctx);
 }
 
 TEST(Gpu, DeviceScenesOfUniformWorldsAndBadInput) {
@@ -262,9 +260,7 @@ TEST(Gpu, DeviceScenesOfUniformWorldsAndBadInput) {
   bad.view = RenderView::kDistance;
   bad.slice_z = 99;
   EXPECT_THROW(device.render(Camera::framing(device.box(), 1.5), bad), InvalidArgument);
-  const auto messages = ctx->validation_messages();
-  EXPECT_TRUE(messages.empty()) << messages.size()
-                                << " validation messages, first: " << messages.front();
+  test::expect_no_validation_messages(*ctx);
 }
 
 TEST(Gpu, DeviceScenesOfABoxThatStartsAndEndsInsideChunks) {
@@ -286,7 +282,5 @@ TEST(Gpu, DeviceScenesOfABoxThatStartsAndEndsInsideChunks) {
   EXPECT_EQ(device.box(), box);
   expect_same_cells(device, host_scene, "box " + to_string(box));
   expect_same_frames(device, host, views_of(box, true), "box " + to_string(box));
-  const auto messages = ctx->validation_messages();
-  EXPECT_TRUE(messages.empty()) << messages.size()
-                                << " validation messages, first: " << messages.front();
+  test::expect_no_validation_messages(*ctx);
 }

@@ -71,15 +71,19 @@ int run_render(const RenderSettings& s) {
   std::optional<gpu::DeviceRenderScene> device_scene;
   if (executor.on_gpu() &&
       (s.fields == "device" || (s.fields == "auto" && executor.device()->device().hardware))) {
+    // What the device cannot hold (a box beyond its storage-buffer range or its memory) the host
+    // computes, unless the device was asked for.
+    const auto on_the_host = [&](const Error& e) {
+      std::cerr << "voxfield: the fields on the host: " << e.what() << "\n";
+    };
     try {
       device_scene.emplace(executor.shared_device(), in.world, so, in.extent);
-    } catch (const Error& e) {
-      // What the device cannot hold (a box beyond its storage-buffer range or its memory) the
-      // host computes, unless the device was asked for.
-      const bool too_large = dynamic_cast<const InvalidArgument*>(&e) != nullptr ||
-                             dynamic_cast<const GpuOutOfMemory*>(&e) != nullptr;
-      if (s.fields == "device" || !too_large) throw;
-      std::cerr << "voxfield: the fields on the host: " << e.what() << "\n";
+    } catch (const InvalidArgument& e) {
+      if (s.fields == "device") throw InvalidArgument(s.in + ": " + e.what());
+      on_the_host(e);
+    } catch (const GpuOutOfMemory& e) {
+      if (s.fields == "device") throw;
+      on_the_host(e);
     }
   }
   const bool device_fields = device_scene.has_value();

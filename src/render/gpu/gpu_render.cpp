@@ -113,19 +113,21 @@ bool ResidentScene::record_sync(Recorder& rec, const RenderScene& scene) {
   // Device buffers as large as the host arenas' capacity, so growth is rare. A new scene gets
   // everything copied; an arena that outgrew its buffer moves to a larger one on the GPU (the old
   // buffer is retired until this submission has completed), so only the changed chunks travel.
+  // Every replaced buffer goes to retired_ (a frame may still read it), which is reserved for all
+  // four, so the copies recorded out of them name buffers that do not move.
   retired_.clear();
-  std::vector<std::pair<Buffer*, Buffer>> grown;
+  retired_.reserve(4);
+  std::vector<std::pair<Buffer*, Buffer*>> grown;  // (the larger buffer, the old one in retired_)
   auto ensure = [&](Buffer& b, std::size_t bytes, bool keep) {
     bytes = std::max<std::size_t>(bytes, 16);
     if (b.handle() != VK_NULL_HANDLE && b.size() >= bytes) return;
     Buffer bigger(ctx_, bytes, kSceneBufferUsage, false);
-    if (keep && !whole && b.handle() != VK_NULL_HANDLE) {
-      grown.emplace_back(&b, std::move(b));
-    } else {
+    const bool had = b.handle() != VK_NULL_HANDLE;
+    if (had) retired_.push_back(std::move(b));
+    if (keep && !whole && had)
+      grown.emplace_back(&b, &retired_.back());
+    else
       whole = true;
-      if (b.handle() != VK_NULL_HANDLE)
-        retired_.push_back(std::move(b));  // a frame may still read it
-    }
     b = std::move(bigger);
     frames_.buffers_replaced();
   };
@@ -137,10 +139,7 @@ bool ResidentScene::record_sync(Recorder& rec, const RenderScene& scene) {
   // The recorder orders these copies after the frames submitted earlier that read the buffers
   // they write (an application that records frames into its own command buffers need not wait
   // for one before syncing), and the moved contents before the changed chunks written over them.
-  for (auto& [now, old] : grown) {
-    rec.copy(old, 0, *now, 0, old.size());
-    retired_.push_back(std::move(old));
-  }
+  for (auto& [now, old] : grown) rec.copy(*old, 0, *now, 0, old->size());
 
   std::vector<std::size_t> changed;
   const bool palette_changed = whole || synced_palette_ != s.palette_generation;
