@@ -356,8 +356,8 @@ for delay in 0.1 0.3 0.5 0.7; do
     --metric euclidean --signed --chunk 16 >/dev/null 2>kill_err.txt &
   job=$!
   sleep "$delay"
-  # The newest rank: a process named voxfield-mpi (mpirun is named mpirun; the MPI tests run alone,
-  # see tests/CMakeLists.txt). None yet (a slow start under a sanitizer) means no kill this round.
+  # The newest rank: a process named voxfield-mpi (mpirun is named mpirun; no other test runs
+  # voxfield-mpi). None yet (a slow start under a sanitizer) means no kill this round.
   # Zombies are skipped: a rank of the previous round may not be reaped yet.
   victim=$(pgrep -n -x -r R,S,D voxfield-mpi || true)
   if [ -n "$victim" ]; then
