@@ -11,6 +11,11 @@
 #ifdef CONSUMER_VULKAN
 #include "voxfield/gpu_vulkan.h"  // needs the Vulkan headers: the vulkan component provides them
 #endif
+#ifdef CONSUMER_MPI
+#include <mpi.h>
+
+#include "voxfield/mpi.h"  // the mpi component: voxfield::mpi and MPI::MPI_CXX
+#endif
 
 int main(int argc, char** argv) {
   using namespace voxfield;
@@ -30,6 +35,31 @@ int main(int argc, char** argv) {
       ++wrong;
     }
   }
+#ifdef CONSUMER_MPI
+  // The same field through the MPI layer, over the ranks of this job (one when run on its own):
+  // each rank's slab equals the single-process field there.
+  int provided = 0;  // only this thread talks to MPI; voxfield's pool works between the calls
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  int ranks = 1, rank = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  const mpi::SlabPartition partition = mpi::partition_slabs(domain, ranks);
+  const Box3i slab = partition.slab(rank);
+  const DistanceField part =
+      mpi::compute_distance_field(MPI_COMM_WORLD, partition, world.voxels, options);
+  std::int64_t differ = 0;
+  for (int z = slab.begin.z; z < slab.end.z; ++z)
+    for (int y = slab.begin.y; y < slab.end.y; ++y)
+      for (int x = slab.begin.x; x < slab.end.x; ++x)
+        differ += part.distance({x, y, z}) != field.distance({x, y, z});
+  if (differ) {
+    std::fprintf(stderr, "rank %d: %lld voxels of the MPI layer's field differ\n", rank,
+                 static_cast<long long>(differ));
+    ++wrong;
+  }
+  MPI_Finalize();
+  std::printf("voxfield consumer: MPI layer on %d rank(s) %s\n", ranks, differ ? "FAILED" : "ok");
+#endif
   const std::filesystem::path path =
       std::filesystem::path(argc > 1 ? argv[1] : ".") / "consumer.npy";
   save_world(world, domain, path);
