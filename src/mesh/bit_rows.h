@@ -118,17 +118,12 @@ class RowRanks {
   std::vector<const std::uint64_t*> rows_;
 };
 
-// Asks the cache for the sample row a writing pass over plane z reaches first when it comes to
-// row y + 1: row (y + 3, z + 2), the gradients' farthest reach (a cell row's corners go to z + 1,
-// their central differences one further). Its nearer rows were read for the previous plane, but
-// that plane is new, and its reads are sparse (only around crossings) and so not prefetched by
-// the hardware: without this, one thread's marching cubes of a 256³ terrain spent a tenth of its
-// time waiting for those loads.
-inline void prefetch_ahead(const Lattice& lattice, int y, int z) {
-  if (z + 2 >= lattice.n.z || y + 3 >= lattice.n.y) return;
-  const float* row =
-      lattice.values + static_cast<std::ptrdiff_t>(lattice.n.x) *
-                           (y + 3 + static_cast<std::ptrdiff_t>(lattice.n.y) * (z + 2));
+// Asks the cache for sample row (y, z) (0 <= y < n.y, 0 <= z < n.z) ahead of a writing pass's
+// sparse reads around crossings, which the hardware does not prefetch (without this, one thread's
+// marching cubes of a 256³ terrain spent a tenth of its time waiting for those loads).
+inline void prefetch_row(const Lattice& lattice, int y, int z) {
+  const float* row = lattice.values + static_cast<std::ptrdiff_t>(lattice.n.x) *
+                                          (y + static_cast<std::ptrdiff_t>(lattice.n.y) * z);
   for (int x = 0; x < lattice.n.x; x += 16) __builtin_prefetch(row + x);  // 64-byte lines
 }
 
@@ -156,6 +151,17 @@ class InsideBits {
   const std::uint64_t* row(int y, int z) const {
     return bits_.data() + words_ * (static_cast<std::size_t>(y) +
                                     static_cast<std::size_t>(ny_) * static_cast<std::size_t>(z));
+  }
+  // Whether row (y, z) and its eight neighbours in y and z (those the lattice has) are all inside
+  // or all outside alike: no edge between two of them crosses the surface, so no central
+  // difference taken at one of the eight around a crossing reads row (y, z) — unless the crossing
+  // is on an edge from them to a row further out, which the caller checks if it needs to.
+  bool quiet_around(int y, int z) const {
+    const int y0 = y > 0 ? y - 1 : y, z0 = z > 0 ? z - 1 : z;
+    return quiet(y0, z0) && quiet(y0 + 1 < ny_ ? y0 + 1 : y0, z0) &&
+           quiet(y0, static_cast<std::size_t>(z0) + 1 < planes_ ? z0 + 1 : z0) &&
+           quiet(y0 + 1 < ny_ ? y0 + 1 : y0,
+                 static_cast<std::size_t>(z0) + 1 < planes_ ? z0 + 1 : z0);
   }
   // Whether row (y, z) and the rows after it in y, in z and in both (those the lattice has) are
   // all inside or all outside alike: no edge starting on the row crosses the surface and no cell

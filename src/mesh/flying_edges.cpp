@@ -340,7 +340,13 @@ void FlyingEdges::write_plane(int z, std::uint64_t first_vertex, std::uint64_t f
   RowRanks counts(8, words_);
   for (int y = 0; y < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
-    prefetch_ahead(lattice_, y, z);
+    // Row (y + 3, z + 2) is first read three rows on, by the gradient at the upper end of a
+    // z-edge of row (y + 3, z) that crosses, or later around a crossing near it (the next plane's
+    // reads): the prefetch skips the rows no crossing comes near (37 % of the MRI's), whose lines
+    // would only displace ones in use. (Measured on the MRI: about 3 % of the pass.)
+    if (y + 3 < n.y && z + 2 < n.z &&
+        (!inside_->quiet(y + 3, z) || !inside_->quiet_around(y + 3, z + 2)))
+      prefetch_row(lattice_, y + 3, z + 2);
     if (inside_->quiet(y, z)) continue;  // no crossing, no cell crossed
     const std::uint64_t* b = inside_->row(y, z);
     // This row's edge vertices: its x-edge crossings, then its y-edge and z-edge ones.
