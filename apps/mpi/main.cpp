@@ -35,6 +35,7 @@
 #include "bench_world.h"
 #include "mesh_command.h"
 #include "rank_stats.h"
+#include "read_option.h"
 #include "render_command.h"
 #include "voxfield/distance.h"
 #include "voxfield/edit_script.h"
@@ -54,6 +55,7 @@ struct FieldSettings {
   double max_distance = 0;
   std::vector<double> spacing;
   int chunk = 32, threads = 0;
+  std::string read = "every";  // --read (field and edit)
 
   void add_to(CLI::App* cmd) {
     cmd->add_option("--metric", metric, "manhattan, chebyshev or euclidean")
@@ -112,7 +114,7 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
   // Everything that can be wrong with the outputs is found before the world is loaded.
   mpi::check_outputs(comm, {out, sites}, {stats});
   const double t0 = MPI_Wtime();
-  const mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk);
+  const mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk, 0, mpi_cli::read_by(f.read));
   const double load_ms = (MPI_Wtime() - t0) * 1e3;
   mpi::ExchangeStats ex;
   MPI_Barrier(comm);  // the field's time starts together on every rank
@@ -128,6 +130,7 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
                           {"load_ms_max", max_over(comm, load_ms)},
                           {"format", slab.format},
                           {"read_in_parts", slab.read_in_parts},
+                          {"read", f.read},
                           {"slabs", slab.partition.z}});
   j["exchange"] = exchange_json(comm, ex);
   mpi::FieldFiles files{out, sites, stats, j.dump(2) + "\n"};
@@ -173,23 +176,28 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   const std::vector<Edit>& edits = script_and_ghost.first;
   const int ghost = script_and_ghost.second;
   const double l0 = MPI_Wtime();
+  const mpi::ReadBy read = mpi_cli::read_by(f.read);
   mpi::WorldSlab slab = [&] {
     // By the script's edits: what each unit of slices will recompute, known before any reading.
     if (balance == "edits")
-      return mpi::load_world_slab(comm, in, f.chunk, ghost, [&](const Box3i& domain) {
-        return mpi::partition_slabs(domain, size, f.chunk,
-                                    mpi::edit_unit_weights(domain, f.chunk, edits, ghost));
-      });
-    mpi::WorldSlab equal = mpi::load_world_slab(comm, in, f.chunk, ghost);
+      return mpi::load_world_slab(
+          comm, in, f.chunk, ghost,
+          [&](const Box3i& domain) {
+            return mpi::partition_slabs(domain, size, f.chunk,
+                                        mpi::edit_unit_weights(domain, f.chunk, edits, ghost));
+          },
+          read);
+    mpi::WorldSlab equal = mpi::load_world_slab(comm, in, f.chunk, ghost, read);
     if (balance != "content") return equal;
     // By content: the chunks holding air and solid (the surface), counted in the slabs of equal
     // volume; then the world read again in the slabs they weigh.
     const std::vector<double> weights =
         mpi::content_unit_weights(comm, equal.partition, equal.world, f.chunk);
     equal.world = World();  // let go before the second reading
-    return mpi::load_world_slab(comm, in, f.chunk, ghost, [&](const Box3i& domain) {
-      return mpi::partition_slabs(domain, size, f.chunk, weights);
-    });
+    return mpi::load_world_slab(
+        comm, in, f.chunk, ghost,
+        [&](const Box3i& domain) { return mpi::partition_slabs(domain, size, f.chunk, weights); },
+        read);
   }();
   const double load_ms = max_over(comm, (MPI_Wtime() - l0) * 1e3);
   const double t0 = MPI_Wtime();
@@ -221,6 +229,7 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
       {"load_ms", load_ms},
       {"build_ms", build_ms},
       {"balance", balance},
+      {"read", f.read},
       {"edits", edits.size()},
       {"ghost_slices", ghost},
       {"edit_ms", slowest},
@@ -314,6 +323,7 @@ int main(int argc, char** argv) {
   field->add_option("--sites", sites, "also write nearest-site offsets, int16 a[x, y, z, 3]");
   field->add_option("--stats", stats, "timing and exchange figures as JSON");
   f.add_to(field);
+  mpi_cli::add_read_option(field, f.read);
   FieldSettings fe;
   std::string edit_in, edit_script, edit_out, edit_stats, edit_save, edit_balance = "volume";
   CLI::App* edit = app.add_subcommand(
@@ -332,6 +342,7 @@ int main(int argc, char** argv) {
                    "recompute)")
       ->check(CLI::IsMember({"volume", "content", "edits"}));
   fe.add_to(edit);
+  mpi_cli::add_read_option(edit, fe.read);
   std::vector<int> dims;
   int spheres = 200, repeat = 3;
   FieldSettings fb;

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "rank_stats.h"
+#include "read_option.h"
 #include "voxfield/error.h"
 #include "voxfield/file.h"
 #include "voxfield/mpi.h"
@@ -47,6 +48,7 @@ CLI::App* add_render_command(CLI::App& app, RenderSettings& s) {
   cmd->add_option("--threads", s.threads, "threads per rank (default: all cores)")
       ->check(CLI::Range(1, 1024));
   cmd->add_option("--stats", s.stats, "timings, ray counters and exchange figures as JSON");
+  add_read_option(cmd, s.read);
   return cmd;
 }
 
@@ -70,7 +72,8 @@ int run_render(MPI_Comm comm, const RenderSettings& s) {
   mpi::check_outputs(comm, {}, {s.out, s.stats});
   const double t0 = MPI_Wtime();
   // Each rank holds its slab and the slices its lighting reads beyond it.
-  const mpi::WorldSlab slab = mpi::load_world_slab(comm, s.in, s.chunk, relay_ghost_slices(so));
+  const mpi::WorldSlab slab =
+      mpi::load_world_slab(comm, s.in, s.chunk, relay_ghost_slices(so), read_by(s.read));
   const double load_ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
   const Box3i& domain = slab.partition.domain;
   // Automatic cameras frame what is there, as voxfield render's do: the content, within the
@@ -121,6 +124,7 @@ int run_render(MPI_Comm comm, const RenderSettings& s) {
                        {"ranks", size},
                        {"threads", max_threads()},
                        {"read_in_parts", slab.read_in_parts},
+                       {"read", s.read},
                        {"slabs", slab.partition.z},
                        {"primary", primary},
                        {"shadow", shadow}};

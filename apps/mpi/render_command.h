@@ -16,6 +16,7 @@ struct RenderSettings {
   bool no_shadows = false, no_ao = false;
   double fog = 0;
   std::string camera_frame = "voxels";
+  std::string read = "every";  // --read: who opens IN
 };
 
 // The subcommand and its options, as `voxfield render` names them.

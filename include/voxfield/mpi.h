@@ -186,6 +186,10 @@ class SlabEditor {
   DirtyRegions dirty_;
 };
 
+// Who opens a world file load_world_slab reads: every rank (a shared file system), or rank 0
+// alone, which sends the others what they need (load_world_slab says what).
+enum class ReadBy { kEveryRank, kRankZero };
+
 // A rank's slab of a world file.
 struct WorldSlab {
   World world;  // the slab's voxels and its ghost slices, at their place in the whole world
@@ -193,8 +197,10 @@ struct WorldSlab {
   std::string format;  // "npy", "vox", "vfw" or "vdb"
   // Each rank built only its slab: a .npy's part read alone, a .vfw's chunks decompressed alone,
   // a .vox's voxels placed within the slab alone, a .vdb's leaves decoded within the slab alone
-  // (the file read by every rank). Every format voxfield reads is read so.
+  // (the file read by every rank, or its bytes sent by rank 0). Every format voxfield reads is
+  // read so.
   bool read_in_parts = false;
+  ReadBy read_by = ReadBy::kEveryRank;
 };
 
 // Loads `path` for this rank, keeping its slab and `ghost_slices` slices on either side: a .npy is
@@ -210,14 +216,23 @@ struct WorldSlab {
 // voxels, comes from an equal z-share of the tree's stored bounds decoded by each rank first. The
 // domain is the file's volume (the .npy shape, the .vox/.vfw/.vdb extent), as `voxfield field`
 // uses.
+//
+// `read_by` kRankZero is the fallback for ranks that cannot see rank 0's files (no shared file
+// system): rank 0 alone opens the file. A .npy's parts are read by rank 0 one rank at a time and
+// each sent to its rank (rank 0 holds its own part and, for a moment, one other); a .vfw's,
+// .vox's or .vdb's bytes (compressed, or a list of voxels: small beside the world) are broadcast,
+// and each rank decodes its own slab of them as above. The slabs are the same either way. Every
+// transfer is agreed on first: a rank that cannot hold what it would receive fails every rank
+// with its reason.
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
-                          int ghost_slices = 0);
+                          int ghost_slices = 0, ReadBy read_by = ReadBy::kEveryRank);
 // The same with the slabs cut by cut(domain) once the domain is known (every rank must cut it
 // alike; InvalidArgument unless it is a partition of that domain into the communicator's ranks):
 // slabs weighed by content (content_unit_weights) or by a script's edits (edit_unit_weights).
 using SlabCut = std::function<SlabPartition(const Box3i& domain)>;
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
-                          int ghost_slices, const SlabCut& cut);
+                          int ghost_slices, const SlabCut& cut,
+                          ReadBy read_by = ReadBy::kEveryRank);
 
 // Collective: per unit of slab_units(partition.domain, align), the chunks of the ranks' worlds
 // within the unit's slices that hold both air and solid voxels (where a world's surface lies, and

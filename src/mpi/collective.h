@@ -54,6 +54,16 @@ void require_partition(MPI_Comm comm, const SlabPartition& partition);
 // Rank 0's `text` on every rank.
 std::string broadcast_string(MPI_Comm comm, std::string text, ExchangeStats* stats);
 
+// Rank 0's `bytes` on every rank (byte_transfer.cpp): the size first, each rank's room for it
+// agreed on (ResourceLimitError past a rank's memory limit, naming `name`, on every rank), then
+// the bytes.
+std::vector<std::uint8_t> broadcast_bytes(MPI_Comm comm, std::vector<std::uint8_t> bytes,
+                                          const std::string& name, ExchangeStats* stats);
+// Rank 0's `bytes` on rank `to` alone, the same way (every rank calls it; the others pass nothing
+// and get nothing; `to` 0 keeps rank 0's own).
+std::vector<std::uint8_t> send_bytes(MPI_Comm comm, int to, std::vector<std::uint8_t> bytes,
+                                     const std::string& name, ExchangeStats* stats);
+
 // Bytes of a shared file at an offset.
 struct FilePiece {
   std::uint64_t offset = 0;

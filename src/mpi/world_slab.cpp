@@ -3,6 +3,8 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <array>
+#include <cstring>
 #include <optional>
 
 #include "collective.h"
@@ -57,7 +59,7 @@ SlabPartition checked_cut(const SlabCut& cut, const Box3i& domain, int ranks) {
 // of it and bounds what it finds, and the union of the ranks' bounds is the domain — so no rank
 // ever decodes more than about two slabs, whatever the world's size.
 WorldSlab vfw_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge, int ghost,
-                   const SlabCut& cut) {
+                   const SlabCut& cut, std::vector<std::uint8_t>* sent) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
@@ -70,7 +72,7 @@ WorldSlab vfw_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
   Head h = detail::collectively(comm, nullptr, [&] {
     Head out;
     const std::uint64_t limit = effective_memory_limit(0);
-    out.bytes = read_file(path, limit);
+    out.bytes = sent ? std::move(*sent) : read_file(path, limit);
     out.options.memory_limit_bytes = remaining_memory(limit, out.bytes.size());
     out.options.keep_z = std::pair<std::int32_t, std::int32_t>{0, 0};
     const WorldFile head = parse_world_file(out.bytes, path.string(), out.options);
@@ -106,7 +108,7 @@ WorldSlab vfw_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
 // empty clip) bounds where content may lie, each rank decodes an equal z-share of that and bounds
 // the solid voxels it finds, and the union over the ranks is the domain.
 WorldSlab vdb_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge, int ghost,
-                   const SlabCut& cut) {
+                   const SlabCut& cut, std::vector<std::uint8_t>* sent) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
@@ -127,7 +129,7 @@ WorldSlab vdb_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
   Head h = detail::collectively(comm, nullptr, [&] {
     Head out;
     const std::uint64_t limit = effective_memory_limit(0);
-    out.bytes = read_file(path, limit);
+    out.bytes = sent ? std::move(*sent) : read_file(path, limit);
     out.options.memory_limit_bytes = remaining_memory(limit, out.bytes.size());
     const VdbWorld topology = world_in(out, Box3i{});
     out.content = topology.extent;
@@ -153,27 +155,103 @@ WorldSlab vdb_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
   });
 }
 
-}  // namespace
+// A part of a .npy as bytes to send: its values as read_npy_part gives them, after the fields
+// that place them in the file (so a value refused on the receiving rank is named by its index and
+// byte offset in the file, as when that rank reads it itself).
+constexpr std::size_t kPartFields = 13;
+std::vector<std::uint8_t> pack_part(NpyVolume part) {
+  const std::array<std::int64_t, kPartFields> f{static_cast<std::int64_t>(part.dtype),
+                                                part.dims.x,
+                                                part.dims.y,
+                                                part.dims.z,
+                                                static_cast<std::int64_t>(part.file_data_offset),
+                                                part.file_c_order ? 1 : 0,
+                                                part.file_origin.x,
+                                                part.file_origin.y,
+                                                part.file_origin.z,
+                                                part.file_dims.x,
+                                                part.file_dims.y,
+                                                part.file_dims.z,
+                                                part.components};
+  std::vector<std::uint8_t> out(sizeof f + part.bytes.size());
+  std::memcpy(out.data(), f.data(), sizeof f);
+  std::memcpy(out.data() + sizeof f, part.bytes.data(), part.bytes.size());
+  return out;
+}
+NpyVolume unpack_part(const std::vector<std::uint8_t>& in) {
+  std::array<std::int64_t, kPartFields> f{};
+  std::memcpy(f.data(), in.data(), sizeof f);  // rank 0's packing: at least these bytes
+  const auto i32 = [](std::int64_t v) { return static_cast<std::int32_t>(v); };
+  NpyVolume part;
+  part.dtype = static_cast<DType>(f[0]);
+  part.dims = {i32(f[1]), i32(f[2]), i32(f[3])};
+  part.file_data_offset = static_cast<std::uint64_t>(f[4]);
+  part.file_c_order = f[5] != 0;
+  part.file_origin = {i32(f[6]), i32(f[7]), i32(f[8])};
+  part.file_dims = {i32(f[9]), i32(f[10]), i32(f[11])};
+  part.components = static_cast<int>(f[12]);
+  part.bytes.assign(in.begin() + sizeof f, in.end());
+  return part;
+}
 
-WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
-                          int ghost_slices) {
-  int size = 0;
+// A .npy read by rank 0 alone: its header's shape broadcast, then each rank's part (its slab and
+// ghost slices) read by rank 0 and sent to it, one rank at a time.
+WorldSlab npy_slab_from_rank_zero(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
+                                  int ghost, const SlabCut& cut) {
+  int rank = 0, size = 0;
+  MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
-  return load_world_slab(comm, path, chunk_edge, ghost_slices, [&](const Box3i& domain) {
-    return partition_slabs(domain, size, chunk_edge);
+  std::array<std::int32_t, 3> dims = detail::collectively(comm, nullptr, [&] {
+    const Vec3i d = rank == 0 ? read_npy_header(path).dims : Vec3i{};
+    return std::array<std::int32_t, 3>{d.x, d.y, d.z};
+  });
+  MPI_Bcast(dims.data(), 3, MPI_INT32_T, 0, comm);
+  const Box3i domain = Box3i::from_size({dims[0], dims[1], dims[2]});
+  const SlabPartition partition =
+      detail::collectively(comm, nullptr, [&] { return checked_cut(cut, domain, size); });
+  const auto part_of = [&](int r) {
+    const Box3i keep = kept_box(domain, partition, r, ghost);
+    return read_npy_part(path, keep.begin.z, keep.end.z);
+  };
+  std::vector<std::uint8_t> mine;
+  for (int r = 1; r < size; ++r) {
+    std::vector<std::uint8_t> part = detail::collectively(comm, nullptr, [&] {
+      return rank == 0 ? pack_part(part_of(r)) : std::vector<std::uint8_t>{};
+    });
+    std::vector<std::uint8_t> got =
+        detail::send_bytes(comm, r, std::move(part), path.string(), nullptr);
+    if (rank == r) mine = std::move(got);
+  }
+  return detail::collectively(comm, nullptr, [&] {
+    const NpyVolume part = rank == 0 ? part_of(0) : unpack_part(mine);
+    return WorldSlab{world_from_npy(part, path.string(), chunk_edge), partition, "npy", true};
   });
 }
 
-WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
-                          int ghost_slices, const SlabCut& cut) {
+WorldSlab read_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
+                          int ghost_slices, const SlabCut& cut, ReadBy read_by) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
   // (The format is named by the extension alone: every rank agrees on it without a word.)
   const WorldFormat format =
       detail::collectively(comm, nullptr, [&] { return world_format_of(path); });
-  if (format == WorldFormat::kVfw) return vfw_slab(comm, path, chunk_edge, ghost_slices, cut);
-  if (format == WorldFormat::kVdb) return vdb_slab(comm, path, chunk_edge, ghost_slices, cut);
+  const bool from_zero = read_by == ReadBy::kRankZero;
+  if (from_zero && format == WorldFormat::kNpy)
+    return npy_slab_from_rank_zero(comm, path, chunk_edge, ghost_slices, cut);
+  // The other formats' bytes, read by rank 0 and broadcast: each rank decodes its own slab of them.
+  std::vector<std::uint8_t> sent;
+  if (from_zero) {
+    std::vector<std::uint8_t> bytes = detail::collectively(comm, nullptr, [&] {
+      return rank == 0 ? read_file(path, effective_memory_limit(0)) : std::vector<std::uint8_t>{};
+    });
+    sent = detail::broadcast_bytes(comm, std::move(bytes), path.string(), nullptr);
+  }
+  std::vector<std::uint8_t>* const bytes_sent = from_zero ? &sent : nullptr;
+  if (format == WorldFormat::kVfw)
+    return vfw_slab(comm, path, chunk_edge, ghost_slices, cut, bytes_sent);
+  if (format == WorldFormat::kVdb)
+    return vdb_slab(comm, path, chunk_edge, ghost_slices, cut, bytes_sent);
   return detail::collectively(comm, nullptr, [&] {
     if (format == WorldFormat::kNpy) {
       const NpyVolume head = read_npy_header(path);
@@ -188,7 +266,8 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
     // (nothing placed: its extent gives the slabs), then only this rank's slab and ghost slices
     // placed.
     const std::uint64_t limit = effective_memory_limit(0);
-    const std::vector<std::uint8_t> bytes = read_file(path, limit);
+    const std::vector<std::uint8_t> bytes =
+        bytes_sent ? std::move(*bytes_sent) : read_file(path, limit);
     VoxImportOptions vo;
     vo.chunk_edge = chunk_edge;
     vo.memory_limit_bytes = remaining_memory(limit, bytes.size());
@@ -203,6 +282,24 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
     part.palette = slab.world.palette;
     return WorldSlab{std::move(part), partition, "vox", true};
   });
+}
+
+}  // namespace
+
+WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
+                          int ghost_slices, ReadBy read_by) {
+  int size = 0;
+  MPI_Comm_size(comm, &size);
+  return load_world_slab(
+      comm, path, chunk_edge, ghost_slices,
+      [&](const Box3i& domain) { return partition_slabs(domain, size, chunk_edge); }, read_by);
+}
+
+WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
+                          int ghost_slices, const SlabCut& cut, ReadBy read_by) {
+  WorldSlab slab = read_world_slab(comm, path, chunk_edge, ghost_slices, cut, read_by);
+  slab.read_by = read_by;
+  return slab;
 }
 
 }  // namespace voxfield::mpi

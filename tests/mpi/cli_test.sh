@@ -206,6 +206,62 @@ done
 "$VF" convert air.npy air.vfw 2>/dev/null
 EXPECT_RANKS=3 expect_failure 1 "air.vfw: the input holds no volume" field air.vfw -o bad.npy
 
+# Read by rank 0 alone (--read rank0, for ranks that cannot see its files): a .npy's parts read by
+# rank 0 and sent rank by rank, the other formats' bytes broadcast and each rank's slab decoded
+# from them; the same fields, edits and frames.
+inputs="f.npy c.npy ref.vfw margins.vfw"
+if [ -f axes.vfw ]; then inputs="$inputs axes.vfw $vox axes.vdb"; fi
+for input in $inputs; do
+  "$VF" field "$input" -o ref.npy --metric euclidean --signed 2>/dev/null
+  MPIEXEC -np 3 "$VFM" field "$input" -o out.npy --chunk 8 --metric euclidean --signed \
+    --read rank0 --stats stats.json 2>/dev/null
+  same ref.npy out.npy "3 ranks, $input read by rank 0"
+  /usr/bin/python3 -c "import json; s = json.load(open('stats.json')); assert s['read'] == 'rank0' and s['read_in_parts'] is True, s"
+done
+"$VF" edit f.npy -e edits.jsonl -o ref.npy --chunk 8 --max-distance 6 2>/dev/null
+MPIEXEC -np 3 "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 --max-distance 6 \
+  --balance content --read rank0 2>/dev/null
+same ref.npy out.npy "edit --balance content --read rank0, 3 ranks"
+"$VF" render margins.vfw -o ref.png --width 100 --height 80 --chunk 8 2>/dev/null
+MPIEXEC -np 3 "$VFM" render margins.vfw -o out.png --width 100 --height 80 --chunk 8 \
+  --read rank0 2>/dev/null
+same ref.png out.png "render --read rank0, 3 ranks, margins.vfw"
+# Ranks 1 and 2 run where the input does not exist (their own working directory; the output's path
+# is absolute): read by rank 0 the field is the same; read by every rank, rank 1 names the file it
+# cannot open and nothing is written.
+mkdir -p seen unseen && cp f.npy seen/in.npy
+"$VF" field f.npy -o ref.npy --metric euclidean --signed 2>/dev/null
+for read in rank0 every; do
+  rm -f out.npy
+  set +e
+  MPIEXEC -np 1 --wdir "$work/seen" "$VFM" field in.npy -o "$work/out.npy" --chunk 8 \
+    --metric euclidean --signed --read "$read" : \
+    -np 2 --wdir "$work/unseen" "$VFM" field in.npy -o "$work/out.npy" --chunk 8 \
+    --metric euclidean --signed --read "$read" >/dev/null 2>err.txt
+  code=$?
+  set -e
+  if [ "$read" = rank0 ]; then
+    [ "$code" -eq 0 ] || { echo "FAIL: --read rank0 with an input only rank 0 sees exited $code"; cat err.txt; fail=1; }
+    same ref.npy out.npy "3 ranks, the input seen by rank 0 alone, --read rank0"
+  else
+    [ "$code" -eq 1 ] || { echo "FAIL: --read every with an input rank 1 cannot see exited $code"; fail=1; }
+    grep -q "rank 1: in.npy: cannot open" err.txt || { echo "FAIL: no 'rank 1: in.npy: cannot open' in:"; cat err.txt; fail=1; }
+    [ ! -e out.npy ] || { echo "FAIL: --read every wrote an output though rank 1 failed"; fail=1; }
+  fi
+done
+# A rank that cannot hold the part rank 0 would send it says so, before anything is sent, and every
+# rank stops: nothing written.
+rm -f out.npy
+set +e
+MPIEXEC -np 1 --wdir "$work/seen" "$VFM" field in.npy -o "$work/out.npy" --read rank0 : \
+  -np 2 --wdir "$work/unseen" env VOXFIELD_MEMORY_LIMIT=4K "$VFM" field in.npy -o "$work/out.npy" \
+  --read rank0 >/dev/null 2>err.txt
+code=$?
+set -e
+[ "$code" -eq 1 ] || { echo "FAIL: a rank short of memory for its part: exit $code"; fail=1; }
+grep -q "rank 1: in.npy: the bytes rank 0 sends needs" err.txt || { echo "FAIL: no refusal of rank 1's part in:"; cat err.txt; fail=1; }
+[ ! -e out.npy ] || { echo "FAIL: a rank short of memory for its part, yet an output was written"; fail=1; }
+
 expect_failure 1 "missing.npy: cannot open" field missing.npy -o bad.npy
 expect_failure 1 "a\[.*holds 0.5, not a material index" field fraction.npy -o bad.npy
 expect_failure 1 "/no/such/dir/bad.npy: directory /no/such/dir does not exist" field f.npy -o /no/such/dir/bad.npy
