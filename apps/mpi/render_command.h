@@ -12,7 +12,7 @@ namespace voxfield::mpi_cli {
 struct RenderSettings {
   std::string in, out, stats, camera = "auto", view = "shaded", metric = "manhattan",
                               skip = "distance";
-  int width = 1280, height = 720, chunk = 32, threads = 0;
+  int width = 1280, height = 720, chunk = 32, threads = 0, repeat = 1;
   bool no_shadows = false, no_ao = false;
   double fog = 0;
   std::string camera_frame = "voxels";

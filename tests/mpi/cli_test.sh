@@ -313,6 +313,21 @@ done
 "$VF" render margins.vfw -o ref.png --width 100 --height 80 --chunk 8 2>/dev/null
 MPIEXEC -np 3 "$VFM" render margins.vfw -o out.png --width 100 --height 80 --chunk 8 2>/dev/null
 same ref.png out.png "render, 3 ranks, margins.vfw"
+# --repeat: the same frame drawn three times, the median of the three times reported, the
+# counters one frame's (those of a single frame, not three summed).
+MPIEXEC -np 2 "$VFM" render margins.vfw -o out.png --width 100 --height 80 --chunk 8 \
+  --stats once.json 2>/dev/null
+MPIEXEC -np 2 "$VFM" render margins.vfw -o out.png --width 100 --height 80 --chunk 8 \
+  --repeat 3 --stats repeat.json 2>/dev/null
+same ref.png out.png "render --repeat 3, 2 ranks, margins.vfw"
+/usr/bin/python3 - <<'PY'
+import json
+once, s = json.load(open("once.json")), json.load(open("repeat.json"))
+e = s["ms_each"]
+assert len(e) == 3 and s["ms"] == sorted(e)[1] and len(once["ms_each"]) == 1, s
+assert s["primary"] == once["primary"] and s["shadow"] == once["shadow"], (s, once)
+assert s["exchange"]["bytes_sent_total"] == once["exchange"]["bytes_sent_total"], (s, once)
+PY
 # A camera in the world's frame: voxel v of framed.vfw lies at (100, -50, 3) + v / 4.
 "$VF" convert f.npy framed.vfw --voxel-size 0.25 --origin 100,-50,3 2>/dev/null
 "$VF" render framed.vfw -o ref.png --width 100 --height 80 --chunk 8 --camera "eye=60,-20,40:target=12,12,8" 2>/dev/null
