@@ -103,7 +103,7 @@ using mpi_cli::peak_rss_bytes;
 using mpi_cli::sum_over;
 
 int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, const std::string& out,
-              const std::string& sites, const std::string& stats) {
+              const std::string& sites, const std::string& packed, const std::string& stats) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
@@ -112,7 +112,7 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
   DistanceOptions o = f.options();
   o.nearest_sites = !sites.empty();
   // Everything that can be wrong with the outputs is found before the world is loaded.
-  mpi::check_outputs(comm, {out, sites}, {stats});
+  mpi::check_outputs(comm, {out, sites, packed}, {stats});
   const double t0 = MPI_Wtime();
   const mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk, 0, mpi_cli::read_by(f.read));
   const double load_ms = (MPI_Wtime() - t0) * 1e3;
@@ -130,10 +130,10 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
                           {"load_ms_max", max_over(comm, load_ms)},
                           {"format", slab.format},
                           {"read_in_parts", slab.read_in_parts},
-                          {"read", f.read},
+                          {"read", mpi_cli::read_name(slab.read_by)},
                           {"slabs", slab.partition.z}});
   j["exchange"] = exchange_json(comm, ex);
-  mpi::FieldFiles files{out, sites, stats, j.dump(2) + "\n"};
+  mpi::FieldFiles files{out, sites, stats, j.dump(2) + "\n", packed, &slab.world};
   mpi::write_field_npy(comm, slab.partition, field, files);
   if (rank == 0) {
     const Vec3i d = domain.size();
@@ -229,7 +229,7 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
       {"load_ms", load_ms},
       {"build_ms", build_ms},
       {"balance", balance},
-      {"read", f.read},
+      {"read", mpi_cli::read_name(slab.read_by)},
       {"edits", edits.size()},
       {"ghost_slices", ghost},
       {"edit_ms", slowest},
@@ -246,8 +246,8 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   std::optional<FileTransaction> outputs;
   if (rank == 0) outputs.emplace();
   FileTransaction* tx = outputs ? &*outputs : nullptr;
-  mpi::write_field_npy(comm, slab.partition, editor.field(), {out, {}, stats, j.dump(2) + "\n"},
-                       nullptr, tx);
+  mpi::write_field_npy(comm, slab.partition, editor.field(),
+                       {out, {}, stats, j.dump(2) + "\n", {}, nullptr}, nullptr, tx);
   if (!save_world.empty())
     mpi::save_world_vfw(comm, slab.partition, editor.world(), save_world, nullptr, tx);
   mpi::collectively(comm, [&] {
@@ -316,11 +316,13 @@ int main(int argc, char** argv) {
                  "memory limit per rank (bytes, or with K/M/G; default: $VOXFIELD_MEMORY_LIMIT, "
                  "else half of physical memory)");
   FieldSettings f;
-  std::string in, out, sites, stats;
+  std::string in, out, sites, packed, stats;
   CLI::App* field = app.add_subcommand("field", "a distance field of a world, as `voxfield field`");
   field->add_option("IN", in, "input .npy (read a slab per rank), .vox or .vfw")->required();
   field->add_option("-o,--output", out, "output .npy")->required();
   field->add_option("--sites", sites, "also write nearest-site offsets, int16 a[x, y, z, 3]");
+  field->add_option("--packed", packed,
+                    "also write the dissertation's packed uint32 voxels to this .npy");
   field->add_option("--stats", stats, "timing and exchange figures as JSON");
   f.add_to(field);
   mpi_cli::add_read_option(field, f.read);
@@ -366,7 +368,7 @@ int main(int argc, char** argv) {
     if (!memory_limit.empty())
       voxfield::set_default_memory_limit(voxfield::parse_byte_size(memory_limit, "--memory-limit"));
     if (field->parsed()) {
-      code = run_field(comm, f, in, out, sites, stats);
+      code = run_field(comm, f, in, out, sites, packed, stats);
     } else if (edit->parsed()) {
       code =
           run_edit(comm, fe, edit_in, edit_script, edit_out, edit_stats, edit_save, edit_balance);

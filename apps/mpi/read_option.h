@@ -19,5 +19,9 @@ inline void add_read_option(CLI::App* cmd, std::string& read) {
 inline mpi::ReadBy read_by(const std::string& read) {
   return read == "rank0" ? mpi::ReadBy::kRankZero : mpi::ReadBy::kEveryRank;
 }
+// How a slab was read, for --stats: what load_world_slab did, not what was asked.
+inline const char* read_name(mpi::ReadBy by) {
+  return by == mpi::ReadBy::kRankZero ? "rank0" : "every";
+}
 
 }  // namespace voxfield::mpi_cli

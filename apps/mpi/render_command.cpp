@@ -141,7 +141,7 @@ int run_render(MPI_Comm comm, const RenderSettings& s) {
                        {"ranks", size},
                        {"threads", max_threads()},
                        {"read_in_parts", slab.read_in_parts},
-                       {"read", s.read},
+                       {"read", read_name(slab.read_by)},
                        {"slabs", slab.partition.z},
                        {"primary", primary},
                        {"shadow", shadow}};

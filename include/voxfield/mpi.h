@@ -219,7 +219,7 @@ struct WorldSlab {
 //
 // `read_by` kRankZero is the fallback for ranks that cannot see rank 0's files (no shared file
 // system): rank 0 alone opens the file. A .npy's parts are read by rank 0 one rank at a time and
-// each sent to its rank (rank 0 holds its own part and, for a moment, one other); a .vfw's,
+// each sent to its rank (rank 0 holds one part at a time, its own last); a .vfw's,
 // .vox's or .vdb's bytes (compressed, or a list of voxels: small beside the world) are broadcast,
 // and each rank decodes its own slab of them as above. The slabs are the same either way. Every
 // transfer is agreed on first: a rank that cannot hold what it would receive fails every rank
@@ -249,6 +249,10 @@ struct FieldFiles {
   std::filesystem::path sites;   // optional: int16 a[x, y, z, 3] nearest-site offsets
   std::filesystem::path json;    // optional: written by rank 0 with `json_text`
   std::string json_text;
+  // Optional: the dissertation's packed uint32 voxels (dissertation_format.h) of `world`, this
+  // rank's world holding at least its slab, with the field's distances.
+  std::filesystem::path packed;
+  const World* world = nullptr;
 };
 
 // Checks the targets (empty paths skipped) as check_output_path does, on rank 0 whose view of the

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "collective.h"
+#include "voxfield/dissertation_format.h"
 #include "voxfield/file.h"
 #include "voxfield/limits.h"
 #include "voxfield/npy.h"
@@ -72,6 +73,21 @@ std::vector<detail::FilePiece> sites_pieces(const Grid<SiteOffset>& g, const Box
   return out;
 }
 
+// The dissertation's packed voxels of this rank's slab (dissertation_format.h), at its place.
+detail::FilePiece packed_piece(const World& world, const DistanceField& f, const Box3i& slab,
+                               const Box3i& domain) {
+  require_memory(dense_bytes(slab, 2 * sizeof(std::uint32_t)), 0, "--packed output",
+                 "a dense copy of this rank's slab " + to_string(slab));
+  const std::vector<std::uint32_t> packed = pack_dissertation_format(world, f, slab);
+  detail::FilePiece p;
+  p.offset = static_cast<std::uint64_t>(slab.begin.z - domain.begin.z) *
+             static_cast<std::uint64_t>(domain.size().x) *
+             static_cast<std::uint64_t>(domain.size().y) * sizeof(std::uint32_t);
+  p.bytes.resize(packed.size() * sizeof(std::uint32_t));
+  std::memcpy(p.bytes.data(), packed.data(), p.bytes.size());
+  return p;
+}
+
 }  // namespace
 
 void check_outputs(MPI_Comm comm, const std::vector<std::filesystem::path>& shared,
@@ -99,56 +115,65 @@ void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const Distan
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   const Box3i& domain = partition.domain;
-  const bool sites = !files.sites.empty();
+  // The outputs in order: the values, then the sites and the packed voxels when asked for.
+  struct Output {
+    const std::filesystem::path* path;
+    std::vector<std::uint8_t> head;
+    std::string temporary;
+    std::vector<detail::FilePiece> pieces;
+  };
+  std::vector<Output> outputs;
   // Rank 0 stages the temporaries (headers written); the others learn their names.
   std::optional<FileTransaction> own;
   FileTransaction* transaction = into;
-  std::vector<std::uint8_t> values_head, sites_head;
-  std::string temporaries;  // values '\n' sites
+  std::string temporaries;  // '\0' between the names: the one byte no path holds
   detail::collectively(comm, stats, [&] {
     detail::require_partition(comm, partition);
     if (!slab.domain.contains(partition.slab(rank)))
       throw InvalidArgument("this rank's field covers " + to_string(slab.domain) +
                             ", not all of its slab " + to_string(partition.slab(rank)));
-    if (sites && !slab.sites) throw InvalidArgument("the field has no nearest sites to write");
-    values_head = npy_header(values_dtype(slab), domain.size());
-    if (sites) sites_head = npy_header(DType::kInt16, domain.size(), 3);
+    if (!files.sites.empty() && !slab.sites)
+      throw InvalidArgument("the field has no nearest sites to write");
+    if (!files.packed.empty() && !files.world)
+      throw InvalidArgument("packed voxels need this rank's world (FieldFiles::world)");
+    outputs.push_back({&files.values, npy_header(values_dtype(slab), domain.size()), {}, {}});
+    if (!files.sites.empty())
+      outputs.push_back({&files.sites, npy_header(DType::kInt16, domain.size(), 3), {}, {}});
+    if (!files.packed.empty())
+      outputs.push_back({&files.packed, npy_header(DType::kUInt32, domain.size()), {}, {}});
     if (rank != 0) return;
     if (!transaction) transaction = &own.emplace();
-    temporaries = transaction->stage_shared(files.values, values_head).string();
-    // '\0' between the names: the one byte no path holds.
-    if (sites)
-      temporaries +=
-          std::string(1, '\0') + transaction->stage_shared(files.sites, sites_head).string();
+    for (std::size_t k = 0; k < outputs.size(); ++k)
+      temporaries += (k ? std::string(1, '\0') : std::string()) +
+                     transaction->stage_shared(*outputs[k].path, outputs[k].head).string();
     if (!files.json.empty()) transaction->stage(files.json, files.json_text);
   });
   temporaries = detail::broadcast_string(comm, temporaries, stats);
-  const std::size_t cut = temporaries.find('\0');
-  const std::string values_tmp = temporaries.substr(0, cut);
-  const std::string sites_tmp = cut == std::string::npos ? "" : temporaries.substr(cut + 1);
+  for (std::size_t k = 0, at = 0; k < outputs.size(); ++k) {
+    const std::size_t cut = temporaries.find('\0', at);
+    outputs[k].temporary = temporaries.substr(at, cut == std::string::npos ? cut : cut - at);
+    at = cut + 1;
+  }
 
   std::string error;
   {
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<detail::FilePiece> values;
-    std::vector<detail::FilePiece> site_planes;
+    const Box3i mine = partition.slab(rank);
     try {
-      values.push_back(values_piece(slab, partition.slab(rank), domain));
-      if (sites) site_planes = sites_pieces(*slab.sites, partition.slab(rank), domain);
+      outputs[0].pieces.push_back(values_piece(slab, mine, domain));
+      std::size_t k = 1;
+      if (!files.sites.empty()) outputs[k++].pieces = sites_pieces(*slab.sites, mine, domain);
+      if (!files.packed.empty())
+        outputs[k++].pieces.push_back(packed_piece(*files.world, slab, mine, domain));
     } catch (const std::exception& e) {
       error = e.what();
-      values.clear();
-      site_planes.clear();
+      for (Output& o : outputs) o.pieces.clear();
     }
-    // The pieces' offsets count from the end of the headers.
-    for (auto& p : values) p.offset += values_head.size();
-    for (auto& p : site_planes) p.offset += sites_head.size();
-    const std::string e1 = detail::write_pieces(comm, values_tmp, files.values.string(), values);
-    if (error.empty()) error = e1;
-    if (sites) {
-      const std::string e2 =
-          detail::write_pieces(comm, sites_tmp, files.sites.string(), site_planes);
-      if (error.empty()) error = e2;
+    // Every rank writes into every temporary (nothing when it failed), so none waits on another.
+    for (Output& o : outputs) {
+      for (auto& p : o.pieces) p.offset += o.head.size();  // offsets count from the header's end
+      const std::string e = detail::write_pieces(comm, o.temporary, o.path->string(), o.pieces);
+      if (error.empty()) error = e;
     }
     if (stats) stats->exchange_ms += detail::ms_since(t0);
   }

@@ -155,11 +155,11 @@ WorldSlab vdb_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
   });
 }
 
-// A part of a .npy as bytes to send: its values as read_npy_part gives them, after the fields
-// that place them in the file (so a value refused on the receiving rank is named by its index and
-// byte offset in the file, as when that rank reads it itself).
+// The fields that place a part of a .npy in its file, sent before its values (so a value refused
+// on the receiving rank is named by its index and byte offset in the file, as when that rank reads
+// it itself).
 constexpr std::size_t kPartFields = 13;
-std::vector<std::uint8_t> pack_part(NpyVolume part) {
+std::vector<std::uint8_t> part_fields(const NpyVolume& part) {
   const std::array<std::int64_t, kPartFields> f{static_cast<std::int64_t>(part.dtype),
                                                 part.dims.x,
                                                 part.dims.y,
@@ -173,14 +173,13 @@ std::vector<std::uint8_t> pack_part(NpyVolume part) {
                                                 part.file_dims.y,
                                                 part.file_dims.z,
                                                 part.components};
-  std::vector<std::uint8_t> out(sizeof f + part.bytes.size());
+  std::vector<std::uint8_t> out(sizeof f);
   std::memcpy(out.data(), f.data(), sizeof f);
-  std::memcpy(out.data() + sizeof f, part.bytes.data(), part.bytes.size());
   return out;
 }
-NpyVolume unpack_part(const std::vector<std::uint8_t>& in) {
+NpyVolume part_from(const std::vector<std::uint8_t>& fields, std::vector<std::uint8_t> values) {
   std::array<std::int64_t, kPartFields> f{};
-  std::memcpy(f.data(), in.data(), sizeof f);  // rank 0's packing: at least these bytes
+  std::memcpy(f.data(), fields.data(), sizeof f);  // part_fields' bytes, from rank 0
   const auto i32 = [](std::int64_t v) { return static_cast<std::int32_t>(v); };
   NpyVolume part;
   part.dtype = static_cast<DType>(f[0]);
@@ -190,7 +189,7 @@ NpyVolume unpack_part(const std::vector<std::uint8_t>& in) {
   part.file_origin = {i32(f[6]), i32(f[7]), i32(f[8])};
   part.file_dims = {i32(f[9]), i32(f[10]), i32(f[11])};
   part.components = static_cast<int>(f[12]);
-  part.bytes.assign(in.begin() + sizeof f, in.end());
+  part.bytes = std::move(values);
   return part;
 }
 
@@ -213,17 +212,19 @@ WorldSlab npy_slab_from_rank_zero(MPI_Comm comm, const std::filesystem::path& pa
     const Box3i keep = kept_box(domain, partition, r, ghost);
     return read_npy_part(path, keep.begin.z, keep.end.z);
   };
-  std::vector<std::uint8_t> mine;
+  // Rank 0 holds one part at a time: each other rank's, moved into its sends, then its own.
+  std::vector<std::uint8_t> fields, values;
   for (int r = 1; r < size; ++r) {
-    std::vector<std::uint8_t> part = detail::collectively(comm, nullptr, [&] {
-      return rank == 0 ? pack_part(part_of(r)) : std::vector<std::uint8_t>{};
-    });
-    std::vector<std::uint8_t> got =
-        detail::send_bytes(comm, r, std::move(part), path.string(), nullptr);
-    if (rank == r) mine = std::move(got);
+    NpyVolume part =
+        detail::collectively(comm, nullptr, [&] { return rank == 0 ? part_of(r) : NpyVolume{}; });
+    std::vector<std::uint8_t> f =
+        detail::send_bytes(comm, r, part_fields(part), path.string(), nullptr);
+    std::vector<std::uint8_t> v =
+        detail::send_bytes(comm, r, std::move(part.bytes), path.string(), nullptr);
+    if (rank == r) fields = std::move(f), values = std::move(v);
   }
   return detail::collectively(comm, nullptr, [&] {
-    const NpyVolume part = rank == 0 ? part_of(0) : unpack_part(mine);
+    const NpyVolume part = rank == 0 ? part_of(0) : part_from(fields, std::move(values));
     return WorldSlab{world_from_npy(part, path.string(), chunk_edge), partition, "npy", true};
   });
 }

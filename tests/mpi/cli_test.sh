@@ -64,6 +64,14 @@ s = json.load(open("stats.json"))
 assert s["ranks"] == 4 and s["read_in_parts"] is True and len(s["slabs"]) == 5, s
 assert s["exchange"]["bytes_sent_total"] == 3 * 16 * 37 * 29, s["exchange"]
 PY
+# --packed: the dissertation's packed voxels (materials' colours and distances), voxfield's file.
+"$VF" field f.npy -o ref.npy --packed ref_packed.npy --metric manhattan --max-distance 20 2>/dev/null
+for n in 1 3; do
+  MPIEXEC -np "$n" "$VFM" field f.npy -o out.npy --packed out_packed.npy --chunk 8 \
+    --metric manhattan --max-distance 20 2>/dev/null
+  same ref_packed.npy out_packed.npy "--packed, $n ranks"
+  same ref.npy out.npy "--packed, $n ranks (field)"
+done
 
 # Bad input: one message (from rank 0), exit 1 (2 for usage), nothing written.
 expect_failure() {  # expect_failure CODE PATTERN ARGS...
@@ -209,9 +217,9 @@ EXPECT_RANKS=3 expect_failure 1 "air.vfw: the input holds no volume" field air.v
 # Read by rank 0 alone (--read rank0, for ranks that cannot see its files): a .npy's parts read by
 # rank 0 and sent rank by rank, the other formats' bytes broadcast and each rank's slab decoded
 # from them; the same fields, edits and frames.
-inputs="f.npy c.npy ref.vfw margins.vfw"
-if [ -f axes.vfw ]; then inputs="$inputs axes.vfw $vox axes.vdb"; fi
-for input in $inputs; do
+inputs=(f.npy c.npy ref.vfw margins.vfw)
+if [ -f axes.vfw ]; then inputs+=(axes.vfw "$vox" axes.vdb); fi
+for input in "${inputs[@]}"; do
   "$VF" field "$input" -o ref.npy --metric euclidean --signed 2>/dev/null
   MPIEXEC -np 3 "$VFM" field "$input" -o out.npy --chunk 8 --metric euclidean --signed \
     --read rank0 --stats stats.json 2>/dev/null
@@ -226,10 +234,31 @@ same ref.npy out.npy "edit --balance content --read rank0, 3 ranks"
 MPIEXEC -np 3 "$VFM" render margins.vfw -o out.png --width 100 --height 80 --chunk 8 \
   --read rank0 2>/dev/null
 same ref.png out.png "render --read rank0, 3 ranks, margins.vfw"
+# Rank 0 cannot read the input: its reason, once, and nothing written.
+expect_failure 1 "missing.npy: cannot open" field missing.npy -o bad.npy --read rank0
+# A value that is no material in rank 1's part: named by its index and byte offset in the file
+# as when rank 1 reads the part itself, though rank 0 read it.
+/usr/bin/python3 -c "
+import numpy as np
+a = np.zeros((9, 7, 30), np.float32); a[4, 3, 27] = 0.5
+np.save('late_fraction.npy', np.asfortranarray(a))"
+expect_failure 1 "rank 1: .*a\[4, 3, 27\] holds 0.5" field late_fraction.npy -o bad.npy --read rank0
+cp err.txt err_rank0.txt
+expect_failure 1 "rank 1: .*a\[4, 3, 27\] holds 0.5" field late_fraction.npy -o bad.npy
+# (voxfield-mpi's own line; mpirun's report after it names its job.)
+[ "$(grep '^voxfield-mpi:' err_rank0.txt)" = "$(grep '^voxfield-mpi:' err.txt)" ] ||
+  { echo "FAIL: a refused value named otherwise when rank 0 read it:"; cat err_rank0.txt err.txt; fail=1; }
 # Ranks 1 and 2 run where the input does not exist (their own working directory; the output's path
-# is absolute): read by rank 0 the field is the same; read by every rank, rank 1 names the file it
-# cannot open and nothing is written.
-mkdir -p seen unseen && cp f.npy seen/in.npy
+# is absolute): read by rank 0 the field is the same, for a .npy (parts sent) and a .vfw (bytes
+# broadcast); read by every rank, rank 1 names the file it cannot open and nothing is written.
+mkdir -p seen unseen && cp f.npy seen/in.npy && cp ref.vfw seen/in.vfw
+"$VF" field ref.vfw -o ref_vfw.npy --metric euclidean --signed 2>/dev/null
+rm -f out.npy
+MPIEXEC -np 1 --wdir "$work/seen" "$VFM" field in.vfw -o "$work/out.npy" --chunk 8 \
+  --metric euclidean --signed --read rank0 : \
+  -np 2 --wdir "$work/unseen" "$VFM" field in.vfw -o "$work/out.npy" --chunk 8 \
+  --metric euclidean --signed --read rank0 >/dev/null 2>&1
+same ref_vfw.npy out.npy "3 ranks, a .vfw seen by rank 0 alone, --read rank0"
 "$VF" field f.npy -o ref.npy --metric euclidean --signed 2>/dev/null
 for read in rank0 every; do
   rm -f out.npy
@@ -417,6 +446,17 @@ rng = np.random.default_rng(5)
 np.save('large.npy', np.asfortranarray((rng.random((160, 160, 160)) < 0.001).astype(np.uint8)))"
 "$VF" field large.npy -o large_ref.npy --metric euclidean --signed 2>/dev/null
 killed=0
+ranks_of() {  # ranks_of PID: the live (not zombie) voxfield-mpi processes descending from PID
+  # (One ps: the job lasts about a second, and a walk of pgrep calls took much of it.)
+  ps -eo pid=,ppid=,stat=,comm= | awk -v root="$1" '
+    { parent[$1] = $2; state[$1] = $3; name[$1] = $4 }
+    END {
+      for (p in parent) if (name[p] == "voxfield-mpi" && state[p] !~ /^Z/) {
+        for (q = p; (q in parent) && q != root; q = parent[q]) {}
+        if (q == root) print p
+      }
+    }'
+}
 for delay in 0.1 0.3 0.5 0.7; do
   printf 'old' > target.npy
   set +e
@@ -427,10 +467,11 @@ for delay in 0.1 0.3 0.5 0.7; do
     --metric euclidean --signed --chunk 16 >/dev/null 2>kill_err.txt &
   job=$!
   sleep "$delay"
-  # The newest rank: a process named voxfield-mpi (mpirun is named mpirun; no other test runs
-  # voxfield-mpi). None yet (a slow start under a sanitizer) means no kill this round.
-  # Zombies are skipped: a rank of the previous round may not be reaped yet.
-  victim=$(pgrep -n -x -r R,S,D voxfield-mpi || true)
+  # A rank of this job: a process named voxfield-mpi among the job's descendants (mpirun is named
+  # mpirun; voxfield-mpi runs of other tests or users on the machine are not this job's). None
+  # yet (a slow start under a sanitizer) means no kill this round. Zombies are skipped: a rank of
+  # the previous round may not be reaped yet.
+  victim=$(ranks_of "$job" | tail -1)
   if [ -n "$victim" ]; then
     # Only once the rank is past MPI's start-up handshake (its PML component is mapped, ~0.1 s
     # in): a rank killed inside the handshake leaves Open MPI 4.1's mpirun waiting forever (it
