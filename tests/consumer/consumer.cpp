@@ -40,6 +40,10 @@ int main(int argc, char** argv) {
   // each rank's slab equals the single-process field there.
   int provided = 0;  // only this thread talks to MPI; voxfield's pool works between the calls
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  if (provided < MPI_THREAD_FUNNELED) {
+    std::fprintf(stderr, "MPI gives thread level %d, below MPI_THREAD_FUNNELED\n", provided);
+    ++wrong;
+  }
   int ranks = 1, rank = 0;
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
