@@ -5,7 +5,7 @@
 //          [--storage S] [--spacing sx,sy,sz] [--sites S.npy] [--stats S.json] [--chunk C]
 //          [--threads T] [--memory-limit B]
 //   mpirun -np N voxfield-mpi edit IN -e EDITS.jsonl -o OUT.npy [field options] [--stats S.json]
-//          [--balance volume|content|edits] [--save-world W.vfw]
+//          [--balance volume|content|edits] [--save-world W.vfw|W.npy]
 //   mpirun -np N voxfield-mpi bench --size X,Y,Z [--spheres K] [--repeat R] [field options]
 //   mpirun -np N voxfield-mpi mesh IN.npy -o OUT.{ply,obj,stl,glb} [--algorithm mc|sn|dc]
 //          [--iso V] [--inside below|above] [--spacing sx,sy,sz] [--chunk C]
@@ -133,7 +133,7 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
                           {"read", mpi_cli::read_name(slab.read_by)},
                           {"slabs", slab.partition.z}});
   j["exchange"] = exchange_json(comm, ex);
-  mpi::FieldFiles files{out, sites, stats, j.dump(2) + "\n", packed, &slab.world};
+  mpi::FieldFiles files{out, sites, stats, j.dump(2) + "\n", packed, &slab.world, {}};
   mpi::write_field_npy(comm, slab.partition, field, files);
   if (rank == 0) {
     const Vec3i d = domain.size();
@@ -160,10 +160,11 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   std::optional<ThreadLimit> limit;
   if (f.threads > 0) limit.emplace(f.threads);
   const DistanceOptions o = f.options();
-  if (!save_world.empty() && std::filesystem::path(save_world).extension() != ".vfw")
+  const std::string world_ext = std::filesystem::path(save_world).extension().string();
+  if (!save_world.empty() && world_ext != ".vfw" && world_ext != ".npy")
     throw InvalidArgument(
-        "--save-world: voxfield-mpi writes worlds as .vfw (each rank its "
-        "chunks); voxfield convert turns it into .vox or .npy");
+        "--save-world: voxfield-mpi writes worlds as .vfw or .npy (each rank its "
+        "slab); voxfield convert turns either into .vox");
   mpi::check_outputs(comm, {out, save_world}, {stats});
   // The script and the ghost slices are checked on every rank before the world is loaded.
   // (Two named values, not a structured binding: the loop's lambda below captures the script,
@@ -246,9 +247,17 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   std::optional<FileTransaction> outputs;
   if (rank == 0) outputs.emplace();
   FileTransaction* tx = outputs ? &*outputs : nullptr;
+  const bool world_npy = world_ext == ".npy";
   mpi::write_field_npy(comm, slab.partition, editor.field(),
-                       {out, {}, stats, j.dump(2) + "\n", {}, nullptr}, nullptr, tx);
-  if (!save_world.empty())
+                       {out,
+                        {},
+                        stats,
+                        j.dump(2) + "\n",
+                        {},
+                        &editor.world(),
+                        world_npy ? save_world : std::string()},
+                       nullptr, tx);
+  if (!save_world.empty() && !world_npy)
     mpi::save_world_vfw(comm, slab.partition, editor.world(), save_world, nullptr, tx);
   mpi::collectively(comm, [&] {
     if (tx) tx->commit();
@@ -337,7 +346,7 @@ int main(int argc, char** argv) {
   edit->add_option("-o,--output", edit_out, "output .npy of the final field")->required();
   edit->add_option("--stats", edit_stats, "per-edit latency of the slowest rank, as JSON");
   edit->add_option("--save-world", edit_save,
-                   "also write the edited world as one .vfw (every rank its chunks)");
+                   "also write the edited world as one .vfw or .npy (every rank its slab)");
   edit->add_option("--balance", edit_balance,
                    "cut the slabs by volume (default), by content (the chunks holding air and "
                    "solid, counted in a first reading) or by the script's edits (what each will "

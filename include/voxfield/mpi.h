@@ -250,9 +250,11 @@ struct FieldFiles {
   std::filesystem::path json;    // optional: written by rank 0 with `json_text`
   std::string json_text;
   // Optional: the dissertation's packed uint32 voxels (dissertation_format.h) of `world`, this
-  // rank's world holding at least its slab, with the field's distances.
+  // rank's world holding at least its slab, with the field's distances; and the world's
+  // materials, uint8 a[x, y, z] over the domain (the .npy save_world writes).
   std::filesystem::path packed;
   const World* world = nullptr;
+  std::filesystem::path materials;
 };
 
 // Checks the targets (empty paths skipped) as check_output_path does, on rank 0 whose view of the

@@ -88,6 +88,19 @@ detail::FilePiece packed_piece(const World& world, const DistanceField& f, const
   return p;
 }
 
+// The world's materials over this rank's slab, at its place.
+detail::FilePiece materials_piece(const World& world, const Box3i& slab, const Box3i& domain) {
+  require_memory(dense_bytes(slab, 1), 0, "materials output",
+                 "a dense copy of this rank's slab " + to_string(slab));
+  detail::FilePiece p;
+  p.offset = static_cast<std::uint64_t>(slab.begin.z - domain.begin.z) *
+             static_cast<std::uint64_t>(domain.size().x) *
+             static_cast<std::uint64_t>(domain.size().y);
+  p.bytes.resize(static_cast<std::size_t>(slab.volume()));
+  world.voxels.copy_to_dense(slab, p.bytes.data());
+  return p;
+}
+
 }  // namespace
 
 void check_outputs(MPI_Comm comm, const std::vector<std::filesystem::path>& shared,
@@ -134,13 +147,16 @@ void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const Distan
                             ", not all of its slab " + to_string(partition.slab(rank)));
     if (!files.sites.empty() && !slab.sites)
       throw InvalidArgument("the field has no nearest sites to write");
-    if (!files.packed.empty() && !files.world)
-      throw InvalidArgument("packed voxels need this rank's world (FieldFiles::world)");
+    if ((!files.packed.empty() || !files.materials.empty()) && !files.world)
+      throw InvalidArgument(
+          "packed voxels and materials need this rank's world (FieldFiles::world)");
     outputs.push_back({&files.values, npy_header(values_dtype(slab), domain.size()), {}, {}});
     if (!files.sites.empty())
       outputs.push_back({&files.sites, npy_header(DType::kInt16, domain.size(), 3), {}, {}});
     if (!files.packed.empty())
       outputs.push_back({&files.packed, npy_header(DType::kUInt32, domain.size()), {}, {}});
+    if (!files.materials.empty())
+      outputs.push_back({&files.materials, npy_header(DType::kUInt8, domain.size()), {}, {}});
     if (rank != 0) return;
     if (!transaction) transaction = &own.emplace();
     for (std::size_t k = 0; k < outputs.size(); ++k)
@@ -165,6 +181,8 @@ void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const Distan
       if (!files.sites.empty()) outputs[k++].pieces = sites_pieces(*slab.sites, mine, domain);
       if (!files.packed.empty())
         outputs[k++].pieces.push_back(packed_piece(*files.world, slab, mine, domain));
+      if (!files.materials.empty())
+        outputs[k++].pieces.push_back(materials_piece(*files.world, mine, domain));
     } catch (const std::exception& e) {
       error = e.what();
       for (Output& o : outputs) o.pieces.clear();

@@ -135,6 +135,14 @@ for n in 1 2 3 4; do
   same ref.vfw out.vfw "edit --save-world, $n ranks"
   same ref.npy out.npy "edit --save-world, $n ranks (field)"
 done
+# The edited world as one .npy of materials, every rank its slices: voxfield edit's file.
+"$VF" edit f.npy -e edits.jsonl -o ref.npy --chunk 8 --max-distance 6 --save-world ref_world.npy 2>/dev/null
+for n in 1 3; do
+  MPIEXEC -np "$n" "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 --max-distance 6 \
+    --save-world out_world.npy 2>/dev/null
+  same ref_world.npy out_world.npy "edit --save-world .npy, $n ranks"
+  same ref.npy out.npy "edit --save-world .npy, $n ranks (field)"
+done
 # That bounded .vfw as input: every rank decodes only its slab's chunks (read_in_parts), in the
 # file's chunks of 8 or re-chunked to 16, the field byte-identical to voxfield's.
 "$VF" field ref.vfw -o ref.npy --metric euclidean --signed 2>/dev/null
@@ -154,7 +162,7 @@ PY
 /usr/bin/python3 -c "import numpy as np; np.save('short.npy', np.ones((8, 8, 20), np.uint8))"
 EXPECT_RANKS=4 expect_failure 1 "needs slabs cut on chunk boundaries" edit short.npy -e edits.jsonl -o bad.npy \
   --chunk 8 --max-distance 3 --save-world bad.vfw
-expect_failure 1 "writes worlds as .vfw" edit f.npy -e edits.jsonl -o bad.npy --max-distance 3 \
+expect_failure 1 "writes worlds as .vfw or .npy" edit f.npy -e edits.jsonl -o bad.npy --max-distance 3 \
   --save-world bad.vox
 expect_failure 1 "edits over several ranks need a clamped field" edit f.npy -e edits.jsonl -o bad.npy --metric euclidean
 printf '{"op":"place","shape":"sphere","center":[1,2,3],"radius":-1,"material":1}\n' > bad_edit.jsonl

@@ -311,7 +311,7 @@ TEST(MpiField, WritesOneFileOrNothing) {
     std::filesystem::create_directories(dir);
   }
   MPI_Barrier(comm());
-  mpi::FieldFiles files{dir / "f.npy", dir / "s.npy", dir / "f.json", "{}\n", {}, nullptr};
+  mpi::FieldFiles files{dir / "f.npy", dir / "s.npy", dir / "f.json", "{}\n", {}, nullptr, {}};
   mpi::write_field_npy(comm(), p, f, files);
   if (rank() == 0) {
     DistanceOptions whole_o = o;
@@ -344,7 +344,7 @@ TEST(MpiField, WritesOneFileOrNothing) {
   }
   MPI_Barrier(comm());
   const auto before = rank() == 0 ? read_file(dir / "f.npy") : std::vector<std::uint8_t>{};
-  mpi::FieldFiles bad{dir / "f.npy", dir / "ro.npy", {}, {}, {}, nullptr};
+  mpi::FieldFiles bad{dir / "f.npy", dir / "ro.npy", {}, {}, {}, nullptr, {}};
   EXPECT_THROW(mpi::write_field_npy(comm(), p, f, bad), mpi::RankError);
   if (rank() == 0) {
     EXPECT_EQ(read_file(dir / "f.npy"), before);
