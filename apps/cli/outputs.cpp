@@ -8,19 +8,6 @@
 #include "cli.h"
 
 namespace voxfield::cli {
-namespace {
-
-// Two names for one file: the same existing file, or the same path once made absolute.
-bool same_target(const std::string& a, const std::string& b) {
-  if (a == "-" || b == "-") return a == b;  // standard output once at most
-  if (same_file(a, b)) return true;
-  std::error_code ea, eb;
-  const auto ca = std::filesystem::weakly_canonical(a, ea),
-             cb = std::filesystem::weakly_canonical(b, eb);
-  return !ea && !eb && ca == cb;
-}
-
-}  // namespace
 
 void Outputs::expect(const std::string& path, const std::string& option, bool may_be_input) {
   if (path.empty()) return;

@@ -112,7 +112,7 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
   DistanceOptions o = f.options();
   o.nearest_sites = !sites.empty();
   // Everything that can be wrong with the outputs is found before the world is loaded.
-  mpi::check_outputs(comm, {out, sites, packed}, {stats});
+  mpi::check_outputs(comm, {out, sites, packed}, {stats}, {in});
   const double t0 = MPI_Wtime();
   const mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk, 0, mpi_cli::read_by(f.read));
   const double load_ms = (MPI_Wtime() - t0) * 1e3;
@@ -165,7 +165,7 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
     throw InvalidArgument(
         "--save-world: voxfield-mpi writes worlds as .vfw or .npy (each rank its "
         "slab); voxfield convert turns either into .vox");
-  mpi::check_outputs(comm, {out, save_world}, {stats});
+  mpi::check_outputs(comm, {out, save_world}, {stats}, {in, edits_path});
   // The script and the ghost slices are checked on every rank before the world is loaded.
   // (Two named values, not a structured binding: the loop's lambda below captures the script,
   // and clang 14, which CI's sanitizer builds use, cannot capture a binding.)

@@ -62,7 +62,7 @@ int run_mesh(MPI_Comm comm, const MeshSettings& s) {
   options.inside_above = s.inside == "above";
   options.chunk_edge = s.chunk;
   (void)mesh_format_of(s.out);  // an unknown extension is refused before any work
-  mpi::check_outputs(comm, {}, {s.out, s.stats});
+  mpi::check_outputs(comm, {}, {s.out, s.stats}, {s.in});
   // Every rank reads the header; a world (integer or bool .npy) is not a float volume.
   const NpyVolume header = mpi::collectively(comm, [&] {
     NpyVolume h = read_npy_header(s.in);

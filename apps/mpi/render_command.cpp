@@ -73,7 +73,7 @@ int run_render(MPI_Comm comm, const RenderSettings& s) {
   o.soft_shadows = !s.no_shadows;
   o.ambient_occlusion = !s.no_ao;
   o.fog_density = s.fog;
-  mpi::check_outputs(comm, {}, {s.out, s.stats});
+  mpi::check_outputs(comm, {}, {s.out, s.stats}, {s.in});
   const double t0 = MPI_Wtime();
   // Each rank holds its slab and the slices its lighting reads beyond it.
   const mpi::WorldSlab slab =

@@ -60,6 +60,9 @@ void check_output_path(const std::filesystem::path& path);
 // Whether two paths name the same existing file (std::filesystem::equivalent, following symbolic
 // links); false when either does not exist or cannot be examined.
 bool same_file(const std::filesystem::path& a, const std::filesystem::path& b);
+// Whether two paths name one target to write: the same existing file, or the same path once made
+// absolute (a file not written yet); "-" (standard output) is only itself.
+bool same_target(const std::filesystem::path& a, const std::filesystem::path& b);
 
 // A set of output files written all or nothing.
 //

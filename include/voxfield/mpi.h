@@ -260,9 +260,11 @@ struct FieldFiles {
 // Checks the targets (empty paths skipped) as check_output_path does, on rank 0 whose view of the
 // file system writes them, before any work: every rank throws RankError when one cannot be
 // written. `shared` targets, which every rank writes into (the .npy and .vfw outputs), must also be
-// regular files or new ones; `rank0` ones (a JSON file) may be standard output.
+// regular files or new ones; `rank0` ones (a JSON file) may be standard output. No two targets may
+// name one file (the later would replace the earlier), nor any of `inputs`.
 void check_outputs(MPI_Comm comm, const std::vector<std::filesystem::path>& shared,
-                   const std::vector<std::filesystem::path>& rank0 = {});
+                   const std::vector<std::filesystem::path>& rank0 = {},
+                   const std::vector<std::filesystem::path>& inputs = {});
 
 // Writes every rank's slab of the field (a field covering at least the rank's slab: its values over
 // the slab are written) into one .npy per output, byte for byte what `voxfield

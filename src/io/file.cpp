@@ -339,6 +339,15 @@ bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
   return !ec && same;
 }
 
+bool same_target(const std::filesystem::path& a, const std::filesystem::path& b) {
+  if (a == "-" || b == "-") return a == b;  // standard output once at most
+  if (same_file(a, b)) return true;
+  std::error_code ea, eb;
+  const auto ca = std::filesystem::weakly_canonical(a, ea),
+             cb = std::filesystem::weakly_canonical(b, eb);
+  return !ea && !eb && ca == cb;
+}
+
 struct FileTransaction::Impl {
   std::vector<Staged> staged;
   std::string failure;  // the error that ended this transaction, if one did

@@ -76,7 +76,8 @@ std::vector<detail::FilePiece> sites_pieces(const Grid<SiteOffset>& g, const Box
 // The dissertation's packed voxels of this rank's slab (dissertation_format.h), at its place.
 detail::FilePiece packed_piece(const World& world, const DistanceField& f, const Box3i& slab,
                                const Box3i& domain) {
-  require_memory(dense_bytes(slab, 2 * sizeof(std::uint32_t)), 0, "--packed output",
+  // At its peak, packing holds 13 bytes a voxel: the words, a byte of material and a float.
+  require_memory(dense_bytes(slab, 13), 0, "--packed output",
                  "a dense copy of this rank's slab " + to_string(slab));
   const std::vector<std::uint32_t> packed = pack_dissertation_format(world, f, slab);
   detail::FilePiece p;
@@ -104,7 +105,8 @@ detail::FilePiece materials_piece(const World& world, const Box3i& slab, const B
 }  // namespace
 
 void check_outputs(MPI_Comm comm, const std::vector<std::filesystem::path>& shared,
-                   const std::vector<std::filesystem::path>& rank0) {
+                   const std::vector<std::filesystem::path>& rank0,
+                   const std::vector<std::filesystem::path>& inputs) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   detail::collectively(comm, nullptr, [&] {
@@ -120,6 +122,19 @@ void check_outputs(MPI_Comm comm, const std::vector<std::filesystem::path>& shar
     }
     for (const auto& p : rank0)
       if (!p.empty()) check_output_path(p);
+    std::vector<std::filesystem::path> targets;
+    for (const auto* list : {&shared, &rank0})
+      for (const auto& p : *list) {
+        if (p.empty()) continue;
+        for (const auto& in : inputs)
+          if (same_target(p, in))
+            throw InvalidArgument(p.string() +
+                                  " is also an input of this command; writing it would destroy " +
+                                  in.string() + " (choose another output)");
+        for (const auto& t : targets)
+          if (same_target(p, t)) throw InvalidArgument(p.string() + " is given as two outputs");
+        targets.push_back(p);
+      }
   });
 }
 

@@ -162,6 +162,12 @@ PY
 /usr/bin/python3 -c "import numpy as np; np.save('short.npy', np.ones((8, 8, 20), np.uint8))"
 EXPECT_RANKS=4 expect_failure 1 "needs slabs cut on chunk boundaries" edit short.npy -e edits.jsonl -o bad.npy \
   --chunk 8 --max-distance 3 --save-world bad.vfw
+# Two outputs on one file, or an output on an input: refused before anything is read.
+expect_failure 1 "bad.npy is given as two outputs" field f.npy -o bad.npy --packed bad.npy
+cp f.npy keep.npy
+expect_failure 1 "keep.npy is also an input of this command" edit keep.npy -e edits.jsonl -o bad.npy \
+  --max-distance 3 --save-world keep.npy
+same f.npy keep.npy "an input named as --save-world"
 expect_failure 1 "writes worlds as .vfw or .npy" edit f.npy -e edits.jsonl -o bad.npy --max-distance 3 \
   --save-world bad.vox
 expect_failure 1 "edits over several ranks need a clamped field" edit f.npy -e edits.jsonl -o bad.npy --metric euclidean
