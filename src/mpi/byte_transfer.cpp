@@ -4,7 +4,7 @@
 // Every transfer is agreed on before a byte moves: the size goes first, each receiving rank
 // checks it against its memory limit and allocates, and the ranks agree on that, so a rank that
 // cannot hold the bytes fails every rank with its reason instead of leaving rank 0 waiting in a
-// send. The bytes then move in pieces of at most 1 GiB (MPI's counts are ints).
+// send. The bytes then move in pieces of at most kMessageBytes (collective.h).
 #include <algorithm>
 #include <utility>
 
@@ -15,7 +15,7 @@ namespace voxfield::mpi::detail {
 
 namespace {
 
-constexpr std::uint64_t kPiece = std::uint64_t{1} << 30;
+constexpr std::uint64_t kPiece = kMessageBytes;
 
 // Room for `n` bytes on this rank, agreed on by every rank (ResourceLimitError past the limit).
 std::vector<std::uint8_t> agreed_room(MPI_Comm comm, bool receives, std::uint64_t n,

@@ -54,6 +54,10 @@ void require_partition(MPI_Comm comm, const SlabPartition& partition);
 // Rank 0's `text` on every rank.
 std::string broadcast_string(MPI_Comm comm, std::string text, ExchangeStats* stats);
 
+// The largest message the layer sends in one call: MPI counts are ints, and pieces of this size
+// keep a transfer's buffers in MPI's eager and rendezvous paths alike.
+constexpr std::size_t kMessageBytes = std::size_t{256} << 20;
+
 // Rank 0's `bytes` on every rank (byte_transfer.cpp): the size first, each rank's room for it
 // agreed on (ResourceLimitError past a rank's memory limit, naming `name`, on every rank), then
 // the bytes.

@@ -153,7 +153,7 @@ std::vector<double> mesh_layer_weights(MPI_Comm comm, Vec3i samples, int z0, int
 namespace {
 
 constexpr int kPieceTag = 7401;
-constexpr std::size_t kMessageBytes = std::size_t{256} << 20;
+using detail::kMessageBytes;
 
 // Every rank's piece on rank 0 (in rank order; empty on the others). Sizes first, then each
 // piece in messages of at most kMessageBytes.

@@ -32,7 +32,7 @@ namespace voxfield::mpi {
 namespace {
 
 constexpr int kWeldTag = 7402;
-constexpr std::size_t kMessageBytes = std::size_t{256} << 20;
+using detail::kMessageBytes;
 
 // Sends `out` to `to` and receives from `from` (either MPI_PROC_NULL): a count, then the items in
 // messages of at most kMessageBytes.
