@@ -143,7 +143,8 @@ void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const Distan
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   const Box3i& domain = partition.domain;
-  // The outputs in order: the values, then the sites and the packed voxels when asked for.
+  // The outputs in order: the values, then the sites, the packed voxels and the materials when
+  // asked for.
   struct Output {
     const std::filesystem::path* path;
     std::vector<std::uint8_t> head;
