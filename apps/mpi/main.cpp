@@ -2,17 +2,17 @@
 // an MPI job.
 //
 //   mpirun -np N voxfield-mpi field IN -o OUT.npy [--metric M] [--signed] [--max-distance D]
-//          [--storage S] [--spacing sx,sy,sz] [--sites S.npy] [--stats S.json] [--chunk C]
-//          [--threads T] [--memory-limit B]
+//          [--storage S] [--spacing sx,sy,sz] [--sites S.npy] [--packed P.npy] [--stats S.json]
+//          [--chunk C] [--threads T] [--read every|rank0] [--memory-limit B]
 //   mpirun -np N voxfield-mpi edit IN -e EDITS.jsonl -o OUT.npy [field options] [--stats S.json]
-//          [--balance volume|content|edits] [--save-world W.vfw|W.npy]
+//          [--balance volume|content|edits] [--save-world W.vfw|W.npy] [--read every|rank0]
 //   mpirun -np N voxfield-mpi bench --size X,Y,Z [--spheres K] [--repeat R] [field options]
 //   mpirun -np N voxfield-mpi mesh IN.npy -o OUT.{ply,obj,stl,glb} [--algorithm mc|sn|dc]
 //          [--iso V] [--inside below|above] [--spacing sx,sy,sz] [--chunk C]
 //          [--balance content|count] [--threads T] [--stats S.json]
 //   mpirun -np N voxfield-mpi render IN -o OUT.png [--width W] [--height H] [--camera C]
 //          [--view shaded|chunks] [--metric M] [--skip S] [--no-shadows] [--no-ao] [--fog F]
-//          [--chunk C] [--threads T] [--stats S.json]
+//          [--chunk C] [--threads T] [--repeat N] [--read every|rank0] [--stats S.json]
 //
 // `field` writes byte for byte what `voxfield field` writes for the same input and options; each
 // rank holds only its slab of a .npy input and of the field. `edit` writes what `voxfield edit`
