@@ -67,9 +67,9 @@ int relay_ghost_slices(const RenderSceneOptions& options);
 // The box a part's world must hold: the part and relay_ghost_slices along z, within `whole`.
 Box3i relay_world_box(const Box3i& whole, const Box3i& part, const RenderSceneOptions& options);
 
-// What RelayFrame refuses before any field is computed (InvalidArgument): a view other than
-// shaded and chunks, a part that is not a slab of `whole` cut on chunk boundaries of `chunk_edge`,
-// options render() or RenderScene refuse.
+// What RelayFrame refuses before any field is computed (InvalidArgument): the error view, a
+// distance view whose slice lies outside `whole`, a part that is not a slab of `whole` cut on chunk
+// boundaries of `chunk_edge`, options render() or RenderScene refuse.
 void check_relay_frame(const Box3i& whole, const Box3i& part, int chunk_edge,
                        const RenderSceneOptions& scene_options, const RenderOptions& options);
 
@@ -85,9 +85,10 @@ class RelayFrame {
   // where they straddle the box's faces, so outside `whole` the world must hold what the whole
   // scene's world holds there (nothing, when `whole` bounds the content, as a file's extent does).
   // `skip`: a field of relay_skip_field_options(scene_options, whole) whose values over `part` are
-  // the whole box's. The part's lighting field is computed here. Views: shaded and chunks. Throws
-  // InvalidArgument for another view, a part that is not such a slab, fields or options that do not
-  // fit (as render() and RenderScene do).
+  // the whole box's. The part's lighting field is computed here. Views: shaded, chunks and
+  // distance (its rays walk the box below the cut plane, with no shadow rays, and the part holding
+  // the plane's slice draws the cut). Throws InvalidArgument for the error view, a part that is not
+  // such a slab, fields or options that do not fit (as render() and RenderScene do).
   RelayFrame(const World& world, const Box3i& whole, const Box3i& part, const DistanceField& skip,
              const RenderSceneOptions& scene_options, const Camera& camera,
              const RenderOptions& options);

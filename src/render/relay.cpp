@@ -9,6 +9,11 @@
 // carrying the DDA's state, which the next part resumes with Dda::start, its penumbra travelling
 // along (the minimum over the voxels read is the same whichever part read them); it cannot start
 // early, since its estimate depends on every voxel before.
+//
+// The distance view walks its primary rays through the box below the cut plane instead, and has no
+// shadow rays: a ray that enters that box through the plane on an air voxel is the cut's pixel,
+// drawn from the skip field there by the part that holds the plane's slice (nothing along the ray
+// comes before its entry into the box).
 #include "voxfield/render_relay.h"
 
 #include <algorithm>
@@ -109,12 +114,28 @@ Box3i relay_world_box(const Box3i& whole, const Box3i& part, const RenderSceneOp
   return grown_along_z(part, relay_ghost_slices(options), whole);
 }
 
+namespace {
+
+// The distance view's cut plane: RenderOptions::slice_z, by default the middle of the whole box
+// (as RenderScene's, whose box the whole box is).
+int relay_slice_z(const Box3i& whole, const RenderOptions& options) {
+  const int z = options.slice_z ? *options.slice_z : (whole.begin.z + whole.end.z) / 2;
+  if (z < whole.begin.z || z >= whole.end.z)
+    throw InvalidArgument("render: slice z=" + std::to_string(z) + " lies outside the box " +
+                          to_string(whole));
+  return z;
+}
+
+}  // namespace
+
 void check_relay_frame(const Box3i& whole, const Box3i& part, int chunk_edge,
                        const RenderSceneOptions& scene_options, const RenderOptions& options) {
-  if (options.view != RenderView::kShaded && options.view != RenderView::kChunks)
-    throw InvalidArgument(std::string("render: the ") + render_view_name(options.view) +
-                          " view is not drawn part by part (shaded and chunks are)");
+  if (options.view == RenderView::kError)
+    throw InvalidArgument(
+        "render: the error view is not drawn part by part (shaded, chunks and distance are): the "
+        "approximate algorithms it shows run on one process");
   check_part(whole, part, chunk_edge);
+  if (options.view == RenderView::kDistance) (void)relay_slice_z(whole, options);
   (void)relay_skip_field_options(scene_options, whole);
   (void)relay_ghost_slices(scene_options);
   render_detail::check_frame_options(scene_options.lighting_field, options);
@@ -126,12 +147,21 @@ DistanceOptions relay_skip_field_options(const RenderSceneOptions& options, cons
 
 struct RelayFrame::Impl {
   Box3i whole, part;
+  // The box primary rays walk (the whole box, or in the distance view the part of it below the cut
+  // plane), and its part in this part's slab (can be empty).
+  Box3i walk_box, walk_part;
+  bool distance_view = false;
+  int slice_z = 0;
+  double heat_max = 1;  // the distance view's top of the heat ramp, if the slice is this part's
   RenderScene scene;
   RenderOptions o;
   Camera::Projector projector;
   HitShading light;
   std::vector<RayHit> hits;
   std::vector<RelayHit> candidates;  // this part's hit per pixel, for the pixel's first
+  // The distance view: per pixel, the skip field's stored value where its ray enters the cut plane
+  // on an air voxel of this part, else -1.
+  std::vector<std::int16_t> cut_values;
   std::vector<double> shadow_ends;
   RenderStats stats;
   std::mutex merge;
@@ -140,10 +170,20 @@ struct RelayFrame::Impl {
        const RenderSceneOptions& scene_options, const Camera& camera, const RenderOptions& options)
       : whole(whole_box),
         part(part_box),
+        walk_box(whole_box),
+        walk_part(part_box),
+        distance_view(options.view == RenderView::kDistance),
         scene(part_scene(world, whole_box, part_box, skip, scene_options)),
         o(options),
         projector(camera.projector(options.width, options.height)),
-        light{scene.impl(), o, options.sun_direction.normalized(), projector.sky_scale} {}
+        light{scene.impl(), o, options.sun_direction.normalized(), projector.sky_scale} {
+    if (!distance_view) return;
+    slice_z = relay_slice_z(whole, o);
+    walk_box.end.z = slice_z + 1;
+    walk_part = part.intersect(walk_box);
+    // The scene's box spans the whole box along x and y, so its slice is the whole box's.
+    if (part.begin.z <= slice_z && slice_z < part.end.z) heat_max = scene.impl().heat_max(slice_z);
+  }
 
   std::size_t pixels() const { return static_cast<std::size_t>(o.width) * o.height; }
   Ray primary_ray(std::uint32_t pixel) const {
@@ -167,30 +207,30 @@ struct RelayFrame::Impl {
     return ray.direction.z < 0 ? -part.begin.z : part.begin.z;
   }
 
-  // Moves a walk that entered the whole box outside the part to the voxel where the plain DDA
-  // enters the part: leaving the box that reaches from dda's voxel to the part along z and to the
-  // whole box's faces along x and y lands there, on the plain DDA's voxel, time and face (dda.h).
-  // False when the ray moves away from the part or leaves the whole box first.
+  // Moves a primary ray's walk that entered the walk box outside the part to the voxel where the
+  // plain DDA enters the part: leaving the box that reaches from dda's voxel to the part along z
+  // and to the walk box's faces along x and y lands there, on the plain DDA's voxel, time and face
+  // (dda.h). False when the ray moves away from the part or leaves the walk box first.
   bool enter_part(Dda& dda) const {
     int caps[3] = {0, 0, 0};
-    if (dda.step[2] > 0 && dda.v.z < part.begin.z) {
-      caps[2] = part.begin.z - dda.v.z - 1;
-    } else if (dda.step[2] < 0 && dda.v.z >= part.end.z) {
-      caps[2] = dda.v.z - part.end.z;
+    if (dda.step[2] > 0 && dda.v.z < walk_part.begin.z) {
+      caps[2] = walk_part.begin.z - dda.v.z - 1;
+    } else if (dda.step[2] < 0 && dda.v.z >= walk_part.end.z) {
+      caps[2] = dda.v.z - walk_part.end.z;
     } else {
       return false;
     }
     for (int a = 0; a < 2; ++a)
-      caps[a] = dda.step[a] > 0 ? whole.end[a] - 1 - dda.v[a] : dda.v[a] - whole.begin[a];
+      caps[a] = dda.step[a] > 0 ? walk_box.end[a] - 1 - dda.v[a] : dda.v[a] - walk_box.begin[a];
     const Dda::Exit e = dda.exit_of(caps);
     if (e.axis != 2) return false;
     dda.leave(caps, e);
     return true;
   }
 
-  // Walks a ray from dda's voxel (in the part) until it hits, leaves the whole box, or leaves the
-  // part for another (a shadow ray then goes on as a leg in `out`; the part a primary ray goes on
-  // to walks it from there itself).
+  // Walks a ray from dda's voxel (in the part: walk_part for a primary ray) until it hits, leaves
+  // the whole box, or leaves the part for another (a shadow ray then goes on as a leg in `out`; the
+  // part a primary ray goes on to walks it from there itself).
   void run(const Ray& ray, Dda& dda, std::uint32_t pixel, bool shadow, double lit,
            std::vector<RayLeg>& out, RenderStats& st) {
     const RenderScene::Impl& s = scene.impl();
@@ -202,8 +242,9 @@ struct RelayFrame::Impl {
     };
     RayHit hit;
     for (;;) {
-      const Step step = render_detail::visit(s, part, shadow ? SkipMode::kDistance : o.skip, s.skip,
-                                             sw, dda, c, on_air, hit);
+      const Step step =
+          render_detail::visit(s, shadow ? part : walk_part, shadow ? SkipMode::kDistance : o.skip,
+                               s.skip, sw, dda, c, on_air, hit);
       if (step == Step::kContinue) continue;
       if (step == Step::kHit) {
         if (shadow) {
@@ -226,7 +267,7 @@ struct RelayFrame::Impl {
   // here.
   void first_hit(std::uint32_t pixel, const Ray& ray, const RayHit& hit, std::vector<RayLeg>& out,
                  RenderStats& st) {
-    if (!light.wants_shadow(hit, ray)) {
+    if (distance_view || !light.wants_shadow(hit, ray)) {  // the distance view casts no shadows
       shadow_ends[pixel] = 1;
       return;
     }
@@ -270,6 +311,7 @@ RelayFrame::RelayFrame(const World& world, const Box3i& whole, const Box3i& part
   impl_ = std::make_unique<Impl>(world, whole, part, skip, scene_options, camera, options);
   impl_->hits.assign(impl_->pixels(), RayHit{});
   impl_->candidates.assign(impl_->pixels(), RelayHit{});
+  if (impl_->distance_view) impl_->cut_values.assign(impl_->pixels(), -1);
   impl_->shadow_ends.assign(impl_->pixels(), std::numeric_limits<double>::infinity());
   impl_->stats.width = options.width;
   impl_->stats.height = options.height;
@@ -283,12 +325,24 @@ const std::vector<RelayHit>& RelayFrame::start() {
     const auto pixel = static_cast<std::uint32_t>(i);
     const Ray ray = f.primary_ray(pixel);
     Dda d;
-    if (!render_detail::start_in_box(f.whole, ray, d)) return;
-    // The time the ray enters the whole box comes from the box's planes, its later events from the
+    if (!render_detail::start_in_box(f.walk_box, ray, d)) return;
+    // The time the ray enters the walk box comes from the box's planes, its later events from the
     // DDA's formula, which can be an ulp earlier (a z crossing right after an entry through x or
     // y): no hit is ordered before it, so the part met first keeps a tie there too.
     const double entry_t = d.t;
-    if (!f.part.contains(d.v) && !f.enter_part(d)) return;
+    if (f.distance_view && d.face_axis == 2 && d.step[2] < 0 && f.part.contains(d.v)) {
+      const RenderScene::Impl& s = f.scene.impl();
+      const std::size_t chunk = s.table.chunk_index(d.v);
+      const std::uint32_t brick = s.table.brick_index(d.v);
+      if (s.skip.material(chunk, brick) == 0) {
+        // In through the cut plane on air: the cut's pixel, first along the ray.
+        ++st.primary.rays;
+        f.cut_values[pixel] = s.skip.distance(chunk, brick);
+        f.candidates[pixel] = {entry_t, f.along(ray)};
+        return;
+      }
+    }
+    if (f.walk_part.empty() || (!f.walk_part.contains(d.v) && !f.enter_part(d))) return;
     f.run(ray, d, pixel, false, 1, out, st);
     const RayHit& hit = f.hits[pixel];
     if (hit.hit) f.candidates[pixel] = {std::max(hit.t, entry_t), f.along(ray)};
@@ -303,12 +357,15 @@ std::vector<RayLeg> RelayFrame::start_shadows(std::span<const RelayHit> first) {
                           std::to_string(f.pixels()) + " pixels");
   return f.in_parallel(f.pixels(), [&](std::size_t i, std::vector<RayLeg>& out, RenderStats& st) {
     RayHit& hit = f.hits[i];
-    if (!hit.hit) return;
+    const bool cut = f.distance_view && f.cut_values[i] >= 0;
+    if (!hit.hit && !cut) return;
     const RelayHit mine = f.candidates[i];
     if (first[i].t != mine.t || first[i].along != mine.along) {
       hit.hit = false;  // a part before this one along the ray hit first
+      if (cut) f.cut_values[i] = -1;
       return;
     }
+    if (cut) return;  // the cut's pixel: no shadow
     const auto pixel = static_cast<std::uint32_t>(i);
     f.first_hit(pixel, f.primary_ray(pixel), hit, out, st);
   });
@@ -350,6 +407,13 @@ std::vector<std::uint8_t> RelayFrame::shade(std::span<const double> shadow) cons
   parallel_for(f.pixels(), 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const RayHit& h = f.hits[i];
+      if (f.distance_view && f.cut_values[i] >= 0) {
+        render_detail::cut_plane_heat(static_cast<std::uint8_t>(f.cut_values[i]),
+                                      f.scene.impl().skip.inv_scale, f.heat_max,
+                                      rgba.data() + 4 * i);
+        rgba[4 * i + 3] = 255;
+        continue;
+      }
       if (!h.hit) continue;
       const Ray ray = f.primary_ray(static_cast<std::uint32_t>(i));
       Rgb c = f.light.shade(h, ray, shadow[i]);

@@ -48,16 +48,7 @@ using render_detail::Rgb;
 using render_detail::sky;
 using render_detail::tone_map;
 
-// A perceptual heat ramp (dark blue, blue, green, yellow, red) for x in [0, 1], as sRGB bytes.
-void heat(double x, std::uint8_t* px) {
-  static constexpr double kStops[5][3] = {
-      {20, 12, 70}, {30, 100, 220}, {40, 190, 130}, {245, 215, 50}, {215, 40, 30}};
-  x = std::clamp(x, 0.0, 1.0) * 4;
-  const int i = std::min(3, static_cast<int>(x));
-  const double f = x - i;
-  for (int c = 0; c < 3; ++c)
-    px[c] = static_cast<std::uint8_t>(std::lround(kStops[i][c] * (1 - f) + kStops[i + 1][c] * f));
-}
+using render_detail::heat;
 
 struct Frame {
   const RenderScene::Impl& s;
@@ -131,10 +122,7 @@ struct Frame {
           // The ray enters through the cut plane on an air voxel: show the field there, with a
           // darker band every 8 voxels of distance.
           ++st.primary.rays;
-          const std::uint8_t stored = skip_at(first.v);
-          heat(stored * s.skip.inv_scale / heat_max, out);
-          if (static_cast<int>(stored * s.skip.inv_scale) % 8 == 0)
-            for (int ch = 0; ch < 3; ++ch) out[ch] = static_cast<std::uint8_t>(out[ch] * 3 / 4);
+          render_detail::cut_plane_heat(skip_at(first.v), s.skip.inv_scale, heat_max, out);
           return;
         }
         const RayHit h = traverse(s, cut, ray, o.skip, s.skip, st.primary, noop);

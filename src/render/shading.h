@@ -81,4 +81,25 @@ inline const ToneMap& tone_map() {
   return t;
 }
 
+// A perceptual heat ramp (dark blue, blue, green, yellow, red) for x in [0, 1], as sRGB bytes.
+inline void heat(double x, std::uint8_t* px) {
+  static constexpr double kStops[5][3] = {
+      {20, 12, 70}, {30, 100, 220}, {40, 190, 130}, {245, 215, 50}, {215, 40, 30}};
+  x = std::clamp(x, 0.0, 1.0) * 4;
+  const int i = std::min(3, static_cast<int>(x));
+  const double f = x - i;
+  for (int c = 0; c < 3; ++c)
+    px[c] = static_cast<std::uint8_t>(std::lround(kStops[i][c] * (1 - f) + kStops[i + 1][c] * f));
+}
+
+// The distance view's pixel where its ray enters the cut plane on an air voxel: the skip field's
+// stored value there (times inv_scale: voxels) on the heat ramp up to heat_max, with a darker band
+// every 8 voxels of distance.
+inline void cut_plane_heat(std::uint8_t stored, double inv_scale, double heat_max,
+                           std::uint8_t* px) {
+  heat(stored * inv_scale / heat_max, px);
+  if (static_cast<int>(stored * inv_scale) % 8 == 0)
+    for (int c = 0; c < 3; ++c) px[c] = static_cast<std::uint8_t>(px[c] * 3 / 4);
+}
+
 }  // namespace voxfield::render_detail

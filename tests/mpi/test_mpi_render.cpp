@@ -2,7 +2,8 @@
 // mpirun with 1..N ranks, every rank builds the same world, keeps its slab and ghost slices, and
 // rank 0's frame must equal render() of the whole world's scene byte for byte — soft shadows cast
 // across slabs, ambient occlusion at slab borders, skipping rays, fog, the chunks view and cameras
-// from above, below and inside included; bad options must fail on every rank alike.
+// from above, below and inside included, and the distance view's cuts; bad options must fail on
+// every rank alike.
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -72,14 +73,23 @@ void check(const Case& c, const World& whole, const Box3i& domain, int edge) {
   EXPECT_EQ(differ, 0u) << c.what << ": bytes that differ from one process's frame";
 }
 
-TEST(MpiRender, FramesEqualOneProcessByteForByte) {
-  const int edge = 8;
-  // 8 chunk layers along z; the first starts off a chunk boundary (at the domain's face).
-  const Box3i domain{{-7, 5, -13}, {41, 45, 48}};
-  const World w = scene_world(17, domain, edge);
+// 8 chunk layers of 8 along z; the first starts off a chunk boundary (at the domain's face).
+const Box3i kSceneDomain{{-7, 5, -13}, {41, 45, 48}};
+
+// A 96 x 64 frame (aspect 1.5) in the given view.
+RenderOptions small_frame(RenderView view) {
   RenderOptions o;
   o.width = 96;
   o.height = 64;
+  o.view = view;
+  return o;
+}
+
+TEST(MpiRender, FramesEqualOneProcessByteForByte) {
+  const int edge = 8;
+  const Box3i domain = kSceneDomain;
+  const World w = scene_world(17, domain, edge);
+  const RenderOptions o = small_frame(RenderView::kShaded);
   const double aspect = 1.5;
   std::vector<Case> cases;
   cases.push_back({"shaded, framing camera", {}, Camera::framing(domain, aspect), o});
@@ -119,6 +129,44 @@ TEST(MpiRender, FramesEqualOneProcessByteForByte) {
   plain.options.ambient_occlusion = false;
   plain.options.soft_shadows = false;
   plain.options.skip = SkipMode::kChunks;
+  cases.push_back(plain);
+  for (const Case& c : cases) check(c, w, domain, edge);
+}
+
+// The distance view: rays walk the box below the cut plane, and those that enter it through the
+// plane on air show the skip field there, drawn by the rank that holds the plane's slice.
+TEST(MpiRender, DistanceViewsEqualOneProcessByteForByte) {
+  const int edge = 8;
+  const Box3i domain = kSceneDomain;
+  const World w = scene_world(29, domain, edge);
+  const RenderOptions o = small_frame(RenderView::kDistance);
+  const double aspect = 1.5;
+  std::vector<Case> cases;
+  cases.push_back({"the middle slice, framing camera", {}, Camera::framing(domain, aspect), o});
+  // Slab borders lie on multiples of 8 (and at the domain's faces): cuts on either side of one,
+  // the bottom and the top slice.
+  for (const int z : {-13, 7, 8, 15, 16, 31, 47}) {
+    Case c{"slice z=" + std::to_string(z), {}, Camera::framing(domain, aspect, 40), o};
+    c.options.slice_z = z;
+    cases.push_back(c);
+  }
+  Case top{
+      "orthographic from above, Euclidean skip clamped at 12", {}, Camera::top(domain, aspect), o};
+  top.scene.skip_metric = Metric::kEuclidean;
+  top.scene.skip_max_distance_vox = 12;
+  top.options.slice_z = 20;
+  cases.push_back(top);
+  Case below{"from below the ground (rays rise: no ray enters through the cut)",
+             {},
+             Camera::parse("eye=17,25,-40:target=17,25,10:up=0,1,0", domain, aspect),
+             o};
+  cases.push_back(below);
+  Case plain{"no lighting field, chunk skipping", {}, Camera::framing(domain, aspect), o};
+  plain.scene.lighting_field = false;
+  plain.options.ambient_occlusion = false;
+  plain.options.soft_shadows = false;
+  plain.options.skip = SkipMode::kChunks;
+  plain.options.slice_z = 3;
   cases.push_back(plain);
   for (const Case& c : cases) check(c, w, domain, edge);
 }
@@ -172,14 +220,23 @@ TEST(MpiRender, BadOptionsFailOnEveryRankAlike) {
   RenderOptions o;
   o.width = 32;
   o.height = 24;
-  o.view = RenderView::kDistance;
+  o.view = RenderView::kError;
   const Camera cam = Camera::framing(domain, 32.0 / 24);
   try {
     (void)mpi::render(comm(), p, w, {}, cam, o);
-    ADD_FAILURE() << "the distance view was drawn";
+    ADD_FAILURE() << "the error view was drawn";
   } catch (const mpi::RankError& e) {
     EXPECT_NE(std::string(e.what()).find("not drawn part by part"), std::string::npos) << e.what();
   }
+  o.view = RenderView::kDistance;
+  o.slice_z = 32;
+  try {
+    (void)mpi::render(comm(), p, w, {}, cam, o);
+    ADD_FAILURE() << "a slice outside the box was drawn";
+  } catch (const mpi::RankError& e) {
+    EXPECT_NE(std::string(e.what()).find("slice z=32 lies outside"), std::string::npos) << e.what();
+  }
+  o.slice_z.reset();
   o.view = RenderView::kShaded;
   RenderSceneOptions bad;
   bad.skip_max_distance_vox = 300;
