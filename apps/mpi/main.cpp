@@ -3,16 +3,17 @@
 //
 //   mpirun -np N voxfield-mpi field IN -o OUT.npy [--metric M] [--signed] [--max-distance D]
 //          [--storage S] [--spacing sx,sy,sz] [--sites S.npy] [--packed P.npy] [--stats S.json]
-//          [--chunk C] [--threads T] [--read every|rank0] [--memory-limit B]
+//          [--chunk C] [--threads T] [--read every|rank0] [--grid G] [--memory-limit B]
 //   mpirun -np N voxfield-mpi edit IN -e EDITS.jsonl -o OUT.npy [field options] [--stats S.json]
-//          [--balance volume|content|edits] [--save-world W.vfw|W.npy] [--read every|rank0]
+//          [--balance volume|content|edits] [--save-world W.vfw|W.npy]
 //   mpirun -np N voxfield-mpi bench --size X,Y,Z [--spheres K] [--repeat R] [field options]
 //   mpirun -np N voxfield-mpi mesh IN.npy -o OUT.{ply,obj,stl,glb} [--algorithm mc|sn|dc]
 //          [--iso V] [--inside below|above] [--spacing sx,sy,sz] [--chunk C]
 //          [--balance content|count] [--threads T] [--stats S.json]
 //   mpirun -np N voxfield-mpi render IN -o OUT.png [--width W] [--height H] [--camera C]
-//          [--view shaded|chunks] [--metric M] [--skip S] [--no-shadows] [--no-ao] [--fog F]
-//          [--chunk C] [--threads T] [--repeat N] [--read every|rank0] [--stats S.json]
+//          [--view shaded|chunks|distance] [--slice Z] [--metric M] [--skip S] [--no-shadows]
+//          [--no-ao] [--fog F] [--chunk C] [--threads T] [--repeat N] [--read every|rank0]
+//          [--grid G] [--stats S.json]
 //
 // `field` writes byte for byte what `voxfield field` writes for the same input and options; each
 // rank holds only its slab of a .npy input and of the field. `edit` writes what `voxfield edit`
@@ -28,6 +29,8 @@
 #include <mpi.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -55,7 +58,7 @@ struct FieldSettings {
   double max_distance = 0;
   std::vector<double> spacing;
   int chunk = 32, threads = 0;
-  std::string read = "every";  // --read (field and edit)
+  mpi_cli::ReadSettings read;  // --read and --grid (field and edit)
 
   void add_to(CLI::App* cmd) {
     cmd->add_option("--metric", metric, "manhattan, chebyshev or euclidean")
@@ -114,7 +117,8 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
   // Everything that can be wrong with the outputs is found before the world is loaded.
   mpi::check_outputs(comm, {out, sites, packed}, {stats}, {in});
   const double t0 = MPI_Wtime();
-  const mpi::WorldSlab slab = mpi::load_world_slab(comm, in, f.chunk, 0, mpi_cli::read_by(f.read));
+  const mpi::WorldSlab slab =
+      mpi::load_world_slab(comm, in, f.chunk, 0, mpi_cli::slab_read_options(f.read));
   const double load_ms = (MPI_Wtime() - t0) * 1e3;
   mpi::ExchangeStats ex;
   MPI_Barrier(comm);  // the field's time starts together on every rank
@@ -160,7 +164,10 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   std::optional<ThreadLimit> limit;
   if (f.threads > 0) limit.emplace(f.threads);
   const DistanceOptions o = f.options();
-  const std::string world_ext = std::filesystem::path(save_world).extension().string();
+  // The extension in any case, as voxfield edit reads it.
+  std::string world_ext = std::filesystem::path(save_world).extension().string();
+  std::transform(world_ext.begin(), world_ext.end(), world_ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (!save_world.empty() && world_ext != ".vfw" && world_ext != ".npy")
     throw InvalidArgument(
         "--save-world: voxfield-mpi writes worlds as .vfw or .npy (each rank its "
@@ -177,7 +184,7 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   const std::vector<Edit>& edits = script_and_ghost.first;
   const int ghost = script_and_ghost.second;
   const double l0 = MPI_Wtime();
-  const mpi::ReadBy read = mpi_cli::read_by(f.read);
+  const mpi::SlabReadOptions read = mpi_cli::slab_read_options(f.read);
   mpi::WorldSlab slab = [&] {
     // By the script's edits: what each unit of slices will recompute, known before any reading.
     if (balance == "edits")
@@ -334,7 +341,7 @@ int main(int argc, char** argv) {
                     "also write the dissertation's packed uint32 voxels to this .npy");
   field->add_option("--stats", stats, "timing and exchange figures as JSON");
   f.add_to(field);
-  mpi_cli::add_read_option(field, f.read);
+  mpi_cli::add_read_options(field, f.read);
   FieldSettings fe;
   std::string edit_in, edit_script, edit_out, edit_stats, edit_save, edit_balance = "volume";
   CLI::App* edit = app.add_subcommand(
@@ -353,7 +360,7 @@ int main(int argc, char** argv) {
                    "recompute)")
       ->check(CLI::IsMember({"volume", "content", "edits"}));
   fe.add_to(edit);
-  mpi_cli::add_read_option(edit, fe.read);
+  mpi_cli::add_read_options(edit, fe.read);
   std::vector<int> dims;
   int spheres = 200, repeat = 3;
   FieldSettings fb;

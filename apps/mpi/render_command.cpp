@@ -36,7 +36,11 @@ CLI::App* add_render_command(CLI::App& app, RenderSettings& s) {
          "(a .vfw's origin, voxel size and rotation, of any voxel shape); auto and top frame "
          "the content either way")
       ->check(CLI::IsMember({"voxels", "world"}));
-  cmd->add_option("--view", s.view, "shaded | chunks")->check(CLI::IsMember({"shaded", "chunks"}));
+  cmd->add_option("--view", s.view,
+                  "shaded | chunks | distance (the error view's approximations run on one process: "
+                  "voxfield render)")
+      ->check(CLI::IsMember({"shaded", "chunks", "distance"}));
+  cmd->add_option("--slice", s.slice, "distance view: z of the cut plane (default: the middle)");
   cmd->add_option("--metric", s.metric,
                   "field rays skip by: manhattan (default), chebyshev, euclidean")
       ->check(CLI::IsMember({"manhattan", "chebyshev", "euclidean"}));
@@ -50,7 +54,7 @@ CLI::App* add_render_command(CLI::App& app, RenderSettings& s) {
   cmd->add_option("--threads", s.threads, "threads per rank (default: all cores)")
       ->check(CLI::Range(1, 1024));
   cmd->add_option("--stats", s.stats, "timings, ray counters and exchange figures as JSON");
-  add_read_option(cmd, s.read);
+  add_read_options(cmd, s.read);
   cmd->add_option("--repeat", s.repeat, "draw the frame N times, report the median time")
       ->check(CLI::Range(1, 1000));
   return cmd;
@@ -73,11 +77,12 @@ int run_render(MPI_Comm comm, const RenderSettings& s) {
   o.soft_shadows = !s.no_shadows;
   o.ambient_occlusion = !s.no_ao;
   o.fog_density = s.fog;
+  o.slice_z = s.slice;
   mpi::check_outputs(comm, {}, {s.out, s.stats}, {s.in});
   const double t0 = MPI_Wtime();
   // Each rank holds its slab and the slices its lighting reads beyond it.
   const mpi::WorldSlab slab =
-      mpi::load_world_slab(comm, s.in, s.chunk, relay_ghost_slices(so), read_by(s.read));
+      mpi::load_world_slab(comm, s.in, s.chunk, relay_ghost_slices(so), slab_read_options(s.read));
   const double load_ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
   const Box3i& domain = slab.partition.domain;
   // Automatic cameras frame what is there, as voxfield render's do: the content, within the

@@ -5,7 +5,10 @@
 #include <mpi.h>
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
+
+#include "read_option.h"
 
 namespace voxfield::mpi_cli {
 
@@ -13,10 +16,11 @@ struct RenderSettings {
   std::string in, out, stats, camera = "auto", view = "shaded", metric = "manhattan",
                               skip = "distance";
   int width = 1280, height = 720, chunk = 32, threads = 0, repeat = 1;
+  std::optional<int> slice;  // --slice: the distance view's cut plane
   bool no_shadows = false, no_ao = false;
   double fog = 0;
   std::string camera_frame = "voxels";
-  std::string read = "every";  // --read: who opens IN
+  ReadSettings read;  // --read and --grid
 };
 
 // The subcommand and its options, as `voxfield render` names them.

@@ -190,6 +190,14 @@ class SlabEditor {
 // alone, which sends the others what they need (load_world_slab says what).
 enum class ReadBy { kEveryRank, kRankZero };
 
+// How load_world_slab reads a world file.
+struct SlabReadOptions {
+  ReadBy read_by = ReadBy::kEveryRank;
+  // A .vdb input's grid, by name (LoadOptions::vdb_grid: by default voxfield's world grid, else
+  // the first int32 grid, else the first); InvalidArgument for another format.
+  std::string vdb_grid;
+};
+
 // A rank's slab of a world file.
 struct WorldSlab {
   World world;  // the slab's voxels and its ghost slices, at their place in the whole world
@@ -217,7 +225,7 @@ struct WorldSlab {
 // domain is the file's volume (the .npy shape, the .vox/.vfw/.vdb extent), as `voxfield field`
 // uses.
 //
-// `read_by` kRankZero is the fallback for ranks that cannot see rank 0's files (no shared file
+// `read.read_by` kRankZero is the fallback for ranks that cannot see rank 0's files (no shared file
 // system): rank 0 alone opens the file. A .npy's parts are read by rank 0 one rank at a time and
 // each sent to its rank (rank 0 holds one part at a time, its own last); a .vfw's,
 // .vox's or .vdb's bytes (compressed, or a list of voxels: small beside the world) are broadcast,
@@ -225,14 +233,13 @@ struct WorldSlab {
 // transfer is agreed on first: a rank that cannot hold what it would receive fails every rank
 // with its reason.
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
-                          int ghost_slices = 0, ReadBy read_by = ReadBy::kEveryRank);
+                          int ghost_slices = 0, const SlabReadOptions& read = {});
 // The same with the slabs cut by cut(domain) once the domain is known (every rank must cut it
 // alike; InvalidArgument unless it is a partition of that domain into the communicator's ranks):
 // slabs weighed by content (content_unit_weights) or by a script's edits (edit_unit_weights).
 using SlabCut = std::function<SlabPartition(const Box3i& domain)>;
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
-                          int ghost_slices, const SlabCut& cut,
-                          ReadBy read_by = ReadBy::kEveryRank);
+                          int ghost_slices, const SlabCut& cut, const SlabReadOptions& read = {});
 
 // Collective: per unit of slab_units(partition.domain, align), the chunks of the ranks' worlds
 // within the unit's slices that hold both air and solid voxels (where a world's surface lies, and
@@ -322,7 +329,8 @@ struct RenderPhases {
 // either side along z: load_world_slab's ghost_slices), the slabs cut on the world's chunk
 // boundaries (partition_slabs with the chunk edge when the domain has a chunk layer per rank). The
 // skip field is computed over the ranks (compute_distance_field above), the lighting field by each
-// rank over its slab and ghost slices. Views: shaded and chunks. `stats`: this rank's walks (a
+// rank over its slab and ghost slices. Views: shaded, chunks and distance (the cut drawn by the
+// rank holding its slice). `stats`: this rank's walks (a
 // ray counts once per rank that walked a stretch of it); `phases`: where its time went.
 Image render(MPI_Comm comm, const SlabPartition& partition, const World& world,
              const RenderSceneOptions& scene_options, const Camera& camera,

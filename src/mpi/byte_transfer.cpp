@@ -15,8 +15,6 @@ namespace voxfield::mpi::detail {
 
 namespace {
 
-constexpr std::uint64_t kPiece = kMessageBytes;
-
 // Room for `n` bytes on this rank, agreed on by every rank (ResourceLimitError past the limit).
 std::vector<std::uint8_t> agreed_room(MPI_Comm comm, bool receives, std::uint64_t n,
                                       const std::string& name, ExchangeStats* stats) {
@@ -44,8 +42,9 @@ std::vector<std::uint8_t> broadcast_bytes(MPI_Comm comm, std::vector<std::uint8_
   std::vector<std::uint8_t> room = agreed_room(comm, rank != 0, n, name, stats);
   if (rank != 0) bytes = std::move(room);
   CollectiveTimer t(stats);
-  for (std::uint64_t at = 0; at < n; at += kPiece)
-    MPI_Bcast(bytes.data() + at, static_cast<int>(std::min(kPiece, n - at)), MPI_BYTE, 0, comm);
+  for (std::uint64_t at = 0; at < n; at += kMessageBytes)
+    MPI_Bcast(bytes.data() + at, static_cast<int>(std::min<std::uint64_t>(kMessageBytes, n - at)),
+              MPI_BYTE, 0, comm);
   if (stats) (rank == 0 ? stats->bytes_sent : stats->bytes_received) += n;
   return bytes;
 }
@@ -61,8 +60,8 @@ std::vector<std::uint8_t> send_bytes(MPI_Comm comm, int to, std::vector<std::uin
   if (rank == to) MPI_Recv(&n, 1, MPI_UINT64_T, 0, 0, own.comm, MPI_STATUS_IGNORE);
   std::vector<std::uint8_t> received = agreed_room(comm, rank == to, n, name, stats);
   CollectiveTimer t(stats);
-  for (std::uint64_t at = 0; at < n; at += kPiece) {
-    const int count = static_cast<int>(std::min(kPiece, n - at));
+  for (std::uint64_t at = 0; at < n; at += kMessageBytes) {
+    const int count = static_cast<int>(std::min<std::uint64_t>(kMessageBytes, n - at));
     if (rank == 0) MPI_Send(bytes.data() + at, count, MPI_BYTE, to, 1, own.comm);
     if (rank == to)
       MPI_Recv(received.data() + at, count, MPI_BYTE, 0, 1, own.comm, MPI_STATUS_IGNORE);

@@ -108,7 +108,7 @@ WorldSlab vfw_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
 // empty clip) bounds where content may lie, each rank decodes an equal z-share of that and bounds
 // the solid voxels it finds, and the union over the ranks is the domain.
 WorldSlab vdb_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge, int ghost,
-                   const SlabCut& cut, std::vector<std::uint8_t>* sent) {
+                   const SlabCut& cut, const std::string& grid, std::vector<std::uint8_t>* sent) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
@@ -124,7 +124,7 @@ WorldSlab vdb_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_e
     o.clip = clip;
     const VdbFile file = decode_vdb(h.bytes, name, o);
     return world_from_vdb(file, name, chunk_edge,
-                          remaining_memory(o.memory_limit_bytes, file.memory_bytes()));
+                          remaining_memory(o.memory_limit_bytes, file.memory_bytes()), grid);
   };
   Head h = detail::collectively(comm, nullptr, [&] {
     Head out;
@@ -218,7 +218,8 @@ WorldSlab npy_slab_from_rank_zero(MPI_Comm comm, const std::filesystem::path& pa
     NpyVolume part =
         detail::collectively(comm, nullptr, [&] { return rank == 0 ? part_of(r) : NpyVolume{}; });
     std::vector<std::uint8_t> f =
-        detail::send_bytes(comm, r, part_fields(part), path.string(), nullptr);
+        detail::send_bytes(comm, r, rank == 0 ? part_fields(part) : std::vector<std::uint8_t>{},
+                           path.string(), nullptr);
     std::vector<std::uint8_t> v =
         detail::send_bytes(comm, r, std::move(part.bytes), path.string(), nullptr);
     if (rank == r) fields = std::move(f), values = std::move(v);
@@ -230,14 +231,19 @@ WorldSlab npy_slab_from_rank_zero(MPI_Comm comm, const std::filesystem::path& pa
 }
 
 WorldSlab read_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
-                          int ghost_slices, const SlabCut& cut, ReadBy read_by) {
+                          int ghost_slices, const SlabCut& cut, const SlabReadOptions& read) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
   // (The format is named by the extension alone: every rank agrees on it without a word.)
-  const WorldFormat format =
-      detail::collectively(comm, nullptr, [&] { return world_format_of(path); });
-  const bool from_zero = read_by == ReadBy::kRankZero;
+  const WorldFormat format = detail::collectively(comm, nullptr, [&] {
+    const WorldFormat f = world_format_of(path);
+    if (!read.vdb_grid.empty() && f != WorldFormat::kVdb)
+      throw InvalidArgument(path.string() + ": a grid name ('" + read.vdb_grid +
+                            "') is for .vdb files, which hold several grids");
+    return f;
+  });
+  const bool from_zero = read.read_by == ReadBy::kRankZero;
   if (from_zero && format == WorldFormat::kNpy)
     return npy_slab_from_rank_zero(comm, path, chunk_edge, ghost_slices, cut);
   // The other formats' bytes, read by rank 0 and broadcast: each rank decodes its own slab of them.
@@ -252,7 +258,7 @@ WorldSlab read_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
   if (format == WorldFormat::kVfw)
     return vfw_slab(comm, path, chunk_edge, ghost_slices, cut, bytes_sent);
   if (format == WorldFormat::kVdb)
-    return vdb_slab(comm, path, chunk_edge, ghost_slices, cut, bytes_sent);
+    return vdb_slab(comm, path, chunk_edge, ghost_slices, cut, read.vdb_grid, bytes_sent);
   return detail::collectively(comm, nullptr, [&] {
     if (format == WorldFormat::kNpy) {
       const NpyVolume head = read_npy_header(path);
@@ -288,18 +294,18 @@ WorldSlab read_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
 }  // namespace
 
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
-                          int ghost_slices, ReadBy read_by) {
+                          int ghost_slices, const SlabReadOptions& read) {
   int size = 0;
   MPI_Comm_size(comm, &size);
   return load_world_slab(
       comm, path, chunk_edge, ghost_slices,
-      [&](const Box3i& domain) { return partition_slabs(domain, size, chunk_edge); }, read_by);
+      [&](const Box3i& domain) { return partition_slabs(domain, size, chunk_edge); }, read);
 }
 
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
-                          int ghost_slices, const SlabCut& cut, ReadBy read_by) {
-  WorldSlab slab = read_world_slab(comm, path, chunk_edge, ghost_slices, cut, read_by);
-  slab.read_by = read_by;
+                          int ghost_slices, const SlabCut& cut, const SlabReadOptions& read) {
+  WorldSlab slab = read_world_slab(comm, path, chunk_edge, ghost_slices, cut, read);
+  slab.read_by = read.read_by;
   return slab;
 }
 

@@ -143,6 +143,10 @@ for n in 1 3; do
   same ref_world.npy out_world.npy "edit --save-world .npy, $n ranks"
   same ref.npy out.npy "edit --save-world .npy, $n ranks (field)"
 done
+# The extension in any case, as voxfield edit takes it.
+MPIEXEC -np 2 "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 --max-distance 6 \
+  --save-world OUT_WORLD.NPY 2>/dev/null
+same ref_world.npy OUT_WORLD.NPY "edit --save-world .NPY, 2 ranks"
 # That bounded .vfw as input: every rank decodes only its slab's chunks (read_in_parts), in the
 # file's chunks of 8 or re-chunked to 16, the field byte-identical to voxfield's.
 "$VF" field ref.vfw -o ref.npy --metric euclidean --signed 2>/dev/null
@@ -227,6 +231,35 @@ for run in "3 8" "4 16"; do
 done
 "$VF" convert air.npy air.vfw 2>/dev/null
 EXPECT_RANKS=3 expect_failure 1 "air.vfw: the input holds no volume" field air.vfw -o bad.npy
+
+# --grid: a .vdb of two grids, a fog volume first (what is read without --grid: no Int32 grid) and
+# a level-set sphere, written by pyopenvdb; each grid by name, by every rank or by rank 0 alone,
+# gives voxfield's field, and a frame of the sphere is voxfield's.
+/usr/bin/python3 - <<'PY'
+import pyopenvdb as vdb
+fog = vdb.FloatGrid(0.0)
+fog.name = "fog"
+fog.fill((0, 0, 0), (13, 9, 21), 0.25, True)
+sphere = vdb.createLevelSetSphere(radius=9.0, center=(2.0, -3.0, 1.5), voxelSize=0.5, halfWidth=3.0)
+sphere.name = "sphere"
+vdb.write("pair.vdb", grids=[fog, sphere])
+PY
+for grid in "" fog sphere; do
+  # shellcheck disable=SC2086
+  "$VF" field pair.vdb -o ref.npy --metric euclidean --signed ${grid:+--grid $grid} 2>/dev/null
+  for read in every rank0; do
+    # shellcheck disable=SC2086
+    MPIEXEC -np 3 "$VFM" field pair.vdb -o out.npy --chunk 8 --metric euclidean --signed \
+      --read "$read" ${grid:+--grid $grid} 2>/dev/null
+    same ref.npy out.npy "3 ranks, pair.vdb, grid '${grid:-default}', read by $read"
+  done
+done
+"$VF" render pair.vdb -o ref.png --grid sphere --width 100 --height 80 --chunk 8 2>/dev/null
+MPIEXEC -np 2 "$VFM" render pair.vdb -o out.png --grid sphere --width 100 --height 80 --chunk 8 \
+  2>/dev/null
+same ref.png out.png "render --grid sphere, 2 ranks"
+expect_failure 1 "f.npy: a grid name ('fog') is for .vdb files" field f.npy -o bad.npy --grid fog
+expect_failure 1 "no grid named" field pair.vdb -o bad.npy --grid smoke
 
 # Read by rank 0 alone (--read rank0, for ranks that cannot see its files): a .npy's parts read by
 # rank 0 and sent rank by rank, the other formats' bytes broadcast and each rank's slab decoded
@@ -345,7 +378,8 @@ for r in range(4):
 assert p["relay_rounds"] >= 1, p
 PY
 fi
-for view in "--camera top --fog 0.02" "--view chunks --metric euclidean --skip chunks"; do
+for view in "--camera top --fog 0.02" "--view chunks --metric euclidean --skip chunks" \
+  "--view distance" "--view distance --slice 24 --camera top --metric chebyshev"; do
   # shellcheck disable=SC2086
   "$VF" render f.npy -o ref.png --width 120 --height 90 --chunk 8 $view 2>/dev/null
   # shellcheck disable=SC2086
@@ -386,7 +420,8 @@ MPIEXEC -np 2 "$VFM" render stretched.vfw -o out.png --width 100 --height 80 --c
   --camera "eye=115,-55,40:target=103,-47,12" --camera-frame world 2>/dev/null
 same ref.png out.png "render, 2 ranks, a camera in a frame of non-cubic voxels"
 rm -f bad.png
-expect_failure 2 "distance not in" render f.npy -o bad.png --view distance
+expect_failure 2 "error not in" render f.npy -o bad.png --view error
+expect_failure 1 "slice z=53 lies outside" render f.npy -o bad.png --view distance --slice 53
 expect_failure 1 "cut on chunk boundaries" render f.npy -o bad.png --chunk 64
 if [ -e bad.png ]; then echo "FAIL: a failed render wrote bad.png"; fail=1; fi
 
