@@ -138,11 +138,12 @@ DistanceField compute_distance_field(MPI_Comm comm, const SlabPartition& partiti
 // all ranks) to its slab and to `edit_ghost_slices` slices on either side, and updates its own
 // incremental field (dynamic_field.h) over that box: a clamped value depends only on sites within
 // the clamp, so the slab's values stay exact — equal to one process's field after the same edits —
-// with no message per edit. An edit that misses a rank's box costs that rank nothing.
+// with no message per edit. An edit that misses a rank's box costs that rank nothing. An unclamped
+// f32 value may depend on every voxel of the domain: each rank then keeps its slab alone, edits
+// change its materials, and SlabEditor::refresh recomputes the field over the ranks.
 
 // The slices a rank's box reaches past its slab on either side: the effective clamp over the
-// spacing along z, rounded up (distance_slab.h). Throws InvalidArgument for an unclamped f32 field,
-// whose every value may depend on every voxel (give --max-distance, or integer storage).
+// spacing along z, rounded up (distance_slab.h); 0 for an unclamped f32 field (kept by refresh()).
 int edit_ghost_slices(const DistanceOptions& options);
 
 // Per unit of slab_units(domain, align): the work a script's edits bring it, for partition_slabs —
@@ -153,8 +154,8 @@ std::vector<double> edit_unit_weights(const Box3i& domain, int align,
                                       const std::vector<Edit>& edits, int ghost_slices);
 
 // A rank's slab of a world and its exact field, kept under edits. Constructing is collective (it
-// agrees on failures); apply() is local to the rank and may be called any number of times between
-// collective calls.
+// agrees on failures; an unclamped f32 field is computed over the ranks); apply() is local to the
+// rank and may be called any number of times between collective calls; refresh() is collective.
 class SlabEditor {
  public:
   // `world` must hold the partition's slab of this rank grown by edit_ghost_slices along z (clipped
@@ -166,15 +167,25 @@ class SlabEditor {
 
   struct Result {
     std::int64_t voxels_changed = 0;     // in this rank's box
-    std::int64_t voxels_recomputed = 0;  // by this rank's field update
+    std::int64_t voxels_recomputed = 0;  // by this rank's field update (0 when refresh() does it)
     bool reached = false;                // whether the edit touched this rank's box
   };
-  // Applies the edit clipped to this rank's box and updates the field. Throws what apply_edit
-  // throws (a malformed edit: on every rank alike).
+  // Applies the edit clipped to this rank's box and updates a clamped field (an unclamped one
+  // waits for refresh()). Throws what apply_edit throws (a malformed edit: on every rank alike).
   Result apply(const Edit& edit);
+  // Collective: brings an unclamped f32 field up to date with the edits applied since the last
+  // refresh — one exact transform over the ranks (compute_distance_field above) when an edit
+  // changed the solids of any rank's slab; nothing when none did, or for a clamped field, which
+  // apply() keeps exact. Returns whether the field was recomputed; `voxels` (if given) counts the
+  // slab's voxels recomputed here. On a failure (RankError on every rank) the field is gone until
+  // a refresh succeeds.
+  bool refresh(MPI_Comm comm, ExchangeStats* stats = nullptr, std::int64_t* voxels = nullptr);
+  // Whether field() waits on refresh(): an unclamped field with solids changed since.
+  bool stale() const { return stale_; }
 
-  // The rank's field over its box; its values over slab() are the whole field's.
-  const DistanceField& field() const { return field_->field(); }
+  // The rank's field over its box; its values over slab() are the whole field's (an unclamped
+  // field's as of the last refresh(); InvalidArgument if the last one failed).
+  const DistanceField& field() const;
   const World& world() const { return world_; }
   Box3i slab() const { return slab_; }
   Box3i box() const { return box_; }
@@ -182,7 +193,11 @@ class SlabEditor {
  private:
   Box3i slab_, box_;
   World world_;
-  std::unique_ptr<DynamicDistanceField> field_;
+  SlabPartition partition_;
+  DistanceOptions options_;
+  std::unique_ptr<DynamicDistanceField> field_;  // a clamped field, kept by apply()
+  std::optional<DistanceField> whole_;           // an unclamped one, kept by refresh()
+  bool stale_ = false;
   DirtyRegions dirty_;
 };
 

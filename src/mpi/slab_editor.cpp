@@ -5,6 +5,10 @@
 // rank keeps its slab and that many ghost slices on either side as a bounded world, applies every
 // edit clipped to that box, and lets its own DynamicDistanceField follow: over the slab its values
 // are the whole field's (the ghost slices' values are not, and are never handed out).
+//
+// An unclamped f32 value may depend on any voxel of the domain, so no finite ghost holds what an
+// edit reaches: each rank keeps its slab alone, edits change its materials, and refresh() runs the
+// exact transform over the ranks again (its all-to-all passes) once edits changed any solid.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -18,10 +22,7 @@ namespace voxfield::mpi {
 
 int edit_ghost_slices(const DistanceOptions& options) {
   const double clamp = effective_clamp(options);
-  if (!std::isfinite(clamp))
-    throw InvalidArgument(
-        "edits over several ranks need a clamped field (a max distance, or u8 or u16 storage): "
-        "an unclamped f32 value may depend on every voxel of the domain");
+  if (!std::isfinite(clamp)) return 0;  // the slab alone: refresh() recomputes over the ranks
   const double slices = std::ceil(clamp / options.spacing[2]);
   return static_cast<int>(std::min<double>(slices, std::numeric_limits<std::int32_t>::max() / 4));
 }
@@ -48,9 +49,13 @@ std::vector<double> edit_unit_weights(const Box3i& domain, int align,
 
 SlabEditor::SlabEditor(MPI_Comm comm, const SlabPartition& partition, const World& world,
                        const DistanceOptions& options)
-    : dirty_(world.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy) {
+    : partition_(partition),
+      options_(options),
+      dirty_(world.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
+  // The same on every rank (the options are): no rank waits in a transform the others skip.
+  const bool unclamped = !std::isfinite(effective_clamp(options));
   detail::collectively(comm, nullptr, [&] {
     detail::require_partition(comm, partition);
     slab_ = partition.slab(rank);
@@ -64,10 +69,12 @@ SlabEditor::SlabEditor(MPI_Comm comm, const SlabPartition& partition, const Worl
     // A bounded copy of the box: edits are clipped to it, and the field's domain is it.
     world_ = rechunk_world(world, world.voxels.chunk_edge(), box_, "rank " + std::to_string(rank));
     world_.palette = world.palette;
+    if (unclamped) return;
     DistanceOptions o = options;
     o.domain = box_;
     field_ = std::make_unique<DynamicDistanceField>(world_, o);
   });
+  if (unclamped) whole_ = compute_distance_field(comm, partition_, world_.voxels, options_);
 }
 
 SlabEditor::Result SlabEditor::apply(const Edit& edit) {
@@ -77,11 +84,40 @@ SlabEditor::Result SlabEditor::apply(const Edit& edit) {
   r.voxels_changed = e.voxels_changed;
   r.reached = !dirty_.empty() || e.voxels_changed > 0;
   if (!dirty_.empty()) {
-    const DynamicDistanceField::UpdateStats s = field_->update(dirty_);
-    r.voxels_recomputed = s.voxels_recomputed;
+    if (field_) {
+      const DynamicDistanceField::UpdateStats s = field_->update(dirty_);
+      r.voxels_recomputed = s.voxels_recomputed;
+    } else {
+      stale_ = true;  // solids changed: the unclamped field waits for refresh()
+    }
     dirty_.clear();
   }
   return r;
+}
+
+bool SlabEditor::refresh(MPI_Comm comm, ExchangeStats* stats, std::int64_t* voxels) {
+  if (voxels) *voxels = 0;
+  if (field_) return false;  // clamped: kept by apply() (every rank knows it from the options)
+  int mine = stale_ ? 1 : 0, any = 0;
+  {
+    detail::CollectiveTimer timer(stats);
+    MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, comm);
+  }
+  if (any == 0 && whole_) return false;
+  whole_.reset();  // let go of the old field before the new one is built
+  whole_ = compute_distance_field(comm, partition_, world_.voxels, options_, stats);
+  stale_ = false;
+  if (voxels) *voxels = slab_.volume();
+  return true;
+}
+
+const DistanceField& SlabEditor::field() const {
+  if (field_) return field_->field();
+  if (!whole_)
+    throw InvalidArgument(
+        "mpi::SlabEditor: the unclamped field's last refresh() failed (call it "
+        "again)");
+  return *whole_;
 }
 
 }  // namespace voxfield::mpi

@@ -6,12 +6,14 @@
 #include <gtest/gtest.h>
 #include <mpi.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
 
 #include "mpi_ranks.h"
+#include "voxfield/distance_slab.h"
 #include "voxfield/dynamic_field.h"
 #include "voxfield/file.h"
 #include "voxfield/limits.h"
@@ -122,6 +124,8 @@ void check_edits(const DistanceOptions& o, std::uint32_t seed) {
   World whole = random_world(seed, domain, edge, seed % 2 ? 0.002 : 0.02);
   const mpi::SlabPartition p = mpi::partition_slabs(domain, ranks(), seed % 3 ? 8 : 1);
   const int ghost = mpi::edit_ghost_slices(o);
+  const bool unclamped = !std::isfinite(effective_clamp(o));
+  EXPECT_EQ(ghost == 0, unclamped);
   const Box3i slab = p.slab(rank());
   const Box3i box{{domain.begin.x, domain.begin.y, std::max(domain.begin.z, slab.begin.z - ghost)},
                   {domain.end.x, domain.end.y, std::min(domain.end.z, slab.end.z + ghost)}};
@@ -152,6 +156,17 @@ void check_edits(const DistanceOptions& o, std::uint32_t seed) {
     (void)oracle.update(dirty);
     dirty.clear();
     if (i % 4 != 3) continue;
+    // An unclamped f32 field follows the edits at refresh() (on every rank; a clamped one needs
+    // none, and says so).
+    int stale = editor.stale() ? 1 : 0, any_stale = 0;
+    MPI_Allreduce(&stale, &any_stale, 1, MPI_INT, MPI_MAX, comm());
+    EXPECT_TRUE(unclamped || any_stale == 0);  // a clamped field is never stale
+    std::int64_t refreshed_voxels = -1;
+    const bool refreshed = editor.refresh(comm(), nullptr, &refreshed_voxels);
+    EXPECT_EQ(refreshed, any_stale != 0);
+    EXPECT_EQ(refreshed_voxels, refreshed ? slab.volume() : 0);
+    EXPECT_FALSE(editor.stale());
+    if (unclamped) EXPECT_EQ(editor.field().domain, slab);
     const std::string what = std::string(metric_name(o.metric)) +
                              (o.signed_distance ? " signed" : "") + " clamp " +
                              std::to_string(o.max_distance) + " " + storage_name(o.storage) +
@@ -185,9 +200,20 @@ TEST(MpiField, EditsKeepEverySlabEqualToOneProcess) {
         o.storage = Storage::kU8;  // the storage's range is the clamp
         check_edits(o, seed++);
       }
-  DistanceOptions unclamped;
-  unclamped.metric = Metric::kEuclidean;
-  EXPECT_THROW((void)mpi::edit_ghost_slices(unclamped), InvalidArgument);
+}
+
+// Unclamped f32 fields: every rank keeps its slab alone, and refresh() computes the field over the
+// ranks again after the edits; every few edits it must equal one process's incremental field.
+TEST(MpiField, UnclampedEditsRefreshEverySlabToOneProcess) {
+  std::uint32_t seed = 700;
+  for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
+    for (bool sgn : {false, true}) {
+      DistanceOptions o;
+      o.metric = m;
+      o.signed_distance = sgn;
+      o.nearest_sites = seed % 2 == 0;
+      check_edits(o, seed++);
+    }
 }
 
 TEST(MpiField, PartitionsCoverTheDomainInOrder) {
