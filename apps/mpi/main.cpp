@@ -5,7 +5,8 @@
 //          [--storage S] [--spacing sx,sy,sz] [--sites S.npy] [--packed P.npy] [--stats S.json]
 //          [--chunk C] [--threads T] [--read every|rank0] [--grid G] [--memory-limit B]
 //   mpirun -np N voxfield-mpi edit IN -e EDITS.jsonl -o OUT.npy [field options] [--stats S.json]
-//          [--balance volume|content|edits] [--save-world W.vfw|W.npy]
+//          [--balance volume|content|edits] [--save-world W.vfw|W.npy] [--read every|rank0]
+//          [--grid G]
 //   mpirun -np N voxfield-mpi bench --size X,Y,Z [--spheres K] [--repeat R] [field options]
 //   mpirun -np N voxfield-mpi mesh IN.npy -o OUT.{ply,obj,stl,glb} [--algorithm mc|sn|dc]
 //          [--iso V] [--inside below|above] [--spacing sx,sy,sz] [--chunk C]
@@ -171,9 +172,9 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   std::transform(world_ext.begin(), world_ext.end(), world_ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (!save_world.empty() && world_ext != ".vfw" && world_ext != ".npy")
-    throw InvalidArgument(
-        "--save-world: voxfield-mpi writes worlds as .vfw or .npy (each rank its "
-        "slab); voxfield convert turns either into .vox");
+    throw InvalidArgument("--save-world " + save_world +
+                          ": voxfield-mpi writes worlds as .vfw or .npy (each rank its slab); "
+                          "voxfield convert turns either into .vox");
   mpi::check_outputs(comm, {out, save_world}, {stats}, {in, edits_path});
   // The script and the ghost slices are checked on every rank before the world is loaded.
   // (Two named values, not a structured binding: the loop's lambda below captures the script,
@@ -186,6 +187,12 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   const std::vector<Edit>& edits = script_and_ghost.first;
   const int ghost = script_and_ghost.second;
   const bool unclamped = !std::isfinite(effective_clamp(o));  // f32: kept by refresh()
+  if (unclamped && balance == "edits")
+    throw InvalidArgument(
+        "--balance edits weighs each slab by the field updates the edits bring it; an unclamped "
+        "f32 "
+        "field is computed again whole after the script, at a cost that follows the volume "
+        "(--balance volume, the default)");
   const double l0 = MPI_Wtime();
   const mpi::SlabReadOptions read = mpi_cli::slab_read_options(f.read);
   mpi::WorldSlab slab = [&] {

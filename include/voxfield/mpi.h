@@ -154,8 +154,9 @@ std::vector<double> edit_unit_weights(const Box3i& domain, int align,
                                       const std::vector<Edit>& edits, int ghost_slices);
 
 // A rank's slab of a world and its exact field, kept under edits. Constructing is collective (it
-// agrees on failures; an unclamped f32 field is computed over the ranks); apply() is local to the
-// rank and may be called any number of times between collective calls; refresh() is collective.
+// agrees on failures; a clamped field is computed then, an unclamped f32 one by the first
+// refresh()); apply() is local to the rank and may be called any number of times between
+// collective calls; refresh() is collective.
 class SlabEditor {
  public:
   // `world` must hold the partition's slab of this rank grown by edit_ghost_slices along z (clipped
@@ -174,17 +175,18 @@ class SlabEditor {
   // waits for refresh()). Throws what apply_edit throws (a malformed edit: on every rank alike).
   Result apply(const Edit& edit);
   // Collective: brings an unclamped f32 field up to date with the edits applied since the last
-  // refresh — one exact transform over the ranks (compute_distance_field above) when an edit
-  // changed the solids of any rank's slab; nothing when none did, or for a clamped field, which
-  // apply() keeps exact. Returns whether the field was recomputed; `voxels` (if given) counts the
-  // slab's voxels recomputed here. On a failure (RankError on every rank) the field is gone until
-  // a refresh succeeds.
+  // refresh — one exact transform over the ranks (compute_distance_field above) on the first call
+  // and whenever an edit changed the solids of any rank's slab since; nothing when none did, or for
+  // a clamped field, which apply() keeps exact. Returns whether the field was recomputed; `voxels`
+  // (if given) counts the slab's voxels recomputed here. On a failure (RankError on every rank) the
+  // field is gone until a refresh succeeds.
   bool refresh(MPI_Comm comm, ExchangeStats* stats = nullptr, std::int64_t* voxels = nullptr);
-  // Whether field() waits on refresh(): an unclamped field with solids changed since.
+  // Whether field() waits on refresh(): an unclamped field not yet computed, or with solids changed
+  // since.
   bool stale() const { return stale_; }
 
   // The rank's field over its box; its values over slab() are the whole field's (an unclamped
-  // field's as of the last refresh(); InvalidArgument if the last one failed).
+  // field's as of the last refresh(); InvalidArgument before one has succeeded).
   const DistanceField& field() const;
   const World& world() const { return world_; }
   Box3i slab() const { return slab_; }

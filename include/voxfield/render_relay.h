@@ -49,12 +49,13 @@ struct RayLeg {
 };
 
 // A part's hit for a pixel's primary ray: when the ray entered the hit voxel (its ray parameter, or
-// the ray's entry into the whole box if that is later: +inf for no hit in the part) and the part's
-// place along the ray (smaller: met first). Ordered by t, then by place, the smallest over the
-// parts is the pixel's first hit: two parts' hits can share a t where the ray crosses a voxel edge
-// on their border (or within an ulp of its entry into the box, where the box's planes and the
-// DDA's formula round apart), and the plain DDA enters the part it meets first first. The layout
-// of MPI's MPI_DOUBLE_INT (mpi::render reduces it with MPI_MINLOC).
+// the ray's entry into the whole box — the box below the cut in the distance view — if that is
+// later: +inf for no hit in the part) and the part's place along the ray (smaller: met first).
+// Ordered by t, then by place, the smallest over the parts is the pixel's first hit: two parts'
+// hits can share a t where the ray crosses a voxel edge on their border (or within an ulp of its
+// entry into the box, where the box's planes and the DDA's formula round apart), and the plain DDA
+// enters the part it meets first first. The layout of MPI's MPI_DOUBLE_INT (mpi::render reduces it
+// with MPI_MINLOC).
 struct RelayHit {
   double t = std::numeric_limits<double>::infinity();
   std::int32_t along = 0;

@@ -54,10 +54,9 @@ SlabEditor::SlabEditor(MPI_Comm comm, const SlabPartition& partition, const Worl
       dirty_(world.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
-  // The same on every rank (the options are): no rank waits in a transform the others skip.
-  const bool unclamped = !std::isfinite(effective_clamp(options));
   detail::collectively(comm, nullptr, [&] {
     detail::require_partition(comm, partition);
+    const bool unclamped = !std::isfinite(effective_clamp(options));
     slab_ = partition.slab(rank);
     const int ghost = edit_ghost_slices(options);
     const Box3i& d = partition.domain;
@@ -69,12 +68,14 @@ SlabEditor::SlabEditor(MPI_Comm comm, const SlabPartition& partition, const Worl
     // A bounded copy of the box: edits are clipped to it, and the field's domain is it.
     world_ = rechunk_world(world, world.voxels.chunk_edge(), box_, "rank " + std::to_string(rank));
     world_.palette = world.palette;
+    // An unclamped field is computed by the first refresh(), after any edits the caller applies
+    // first: one transform for a script, not one before it and one after.
+    stale_ = unclamped;
     if (unclamped) return;
     DistanceOptions o = options;
     o.domain = box_;
     field_ = std::make_unique<DynamicDistanceField>(world_, o);
   });
-  if (unclamped) whole_ = compute_distance_field(comm, partition_, world_.voxels, options_);
 }
 
 SlabEditor::Result SlabEditor::apply(const Edit& edit) {
@@ -115,8 +116,8 @@ const DistanceField& SlabEditor::field() const {
   if (field_) return field_->field();
   if (!whole_)
     throw InvalidArgument(
-        "mpi::SlabEditor: the unclamped field's last refresh() failed (call it "
-        "again)");
+        "mpi::SlabEditor: an unclamped field is computed by refresh(), which has not yet succeeded "
+        "(call it first)");
   return *whole_;
 }
 

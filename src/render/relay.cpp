@@ -229,8 +229,8 @@ struct RelayFrame::Impl {
   }
 
   // Walks a ray from dda's voxel (in the part: walk_part for a primary ray) until it hits, leaves
-  // the whole box, or leaves the part for another (a shadow ray then goes on as a leg in `out`; the
-  // part a primary ray goes on to walks it from there itself).
+  // the whole box (the walk box, for a primary ray), or leaves the part for another (a shadow ray
+  // then goes on as a leg in `out`; the part a primary ray goes on to walks it from there itself).
   void run(const Ray& ray, Dda& dda, std::uint32_t pixel, bool shadow, double lit,
            std::vector<RayLeg>& out, RenderStats& st) {
     const RenderScene::Impl& s = scene.impl();
@@ -342,6 +342,9 @@ const std::vector<RelayHit>& RelayFrame::start() {
         return;
       }
     }
+    // A ray in through the cut plane is the slice's part's alone: its cut pixel, or a hit on the
+    // voxel it enters. The parts below need not walk it.
+    if (f.distance_view && d.face_axis == 2 && d.step[2] < 0 && !f.part.contains(d.v)) return;
     if (f.walk_part.empty() || (!f.walk_part.contains(d.v) && !f.enter_part(d))) return;
     f.run(ray, d, pixel, false, 1, out, st);
     const RayHit& hit = f.hits[pixel];

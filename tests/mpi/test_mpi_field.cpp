@@ -132,6 +132,9 @@ void check_edits(const DistanceOptions& o, std::uint32_t seed) {
   World mine(edge, box);  // this rank's box only
   mine.voxels.copy_from_dense(box, dense(whole.voxels, box).data());
   mpi::SlabEditor editor(comm(), p, mine, o);
+  // An unclamped field is computed by the first refresh(), after the edits before it.
+  EXPECT_EQ(editor.stale(), unclamped);
+  if (unclamped) EXPECT_THROW((void)editor.field(), InvalidArgument);
   DynamicDistanceField oracle(whole, o);
   DirtyRegions dirty(edge, DirtyRegions::Track::kOccupancy);
   std::mt19937 rng(seed * 7 + 1);
@@ -207,13 +210,14 @@ TEST(MpiField, EditsKeepEverySlabEqualToOneProcess) {
 TEST(MpiField, UnclampedEditsRefreshEverySlabToOneProcess) {
   std::uint32_t seed = 700;
   for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
-    for (bool sgn : {false, true}) {
-      DistanceOptions o;
-      o.metric = m;
-      o.signed_distance = sgn;
-      o.nearest_sites = seed % 2 == 0;
-      check_edits(o, seed++);
-    }
+    for (bool sgn : {false, true})
+      for (bool sites : {false, true}) {
+        DistanceOptions o;
+        o.metric = m;
+        o.signed_distance = sgn;
+        o.nearest_sites = sites;
+        check_edits(o, seed++);
+      }
 }
 
 TEST(MpiField, PartitionsCoverTheDomainInOrder) {
