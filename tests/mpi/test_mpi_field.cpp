@@ -188,8 +188,10 @@ void check_edits(const DistanceOptions& o, std::uint32_t seed) {
   }
 }
 
-TEST(MpiField, EditsKeepEverySlabEqualToOneProcess) {
-  std::uint32_t seed = 500;
+// f(options) for every metric, signed or not, with nearest sites or not (the other options
+// default).
+template <class F>
+void for_every_kind_of_field(F&& f) {
   for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
     for (bool sgn : {false, true})
       for (bool sites : {false, true}) {
@@ -197,27 +199,26 @@ TEST(MpiField, EditsKeepEverySlabEqualToOneProcess) {
         o.metric = m;
         o.signed_distance = sgn;
         o.nearest_sites = sites;
-        o.max_distance = 2.5 + static_cast<double>(seed % 6);
-        check_edits(o, seed++);
-        o.max_distance = 0;
-        o.storage = Storage::kU8;  // the storage's range is the clamp
-        check_edits(o, seed++);
+        f(o);
       }
+}
+
+TEST(MpiField, EditsKeepEverySlabEqualToOneProcess) {
+  std::uint32_t seed = 500;
+  for_every_kind_of_field([&](DistanceOptions o) {
+    o.max_distance = 2.5 + static_cast<double>(seed % 6);
+    check_edits(o, seed++);
+    o.max_distance = 0;
+    o.storage = Storage::kU8;  // the storage's range is the clamp
+    check_edits(o, seed++);
+  });
 }
 
 // Unclamped f32 fields: every rank keeps its slab alone, and refresh() computes the field over the
 // ranks again after the edits; every few edits it must equal one process's incremental field.
 TEST(MpiField, UnclampedEditsRefreshEverySlabToOneProcess) {
   std::uint32_t seed = 700;
-  for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
-    for (bool sgn : {false, true})
-      for (bool sites : {false, true}) {
-        DistanceOptions o;
-        o.metric = m;
-        o.signed_distance = sgn;
-        o.nearest_sites = sites;
-        check_edits(o, seed++);
-      }
+  for_every_kind_of_field([&](const DistanceOptions& o) { check_edits(o, seed++); });
 }
 
 TEST(MpiField, PartitionsCoverTheDomainInOrder) {
