@@ -1,7 +1,7 @@
 // voxfield-mpi: exact distance fields, meshes and frames of volumes split over the processes of
 // an MPI job.
 //
-//   mpirun -np N voxfield-mpi field IN -o OUT.npy [--metric M] [--signed] [--max-distance D]
+//   mpirun -np N voxfield-mpi field IN -o OUT.{npy,vdb} [--metric M] [--signed] [--max-distance D]
 //          [--storage S] [--spacing sx,sy,sz] [--sites S.npy] [--packed P.npy] [--stats S.json]
 //          [--chunk C] [--threads T] [--read every|rank0] [--grid G] [--memory-limit B]
 //   mpirun -np N voxfield-mpi edit IN -e EDITS.jsonl -o OUT.npy [field options] [--stats S.json]
@@ -103,6 +103,14 @@ struct FieldSettings {
   }
 };
 
+// A path's extension in lower case: voxfield reads .NPY as .npy, and so does voxfield-mpi.
+std::string lowercase_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
 using mpi_cli::exchange_json;
 using mpi_cli::max_over;
 using mpi_cli::peak_rss_bytes;
@@ -117,17 +125,33 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
   if (f.threads > 0) limit.emplace(f.threads);
   DistanceOptions o = f.options();
   o.nearest_sites = !sites.empty();
+  const std::string out_ext = lowercase_extension(out);
+  if (out_ext != ".npy" && out_ext != ".vdb")
+    throw InvalidArgument(out + ": voxfield-mpi writes fields as .npy or .vdb");
+  const bool vdb_output = out_ext == ".vdb";
   // Everything that can be wrong with the outputs is found before the world is loaded.
   mpi::check_outputs(comm, {out, sites, packed}, {stats}, {in});
   const double t0 = MPI_Wtime();
   const mpi::WorldSlab slab =
       mpi::load_world_slab(comm, in, f.chunk, 0, mpi_cli::slab_read_options(f.read));
   const double load_ms = (MPI_Wtime() - t0) * 1e3;
+  // A .vdb level set holds world distances: a world of anisotropic voxels is measured in its
+  // voxel size unless --spacing says otherwise, as voxfield field does.
+  const Vec3d voxel = slab.world.frame.voxel_size_world;
+  if (vdb_output && f.spacing.empty() && o.metric == Metric::kEuclidean &&
+      !(voxel.x == voxel.y && voxel.y == voxel.z)) {
+    o.spacing = {voxel.x, voxel.y, voxel.z};
+    if (rank == 0)
+      std::cerr << "voxfield-mpi: measuring in the world's voxel size " << voxel.x << " x "
+                << voxel.y << " x " << voxel.z << " (--spacing), so that " << out
+                << " holds distances in its units (--max-distance too)\n";
+  }
   mpi::ExchangeStats ex;
   MPI_Barrier(comm);  // the field's time starts together on every rank
   const double t1 = MPI_Wtime();
-  const DistanceField field =
+  DistanceField field =
       mpi::compute_distance_field(comm, slab.partition, slab.world.voxels, o, &ex);
+  field.frame = slab.world.frame;  // where a .vdb places it
   const double field_ms = max_over(comm, (MPI_Wtime() - t1) * 1e3);
   const Box3i& domain = slab.partition.domain;
   nlohmann::json j = f.describe(o, domain.size(), size);
@@ -140,8 +164,24 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
                           {"read", mpi_cli::read_name(slab.read_by)},
                           {"slabs", slab.partition.z}});
   j["exchange"] = exchange_json(comm, ex);
-  mpi::FieldFiles files{out, sites, stats, j.dump(2) + "\n", packed, &slab.world, {}};
-  mpi::write_field_npy(comm, slab.partition, field, files);
+  // A .vdb is joined on rank 0 and staged with the other outputs: written all or nothing.
+  std::optional<FileTransaction> outputs;
+  if (rank == 0) outputs.emplace();
+  FileTransaction* tx = outputs ? &*outputs : nullptr;
+  if (vdb_output) {
+    mpi::ExchangeStats vdb_ex;
+    std::vector<std::uint8_t> vdb = mpi::encode_vdb_field(comm, slab.partition, field, &vdb_ex);
+    j["vdb_exchange"] = exchange_json(comm, vdb_ex);
+    mpi::collectively(comm, [&] {
+      if (tx) tx->stage(out, std::move(vdb));
+    });
+  }
+  mpi::FieldFiles files{
+      vdb_output ? std::string() : out, sites, stats, j.dump(2) + "\n", packed, &slab.world, {}};
+  mpi::write_field_npy(comm, slab.partition, field, files, nullptr, tx);
+  mpi::collectively(comm, [&] {
+    if (tx) tx->commit();
+  });
   if (rank == 0) {
     const Vec3i d = domain.size();
     std::cerr << "voxfield-mpi: exact " << metric_name(o.metric) << " field of " << d.x << "x"
@@ -167,10 +207,7 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   std::optional<ThreadLimit> limit;
   if (f.threads > 0) limit.emplace(f.threads);
   const DistanceOptions o = f.options();
-  // The extension in any case, as voxfield edit reads it.
-  std::string world_ext = std::filesystem::path(save_world).extension().string();
-  std::transform(world_ext.begin(), world_ext.end(), world_ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string world_ext = lowercase_extension(save_world);
   if (!save_world.empty() && world_ext != ".vfw" && world_ext != ".npy")
     throw InvalidArgument("--save-world " + save_world +
                           ": voxfield-mpi writes worlds as .vfw or .npy (each rank its slab); "
@@ -362,7 +399,10 @@ int main(int argc, char** argv) {
   std::string in, out, sites, packed, stats;
   CLI::App* field = app.add_subcommand("field", "a distance field of a world, as `voxfield field`");
   field->add_option("IN", in, "input .npy (read a slab per rank), .vox or .vfw")->required();
-  field->add_option("-o,--output", out, "output .npy")->required();
+  field
+      ->add_option("-o,--output", out,
+                   "output .npy (every rank its slices) or .vdb (joined on rank 0)")
+      ->required();
   field->add_option("--sites", sites, "also write nearest-site offsets, int16 a[x, y, z, 3]");
   field->add_option("--packed", packed,
                     "also write the dissertation's packed uint32 voxels to this .npy");

@@ -269,9 +269,11 @@ std::vector<double> content_unit_weights(MPI_Comm comm, const SlabPartition& par
 
 // What write_field_npy writes.
 struct FieldFiles {
-  std::filesystem::path values;  // a[x, y, z] of the stored values (uint8, uint16 or float32)
-  std::filesystem::path sites;   // optional: int16 a[x, y, z, 3] nearest-site offsets
-  std::filesystem::path json;    // optional: written by rank 0 with `json_text`
+  // a[x, y, z] of the stored values (uint8, uint16 or float32); empty: not written (a .vdb
+  // written by encode_vdb_field below instead)
+  std::filesystem::path values;
+  std::filesystem::path sites;  // optional: int16 a[x, y, z, 3] nearest-site offsets
+  std::filesystem::path json;   // optional: written by rank 0 with `json_text`
   std::string json_text;
   // Optional: the dissertation's packed uint32 voxels (dissertation_format.h) of `world`, this
   // rank's world holding at least its slab, with the field's distances; and the world's
@@ -301,6 +303,18 @@ void check_outputs(MPI_Comm comm, const std::vector<std::filesystem::path>& shar
 void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const DistanceField& slab,
                      const FieldFiles& files, ExchangeStats* stats = nullptr,
                      FileTransaction* into = nullptr);
+
+// Collective: the field the ranks hold in slabs as the bytes of one .vdb file on rank 0 (empty on
+// the others) — the bytes `voxfield field -o F.vdb` (encode_vdb_field, vdb.h) writes for the whole
+// field. Each rank encodes its slab's grid with the whole field's background (the largest of the
+// ranks' vdb_field_background) and sends it to rank 0, one rank at a time; rank 0 joins them
+// (VdbFieldParts). Rank 0 so holds the whole grid: the narrow band of a clamped field (active where
+// |distance| is below the clamp), every voxel of an unclamped one; each part's room on rank 0 is
+// agreed on before it moves (ResourceLimitError on every rank past rank 0's memory limit). `slab`:
+// this rank's field over exactly its slab (compute_distance_field's), in the world's frame.
+std::vector<std::uint8_t> encode_vdb_field(MPI_Comm comm, const SlabPartition& partition,
+                                           const DistanceField& slab,
+                                           ExchangeStats* stats = nullptr);
 
 // Writes the world of every rank's slab into one .vfw world file (docs/formats.md), byte for byte
 // what one process writes for the whole world bounded to the partition's domain (`voxfield edit

@@ -38,6 +38,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -62,6 +63,38 @@ std::vector<std::uint8_t> encode_vdb_world(const World& world, const Box3i& exte
 // non-zero distance to bound its background (an unclamped field of an empty world).
 std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
                                            const std::string& grid_name = "distance");
+
+// A field's .vdb written in parts (voxfield-mpi: each rank holds a slab of the field). The grid's
+// background is the whole field's: the clamp's level, or unclamped the largest finite |distance|
+// of any part — the largest vdb_field_background over the parts (0 for a part with none; the
+// field is refused if every part has none). Each part's grid is encode_vdb_field_part's bytes,
+// and VdbFieldParts joins them into the bytes encode_vdb_field writes for the whole field. The
+// parts must not overlap, and their borders must lie on multiples of 8 (OpenVDB's leaf edge) or
+// on the domain's faces; slabs cut on chunk boundaries do.
+double vdb_field_background(const DistanceField& field);
+std::vector<std::uint8_t> encode_vdb_field_part(const DistanceField& part, double background,
+                                                const Box3i& domain,
+                                                const std::string& grid_name = "distance");
+class VdbFieldParts {
+ public:
+  // Starts from the grid of `own` (one part), as encode_vdb_field_part builds it. Throws as
+  // encode_vdb_field does.
+  VdbFieldParts(const DistanceField& own, double background, const Box3i& domain,
+                const std::string& grid_name = "distance");
+  ~VdbFieldParts();
+  VdbFieldParts(const VdbFieldParts&) = delete;
+  VdbFieldParts& operator=(const VdbFieldParts&) = delete;
+  // Moves another part's leaves and tiles in. `part`: encode_vdb_field_part's bytes, made by this
+  // library (OpenVDB's own reader parses them, which must never see bytes from elsewhere);
+  // InvalidArgument, naming `name`, for a grid of another background.
+  void add(std::span<const std::uint8_t> part, const std::string& name);
+  // The .vdb file of the whole field.
+  std::vector<std::uint8_t> finish();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // The bytes of a .vdb file holding a vector field's texture over `volume` as the grids "vectors"
 // and "strength" (above; an rgba8 or rgba16f texture as it decodes). Throws InvalidArgument for

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <sstream>
 #include <utility>
@@ -158,27 +159,39 @@ std::vector<std::uint8_t> encode_vdb_world(const World& world, const Box3i& exte
   return write_grids({grid});
 }
 
-std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
-                                           const std::string& grid_name) {
-  ensure_initialized();
-  const DistanceOptions& o = field.options;
-  const double clamp = o.max_distance;
-  const bool is_signed = o.signed_distance;
-  // voxfield's signed field is the distance between voxel centres of the two kinds, so it steps
-  // from -1 to +1 voxel across the surface; a level set is the distance to the surface itself,
-  // which lies midway (|gradient| = 1 there too, as OpenVDB's tools assume: its volume measure
-  // read half the volume before this shift). Half a voxel comes off each side; on anisotropic
-  // voxels, half the smallest edge (exact across faces normal to that axis).
-  const double offset =
-      is_signed ? 0.5 * std::min({o.spacing[0], o.spacing[1], o.spacing[2]}) : 0.0;
-  // The grid's world units: its frame's, k per unit of the field's values.
-  // (Not a structured binding: clang before 16 cannot capture one in the lambda below.)
-  const std::pair<VoxelFrame, double> units = field_world_units(field);
-  const VoxelFrame& frame = units.first;
-  const double k = units.second;
-  const auto level = [&](double d) { return k * (d > 0 ? d - offset : d < 0 ? d + offset : d); };
+namespace {
+
+// How encode_vdb_field turns a field's values into the grid's: the frame and world units it is
+// written in, and the surface offset of a level set.
+struct FieldLevels {
+  const DistanceField& field;
+  bool is_signed;
+  double offset;  // taken off |distance|
+  VoxelFrame frame;
+  double k;  // world units per unit of the field's values
+
+  explicit FieldLevels(const DistanceField& f)
+      : field(f),
+        is_signed(f.options.signed_distance),
+        // voxfield's signed field is the distance between voxel centres of the two kinds, so it
+        // steps from -1 to +1 voxel across the surface; a level set is the distance to the surface
+        // itself, which lies midway (|gradient| = 1 there too, as OpenVDB's tools assume: its
+        // volume measure read half the volume before this shift). Half a voxel comes off each
+        // side; on anisotropic voxels, half the smallest edge (exact across faces normal to that
+        // axis).
+        offset(is_signed ? 0.5 * std::min({f.options.spacing[0], f.options.spacing[1],
+                                           f.options.spacing[2]})
+                         : 0.0) {
+    // The grid's world units: its frame's, k per unit of the field's values.
+    const std::pair<VoxelFrame, double> units = field_world_units(f);
+    frame = units.first;
+    k = units.second;
+  }
+  double level(double d) const { return k * (d > 0 ? d - offset : d < 0 ? d + offset : d); }
+
   // Visits every stored chunk of the field within its domain with the decoded values.
-  const auto for_each_value = [&](auto&& on_uniform, auto&& on_voxel) {
+  template <class OnUniform, class OnVoxel>
+  void for_each_value(OnUniform&& on_uniform, OnVoxel&& on_voxel) const {
     std::visit(
         [&](const auto& values) {
           const int e = values.chunk_edge();
@@ -203,40 +216,30 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
           });
         },
         field.values);
-  };
-  // The background: the clamp as the field stores it — what voxels beyond it and outside the
-  // domain read, which integer storage may have lowered to its range and rounded, and f32 rounded
-  // to a float — or, unclamped, the largest finite |distance| of the field.
-  const double stored_clamp = std::visit(
-      [&](const auto& g) { return field.encoding.decode(static_cast<double>(g.background())); },
-      field.values);
-  double background = level(stored_clamp);
-  if (clamp > 0 && !(background > 0))
-    throw InvalidArgument("vdb: a clamp of " + std::to_string(clamp) +
-                          " leaves no band around the surface (the level set needs more than half "
-                          "a voxel)");
-  if (!(clamp > 0)) {
-    background = 0;
-    const auto widen = [&](double d) {
-      if (std::isfinite(d)) background = std::max(background, std::abs(level(d)));
-    };
-    for_each_value([&](const Box3i&, double d) { widen(d); }, [&](Vec3i, double d) { widen(d); });
-    if (!(background > 0))
-      throw InvalidArgument(
-          "vdb: the field has no finite non-zero distance (an empty world?): "
-          "nothing bounds its grid's background");
   }
+};
+
+// The grid of `field`'s values over its domain with the given background, pruned, named and
+// described as a field over `domain` (the whole field's, when `field` is a part of it).
+openvdb::FloatGrid::Ptr field_grid(const DistanceField& field, double background,
+                                   const Box3i& domain, const std::string& grid_name) {
+  const FieldLevels f(field);
+  const DistanceOptions& o = field.options;
+  if (!(background > 0))
+    throw InvalidArgument(
+        "vdb: the field has no finite non-zero distance (an empty world?): "
+        "nothing bounds its grid's background");
   const auto bg = static_cast<float>(background);
   openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(bg);
   grid->setName(grid_name);
-  grid->setTransform(frame_transform(frame));
-  grid->setGridClass(is_signed ? openvdb::GRID_LEVEL_SET : openvdb::GRID_UNKNOWN);
+  grid->setTransform(frame_transform(f.frame));
+  grid->setGridClass(f.is_signed ? openvdb::GRID_LEVEL_SET : openvdb::GRID_UNKNOWN);
   auto access = grid->getAccessor();
   // Active where |d| is below the background; beyond it, the outside is the background itself
   // and (level sets) the inside is -background, inactive. Non-finite values (no site in reach)
   // read as the background.
   const auto put_voxel = [&](Vec3i p, double distance) {
-    const double d = level(distance);
+    const double d = f.level(distance);
     if (!std::isfinite(d) || d >= background) return;
     if (d <= -background) {
       access.setValueOff(coord(p), -bg);
@@ -245,7 +248,7 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
     access.setValueOn(coord(p), static_cast<float>(d));
   };
   const auto put_box = [&](const Box3i& box, double distance) {
-    const double d = level(distance);
+    const double d = f.level(distance);
     if (!std::isfinite(d) || d >= background) return;
     if (d <= -background) {
       grid->tree().fill(bbox(box), -bg, /*active=*/false);
@@ -253,16 +256,106 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
     }
     grid->tree().fill(bbox(box), static_cast<float>(d), /*active=*/true);
   };
-  for_each_value(put_box, put_voxel);
+  f.for_each_value(put_box, put_voxel);
   grid->tree().prune();
   grid->insertMeta(kKind,
-                   openvdb::StringMetadata(is_signed ? "signed distance" : "unsigned distance"));
+                   openvdb::StringMetadata(f.is_signed ? "signed distance" : "unsigned distance"));
   grid->insertMeta(kMetric, openvdb::StringMetadata(metric_name(o.metric)));
-  grid->insertMeta(kMaxDistance, openvdb::DoubleMetadata(k * clamp));
-  grid->insertMeta(kSurfaceOffset, openvdb::DoubleMetadata(k * offset));
+  grid->insertMeta(kMaxDistance, openvdb::DoubleMetadata(f.k * o.max_distance));
+  grid->insertMeta(kSurfaceOffset, openvdb::DoubleMetadata(f.k * f.offset));
   grid->insertMeta(kStorage, openvdb::StringMetadata(storage_name(o.storage)));
-  insert_box(*grid, kDomainMin, kDomainMax, field.domain);
-  return write_grids({grid});
+  insert_box(*grid, kDomainMin, kDomainMax, domain);
+  return grid;
+}
+
+}  // namespace
+
+double vdb_field_background(const DistanceField& field) {
+  const FieldLevels f(field);
+  const double clamp = field.options.max_distance;
+  // The clamp as the field stores it — what voxels beyond it and outside the domain read, which
+  // integer storage may have lowered to its range and rounded, and f32 rounded to a float — or,
+  // unclamped, the largest finite |distance| of the field.
+  const double stored_clamp = std::visit(
+      [&](const auto& g) { return field.encoding.decode(static_cast<double>(g.background())); },
+      field.values);
+  if (clamp > 0) {
+    const double background = f.level(stored_clamp);
+    if (!(background > 0))
+      throw InvalidArgument("vdb: a clamp of " + std::to_string(clamp) +
+                            " leaves no band around the surface (the level set needs more than "
+                            "half a voxel)");
+    return background;
+  }
+  double background = 0;
+  const auto widen = [&](double d) {
+    if (std::isfinite(d)) background = std::max(background, std::abs(f.level(d)));
+  };
+  f.for_each_value([&](const Box3i&, double d) { widen(d); }, [&](Vec3i, double d) { widen(d); });
+  return background;
+}
+
+std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
+                                           const std::string& grid_name) {
+  ensure_initialized();
+  return write_grids({field_grid(field, vdb_field_background(field), field.domain, grid_name)});
+}
+
+std::vector<std::uint8_t> encode_vdb_field_part(const DistanceField& part, double background,
+                                                const Box3i& domain, const std::string& grid_name) {
+  ensure_initialized();
+  return write_grids({field_grid(part, background, domain, grid_name)});
+}
+
+struct VdbFieldParts::Impl {
+  openvdb::FloatGrid::Ptr grid;
+};
+
+VdbFieldParts::VdbFieldParts(const DistanceField& own, double background, const Box3i& domain,
+                             const std::string& grid_name)
+    : impl_(std::make_unique<Impl>()) {
+  ensure_initialized();
+  impl_->grid = field_grid(own, background, domain, grid_name);
+}
+
+VdbFieldParts::~VdbFieldParts() = default;
+
+void VdbFieldParts::add(std::span<const std::uint8_t> part, const std::string& name) {
+  // The bytes are encode_vdb_field_part's, made by this library (OpenVDB's reader must not be
+  // handed bytes from elsewhere: vdb_read.cpp).
+  std::istringstream in(std::string(part.begin(), part.end()), std::ios_base::binary);
+  openvdb::io::Stream stream(in);
+  const openvdb::GridPtrVecPtr grids = stream.getGrids();
+  openvdb::FloatGrid::Ptr other = grids && grids->size() == 1
+                                      ? openvdb::gridPtrCast<openvdb::FloatGrid>(grids->front())
+                                      : nullptr;
+  if (!other || other->background() != impl_->grid->background())
+    throw InvalidArgument(name +
+                          ": not a part of this field's grid (encode_vdb_field_part's, with "
+                          "the same background)");
+  openvdb::FloatTree& tree = impl_->grid->tree();
+  // The parts' regions do not overlap (slabs of one field): each leaf and tile moves as it is,
+  // and the final prune makes the tree the one the whole field's values give.
+  // (A node that reaches past its part holds the background in its slots beyond it: those are
+  // not the part's, and would overwrite the other parts' nodes there.)
+  const float bg = other->background();
+  for (auto it = other->tree().cbeginValueAll(); it; ++it)
+    if (!it.isVoxelValue() && (it.isValueOn() || *it != bg))
+      tree.addTile(it.getLevel(), it.getCoord(), *it, it.isValueOn());
+  // A part's grid holds -background inactive inside its solids and the background everywhere else
+  // it does not hold a value (field_grid), but OpenVDB's reader may fill a leaf's inactive voxels
+  // with other values (0 beyond the domain, in leaves that reach past it): they are set back.
+  for (auto leaf = other->tree().beginLeaf(); leaf; ++leaf)
+    for (auto v = leaf->beginValueOff(); v; ++v)
+      if (*v != -bg) v.setValue(bg);
+  std::vector<openvdb::FloatTree::LeafNodeType*> leaves;
+  other->tree().stealNodes(leaves);
+  for (openvdb::FloatTree::LeafNodeType* leaf : leaves) tree.addLeaf(leaf);
+}
+
+std::vector<std::uint8_t> VdbFieldParts::finish() {
+  impl_->grid->tree().prune();
+  return write_grids({impl_->grid});
 }
 
 namespace {

@@ -67,6 +67,10 @@ std::vector<std::uint8_t> broadcast_bytes(MPI_Comm comm, std::vector<std::uint8_
 // and get nothing; `to` 0 keeps rank 0's own).
 std::vector<std::uint8_t> send_bytes(MPI_Comm comm, int to, std::vector<std::uint8_t> bytes,
                                      const std::string& name, ExchangeStats* stats);
+// Rank `from`'s `bytes` on rank `to` alone, the same way (send_bytes is from 0).
+std::vector<std::uint8_t> move_bytes(MPI_Comm comm, int from, int to,
+                                     std::vector<std::uint8_t> bytes, const std::string& name,
+                                     ExchangeStats* stats);
 
 // Bytes of a shared file at an offset.
 struct FilePiece {

@@ -18,10 +18,12 @@ namespace voxfield::mpi {
 namespace {
 
 // An exclusive scan of `values` (count ints) over the ranks of `comm` with `op`; rank 0 (which gets
-// nothing from MPI) gets `none`.
+// nothing from MPI) gets `none`. The output's room is agreed on first: a rank that cannot allocate
+// it fails every rank instead of leaving them in the scan.
 void exclusive_scan(MPI_Comm comm, std::vector<std::int32_t>& values, MPI_Op op, std::int32_t none,
                     ExchangeStats* stats) {
-  std::vector<std::int32_t> out(values.size(), none);
+  std::vector<std::int32_t> out = detail::collectively(
+      comm, stats, [&] { return std::vector<std::int32_t>(values.size(), none); });
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   {
@@ -78,11 +80,15 @@ DistanceField compute_distance_field(MPI_Comm comm, const SlabPartition& partiti
     MPI_Comm_split(comm, 0, size - 1 - rank, &reversed);
     exclusive_scan(reversed, above, MPI_MIN, ColumnSites::kNoneLow, stats);
     MPI_Comm_free(&reversed);
-    const auto half = static_cast<std::ptrdiff_t>(n);
-    neighbours.solid_below.assign(below.begin(), below.begin() + half);
-    neighbours.air_below.assign(below.begin() + half, below.end());
-    neighbours.solid_above.assign(above.begin(), above.begin() + half);
-    neighbours.air_above.assign(above.begin() + half, above.end());
+    // (Agreed on too: a rank that cannot hold its neighbours would leave the others in the
+    // transform's agreement.)
+    detail::collectively(comm, stats, [&] {
+      const auto half = static_cast<std::ptrdiff_t>(n);
+      neighbours.solid_below.assign(below.begin(), below.begin() + half);
+      neighbours.air_below.assign(below.begin() + half, below.end());
+      neighbours.solid_above.assign(above.begin(), above.begin() + half);
+      neighbours.air_above.assign(above.begin() + half, above.end());
+    });
   }
   const auto t1 = std::chrono::steady_clock::now();
   DistanceField field = detail::collectively(comm, stats, [&] {

@@ -166,7 +166,8 @@ void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const Distan
     if ((!files.packed.empty() || !files.materials.empty()) && !files.world)
       throw InvalidArgument(
           "packed voxels and materials need this rank's world (FieldFiles::world)");
-    outputs.push_back({&files.values, npy_header(values_dtype(slab), domain.size()), {}, {}});
+    if (!files.values.empty())
+      outputs.push_back({&files.values, npy_header(values_dtype(slab), domain.size()), {}, {}});
     if (!files.sites.empty())
       outputs.push_back({&files.sites, npy_header(DType::kInt16, domain.size(), 3), {}, {}});
     if (!files.packed.empty())
@@ -192,8 +193,8 @@ void write_field_npy(MPI_Comm comm, const SlabPartition& partition, const Distan
     const auto t0 = std::chrono::steady_clock::now();
     const Box3i mine = partition.slab(rank);
     try {
-      outputs[0].pieces.push_back(values_piece(slab, mine, domain));
-      std::size_t k = 1;
+      std::size_t k = 0;
+      if (!files.values.empty()) outputs[k++].pieces.push_back(values_piece(slab, mine, domain));
       if (!files.sites.empty()) outputs[k++].pieces = sites_pieces(*slab.sites, mine, domain);
       if (!files.packed.empty())
         outputs[k++].pieces.push_back(packed_piece(*files.world, slab, mine, domain));

@@ -44,7 +44,7 @@ same() {  # same REF OUT WHAT
 expect_failure() {  # expect_failure CODE PATTERN ARGS...
   local code=$1 pattern=$2
   shift 2
-  rm -f bad.npy bad.vfw bad.ply
+  rm -f bad.npy bad.vfw bad.ply bad.vdb bad.txt
   set +e
   MPIEXEC -np "${EXPECT_RANKS:-2}" "$VFM" "$@" >out.txt 2>err.txt
   local got=$?
@@ -52,7 +52,7 @@ expect_failure() {  # expect_failure CODE PATTERN ARGS...
   if [ "$got" -ne "$code" ]; then echo "FAIL: $* exited $got, expected $code"; cat err.txt; fail=1; fi
   if ! grep -q -- "$pattern" err.txt; then echo "FAIL: $*: no '$pattern' in:"; cat err.txt; fail=1; fi
   if [ "$(grep -c -- "$pattern" err.txt)" -gt 1 ]; then echo "FAIL: $*: said more than once"; fail=1; fi
-  if [ -e bad.npy ] || [ -e bad.vfw ] || [ -e bad.ply ]; then echo "FAIL: $* wrote an output"; fail=1; fi
+  if [ -e bad.npy ] || [ -e bad.vfw ] || [ -e bad.ply ] || [ -e bad.vdb ] || [ -e bad.txt ]; then echo "FAIL: $* wrote an output"; fail=1; fi
   if ls -a | grep -q vftmp; then echo "FAIL: $* left a temporary"; fail=1; fi
 }
 # The shared corpus lies beside the repository (README).

@@ -224,6 +224,42 @@ same ref.png out.png "render --grid sphere, 2 ranks"
 expect_failure 1 "f.npy: a grid name ('fog') is for .vdb files" field f.npy -o bad.npy --grid fog
 expect_failure 1 "no grid named" field pair.vdb -o bad.npy --grid smoke
 
+# A .vdb output: every rank encodes its slab's grid, rank 0 joins them into voxfield field's file,
+# byte for byte but for the stream's UUID (random in every file OpenVDB writes); OpenVDB reads it.
+vdb_same() {  # vdb_same REF OUT WHAT
+  if ! /usr/bin/python3 - "$1" "$2" <<'PY'
+import sys
+a, b = open(sys.argv[1], "rb").read(), open(sys.argv[2], "rb").read()
+# Magic, three versions and a flag (21 bytes), then the 36 characters of the UUID.
+sys.exit(0 if len(a) == len(b) and a[:21] == b[:21] and a[57:] == b[57:] else 1)
+PY
+  then echo "FAIL: $3: $2 differs from voxfield's $1"; fail=1; fi
+}
+"$VF" convert f.npy stretched.vfw --voxel-size 0.25,0.25,1 --origin 100,-50,3 2>/dev/null
+for run in "f.npy|--metric euclidean --signed --max-distance 4" "f.npy|--metric euclidean --signed" \
+           "f.npy|--metric manhattan --max-distance 6 --storage u8" "margins.vfw|--metric chebyshev" \
+           "stretched.vfw|--metric euclidean --signed --max-distance 2"; do
+  input=${run%%|*} opts=${run#*|}
+  # shellcheck disable=SC2086
+  "$VF" field "$input" -o ref.vdb $opts 2>/dev/null
+  for n in 1 3 4; do
+    # shellcheck disable=SC2086
+    MPIEXEC -np "$n" "$VFM" field "$input" -o out.vdb --chunk 8 $opts --stats vdb.json 2>/dev/null
+    vdb_same ref.vdb out.vdb "$n ranks, $input as .vdb, $opts"
+  done
+done
+/usr/bin/python3 - <<'PY'
+import json, pyopenvdb as vdb
+g = vdb.read("out.vdb", "distance")
+assert g.gridClass == vdb.GridClass.LEVEL_SET and g.activeVoxelCount() > 0, g
+s = json.load(open("vdb.json"))
+assert s["ranks"] == 4 and s["vdb_exchange"]["bytes_received_total"] > 0, s
+PY
+EXPECT_RANKS=3 expect_failure 1 "voxfield-mpi writes fields as .npy or .vdb" field f.npy -o bad.txt
+/usr/bin/python3 -c "import numpy as np; np.save('empty.npy', np.zeros((9, 9, 20), np.uint8))"
+EXPECT_RANKS=3 expect_failure 1 "no finite non-zero distance" field empty.npy -o bad.vdb \
+  --metric euclidean
+
 # Read by rank 0 alone (--read rank0, for ranks that cannot see its files): a .npy's parts read by
 # rank 0 and sent rank by rank, the other formats' bytes broadcast and each rank's slab decoded
 # from them; the same fields, edits and frames.
