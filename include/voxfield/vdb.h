@@ -69,8 +69,7 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
 // of any part — the largest vdb_field_background over the parts (0 for a part with none; the
 // field is refused if every part has none). Each part's grid is encode_vdb_field_part's bytes,
 // and VdbFieldParts joins them into the bytes encode_vdb_field writes for the whole field. The
-// parts must not overlap, and their borders must lie on multiples of 8 (OpenVDB's leaf edge) or
-// on the domain's faces; slabs cut on chunk boundaries do.
+// parts must not overlap; a leaf split between parts is joined voxel by voxel.
 double vdb_field_background(const DistanceField& field);
 std::vector<std::uint8_t> encode_vdb_field_part(const DistanceField& part, double background,
                                                 const Box3i& domain,

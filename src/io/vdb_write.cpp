@@ -334,23 +334,47 @@ void VdbFieldParts::add(std::span<const std::uint8_t> part, const std::string& n
                           ": not a part of this field's grid (encode_vdb_field_part's, with "
                           "the same background)");
   openvdb::FloatTree& tree = impl_->grid->tree();
-  // The parts' regions do not overlap (slabs of one field): each leaf and tile moves as it is,
-  // and the final prune makes the tree the one the whole field's values give.
-  // (A node that reaches past its part holds the background in its slots beyond it: those are
-  // not the part's, and would overwrite the other parts' nodes there.)
+  // The parts' regions do not overlap (slabs of one field), and a part writes only inside its
+  // own: outside it every voxel is the background, inactive (field_grid). So a tile that is not
+  // that lies wholly inside the part and moves as it is. (A node that reaches past its part holds
+  // the background in its slots beyond it: those are not the part's, and would overwrite the
+  // other parts' nodes there.)
   const float bg = other->background();
-  for (auto it = other->tree().cbeginValueAll(); it; ++it)
-    if (!it.isVoxelValue() && (it.isValueOn() || *it != bg))
+  auto it = other->tree().cbeginValueAll();
+  it.setMaxDepth(openvdb::FloatTree::ValueAllCIter::LEAF_DEPTH - 1);  // tiles only
+  for (; it; ++it)
+    if (it.isValueOn() || *it != bg)
       tree.addTile(it.getLevel(), it.getCoord(), *it, it.isValueOn());
   // A part's grid holds -background inactive inside its solids and the background everywhere else
   // it does not hold a value (field_grid), but OpenVDB's reader may fill a leaf's inactive voxels
-  // with other values (0 beyond the domain, in leaves that reach past it): they are set back.
+  // with other values (0 beyond the domain, in leaves that reach past it, was seen): they are set
+  // back.
   for (auto leaf = other->tree().beginLeaf(); leaf; ++leaf)
     for (auto v = leaf->beginValueOff(); v; ++v)
       if (*v != -bg) v.setValue(bg);
-  std::vector<openvdb::FloatTree::LeafNodeType*> leaves;
-  other->tree().stealNodes(leaves);
-  for (openvdb::FloatTree::LeafNodeType* leaf : leaves) tree.addLeaf(leaf);
+  // Leaves move whole; one that another part already holds (slabs cut off a multiple of 8, as
+  // partition_slabs does when the domain has fewer chunk layers than ranks) is joined voxel by
+  // voxel: the incoming part's voxels are those it wrote, active or -background.
+  std::vector<openvdb::FloatTree::LeafNodeType*> stolen;
+  other->tree().stealNodes(stolen);
+  std::vector<std::unique_ptr<openvdb::FloatTree::LeafNodeType>> leaves(stolen.begin(),
+                                                                        stolen.end());
+  for (auto& leaf : leaves) {
+    openvdb::FloatTree::LeafNodeType* held = tree.probeLeaf(leaf->origin());
+    if (!held) {
+      tree.addLeaf(leaf.get());
+      (void)leaf.release();  // the tree owns it now
+      continue;
+    }
+    for (openvdb::Index i = 0; i < openvdb::FloatTree::LeafNodeType::SIZE; ++i) {
+      const bool on = leaf->isValueOn(i);
+      const float v = leaf->getValue(i);
+      if (on || v != bg) {
+        held->setValueOnly(i, v);
+        held->setActiveState(i, on);
+      }
+    }
+  }
 }
 
 std::vector<std::uint8_t> VdbFieldParts::finish() {

@@ -1,10 +1,11 @@
 // voxfield — a field the ranks hold in slabs written as one .vdb (mpi.h's encode_vdb_field).
 //
-// OpenVDB's trees are sparse and their leaves are 8-voxel cubes on multiples of 8: slabs cut on
-// chunk boundaries (chunk edges 8 to 128) never split a leaf, so each rank's grid holds whole
-// leaves and the tiles of its own slab, and rank 0 moves every part's leaves and tiles into one
-// tree (VdbFieldParts, vdb.h). The final prune gives the tree the whole field's values give, and
-// so the bytes one process writes. The background must be the whole field's before any part is
+// OpenVDB's trees are sparse and their leaves are 8-voxel cubes on multiples of 8. Each rank's grid
+// holds the leaves and tiles of its own slab, and rank 0 moves every part's leaves and tiles into
+// one tree (VdbFieldParts, vdb.h): slabs cut on chunk boundaries never split a leaf, and a leaf
+// that slabs cut at single slices split (fewer chunk layers than ranks) is joined voxel by voxel.
+// The final prune gives the tree the whole field's values give, and so the bytes one process
+// writes. The background must be the whole field's before any part is
 // encoded: an unclamped field's is its largest finite |distance|, a maximum over the ranks.
 #include <optional>
 #include <string>
