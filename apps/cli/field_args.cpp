@@ -46,13 +46,6 @@ void add_grid_option(CLI::App* cmd, std::string& grid) {
                   "world grid, else the first int32 grid, else the first)");
 }
 
-std::string lowercase_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
 void check_grid_input(const std::string& in, const std::string& grid) {
   if (!grid.empty() && lowercase_extension(in) != ".vdb")
     throw UsageError("--grid picks a .vdb input's grid; " + in + " is not a .vdb file");

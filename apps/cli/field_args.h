@@ -40,8 +40,6 @@ struct FieldArgs {
 void add_grid_option(CLI::App* cmd, std::string& grid);
 // Refuses (UsageError, before anything is read) a --grid for an input that is not a .vdb file.
 void check_grid_input(const std::string& in, const std::string& grid);
-// A path's extension in lower case, with its dot (".vdb"); empty without one.
-std::string lowercase_extension(const std::string& path);
 
 // Every algorithm's name, for --algorithm's check.
 std::vector<std::string> algorithm_names();

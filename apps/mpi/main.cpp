@@ -31,7 +31,6 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -102,14 +101,6 @@ struct FieldSettings {
             {"ranks", ranks}};
   }
 };
-
-// A path's extension in lower case: voxfield reads .NPY as .npy, and so does voxfield-mpi.
-std::string lowercase_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
 
 using mpi_cli::exchange_json;
 using mpi_cli::max_over;

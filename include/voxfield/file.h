@@ -64,6 +64,9 @@ bool same_file(const std::filesystem::path& a, const std::filesystem::path& b);
 // absolute (a file not written yet); "-" (standard output) is only itself.
 bool same_target(const std::filesystem::path& a, const std::filesystem::path& b);
 
+// A path's extension in lower case (".NPY" reads as ".npy"): how every format is told by name.
+std::string lowercase_extension(const std::filesystem::path& path);
+
 // A set of output files written all or nothing.
 //
 // stage() checks the target as check_output_path does, then writes the bytes to a temporary file

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -337,6 +338,13 @@ bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
   std::error_code ec;
   const bool same = std::filesystem::equivalent(a, b, ec);
   return !ec && same;
+}
+
+std::string lowercase_extension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
 }
 
 bool same_target(const std::filesystem::path& a, const std::filesystem::path& b) {

@@ -287,9 +287,7 @@ TriangleMesh parse_stl(std::span<const std::uint8_t> bytes, const std::string& n
 }  // namespace
 
 std::optional<MeshInputFormat> mesh_input_format_of(const std::filesystem::path& path) {
-  std::string e = path.extension().string();
-  std::transform(e.begin(), e.end(), e.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string e = lowercase_extension(path);
   if (e == ".obj") return MeshInputFormat::kObj;
   if (e == ".ply") return MeshInputFormat::kPly;
   if (e == ".stl") return MeshInputFormat::kStl;

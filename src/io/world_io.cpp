@@ -15,12 +15,6 @@
 namespace voxfield {
 namespace {
 
-std::string extension(const std::filesystem::path& p) {
-  std::string e = p.extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
-  return e;
-}
-
 // Checks the first bytes against the format's magic; a mismatch is reported by the format's own
 // parser (which names what it found), run on those bytes alone.
 void check_magic(const std::filesystem::path& path, WorldFormat f) {
@@ -48,7 +42,7 @@ void check_magic(const std::filesystem::path& path, WorldFormat f) {
 }  // namespace
 
 WorldFormat world_format_of(const std::filesystem::path& path) {
-  const std::string ext = extension(path);
+  const std::string ext = lowercase_extension(path);
   if (ext == ".vox") return WorldFormat::kVox;
   if (ext == ".npy") return WorldFormat::kNpy;
   if (ext == ".vfw") return WorldFormat::kVfw;

@@ -85,90 +85,102 @@ RenderOptions small_frame(RenderView view) {
   return o;
 }
 
-TEST(MpiRender, FramesEqualOneProcessByteForByte) {
-  const int edge = 8;
-  const Box3i domain = kSceneDomain;
-  const World w = scene_world(17, domain, edge);
-  const RenderOptions o = small_frame(RenderView::kShaded);
-  const double aspect = 1.5;
+// One scene's frames to check: the scene world of `seed` over kSceneDomain in chunks of 8, and
+// small_frame(view) for the cases to start from.
+struct SceneFrames {
+  int edge = 8;
+  Box3i domain = kSceneDomain;
+  World world;
+  RenderOptions options;
+  double aspect = 1.5;
   std::vector<Case> cases;
-  cases.push_back({"shaded, framing camera", {}, Camera::framing(domain, aspect), o});
-  cases.push_back({"shaded, orthographic from above", {}, Camera::top(domain, aspect), o});
+
+  SceneFrames(std::uint32_t seed, RenderView view)
+      : world(scene_world(seed, kSceneDomain, 8)), options(small_frame(view)) {}
+  void check_all() const {
+    for (const Case& c : cases) check(c, world, domain, edge);
+  }
+};
+
+TEST(MpiRender, FramesEqualOneProcessByteForByte) {
+  SceneFrames s(17, RenderView::kShaded);
+  s.cases.push_back({"shaded, framing camera", {}, Camera::framing(s.domain, s.aspect), s.options});
+  s.cases.push_back(
+      {"shaded, orthographic from above", {}, Camera::top(s.domain, s.aspect), s.options});
   Case low{"a low sun, from below the ground, fog",
            {},
-           Camera::parse("eye=17,25,-40:target=17,25,10:up=0,1,0", domain, aspect),
-           o};
+           Camera::parse("eye=17,25,-40:target=17,25,10:up=0,1,0", s.domain, s.aspect),
+           s.options};
   low.options.sun_direction = {0.9, 0.2, 0.15};
   low.options.fog_density = 0.01;
-  cases.push_back(low);
+  s.cases.push_back(low);
   Case inside{"from inside, the sun below",
               {},
-              Camera::parse("eye=30,12,20:target=0,40,0:fov=80", domain, aspect),
-              o};
+              Camera::parse("eye=30,12,20:target=0,40,0:fov=80", s.domain, s.aspect),
+              s.options};
   inside.options.sun_direction = {-0.3, 0.4, -0.8};
-  cases.push_back(inside);
+  s.cases.push_back(inside);
   Case chunks{"the chunks view, Euclidean skip clamped at 12, no skipping for primary rays",
               {},
-              Camera::framing(domain, aspect, 35),
-              o};
+              Camera::framing(s.domain, s.aspect, 35),
+              s.options};
   chunks.scene.skip_metric = Metric::kEuclidean;
   chunks.scene.skip_max_distance_vox = 12;
   chunks.scene.lighting_max_distance_vox = 9.5;
   chunks.options.view = RenderView::kChunks;
   chunks.options.skip = SkipMode::kNone;
-  cases.push_back(chunks);
+  s.cases.push_back(chunks);
   Case flat{"Chebyshev skip, a sun on the horizon, orthographic from the side",
             {},
-            Camera::parse("eye=17,-60,20:target=17,25,10:ortho=70", domain, aspect),
-            o};
+            Camera::parse("eye=17,-60,20:target=17,25,10:ortho=70", s.domain, s.aspect),
+            s.options};
   flat.scene.skip_metric = Metric::kChebyshev;
   flat.options.sun_direction = {0.6, 0.8, 0};
-  cases.push_back(flat);
-  Case plain{"no lighting field", {}, Camera::framing(domain, aspect), o};
+  s.cases.push_back(flat);
+  Case plain{"no lighting field", {}, Camera::framing(s.domain, s.aspect), s.options};
   plain.scene.lighting_field = false;
   plain.options.ambient_occlusion = false;
   plain.options.soft_shadows = false;
   plain.options.skip = SkipMode::kChunks;
-  cases.push_back(plain);
-  for (const Case& c : cases) check(c, w, domain, edge);
+  s.cases.push_back(plain);
+  s.check_all();
 }
 
 // The distance view: rays walk the box below the cut plane, and those that enter it through the
 // plane on air show the skip field there, drawn by the rank that holds the plane's slice.
 TEST(MpiRender, DistanceViewsEqualOneProcessByteForByte) {
-  const int edge = 8;
-  const Box3i domain = kSceneDomain;
-  const World w = scene_world(29, domain, edge);
-  const RenderOptions o = small_frame(RenderView::kDistance);
-  const double aspect = 1.5;
-  std::vector<Case> cases;
-  cases.push_back({"the middle slice, framing camera", {}, Camera::framing(domain, aspect), o});
+  SceneFrames s(29, RenderView::kDistance);
+  s.cases.push_back(
+      {"the middle slice, framing camera", {}, Camera::framing(s.domain, s.aspect), s.options});
   // Slab borders lie on multiples of 8 (and at the domain's faces): cuts on either side of one,
   // the bottom and the top slice.
   for (const int z : {-13, 7, 8, 15, 16, 31, 47}) {
-    Case c{"slice z=" + std::to_string(z), {}, Camera::framing(domain, aspect, 40), o};
+    Case c{"slice z=" + std::to_string(z), {}, Camera::framing(s.domain, s.aspect, 40), s.options};
     c.options.slice_z = z;
-    cases.push_back(c);
+    s.cases.push_back(c);
   }
-  Case top{
-      "orthographic from above, Euclidean skip clamped at 12", {}, Camera::top(domain, aspect), o};
+  Case top{"orthographic from above, Euclidean skip clamped at 12",
+           {},
+           Camera::top(s.domain, s.aspect),
+           s.options};
   top.scene.skip_metric = Metric::kEuclidean;
   top.scene.skip_max_distance_vox = 12;
   top.options.slice_z = 20;
-  cases.push_back(top);
+  s.cases.push_back(top);
   Case below{"from below the ground (rays rise: no ray enters through the cut)",
              {},
-             Camera::parse("eye=17,25,-40:target=17,25,10:up=0,1,0", domain, aspect),
-             o};
-  cases.push_back(below);
-  Case plain{"no lighting field, chunk skipping", {}, Camera::framing(domain, aspect), o};
+             Camera::parse("eye=17,25,-40:target=17,25,10:up=0,1,0", s.domain, s.aspect),
+             s.options};
+  s.cases.push_back(below);
+  Case plain{
+      "no lighting field, chunk skipping", {}, Camera::framing(s.domain, s.aspect), s.options};
   plain.scene.lighting_field = false;
   plain.options.ambient_occlusion = false;
   plain.options.soft_shadows = false;
   plain.options.skip = SkipMode::kChunks;
   plain.options.slice_z = 3;
-  cases.push_back(plain);
-  for (const Case& c : cases) check(c, w, domain, edge);
+  s.cases.push_back(plain);
+  s.check_all();
 }
 
 // Every rank walks its stretch of every primary ray at once, and the first hit along the ray is the
