@@ -107,10 +107,12 @@ struct CrossingSums {
   double x, y, z;
   int count;  // > 0 for a cell the surface crosses
 };
-// t_of is called for the crossed edges only; with `kReadsAnyEdge`, for every edge (t_of then
-// reads without side effects, whatever an edge not crossed holds), and the sums are selected
-// without a branch per edge — the edges a noisy volume's cells cross are unpredictable.
-template <bool kReadsAnyEdge = false, class CrossingOf>
+// How crossing_sums reads t_of: for the crossed edges only, or for every edge where t_of gives +0
+// for an edge not crossed (which leaves a sum unchanged). The second has no branch and no mask per
+// edge: the edges a noisy volume's cells cross are unpredictable, and a mask per edge was a fifth
+// of surface nets' whole-volume pass on the noise volume (docs/benchmarks.md).
+enum class EdgeReads { kCrossed, kAnyZeroElsewhere };
+template <EdgeReads kReads = EdgeReads::kCrossed, class CrossingOf>
 CrossingSums crossing_sums(const CubeCases& table, unsigned inside, CrossingOf&& t_of) {
   const unsigned crossed = table.crossed_edges(inside);
   // Edges 4a..4a+3 run along axis a (the numbering above; cube_edges() is built from it).
@@ -119,11 +121,8 @@ CrossingSums crossing_sums(const CubeCases& table, unsigned inside, CrossingOf&&
     double s = 0;
     for (unsigned j = 0; j < 4; ++j) {
       const unsigned e = 4 * a + j;
-      if constexpr (kReadsAnyEdge) {
-        // t, or +0 (which leaves a sum unchanged) for an edge not crossed, by masking its bits:
-        // GCC 12 turns a select here into a branch, mispredicted on every other noisy cell.
-        const std::uint64_t keep = 0 - static_cast<std::uint64_t>(crossed >> e & 1);
-        s += std::bit_cast<double>(std::bit_cast<std::uint64_t>(t_of(e)) & keep);
+      if constexpr (kReads == EdgeReads::kAnyZeroElsewhere) {
+        s += t_of(e);
       } else if (crossed >> e & 1) {
         s += t_of(e);
       }

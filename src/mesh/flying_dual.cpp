@@ -302,8 +302,10 @@ void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const
   const std::size_t words = words_, nx = static_cast<std::size_t>(n.x);
   // Crossings of x-edges on sample rows (y', z + dz), kept for two y' (by parity) per layer dz;
   // of z-edges from rows (y', z) to (y', z + 1), two y'; of y-edges from (y, z + dz) to
-  // (y + 1, z + dz), the current y only. Entries of edges not crossed hold a finite stale value
-  // (or the initial zero), read and discarded by crossing_sums<true>.
+  // (y + 1, z + dz), the current y only. Entries of edges not crossed hold +0, which the cells'
+  // sums add without a mask (crossing_sums' kAnyZeroElsewhere): clearing a row's array costs less
+  // than masking each of a cell's twelve reads (measured: a fifth of surface nets' whole pass on
+  // the noise volume).
   std::vector<double> store(8 * nx);
   double* tx[2][2] = {{&store[0], &store[nx]}, {&store[2 * nx], &store[3 * nx]}};
   double* tz[2] = {&store[4 * nx], &store[5 * nx]};
@@ -311,6 +313,7 @@ void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const
   std::vector<std::uint64_t> mask(words);
   // t along each crossed edge from r0[x] to r1[x], for x below `end`.
   const auto crossings = [&](const float* r0, const float* r1, int end, double* t) {
+    std::fill_n(t, nx, 0.0);
     for (std::size_t w = 0; w < words; ++w)
       for (std::uint64_t m = mask[w]; m; m &= m - 1) {
         const int x = static_cast<int>(64 * w) + std::countr_zero(m);
@@ -368,8 +371,8 @@ void FlyingDual::write_surface_nets_vertices(int z, const WeldOutput& out) const
           v[c] = block_.s_of(row[c >> 1][x + (c & 1)]);
           inside |= static_cast<unsigned>(v[c] < 0) << c;
         }
-        const CrossingSums sums =
-            crossing_sums<true>(table, inside, [&](unsigned e) { return tp[e][x]; });
+        const CrossingSums sums = crossing_sums<EdgeReads::kAnyZeroElsewhere>(
+            table, inside, [&](unsigned e) { return tp[e][x]; });
         for (std::size_t c = 0; c < 8; ++c) cells.v[c][k] = v[c];
         cells.x[k] = x;
         cells.sum[0][k] = sums.x, cells.sum[1][k] = sums.y, cells.sum[2][k] = sums.z;
