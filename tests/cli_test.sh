@@ -520,8 +520,11 @@ assert np.allclose(d, (0, 2, 0)), d
 assert np.allclose(g.transform.indexToWorld((0, 0, 0)), (-1, 1, 1)), g.transform.indexToWorld((0, 0, 0))"
 check "an anisotropic level set in voxels refused" 1 "$V" field "$tmp/scan.vfw" --metric euclidean --signed --max-distance 3 --spacing 1,1,1 -o "$tmp/scan.vdb"
 expect_grep "spacing named" "$tmp/err" "spacing"
+expect_grep "the refusal names the output (given before the field is computed)" "$tmp/err" "scan.vdb: vdb: the field was measured"
 check "an anisotropic Manhattan level set refused" 1 "$V" field "$tmp/scan.vfw" --metric manhattan --signed --max-distance 3 -o "$tmp/scan.vdb"
 expect_grep "metric named" "$tmp/err" "Manhattan"
+check "a clamp within half a voxel refused" 1 "$V" field "$tmp/scan.vfw" --metric euclidean --signed --max-distance 0.2 -o "$tmp/scan.vdb"
+expect_grep "the clamp's refusal names the output" "$tmp/err" "scan.vdb: vdb: a clamp of 0.2"
 [ ! -e "$tmp/scan.vdb" ] && passes=$((passes+1)) || { echo "FAIL: a refused level set wrote its output"; fails=$((fails+1)); }
 check "a level set in world units" 0 "$V" field "$tmp/scan.vfw" --metric euclidean --signed --max-distance 3 -o "$tmp/scan.vdb"
 expect_grep "measured in the voxel size, said" "$tmp/err" "measuring in the world's voxel size 0.5 x 0.5 x 2"

@@ -6,6 +6,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetMeasure.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -13,6 +14,7 @@
 
 #include "error_text.h"
 #include "voxfield/error.h"
+#include "voxfield/limits.h"
 #include "voxfield/vdb.h"
 #include "voxfield/world_io.h"
 
@@ -283,6 +285,39 @@ TEST(Vdb, LevelSetsAreClosedAndEncloseTheSolidVolume) {
   // The block is 80^3 voxels of 0.5^3 units, plus one voxel.
   const double want = (80.0 * 80 * 80 + 1) * 0.125;
   EXPECT_NEAR(openvdb::tools::levelSetVolume(*grid), want, 0.01 * want);
+}
+
+// A field's .vdb joined from two parts (voxfield-mpi's slabs) is the whole field's file but for the
+// stream's UUID (bytes 21-57, random in every file OpenVDB writes); the joined grid is charged to
+// the memory limit as each part comes in, and a part past it is refused by name.
+TEST(Vdb, FieldsJoinedFromPartsAreTheWholeFieldsFileWithinTheMemoryLimit) {
+  DistanceOptions o;
+  o.metric = Metric::kEuclidean;
+  o.signed_distance = true;
+  o.max_distance = 3;
+  o.domain = Box3i{{-4, -4, -4}, {32, 24, 28}};
+  const DistanceField whole = compute_distance_field(blob_world(), o);
+  DistanceField lower = whole, upper = whole;
+  lower.domain.end.z = 13;  // not a multiple of 8: the leaves at z 8..15 are split between them
+  upper.domain.begin.z = 13;
+  const double background = vdb_field_background(whole);
+  ASSERT_EQ(background, std::max(vdb_field_background(lower), vdb_field_background(upper)));
+  const std::vector<std::uint8_t> part = encode_vdb_field_part(upper, background, whole.domain);
+  VdbFieldParts joined(lower, background, whole.domain);
+  joined.add(part, "the upper part");
+  const std::vector<std::uint8_t> want = encode_vdb_field(whole), got = joined.finish();
+  ASSERT_EQ(got.size(), want.size());
+  EXPECT_TRUE(std::equal(got.begin(), got.begin() + 21, want.begin()));
+  EXPECT_TRUE(std::equal(got.begin() + 57, got.end(), want.begin() + 57));
+
+  struct LimitGuard {
+    ~LimitGuard() { set_default_memory_limit(0); }
+  } guard;
+  VdbFieldParts tight(lower, background, whole.domain);
+  set_default_memory_limit(4096);
+  const std::string refusal = error_of([&] { tight.add(part, "the upper part"); });
+  EXPECT_NE(refusal.find("the upper part"), std::string::npos) << refusal;
+  EXPECT_NE(refusal.find("memory limit"), std::string::npos) << refusal;
 }
 
 // Unclamped fields of empty worlds have nothing to bound their background; bad names of outputs

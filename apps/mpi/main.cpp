@@ -36,6 +36,7 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 
+#include "../common/vdb_output.h"
 #include "bench_world.h"
 #include "mesh_command.h"
 #include "rank_stats.h"
@@ -137,6 +138,8 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
                 << voxel.y << " x " << voxel.z << " (--spacing), so that " << out
                 << " holds distances in its units (--max-distance too)\n";
   }
+  // The .vdb's refusals before the field is computed (every rank reaches the same verdict).
+  if (vdb_output) mpi::collectively(comm, [&] { app::check_vdb_output(out, o, slab.world.frame); });
   mpi::ExchangeStats ex;
   MPI_Barrier(comm);  // the field's time starts together on every rank
   const double t1 = MPI_Wtime();

@@ -12,11 +12,12 @@
 #include <limits>
 #include <memory>
 #include <mutex>
-#include <sstream>
 #include <utility>
 #include <variant>
 
+#include "byte_streams.h"
 #include "voxfield/error.h"
+#include "voxfield/limits.h"
 #include "voxfield/vdb.h"
 
 namespace voxfield {
@@ -98,10 +99,11 @@ openvdb::CoordBBox bbox(const Box3i& b) {  // half-open to OpenVDB's inclusive
 }
 
 std::vector<std::uint8_t> write_grids(const openvdb::GridCPtrVec& grids) {
-  std::ostringstream out(std::ios_base::binary);
+  std::vector<std::uint8_t> bytes;
+  detail::ByteSink sink(bytes);
+  std::ostream out(&sink);
   openvdb::io::Stream(out).write(grids);
-  const std::string bytes = out.str();
-  return {bytes.begin(), bytes.end()};
+  return bytes;
 }
 
 std::string palette_text(const Palette& p) {
@@ -323,7 +325,8 @@ VdbFieldParts::~VdbFieldParts() = default;
 void VdbFieldParts::add(std::span<const std::uint8_t> part, const std::string& name) {
   // The bytes are encode_vdb_field_part's, made by this library (OpenVDB's reader must not be
   // handed bytes from elsewhere: vdb_read.cpp).
-  std::istringstream in(std::string(part.begin(), part.end()), std::ios_base::binary);
+  detail::ByteSource source(part);
+  std::istream in(&source);
   openvdb::io::Stream stream(in);
   const openvdb::GridPtrVecPtr grids = stream.getGrids();
   openvdb::FloatGrid::Ptr other = grids && grids->size() == 1
@@ -334,6 +337,10 @@ void VdbFieldParts::add(std::span<const std::uint8_t> part, const std::string& n
                           ": not a part of this field's grid (encode_vdb_field_part's, with "
                           "the same background)");
   openvdb::FloatTree& tree = impl_->grid->tree();
+  // The joined tree is the whole field's: on the rank that joins it, it is charged to the memory
+  // limit as the parts come in (the nodes of the part move; the bytes of the file come after).
+  require_memory(add_sat(tree.memUsage(), other->tree().memUsage()), 0, "vdb",
+                 "the grid joined from the field's parts, with " + name + ",");
   // The parts' regions do not overlap (slabs of one field), and a part writes only inside its
   // own: outside it every voxel is the background, inactive (field_grid). So a tile that is not
   // that lies wholly inside the part and moves as it is. (A node that reaches past its part holds

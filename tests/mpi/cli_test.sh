@@ -265,6 +265,12 @@ s = json.load(open("vdb.json"))
 assert s["ranks"] == 4 and s["vdb_exchange"]["bytes_received_total"] > 0, s
 PY
 EXPECT_RANKS=3 expect_failure 1 "voxfield-mpi writes fields as .npy or .vdb" field f.npy -o bad.txt
+# The .vdb's refusals that follow from the options and the frame come before the field is computed,
+# naming the output: a clamp that leaves no band around the surface, a spacing out of proportion.
+EXPECT_RANKS=3 expect_failure 1 "bad.vdb: vdb: a clamp of 0.4" field f.npy -o bad.vdb \
+  --metric euclidean --signed --max-distance 0.4
+expect_failure 1 "bad.vdb: vdb: the field was measured with spacing (1, 1, 1)" field stretched.vfw \
+  -o bad.vdb --metric euclidean --signed --spacing 1,1,1
 /usr/bin/python3 -c "import numpy as np; np.save('empty.npy', np.zeros((9, 9, 20), np.uint8))"
 EXPECT_RANKS=3 expect_failure 1 "no finite non-zero distance" field empty.npy -o bad.vdb \
   --metric euclidean
