@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 
+#include "../common/freed_pages.h"
 #include "backend_choice.h"
 #include "cli.h"
 #include "field_args.h"
@@ -72,7 +73,9 @@ int run_mesh(const MeshSettings& s) {
   double mesh_ms = 0;
   if (volume_input) {
     const std::vector<float> values = float_samples(*npy, s.in);
-    // The raw bytes are converted: freed before meshing, they no longer add to the peak memory.
+    // The raw bytes are converted: freed before meshing, they no longer add to the peak memory,
+    // and their pages hold the mesh's first arrays (freed_pages.h), until the mesh is made.
+    std::optional<app::KeepFreedPages> keep_freed_pages(std::in_place);
     std::vector<std::uint8_t>().swap(npy->bytes);
     ScalarVolume volume{npy->dims, values.data()};
     if (!s.spacing.empty()) volume.spacing_units = {s.spacing[0], s.spacing[1], s.spacing[2]};
@@ -94,6 +97,7 @@ int run_mesh(const MeshSettings& s) {
     }
     if (!gpu_stats) mesh = mesh_volume(volume, options);
     mesh_ms = ms_since(start);
+    keep_freed_pages.reset();
   } else {
     if (s.backend != "cpu")
       throw UsageError("--backend " + s.backend +

@@ -12,6 +12,10 @@
 // on top of this, e.g. MALLOC_CONF=thp:default turns the huge pages off again.
 #include <jemalloc/jemalloc.h>
 
+#include <string>
+
+#include "freed_pages.h"
+
 // thp:always advises every mapping jemalloc makes for huge pages (the kernel then backs whole
 // 2 MiB ranges at the first fault); metadata_thp:auto does so for its own metadata once that is
 // large enough to matter. oversize_threshold:0 turns off jemalloc's dedicated arena for blocks of
@@ -24,3 +28,30 @@
 // threshold for returning those to the kernel at once (strace shows the input's bytes returned
 // either way). docs/benchmarks.md has the runs.
 const char* malloc_conf = "thp:always,metadata_thp:auto,oversize_threshold:0";
+
+namespace voxfield::app {
+
+// The calling thread's arena keeps its dirty pages (decay -1: never purged) until the scope ends,
+// then purges what is left and decays as before. Advice only: where a call fails, nothing changes.
+KeepFreedPages::KeepFreedPages() {
+  std::size_t size = sizeof arena_;
+  if (mallctl("thread.arena", &arena_, &size, nullptr, 0) != 0) return;
+  ssize_t keep = -1, old = 0;
+  size = sizeof old;
+  const std::string name = "arena." + std::to_string(arena_) + ".dirty_decay_ms";
+  if (mallctl(name.c_str(), &old, &size, &keep, sizeof keep) != 0) return;
+  decay_ms_ = static_cast<long>(old);
+  set_ = true;
+}
+
+KeepFreedPages::~KeepFreedPages() {
+  if (!set_) return;
+  ssize_t old = static_cast<ssize_t>(decay_ms_);
+  const std::string arena = "arena." + std::to_string(arena_);
+  (void)mallctl((arena + ".dirty_decay_ms").c_str(), nullptr, nullptr, &old, sizeof old);
+  // What the scope kept and no allocation took goes back to the kernel now, as it would have
+  // when it was freed: the scope moves no page into the program's peak.
+  (void)mallctl((arena + ".purge").c_str(), nullptr, nullptr, nullptr, 0);
+}
+
+}  // namespace voxfield::app

@@ -1,0 +1,37 @@
+// voxfield's programs — a scope in which the pages the calling thread frees stay its own, for its
+// next allocations to take without the kernel's help.
+//
+// A page a program frees is handed back to the kernel after a while (jemalloc's decay), and a page
+// it takes from the kernel is zeroed on its first write. `voxfield mesh` of a scan frees the .npy
+// file's bytes just before it sizes the mesh: kept, those pages hold the mesh's first arrays, and
+// marching cubes of the 301 x 370 x 316 MRI takes 92-95 ms instead of 99-100 (six rounds each,
+// docs/benchmarks.md). Kept for the whole run instead, `voxfield field` of a 256³ volume peaked
+// 100 MB higher for nothing: hence a scope. Where the program is built without jemalloc
+// (VOXFIELD_JEMALLOC off, the sanitizer builds), the scope does nothing.
+#pragma once
+
+namespace voxfield::app {
+
+#if defined(VOXFIELD_HAS_JEMALLOC)
+class KeepFreedPages {
+ public:
+  KeepFreedPages();  // huge_page_allocator.cpp
+  ~KeepFreedPages();
+  KeepFreedPages(const KeepFreedPages&) = delete;
+  KeepFreedPages& operator=(const KeepFreedPages&) = delete;
+
+ private:
+  unsigned arena_ = 0;
+  long decay_ms_ = 0;  // the arena's, restored on leaving
+  bool set_ = false;
+};
+#else
+class KeepFreedPages {
+ public:
+  KeepFreedPages() = default;
+  KeepFreedPages(const KeepFreedPages&) = delete;
+  KeepFreedPages& operator=(const KeepFreedPages&) = delete;
+};
+#endif
+
+}  // namespace voxfield::app
