@@ -168,33 +168,43 @@ RUN_ENV="VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json" t
 # right click carves at the ray hit, each a separate edit; F12 saves a screenshot; Ctrl+Q quits
 # (within 30 s, well before the runs' cap of 3000 frames).
 if command -v xdotool >/dev/null; then
-  mkdir -p "$out/interactive"
-  status=0 t0=$SECONDS
-  (cd "$out/interactive" && DEMO="$DEMO" xvfb-run -a -s "-screen 0 1024x768x24" bash -c '
-    "$DEMO" --world 64 --width 640 --height 360 --backend cpu --frames 3000 --csv i.csv 2>i.err &
-    pid=$!
-    win=$(timeout 60 xdotool search --sync --name voxfield-demo | head -1)
-    sleep 1
-    xdotool mousemove --window "$win" 480 220 click 1   # right of the panel, on the terrain
-    sleep 0.5
-    xdotool mousemove --window "$win" 480 220 click 3
-    sleep 0.3
-    xdotool key --window "$win" F12
-    sleep 0.3
-    xdotool key --window "$win" ctrl+q
-    # Ctrl+Q must end the run within 30 s (running out the frame cap would take minutes under ASan).
-    for _ in $(seq 60); do kill -0 $pid 2>/dev/null || break; sleep 0.5; done
-    if kill -0 $pid 2>/dev/null; then kill $pid; wait $pid; exit 97; fi
-    wait $pid') || status=$?
-  if [ "$status" -eq 97 ]; then
-    fail "interactive: Ctrl+Q did not quit within 30 s"
-  elif [ "$status" -ne 0 ]; then
-    fail "interactive: exit status $status: $(tail -3 "$out/interactive/i.err" 2>/dev/null)"
-  else
-    awk -F, 'END { exit !($5 >= 2) }' "$out/interactive/i.csv" || fail "interactive: the clicks did not edit (edits: $(tail -1 "$out/interactive/i.csv"))"
-    "$FRAME_CHECK" "$out/interactive/voxfield-demo-1.png" || fail "interactive: no F12 screenshot of the world"
-    echo "ok: interactive, $((SECONDS - t0)) s (clicks placed and carved; F12 saved a screenshot)"
-  fi
+  # The clicks pick in the world itself: with the host's scene (cpu), and with the fields kept on
+  # the device only (no host scene).
+  interactive() {  # interactive NAME ARGS...
+    local name=$1; shift
+    mkdir -p "$out/$name"
+    local status=0 t0=$SECONDS
+    (cd "$out/$name" && DEMO="$DEMO" DEMO_ARGS="$*" xvfb-run -a -s "-screen 0 1024x768x24" bash -c '
+      # shellcheck disable=SC2086
+      "$DEMO" --world 64 --width 640 --height 360 $DEMO_ARGS --frames 3000 --csv i.csv 2>i.err &
+      pid=$!
+      win=$(timeout 60 xdotool search --sync --name voxfield-demo | head -1)
+      sleep 1
+      xdotool mousemove --window "$win" 480 220 click 1   # right of the panel, on the terrain
+      sleep 0.5
+      xdotool mousemove --window "$win" 480 220 click 3
+      sleep 0.3
+      xdotool key --window "$win" F12
+      sleep 0.3
+      xdotool key --window "$win" ctrl+q
+      # Ctrl+Q must end the run within 30 s (running out the frame cap would take minutes under ASan).
+      for _ in $(seq 60); do kill -0 $pid 2>/dev/null || break; sleep 0.5; done
+      if kill -0 $pid 2>/dev/null; then kill $pid; wait $pid; exit 97; fi
+      wait $pid') || status=$?
+    if [ "$status" -eq 97 ]; then
+      fail "$name: Ctrl+Q did not quit within 30 s"
+    elif [ "$status" -ne 0 ]; then
+      fail "$name: exit status $status: $(tail -3 "$out/$name/i.err" 2>/dev/null)"
+    else
+      awk -F, 'END { exit !($5 >= 2) }' "$out/$name/i.csv" || fail "$name: the clicks did not edit (edits: $(tail -1 "$out/$name/i.csv"))"
+      "$FRAME_CHECK" "$out/$name/voxfield-demo-1.png" || fail "$name: no F12 screenshot of the world"
+      echo "ok: $name, $((SECONDS - t0)) s (clicks placed and carved; F12 saved a screenshot)"
+    fi
+  }
+  interactive interactive --backend cpu
+  interactive interactive-device-fields --backend vulkan --fields device
+  grep -q "its fields computed there" "$out/interactive-device-fields/i.err" ||
+    fail "interactive-device-fields: the fields did not go to the device: $(head -3 "$out/interactive-device-fields/i.err")"
   # The terrain mode under the mouse: a left click adds a sphere where the cursor's ray meets the
   # surface, a right click carves one.
   mkdir -p "$out/terrain-interactive"

@@ -115,6 +115,27 @@ TEST(Render, SkippingNeverChangesAHit) {
   }
 }
 
+// A pick from the world itself (no scene, no field: what the demo does when its fields live on a
+// device) hits what a scene's rays hit, over the world's bounds and over a box inside them.
+TEST(Render, PicksFromTheWorldItselfHitWhatTheScenesRaysHit) {
+  const World w = random_world({61, 38, 29}, 8, 31, 30, 24);
+  RenderSceneOptions so;
+  so.lighting_field = false;
+  const Box3i inner{{5, 3, 2}, {50, 30, 20}};
+  for (const std::optional<Box3i>& box : {std::optional<Box3i>(), std::optional<Box3i>(inner)}) {
+    const RenderScene scene(w, so, box);
+    int hits = 0;
+    for (const Ray& r : test_rays(scene.box(), 41, 3000)) {
+      const RayHit want = trace_ray(scene, r, SkipMode::kNone);
+      expect_same_hit(trace_ray(w, r, box), want, box ? "inner box" : "world bounds");
+      hits += want.hit;
+    }
+    EXPECT_GT(hits, 500);
+  }
+  EXPECT_THROW((void)trace_ray(w, Ray{{0, 0, 0}, {0, 0, 0}}), InvalidArgument);
+  EXPECT_THROW((void)trace_ray(w, Ray{{0, 0, 0}, {1, 0, 0}}, Box3i{}), InvalidArgument);
+}
+
 // Batches walk their rays in turns (src/render/ray_group.h): every hit and every counter must be
 // what the rays traced one by one give, for every metric and skip mode, and for a batch whose
 // last group is partial.

@@ -61,6 +61,12 @@ DemoWorld::DemoWorld(const WorldSettings& settings, const std::filesystem::path&
 
 void DemoWorld::make_scene() {
   live_ = std::make_unique<DynamicRenderScene>(*world_, scene_options(settings_));
+  box_ = live_->scene().box();
+}
+
+const RenderScene& DemoWorld::scene() {
+  if (!live_) make_scene();
+  return live_->scene();
 }
 
 void DemoWorld::follow_on_device(std::shared_ptr<gpu::Context> context) {
@@ -68,6 +74,7 @@ void DemoWorld::follow_on_device(std::shared_ptr<gpu::Context> context) {
   device_context_.reset();
   device_ = std::make_unique<gpu::DeviceRenderScene>(context, *world_, scene_options(settings_));
   device_context_ = std::move(context);
+  live_.reset();  // the device draws, and the cursor picks in the world
 }
 
 DynamicRenderScene::UpdateStats DemoWorld::apply(std::span<const Edit> edits) {
@@ -76,16 +83,27 @@ DynamicRenderScene::UpdateStats DemoWorld::apply(std::span<const Edit> edits) {
     apply_edit(*world_, edit, &dirty_);
     ++edits_;
   }
-  DynamicRenderScene::UpdateStats st = live_->update(dirty_);
+  DynamicRenderScene::UpdateStats st;
   if (device_) {
     try {
-      device_->update(dirty_);
+      const gpu::DeviceRenderScene::UpdateStats d = device_->update(dirty_);
+      st.field_ms = d.field_ms;
+      st.scene_ms = d.scene_ms;
+      st.voxels_recomputed = d.voxels_recomputed;
+      st.chunks_changed = d.chunks_repacked;
     } catch (const Error& e) {
-      // The host's scene is up to date: draw from it from now on rather than stop.
+      // Draw from the host from now on rather than stop: its scene, built from the edited world
+      // (or brought up to date below, when a CPU frame kept one).
       std::cerr << "voxfield-demo: the fields stay on the host from now on: " << e.what() << "\n";
       stop_device();
+      if (!live_) {
+        make_scene();
+        dirty_.clear();
+        return st;
+      }
     }
   }
+  if (live_) st = live_->update(dirty_);
   dirty_.clear();
   return st;
 }
@@ -94,17 +112,34 @@ void DemoWorld::set_field(Metric metric, double max_distance_vox) {
   WorldSettings next = settings_;
   next.metric = metric;
   next.max_distance_vox = max_distance_vox;
-  // Build first: bad options leave the current scene as it was.
-  auto live = std::make_unique<DynamicRenderScene>(*world_, scene_options(next));
-  live_ = std::move(live);
-  settings_ = next;
-  if (device_context_) {
-    // The old device copy goes first (never two on the device at once). One the device cannot
-    // hold leaves the host's new fields to draw from, and its error to say so.
-    device_.reset();
-    device_ =
-        std::make_unique<gpu::DeviceRenderScene>(device_context_, *world_, scene_options(next));
+  // The host's scene is built first where it is kept (or no device is followed): bad options then
+  // throw here, leaving everything as it was.
+  if (live_ || !device_context_) {
+    auto live = std::make_unique<DynamicRenderScene>(*world_, scene_options(next));
+    live_ = std::move(live);
   }
+  if (device_context_) {
+    // The old device copy goes first (never two on the device at once).
+    device_.reset();
+    try {
+      device_ =
+          std::make_unique<gpu::DeviceRenderScene>(device_context_, *world_, scene_options(next));
+    } catch (const Error&) {
+      // The host draws from now on, with the new fields: built here if it was not kept (bad
+      // options throw from it too, and the old fields come back to the host).
+      if (!live_) {
+        try {
+          live_ = std::make_unique<DynamicRenderScene>(*world_, scene_options(next));
+        } catch (const Error&) {
+          make_scene();
+          throw;
+        }
+      }
+      settings_ = next;
+      throw;
+    }
+  }
+  settings_ = next;
 }
 
 void DemoWorld::save(const std::filesystem::path& path) const {

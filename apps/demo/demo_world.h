@@ -40,13 +40,15 @@ class DemoWorld {
   DynamicRenderScene::UpdateStats apply(const Edit& edit) {
     return apply(std::span<const Edit>(&edit, 1));
   }
-  // Rebuilds the fields for new metric / clamp settings (a full computation). With the fields on a
-  // device, a device that cannot hold the new ones throws after the host's are rebuilt, keeping
-  // no device copy (frames then come from the host's scene).
+  // Rebuilds the fields for new metric / clamp settings (a full computation); bad settings throw,
+  // leaving the fields as they were (with the fields on a device only: on the host, since the old
+  // device copy goes first). A device that cannot hold the new ones throws after the host's scene
+  // is built with them, keeping no device copy (frames then come from the host's scene).
   void set_field(Metric metric, double max_distance_vox);
-  // Also keeps the fields on `context`'s device from now on (gpu::DeviceRenderScene): computed
-  // there, updated there by every apply() and set_field(), drawn there. The host's scene stays
-  // (the cursor picks voxels in it). Throws what DeviceRenderScene throws, keeping no device copy.
+  // Keeps the fields on `context`'s device from now on (gpu::DeviceRenderScene): computed there,
+  // updated there by every apply() and set_field(), drawn there — and only there: the host's
+  // scene goes (the cursor picks voxels in the world itself), and comes back only if the device
+  // fails or a CPU frame asks for it. Throws what DeviceRenderScene throws, keeping no device copy.
   void follow_on_device(std::shared_ptr<gpu::Context> context);
   gpu::DeviceRenderScene* device_scene() { return device_.get(); }
   // Drops the device's copy (before the device goes).
@@ -60,7 +62,13 @@ class DemoWorld {
   void save(const std::filesystem::path& path) const;
 
   const World& world() const { return *world_; }
-  const RenderScene& scene() const { return live_->scene(); }
+  // The host's scene, for CPU frames: built here on first use when the fields are on a device
+  // (then kept up to date beside them).
+  const RenderScene& scene();
+  // The box drawn and edited: the world's bounds (a RenderScene's default box).
+  const Box3i& box() const { return box_; }
+  // The voxel under a ray (the cursor's), read from the world: no scene needed.
+  RayHit pick(const Ray& ray) const { return trace_ray(*world_, ray, box()); }
   const WorldSettings& settings() const { return settings_; }
   std::int64_t edits() const { return edits_; }
   const std::string& origin() const { return origin_; }
@@ -70,7 +78,8 @@ class DemoWorld {
 
   WorldSettings settings_;
   std::unique_ptr<World> world_;  // fixed address: the scene refers to it
-  std::unique_ptr<DynamicRenderScene> live_;
+  Box3i box_;
+  std::unique_ptr<DynamicRenderScene> live_;      // the host's scene, when it is kept
   std::shared_ptr<gpu::Context> device_context_;  // set by follow_on_device
   std::unique_ptr<gpu::DeviceRenderScene> device_;
   DirtyRegions dirty_;

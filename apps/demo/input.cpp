@@ -35,7 +35,7 @@ void Demo::edit_at_cursor(EditOp op) {
     return;
   }
   const Ray ray = cursor_ray();
-  const RayHit hit = trace_ray(world_->scene(), ray);
+  const RayHit hit = world_->pick(ray);
   if (!hit.hit) return;
   Vec3d centre{static_cast<double>(hit.voxel.x), static_cast<double>(hit.voxel.y),
                static_cast<double>(hit.voxel.z)};
@@ -78,7 +78,7 @@ void Demo::handle_input(double dt_s) {
         (down(GLFW_KEY_LEFT_CONTROL) || down(GLFW_KEY_RIGHT_CONTROL) ? 4.0 : 1.0) *
         (vectors_   ? 4.0  // world units per second across the agents' 10-unit box
          : terrain_ ? std::max(16.0, terrain_->box().size().x * 0.35)
-                    : std::max(16.0, world_->scene().box().size().x * 0.35));  // voxels per second
+                    : std::max(16.0, world_->box().size().x * 0.35));  // voxels per second
     Vec3d move{0, 0, 0};
     const Vec3d f = camera_.forward(), r = camera_.right();
     if (down(GLFW_KEY_W)) move = move + f;

@@ -185,7 +185,7 @@ bool Demo::follow_on_device() {
 }
 
 void Demo::frame_camera() {
-  const Box3i box = world_->scene().box();
+  const Box3i box = world_->box();
   const Vec3i s = box.size();
   const Vec3d centre{box.begin.x + s.x / 2.0, box.begin.y + s.y / 2.0, box.begin.z + s.z * 0.3};
   camera_.look({box.begin.x - s.x * 0.25, box.begin.y - s.y * 0.25, box.begin.z + s.z * 1.1},
@@ -313,8 +313,7 @@ int Demo::run() {
   std::optional<RandomEditStream> stream;
   std::mt19937_64 terrain_edits(options_.world.seed);
   if (options_.benchmark && !terrain_)
-    stream.emplace(world_->scene().box(), options_.world.seed, 1,
-                   world_->settings().chunk_edge - 1);
+    stream.emplace(world_->box(), options_.world.seed, 1, world_->settings().chunk_edge - 1);
   const auto start = Clock::now();
   auto previous = start;
   std::int64_t streamed = 0;
@@ -368,7 +367,7 @@ int Demo::run() {
       update_ms = ms_between(a, Clock::now());
       last_.update_ms = update_ms;
     } else if (stream) {
-      const Box3i box = world_->scene().box();
+      const Box3i box = world_->box();
       const Vec3i s = box.size();
       const double angle = 0.6 + frame * 0.02;
       const Vec3d centre{box.begin.x + s.x / 2.0, box.begin.y + s.y / 2.0, box.begin.z + s.z * 0.3};

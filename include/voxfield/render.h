@@ -238,6 +238,14 @@ struct TraversalCounters {
 RayHit trace_ray(const RenderScene& scene, const Ray& ray, SkipMode mode = SkipMode::kDistance,
                  TraversalCounters* counters = nullptr);
 
+// The first solid voxel along the ray inside `box` (default: the world's bounds, else its content
+// box, as RenderScene's), read from the world itself: the plain DDA, one voxel read per step, with
+// no scene and no field to keep — for a pick under the cursor where the fields live elsewhere (on
+// a device). The same hit as trace_ray() of a RenderScene of the world over the same box; a ray
+// crosses at most the box's three sides' worth of voxels. Throws InvalidArgument for a degenerate
+// ray or an empty box.
+RayHit trace_ray(const World& world, const Ray& ray, std::optional<Box3i> box = std::nullopt);
+
 // The same for many rays at once (hits[i] for rays[i]), multi-threaded — for ray casts that are
 // not pictures (sensor simulation, visibility queries). Throws InvalidArgument when the spans
 // differ in size or a ray is degenerate.

@@ -49,6 +49,18 @@ RayHit trace_ray(const RenderScene& scene, const Ray& ray, SkipMode mode,
   return hit;
 }
 
+RayHit trace_ray(const World& world, const Ray& ray, std::optional<Box3i> box) {
+  check_ray(ray);
+  if (!box) box = world.voxels.bounds() ? *world.voxels.bounds() : world.voxels.content_bounds();
+  if (box->empty()) throw InvalidArgument("trace_ray: nothing to trace (empty box)");
+  render_detail::Dda dda;
+  if (!render_detail::start_in_box(*box, ray, dda)) return {};
+  for (; box->contains(dda.v); dda.step_once())
+    if (const std::uint8_t m = world.voxels.get(dda.v); m != 0)
+      return render_detail::make_hit(dda, m);
+  return {};
+}
+
 void trace_rays(const RenderScene& scene, std::span<const Ray> rays, std::span<RayHit> hits,
                 SkipMode mode, TraversalCounters* counters) {
   if (hits.size() != rays.size()) throw InvalidArgument("trace_rays: as many hits as rays, please");
