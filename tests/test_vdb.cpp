@@ -310,11 +310,21 @@ TEST(Vdb, FieldsJoinedFromPartsAreTheWholeFieldsFileWithinTheMemoryLimit) {
   EXPECT_TRUE(std::equal(got.begin(), got.begin() + 21, want.begin()));
   EXPECT_TRUE(std::equal(got.begin() + 57, got.end(), want.begin() + 57));
 
+  // Each part's tree as OpenVDB holds it (read whole, not delay-loaded), and a limit above
+  // either alone but below both: the joined tree and the incoming part's are charged together.
+  const auto usage = [](const std::vector<std::uint8_t>& bytes) {
+    std::istringstream in(std::string(bytes.begin(), bytes.end()), std::ios_base::binary);
+    const openvdb::GridPtrVecPtr grids = openvdb::io::Stream(in, false).getGrids();
+    return static_cast<std::uint64_t>(
+        openvdb::gridPtrCast<openvdb::FloatGrid>(grids->front())->tree().memUsage());
+  };
+  const std::uint64_t a = usage(encode_vdb_field_part(lower, background, whole.domain)),
+                      b = usage(part);
   struct LimitGuard {
     ~LimitGuard() { set_default_memory_limit(0); }
   } guard;
   VdbFieldParts tight(lower, background, whole.domain);
-  set_default_memory_limit(4096);
+  set_default_memory_limit(std::max(a, b) + std::min(a, b) / 2);
   const std::string refusal = error_of([&] { tight.add(part, "the upper part"); });
   EXPECT_NE(refusal.find("the upper part"), std::string::npos) << refusal;
   EXPECT_NE(refusal.find("memory limit"), std::string::npos) << refusal;

@@ -85,7 +85,8 @@ class VdbFieldParts {
   VdbFieldParts& operator=(const VdbFieldParts&) = delete;
   // Moves another part's leaves and tiles in. `part`: encode_vdb_field_part's bytes, made by this
   // library (OpenVDB's own reader parses them, which must never see bytes from elsewhere);
-  // InvalidArgument, naming `name`, for a grid of another background.
+  // InvalidArgument, naming `name`, for a grid of another background; ResourceLimitError, naming
+  // it, when the joined grid and the part's would pass the memory limit (limits.h).
   void add(std::span<const std::uint8_t> part, const std::string& name);
   // The .vdb file of the whole field.
   std::vector<std::uint8_t> finish();

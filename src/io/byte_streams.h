@@ -3,7 +3,7 @@
 // OpenVDB reads and writes its files through std::istream and std::ostream. A string stream copies:
 // the bytes into its string, and its string out again. A .vdb of a large field is hundreds of
 // megabytes, and voxfield-mpi's rank 0 holds the parts and the joined file at once, so these
-// buffers read the caller's bytes in place and write straight into the caller's vector.
+// buffers read the caller's bytes where they are and write straight into the caller's vector.
 #pragma once
 
 #include <cstdint>

@@ -102,6 +102,9 @@ std::vector<std::uint8_t> write_grids(const openvdb::GridCPtrVec& grids) {
   std::vector<std::uint8_t> bytes;
   detail::ByteSink sink(bytes);
   std::ostream out(&sink);
+  // A failure to grow the bytes (std::bad_alloc from the sink) is the stream's badbit, rethrown
+  // here rather than returned as a file cut short.
+  out.exceptions(std::ios_base::badbit);
   openvdb::io::Stream(out).write(grids);
   return bytes;
 }
@@ -327,7 +330,9 @@ void VdbFieldParts::add(std::span<const std::uint8_t> part, const std::string& n
   // handed bytes from elsewhere: vdb_read.cpp).
   detail::ByteSource source(part);
   std::istream in(&source);
-  openvdb::io::Stream stream(in);
+  // Read whole: delayed loading would copy the stream to a temporary file and leave the leaves'
+  // values there, out of the tree's memory use (which is charged below).
+  openvdb::io::Stream stream(in, /*delayLoad=*/false);
   const openvdb::GridPtrVecPtr grids = stream.getGrids();
   openvdb::FloatGrid::Ptr other = grids && grids->size() == 1
                                       ? openvdb::gridPtrCast<openvdb::FloatGrid>(grids->front())
