@@ -7,7 +7,6 @@
 #include <fstream>
 #include <iostream>
 
-#include "../common/vdb_output.h"
 #include "backend_choice.h"
 #include "cli.h"
 #include "field_args.h"
@@ -127,7 +126,7 @@ int run_field(const FieldSettings& s) {
               << " x " << size.z << " (--spacing), so that " << s.out
               << " holds distances in its units (--max-distance too)\n";
   }
-  if (vdb_output) app::check_vdb_output(s.out, o, in.world.frame);  // before the field's time
+  if (vdb_output) check_vdb_field_output(o, in.world.frame, s.out);  // before the field's time
   AlgorithmStats stats;
   const auto gpu_context = choose_backend(s.backend);
   std::vector<gpu::PassTiming> pass_timings;

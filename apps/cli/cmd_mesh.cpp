@@ -7,10 +7,10 @@
 #include <limits>
 #include <optional>
 
-#include "../common/freed_pages.h"
 #include "backend_choice.h"
 #include "cli.h"
 #include "field_args.h"
+#include "freed_pages.h"
 #include "voxfield/gpu_mesh.h"
 #include "voxfield/mesh.h"
 #include "voxfield/mesh_files.h"

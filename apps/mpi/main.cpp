@@ -36,7 +36,6 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 
-#include "../common/vdb_output.h"
 #include "bench_world.h"
 #include "mesh_command.h"
 #include "rank_stats.h"
@@ -50,6 +49,7 @@
 #include "voxfield/limits.h"
 #include "voxfield/mpi.h"
 #include "voxfield/parallel.h"
+#include "voxfield/vdb.h"
 
 namespace {
 
@@ -139,7 +139,8 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
                 << " holds distances in its units (--max-distance too)\n";
   }
   // The .vdb's refusals before the field is computed (every rank reaches the same verdict).
-  if (vdb_output) mpi::collectively(comm, [&] { app::check_vdb_output(out, o, slab.world.frame); });
+  if (vdb_output)
+    mpi::collectively(comm, [&] { check_vdb_field_output(o, slab.world.frame, out); });
   mpi::ExchangeStats ex;
   MPI_Barrier(comm);  // the field's time starts together on every rank
   const double t1 = MPI_Wtime();

@@ -71,6 +71,13 @@ std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,
 // and VdbFieldParts joins them into the bytes encode_vdb_field writes for the whole field. The
 // parts must not overlap; a leaf split between parts is joined voxel by voxel.
 double vdb_field_background(const DistanceField& field);
+// The refusals encode_vdb_field gives a field of `options` in `frame` whatever its values — a clamp
+// that leaves no band around a level set's surface, a spacing out of proportion with the frame's
+// voxel size — given before the field is computed: InvalidArgument, its message starting with
+// `name` (the output's). (A field of the same options over two voxels meets them, in
+// microseconds: the same code decides, so the verdict is the same.)
+void check_vdb_field_output(const DistanceOptions& options, const VoxelFrame& frame,
+                            const std::string& name);
 std::vector<std::uint8_t> encode_vdb_field_part(const DistanceField& part, double background,
                                                 const Box3i& domain,
                                                 const std::string& grid_name = "distance");

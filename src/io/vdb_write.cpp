@@ -19,6 +19,7 @@
 #include "voxfield/error.h"
 #include "voxfield/limits.h"
 #include "voxfield/vdb.h"
+#include "voxfield/world.h"
 
 namespace voxfield {
 namespace {
@@ -298,6 +299,23 @@ double vdb_field_background(const DistanceField& field) {
   };
   f.for_each_value([&](const Box3i&, double d) { widen(d); }, [&](Vec3i, double d) { widen(d); });
   return background;
+}
+
+void check_vdb_field_output(const DistanceOptions& options, const VoxelFrame& frame,
+                            const std::string& name) {
+  World probe;
+  probe.voxels.set({0, 0, 0}, 1);
+  DistanceOptions o = options;
+  o.domain = Box3i{{0, 0, 0}, {2, 1, 1}};  // one solid voxel and one empty one
+  o.nearest_sites = false;
+  o.interrupter = nullptr;
+  DistanceField field = compute_distance_field(probe, o);
+  field.frame = frame;
+  try {
+    (void)vdb_field_background(field);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(name + ": " + e.what());
+  }
 }
 
 std::vector<std::uint8_t> encode_vdb_field(const DistanceField& field,

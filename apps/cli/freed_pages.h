@@ -1,4 +1,4 @@
-// voxfield's programs — a scope in which the pages the calling thread frees stay its own, for its
+// voxfield CLI — a scope in which the pages the calling thread frees stay its own, for its
 // next allocations to take without the kernel's help.
 //
 // A page a program frees is handed back to the kernel after a while (jemalloc's decay), and a page
@@ -7,7 +7,8 @@
 // marching cubes of the 301 x 370 x 316 MRI took 89.8 / 93.1 ms instead of 96.4 / 97.3, its peak
 // 5-6 MB higher (docs/benchmarks.md). Kept for the whole run instead, `voxfield field` of a 256³
 // volume peaked 100 MB higher for nothing: hence a scope, and a purge at its end. Where the program
-// is built without jemalloc (VOXFIELD_JEMALLOC off, the sanitizer builds), the scope does nothing.
+// is built without jemalloc (VOXFIELD_JEMALLOC off, the sanitizer builds), the scope does nothing
+// (freed_pages.cpp is not compiled).
 #pragma once
 
 #include <cstddef>
@@ -17,7 +18,7 @@ namespace voxfield::app {
 #if defined(VOXFIELD_HAS_JEMALLOC)
 class KeepFreedPages {
  public:
-  KeepFreedPages();  // huge_page_allocator.cpp
+  KeepFreedPages();  // freed_pages.cpp
   ~KeepFreedPages();
   KeepFreedPages(const KeepFreedPages&) = delete;
   KeepFreedPages& operator=(const KeepFreedPages&) = delete;
