@@ -22,7 +22,7 @@ if [ ! -f "$vox" ]; then echo "FAIL: $vox is missing (../shared beside the repos
 if [ -f "$vox" ]; then
   trex=$(dirname "$vox")/ephtracy_T-Rex.vox
   "$VF" render "$trex" -o ref.png --width 160 --height 100 --chunk 8 2>/dev/null
-  for n in 2 4; do
+  for n in $(rank_counts 2 4); do
     MPIEXEC -np "$n" "$VFM" render "$trex" -o out.png --width 160 --height 100 --chunk 8 \
       --stats stats.json 2>/dev/null
     same ref.png out.png "render, $n ranks, ephtracy_T-Rex.vox"
@@ -112,7 +112,7 @@ for alg in mc sn dc; do
   ranks="1 2 3 4"
   [ "$alg" = sn ] && ranks=3
   [ "$alg" = dc ] && ranks=2
-  for n in $ranks; do
+  for n in $(rank_counts $ranks); do
     MPIEXEC -np "$n" "$VFM" mesh wave.npy -o out.ply --algorithm "$alg" --iso 0.2 --spacing 0.5,1,1.5 \
       --chunk 8 --stats mesh.json 2>/dev/null
     same_triangles ref.ply out.ply "$alg, $n ranks"

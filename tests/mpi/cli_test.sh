@@ -13,7 +13,7 @@ for opts in "--metric euclidean --signed" "--metric manhattan --max-distance 5 -
   # Every rank count and input order for the first options; two rank counts for the others.
   ranks="2 4" inputs="f.npy"
   if [ "$opts" = "--metric euclidean --signed" ]; then ranks="1 2 3 4" inputs="f.npy c.npy big_endian.npy"; fi
-  for n in $ranks; do
+  for n in $(rank_counts $ranks); do
     for input in $inputs; do
       # shellcheck disable=SC2086
       MPIEXEC -np "$n" "$VFM" field "$input" -o out.npy --sites out_sites.npy --chunk 8 \
@@ -31,7 +31,7 @@ assert s["exchange"]["bytes_sent_total"] == 3 * 16 * 37 * 29, s["exchange"]
 PY
 # --packed: the dissertation's packed voxels (materials' colours and distances), voxfield's file.
 "$VF" field f.npy -o ref.npy --packed ref_packed.npy --metric manhattan --max-distance 20 2>/dev/null
-for n in 1 3; do
+for n in $(rank_counts 1 3); do
   MPIEXEC -np "$n" "$VFM" field f.npy -o out.npy --packed out_packed.npy --chunk 8 \
     --metric manhattan --max-distance 20 2>/dev/null
   same ref_packed.npy out_packed.npy "--packed, $n ranks"
@@ -62,7 +62,7 @@ for opts in "--metric euclidean --signed --max-distance 6" "--metric manhattan -
             "--metric euclidean --max-distance 4.5"; do
   # shellcheck disable=SC2086
   "$VF" edit f.npy -e edits.jsonl -o ref.npy $opts 2>/dev/null
-  for n in 1 2 3 4; do
+  for n in $(rank_counts 1 2 3 4); do
     # shellcheck disable=SC2086
     MPIEXEC -np "$n" "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 $opts 2>/dev/null
     same ref.npy out.npy "edit, $n ranks, $opts"
@@ -73,7 +73,7 @@ done
 for opts in "--metric euclidean --signed" "--metric manhattan" "--metric chebyshev --signed"; do
   # shellcheck disable=SC2086
   "$VF" edit f.npy -e edits.jsonl -o ref.npy $opts 2>/dev/null
-  for n in 1 3; do
+  for n in $(rank_counts 1 3); do
     # shellcheck disable=SC2086
     MPIEXEC -np "$n" "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 $opts \
       --stats unclamped.json 2>/dev/null
@@ -94,7 +94,7 @@ for balance in content edits; do
 done
 # The edited world as one .vfw written by every rank: voxfield edit --save-world's file.
 "$VF" edit f.npy -e edits.jsonl -o ref.npy --chunk 8 --max-distance 6 --save-world ref.vfw 2>/dev/null
-for n in 1 2 3 4; do
+for n in $(rank_counts 1 2 3 4); do
   MPIEXEC -np "$n" "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 --max-distance 6 \
     --save-world out.vfw 2>/dev/null
   same ref.vfw out.vfw "edit --save-world, $n ranks"
@@ -102,7 +102,7 @@ for n in 1 2 3 4; do
 done
 # The edited world as one .npy of materials, every rank its slices: voxfield edit's file.
 "$VF" edit f.npy -e edits.jsonl -o ref.npy --chunk 8 --max-distance 6 --save-world ref_world.npy 2>/dev/null
-for n in 1 3; do
+for n in $(rank_counts 1 3); do
   MPIEXEC -np "$n" "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 --max-distance 6 \
     --save-world out_world.npy 2>/dev/null
   same ref_world.npy out_world.npy "edit --save-world .npy, $n ranks"
@@ -115,7 +115,7 @@ same ref_world.npy OUT_WORLD.NPY "edit --save-world .NPY, 2 ranks"
 # That bounded .vfw as input: every rank decodes only its slab's chunks (read_in_parts), in the
 # file's chunks of 8 or re-chunked to 16, the field byte-identical to voxfield's.
 "$VF" field ref.vfw -o ref.npy --metric euclidean --signed 2>/dev/null
-for n in 1 3; do
+for n in $(rank_counts 1 3); do
   for chunk in 8 16; do
     MPIEXEC -np "$n" "$VFM" field ref.vfw -o out.npy --chunk "$chunk" --stats stats.json \
       --metric euclidean --signed 2>/dev/null
@@ -153,7 +153,7 @@ if [ ! -f "$vox" ]; then echo "FAIL: $vox is missing (../shared beside the repos
   # stored chunks before each decodes its slab (read_in_parts).
   "$VF" convert "$vox" axes.vfw 2>/dev/null
   "$VF" field axes.vfw -o ref.npy --metric euclidean --signed 2>/dev/null
-  for n in 2 4; do
+  for n in $(rank_counts 2 4); do
     MPIEXEC -np "$n" "$VFM" field axes.vfw -o out.npy --metric euclidean --signed \
       --stats stats.json 2>/dev/null
     same ref.npy out.npy "$n ranks, dotvox_axes.vox as an unbounded .vfw"
@@ -166,7 +166,7 @@ if [ ! -f "$vox" ]; then echo "FAIL: $vox is missing (../shared beside the repos
   "$VF" field "$vox" -o axes-sdf.vdb --metric euclidean --signed --max-distance 4 2>/dev/null
   for input in axes.vdb axes-sdf.vdb; do
     "$VF" field "$input" -o ref.npy --metric euclidean --signed 2>/dev/null
-    for n in 1 3; do
+    for n in $(rank_counts 1 3); do
       MPIEXEC -np "$n" "$VFM" field "$input" -o out.npy --metric euclidean --signed \
         --stats stats.json 2>/dev/null
       same ref.npy out.npy "$n ranks, dotvox_axes.vox as $input"
@@ -242,7 +242,7 @@ for run in "f.npy|--metric euclidean --signed --max-distance 4" "f.npy|--metric 
   input=${run%%|*} opts=${run#*|}
   # shellcheck disable=SC2086
   "$VF" field "$input" -o ref.vdb $opts 2>/dev/null
-  for n in 1 3 4; do
+  for n in $(rank_counts 1 3 4); do
     # shellcheck disable=SC2086
     MPIEXEC -np "$n" "$VFM" field "$input" -o out.vdb --chunk 8 $opts --stats vdb.json 2>/dev/null
     vdb_same ref.vdb out.vdb "$n ranks, $input as .vdb, $opts"
@@ -250,7 +250,7 @@ for run in "f.npy|--metric euclidean --signed --max-distance 4" "f.npy|--metric 
   # The default chunks of 32: f.npy's 53 slices hold fewer chunk layers than 3 or 4 ranks, which
   # are then cut at single slices (17, 35; 13, 26, 39): leaves of 8 split between ranks.
   if [ "$input" = f.npy ]; then
-    for n in 3 4; do
+    for n in $(rank_counts 3 4); do
       # shellcheck disable=SC2086
       MPIEXEC -np "$n" "$VFM" field "$input" -o out.vdb $opts 2>/dev/null
       vdb_same ref.vdb out.vdb "$n ranks cut off the leaves, $input as .vdb, $opts"
