@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <type_traits>
 
+#include "voxfield/detail/vector_clones.h"
 #include "voxfield/error.h"
 
 namespace voxfield::detail::mesh {
@@ -187,6 +189,23 @@ std::uint32_t ChunkPart::add(const std::array<double, 3>& position, std::array<d
   owned.push_back(is_owned);
   shared.push_back(is_shared);
   return static_cast<std::uint32_t>(positions.size() - 1);
+}
+
+VOXFIELD_AVX2_CLONE void unit_normals(const double* __restrict x, const double* __restrict y,
+                                      const double* __restrict z, std::size_t count,
+                                      std::array<float, 3>* __restrict out) {
+  constexpr double kMax = std::numeric_limits<double>::max();
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC ivdep
+#endif
+  for (std::size_t i = 0; i < count; ++i) {
+    const double length = std::sqrt(x[i] * x[i] + y[i] * y[i] + z[i] * z[i]);
+    const bool unit = length > 0 && length <= kMax;  // unit_normal's test (NaN fails both)
+    const double inverse = 1 / length;               // unit_normal's arithmetic
+    out[i] = {unit ? static_cast<float>(x[i] * inverse) : 0.0f,
+              unit ? static_cast<float>(y[i] * inverse) : 0.0f,
+              unit ? static_cast<float>(z[i] * inverse) : 1.0f};
+  }
 }
 
 }  // namespace voxfield::detail::mesh

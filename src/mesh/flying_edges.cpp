@@ -22,6 +22,7 @@
 #include <bit>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "bit_rows.h"
 #include "cube_cases.h"
@@ -146,9 +147,16 @@ struct Vertex {
   std::uint64_t source;
 };
 
+// A crossing before its normal is scaled to unit length.
+struct UnscaledVertex {
+  std::array<float, 3> position;
+  std::array<double, 3> normal;
+  std::uint64_t source;
+};
+
 // The crossing on the edge from lattice point (x, y, z) along `axis` (marching_cubes.cpp's
-// vertex(), without an analytic value or gradient).
-Vertex edge_vertex(const RowSamples& in, int x, int y, int z, int axis) {
+// vertex(), without an analytic value or gradient), its normal not yet scaled.
+UnscaledVertex unscaled_edge_vertex(const RowSamples& in, int x, int y, int z, int axis) {
   const std::ptrdiff_t i0 = in.index(x, y, z);
   const std::ptrdiff_t i1 = i0 + (axis == 0 ? 1 : axis == 1 ? in.sy : in.sz);
   const double s0 = in.s(i0), s1 = in.s(i1);
@@ -169,8 +177,13 @@ Vertex edge_vertex(const RowSamples& in, int x, int y, int z, int axis) {
     normal[static_cast<std::size_t>(axis)] = s0 < 0 ? 1 : -1;
   return {{static_cast<float>(position[0]), static_cast<float>(position[1]),
            static_cast<float>(position[2])},
-          unit_normal(normal),
+          normal,
           static_cast<std::uint64_t>((s0 < 0 ? i0 : i1) + in.sz * in.z_offset)};
+}
+
+Vertex edge_vertex(const RowSamples& in, int x, int y, int z, int axis) {
+  const UnscaledVertex v = unscaled_edge_vertex(in, x, y, z, axis);
+  return {v.position, unit_normal(v.normal), v.source};
 }
 
 // edge_vertex() called out of line. (Inlined into centre_vertex(), GCC 12 at -O3 gave some means
@@ -338,6 +351,13 @@ void FlyingEdges::write_plane(int z, std::uint64_t first_vertex, std::uint64_t f
     if (out.sources) out.sources[g] = v.source;
   };
   RowRanks counts(8, words_);
+  // A row's edge vertices' normals, scaled to unit length together once the row's crossings are
+  // placed (unit_normals: the square roots and divisions then overlap).
+  const std::size_t row_crossings = 3 * 64 * words_;
+  std::vector<double> unscaled(3 * row_crossings);
+  double* const normal_x = unscaled.data();
+  double* const normal_y = normal_x + row_crossings;
+  double* const normal_z = normal_y + row_crossings;
   for (int y = 0; y < n.y; ++y) {
     const std::size_t r = static_cast<std::size_t>(y) + static_cast<std::size_t>(n.y) * z;
     // Row (y + 3, z + 2) is first read three rows on, by the gradient at the upper end of a
@@ -350,11 +370,20 @@ void FlyingEdges::write_plane(int z, std::uint64_t first_vertex, std::uint64_t f
     if (inside_->quiet(y, z)) continue;  // no crossing, no cell crossed
     const std::uint64_t* b = inside_->row(y, z);
     // This row's edge vertices: its x-edge crossings, then its y-edge and z-edge ones.
-    std::uint64_t g = first_vertex_[r] - first_vertex;
+    const std::uint64_t row_first = first_vertex_[r] - first_vertex;
+    std::size_t placed = 0;
     const auto emit = [&](const std::uint64_t* mask, int axis) {
       for (std::size_t w = 0; w < words_; ++w)
-        for (std::uint64_t m = mask[w]; m; m &= m - 1)
-          put(g++, edge_vertex(in, static_cast<int>(64 * w) + std::countr_zero(m), y, z, axis));
+        for (std::uint64_t m = mask[w]; m; m &= m - 1) {
+          const UnscaledVertex v =
+              unscaled_edge_vertex(in, static_cast<int>(64 * w) + std::countr_zero(m), y, z, axis);
+          out.positions[row_first + placed] = v.position;
+          if (out.sources) out.sources[row_first + placed] = v.source;
+          normal_x[placed] = v.normal[0];
+          normal_y[placed] = v.normal[1];
+          normal_z[placed] = v.normal[2];
+          ++placed;
+        }
     };
     const bool up_y = y + 1 < n.y, up_z = z + 1 < n.z;
     // Masks 0 (x), 4 (y) and 6 (z) of the cell row starting here are this row's own.
@@ -368,6 +397,7 @@ void FlyingEdges::write_plane(int z, std::uint64_t first_vertex, std::uint64_t f
       differences(b, inside_->row(y, z + 1), words_, counts.mask(6));
       emit(counts.mask(6), 2);
     }
+    unit_normals(normal_x, normal_y, normal_z, placed, out.normals + row_first);
     if (!up_y || !up_z) continue;
     // The cell row (y, z): every crossing's number from the masks' running counts.
     const std::uint64_t* rows[4] = {b, inside_->row(y + 1, z), inside_->row(y, z + 1),
