@@ -17,11 +17,14 @@ RenderSceneOptions scene_options(const WorldSettings& s) {
   return o;
 }
 
+// The settings' refusals, before the world is made: no field is built here (the scene is, on the
+// host or on a device, once the demo knows where its fields go).
 void check_settings(const WorldSettings& s) {
   if (s.size < 16 || s.size > 1024)
     throw InvalidArgument("demo: --world must lie in 16..1024 voxels");
   if (s.chunk_edge < 8 || s.chunk_edge > 128 || (s.chunk_edge & (s.chunk_edge - 1)) != 0)
     throw InvalidArgument("demo: --chunk must be a power of two in 8..128");
+  check_render_scene_options(scene_options(s));
 }
 
 }  // namespace
@@ -36,7 +39,7 @@ DemoWorld::DemoWorld(const WorldSettings& settings)
   world_ = std::make_unique<World>(make_terrain(so));
   origin_ = "terrain " + std::to_string(so.size.x) + "x" + std::to_string(so.size.y) + "x" +
             std::to_string(so.size.z);
-  make_scene();
+  box_ = *world_->voxels.bounds();
 }
 
 DemoWorld::DemoWorld(const WorldSettings& settings, const std::filesystem::path& file)
@@ -56,12 +59,11 @@ DemoWorld::DemoWorld(const WorldSettings& settings, const std::filesystem::path&
   world_ =
       std::make_unique<World>(rechunk_world(in.world, settings.chunk_edge, extent, file.string()));
   origin_ = file.filename().string();
-  make_scene();
+  box_ = *world_->voxels.bounds();
 }
 
 void DemoWorld::make_scene() {
   live_ = std::make_unique<DynamicRenderScene>(*world_, scene_options(settings_));
-  box_ = live_->scene().box();
 }
 
 const RenderScene& DemoWorld::scene() {
@@ -112,8 +114,10 @@ void DemoWorld::set_field(Metric metric, double max_distance_vox) {
   WorldSettings next = settings_;
   next.metric = metric;
   next.max_distance_vox = max_distance_vox;
-  // The host's scene is built first where it is kept (or no device is followed): bad options then
-  // throw here, leaving everything as it was.
+  // Bad options throw here, before anything changes (the device's copy included).
+  check_render_scene_options(scene_options(next));
+  // The host's scene is built first where it is kept (or no device is followed): a failure then
+  // (the memory limit) leaves everything as it was.
   if (live_ || !device_context_) {
     auto live = std::make_unique<DynamicRenderScene>(*world_, scene_options(next));
     live_ = std::move(live);
@@ -125,8 +129,8 @@ void DemoWorld::set_field(Metric metric, double max_distance_vox) {
       device_ =
           std::make_unique<gpu::DeviceRenderScene>(device_context_, *world_, scene_options(next));
     } catch (const Error&) {
-      // The host draws from now on, with the new fields: built here if it was not kept (bad
-      // options throw from it too, and the old fields come back to the host).
+      // The host draws from now on, with the new fields: built here if it was not kept (if that
+      // fails too, the old fields come back to the host).
       if (!live_) {
         try {
           live_ = std::make_unique<DynamicRenderScene>(*world_, scene_options(next));

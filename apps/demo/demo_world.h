@@ -29,7 +29,8 @@ struct WorldSettings {
 
 class DemoWorld {
  public:
-  // A generated terrain. Throws voxfield::Error for bad settings.
+  // A generated terrain. Throws voxfield::Error for bad settings. No field is built yet: scene()
+  // builds the host's, follow_on_device() the device's.
   explicit DemoWorld(const WorldSettings& settings);
   // A world read from a .vox, .npy or .vfw file, bounded to its extent with room above to build.
   DemoWorld(const WorldSettings& settings, const std::filesystem::path& file);
@@ -40,10 +41,9 @@ class DemoWorld {
   DynamicRenderScene::UpdateStats apply(const Edit& edit) {
     return apply(std::span<const Edit>(&edit, 1));
   }
-  // Rebuilds the fields for new metric / clamp settings (a full computation); bad settings throw,
-  // leaving the fields as they were (with the fields on a device only: on the host, since the old
-  // device copy goes first). A device that cannot hold the new ones throws after the host's scene
-  // is built with them, keeping no device copy (frames then come from the host's scene).
+  // Rebuilds the fields for new metric / clamp settings (a full computation); bad settings throw
+  // before anything changes. A device that cannot hold the new fields throws after the host's
+  // scene is built with them, keeping no device copy (frames then come from the host's scene).
   void set_field(Metric metric, double max_distance_vox);
   // Keeps the fields on `context`'s device from now on (gpu::DeviceRenderScene): computed there,
   // updated there by every apply() and set_field(), drawn there — and only there: the host's
@@ -62,8 +62,7 @@ class DemoWorld {
   void save(const std::filesystem::path& path) const;
 
   const World& world() const { return *world_; }
-  // The host's scene, for CPU frames: built here on first use when the fields are on a device
-  // (then kept up to date beside them).
+  // The host's scene, for CPU frames: built here on first use (then kept up to date by apply()).
   const RenderScene& scene();
   // The box drawn and edited: the world's bounds (a RenderScene's default box).
   const Box3i& box() const { return box_; }

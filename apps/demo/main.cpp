@@ -52,6 +52,9 @@ Demo::Demo(const Options& o) : options_(o) {
   vectors_settings_ = o.vectors;
   terrain_settings_ = o.terrain;
   choose_path(o.backend);
+  // Fields not followed on a device are the host's: built now, so that a world too large for
+  // them (the memory limit) is refused at start-up rather than by the first frame.
+  if (!world_->device_scene()) (void)world_->scene();
   frame_camera();
   if (o.mode == "vectors") set_mode(Mode::kVectors);
   if (o.mode == "terrain") set_mode(Mode::kTerrain);

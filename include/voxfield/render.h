@@ -127,6 +127,11 @@ struct RenderSceneOptions {
   double lighting_max_distance_vox = 16;
 };
 
+// Throws InvalidArgument, naming the option, for options every scene built with them would refuse
+// (RenderScene, DynamicRenderScene, a device's scene): a check that builds no field, for a program
+// that builds its scene later, or on a device only.
+void check_render_scene_options(const RenderSceneOptions& options);
+
 // A world prepared for rendering: the fields rays skip by and shade with, copied with the
 // materials into a flat table of bricked chunks over the render box. A snapshot: edits to the
 // world after construction are not seen. Keeps a reference to the world (for the error view's

@@ -126,6 +126,11 @@ DistanceOptions light_field_options(const RenderSceneOptions& options, const Box
   return o;
 }
 
+void check_render_scene_options(const RenderSceneOptions& options) {
+  (void)skip_field_options(options, {});
+  if (options.lighting_field) (void)light_field_options(options, {});
+}
+
 namespace {
 
 std::atomic<std::uint64_t> next_scene_id{1};
