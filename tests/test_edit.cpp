@@ -525,3 +525,64 @@ TEST(EditStream, IsTheSameStreamOnEveryMachine) {
     EXPECT_EQ(e.material, w.material);
   }
 }
+
+TEST(UpdateRegions, CutsCoverEachRegionOnceWithTheSitesEachPartNeeds) {
+  // split_regions (how a device with small buffers computes a clamped field in parts): every
+  // voxel of a region's `out` lies in exactly one part, each part reads the sites within the reach
+  // of its own voxels (its box grown by the reach, clipped to the domain), and each reads at most
+  // the bound — or, where no cut along any axis could bring it under, the region stays whole.
+  std::mt19937 rng(29);
+  auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  int cut = 0, whole = 0;
+  for (int round = 0; round < 300; ++round) {
+    const Box3i domain{{uni(-20, 5), uni(-20, 5), uni(-20, 5)},
+                       {uni(10, 70), uni(10, 70), uni(10, 40)}};
+    const Vec3i reach{uni(0, 9), uni(0, 9), uni(0, 9)};
+    std::vector<detail::UpdateRegion> regions;
+    if (round % 3 == 0) {
+      regions.push_back({domain, domain});  // a whole build
+    } else {
+      DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
+      for (int k = uni(1, 3); k > 0; --k) {
+        const Vec3i p{uni(domain.begin.x, domain.end.x - 1), uni(domain.begin.y, domain.end.y - 1),
+                      uni(domain.begin.z, domain.end.z - 1)};
+        dirty.add(Box3i{p, p + Vec3i{uni(1, 12), uni(1, 12), uni(1, 12)}}.intersect(domain));
+      }
+      regions = detail::update_regions(dirty, domain, reach);
+    }
+    const std::int64_t most = uni(1, 40000);
+    for (const detail::UpdateRegion& r : regions) {
+      const std::vector<detail::UpdateRegion> parts =
+          detail::split_regions({r}, domain, reach, most);
+      ASSERT_FALSE(parts.empty());
+      if (r.in.volume() <= most) {
+        ASSERT_EQ(parts.size(), 1u);
+        EXPECT_EQ(parts[0].out, r.out);
+        EXPECT_EQ(parts[0].in, r.in);
+        continue;
+      }
+      std::int64_t covered = 0;
+      for (std::size_t i = 0; i < parts.size(); ++i) {
+        const detail::UpdateRegion& p = parts[i];
+        EXPECT_FALSE(p.out.empty());
+        EXPECT_EQ(p.out.intersect(r.out), p.out);
+        for (std::size_t j = 0; j < i; ++j) EXPECT_TRUE(p.out.intersect(parts[j].out).empty());
+        EXPECT_EQ(p.in, (Box3i{p.out.begin - reach, p.out.end + reach}).intersect(domain));
+        covered += p.out.volume();
+      }
+      EXPECT_EQ(covered, r.out.volume());
+      if (parts.size() > 1) {
+        ++cut;
+        for (const auto& p : parts) EXPECT_LE(p.in.volume(), most);
+      } else {
+        ++whole;
+        // Left whole: even a slab one voxel thick along any axis reads more than the bound.
+        for (int a = 0; a < 3; ++a)
+          EXPECT_GT(std::min(1 + 2 * reach[a], r.in.size()[a]) * (r.in.volume() / r.in.size()[a]),
+                    most);
+      }
+    }
+  }
+  EXPECT_GT(cut, 20);  // both outcomes occur
+  EXPECT_GT(whole, 20);
+}

@@ -329,38 +329,68 @@ TEST(Gpu, FieldsShareOneResidentWorld) {
   test::expect_no_validation_messages(*ctx);
 }
 
-TEST(Gpu, WorkBuffersBeyondTheStorageBufferRangeAreRefused) {
+TEST(Gpu, ClampedFieldsBeyondTheStorageBufferRangeAreComputedInParts) {
   // The exact transform's work buffers hold 4 bytes per voxel of a region (24 more with nearest
-  // sites): a device whose storage-buffer range cannot bind them refuses the field with
-  // InvalidArgument, before anything is uploaded, instead of binding past the range. The range is
-  // lowered on a real context to make a small world too large.
+  // sites). On a device whose storage-buffer range cannot bind them (lowered here through
+  // ContextOptions, as a user sharing a device would), a clamped field is computed in slabs, each
+  // with the sites within its reach: the same bits as the CPU's, builds and updates alike, with
+  // more dispatches. Where no slab is small enough (an unclamped field's reach is the whole domain,
+  // and nearest sites need six times the room) the field is refused with InvalidArgument before
+  // anything is uploaded, instead of binding past the range.
   if (!gpu_tests_wanted()) GTEST_SKIP();
-  auto ctx = validated_context();
+  gpu::ContextOptions co;
+  co.validation = true;
+  co.max_storage_buffer_bytes = 64 * 1024 - 4;  // 16 383 voxels: one short of the whole domain
+  auto small = gpu::Context::create(co);
+  auto whole = validated_context();
   World w = random_world({32, 32, 16}, 8, 0.01, 4);  // 16 384 voxels: 64 KiB per cost buffer
+  w.voxels.set(Vec3i{31, 31, 15}, 2);  // a site in the last corner: a slab's edge is crossed
   DistanceOptions o;
-  o.metric = Metric::kManhattan;
-  o.max_distance = 6;
   o.storage = Storage::kU8;
-  std::uint32_t& range = ctx->impl().limits.maxStorageBufferRange;
-  struct Restore {
-    std::uint32_t& range;
-    std::uint32_t saved;
-    ~Restore() { range = saved; }
-  } restore{range, range};
-  range = 64 * 1024;  // the u8 field (16 KiB) fits, a cost buffer exactly fits
-  const gpu::Counters before = ctx->counters();
-  EXPECT_NO_THROW(gpu::DynamicField(ctx, w, o));
-  o.nearest_sites = true;  // 6 x 64 KiB of sites
+  o.max_distance = 6;
+  for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
+    for (bool is_signed : {false, true}) {
+      o.metric = m;
+      o.signed_distance = is_signed;
+      const std::string what = std::string(metric_name(m)) + (is_signed ? " signed" : "");
+      const std::int64_t before = small->counters().dispatches;
+      const DistanceField parts = gpu::compute_distance_field(*small, w, o);
+      const std::int64_t in_parts = small->counters().dispatches - before;
+      const std::int64_t before_whole = whole->counters().dispatches;
+      expect_same_field(parts, gpu::compute_distance_field(*whole, w, o), what);
+      expect_same_field(parts, compute_distance_field(w, o), what);
+      EXPECT_GT(in_parts, whole->counters().dispatches - before_whole) << what;
+      // An update whose region is the whole domain (a box edit across it), then a small one.
+      World edited = w;
+      gpu::DynamicField live(small, edited, o);
+      DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
+      apply_edit(edited, Edit{EditOp::kPlace, BoxBrush{{2, 3, 4}, {30, 29, 12}}, 3}, &dirty);
+      live.update(dirty);
+      dirty.clear();
+      apply_edit(edited, Edit{EditOp::kCarve, SphereBrush{{16, 16, 8}, 5}, 0}, &dirty);
+      live.update(dirty);
+      expect_same_field(live.download(), compute_distance_field(edited, o), what + ", edited");
+    }
+  o.metric = Metric::kManhattan;
+  o.signed_distance = false;
+  o.nearest_sites = true;  // 6 x 64 KiB of sites: no slab of reach 6 fits
   try {
-    gpu::DynamicField refused(ctx, w, o);
+    gpu::DynamicField refused(small, w, o);
     ADD_FAILURE() << "a work buffer beyond the storage-buffer range was made";
   } catch (const InvalidArgument& e) {
     EXPECT_NE(std::string(e.what()).find("storage-buffer range"), std::string::npos) << e.what();
   }
-  range = 64 * 1024 - 4;  // now not even a cost buffer
   o.nearest_sites = false;
-  EXPECT_THROW(gpu::DynamicField(ctx, w, o), InvalidArgument);
-  EXPECT_GT(ctx->counters().submits, before.submits);  // (the first field was built)
+  o.max_distance = 0;  // unclamped: the reach is the whole domain, computed whole
+  const gpu::Counters before = small->counters();
+  try {
+    gpu::DynamicField refused(small, w, o);
+    ADD_FAILURE() << "an unclamped field beyond the storage-buffer range was made";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("no slab"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(small->counters().bytes_uploaded, before.bytes_uploaded);  // nothing was uploaded
+  test::expect_no_validation_messages(*small);
 }
 
 TEST(Gpu, JumpFloodingEqualsTheCpu) {

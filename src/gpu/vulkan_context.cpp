@@ -384,6 +384,9 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
   check(vkCreateDevice(s.physical, &dci, nullptr, &s.device), "vkCreateDevice");
   vkGetDeviceQueue(s.device, s.queue_family, 0, &s.queue);
   s.finish_setup();
+  if (options.max_storage_buffer_bytes > 0 &&
+      options.max_storage_buffer_bytes < s.limits.maxStorageBufferRange)
+    s.limits.maxStorageBufferRange = static_cast<std::uint32_t>(options.max_storage_buffer_bytes);
   guard.s = nullptr;
   return std::make_shared<Context>(std::move(impl));
 }

@@ -109,6 +109,11 @@ struct WorkBuffers {
     // Nearest sites: 8 bytes per voxel for each of the three cost buffers.
     return std::max(bytes, needed) * (with_sites || need_sites ? 6 : 1);
   }
+  // The most voxels one region's box of sites may hold on a device binding at most `range` bytes
+  // of a buffer.
+  std::int64_t most_region_voxels(VkDeviceSize range, bool need_sites) const {
+    return static_cast<std::int64_t>(range / 4 / (with_sites || need_sites ? 6 : 1));
+  }
   void grow(Context::Impl& ctx, VkDeviceSize needed, bool need_sites) {
     if (needed <= bytes && (with_sites || !need_sites)) return;
     const VkDeviceSize n = std::max(bytes, needed);
@@ -180,6 +185,14 @@ class FieldEngine {
 
   // Every chunk the domain touches.
   std::vector<Vec3i> all_chunks() const { return resident_->all_chunks(); }
+  // `regions` cut into parts whose work buffers fit the device's storage-buffer range: the same
+  // values (a clamped field's depend only on the sites within its reach), more dispatches. An
+  // unclamped field's region cannot be cut; run() refuses it if it does not fit.
+  std::vector<detail::UpdateRegion> parts(const std::vector<detail::UpdateRegion>& regions) const {
+    return detail::split_regions(
+        regions, plan_.domain, detail::field_reach(plan_),
+        work_->most_region_voxels(ctx_.limits.maxStorageBufferRange, options_.nearest_sites));
+  }
   const std::shared_ptr<ResidentWorld>& resident_world() const { return resident_; }
   const std::shared_ptr<WorkBuffers>& work_buffers() const { return work_; }
   bool owns_world() const { return owns_world_; }
@@ -263,7 +276,9 @@ class FieldEngine {
       throw InvalidArgument("GPU: a region of " + std::to_string(largest / 4) +
                             " voxels needs a work buffer of " + std::to_string(widest) +
                             " bytes, more than this device's storage-buffer range (" +
-                            std::to_string(ctx_.limits.maxStorageBufferRange) + ")");
+                            std::to_string(ctx_.limits.maxStorageBufferRange) +
+                            "), and no slab of it within the field's reach fits either: a "
+                            "smaller clamp (max distance) gives thinner slabs");
     work_->grow(ctx_, largest, options_.nearest_sites);
     if (owns_world_) resident_->stage(chunks, up, uploads);
   }
@@ -419,7 +434,8 @@ DistanceField compute_distance_field(Context& context, const World& world,
     return voxfield::compute_distance_field(world, options);
   }
   FieldEngine engine(context.impl(), world, options);
-  engine.run(engine.all_chunks(), {{plan.domain, plan.domain}}, /*download=*/true, timings);
+  engine.run(engine.all_chunks(), engine.parts({{plan.domain, plan.domain}}), /*download=*/true,
+             timings);
   DistanceField f = engine.read_back();
   f.frame = world.frame;
   return f;
@@ -466,7 +482,7 @@ const DistanceOptions& DynamicField::options() const {
 
 void DynamicField::rebuild() {
   const Box3i domain = engine_->plan().domain;
-  engine_->run(engine_->all_chunks(), {{domain, domain}}, false, &timings_);
+  engine_->run(engine_->all_chunks(), engine_->parts({{domain, domain}}), false, &timings_);
 }
 
 std::size_t DynamicField::field_bytes() const {
@@ -477,7 +493,7 @@ DynamicDistanceField::UpdateStats DynamicField::update(const DirtyRegions& dirty
   DynamicDistanceField::UpdateStats stats;
   if (dirty.empty()) return stats;
   const std::vector<detail::UpdateRegion> regions =
-      detail::update_regions(dirty, engine_->plan().domain, reach_);
+      engine_->parts(detail::update_regions(dirty, engine_->plan().domain, reach_));
   // The chunks whose voxels changed: the dirty boxes are per chunk.
   std::vector<Vec3i> chunks;
   for (const Box3i& b : dirty.boxes())

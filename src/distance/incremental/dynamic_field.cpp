@@ -65,6 +65,42 @@ std::vector<UpdateRegion> update_regions(const DirtyRegions& dirty, const Box3i&
   return regions;
 }
 
+std::vector<UpdateRegion> split_regions(const std::vector<UpdateRegion>& regions,
+                                        const Box3i& domain, Vec3i reach,
+                                        std::int64_t max_in_voxels) {
+  std::vector<UpdateRegion> out;
+  for (const UpdateRegion& r : regions) {
+    if (r.in.volume() <= max_in_voxels) {
+      out.push_back(r);
+      continue;
+    }
+    // Along axis a, a slab of s voxels of `out` needs at most s + 2 * reach[a] of `in`'s (the
+    // other two extents are in's own): the axis that needs the fewest slabs.
+    int best_axis = -1;
+    std::int64_t best_slabs = 0;
+    for (int a = 0; a < 3; ++a) {
+      const std::int64_t across = r.in.volume() / r.in.size()[a];
+      const std::int64_t slab = max_in_voxels / across - 2 * static_cast<std::int64_t>(reach[a]);
+      if (slab < 1) continue;
+      const std::int64_t slabs = (r.out.size()[a] + slab - 1) / slab;
+      if (best_axis < 0 || slabs < best_slabs) best_axis = a, best_slabs = slabs;
+    }
+    if (best_axis < 0) {
+      out.push_back(r);
+      continue;
+    }
+    // Slabs of equal thickness (to one voxel): none thinner than it must be.
+    const int a = best_axis, length = r.out.size()[a];
+    for (std::int64_t k = 0; k < best_slabs; ++k) {
+      Box3i slab = r.out;
+      slab.begin[a] = r.out.begin[a] + static_cast<int>(length * k / best_slabs);
+      slab.end[a] = r.out.begin[a] + static_cast<int>(length * (k + 1) / best_slabs);
+      out.push_back({slab, grow(slab, reach).intersect(domain)});
+    }
+  }
+  return out;
+}
+
 namespace {
 
 // ---- The steps of DynamicDistanceField::update, one region at a time ---------------------------
