@@ -237,17 +237,10 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
                                         mpi::edit_unit_weights(domain, f.chunk, edits, ghost));
           },
           read);
-    mpi::WorldSlab equal = mpi::load_world_slab(comm, in, f.chunk, ghost, read);
-    if (balance != "content") return equal;
-    // By content: the chunks holding air and solid (the surface), counted in the slabs of equal
-    // volume; then the world read again in the slabs they weigh.
-    const std::vector<double> weights =
-        mpi::content_unit_weights(comm, equal.partition, equal.world, f.chunk);
-    equal.world = World();  // let go before the second reading
-    return mpi::load_world_slab(
-        comm, in, f.chunk, ghost,
-        [&](const Box3i& domain) { return mpi::partition_slabs(domain, size, f.chunk, weights); },
-        read);
+    // By content: the chunks holding air and solid (the surface).
+    if (balance == "content")
+      return mpi::load_world_slab_by_content(comm, in, f.chunk, ghost, read);
+    return mpi::load_world_slab(comm, in, f.chunk, ghost, read);
   }();
   const double load_ms = max_over(comm, (MPI_Wtime() - l0) * 1e3);
   const double t0 = MPI_Wtime();

@@ -257,6 +257,13 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
 using SlabCut = std::function<SlabPartition(const Box3i& domain)>;
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
                           int ghost_slices, const SlabCut& cut, const SlabReadOptions& read = {});
+// The same with the slabs weighed by content, for work that follows the surface (a clamped field,
+// a frame's rays): read first in slabs of equal volume, the ranks count where the surface lies
+// (content_unit_weights, on `chunk_edge`), let go of that reading, and read the world again in
+// slabs of equal weight. Twice the reading; the same world, cut elsewhere.
+WorldSlab load_world_slab_by_content(MPI_Comm comm, const std::filesystem::path& path,
+                                     int chunk_edge, int ghost_slices = 0,
+                                     const SlabReadOptions& read = {});
 
 // Collective: per unit of slab_units(partition.domain, align), the chunks of the ranks' worlds
 // within the unit's slices that hold both air and solid voxels (where a world's surface lies, and

@@ -309,4 +309,20 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
   return slab;
 }
 
+WorldSlab load_world_slab_by_content(MPI_Comm comm, const std::filesystem::path& path,
+                                     int chunk_edge, int ghost_slices,
+                                     const SlabReadOptions& read) {
+  int size = 0;
+  MPI_Comm_size(comm, &size);
+  std::vector<double> weights;
+  {
+    const WorldSlab equal = load_world_slab(comm, path, chunk_edge, ghost_slices, read);
+    weights = content_unit_weights(comm, equal.partition, equal.world, chunk_edge);
+  }  // the first reading goes before the second
+  return load_world_slab(
+      comm, path, chunk_edge, ghost_slices,
+      [&](const Box3i& domain) { return partition_slabs(domain, size, chunk_edge, weights); },
+      read);
+}
+
 }  // namespace voxfield::mpi
