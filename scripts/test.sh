@@ -26,9 +26,10 @@ for preset in $presets; do
   ctest --preset "$preset" -j "$(nproc)"
   phase_done "$preset tests"
 done
-# 10 s per harness (11 harnesses, one per core: about a minute): every seed runs at the start, and
-# the CI run as a whole keeps under its 40 minutes (at 15 s it passed them by a few seconds).
-fuzz_seconds=${VOXFIELD_FUZZ_SECONDS:-10}
+# 6 s per harness (11 harnesses, one per core: about 40 s): every seed runs at the start, and the
+# CI run as a whole keeps under its 40 minutes (at 15 s it passed them by a few seconds; at 10 s,
+# on a slow day, by a minute: 72 s of its 2473).
+fuzz_seconds=${VOXFIELD_FUZZ_SECONDS:-6}
 if [ "$fuzz_seconds" -gt 0 ]; then
   echo "=== voxfield fuzz smoke: ${fuzz_seconds}s per harness ==="
   # The seeds are made by an optimised CLI: the one this run built, or release's.

@@ -371,9 +371,18 @@ TEST(Gpu, ClampedFieldsBeyondTheStorageBufferRangeAreComputedInParts) {
       live.update(dirty);
       expect_same_field(live.download(), compute_distance_field(edited, o), what + ", edited");
     }
+  // Every chunk holding voxels: the world's brick pool (1 byte per voxel of those chunks) fills the
+  // range but for 1.5 KiB, and grows no further than it (the recorder refuses a binding past it).
+  const World dense = random_world({40, 40, 40}, 8, 0.3, 6);
+  o.metric = Metric::kEuclidean;
+  o.signed_distance = true;
+  o.max_distance = 2;  // slabs of 6 slices, each reading 2 more on either side
+  expect_same_field(gpu::compute_distance_field(*small, dense, o), compute_distance_field(dense, o),
+                    "every chunk holding voxels");
+  o.max_distance = 6;
   o.metric = Metric::kManhattan;
   o.signed_distance = false;
-  o.nearest_sites = true;  // 6 x 64 KiB of sites: no slab of reach 6 fits
+  o.nearest_sites = true;  // the sites, 8 bytes per voxel of the domain, are not cut: 128 KiB
   try {
     gpu::DynamicField refused(small, w, o);
     ADD_FAILURE() << "a work buffer beyond the storage-buffer range was made";

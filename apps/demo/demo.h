@@ -69,6 +69,9 @@ class Demo {
   // Keeps the world's fields on the path's device; false (the reason in the status line) when the
   // device cannot hold them.
   bool follow_on_device();
+  // Draws `next` from now on (regenerate, load). Throws voxfield::Error, keeping the current world,
+  // when `next`'s fields cannot be built on the host where they are to stay there.
+  void replace_world(std::unique_ptr<DemoWorld> next, const std::string& done);
   void frame_camera();
   void handle_input(double dt_s);
   void edit_at_cursor(EditOp op);

@@ -187,6 +187,19 @@ bool Demo::follow_on_device() {
   }
 }
 
+void Demo::replace_world(std::unique_ptr<DemoWorld> next, const std::string& done) {
+  // Fields meant for the host are built before the swap, so that a world too large for them
+  // leaves the current one in place; fields meant for the device are built there after the
+  // current world's copy has gone (never two on the device), on the host if the device refuses.
+  if (!path_.device_fields) (void)next->scene();
+  wait_idle();
+  world_->stop_device();
+  world_ = std::move(next);
+  frame_camera();
+  status_ = done;
+  if (path_.device_fields && !follow_on_device()) (void)world_->scene();
+}
+
 void Demo::frame_camera() {
   const Box3i box = world_->box();
   const Vec3i s = box.size();

@@ -137,13 +137,7 @@ void Demo::panel() {
       s.size = ui_size_;
       s.chunk_edge = ui_chunk_;
       try {
-        auto next = std::make_unique<DemoWorld>(s);
-        wait_idle();
-        world_->stop_device();
-        world_ = std::move(next);
-        frame_camera();
-        status_ = "regenerated";
-        if (path_.device_fields) follow_on_device();
+        replace_world(std::make_unique<DemoWorld>(s), "regenerated");
       } catch (const Error& e) {
         status_ = e.what();
       }
@@ -162,13 +156,8 @@ void Demo::panel() {
       try {
         WorldSettings s = world_->settings();
         s.chunk_edge = ui_chunk_;
-        auto loaded = std::make_unique<DemoWorld>(s, load_path_);
-        wait_idle();
-        world_->stop_device();
-        world_ = std::move(loaded);
-        frame_camera();
-        status_ = std::string("loaded ") + load_path_;
-        if (path_.device_fields) follow_on_device();
+        replace_world(std::make_unique<DemoWorld>(s, load_path_),
+                      std::string("loaded ") + load_path_);
       } catch (const Error& e) {
         status_ = e.what();  // the current world stays
       }

@@ -25,6 +25,8 @@ struct AdoptedDevice {
   // Whether the device was created with the shaderFloat64 feature enabled: the vector-field
   // passes need it (gpu_vectors.h); everything else runs without it.
   bool shader_float64 = false;
+  // ContextOptions::max_storage_buffer_bytes (gpu.h): 0, the device's own range.
+  std::uint64_t max_storage_buffer_bytes = 0;
 };
 
 // A context on the application's device and queue: voxfield creates its command pool, pipelines

@@ -257,10 +257,11 @@ WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int 
 using SlabCut = std::function<SlabPartition(const Box3i& domain)>;
 WorldSlab load_world_slab(MPI_Comm comm, const std::filesystem::path& path, int chunk_edge,
                           int ghost_slices, const SlabCut& cut, const SlabReadOptions& read = {});
-// The same with the slabs weighed by content, for work that follows the surface (a clamped field,
-// a frame's rays): read first in slabs of equal volume, the ranks count where the surface lies
-// (content_unit_weights, on `chunk_edge`), let go of that reading, and read the world again in
-// slabs of equal weight. Twice the reading; the same world, cut elsewhere.
+// The same with the slabs weighed by content, for work that follows the surface (a script's edits,
+// which land on it; a field's own work follows the volume, docs/mpi.md): read first in slabs of
+// equal volume, the ranks count where the surface lies (content_unit_weights, on `chunk_edge`),
+// let go of that reading, and read the world again in slabs of equal weight. Twice the reading;
+// the same world, cut elsewhere.
 WorldSlab load_world_slab_by_content(MPI_Comm comm, const std::filesystem::path& path,
                                      int chunk_edge, int ghost_slices = 0,
                                      const SlabReadOptions& read = {});

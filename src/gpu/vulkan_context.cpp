@@ -384,9 +384,7 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
   check(vkCreateDevice(s.physical, &dci, nullptr, &s.device), "vkCreateDevice");
   vkGetDeviceQueue(s.device, s.queue_family, 0, &s.queue);
   s.finish_setup();
-  if (options.max_storage_buffer_bytes > 0 &&
-      options.max_storage_buffer_bytes < s.limits.maxStorageBufferRange)
-    s.limits.maxStorageBufferRange = static_cast<std::uint32_t>(options.max_storage_buffer_bytes);
+  s.cap_storage_buffer_range(options.max_storage_buffer_bytes);
   guard.s = nullptr;
   return std::make_shared<Context>(std::move(impl));
 }
@@ -450,8 +448,14 @@ std::shared_ptr<Context> adopt(const AdoptedDevice& app) {
     }
   } guard{&s};
   s.finish_setup();
+  s.cap_storage_buffer_range(app.max_storage_buffer_bytes);
   guard.s = nullptr;
   return std::make_shared<Context>(std::move(impl));
+}
+
+void Context::Impl::cap_storage_buffer_range(std::uint64_t bytes) {
+  if (bytes > 0 && bytes < limits.maxStorageBufferRange)
+    limits.maxStorageBufferRange = static_cast<std::uint32_t>(bytes);
 }
 
 Context::Context(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

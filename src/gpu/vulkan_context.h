@@ -107,6 +107,8 @@ struct Context::Impl {
   // Throws GpuDeviceLost when the device was lost earlier.
   void require_device() const;
   void finish_setup();
+  // Lowers limits.maxStorageBufferRange to `bytes` (0: leaves it), as the options ask.
+  void cap_storage_buffer_range(std::uint64_t bytes);
   void destroy();
 };
 

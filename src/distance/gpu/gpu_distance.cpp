@@ -99,33 +99,34 @@ DistanceField build_field(const World& world, const DistanceOptions& options,
 }  // namespace
 
 // The exact transform's work buffers: three cost buffers, the envelope scans' scratch, and the
-// nearest sites of each cost buffer. Grown to the largest region a run computes, never shrunk.
+// nearest sites of each cost buffer. Grown to the largest region a run computes, never shrunk;
+// shared by the fields on one resident world, so the sites buffer is sized by the fields that
+// carry sites alone.
 struct WorkBuffers {
   Buffer cost[3], scratch_s, scratch_t, sites;
-  VkDeviceSize bytes = 0;
-  bool with_sites = false;
-  // The largest buffer a grow to `needed` bytes per cost buffer would make.
+  VkDeviceSize bytes = 0;       // per cost buffer: 4 per voxel of the largest region computed
+  VkDeviceSize site_bytes = 0;  // 24 per voxel of the largest region computed with nearest sites
+  // The largest buffer a grow for a region of `needed` bytes per cost buffer would make.
   VkDeviceSize widest_after(VkDeviceSize needed, bool need_sites) const {
-    // Nearest sites: 8 bytes per voxel for each of the three cost buffers.
-    return std::max(bytes, needed) * (with_sites || need_sites ? 6 : 1);
+    return std::max({bytes, needed, need_sites ? std::max(site_bytes, 6 * needed) : site_bytes});
   }
   // The most voxels one region's box of sites may hold on a device binding at most `range` bytes
   // of a buffer.
-  std::int64_t most_region_voxels(VkDeviceSize range, bool need_sites) const {
-    return static_cast<std::int64_t>(range / 4 / (with_sites || need_sites ? 6 : 1));
+  static std::int64_t most_region_voxels(VkDeviceSize range, bool need_sites) {
+    return static_cast<std::int64_t>(range / 4 / (need_sites ? 6 : 1));
   }
   void grow(Context::Impl& ctx, VkDeviceSize needed, bool need_sites) {
-    if (needed <= bytes && (with_sites || !need_sites)) return;
     const VkDeviceSize n = std::max(bytes, needed);
-    const bool s = with_sites || need_sites;
+    const VkDeviceSize s = need_sites ? std::max(site_bytes, 6 * needed) : site_bytes;
+    if (n == bytes && s == site_bytes) return;
     // Made before any is kept: a failed allocation (GpuOutOfMemory) leaves the old set and sizes.
     WorkBuffers next;
     for (Buffer& b : next.cost) b = Buffer(ctx, n, kStorage, false);
-    next.sites = Buffer(ctx, s ? n * 6 : 16, kStorage, false);
+    next.sites = Buffer(ctx, std::max<VkDeviceSize>(s, 16), kStorage, false);
     next.scratch_s = Buffer(ctx, n, kStorage, false);
     next.scratch_t = Buffer(ctx, n, kStorage, false);
     next.bytes = n;
-    next.with_sites = s;
+    next.site_bytes = s;
     *this = std::move(next);
   }
 };
@@ -162,6 +163,14 @@ class FieldEngine {
                             std::to_string(field_bytes_) +
                             " bytes per buffer, more than this device's storage-buffer range (" +
                             std::to_string(ctx.limits.maxStorageBufferRange) + ")");
+    // Nearest sites: 8 bytes per voxel of the domain (three int16 offsets, padded), resident
+    // whole: slabs cut the work buffers, not this one.
+    site_bytes_ = options.nearest_sites ? static_cast<VkDeviceSize>(plan_.domain.volume()) * 8 : 0;
+    if (site_bytes_ > ctx.limits.maxStorageBufferRange)
+      throw InvalidArgument("GPU: nearest sites of a " + to_string(n) + " domain need " +
+                            std::to_string(site_bytes_) +
+                            " bytes, more than this device's storage-buffer range (" +
+                            std::to_string(ctx.limits.maxStorageBufferRange) + ")");
     make_header();
     owns_world_ = shared == nullptr;
     resident_ =
@@ -174,8 +183,6 @@ class FieldEngine {
     work_ = work ? std::move(work) : std::make_shared<WorkBuffers>();
     header_buf_ = Buffer(ctx, sizeof header_, kStorage, false);
     field_buf_ = Buffer(ctx, field_bytes_, kStorage, false);
-    // Nearest sites: 8 bytes per voxel of the domain (three int16 offsets, padded).
-    site_bytes_ = options.nearest_sites ? static_cast<VkDeviceSize>(plan_.domain.volume()) * 8 : 0;
     field_sites_buf_ = Buffer(ctx, std::max<VkDeviceSize>(site_bytes_, 16), kStorage, false);
   }
 
@@ -191,7 +198,7 @@ class FieldEngine {
   std::vector<detail::UpdateRegion> parts(const std::vector<detail::UpdateRegion>& regions) const {
     return detail::split_regions(
         regions, plan_.domain, detail::field_reach(plan_),
-        work_->most_region_voxels(ctx_.limits.maxStorageBufferRange, options_.nearest_sites));
+        WorkBuffers::most_region_voxels(ctx_.limits.maxStorageBufferRange, options_.nearest_sites));
   }
   const std::shared_ptr<ResidentWorld>& resident_world() const { return resident_; }
   const std::shared_ptr<WorkBuffers>& work_buffers() const { return work_; }
@@ -277,8 +284,8 @@ class FieldEngine {
                             " voxels needs a work buffer of " + std::to_string(widest) +
                             " bytes, more than this device's storage-buffer range (" +
                             std::to_string(ctx_.limits.maxStorageBufferRange) +
-                            "), and no slab of it within the field's reach fits either: a "
-                            "smaller clamp (max distance) gives thinner slabs");
+                            "), and no slab of it fits either (a slab reads the field's reach "
+                            "on both sides: its clamp, or the whole domain when unclamped)");
     work_->grow(ctx_, largest, options_.nearest_sites);
     if (owns_world_) resident_->stage(chunks, up, uploads);
   }
@@ -492,8 +499,10 @@ std::size_t DynamicField::field_bytes() const {
 DynamicDistanceField::UpdateStats DynamicField::update(const DirtyRegions& dirty) {
   DynamicDistanceField::UpdateStats stats;
   if (dirty.empty()) return stats;
-  const std::vector<detail::UpdateRegion> regions =
-      engine_->parts(detail::update_regions(dirty, engine_->plan().domain, reach_));
+  const std::vector<detail::UpdateRegion> merged =
+      detail::update_regions(dirty, engine_->plan().domain, reach_);
+  // (Each cut into slabs where the device's buffers need it: the slabs read more sites.)
+  const std::vector<detail::UpdateRegion> regions = engine_->parts(merged);
   // The chunks whose voxels changed: the dirty boxes are per chunk.
   std::vector<Vec3i> chunks;
   for (const Box3i& b : dirty.boxes())
@@ -503,8 +512,8 @@ DynamicDistanceField::UpdateStats DynamicField::update(const DirtyRegions& dirty
   for (const auto& r : regions) {
     stats.voxels_recomputed += r.out.volume();
     stats.voxels_read += r.in.volume();
-    ++stats.regions;
   }
+  stats.regions = static_cast<int>(merged.size());
   return stats;
 }
 

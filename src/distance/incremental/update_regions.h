@@ -26,9 +26,9 @@ Vec3i field_reach(const FieldPlan& plan);
 std::vector<UpdateRegion> update_regions(const DirtyRegions& dirty, const Box3i& domain,
                                          Vec3i reach);
 
-// `regions`, each whose box of sites holds more than `max_in_voxels` voxels cut across its longest
-// axis the reach allows into slabs of its `out` box, each with the sites it needs (the slab grown
-// by the reach, clipped to the domain) and at most `max_in_voxels` of them: the same values,
+// `regions`, each whose box of sites holds more than `max_in_voxels` voxels cut, across the axis
+// that needs the fewest, into slabs of its `out` box, each with the sites it needs (the slab
+// grown by the reach, clipped to the domain) and at most `max_in_voxels` of them: the same values,
 // computed in parts by a device whose buffers hold no more. A region no cut brings under the
 // bound (an unclamped field's: its reach is the whole domain) stays whole, for the caller to
 // refuse.
