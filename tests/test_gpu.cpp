@@ -371,8 +371,9 @@ TEST(Gpu, ClampedFieldsBeyondTheStorageBufferRangeAreComputedInParts) {
       live.update(dirty);
       expect_same_field(live.download(), compute_distance_field(edited, o), what + ", edited");
     }
-  // Every chunk holding voxels: the world's brick pool (1 byte per voxel of those chunks) fills the
-  // range but for 1.5 KiB, and grows no further than it (the recorder refuses a binding past it).
+  // 121 of the 125 chunks holding voxels (the solid block makes four uniform): the world's brick
+  // pool (512 bytes a chunk) needs 61 952 bytes of the 65 532 and grows no further than the range
+  // (127 slots), where its amortised growth would have made 159.
   const World dense = random_world({40, 40, 40}, 8, 0.3, 6);
   o.metric = Metric::kEuclidean;
   o.signed_distance = true;

@@ -194,10 +194,20 @@ void Demo::replace_world(std::unique_ptr<DemoWorld> next, const std::string& don
   if (!path_.device_fields) (void)next->scene();
   wait_idle();
   world_->stop_device();
-  world_ = std::move(next);
+  std::unique_ptr<DemoWorld> previous = std::exchange(world_, std::move(next));
+  if (path_.device_fields && !follow_on_device()) {
+    try {
+      (void)world_->scene();
+    } catch (const Error&) {
+      // Neither the device nor the host can hold the new world's fields: the previous world
+      // comes back, where its fields were.
+      world_ = std::move(previous);
+      if (!follow_on_device()) (void)world_->scene();
+      throw;
+    }
+  }
   frame_camera();
   status_ = done;
-  if (path_.device_fields && !follow_on_device()) (void)world_->scene();
 }
 
 void Demo::frame_camera() {

@@ -41,15 +41,6 @@ void DescriptorArena::reset() {
 }
 
 VkDescriptorSet DescriptorArena::set(const Kernel& kernel, std::span<Buffer* const> buffers) {
-  // Each buffer is bound whole: past the range one binding may hold (the device's, or the lower
-  // one ContextOptions asks for), the binding is invalid. Whoever sizes a buffer refuses or cuts
-  // work before that, naming the sizes; reaching here is voxfield's error.
-  for (std::size_t b = 0; b < buffers.size(); ++b)
-    if (buffers[b]->size() > ctx_->limits.maxStorageBufferRange)
-      throw Error("GPU: internal error: binding " + std::to_string(b) + " of " + kernel.name +
-                  " holds " + std::to_string(buffers[b]->size()) +
-                  " bytes, past the storage-buffer range (" +
-                  std::to_string(ctx_->limits.maxStorageBufferRange) + ")");
   Key key{kernel.set_layout, {}};
   key.buffers.reserve(buffers.size());
   for (const Buffer* b : buffers) key.buffers.push_back(b->handle());

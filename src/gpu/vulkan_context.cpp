@@ -454,6 +454,8 @@ std::shared_ptr<Context> adopt(const AdoptedDevice& app) {
 }
 
 void Context::Impl::cap_storage_buffer_range(std::uint64_t bytes) {
+  // Whole words: buffers are sized in 32-bit words, checked against the range before rounding.
+  bytes &= ~std::uint64_t{3};
   if (bytes > 0 && bytes < limits.maxStorageBufferRange)
     limits.maxStorageBufferRange = static_cast<std::uint32_t>(bytes);
 }

@@ -212,6 +212,13 @@ class FieldEngine {
     Staging up;
     Uploads uploads;
     stage(chunks, regions, up, uploads);
+    // Every buffer the passes bind is bound whole, and stage() and the constructor keep each
+    // within the range one binding may hold; past it the binding would be invalid.
+    for (const Buffer* b : bindings())
+      if (b->size() > ctx_.limits.maxStorageBufferRange)
+        throw Error("GPU: internal error: a distance pass would bind " + std::to_string(b->size()) +
+                    " bytes, past the storage-buffer range (" +
+                    std::to_string(ctx_.limits.maxStorageBufferRange) + ")");
     // What the copies carry (the staging's alignment padding stays behind).
     upload_bytes_ = first_run_ ? sizeof header_ : 0;
     for (const auto* copies : {&uploads.page_copies, &uploads.brick_copies})

@@ -1,6 +1,7 @@
 // voxfield GPU backend — a world's page table and brick pool on the device (resident_world.h).
 #include "resident_world.h"
 
+#include <algorithm>
 #include <cstring>
 
 namespace voxfield::gpu {
@@ -69,20 +70,30 @@ void ResidentWorld::stage(const std::vector<Vec3i>& chunks, Staging& up, Uploads
     std::uint8_t value;
   };
   std::vector<Change> changes;
-  // Slots the sync may need beyond the free list (frees within the sync are not counted: the
-  // estimate can only be high, never low).
-  std::uint32_t new_dense = 0;
   for (const Vec3i& c : chunks) {
     if (c.x < origin_.x || c.y < origin_.y || c.z < origin_.z) continue;
     const Vec3i r = c - origin_;
     if (r.x >= dims_.x || r.y >= dims_.y || r.z >= dims_.z) continue;
     const ChunkView<std::uint8_t> v = world_.voxels.chunk_view(c);
-    const std::size_t page = page_index(c);
-    changes.push_back({page, v.voxels, v.uniform_value});
-    const bool had_slot = (pages_[page] & L::VF_UNIFORM) == 0;
-    if (v.voxels && !had_slot) ++new_dense;
+    changes.push_back({page_index(c), v.voxels, v.uniform_value});
   }
-  const std::uint32_t reusable = static_cast<std::uint32_t>(free_slots_.size());
+  // One change per page (a chunk named twice is staged once), the chunks that became uniform
+  // first: the slots they free are there for the chunks that became dense, so the slots the sync
+  // needs beyond the free list are counted exactly (a pool at the range is not refused for them).
+  std::sort(changes.begin(), changes.end(),
+            [](const Change& a, const Change& b) { return a.page < b.page; });
+  changes.erase(std::unique(changes.begin(), changes.end(),
+                            [](const Change& a, const Change& b) { return a.page == b.page; }),
+                changes.end());
+  std::stable_partition(changes.begin(), changes.end(),
+                        [](const Change& ch) { return ch.voxels == nullptr; });
+  std::uint32_t new_dense = 0, freed = 0;
+  for (const Change& ch : changes) {
+    const bool had_slot = (pages_[ch.page] & L::VF_UNIFORM) == 0;
+    if (ch.voxels && !had_slot) ++new_dense;
+    if (!ch.voxels && had_slot) ++freed;
+  }
+  const std::uint32_t reusable = static_cast<std::uint32_t>(free_slots_.size()) + freed;
   const std::uint32_t needed = used_slots_ + (new_dense > reusable ? new_dense - reusable : 0);
   if (needed > slot_capacity_) {
     // Grow the pool (amortised doubling, within what one binding holds); the old bricks are
