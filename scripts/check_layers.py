@@ -38,7 +38,7 @@ PUBLIC_LAYER = {
 }
 # Headers of the GPU compute layer that the modules above it may include (its internal interface).
 INTERNAL_INTERFACE = {"src/gpu/vulkan_context.h", "src/gpu/kernel.h", "src/gpu/recorder.h",
-                      "src/gpu/graphics.h",
+                      "src/gpu/graphics.h", "src/gpu/split_buffer.h",
                       "src/gpu/shader_source.h", "src/gpu/unavailable.h", "shaders/layout.h"}
 # Headers generated in the build tree: each module's list of embedded shaders
 # (voxfield_embed_shaders in src/CMakeLists.txt), private to that module (and its tests).

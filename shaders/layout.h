@@ -27,6 +27,8 @@ struct vec4f {
 
 VF_CONST(uint, VF_UNIFORM, 0x80000000u);  // page-table entry flag: uniform chunk, value in bits 0-7
 VF_CONST(uint, VF_INF, 0xFFFFFFFFu);      // "no site" in cost buffers
+// Windows a buffer past one binding's range is bound as (shaders/split_buffer.glsl).
+VF_CONST(uint, VF_SPLIT_PARTS, 4u);
 
 // Metrics, as in voxfield::Metric.
 VF_CONST(uint, VF_MANHATTAN, 0u);
@@ -153,7 +155,7 @@ struct RenderParams {
                            // least 1); the heat ramp's top is max(1, heat_top * skip_inv_scale)
   float approx_inv_scale;  // error view: stored approximate value * this = voxels
   float footprint_scale;   // Camera::Projector::footprint_scale
-  uint pad2;
+  uint part_shift;         // log2 of the words per window of the arenas and the image
 };
 
 // Push constants of the passes that pack a device-resident scene's cells from fields computed on
@@ -171,7 +173,8 @@ struct ScenePackParams {
   int slice_z;           // heat: the cut
   uint skip_background;  // the fields' stored values outside their domain
   uint light_background;
-  uint pad0, pad1;
+  uint part_shift;  // log2 of the words per window of the arenas
+  uint pad0;
 };
 
 // ---- vector fields (src/vectors/gpu)
@@ -216,7 +219,8 @@ struct VectorViewParams {
   vec4f march;  // x: step (world units), y: density per world unit, z: max steps, w unused
   vec4f sheet;  // the reactive sheet: x 1 (drawn) or 0, y its rest height and z its push per
                 // unit of vector (volume units), w unused
-  ivec4 image;  // width, height; z = 1: pack pixels blue first (B8G8R8A8 swapchains)
+  ivec4 image;  // width, height; z = 1: pack pixels blue first (B8G8R8A8 swapchains); w: log2 of
+                // the words per window of the image (shaders/split_buffer.glsl)
 };
 
 // ---- marching cubes on the GPU (src/mesh/gpu) ---------------------------------------------------

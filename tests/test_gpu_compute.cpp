@@ -85,8 +85,12 @@ TEST(GpuCompute, EveryShaderDeclaresWhatItsCppSideSends) {
   EXPECT_EQ(fim.buffers.size(), 2u);
   const ShaderInterface render = reflect("render", shaders::render().spirv);
   EXPECT_EQ(render.push_bytes, 0u);
-  EXPECT_EQ(render.buffers.size(), 8u);
-  EXPECT_EQ(render.buffers[5], Access::kWrite) << "the pixels are write-only";
+  // Eight buffers, the arenas and the image each bound as four windows (split_buffer.h).
+  ASSERT_EQ(render.buffers.size(), 8u + 3u * layout::VF_SPLIT_PARTS);
+  for (std::size_t b : {5, 14, 15, 16})
+    EXPECT_EQ(render.buffers[b], Access::kWrite) << "the pixels' windows are write-only: " << b;
+  for (std::size_t b : {2, 3, 7, 8, 9, 10, 11, 12, 13, 17, 18, 19})
+    EXPECT_EQ(render.buffers[b], Access::kRead) << "the arenas' windows are read-only: " << b;
 }
 
 TEST(GpuCompute, GeneratedGlslIsReflectedAndRefusedByName) {

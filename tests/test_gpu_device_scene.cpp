@@ -284,3 +284,108 @@ TEST(Gpu, DeviceScenesOfABoxThatStartsAndEndsInsideChunks) {
   expect_same_frames(device, host, views_of(box, true), "box " + to_string(box));
   test::expect_no_validation_messages(*ctx);
 }
+
+TEST(Gpu, ArenasAndImagesPastTheStorageBufferRangeAreBoundInWindows) {
+  // On a device whose storage-buffer range is lowered (ContextOptions, as a user sharing a device
+  // would) below a scene's cell arenas and its image, the ray marcher and the packing pass reach
+  // them through four windows each (src/gpu/split_buffer.h). Every frame equals the one a device
+  // binding them whole draws, pixel for pixel — host scenes, device scenes and the error view's
+  // approximation alike, through edits that grow the arenas into further windows. What four
+  // windows cannot hold is refused by name before anything is drawn.
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  gpu::ContextOptions co;
+  co.validation = true;
+  co.max_storage_buffer_bytes = 32 * 1024 - 4;  // windows of 16 KiB, 64 KiB in four
+  auto small = gpu::Context::create(co);
+  auto whole = validated_context();
+  whole->clear_validation_messages();
+  constexpr std::size_t kWindow = 16 * 1024;
+
+  // 54 chunks of 8^3 (1 KiB of cells, 512 bytes of lighting each); thin across x, so that the
+  // device's clamped fields are computed in slabs on this range.
+  World w = random_world({72, 24, 16}, 8, 0.004, 23);
+  w.voxels.fill(Box3i{{0, 0, 0}, {72, 24, 3}}, 120);
+  w.voxels.fill(Box3i{{48, 0, 0}, {72, 24, 16}}, 0);  // clear air, for edits to grow into
+  RenderSceneOptions so = DynamicRenderScene::default_options();
+  so.skip_max_distance_vox = 6;
+  so.lighting_max_distance_vox = 6;
+  DynamicRenderScene live(w, so);
+  const auto skip_bytes = [&] {
+    const RenderScene::Impl& h = live.scene().impl();
+    return std::size_t{h.skip.cells.slots_used} * h.skip.cells.slot_bytes();
+  };
+  const auto light_bytes = [&] {
+    const RenderScene::Impl& h = live.scene().impl();
+    return std::size_t{h.light.slots_used} * h.light.slot_bytes();
+  };
+  ASSERT_GT(skip_bytes(), 2 * kWindow) << "the cells span three windows";
+  ASSERT_LT(skip_bytes(), 3 * kWindow);
+  ASSERT_GT(light_bytes(), kWindow) << "the lighting two";
+
+  const Box3i box = live.scene().box();
+  Views views = views_of(box, true);
+  for (RenderOptions& o : views.options) {
+    o.width = 120;  // 38 400 bytes of pixels: three windows
+    o.height = 80;
+    // The error view's approximation on the host (brute force), its arena in windows.
+    o.error_algorithm = Algorithm::kBruteChunked;
+  }
+  gpu::SceneRenderer host_small(small), host_whole(whole);
+  gpu::DeviceRenderScene device_small(small, w, so);
+  const auto expect_same = [&](const std::string& what) {
+    host_small.sync(live.scene());
+    host_whole.sync(live.scene());
+    for (std::size_t c = 0; c < views.cameras.size(); ++c)
+      for (const RenderOptions& o : views.options) {
+        const std::string at = what + ", camera " + std::to_string(c) + ", view " +
+                               render_view_name(o.view) + ", slice " +
+                               std::to_string(o.slice_z.value_or(-1));
+        const Image reference = host_whole.render(views.cameras[c], o);
+        EXPECT_EQ(host_small.render(views.cameras[c], o).rgb, reference.rgb) << "host, " << at;
+        EXPECT_EQ(device_small.render(views.cameras[c], o).rgb, reference.rgb) << "device, " << at;
+      }
+  };
+  expect_same("built");
+
+  // Blocks placed in the clear air: new chunks stored voxel by voxel, the arenas grow into a
+  // fourth window (the host scene's and the device scene's alike).
+  DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
+  const std::size_t before = skip_bytes();
+  for (int y = 4; y < 24; y += 8)
+    apply_edit(w, {EditOp::kPlace, SphereBrush{{64.5, y + 0.5, 8.5}, 3.5}, 7}, &dirty);
+  live.update(dirty);
+  device_small.update(dirty);
+  dirty.clear();
+  ASSERT_GT(skip_bytes(), 3 * kWindow) << "from " << before << " bytes";
+  ASSERT_LE(skip_bytes(), 4 * kWindow);
+  expect_same("after edits");
+  test::expect_no_validation_messages(*small);
+  test::expect_no_validation_messages(*whole);
+
+  // Past four windows: refused by name, on each path, and the next frame that fits still draws.
+  const auto expect_refused = [](const auto& call, const std::string& what) {
+    try {
+      call();
+      ADD_FAILURE() << what << " was drawn past what the device binds";
+    } catch (const InvalidArgument& e) {
+      EXPECT_NE(std::string(e.what()).find("more than this device binds"), std::string::npos)
+          << what << ": " << e.what();
+    }
+  };
+  World big = random_world({64, 64, 32}, 8, 0.004, 29);  // 256 chunks: 256 KiB of cells
+  const RenderScene big_scene(big, so);
+  const Camera cam = Camera::framing(big_scene.box(), 1.5);
+  RenderOptions o;
+  o.width = 64;
+  o.height = 48;
+  expect_refused([&] { (void)gpu::render(*small, big_scene, cam, o); }, "a host scene");
+  // (A device scene's fields, a byte per voxel in one binding, are refused before its arenas,
+  // two bytes per voxel in four.)
+  EXPECT_THROW(gpu::DeviceRenderScene(small, big, so), InvalidArgument);
+  o.width = 160;  // 76 800 bytes of pixels
+  o.height = 120;
+  expect_refused([&] { (void)host_small.render(views.cameras[0], o); }, "an image");
+  EXPECT_EQ(host_small.render(views.cameras[0], views.options[0]).rgb,
+            host_whole.render(views.cameras[0], views.options[0]).rgb);
+  test::expect_no_validation_messages(*small);
+}

@@ -178,6 +178,30 @@ TEST(GpuVectorPasses, TheVisualiserMatchesTheCpuImage) {
   for (int y = 0; y < view.height; ++y)
     for (int x = 0; x < view.width; ++x) ASSERT_EQ(std::memcmp(a.pixel(x, y), b.pixel(x, y), 3), 0);
   testing_backends::expect_no_validation_messages(Backend::kVulkan);
+
+  // On a device whose storage-buffer range is below the image (lowered through ContextOptions,
+  // as a user sharing a device would), the image is written through four windows
+  // (src/gpu/split_buffer.h): the same pixels. An image past four windows is refused by name.
+  gpu::ContextOptions co;
+  co.validation = true;
+  co.max_storage_buffer_bytes = 32 * 1024 - 4;  // windows of 16 KiB
+  auto small = gpu::Context::create(co);
+  const VectorTexture rgba = generate_vectors(v, sources, VectorStorage::kRgba8);  // 20 KiB
+  VectorViewOptions wide;
+  wide.width = 160;  // 51 200 bytes of pixels: four windows
+  wide.height = 80;
+  wide.sheet = true;
+  EXPECT_EQ(gpu::render_vectors(*small, v, rgba, wide).rgb,
+            gpu::render_vectors(*ctx, v, rgba, wide).rgb);
+  wide.width = 256;  // 81 920 bytes
+  try {
+    (void)gpu::render_vectors(*small, v, rgba, wide);
+    ADD_FAILURE() << "an image past four windows was drawn";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("more than this device binds"), std::string::npos)
+        << e.what();
+  }
+  test::expect_no_validation_messages(*small);
 }
 
 // Steps and pictures recorded into a command buffer the application owns and submits: the same

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "gpu/split_buffer.h"
+
 #include "voxfield/error.h"
 
 namespace voxfield::gpu {
@@ -40,10 +42,29 @@ void DescriptorArena::reset() {
   cached_.clear();
 }
 
-VkDescriptorSet DescriptorArena::set(const Kernel& kernel, std::span<Buffer* const> buffers) {
+VkDeviceSize Binding::covered() const {
+  if (offset >= buffer->size()) return 0;
+  return bytes == VK_WHOLE_SIZE ? buffer->size() - offset
+                                : std::min(bytes, buffer->size() - offset);
+}
+
+std::array<Binding, kSplitParts> split_bindings(Buffer& b, const Context::Impl& ctx) {
+  const VkDeviceSize part = split_part_bytes(ctx);
+  if (b.size() > part * kSplitParts)
+    throw Error("GPU: internal error: a buffer of " + std::to_string(b.size()) +
+                " bytes is bound in more than " + std::to_string(kSplitParts) + " parts");
+  std::array<Binding, kSplitParts> parts{&b, &b, &b, &b};
+  for (int k = 0; k < kSplitParts; ++k) {
+    const VkDeviceSize at = part * static_cast<VkDeviceSize>(k);
+    parts[k] = at < b.size() ? Binding(&b, at, std::min(part, b.size() - at)) : parts[0];
+  }
+  return parts;
+}
+
+VkDescriptorSet DescriptorArena::set(const Kernel& kernel, std::span<const Binding> buffers) {
   Key key{kernel.set_layout, {}};
   key.buffers.reserve(buffers.size());
-  for (const Buffer* b : buffers) key.buffers.push_back(b->handle());
+  for (const Binding& b : buffers) key.buffers.push_back({b.buffer->handle(), b.offset, b.bytes});
   for (const auto& [k, s] : cached_)
     if (k == key) return s;
 
@@ -82,7 +103,7 @@ VkDescriptorSet DescriptorArena::set(const Kernel& kernel, std::span<Buffer* con
   std::vector<VkDescriptorBufferInfo> infos(buffers.size());
   std::vector<VkWriteDescriptorSet> writes(buffers.size());
   for (std::size_t b = 0; b < buffers.size(); ++b) {
-    infos[b] = {buffers[b]->handle(), 0, VK_WHOLE_SIZE};
+    infos[b] = {buffers[b].buffer->handle(), buffers[b].offset, buffers[b].bytes};
     writes[b] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     writes[b].dstSet = set;
     writes[b].dstBinding = static_cast<std::uint32_t>(b);
@@ -249,9 +270,18 @@ void Recorder::bind(const Kernel& kernel, Buffers buffers, const void* push, std
                           std::to_string(kernel.interface.push_bytes));
   const std::size_t used = kernel.interface.buffers.size();
   std::vector<Use> uses;
-  for (std::size_t b = 0; b < used; ++b)
-    if (kernel.interface.buffers[b] != Access::kNone)
-      uses.push_back({buffers[b], stage, shader_access(kernel.interface.buffers[b])});
+  for (std::size_t b = 0; b < used; ++b) {
+    if (kernel.interface.buffers[b] == Access::kNone) continue;
+    // Past the range the binding is invalid, and a device may read or write only part of it
+    // (lavapipe tolerates it, other drivers need not): the module must bind such a buffer in parts.
+    const VkDeviceSize covered = buffers[b].covered();
+    if (covered > ctx_.limits.maxStorageBufferRange)
+      throw Error("GPU: internal error: kernel " + kernel.name + " would bind " +
+                  std::to_string(covered) + " bytes at binding " + std::to_string(b) +
+                  ", past the device's storage-buffer range (" +
+                  std::to_string(ctx_.limits.maxStorageBufferRange) + ")");
+    uses.push_back({buffers[b].buffer, stage, shader_access(kernel.interface.buffers[b])});
+  }
   if (also) uses.push_back(*also);  // one barrier for the command's every use
   prepare(uses);
   const VkDescriptorSet set = sets_->set(kernel, buffers.first(used));

@@ -30,6 +30,20 @@ namespace voxfield::gpu {
 class GraphicsKernel;
 class RenderTarget;
 
+// One storage-buffer binding of a command: a buffer, whole, or a window of it. A window lets a
+// buffer larger than the device's maxStorageBufferRange be bound in parts (split_buffer.h).
+// Barriers are derived for the whole buffer either way.
+struct Binding {
+  Binding(Buffer* b) : buffer(b) {}  // NOLINT(google-explicit-constructor): a whole buffer
+  Binding(Buffer* b, VkDeviceSize offset_bytes, VkDeviceSize size_bytes)
+      : buffer(b), offset(offset_bytes), bytes(size_bytes) {}
+  Buffer* buffer;
+  VkDeviceSize offset = 0;
+  VkDeviceSize bytes = VK_WHOLE_SIZE;
+  // The bytes the binding covers.
+  VkDeviceSize covered() const;
+};
+
 // Descriptor sets for recorded dispatches, one per distinct (kernel, buffers) pair, from pools
 // grown on demand. reset() recycles them all: only once no recorded command can still run. Sets
 // are found by the buffers' handles: a buffer destroyed while an arena still holds sets naming it
@@ -42,14 +56,19 @@ class DescriptorArena {
   DescriptorArena(const DescriptorArena&) = delete;
   DescriptorArena& operator=(const DescriptorArena&) = delete;
 
-  VkDescriptorSet set(const Kernel& kernel, std::span<Buffer* const> buffers);
+  VkDescriptorSet set(const Kernel& kernel, std::span<const Binding> buffers);
   void reset();
   std::size_t sets() const { return cached_.size(); }
 
  private:
   struct Key {
     VkDescriptorSetLayout layout;
-    std::vector<VkBuffer> buffers;
+    struct Bound {
+      VkBuffer handle;
+      VkDeviceSize offset, bytes;
+      bool operator==(const Bound&) const = default;
+    };
+    std::vector<Bound> buffers;
     bool operator==(const Key&) const = default;
   };
   Context::Impl* ctx_;
@@ -69,8 +88,9 @@ class Recorder {
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
 
-  // The buffers of a dispatch, binding 0 first.
-  using Buffers = std::span<Buffer* const>;
+  // The buffers of a dispatch, binding 0 first. Every binding must cover at most the device's
+  // maxStorageBufferRange (an internal error otherwise: the module binds larger buffers in parts).
+  using Buffers = std::span<const Binding>;
 
   // `invocations` invocations of `kernel` along x, in workgroups of its local size, split over y
   // when the count exceeds the device's limit. `push` must be exactly the shader's push-constant
@@ -98,15 +118,15 @@ class Recorder {
     dispatch(k, b, &p, sizeof p, invocations);
   }
   template <class Push>
-  void dispatch(const Kernel& k, std::initializer_list<Buffer*> b, const Push& p,
+  void dispatch(const Kernel& k, std::initializer_list<Binding> b, const Push& p,
                 std::uint64_t invocations) {
     dispatch(k, Buffers(b.begin(), b.size()), &p, sizeof p, invocations);
   }
-  void dispatch_groups(const Kernel& k, std::initializer_list<Buffer*> b, const void* push,
+  void dispatch_groups(const Kernel& k, std::initializer_list<Binding> b, const void* push,
                        std::size_t push_bytes, std::array<std::uint32_t, 3> groups) {
     dispatch_groups(k, Buffers(b.begin(), b.size()), push, push_bytes, groups);
   }
-  void dispatch_indirect(const Kernel& k, std::initializer_list<Buffer*> b, const void* push,
+  void dispatch_indirect(const Kernel& k, std::initializer_list<Binding> b, const void* push,
                          std::size_t push_bytes, Buffer& args, VkDeviceSize offset) {
     dispatch_indirect(k, Buffers(b.begin(), b.size()), push, push_bytes, args, offset);
   }

@@ -214,10 +214,10 @@ class FieldEngine {
     stage(chunks, regions, up, uploads);
     // Every buffer the passes bind is bound whole, and stage() and the constructor keep each
     // within the range one binding may hold; past it the binding would be invalid.
-    for (const Buffer* b : bindings())
-      if (b->size() > ctx_.limits.maxStorageBufferRange)
-        throw Error("GPU: internal error: a distance pass would bind " + std::to_string(b->size()) +
-                    " bytes, past the storage-buffer range (" +
+    for (const Binding& b : bindings())
+      if (b.covered() > ctx_.limits.maxStorageBufferRange)
+        throw Error("GPU: internal error: a distance pass would bind " +
+                    std::to_string(b.covered()) + " bytes, past the storage-buffer range (" +
                     std::to_string(ctx_.limits.maxStorageBufferRange) + ")");
     // What the copies carry (the staging's alignment padding stays behind).
     upload_bytes_ = first_run_ ? sizeof header_ : 0;
@@ -310,7 +310,7 @@ class FieldEngine {
 
   // Step 3, one region's passes: recompute its compute box, encode its out box into the field.
   void record_region(Recorder& rec, const detail::UpdateRegion& r, bool timed) {
-    const std::array<Buffer*, 11> bound = bindings();
+    const std::array<Binding, 11> bound = bindings();
     const auto pass = [&](const Kernel& kernel, const L::PassParams& t, std::uint64_t invocations,
                           std::string name) {
       const int ticket = timed ? rec.begin_pass() : -1;
@@ -407,7 +407,7 @@ class FieldEngine {
   }
 
   // The exact transform's binding plan (shaders/layout.h), the same for its three kernels.
-  std::array<Buffer*, 11> bindings() {
+  std::array<Binding, 11> bindings() {
     WorkBuffers& w = *work_;
     return {&header_buf_,     &resident_->pages(), &resident_->bricks(), &w.cost[0],  &w.cost[1],
             &w.cost[2],       &w.scratch_s,        &w.scratch_t,         &field_buf_, &w.sites,

@@ -229,7 +229,7 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
 
     p.iso = f.iso;
     p.negate = f.negate ? 1u : 0u;
-    Buffer* all[9] = {&samples, &tables,          &frame_buf, &level_buf,  &pyramid,
+    Binding all[9] = {&samples, &tables,          &frame_buf, &level_buf,  &pyramid,
                       &cases,   &unused_vertices, &args,      &unused_keys};
     const Recorder::Buffers list(all, 9);
     mc::record_pyramid(rec, c, list, p, levels);
@@ -258,7 +258,7 @@ Mesh run(Context& context, const Field& f, const GpuMeshOptions& g, GpuMeshStats
     keys = Buffer(c, key_bytes, kUsage, false);
     Buffer& readback = c.readback_buffer(vertex_bytes + key_bytes);
     Recorder rec(c);
-    Buffer* all[9] = {&samples, &tables,   &frame_buf, &level_buf, &pyramid,
+    Binding all[9] = {&samples, &tables,   &frame_buf, &level_buf, &pyramid,
                       &cases,   &vertices, &args,      &keys};
     const int traverse = rec.begin_pass();
     rec.dispatch_indirect(c.kernel(shaders::mesh_traverse()), Recorder::Buffers(all, 9), &p,

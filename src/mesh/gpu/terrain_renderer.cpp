@@ -278,7 +278,7 @@ void TerrainRenderer::Impl::record_frame(Recorder& rec, const TerrainView& o) {
   rec.update(view, 0, &v, sizeof v);
 
   L::MeshParams p = params();
-  Buffer* all[10] = {&samples, &tables, &frame,     &level_buf, &pyramid,
+  Binding all[10] = {&samples, &tables, &frame,     &level_buf, &pyramid,
                      &cases,   &view,   &materials, &palette,   &draw};
   const Recorder::Buffers list(all, 10);
   mc::record_pyramid(rec, c, list, p, levels);

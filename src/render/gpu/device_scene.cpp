@@ -11,6 +11,7 @@
 
 #include "../shading.h"
 #include "device_scene.h"
+#include "gpu/split_buffer.h"
 #include "render_shaders.h"
 #include "voxfield/detail/assert.h"
 #include "voxfield/gpu_render_vulkan.h"
@@ -73,9 +74,11 @@ Impl::Impl(std::shared_ptr<Context> c, const World& w, const RenderSceneOptions&
 }
 
 // The pack kernel's bindings (scene_pack.comp), `params` for the heat pass.
-std::array<Buffer*, 10> Impl::bindings(Buffer* params) {
+std::array<Binding, 16> Impl::bindings(Buffer* params) {
   const ResidentField s = skip.resident();
   Buffer* light_values = light ? light->resident().values : nullptr;
+  const auto skip_parts = split_bindings(bound_or_dummy(&skip_arena), ctx);
+  const auto light_parts = split_bindings(bound_or_dummy(&light_arena), ctx);
   return {s.header,
           s.pages,
           &bound_or_dummy(s.bricks),
@@ -83,9 +86,15 @@ std::array<Buffer*, 10> Impl::bindings(Buffer* params) {
           &bound_or_dummy(light_values),
           &bound_or_dummy(&items_buf),
           &bound_or_dummy(&summaries_buf),
-          &bound_or_dummy(&skip_arena),
-          &bound_or_dummy(&light_arena),
-          &bound_or_dummy(params)};
+          skip_parts[0],
+          light_parts[0],
+          &bound_or_dummy(params),
+          skip_parts[1],
+          skip_parts[2],
+          skip_parts[3],
+          light_parts[1],
+          light_parts[2],
+          light_parts[3]};
 }
 
 L::ScenePackParams Impl::pack_params(std::uint32_t mode, std::size_t items) {
@@ -98,6 +107,7 @@ L::ScenePackParams Impl::pack_params(std::uint32_t mode, std::size_t items) {
   p.has_light = light ? 1u : 0u;
   p.skip_background = skip.resident().background_bits & 0xFFu;
   p.light_background = light ? light->resident().background_bits & 0xFFu : 0u;
+  p.part_shift = split_part_shift(ctx);
   return p;
 }
 
@@ -112,14 +122,16 @@ void Impl::ensure_arena(Recorder& rec, Buffer& arena, std::vector<Buffer>& retir
                         std::uint32_t slots, std::uint32_t live_slots, std::size_t slot_bytes) {
   const std::size_t bytes = std::max<std::size_t>(std::size_t{slots} * slot_bytes, 16);
   if (arena.handle() != VK_NULL_HANDLE && arena.size() >= bytes) return;
-  const std::size_t range = ctx.limits.maxStorageBufferRange;
-  if (bytes > range)
+  // The shaders bind an arena as split_buffer.h's windows.
+  const std::size_t capacity = split_capacity_bytes(ctx);
+  if (bytes > capacity)
     throw InvalidArgument("DeviceRenderScene: its cells need an arena of " + std::to_string(bytes) +
-                          " bytes, more than this device's storage-buffer range (" +
-                          std::to_string(range) + ")");
-  // Half again for the edits to come, within the range.
+                          " bytes, more than this device binds (" + std::to_string(kSplitParts) +
+                          " storage buffers of " + std::to_string(split_part_bytes(ctx)) +
+                          " bytes)");
+  // Half again for the edits to come, within what can be bound.
   const std::size_t grown =
-      std::min(range, std::max(bytes, static_cast<std::size_t>(arena.size()) * 3 / 2));
+      std::min(capacity, std::max(bytes, static_cast<std::size_t>(arena.size()) * 3 / 2));
   Buffer bigger(ctx, grown, kSceneBufferUsage, false);
   if (arena.handle() != VK_NULL_HANDLE) {
     // The old buffer lives in `retired` (reserved by the caller, so it does not move) until the

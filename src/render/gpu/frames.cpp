@@ -8,6 +8,8 @@
 #include <chrono>
 #include <cstring>
 
+#include "gpu/split_buffer.h"
+
 #include "render_shaders.h"
 #include "shaders/layout.h"
 #include "voxfield/detail/assert.h"
@@ -53,6 +55,12 @@ Frames::Frames(Context& context)
       sets_(ctx_) {}
 
 void Frames::ensure_pixels(VkDeviceSize bytes) {
+  // The shader writes the image through split_buffer.glsl's windows.
+  if (bytes > split_capacity_bytes(ctx_))
+    throw InvalidArgument("render: the image's " + std::to_string(bytes) +
+                          " bytes of pixels are more than this device binds (" +
+                          std::to_string(kSplitParts) + " storage buffers of " +
+                          std::to_string(split_part_bytes(ctx_)) + " bytes)");
   if (pixels_.handle() != VK_NULL_HANDLE && pixels_.size() >= bytes) return;
   pixels_ = Buffer(ctx_, bytes, kSceneBufferUsage, false);
   descriptors_stale_ = true;
@@ -101,6 +109,11 @@ void Frames::record_approximation(Recorder& rec, const FrameScene& s) {
   }
   const std::size_t info_bytes = info.size() * 4;
   const std::size_t arena_bytes = std::size_t{approx.cells.slots_used} * approx.cells.slot_bytes();
+  if (arena_bytes > split_capacity_bytes(ctx_))
+    throw InvalidArgument("render: the error view's approximation needs an arena of " +
+                          std::to_string(arena_bytes) + " bytes, more than this device binds (" +
+                          std::to_string(kSplitParts) + " storage buffers of " +
+                          std::to_string(split_part_bytes(ctx_)) + " bytes)");
   if (approx_info_.size() < std::max<std::size_t>(info_bytes, 16) ||
       approx_arena_.size() < std::max<std::size_t>(arena_bytes, 16)) {
     approx_info_ = Buffer(ctx_, std::max<std::size_t>(info_bytes, 16), kSceneBufferUsage, false);
@@ -167,6 +180,7 @@ void Frames::record_render(Recorder& rec, const FrameScene& s, const Camera& cam
              (distance ? L::VF_RENDER_DISTANCE : 0u) | (error ? L::VF_RENDER_ERROR : 0u);
   rp.approx_inv_scale = static_cast<float>(approx_inv_scale_);
   rp.heat_top = 1;
+  rp.part_shift = split_part_shift(ctx_);
   if (distance) {
     rp.slice_z = s.slice_z(o);
     if (s.heat_top) rp.heat_top = s.heat_top(rp.slice_z);
@@ -174,8 +188,12 @@ void Frames::record_render(Recorder& rec, const FrameScene& s, const Camera& cam
 
   rec.update(params_, 0, &rp, sizeof rp);
   if (distance && s.record_heat) s.record_heat(rec, params_, rp.slice_z);
-  Buffer* const bound[] = {&params_,  s.info,   s.skip,        s.light,
-                           s.palette, &pixels_, &approx_info_, &approx_arena_};
+  const auto skip = split_bindings(*s.skip, ctx_), light = split_bindings(*s.light, ctx_),
+             pixels = split_bindings(pixels_, ctx_), approx = split_bindings(approx_arena_, ctx_);
+  const Binding bound[] = {&params_,  s.info,        skip[0],   light[0],  s.palette,
+                           pixels[0], &approx_info_, approx[0], skip[1],   skip[2],
+                           skip[3],   light[1],      light[2],  light[3],  pixels[1],
+                           pixels[2], pixels[3],     approx[1], approx[2], approx[3]};
   const int pass = timed ? rec.begin_pass() : -1;
   rec.dispatch(kernel_, bound, nullptr, 0, static_cast<std::uint64_t>(o.width) * o.height);
   rec.end_pass(pass, "render");

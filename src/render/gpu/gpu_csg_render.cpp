@@ -303,7 +303,7 @@ Image render_csg(Context& context, const csg::Model& model, const CsgRenderOptio
   Buffer queue(c, pixels * 4, storage, false), out(c, pixels * 4, storage, false);
   Buffer& staging = c.upload_buffer(upload_bytes);
   Buffer& readback = c.readback_buffer(std::max<VkDeviceSize>(pixels * 4, 16));
-  std::array<Buffer*, 12> all{&in[0], &in[1], &in[2], &in[3], &in[4], &in[5],
+  std::array<Binding, 12> all{&in[0], &in[1], &in[2], &in[3], &in[4], &in[5],
                               &rays,  &hits,  &bins,  &args,  &queue, &out};
 
   {

@@ -9,6 +9,7 @@
 #include "../scene_impl.h"
 #include "frames.h"
 #include "gpu/recorder.h"
+#include "gpu/split_buffer.h"
 #include "shaders/layout.h"
 #include "voxfield/gpu_render_vulkan.h"
 
@@ -52,9 +53,8 @@ class ResidentScene {
   bool current(const RenderScene& scene) const {
     const RenderScene::Impl& s = scene.impl();
     return scene_ == &s && scene_id_ == s.id && synced_generation_ == s.chunk_generation &&
-           synced_palette_ == s.palette_generation &&
-           skip_.size() >= std::max<std::size_t>(s.skip.cells.arena.size(), 16) &&
-           light_.size() >= std::max<std::size_t>(s.has_light ? s.light.arena.size() : 0, 16);
+           synced_palette_ == s.palette_generation && skip_.size() >= skip_bytes(s) &&
+           light_.size() >= light_bytes(s);
   }
   // What a frame of `s` reads, with this copy's buffers.
   FrameScene frame_scene(const RenderScene::Impl& s) {
@@ -81,6 +81,25 @@ class ResidentScene {
   const RenderScene::Impl* scene() const { return scene_; }
 
  private:
+  // Device bytes of the arenas: the host arenas' capacity, so growth is rare, within what the
+  // shaders can bind (split_buffer.h); never less than their live slots.
+  static std::size_t skip_live(const RenderScene::Impl& s) {
+    return std::size_t{s.skip.cells.slots_used} * s.skip.cells.slot_bytes();
+  }
+  static std::size_t light_live(const RenderScene::Impl& s) {
+    return s.has_light ? std::size_t{s.light.slots_used} * s.light.slot_bytes() : 0;
+  }
+  std::size_t arena_bytes(std::size_t capacity, std::size_t live) const {
+    return std::max<std::size_t>(
+        {std::min<std::size_t>(capacity, split_capacity_bytes(ctx_)), live, 16});
+  }
+  std::size_t skip_bytes(const RenderScene::Impl& s) const {
+    return arena_bytes(s.skip.cells.arena.size(), skip_live(s));
+  }
+  std::size_t light_bytes(const RenderScene::Impl& s) const {
+    return arena_bytes(s.has_light ? s.light.arena.size() : 0, light_live(s));
+  }
+
   Context::Impl& ctx_;
   Frames frames_;
   const RenderScene::Impl* scene_ = nullptr;
@@ -105,9 +124,15 @@ struct Staged {
 bool ResidentScene::record_sync(Recorder& rec, const RenderScene& scene) {
   const RenderScene::Impl& s = scene.impl();
   const std::size_t chunks = s.table.chunk_count();
-  const std::size_t skip_live = std::size_t{s.skip.cells.slots_used} * s.skip.cells.slot_bytes();
-  const std::size_t light_live =
-      s.has_light ? std::size_t{s.light.slots_used} * s.light.slot_bytes() : 0;
+  const std::size_t skip_live = ResidentScene::skip_live(s),
+                    light_live = ResidentScene::light_live(s);
+  // The render shader binds each arena as split_buffer.h's windows.
+  for (const std::size_t live : {skip_live, light_live})
+    if (live > split_capacity_bytes(ctx_))
+      throw InvalidArgument("render: the scene's cells need an arena of " + std::to_string(live) +
+                            " bytes, more than this device binds (" + std::to_string(kSplitParts) +
+                            " storage buffers of " + std::to_string(split_part_bytes(ctx_)) +
+                            " bytes)");
   bool whole = scene_ != &s || scene_id_ != s.id || synced_generation_.size() != chunks;
 
   // Device buffers as large as the host arenas' capacity, so growth is rare. A new scene gets
@@ -133,8 +158,8 @@ bool ResidentScene::record_sync(Recorder& rec, const RenderScene& scene) {
   };
   ensure(info_, chunks * 16, false);
   ensure(palette_, 256 * 16, false);
-  ensure(skip_, s.skip.cells.arena.size(), true);
-  ensure(light_, s.has_light ? s.light.arena.size() : 0, true);
+  ensure(skip_, skip_bytes(s), true);
+  ensure(light_, light_bytes(s), true);
   if (whole) grown.clear();  // everything is copied from the host anyway
   // The recorder orders these copies after the frames submitted earlier that read the buffers
   // they write (an application that records frames into its own command buffers need not wait

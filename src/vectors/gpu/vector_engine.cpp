@@ -10,6 +10,7 @@
 
 #include "../texel_codec.h"
 #include "../vector_internal.h"
+#include "gpu/split_buffer.h"
 #include "shaders/layout.h"
 #include "vectors_shaders.h"
 #include "voxfield/error.h"
@@ -255,7 +256,7 @@ void VectorEngine::record(Recorder& rec, std::span<const VectorSource> sources,
   Buffer* segs = count > 0 ? &segments_ : &unused_read_;
   Buffer* tile_buf = search == L::VF_VECTORS_SPLAT ? &tiles_ : &unused_read_;
   auto list = [&](Buffer* seeds, Buffer* in, Buffer* out) {
-    return std::array<Buffer*, 10>{segs,
+    return std::array<Binding, 10>{segs,
                                    &centres_,
                                    tile_buf,
                                    seeds,
@@ -342,13 +343,22 @@ Buffer& VectorEngine::record_view(Recorder& rec, Buffer& texels, const VectorVie
                   static_cast<float>(4.0 * (v.resolution.x + v.resolution.y + v.resolution.z)), 0};
   params.sheet = {view.sheet ? 1.0f : 0.0f, static_cast<float>(view.sheet_height),
                   static_cast<float>(view.sheet_push / v.size.z), 0};
-  params.image = {view.width, view.height, bgra ? 1 : 0, 0};
+  params.image = {view.width, view.height, bgra ? 1 : 0, static_cast<int>(split_part_shift(c_))};
+  // The shader writes the image through split_buffer.h's windows.
+  const VkDeviceSize pixel_bytes = static_cast<VkDeviceSize>(view.width) * view.height * 4;
+  if (pixel_bytes > split_capacity_bytes(c_))
+    throw InvalidArgument("render_vectors: the image's " + std::to_string(pixel_bytes) +
+                          " bytes of pixels are more than this device binds (" +
+                          std::to_string(kSplitParts) + " storage buffers of " +
+                          std::to_string(split_part_bytes(c_)) + " bytes)");
   grow(view_, sizeof params, false);
-  grow(pixels_, static_cast<VkDeviceSize>(view.width) * view.height * 4, false);
+  grow(pixels_, pixel_bytes, false);
   rec.update(view_, 0, &params, sizeof params);
-  const std::array<Buffer*, 12> b{&unused_read_, &unused_read_,  &unused_read_, &unused_read_,
+  const auto px = split_bindings(pixels_, c_);
+  const std::array<Binding, 15> b{&unused_read_, &unused_read_,  &unused_read_, &unused_read_,
                                   &unused_read_, &unused_write_, &unused_read_, &texels,
-                                  &unused_read_, &unused_write_, &view_,        &pixels_};
+                                  &unused_read_, &unused_write_, &view_,        px[0],
+                                  px[1],         px[2],          px[3]};
   const int ticket = rec.begin_pass();
   rec.dispatch_strided(c_.kernel(shaders::vectors_view()), Recorder::Buffers(b), nullptr, 0,
                        static_cast<std::uint64_t>(view.width) * view.height);

@@ -8,19 +8,27 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "layout.h"
+#include "split_buffer.glsl"
 
 layout(local_size_x = 64) in;
 
 layout(std430, set = 0, binding = 0) readonly buffer ParamsBuf { RenderParams rp; };
 layout(std430, set = 0, binding = 1) readonly buffer ChunkInfo { uint chunk_info[]; };
-layout(std430, set = 0, binding = 2) readonly buffer SkipArena { uint skip_words[]; };   // u16 per voxel
-layout(std430, set = 0, binding = 3) readonly buffer LightArena { uint light_words[]; };  // u8 per voxel
-layout(std430, set = 0, binding = 4) readonly buffer Palette { vec4 albedo[]; };         // linear RGB
-layout(std430, set = 0, binding = 5) writeonly buffer Image { uint pixels[]; };          // RGBA8
+layout(std430, set = 0, binding = 4) readonly buffer Palette { vec4 albedo[]; };  // linear RGB
 // The error view's approximate field: per chunk its slot (or VF_UNIFORM) and its uniform cell |
-// smallest distance << 16; cells as in SkipArena.
+// smallest distance << 16; cells as in the skip arena.
 layout(std430, set = 0, binding = 6) readonly buffer ApproxInfo { uint approx_info[]; };
-layout(std430, set = 0, binding = 7) readonly buffer ApproxArena { uint approx_words[]; };
+// The arenas and the image, each bound as four windows of 2^rp.part_shift words (a large scene's
+// arenas and a large image outgrow one binding): the skip arena (u16 per voxel: distance, material
+// above it), the lighting arena (u8 per voxel), the image (RGBA8), the approximation's arena.
+VF_SPLIT_WORDS(readonly, SkipArena, skip_words, 2, 8, 9, 10);
+VF_SPLIT_WORDS(readonly, LightArena, light_words, 3, 11, 12, 13);
+VF_SPLIT_WORDS(writeonly, Image, pixel_words, 5, 14, 15, 16);
+VF_SPLIT_WORDS(readonly, ApproxArena, approx_words, 7, 17, 18, 19);
+VF_SPLIT_LOAD(skip_words, rp.part_shift)
+VF_SPLIT_LOAD(light_words, rp.part_shift)
+VF_SPLIT_STORE(pixel_words, rp.part_shift)
+VF_SPLIT_LOAD(approx_words, rp.part_shift)
 
 const float kInf = 1.0 / 0.0;
 
@@ -44,7 +52,7 @@ uint skip_cell(uint chunk, ivec3 v) {
   const uint slot = chunk_info[4 * chunk];
   if (slot == VF_UNIFORM) return chunk_info[4 * chunk + 1] & 0xFFFFu;
   const uint i = slot * uint(rp.chunk_dims.w) + brick_index(v);
-  return (skip_words[i >> 1] >> ((i & 1u) * 16u)) & 0xFFFFu;
+  return (skip_words(i >> 1) >> ((i & 1u) * 16u)) & 0xFFFFu;
 }
 
 uint chunk_min(uint chunk) { return (chunk_info[4 * chunk + 1] >> 16) & 0xFFu; }
@@ -55,7 +63,7 @@ uint cell_of(bool approx, uint chunk, ivec3 v) {
   const uint slot = approx_info[2 * chunk];
   if (slot == VF_UNIFORM) return approx_info[2 * chunk + 1] & 0xFFFFu;
   const uint i = slot * uint(rp.chunk_dims.w) + brick_index(v);
-  return (approx_words[i >> 1] >> ((i & 1u) * 16u)) & 0xFFFFu;
+  return (approx_words(i >> 1) >> ((i & 1u) * 16u)) & 0xFFFFu;
 }
 uint min_of(bool approx, uint chunk) { return approx ? (approx_info[2 * chunk + 1] >> 16) & 0xFFu : chunk_min(chunk); }
 bool chunk_empty(uint chunk) { return (chunk_info[4 * chunk + 1] & (1u << 24)) != 0u; }
@@ -69,7 +77,7 @@ float light_value(ivec3 v) {
     stored = chunk_info[4 * chunk + 3];
   } else {
     const uint i = slot * uint(rp.chunk_dims.w) + brick_index(v);
-    stored = (light_words[i >> 2] >> ((i & 3u) * 8u)) & 0xFFu;
+    stored = (light_words(i >> 2) >> ((i & 3u) * 8u)) & 0xFFu;
   }
   return float(stored) * rp.light_inv_scale;
 }
@@ -357,7 +365,7 @@ void main() {
         const float distance = float(cell & 0xFFu) * rp.skip_inv_scale;
         uvec3 b = heat(distance / max(1.0, float(rp.heat_top) * rp.skip_inv_scale));
         if (int(distance) % 8 == 0) b = b * 3u / 4u;
-        pixels[i] = pack_bytes(b);
+        pixel_words_store(i, pack_bytes(b));
         return;
       }
     }
@@ -435,8 +443,8 @@ void main() {
     } else if (worst > 0.0) {
       b = (2u * b + 3u * heat(log2(1.0 + worst) / 6.0)) / 5u;
     }
-    pixels[i] = pack_bytes(b);
+    pixel_words_store(i, pack_bytes(b));
     return;
   }
-  pixels[i] = encode(color);
+  pixel_words_store(i, encode(color));
 }

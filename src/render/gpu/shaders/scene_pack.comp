@@ -17,6 +17,7 @@
 // host Grid, so the cells equal RenderScene's for the same fields.
 #extension GL_GOOGLE_include_directive : require
 #include "layout.h"
+#include "split_buffer.glsl"
 
 layout(local_size_x = 64) in;
 
@@ -30,11 +31,14 @@ layout(std430, set = 0, binding = 5) readonly buffer Items { uvec4 items[]; };
 // Per listed chunk: distance min | max << 8 | light min << 16 | light max << 24, then 1 when a
 // voxel is solid.
 layout(std430, set = 0, binding = 6) writeonly buffer Summaries { uvec2 summaries[]; };
-layout(std430, set = 0, binding = 7) writeonly buffer SkipArena { uint skip_words[]; };  // u16
-layout(std430, set = 0, binding = 8) writeonly buffer LightArena { uint light_words[]; };  // u8
 layout(std430, set = 0, binding = 9) buffer ParamsBuf { RenderParams rp; };
+// The arenas, each bound as four windows of 2^p.part_shift words (render.comp reads them so).
+VF_SPLIT_WORDS(writeonly, SkipArena, skip_words, 7, 10, 11, 12);    // u16 per voxel
+VF_SPLIT_WORDS(writeonly, LightArena, light_words, 8, 13, 14, 15);  // u8 per voxel
 
 layout(push_constant) uniform Push { ScenePackParams p; };
+VF_SPLIT_STORE(skip_words, p.part_shift)
+VF_SPLIT_STORE(light_words, p.part_shift)
 
 shared uint s_range[64];  // distance min | max << 8 | light min << 16 | light max << 24
 shared uint s_solid[64];
@@ -121,10 +125,10 @@ void write_cells() {
     }
     if (item.y != VF_UNIFORM) {
       const uint at = (item.y * uint(p.chunk_dims.w) + k) >> 1;
-      skip_words[at] = cells[0] | (cells[1] << 16);
-      skip_words[at + 1u] = cells[2] | (cells[3] << 16);
+      skip_words_store(at, cells[0] | (cells[1] << 16));
+      skip_words_store(at + 1u, cells[2] | (cells[3] << 16));
     }
-    if (item.z != VF_UNIFORM) light_words[(item.z * uint(p.chunk_dims.w) + k) >> 2] = light;
+    if (item.z != VF_UNIFORM) light_words_store((item.z * uint(p.chunk_dims.w) + k) >> 2, light);
   }
 }
 

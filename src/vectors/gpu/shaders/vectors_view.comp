@@ -9,12 +9,15 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "layout.h"
+#include "split_buffer.glsl"
 
 layout(local_size_x = 64) in;
 
 layout(std430, set = 0, binding = 7) readonly buffer Texels { uint texels[]; };
 layout(std430, set = 0, binding = 10) readonly buffer View { VectorViewParams view; };
-layout(std430, set = 0, binding = 11) writeonly buffer Pixels { uint pixels[]; };
+// The image (RGBA8) in four windows of 2^view.image.w words: a large image outgrows one binding.
+VF_SPLIT_WORDS(writeonly, Pixels, pixels, 11, 12, 13, 14);
+VF_SPLIT_STORE(pixels, uint(view.image.w))
 
 #define VF_VECTORS_TEXEL_FETCH
 #include "voxfield/glsl/voxfield_vectors.glsl"
@@ -133,7 +136,8 @@ void pixel(uint i) {
     colour = acc + transmittance * colour;
   }
   const uvec3 c = uvec3(to_srgb8(colour.r), to_srgb8(colour.g), to_srgb8(colour.b));
-  pixels[i] = (view.image.z != 0 ? (c.b | (c.r << 16)) : (c.r | (c.b << 16))) | (c.g << 8) | (255u << 24);
+  pixels_store(i, (view.image.z != 0 ? (c.b | (c.r << 16)) : (c.r | (c.b << 16))) | (c.g << 8) |
+                     (255u << 24));
 }
 
 void main() {
