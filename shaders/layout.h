@@ -83,8 +83,8 @@ struct Header {
   uint scale_sq;       // fixed-point scale squared (integer storage of Euclidean costs)
   int bias;            // offset of signed integer storage
   uint site_cost_max;  // nearest sites: a site is kept when its cost is at most this (the clamp)
-  uint pad2;
-  uint clamp_pos;  // stored bits for +clamp, -clamp, and "no site" outside / inside
+  uint part_shift;     // log2 of the words per window of the brick pool, field and sites
+  uint clamp_pos;      // stored bits for +clamp, -clamp, and "no site" outside / inside
   uint clamp_neg;
   uint none_pos;
   uint none_neg;

@@ -372,18 +372,37 @@ TEST(Gpu, ClampedFieldsBeyondTheStorageBufferRangeAreComputedInParts) {
       expect_same_field(live.download(), compute_distance_field(edited, o), what + ", edited");
     }
   // 121 of the 125 chunks holding voxels (the solid block makes four uniform): the world's brick
-  // pool (512 bytes a chunk) needs 61 952 bytes of the 65 532 and grows no further than the range
-  // (127 slots), where its amortised growth would have made 159.
+  // pool (512 bytes a chunk) needs 61 952 bytes, and with its amortised growth (159 slots) spans
+  // three of the 32 KiB windows the passes bind it in (src/gpu/split_buffer.h).
   const World dense = random_world({40, 40, 40}, 8, 0.3, 6);
   o.metric = Metric::kEuclidean;
   o.signed_distance = true;
   o.max_distance = 2;  // slabs of 6 slices, each reading 2 more on either side
   expect_same_field(gpu::compute_distance_field(*small, dense, o), compute_distance_field(dense, o),
                     "every chunk holding voxels");
+  // The field and its nearest sites are resident whole, bound in windows too: an f32 field of
+  // 64 KiB (two windows) and the sites of a 64x16x16 domain, 128 KiB (all four), built and
+  // updated, while the passes' work buffers go in slabs.
+  {
+    World long_world = random_world({64, 16, 16}, 8, 0.01, 8);
+    DistanceOptions f = o;
+    f.storage = Storage::kF32;
+    f.nearest_sites = true;
+    expect_same_field(gpu::compute_distance_field(*small, long_world, f),
+                      compute_distance_field(long_world, f), "f32 with nearest sites in windows");
+    gpu::DynamicField live(small, long_world, f);
+    DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
+    apply_edit(long_world, Edit{EditOp::kPlace, SphereBrush{{50, 8, 8}, 4}, 5}, &dirty);
+    live.update(dirty);
+    expect_same_field(live.download(), compute_distance_field(long_world, f),
+                      "f32 with nearest sites in windows, edited");
+  }
   o.max_distance = 6;
   o.metric = Metric::kManhattan;
   o.signed_distance = false;
-  o.nearest_sites = true;  // the sites, 8 bytes per voxel of the domain, are not cut: 128 KiB
+  // The sites' work buffers, 24 bytes per voxel of a slab, leave no slab within the range at this
+  // clamp.
+  o.nearest_sites = true;
   try {
     gpu::DynamicField refused(small, w, o);
     ADD_FAILURE() << "a work buffer beyond the storage-buffer range was made";

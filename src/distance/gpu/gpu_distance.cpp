@@ -20,6 +20,7 @@
 #include "../incremental/update_regions.h"
 #include "distance_shaders.h"
 #include "gpu/recorder.h"
+#include "gpu/split_buffer.h"
 #include "resident_world.h"
 #include "shaders/layout.h"
 #include "voxfield/gpu_distance.h"
@@ -158,19 +159,19 @@ class FieldEngine {
     field_bytes_ = static_cast<VkDeviceSize>(n.y) * n.z *
                    static_cast<VkDeviceSize>(row_pitch(plan_, options.storage)) *
                    (4 / lanes_of(options.storage));
-    if (field_bytes_ > ctx.limits.maxStorageBufferRange)
-      throw InvalidArgument("GPU: a " + to_string(n) + " domain needs " +
-                            std::to_string(field_bytes_) +
-                            " bytes per buffer, more than this device's storage-buffer range (" +
-                            std::to_string(ctx.limits.maxStorageBufferRange) + ")");
-    // Nearest sites: 8 bytes per voxel of the domain (three int16 offsets, padded), resident
-    // whole: slabs cut the work buffers, not this one.
+    // The field and its sites are resident whole (slabs cut the work buffers, not these), bound
+    // as split_buffer.h's windows.
+    const std::string binds = "more than this device binds (" + std::to_string(kSplitParts) +
+                              " storage buffers of " + std::to_string(split_part_bytes(ctx)) +
+                              " bytes)";
+    if (field_bytes_ > split_capacity_bytes(ctx))
+      throw InvalidArgument("GPU: a " + to_string(n) + " domain needs a field of " +
+                            std::to_string(field_bytes_) + " bytes, " + binds);
+    // Nearest sites: 8 bytes per voxel of the domain (three int16 offsets, padded).
     site_bytes_ = options.nearest_sites ? static_cast<VkDeviceSize>(plan_.domain.volume()) * 8 : 0;
-    if (site_bytes_ > ctx.limits.maxStorageBufferRange)
+    if (site_bytes_ > split_capacity_bytes(ctx))
       throw InvalidArgument("GPU: nearest sites of a " + to_string(n) + " domain need " +
-                            std::to_string(site_bytes_) +
-                            " bytes, more than this device's storage-buffer range (" +
-                            std::to_string(ctx.limits.maxStorageBufferRange) + ")");
+                            std::to_string(site_bytes_) + " bytes, " + binds);
     make_header();
     owns_world_ = shared == nullptr;
     resident_ =
@@ -310,7 +311,7 @@ class FieldEngine {
 
   // Step 3, one region's passes: recompute its compute box, encode its out box into the field.
   void record_region(Recorder& rec, const detail::UpdateRegion& r, bool timed) {
-    const std::array<Binding, 11> bound = bindings();
+    const std::array<Binding, 20> bound = bindings();
     const auto pass = [&](const Kernel& kernel, const L::PassParams& t, std::uint64_t invocations,
                           std::string name) {
       const int ticket = timed ? rec.begin_pass() : -1;
@@ -374,6 +375,7 @@ class FieldEngine {
                                                           : L::VF_F32;
     header_.clamp_cost = clamp_cost(plan_);
     header_.track_sites = options_.nearest_sites ? 1u : 0u;
+    header_.part_shift = split_part_shift(ctx_);
     // The CPU keeps a site when its cost is at most the clamp's cost, rounded down.
     const double clamp_c =
         plan_.metric == Metric::kEuclidean ? plan_.clamp * plan_.clamp : plan_.clamp;
@@ -407,11 +409,23 @@ class FieldEngine {
   }
 
   // The exact transform's binding plan (shaders/layout.h), the same for its three kernels.
-  std::array<Binding, 11> bindings() {
+  // The brick pool, the field and its sites in split_buffer.h's windows: the first at its own
+  // binding, the other three from binding 11 on.
+  std::array<Binding, 20> bindings() {
     WorkBuffers& w = *work_;
-    return {&header_buf_,     &resident_->pages(), &resident_->bricks(), &w.cost[0],  &w.cost[1],
-            &w.cost[2],       &w.scratch_s,        &w.scratch_t,         &field_buf_, &w.sites,
-            &field_sites_buf_};
+    const auto bricks = split_bindings(resident_->bricks(), ctx_);
+    const auto field = split_bindings(field_buf_, ctx_);
+    const auto sites = split_bindings(field_sites_buf_, ctx_);
+    return {&header_buf_, &resident_->pages(),
+            bricks[0],    &w.cost[0],
+            &w.cost[1],   &w.cost[2],
+            &w.scratch_s, &w.scratch_t,
+            field[0],     &w.sites,
+            sites[0],     bricks[1],
+            bricks[2],    bricks[3],
+            field[1],     field[2],
+            field[3],     sites[1],
+            sites[2],     sites[3]};
   }
 
   Context::Impl& ctx_;

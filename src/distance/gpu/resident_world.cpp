@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include "gpu/split_buffer.h"
+
 namespace voxfield::gpu {
 namespace {
 
@@ -96,15 +98,17 @@ void ResidentWorld::stage(const std::vector<Vec3i>& chunks, Staging& up, Uploads
   const std::uint32_t reusable = static_cast<std::uint32_t>(free_slots_.size()) + freed;
   const std::uint32_t needed = used_slots_ + (new_dense > reusable ? new_dense - reusable : 0);
   if (needed > slot_capacity_) {
-    // Grow the pool (amortised doubling, within what one binding holds); the old bricks are
-    // copied over on the GPU. A pool past the binding is refused before anything changes.
-    const std::uint64_t most = ctx_.limits.maxStorageBufferRange / chunk_bytes_;
+    // Grow the pool (amortised doubling, within what the shaders bind: split_buffer.h's
+    // windows); the old bricks are copied over on the GPU. A pool past that is refused before
+    // anything changes.
+    const std::uint64_t most = split_capacity_bytes(ctx_) / chunk_bytes_;
     if (needed > most)
       throw InvalidArgument("GPU: the world's " + std::to_string(needed) +
                             " chunks holding voxels need a brick pool of " +
                             std::to_string(static_cast<std::uint64_t>(needed) * chunk_bytes_) +
-                            " bytes, more than this device's storage-buffer range (" +
-                            std::to_string(ctx_.limits.maxStorageBufferRange) + ")");
+                            " bytes, more than this device binds (" + std::to_string(kSplitParts) +
+                            " storage buffers of " + std::to_string(split_part_bytes(ctx_)) +
+                            " bytes)");
     const std::uint32_t capacity = static_cast<std::uint32_t>(std::min<std::uint64_t>(
         std::max<std::uint32_t>(needed + needed / 4 + 8, slot_capacity_ * 2), most));
     Buffer grown(ctx_, static_cast<VkDeviceSize>(capacity) * chunk_bytes_, kStorage, false);

@@ -74,16 +74,19 @@ Impl::Impl(std::shared_ptr<Context> c, const World& w, const RenderSceneOptions&
 }
 
 // The pack kernel's bindings (scene_pack.comp), `params` for the heat pass.
-std::array<Binding, 16> Impl::bindings(Buffer* params) {
+std::array<Binding, 25> Impl::bindings(Buffer* params) {
   const ResidentField s = skip.resident();
   Buffer* light_values = light ? light->resident().values : nullptr;
   const auto skip_parts = split_bindings(bound_or_dummy(&skip_arena), ctx);
   const auto light_parts = split_bindings(bound_or_dummy(&light_arena), ctx);
+  const auto bricks = split_bindings(bound_or_dummy(s.bricks), ctx);
+  const auto skip_values = split_bindings(*s.values, ctx);
+  const auto light_field = split_bindings(bound_or_dummy(light_values), ctx);
   return {s.header,
           s.pages,
-          &bound_or_dummy(s.bricks),
-          s.values,
-          &bound_or_dummy(light_values),
+          bricks[0],
+          skip_values[0],
+          light_field[0],
           &bound_or_dummy(&items_buf),
           &bound_or_dummy(&summaries_buf),
           skip_parts[0],
@@ -94,7 +97,16 @@ std::array<Binding, 16> Impl::bindings(Buffer* params) {
           skip_parts[3],
           light_parts[1],
           light_parts[2],
-          light_parts[3]};
+          light_parts[3],
+          bricks[1],
+          bricks[2],
+          bricks[3],
+          skip_values[1],
+          skip_values[2],
+          skip_values[3],
+          light_field[1],
+          light_field[2],
+          light_field[3]};
 }
 
 L::ScenePackParams Impl::pack_params(std::uint32_t mode, std::size_t items) {

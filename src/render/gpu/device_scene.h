@@ -74,7 +74,7 @@ struct DeviceRenderScene::Impl {
 
  private:
   Buffer& bound_or_dummy(Buffer* b) { return b && b->handle() != VK_NULL_HANDLE ? *b : dummy; }
-  std::array<Binding, 16> bindings(Buffer* params);
+  std::array<Binding, 25> bindings(Buffer* params);
   layout::ScenePackParams pack_params(std::uint32_t mode, std::size_t items);
   void ensure_items(std::size_t items);
   // Grows an arena to hold `slots` slots of `slot_bytes` (InvalidArgument beyond the device's

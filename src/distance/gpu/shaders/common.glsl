@@ -1,12 +1,16 @@
 // voxfield shaders — bindings and helpers shared by the distance passes.
 #extension GL_GOOGLE_include_directive : require
 #include "layout.h"
+#include "split_buffer.glsl"
 
 layout(local_size_x = 64) in;
 
 layout(std430, set = 0, binding = 0) readonly buffer HeaderBuf { Header h; };
 layout(std430, set = 0, binding = 1) readonly buffer PageBuf { uint pages[]; };
-layout(std430, set = 0, binding = 2) readonly buffer BrickBuf { uint bricks[]; };
+// The world's brick pool, the resident field and its nearest sites can each outgrow one binding:
+// they are bound as four windows of 2^h.part_shift words (shaders/split_buffer.glsl).
+VF_SPLIT_WORDS(readonly, BrickBuf, bricks, 2, 11, 12, 13);
+VF_SPLIT_LOAD(bricks, h.part_shift)
 // Three cost buffers of one value per compute-box voxel (x fastest), used in turn by the passes.
 layout(std430, set = 0, binding = 3) buffer Cost0 { uint cost0[]; };
 layout(std430, set = 0, binding = 4) buffer Cost1 { uint cost1[]; };
@@ -15,12 +19,16 @@ layout(std430, set = 0, binding = 5) buffer Cost2 { uint cost2[]; };
 layout(std430, set = 0, binding = 6) buffer ScratchS { int scratch_s[]; };
 layout(std430, set = 0, binding = 7) buffer ScratchT { int scratch_t[]; };
 // The resident field: one stored value per voxel of the field's domain (x fastest).
-layout(std430, set = 0, binding = 8) buffer FieldBuf { uint field_values[]; };  // packed (edt_encode.comp)
+VF_SPLIT_WORDS(, FieldBuf, field_values, 8, 14, 15, 16);  // packed (edt_encode.comp)
+VF_SPLIT_LOAD(field_values, h.part_shift)
+VF_SPLIT_STORE(field_values, h.part_shift)
 // Nearest sites (Header::track_sites): per compute-box voxel and cost buffer, the site's
 // coordinates relative to the compute box packed as (x | y << 16, z), VF_INF for none; and the
 // resident field's site offsets, (dx | dy << 16, dz) as int16s, x fastest over the field's domain.
 layout(std430, set = 0, binding = 9) buffer WorkSites { uvec2 work_sites[]; };
-layout(std430, set = 0, binding = 10) buffer FieldSites { uvec2 field_sites[]; };
+// (As words: two per voxel.)
+VF_SPLIT_WORDS(, FieldSites, field_site_words, 10, 17, 18, 19);
+VF_SPLIT_STORE(field_site_words, h.part_shift)
 
 layout(push_constant) uniform Push { PassParams p; };
 

@@ -52,7 +52,9 @@ void store_site_offset(ivec3 v) {
     packed = uvec2((uint(d.x) & 0xFFFFu) | (uint(d.y) << 16), uint(d.z) & 0xFFFFu);
   }
   const ivec3 f = v - h.field_begin.xyz;
-  field_sites[uint((f.z * h.field_size.y + f.y) * h.field_size.x + f.x)] = packed;
+  const uint at = 2u * uint((f.z * h.field_size.y + f.y) * h.field_size.x + f.x);
+  field_site_words_store(at, packed.x);
+  field_site_words_store(at + 1u, packed.y);
 }
 
 // The resident field is packed: 4 u8 or 2 u16 values per word along x (rows padded to
@@ -68,12 +70,12 @@ void main() {
   const int wx = w0 + int(i) % n.x, y = o.y + (int(i) / n.x) % n.y, z = o.z + int(i) / (n.x * n.y);
   const uint word_index = uint((z * h.field_size.y + y) * (h.field_size.w / lanes) + wx);
   if (lanes == 1) {
-    field_values[word_index] = stored_value(h.field_begin.xyz + ivec3(wx, y, z));
+    field_values_store(word_index, stored_value(h.field_begin.xyz + ivec3(wx, y, z)));
     if (h.track_sites != 0u) store_site_offset(h.field_begin.xyz + ivec3(wx, y, z));
     return;
   }
   const uint bits = 32u / uint(lanes), mask = (1u << bits) - 1u;
-  uint word = field_values[word_index];
+  uint word = field_values(word_index);
   for (int j = 0; j < lanes; ++j) {
     const int x = wx * lanes + j;
     if (x < o.x || x >= o.x + p.out_size.x) continue;
@@ -81,5 +83,5 @@ void main() {
     word = (word & ~(mask << shift)) | ((stored_value(h.field_begin.xyz + ivec3(x, y, z)) & mask) << shift);
     if (h.track_sites != 0u) store_site_offset(h.field_begin.xyz + ivec3(x, y, z));
   }
-  field_values[word_index] = word;
+  field_values_store(word_index, word);
 }

@@ -23,9 +23,13 @@ layout(local_size_x = 64) in;
 
 layout(std430, set = 0, binding = 0) readonly buffer HeaderBuf { Header h; };
 layout(std430, set = 0, binding = 1) readonly buffer PageBuf { uint pages[]; };
-layout(std430, set = 0, binding = 2) readonly buffer BrickBuf { uint bricks[]; };
-layout(std430, set = 0, binding = 3) readonly buffer SkipField { uint skip_values[]; };    // u8
-layout(std430, set = 0, binding = 4) readonly buffer LightField { uint light_values[]; };  // u8
+// The world's brick pool and the fields (u8), each in four windows of 2^h.part_shift words.
+VF_SPLIT_WORDS(readonly, BrickBuf, bricks, 2, 16, 17, 18);
+VF_SPLIT_WORDS(readonly, SkipField, skip_values, 3, 19, 20, 21);
+VF_SPLIT_WORDS(readonly, LightField, light_values, 4, 22, 23, 24);
+VF_SPLIT_LOAD(bricks, h.part_shift)
+VF_SPLIT_LOAD(skip_values, h.part_shift)
+VF_SPLIT_LOAD(light_values, h.part_shift)
 // Per listed chunk: its chunk-table index, its skip and lighting slots (VF_UNIFORM: none).
 layout(std430, set = 0, binding = 5) readonly buffer Items { uvec4 items[]; };
 // Per listed chunk: distance min | max << 8 | light min << 16 | light max << 24, then 1 when a
@@ -49,7 +53,7 @@ uint stored_at(bool light, ivec3 v) {
   if (any(lessThan(f, ivec3(0))) || any(greaterThanEqual(f, h.field_size.xyz)))
     return light ? p.light_background : p.skip_background;
   const uint word = uint((f.z * h.field_size.y + f.y) * (h.field_size.w >> 2) + (f.x >> 2));
-  const uint bits = light ? light_values[word] : skip_values[word];
+  const uint bits = light ? light_values(word) : skip_values(word);
   return (bits >> (uint(f.x & 3) * 8u)) & 0xFFu;
 }
 
