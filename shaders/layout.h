@@ -110,7 +110,7 @@ struct PassParams {
 
 // Push constants of a jump-flooding pass: 32 bytes.
 struct JfaParams {
-  ivec4 size;   // the domain's extent; w unused
+  ivec4 size;   // the domain's extent; w: log2 of the words per window of the ping-pong buffer
   int step;     // this pass's jump, in voxels
   uint metric;  // VF_MANHATTAN...
   uint src;     // where the previous pass's sites start in the ping-pong buffer (elements)
@@ -120,7 +120,8 @@ struct JfaParams {
 // Push constants of a Fast Iterative Method pass (src/distance/gpu/shaders/fim.comp): 64 bytes.
 struct FimParams {
   ivec4 size;  // the domain's extent; w = mode: VF_FIM_UPDATE, VF_FIM_CONTROL, VF_FIM_RESOLVE
-  ivec4 region_begin;  // the voxels the passes update (the rest only feed them); w unused
+  ivec4 region_begin;  // the voxels the passes update (the rest only feed them); w: log2 of the
+                       // words per window of the ping-pong buffer
   ivec4 region_end;
   uint src;     // where the previous pass's values start in the ping-pong buffer (elements)
   uint dst;     // where this pass writes

@@ -25,6 +25,16 @@ inline std::shared_ptr<gpu::Context> validated_context() {
   return testing_backends::vulkan_context();
 }
 
+// A context of its own, validated, whose storage-buffer range is lowered to `range_bytes`
+// (ContextOptions::max_storage_buffer_bytes, as a user sharing a device would): the paths that cut
+// work into slabs or bind buffers in windows run on small inputs.
+inline std::shared_ptr<gpu::Context> capped_context(std::uint64_t range_bytes) {
+  gpu::ContextOptions co;
+  co.validation = true;
+  co.max_storage_buffer_bytes = range_bytes;
+  return gpu::Context::create(co);
+}
+
 // The validation layer (synchronisation validation included) said nothing since the context's
 // messages were last cleared.
 inline void expect_no_validation_messages(gpu::Context& ctx) {

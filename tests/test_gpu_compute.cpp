@@ -84,7 +84,8 @@ TEST(GpuCompute, EveryShaderDeclaresWhatItsCppSideSends) {
   EXPECT_EQ(reflect("jfa_seed", shaders::jfa_seed().spirv).push_bytes, sizeof(layout::JfaParams));
   const ShaderInterface fim = reflect("fim", shaders::fim().spirv);
   EXPECT_EQ(fim.push_bytes, sizeof(layout::FimParams));
-  EXPECT_EQ(fim.buffers.size(), 2u);
+  // The values' windows at 0, 2, 3, 4 (split_buffer.h), the control words at 1.
+  EXPECT_EQ(fim.buffers.size(), 2u + layout::VF_SPLIT_PARTS - 1);
   const ShaderInterface render = reflect("render", shaders::render().spirv);
   EXPECT_EQ(render.push_bytes, 0u);
   // Eight buffers, the arenas and the image each bound as four windows (split_buffer.h).

@@ -182,10 +182,7 @@ TEST(GpuVectorPasses, TheVisualiserMatchesTheCpuImage) {
   // On a device whose storage-buffer range is below the image (lowered through ContextOptions,
   // as a user sharing a device would), the image is written through four windows
   // (src/gpu/split_buffer.h): the same pixels. An image past four windows is refused by name.
-  gpu::ContextOptions co;
-  co.validation = true;
-  co.max_storage_buffer_bytes = 32 * 1024 - 4;  // windows of 16 KiB
-  auto small = gpu::Context::create(co);
+  auto small = test::capped_context(32 * 1024 - 4);  // windows of 16 KiB
   const VectorTexture rgba = generate_vectors(v, sources, VectorStorage::kRgba8);  // 20 KiB
   VectorViewOptions wide;
   wide.width = 160;  // 51 200 bytes of pixels: four windows

@@ -14,7 +14,7 @@ constexpr VkAccessFlags kWriteAccess =
     VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_HOST_WRITE_BIT;
 // Sets per descriptor pool, and storage-buffer descriptors per set on average.
 constexpr std::uint32_t kSetsPerPool = 64;
-constexpr std::uint32_t kBuffersPerSet = 16;
+constexpr std::uint32_t kBuffersPerSet = 32;  // the largest plans bind 25 (split_buffer.h windows)
 
 VkAccessFlags shader_access(Access a) {
   VkAccessFlags flags = 0;
@@ -46,6 +46,13 @@ VkDeviceSize Binding::covered() const {
   if (offset >= buffer->size()) return 0;
   return bytes == VK_WHOLE_SIZE ? buffer->size() - offset
                                 : std::min(bytes, buffer->size() - offset);
+}
+
+void check_whole_binding(const Context::Impl& ctx, VkDeviceSize bytes, const std::string& what) {
+  if (bytes > ctx.limits.maxStorageBufferRange)
+    throw InvalidArgument(what + " needs " + std::to_string(bytes) +
+                          " bytes in one storage buffer, more than this device's range (" +
+                          std::to_string(ctx.limits.maxStorageBufferRange) + ")");
 }
 
 std::array<Binding, kSplitParts> split_bindings(Buffer& b, const Context::Impl& ctx) {
@@ -271,16 +278,17 @@ void Recorder::bind(const Kernel& kernel, Buffers buffers, const void* push, std
   const std::size_t used = kernel.interface.buffers.size();
   std::vector<Use> uses;
   for (std::size_t b = 0; b < used; ++b) {
-    if (kernel.interface.buffers[b] == Access::kNone) continue;
-    // Past the range the binding is invalid, and a device may read or write only part of it
-    // (lavapipe tolerates it, other drivers need not): the module must bind such a buffer in parts.
+    // Past the range the binding is invalid (even one the shader never touches: it is written to
+    // the set), and a device may read or write only part of it (lavapipe tolerates it, other
+    // drivers need not): the module must bind such a buffer in parts.
     const VkDeviceSize covered = buffers[b].covered();
     if (covered > ctx_.limits.maxStorageBufferRange)
       throw Error("GPU: internal error: kernel " + kernel.name + " would bind " +
                   std::to_string(covered) + " bytes at binding " + std::to_string(b) +
                   ", past the device's storage-buffer range (" +
                   std::to_string(ctx_.limits.maxStorageBufferRange) + ")");
-    uses.push_back({buffers[b].buffer, stage, shader_access(kernel.interface.buffers[b])});
+    if (kernel.interface.buffers[b] != Access::kNone)
+      uses.push_back({buffers[b].buffer, stage, shader_access(kernel.interface.buffers[b])});
   }
   if (also) uses.push_back(*also);  // one barrier for the command's every use
   prepare(uses);

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <bit>
+#include <string>
 
 #include "gpu/recorder.h"
 #include "shaders/layout.h"
@@ -17,9 +18,13 @@ namespace voxfield::gpu {
 
 inline constexpr int kSplitParts = static_cast<int>(layout::VF_SPLIT_PARTS);
 
-// Bytes per window on `ctx`: the largest power of two within its storage-buffer range.
+// Bytes per window on `ctx`: the largest power of two within its storage-buffer range (at least
+// its offset alignment, a power of two no larger: Context::Impl::cap_storage_buffer_range), and
+// at most 1 GiB, so that four windows, 4 GiB, index every byte with the shaders' 32-bit uints.
 inline VkDeviceSize split_part_bytes(const Context::Impl& ctx) {
-  return std::bit_floor(static_cast<VkDeviceSize>(ctx.limits.maxStorageBufferRange));
+  return std::min<VkDeviceSize>(
+      std::bit_floor(static_cast<VkDeviceSize>(ctx.limits.maxStorageBufferRange)),
+      VkDeviceSize{1} << 30);
 }
 // log2 of the 32-bit words per window, as the shaders take it.
 inline std::uint32_t split_part_shift(const Context::Impl& ctx) {
@@ -29,6 +34,11 @@ inline std::uint32_t split_part_shift(const Context::Impl& ctx) {
 inline VkDeviceSize split_capacity_bytes(const Context::Impl& ctx) {
   return split_part_bytes(ctx) * kSplitParts;
 }
+
+// Refuses (InvalidArgument naming `what` and the sizes) a buffer of `bytes` that is bound whole
+// but would not fit one binding: the per-chunk tables, which only a box of millions of chunks
+// outgrows.
+void check_whole_binding(const Context::Impl& ctx, VkDeviceSize bytes, const std::string& what);
 
 // The windows of `b`, binding by binding: part k covers bytes [k, k + 1) * split_part_bytes() of
 // it; parts wholly past its end repeat part 0 (bound, never read). `b` must fit

@@ -454,6 +454,16 @@ std::shared_ptr<Context> adopt(const AdoptedDevice& app) {
 }
 
 void Context::Impl::cap_storage_buffer_range(std::uint64_t bytes) {
+  if (bytes == 0) return;
+  // Windows of large buffers (split_buffer.h) start at multiples of a power of two within the
+  // range, which must then be a whole word and aligned as a binding's offset must.
+  const std::uint64_t least =
+      std::max<std::uint64_t>(limits.minStorageBufferOffsetAlignment, std::uint64_t{4});
+  if (bytes < least)
+    throw InvalidArgument("GPU: a storage-buffer range of " + std::to_string(bytes) +
+                          " bytes is below a word and the device's storage-buffer offset "
+                          "alignment (" +
+                          std::to_string(least) + " bytes)");
   // Whole words: buffers are sized in 32-bit words, checked against the range before rounding.
   bytes &= ~std::uint64_t{3};
   if (bytes > 0 && bytes < limits.maxStorageBufferRange)

@@ -12,6 +12,7 @@
 #include "../family_driver.h"
 #include "distance_shaders.h"
 #include "gpu/recorder.h"
+#include "gpu/split_buffer.h"
 #include "shaders/layout.h"
 #include "voxfield/gpu_distance.h"
 
@@ -43,6 +44,16 @@ std::vector<int> extra_steps(Algorithm a) {
   }
 }
 
+// A ping-pong buffer (both halves, `bytes`) is bound as split_buffer.h's windows.
+void check_ping_pong(const Context::Impl& ctx, std::size_t voxels, VkDeviceSize bytes,
+                     const std::string& label) {
+  if (bytes > split_capacity_bytes(ctx))
+    throw InvalidArgument("GPU: " + label + " over " + std::to_string(voxels) + " voxels needs " +
+                          std::to_string(bytes) + " bytes of ping-pong buffer, more than this " +
+                          "device binds (" + std::to_string(kSplitParts) + " storage buffers of " +
+                          std::to_string(split_part_bytes(ctx)) + " bytes)");
+}
+
 // Runs one pass of `kernel` per step over a ping-pong buffer of p.size() elements (both halves
 // in one buffer), starting from `initial`, in one command buffer (the recorder puts a barrier
 // between passes, as each reads what the last wrote); returns the last pass's elements.
@@ -53,9 +64,7 @@ std::vector<std::uint8_t> ping_pong(Context::Impl& ctx, const Kernel& kernel,
                                     const std::string& label, std::vector<PassTiming>* timings) {
   const std::size_t n = p.size();
   const VkDeviceSize half = static_cast<VkDeviceSize>(n) * element_bytes;
-  if (2 * half > ctx.limits.maxStorageBufferRange)
-    throw InvalidArgument("GPU: " + std::to_string(n) +
-                          " voxels exceed this device's storage-buffer range for " + label);
+  check_ping_pong(ctx, n, 2 * half, label);
   Buffer data(ctx, 2 * half,
               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
                   VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
@@ -68,13 +77,13 @@ std::vector<std::uint8_t> ping_pong(Context::Impl& ctx, const Kernel& kernel,
   std::uint32_t src = 0;
   for (const int step : steps) {
     L::JfaParams jp{};
-    jp.size = {p.n.x, p.n.y, p.n.z, 0};
+    jp.size = {p.n.x, p.n.y, p.n.z, static_cast<std::int32_t>(split_part_shift(ctx))};
     jp.step = step;
     jp.metric = static_cast<std::uint32_t>(p.metric);
     jp.src = src;
     jp.dst = src == 0 ? static_cast<std::uint32_t>(n) : 0u;
     const int pass = timings ? rec.begin_pass() : -1;
-    rec.dispatch(kernel, {&data}, jp, n);
+    rec.dispatch(kernel, split_bindings(data, ctx), jp, n);
     rec.end_pass(pass, label + " step " + std::to_string(step));
     src = jp.dst;
   }
@@ -156,9 +165,7 @@ detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p,
                               AlgorithmStats& stats, std::vector<PassTiming>* timings) {
   const std::size_t n = p.size();
   const VkDeviceSize half = static_cast<VkDeviceSize>(n) * 4;
-  if (2 * half > ctx.limits.maxStorageBufferRange)
-    throw InvalidArgument("GPU: " + std::to_string(n) +
-                          " voxels exceed this device's storage-buffer range for fim");
+  check_ping_pong(ctx, n, 2 * half, "fim");
   detail::DenseSolution solution;
   solution.d = initial;
   if (region.empty() || n == 0) return solution;
@@ -189,7 +196,8 @@ detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p,
 
   L::FimParams fp{};
   fp.size = {p.n.x, p.n.y, p.n.z, L::VF_FIM_UPDATE};
-  fp.region_begin = {region.begin.x, region.begin.y, region.begin.z, 0};
+  fp.region_begin = {region.begin.x, region.begin.y, region.begin.z,
+                     static_cast<std::int32_t>(split_part_shift(ctx))};
   fp.region_end = {region.end.x, region.end.y, region.end.z, 0};
   fp.metric = static_cast<std::uint32_t>(p.metric);
   fp.eps = p.metric == Metric::kEuclidean ? 1e-5f : 0.0f;  // the CPU's tolerance
@@ -197,18 +205,21 @@ detail::DenseSolution iterate(Context::Impl& ctx, const detail::DenseProblem& p,
   const int timed = timings ? rec.begin_pass() : -1;
   const VkBufferCopy in{0, 0, half}, in_control{half, 0, kControlBytes};
   rec.copy({{&upload, &data, {&in, 1}}, {&upload, &control, {&in_control, 1}}});
+  // The values' windows at bindings 0, 2, 3 and 4, the control words at 1.
+  const auto values = split_bindings(data, ctx);
+  const std::array<Binding, 5> bound{values[0], &control, values[1], values[2], values[3]};
   std::uint32_t src = 0;
   for (std::uint32_t k = 0; k < passes; ++k) {
     fp.size.w = L::VF_FIM_UPDATE;
     fp.src = src;
     fp.dst = src == 0 ? static_cast<std::uint32_t>(n) : 0u;
-    rec.dispatch_indirect(fim, {&data, &control}, &fp, sizeof fp, control, L::VF_FIM_GROUPS * 4);
+    rec.dispatch_indirect(fim, bound, &fp, sizeof fp, control, L::VF_FIM_GROUPS * 4);
     fp.size.w = L::VF_FIM_CONTROL;
-    rec.dispatch_groups(fim, {&data, &control}, &fp, sizeof fp, {1, 1, 1});
+    rec.dispatch_groups(fim, bound, &fp, sizeof fp, {1, 1, 1});
     src = fp.dst;
   }
   fp.size.w = L::VF_FIM_RESOLVE;
-  rec.dispatch(fim, {&data, &control}, fp, n);
+  rec.dispatch(fim, bound, fp, n);
   rec.end_pass(timed, "fim");
   const VkBufferCopy out{0, 0, half}, out_control{0, half, kControlBytes};
   rec.copy({{&data, &readback, {&out, 1}}, {&control, &readback, {&out_control, 1}}});

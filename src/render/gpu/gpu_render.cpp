@@ -126,6 +126,8 @@ bool ResidentScene::record_sync(Recorder& rec, const RenderScene& scene) {
   const std::size_t chunks = s.table.chunk_count();
   const std::size_t skip_live = ResidentScene::skip_live(s),
                     light_live = ResidentScene::light_live(s);
+  check_whole_binding(ctx_, chunks * 16,
+                      "render: the chunk table of " + std::to_string(chunks) + " chunks");
   // The render shader binds each arena as split_buffer.h's windows.
   for (const std::size_t live : {skip_live, light_live})
     if (live > split_capacity_bytes(ctx_))

@@ -13,13 +13,20 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "layout.h"
+#include "split_buffer.glsl"
 
 layout(local_size_x = 64) in;
 
-layout(std430, set = 0, binding = 0) buffer Values { float values[]; };  // both halves
 layout(std430, set = 0, binding = 1) buffer Control { uint control[]; };
 
 layout(push_constant) uniform Push { FimParams p; };
+
+// Both halves of the ping-pong in four windows of 2^p.region_begin.w words (a large domain's
+// outgrow one binding).
+VF_SPLIT_WORDS(, Values, value_words, 0, 2, 3, 4);
+VF_SPLIT_LOAD(value_words, uint(p.region_begin.w))
+VF_SPLIT_STORE(value_words, uint(p.region_begin.w))
+float value(uint e) { return uintBitsToFloat(value_words(e)); }
 
 float infinity() { return uintBitsToFloat(0x7F800000u); }  // the CPU's kFar
 
@@ -34,7 +41,7 @@ float neighbour_rule(ivec3 v, ivec3 n) {
         const int l1 = abs(dx) + abs(dy) + abs(dz);
         if (l1 == 0 || (p.metric == VF_MANHATTAN && l1 != 1)) continue;
         const ivec3 q = v + ivec3(dx, dy, dz);
-        if (inside(q, n)) best = min(best, values[p.src + index_of(q, n)] + 1.0);
+        if (inside(q, n)) best = min(best, value(p.src + index_of(q, n)) + 1.0);
       }
   return best;
 }
@@ -46,7 +53,7 @@ float eikonal_rule(ivec3 v, ivec3 n) {
     for (int s = -1; s <= 1; s += 2) {
       ivec3 q = v;
       q[axis] += s;
-      if (inside(q, n)) a[axis] = min(a[axis], values[p.src + index_of(q, n)]);
+      if (inside(q, n)) a[axis] = min(a[axis], value(p.src + index_of(q, n)));
     }
   }
   // Sort ascending.
@@ -92,11 +99,11 @@ void main() {
   if (i >= uint(n.x * n.y * n.z)) return;
   if (mode == VF_FIM_RESOLVE) {
     const uint last = control[VF_FIM_LAST];
-    if (last != 0u) values[i] = values[last + i];
+    if (last != 0u) value_words_store(i, value_words(last + i));
     return;
   }
   const ivec3 v = ivec3(int(i) % n.x, (int(i) / n.x) % n.y, int(i) / (n.x * n.y));
-  const float old = values[p.src + i];
+  const float old = value(p.src + i);
   float d = old;
   // Sites (value 0) never change; nor do voxels outside the region.
   if (old != 0.0 && all(greaterThanEqual(v, p.region_begin.xyz)) && all(lessThan(v, p.region_end.xyz))) {
@@ -104,5 +111,5 @@ void main() {
     if (u < old) d = u;
     if (old - d > p.eps) atomicOr(control[VF_FIM_MOVED], 1u);
   }
-  values[p.dst + i] = d;
+  value_words_store(p.dst + i, floatBitsToUint(d));
 }

@@ -8,13 +8,19 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "layout.h"
+#include "split_buffer.glsl"
 
 layout(local_size_x = 64) in;
 
-// Both halves of the ping-pong in one buffer: a pass reads [p.src, p.src + n) and writes at p.dst.
-layout(std430, set = 0, binding = 0) buffer Sites { uvec2 sites[]; };
-
 layout(push_constant) uniform Push { JfaParams p; };
+
+// Both halves of the ping-pong in one buffer: a pass reads sites [p.src, p.src + n) and writes at
+// p.dst, two words a site, in four windows of 2^p.size.w words (a large domain's outgrow one
+// binding).
+VF_SPLIT_WORDS(, Sites, site_words, 0, 1, 2, 3);
+VF_SPLIT_LOAD(site_words, uint(p.size.w))
+VF_SPLIT_STORE(site_words, uint(p.size.w))
+uvec2 site_at(uint e) { return uvec2(site_words(2u * e), site_words(2u * e + 1u)); }
 
 uint cost(ivec3 d) {
   const uvec3 a = uvec3(abs(d));
@@ -36,14 +42,14 @@ void main() {
   const ivec3 n = p.size.xyz;
   if (i >= uint(n.x * n.y * n.z)) return;
   const ivec3 v = ivec3(int(i) % n.x, (int(i) / n.x) % n.y, int(i) / (n.x * n.y));
-  uvec2 best = sites[p.src + i];
+  uvec2 best = site_at(p.src + i);
   uint best_cost = best.x == VF_INF ? VF_INF : cost(unpack(best) - v);
   for (int dz = -1; dz <= 1; ++dz)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
         const ivec3 q = v + ivec3(dx, dy, dz) * p.step;
         if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, n))) continue;
-        const uvec2 s = sites[p.src + uint((q.z * n.y + q.y) * n.x + q.x)];
+        const uvec2 s = site_at(p.src + uint((q.z * n.y + q.y) * n.x + q.x));
         if (s.x == VF_INF) continue;
         const uint c = cost(unpack(s) - v);
         if (c < best_cost || (c == best_cost && smaller(unpack(s), unpack(best)))) {
@@ -51,5 +57,6 @@ void main() {
           best = s;
         }
       }
-  sites[p.dst + i] = best;
+  site_words_store(2u * (p.dst + i), best.x);
+  site_words_store(2u * (p.dst + i) + 1u, best.y);
 }

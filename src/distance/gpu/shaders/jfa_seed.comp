@@ -5,13 +5,18 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "layout.h"
+#include "split_buffer.glsl"
 
 layout(local_size_x = 64) in;
 
-// Both halves of the ping-pong in one buffer: a pass reads [p.src, p.src + n) and writes at p.dst.
-layout(std430, set = 0, binding = 0) buffer Values { float values[]; };
-
 layout(push_constant) uniform Push { JfaParams p; };
+
+// Both halves of the ping-pong in one buffer: a pass reads [p.src, p.src + n) and writes at p.dst,
+// in four windows of 2^p.size.w words (a large domain's outgrow one binding).
+VF_SPLIT_WORDS(, Values, value_words, 0, 1, 2, 3);
+VF_SPLIT_LOAD(value_words, uint(p.size.w))
+VF_SPLIT_STORE(value_words, uint(p.size.w))
+float value(uint e) { return uintBitsToFloat(value_words(e)); }
 
 void main() {
   const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
@@ -21,12 +26,12 @@ void main() {
   const int k = p.step;
   const float fk = float(k);
   const uint sy = uint(n.x), sz = uint(n.x * n.y);
-  float d = values[p.src + i];
-  if (v.x - k >= 0) d = min(d, values[p.src + i - uint(k)] + fk);
-  if (v.x + k < n.x) d = min(d, values[p.src + i + uint(k)] + fk);
-  if (v.y - k >= 0) d = min(d, values[p.src + i - uint(k) * sy] + fk);
-  if (v.y + k < n.y) d = min(d, values[p.src + i + uint(k) * sy] + fk);
-  if (v.z - k >= 0) d = min(d, values[p.src + i - uint(k) * sz] + fk);
-  if (v.z + k < n.z) d = min(d, values[p.src + i + uint(k) * sz] + fk);
-  values[p.dst + i] = d;
+  float d = value(p.src + i);
+  if (v.x - k >= 0) d = min(d, value(p.src + i - uint(k)) + fk);
+  if (v.x + k < n.x) d = min(d, value(p.src + i + uint(k)) + fk);
+  if (v.y - k >= 0) d = min(d, value(p.src + i - uint(k) * sy) + fk);
+  if (v.y + k < n.y) d = min(d, value(p.src + i + uint(k) * sy) + fk);
+  if (v.z - k >= 0) d = min(d, value(p.src + i - uint(k) * sz) + fk);
+  if (v.z + k < n.z) d = min(d, value(p.src + i + uint(k) * sz) + fk);
+  value_words_store(p.dst + i, floatBitsToUint(d));
 }
