@@ -35,6 +35,17 @@ inline std::shared_ptr<gpu::Context> capped_context(std::uint64_t range_bytes) {
   return gpu::Context::create(co);
 }
 
+// A capped context beside the shared one (its messages cleared), for tests that hold what the
+// capped device computes in parts or windows to what a device binding everything whole computes.
+struct CappedAndWhole {
+  std::shared_ptr<gpu::Context> small, whole;
+};
+inline CappedAndWhole capped_and_whole(std::uint64_t range_bytes) {
+  CappedAndWhole c{capped_context(range_bytes), validated_context()};
+  c.whole->clear_validation_messages();
+  return c;
+}
+
 // The validation layer (synchronisation validation included) said nothing since the context's
 // messages were last cleared.
 inline void expect_no_validation_messages(gpu::Context& ctx) {

@@ -1,11 +1,11 @@
 // The Vulkan backend's own checks: GPU against CPU field for field, the API traffic each operation
 // costs (submits, fence waits, bytes), adopted devices, refusals (frames and resident scenes:
-// test_gpu_render.cpp). The behaviour suites themselves have one body run on both backends
-// (tests/backends.h: the brute-force sweep in test_distance.cpp, the incremental stream in
-// test_edit.cpp). Integer fields must be bit-identical, f32 fields within gpu::kF32Tolerance; sizes
-// that are not multiples of the workgroup or the chunk edge; the Khronos validation layer (with
-// synchronisation validation) on, and not a single message from it. In CI this runs on Mesa's
-// lavapipe.
+// test_gpu_render.cpp; work past one storage-buffer binding: test_gpu_ranges.cpp). The behaviour
+// suites themselves have one body run on both backends (tests/backends.h: the brute-force sweep in
+// test_distance.cpp, the incremental stream in test_edit.cpp). Integer fields must be
+// bit-identical, f32 fields within gpu::kF32Tolerance; sizes that are not multiples of the
+// workgroup or the chunk edge; the Khronos validation layer (with synchronisation validation) on,
+// and not a single message from it. In CI this runs on Mesa's lavapipe.
 #include <gtest/gtest.h>
 
 #include <dlfcn.h>
@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <random>
 
+#include "gpu_fields.h"
 #include "gpu_suite.h"
 #include "shaders/layout.h"
 #include "voxfield/edit.h"
@@ -26,56 +27,8 @@ using test::gpu_tests_wanted;
 using test::random_world;
 using test::validated_context;
 
-namespace {
-
-template <class T>
-std::vector<T> dense(const DistanceField& f) {
-  std::vector<T> v(static_cast<std::size_t>(f.domain.volume()));
-  std::get<Grid<T>>(f.values).copy_to_dense(f.domain, v.data());
-  return v;
-}
-
-void expect_same_field(const DistanceField& gpu_field, const DistanceField& cpu_field,
-                       const std::string& what) {
-  ASSERT_EQ(gpu_field.domain, cpu_field.domain) << what;
-  ASSERT_EQ(gpu_field.values.index(), cpu_field.values.index()) << what;
-  EXPECT_EQ(gpu_field.encoding.scale, cpu_field.encoding.scale) << what;
-  EXPECT_EQ(gpu_field.encoding.bias, cpu_field.encoding.bias) << what;
-  if (std::holds_alternative<Grid<std::uint8_t>>(cpu_field.values)) {
-    EXPECT_EQ(dense<std::uint8_t>(gpu_field), dense<std::uint8_t>(cpu_field)) << what;
-  } else if (std::holds_alternative<Grid<std::uint16_t>>(cpu_field.values)) {
-    EXPECT_EQ(dense<std::uint16_t>(gpu_field), dense<std::uint16_t>(cpu_field)) << what;
-  } else {
-    const auto a = dense<float>(gpu_field), b = dense<float>(cpu_field);
-    std::size_t off = 0;
-    for (std::size_t i = 0; i < a.size(); ++i) {
-      const bool same =
-          a[i] == b[i] || std::abs(a[i] - b[i]) <= gpu::kF32Tolerance * std::abs(b[i]);
-      if (!same && off++ < 5)
-        ADD_FAILURE() << what << ": voxel " << i << " gpu " << a[i] << " cpu " << b[i];
-    }
-    EXPECT_EQ(off, 0u) << what;
-  }
-  // Outside the domain both read the background.
-  const Vec3i outside = cpu_field.domain.end;
-  EXPECT_EQ(gpu_field.distance(outside), cpu_field.distance(outside)) << what;
-  // Nearest sites: the same site for every voxel, ties included.
-  ASSERT_EQ(gpu_field.sites.has_value(), cpu_field.sites.has_value()) << what;
-  if (cpu_field.sites) {
-    std::vector<SiteOffset> a(static_cast<std::size_t>(cpu_field.domain.volume())), b(a.size());
-    gpu_field.sites->copy_to_dense(gpu_field.domain, a.data());
-    cpu_field.sites->copy_to_dense(cpu_field.domain, b.data());
-    std::size_t off = 0;
-    for (std::size_t i = 0; i < a.size(); ++i)
-      if (!(a[i] == b[i]) && off++ < 5)
-        ADD_FAILURE() << what << ": voxel " << i << " site gpu (" << a[i].dx << "," << a[i].dy
-                      << "," << a[i].dz << ") cpu (" << b[i].dx << "," << b[i].dy << "," << b[i].dz
-                      << ")";
-    EXPECT_EQ(off, 0u) << what << ": voxels with another nearest site";
-  }
-}
-
-}  // namespace
+using test::dense;
+using test::expect_same_field;
 
 TEST(Gpu, BackendNamesAndChoice) {
   EXPECT_EQ(parse_backend("vulkan"), Backend::kVulkan);
@@ -329,102 +282,6 @@ TEST(Gpu, FieldsShareOneResidentWorld) {
   test::expect_no_validation_messages(*ctx);
 }
 
-TEST(Gpu, ClampedFieldsBeyondTheStorageBufferRangeAreComputedInParts) {
-  // The exact transform's work buffers hold 4 bytes per voxel of a region (24 more with nearest
-  // sites). On a device whose storage-buffer range cannot bind them (lowered here through
-  // ContextOptions, as a user sharing a device would), a clamped field is computed in slabs, each
-  // with the sites within its reach: the same bits as the CPU's, builds and updates alike, with
-  // more dispatches. Where no slab is small enough (an unclamped field's reach is the whole domain,
-  // and nearest sites need six times the room) the field is refused with InvalidArgument before
-  // anything is uploaded, instead of binding past the range.
-  if (!gpu_tests_wanted()) GTEST_SKIP();
-  auto small = test::capped_context(64 * 1024 - 4);  // 16 383 voxels: one short of the whole domain
-  auto whole = validated_context();
-  World w = random_world({32, 32, 16}, 8, 0.01, 4);  // 16 384 voxels: 64 KiB per cost buffer
-  w.voxels.set(Vec3i{31, 31, 15}, 2);  // a site in the last corner: a slab's edge is crossed
-  DistanceOptions o;
-  o.storage = Storage::kU8;
-  o.max_distance = 6;
-  for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
-    for (bool is_signed : {false, true}) {
-      o.metric = m;
-      o.signed_distance = is_signed;
-      const std::string what = std::string(metric_name(m)) + (is_signed ? " signed" : "");
-      const std::int64_t before = small->counters().dispatches;
-      const DistanceField parts = gpu::compute_distance_field(*small, w, o);
-      const std::int64_t in_parts = small->counters().dispatches - before;
-      const std::int64_t before_whole = whole->counters().dispatches;
-      expect_same_field(parts, gpu::compute_distance_field(*whole, w, o), what);
-      expect_same_field(parts, compute_distance_field(w, o), what);
-      EXPECT_GT(in_parts, whole->counters().dispatches - before_whole) << what;
-      // An update whose region is the whole domain (a box edit across it), then a small one.
-      World edited = w;
-      gpu::DynamicField live(small, edited, o);
-      DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
-      apply_edit(edited, Edit{EditOp::kPlace, BoxBrush{{2, 3, 4}, {30, 29, 12}}, 3}, &dirty);
-      live.update(dirty);
-      dirty.clear();
-      apply_edit(edited, Edit{EditOp::kCarve, SphereBrush{{16, 16, 8}, 5}, 0}, &dirty);
-      live.update(dirty);
-      expect_same_field(live.download(), compute_distance_field(edited, o), what + ", edited");
-    }
-  // Nearly every chunk holding voxels: the world's brick pool (512 bytes a chunk) reaches into the
-  // last of the four 32 KiB windows the passes bind it in (src/gpu/split_buffer.h), and so does
-  // the u8 field (125 440 bytes).
-  const World dense = random_world({56, 56, 40}, 8, 0.3, 6);
-  std::size_t bricks = 0;
-  for (int z = 0; z < 5; ++z)
-    for (int y = 0; y < 7; ++y)
-      for (int x = 0; x < 7; ++x) bricks += dense.voxels.chunk_view({x, y, z}).voxels != nullptr;
-  ASSERT_GT(bricks * 512, 3u * 32 * 1024) << "the live bricks reach the fourth window";
-  ASSERT_LE(bricks * 512, 4u * 32 * 1024);
-  o.metric = Metric::kEuclidean;
-  o.signed_distance = true;
-  o.max_distance = 2;  // slabs of 3 slices, each reading 2 more on either side
-  expect_same_field(gpu::compute_distance_field(*small, dense, o), compute_distance_field(dense, o),
-                    "every chunk holding voxels");
-  // The field and its nearest sites are resident whole, bound in windows too: an f32 field of
-  // 64 KiB (two windows) and the sites of a 64x16x16 domain, 128 KiB (all four), built and
-  // updated, while the passes' work buffers go in slabs.
-  {
-    World long_world = random_world({64, 16, 16}, 8, 0.01, 8);
-    DistanceOptions f = o;
-    f.storage = Storage::kF32;
-    f.nearest_sites = true;
-    expect_same_field(gpu::compute_distance_field(*small, long_world, f),
-                      compute_distance_field(long_world, f), "f32 with nearest sites in windows");
-    gpu::DynamicField live(small, long_world, f);
-    DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
-    apply_edit(long_world, Edit{EditOp::kPlace, SphereBrush{{50, 8, 8}, 4}, 5}, &dirty);
-    live.update(dirty);
-    expect_same_field(live.download(), compute_distance_field(long_world, f),
-                      "f32 with nearest sites in windows, edited");
-  }
-  o.max_distance = 6;
-  o.metric = Metric::kManhattan;
-  o.signed_distance = false;
-  // The sites' work buffers, 24 bytes per voxel of a slab, leave no slab within the range at this
-  // clamp.
-  o.nearest_sites = true;
-  try {
-    gpu::DynamicField refused(small, w, o);
-    ADD_FAILURE() << "a work buffer beyond the storage-buffer range was made";
-  } catch (const InvalidArgument& e) {
-    EXPECT_NE(std::string(e.what()).find("storage-buffer range"), std::string::npos) << e.what();
-  }
-  o.nearest_sites = false;
-  o.max_distance = 0;  // unclamped: the reach is the whole domain, computed whole
-  const gpu::Counters before = small->counters();
-  try {
-    gpu::DynamicField refused(small, w, o);
-    ADD_FAILURE() << "an unclamped field beyond the storage-buffer range was made";
-  } catch (const InvalidArgument& e) {
-    EXPECT_NE(std::string(e.what()).find("no slab"), std::string::npos) << e.what();
-  }
-  EXPECT_EQ(small->counters().bytes_uploaded, before.bytes_uploaded);  // nothing was uploaded
-  test::expect_no_validation_messages(*small);
-}
-
 TEST(Gpu, JumpFloodingEqualsTheCpu) {
   if (!gpu_tests_wanted()) GTEST_SKIP();
   auto ctx = validated_context();
@@ -586,73 +443,4 @@ TEST(Gpu, AdoptsAnApplicationsDevice) {
   destroy_device(device, nullptr);
   destroy_instance(instance, nullptr);
   dlclose(loader);
-}
-
-TEST(Gpu, FamilyPingPongBuffersPastTheRangeAreBoundInWindows) {
-  // Jump flooding and FIM keep both halves of their ping-pong in one buffer: 16 bytes a voxel for
-  // JFA's sites, 8 for jfa-seed's and FIM's values. On a device whose storage-buffer range is
-  // below that (lowered through ContextOptions) the passes bind it as four windows
-  // (src/gpu/split_buffer.h): the fields equal a device's that binds it whole, bit for bit (the
-  // same shaders; the tests above hold those to the CPU). Past four windows the algorithm is
-  // refused by name.
-  if (!gpu_tests_wanted()) GTEST_SKIP();
-  auto small = test::capped_context(128 * 1024 - 4);  // windows of 64 KiB, 256 KiB in four
-  auto whole = validated_context();
-  whole->clear_validation_messages();
-  // 14 400 voxels: JFA's ping-pong 230 400 bytes (four windows), the values' 115 200 (two).
-  const World w = random_world({30, 24, 20}, 8, 0.004, 61);
-  for (Algorithm alg : {Algorithm::kJfaSeed, Algorithm::kJfa, Algorithm::kJfa1, Algorithm::kFim,
-                        Algorithm::kHybrid})
-    for (Metric m : {Metric::kManhattan, Metric::kEuclidean}) {
-      DistanceOptions o;
-      o.metric = m;
-      o.signed_distance = true;
-      o.storage = Storage::kF32;
-      AlgorithmOptions a;
-      a.algorithm = alg;
-      const std::string what = std::string(algorithm_name(alg)) + " " + metric_name(m);
-      const DistanceField windows = gpu::compute_distance_field(*small, w, o, a);
-      const DistanceField bound_whole = gpu::compute_distance_field(*whole, w, o, a);
-      EXPECT_EQ(dense<float>(windows), dense<float>(bound_whole)) << what;
-    }
-  // Windows begin at multiples of a power of two within the range: a range below a word and the
-  // device's offset alignment is refused.
-  EXPECT_THROW(test::capped_context(2), InvalidArgument);
-  const World big = random_world({40, 30, 20}, 8, 0.004, 62);  // 24 000 voxels: 384 000 bytes
-  AlgorithmOptions jfa;
-  jfa.algorithm = Algorithm::kJfa;
-  try {
-    (void)gpu::compute_distance_field(*small, big, DistanceOptions{}, jfa);
-    ADD_FAILURE() << "a ping-pong buffer past four windows was bound";
-  } catch (const InvalidArgument& e) {
-    EXPECT_NE(std::string(e.what()).find("more than this device binds"), std::string::npos)
-        << e.what();
-  }
-  test::expect_no_validation_messages(*small);
-  test::expect_no_validation_messages(*whole);
-}
-
-TEST(Gpu, UpdatesRecycleTheirDescriptorPools) {
-  // The exact transform's passes bind 20 buffers (the pool, the field and its sites in windows):
-  // their sets come from the shared arena's recycled pool update after update, not from a pool
-  // made and destroyed for each.
-  if (!gpu_tests_wanted()) GTEST_SKIP();
-  auto ctx = validated_context();
-  World w = random_world({40, 32, 24}, 8, 0.004, 71);
-  DistanceOptions o;
-  o.metric = Metric::kEuclidean;
-  o.max_distance = 5;
-  o.nearest_sites = true;
-  gpu::DynamicField live(ctx, w, o);
-  DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
-  const auto edit = [&](int i) {
-    apply_edit(w, Edit{EditOp::kPlace, SphereBrush{{5.0 + 3 * i, 16, 12}, 2}, 4}, &dirty);
-    live.update(dirty);
-    dirty.clear();
-  };
-  edit(0);
-  const std::int64_t pools = ctx->counters().descriptor_pools;
-  for (int i = 1; i < 10; ++i) edit(i);
-  EXPECT_EQ(ctx->counters().descriptor_pools, pools) << "sets recycled, no new pools";
-  expect_same_field(live.download(), compute_distance_field(w, o), "after the updates");
 }

@@ -94,7 +94,9 @@ void expect_same_cells(gpu::DeviceRenderScene& device, const RenderScene& host_s
                                                                  : host_slot;
     };
     EXPECT_EQ(e[0], slot(h.skip.cells.slot[i])) << chunk;
-    if (h.has_light) EXPECT_EQ(e[2], slot(h.light.slot[i])) << chunk;
+    if (h.has_light) {
+      EXPECT_EQ(e[2], slot(h.light.slot[i])) << chunk;
+    }
     EXPECT_EQ((e[1] >> 16) & 0xFF, h.skip.chunk_min[i]) << chunk;
     EXPECT_EQ((e[1] >> 24) & 1, h.empty_chunk[i]) << chunk;
     EXPECT_EQ((e[1] >> 25) & 1, h.dense_material[i]) << chunk;
@@ -293,9 +295,7 @@ TEST(Gpu, ArenasAndImagesPastTheStorageBufferRangeAreBoundInWindows) {
   // approximation alike, through edits that grow the arenas into further windows. What four
   // windows cannot hold is refused by name before anything is drawn.
   if (!gpu_tests_wanted()) GTEST_SKIP();
-  auto small = test::capped_context(32 * 1024 - 4);  // windows of 16 KiB, 64 KiB in four
-  auto whole = validated_context();
-  whole->clear_validation_messages();
+  auto [small, whole] = test::capped_and_whole(32 * 1024 - 4);  // windows of 16 KiB, 64 KiB in four
   constexpr std::size_t kWindow = 16 * 1024;
 
   // 54 chunks of 8^3 (1 KiB of cells, 512 bytes of lighting each); thin across x, so that the
