@@ -295,7 +295,8 @@ TEST(Gpu, ArenasAndImagesPastTheStorageBufferRangeAreBoundInWindows) {
   // approximation alike, through edits that grow the arenas into further windows. What four
   // windows cannot hold is refused by name before anything is drawn.
   if (!gpu_tests_wanted()) GTEST_SKIP();
-  auto [small, whole] = test::capped_and_whole(32 * 1024 - 4);  // windows of 16 KiB, 64 KiB in four
+  // Windows of 16 KiB, 64 KiB in four.
+  auto [small, whole] = test::capped_and_whole(32 * 1024 - 4);
   constexpr std::size_t kWindow = 16 * 1024;
 
   // 54 chunks of 8^3 (1 KiB of cells, 512 bytes of lighting each); thin across x, so that the

@@ -28,8 +28,8 @@ TEST(Gpu, ClampedFieldsBeyondTheStorageBufferRangeAreComputedInParts) {
   // and nearest sites need six times the room) the field is refused with InvalidArgument before
   // anything is uploaded, instead of binding past the range.
   if (!gpu_tests_wanted()) GTEST_SKIP();
-  auto [small, whole] =
-      test::capped_and_whole(64 * 1024 - 4);         // 16 383 voxels: one short of the whole domain
+  // 16 383 voxels a binding: one short of the whole domain.
+  auto [small, whole] = test::capped_and_whole(64 * 1024 - 4);
   World w = random_world({32, 32, 16}, 8, 0.01, 4);  // 16 384 voxels: 64 KiB per cost buffer
   w.voxels.set(Vec3i{31, 31, 15}, 2);  // a site in the last corner: a slab's edge is crossed
   DistanceOptions o;
@@ -123,8 +123,8 @@ TEST(Gpu, FamilyPingPongBuffersPastTheRangeAreBoundInWindows) {
   // same shaders; the tests above hold those to the CPU). Past four windows the algorithm is
   // refused by name.
   if (!gpu_tests_wanted()) GTEST_SKIP();
-  auto [small, whole] =
-      test::capped_and_whole(128 * 1024 - 4);  // windows of 64 KiB, 256 KiB in four
+  // Windows of 64 KiB, 256 KiB in four.
+  auto [small, whole] = test::capped_and_whole(128 * 1024 - 4);
   // 14 400 voxels: JFA's ping-pong 230 400 bytes (four windows), the values' 115 200 (two).
   const World w = random_world({30, 24, 20}, 8, 0.004, 61);
   for (Algorithm alg : {Algorithm::kJfaSeed, Algorithm::kJfa, Algorithm::kJfa1, Algorithm::kFim,
