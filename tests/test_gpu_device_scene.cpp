@@ -380,6 +380,11 @@ TEST(Gpu, ArenasAndImagesPastTheStorageBufferRangeAreBoundInWindows) {
   // (A device scene's skip field, a byte for every voxel of the box, outgrows the windows before
   // its arenas, two bytes for each voxel of the chunks that vary, do.)
   expect_refused([&] { gpu::DeviceRenderScene(small, big, so); }, "a device scene");
+  // A host scene's chunk table, 16 bytes a chunk bound whole: 2 048 chunks of air are one word
+  // past the range.
+  const World air(8, Box3i::from_size({128, 128, 64}));
+  const RenderScene air_scene(air, so);
+  expect_refused([&] { (void)gpu::render(*small, air_scene, cam, o); }, "a chunk table");
   o.width = 160;  // 76 800 bytes of pixels
   o.height = 120;
   expect_refused([&] { (void)host_small.render(views.cameras[0], o); }, "an image");

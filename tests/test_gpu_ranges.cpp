@@ -125,25 +125,33 @@ TEST(Gpu, FamilyPingPongBuffersPastTheRangeAreBoundInWindows) {
   if (!gpu_tests_wanted()) GTEST_SKIP();
   // Windows of 64 KiB, 256 KiB in four.
   auto [small, whole] = test::capped_and_whole(128 * 1024 - 4);
-  // 14 400 voxels: JFA's ping-pong 230 400 bytes (four windows), the values' 115 200 (two).
+  // 14 400 voxels: JFA's ping-pong 230 400 bytes (four windows); 28 800 voxels: the values'
+  // ping-pong of jfa-seed and FIM, 8 bytes a voxel, as large.
   const World w = random_world({30, 24, 20}, 8, 0.004, 61);
-  for (Algorithm alg : {Algorithm::kJfaSeed, Algorithm::kJfa, Algorithm::kJfa1, Algorithm::kFim,
-                        Algorithm::kHybrid})
+  const World w8 = random_world({40, 30, 24}, 8, 0.004, 63);
+  struct Case {
+    Algorithm algorithm;
+    const World* world;
+  };
+  for (const Case& k :
+       {Case{Algorithm::kJfa, &w}, Case{Algorithm::kJfa1, &w}, Case{Algorithm::kHybrid, &w},
+        Case{Algorithm::kLod, &w}, Case{Algorithm::kJfaSeed, &w8}, Case{Algorithm::kFim, &w8}})
     for (Metric m : {Metric::kManhattan, Metric::kEuclidean}) {
       DistanceOptions o;
       o.metric = m;
       o.signed_distance = true;
       o.storage = Storage::kF32;
       AlgorithmOptions a;
-      a.algorithm = alg;
-      const std::string what = std::string(algorithm_name(alg)) + " " + metric_name(m);
-      const DistanceField windows = gpu::compute_distance_field(*small, w, o, a);
-      const DistanceField bound_whole = gpu::compute_distance_field(*whole, w, o, a);
+      a.algorithm = k.algorithm;
+      a.focus = Box3i{{8, 8, 4}, {20, 16, 12}};  // LOD's FIM region
+      const std::string what = std::string(algorithm_name(k.algorithm)) + " " + metric_name(m);
+      const DistanceField windows = gpu::compute_distance_field(*small, *k.world, o, a);
+      const DistanceField bound_whole = gpu::compute_distance_field(*whole, *k.world, o, a);
       EXPECT_EQ(dense<float>(windows), dense<float>(bound_whole)) << what;
     }
-  // Windows begin at multiples of a power of two within the range: a range below a word and the
-  // device's offset alignment is refused.
-  EXPECT_THROW(test::capped_context(2), InvalidArgument);
+  // A range below a palette's 4 KiB (bound whole) or the device's offset alignment (windows begin
+  // at multiples of a power of two within the range) is refused.
+  EXPECT_THROW(test::capped_context(4095), InvalidArgument);
   const World big = random_world({40, 30, 20}, 8, 0.004, 62);  // 24 000 voxels: 384 000 bytes
   AlgorithmOptions jfa;
   jfa.algorithm = Algorithm::kJfa;

@@ -61,7 +61,7 @@ struct ContextOptions {
   // Accept CPU implementations of Vulkan such as Mesa's lavapipe.
   bool allow_software = true;
   // At most this many bytes in one storage buffer binding (0: the device's
-  // maxStorageBufferRange; a larger value is lowered to it; at least the device's
+  // maxStorageBufferRange; a larger value is lowered to it; at least 4 KiB and the device's
   // minStorageBufferOffsetAlignment, InvalidArgument otherwise). Work that does not fit is done in
   // parts where it can be (a clamped distance field's passes in slabs, large buffers bound in
   // windows: docs/gpu.md) and refused, naming the sizes, where it cannot; lower it to leave room

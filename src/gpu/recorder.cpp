@@ -39,6 +39,8 @@ void DescriptorArena::reset() {
     pools_.pop_back();
   }
   left_in_pool_ = pools_.empty() ? 0 : kSetsPerPool;
+  pool_descriptors_.resize(pools_.size());
+  left_descriptors_ = pools_.empty() ? 0 : pool_descriptors_[0];
   cached_.clear();
 }
 
@@ -51,8 +53,8 @@ VkDeviceSize Binding::covered() const {
 void check_whole_binding(const Context::Impl& ctx, VkDeviceSize bytes, const std::string& what) {
   if (bytes > ctx.limits.maxStorageBufferRange)
     throw InvalidArgument(what + " needs " + std::to_string(bytes) +
-                          " bytes in one storage buffer, more than this device's range (" +
-                          std::to_string(ctx.limits.maxStorageBufferRange) + ")");
+                          " bytes, more than this device binds (one storage buffer of " +
+                          std::to_string(ctx.limits.maxStorageBufferRange) + " bytes)");
 }
 
 std::array<Binding, kSplitParts> split_bindings(Buffer& b, const Context::Impl& ctx) {
@@ -77,7 +79,9 @@ VkDescriptorSet DescriptorArena::set(const Kernel& kernel, std::span<const Bindi
 
   VkDescriptorSet set = VK_NULL_HANDLE;
   for (int attempt = 0; attempt < 2 && set == VK_NULL_HANDLE; ++attempt) {
-    if (left_in_pool_ == 0 || buffers.size() > kBuffersPerSet || attempt == 1) {
+    // A fresh pool when the last one has no set or too few descriptors left for this one (sized
+    // for the larger of a typical set and this one), or when it failed to give a set anyway.
+    if (left_in_pool_ == 0 || buffers.size() > left_descriptors_ || attempt == 1) {
       const std::uint32_t descriptors =
           kSetsPerPool *
           std::max<std::uint32_t>(kBuffersPerSet, static_cast<std::uint32_t>(buffers.size()));
@@ -91,6 +95,8 @@ VkDescriptorSet DescriptorArena::set(const Kernel& kernel, std::span<const Bindi
       pools_.push_back(pool);
       ++ctx_->counters.descriptor_pools;
       left_in_pool_ = kSetsPerPool;
+      left_descriptors_ = descriptors;
+      pool_descriptors_.push_back(descriptors);
     }
     VkDescriptorSetAllocateInfo dsa{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     dsa.descriptorPool = pools_.back();
@@ -104,6 +110,7 @@ VkDescriptorSet DescriptorArena::set(const Kernel& kernel, std::span<const Bindi
     }
     check(r, "vkAllocateDescriptorSets");
     --left_in_pool_;
+    left_descriptors_ -= static_cast<std::uint32_t>(buffers.size());
   }
   if (set == VK_NULL_HANDLE) check(VK_ERROR_OUT_OF_POOL_MEMORY, "vkAllocateDescriptorSets");
 

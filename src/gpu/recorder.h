@@ -74,6 +74,8 @@ class DescriptorArena {
   Context::Impl* ctx_;
   std::vector<VkDescriptorPool> pools_;
   std::uint32_t left_in_pool_ = 0;
+  std::uint32_t left_descriptors_ = 0;           // in the last pool
+  std::vector<std::uint32_t> pool_descriptors_;  // each pool's, as made
   std::vector<std::pair<Key, VkDescriptorSet>> cached_;
 };
 

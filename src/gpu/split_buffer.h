@@ -36,8 +36,8 @@ inline VkDeviceSize split_capacity_bytes(const Context::Impl& ctx) {
 }
 
 // Refuses (InvalidArgument naming `what` and the sizes) a buffer of `bytes` that is bound whole
-// but would not fit one binding: the per-chunk tables, which only a box of millions of chunks
-// outgrows.
+// but would not fit one binding: a host scene's chunk table, which only a box of millions of
+// chunks outgrows (other per-chunk tables are smaller than a field their module checks first).
 void check_whole_binding(const Context::Impl& ctx, VkDeviceSize bytes, const std::string& what);
 
 // The windows of `b`, binding by binding: part k covers bytes [k, k + 1) * split_part_bytes() of

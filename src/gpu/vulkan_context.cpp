@@ -455,15 +455,15 @@ std::shared_ptr<Context> adopt(const AdoptedDevice& app) {
 
 void Context::Impl::cap_storage_buffer_range(std::uint64_t bytes) {
   if (bytes == 0) return;
-  // Windows of large buffers (split_buffer.h) start at multiples of a power of two within the
-  // range, which must then be a whole word and aligned as a binding's offset must.
+  // At least the largest buffer of a fixed size bound whole (a palette, 256 colours of 16 bytes),
+  // and aligned as a binding's offset must be: windows of large buffers (split_buffer.h) start at
+  // multiples of a power of two within the range.
   const std::uint64_t least =
-      std::max<std::uint64_t>(limits.minStorageBufferOffsetAlignment, std::uint64_t{4});
+      std::max<std::uint64_t>(limits.minStorageBufferOffsetAlignment, std::uint64_t{4096});
   if (bytes < least)
     throw InvalidArgument("GPU: a storage-buffer range of " + std::to_string(bytes) +
-                          " bytes is below a word and the device's storage-buffer offset "
-                          "alignment (" +
-                          std::to_string(least) + " bytes)");
+                          " bytes is below " + std::to_string(least) +
+                          " (a palette's 4 KiB, and the device's storage-buffer offset alignment)");
   // Whole words: buffers are sized in 32-bit words, checked against the range before rounding.
   bytes &= ~std::uint64_t{3};
   if (bytes > 0 && bytes < limits.maxStorageBufferRange)

@@ -30,10 +30,9 @@ ResidentWorld::ResidentWorld(Context::Impl& ctx, const World& world, const Box3i
   const Vec3i last{(box.end.x - 1) >> shift_, (box.end.y - 1) >> shift_, (box.end.z - 1) >> shift_};
   dims_ = last - origin_ + Vec3i::splat(1);
   chunk_bytes_ = static_cast<std::size_t>(world.voxels.chunk_volume());
-  const std::size_t pages = static_cast<std::size_t>(dims_.x) * dims_.y * dims_.z;
-  check_whole_binding(ctx, pages * 4,
-                      "GPU: the page table of " + std::to_string(pages) + " chunks");
-  pages_.assign(pages, L::VF_UNIFORM);  // all air until synced
+  // (4 bytes a chunk, bound whole: the fields on it, a byte a voxel, outgrow a binding first.)
+  pages_.assign(static_cast<std::size_t>(dims_.x) * dims_.y * dims_.z,
+                L::VF_UNIFORM);  // all air until synced
   pages_buf_ = Buffer(ctx, pages_.size() * 4, kStorage, false);
   // A pool of one brick to begin with: a world of uniform chunks alone still binds one.
   bricks_buf_ = Buffer(ctx, chunk_bytes_, kStorage, false);
