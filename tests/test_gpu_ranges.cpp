@@ -29,7 +29,10 @@ TEST(Gpu, ClampedFieldsBeyondTheStorageBufferRangeAreComputedInParts) {
   // anything is uploaded, instead of binding past the range.
   if (!gpu_tests_wanted()) GTEST_SKIP();
   // 16 383 voxels a binding: one short of the whole domain.
-  auto [small, whole] = test::capped_and_whole(64 * 1024 - 4);
+  // (Named, not structured, bindings: the lambdas below capture them, which Clang 14 refuses.)
+  const test::CappedAndWhole contexts = test::capped_and_whole(64 * 1024 - 4);
+  const std::shared_ptr<gpu::Context>& small = contexts.small;
+  const std::shared_ptr<gpu::Context>& whole = contexts.whole;
   World w = random_world({32, 32, 16}, 8, 0.01, 4);  // 16 384 voxels: 64 KiB per cost buffer
   w.voxels.set(Vec3i{31, 31, 15}, 2);  // a site in the last corner: a slab's edge is crossed
   DistanceOptions o;
@@ -124,7 +127,9 @@ TEST(Gpu, FamilyPingPongBuffersPastTheRangeAreBoundInWindows) {
   // refused by name.
   if (!gpu_tests_wanted()) GTEST_SKIP();
   // Windows of 64 KiB, 256 KiB in four.
-  auto [small, whole] = test::capped_and_whole(128 * 1024 - 4);
+  const test::CappedAndWhole contexts = test::capped_and_whole(128 * 1024 - 4);
+  const std::shared_ptr<gpu::Context>& small = contexts.small;
+  const std::shared_ptr<gpu::Context>& whole = contexts.whole;
   // 14 400 voxels: JFA's ping-pong 230 400 bytes (four windows); 28 800 voxels: the values'
   // ping-pong of jfa-seed and FIM, 8 bytes a voxel, as large.
   const World w = random_world({30, 24, 20}, 8, 0.004, 61);
