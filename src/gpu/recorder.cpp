@@ -50,6 +50,14 @@ VkDeviceSize Binding::covered() const {
                                 : std::min(bytes, buffer->size() - offset);
 }
 
+void check_split_binding(const Context::Impl& ctx, VkDeviceSize bytes, const std::string& what) {
+  if (bytes > split_capacity_bytes(ctx))
+    throw InvalidArgument(what + " needs " + std::to_string(bytes) +
+                          " bytes, more than this device binds (" + std::to_string(kSplitParts) +
+                          " storage buffers of " + std::to_string(split_part_bytes(ctx)) +
+                          " bytes)");
+}
+
 void check_whole_binding(const Context::Impl& ctx, VkDeviceSize bytes, const std::string& what) {
   if (bytes > ctx.limits.maxStorageBufferRange)
     throw InvalidArgument(what + " needs " + std::to_string(bytes) +

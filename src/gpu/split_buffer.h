@@ -35,6 +35,10 @@ inline VkDeviceSize split_capacity_bytes(const Context::Impl& ctx) {
   return split_part_bytes(ctx) * kSplitParts;
 }
 
+// Refuses (InvalidArgument: "<what> needs <bytes> bytes, more than this device binds (...)") a
+// buffer bound in windows that four cannot hold.
+void check_split_binding(const Context::Impl& ctx, VkDeviceSize bytes, const std::string& what);
+
 // Refuses (InvalidArgument naming `what` and the sizes) a buffer of `bytes` that is bound whole
 // but would not fit one binding: a host scene's chunk table, which only a box of millions of
 // chunks outgrows (other per-chunk tables are smaller than a field their module checks first).

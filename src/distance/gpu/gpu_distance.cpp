@@ -161,17 +161,11 @@ class FieldEngine {
                    (4 / lanes_of(options.storage));
     // The field and its sites are resident whole (slabs cut the work buffers, not these), bound
     // as split_buffer.h's windows.
-    const std::string binds = "more than this device binds (" + std::to_string(kSplitParts) +
-                              " storage buffers of " + std::to_string(split_part_bytes(ctx)) +
-                              " bytes)";
-    if (field_bytes_ > split_capacity_bytes(ctx))
-      throw InvalidArgument("GPU: a " + to_string(n) + " domain needs a field of " +
-                            std::to_string(field_bytes_) + " bytes, " + binds);
+    check_split_binding(ctx, field_bytes_, "GPU: the field of a " + to_string(n) + " domain");
     // Nearest sites: 8 bytes per voxel of the domain (three int16 offsets, padded).
     site_bytes_ = options.nearest_sites ? static_cast<VkDeviceSize>(plan_.domain.volume()) * 8 : 0;
-    if (site_bytes_ > split_capacity_bytes(ctx))
-      throw InvalidArgument("GPU: nearest sites of a " + to_string(n) + " domain need " +
-                            std::to_string(site_bytes_) + " bytes, " + binds);
+    check_split_binding(ctx, site_bytes_,
+                        "GPU: the nearest-site buffer of a " + to_string(n) + " domain");
     make_header();
     owns_world_ = shared == nullptr;
     resident_ =

@@ -47,11 +47,9 @@ std::vector<int> extra_steps(Algorithm a) {
 // A ping-pong buffer (both halves, `bytes`) is bound as split_buffer.h's windows.
 void check_ping_pong(const Context::Impl& ctx, std::size_t voxels, VkDeviceSize bytes,
                      const std::string& label) {
-  if (bytes > split_capacity_bytes(ctx))
-    throw InvalidArgument("GPU: " + label + " over " + std::to_string(voxels) + " voxels needs " +
-                          std::to_string(bytes) + " bytes of ping-pong buffer, more than this " +
-                          "device binds (" + std::to_string(kSplitParts) + " storage buffers of " +
-                          std::to_string(split_part_bytes(ctx)) + " bytes)");
+  check_split_binding(
+      ctx, bytes,
+      "GPU: " + label + "'s ping-pong buffer over " + std::to_string(voxels) + " voxels");
 }
 
 // Runs one pass of `kernel` per step over a ping-pong buffer of p.size() elements (both halves

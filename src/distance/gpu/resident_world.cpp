@@ -102,14 +102,10 @@ void ResidentWorld::stage(const std::vector<Vec3i>& chunks, Staging& up, Uploads
     // Grow the pool (amortised doubling, within what the shaders bind: split_buffer.h's
     // windows); the old bricks are copied over on the GPU. A pool past that is refused before
     // anything changes.
+    check_split_binding(
+        ctx_, static_cast<VkDeviceSize>(needed) * chunk_bytes_,
+        "GPU: the brick pool of the world's " + std::to_string(needed) + " chunks holding voxels");
     const std::uint64_t most = split_capacity_bytes(ctx_) / chunk_bytes_;
-    if (needed > most)
-      throw InvalidArgument("GPU: the world's " + std::to_string(needed) +
-                            " chunks holding voxels need a brick pool of " +
-                            std::to_string(static_cast<std::uint64_t>(needed) * chunk_bytes_) +
-                            " bytes, more than this device binds (" + std::to_string(kSplitParts) +
-                            " storage buffers of " + std::to_string(split_part_bytes(ctx_)) +
-                            " bytes)");
     const std::uint32_t capacity = static_cast<std::uint32_t>(std::min<std::uint64_t>(
         std::max<std::uint32_t>(needed + needed / 4 + 8, slot_capacity_ * 2), most));
     Buffer grown(ctx_, static_cast<VkDeviceSize>(capacity) * chunk_bytes_, kStorage, false);

@@ -136,12 +136,8 @@ void Impl::ensure_arena(Recorder& rec, Buffer& arena, std::vector<Buffer>& retir
   const std::size_t bytes = std::max<std::size_t>(std::size_t{slots} * slot_bytes, 16);
   if (arena.handle() != VK_NULL_HANDLE && arena.size() >= bytes) return;
   // The shaders bind an arena as split_buffer.h's windows.
+  check_split_binding(ctx, bytes, "DeviceRenderScene: an arena of its cells");
   const std::size_t capacity = split_capacity_bytes(ctx);
-  if (bytes > capacity)
-    throw InvalidArgument("DeviceRenderScene: its cells need an arena of " + std::to_string(bytes) +
-                          " bytes, more than this device binds (" + std::to_string(kSplitParts) +
-                          " storage buffers of " + std::to_string(split_part_bytes(ctx)) +
-                          " bytes)");
   // Half again for the edits to come, within what can be bound.
   const std::size_t grown =
       std::min(capacity, std::max(bytes, static_cast<std::size_t>(arena.size()) * 3 / 2));

@@ -56,11 +56,7 @@ Frames::Frames(Context& context)
 
 void Frames::ensure_pixels(VkDeviceSize bytes) {
   // The shader writes the image through split_buffer.glsl's windows.
-  if (bytes > split_capacity_bytes(ctx_))
-    throw InvalidArgument("render: the image's " + std::to_string(bytes) +
-                          " bytes of pixels are more than this device binds (" +
-                          std::to_string(kSplitParts) + " storage buffers of " +
-                          std::to_string(split_part_bytes(ctx_)) + " bytes)");
+  check_split_binding(ctx_, bytes, "render: the image");
   if (pixels_.handle() != VK_NULL_HANDLE && pixels_.size() >= bytes) return;
   pixels_ = Buffer(ctx_, bytes, kSceneBufferUsage, false);
   descriptors_stale_ = true;
@@ -109,11 +105,7 @@ void Frames::record_approximation(Recorder& rec, const FrameScene& s) {
   }
   const std::size_t info_bytes = info.size() * 4;
   const std::size_t arena_bytes = std::size_t{approx.cells.slots_used} * approx.cells.slot_bytes();
-  if (arena_bytes > split_capacity_bytes(ctx_))
-    throw InvalidArgument("render: the error view's approximation needs an arena of " +
-                          std::to_string(arena_bytes) + " bytes, more than this device binds (" +
-                          std::to_string(kSplitParts) + " storage buffers of " +
-                          std::to_string(split_part_bytes(ctx_)) + " bytes)");
+  check_split_binding(ctx_, arena_bytes, "render: the error view's approximation's arena");
   if (approx_info_.size() < std::max<std::size_t>(info_bytes, 16) ||
       approx_arena_.size() < std::max<std::size_t>(arena_bytes, 16)) {
     approx_info_ = Buffer(ctx_, std::max<std::size_t>(info_bytes, 16), kSceneBufferUsage, false);

@@ -129,12 +129,8 @@ bool ResidentScene::record_sync(Recorder& rec, const RenderScene& scene) {
   check_whole_binding(ctx_, chunks * 16,
                       "render: the chunk table of " + std::to_string(chunks) + " chunks");
   // The render shader binds each arena as split_buffer.h's windows.
-  for (const std::size_t live : {skip_live, light_live})
-    if (live > split_capacity_bytes(ctx_))
-      throw InvalidArgument("render: the scene's cells need an arena of " + std::to_string(live) +
-                            " bytes, more than this device binds (" + std::to_string(kSplitParts) +
-                            " storage buffers of " + std::to_string(split_part_bytes(ctx_)) +
-                            " bytes)");
+  check_split_binding(ctx_, skip_live, "render: the scene's cell arena");
+  check_split_binding(ctx_, light_live, "render: the scene's lighting arena");
   bool whole = scene_ != &s || scene_id_ != s.id || synced_generation_.size() != chunks;
 
   // Device buffers as large as the host arenas' capacity, so growth is rare. A new scene gets

@@ -346,11 +346,7 @@ Buffer& VectorEngine::record_view(Recorder& rec, Buffer& texels, const VectorVie
   params.image = {view.width, view.height, bgra ? 1 : 0, static_cast<int>(split_part_shift(c_))};
   // The shader writes the image through split_buffer.h's windows.
   const VkDeviceSize pixel_bytes = static_cast<VkDeviceSize>(view.width) * view.height * 4;
-  if (pixel_bytes > split_capacity_bytes(c_))
-    throw InvalidArgument("render_vectors: the image's " + std::to_string(pixel_bytes) +
-                          " bytes of pixels are more than this device binds (" +
-                          std::to_string(kSplitParts) + " storage buffers of " +
-                          std::to_string(split_part_bytes(c_)) + " bytes)");
+  check_split_binding(c_, pixel_bytes, "render_vectors: the image");
   grow(view_, sizeof params, false);
   grow(pixels_, pixel_bytes, false);
   rec.update(view_, 0, &params, sizeof params);
