@@ -29,6 +29,10 @@ VF_CONST(uint, VF_UNIFORM, 0x80000000u);  // page-table entry flag: uniform chun
 VF_CONST(uint, VF_INF, 0xFFFFFFFFu);      // "no site" in cost buffers
 // Windows a buffer past one binding's range is bound as (shaders/split_buffer.glsl).
 VF_CONST(uint, VF_SPLIT_PARTS, 4u);
+// A slab's column neighbours (binding 20 of the exact transform): per column two words, the
+// nearest solid and the nearest air voxel beyond the slab, each packed as two int16 z offsets from
+// the slab's first slice (below | above << 16); this offset means "none on that side".
+VF_CONST(int, VF_NO_NEIGHBOUR, -32768);
 
 // Metrics, as in voxfield::Metric.
 VF_CONST(uint, VF_MANHATTAN, 0u);
@@ -98,12 +102,13 @@ struct PassParams {
   ivec4 box_size;
   ivec4 out_begin;  // encode: the voxels written (inside the compute box)
   ivec4 out_size;
-  uint axis;           // 0, 1, 2: the axis this pass's lines run along
-  uint sites_are_air;  // 1: sites are the air voxels (the inside half of a signed field)
-  uint src;            // cost buffer read by this pass (0, 1, 2)
-  uint dst;            // cost buffer written by this pass
-  uint src2;           // encode: the inside cost buffer of a signed field
-  uint pad0;
+  uint axis;               // 0, 1, 2: the axis this pass's lines run along
+  uint sites_are_air;      // 1: sites are the air voxels (the inside half of a signed field)
+  uint src;                // cost buffer read by this pass (0, 1, 2)
+  uint dst;                // cost buffer written by this pass
+  uint src2;               // encode: the inside cost buffer of a signed field
+  uint column_neighbours;  // 1: the domain goes on past the field's z faces (a slab of a larger
+                           // one): the z pass starts each column from its nearest sites there
   uint pad1;
   uint pad2;
 };

@@ -8,11 +8,14 @@
 #include <algorithm>
 #include <random>
 
+#include "slab_neighbours.h"
 #include "voxfield/distance_slab.h"
 #include "voxfield/error.h"
 
 namespace voxfield {
 namespace {
+
+using test::neighbours_of;
 
 struct Case {
   Metric metric;
@@ -28,29 +31,6 @@ std::vector<T> dense(const Grid<T>& g, const Box3i& box) {
   std::vector<T> v(static_cast<std::size_t>(box.volume()));
   g.copy_to_dense(box, v.data());
   return v;
-}
-
-// The neighbours of slab i: the nearest below is the highest of the slabs below, the nearest above
-// the lowest of the slabs above (the reductions voxfield-mpi runs over its ranks).
-SlabNeighbours neighbours_of(const std::vector<ColumnSites>& all, std::size_t i) {
-  const std::size_t n = all[i].lowest_solid.size();
-  SlabNeighbours s;
-  s.solid_below.assign(n, ColumnSites::kNoneHigh);
-  s.air_below.assign(n, ColumnSites::kNoneHigh);
-  s.solid_above.assign(n, ColumnSites::kNoneLow);
-  s.air_above.assign(n, ColumnSites::kNoneLow);
-  for (std::size_t j = 0; j < all.size(); ++j) {
-    for (std::size_t c = 0; c < n; ++c) {
-      if (j < i) {
-        s.solid_below[c] = std::max(s.solid_below[c], all[j].highest_solid[c]);
-        s.air_below[c] = std::max(s.air_below[c], all[j].highest_air[c]);
-      } else if (j > i) {
-        s.solid_above[c] = std::min(s.solid_above[c], all[j].lowest_solid[c]);
-        s.air_above[c] = std::min(s.air_above[c], all[j].lowest_air[c]);
-      }
-    }
-  }
-  return s;
 }
 
 void check_slabs(const Case& k, std::uint32_t seed, double density, int edge) {

@@ -4,6 +4,7 @@
 //   mpirun -np N voxfield-mpi field IN -o OUT.{npy,vdb} [--metric M] [--signed] [--max-distance D]
 //          [--storage S] [--spacing sx,sy,sz] [--sites S.npy] [--packed P.npy] [--stats S.json]
 //          [--chunk C] [--threads T] [--read every|rank0] [--grid G] [--memory-limit B]
+//          [--backend cpu|vulkan|auto]
 //   mpirun -np N voxfield-mpi edit IN -e EDITS.jsonl -o OUT.npy [field options] [--stats S.json]
 //          [--balance volume|content|edits] [--save-world W.vfw|W.npy] [--read every|rank0]
 //          [--grid G]
@@ -36,12 +37,14 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 
+#include "backend_option.h"
 #include "bench_world.h"
 #include "mesh_command.h"
 #include "rank_stats.h"
 #include "read_option.h"
 #include "render_command.h"
 #include "voxfield/distance.h"
+#include "voxfield/distance_executor.h"
 #include "voxfield/distance_slab.h"
 #include "voxfield/edit_script.h"
 #include "voxfield/error.h"
@@ -56,7 +59,7 @@ namespace {
 using namespace voxfield;
 
 struct FieldSettings {
-  std::string metric = "manhattan", storage = "f32";
+  std::string metric = "manhattan", storage = "f32", backend = "cpu";
   bool is_signed = false;
   double max_distance = 0;
   std::vector<double> spacing;
@@ -81,6 +84,7 @@ struct FieldSettings {
         ->check(CLI::IsMember({8, 16, 32, 64, 128}));
     cmd->add_option("--threads", threads, "threads per rank (default: all cores)")
         ->check(CLI::Range(1, 1024));
+    mpi_cli::add_backend_option(cmd, backend);
   }
   DistanceOptions options() const {
     DistanceOptions o;
@@ -91,8 +95,12 @@ struct FieldSettings {
     if (!spacing.empty()) o.spacing = {spacing[0], spacing[1], spacing[2]};
     return o;
   }
-  nlohmann::json describe(const DistanceOptions& o, Vec3i dims, int ranks) const {
+  // Collective (the devices' counters are summed over the ranks).
+  nlohmann::json describe(MPI_Comm comm, const DistanceOptions& o, Vec3i dims, int ranks,
+                          const Executor& executor) const {
     return {{"metric", metric_name(o.metric)},
+            {"backend", executor.on_gpu() ? "vulkan" : "cpu"},
+            {"gpu", mpi_cli::gpu_json_over(comm, executor)},
             {"signed", o.signed_distance},
             {"max_distance", o.max_distance},
             {"storage", storage_name(o.storage)},
@@ -123,6 +131,7 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
   const bool vdb_output = out_ext == ".vdb";
   // Everything that can be wrong with the outputs is found before the world is loaded.
   mpi::check_outputs(comm, {out, sites, packed}, {stats}, {in});
+  const Executor executor = mpi_cli::choose_rank_executor(comm, f.backend);
   const double t0 = MPI_Wtime();
   const mpi::WorldSlab slab =
       mpi::load_world_slab(comm, in, f.chunk, 0, mpi_cli::slab_read_options(f.read));
@@ -145,11 +154,11 @@ int run_field(MPI_Comm comm, const FieldSettings& f, const std::string& in, cons
   MPI_Barrier(comm);  // the field's time starts together on every rank
   const double t1 = MPI_Wtime();
   DistanceField field =
-      mpi::compute_distance_field(comm, slab.partition, slab.world.voxels, o, &ex);
+      mpi::compute_distance_field(comm, slab.partition, slab.world, o, executor, &ex);
   field.frame = slab.world.frame;  // where a .vdb places it
   const double field_ms = max_over(comm, (MPI_Wtime() - t1) * 1e3);
   const Box3i& domain = slab.partition.domain;
-  nlohmann::json j = f.describe(o, domain.size(), size);
+  nlohmann::json j = f.describe(comm, o, domain.size(), size, executor);
   j.update(nlohmann::json{{"algorithm", "exact"},
                           {"ms", field_ms},
                           {"mvox_per_s", static_cast<double>(domain.volume()) / (field_ms * 1e3)},
@@ -243,8 +252,9 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
     return mpi::load_world_slab(comm, in, f.chunk, ghost, read);
   }();
   const double load_ms = max_over(comm, (MPI_Wtime() - l0) * 1e3);
+  const Executor executor = mpi_cli::choose_rank_executor(comm, f.backend);
   const double t0 = MPI_Wtime();
-  mpi::SlabEditor editor(comm, slab.partition, slab.world, o);
+  mpi::SlabEditor editor(comm, slab.partition, slab.world, o, executor);
   slab.world = World();  // the editor holds its own copy
   const double build_ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
   // Local work only: a failure on one rank is agreed on after the loop.
@@ -274,7 +284,7 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   // The ranks run through the script without waiting for each other: the stream takes as long as
   // the rank with the most work.
   const double stream_ms = max_over(comm, std::accumulate(edit_ms.begin(), edit_ms.end(), 0.0));
-  nlohmann::json j = f.describe(o, slab.partition.domain.size(), size);
+  nlohmann::json j = f.describe(comm, o, slab.partition.domain.size(), size, executor);
   j.update(nlohmann::json{
       {"load_ms", load_ms},
       {"build_ms", build_ms},
@@ -338,6 +348,7 @@ int run_bench(MPI_Comm comm, const FieldSettings& f, const std::vector<int>& dim
   const DistanceOptions o = f.options();
   const Box3i domain = Box3i::from_size({dims[0], dims[1], dims[2]});
   const mpi::SlabPartition partition = mpi::partition_slabs(domain, size, f.chunk);
+  const Executor executor = mpi_cli::choose_rank_executor(comm, f.backend);
   const World world = mpi::collectively(comm, [&] {
     return mpi_bench::sphere_world_slab(domain, partition.slab(rank), spheres, f.chunk);
   });
@@ -345,9 +356,10 @@ int run_bench(MPI_Comm comm, const FieldSettings& f, const std::vector<int>& dim
     mpi::ExchangeStats ex;
     MPI_Barrier(comm);
     const double t0 = MPI_Wtime();
-    const DistanceField field = mpi::compute_distance_field(comm, partition, world.voxels, o, &ex);
+    const DistanceField field =
+        mpi::compute_distance_field(comm, partition, world, o, executor, &ex);
     const double ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
-    nlohmann::json j = f.describe(o, domain.size(), size);
+    nlohmann::json j = f.describe(comm, o, domain.size(), size, executor);
     j.update(nlohmann::json{
         {"run", r},
         {"ms", ms},

@@ -10,6 +10,7 @@
 
 #include "voxfield/algorithms.h"
 #include "voxfield/distance.h"
+#include "voxfield/distance_slab.h"
 #include "voxfield/dynamic_field.h"
 #include "voxfield/gpu.h"
 #include "voxfield/gpu_distance.h"
@@ -23,6 +24,14 @@ DistanceField compute_distance_field(const Executor& executor, const World& worl
                                      const DistanceOptions& options,
                                      const AlgorithmOptions& algorithm = {},
                                      AlgorithmStats* stats = nullptr);
+
+// The slab [z0, z1) of the exact field of the whole domain options.domain, from the slab's own
+// voxels and the nearest sites beyond it (distance_slab.h), on `executor`: the slabs of a field
+// split over an MPI job's processes (mpi.h), each on its own process's backend. Throws as
+// compute_slab_distance_field (distance_slab.h) or its GPU half (gpu_distance.h) does.
+DistanceField compute_slab_distance_field(const Executor& executor, const World& world,
+                                          const DistanceOptions& options, std::int32_t z0,
+                                          std::int32_t z1, const SlabNeighbours& neighbours);
 
 // A distance field that follows its world through edits, on the CPU (DynamicDistanceField) or
 // resident on a device (gpu::DynamicField) — one type for both, so an application, the CLI and the

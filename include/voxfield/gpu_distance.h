@@ -8,6 +8,7 @@
 
 #include "voxfield/algorithms.h"
 #include "voxfield/distance.h"
+#include "voxfield/distance_slab.h"
 #include "voxfield/dynamic_field.h"
 #include "voxfield/gpu.h"
 
@@ -24,6 +25,19 @@ namespace voxfield::gpu {
 DistanceField compute_distance_field(Context& context, const World& world,
                                      const DistanceOptions& options,
                                      std::vector<PassTiming>* timings = nullptr);
+
+// The slab [z0, z1) of the exact field of the whole domain options.domain (required), from the
+// slab's own voxels of `world` and the nearest sites beyond it, `neighbours`: what
+// voxfield::compute_slab_distance_field (distance_slab.h) gives, on the GPU, with the agreement
+// stated above — so the slabs of a field split over the processes of an MPI job (mpi.h) can each
+// be computed on a process's own device. The device holds the slab's world, field and work
+// buffers alone (an unclamped slab must fit one work buffer: InvalidArgument otherwise). Throws
+// InvalidArgument as the CPU's function does for a missing domain, a slab outside it or bad
+// neighbours, and as compute_distance_field(Context&...) does for the rest.
+DistanceField compute_slab_distance_field(Context& context, const World& world,
+                                          const DistanceOptions& options, std::int32_t z0,
+                                          std::int32_t z1, const SlabNeighbours& neighbours,
+                                          std::vector<PassTiming>* timings = nullptr);
 
 // One of the dissertation's algorithms on the GPU: kExact (as above); jump flooding — kJfaSeed,
 // kJfa, kJfa1, kJfa2 — bit-identical to the CPU's (same passes, same tie rule, one command buffer

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "voxfield/distance.h"
+#include "voxfield/distance_executor.h"
 #include "voxfield/dynamic_field.h"
 #include "voxfield/edit.h"
 #include "voxfield/error.h"
@@ -134,6 +135,16 @@ DistanceField compute_distance_field(MPI_Comm comm, const SlabPartition& partiti
                                      const DistanceOptions& options,
                                      ExchangeStats* stats = nullptr);
 
+// The same field with each rank's slab computed on `executor`: that rank's own device (each
+// process of a job on a GPU node takes its own Executor) or the CPU
+// (compute_slab_distance_field in distance_executor.h). `world` holds this rank's slab. Equal to
+// the CPU's as the GPU's fields are (gpu_distance.h): bit for bit in integer storage. A rank whose
+// device refuses the options (a work buffer it cannot bind, anisotropic spacing) fails every rank
+// with its message.
+DistanceField compute_distance_field(MPI_Comm comm, const SlabPartition& partition,
+                                     const World& world, const DistanceOptions& options,
+                                     const Executor& executor, ExchangeStats* stats = nullptr);
+
 // Edits. Every rank applies every edit (an edit script or a seeded stream is small, and the same on
 // all ranks) to its slab and to `edit_ghost_slices` slices on either side, and updates its own
 // incremental field (dynamic_field.h) over that box: a clamped value depends only on sites within
@@ -160,9 +171,10 @@ std::vector<double> edit_unit_weights(const Box3i& domain, int align,
 class SlabEditor {
  public:
   // `world` must hold the partition's slab of this rank grown by edit_ghost_slices along z (clipped
-  // to the domain); what lies beyond is not read. The field is computed over that box.
+  // to the domain); what lies beyond is not read. The field is computed over that box, on
+  // `executor` (this rank's device or the CPU: an IncrementalDistanceField, distance_executor.h).
   SlabEditor(MPI_Comm comm, const SlabPartition& partition, const World& world,
-             const DistanceOptions& options);
+             const DistanceOptions& options, const Executor& executor = {});
   SlabEditor(const SlabEditor&) = delete;  // the field is bound to the world it holds
   SlabEditor& operator=(const SlabEditor&) = delete;
 
@@ -197,8 +209,9 @@ class SlabEditor {
   World world_;
   SlabPartition partition_;
   DistanceOptions options_;
-  std::unique_ptr<DynamicDistanceField> field_;  // a clamped field, kept by apply()
-  std::optional<DistanceField> whole_;           // an unclamped one, kept by refresh()
+  Executor executor_;
+  std::unique_ptr<IncrementalDistanceField> field_;  // a clamped field, kept by apply()
+  std::optional<DistanceField> whole_;               // an unclamped one, kept by refresh()
   bool stale_ = false;
   DirtyRegions dirty_;
 };

@@ -14,6 +14,14 @@ DistanceField compute_distance_field(const Executor& executor, const World& worl
   return compute_distance_field(world, options, algorithm, stats);
 }
 
+DistanceField compute_slab_distance_field(const Executor& executor, const World& world,
+                                          const DistanceOptions& options, std::int32_t z0,
+                                          std::int32_t z1, const SlabNeighbours& neighbours) {
+  if (executor.on_gpu())
+    return gpu::compute_slab_distance_field(*executor.device(), world, options, z0, z1, neighbours);
+  return compute_slab_distance_field(world.voxels, options, z0, z1, neighbours);
+}
+
 IncrementalDistanceField::IncrementalDistanceField(const Executor& executor, const World& world,
                                                    DistanceOptions options)
     : executor_(executor) {

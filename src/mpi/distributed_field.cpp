@@ -11,6 +11,7 @@
 #include <chrono>
 
 #include "collective.h"
+#include "voxfield/distance_executor.h"
 #include "voxfield/distance_slab.h"
 #include "voxfield/mpi.h"
 
@@ -46,57 +47,89 @@ void exclusive_scan(MPI_Comm comm, std::vector<std::int32_t>& values, MPI_Op op,
   values.swap(out);
 }
 
+// Every rank's neighbours beyond its slab: its own extremes, packed for the two scans — [highest
+// solid | highest air] and [lowest solid | lowest air] — then scanned over the ranks below it and
+// (in reverse order) above it. The packed arrays die before the transform: at 8192^2 columns each
+// is half a gigabyte.
+SlabNeighbours exchange_neighbours(MPI_Comm comm, const SlabPartition& partition,
+                                   const Grid<std::uint8_t>& occupancy, ExchangeStats* stats) {
+  int rank = 0, size = 0;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  const auto t0 = std::chrono::steady_clock::now();
+  SlabNeighbours neighbours;
+  std::vector<std::int32_t> below, above;
+  detail::collectively(comm, stats, [&] {
+    detail::require_partition(comm, partition);
+    const Box3i slab = partition.slab(rank);
+    ColumnSites own = slab_column_sites(occupancy, partition.domain, slab.begin.z, slab.end.z);
+    below = std::move(own.highest_solid);
+    below.insert(below.end(), own.highest_air.begin(), own.highest_air.end());
+    above = std::move(own.lowest_solid);
+    above.insert(above.end(), own.lowest_air.begin(), own.lowest_air.end());
+  });
+  if (stats) stats->compute_ms += detail::ms_since(t0);
+  const std::size_t n = below.size() / 2;
+  exclusive_scan(comm, below, MPI_MAX, ColumnSites::kNoneHigh, stats);
+  // The slabs above: the same scan over the ranks in reverse order.
+  MPI_Comm reversed = MPI_COMM_NULL;
+  MPI_Comm_split(comm, 0, size - 1 - rank, &reversed);
+  exclusive_scan(reversed, above, MPI_MIN, ColumnSites::kNoneLow, stats);
+  MPI_Comm_free(&reversed);
+  // (Agreed on too: a rank that cannot hold its neighbours would leave the others in the
+  // transform's agreement.)
+  detail::collectively(comm, stats, [&] {
+    const auto half = static_cast<std::ptrdiff_t>(n);
+    neighbours.solid_below.assign(below.begin(), below.begin() + half);
+    neighbours.air_below.assign(below.begin() + half, below.end());
+    neighbours.solid_above.assign(above.begin(), above.begin() + half);
+    neighbours.air_above.assign(above.begin() + half, above.end());
+  });
+  return neighbours;
+}
+
+// This rank's slab from its neighbours, by `transform` (the CPU's or an executor's), failures
+// agreed on.
+template <class Transform>
+DistanceField slab_field(MPI_Comm comm, const SlabPartition& partition,
+                         const Grid<std::uint8_t>& occupancy, ExchangeStats* stats,
+                         Transform&& transform) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  const SlabNeighbours neighbours = exchange_neighbours(comm, partition, occupancy, stats);
+  const auto t1 = std::chrono::steady_clock::now();
+  DistanceField field = detail::collectively(comm, stats, [&] {
+    const Box3i slab = partition.slab(rank);
+    return transform(slab.begin.z, slab.end.z, neighbours);
+  });
+  if (stats) stats->compute_ms += detail::ms_since(t1);
+  return field;
+}
+
 }  // namespace
 
 DistanceField compute_distance_field(MPI_Comm comm, const SlabPartition& partition,
                                      const Grid<std::uint8_t>& occupancy,
                                      const DistanceOptions& options, ExchangeStats* stats) {
-  int rank = 0, size = 0;
-  MPI_Comm_rank(comm, &rank);
-  MPI_Comm_size(comm, &size);
   DistanceOptions o = options;
   o.domain = partition.domain;
-  const auto t0 = std::chrono::steady_clock::now();
-  // This rank's extremes, packed for the two scans — [highest solid | highest air] and [lowest
-  // solid | lowest air] — then scanned into the neighbours. The packed arrays die before the
-  // transform: at 8192^2 columns each is half a gigabyte.
-  SlabNeighbours neighbours;
-  {
-    std::vector<std::int32_t> below, above;
-    detail::collectively(comm, stats, [&] {
-      detail::require_partition(comm, partition);
-      const Box3i slab = partition.slab(rank);
-      ColumnSites own = slab_column_sites(occupancy, partition.domain, slab.begin.z, slab.end.z);
-      below = std::move(own.highest_solid);
-      below.insert(below.end(), own.highest_air.begin(), own.highest_air.end());
-      above = std::move(own.lowest_solid);
-      above.insert(above.end(), own.lowest_air.begin(), own.lowest_air.end());
-    });
-    if (stats) stats->compute_ms += detail::ms_since(t0);
-    const std::size_t n = below.size() / 2;
-    exclusive_scan(comm, below, MPI_MAX, ColumnSites::kNoneHigh, stats);
-    // The slabs above: the same scan over the ranks in reverse order.
-    MPI_Comm reversed = MPI_COMM_NULL;
-    MPI_Comm_split(comm, 0, size - 1 - rank, &reversed);
-    exclusive_scan(reversed, above, MPI_MIN, ColumnSites::kNoneLow, stats);
-    MPI_Comm_free(&reversed);
-    // (Agreed on too: a rank that cannot hold its neighbours would leave the others in the
-    // transform's agreement.)
-    detail::collectively(comm, stats, [&] {
-      const auto half = static_cast<std::ptrdiff_t>(n);
-      neighbours.solid_below.assign(below.begin(), below.begin() + half);
-      neighbours.air_below.assign(below.begin() + half, below.end());
-      neighbours.solid_above.assign(above.begin(), above.begin() + half);
-      neighbours.air_above.assign(above.begin() + half, above.end());
-    });
-  }
-  const auto t1 = std::chrono::steady_clock::now();
-  DistanceField field = detail::collectively(comm, stats, [&] {
-    const Box3i slab = partition.slab(rank);
-    return compute_slab_distance_field(occupancy, o, slab.begin.z, slab.end.z, neighbours);
-  });
-  if (stats) stats->compute_ms += detail::ms_since(t1);
-  return field;
+  return slab_field(comm, partition, occupancy, stats,
+                    [&](std::int32_t z0, std::int32_t z1, const SlabNeighbours& n) {
+                      return compute_slab_distance_field(occupancy, o, z0, z1, n);
+                    });
+}
+
+DistanceField compute_distance_field(MPI_Comm comm, const SlabPartition& partition,
+                                     const World& world, const DistanceOptions& options,
+                                     const Executor& executor, ExchangeStats* stats) {
+  DistanceOptions o = options;
+  o.domain = partition.domain;
+  return slab_field(comm, partition, world.voxels, stats,
+                    [&](std::int32_t z0, std::int32_t z1, const SlabNeighbours& n) {
+                      DistanceField f = compute_slab_distance_field(executor, world, o, z0, z1, n);
+                      f.frame = world.frame;
+                      return f;
+                    });
 }
 
 }  // namespace voxfield::mpi

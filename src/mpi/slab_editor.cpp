@@ -3,8 +3,9 @@
 // With clamp D, a voxel's value depends only on the sites within D (docs/distance.md, "Exactness
 // with a clamp"): the sites within D of a slab lie within ceil(D / spacing_z) slices of it. So each
 // rank keeps its slab and that many ghost slices on either side as a bounded world, applies every
-// edit clipped to that box, and lets its own DynamicDistanceField follow: over the slab its values
-// are the whole field's (the ghost slices' values are not, and are never handed out).
+// edit clipped to that box, and lets its own incremental field follow (on its executor: the CPU's
+// DynamicDistanceField or its device's): over the slab its values are the whole field's (the ghost
+// slices' values are not, and are never handed out).
 //
 // An unclamped f32 value may depend on any voxel of the domain, so no finite ghost holds what an
 // edit reaches: each rank keeps its slab alone, edits change its materials, and refresh() runs the
@@ -48,9 +49,10 @@ std::vector<double> edit_unit_weights(const Box3i& domain, int align,
 }
 
 SlabEditor::SlabEditor(MPI_Comm comm, const SlabPartition& partition, const World& world,
-                       const DistanceOptions& options)
+                       const DistanceOptions& options, const Executor& executor)
     : partition_(partition),
       options_(options),
+      executor_(executor),
       dirty_(world.voxels.chunk_edge(), DirtyRegions::Track::kOccupancy) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
@@ -74,7 +76,7 @@ SlabEditor::SlabEditor(MPI_Comm comm, const SlabPartition& partition, const Worl
     if (unclamped) return;
     DistanceOptions o = options;
     o.domain = box_;
-    field_ = std::make_unique<DynamicDistanceField>(world_, o);
+    field_ = std::make_unique<IncrementalDistanceField>(executor_, world_, o);
   });
 }
 
@@ -106,7 +108,7 @@ bool SlabEditor::refresh(MPI_Comm comm, ExchangeStats* stats, std::int64_t* voxe
   }
   if (any == 0 && whole_) return false;
   whole_.reset();  // let go of the old field before the new one is built
-  whole_ = compute_distance_field(comm, partition_, world_.voxels, options_, stats);
+  whole_ = compute_distance_field(comm, partition_, world_, options_, executor_, stats);
   stale_ = false;
   if (voxels) *voxels = slab_.volume();
   return true;

@@ -78,13 +78,10 @@ ColumnSites slab_column_sites(const Grid<std::uint8_t>& occupancy, const Box3i& 
   return out;
 }
 
-DistanceField compute_slab_distance_field(const Grid<std::uint8_t>& occupancy,
-                                          const DistanceOptions& options, std::int32_t z0,
-                                          std::int32_t z1, const SlabNeighbours& neighbours) {
-  if (!options.domain || options.domain->empty())
-    throw InvalidArgument("a slab's field needs the whole field's domain (options.domain)");
-  const Box3i domain = *options.domain;
-  const Box3i slab = slab_of(domain, z0, z1);
+namespace detail::exact {
+
+Box3i check_slab_neighbours(const Box3i& domain, std::int32_t z0, std::int32_t z1,
+                            const SlabNeighbours& neighbours) {
   const std::size_t columns =
       static_cast<std::size_t>(domain.size().x) * static_cast<std::size_t>(domain.size().y);
   for (const auto* a : {&neighbours.solid_below, &neighbours.air_below, &neighbours.solid_above,
@@ -93,7 +90,6 @@ DistanceField compute_slab_distance_field(const Grid<std::uint8_t>& occupancy,
       throw InvalidArgument("slab neighbours: " + std::to_string(a->size()) +
                             " columns given, the domain has " + std::to_string(columns));
   }
-  const detail::FieldPlan plan = detail::make_field_plan(occupancy, options, &slab);
   // A neighbour must lie in the domain on its side of the slab: anything else would be a distance
   // of the wrong sign.
   auto check = [&](const std::vector<std::int32_t>& a, bool below, const char* what) {
@@ -111,6 +107,21 @@ DistanceField compute_slab_distance_field(const Grid<std::uint8_t>& occupancy,
   check(neighbours.air_below, true, "an air voxel");
   check(neighbours.solid_above, false, "a solid voxel");
   check(neighbours.air_above, false, "an air voxel");
+  return slab_of(domain, z0, z1);
+}
+
+}  // namespace detail::exact
+
+DistanceField compute_slab_distance_field(const Grid<std::uint8_t>& occupancy,
+                                          const DistanceOptions& options, std::int32_t z0,
+                                          std::int32_t z1, const SlabNeighbours& neighbours) {
+  if (!options.domain || options.domain->empty())
+    throw InvalidArgument("a slab's field needs the whole field's domain (options.domain)");
+  const Box3i domain = *options.domain;
+  const Box3i slab = slab_of(domain, z0, z1);
+  // The plan first: it refuses a slab outside the domain before the neighbours are read.
+  const detail::FieldPlan plan = detail::make_field_plan(occupancy, options, &slab);
+  detail::exact::check_slab_neighbours(domain, z0, z1, neighbours);
   const detail::exact::ColumnsBeyond beyond{
       neighbours.solid_below.data(), neighbours.air_below.data(), neighbours.solid_above.data(),
       neighbours.air_above.data()};

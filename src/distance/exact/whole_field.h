@@ -4,6 +4,7 @@
 #pragma once
 
 #include "chunk_rows.h"
+#include "voxfield/distance_slab.h"
 #include "z_pass.h"
 
 namespace voxfield::detail::exact {
@@ -13,5 +14,10 @@ namespace voxfield::detail::exact {
 // solvers' arithmetic (32-bit squared distances when its diagonal allows).
 DistanceField compute_exact_field(const Grid<std::uint8_t>& occupancy, const DistanceOptions& o,
                                   const Plan& p, const ColumnsBeyond* beyond, Vec3i solver_extent);
+
+// Checks a slab's neighbours against the whole `domain` and the slab [z0, z1) (distance_slab.h's
+// rules, InvalidArgument otherwise) and returns the slab's box. Both backends' slab fields use it.
+Box3i check_slab_neighbours(const Box3i& domain, std::int32_t z0, std::int32_t z1,
+                            const SlabNeighbours& neighbours);
 
 }  // namespace voxfield::detail::exact

@@ -17,8 +17,10 @@
 #include <cmath>
 #include <cstring>
 
+#include "../exact/whole_field.h"
 #include "../incremental/update_regions.h"
 #include "distance_shaders.h"
+#include "field_encoding.h"
 #include "gpu/recorder.h"
 #include "gpu/split_buffer.h"
 #include "resident_world.h"
@@ -29,73 +31,12 @@ namespace voxfield::gpu {
 namespace {
 
 namespace L = layout;
+using namespace detail_encoding;
 
 constexpr int kMaxExtent = 16384;  // keeps every cost of the passes within 31 bits
 constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT |
                                         VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-
-template <class T>
-std::uint32_t bits(T value) {
-  std::uint32_t b = 0;
-  std::memcpy(&b, &value, sizeof(T));
-  return b;
-}
-
-template <class T>
-void set_encoding(L::Header& h, const detail::FieldPlan& plan) {
-  h.clamp_pos = bits(detail::encode_distance<T>(plan.clamp, plan));
-  h.clamp_neg = bits(detail::encode_distance<T>(-plan.clamp, plan));
-  h.none_pos = bits(detail::encode_distance<T>(std::numeric_limits<double>::infinity(), plan));
-  h.none_neg = bits(detail::encode_distance<T>(-std::numeric_limits<double>::infinity(), plan));
-}
-
-// The smallest cost whose distance is at or beyond the clamp, with the CPU's own comparison
-// (d < clamp, d = sqrt(cost) for Euclidean).
-std::uint32_t clamp_cost(const detail::FieldPlan& plan) {
-  if (!std::isfinite(plan.clamp)) return L::VF_INF;
-  auto distance = [&](double cost) {
-    return plan.metric == Metric::kEuclidean ? std::sqrt(cost) : cost;
-  };
-  double c = std::ceil(plan.metric == Metric::kEuclidean ? plan.clamp * plan.clamp : plan.clamp);
-  while (c > 0 && distance(c - 1) >= plan.clamp) c -= 1;
-  while (distance(c) < plan.clamp) c += 1;
-  return static_cast<std::uint32_t>(std::min<double>(c, L::VF_INF - 1.0));
-}
-
-// Values of T per word of the resident field (u8: 4, u16: 2, f32: 1).
-std::size_t lanes_of(Storage s) {
-  return s == Storage::kU8 ? 4 : s == Storage::kU16 ? 2 : 1;
-}
-
-// Voxels per stored row: x padded to whole words.
-int row_pitch(const detail::FieldPlan& plan, Storage s) {
-  const int lanes = static_cast<int>(lanes_of(s));
-  return (plan.domain.size().x + lanes - 1) / lanes * lanes;
-}
-
-// The field from the resident buffer's bytes: rows of row_pitch() values of T, packed.
-template <class T>
-DistanceField build_field(const World& world, const DistanceOptions& options,
-                          const detail::FieldPlan& plan, const std::uint8_t* stored) {
-  DistanceField out;
-  out.options = options;
-  out.domain = plan.domain;
-  out.encoding = plan.encoding;
-  Grid<T> values(world.voxels.chunk_edge(), detail::field_background<T>(plan),
-                 world.voxels.bounds());
-  const Vec3i n = plan.domain.size();
-  const std::size_t pitch = static_cast<std::size_t>(row_pitch(plan, options.storage));
-  std::vector<T> dense(static_cast<std::size_t>(plan.domain.volume()));
-  for (std::size_t row = 0; row < static_cast<std::size_t>(n.y) * n.z;
-       ++row)  // little-endian lanes: bytes in x order
-    std::memcpy(&dense[row * n.x], stored + row * pitch * sizeof(T),
-                static_cast<std::size_t>(n.x) * sizeof(T));
-  values.copy_from_dense(plan.domain, dense.data());
-  values.compact();
-  out.values = std::move(values);
-  return out;
-}
 
 }  // namespace
 
@@ -135,26 +76,30 @@ struct WorkBuffers {
 class FieldEngine {
  public:
   // Keeps its own resident world, or rides on `shared` (another field's, over the same chunks),
-  // which its runs then neither upload to nor grow.
+  // which its runs then neither upload to nor grow. With `slab`, the field is that slab of the
+  // domain options.domain (distance_slab.h): the resident field covers the slab alone, and
+  // set_column_neighbours() says what lies beyond it.
   FieldEngine(Context::Impl& ctx, const World& world, const DistanceOptions& options,
               std::shared_ptr<ResidentWorld> shared = nullptr,
-              std::shared_ptr<WorkBuffers> work = nullptr)
+              std::shared_ptr<WorkBuffers> work = nullptr, const Box3i* slab = nullptr)
       : ctx_(ctx),
         kernels_{ctx.kernel(shaders::edt_sites()), ctx.kernel(shaders::edt_lines()),
                  ctx.kernel(shaders::edt_encode())},
         world_(world),
         options_(options),
-        plan_(detail::make_field_plan(world.voxels, options)) {
-    if (options.nearest_sites && (plan_.domain.size().x > 32767 || plan_.domain.size().y > 32767 ||
-                                  plan_.domain.size().z > 32767))
-      throw InvalidArgument("GPU: nearest sites need a domain of at most 32767 voxels per axis");
+        plan_(detail::make_field_plan(world.voxels, options, slab)) {
     if (!plan_.unit_spacing)
       throw InvalidArgument("GPU: the Vulkan backend supports unit voxel spacing only");
     if (plan_.domain.empty()) throw InvalidArgument("GPU: the field's domain is empty");
-    const Vec3i n = plan_.domain.size();
-    if (n.x > kMaxExtent || n.y > kMaxExtent || n.z > kMaxExtent)
-      throw InvalidArgument("GPU: domain " + to_string(plan_.domain) + " exceeds " +
+    // A slab's costs and site offsets span the whole domain.
+    const Box3i whole = slab ? *options.domain : plan_.domain;
+    const Vec3i extent = whole.size();
+    if (options.nearest_sites && (extent.x > 32767 || extent.y > 32767 || extent.z > 32767))
+      throw InvalidArgument("GPU: nearest sites need a domain of at most 32767 voxels per axis");
+    if (extent.x > kMaxExtent || extent.y > kMaxExtent || extent.z > kMaxExtent)
+      throw InvalidArgument("GPU: domain " + to_string(whole) + " exceeds " +
                             std::to_string(kMaxExtent) + " voxels along an axis");
+    const Vec3i n = plan_.domain.size();
     // Packed as stored on the CPU (1, 2 or 4 bytes per voxel), rows padded to whole words.
     field_bytes_ = static_cast<VkDeviceSize>(n.y) * n.z *
                    static_cast<VkDeviceSize>(row_pitch(plan_, options.storage)) *
@@ -179,6 +124,30 @@ class FieldEngine {
     header_buf_ = Buffer(ctx, sizeof header_, kStorage, false);
     field_buf_ = Buffer(ctx, field_bytes_, kStorage, false);
     field_sites_buf_ = Buffer(ctx, std::max<VkDeviceSize>(site_bytes_, 16), kStorage, false);
+    neighbours_buf_ = Buffer(ctx, 16, kStorage, false);
+  }
+
+  // The nearest solid and air voxels beyond the slab's z faces, per column (distance_slab.h; the
+  // caller has checked them): uploaded by the next run, read by every z pass whose box reaches a
+  // face. Offsets from the slab's first slice fit int16, as the whole domain's extent does.
+  void set_column_neighbours(const SlabNeighbours& n) {
+    const std::size_t columns = n.solid_below.size();
+    const VkDeviceSize bytes = std::max<VkDeviceSize>(columns * 8, 16);
+    check_whole_binding(
+        ctx_, bytes, "GPU: the column neighbours of a " + to_string(plan_.domain.size()) + " slab");
+    const std::int32_t z0 = plan_.domain.begin.z;
+    auto pack = [&](std::int32_t below, std::int32_t above) {
+      const std::int32_t b = below == ColumnSites::kNoneHigh ? L::VF_NO_NEIGHBOUR : below - z0;
+      const std::int32_t a = above == ColumnSites::kNoneLow ? L::VF_NO_NEIGHBOUR : above - z0;
+      return (static_cast<std::uint32_t>(b) & 0xFFFFu) | (static_cast<std::uint32_t>(a) << 16);
+    };
+    neighbour_words_.resize(2 * columns);
+    for (std::size_t c = 0; c < columns; ++c) {
+      neighbour_words_[2 * c] = pack(n.solid_below[c], n.solid_above[c]);
+      neighbour_words_[2 * c + 1] = pack(n.air_below[c], n.air_above[c]);
+    }
+    neighbours_buf_ = Buffer(ctx_, bytes, kStorage, false);
+    column_neighbours_ = true;
   }
 
   const detail::FieldPlan& plan() const { return plan_; }
@@ -276,6 +245,10 @@ class FieldEngine {
       const VkDeviceSize at = up.add(&header_, sizeof header_);
       header_copy_ = VkBufferCopy{at, 0, sizeof header_};
     }
+    if (!neighbour_words_.empty()) {
+      const VkDeviceSize bytes = neighbour_words_.size() * 4;
+      neighbours_copy_ = VkBufferCopy{up.add(neighbour_words_.data(), bytes), 0, bytes};
+    }
     // The work buffers first: a region too large for them is refused before anything changes.
     VkDeviceSize largest = 4;
     for (const auto& r : regions)
@@ -300,12 +273,16 @@ class FieldEngine {
         first_run_ ? std::span<const VkBufferCopy>(&header_copy_, 1)
                    : std::span<const VkBufferCopy>();
     resident_->record(rec, upload, uploads, &header_buf_, header);
+    if (!neighbour_words_.empty()) {
+      rec.copy(upload, neighbours_buf_, std::span(&neighbours_copy_, 1));
+      neighbour_words_.clear();  // on the device now
+    }
     first_run_ = false;
   }
 
   // Step 3, one region's passes: recompute its compute box, encode its out box into the field.
   void record_region(Recorder& rec, const detail::UpdateRegion& r, bool timed) {
-    const std::array<Binding, 20> bound = bindings();
+    const std::array<Binding, 21> bound = bindings();
     const auto pass = [&](const Kernel& kernel, const L::PassParams& t, std::uint64_t invocations,
                           std::string name) {
       const int ticket = timed ? rec.begin_pass() : -1;
@@ -318,6 +295,7 @@ class FieldEngine {
     pp.box_size = {n.x, n.y, n.z, 0};
     pp.out_begin = {r.out.begin.x, r.out.begin.y, r.out.begin.z, 0};
     pp.out_size = {r.out.size().x, r.out.size().y, r.out.size().z, 0};
+    pp.column_neighbours = column_neighbours_ ? 1u : 0u;
     // One separable transform: sites along z into `result`, then x and y through `other` —
     // the CPU's order, so that nearest sites break ties the same way (docs/distance.md).
     auto transform = [&](std::uint32_t result, std::uint32_t other, bool to_air) {
@@ -404,22 +382,23 @@ class FieldEngine {
 
   // The exact transform's binding plan (shaders/layout.h), the same for its three kernels.
   // The brick pool, the field and its sites in split_buffer.h's windows: the first at its own
-  // binding, the other three from binding 11 on.
-  std::array<Binding, 20> bindings() {
+  // binding, the other three from binding 11 on; a slab's column neighbours at 20.
+  std::array<Binding, 21> bindings() {
     WorkBuffers& w = *work_;
     const auto bricks = split_bindings(resident_->bricks(), ctx_);
     const auto field = split_bindings(field_buf_, ctx_);
     const auto sites = split_bindings(field_sites_buf_, ctx_);
-    return {&header_buf_, &resident_->pages(),
-            bricks[0],    &w.cost[0],
-            &w.cost[1],   &w.cost[2],
-            &w.scratch_s, &w.scratch_t,
-            field[0],     &w.sites,
-            sites[0],     bricks[1],
-            bricks[2],    bricks[3],
-            field[1],     field[2],
-            field[3],     sites[1],
-            sites[2],     sites[3]};
+    return {&header_buf_,    &resident_->pages(),
+            bricks[0],       &w.cost[0],
+            &w.cost[1],      &w.cost[2],
+            &w.scratch_s,    &w.scratch_t,
+            field[0],        &w.sites,
+            sites[0],        bricks[1],
+            bricks[2],       bricks[3],
+            field[1],        field[2],
+            field[3],        sites[1],
+            sites[2],        sites[3],
+            &neighbours_buf_};
   }
 
   Context::Impl& ctx_;
@@ -444,6 +423,11 @@ class FieldEngine {
   // submitted and waited for one at a time).
   std::shared_ptr<WorkBuffers> work_;
   Buffer header_buf_, field_buf_, field_sites_buf_;
+  // A slab's column neighbours: staged by the next run, then on the device alone.
+  Buffer neighbours_buf_;
+  std::vector<std::uint32_t> neighbour_words_;
+  VkBufferCopy neighbours_copy_{};
+  bool column_neighbours_ = false;
 };
 
 DistanceField compute_distance_field(Context& context, const World& world,
@@ -458,6 +442,24 @@ DistanceField compute_distance_field(Context& context, const World& world,
   FieldEngine engine(context.impl(), world, options);
   engine.run(engine.all_chunks(), engine.parts({{plan.domain, plan.domain}}), /*download=*/true,
              timings);
+  DistanceField f = engine.read_back();
+  f.frame = world.frame;
+  return f;
+}
+
+DistanceField compute_slab_distance_field(Context& context, const World& world,
+                                          const DistanceOptions& options, std::int32_t z0,
+                                          std::int32_t z1, const SlabNeighbours& neighbours,
+                                          std::vector<PassTiming>* timings) {
+  if (!options.domain || options.domain->empty())
+    throw InvalidArgument("a slab's field needs the whole field's domain (options.domain)");
+  const Box3i& d = *options.domain;
+  const Box3i slab{{d.begin.x, d.begin.y, z0}, {d.end.x, d.end.y, z1}};
+  // The engine's plan refuses a slab outside the domain before the neighbours are read.
+  FieldEngine engine(context.impl(), world, options, nullptr, nullptr, &slab);
+  detail::exact::check_slab_neighbours(d, z0, z1, neighbours);
+  engine.set_column_neighbours(neighbours);
+  engine.run(engine.all_chunks(), engine.parts({{slab, slab}}), /*download=*/true, timings);
   DistanceField f = engine.read_back();
   f.frame = world.frame;
   return f;

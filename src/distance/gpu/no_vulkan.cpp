@@ -16,6 +16,12 @@ DistanceField compute_distance_field(Context&, const World&, const DistanceOptio
   built_without_vulkan();
 }
 
+DistanceField compute_slab_distance_field(Context&, const World&, const DistanceOptions&,
+                                          std::int32_t, std::int32_t, const SlabNeighbours&,
+                                          std::vector<PassTiming>*) {
+  built_without_vulkan();
+}
+
 class FieldEngine {};
 DynamicField::DynamicField(std::shared_ptr<Context>, const World&, DistanceOptions) {
   built_without_vulkan();

@@ -30,6 +30,10 @@ layout(std430, set = 0, binding = 9) buffer WorkSites { uvec2 work_sites[]; };
 VF_SPLIT_WORDS(, FieldSites, field_site_words, 10, 17, 18, 19);
 VF_SPLIT_STORE(field_site_words, h.part_shift)
 
+// A slab's column neighbours (PassParams::column_neighbours): per column of the field's x-y extent,
+// [solid, air], each (below | above << 16) as int16 z offsets from the field's first slice.
+layout(std430, set = 0, binding = 20) readonly buffer Neighbours { uint neighbour_words[]; };
+
 layout(push_constant) uniform Push { PassParams p; };
 
 // Dispatches wider than the device's x limit spill into y (src/gpu/recorder.cpp: Recorder::dispatch).

@@ -1,0 +1,73 @@
+// voxfield-mpi: --backend, where each rank computes its slab's field — the CPU or a Vulkan device
+// of its own — and what the devices did, for --stats.
+#pragma once
+
+#include <mpi.h>
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "rank_stats.h"
+#include "voxfield/gpu.h"
+
+namespace voxfield::mpi_cli {
+
+inline void add_backend_option(CLI::App* cmd, std::string& backend) {
+  cmd->add_option("--backend", backend,
+                  "cpu (default), vulkan or auto: where every rank computes its slab's field (each "
+                  "rank opens a device of its own; auto takes a hardware GPU when every rank has "
+                  "one)")
+      ->check(CLI::IsMember({"cpu", "vulkan", "auto"}))
+      ->capture_default_str();
+}
+
+// Collective: every rank's executor, one backend for the whole job. A rank with no usable device
+// for vulkan (or no hardware GPU for auto) puts every rank on the CPU — mixing backends would give
+// f32 Euclidean slabs from two square roots — and rank 0 says so, as voxfield does on one machine.
+inline Executor choose_rank_executor(MPI_Comm comm, const std::string& name) {
+  int rank = 0, size = 0;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  std::string why;
+  std::shared_ptr<gpu::Context> device;
+  try {
+    device = gpu::select_backend(parse_backend(name), {}, &why);
+  } catch (const Error& e) {  // GpuUnavailable, or a device that failed to open
+    why = std::string("no usable Vulkan device (") + e.what() + ")";
+  }
+  const int mine = device ? 1 : 0;
+  int with_device = 0;
+  MPI_Allreduce(&mine, &with_device, 1, MPI_INT, MPI_SUM, comm);
+  if (with_device < size) device.reset();
+  if (rank == 0) {
+    std::cerr << "voxfield-mpi: rank 0: " << why << "\n";
+    if (with_device > 0 && with_device < size)
+      std::cerr << "voxfield-mpi: " << size - with_device << " of " << size
+                << " ranks have no device for --backend " << name
+                << "; every rank uses the cpu backend\n";
+  }
+  return Executor(std::move(device));
+}
+
+// The devices' hardware-independent counters summed over the ranks (null on the CPU), and rank
+// 0's device: every rank's dispatches, submits and bytes moved.
+inline nlohmann::json gpu_json_over(MPI_Comm comm, const Executor& executor) {
+  if (!executor.on_gpu()) return nullptr;
+  const gpu::Counters c = executor.device()->counters();
+  const gpu::DeviceInfo& d = executor.device()->device();
+  auto total = [&](std::int64_t v) {
+    return static_cast<std::int64_t>(sum_over(comm, static_cast<std::uint64_t>(v)));
+  };
+  return {{"device_rank0", d.name},
+          {"timings_are", d.hardware ? "gpu" : "cpu emulation"},
+          {"dispatches_total", total(c.dispatches)},
+          {"pipeline_barriers_total", total(c.pipeline_barriers)},
+          {"submits_total", total(c.submits)},
+          {"fence_waits_total", total(c.fence_waits)},
+          {"bytes_uploaded_total", total(c.bytes_uploaded)},
+          {"bytes_downloaded_total", total(c.bytes_downloaded)}};
+}
+
+}  // namespace voxfield::mpi_cli
