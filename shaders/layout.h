@@ -94,21 +94,34 @@ struct Header {
   uint none_neg;
 };
 
-// What changes from dispatch to dispatch, as push constants: 96 bytes. A pass works on a
+// What changes from dispatch to dispatch, as push constants: 128 bytes. A pass works on a
 // "compute box" (the whole domain for a full build, an edit's reach grown by the clamp for an
 // update); the encode pass writes the "out box" inside it into the resident field.
+//
+// Column neighbours (binding 20; VF_NO_NEIGHBOUR). A box may be one z-slab of a larger problem: of
+// a domain split over the processes of an MPI job (the table uploaded once, at word 0, its faces
+// the field's), or of a region too large for the work buffers (tables written by edt_columns). The
+// z pass then starts each column from the nearest sites beyond the slab's faces, so that its
+// values are the larger problem's.
 struct PassParams {
   ivec4 box_begin;  // compute box, voxel coordinates
   ivec4 box_size;
   ivec4 out_begin;  // encode: the voxels written (inside the compute box)
   ivec4 out_size;
+  // The neighbour table the z pass reads: its first column (x, y), its columns per row (z) and its
+  // first word in binding 20 (w); edt_columns writes its slabs' tables from word w on.
+  ivec4 table;
+  // The z of the slab's first slice and one past its last (x, y): the table's offsets count from
+  // x, and its neighbours apply to a box reaching that face. edt_columns: the thickness of the
+  // slabs it cuts the box into (z) and their count (w).
+  ivec4 faces;
   uint axis;               // 0, 1, 2: the axis this pass's lines run along
   uint sites_are_air;      // 1: sites are the air voxels (the inside half of a signed field)
   uint src;                // cost buffer read by this pass (0, 1, 2)
   uint dst;                // cost buffer written by this pass
   uint src2;               // encode: the inside cost buffer of a signed field
-  uint column_neighbours;  // 1: the domain goes on past the field's z faces (a slab of a larger
-                           // one): the z pass starts each column from its nearest sites there
+  uint column_neighbours;  // 1: the z pass reads `table`; edt_columns: a table at word 0 (an MPI
+                           // slab's) says what lies beyond the field's z faces
   uint pad1;
   uint pad2;
 };
@@ -277,7 +290,7 @@ struct MeshDrawView {
 static_assert(sizeof(MeshDrawView) == 112, "std430 size of MeshDrawView");
 static_assert(sizeof(MeshParams) == 64, "push-constant size of MeshParams");
 static_assert(sizeof(Header) == 128, "std430 size of Header");
-static_assert(sizeof(PassParams) == 96, "push-constant size of PassParams");
+static_assert(sizeof(PassParams) == 128, "push-constant size of PassParams");
 static_assert(sizeof(JfaParams) == 32, "push-constant size of JfaParams");
 static_assert(sizeof(FimParams) == 64, "push-constant size of FimParams");
 static_assert(sizeof(RenderParams) == 192, "std430 size of RenderParams");

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <random>
+#include <set>
 
 #include "gpu_fields.h"
 #include "gpu_suite.h"
@@ -45,6 +46,26 @@ TEST(Gpu, BackendNamesAndChoice) {
   if (!gpu::built_with_vulkan()) {
     EXPECT_THROW(gpu::Context::create(), GpuUnavailable);
   }
+}
+
+TEST(Gpu, DevicesAreChosenByIndexModuloTheirNumber) {
+  // A node-local rank picks a device of its own (voxfield-mpi --device-per-rank): index k is the
+  // usable device k modulo their number, so any index names one, and index 0 the loader's first.
+  if (!gpu_tests_wanted()) GTEST_SKIP();
+  gpu::ContextOptions first;
+  first.device_index = 0;
+  const std::string name = gpu::Context::create(first)->device().name;
+  std::set<std::string> names;
+  for (int k : {1, 2, 3, 7}) {
+    gpu::ContextOptions o;
+    o.device_index = k;
+    names.insert(gpu::Context::create(o)->device().name);
+  }
+  // Every index opened a device (none past the count is refused). With one usable device (this
+  // machine's lavapipe) each is that device, the one chosen without an index too; which of
+  // several devices an index names is the loader's order, not checked here.
+  if (names.size() == 1 && *names.begin() == name)
+    EXPECT_EQ(gpu::Context::create()->device().name, name);
 }
 
 TEST(Gpu, ExactFieldsEqualTheCpu) {

@@ -19,14 +19,14 @@ using test::gpu_tests_wanted;
 using test::random_world;
 using test::validated_context;
 
-TEST(Gpu, ClampedFieldsBeyondTheStorageBufferRangeAreComputedInParts) {
+TEST(Gpu, FieldsBeyondTheStorageBufferRangeAreComputedInParts) {
   // The exact transform's work buffers hold 4 bytes per voxel of a region (24 more with nearest
   // sites). On a device whose storage-buffer range cannot bind them (lowered here through
   // ContextOptions, as a user sharing a device would), a clamped field is computed in slabs, each
-  // with the sites within its reach: the same bits as the CPU's, builds and updates alike, with
-  // more dispatches. Where no slab is small enough (an unclamped field's reach is the whole domain,
-  // and nearest sites need six times the room) the field is refused with InvalidArgument before
-  // anything is uploaded, instead of binding past the range.
+  // with the sites within its reach, and any field in z-slabs with each column's nearest sites
+  // beyond them: the same bits as the CPU's, builds and updates alike, with more dispatches. Where
+  // not even one z-slice fits, the field is refused with InvalidArgument before anything is
+  // uploaded, instead of binding past the range.
   if (!gpu_tests_wanted()) GTEST_SKIP();
   // 16 383 voxels a binding: one short of the whole domain.
   // (Named, not structured, bindings: the lambdas below capture them, which Clang 14 refuses.)
@@ -93,26 +93,52 @@ TEST(Gpu, ClampedFieldsBeyondTheStorageBufferRangeAreComputedInParts) {
     expect_same_field(live.download(), compute_distance_field(long_world, f),
                       "f32 with nearest sites in windows, edited");
   }
-  o.max_distance = 6;
-  o.metric = Metric::kManhattan;
-  o.signed_distance = false;
-  // The sites' work buffers, 24 bytes per voxel of a slab, leave no slab within the range at this
-  // clamp.
-  o.nearest_sites = true;
-  try {
-    gpu::DynamicField refused(small, w, o);
-    ADD_FAILURE() << "a work buffer beyond the storage-buffer range was made";
-  } catch (const InvalidArgument& e) {
-    EXPECT_NE(std::string(e.what()).find("storage-buffer range"), std::string::npos) << e.what();
+  // Where no slab with halos fits — an unclamped field, whose reach is the whole domain, or the
+  // sites' work buffers (24 bytes a voxel) — a region is cut into z-slabs whose z passes start each
+  // column from its nearest sites beyond the slab (edt_columns, column_slabs.h): the CPU's bits,
+  // built and updated, at more dispatches.
+  o.max_distance = 0;
+  o.metric = Metric::kEuclidean;
+  o.signed_distance = true;
+  o.storage = Storage::kU16;
+  {
+    const std::int64_t before = small->counters().dispatches;
+    expect_same_field(gpu::compute_distance_field(*small, w, o), compute_distance_field(w, o),
+                      "unclamped, in z-slabs");
+    const std::int64_t in_slabs = small->counters().dispatches - before;
+    const std::int64_t before_whole = whole->counters().dispatches;
+    (void)gpu::compute_distance_field(*whole, w, o);
+    EXPECT_GT(in_slabs, whole->counters().dispatches - before_whole);
+    World edited = w;
+    gpu::DynamicField live(small, edited, o);
+    DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
+    apply_edit(edited, Edit{EditOp::kCarve, BoxBrush{{0, 0, 0}, {12, 12, 6}}, 0}, &dirty);
+    apply_edit(edited, Edit{EditOp::kPlace, SphereBrush{{20, 24, 12}, 3}, 2}, &dirty);
+    live.update(dirty);
+    expect_same_field(live.download(), compute_distance_field(edited, o),
+                      "unclamped, in z-slabs, edited");
   }
-  o.nearest_sites = false;
-  o.max_distance = 0;  // unclamped: the reach is the whole domain, computed whole
+  {
+    World shorter = random_world({32, 32, 12}, 8, 0.02, 12);  // slabs of 2 slices with sites
+    DistanceOptions f = o;
+    f.metric = Metric::kManhattan;
+    f.storage = Storage::kF32;
+    f.nearest_sites = true;
+    expect_same_field(gpu::compute_distance_field(*small, shorter, f),
+                      compute_distance_field(shorter, f), "unclamped with sites, in z-slabs");
+  }
+  // Not even one z-slice fits (160 x 128 voxels, 80 KiB a cost buffer; the u8 field fits its
+  // windows): refused by name before anything is uploaded.
+  const World wide = random_world({160, 128, 4}, 8, 0.01, 13);
+  o.storage = Storage::kU8;
   const gpu::Counters before = small->counters();
   try {
-    gpu::DynamicField refused(small, w, o);
-    ADD_FAILURE() << "an unclamped field beyond the storage-buffer range was made";
+    gpu::DynamicField refused(small, wide, o);
+    ADD_FAILURE() << "an unclamped field whose slices pass the storage-buffer range was made";
   } catch (const InvalidArgument& e) {
-    EXPECT_NE(std::string(e.what()).find("no slab"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("and so does one z-slice of it (160 x 128 voxels)"),
+              std::string::npos)
+        << e.what();
   }
   EXPECT_EQ(small->counters().bytes_uploaded, before.bytes_uploaded);  // nothing was uploaded
   test::expect_no_validation_messages(*small);

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <utility>
 
 #include "gpu_fields.h"
 #include "gpu_suite.h"
@@ -99,7 +100,7 @@ TEST(GpuSlabs, EachSlabEqualsTheCpusSlab) {
   test::expect_no_validation_messages(*ctx);
 }
 
-TEST(GpuSlabs, ASlabCutIntoPartsByASmallDeviceStillEqualsTheCpusSlab) {
+TEST(GpuSlabs, ASlabCutIntoPartsOrThinnerSlabsByASmallDeviceStillEqualsTheCpusSlab) {
   // A clamped slab too large for one work buffer is computed in parts, each with the sites
   // within its reach: the parts whose box reaches a face of the slab start their columns from the
   // neighbours beyond it (the others lie farther than the clamp from those).
@@ -132,9 +133,28 @@ TEST(GpuSlabs, ASlabCutIntoPartsByASmallDeviceStillEqualsTheCpusSlab) {
           parts, compute_slab_distance_field(w.slabs[i].voxels, o, box.begin.z, box.end.z, n),
           what);
     }
+  // Unclamped, no cut with halos fits: the slab is cut into thinner z-slabs whose column
+  // neighbours (edt_columns) start from the slab's own beyond its faces — both tables at once.
+  for (const auto& [i, sites] : {std::pair<std::size_t, bool>{1, false}, {0, true}})
+    for (Metric m : {Metric::kChebyshev, Metric::kEuclidean}) {
+      DistanceOptions o;
+      o.metric = m;
+      o.signed_distance = true;
+      o.storage = Storage::kF32;
+      o.nearest_sites = sites;
+      o.domain = domain;
+      const Box3i box = w.slab(i);
+      const SlabNeighbours n = neighbours_of(w.extremes, i);
+      const std::string what = std::string(metric_name(m)) + " unclamped" + (sites ? " sites" : "");
+      const DistanceField slabs = gpu::compute_slab_distance_field(*contexts.small, w.slabs[i], o,
+                                                                   box.begin.z, box.end.z, n);
+      expect_same_field(
+          slabs, compute_slab_distance_field(w.slabs[i].voxels, o, box.begin.z, box.end.z, n),
+          what);
+    }
 }
 
-TEST(GpuSlabs, BadNeighboursAndSlabsTooLargeAreRefusedAsOnTheCpu) {
+TEST(GpuSlabs, BadNeighboursAndSlicesTooLargeAreRefused) {
   if (!gpu_tests_wanted()) GTEST_SKIP();
   const std::shared_ptr<gpu::Context> ctx = test::validated_context();
   const Box3i domain{{0, 0, 0}, {12, 10, 20}};
@@ -169,15 +189,20 @@ TEST(GpuSlabs, BadNeighboursAndSlabsTooLargeAreRefusedAsOnTheCpu) {
   no_domain.domain.reset();
   same_refusal(no_domain, 0, 8, good, "needs the whole field's domain");
 
-  // An unclamped slab's region cannot be cut: on a device whose binding cannot hold its work
-  // buffers it is refused by name.
-  // (12 x 10 x 12 voxels: 5760 bytes a cost buffer.)
+  // A slab of which not even one z-slice fits the work buffers' binding is refused by name
+  // (40 x 30 voxels: 4800 bytes a cost buffer).
   const std::shared_ptr<gpu::Context> small = test::capped_context(4096);
+  const Box3i wide{{0, 0, 0}, {40, 30, 6}};
+  const SlabbedWorld v = slabbed_world(wide, {0, 3, 6}, 0.05, 4);
+  DistanceOptions u;
+  u.domain = wide;
   try {
-    (void)gpu::compute_slab_distance_field(*small, w.slabs[1], o, 8, 20,
-                                           neighbours_of(w.extremes, 1));
-    ADD_FAILURE() << "an unclamped slab past the work buffers' binding was computed";
+    (void)gpu::compute_slab_distance_field(*small, v.slabs[1], u, 3, 6,
+                                           neighbours_of(v.extremes, 1));
+    ADD_FAILURE() << "a slab whose slices pass the work buffers' binding was computed";
   } catch (const InvalidArgument& e) {
-    EXPECT_NE(std::string(e.what()).find("no slab of it fits"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("and so does one z-slice of it (40 x 30 voxels)"),
+              std::string::npos)
+        << e.what();
   }
 }

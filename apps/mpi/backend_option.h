@@ -14,26 +14,43 @@
 
 namespace voxfield::mpi_cli {
 
-inline void add_backend_option(CLI::App* cmd, std::string& backend) {
-  cmd->add_option("--backend", backend,
+struct BackendSettings {
+  std::string name = "cpu";      // --backend
+  bool device_per_rank = false;  // --device-per-rank
+};
+
+inline void add_backend_option(CLI::App* cmd, BackendSettings& backend) {
+  cmd->add_option("--backend", backend.name,
                   "cpu (default), vulkan or auto: where every rank computes its slab's field (each "
                   "rank opens a device of its own; auto takes a hardware GPU when every rank has "
                   "one)")
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}))
       ->capture_default_str();
+  cmd->add_flag("--device-per-rank", backend.device_per_rank,
+                "each rank on a node takes the node's device of its node-local rank (modulo "
+                "their number) instead of the most capable one");
 }
 
 // Collective: every rank's executor, one backend for the whole job. A rank with no usable device
 // for vulkan (or no hardware GPU for auto) puts every rank on the CPU — mixing backends would give
 // f32 Euclidean slabs from two square roots — and rank 0 says so, as voxfield does on one machine.
-inline Executor choose_rank_executor(MPI_Comm comm, const std::string& name) {
+inline Executor choose_rank_executor(MPI_Comm comm, const BackendSettings& backend) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
+  gpu::ContextOptions options;
+  if (backend.device_per_rank) {
+    // The rank among those sharing this node's memory (and so its devices).
+    MPI_Comm node = MPI_COMM_NULL;
+    MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &node);
+    MPI_Comm_rank(node, &options.device_index);
+    MPI_Comm_free(&node);
+  }
+  const std::string& name = backend.name;
   std::string why;
   std::shared_ptr<gpu::Context> device;
   try {
-    device = gpu::select_backend(parse_backend(name), {}, &why);
+    device = gpu::select_backend(parse_backend(name), options, &why);
   } catch (const Error& e) {  // GpuUnavailable, or a device that failed to open
     why = std::string("no usable Vulkan device (") + e.what() + ")";
   }

@@ -4,7 +4,7 @@
 //   mpirun -np N voxfield-mpi field IN -o OUT.{npy,vdb} [--metric M] [--signed] [--max-distance D]
 //          [--storage S] [--spacing sx,sy,sz] [--sites S.npy] [--packed P.npy] [--stats S.json]
 //          [--chunk C] [--threads T] [--read every|rank0] [--grid G] [--memory-limit B]
-//          [--backend cpu|vulkan|auto]
+//          [--backend cpu|vulkan|auto] [--device-per-rank]
 //   mpirun -np N voxfield-mpi edit IN -e EDITS.jsonl -o OUT.npy [field options] [--stats S.json]
 //          [--balance volume|content|edits] [--save-world W.vfw|W.npy] [--read every|rank0]
 //          [--grid G]
@@ -59,7 +59,8 @@ namespace {
 using namespace voxfield;
 
 struct FieldSettings {
-  std::string metric = "manhattan", storage = "f32", backend = "cpu";
+  std::string metric = "manhattan", storage = "f32";
+  mpi_cli::BackendSettings backend;  // --backend, --device-per-rank
   bool is_signed = false;
   double max_distance = 0;
   std::vector<double> spacing;

@@ -68,6 +68,12 @@ struct ContextOptions {
   // on a device shared with other programs. (An adopted device takes the same cap:
   // AdoptedDevice, gpu_vulkan.h.)
   std::uint64_t max_storage_buffer_bytes = 0;
+  // Which device: -1 the most capable usable one (a discrete GPU before an integrated one, a
+  // software one last); k >= 0 the usable device k modulo their number, counting in the Vulkan
+  // loader's order — so that the processes of a job on one node can each pass their node-local
+  // rank and get a device of their own (voxfield-mpi --device-per-rank). Usable: Vulkan 1.1, a
+  // compute queue, and a hardware device unless allow_software.
+  int device_index = -1;
 };
 
 struct DeviceInfo {

@@ -31,7 +31,7 @@ DistanceField compute_distance_field(Context& context, const World& world,
 // voxfield::compute_slab_distance_field (distance_slab.h) gives, on the GPU, with the agreement
 // stated above — so the slabs of a field split over the processes of an MPI job (mpi.h) can each
 // be computed on a process's own device. The device holds the slab's world, field and work
-// buffers alone (an unclamped slab must fit one work buffer: InvalidArgument otherwise). Throws
+// buffers alone. Throws
 // InvalidArgument as the CPU's function does for a missing domain, a slab outside it or bad
 // neighbours, and as compute_distance_field(Context&...) does for the rest.
 DistanceField compute_slab_distance_field(Context& context, const World& world,

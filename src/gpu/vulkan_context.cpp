@@ -343,7 +343,13 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
   vkEnumeratePhysicalDevices(s.instance, &count, nullptr);
   std::vector<VkPhysicalDevice> devices(count);
   vkEnumeratePhysicalDevices(s.instance, &count, devices.data());
-  int best = -1;
+  // The usable devices in the loader's order, each with its first compute queue family.
+  struct Usable {
+    VkPhysicalDevice device;
+    std::uint32_t family;
+    int preference;
+  };
+  std::vector<Usable> usable;
   for (VkPhysicalDevice d : devices) {
     VkPhysicalDeviceProperties props;
     vkGetPhysicalDeviceProperties(d, &props);
@@ -355,17 +361,23 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
     vkGetPhysicalDeviceQueueFamilyProperties(d, &nq, families.data());
     for (std::uint32_t f = 0; f < nq; ++f) {
       if (!(families[f].queueFlags & VK_QUEUE_COMPUTE_BIT)) continue;
-      if (preference(props.deviceType) > best) {
-        best = preference(props.deviceType);
-        s.physical = d;
-        s.queue_family = f;
-      }
+      usable.push_back({d, f, preference(props.deviceType)});
       break;
     }
   }
-  if (!s.physical)
+  if (usable.empty())
     throw GpuUnavailable(std::string("Vulkan: no device with a compute queue") +
                          (options.allow_software ? "" : " (software devices excluded)"));
+  // By index (modulo the count: a node-local rank picks its own), or the most capable.
+  const Usable* chosen = &usable[0];
+  if (options.device_index >= 0) {
+    chosen = &usable[static_cast<std::size_t>(options.device_index) % usable.size()];
+  } else {
+    for (const Usable& u : usable)
+      if (u.preference > chosen->preference) chosen = &u;
+  }
+  s.physical = chosen->device;
+  s.queue_family = chosen->family;
   const float priority = 1;
   VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
   qci.queueFamilyIndex = s.queue_family;

@@ -19,6 +19,7 @@
 
 #include "../exact/whole_field.h"
 #include "../incremental/update_regions.h"
+#include "column_slabs.h"
 #include "distance_shaders.h"
 #include "field_encoding.h"
 #include "gpu/recorder.h"
@@ -84,10 +85,11 @@ class FieldEngine {
               std::shared_ptr<WorkBuffers> work = nullptr, const Box3i* slab = nullptr)
       : ctx_(ctx),
         kernels_{ctx.kernel(shaders::edt_sites()), ctx.kernel(shaders::edt_lines()),
-                 ctx.kernel(shaders::edt_encode())},
+                 ctx.kernel(shaders::edt_encode()), ctx.kernel(shaders::edt_columns())},
         world_(world),
         options_(options),
-        plan_(detail::make_field_plan(world.voxels, options, slab)) {
+        plan_(detail::make_field_plan(world.voxels, options, slab)),
+        tables_(ctx) {
     if (!plan_.unit_spacing)
       throw InvalidArgument("GPU: the Vulkan backend supports unit voxel spacing only");
     if (plan_.domain.empty()) throw InvalidArgument("GPU: the field's domain is empty");
@@ -124,31 +126,12 @@ class FieldEngine {
     header_buf_ = Buffer(ctx, sizeof header_, kStorage, false);
     field_buf_ = Buffer(ctx, field_bytes_, kStorage, false);
     field_sites_buf_ = Buffer(ctx, std::max<VkDeviceSize>(site_bytes_, 16), kStorage, false);
-    neighbours_buf_ = Buffer(ctx, 16, kStorage, false);
   }
 
   // The nearest solid and air voxels beyond the slab's z faces, per column (distance_slab.h; the
   // caller has checked them): uploaded by the next run, read by every z pass whose box reaches a
   // face. Offsets from the slab's first slice fit int16, as the whole domain's extent does.
-  void set_column_neighbours(const SlabNeighbours& n) {
-    const std::size_t columns = n.solid_below.size();
-    const VkDeviceSize bytes = std::max<VkDeviceSize>(columns * 8, 16);
-    check_whole_binding(
-        ctx_, bytes, "GPU: the column neighbours of a " + to_string(plan_.domain.size()) + " slab");
-    const std::int32_t z0 = plan_.domain.begin.z;
-    auto pack = [&](std::int32_t below, std::int32_t above) {
-      const std::int32_t b = below == ColumnSites::kNoneHigh ? L::VF_NO_NEIGHBOUR : below - z0;
-      const std::int32_t a = above == ColumnSites::kNoneLow ? L::VF_NO_NEIGHBOUR : above - z0;
-      return (static_cast<std::uint32_t>(b) & 0xFFFFu) | (static_cast<std::uint32_t>(a) << 16);
-    };
-    neighbour_words_.resize(2 * columns);
-    for (std::size_t c = 0; c < columns; ++c) {
-      neighbour_words_[2 * c] = pack(n.solid_below[c], n.solid_above[c]);
-      neighbour_words_[2 * c + 1] = pack(n.air_below[c], n.air_above[c]);
-    }
-    neighbours_buf_ = Buffer(ctx_, bytes, kStorage, false);
-    column_neighbours_ = true;
-  }
+  void set_column_neighbours(const SlabNeighbours& n) { tables_.set_uploaded(n, plan_.domain); }
 
   const detail::FieldPlan& plan() const { return plan_; }
   std::size_t field_bytes() const { return static_cast<std::size_t>(field_bytes_); }
@@ -157,8 +140,9 @@ class FieldEngine {
   // Every chunk the domain touches.
   std::vector<Vec3i> all_chunks() const { return resident_->all_chunks(); }
   // `regions` cut into parts whose work buffers fit the device's storage-buffer range: the same
-  // values (a clamped field's depend only on the sites within its reach), more dispatches. An
-  // unclamped field's region cannot be cut; run() refuses it if it does not fit.
+  // values (a clamped field's depend only on the sites within its reach), more dispatches. A
+  // region no such cut fits (an unclamped field's, whose reach is the whole domain) stays whole,
+  // and run() computes it in z-slabs with column neighbours instead (column_slabs.h).
   std::vector<detail::UpdateRegion> parts(const std::vector<detail::UpdateRegion>& regions) const {
     return detail::split_regions(
         regions, plan_.domain, detail::field_reach(plan_),
@@ -245,22 +229,23 @@ class FieldEngine {
       const VkDeviceSize at = up.add(&header_, sizeof header_);
       header_copy_ = VkBufferCopy{at, 0, sizeof header_};
     }
-    if (!neighbour_words_.empty()) {
-      const VkDeviceSize bytes = neighbour_words_.size() * 4;
-      neighbours_copy_ = VkBufferCopy{up.add(neighbour_words_.data(), bytes), 0, bytes};
-    }
-    // The work buffers first: a region too large for them is refused before anything changes.
+    // The work buffers first: a region too large for them, even in z-slabs, is refused before
+    // anything changes.
     VkDeviceSize largest = 4;
-    for (const auto& r : regions)
-      largest = std::max<VkDeviceSize>(largest, static_cast<VkDeviceSize>(r.in.volume()) * 4);
+    std::int64_t table_words = 0;
+    for (const auto& r : regions) {
+      const ColumnSlabs cut = column_slabs(r);
+      largest = std::max<VkDeviceSize>(largest, static_cast<VkDeviceSize>(cut.work_voxels) * 4);
+      table_words = std::max(table_words, cut.table_words);
+    }
+    tables_.stage(table_words, up);
     const VkDeviceSize widest = work_->widest_after(largest, options_.nearest_sites);
     if (widest > ctx_.limits.maxStorageBufferRange)
       throw InvalidArgument("GPU: a region of " + std::to_string(largest / 4) +
                             " voxels needs a work buffer of " + std::to_string(widest) +
                             " bytes, more than this device's storage-buffer range (" +
                             std::to_string(ctx_.limits.maxStorageBufferRange) +
-                            "), and no slab of it fits either (a slab reads the field's reach "
-                            "on both sides: its clamp, or the whole domain when unclamped)");
+                            ") (internal error: z-slabs should fit)");
     work_->grow(ctx_, largest, options_.nearest_sites);
     if (owns_world_) resident_->stage(chunks, up, uploads);
   }
@@ -273,14 +258,22 @@ class FieldEngine {
         first_run_ ? std::span<const VkBufferCopy>(&header_copy_, 1)
                    : std::span<const VkBufferCopy>();
     resident_->record(rec, upload, uploads, &header_buf_, header);
-    if (!neighbour_words_.empty()) {
-      rec.copy(upload, neighbours_buf_, std::span(&neighbours_copy_, 1));
-      neighbour_words_.clear();  // on the device now
-    }
+    tables_.record(rec, upload);
     first_run_ = false;
   }
 
-  // Step 3, one region's passes: recompute its compute box, encode its out box into the field.
+  // How region `r` is computed: whole, or in z-slabs when its box of sites is too large for the
+  // work buffers (column_slabs.h).
+  ColumnSlabs column_slabs(const detail::UpdateRegion& r) const {
+    const std::uint64_t range = ctx_.limits.maxStorageBufferRange;
+    return plan_column_slabs(r.in, WorkBuffers::most_region_voxels(range, options_.nearest_sites),
+                             range, options_.nearest_sites ? 24 : 4);
+  }
+
+  // Step 3, one region's passes: recompute its compute box, encode its out box into the field —
+  // in z-slabs when it is too large for the work buffers: first the slabs' column neighbours
+  // (edt_columns), then each slab that holds voxels of the out box, its z passes starting from
+  // them.
   void record_region(Recorder& rec, const detail::UpdateRegion& r, bool timed) {
     const std::array<Binding, 21> bound = bindings();
     const auto pass = [&](const Kernel& kernel, const L::PassParams& t, std::uint64_t invocations,
@@ -289,13 +282,49 @@ class FieldEngine {
       rec.dispatch(kernel, bound, t, invocations);
       rec.end_pass(ticket, std::move(name));
     };
-    const Vec3i n = r.in.size();
+    const Box3i& field = plan_.domain;
+    const ColumnSlabs cut = column_slabs(r);
+    if (cut.thickness == 0) {
+      // A field that is a slab of a larger domain reads its uploaded table; others none.
+      record_box(pass, r.in, r.out, {field.begin.x, field.begin.y, field.size().x, 0},
+                 {field.begin.z, field.end.z, 0, 0}, tables_.has_uploaded());
+      return;
+    }
+    L::PassParams cp{};
+    cp.box_begin = {r.in.begin.x, r.in.begin.y, r.in.begin.z, 0};
+    cp.box_size = {r.in.size().x, r.in.size().y, r.in.size().z, 0};
+    cp.table = {r.in.begin.x, r.in.begin.y, r.in.size().x,
+                static_cast<std::int32_t>(tables_.computed_base())};
+    cp.faces = {0, 0, cut.thickness, cut.count};
+    cp.column_neighbours = tables_.has_uploaded() ? 1u : 0u;
+    const std::int64_t columns = static_cast<std::int64_t>(r.in.size().x) * r.in.size().y;
+    pass(kernels_.columns, cp, static_cast<std::uint64_t>(columns), "slab neighbours");
+    for (int k = 0; k < cut.count; ++k) {
+      Box3i slab = r.in;
+      slab.begin.z = r.in.begin.z + k * cut.thickness;
+      slab.end.z = std::min(r.in.end.z, slab.begin.z + cut.thickness);
+      const Box3i out = r.out.intersect(slab);
+      if (out.empty()) continue;  // its sites are in the other slabs' neighbours already
+      const auto base = static_cast<std::int32_t>(tables_.computed_base() + 2 * columns * k);
+      record_box(pass, slab, out, {r.in.begin.x, r.in.begin.y, r.in.size().x, base},
+                 {slab.begin.z, slab.end.z, 0, 0}, true);
+    }
+  }
+
+  // The transform over box `in` and the encoding of `out` (inside it), the z passes reading the
+  // neighbour table `table` of faces `faces` (PassParams) when `neighbours`.
+  template <class Pass>
+  void record_box(const Pass& pass, const Box3i& in, const Box3i& out, L::ivec4 table,
+                  L::ivec4 faces, bool neighbours) {
+    const Vec3i n = in.size();
     L::PassParams pp{};
-    pp.box_begin = {r.in.begin.x, r.in.begin.y, r.in.begin.z, 0};
+    pp.box_begin = {in.begin.x, in.begin.y, in.begin.z, 0};
     pp.box_size = {n.x, n.y, n.z, 0};
-    pp.out_begin = {r.out.begin.x, r.out.begin.y, r.out.begin.z, 0};
-    pp.out_size = {r.out.size().x, r.out.size().y, r.out.size().z, 0};
-    pp.column_neighbours = column_neighbours_ ? 1u : 0u;
+    pp.out_begin = {out.begin.x, out.begin.y, out.begin.z, 0};
+    pp.out_size = {out.size().x, out.size().y, out.size().z, 0};
+    pp.table = table;
+    pp.faces = faces;
+    pp.column_neighbours = neighbours ? 1u : 0u;
     // One separable transform: sites along z into `result`, then x and y through `other` —
     // the CPU's order, so that nearest sites break ties the same way (docs/distance.md).
     auto transform = [&](std::uint32_t result, std::uint32_t other, bool to_air) {
@@ -321,9 +350,9 @@ class FieldEngine {
     enc.src2 = 2;
     // One invocation per word of packed values that the out box touches.
     const std::int64_t lanes = static_cast<std::int64_t>(lanes_of(options_.storage));
-    const std::int64_t ox = r.out.begin.x - plan_.domain.begin.x;
-    const std::int64_t words = (ox + r.out.size().x - 1) / lanes - ox / lanes + 1;
-    pass(kernels_.encode, enc, static_cast<std::uint64_t>(words * r.out.size().y * r.out.size().z),
+    const std::int64_t ox = out.begin.x - plan_.domain.begin.x;
+    const std::int64_t words = (ox + out.size().x - 1) / lanes - ox / lanes + 1;
+    pass(kernels_.encode, enc, static_cast<std::uint64_t>(words * out.size().y * out.size().z),
          "encode");
   }
 
@@ -388,17 +417,17 @@ class FieldEngine {
     const auto bricks = split_bindings(resident_->bricks(), ctx_);
     const auto field = split_bindings(field_buf_, ctx_);
     const auto sites = split_bindings(field_sites_buf_, ctx_);
-    return {&header_buf_,    &resident_->pages(),
-            bricks[0],       &w.cost[0],
-            &w.cost[1],      &w.cost[2],
-            &w.scratch_s,    &w.scratch_t,
-            field[0],        &w.sites,
-            sites[0],        bricks[1],
-            bricks[2],       bricks[3],
-            field[1],        field[2],
-            field[3],        sites[1],
-            sites[2],        sites[3],
-            &neighbours_buf_};
+    return {&header_buf_,     &resident_->pages(),
+            bricks[0],        &w.cost[0],
+            &w.cost[1],       &w.cost[2],
+            &w.scratch_s,     &w.scratch_t,
+            field[0],         &w.sites,
+            sites[0],         bricks[1],
+            bricks[2],        bricks[3],
+            field[1],         field[2],
+            field[3],         sites[1],
+            sites[2],         sites[3],
+            &tables_.buffer()};
   }
 
   Context::Impl& ctx_;
@@ -408,6 +437,7 @@ class FieldEngine {
     const Kernel& sites;
     const Kernel& lines;
     const Kernel& encode;
+    const Kernel& columns;
   } kernels_;
   const World& world_;
   DistanceOptions options_;
@@ -423,11 +453,8 @@ class FieldEngine {
   // submitted and waited for one at a time).
   std::shared_ptr<WorkBuffers> work_;
   Buffer header_buf_, field_buf_, field_sites_buf_;
-  // A slab's column neighbours: staged by the next run, then on the device alone.
-  Buffer neighbours_buf_;
-  std::vector<std::uint32_t> neighbour_words_;
-  VkBufferCopy neighbours_copy_{};
-  bool column_neighbours_ = false;
+  // The column neighbours of slabs: a slab field's own, and those of regions cut into z-slabs.
+  NeighbourTables tables_;
 };
 
 DistanceField compute_distance_field(Context& context, const World& world,

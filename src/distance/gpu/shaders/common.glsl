@@ -30,9 +30,15 @@ layout(std430, set = 0, binding = 9) buffer WorkSites { uvec2 work_sites[]; };
 VF_SPLIT_WORDS(, FieldSites, field_site_words, 10, 17, 18, 19);
 VF_SPLIT_STORE(field_site_words, h.part_shift)
 
-// A slab's column neighbours (PassParams::column_neighbours): per column of the field's x-y extent,
-// [solid, air], each (below | above << 16) as int16 z offsets from the field's first slice.
-layout(std430, set = 0, binding = 20) readonly buffer Neighbours { uint neighbour_words[]; };
+// Column neighbours (PassParams::table): per column of a table, [solid, air], each
+// (below | above << 16) as int16 z offsets from its slab's first slice. Read-only but in
+// edt_columns, which writes the tables.
+#ifndef VF_NEIGHBOURS_ACCESS
+#define VF_NEIGHBOURS_ACCESS readonly
+#endif
+layout(std430, set = 0, binding = 20) VF_NEIGHBOURS_ACCESS buffer Neighbours {
+  uint neighbour_words[];
+};
 
 layout(push_constant) uniform Push { PassParams p; };
 

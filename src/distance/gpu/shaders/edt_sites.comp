@@ -25,16 +25,18 @@ void main() {
   bool found = false, have_next = false;
   int last = 0, next = 0;
   if (p.column_neighbours != 0u && p.axis == 2u) {
-    const ivec2 c = origin.xy + first.xy - h.field_begin.xy;
-    const int word = int(neighbour_words[2u * uint(c.y * h.field_size.x + c.x) + p.sites_are_air]);
+    const ivec2 c = origin.xy + first.xy - p.table.xy;
+    const int word =
+        int(neighbour_words[uint(p.table.w) + 2u * uint(c.y * p.table.z + c.x) + p.sites_are_air]);
     const int below = bitfieldExtract(word, 0, 16), above = bitfieldExtract(word, 16, 16);
-    if (below != VF_NO_NEIGHBOUR && origin.z == h.field_begin.z) {
+    // (Offsets count from the slab's first slice; u from the box's.)
+    if (below != VF_NO_NEIGHBOUR && origin.z == p.faces.x) {
       found = true;
-      last = below;
+      last = below + p.faces.x - origin.z;
     }
-    if (above != VF_NO_NEIGHBOUR && origin.z + len == h.field_begin.z + h.field_size.z) {
+    if (above != VF_NO_NEIGHBOUR && origin.z + len == p.faces.y) {
       have_next = true;
-      next = above;
+      next = above + p.faces.x - origin.z;
     }
   }
   // Forward: distance to the nearest site at or before u.
