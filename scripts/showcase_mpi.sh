@@ -2,7 +2,8 @@
 # The showcase's MPI section (called by scripts/showcase.sh after `voxfield showcase`): the
 # showcase's 256^3 terrain, its exact signed Euclidean field computed by one process and by
 # voxfield-mpi on 1, 2 and 4 ranks, each rank reading only its slab of the .npy; the files must be
-# identical, byte for byte; then that field meshed by one process and over 2 and 4 ranks: the same
+# identical, byte for byte (and on 2 ranks each on a Vulkan device of its own); then that field
+# meshed by one process and over 2 and 4 ranks: the same
 # file; then a frame of the terrain drawn over 2 and 4 ranks: voxfield render's PNG. Appends
 # a section with the times and the bytes exchanged to the report.
 # Usage: showcase_mpi.sh OUT_DIR   (skipped, saying so, when voxfield-mpi was not built)
@@ -36,6 +37,25 @@ PY
   rm -f "$out/mpi-$n.npy"
 done
 one_ms=$(/usr/bin/python3 -c "import json; print('%.0f' % json.load(open('$out/mpi-one-process.json'))['ms'])")
+# The same field with each of 2 ranks computing its slab on a Vulkan device of its own (lavapipe
+# here: its times are CPU emulation, its counters carry over), the z passes starting from the
+# neighbours the ranks exchange: the same file. Without a device the ranks say so and use the CPU.
+mpirun --oversubscribe -np 2 "$B/voxfield-mpi" field "$out/terrain.npy" -o "$out/mpi-gpu-2.npy" \
+  "${opts[@]}" --backend vulkan --stats "$out/mpi-gpu-2.json" 2>/dev/null
+gpu_same=no
+cmp -s "$out/mpi-one-process.npy" "$out/mpi-gpu-2.npy" && gpu_same=yes
+gpu_row=$(/usr/bin/python3 - "$out/mpi-gpu-2.json" "$gpu_same" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+g = j["gpu"]
+if g is None:
+    print("| 2 | cpu (no usable Vulkan device) | — | — | — | %s |" % sys.argv[2])
+else:
+    print("| 2 | %s (%s) | %d | %d | %d | %s |" % (g["device_rank0"], g["timings_are"], g["submits_total"],
+          g["dispatches_total"], g["bytes_uploaded_total"], sys.argv[2]))
+PY
+)
+rm -f "$out/mpi-gpu-2.npy"
 # The showcase's OpenVDB level set of the terrain read by 2 ranks, each decoding only its slab's
 # leaves: the same field as one process reading the whole file.
 # (A failure is reported as "no" in the table, and fails the section below, not the script here.)
@@ -97,6 +117,10 @@ rm -f "$out/mpi-frame.png"
   printf '| ranks | slabs (z cuts) | ms | compute ms (slowest rank) | exchange ms | bytes sent | file identical to one process |\n'
   printf '|---|---|---|---|---|---|---|\n'
   printf '%s' "$rows"
+  printf '\nThe same field with each rank computing its slab on a Vulkan device of its own (`--backend\n'
+  printf 'vulkan`; the counters summed over the ranks):\n\n'
+  printf '| ranks | device | submits | dispatches | bytes up | file identical to one process |\n|---|---|---|---|---|---|\n'
+  printf '%s\n' "$gpu_row"
   printf '\nThe same field from `terrain-sdf.vdb` (the OpenVDB level set above), each rank decoding only the\n'
   printf 'leaves of its slab (the others'"'"' values stepped over, never decompressed):\n\n'
   printf '| input | ranks | field identical to one process reading the whole file |\n|---|---|---|\n'
