@@ -13,6 +13,7 @@
 #include <random>
 
 #include "mpi_ranks.h"
+#include "voxfield/distance_executor.h"
 #include "voxfield/distance_slab.h"
 #include "voxfield/dynamic_field.h"
 #include "voxfield/file.h"
@@ -51,8 +52,10 @@ World random_world(std::uint32_t seed, Box3i& domain, int edge, double density =
   return w;
 }
 
-// Every rank computes the whole field too: the oracle.
-void check(const DistanceOptions& base, std::uint32_t seed, int align) {
+// Every rank computes the whole field too: the oracle. With a device executor, each rank computes
+// its slab on it (the Executor overload); otherwise on the CPU from its occupancy alone.
+void check(const DistanceOptions& base, std::uint32_t seed, int align,
+           const Executor& executor = {}) {
   Box3i domain;
   const int edge = seed % 2 ? 8 : 16;
   const World w = random_world(seed, domain, edge);
@@ -61,7 +64,9 @@ void check(const DistanceOptions& base, std::uint32_t seed, int align) {
   World mine(edge, slab);  // this rank's voxels only
   mine.voxels.copy_from_dense(slab, dense(w.voxels, slab).data());
   mpi::ExchangeStats stats;
-  const DistanceField f = mpi::compute_distance_field(comm(), p, mine.voxels, base, &stats);
+  const DistanceField f = executor.on_gpu()
+                              ? mpi::compute_distance_field(comm(), p, mine, base, executor, &stats)
+                              : mpi::compute_distance_field(comm(), p, mine.voxels, base, &stats);
   DistanceOptions whole_o = base;
   whole_o.domain = domain;
   const DistanceField whole = compute_distance_field(w.voxels, whole_o);
@@ -117,7 +122,7 @@ TEST(MpiField, EqualsOneProcessForEveryOption) {
 
 // Edits applied by every rank to its slab and ghost slices, against one process's incremental
 // field after the same edits (itself tested against full rebuilds), checked every few edits.
-void check_edits(const DistanceOptions& o, std::uint32_t seed) {
+void check_edits(const DistanceOptions& o, std::uint32_t seed, const Executor& executor = {}) {
   Box3i domain;
   const int edge = seed % 2 ? 8 : 16;
   // Sparse worlds: a voxel's nearest site is often far along z, where a missing ghost slice shows.
@@ -131,7 +136,7 @@ void check_edits(const DistanceOptions& o, std::uint32_t seed) {
                   {domain.end.x, domain.end.y, std::min(domain.end.z, slab.end.z + ghost)}};
   World mine(edge, box);  // this rank's box only
   mine.voxels.copy_from_dense(box, dense(whole.voxels, box).data());
-  mpi::SlabEditor editor(comm(), p, mine, o);
+  mpi::SlabEditor editor(comm(), p, mine, o, executor);
   // An unclamped field is computed by the first refresh(), after the edits before it.
   EXPECT_EQ(editor.stale(), unclamped);
   if (unclamped) EXPECT_THROW((void)editor.field(), InvalidArgument);
@@ -219,6 +224,50 @@ TEST(MpiField, EditsKeepEverySlabEqualToOneProcess) {
 TEST(MpiField, UnclampedEditsRefreshEverySlabToOneProcess) {
   std::uint32_t seed = 700;
   for_every_kind_of_field([&](const DistanceOptions& o) { check_edits(o, seed++); });
+}
+
+// The same with every rank on a Vulkan device of its own (lavapipe here): each slab from its
+// device's transform, its z passes starting from the neighbours the ranks exchanged, and edits
+// kept by each rank's device field (or, unclamped, computed again over the devices). Integer
+// storage and f32 values without square roots are the CPU's bits (gpu_distance.h).
+TEST(MpiField, EveryRankOnItsOwnDeviceEqualsOneProcess) {
+  std::shared_ptr<gpu::Context> device;
+  try {
+    device = gpu::Context::create();
+  } catch (const Error&) {  // no device, or a build without Vulkan
+  }
+  int mine = device ? 1 : 0, every = 0;
+  MPI_Allreduce(&mine, &every, 1, MPI_INT, MPI_MIN, comm());
+  if (every == 0) GTEST_SKIP() << "a rank has no Vulkan device";
+  const Executor gpu(device);
+  std::uint32_t seed = 900;
+  for (Metric m : {Metric::kManhattan, Metric::kChebyshev, Metric::kEuclidean})
+    for (bool sgn : {false, true})
+      for (Storage st : {Storage::kU8, Storage::kU16, Storage::kF32}) {
+        if (st == Storage::kF32 && m == Metric::kEuclidean)
+          continue;  // square roots: within
+                     // kF32Tolerance, not bits
+        DistanceOptions o;
+        o.metric = m;
+        o.signed_distance = sgn;
+        o.storage = st;
+        o.max_distance = seed % 2 ? 0.0 : 4.5;
+        o.nearest_sites = seed % 3 == 0;
+        check(o, seed, 8, gpu);
+        ++seed;
+      }
+  EXPECT_GT(device->counters().submits, 0);
+  DistanceOptions o;
+  o.metric = Metric::kEuclidean;
+  o.signed_distance = true;
+  o.max_distance = 3.5;
+  o.storage = Storage::kU8;
+  check_edits(o, 950, gpu);
+  o.metric = Metric::kChebyshev;
+  o.max_distance = 0;
+  o.storage = Storage::kF32;
+  o.nearest_sites = true;
+  check_edits(o, 951, gpu);
 }
 
 TEST(MpiField, PartitionsCoverTheDomainInOrder) {
