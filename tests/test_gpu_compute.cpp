@@ -70,14 +70,19 @@ constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
 
 TEST(GpuCompute, EveryShaderDeclaresWhatItsCppSideSends) {
   REQUIRE_GPU();
-  for (const ShaderSource& s :
-       {shaders::edt_sites(), shaders::edt_lines(), shaders::edt_encode()}) {
+  for (const ShaderSource& s : {shaders::edt_sites(), shaders::edt_lines(), shaders::edt_encode(),
+                                shaders::edt_columns()}) {
     const ShaderInterface i = reflect(s.name, s.spirv);
     EXPECT_EQ(i.push_bytes, sizeof(layout::PassParams)) << s.name;
     // Eleven buffers, the brick pool, the field and its sites each in four windows
     // (split_buffer.h), and a slab's column neighbours: the binding plan FieldEngine::bindings()
     // sends.
     EXPECT_LE(i.buffers.size(), 12u + 3u * (layout::VF_SPLIT_PARTS - 1)) << s.name;
+    // The neighbour tables: written by edt_columns alone.
+    if (i.buffers.size() > 20)
+      EXPECT_EQ(i.buffers.at(20),
+                std::string(s.name) == "edt_columns" ? Access::kReadWrite : Access::kRead)
+          << s.name;
     EXPECT_EQ(i.buffers.at(0), Access::kRead) << s.name << ": the header is read-only";
     EXPECT_GT(i.invocations_per_group(), 0u);
   }

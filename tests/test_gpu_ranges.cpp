@@ -127,6 +127,25 @@ TEST(Gpu, FieldsBeyondTheStorageBufferRangeAreComputedInParts) {
     expect_same_field(gpu::compute_distance_field(*small, shorter, f),
                       compute_distance_field(shorter, f), "unclamped with sites, in z-slabs");
   }
+  // A clamp too wide for halos (20 voxels on a 32 x 32 x 64 world) takes the z-slabs too; an
+  // update's region then reads more slices than it writes, and the slabs holding none of the
+  // voxels it writes are skipped (their sites reach the others through the column neighbours).
+  {
+    World deep = random_world({32, 32, 64}, 8, 0.01, 14);
+    DistanceOptions f;
+    f.metric = Metric::kEuclidean;
+    f.max_distance = 20;
+    f.storage = Storage::kU8;
+    gpu::DynamicField live(small, deep, f);
+    expect_same_field(live.download(), compute_distance_field(deep, f), "clamp 20, in z-slabs");
+    DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
+    apply_edit(deep, Edit{EditOp::kPlace, SphereBrush{{10, 20, 3}, 2}, 4}, &dirty);
+    const DynamicDistanceField::UpdateStats st = live.update(dirty);
+    EXPECT_LT(st.voxels_recomputed,
+              st.voxels_read);  // the region writes fewer slices than it reads
+    expect_same_field(live.download(), compute_distance_field(deep, f),
+                      "clamp 20, in z-slabs, edited");
+  }
   // Not even one z-slice fits (160 x 128 voxels, 80 KiB a cost buffer; the u8 field fits its
   // windows): refused by name before anything is uploaded.
   const World wide = random_world({160, 128, 4}, 8, 0.01, 13);

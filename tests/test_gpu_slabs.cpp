@@ -103,36 +103,43 @@ TEST(GpuSlabs, EachSlabEqualsTheCpusSlab) {
 TEST(GpuSlabs, ASlabCutIntoPartsOrThinnerSlabsByASmallDeviceStillEqualsTheCpusSlab) {
   // A clamped slab too large for one work buffer is computed in parts, each with the sites
   // within its reach: the parts whose box reaches a face of the slab start their columns from the
-  // neighbours beyond it (the others lie farther than the clamp from those).
+  // neighbours beyond it (the others lie farther than the clamp from those). The 32 x 24 slab is
+  // cut across x (every part reaches both faces); the tall 16 x 16 one across z, into a part that
+  // reaches only the lower face and one that reaches only the upper, whose box starts above the
+  // slab's first slice (the neighbours' offsets count from that slice).
   if (!gpu_tests_wanted()) GTEST_SKIP();
   const test::CappedAndWhole contexts = test::capped_and_whole(64 * 1024);
   const Box3i domain{{0, 0, 0}, {32, 24, 60}};
   const SlabbedWorld w = slabbed_world(domain, {0, 11, 45, 60}, 0.01, 11);
-  for (Metric m : {Metric::kManhattan, Metric::kEuclidean})
-    for (bool is_signed : {false, true}) {
-      DistanceOptions o;
-      o.metric = m;
-      o.signed_distance = is_signed;
-      o.max_distance = 5;
-      o.storage = Storage::kU16;
-      o.domain = domain;
-      const std::size_t i = 1;  // 32 x 24 x 34 voxels: 104 448 bytes per cost buffer
-      const Box3i box = w.slab(i);
-      const SlabNeighbours n = neighbours_of(w.extremes, i);
-      const std::string what = std::string(metric_name(m)) + (is_signed ? " signed" : "");
-      const std::int64_t before = contexts.small->counters().dispatches;
-      const DistanceField parts = gpu::compute_slab_distance_field(*contexts.small, w.slabs[i], o,
-                                                                   box.begin.z, box.end.z, n);
-      const std::int64_t in_parts = contexts.small->counters().dispatches - before;
-      const std::int64_t before_whole = contexts.whole->counters().dispatches;
-      const DistanceField one = gpu::compute_slab_distance_field(*contexts.whole, w.slabs[i], o,
-                                                                 box.begin.z, box.end.z, n);
-      EXPECT_GT(in_parts, contexts.whole->counters().dispatches - before_whole) << what;
-      expect_same_field(parts, one, what);
-      expect_same_field(
-          parts, compute_slab_distance_field(w.slabs[i].voxels, o, box.begin.z, box.end.z, n),
-          what);
-    }
+  const SlabbedWorld tall = slabbed_world({{0, 0, 0}, {16, 16, 110}}, {0, 11, 91, 110}, 0.004, 12);
+  for (const SlabbedWorld* world : {&w, &tall})
+    for (Metric m : {Metric::kManhattan, Metric::kEuclidean})
+      for (bool is_signed : {false, true}) {
+        DistanceOptions o;
+        o.metric = m;
+        o.signed_distance = is_signed;
+        o.max_distance = 5;
+        o.storage = Storage::kU16;
+        o.domain = world->domain;
+        const std::size_t i = 1;  // 104 448 and 81 920 bytes per cost buffer
+        const Box3i box = world->slab(i);
+        const SlabNeighbours n = neighbours_of(world->extremes, i);
+        const std::string what =
+            std::string(metric_name(m)) + (is_signed ? " signed " : " ") + to_string(world->domain);
+        const std::int64_t before = contexts.small->counters().dispatches;
+        const DistanceField parts = gpu::compute_slab_distance_field(
+            *contexts.small, world->slabs[i], o, box.begin.z, box.end.z, n);
+        const std::int64_t in_parts = contexts.small->counters().dispatches - before;
+        const std::int64_t before_whole = contexts.whole->counters().dispatches;
+        const DistanceField one = gpu::compute_slab_distance_field(*contexts.whole, world->slabs[i],
+                                                                   o, box.begin.z, box.end.z, n);
+        EXPECT_GT(in_parts, contexts.whole->counters().dispatches - before_whole) << what;
+        expect_same_field(parts, one, what);
+        expect_same_field(
+            parts,
+            compute_slab_distance_field(world->slabs[i].voxels, o, box.begin.z, box.end.z, n),
+            what);
+      }
   // Unclamped, no cut with halos fits: the slab is cut into thinner z-slabs whose column
   // neighbours (edt_columns) start from the slab's own beyond its faces — both tables at once.
   for (const auto& [i, sites] : {std::pair<std::size_t, bool>{1, false}, {0, true}})
@@ -152,6 +159,7 @@ TEST(GpuSlabs, ASlabCutIntoPartsOrThinnerSlabsByASmallDeviceStillEqualsTheCpusSl
           slabs, compute_slab_distance_field(w.slabs[i].voxels, o, box.begin.z, box.end.z, n),
           what);
     }
+  test::expect_no_validation_messages(*contexts.small);
 }
 
 TEST(GpuSlabs, BadNeighboursAndSlicesTooLargeAreRefused) {

@@ -51,7 +51,7 @@ inline Executor choose_rank_executor(MPI_Comm comm, const BackendSettings& backe
   std::shared_ptr<gpu::Context> device;
   try {
     device = gpu::select_backend(parse_backend(name), options, &why);
-  } catch (const Error& e) {  // GpuUnavailable, or a device that failed to open
+  } catch (const std::exception& e) {  // GpuUnavailable, or a device that failed to open
     why = std::string("no usable Vulkan device (") + e.what() + ")";
   }
   const int mine = device ? 1 : 0;
@@ -69,10 +69,17 @@ inline Executor choose_rank_executor(MPI_Comm comm, const BackendSettings& backe
 }
 
 // The devices' hardware-independent counters summed over the ranks (null on the CPU), and rank
-// 0's device: every rank's dispatches, submits and bytes moved.
-inline nlohmann::json gpu_json_over(MPI_Comm comm, const Executor& executor) {
+// 0's device: every rank's dispatches, submits and bytes moved since its counters read `since`.
+inline nlohmann::json gpu_json_over(MPI_Comm comm, const Executor& executor,
+                                    const gpu::Counters& since = {}) {
   if (!executor.on_gpu()) return nullptr;
-  const gpu::Counters c = executor.device()->counters();
+  gpu::Counters c = executor.device()->counters();
+  c.dispatches -= since.dispatches;
+  c.pipeline_barriers -= since.pipeline_barriers;
+  c.submits -= since.submits;
+  c.fence_waits -= since.fence_waits;
+  c.bytes_uploaded -= since.bytes_uploaded;
+  c.bytes_downloaded -= since.bytes_downloaded;
   const gpu::DeviceInfo& d = executor.device()->device();
   auto total = [&](std::int64_t v) {
     return static_cast<std::int64_t>(sum_over(comm, static_cast<std::uint64_t>(v)));

@@ -98,10 +98,10 @@ struct FieldSettings {
   }
   // Collective (the devices' counters are summed over the ranks).
   nlohmann::json describe(MPI_Comm comm, const DistanceOptions& o, Vec3i dims, int ranks,
-                          const Executor& executor) const {
+                          const Executor& executor, const gpu::Counters& since = {}) const {
     return {{"metric", metric_name(o.metric)},
             {"backend", executor.on_gpu() ? "vulkan" : "cpu"},
-            {"gpu", mpi_cli::gpu_json_over(comm, executor)},
+            {"gpu", mpi_cli::gpu_json_over(comm, executor, since)},
             {"signed", o.signed_distance},
             {"max_distance", o.max_distance},
             {"storage", storage_name(o.storage)},
@@ -314,7 +314,9 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   if (rank == 0) outputs.emplace();
   FileTransaction* tx = outputs ? &*outputs : nullptr;
   const bool world_npy = world_ext == ".npy";
-  mpi::write_field_npy(comm, slab.partition, editor.field(),
+  // (On a device the field is read back here: a failure on one rank reaches every rank.)
+  const DistanceField* const final_field = mpi::collectively(comm, [&] { return &editor.field(); });
+  mpi::write_field_npy(comm, slab.partition, *final_field,
                        {out,
                         {},
                         stats,
@@ -355,12 +357,14 @@ int run_bench(MPI_Comm comm, const FieldSettings& f, const std::vector<int>& dim
   });
   for (int r = 0; r < repeat; ++r) {
     mpi::ExchangeStats ex;
+    const gpu::Counters before =
+        executor.on_gpu() ? executor.device()->counters() : gpu::Counters{};  // per run
     MPI_Barrier(comm);
     const double t0 = MPI_Wtime();
     const DistanceField field =
         mpi::compute_distance_field(comm, partition, world, o, executor, &ex);
     const double ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
-    nlohmann::json j = f.describe(comm, o, domain.size(), size, executor);
+    nlohmann::json j = f.describe(comm, o, domain.size(), size, executor, before);
     j.update(nlohmann::json{
         {"run", r},
         {"ms", ms},

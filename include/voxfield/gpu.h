@@ -63,16 +63,17 @@ struct ContextOptions {
   // At most this many bytes in one storage buffer binding (0: the device's
   // maxStorageBufferRange; a larger value is lowered to it; at least 4 KiB and the device's
   // minStorageBufferOffsetAlignment, InvalidArgument otherwise). Work that does not fit is done in
-  // parts where it can be (a clamped distance field's passes in slabs, large buffers bound in
-  // windows: docs/gpu.md) and refused, naming the sizes, where it cannot; lower it to leave room
+  // parts where it can be (a distance field's passes in slabs — with the clamp's halo, or with
+  // each column's nearest sites beyond the slab — and large buffers bound in windows:
+  // docs/gpu.md) and refused, naming the sizes, where it cannot; lower it to leave room
   // on a device shared with other programs. (An adopted device takes the same cap:
   // AdoptedDevice, gpu_vulkan.h.)
   std::uint64_t max_storage_buffer_bytes = 0;
-  // Which device: -1 the most capable usable one (a discrete GPU before an integrated one, a
-  // software one last); k >= 0 the usable device k modulo their number, counting in the Vulkan
-  // loader's order — so that the processes of a job on one node can each pass their node-local
-  // rank and get a device of their own (voxfield-mpi --device-per-rank). Usable: Vulkan 1.1, a
-  // compute queue, and a hardware device unless allow_software.
+  // Which device, among the usable ones (Vulkan 1.1, a compute queue, hardware unless
+  // allow_software) of the most capable kind present (discrete GPUs, else integrated, else
+  // virtual, else software): -1 the first the Vulkan loader lists; k >= 0 device k modulo their
+  // number — so the processes of a job on one node, each passing its node-local rank, spread
+  // over the node's GPUs (voxfield-mpi --device-per-rank) and none falls back to a software one.
   int device_index = -1;
 };
 

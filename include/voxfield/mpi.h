@@ -198,7 +198,10 @@ class SlabEditor {
   bool stale() const { return stale_; }
 
   // The rank's field over its box; its values over slab() are the whole field's (an unclamped
-  // field's as of the last refresh(); InvalidArgument before one has succeeded).
+  // field's as of the last refresh(); InvalidArgument before one has succeeded). A clamped field on
+  // a device is read back by the first call after a change (bytes moved; it may throw what a
+  // device throws, on this rank alone: call it inside mpi::collectively), and the reference is
+  // valid until the next apply() or refresh(). Not thread-safe.
   const DistanceField& field() const;
   const World& world() const { return world_; }
   Box3i slab() const { return slab_; }

@@ -368,14 +368,17 @@ std::shared_ptr<Context> Context::create(const ContextOptions& options) {
   if (usable.empty())
     throw GpuUnavailable(std::string("Vulkan: no device with a compute queue") +
                          (options.allow_software ? "" : " (software devices excluded)"));
-  // By index (modulo the count: a node-local rank picks its own), or the most capable.
-  const Usable* chosen = &usable[0];
-  if (options.device_index >= 0) {
-    chosen = &usable[static_cast<std::size_t>(options.device_index) % usable.size()];
-  } else {
-    for (const Usable& u : usable)
-      if (u.preference > chosen->preference) chosen = &u;
-  }
+  // The most capable kind present (discrete, integrated, virtual, software); without an index
+  // its first device, with one the device of that index among them, modulo their number — so the
+  // node-local ranks of a job spread over a node's GPUs and never fall back to a software device.
+  int best = usable[0].preference;
+  for (const Usable& u : usable) best = std::max(best, u.preference);
+  std::vector<const Usable*> kind;
+  for (const Usable& u : usable)
+    if (u.preference == best) kind.push_back(&u);
+  const Usable* chosen =
+      kind[options.device_index >= 0 ? static_cast<std::size_t>(options.device_index) % kind.size()
+                                     : 0];
   s.physical = chosen->device;
   s.queue_family = chosen->family;
   const float priority = 1;

@@ -130,8 +130,8 @@ else
   done
   # Edits: a clamped field kept by each rank's device field, an unclamped one computed again
   # over the ranks' devices after the script.
-  for opts in "--metric euclidean --signed --max-distance 6" "--metric manhattan --storage u8" \
-              "--metric chebyshev --signed"; do
+  for opts in "--metric euclidean --signed --max-distance 6 --storage u16" \
+              "--metric manhattan --storage u8" "--metric chebyshev --signed"; do
     # shellcheck disable=SC2086
     "$VF" edit f.npy -e edits.jsonl -o ref.npy $opts 2>/dev/null
     # shellcheck disable=SC2086

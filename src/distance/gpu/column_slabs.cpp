@@ -50,12 +50,14 @@ void NeighbourTables::set_uploaded(const SlabNeighbours& n, const Box3i& field) 
     uploaded_[2 * c + 1] = pack(n.air_below[c], n.air_above[c]);
   }
   uploaded_words_ = uploaded_.size();
-  capacity_words_ = 0;  // the next stage() makes the buffer and uploads the table
+  on_device_ = false;  // the next stage() uploads the table
 }
 
 void NeighbourTables::stage(std::int64_t computed_words, Staging& up) {
+  // What a run that failed before its submit left staged is staged again, in this run's upload.
+  pending_ = false;
   const VkDeviceSize words = uploaded_words_ + static_cast<VkDeviceSize>(computed_words);
-  if (words > capacity_words_ || (capacity_words_ == 0 && words > 0)) {
+  if (words > capacity_words_) {
     check_whole_binding(
         ctx_, words * 4,
         "GPU: the column neighbours of the slabs of a field (" + std::to_string(words) + " words)");
@@ -63,17 +65,25 @@ void NeighbourTables::stage(std::int64_t computed_words, Staging& up) {
         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     buffer_ = Buffer(ctx_, std::max<VkDeviceSize>(words * 4, 16), kUsage, false);
     capacity_words_ = words;
-    if (!uploaded_.empty()) {
-      const VkDeviceSize bytes = uploaded_.size() * 4;
-      copy_ = VkBufferCopy{up.add(uploaded_.data(), bytes), 0, bytes};
-      pending_ = true;
-    }
+    on_device_ = false;  // a new buffer holds nothing yet
+  }
+  if (!uploaded_.empty() && !on_device_) {
+    const VkDeviceSize bytes = uploaded_.size() * 4;
+    copy_ = VkBufferCopy{up.add(uploaded_.data(), bytes), 0, bytes};
+    pending_ = true;
   }
 }
 
+std::size_t NeighbourTables::staged_bytes() const {
+  return pending_ ? static_cast<std::size_t>(copy_.size) : 0;
+}
+
 void NeighbourTables::record(Recorder& rec, Buffer& upload) {
-  if (!pending_) return;
-  rec.copy(upload, buffer_, std::span(&copy_, 1));
+  if (pending_) rec.copy(upload, buffer_, std::span(&copy_, 1));
+}
+
+void NeighbourTables::submitted() {
+  if (pending_) on_device_ = true;
   pending_ = false;
 }
 

@@ -50,10 +50,13 @@ class NeighbourTables {
 
   // Before a run whose slabbed regions need at most `computed_words` words of tables: grows the
   // buffer (checked against one binding; InvalidArgument) and stages the uploaded table into `up`
-  // when the buffer is new.
+  // until a run that carried it has been submitted.
   void stage(std::int64_t computed_words, Staging& up);
+  std::size_t staged_bytes() const;  // of the uploaded table, by this run
   // Records the staged upload, if any, from `upload`.
   void record(Recorder& rec, Buffer& upload);
+  // The run was submitted (and waited for): what it uploaded is on the device.
+  void submitted();
   Buffer& buffer() { return buffer_; }
 
  private:
@@ -62,7 +65,8 @@ class NeighbourTables {
   std::size_t uploaded_words_ = 0;
   Buffer buffer_;
   VkDeviceSize capacity_words_ = 0;
-  bool pending_ = false;  // the uploaded table is staged, not yet recorded
+  bool pending_ = false;    // the uploaded table is staged in this run
+  bool on_device_ = false;  // the uploaded table is in buffer_
   VkBufferCopy copy_{};
 };
 

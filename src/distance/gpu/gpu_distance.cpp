@@ -171,6 +171,7 @@ class FieldEngine {
     upload_bytes_ = first_run_ ? sizeof header_ : 0;
     for (const auto* copies : {&uploads.page_copies, &uploads.brick_copies})
       for (const VkBufferCopy& c : *copies) upload_bytes_ += static_cast<std::size_t>(c.size);
+    upload_bytes_ += tables_.staged_bytes();
     Buffer& upload = ctx_.upload_buffer(std::max<VkDeviceSize>(up.bytes.size(), 16));
     if (!up.bytes.empty()) std::memcpy(upload.mapped(), up.bytes.data(), up.bytes.size());
     Buffer* readback = download ? &ctx_.readback_buffer(field_bytes_ + site_bytes_) : nullptr;
@@ -179,6 +180,7 @@ class FieldEngine {
     for (const detail::UpdateRegion& r : regions) record_region(rec, r, timings != nullptr);
     if (readback) record_readback(rec, *readback);
     rec.submit();
+    tables_.submitted();
     if (timings) *timings = rec.timings();
   }
 

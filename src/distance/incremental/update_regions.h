@@ -30,8 +30,8 @@ std::vector<UpdateRegion> update_regions(const DirtyRegions& dirty, const Box3i&
 // that needs the fewest, into slabs of its `out` box, each with the sites it needs (the slab
 // grown by the reach, clipped to the domain) and at most `max_in_voxels` of them: the same values,
 // computed in parts by a device whose buffers hold no more. A region no cut brings under the
-// bound (an unclamped field's: its reach is the whole domain) stays whole, for the caller to
-// refuse.
+// bound (an unclamped field's: its reach is the whole domain) stays whole, for the caller to cut
+// otherwise (the GPU's z-slabs with column neighbours, src/distance/gpu/column_slabs.h).
 std::vector<UpdateRegion> split_regions(const std::vector<UpdateRegion>& regions,
                                         const Box3i& domain, Vec3i reach,
                                         std::int64_t max_in_voxels);
