@@ -2,7 +2,8 @@
 # The showcase's MPI section (called by scripts/showcase.sh after `voxfield showcase`): the
 # showcase's 256^3 terrain, its exact signed Euclidean field computed by one process and by
 # voxfield-mpi on 1, 2 and 4 ranks, each rank reading only its slab of the .npy; the files must be
-# identical, byte for byte (and on 2 ranks each on a Vulkan device of its own); then that field
+# identical, byte for byte (and on 2 ranks each on a Vulkan device of its own: identical, or within
+# the device's f32 square roots); then that field
 # meshed by one process and over 2 and 4 ranks: the same
 # file; then a frame of the terrain drawn over 2 and 4 ranks: voxfield render's PNG. Appends
 # a section with the times and the bytes exchanged to the report.
@@ -131,7 +132,7 @@ rm -f "$out/mpi-frame.png"
   printf '%s' "$rows"
   printf '\nThe same field with each rank computing its slab on a Vulkan device of its own (`--backend\n'
   printf 'vulkan`; the counters summed over the ranks):\n\n'
-  printf '| ranks | device | submits | dispatches | bytes up | file identical to one process |\n|---|---|---|---|---|---|\n'
+  printf '| ranks | device | submits | dispatches | bytes up | file equal to one process'"'"'s |\n|---|---|---|---|---|---|\n'
   printf '%s\n' "$gpu_row"
   printf '\nThe same field from `terrain-sdf.vdb` (the OpenVDB level set above), each rank decoding only the\n'
   printf 'leaves of its slab (the others'"'"' values stepped over, never decompressed):\n\n'

@@ -49,8 +49,9 @@ TEST(Gpu, BackendNamesAndChoice) {
 }
 
 TEST(Gpu, DevicesAreChosenByIndexModuloTheirNumber) {
-  // A node-local rank picks a device of its own (voxfield-mpi --device-per-rank): index k is the
-  // usable device k modulo their number, so any index names one, and index 0 the loader's first.
+  // A node-local rank picks a device of its own (voxfield-mpi --device-per-rank): index k is device
+  // k, modulo their number, among the usable devices of the most capable kind present, so any
+  // index names one, and index 0 the first of them the loader lists.
   if (!gpu_tests_wanted()) GTEST_SKIP();
   gpu::ContextOptions first;
   first.device_index = 0;

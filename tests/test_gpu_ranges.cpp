@@ -136,13 +136,18 @@ TEST(Gpu, FieldsBeyondTheStorageBufferRangeAreComputedInParts) {
     f.metric = Metric::kEuclidean;
     f.max_distance = 20;
     f.storage = Storage::kU8;
+    // The build: the slab neighbours, then five slabs of 15 slices (z, x and y passes, encode).
+    const std::int64_t d0 = small->counters().dispatches;
     gpu::DynamicField live(small, deep, f);
+    EXPECT_EQ(small->counters().dispatches - d0, 1 + 5 * 4);
     expect_same_field(live.download(), compute_distance_field(deep, f), "clamp 20, in z-slabs");
     DirtyRegions dirty(8, DirtyRegions::Track::kAnyChange);
     apply_edit(deep, Edit{EditOp::kPlace, SphereBrush{{10, 20, 3}, 2}, 4}, &dirty);
+    // The update writes z 0..26 and reads z 0..46: of its four slabs the last two write nothing.
+    const std::int64_t d1 = small->counters().dispatches;
     const DynamicDistanceField::UpdateStats st = live.update(dirty);
-    EXPECT_LT(st.voxels_recomputed,
-              st.voxels_read);  // the region writes fewer slices than it reads
+    EXPECT_EQ(small->counters().dispatches - d1, 1 + 2 * 4);
+    EXPECT_LT(st.voxels_recomputed, st.voxels_read);
     expect_same_field(live.download(), compute_distance_field(deep, f),
                       "clamp 20, in z-slabs, edited");
   }

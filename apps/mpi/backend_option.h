@@ -27,8 +27,8 @@ inline void add_backend_option(CLI::App* cmd, BackendSettings& backend) {
       ->check(CLI::IsMember({"cpu", "vulkan", "auto"}))
       ->capture_default_str();
   cmd->add_flag("--device-per-rank", backend.device_per_rank,
-                "each rank on a node takes the node's device of its node-local rank (modulo "
-                "their number) instead of the most capable one");
+                "each rank on a node takes, among the node's most capable devices (its GPUs), "
+                "the one of its node-local rank, modulo their number, instead of the first");
 }
 
 // Collective: every rank's executor, one backend for the whole job. A rank with no usable device

@@ -285,6 +285,9 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   // The ranks run through the script without waiting for each other: the stream takes as long as
   // the rank with the most work.
   const double stream_ms = max_over(comm, std::accumulate(edit_ms.begin(), edit_ms.end(), 0.0));
+  // (On a device the field is read back here, before the counters are read: a failure on one rank
+  // reaches every rank.)
+  const DistanceField* const final_field = mpi::collectively(comm, [&] { return &editor.field(); });
   nlohmann::json j = f.describe(comm, o, slab.partition.domain.size(), size, executor);
   j.update(nlohmann::json{
       {"load_ms", load_ms},
@@ -314,8 +317,6 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
   if (rank == 0) outputs.emplace();
   FileTransaction* tx = outputs ? &*outputs : nullptr;
   const bool world_npy = world_ext == ".npy";
-  // (On a device the field is read back here: a failure on one rank reaches every rank.)
-  const DistanceField* const final_field = mpi::collectively(comm, [&] { return &editor.field(); });
   mpi::write_field_npy(comm, slab.partition, *final_field,
                        {out,
                         {},

@@ -90,6 +90,9 @@ class DynamicField {
   DynamicField(const DynamicField&) = delete;
   DynamicField& operator=(const DynamicField&) = delete;
 
+  // If rebuild() or update() throws (a device error, a region refused), the field is not exact
+  // for its world until a rebuild() succeeds; the next run sends the whole world again, since
+  // the device's copy of it is in doubt.
   void rebuild();
   DynamicDistanceField::UpdateStats update(const DirtyRegions& dirty);
   // Reads the resident field back (for saving, checking or CPU consumers).

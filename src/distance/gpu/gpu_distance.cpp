@@ -155,8 +155,27 @@ class FieldEngine {
 
   // Uploads `chunks` (those inside the page table), recomputes `regions`, optionally reads the
   // whole field back: one command buffer, one submit, one fence wait.
+  // A run that throws leaves the device's copy of the world in doubt (the host counts page
+  // entries and bricks as sent that may not have been, and a grown pool may have lost its old
+  // bricks): the next run sends the header and the whole world again.
   void run(const std::vector<Vec3i>& chunks, const std::vector<detail::UpdateRegion>& regions,
            bool download, std::vector<PassTiming>* timings) {
+    const bool resync = resync_;
+    if (resync) {
+      first_run_ = true;
+      if (owns_world_) resident_->resync();
+    }
+    try {
+      run_once(resync ? all_chunks() : chunks, regions, download, timings);
+    } catch (...) {
+      resync_ = true;
+      throw;
+    }
+    resync_ = false;
+  }
+
+  void run_once(const std::vector<Vec3i>& chunks, const std::vector<detail::UpdateRegion>& regions,
+                bool download, std::vector<PassTiming>* timings) {
     Staging up;
     Uploads uploads;
     stage(chunks, regions, up, uploads);
@@ -451,6 +470,7 @@ class FieldEngine {
   std::shared_ptr<ResidentWorld> resident_;
   bool owns_world_ = true;
   bool first_run_ = true;
+  bool resync_ = false;  // the last run threw: the next sends the whole world (run())
   // The passes' work buffers, shared with the fields on the same resident world (their runs are
   // submitted and waited for one at a time).
   std::shared_ptr<WorkBuffers> work_;

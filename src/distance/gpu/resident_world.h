@@ -43,6 +43,10 @@ class ResidentWorld {
   void record(Recorder& rec, Buffer& upload, Uploads& uploads, Buffer* header_buffer,
               std::span<const VkBufferCopy> header);
 
+  // After a run that failed: the next stage() sends every page entry it is given again (and
+  // every brick, as always), whatever the host counts as sent.
+  void resync() { first_sync_ = true; }
+
   // Every chunk of the page table.
   std::vector<Vec3i> all_chunks() const;
   // The page table's part of a field's header.
