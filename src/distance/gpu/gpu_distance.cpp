@@ -27,6 +27,7 @@
 #include "resident_world.h"
 #include "shaders/layout.h"
 #include "voxfield/gpu_distance.h"
+#include "work_buffers.h"
 
 namespace voxfield::gpu {
 namespace {
@@ -40,39 +41,6 @@ constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
                                         VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
 
 }  // namespace
-
-// The exact transform's work buffers: three cost buffers, the envelope scans' scratch, and the
-// nearest sites of each cost buffer. Grown to the largest region a run computes, never shrunk;
-// shared by the fields on one resident world, so the sites buffer is sized by the fields that
-// carry sites alone.
-struct WorkBuffers {
-  Buffer cost[3], scratch_s, scratch_t, sites;
-  VkDeviceSize bytes = 0;       // per cost buffer: 4 per voxel of the largest region computed
-  VkDeviceSize site_bytes = 0;  // 24 per voxel of the largest region computed with nearest sites
-  // The largest buffer a grow for a region of `needed` bytes per cost buffer would make.
-  VkDeviceSize widest_after(VkDeviceSize needed, bool need_sites) const {
-    return std::max({bytes, needed, need_sites ? std::max(site_bytes, 6 * needed) : site_bytes});
-  }
-  // The most voxels one region's box of sites may hold on a device binding at most `range` bytes
-  // of a buffer.
-  static std::int64_t most_region_voxels(VkDeviceSize range, bool need_sites) {
-    return static_cast<std::int64_t>(range / 4 / (need_sites ? 6 : 1));
-  }
-  void grow(Context::Impl& ctx, VkDeviceSize needed, bool need_sites) {
-    const VkDeviceSize n = std::max(bytes, needed);
-    const VkDeviceSize s = need_sites ? std::max(site_bytes, 6 * needed) : site_bytes;
-    if (n == bytes && s == site_bytes) return;
-    // Made before any is kept: a failed allocation (GpuOutOfMemory) leaves the old set and sizes.
-    WorkBuffers next;
-    for (Buffer& b : next.cost) b = Buffer(ctx, n, kStorage, false);
-    next.sites = Buffer(ctx, std::max<VkDeviceSize>(s, 16), kStorage, false);
-    next.scratch_s = Buffer(ctx, n, kStorage, false);
-    next.scratch_t = Buffer(ctx, n, kStorage, false);
-    next.bytes = n;
-    next.site_bytes = s;
-    *this = std::move(next);
-  }
-};
 
 class FieldEngine {
  public:
