@@ -58,7 +58,9 @@ expect_failure() {  # expect_failure CODE PATTERN ARGS...
   set -e
   if [ "$got" -ne "$code" ]; then echo "FAIL: $* exited $got, expected $code"; cat err.txt; fail=1; fi
   if ! grep -q -- "$pattern" err.txt; then echo "FAIL: $*: no '$pattern' in:"; cat err.txt; fail=1; fi
-  if [ "$(grep -c -- "$pattern" err.txt)" -gt 1 ]; then echo "FAIL: $*: said more than once"; fail=1; fi
+  if [ "$(grep -c -- "$pattern" err.txt)" -gt 1 ]; then
+    echo "FAIL: $*: said more than once:"; cat err.txt; fail=1
+  fi
   if [ -e bad.npy ] || [ -e bad.vfw ] || [ -e bad.ply ] || [ -e bad.vdb ] || [ -e bad.txt ]; then echo "FAIL: $* wrote an output"; fail=1; fi
   if ls -a | grep -q vftmp; then echo "FAIL: $* left a temporary"; fail=1; fi
 }

@@ -427,19 +427,36 @@ rng = np.random.default_rng(5)
 np.save('large.npy', np.asfortranarray((rng.random((160, 160, 160)) < 0.001).astype(np.uint8)))"
 "$VF" field large.npy -o large_ref.npy --metric euclidean --signed 2>/dev/null
 killed=0
-ranks_of() {  # ranks_of PID: the live (not zombie) voxfield-mpi processes descending from PID
-  # (One ps: the job lasts about a second, and a walk of pgrep calls took much of it.)
-  ps -eo pid=,ppid=,stat=,comm= | awk -v root="$1" '
+rank_process() {  # rank_process JOB RANK: the PID of RANK of the job started as JOB, if running
+  # The ranks are the live (not zombie) processes named voxfield-mpi that descend from JOB and
+  # whose parent is not one: under the sanitizers a rank's leak check clones a tracer process of
+  # the same name (a child of the rank, sharing its memory and so its environment), and killing
+  # that tracer fails the leak check instead of killing a rank. The rank is read from the
+  # environment mpirun gave it, not guessed from ps's order. (One ps: the job lasts about a
+  # second, and a walk of pgrep calls took much of it.)
+  local pid
+  for pid in $(ps -eo pid=,ppid=,stat=,comm= | awk -v root="$1" '
     { parent[$1] = $2; state[$1] = $3; name[$1] = $4 }
     END {
-      for (p in parent) if (name[p] == "voxfield-mpi" && state[p] !~ /^Z/) {
+      for (p in parent) if (name[p] == "voxfield-mpi" && state[p] !~ /^Z/ &&
+                            name[parent[p]] != "voxfield-mpi") {
         for (q = p; (q in parent) && q != root; q = parent[q]) {}
         if (q == root) print p
       }
-    }'
+    }'); do
+    if tr '\0' '\n' < "/proc/$pid/environ" 2>/dev/null | grep -qx "OMPI_COMM_WORLD_RANK=$2"; then
+      echo "$pid"
+      return
+    fi
+  done
 }
+round=0
 for delay in 0.1 0.3 0.5 0.7; do
   printf 'old' > target.npy
+  # Rank 1, then rank 0, alternately: a dead rank 0 (the one that stages the temporary) and a
+  # dead rank 1 (whose survivor, rank 0, must clean up) are both covered.
+  victim_rank=$(( (round + 1) % 2 ))
+  round=$((round + 1))
   set +e
   # With Open MPI's default grace: the surviving rank gets SIGTERM and a second to remove its
   # staged temporary before SIGKILL (the rest of this script runs without it, to end failed jobs
@@ -448,11 +465,10 @@ for delay in 0.1 0.3 0.5 0.7; do
     --metric euclidean --signed --chunk 16 >/dev/null 2>kill_err.txt &
   job=$!
   sleep "$delay"
-  # A rank of this job: a process named voxfield-mpi among the job's descendants (mpirun is named
-  # mpirun; voxfield-mpi runs of other tests or users on the machine are not this job's). None
-  # yet (a slow start under a sanitizer) means no kill this round. Zombies are skipped: a rank of
-  # the previous round may not be reaped yet.
-  victim=$(ranks_of "$job" | tail -1)
+  # The rank of this job (mpirun is named mpirun; voxfield-mpi runs of other tests or users on
+  # the machine are not this job's). None yet (a slow start under a sanitizer) or none any more
+  # means no kill this round.
+  victim=$(rank_process "$job" "$victim_rank")
   if [ -n "$victim" ]; then
     # Only once the rank is past MPI's start-up handshake (its PML component is mapped, ~0.1 s
     # in): a rank killed inside the handshake leaves Open MPI 4.1's mpirun waiting forever (it
@@ -477,8 +493,10 @@ for delay in 0.1 0.3 0.5 0.7; do
     echo "FAIL: a kill after ${delay}s left target.npy neither old nor new"; fail=1
   elif [ "$code" -eq 0 ]; then
     echo "FAIL: a killed job exited 0 without writing"; fail=1
-  elif ! grep -Eq "rank [0-9]+ .*exited on signal 9" kill_err.txt; then
-    echo "FAIL: mpirun did not say which rank died:"; cat kill_err.txt; fail=1
+  elif [ -z "$victim" ]; then
+    echo "FAIL: a job that was not killed exited $code:"; cat kill_err.txt; fail=1
+  elif ! grep -Eq "rank $victim_rank .*exited on signal 9" kill_err.txt; then
+    echo "FAIL: mpirun did not say that rank $victim_rank died:"; cat kill_err.txt; fail=1
   else
     killed=$((killed + 1))
   fi
