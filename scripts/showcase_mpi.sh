@@ -5,7 +5,7 @@
 # identical, byte for byte (and on 2 ranks each on a Vulkan device of its own: identical, or within
 # the device's f32 square roots); then that field
 # meshed by one process and over 2 and 4 ranks: the same
-# file; then a frame of the terrain drawn over 2 and 4 ranks: voxfield render's PNG. Appends
+# file; the terrain world's own surface over 2 ranks: voxfield mesh's file; then a frame of the terrain drawn over 2 and 4 ranks: voxfield render's PNG. Appends
 # a section with the times and the bytes exchanged to the report.
 # Usage: showcase_mpi.sh OUT_DIR   (skipped, saying so, when voxfield-mpi was not built)
 set -euo pipefail
@@ -101,6 +101,24 @@ done
 rm -f "$out/mpi-mesh-2.ply" "$out/mpi-mesh-4.ply"
 mesh_one=$(/usr/bin/python3 -c "import json; j = json.load(open('$out/mpi-mesh-one.json')); print('%d triangles in %.0f ms' % (j['triangles'], j['ms']))")
 rm -f "$out/mpi-one-process.npy" "$out/mpi-mesh-one.ply"
+# The terrain world's own surface (a world meshed as `voxfield mesh` meshes it: its voxels' faces
+# through the exact signed field, coloured by material) over 2 ranks, each reading only the slices
+# its chunk layers need: the same file, byte for byte.
+"$B/voxfield" mesh "$out/terrain.npy" -o "$out/mpi-world-one.ply" --stats "$out/mpi-world-one.json" \
+  2>/dev/null
+mpirun --oversubscribe -np 2 "$B/voxfield-mpi" mesh "$out/terrain.npy" -o "$out/mpi-world-2.ply" \
+  --stats "$out/mpi-world-2.json" 2>/dev/null
+world_same=no
+cmp -s "$out/mpi-world-one.ply" "$out/mpi-world-2.ply" && world_same=yes
+world_row=$(/usr/bin/python3 - "$out/mpi-world-one.json" "$out/mpi-world-2.json" "$world_same" <<'PY'
+import json, sys
+one, j = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+print("| terrain.npy | %d | %s | %d | %.0f (one process: %.0f) | %d | %s |" % (j["ranks"],
+      " ".join(str(k) for k in j["chunk_layers"]), j["triangles"], j["ms"], one["ms"],
+      j["ghost_slices"], sys.argv[3]))
+PY
+)
+rm -f "$out/mpi-world-one.ply" "$out/mpi-world-2.ply"
 # A frame of the terrain drawn where it lies (`voxfield-mpi render`): the rays, and the soft
 # shadows' rays, handed from slab to slab; the PNG must be voxfield render's, byte for byte.
 frame_opts=(--width 640 --height 360 --chunk 32)
@@ -145,6 +163,12 @@ rm -f "$out/mpi-frame.png"
   printf '| ranks | chunk layers (cuts) | triangles | ms (made and written) | bytes received (weights, census) | the same file as one process |\n'
   printf '|---|---|---|---|---|---|\n'
   printf '%s' "$mesh_rows"
+  printf '\nThe terrain world'"'"'s own surface over the ranks (`voxfield-mpi mesh terrain.npy`, a world): the\n'
+  printf 'voxels'"'"' faces through the exact signed field, coloured by material; after a first reading bounds\n'
+  printf 'the content, each rank reads only its layers'"'"' slices and the field'"'"'s clamp beyond them (ghost slices).\n\n'
+  printf '| world | ranks | chunk layers (cuts) | triangles | ms (made and written) | ghost slices | the same file as `voxfield mesh` |\n'
+  printf '|---|---|---|---|---|---|---|\n'
+  printf '%s\n' "$world_row"
   printf '\nA frame of the terrain over the ranks (`voxfield-mpi render`): each rank walks the rays that cross\n'
   printf 'its slab and hands each on, with the DDA'"'"'s exact state, to the rank it enters, soft-shadow rays\n'
   printf 'included; each pixel is shaded by the rank where it hit. The PNG must equal `voxfield render`'"'"'s.\n\n'

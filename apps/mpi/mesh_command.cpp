@@ -21,8 +21,12 @@ namespace voxfield::mpi_cli {
 CLI::App* add_mesh_command(CLI::App& app, MeshSettings& s) {
   CLI::App* cmd = app.add_subcommand(
       "mesh",
-      "the iso-surface of a float .npy volume, as `voxfield mesh` (each rank reads its planes)");
-  cmd->add_option("IN", s.in, "input float32/float64 .npy volume")->required();
+      "the iso-surface of a float .npy volume or the surface of a world, as `voxfield mesh` (each "
+      "rank reads its planes)");
+  cmd->add_option("IN", s.in,
+                  "input float32/float64 .npy volume, or world (.vox, .vfw, .vdb, integer .npy: "
+                  "its surface, through its exact signed field, as `voxfield mesh` meshes it)")
+      ->required();
   cmd->add_option("-o,--output", s.out,
                   "output .ply, .obj, .stl or .glb (each rank writes its share)")
       ->required();
@@ -46,6 +50,11 @@ CLI::App* add_mesh_command(CLI::App& app, MeshSettings& s) {
                   "deal the chunk layers to the ranks by content (default: each rank about as many "
                   "crossed edges, read in a first pass) or by count")
       ->check(CLI::IsMember({"content", "count"}));
+  cmd->add_option("--metric", s.metric,
+                  "a world's field: euclidean (default), chebyshev or manhattan (at iso 0 the "
+                  "voxels' surface is the same for every metric)")
+      ->check(CLI::IsMember({"euclidean", "chebyshev", "manhattan"}));
+  add_read_options(cmd, s.read);
   cmd->add_option("--stats", s.stats, "counts, timings and exchange figures as JSON");
   return cmd;
 }
@@ -63,17 +72,21 @@ int run_mesh(MPI_Comm comm, const MeshSettings& s) {
   options.chunk_edge = s.chunk;
   (void)mesh_format_of(s.out);  // an unknown extension is refused before any work
   mpi::check_outputs(comm, {}, {s.out, s.stats}, {s.in});
-  // Every rank reads the header; a world (integer or bool .npy) is not a float volume.
-  const NpyVolume header = mpi::collectively(comm, [&] {
-    NpyVolume h = read_npy_header(s.in);
-    if (h.dtype != DType::kFloat32 && h.dtype != DType::kFloat64)
-      throw InvalidArgument(s.in +
-                            ": voxfield-mpi mesh meshes float32/float64 volumes; for a world, "
-                            "write its signed field first (voxfield-mpi field IN -o F.npy "
-                            "--metric euclidean --signed) and mesh that, or use voxfield mesh");
+  // Every rank reads the header: a float .npy is a volume; any other input is a world.
+  const std::optional<NpyVolume> header = mpi::collectively(comm, [&] {
+    std::optional<NpyVolume> h;
+    if (lowercase_extension(s.in) == ".npy") h = read_npy_header(s.in);
+    if (h && h->dtype != DType::kFloat32 && h->dtype != DType::kFloat64) h.reset();
     return h;
   });
-  ScalarVolume frame{header.dims, nullptr};
+  if (!header) return run_world_mesh(comm, s);
+  if (s.metric)
+    throw InvalidArgument("--metric is for worlds (meshed through their exact signed field); " +
+                          s.in + " is a float volume, meshed as it is");
+  if (s.read.by != "every" || !s.read.grid.empty())
+    throw InvalidArgument("--read and --grid are for worlds; each rank reads its planes of " +
+                          s.in);
+  ScalarVolume frame{header->dims, nullptr};
   if (!s.spacing.empty()) frame.spacing_units = {s.spacing[0], s.spacing[1], s.spacing[2]};
   const double t0 = MPI_Wtime();
   // Planes [z0, z1) of the file as floats (a value past float's range refused, as voxfield mesh
@@ -87,16 +100,16 @@ int run_mesh(MPI_Comm comm, const MeshSettings& s) {
   const mpi::MeshLayers layers = [&] {
     if (s.balance == "count")
       return mpi::collectively(
-          comm, [&] { return mpi::partition_mesh_layers(header.dims, s.chunk, size); });
+          comm, [&] { return mpi::partition_mesh_layers(header->dims, s.chunk, size); });
     // By content: a first pass over equal shares of the planes counts each layer's crossings.
-    const int z0 = static_cast<int>(static_cast<std::int64_t>(header.dims.z) * rank / size);
-    const int z1 = static_cast<int>(static_cast<std::int64_t>(header.dims.z) * (rank + 1) / size);
+    const int z0 = static_cast<int>(static_cast<std::int64_t>(header->dims.z) * rank / size);
+    const int z1 = static_cast<int>(static_cast<std::int64_t>(header->dims.z) * (rank + 1) / size);
     const std::vector<double> weights = [&] {
       const std::vector<float> share = read_planes(z0, z1);
-      return mpi::mesh_layer_weights(comm, header.dims, z0, z1, share.data(), options, &ex);
+      return mpi::mesh_layer_weights(comm, header->dims, z0, z1, share.data(), options, &ex);
     }();
     return mpi::collectively(
-        comm, [&] { return mpi::partition_mesh_layers(header.dims, s.chunk, size, weights); });
+        comm, [&] { return mpi::partition_mesh_layers(header->dims, s.chunk, size, weights); });
   }();
   std::vector<float> planes = [&] {
     const auto [z0, z1] = layers.planes(rank);
@@ -117,9 +130,21 @@ int run_mesh(MPI_Comm comm, const MeshSettings& s) {
                                   options, s.out, !s.stats.empty(), &ex,
                                   outputs ? &*outputs : nullptr);
   }();
+  return finish_mesh(
+      comm, s, mesh, t1, ex, outputs,
+      {{"load_ms_max", load_ms}, {"chunk_layers", layers.layers}, {"balance", s.balance}});
+}
+
+int finish_mesh(MPI_Comm comm, const MeshSettings& s, const mpi::MeshFileSummary& mesh,
+                double t_mesh, const mpi::ExchangeStats& ex,
+                std::optional<FileTransaction>& outputs, nlohmann::json extra) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  const Mesher algorithm = parse_mesher(s.algorithm);
   // The census (--stats only) is timed apart: "ms" is the mesh made and written.
   const double census_ms = max_over(comm, mesh.census_ms);
-  const double mesh_ms = max_over(comm, (MPI_Wtime() - t1) * 1e3 - mesh.census_ms);
+  const double mesh_ms = max_over(comm, (MPI_Wtime() - t_mesh) * 1e3 - mesh.census_ms);
   nlohmann::json exchange = exchange_json(comm, ex);
   const double peak_mb = max_over(comm, static_cast<double>(peak_rss_bytes()) / 1048576.0);
   mpi::collectively(comm, [&] {
@@ -128,31 +153,28 @@ int run_mesh(MPI_Comm comm, const MeshSettings& s) {
       const MeshStats& st = *mesh.census;
       nlohmann::json j{{"input", s.in},
                        {"output", s.out},
-                       {"algorithm", mesher_name(options.algorithm)},
+                       {"algorithm", mesher_name(algorithm)},
                        {"ms", mesh_ms},
                        {"census_ms_max", census_ms},
-                       {"load_ms_max", load_ms},
                        {"ranks", size},
                        {"threads", max_threads()},
                        {"chunk_edge", s.chunk},
-                       {"chunk_layers", layers.layers},
-                       {"balance", s.balance},
                        {"vertices", st.vertices},
                        {"triangles", st.triangles},
                        {"watertight", st.watertight()},
                        {"boundary_edges", st.boundary_edges},
                        {"euler_characteristic", st.euler_characteristic},
                        {"peak_rss_mb_max", peak_mb}};
+      j.update(extra);
       j["exchange"] = exchange;
       outputs->stage(s.stats, j.dump(2) + "\n");
     }
     outputs->commit();
   });
-  const std::uint64_t triangles = mesh.triangles, vertices = mesh.vertices;
   if (rank == 0)
-    std::cerr << "voxfield-mpi: wrote " << s.out << " (" << triangles << " triangles, " << vertices
-              << " vertices, " << mesher_name(options.algorithm) << ", " << size << " ranks, "
-              << std::lround(mesh_ms) << " ms)\n";
+    std::cerr << "voxfield-mpi: wrote " << s.out << " (" << mesh.triangles << " triangles, "
+              << mesh.vertices << " vertices, " << mesher_name(algorithm) << ", " << size
+              << " ranks, " << std::lround(mesh_ms) << " ms)\n";
   return 0;
 }
 

@@ -73,4 +73,22 @@ struct MeshSlab {
 MeshSlab mesh_slab(const ScalarVolume& frame, int planes_z0, int plane_count, const float* planes,
                    const MeshOptions& options, int z_begin, int z_end);
 
+// The same for a voxel world's surface at iso 0: the rows [z_begin, z_end) of mesh_world(world,
+// options, metric)'s lattice, whose box is `lattice` — the world's content bounds grown by
+// mesh_world_margin(0), as mesh_world takes them (a program holding part of the world learns them
+// from every part: mpi::content_bounds). The slab computes the world's exact signed field over the
+// planes it reads from the voxels within its clamp of them, so `world` needs to hold only the
+// z-slices mesh_world_slab_voxels names (a bounded world of those slices will do; beyond a bounded
+// world's bounds is air, as for mesh_world). The part's vertices are coloured from the world's
+// palette and placed in its frame: consecutive slabs laid end to end are mesh_world's mesh, array
+// for array. InvalidArgument for an offset surface (options.iso != 0: its normals come from the
+// nearest voxels, which may lie anywhere), an analytic value or gradient, a lattice under 2
+// samples along an axis, or a slab outside it; what mesh_world throws otherwise.
+MeshSlab mesh_world_slab(const World& world, const Box3i& lattice, const MeshOptions& options,
+                         Metric metric, int z_begin, int z_end);
+// The world's slices [first, second) (world z, within the lattice) mesh_world_slab reads for the
+// rows [z_begin, z_end) of `lattice`.
+std::pair<int, int> mesh_world_slab_voxels(const Box3i& lattice, int z_begin, int z_end,
+                                           Mesher mesher = Mesher::kMarchingCubes);
+
 }  // namespace voxfield

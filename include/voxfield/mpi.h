@@ -474,4 +474,18 @@ MeshFileSummary write_mesh_volume(MPI_Comm comm, const MeshLayers& layers,
                                   bool census = false, ExchangeStats* stats = nullptr,
                                   FileTransaction* into = nullptr);
 
+// Collective: a voxel world's surface (mesh_world at iso 0, mesh.h) written to `path` as
+// write_mesh_volume writes a float volume's — the bytes write_mesh writes for mesh_world(the whole
+// world, options, metric), each rank writing its share, nothing gathered. `lattice` is
+// mesh_world's: the world's content bounds over the ranks (content_bounds above) grown by
+// mesh_world_margin(0); `layers` are cut for its size (partition_mesh_layers(lattice.size(), ...)).
+// Each rank's `world` holds, with the world's palette and frame, at least the slices
+// mesh_world_slab_voxels(lattice, layers.slab(rank)) names (mesh_slab.h): each computes the exact
+// signed field of the planes it meshes from them. Throws RankError on every rank when any fails (an
+// offset surface, iso != 0, is refused: its normals come from nearest voxels in any slab).
+MeshFileSummary write_world_mesh(MPI_Comm comm, const MeshLayers& layers, const Box3i& lattice,
+                                 const World& world, const MeshOptions& options, Metric metric,
+                                 const std::filesystem::path& path, bool census = false,
+                                 ExchangeStats* stats = nullptr, FileTransaction* into = nullptr);
+
 }  // namespace voxfield::mpi

@@ -8,6 +8,7 @@
 
 #include "chunked_mesh.h"
 #include "voxfield/mesh.h"
+#include "voxfield/mesh_slab.h"
 #include "voxfield/terrain.h"
 
 namespace voxfield::detail::mesh {
@@ -17,6 +18,12 @@ namespace voxfield::detail::mesh {
 // `voxel_faces`: the volume is a voxel world's signed field (see Lattice::voxel_faces).
 Mesh mesh_lattice(const ScalarVolume& volume, const MeshOptions& options,
                   std::vector<std::uint64_t>* sources, bool voxel_faces = false);
+
+// mesh_slab (mesh_slab.h) with the lattice's voxel_faces rule, also giving each part vertex's
+// source sample (an index x fastest in the whole lattice) when `sources` is not null.
+MeshSlab mesh_lattice_slab(const ScalarVolume& frame, int planes_z0, int plane_count,
+                           const float* planes, const MeshOptions& options, int z_begin, int z_end,
+                           bool voxel_faces, std::vector<std::uint64_t>* sources);
 
 // The lattice of a request, after checking it (InvalidArgument for a bad volume or options).
 // A volume without values is read through `fill` (Lattice::fill).
@@ -46,6 +53,10 @@ int world_surface_margin(double iso);
 DistanceOptions world_field_options(double iso, Metric metric, const Box3i& domain);
 ScalarVolume world_lattice_frame(const Box3i& domain);
 std::uint8_t world_vertex_material(const World& world, const DistanceField& field, Vec3i p);
+// Colours `mesh`'s vertices from the world's palette by their source samples (indices x fastest in
+// the box `lattice`): world_vertex_material of each.
+void color_by_sources(const World& world, const DistanceField& field, const Box3i& lattice,
+                      const std::vector<std::uint64_t>& sources, Mesh& mesh);
 std::function<std::array<double, 3>(const std::array<double, 3>&)> offset_gradient(
     const World& world, const DistanceField& field, Metric metric, bool outside);
 

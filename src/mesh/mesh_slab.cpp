@@ -32,7 +32,7 @@ namespace {
 // The dual meshers' slab: FlyingDual over the planes held, its first cell plane's vertices (the
 // slab before's last) moved behind the slab's own.
 MeshSlab dual_slab(const detail::mesh::Lattice& lattice, const MeshOptions& options, int w0,
-                   int whole_z, int b, int e) {
+                   int whole_z, int b, int e, std::vector<std::uint64_t>* sources) {
   using namespace detail::mesh;
   const FlyingDual passes(lattice, options, w0, whole_z, b, e);
   MeshSlab slab;
@@ -42,13 +42,15 @@ MeshSlab dual_slab(const detail::mesh::Lattice& lattice, const MeshOptions& opti
   slab.owned_vertices = all - lent;
   slab.last_plane_vertices = passes.vertices_before(e) - passes.vertices_before(e - 1);
   // (vertices_before(b) counts the plane before only: nothing is counted below it.)
-  const WeldOutput out = size_mesh(slab.part, all, passes.indices(), false, nullptr);
+  const WeldOutput out = size_mesh(slab.part, all, passes.indices(), false, sources);
   passes.write(out);
   Mesh& m = slab.part;
-  std::rotate(m.positions.begin(), m.positions.begin() + static_cast<std::ptrdiff_t>(lent),
-              m.positions.end());
-  std::rotate(m.normals.begin(), m.normals.begin() + static_cast<std::ptrdiff_t>(lent),
-              m.normals.end());
+  const auto behind = [lent](auto& v) {
+    std::rotate(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(lent), v.end());
+  };
+  behind(m.positions);
+  behind(m.normals);
+  if (sources) behind(*sources);
   const auto owned = static_cast<std::uint32_t>(slab.owned_vertices),
              first = static_cast<std::uint32_t>(lent);
   for (std::uint32_t& i : m.indices) i = i < first ? i + owned : i - first;
@@ -59,7 +61,15 @@ MeshSlab dual_slab(const detail::mesh::Lattice& lattice, const MeshOptions& opti
 
 MeshSlab mesh_slab(const ScalarVolume& frame, int planes_z0, int plane_count, const float* planes,
                    const MeshOptions& options, int z_begin, int z_end) {
-  using detail::mesh::FlyingEdges;
+  return detail::mesh::mesh_lattice_slab(frame, planes_z0, plane_count, planes, options, z_begin,
+                                         z_end, false, nullptr);
+}
+
+namespace detail::mesh {
+
+MeshSlab mesh_lattice_slab(const ScalarVolume& frame, int planes_z0, int plane_count,
+                           const float* planes, const MeshOptions& options, int z_begin, int z_end,
+                           bool voxel_faces, std::vector<std::uint64_t>* sources) {
   if (!mesh_slab_applies(options))
     throw InvalidArgument("mesh_slab: meshes without an analytic value or gradient");
   const int nz = frame.size.z;
@@ -78,23 +88,25 @@ MeshSlab mesh_slab(const ScalarVolume& frame, int planes_z0, int plane_count, co
   // The whole lattice's checks (its far corner, spacing, options), then its planes [w0, w1).
   ScalarVolume whole = frame;
   whole.values = planes;
-  detail::mesh::Lattice lattice = detail::mesh::checked_lattice(whole, options, false);
+  Lattice lattice = checked_lattice(whole, options, voxel_faces);
   const std::size_t plane = static_cast<std::size_t>(frame.size.x) * frame.size.y;
   lattice.n.z = w1 - w0;
   lattice.values = planes + plane * static_cast<std::size_t>(w0 - planes_z0);
   if (options.algorithm != Mesher::kMarchingCubes)
-    return dual_slab(lattice, options, w0, nz, z_begin - w0, z_end - w0);
+    return dual_slab(lattice, options, w0, nz, z_begin - w0, z_end - w0, sources);
   const FlyingEdges passes(lattice, options.interrupter, w0);
   // Local planes: the slab's own [b, e), plane z_end's rows up to v (their vertices only).
   const int b = z_begin - w0, e = z_end - w0, v = std::min(z_end + 1, nz) - w0;
   MeshSlab slab;
   slab.owned_vertices = passes.vertices_before(e) - passes.vertices_before(b);
   slab.first_plane_vertices = passes.vertices_before(b + 1) - passes.vertices_before(b);
-  const detail::mesh::WeldOutput out =
-      detail::mesh::size_mesh(slab.part, passes.vertices_before(v) - passes.vertices_before(b),
-                              passes.indices_before(e) - passes.indices_before(b), false, nullptr);
+  const WeldOutput out =
+      size_mesh(slab.part, passes.vertices_before(v) - passes.vertices_before(b),
+                passes.indices_before(e) - passes.indices_before(b), false, sources);
   passes.write_planes(b, v, e, out);
   return slab;
 }
+
+}  // namespace detail::mesh
 
 }  // namespace voxfield

@@ -130,6 +130,22 @@ std::uint8_t world_vertex_material(const World& world, const DistanceField& fiel
   return material;
 }
 
+void color_by_sources(const World& world, const DistanceField& field, const Box3i& lattice,
+                      const std::vector<std::uint64_t>& sources, Mesh& mesh) {
+  mesh.colors.resize(mesh.positions.size());
+  const Vec3i size = lattice.size();
+  const std::uint64_t nx = static_cast<std::uint64_t>(size.x),
+                      nxy = nx * static_cast<std::uint64_t>(size.y);
+  for (std::size_t i = 0; i < sources.size(); ++i) {
+    const std::uint64_t s = sources[i];
+    const Vec3i p{lattice.begin.x + static_cast<int>(s % nx),
+                  lattice.begin.y + static_cast<int>(s / nx % static_cast<std::uint64_t>(size.y)),
+                  lattice.begin.z + static_cast<int>(s / nxy)};
+    const Rgba c = world.palette[world_vertex_material(world, field, p)];
+    mesh.colors[i] = {c.r, c.g, c.b};
+  }
+}
+
 }  // namespace detail::mesh
 
 int mesh_world_margin(double iso) {
@@ -143,7 +159,6 @@ Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
   const Box3i content = world.voxels.content_bounds();
   if (content.empty()) return Mesh{};
   const Box3i domain = content.grown(margin);
-  const Vec3i size = domain.size();
   // Voxels beyond a bounded world's bounds are air: where the grown content leaves the bounds, the
   // field is computed on an unbounded copy so that the surface closes there with exact distances.
   const bool clipped = world.voxels.bounds() && domain.intersect(*world.voxels.bounds()) != domain;
@@ -168,17 +183,7 @@ Mesh mesh_world(const World& world, const MeshOptions& options, Metric metric) {
   if (iso != 0) o.gradient = offset_gradient(source, field, metric, iso > 0);
   std::vector<std::uint64_t> sources;
   Mesh mesh = mesh_lattice(volume, o, &sources, /*voxel_faces=*/iso == 0);
-  mesh.colors.resize(mesh.positions.size());
-  const std::uint64_t nx = static_cast<std::uint64_t>(size.x),
-                      nxy = nx * static_cast<std::uint64_t>(size.y);
-  for (std::size_t i = 0; i < sources.size(); ++i) {
-    const std::uint64_t s = sources[i];
-    const Vec3i p{domain.begin.x + static_cast<int>(s % nx),
-                  domain.begin.y + static_cast<int>(s / nx % static_cast<std::uint64_t>(size.y)),
-                  domain.begin.z + static_cast<int>(s / nxy)};
-    const Rgba c = world.palette[world_vertex_material(world, field, p)];
-    mesh.colors[i] = {c.r, c.g, c.b};
-  }
+  color_by_sources(world, field, domain, sources, mesh);
   place_in_frame(mesh, world.frame);
   return mesh;
 }

@@ -277,6 +277,13 @@ std::vector<detail::FilePiece> place_runs(MPI_Comm comm, MeshFormat format, cons
 // that writes their lower vertex, which counts them; every other edge is counted where it is.
 MeshStats census_over_ranks(MPI_Comm comm, const Share& s, ExchangeStats* stats);
 
+// The file of the ranks' slabs (or, unless `slabs`, their chunked pieces: every rank passes the
+// same), each rank writing its share: write_mesh_volume after its meshing.
+MeshFileSummary write_parts(MPI_Comm comm, const MeshLayers& layers, MeshFormat format, bool slabs,
+                            std::optional<MeshSlab> slab, std::optional<PieceWeld> weld,
+                            const std::filesystem::path& path, bool census, ExchangeStats* stats,
+                            FileTransaction* into);
+
 }  // namespace
 
 MeshFileSummary write_mesh_volume(MPI_Comm comm, const MeshLayers& layers,
@@ -309,6 +316,42 @@ MeshFileSummary write_mesh_volume(MPI_Comm comm, const MeshLayers& layers,
     }
   });
   if (stats) stats->compute_ms += detail::ms_since(t0);
+  return write_parts(comm, layers, format, slabs, std::move(slab), std::move(weld), path, census,
+                     stats, into);
+}
+
+MeshFileSummary write_world_mesh(MPI_Comm comm, const MeshLayers& layers, const Box3i& lattice,
+                                 const World& world, const MeshOptions& options, Metric metric,
+                                 const std::filesystem::path& path, bool census,
+                                 ExchangeStats* stats, FileTransaction* into) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  const MeshFormat format = collectively(
+      comm, [&] { return mesh_format_of(path); }, stats);
+  const auto t0 = std::chrono::steady_clock::now();
+  std::optional<MeshSlab> slab;
+  detail::collectively(comm, stats, [&] {
+    ScalarVolume frame;
+    frame.size = lattice.size();
+    detail::check_mesh_layers(layers, frame, options, size, "mpi::write_world_mesh");
+    if (layers.empty(rank)) return;
+    const auto [s0, s1] = layers.slab(rank);
+    slab = mesh_world_slab(world, lattice, options, metric, s0, s1);
+  });
+  if (stats) stats->compute_ms += detail::ms_since(t0);
+  return write_parts(comm, layers, format, /*slabs=*/true, std::move(slab), std::nullopt, path,
+                     census, stats, into);
+}
+
+namespace {
+
+MeshFileSummary write_parts(MPI_Comm comm, const MeshLayers& layers, MeshFormat format, bool slabs,
+                            std::optional<MeshSlab> slab, std::optional<PieceWeld> weld,
+                            const std::filesystem::path& path, bool census, ExchangeStats* stats,
+                            FileTransaction* into) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
   const detail::OwnComm own(comm);
   Share share = slabs ? slab_share(own.comm, layers, std::move(slab), stats)
                       : weld_share(own.comm, layers, std::move(weld), stats);
@@ -342,6 +385,8 @@ MeshFileSummary write_mesh_volume(MPI_Comm comm, const MeshLayers& layers,
   });
   return summary;
 }
+
+}  // namespace
 
 namespace {
 

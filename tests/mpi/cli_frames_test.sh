@@ -142,7 +142,46 @@ done
 "$VF" mesh wave.npy -o ref.glb --algorithm sn 2>/dev/null
 MPIEXEC -np 3 "$VFM" mesh wave.npy -o three.glb --chunk 8 --algorithm sn 2>/dev/null
 same ref.glb three.glb "sn .glb, 3 ranks"
-expect_failure 1 "f.npy: voxfield-mpi mesh meshes float32/float64 volumes" mesh f.npy -o bad.ply
+
+# Worlds: their surface (mesh_world at iso 0, through the exact signed field, coloured by
+# material) is voxfield mesh's file byte for byte — a .npy world read a slab per rank, an unbounded
+# .vfw whose content lies away from its faces, a framed and rotated .vfw (positions and normals in
+# the world's frame), a real .vox with its palette, a .vdb — on 1 to 4 ranks in layers of 8 (ranks
+# without layers first or last), for every mesher, in every format.
+"$VF" convert f.npy turned.vfw --voxel-size 0.25,0.5,1 --origin 100,-50,3 --rotate 90,0,0,1 2>/dev/null
+"$VF" convert f.npy f.vdb 2>/dev/null
+worlds="f.npy margins.vfw turned.vfw f.vdb"
+[ -f "$vox" ] && worlds="$worlds $(dirname "$vox")/ephtracy_chr_knight.vox"
+for world in $worlds; do
+  for alg in mc sn dc; do
+    "$VF" mesh "$world" -o ref.ply --algorithm "$alg" 2>/dev/null
+    ranks="2"
+    [ "$alg" = mc ] && ranks="1 2 3 4"
+    for n in $(rank_counts $ranks); do
+      MPIEXEC -np "$n" "$VFM" mesh "$world" -o out.ply --algorithm "$alg" --chunk 8 \
+        --stats world.json 2>/dev/null
+      same ref.ply out.ply "mesh $(basename "$world"), $alg, $n ranks"
+    done
+  done
+done
+/usr/bin/python3 -c "
+import json; s = json.load(open('world.json'))
+assert s['read_in_parts'] is True and s['read'] == 'every' and s['ghost_slices'] >= 6, s
+assert s['vertices'] > 500 and s['chunk_layers'][0] == 0, s"
+for fmt in obj stl glb; do
+  "$VF" mesh f.npy -o "ref.$fmt" 2>/dev/null
+  MPIEXEC -np 3 "$VFM" mesh f.npy -o "out.$fmt" --chunk 8 --balance count --read rank0 2>/dev/null
+  same "ref.$fmt" "out.$fmt" "mesh f.npy .$fmt, 3 ranks, --read rank0"
+done
+# A world with no solid voxel: no surface, the empty file voxfield mesh writes.
+/usr/bin/python3 -c "import numpy as np; np.save('air.npy', np.zeros((9, 8, 12), np.uint8))"
+"$VF" mesh air.npy -o ref.glb 2>/dev/null
+MPIEXEC -np 2 "$VFM" mesh air.npy -o out.glb 2>/dev/null
+same ref.glb out.glb "mesh of a world of air, 2 ranks"
+expect_failure 1 "meshes a world's surface at iso 0" mesh f.npy -o bad.ply --iso 2
+expect_failure 1 "--inside and --spacing are for float volumes" mesh f.npy -o bad.ply --spacing 1,1,2
+expect_failure 1 "--metric is for worlds" mesh wave.npy -o bad.ply --metric chebyshev
+expect_failure 1 "--read and --grid are for worlds" mesh wave.npy -o bad.ply --read rank0
 expect_failure 1 "unknown mesh format" mesh wave.npy -o bad.xyz
 /usr/bin/python3 -c "import numpy as np; a = np.zeros((6, 6, 20), np.float32); a[2, 3, 17] = np.nan; np.save('nan.npy', a)"
 expect_failure 1 "sample (2, 3, 17) is NaN" mesh nan.npy -o bad.ply --chunk 4

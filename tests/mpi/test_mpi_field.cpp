@@ -139,7 +139,9 @@ void check_edits(const DistanceOptions& o, std::uint32_t seed, const Executor& e
   mpi::SlabEditor editor(comm(), p, mine, o, executor);
   // An unclamped field is computed by the first refresh(), after the edits before it.
   EXPECT_EQ(editor.stale(), unclamped);
-  if (unclamped) EXPECT_THROW((void)editor.field(), InvalidArgument);
+  if (unclamped) {
+    EXPECT_THROW((void)editor.field(), InvalidArgument);
+  }
   DynamicDistanceField oracle(whole, o);
   DirtyRegions dirty(edge, DirtyRegions::Track::kOccupancy);
   std::mt19937 rng(seed * 7 + 1);
@@ -174,7 +176,9 @@ void check_edits(const DistanceOptions& o, std::uint32_t seed, const Executor& e
     EXPECT_EQ(refreshed, any_stale != 0);
     EXPECT_EQ(refreshed_voxels, refreshed ? slab.volume() : 0);
     EXPECT_FALSE(editor.stale());
-    if (unclamped) EXPECT_EQ(editor.field().domain, slab);
+    if (unclamped) {
+      EXPECT_EQ(editor.field().domain, slab);
+    }
     const std::string what = std::string(metric_name(o.metric)) +
                              (o.signed_distance ? " signed" : "") + " clamp " +
                              std::to_string(o.max_distance) + " " + storage_name(o.storage) +

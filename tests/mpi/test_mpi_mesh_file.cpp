@@ -20,6 +20,7 @@
 #include "voxfield/mesh_pieces.h"
 #include "voxfield/mesh_slab.h"
 #include "voxfield/mpi.h"
+#include "voxfield/world_io.h"
 
 namespace voxfield {
 namespace {
@@ -199,4 +200,83 @@ TEST(MpiMeshFile, AFailureAnywhereLeavesTheTargetAsItWas) {
 }
 
 }  // namespace
+}  // namespace voxfield
+
+namespace voxfield {
+namespace {
+
+// A world of boxes of four materials with a palette of its own, rotated and scaled by its frame:
+// every rank builds the same one.
+World framed_boxes() {
+  World w(8);
+  const std::array<std::array<int, 7>, 5> boxes{{{2, 3, 1, 9, 8, 14, 1},
+                                                 {6, 1, 10, 13, 7, 27, 2},
+                                                 {0, 6, 20, 4, 11, 33, 3},
+                                                 {9, 9, 4, 12, 12, 7, 4},
+                                                 {3, 2, 30, 5, 4, 31, 1}}};
+  for (const auto& b : boxes)
+    for (int z = b[2]; z < b[5]; ++z)
+      for (int y = b[1]; y < b[4]; ++y)
+        for (int x = b[0]; x < b[3]; ++x) w.voxels.set({x, y, z}, static_cast<std::uint8_t>(b[6]));
+  for (int m = 1; m <= 4; ++m)
+    w.palette[static_cast<std::size_t>(m)] = {static_cast<std::uint8_t>(50 * m), 20,
+                                              static_cast<std::uint8_t>(250 - 40 * m), 255};
+  w.frame.origin_world = {10, -4, 0.5};
+  w.frame.voxel_size_world = {0.5, 1, 2};
+  w.frame.rotation = {{{0, 0, 1}, {1, 0, 0}, {0, 1, 0}}};
+  return w;
+}
+
+}  // namespace
+
+// A world's surface written by every rank from the slices it holds (write_world_mesh) is the file
+// of mesh_world's mesh, for every mesher, with ranks without layers anywhere.
+TEST(MpiMeshFile, AWorldsSurfaceIsTheFileOfMeshWorld) {
+  const SharedDir dir;
+  const World whole = framed_boxes();
+  const Box3i lattice = whole.voxels.content_bounds().grown(mesh_world_margin(0));
+  for (const Mesher m : {Mesher::kMarchingCubes, Mesher::kSurfaceNets, Mesher::kDualContouring}) {
+    MeshOptions o;
+    o.algorithm = m;
+    o.chunk_edge = 4;
+    const Mesh want = mesh_world(whole, o);
+    ASSERT_GT(want.triangle_count(), 100u);
+    for (int cut = 0; cut < 2; ++cut) {
+      mpi::MeshLayers layers = mpi::partition_mesh_layers(lattice.size(), 4, ranks());
+      if (cut == 1 && ranks() >= 2) layers.layers[1] = 0;  // rank 0 without layers
+      if (cut == 1 && ranks() >= 3)
+        layers.layers[static_cast<std::size_t>(ranks()) - 1] = layers.layers.back();
+      // This rank holds only the slices its rows read, as a bounded world.
+      World mine(8);
+      if (!layers.empty(rank())) {
+        const auto [s0, s1] = layers.slab(rank());
+        const auto [v0, v1] = mesh_world_slab_voxels(lattice, s0, s1, m);
+        Box3i keep = lattice;
+        keep.begin.z = v0;
+        keep.end.z = v1;
+        mine = rechunk_world(whole, 8, keep, "rank");
+      }
+      const std::filesystem::path path =
+          dir / (std::string("world_") + mesher_name(m) + (cut ? ".glb" : ".ply"));
+      const mpi::MeshFileSummary got =
+          mpi::write_world_mesh(comm(), layers, lattice, mine, o, Metric::kEuclidean, path, true);
+      EXPECT_EQ(got.vertices, want.vertex_count());
+      EXPECT_EQ(got.triangles, want.triangle_count());
+      ASSERT_TRUE(got.census.has_value());
+      EXPECT_EQ(got.census->edges, mesh_stats(want).edges);
+      if (rank() == 0) {
+        EXPECT_TRUE(read_bytes(path) == encode_mesh(want, mesh_format_of(path)));
+      }
+    }
+  }
+  // An offset surface is refused on every rank, and nothing is written.
+  MeshOptions offset;
+  offset.iso = 2;
+  const mpi::MeshLayers layers = mpi::partition_mesh_layers(lattice.size(), 32, ranks());
+  EXPECT_THROW((void)mpi::write_world_mesh(comm(), layers, lattice, whole, offset,
+                                           Metric::kEuclidean, dir / "offset.ply"),
+               mpi::RankError);
+  EXPECT_FALSE(std::filesystem::exists(dir / "offset.ply"));
+}
+
 }  // namespace voxfield
