@@ -50,6 +50,8 @@
 #include "voxfield/error.h"
 #include "voxfield/file.h"
 #include "voxfield/limits.h"
+#include "voxfield/mesh_files.h"
+#include "voxfield/mesh_slab.h"
 #include "voxfield/mpi.h"
 #include "voxfield/parallel.h"
 #include "voxfield/vdb.h"
@@ -205,7 +207,8 @@ double percentile(std::vector<double> v, double q) {
 
 int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
              const std::string& edits_path, const std::string& out, const std::string& stats,
-             const std::string& save_world, const std::string& balance) {
+             const std::string& save_world, const std::string& balance, const std::string& mesh,
+             const std::string& mesh_algorithm) {
   int rank = 0, size = 0;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
@@ -217,7 +220,11 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
     throw InvalidArgument("--save-world " + save_world +
                           ": voxfield-mpi writes worlds as .vfw or .npy (each rank its slab); "
                           "voxfield convert turns either into .vox");
-  mpi::check_outputs(comm, {out, save_world}, {stats}, {in, edits_path});
+  const Mesher mesher = parse_mesher(mesh_algorithm);
+  if (!mesh.empty()) (void)mesh_format_of(mesh);  // an unknown extension before any work
+  mpi::check_outputs(comm, {out, save_world, mesh}, {stats}, {in, edits_path});
+  // With --mesh the ranks keep the slices beyond their slabs that meshing the edited world reads.
+  const int kept = mesh.empty() ? 0 : mesh_world_slab_reach(mesher);
   // The script and the ghost slices are checked on every rank before the world is loaded.
   // (Two named values, not a structured binding: the loop's lambda below captures the script,
   // and clang 14, which CI's sanitizer builds use, cannot capture a binding.)
@@ -241,7 +248,7 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
     // By the script's edits: what each unit of slices will recompute, known before any reading.
     if (balance == "edits")
       return mpi::load_world_slab(
-          comm, in, f.chunk, ghost,
+          comm, in, f.chunk, std::max(ghost, kept),
           [&](const Box3i& domain) {
             return mpi::partition_slabs(domain, size, f.chunk,
                                         mpi::edit_unit_weights(domain, f.chunk, edits, ghost));
@@ -249,13 +256,13 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
           read);
     // By content: the chunks holding air and solid (the surface).
     if (balance == "content")
-      return mpi::load_world_slab_by_content(comm, in, f.chunk, ghost, read);
-    return mpi::load_world_slab(comm, in, f.chunk, ghost, read);
+      return mpi::load_world_slab_by_content(comm, in, f.chunk, std::max(ghost, kept), read);
+    return mpi::load_world_slab(comm, in, f.chunk, std::max(ghost, kept), read);
   }();
   const double load_ms = max_over(comm, (MPI_Wtime() - l0) * 1e3);
   const Executor executor = mpi_cli::choose_rank_executor(comm, f.backend);
   const double t0 = MPI_Wtime();
-  mpi::SlabEditor editor(comm, slab.partition, slab.world, o, executor);
+  mpi::SlabEditor editor(comm, slab.partition, slab.world, o, executor, kept);
   slab.world = World();  // the editor holds its own copy
   const double build_ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
   // Local work only: a failure on one rank is agreed on after the loop.
@@ -312,10 +319,13 @@ int run_edit(MPI_Comm comm, const FieldSettings& f, const std::string& in,
       {"refreshed", refreshed},
       {"slabs", slab.partition.z}});
   if (refreshed) j["refresh_exchange"] = exchange_json(comm, refresh_exchange);
-  // Both outputs in one transaction of rank 0's: written all or nothing.
+  // Every output in one transaction of rank 0's: written all or nothing.
   std::optional<FileTransaction> outputs;
   if (rank == 0) outputs.emplace();
   FileTransaction* tx = outputs ? &*outputs : nullptr;
+  if (!mesh.empty())
+    j["mesh"] =
+        mpi_cli::write_edited_world_mesh(comm, slab.partition, editor.world(), mesher, mesh, tx);
   const bool world_npy = world_ext == ".npy";
   mpi::write_field_npy(comm, slab.partition, *final_field,
                        {out,
@@ -417,6 +427,7 @@ int main(int argc, char** argv) {
   mpi_cli::add_read_options(field, f.read);
   FieldSettings fe;
   std::string edit_in, edit_script, edit_out, edit_stats, edit_save, edit_balance = "volume";
+  std::string edit_mesh, edit_mesh_algorithm = "mc";
   CLI::App* edit = app.add_subcommand(
       "edit", "scripted edits with incremental exact updates, as `voxfield edit`");
   edit->add_option("IN", edit_in, "input .npy (read a slab per rank), .vox or .vfw")->required();
@@ -432,6 +443,11 @@ int main(int argc, char** argv) {
                    "solid, counted in a first reading) or by the script's edits (what each will "
                    "recompute)")
       ->check(CLI::IsMember({"volume", "content", "edits"}));
+  edit->add_option("--mesh", edit_mesh,
+                   "also write the edited world's surface (.ply, .obj, .stl, .glb): the file "
+                   "`voxfield mesh` writes for the edited world, every rank its slab's share");
+  edit->add_option("--mesh-algorithm", edit_mesh_algorithm, "mc (default), sn or dc")
+      ->check(CLI::IsMember({"mc", "sn", "dc"}));
   fe.add_to(edit);
   mpi_cli::add_read_options(edit, fe.read);
   std::vector<int> dims;
@@ -459,8 +475,8 @@ int main(int argc, char** argv) {
     if (field->parsed()) {
       code = run_field(comm, f, in, out, sites, packed, stats);
     } else if (edit->parsed()) {
-      code =
-          run_edit(comm, fe, edit_in, edit_script, edit_out, edit_stats, edit_save, edit_balance);
+      code = run_edit(comm, fe, edit_in, edit_script, edit_out, edit_stats, edit_save, edit_balance,
+                      edit_mesh, edit_mesh_algorithm);
     } else if (mesh->parsed()) {
       code = mpi_cli::run_mesh(comm, mesh_settings);
     } else if (render->parsed()) {

@@ -33,6 +33,13 @@ int run_mesh(MPI_Comm comm, const MeshSettings& s);
 // The world's side of run_mesh (world_mesh_command.cpp).
 int run_world_mesh(MPI_Comm comm, const MeshSettings& s);
 
+// voxfield-mpi edit --mesh: the edited world's surface — each rank's slab of `world`, which holds
+// mesh_world_slab_reach(algorithm) slices beyond it — staged in `into` (rank 0's; every rank writes
+// its share): the file `voxfield mesh` writes for the edited world. Returns what --stats reports.
+nlohmann::json write_edited_world_mesh(MPI_Comm comm, const mpi::SlabPartition& partition,
+                                       const World& world, Mesher algorithm,
+                                       const std::string& path, FileTransaction* into);
+
 // The end of either: rank 0 stages --stats (the summary's counts and census, `ms` the mesh made
 // and written since `t_mesh` (MPI_Wtime), the exchange, peak memory, and `extra`'s fields) in
 // `outputs` and commits them; every rank takes part. Says what was written on rank 0.

@@ -158,4 +158,41 @@ int run_world_mesh(MPI_Comm comm, const MeshSettings& s) {
                       {"read_in_parts", mine.read_in_parts}});
 }
 
+nlohmann::json write_edited_world_mesh(MPI_Comm comm, const mpi::SlabPartition& partition,
+                                       const World& world, Mesher algorithm,
+                                       const std::string& path, FileTransaction* into) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  const double t0 = MPI_Wtime();
+  mpi::ExchangeStats ex;
+  const Box3i content = mpi::content_bounds(comm, partition, world);
+  if (content.empty()) {  // no surface: the empty mesh voxfield mesh writes
+    mpi::collectively(comm, [&] {
+      if (rank == 0) into->stage(path, encode_mesh(Mesh{}, mesh_format_of(path)));
+    });
+    return {{"triangles", 0}, {"vertices", 0}, {"ms", max_over(comm, (MPI_Wtime() - t0) * 1e3)}};
+  }
+  // Each rank meshes the lattice's rows within its own slab (layers of one cell plane: cut
+  // wherever the slabs are), from the slices beyond it its world keeps.
+  const Box3i lattice = content.grown(mesh_world_margin(0));
+  mpi::MeshLayers layers;
+  layers.samples = lattice.size();
+  layers.chunk_edge = 1;
+  const std::int64_t cells = layers.samples.z - 1;
+  for (const std::int32_t z : partition.z)
+    layers.layers.push_back(static_cast<std::int32_t>(
+        std::clamp<std::int64_t>(std::int64_t{z} - lattice.begin.z, 0, cells)));
+  layers.layers.front() = 0;
+  layers.layers.back() = static_cast<std::int32_t>(cells);
+  MeshOptions options;
+  options.algorithm = algorithm;
+  const mpi::MeshFileSummary mesh = mpi::write_world_mesh(
+      comm, layers, lattice, world, options, Metric::kEuclidean, path, false, &ex, into);
+  return {{"triangles", mesh.triangles},
+          {"vertices", mesh.vertices},
+          {"algorithm", mesher_name(algorithm)},
+          {"ms", max_over(comm, (MPI_Wtime() - t0) * 1e3)},
+          {"exchange", exchange_json(comm, ex)}};
+}
+
 }  // namespace voxfield::mpi_cli

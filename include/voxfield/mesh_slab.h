@@ -90,5 +90,8 @@ MeshSlab mesh_world_slab(const World& world, const Box3i& lattice, const MeshOpt
 // rows [z_begin, z_end) of `lattice`.
 std::pair<int, int> mesh_world_slab_voxels(const Box3i& lattice, int z_begin, int z_end,
                                            Mesher mesher = Mesher::kMarchingCubes);
+// How many slices beyond its rows, at most, on either side: the planes mesh_slab_planes adds and
+// the field's clamp beyond them (6 for every mesher).
+int mesh_world_slab_reach(Mesher mesher = Mesher::kMarchingCubes);
 
 }  // namespace voxfield

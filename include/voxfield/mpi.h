@@ -173,8 +173,12 @@ class SlabEditor {
   // `world` must hold the partition's slab of this rank grown by edit_ghost_slices along z (clipped
   // to the domain); what lies beyond is not read. The field is computed over that box, on
   // `executor` (this rank's device or the CPU: an IncrementalDistanceField, distance_executor.h).
+  // `kept_slices`: the world keeps (and edits) at least that many slices beyond the slab on either
+  // side, for what the caller reads from it afterwards — a surface meshed from the edited world
+  // (mesh_world_slab_reach) — and `world` must then hold them too; the field is computed over the
+  // same box.
   SlabEditor(MPI_Comm comm, const SlabPartition& partition, const World& world,
-             const DistanceOptions& options, const Executor& executor = {});
+             const DistanceOptions& options, const Executor& executor = {}, int kept_slices = 0);
   SlabEditor(const SlabEditor&) = delete;  // the field is bound to the world it holds
   SlabEditor& operator=(const SlabEditor&) = delete;
 
@@ -478,11 +482,13 @@ MeshFileSummary write_mesh_volume(MPI_Comm comm, const MeshLayers& layers,
 // write_mesh_volume writes a float volume's — the bytes write_mesh writes for mesh_world(the whole
 // world, options, metric), each rank writing its share, nothing gathered. `lattice` is
 // mesh_world's: the world's content bounds over the ranks (content_bounds above) grown by
-// mesh_world_margin(0); `layers` are cut for its size (partition_mesh_layers(lattice.size(), ...)).
-// Each rank's `world` holds, with the world's palette and frame, at least the slices
-// mesh_world_slab_voxels(lattice, layers.slab(rank)) names (mesh_slab.h): each computes the exact
-// signed field of the planes it meshes from them. Throws RankError on every rank when any fails (an
-// offset surface, iso != 0, is refused: its normals come from nearest voxels in any slab).
+// mesh_world_margin(0); `layers` are cut for its size (partition_mesh_layers(lattice.size(), ...)),
+// or are of edge 1 — every cell plane a layer, so that the ranks' rows may be cut anywhere (as the
+// slabs of an edited world lie) — whatever options.chunk_edge. Each rank's `world` holds, with the
+// world's palette and frame, at least the slices mesh_world_slab_voxels(lattice, layers.slab(rank))
+// names (mesh_slab.h): each computes the exact signed field of the planes it meshes from them.
+// Throws RankError on every rank when any fails (an offset surface, iso != 0, is refused: its
+// normals come from nearest voxels in any slab).
 MeshFileSummary write_world_mesh(MPI_Comm comm, const MeshLayers& layers, const Box3i& lattice,
                                  const World& world, const MeshOptions& options, Metric metric,
                                  const std::filesystem::path& path, bool census = false,

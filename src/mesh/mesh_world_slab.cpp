@@ -21,14 +21,28 @@
 
 namespace voxfield {
 
+namespace {
+
+// The field's clamp at iso 0 (world_field_options: |iso| + 3), in whole slices.
+int clamp_slices() {
+  return static_cast<int>(
+      std::ceil(detail::mesh::world_field_options(0, Metric::kEuclidean, Box3i{}).max_distance));
+}
+
+}  // namespace
+
 std::pair<int, int> mesh_world_slab_voxels(const Box3i& lattice, int z_begin, int z_end,
                                            Mesher mesher) {
   const auto [w0, w1] = mesh_slab_planes(lattice.size().z, z_begin, z_end, mesher);
-  // The field's clamp at iso 0 (world_field_options: |iso| + 3), in whole slices.
-  const int reach = static_cast<int>(
-      std::ceil(detail::mesh::world_field_options(0, Metric::kEuclidean, lattice).max_distance));
-  return {std::max(lattice.begin.z, lattice.begin.z + w0 - reach),
-          std::min(lattice.end.z, lattice.begin.z + w1 + reach)};
+  return {std::max(lattice.begin.z, lattice.begin.z + w0 - clamp_slices()),
+          std::min(lattice.end.z, lattice.begin.z + w1 + clamp_slices())};
+}
+
+int mesh_world_slab_reach(Mesher mesher) {
+  // mesh_slab_planes' planes before and after a slab, on a lattice too deep to cut them.
+  constexpr int kDeep = 1 << 20, kAt = 1 << 19;
+  const auto [w0, w1] = mesh_slab_planes(kDeep, kAt, kAt + 1, mesher);
+  return std::max(kAt - w0, w1 - (kAt + 1)) + clamp_slices();
 }
 
 MeshSlab mesh_world_slab(const World& world, const Box3i& lattice, const MeshOptions& options,

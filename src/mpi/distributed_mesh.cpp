@@ -305,8 +305,10 @@ void check_mesh_layers(const MeshLayers& layers, const ScalarVolume& frame,
   if (!(layers.samples == frame.size) || layers.chunk_edge != options.chunk_edge)
     throw InvalidArgument(std::string(who) +
                           ": the layers were cut for another lattice size or chunk edge");
-  // The runs must cover every layer once, in order (a layer no rank meshes is a hole).
-  const int count = mesh_chunk_layers(layers.samples, layers.chunk_edge);
+  // The runs must cover every layer once, in order (a layer no rank meshes is a hole). Layers of
+  // one cell plane (edge 1) are write_world_mesh's: any cuts.
+  const int count = layers.chunk_edge == 1 ? layers.samples.z - 1
+                                           : mesh_chunk_layers(layers.samples, layers.chunk_edge);
   for (std::size_t r = 0; r < layers.layers.size(); ++r)
     if ((r == 0 && layers.layers[r] != 0) ||
         (r + 1 == layers.layers.size() && layers.layers[r] != count) ||

@@ -334,7 +334,11 @@ MeshFileSummary write_world_mesh(MPI_Comm comm, const MeshLayers& layers, const 
   detail::collectively(comm, stats, [&] {
     ScalarVolume frame;
     frame.size = lattice.size();
-    detail::check_mesh_layers(layers, frame, options, size, "mpi::write_world_mesh");
+    // A world's slab is the same whatever its cuts (mesh_world_slab): layers of any edge, 1
+    // included, whatever options.chunk_edge.
+    MeshOptions cut = options;
+    cut.chunk_edge = layers.chunk_edge;
+    detail::check_mesh_layers(layers, frame, cut, size, "mpi::write_world_mesh");
     if (layers.empty(rank)) return;
     const auto [s0, s1] = layers.slab(rank);
     slab = mesh_world_slab(world, lattice, options, metric, s0, s1);

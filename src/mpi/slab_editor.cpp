@@ -49,7 +49,7 @@ std::vector<double> edit_unit_weights(const Box3i& domain, int align,
 }
 
 SlabEditor::SlabEditor(MPI_Comm comm, const SlabPartition& partition, const World& world,
-                       const DistanceOptions& options, const Executor& executor)
+                       const DistanceOptions& options, const Executor& executor, int kept_slices)
     : partition_(partition),
       options_(options),
       executor_(executor),
@@ -60,7 +60,7 @@ SlabEditor::SlabEditor(MPI_Comm comm, const SlabPartition& partition, const Worl
     detail::require_partition(comm, partition);
     const bool unclamped = !std::isfinite(effective_clamp(options));
     slab_ = partition.slab(rank);
-    const int ghost = edit_ghost_slices(options);
+    const int ghost = std::max(edit_ghost_slices(options), kept_slices);
     const Box3i& d = partition.domain;
     const auto z0 = static_cast<std::int32_t>(
         std::max<std::int64_t>(d.begin.z, std::int64_t{slab_.begin.z} - ghost));

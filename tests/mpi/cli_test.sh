@@ -92,6 +92,32 @@ for balance in content edits; do
   same ref.npy out.npy "edit --balance $balance, 3 ranks"
   /usr/bin/python3 -c "import json; s = json.load(open('bal.json')); assert s['balance'] == '$balance' and len(s['slabs']) == 4 and s['stream_ms'] >= 0, s"
 done
+# --mesh: the edited world's surface, each rank meshing the rows within its slab from the slices
+# beyond it that it keeps and edits (more than the field's clamp of 2 needs): the file voxfield
+# mesh writes for voxfield edit's saved world, byte for byte, and the triangles of voxfield edit
+# --mesh (which keeps its surface chunk by chunk, and numbers it in another order).
+edit_mesh_case() {  # edit_mesh_case ALGORITHM RANKS "VOXFIELD-MPI'S OWN OPTIONS" OPTIONS...
+  local alg=$1 ranks=$2 own=$3
+  shift 3
+  "$VF" edit f.npy -e edits.jsonl -o ref.npy "$@" --mesh ref_edit.ply --mesh-algorithm "$alg" \
+    --save-world ref_mesh.vfw 2>/dev/null
+  "$VF" mesh ref_mesh.vfw -o ref_mesh.ply --algorithm "$alg" 2>/dev/null
+  for n in $(rank_counts $ranks); do
+    # shellcheck disable=SC2086
+    MPIEXEC -np "$n" "$VFM" edit f.npy -e edits.jsonl -o out.npy --chunk 8 "$@" $own \
+      --mesh out.ply --mesh-algorithm "$alg" --stats mesh_edit.json 2>/dev/null
+    same ref.npy out.npy "edit --mesh, $alg, $n ranks, $* (field)"
+    same ref_mesh.ply out.ply "edit --mesh, $alg, $n ranks, $*"
+    /usr/bin/python3 "$(dirname "$0")/../../scripts/same_triangles.py" ref_edit.ply out.ply \
+      >/dev/null || { echo "FAIL: edit --mesh, $alg, $n ranks: not voxfield edit --mesh's triangles"; fail=1; }
+  done
+}
+edit_mesh_case mc "1 2 3 4" "" --max-distance 2
+edit_mesh_case dc "3" "" --metric euclidean --signed
+edit_mesh_case sn "2" "--balance content" --max-distance 2
+/usr/bin/python3 -c "import json; s = json.load(open('mesh_edit.json')); assert s['mesh']['triangles'] > 1000 and s['mesh']['algorithm'] == 'sn', s"
+expect_failure 1 "unknown mesh format" edit f.npy -e edits.jsonl -o bad.npy --max-distance 2 \
+  --mesh bad.xyz
 # The edited world as one .vfw written by every rank: voxfield edit --save-world's file.
 "$VF" edit f.npy -e edits.jsonl -o ref.npy --chunk 8 --max-distance 6 --save-world ref.vfw 2>/dev/null
 for n in $(rank_counts 1 2 3 4); do
