@@ -93,6 +93,12 @@ void expect_same_arrays(const Mesh& got, const Mesh& want, const std::string& wh
   EXPECT_TRUE(got.indices == want.indices);
 }
 
+// The refusal's message holds `words`.
+void expect_refused(const std::function<void()>& call, const std::string& words) {
+  const std::string said = test::error_of(call);
+  EXPECT_NE(said.find(words), std::string::npos) << said;
+}
+
 }  // namespace
 
 TEST(MeshWorldSlab, SlabsLaidEndToEndAreMeshWorldsArrays) {
@@ -127,12 +133,6 @@ TEST(MeshWorldSlab, SlabsLaidEndToEndAreMeshWorldsArrays) {
                          what + ", uneven slabs");
     }
   }
-}
-
-// The refusal's message holds `words`.
-void expect_refused(const std::function<void()>& call, const std::string& words) {
-  const std::string said = test::error_of(call);
-  EXPECT_NE(said.find(words), std::string::npos) << said;
 }
 
 TEST(MeshWorldSlab, BadRequestsAreRefused) {

@@ -7,11 +7,12 @@
 //          [--backend cpu|vulkan|auto] [--device-per-rank]
 //   mpirun -np N voxfield-mpi edit IN -e EDITS.jsonl -o OUT.npy [field options] [--stats S.json]
 //          [--balance volume|content|edits] [--save-world W.vfw|W.npy] [--read every|rank0]
-//          [--grid G]
+//          [--grid G] [--mesh M.{ply,obj,stl,glb}] [--mesh-algorithm mc|sn|dc]
 //   mpirun -np N voxfield-mpi bench --size X,Y,Z [--spheres K] [--repeat R] [field options]
-//   mpirun -np N voxfield-mpi mesh IN.npy -o OUT.{ply,obj,stl,glb} [--algorithm mc|sn|dc]
+//   mpirun -np N voxfield-mpi mesh IN -o OUT.{ply,obj,stl,glb} [--algorithm mc|sn|dc]
 //          [--iso V] [--inside below|above] [--spacing sx,sy,sz] [--chunk C]
 //          [--balance content|count] [--threads T] [--stats S.json]
+//          (a world IN: [--metric M] [--read every|rank0] [--grid G], iso 0 only)
 //   mpirun -np N voxfield-mpi render IN -o OUT.png [--width W] [--height H] [--camera C]
 //          [--view shaded|chunks|distance] [--slice Z] [--metric M] [--skip S] [--no-shadows]
 //          [--no-ao] [--fog F] [--chunk C] [--threads T] [--repeat N] [--read every|rank0]
@@ -22,8 +23,9 @@
 // writes: every rank applies every edit of the script to its slab and the slices a clamped value
 // can reach beyond it, with incremental updates of its own field. `bench` generates a world of
 // random spheres slab by slab (no file) and prints, per run, the time, the rate and the bytes
-// exchanged. `mesh` meshes a float volume, each rank the chunk layers of its planes (mpi.h), and
-// writes the mesh `voxfield mesh` writes, triangle for triangle. `render` draws the frame `voxfield
+// exchanged. `mesh` meshes a float volume or a world's surface, each rank the chunk layers of its
+// planes (mpi.h), and writes the file `voxfield mesh` writes, byte for byte; `edit --mesh` writes
+// that file for the edited world. `render` draws the frame `voxfield
 // render` draws, byte for byte, each rank walking its stretch of every primary ray and the shadow
 // rays that cross its slab, handing those on (render_relay.h). Every rank parses the same command
 // line; rank 0 alone prints. A failure on any rank is reported by rank 0 as "voxfield-mpi: rank R:
@@ -447,7 +449,8 @@ int main(int argc, char** argv) {
                    "also write the edited world's surface (.ply, .obj, .stl, .glb): the file "
                    "`voxfield mesh` writes for the edited world, every rank its slab's share");
   edit->add_option("--mesh-algorithm", edit_mesh_algorithm, "mc (default), sn or dc")
-      ->check(CLI::IsMember({"mc", "sn", "dc"}));
+      ->check(
+          CLI::IsMember({"mc", "sn", "dc", "marching-cubes", "surface-nets", "dual-contouring"}));
   fe.add_to(edit);
   mpi_cli::add_read_options(edit, fe.read);
   std::vector<int> dims;

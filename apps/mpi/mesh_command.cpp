@@ -52,7 +52,8 @@ CLI::App* add_mesh_command(CLI::App& app, MeshSettings& s) {
       ->check(CLI::IsMember({"content", "count"}));
   cmd->add_option("--metric", s.metric,
                   "a world's field: euclidean (default), chebyshev or manhattan (at iso 0 the "
-                  "voxels' surface is the same for every metric)")
+                  "vertices lie on the voxels' faces for every metric; the normals follow the "
+                  "field)")
       ->check(CLI::IsMember({"euclidean", "chebyshev", "manhattan"}));
   add_read_options(cmd, s.read);
   cmd->add_option("--stats", s.stats, "counts, timings and exchange figures as JSON");

@@ -3,9 +3,11 @@
 //
 // mesh_world's lattice is the world's content bounds grown by two voxels of air, which no rank
 // knows before the world is read: a first reading in slabs of equal volume finds them (and where
-// the surface lies, to deal the chunk layers by content), then each rank reads again only the
-// slices its layers' rows need — their planes and the exact field's clamp beyond
-// (mesh_world_slab_voxels) — and meshes them (mpi::write_world_mesh).
+// the surface lies, to deal the chunk layers by content), then each rank reads again the slices
+// its layers' rows need — their planes and the exact field's clamp beyond
+// (mesh_world_slab_voxels) — and meshes them (mpi::write_world_mesh). The second reading's slabs
+// must still cover the file's whole domain (load_world_slab): the first rank with layers also
+// reads the air below the lattice, and the last the air above it.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -136,8 +138,12 @@ int run_world_mesh(MPI_Comm comm, const MeshSettings& s) {
                                             layer_weights(lattice, s.chunk, units, unit_weights));
   });
   // The second reading: each rank's slices.
-  const auto [cut, ghost] = mpi::collectively(
+  // (Named values, not a structured binding: the lambda below captures the cut, and clang 14,
+  // which CI's sanitizer builds use, cannot capture a binding.)
+  const std::pair<mpi::SlabPartition, int> cut_and_ghost = mpi::collectively(
       comm, [&] { return reading_cut(domain, lattice, layers, options.algorithm); });
+  const mpi::SlabPartition& cut = cut_and_ghost.first;
+  const int ghost = cut_and_ghost.second;
   const mpi::WorldSlab mine = mpi::load_world_slab(
       comm, s.in, kWorldChunk, ghost, [&](const Box3i&) { return cut; }, read);
   const double load_ms = max_over(comm, (MPI_Wtime() - t0) * 1e3);
@@ -170,7 +176,11 @@ nlohmann::json write_edited_world_mesh(MPI_Comm comm, const mpi::SlabPartition& 
     mpi::collectively(comm, [&] {
       if (rank == 0) into->stage(path, encode_mesh(Mesh{}, mesh_format_of(path)));
     });
-    return {{"triangles", 0}, {"vertices", 0}, {"ms", max_over(comm, (MPI_Wtime() - t0) * 1e3)}};
+    return {{"triangles", 0},
+            {"vertices", 0},
+            {"algorithm", mesher_name(algorithm)},
+            {"ms", max_over(comm, (MPI_Wtime() - t0) * 1e3)},
+            {"exchange", exchange_json(comm, ex)}};
   }
   // Each rank meshes the lattice's rows within its own slab (layers of one cell plane: cut
   // wherever the slabs are), from the slices beyond it its world keeps.

@@ -150,8 +150,9 @@ DistanceField compute_distance_field(MPI_Comm comm, const SlabPartition& partiti
 // incremental field (dynamic_field.h) over that box: a clamped value depends only on sites within
 // the clamp, so the slab's values stay exact — equal to one process's field after the same edits —
 // with no message per edit. An edit that misses a rank's box costs that rank nothing. An unclamped
-// f32 value may depend on every voxel of the domain: each rank then keeps its slab alone, edits
-// change its materials, and SlabEditor::refresh recomputes the field over the ranks.
+// f32 value may depend on every voxel of the domain: each rank then keeps its slab (and no more
+// slices than the caller asks it to keep), edits change its materials, and SlabEditor::refresh
+// recomputes the field over the ranks.
 
 // The slices a rank's box reaches past its slab on either side: the effective clamp over the
 // spacing along z, rounded up (distance_slab.h); 0 for an unclamped f32 field (kept by refresh()).
@@ -175,8 +176,8 @@ class SlabEditor {
   // `executor` (this rank's device or the CPU: an IncrementalDistanceField, distance_executor.h).
   // `kept_slices`: the world keeps (and edits) at least that many slices beyond the slab on either
   // side, for what the caller reads from it afterwards — a surface meshed from the edited world
-  // (mesh_world_slab_reach) — and `world` must then hold them too; the field is computed over the
-  // same box.
+  // (mesh_world_slab_reach) — and `world` must then hold them too. A clamped field is computed
+  // over that whole box; an unclamped one over the slab (refresh() reads the slab's voxels only).
   SlabEditor(MPI_Comm comm, const SlabPartition& partition, const World& world,
              const DistanceOptions& options, const Executor& executor = {}, int kept_slices = 0);
   SlabEditor(const SlabEditor&) = delete;  // the field is bound to the world it holds
@@ -485,8 +486,10 @@ MeshFileSummary write_mesh_volume(MPI_Comm comm, const MeshLayers& layers,
 // mesh_world_margin(0); `layers` are cut for its size (partition_mesh_layers(lattice.size(), ...)),
 // or are of edge 1 — every cell plane a layer, so that the ranks' rows may be cut anywhere (as the
 // slabs of an edited world lie) — whatever options.chunk_edge. Each rank's `world` holds, with the
-// world's palette and frame, at least the slices mesh_world_slab_voxels(lattice, layers.slab(rank))
-// names (mesh_slab.h): each computes the exact signed field of the planes it meshes from them.
+// world's palette and frame, at least the slices mesh_world_slab_voxels(lattice, s0, s1,
+// options.algorithm) names for its rows [s0, s1) = layers.slab(rank) (mesh_slab.h; the dual
+// meshers read more below than marching cubes): each computes the exact signed field of the
+// planes it meshes from them.
 // Throws RankError on every rank when any fails (an offset surface, iso != 0, is refused: its
 // normals come from nearest voxels in any slab).
 MeshFileSummary write_world_mesh(MPI_Comm comm, const MeshLayers& layers, const Box3i& lattice,

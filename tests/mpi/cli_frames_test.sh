@@ -146,8 +146,8 @@ same ref.glb three.glb "sn .glb, 3 ranks"
 # Worlds: their surface (mesh_world at iso 0, through the exact signed field, coloured by
 # material) is voxfield mesh's file byte for byte — a .npy world read a slab per rank, an unbounded
 # .vfw whose content lies away from its faces, a framed and rotated .vfw (positions and normals in
-# the world's frame), a real .vox with its palette, a .vdb — on 1 to 4 ranks in layers of 8 (ranks
-# without layers first or last), for every mesher, in every format.
+# the world's frame), a real .vox with its palette, a .vdb — on 1 to 4 ranks in layers of 8, for
+# every mesher, in every format; ranks without layers; another metric (its normals differ).
 "$VF" convert f.npy turned.vfw --voxel-size 0.25,0.5,1 --origin 100,-50,3 --rotate 90,0,0,1 2>/dev/null
 "$VF" convert f.npy f.vdb 2>/dev/null
 worlds="f.npy margins.vfw turned.vfw f.vdb"
@@ -167,7 +167,15 @@ done
 /usr/bin/python3 -c "
 import json; s = json.load(open('world.json'))
 assert s['read_in_parts'] is True and s['read'] == 'every' and s['ghost_slices'] >= 6, s
-assert s['vertices'] > 500 and s['chunk_layers'][0] == 0, s"
+assert s['vertices'] > 500, s"
+# Two layers of 32 for 4 ranks: two ranks mesh nothing (and still read and write their part).
+"$VF" mesh f.npy -o ref.ply --metric manhattan 2>/dev/null
+MPIEXEC -np 4 "$VFM" mesh f.npy -o out.ply --chunk 32 --balance count --metric manhattan \
+  --stats world.json 2>/dev/null
+same ref.ply out.ply "mesh f.npy, manhattan, 4 ranks of which two without layers"
+/usr/bin/python3 -c "
+import json; c = json.load(open('world.json'))['chunk_layers']
+assert len(c) == 5 and sum(c[r] == c[r + 1] for r in range(4)) == 2, c"
 for fmt in obj stl glb; do
   "$VF" mesh f.npy -o "ref.$fmt" 2>/dev/null
   MPIEXEC -np 3 "$VFM" mesh f.npy -o "out.$fmt" --chunk 8 --balance count --read rank0 2>/dev/null

@@ -230,7 +230,9 @@ World framed_boxes() {
 }  // namespace
 
 // A world's surface written by every rank from the slices it holds (write_world_mesh) is the file
-// of mesh_world's mesh, for every mesher, with ranks without layers anywhere.
+// of mesh_world's mesh, for every mesher: layers of 4 planes dealt evenly; rank 0 and (from 3
+// ranks) the last rank without layers; layers of one cell plane cut at uneven planes, as an edited
+// world's slabs cut them.
 TEST(MpiMeshFile, AWorldsSurfaceIsTheFileOfMeshWorld) {
   const SharedDir dir;
   const World whole = framed_boxes();
@@ -241,11 +243,18 @@ TEST(MpiMeshFile, AWorldsSurfaceIsTheFileOfMeshWorld) {
     o.chunk_edge = 4;
     const Mesh want = mesh_world(whole, o);
     ASSERT_GT(want.triangle_count(), 100u);
-    for (int cut = 0; cut < 2; ++cut) {
+    for (int cut = 0; cut < 3; ++cut) {
       mpi::MeshLayers layers = mpi::partition_mesh_layers(lattice.size(), 4, ranks());
       if (cut == 1 && ranks() >= 2) layers.layers[1] = 0;  // rank 0 without layers
       if (cut == 1 && ranks() >= 3)
         layers.layers[static_cast<std::size_t>(ranks()) - 1] = layers.layers.back();
+      if (cut == 2) {  // one cell plane a layer: rank r's rows start at plane 7 r + 3 (r > 0)
+        layers.chunk_edge = 1;
+        const int cells = lattice.size().z - 1;
+        for (int r = 1; r < ranks(); ++r)
+          layers.layers[static_cast<std::size_t>(r)] = std::min(7 * r + 3, cells);
+        layers.layers.back() = cells;
+      }
       // This rank holds only the slices its rows read, as a bounded world.
       World mine(8);
       if (!layers.empty(rank())) {
@@ -256,14 +265,18 @@ TEST(MpiMeshFile, AWorldsSurfaceIsTheFileOfMeshWorld) {
         keep.end.z = v1;
         mine = rechunk_world(whole, 8, keep, "rank");
       }
-      const std::filesystem::path path =
-          dir / (std::string("world_") + mesher_name(m) + (cut ? ".glb" : ".ply"));
+      const std::filesystem::path path = dir / (std::string("world_") + mesher_name(m) + "_" +
+                                                std::to_string(cut) + (cut == 1 ? ".glb" : ".ply"));
       const mpi::MeshFileSummary got =
           mpi::write_world_mesh(comm(), layers, lattice, mine, o, Metric::kEuclidean, path, true);
       EXPECT_EQ(got.vertices, want.vertex_count());
       EXPECT_EQ(got.triangles, want.triangle_count());
       ASSERT_TRUE(got.census.has_value());
-      EXPECT_EQ(got.census->edges, mesh_stats(want).edges);
+      const MeshStats w = mesh_stats(want);
+      EXPECT_EQ(got.census->edges, w.edges);
+      EXPECT_EQ(got.census->boundary_edges, w.boundary_edges);
+      EXPECT_EQ(got.census->nonmanifold_edges, w.nonmanifold_edges);
+      EXPECT_EQ(got.census->euler_characteristic, w.euler_characteristic);
       if (rank() == 0) {
         EXPECT_TRUE(read_bytes(path) == encode_mesh(want, mesh_format_of(path)));
       }
