@@ -25,9 +25,9 @@
 // random spheres slab by slab (no file) and prints, per run, the time, the rate and the bytes
 // exchanged. `mesh` meshes a float volume or a world's surface, each rank the chunk layers of its
 // planes (mpi.h), and writes the file `voxfield mesh` writes, byte for byte; `edit --mesh` writes
-// that file for the edited world. `render` draws the frame `voxfield
-// render` draws, byte for byte, each rank walking its stretch of every primary ray and the shadow
-// rays that cross its slab, handing those on (render_relay.h). Every rank parses the same command
+// that file for the edited world. `render` draws the frame `voxfield render` draws, byte for byte,
+// each rank walking its stretch of every primary ray and the shadow rays that cross its slab,
+// handing those on (render_relay.h). Every rank parses the same command
 // line; rank 0 alone prints. A failure on any rank is reported by rank 0 as "voxfield-mpi: rank R:
 // ..." and every rank exits with 1 (2 for usage errors).
 #include <mpi.h>

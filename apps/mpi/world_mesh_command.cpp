@@ -6,8 +6,8 @@
 // the surface lies, to deal the chunk layers by content), then each rank reads again the slices
 // its layers' rows need — their planes and the exact field's clamp beyond
 // (mesh_world_slab_voxels) — and meshes them (mpi::write_world_mesh). The second reading's slabs
-// must still cover the file's whole domain (load_world_slab): the first rank with layers also
-// reads the air below the lattice, and the last the air above it.
+// must still cover the file's whole domain (load_world_slab): rank 0 also reads the air below the
+// lattice and the last rank the air above it, whether they mesh anything or not.
 #include <algorithm>
 #include <cmath>
 #include <limits>

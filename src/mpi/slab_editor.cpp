@@ -9,8 +9,8 @@
 //
 // An unclamped f32 value may depend on any voxel of the domain, so no finite ghost holds what an
 // edit reaches: each rank keeps its slab (and the slices the caller asks it to keep: kept_slices),
-// edits change its materials, and refresh() runs the
-// exact transform over the ranks again (its all-to-all passes) once edits changed any solid.
+// edits change its materials, and refresh() runs the exact transform over the ranks again (its
+// all-to-all passes) once edits changed any solid.
 #include <algorithm>
 #include <cmath>
 #include <limits>

@@ -153,7 +153,9 @@ same ref.glb three.glb "sn .glb, 3 ranks"
 worlds="f.npy margins.vfw turned.vfw f.vdb"
 [ -f "$vox" ] && worlds="$worlds $(dirname "$vox")/ephtracy_chr_knight.vox"
 # Under the sanitizers (each mpirun takes seconds there) two of the worlds: the .npy read a slab per
-# rank and the framed .vfw; the library tests run every reading and slab under them.
+# rank and the framed .vfw, in the two readings this command makes; the .vdb's, .vox's and
+# unbounded .vfw's slab readings run there under mpi_cli's field, and every mesher's world slabs
+# under the library tests (MpiMeshFile, MeshWorldSlab).
 [ "${VOXFIELD_MPI_RANK_SAMPLE:-0}" = 1 ] && worlds="f.npy turned.vfw"
 for world in $worlds; do
   for alg in mc sn dc; do

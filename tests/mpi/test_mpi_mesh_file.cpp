@@ -230,9 +230,9 @@ World framed_boxes() {
 }  // namespace
 
 // A world's surface written by every rank from the slices it holds (write_world_mesh) is the file
-// of mesh_world's mesh, for every mesher: layers of 4 planes dealt evenly; rank 0 and (from 3
-// ranks) the last rank without layers; layers of one cell plane cut at uneven planes, as an edited
-// world's slabs cut them.
+// of mesh_world's mesh, for every mesher: layers of 4 planes dealt evenly; from 2 ranks rank 0,
+// and from 3 the last rank, without layers; layers of one cell plane cut at uneven planes, as an
+// edited world's slabs cut them.
 TEST(MpiMeshFile, AWorldsSurfaceIsTheFileOfMeshWorld) {
   const SharedDir dir;
   const World whole = framed_boxes();
